@@ -1,0 +1,193 @@
+//! Typed errors of model loading and validation.
+
+use thiserror::Error;
+
+/// A model file could not be loaded: where ([`ModelError::file`]) and what ([`ModelError::kind`]).
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{file}: {kind}")]
+pub struct ModelError {
+    /// The description file (or the label given to an in-memory description).
+    pub file: String,
+    /// What is wrong, naming the item and the fix.
+    pub kind: ModelErrorKind,
+}
+
+impl ModelError {
+    pub(crate) fn new(file: &str, kind: ModelErrorKind) -> Self {
+        Self {
+            file: file.to_owned(),
+            kind,
+        }
+    }
+}
+
+/// What is wrong with a description. Each message names the offending item and how to fix it.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum ModelErrorKind {
+    /// The file could not be read.
+    #[error("cannot read the file: {0}")]
+    Io(String),
+    /// The file is not valid TOML, or does not have the shape of a model description.
+    #[error("malformed description: {0}")]
+    Syntax(String),
+    /// A URDF file could not be parsed or converted.
+    #[error("URDF: {0}")]
+    Urdf(String),
+    /// A joint names a parent frame that no joint creates and that is not the base frame.
+    #[error(
+        "joint `{joint}`: parent frame `{parent}` is not defined; it must be the base frame or the child of another joint"
+    )]
+    UnknownParent {
+        /// The joint.
+        joint: String,
+        /// The parent frame it names.
+        parent: String,
+    },
+    /// A body is attached to a frame that does not exist.
+    #[error("body `{body}`: frame `{frame}` is not defined; attach the body to the base frame or a joint's child frame")]
+    UnknownFrame {
+        /// The body.
+        body: String,
+        /// The frame it names.
+        frame: String,
+    },
+    /// Two items of the same kind share a name.
+    #[error("{what} `{name}` is defined twice; names must be unique")]
+    Duplicate {
+        /// Which kind of item (frame, joint, body, speed, parameter).
+        what: &'static str,
+        /// The repeated name.
+        name: String,
+    },
+    /// The joints do not form a tree rooted at the base frame.
+    #[error(
+        "joint `{joint}`: frame `{frame}` is not reachable from the base frame (the joints form a cycle); every frame needs a chain of joints back to the base"
+    )]
+    Cycle {
+        /// A joint on the cycle.
+        joint: String,
+        /// Its child frame.
+        frame: String,
+    },
+    /// A joint's child frame is the base frame.
+    #[error("joint `{joint}`: the base frame `{frame}` cannot be a joint's child")]
+    BaseAsChild {
+        /// The joint.
+        joint: String,
+        /// The base frame.
+        frame: String,
+    },
+    /// A rotation matrix is not orthonormal or has determinant −1.
+    #[error(
+        "joint `{joint}`: rotation is not a proper rotation ({detail}); give iAj(0) row by row with orthonormal rows and determinant +1"
+    )]
+    BadRotation {
+        /// The joint.
+        joint: String,
+        /// What failed, with the numbers.
+        detail: String,
+    },
+    /// A joint axis is not a unit vector.
+    #[error("joint `{joint}`: axis {axis:?} is not a unit vector (norm {norm}); normalise it")]
+    AxisNotUnit {
+        /// The joint.
+        joint: String,
+        /// The axis as given.
+        axis: [f64; 3],
+        /// Its norm.
+        norm: f64,
+    },
+    /// A body's mass is zero, negative or not finite.
+    #[error("body `{body}`: mass `{symbol}` = {value} must be positive")]
+    NonPositiveMass {
+        /// The body.
+        body: String,
+        /// The mass symbol.
+        symbol: String,
+        /// Its value.
+        value: f64,
+    },
+    /// The inertia about the centre of mass is not positive definite or breaks the triangle inequality.
+    #[error(
+        "body `{body}`: inertia about the centre of mass is not physical ({detail}); principal moments must be positive and each at most the sum of the other two (check the frame-origin inertia XX..ZZ against m and MX..MZ)"
+    )]
+    NonPhysicalInertia {
+        /// The body.
+        body: String,
+        /// Principal moments and which condition failed.
+        detail: String,
+    },
+    /// A symbol used by a joint, body, base or gravity has no value in `[parameters]`.
+    #[error("{item}: symbol `{symbol}` has no value; add `{symbol} = <value>` to [parameters]")]
+    UndefinedSymbol {
+        /// The item that uses the symbol.
+        item: String,
+        /// The missing symbol.
+        symbol: String,
+    },
+    /// A parameter that nothing uses (most often a misspelt name).
+    #[error(
+        "parameter `{name}` is not used by any joint, body, base or gravity; remove it or correct its name"
+    )]
+    UnknownParameter {
+        /// The parameter.
+        name: String,
+    },
+    /// A parameter value is not a finite number.
+    #[error("parameter `{name}` = {value} is not a finite number")]
+    NonFiniteParameter {
+        /// The parameter.
+        name: String,
+        /// Its value.
+        value: f64,
+    },
+    /// A length entry is neither a number nor `[-]SYMBOL`.
+    #[error("joint `{joint}`: translation entry `{text}` is neither a number nor a length symbol such as `L1` or `-L2`")]
+    BadLength {
+        /// The joint.
+        joint: String,
+        /// The entry as written.
+        text: String,
+    },
+    /// A generalized speed is driven by two joints (or a joint and the base).
+    #[error("speed `{speed}` is driven twice, by {first} and by {second}; each speed is driven exactly once")]
+    SpeedTwice {
+        /// The speed.
+        speed: String,
+        /// The first driver.
+        first: String,
+        /// The second driver.
+        second: String,
+    },
+    /// A generalized speed listed in `[model] speeds` is driven by no joint and not by the base.
+    #[error("speed `{speed}` is listed in [model] speeds but no joint or base drives it")]
+    SpeedNever {
+        /// The speed.
+        speed: String,
+    },
+    /// A joint or the base names a speed that is not listed in `[model] speeds`.
+    #[error("{item}: speed `{speed}` is not listed in [model] speeds; add it there (the list fixes the order of u)")]
+    UnknownSpeed {
+        /// The joint or base.
+        item: String,
+        /// The speed.
+        speed: String,
+    },
+    /// A moving joint without a speed, or a fixed joint with one.
+    #[error("joint `{joint}`: {detail}")]
+    JointSpeed {
+        /// The joint.
+        joint: String,
+        /// What is wrong.
+        detail: String,
+    },
+    /// Anything else about the base or gravity declarations.
+    #[error("{item}: {detail}")]
+    Invalid {
+        /// The item.
+        item: String,
+        /// What is wrong and how to fix it.
+        detail: String,
+    },
+}

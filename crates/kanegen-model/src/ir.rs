@@ -1,0 +1,321 @@
+//! The validated robot IR.
+
+use std::fmt;
+
+/// Index of a parameter in [`Model::params`].
+pub type ParamId = usize;
+
+/// What a parameter is; used for documentation and grouping only.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ParamKind {
+    /// A length appearing in a joint translation (`L1`, `L2`, ...).
+    Length,
+    /// The gravity magnitude `g`.
+    Gravity,
+    /// A body inertial parameter (`m1`, `MX1`, ..., `ZZ1`).
+    Inertial,
+    /// A wheel constant (`R`, `L`, `mw`, `YYw`, `ZZw`).
+    Wheel,
+}
+
+/// A named, symbolic model parameter with its default value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Param {
+    /// The symbol, as in the reports (`MX4l`, `L1`, `g`, `R`).
+    pub name: String,
+    /// The default value from the description file (SI units).
+    pub value: f64,
+    /// What the parameter is.
+    pub kind: ParamKind,
+}
+
+/// A generalized speed `u_i` and the coordinate it is the rate of.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Speed {
+    /// Name of the speed (`qd_imu`, `xd`).
+    pub name: String,
+    /// Name of the coordinate (`q_imu`, `x`); for the wheeled base's quasi-velocities a
+    /// coordinate that does not enter M, c or g.
+    pub coordinate: String,
+}
+
+/// A scalar that is either a number or `coef · symbol` (a length such as `-L2`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scalar {
+    /// The factor (±1 for `L1`/`-L2`, or the value itself when `symbol` is `None`).
+    pub coef: f64,
+    /// The parameter multiplied by `coef`, if any.
+    pub symbol: Option<ParamId>,
+}
+
+impl Scalar {
+    /// A plain number.
+    pub fn number(v: f64) -> Self {
+        Self {
+            coef: v,
+            symbol: None,
+        }
+    }
+
+    /// Is this the constant zero?
+    pub fn is_zero(&self) -> bool {
+        self.coef == 0.0
+    }
+
+    /// The value given parameter values indexed by [`ParamId`].
+    pub fn eval(&self, params: &[f64]) -> f64 {
+        match self.symbol {
+            Some(p) => self.coef * params[p],
+            None => self.coef,
+        }
+    }
+}
+
+/// The kind of a joint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum JointKind {
+    /// Rotation about the axis by the coordinate.
+    Revolute,
+    /// Translation along the axis by the coordinate.
+    Prismatic,
+    /// No motion; the child frame is rigidly attached.
+    Fixed,
+}
+
+/// The joint that attaches a frame to its parent.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joint {
+    /// Joint name; for moving joints the name of its coordinate (`q1l`).
+    pub name: String,
+    /// Revolute, prismatic or fixed.
+    pub kind: JointKind,
+    /// Unit axis `e_j` in the child frame.
+    pub axis: [f64; 3],
+    /// `iAj(0)`: columns are the child's unit vectors in the parent frame; stored by rows.
+    pub rotation: [[f64; 3]; 3],
+    /// `iPj`: the child origin in the parent frame.
+    pub translation: [Scalar; 3],
+    /// Index into [`Model::speeds`] of the speed this joint drives (`None` for fixed joints).
+    pub speed: Option<usize>,
+}
+
+/// Khalil's standard inertial parameters of one body, as parameter indices.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Body {
+    /// Body name (`1`, `4l`); also the suffix of its symbols (`m4l`, `MX4l`, ...).
+    pub name: String,
+    /// Mass `m`.
+    pub mass: ParamId,
+    /// First moments `[MX, MY, MZ] = m·S` in the body frame.
+    pub first_moment: [ParamId; 3],
+    /// Inertia about the frame origin `[XX, XY, XZ, YY, YZ, ZZ]`.
+    pub inertia: [ParamId; 6],
+}
+
+/// A frame of the tree. `links[0]` is the base frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Link {
+    /// Frame name (`0`, `1`, `4l`).
+    pub name: String,
+    /// Index of the parent link (always smaller than this link's index); `None` for the base frame.
+    pub parent: Option<usize>,
+    /// The joint to the parent; `None` for the base frame.
+    pub joint: Option<Joint>,
+    /// The rigid body fixed in this frame, if any.
+    pub body: Option<Body>,
+}
+
+/// The two-wheeled inverted-pendulum base of DynamicModeling.tex.
+///
+/// The base frame is the heading frame at the axle midpoint (z up); its motion is given by the
+/// quasi-velocities ẋ (forward speed of the axle midpoint) and ψ̇ (yaw rate):
+/// `ω0 = [0, 0, ψ̇]`, `v0 = [ẋ, 0, 0]`, `α0 = [0, 0, ψ̈]`, `a0 = [ẍ, ẋψ̇, 0]`. The axisymmetric
+/// wheels add inertia only: `(2 mw + 2 YYw/R²)` to `M[ẋ,ẋ]` and
+/// `(mw L²/2 + YYw L²/(2R²) + 2 ZZw)` to `M[ψ̇,ψ̇]`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WheeledBase {
+    /// Index of ẋ in [`Model::speeds`].
+    pub x_speed: usize,
+    /// Index of ψ̇ in [`Model::speeds`].
+    pub psi_speed: usize,
+    /// Wheel radius `R`.
+    pub radius: ParamId,
+    /// Track width `L` (distance between the wheel contact points).
+    pub track: ParamId,
+    /// Mass of one wheel `mw`.
+    pub wheel_mass: ParamId,
+    /// Moment of inertia of one wheel about its axle `YYw`.
+    pub wheel_axle_inertia: ParamId,
+    /// Moment of inertia of one wheel about a diameter `ZZw`.
+    pub wheel_diametral_inertia: ParamId,
+}
+
+/// How the base frame moves.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Base {
+    /// The base frame is inertial.
+    Fixed,
+    /// Two-wheeled inverted-pendulum base with quasi-velocities ẋ, ψ̇.
+    Wheeled(WheeledBase),
+}
+
+/// Uniform gravity `g · direction` in the base frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gravity {
+    /// The magnitude parameter (`g`).
+    pub symbol: ParamId,
+    /// Unit direction in the base frame (`[0, 0, -1]` for z up).
+    pub direction: [f64; 3],
+}
+
+/// A validated robot description.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// Short name (`krang`), used in generated headers.
+    pub name: String,
+    /// One-line description.
+    pub description: String,
+    /// The file the model came from (for messages and generated headers).
+    pub source: String,
+    /// All symbols with default values.
+    pub params: Vec<Param>,
+    /// Generalized speeds in the order of `u`.
+    pub speeds: Vec<Speed>,
+    /// Frames in topological order (parents first); `links[0]` is the base frame.
+    pub links: Vec<Link>,
+    /// The base.
+    pub base: Base,
+    /// Gravity.
+    pub gravity: Gravity,
+}
+
+impl Model {
+    /// Number of generalized speeds.
+    pub fn dof(&self) -> usize {
+        self.speeds.len()
+    }
+
+    /// Index of the parameter called `name`.
+    pub fn param_index(&self, name: &str) -> Option<ParamId> {
+        self.params.iter().position(|p| p.name == name)
+    }
+
+    /// Default parameter values, indexed by [`ParamId`].
+    pub fn param_values(&self) -> Vec<f64> {
+        self.params.iter().map(|p| p.value).collect()
+    }
+
+    /// Index of the speed called `name`.
+    pub fn speed_index(&self, name: &str) -> Option<usize> {
+        self.speeds.iter().position(|s| s.name == name)
+    }
+
+    /// Index of the link called `name`.
+    pub fn link_index(&self, name: &str) -> Option<usize> {
+        self.links.iter().position(|l| l.name == name)
+    }
+
+    /// Indices of the children of link `i`, in order.
+    pub fn children(&self, i: usize) -> Vec<usize> {
+        (0..self.links.len())
+            .filter(|&c| self.links[c].parent == Some(i))
+            .collect()
+    }
+
+    /// The wheeled base, if the model has one.
+    pub fn wheeled_base(&self) -> Option<&WheeledBase> {
+        match &self.base {
+            Base::Wheeled(w) => Some(w),
+            Base::Fixed => None,
+        }
+    }
+
+    /// Number of bodies.
+    pub fn body_count(&self) -> usize {
+        self.links.iter().filter(|l| l.body.is_some()).count()
+    }
+}
+
+fn fmt_scalar(s: &Scalar, m: &Model) -> String {
+    match s.symbol {
+        None => format!("{}", s.coef),
+        Some(p) if s.coef == 1.0 => m.params[p].name.clone(),
+        Some(p) if s.coef == -1.0 => format!("-{}", m.params[p].name),
+        Some(p) => format!("{}*{}", s.coef, m.params[p].name),
+    }
+}
+
+impl fmt::Display for Model {
+    /// A human-readable dump: the frame tree, speeds and parameters.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "model {} ({})", self.name, self.source)?;
+        if !self.description.is_empty() {
+            writeln!(f, "  {}", self.description)?;
+        }
+        match &self.base {
+            Base::Fixed => writeln!(f, "base: fixed frame `{}`", self.links[0].name)?,
+            Base::Wheeled(w) => writeln!(
+                f,
+                "base: two-wheeled heading frame `{}`; speeds {} and {}; R = {}, L = {}, mw = {}, YYw = {}, ZZw = {}",
+                self.links[0].name,
+                self.speeds[w.x_speed].name,
+                self.speeds[w.psi_speed].name,
+                self.params[w.radius].name,
+                self.params[w.track].name,
+                self.params[w.wheel_mass].name,
+                self.params[w.wheel_axle_inertia].name,
+                self.params[w.wheel_diametral_inertia].name,
+            )?,
+        }
+        let g = &self.gravity;
+        writeln!(
+            f,
+            "gravity: {} * {:?} in the base frame",
+            self.params[g.symbol].name, g.direction
+        )?;
+        writeln!(f, "frames ({}):", self.links.len())?;
+        for (i, l) in self.links.iter().enumerate() {
+            let depth = {
+                let mut d = 0;
+                let mut k = i;
+                while let Some(p) = self.links[k].parent {
+                    d += 1;
+                    k = p;
+                }
+                d
+            };
+            let indent = "  ".repeat(depth + 1);
+            match &l.joint {
+                None => write!(f, "{indent}{}", l.name)?,
+                Some(j) => {
+                    let t: Vec<String> = j.translation.iter().map(|s| fmt_scalar(s, self)).collect();
+                    write!(
+                        f,
+                        "{indent}{} <- {:?} joint `{}` axis {:?} P [{}]",
+                        l.name,
+                        j.kind,
+                        j.name,
+                        j.axis,
+                        t.join(", ")
+                    )?;
+                    if let Some(s) = j.speed {
+                        write!(f, " speed {}", self.speeds[s].name)?;
+                    }
+                }
+            }
+            if let Some(b) = &l.body {
+                write!(f, "  [body {}: m = {}]", b.name, self.params[b.mass].value)?;
+            }
+            writeln!(f)?;
+        }
+        writeln!(f, "speeds ({}):", self.speeds.len())?;
+        for (i, s) in self.speeds.iter().enumerate() {
+            writeln!(f, "  u[{i:2}] = {} (rate of {})", s.name, s.coordinate)?;
+        }
+        writeln!(f, "parameters ({}):", self.params.len())?;
+        for p in &self.params {
+            writeln!(f, "  {:<6} = {:<22} ({:?})", p.name, p.value, p.kind)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,21 @@
+//! Robot description IR shared by the kanegen generator and the numeric reference recursion.
+//!
+//! A [`Model`] is a tree of frames rooted at the base frame (`"0"` in the Krang reports). Every
+//! non-root frame is attached to its parent by a [`Joint`] whose transform is
+//! `iTj(q) = iTj(0) · Rot(e_j, q_j)` (revolute), `iTj(0) · Trans(e_j q_j)` (prismatic) or the
+//! constant `iTj(0)` (fixed), with the axis `e_j` expressed in the child frame, as in seed 002 §2.1.
+//! Bodies carry Khalil's standard inertial parameters (mass, first moments `MS = m·S`, inertia about
+//! the frame origin) as named, symbolic [`Param`]s with default values, so that the generator can
+//! keep them as runtime inputs and the reference recursion can evaluate them.
+//!
+//! Models are loaded from TOML ([`Model::from_toml_file`]) and validated; every failure is a typed
+//! [`ModelError`] naming the file, the item and the fix.
+#![forbid(unsafe_code)]
+
+mod error;
+mod ir;
+mod toml_format;
+mod validate;
+
+pub use error::{ModelError, ModelErrorKind};
+pub use ir::*;

@@ -1,0 +1,90 @@
+//! Numeric validation: rotations, axes, masses and inertias.
+
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+
+use crate::error::ModelErrorKind as K;
+use crate::ir::{Body, Model};
+
+/// Tolerance on orthonormality, determinant and unit norms.
+pub const TOLERANCE: f64 = 1e-9;
+
+pub(crate) fn check_axis(joint: &str, axis: [f64; 3]) -> Result<(), K> {
+    let norm = Vector3::from(axis).norm();
+    if !norm.is_finite() || (norm - 1.0).abs() > TOLERANCE {
+        return Err(K::AxisNotUnit {
+            joint: joint.to_owned(),
+            axis,
+            norm,
+        });
+    }
+    Ok(())
+}
+
+pub(crate) fn check_rotation(joint: &str, rows: &[[f64; 3]; 3]) -> Result<(), K> {
+    let r = Matrix3::from_fn(|i, j| rows[i][j]);
+    let err = (r * r.transpose() - Matrix3::identity()).abs().max();
+    if !err.is_finite() || err > TOLERANCE {
+        return Err(K::BadRotation {
+            joint: joint.to_owned(),
+            detail: format!("|R Rᵀ − I| = {err:.3e}"),
+        });
+    }
+    let det = r.determinant();
+    if (det - 1.0).abs() > TOLERANCE {
+        return Err(K::BadRotation {
+            joint: joint.to_owned(),
+            detail: format!("det R = {det}"),
+        });
+    }
+    Ok(())
+}
+
+/// Principal moments of inertia about the centre of mass of `body` for parameter values `p`.
+pub fn principal_moments_about_com(body: &Body, p: &[f64]) -> [f64; 3] {
+    let m = p[body.mass];
+    let ms = Vector3::new(
+        p[body.first_moment[0]],
+        p[body.first_moment[1]],
+        p[body.first_moment[2]],
+    );
+    let [xx, xy, xz, yy, yz, zz] = body.inertia.map(|i| p[i]);
+    let j = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+    // J = I_G + m(|S|² 1 − S Sᵀ) with S = MS/m.
+    let ig = j - (Matrix3::identity() * ms.norm_squared() - ms * ms.transpose()) / m;
+    let e = SymmetricEigen::new(ig).eigenvalues;
+    let mut v = [e[0], e[1], e[2]];
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+pub(crate) fn check_physics(model: &Model) -> Result<(), K> {
+    let p = model.param_values();
+    for link in &model.links {
+        let Some(b) = &link.body else { continue };
+        let m = p[b.mass];
+        if !(m > 0.0) {
+            return Err(K::NonPositiveMass {
+                body: b.name.clone(),
+                symbol: model.params[b.mass].name.clone(),
+                value: m,
+            });
+        }
+        let [a, bb, c] = principal_moments_about_com(b, &p);
+        let scale = (a.abs() + bb.abs() + c.abs()).max(f64::MIN_POSITIVE);
+        if !(a > 0.0) {
+            return Err(K::NonPhysicalInertia {
+                body: b.name.clone(),
+                detail: format!("principal moments {a:.6e}, {bb:.6e}, {c:.6e}: not positive definite"),
+            });
+        }
+        if a + bb < c - TOLERANCE * scale {
+            return Err(K::NonPhysicalInertia {
+                body: b.name.clone(),
+                detail: format!(
+                    "principal moments {a:.6e}, {bb:.6e}, {c:.6e}: {a:.6e} + {bb:.6e} < {c:.6e} (triangle inequality)"
+                ),
+            });
+        }
+    }
+    Ok(())
+}

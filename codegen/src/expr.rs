@@ -1,0 +1,798 @@
+//! Hash-consed expression arena with construction-time exact simplification.
+//!
+//! Every node is interned once (identical subexpressions are shared) and children are always
+//! created before their parents, so arena order is a topological order. Expressions are kept in
+//! a canonical form:
+//!
+//! * a [`Node::Sum`] is `c₀ + Σ cᵢ·tᵢ` with distinct, sorted, non-constant, non-sum terms `tᵢ`
+//!   and non-zero coefficients (like terms collected, numeric factors pulled into `cᵢ`);
+//! * a [`Node::Prod`] is `Π bᵢ^nᵢ` with distinct, sorted bases that are atoms or sums, and non-zero
+//!   integer powers (numeric factors live in the enclosing sum);
+//! * constants are folded; `0·x = 0`, `1·x = x`, `x + 0 = x`.
+//!
+//! No trigonometric identity is applied, so simplification is exact (only f64 rounding of
+//! constants). Substitution variables ([`Atom::Var`]) name compound subexpressions: the reports'
+//! K (kinematic) and D (inertial/gravity) variables.
+
+use std::collections::{BTreeMap, HashMap};
+use std::fmt::Write as _;
+
+/// Handle of a node in an [`Arena`].
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
+pub struct ExprId(pub u32);
+
+impl ExprId {
+    /// Position in the arena.
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// A hashable f64 (bit pattern, with −0 normalised to +0).
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
+pub struct Num(u64);
+
+impl Num {
+    /// Wrap a value.
+    pub fn new(v: f64) -> Self {
+        Num(if v == 0.0 { 0 } else { v.to_bits() })
+    }
+    /// The value.
+    pub fn get(self) -> f64 {
+        f64::from_bits(self.0)
+    }
+}
+
+/// Leaves of expressions.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
+pub enum Atom {
+    /// Model parameter (index into `Model::params`).
+    Param(u32),
+    /// Generalized speed `u[i]`.
+    Speed(u32),
+    /// Generalized acceleration `u̇[i]`.
+    Accel(u32),
+    /// `sin(q[i])` of the coordinate whose speed index is `i`.
+    Sin(u32),
+    /// `cos(q[i])`.
+    Cos(u32),
+    /// The coordinate `q[i]` itself (prismatic joints).
+    Coord(u32),
+    /// Substitution variable (index into [`Arena::vars`]).
+    Var(u32),
+}
+
+/// An interned node.
+#[derive(Clone, PartialEq, Eq, Hash, Debug)]
+pub enum Node {
+    /// A number.
+    Const(Num),
+    /// A leaf.
+    Atom(Atom),
+    /// `constant + Σ coef·term`.
+    Sum {
+        /// The constant part.
+        constant: Num,
+        /// `(term, coefficient)` pairs sorted by term.
+        terms: Box<[(ExprId, Num)]>,
+    },
+    /// `Π base^power`, sorted by base.
+    Prod(Box<[(ExprId, i32)]>),
+}
+
+/// Kind of a substitution variable, as in the reports.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+pub enum VarKind {
+    /// Kinematic quantity (rotations, ω, v, α, a): depends on q, u, u̇ and lengths only.
+    K,
+    /// Inertial or gravity term: involves inertial parameters or gravity.
+    D,
+}
+
+/// A substitution variable: a name for a compound subexpression.
+#[derive(Clone, Debug)]
+pub struct VarInfo {
+    /// The expression it stands for.
+    pub def: ExprId,
+    /// The node `Atom::Var(i)` that refers to it.
+    pub node: ExprId,
+    /// K or D.
+    pub kind: VarKind,
+    /// What it is (`w2.x`, `f3.z`, `JC4l.xx`).
+    pub label: String,
+}
+
+/// Names used when printing expressions.
+#[derive(Clone, Debug, Default)]
+pub struct Names {
+    /// Parameter symbols by index.
+    pub params: Vec<String>,
+    /// Speed names by index (`qd_imu`).
+    pub speeds: Vec<String>,
+    /// Coordinate names by speed index (`q_imu`).
+    pub coords: Vec<String>,
+}
+
+impl Names {
+    /// Name of an acceleration: `qd_imu` → `qdd_imu`, `xd` → `xdd`.
+    pub fn accel(&self, i: usize) -> String {
+        accel_name(&self.speeds[i])
+    }
+}
+
+/// Name of the acceleration of a speed: `qd_imu` → `qdd_imu`, `xd` → `xdd`, `psid` → `psidd`.
+pub fn accel_name(speed: &str) -> String {
+    match speed.strip_prefix("qd") {
+        Some(rest) => format!("qdd{rest}"),
+        None => format!("{speed}d"),
+    }
+}
+
+/// The expression arena.
+#[derive(Clone, Debug)]
+pub struct Arena {
+    nodes: Vec<Node>,
+    map: HashMap<Node, ExprId>,
+    /// Per node: depends on parameters and constants only.
+    param_only: Vec<bool>,
+    vars: Vec<VarInfo>,
+    var_by_def: HashMap<ExprId, u32>,
+    /// Names for printing.
+    pub names: Names,
+    /// Whether [`Arena::subst`] hoists parameter-only parts into their own variables.
+    pub hoist_params: bool,
+}
+
+/// Numeric values of the leaves, for [`Arena::eval`].
+#[derive(Clone, Debug, Default)]
+pub struct Values<'a> {
+    /// Parameter values.
+    pub params: &'a [f64],
+    /// Coordinates `q` (sin/cos are taken of these).
+    pub q: &'a [f64],
+    /// Speeds `u`.
+    pub u: &'a [f64],
+    /// Accelerations `u̇`.
+    pub ud: &'a [f64],
+}
+
+impl Arena {
+    /// An empty arena.
+    pub fn new(names: Names) -> Self {
+        let mut a = Arena {
+            nodes: Vec::new(),
+            map: HashMap::new(),
+            param_only: Vec::new(),
+            vars: Vec::new(),
+            var_by_def: HashMap::new(),
+            names,
+            hoist_params: false,
+        };
+        a.constant(0.0);
+        a.constant(1.0);
+        a
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Is the arena empty (never: 0 and 1 are always present)?
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// The node behind a handle.
+    pub fn node(&self, e: ExprId) -> &Node {
+        &self.nodes[e.index()]
+    }
+
+    /// All substitution variables, in creation order.
+    pub fn vars(&self) -> &[VarInfo] {
+        &self.vars
+    }
+
+    /// Does `e` depend on parameters and constants only?
+    pub fn is_param_only(&self, e: ExprId) -> bool {
+        self.param_only[e.index()]
+    }
+
+    fn intern(&mut self, n: Node) -> ExprId {
+        if let Some(&id) = self.map.get(&n) {
+            return id;
+        }
+        let po = match &n {
+            Node::Const(_) => true,
+            Node::Atom(Atom::Param(_)) => true,
+            Node::Atom(Atom::Var(v)) => self.param_only[self.vars[*v as usize].def.index()],
+            Node::Atom(_) => false,
+            Node::Sum { terms, .. } => terms.iter().all(|(t, _)| self.param_only[t.index()]),
+            Node::Prod(f) => f.iter().all(|(b, _)| self.param_only[b.index()]),
+        };
+        let id = ExprId(self.nodes.len() as u32);
+        self.nodes.push(n.clone());
+        self.param_only.push(po);
+        self.map.insert(n, id);
+        id
+    }
+
+    /// The constant `v`.
+    pub fn constant(&mut self, v: f64) -> ExprId {
+        self.intern(Node::Const(Num::new(v)))
+    }
+    /// Zero.
+    pub fn zero(&self) -> ExprId {
+        ExprId(0)
+    }
+    /// One.
+    pub fn one(&self) -> ExprId {
+        ExprId(1)
+    }
+    /// A leaf.
+    pub fn atom(&mut self, a: Atom) -> ExprId {
+        self.intern(Node::Atom(a))
+    }
+
+    /// The value of `e` if it is a constant.
+    pub fn as_const(&self, e: ExprId) -> Option<f64> {
+        match self.node(e) {
+            Node::Const(c) => Some(c.get()),
+            _ => None,
+        }
+    }
+
+    /// Is `e` the constant zero?
+    pub fn is_zero(&self, e: ExprId) -> bool {
+        self.as_const(e) == Some(0.0)
+    }
+
+    /// `c₀ + Σ cᵢ tᵢ` view of any expression.
+    fn linear(&self, e: ExprId) -> (f64, Vec<(ExprId, f64)>) {
+        match self.node(e) {
+            Node::Const(c) => (c.get(), Vec::new()),
+            Node::Sum { constant, terms } => (
+                constant.get(),
+                terms.iter().map(|(t, c)| (*t, c.get())).collect(),
+            ),
+            _ => (0.0, vec![(e, 1.0)]),
+        }
+    }
+
+    /// `k · Π bᵢ^nᵢ` view of any expression.
+    fn monomial(&self, e: ExprId) -> (f64, Vec<(ExprId, i32)>) {
+        match self.node(e) {
+            Node::Const(c) => (c.get(), Vec::new()),
+            Node::Sum { constant, terms } if constant.get() == 0.0 && terms.len() == 1 => {
+                let (t, k) = terms[0];
+                let (_, f) = self.monomial(t);
+                (k.get(), f)
+            }
+            Node::Prod(f) => (1.0, f.to_vec()),
+            _ => (1.0, vec![(e, 1)]),
+        }
+    }
+
+    fn build_sum(&mut self, constant: f64, terms: BTreeMap<ExprId, f64>) -> ExprId {
+        let terms: Vec<(ExprId, Num)> = terms
+            .into_iter()
+            .filter(|(_, c)| *c != 0.0)
+            .map(|(t, c)| (t, Num::new(c)))
+            .collect();
+        if terms.is_empty() {
+            return self.constant(constant);
+        }
+        if constant == 0.0 && terms.len() == 1 && terms[0].1.get() == 1.0 {
+            return terms[0].0;
+        }
+        self.intern(Node::Sum {
+            constant: Num::new(constant),
+            terms: terms.into_boxed_slice(),
+        })
+    }
+
+    fn build_prod(&mut self, factors: BTreeMap<ExprId, i32>) -> ExprId {
+        let f: Vec<(ExprId, i32)> = factors.into_iter().filter(|(_, p)| *p != 0).collect();
+        match f.as_slice() {
+            [] => self.one(),
+            [(b, 1)] => *b,
+            _ => self.intern(Node::Prod(f.into_boxed_slice())),
+        }
+    }
+
+    /// Sum of any number of expressions.
+    pub fn sum<I: IntoIterator<Item = ExprId>>(&mut self, items: I) -> ExprId {
+        let mut constant = 0.0;
+        let mut acc: BTreeMap<ExprId, f64> = BTreeMap::new();
+        for e in items {
+            let (c, terms) = self.linear(e);
+            constant += c;
+            for (t, k) in terms {
+                *acc.entry(t).or_insert(0.0) += k;
+            }
+        }
+        self.build_sum(constant, acc)
+    }
+
+    /// `a + b`.
+    pub fn add(&mut self, a: ExprId, b: ExprId) -> ExprId {
+        self.sum([a, b])
+    }
+
+    /// `a − b`.
+    pub fn sub(&mut self, a: ExprId, b: ExprId) -> ExprId {
+        let nb = self.scale(b, -1.0);
+        self.sum([a, nb])
+    }
+
+    /// `−a`.
+    pub fn neg(&mut self, a: ExprId) -> ExprId {
+        self.scale(a, -1.0)
+    }
+
+    /// `k · e` (distributes over sums).
+    pub fn scale(&mut self, e: ExprId, k: f64) -> ExprId {
+        if k == 0.0 {
+            return self.zero();
+        }
+        if k == 1.0 {
+            return e;
+        }
+        let (c, terms) = self.linear(e);
+        let acc: BTreeMap<ExprId, f64> = terms.into_iter().map(|(t, x)| (t, x * k)).collect();
+        self.build_sum(c * k, acc)
+    }
+
+    /// `a · b`.
+    pub fn mul(&mut self, a: ExprId, b: ExprId) -> ExprId {
+        if let Some(k) = self.as_const(a) {
+            return self.scale(b, k);
+        }
+        if let Some(k) = self.as_const(b) {
+            return self.scale(a, k);
+        }
+        let (ka, fa) = self.monomial(a);
+        let (kb, fb) = self.monomial(b);
+        let mut f: BTreeMap<ExprId, i32> = BTreeMap::new();
+        for (base, p) in fa.into_iter().chain(fb) {
+            *f.entry(base).or_insert(0) += p;
+        }
+        let m = self.build_prod(f);
+        self.scale(m, ka * kb)
+    }
+
+    /// Product of any number of expressions.
+    pub fn product<I: IntoIterator<Item = ExprId>>(&mut self, items: I) -> ExprId {
+        let mut acc = self.one();
+        for e in items {
+            acc = self.mul(acc, e);
+        }
+        acc
+    }
+
+    /// `e^n` for a small integer `n` (negative powers divide).
+    pub fn powi(&mut self, e: ExprId, n: i32) -> ExprId {
+        if n == 0 {
+            return self.one();
+        }
+        let (k, f) = self.monomial(e);
+        let f: BTreeMap<ExprId, i32> = f.into_iter().map(|(b, p)| (b, p * n)).collect();
+        let m = self.build_prod(f);
+        self.scale(m, k.powi(n))
+    }
+
+    /// Is `e` a constant, a leaf, or a constant times a leaf (never worth a variable)?
+    pub fn is_simple(&self, e: ExprId) -> bool {
+        match self.node(e) {
+            Node::Const(_) | Node::Atom(_) => true,
+            Node::Sum { constant, terms } => {
+                constant.get() == 0.0
+                    && terms.len() == 1
+                    && matches!(self.node(terms[0].0), Node::Atom(_))
+            }
+            Node::Prod(_) => false,
+        }
+    }
+
+    fn new_var(&mut self, def: ExprId, kind: VarKind, label: &str) -> ExprId {
+        if let Some(&v) = self.var_by_def.get(&def) {
+            return self.vars[v as usize].node;
+        }
+        let v = self.vars.len() as u32;
+        // The definition must exist before the variable node (topological order).
+        self.vars.push(VarInfo {
+            def,
+            node: ExprId(u32::MAX),
+            kind,
+            label: label.to_owned(),
+        });
+        let node = self.atom(Atom::Var(v));
+        self.vars[v as usize].node = node;
+        self.var_by_def.insert(def, v);
+        node
+    }
+
+    /// Replace a compound expression by a substitution variable (the reports' K/D method).
+    ///
+    /// Simple expressions are returned unchanged. A numeric factor (or sign) is kept outside the
+    /// variable so that `−(a+b)` and `a+b` share one variable, and identical definitions share
+    /// one variable. With [`Arena::hoist_params`], parameter-only parts of the definition get
+    /// variables of their own (kind D) so that they can be computed once, outside the hot path.
+    pub fn subst(&mut self, e: ExprId, kind: VarKind, label: &str) -> ExprId {
+        if self.is_simple(e) {
+            return e;
+        }
+        let (k, core) = self.split_scale(e);
+        let core = if self.hoist_params {
+            self.hoist(core, label)
+        } else {
+            core
+        };
+        if self.is_simple(core) {
+            return self.scale(core, k);
+        }
+        let kind = if self.involves_params(core) {
+            VarKind::D
+        } else {
+            kind
+        };
+        let v = self.new_var(core, kind, label);
+        self.scale(v, k)
+    }
+
+    /// Does `e` mention a parameter (directly or through variables)?
+    fn involves_params(&self, e: ExprId) -> bool {
+        match self.node(e) {
+            Node::Const(_) => false,
+            Node::Atom(Atom::Param(_)) => true,
+            Node::Atom(Atom::Var(v)) => self.vars[*v as usize].kind == VarKind::D,
+            Node::Atom(_) => false,
+            Node::Sum { terms, .. } => terms.iter().any(|(t, _)| self.involves_params(*t)),
+            Node::Prod(f) => f.iter().any(|(b, _)| self.involves_params(*b)),
+        }
+    }
+
+    /// Split `e = k · core` with `core` having a positive leading coefficient.
+    fn split_scale(&mut self, e: ExprId) -> (f64, ExprId) {
+        match self.node(e).clone() {
+            Node::Sum { constant, terms } if constant.get() == 0.0 && terms.len() == 1 => {
+                (terms[0].1.get(), terms[0].0)
+            }
+            Node::Sum { terms, .. } => {
+                let lead = terms[0].1.get();
+                if lead < 0.0 {
+                    let core = self.scale(e, -1.0);
+                    (-1.0, core)
+                } else {
+                    (1.0, e)
+                }
+            }
+            _ => (1.0, e),
+        }
+    }
+
+    /// Give the parameter-only parts of a sum or product variables of their own.
+    pub fn hoist(&mut self, e: ExprId, label: &str) -> ExprId {
+        if self.is_param_only(e) {
+            return e;
+        }
+        match self.node(e).clone() {
+            Node::Sum { constant, terms } => {
+                let mut fixed: Vec<ExprId> = Vec::new();
+                let mut rest: Vec<ExprId> = Vec::new();
+                let c = self.constant(constant.get());
+                fixed.push(c);
+                for (t, k) in terms.iter() {
+                    let kt = self.scale(*t, k.get());
+                    if self.is_param_only(*t) {
+                        fixed.push(kt);
+                    } else {
+                        let h = self.hoist_prod(*t, label);
+                        let h = self.scale(h, k.get());
+                        rest.push(h);
+                    }
+                }
+                let fixed = self.sum(fixed);
+                let fixed = self.subst(fixed, VarKind::D, &format!("{label} (parameters)"));
+                rest.push(fixed);
+                self.sum(rest)
+            }
+            Node::Prod(_) => self.hoist_prod(e, label),
+            _ => e,
+        }
+    }
+
+    fn hoist_prod(&mut self, e: ExprId, label: &str) -> ExprId {
+        let Node::Prod(f) = self.node(e).clone() else {
+            return e;
+        };
+        let (fixed, rest): (Vec<_>, Vec<_>) = f.iter().partition(|(b, _)| self.is_param_only(*b));
+        if fixed.len() < 2 {
+            return e;
+        }
+        let fixed: Vec<ExprId> = fixed.into_iter().map(|(b, p)| self.powi(b, p)).collect();
+        let fixed = self.product(fixed);
+        let fixed = self.subst(fixed, VarKind::D, &format!("{label} (parameters)"));
+        let mut items = vec![fixed];
+        for (b, p) in rest {
+            let x = self.powi(b, p);
+            items.push(x);
+        }
+        self.product(items)
+    }
+
+    /// Evaluate every node; returns values indexed by node.
+    pub fn eval(&self, v: &Values<'_>) -> Vec<f64> {
+        let mut out = vec![0.0; self.nodes.len()];
+        for (i, n) in self.nodes.iter().enumerate() {
+            out[i] = match n {
+                Node::Const(c) => c.get(),
+                Node::Atom(a) => match *a {
+                    Atom::Param(p) => v.params[p as usize],
+                    Atom::Speed(s) => v.u[s as usize],
+                    Atom::Accel(s) => v.ud[s as usize],
+                    Atom::Sin(s) => v.q[s as usize].sin(),
+                    Atom::Cos(s) => v.q[s as usize].cos(),
+                    Atom::Coord(s) => v.q[s as usize],
+                    Atom::Var(k) => out[self.vars[k as usize].def.index()],
+                },
+                Node::Sum { constant, terms } => terms
+                    .iter()
+                    .fold(constant.get(), |acc, (t, k)| acc + k.get() * out[t.index()]),
+                Node::Prod(f) => f
+                    .iter()
+                    .fold(1.0, |acc, (b, p)| acc * out[b.index()].powi(*p)),
+            };
+        }
+        out
+    }
+
+    /// Name of a leaf for printing.
+    pub fn atom_name(&self, a: Atom) -> String {
+        let n = &self.names;
+        match a {
+            Atom::Param(p) => n.params[p as usize].clone(),
+            Atom::Speed(s) => n.speeds[s as usize].clone(),
+            Atom::Accel(s) => n.accel(s as usize),
+            Atom::Sin(s) => format!("s_{}", n.coords[s as usize]),
+            Atom::Cos(s) => format!("c_{}", n.coords[s as usize]),
+            Atom::Coord(s) => n.coords[s as usize].clone(),
+            Atom::Var(v) => {
+                let info = &self.vars[v as usize];
+                match info.kind {
+                    VarKind::K => format!("K{}", v + 1),
+                    VarKind::D => format!("D{}", v + 1),
+                }
+            }
+        }
+    }
+
+    /// Print an expression (variables by their arena names `K12`, `D7`).
+    pub fn display(&self, e: ExprId) -> String {
+        let mut s = String::new();
+        self.write_expr(&mut s, e, 0);
+        s
+    }
+
+    fn write_expr(&self, s: &mut String, e: ExprId, prec: u8) {
+        match self.node(e) {
+            Node::Const(c) => {
+                let _ = write!(s, "{}", fmt_num(c.get()));
+            }
+            Node::Atom(a) => s.push_str(&self.atom_name(*a)),
+            Node::Sum { constant, terms } => {
+                if prec > 0 {
+                    s.push('(');
+                }
+                let mut first = true;
+                for (t, k) in terms.iter() {
+                    let k = k.get();
+                    if first {
+                        if k < 0.0 {
+                            s.push('-');
+                        }
+                    } else {
+                        s.push_str(if k < 0.0 { " - " } else { " + " });
+                    }
+                    first = false;
+                    if k.abs() != 1.0 {
+                        let _ = write!(s, "{}*", fmt_num(k.abs()));
+                    }
+                    self.write_expr(s, *t, 1);
+                }
+                let c = constant.get();
+                if c != 0.0 {
+                    s.push_str(if c < 0.0 { " - " } else { " + " });
+                    s.push_str(&fmt_num(c.abs()));
+                }
+                if prec > 0 {
+                    s.push(')');
+                }
+            }
+            Node::Prod(f) => {
+                for (i, (b, p)) in f.iter().enumerate() {
+                    if i > 0 {
+                        s.push('*');
+                    }
+                    self.write_expr(s, *b, 2);
+                    if *p != 1 {
+                        let _ = write!(s, "^{p}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// The substitution listing: every variable reachable from `roots`, in order, one per line.
+    pub fn listing(&self, roots: &[ExprId]) -> String {
+        let needed = self.reachable_vars(roots);
+        let mut s = String::new();
+        for (i, info) in self.vars.iter().enumerate() {
+            if needed[i] {
+                let _ = writeln!(
+                    s,
+                    "{} = {};  % {}",
+                    self.atom_name(Atom::Var(i as u32)),
+                    self.display(info.def),
+                    info.label
+                );
+            }
+        }
+        s
+    }
+
+    /// Which variables are needed to compute `roots`.
+    pub fn reachable_vars(&self, roots: &[ExprId]) -> Vec<bool> {
+        let mut seen = vec![false; self.nodes.len()];
+        let mut needed = vec![false; self.vars.len()];
+        let mut stack: Vec<ExprId> = roots.to_vec();
+        while let Some(e) = stack.pop() {
+            if std::mem::replace(&mut seen[e.index()], true) {
+                continue;
+            }
+            match self.node(e) {
+                Node::Atom(Atom::Var(v)) => {
+                    needed[*v as usize] = true;
+                    stack.push(self.vars[*v as usize].def);
+                }
+                Node::Sum { terms, .. } => stack.extend(terms.iter().map(|(t, _)| *t)),
+                Node::Prod(f) => stack.extend(f.iter().map(|(b, _)| *b)),
+                _ => {}
+            }
+        }
+        needed
+    }
+}
+
+/// Shortest round-trip text of a number.
+pub fn fmt_num(v: f64) -> String {
+    format!("{v:?}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn arena() -> Arena {
+        Arena::new(Names {
+            params: vec!["a".into(), "b".into()],
+            speeds: vec!["qd1".into()],
+            coords: vec!["q1".into()],
+        })
+    }
+
+    #[test]
+    fn identical_subexpressions_are_shared() {
+        let mut ar = arena();
+        let a = ar.atom(Atom::Param(0));
+        let b = ar.atom(Atom::Param(1));
+        let x = ar.mul(a, b);
+        let y = ar.mul(b, a);
+        assert_eq!(x, y);
+        let s1 = ar.add(x, a);
+        let s2 = ar.add(a, y);
+        assert_eq!(s1, s2);
+    }
+
+    #[test]
+    fn like_terms_collect_and_cancel() {
+        let mut ar = arena();
+        let a = ar.atom(Atom::Param(0));
+        let b = ar.atom(Atom::Param(1));
+        let two_a = ar.add(a, a);
+        assert_eq!(ar.display(two_a), "2.0*a");
+        let ab = ar.mul(a, b);
+        let e = ar.sum([ab, b, ab]);
+        let f = ar.scale(ab, -2.0);
+        let g = ar.sum([e, f]);
+        assert_eq!(g, b);
+        let z = ar.sub(a, a);
+        assert!(ar.is_zero(z));
+    }
+
+    #[test]
+    fn constants_fold_and_identities_hold() {
+        let mut ar = arena();
+        let a = ar.atom(Atom::Param(0));
+        let zero = ar.zero();
+        let one = ar.one();
+        assert_eq!(ar.mul(a, one), a);
+        assert!(ar.is_zero(ar.clone().mul(a, zero)));
+        let two = ar.constant(2.0);
+        let three = ar.constant(3.0);
+        let six = ar.mul(two, three);
+        assert_eq!(ar.as_const(six), Some(6.0));
+        assert_eq!(ar.add(a, zero), a);
+        let a2 = ar.mul(a, a);
+        let p = ar.powi(a, 2);
+        assert_eq!(a2, p);
+        let inv = ar.powi(a, -1);
+        assert_eq!(ar.mul(a, inv), one);
+    }
+
+    #[test]
+    fn cos_plus_one_minus_cos_is_one() {
+        let mut ar = arena();
+        let c = ar.atom(Atom::Cos(0));
+        let one = ar.one();
+        let omc = ar.sub(one, c);
+        assert_eq!(ar.add(c, omc), one);
+    }
+
+    #[test]
+    fn substitution_shares_negated_definitions() {
+        let mut ar = arena();
+        let a = ar.atom(Atom::Param(0));
+        let s = ar.atom(Atom::Sin(0));
+        let e = ar.add(a, s);
+        let ne = ar.neg(e);
+        let v1 = ar.subst(e, VarKind::K, "x");
+        let v2 = ar.subst(ne, VarKind::K, "y");
+        assert_eq!(ar.vars().len(), 1);
+        assert_eq!(ar.neg(v1), v2);
+        assert_eq!(ar.vars()[0].kind, VarKind::D, "mentions a parameter");
+    }
+
+    #[test]
+    fn evaluator_matches_direct_computation() {
+        let mut ar = arena();
+        let a = ar.atom(Atom::Param(0));
+        let b = ar.atom(Atom::Param(1));
+        let s = ar.atom(Atom::Sin(0));
+        let u = ar.atom(Atom::Speed(0));
+        let ab = ar.add(a, b);
+        let sab = ar.mul(s, ab);
+        let v = ar.subst(sab, VarKind::D, "v");
+        let vu = ar.mul(v, u);
+        let vu2 = ar.powi(vu, 2);
+        let e = ar.sub(vu2, a);
+        let vals = ar.eval(&Values {
+            params: &[0.3, -1.2],
+            q: &[0.7],
+            u: &[2.5],
+            ud: &[0.0],
+        });
+        let expect = (0.7f64.sin() * (0.3 - 1.2) * 2.5f64).powi(2) - 0.3;
+        assert!((vals[e.index()] - expect).abs() < 1e-14);
+    }
+
+    #[test]
+    fn hoisting_moves_parameter_products_out() {
+        let mut ar = arena();
+        ar.hoist_params = true;
+        let a = ar.atom(Atom::Param(0));
+        let b = ar.atom(Atom::Param(1));
+        let c = ar.atom(Atom::Cos(0));
+        let abc = ar.product([a, b, c]);
+        let e = ar.add(abc, a);
+        let e = ar.add(e, b);
+        let v = ar.subst(e, VarKind::K, "x");
+        // a*b and a + b become parameter-only variables.
+        let params_only = ar
+            .vars()
+            .iter()
+            .filter(|i| ar.is_param_only(i.node))
+            .count();
+        assert_eq!(params_only, 2, "{}", ar.listing(&[v]));
+    }
+}

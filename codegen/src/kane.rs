@@ -1,0 +1,850 @@
+//! Recursive Kane's-method derivation with K/D substitution.
+//!
+//! Kane's equations for a tree of rigid bodies read, for every generalized speed r,
+//! `τ_r = Σ_k [F_k · (v_k)_r + N_k · (ω_k)_r] − (generalized gravity force)_r`, where F_k and N_k
+//! are body k's inertia force and moment about its frame origin and (v_k)_r, (ω_k)_r its partial
+//! velocities. In a tree, the partial angular velocity of every descendant of a revolute joint j
+//! is the joint axis e_j and the partial linear velocity is `e_j × (p_k − p_j)`, so the sum over
+//! bodies collapses into `e_j · n_j`, with n_j the moment about O_j of the inertia forces of the
+//! subtree of j. These subtree sums are accumulated backward, so the generated code grows with
+//! the number of bodies plus the sum of depths instead of their product.
+//!
+//! * ω, α and the origin acceleration a of every frame follow seed 002 eqs. 3–6 (K variables);
+//!   for the wheeled base `ω0 = [0,0,ψ̇]`, `α0 = [0,0,ψ̈]`, `a0 = [ẍ, ẋψ̇, 0]` (the report's
+//!   `[ẍ, ψ̇, 0]` is a known error). Gravity enters as the base acceleration `a0 − g0`.
+//! * inverse dynamics and c: body inertia forces and moments (D variables), accumulated backward;
+//! * M: the same generalized inertia forces for a unit acceleration of one speed at rest, i.e.
+//!   composite (subtree) mass, first moment and inertia carried backward, one column per speed,
+//!   only the upper triangle;
+//! * g: composite first moments against the gravity acceleration of each frame;
+//! * wheel terms of DynamicModeling.tex on the ẋ and ψ̇ rows.
+//!
+//! Every compound component is replaced by a substitution variable as soon as it is formed.
+
+use kanegen_model::{Base, JointKind, Model, Scalar};
+
+use crate::expr::{Arena, Atom, ExprId, Names, VarKind};
+
+/// How model parameters enter the generated code.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ParamMode {
+    /// Parameters are runtime inputs (a `Params` value); parameter-only subexpressions are
+    /// computed once per parameter set, outside the hot path.
+    #[default]
+    Runtime,
+    /// The model file's values are folded in as constants; terms of zero parameters vanish.
+    Baked,
+}
+
+/// Generator options.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options {
+    /// How parameters enter.
+    pub params: ParamMode,
+}
+
+/// Shape of a generated function's result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// Symmetric matrix; entries are the upper triangle `(row ≤ col)`.
+    SymmetricMatrix,
+    /// Vector; entries are `(row, 0)`.
+    Vector,
+}
+
+/// Which inputs a function takes besides the parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Signature {
+    /// `f(q)`.
+    Q,
+    /// `f(q, u)`.
+    QU,
+    /// `f(q, u, u̇)`.
+    QUUd,
+}
+
+/// One derived function: its name and output entries as expressions in the arena.
+#[derive(Clone, Debug)]
+pub struct Function {
+    /// Rust name (`mass_matrix`).
+    pub name: &'static str,
+    /// What it computes, for docs.
+    pub doc: &'static str,
+    /// Result shape.
+    pub shape: Shape,
+    /// Inputs.
+    pub signature: Signature,
+    /// `(row, col, expr)`; col = 0 for vectors.
+    pub entries: Vec<(usize, usize, ExprId)>,
+}
+
+/// The symbolic dynamics of a model.
+#[derive(Clone, Debug)]
+pub struct Derivation {
+    /// All expressions and substitution variables.
+    pub arena: Arena,
+    /// `mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`.
+    pub functions: Vec<Function>,
+    /// Number of speeds.
+    pub dof: usize,
+    /// Options used.
+    pub options: Options,
+}
+
+impl Derivation {
+    /// The function called `name`.
+    pub fn function(&self, name: &str) -> Option<&Function> {
+        self.functions.iter().find(|f| f.name == name)
+    }
+}
+
+type V3 = [ExprId; 3];
+type M3 = [[ExprId; 3]; 3];
+
+/// Names for the arena's printer, from the model.
+pub fn names_of(model: &Model) -> Names {
+    Names {
+        params: model.params.iter().map(|p| p.name.clone()).collect(),
+        speeds: model.speeds.iter().map(|s| s.name.clone()).collect(),
+        coords: model.speeds.iter().map(|s| s.coordinate.clone()).collect(),
+    }
+}
+
+/// Derive M (upper triangle), c, g and τ for `model`.
+pub fn derive(model: &Model, options: Options) -> Derivation {
+    let mut arena = Arena::new(names_of(model));
+    arena.hoist_params = options.params == ParamMode::Runtime;
+    let mut cx = Ctx {
+        ar: &mut arena,
+        model,
+        options,
+        rot: vec![None; model.links.len()],
+        pos: vec![None; model.links.len()],
+    };
+    let n = model.dof();
+    let composites = cx.composites(true);
+    let m = cx.mass_matrix(&composites);
+    let g = cx.gravity(&composites);
+    let c = cx.rnea(false, false);
+    let tau = cx.rnea(true, true);
+    let vector = |v: Vec<ExprId>| v.into_iter().enumerate().map(|(i, e)| (i, 0, e)).collect();
+    let functions = vec![
+        Function {
+            name: "mass_matrix",
+            doc: "Mass matrix M(q) (symmetric positive definite).",
+            shape: Shape::SymmetricMatrix,
+            signature: Signature::Q,
+            entries: m,
+        },
+        Function {
+            name: "coriolis",
+            doc: "Coriolis and centrifugal vector c(q, u) (velocity-product terms).",
+            shape: Shape::Vector,
+            signature: Signature::QU,
+            entries: vector(c),
+        },
+        Function {
+            name: "gravity",
+            doc: "Gravity vector g(q).",
+            shape: Shape::Vector,
+            signature: Signature::Q,
+            entries: vector(g),
+        },
+        Function {
+            name: "inverse_dynamics",
+            doc: "Inverse dynamics τ = M(q) u̇ + c(q, u) + g(q), in one pass.",
+            shape: Shape::Vector,
+            signature: Signature::QUUd,
+            entries: vector(tau),
+        },
+    ];
+    debug_assert!(functions.iter().all(|f| f.entries.iter().all(|e| e.0 < n)));
+    Derivation {
+        arena,
+        functions,
+        dof: n,
+        options,
+    }
+}
+
+/// Composite (subtree) inertial quantities of a frame, in that frame.
+#[derive(Clone, Debug)]
+struct Composite {
+    mass: ExprId,
+    first_moment: V3,
+    /// `[XX, XY, XZ, YY, YZ, ZZ]` about the frame origin (empty if not computed).
+    inertia: Option<[ExprId; 6]>,
+}
+
+struct Ctx<'a> {
+    ar: &'a mut Arena,
+    model: &'a Model,
+    options: Options,
+    rot: Vec<Option<M3>>,
+    pos: Vec<Option<V3>>,
+}
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+impl Ctx<'_> {
+    // ---- leaves -------------------------------------------------------------------------------
+
+    fn param(&mut self, p: usize) -> ExprId {
+        match self.options.params {
+            ParamMode::Runtime => self.ar.atom(Atom::Param(p as u32)),
+            ParamMode::Baked => self.ar.constant(self.model.params[p].value),
+        }
+    }
+
+    fn scalar(&mut self, s: &Scalar) -> ExprId {
+        let c = self.ar.constant(s.coef);
+        match s.symbol {
+            None => c,
+            Some(p) => {
+                let p = self.param(p);
+                self.ar.mul(c, p)
+            }
+        }
+    }
+
+    fn consts(&mut self, v: [f64; 3]) -> V3 {
+        v.map(|x| self.ar.constant(x))
+    }
+
+    fn link_name(&self, l: usize) -> &str {
+        &self.model.links[l].name
+    }
+
+    /// `iAj(q)` of link `l` (rows), cached.
+    fn rotation(&mut self, l: usize) -> M3 {
+        if let Some(r) = self.rot[l] {
+            return r;
+        }
+        let j = self.model.links[l].joint.as_ref().expect("non-root link has a joint");
+        let a0: M3 = j.rotation.map(|row| row.map(|x| self.ar.constant(x)));
+        let r = match (j.kind, j.speed) {
+            (JointKind::Revolute, Some(s)) => {
+                let sn = self.ar.atom(Atom::Sin(s as u32));
+                let cs = self.ar.atom(Atom::Cos(s as u32));
+                let e = j.axis;
+                // Rot(e, q) = c·I + s·[e]× + (1 − c)·e eᵀ
+                let one = self.ar.one();
+                let omc = self.ar.sub(one, cs);
+                let ex = [[0.0, -e[2], e[1]], [e[2], 0.0, -e[0]], [-e[1], e[0], 0.0]];
+                let mut rot = [[self.ar.zero(); 3]; 3];
+                for r in 0..3 {
+                    for c in 0..3 {
+                        let id = if r == c { cs } else { self.ar.zero() };
+                        let k1 = self.ar.constant(ex[r][c]);
+                        let t1 = self.ar.mul(k1, sn);
+                        let k2 = self.ar.constant(e[r] * e[c]);
+                        let t2 = self.ar.mul(k2, omc);
+                        rot[r][c] = self.ar.sum([id, t1, t2]);
+                    }
+                }
+                self.matmul(&a0, &rot)
+            }
+            _ => a0,
+        };
+        let name = self.link_name(l).to_owned();
+        let mut out = r;
+        for (ri, row) in out.iter_mut().enumerate() {
+            for (ci, x) in row.iter_mut().enumerate() {
+                *x = self.ar.subst(*x, VarKind::K, &format!("A{name}({},{})", ri + 1, ci + 1));
+            }
+        }
+        self.rot[l] = Some(out);
+        out
+    }
+
+    /// `iPj(q)` of link `l`, cached.
+    fn position(&mut self, l: usize) -> V3 {
+        if let Some(p) = self.pos[l] {
+            return p;
+        }
+        let j = self.model.links[l].joint.clone().expect("non-root link has a joint");
+        let mut p = j.translation.map(|s| self.scalar(&s));
+        if let (JointKind::Prismatic, Some(s)) = (j.kind, j.speed) {
+            let q = self.ar.atom(Atom::Coord(s as u32));
+            let dir = [0, 1, 2].map(|r| (0..3).map(|c| j.rotation[r][c] * j.axis[c]).sum::<f64>());
+            for (r, pr) in p.iter_mut().enumerate() {
+                let k = self.ar.constant(dir[r]);
+                let t = self.ar.mul(k, q);
+                *pr = self.ar.add(*pr, t);
+            }
+        }
+        let name = self.link_name(l).to_owned();
+        let p = self.subst3(p, VarKind::K, &format!("P{name}"));
+        self.pos[l] = Some(p);
+        p
+    }
+
+    // ---- vector algebra -----------------------------------------------------------------------
+
+    fn matmul(&mut self, a: &M3, b: &M3) -> M3 {
+        let mut out = [[self.ar.zero(); 3]; 3];
+        for (r, row) in out.iter_mut().enumerate() {
+            for (c, x) in row.iter_mut().enumerate() {
+                let t: Vec<ExprId> = (0..3).map(|k| self.ar.mul(a[r][k], b[k][c])).collect();
+                *x = self.ar.sum(t);
+            }
+        }
+        out
+    }
+
+    /// `R x`.
+    fn rot_up(&mut self, r: &M3, x: &V3) -> V3 {
+        [0, 1, 2].map(|i| {
+            let t: Vec<ExprId> = (0..3).map(|k| self.ar.mul(r[i][k], x[k])).collect();
+            self.ar.sum(t)
+        })
+    }
+
+    /// `Rᵀ x`.
+    fn rot_down(&mut self, r: &M3, x: &V3) -> V3 {
+        [0, 1, 2].map(|i| {
+            let t: Vec<ExprId> = (0..3).map(|k| self.ar.mul(r[k][i], x[k])).collect();
+            self.ar.sum(t)
+        })
+    }
+
+    fn add3(&mut self, a: &V3, b: &V3) -> V3 {
+        [0, 1, 2].map(|i| self.ar.add(a[i], b[i]))
+    }
+
+    fn sub3(&mut self, a: &V3, b: &V3) -> V3 {
+        [0, 1, 2].map(|i| self.ar.sub(a[i], b[i]))
+    }
+
+    fn scale3(&mut self, k: ExprId, a: &V3) -> V3 {
+        [0, 1, 2].map(|i| self.ar.mul(k, a[i]))
+    }
+
+    fn cross(&mut self, a: &V3, b: &V3) -> V3 {
+        [0, 1, 2].map(|i| {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            let p = self.ar.mul(a[j], b[k]);
+            let m = self.ar.mul(a[k], b[j]);
+            self.ar.sub(p, m)
+        })
+    }
+
+    fn dot(&mut self, a: &V3, b: &V3) -> ExprId {
+        let t: Vec<ExprId> = (0..3).map(|i| self.ar.mul(a[i], b[i])).collect();
+        self.ar.sum(t)
+    }
+
+    fn subst3(&mut self, v: V3, kind: VarKind, label: &str) -> V3 {
+        [0, 1, 2].map(|i| self.ar.subst(v[i], kind, &format!("{label}.{}", AXES[i])))
+    }
+
+    /// Symmetric 3×3 from `[XX, XY, XZ, YY, YZ, ZZ]`.
+    fn sym(j: &[ExprId; 6]) -> M3 {
+        [[j[0], j[1], j[2]], [j[1], j[3], j[4]], [j[2], j[4], j[5]]]
+    }
+
+    fn sym_mul(&mut self, j: &[ExprId; 6], x: &V3) -> V3 {
+        let m = Self::sym(j);
+        self.rot_up(&m, x)
+    }
+
+    // ---- model data ---------------------------------------------------------------------------
+
+    fn body(&mut self, l: usize) -> Option<(ExprId, V3, [ExprId; 6])> {
+        let b = self.model.links[l].body.clone()?;
+        let m = self.param(b.mass);
+        let ms = b.first_moment.map(|p| self.param(p));
+        let j = b.inertia.map(|p| self.param(p));
+        Some((m, ms, j))
+    }
+
+    fn gravity_vector(&mut self) -> V3 {
+        let g = self.param(self.model.gravity.symbol);
+        let d = self.consts(self.model.gravity.direction);
+        self.scale3(g, &d)
+    }
+
+    fn axis(&mut self, l: usize) -> V3 {
+        let e = self.model.links[l].joint.as_ref().map(|j| j.axis).unwrap_or([0.0; 3]);
+        self.consts(e)
+    }
+
+    /// Wheel inertia added to M[ẋ,ẋ] and M[ψ̇,ψ̇].
+    fn wheel_terms(&mut self) -> Option<(usize, ExprId, usize, ExprId)> {
+        let Base::Wheeled(w) = &self.model.base else {
+            return None;
+        };
+        let w = w.clone();
+        let (r, l, mw, yy, zz) = (
+            self.param(w.radius),
+            self.param(w.track),
+            self.param(w.wheel_mass),
+            self.param(w.wheel_axle_inertia),
+            self.param(w.wheel_diametral_inertia),
+        );
+        let two = self.ar.constant(2.0);
+        let half = self.ar.constant(0.5);
+        let r_2 = self.ar.powi(r, -2);
+        let l2 = self.ar.powi(l, 2);
+        // 2 mw + 2 YYw / R²
+        let a = self.ar.mul(two, mw);
+        let b = self.ar.product([two, yy, r_2]);
+        let kx = self.ar.add(a, b);
+        let kx = self.ar.subst(kx, VarKind::D, "wheels: 2 mw + 2 YYw/R^2");
+        // mw L²/2 + YYw L²/(2R²) + 2 ZZw
+        let a = self.ar.product([half, mw, l2]);
+        let b = self.ar.product([half, yy, l2, r_2]);
+        let c = self.ar.mul(two, zz);
+        let kp = self.ar.sum([a, b, c]);
+        let kp = self.ar.subst(kp, VarKind::D, "wheels: mw L^2/2 + YYw L^2/(2R^2) + 2 ZZw");
+        Some((w.x_speed, kx, w.psi_speed, kp))
+    }
+
+    // ---- composite bodies -----------------------------------------------------------------------
+
+    /// Composite mass, first moment and (optionally) inertia of every subtree, in its own frame.
+    fn composites(&mut self, with_inertia: bool) -> Vec<Composite> {
+        let links = self.model.links.len();
+        let zero = self.ar.zero();
+        let mut comp: Vec<Composite> = (0..links)
+            .map(|_| Composite {
+                mass: zero,
+                first_moment: [zero; 3],
+                inertia: if with_inertia { Some([zero; 6]) } else { None },
+            })
+            .collect();
+        for l in 0..links {
+            if let Some((m, ms, j)) = self.body(l) {
+                comp[l] = Composite {
+                    mass: m,
+                    first_moment: ms,
+                    inertia: with_inertia.then_some(j),
+                };
+            }
+        }
+        for c in (1..links).rev() {
+            let parent = self.model.links[c].parent.expect("non-root");
+            let name = self.link_name(c).to_owned();
+            let pname = self.link_name(parent).to_owned();
+            // Finalise the child's composite as substitution variables.
+            let child = comp[c].clone();
+            let mass = self.ar.subst(child.mass, VarKind::D, &format!("mC{name}"));
+            let msc = self.subst3(child.first_moment, VarKind::D, &format!("MSC{name}"));
+            let inertia = child.inertia.map(|j| {
+                let labels = ["xx", "xy", "xz", "yy", "yz", "zz"];
+                let mut out = j;
+                for (k, x) in out.iter_mut().enumerate() {
+                    *x = self.ar.subst(*x, VarKind::D, &format!("JC{name}.{}", labels[k]));
+                }
+                out
+            });
+            comp[c] = Composite {
+                mass,
+                first_moment: msc,
+                inertia,
+            };
+            if self.ar.is_zero(mass) && msc.iter().all(|x| self.ar.is_zero(*x)) {
+                continue;
+            }
+            let r = self.rotation(c);
+            let p = self.position(c);
+            // First moment moved to the parent frame: R·MS + m·p.
+            let u = self.rot_up(&r, &msc);
+            let u = self.subst3(u, VarKind::D, &format!("MSC{name} in {pname}"));
+            let mp = self.scale3(mass, &p);
+            let add = self.add3(&u, &mp);
+            let new_mass = self.ar.add(comp[parent].mass, mass);
+            let new_ms = self.add3(&comp[parent].first_moment, &add);
+            let mut new_inertia = comp[parent].inertia;
+            if let (Some(jc), Some(acc)) = (inertia, new_inertia.as_mut()) {
+                // R J Rᵀ in two stages (T = J Rᵀ, then R T).
+                let jm = Self::sym(&jc);
+                let mut t = [[zero; 3]; 3];
+                for (a, row) in t.iter_mut().enumerate() {
+                    for (b, x) in row.iter_mut().enumerate() {
+                        let terms: Vec<ExprId> =
+                            (0..3).map(|k| self.ar.mul(jm[a][k], r[b][k])).collect();
+                        let s = self.ar.sum(terms);
+                        *x = self.ar.subst(s, VarKind::D, &format!("JC{name}·Aᵀ({},{})", a + 1, b + 1));
+                    }
+                }
+                let idx = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+                // −(u pᵀ + p uᵀ) + 2 (p·u) I  and  m (|p|² I − p pᵀ)
+                let pu = self.dot(&p, &u);
+                let two_pu = self.ar.scale(pu, 2.0);
+                let pp = self.dot(&p, &p);
+                for (k, &(a, b)) in idx.iter().enumerate() {
+                    let terms: Vec<ExprId> = (0..3).map(|i| self.ar.mul(r[a][i], t[i][b])).collect();
+                    let rjr = self.ar.sum(terms);
+                    let upa = self.ar.mul(u[a], p[b]);
+                    let pua = self.ar.mul(p[a], u[b]);
+                    let cross = self.ar.add(upa, pua);
+                    let cross = self.ar.neg(cross);
+                    let ppab = self.ar.mul(p[a], p[b]);
+                    let mterm = if a == b {
+                        let d = self.ar.sub(pp, ppab);
+                        self.ar.mul(mass, d)
+                    } else {
+                        let d = self.ar.neg(ppab);
+                        self.ar.mul(mass, d)
+                    };
+                    let diag = if a == b { two_pu } else { zero };
+                    acc[k] = self.ar.sum([acc[k], rjr, cross, diag, mterm]);
+                }
+            }
+            comp[parent] = Composite {
+                mass: new_mass,
+                first_moment: new_ms,
+                inertia: new_inertia,
+            };
+        }
+        let name = self.link_name(0).to_owned();
+        let root = comp[0].clone();
+        comp[0] = Composite {
+            mass: self.ar.subst(root.mass, VarKind::D, &format!("mC{name}")),
+            first_moment: self.subst3(root.first_moment, VarKind::D, &format!("MSC{name}")),
+            inertia: root.inertia.map(|j| {
+                j.map(|x| self.ar.subst(x, VarKind::D, &format!("JC{name}")))
+            }),
+        };
+        comp
+    }
+
+    // ---- mass matrix ----------------------------------------------------------------------------
+
+    fn mass_matrix(&mut self, comp: &[Composite]) -> Vec<(usize, usize, ExprId)> {
+        let mut entries = Vec::new();
+        let put = |entries: &mut Vec<(usize, usize, ExprId)>, a: usize, b: usize, e: ExprId| {
+            entries.push((a.min(b), a.max(b), e));
+        };
+        let wheeled = self.model.wheeled_base().cloned();
+        // Columns of the joints.
+        for l in 1..self.model.links.len() {
+            let joint = self.model.links[l].joint.clone().expect("non-root");
+            let Some(col) = joint.speed else { continue };
+            let c = &comp[l];
+            let e = self.axis(l);
+            let jc = c.inertia.expect("inertia computed");
+            let name = self.link_name(l).to_owned();
+            // Inertia force and moment about O_l for a unit acceleration of this joint.
+            let (mut f, mut n) = match joint.kind {
+                JointKind::Prismatic => {
+                    let f = self.scale3(c.mass, &e);
+                    let n = self.cross(&c.first_moment, &e);
+                    (f, n)
+                }
+                _ => {
+                    let f = self.cross(&e, &c.first_moment);
+                    let n = self.sym_mul(&jc, &e);
+                    (f, n)
+                }
+            };
+            f = self.subst3(f, VarKind::D, &format!("F(M col {name}) at {name}"));
+            n = self.subst3(n, VarKind::D, &format!("N(M col {name}) at {name}"));
+            let diag = match joint.kind {
+                JointKind::Prismatic => self.dot(&e, &f),
+                _ => self.dot(&e, &n),
+            };
+            put(&mut entries, col, col, diag);
+            let mut k = l;
+            while let Some(parent) = self.model.links[k].parent {
+                let r = self.rotation(k);
+                let p = self.position(k);
+                let fu = self.rot_up(&r, &f);
+                let pname = self.link_name(parent).to_owned();
+                f = self.subst3(fu, VarKind::D, &format!("F(M col {name}) at {pname}"));
+                let nu = self.rot_up(&r, &n);
+                let pxf = self.cross(&p, &f);
+                let nn = self.add3(&nu, &pxf);
+                n = self.subst3(nn, VarKind::D, &format!("N(M col {name}) at {pname}"));
+                k = parent;
+                match self.model.links[k].joint.as_ref() {
+                    Some(pj) if pj.speed.is_some() => {
+                        let row = pj.speed.expect("checked");
+                        let ek = self.axis(k);
+                        let v = match pj.kind {
+                            JointKind::Prismatic => self.dot(&ek, &f),
+                            _ => self.dot(&ek, &n),
+                        };
+                        put(&mut entries, row, col, v);
+                    }
+                    Some(_) => {}
+                    None => {
+                        if let Some(w) = &wheeled {
+                            put(&mut entries, w.x_speed, col, f[0]);
+                            put(&mut entries, w.psi_speed, col, n[2]);
+                        }
+                    }
+                }
+            }
+        }
+        // The base quasi-velocities.
+        if let Some(w) = &wheeled {
+            let c = &comp[0];
+            let jc = c.inertia.expect("inertia computed");
+            let (_, kx, _, kp) = self.wheel_terms().expect("wheeled");
+            let mxx = self.ar.add(c.mass, kx);
+            // x̂ · (ẑ × MS) = −MS_y
+            let mxp = self.ar.neg(c.first_moment[1]);
+            let mpp = self.ar.add(jc[5], kp);
+            put(&mut entries, w.x_speed, w.x_speed, mxx);
+            put(&mut entries, w.x_speed, w.psi_speed, mxp);
+            put(&mut entries, w.psi_speed, w.psi_speed, mpp);
+        }
+        let mut entries: Vec<(usize, usize, ExprId)> = entries
+            .into_iter()
+            .map(|(a, b, e)| {
+                let e = if self.ar.hoist_params {
+                    self.ar.hoist(e, &format!("M[{a},{b}]"))
+                } else {
+                    e
+                };
+                (a, b, e)
+            })
+            .collect();
+        entries.sort_by_key(|&(a, b, _)| (a, b));
+        entries
+    }
+
+    // ---- gravity --------------------------------------------------------------------------------
+
+    fn gravity(&mut self, comp: &[Composite]) -> Vec<ExprId> {
+        let n = self.model.dof();
+        let zero = self.ar.zero();
+        let mut out = vec![zero; n];
+        let g0 = self.gravity_vector();
+        let mut acc: Vec<V3> = vec![[zero; 3]; self.model.links.len()];
+        acc[0] = [0, 1, 2].map(|i| self.ar.neg(g0[i]));
+        for l in 1..self.model.links.len() {
+            let parent = self.model.links[l].parent.expect("non-root");
+            let r = self.rotation(l);
+            let a = self.rot_down(&r, &acc[parent]);
+            let name = self.link_name(l).to_owned();
+            acc[l] = self.subst3(a, VarKind::D, &format!("gravity acceleration in {name}"));
+        }
+        for l in 1..self.model.links.len() {
+            let joint = self.model.links[l].joint.clone().expect("non-root");
+            let Some(row) = joint.speed else { continue };
+            let e = self.axis(l);
+            let c = &comp[l];
+            out[row] = match joint.kind {
+                JointKind::Prismatic => {
+                    let d = self.dot(&e, &acc[l]);
+                    self.ar.mul(c.mass, d)
+                }
+                _ => {
+                    let x = self.cross(&c.first_moment, &acc[l]);
+                    self.dot(&e, &x)
+                }
+            };
+        }
+        if let Some(w) = self.model.wheeled_base().cloned() {
+            let c = &comp[0];
+            out[w.x_speed] = self.ar.mul(c.mass, acc[0][0]);
+            let x = self.cross(&c.first_moment, &acc[0]);
+            out[w.psi_speed] = x[2];
+        }
+        self.finish(out, "g")
+    }
+
+    fn finish(&mut self, v: Vec<ExprId>, label: &str) -> Vec<ExprId> {
+        v.into_iter()
+            .enumerate()
+            .map(|(i, e)| {
+                if self.ar.hoist_params {
+                    self.ar.hoist(e, &format!("{label}[{i}]"))
+                } else {
+                    e
+                }
+            })
+            .collect()
+    }
+
+    // ---- inverse dynamics (backward accumulation of Kane's generalized inertia forces) ------------
+
+    /// τ with the given inputs: `with_accel` keeps u̇ (else u̇ = 0), `with_gravity` folds gravity in.
+    fn rnea(&mut self, with_accel: bool, with_gravity: bool) -> Vec<ExprId> {
+        let model = self.model;
+        let links = model.links.len();
+        let zero = self.ar.zero();
+        let speed = |ar: &mut Arena, s: usize| ar.atom(Atom::Speed(s as u32));
+        let accel = |ar: &mut Arena, s: usize| {
+            if with_accel {
+                ar.atom(Atom::Accel(s as u32))
+            } else {
+                ar.zero()
+            }
+        };
+        let tag = match (with_accel, with_gravity) {
+            (true, true) => "",
+            (false, false) => "|ud=0,g=0",
+            (true, false) => "|g=0",
+            (false, true) => "|ud=0",
+        };
+        let mut w: Vec<V3> = vec![[zero; 3]; links];
+        let mut wd: Vec<V3> = vec![[zero; 3]; links];
+        let mut a: Vec<V3> = vec![[zero; 3]; links];
+        if let Some(wb) = model.wheeled_base() {
+            let xd = speed(self.ar, wb.x_speed);
+            let psid = speed(self.ar, wb.psi_speed);
+            let xdd = accel(self.ar, wb.x_speed);
+            let psidd = accel(self.ar, wb.psi_speed);
+            w[0] = [zero, zero, psid];
+            wd[0] = [zero, zero, psidd];
+            // a0 = [ẍ, ẋψ̇, 0]: the centripetal term ẋψ̇ along y0.
+            let xp = self.ar.mul(xd, psid);
+            a[0] = [xdd, xp, zero];
+        }
+        if with_gravity {
+            let g0 = self.gravity_vector();
+            a[0] = self.sub3(&a[0], &g0);
+        }
+        let root = self.link_name(0).to_owned();
+        a[0] = self.subst3(a[0], VarKind::K, &format!("a{root}{tag}"));
+        // Forward: seed 002 eqs. 3, 4, 6.
+        for l in 1..links {
+            let i = model.links[l].parent.expect("non-root");
+            let joint = model.links[l].joint.clone().expect("non-root");
+            let name = self.link_name(l).to_owned();
+            let r = self.rotation(l);
+            let p = self.position(l);
+            let e = self.axis(l);
+            let wi = self.rot_down(&r, &w[i]);
+            let wi = self.subst3(wi, VarKind::K, &format!("w{} in {name}{tag}", self.link_name(i)));
+            let wdi = self.rot_down(&r, &wd[i]);
+            let (wj, wdj, extra_a) = match (joint.kind, joint.speed) {
+                (JointKind::Revolute, Some(s)) => {
+                    let u = speed(self.ar, s);
+                    let ud = accel(self.ar, s);
+                    let ue = self.scale3(u, &e);
+                    let ude = self.scale3(ud, &e);
+                    let wxe = self.cross(&wi, &e);
+                    let uwxe = self.scale3(u, &wxe);
+                    let wj = self.add3(&wi, &ue);
+                    let t = self.add3(&wdi, &ude);
+                    let wdj = self.add3(&t, &uwxe);
+                    (wj, wdj, [zero; 3])
+                }
+                (JointKind::Prismatic, Some(s)) => {
+                    let u = speed(self.ar, s);
+                    let ud = accel(self.ar, s);
+                    let ude = self.scale3(ud, &e);
+                    let wxe = self.cross(&wi, &e);
+                    let two_u = self.ar.scale(u, 2.0);
+                    let cor = self.scale3(two_u, &wxe);
+                    let extra = self.add3(&ude, &cor);
+                    (wi, wdi, extra)
+                }
+                _ => (wi, wdi, [zero; 3]),
+            };
+            w[l] = self.subst3(wj, VarKind::K, &format!("w{name}{tag}"));
+            wd[l] = self.subst3(wdj, VarKind::K, &format!("wd{name}{tag}"));
+            // a_j = jAi (a_i + α_i × P + ω_i × (ω_i × P)) (+ prismatic terms)
+            let wxp = self.cross(&w[i], &p);
+            let wxp = self.subst3(wxp, VarKind::K, &format!("w{}xP{name}{tag}", self.link_name(i)));
+            let t1 = self.cross(&wd[i], &p);
+            let t2 = self.cross(&w[i], &wxp);
+            let t = self.add3(&a[i], &t1);
+            let t = self.add3(&t, &t2);
+            let t = self.subst3(t, VarKind::K, &format!("a{name} in {}{tag}", self.link_name(i)));
+            let aj = self.rot_down(&r, &t);
+            let aj = self.add3(&aj, &extra_a);
+            a[l] = self.subst3(aj, VarKind::K, &format!("a{name}{tag}"));
+        }
+        // Body inertia forces and moments about the frame origins.
+        let mut f: Vec<V3> = vec![[zero; 3]; links];
+        let mut n: Vec<V3> = vec![[zero; 3]; links];
+        for l in 0..links {
+            let Some((m, ms, j)) = self.body(l) else { continue };
+            let name = self.link_name(l).to_owned();
+            let wxms = self.cross(&w[l], &ms);
+            let wxms = self.subst3(wxms, VarKind::D, &format!("w{name}xMS{name}{tag}"));
+            let ma = self.scale3(m, &a[l]);
+            let t1 = self.cross(&wd[l], &ms);
+            let t2 = self.cross(&w[l], &wxms);
+            let fl = self.add3(&ma, &t1);
+            let fl = self.add3(&fl, &t2);
+            f[l] = self.subst3(fl, VarKind::D, &format!("F{name}{tag}"));
+            let jwd = self.sym_mul(&j, &wd[l]);
+            let jw = self.sym_mul(&j, &w[l]);
+            let jw = self.subst3(jw, VarKind::D, &format!("J{name}w{name}{tag}"));
+            let wxjw = self.cross(&w[l], &jw);
+            let msxa = self.cross(&ms, &a[l]);
+            let nl = self.add3(&jwd, &wxjw);
+            let nl = self.add3(&nl, &msxa);
+            n[l] = self.subst3(nl, VarKind::D, &format!("N{name}{tag}"));
+        }
+        // Backward accumulation over subtrees.
+        for c in (1..links).rev() {
+            let parent = model.links[c].parent.expect("non-root");
+            if f[c].iter().chain(n[c].iter()).all(|x| self.ar.is_zero(*x)) {
+                continue;
+            }
+            let cname = self.link_name(c).to_owned();
+            let pname = self.link_name(parent).to_owned();
+            let r = self.rotation(c);
+            let p = self.position(c);
+            let fu = self.rot_up(&r, &f[c]);
+            let fu = self.subst3(fu, VarKind::D, &format!("f{cname} in {pname}{tag}"));
+            let nu = self.rot_up(&r, &n[c]);
+            let pxf = self.cross(&p, &fu);
+            let nf = self.add3(&f[parent], &fu);
+            let nn = self.add3(&n[parent], &nu);
+            let nn = self.add3(&nn, &pxf);
+            f[parent] = self.subst3(nf, VarKind::D, &format!("f{pname}{tag}"));
+            n[parent] = self.subst3(nn, VarKind::D, &format!("n{pname}{tag}"));
+        }
+        let mut out = vec![zero; model.dof()];
+        for l in 1..links {
+            let joint = model.links[l].joint.clone().expect("non-root");
+            let Some(row) = joint.speed else { continue };
+            let e = self.axis(l);
+            out[row] = match joint.kind {
+                JointKind::Prismatic => self.dot(&e, &f[l]),
+                _ => self.dot(&e, &n[l]),
+            };
+        }
+        if model.wheeled_base().is_some() {
+            let (xs, kx, ps, kp) = self.wheel_terms().expect("wheeled");
+            out[xs] = f[0][0];
+            out[ps] = n[0][2];
+            if with_accel {
+                let xdd = self.ar.atom(Atom::Accel(xs as u32));
+                let psidd = self.ar.atom(Atom::Accel(ps as u32));
+                let tx = self.ar.mul(kx, xdd);
+                let tp = self.ar.mul(kp, psidd);
+                out[xs] = self.ar.add(out[xs], tx);
+                out[ps] = self.ar.add(out[ps], tp);
+            }
+        }
+        self.finish(out, if with_accel { "tau" } else { "c" })
+    }
+}
+
+impl Derivation {
+    /// Evaluate function `name` numerically from the symbolic expressions (no code generation):
+    /// a dense row-major `n × n` matrix (both triangles) or an `n`-vector. Parameter values are
+    /// used in [`ParamMode::Runtime`]; in baked mode the model's values are already folded in.
+    pub fn evaluate(&self, name: &str, params: &[f64], q: &[f64], u: &[f64], ud: &[f64]) -> Vec<f64> {
+        let f = self.function(name).unwrap_or_else(|| panic!("no function `{name}`"));
+        let vals = self.arena.eval(&crate::expr::Values { params, q, u, ud });
+        let n = self.dof;
+        match f.shape {
+            Shape::SymmetricMatrix => {
+                let mut m = vec![0.0; n * n];
+                for &(r, c, e) in &f.entries {
+                    m[r * n + c] = vals[e.index()];
+                    m[c * n + r] = vals[e.index()];
+                }
+                m
+            }
+            Shape::Vector => {
+                let mut v = vec![0.0; n];
+                for &(r, _, e) in &f.entries {
+                    v[r] = vals[e.index()];
+                }
+                v
+            }
+        }
+    }
+}

@@ -45,7 +45,9 @@ pub enum ModelErrorKind {
         parent: String,
     },
     /// A body is attached to a frame that does not exist.
-    #[error("body `{body}`: frame `{frame}` is not defined; attach the body to the base frame or a joint's child frame")]
+    #[error(
+        "body `{body}`: frame `{frame}` is not defined; attach the body to the base frame or a joint's child frame"
+    )]
     UnknownFrame {
         /// The body.
         body: String,
@@ -142,8 +144,10 @@ pub enum ModelErrorKind {
         /// Its value.
         value: f64,
     },
-    /// A length entry is neither a number nor `[-]SYMBOL`.
-    #[error("joint `{joint}`: translation entry `{text}` is neither a number nor a length symbol such as `L1` or `-L2`")]
+    /// A length entry is neither a finite number nor `[-]SYMBOL`.
+    #[error(
+        "joint `{joint}`: translation entry `{text}` is neither a finite number nor a length symbol such as `L1` or `-L2`"
+    )]
     BadLength {
         /// The joint.
         joint: String,
@@ -151,7 +155,9 @@ pub enum ModelErrorKind {
         text: String,
     },
     /// A generalized speed is driven by two joints (or a joint and the base).
-    #[error("speed `{speed}` is driven twice, by {first} and by {second}; each speed is driven exactly once")]
+    #[error(
+        "speed `{speed}` is driven twice, by {first} and by {second}; each speed is driven exactly once"
+    )]
     SpeedTwice {
         /// The speed.
         speed: String,
@@ -167,7 +173,9 @@ pub enum ModelErrorKind {
         speed: String,
     },
     /// A joint or the base names a speed that is not listed in `[model] speeds`.
-    #[error("{item}: speed `{speed}` is not listed in [model] speeds; add it there (the list fixes the order of u)")]
+    #[error(
+        "{item}: speed `{speed}` is not listed in [model] speeds; add it there (the list fixes the order of u)"
+    )]
     UnknownSpeed {
         /// The joint or base.
         item: String,

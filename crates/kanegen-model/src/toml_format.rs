@@ -166,7 +166,11 @@ impl Symbols {
 
 fn parse_length(entry: &LengthEntry, joint: &str, syms: &mut Symbols) -> Result<Scalar, K> {
     match entry {
-        LengthEntry::Number(v) => Ok(Scalar::number(*v)),
+        LengthEntry::Number(v) if v.is_finite() => Ok(Scalar::number(*v)),
+        LengthEntry::Number(v) => Err(K::BadLength {
+            joint: joint.to_owned(),
+            text: v.to_string(),
+        }),
         LengthEntry::Symbol(text) => {
             let t = text.trim();
             let (coef, name) = match t.strip_prefix('-') {
@@ -276,8 +280,18 @@ fn build(f: File, file: &str) -> Result<Model, K> {
             wheel_diametral_inertia,
         } => {
             let item = "base";
-            let xs = drive(x_speed, "the wheeled base (x_speed)".into(), "x", &mut speeds)?;
-            let ps = drive(psi_speed, "the wheeled base (psi_speed)".into(), "psi", &mut speeds)?;
+            let xs = drive(
+                x_speed,
+                "the wheeled base (x_speed)".into(),
+                "x",
+                &mut speeds,
+            )?;
+            let ps = drive(
+                psi_speed,
+                "the wheeled base (psi_speed)".into(),
+                "psi",
+                &mut speeds,
+            )?;
             let w = WheeledBase {
                 x_speed: xs,
                 psi_speed: ps,
@@ -299,7 +313,7 @@ fn build(f: File, file: &str) -> Result<Model, K> {
     let gsym = syms.lookup("gravity", &f.gravity.symbol, ParamKind::Gravity)?;
     let dir = f.gravity.direction;
     let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
-    if (n - 1.0).abs() > 1e-9 {
+    if !n.is_finite() || (n - 1.0).abs() > 1e-9 {
         return Err(K::Invalid {
             item: "gravity".into(),
             detail: format!("direction {dir:?} is not a unit vector (norm {n}); normalise it"),
@@ -367,7 +381,16 @@ fn build(f: File, file: &str) -> Result<Model, K> {
             }
         }
         if next.len() == before {
-            let j = &f.joints[next[0]];
+            // Each unplaced joint's parent frame is the child of another unplaced joint: walk up
+            // from one of them until a joint repeats; that joint is on a cycle (the first unplaced
+            // joint may merely hang off one).
+            let mut k = next[0];
+            let mut seen = vec![false; f.joints.len()];
+            while !seen[k] {
+                seen[k] = true;
+                k = child_of[f.joints[k].parent.as_str()];
+            }
+            let j = &f.joints[k];
             return Err(K::Cycle {
                 joint: j.name.clone(),
                 frame: j.child.clone(),
@@ -387,10 +410,7 @@ fn build(f: File, file: &str) -> Result<Model, K> {
             });
         };
         if body_names.contains(&name) {
-            return Err(K::Duplicate {
-                what: "body",
-                name,
-            });
+            return Err(K::Duplicate { what: "body", name });
         }
         if links[li].body.is_some() {
             return Err(K::Duplicate {
@@ -399,9 +419,8 @@ fn build(f: File, file: &str) -> Result<Model, K> {
             });
         }
         let item = format!("body `{name}`");
-        let mut sym = |prefix: &str| {
-            syms.lookup(&item, &format!("{prefix}{name}"), ParamKind::Inertial)
-        };
+        let mut sym =
+            |prefix: &str| syms.lookup(&item, &format!("{prefix}{name}"), ParamKind::Inertial);
         let body = Body {
             name: name.clone(),
             mass: sym("m")?,
@@ -476,8 +495,9 @@ fn build_joint(
         (_, None) => {
             return Err(K::JointSpeed {
                 joint: j.name.clone(),
-                detail: "a moving joint needs `speed = \"...\"` naming the generalized speed it drives"
-                    .into(),
+                detail:
+                    "a moving joint needs `speed = \"...\"` naming the generalized speed it drives"
+                        .into(),
             });
         }
         (_, Some(s)) => Some(drive(s, format!("joint `{}`", j.name), &j.name, speeds)?),

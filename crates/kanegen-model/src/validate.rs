@@ -62,7 +62,7 @@ pub(crate) fn check_physics(model: &Model) -> Result<(), K> {
     for link in &model.links {
         let Some(b) = &link.body else { continue };
         let m = p[b.mass];
-        if !(m > 0.0) {
+        if m.is_nan() || m <= 0.0 {
             return Err(K::NonPositiveMass {
                 body: b.name.clone(),
                 symbol: model.params[b.mass].name.clone(),
@@ -71,10 +71,12 @@ pub(crate) fn check_physics(model: &Model) -> Result<(), K> {
         }
         let [a, bb, c] = principal_moments_about_com(b, &p);
         let scale = (a.abs() + bb.abs() + c.abs()).max(f64::MIN_POSITIVE);
-        if !(a > 0.0) {
+        if a.is_nan() || a <= 0.0 {
             return Err(K::NonPhysicalInertia {
                 body: b.name.clone(),
-                detail: format!("principal moments {a:.6e}, {bb:.6e}, {c:.6e}: not positive definite"),
+                detail: format!(
+                    "principal moments {a:.6e}, {bb:.6e}, {c:.6e}: not positive definite"
+                ),
             });
         }
         if a + bb < c - TOLERANCE * scale {

@@ -1,0 +1,749 @@
+//! One test per typed error of [`ModelErrorKind`]: a small valid two-link description is mutated
+//! into a malformed one, and the exact variant, its fields, the file label and the message are checked.
+//! Also: the shipped models load, and a missing file is an `Io` error naming the path.
+
+use std::path::PathBuf;
+
+use kanegen_model::{Model, ModelError, ModelErrorKind as K};
+
+/// Two revolute links on a fixed base frame (the shape of seed 002 Appendix B). Both bodies have
+/// m = 2, S = [0, 0.1, 0] and I_G = diag(0.03, 0.01, 0.03), so J = diag(0.05, 0.01, 0.05).
+const VALID: &str = r#"
+[model]
+name = "two-link"
+description = "validation test model"
+speeds = ["qd1", "qd2"]
+
+[base]
+type = "fixed"
+frame = "0"
+
+[gravity]
+symbol = "g"
+direction = [0, 0, -1]
+
+[parameters]
+g = 9.81
+L1 = 0.5
+L2 = 0.1
+m1 = 2.0
+MX1 = 0.0
+MY1 = 0.2
+MZ1 = 0.0
+XX1 = 0.05
+XY1 = 0.0
+XZ1 = 0.0
+YY1 = 0.01
+YZ1 = 0.0
+ZZ1 = 0.05
+m2 = 2.0
+MX2 = 0.0
+MY2 = 0.2
+MZ2 = 0.0
+XX2 = 0.05
+XY2 = 0.0
+XZ2 = 0.0
+YY2 = 0.01
+YZ2 = 0.0
+ZZ2 = 0.05
+
+[[joint]]
+name = "q1"
+type = "revolute"
+parent = "0"
+child = "1"
+speed = "qd1"
+axis = [-1, 0, 0]
+rotation = [[0, 0, -1], [-1, 0, 0], [0, 1, 0]]
+translation = [0, 0, 0]
+
+[[joint]]
+name = "q2"
+type = "revolute"
+parent = "1"
+child = "2"
+speed = "qd2"
+axis = [-1, 0, 0]
+rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+translation = [0, "L1", "-L2"]
+
+[[body]]
+frame = "1"
+
+[[body]]
+frame = "2"
+"#;
+
+const FILE: &str = "bad.toml";
+
+/// `VALID` with each `(from, to)` applied; every `from` must occur exactly once (no silent no-ops).
+fn mutate(edits: &[(&str, &str)]) -> String {
+    let mut text = VALID.to_owned();
+    for (from, to) in edits {
+        assert_eq!(
+            text.matches(from).count(),
+            1,
+            "mutation pattern {from:?} must occur exactly once"
+        );
+        text = text.replacen(from, to, 1);
+    }
+    text
+}
+
+/// Load `text`, expect an error labelled `bad.toml` whose message names every item of `names`.
+fn load_err(text: &str, names: &[&str]) -> ModelError {
+    let err = match Model::from_toml_str(text, FILE) {
+        Ok(_) => panic!("the description should have been rejected:\n{text}"),
+        Err(e) => e,
+    };
+    assert_eq!(err.file, FILE);
+    let msg = err.to_string();
+    assert!(msg.starts_with("bad.toml: "), "message {msg:?}");
+    for n in names {
+        assert!(msg.contains(n), "message {msg:?} should name {n:?}");
+    }
+    err
+}
+
+/// Append a block (e.g. another `[[joint]]`) to `VALID`.
+fn append(extra: &str) -> String {
+    format!("{VALID}\n{extra}")
+}
+
+#[test]
+fn valid_description_loads() {
+    let m = Model::from_toml_str(VALID, FILE).expect("the test model is valid");
+    assert_eq!(m.dof(), 2);
+    assert_eq!(m.body_count(), 2);
+    assert_eq!(m.links.len(), 3);
+}
+
+#[test]
+fn malformed_toml_syntax() {
+    let e = load_err(
+        &mutate(&[(r#"name = "two-link""#, r#"name = "two-link"#)]),
+        &["malformed description", "line"],
+    );
+    assert!(matches!(e.kind, K::Syntax(_)), "{:?}", e.kind);
+}
+
+#[test]
+fn missing_section() {
+    let e = load_err(
+        &mutate(&[("[gravity]\nsymbol = \"g\"\ndirection = [0, 0, -1]\n", "")]),
+        &["gravity"],
+    );
+    assert!(matches!(e.kind, K::Syntax(_)), "{:?}", e.kind);
+}
+
+#[test]
+fn unknown_field() {
+    let e = load_err(
+        &mutate(&[("child = \"2\"\n", "child = \"2\"\ncolour = \"red\"\n")]),
+        &["colour"],
+    );
+    assert!(
+        matches!(&e.kind, K::Syntax(s) if s.contains("colour")),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn unknown_joint_type() {
+    let e = load_err(
+        &mutate(&[(
+            "type = \"revolute\"\nparent = \"1\"",
+            "type = \"spherical\"\nparent = \"1\"",
+        )]),
+        &["spherical"],
+    );
+    assert!(
+        matches!(&e.kind, K::Syntax(s) if s.contains("spherical")),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn unknown_base_type() {
+    let e = load_err(
+        &mutate(&[(r#"type = "fixed""#, r#"type = "legged""#)]),
+        &["legged"],
+    );
+    assert!(
+        matches!(&e.kind, K::Syntax(s) if s.contains("legged")),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn unknown_parent() {
+    let e = load_err(
+        &mutate(&[(r#"parent = "1""#, r#"parent = "7""#)]),
+        &["`q2`", "`7`"],
+    );
+    assert!(
+        matches!(&e.kind, K::UnknownParent { joint, parent } if joint == "q2" && parent == "7"),
+        "{:?}",
+        e.kind
+    );
+}
+
+const CYCLE: &str = r#"
+[[joint]]
+name = "a"
+type = "fixed"
+parent = "fb"
+child = "fa"
+rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+translation = [0, 0, 0]
+
+[[joint]]
+name = "b"
+type = "fixed"
+parent = "fa"
+child = "fb"
+rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+translation = [0, 0, 0]
+"#;
+
+#[test]
+fn cycle() {
+    let e = load_err(&append(CYCLE), &["cycle", "`a`", "`fa`"]);
+    assert!(
+        matches!(&e.kind, K::Cycle { joint, frame } if joint == "a" && frame == "fa"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn cycle_reports_a_joint_on_the_cycle() {
+    // `c` hangs off the cycle a <-> b and comes first in the file; it is unreachable too, but the
+    // error must name a joint that is on the cycle.
+    let dangling = r#"
+[[joint]]
+name = "c"
+type = "fixed"
+parent = "fa"
+child = "fc"
+rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+translation = [0, 0, 0]
+"#;
+    let e = load_err(&append(&format!("{dangling}{CYCLE}")), &["cycle"]);
+    assert!(
+        matches!(&e.kind, K::Cycle { joint, frame }
+            if (joint == "a" && frame == "fa") || (joint == "b" && frame == "fb")),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn self_loop_is_a_cycle() {
+    let e = load_err(
+        &append(
+            r#"
+[[joint]]
+name = "s"
+type = "fixed"
+parent = "fs"
+child = "fs"
+rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+translation = [0, 0, 0]
+"#,
+        ),
+        &["`s`"],
+    );
+    assert!(
+        matches!(&e.kind, K::Cycle { joint, frame } if joint == "s" && frame == "fs"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn duplicate_joint_name() {
+    let e = load_err(
+        &mutate(&[(r#"name = "q2""#, r#"name = "q1""#)]),
+        &["joint `q1`", "twice"],
+    );
+    assert!(
+        matches!(&e.kind, K::Duplicate { what: "joint", name } if name == "q1"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn duplicate_frame() {
+    // A second joint creating frame "2".
+    let e = load_err(
+        &append(
+            r#"
+[[joint]]
+name = "extra"
+type = "fixed"
+parent = "1"
+child = "2"
+rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+translation = [0, 0, 0]
+"#,
+        ),
+        &["frame `2`", "twice"],
+    );
+    assert!(
+        matches!(&e.kind, K::Duplicate { what: "frame", name } if name == "2"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn duplicate_speed() {
+    let e = load_err(
+        &mutate(&[(
+            r#"speeds = ["qd1", "qd2"]"#,
+            r#"speeds = ["qd1", "qd2", "qd1"]"#,
+        )]),
+        &["speed `qd1`", "twice"],
+    );
+    assert!(
+        matches!(&e.kind, K::Duplicate { what: "speed", name } if name == "qd1"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn duplicate_body() {
+    let e = load_err(
+        &append("[[body]]\nframe = \"0\"\nname = \"2\"\n"),
+        &["body `2`", "twice"],
+    );
+    assert!(
+        matches!(&e.kind, K::Duplicate { what: "body", name } if name == "2"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn two_bodies_on_one_frame() {
+    let e = load_err(
+        &append("[[body]]\nframe = \"2\"\nname = \"2b\"\n"),
+        &["`2`", "twice"],
+    );
+    assert!(
+        matches!(&e.kind, K::Duplicate { what: "body on frame", name } if name == "2"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn body_on_unknown_frame() {
+    let e = load_err(
+        &append("[[body]]\nframe = \"9\"\n"),
+        &["body `9`", "frame `9`"],
+    );
+    assert!(
+        matches!(&e.kind, K::UnknownFrame { body, frame } if body == "9" && frame == "9"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn base_frame_as_child() {
+    let e = load_err(
+        &mutate(&[(r#"child = "2""#, r#"child = "0""#)]),
+        &["`q2`", "`0`"],
+    );
+    assert!(
+        matches!(&e.kind, K::BaseAsChild { joint, frame } if joint == "q2" && frame == "0"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn rotation_not_orthonormal() {
+    let e = load_err(
+        &mutate(&[(
+            "rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]",
+            "rotation = [[1, 0.1, 0], [0, 1, 0], [0, 0, 1]]",
+        )]),
+        &["`q2`", "not a proper rotation"],
+    );
+    assert!(
+        matches!(&e.kind, K::BadRotation { joint, detail } if joint == "q2" && detail.contains("R Rᵀ")),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn rotation_with_determinant_minus_one() {
+    let e = load_err(
+        &mutate(&[(
+            "rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]",
+            "rotation = [[1, 0, 0], [0, 1, 0], [0, 0, -1]]",
+        )]),
+        &["`q2`", "det"],
+    );
+    assert!(
+        matches!(&e.kind, K::BadRotation { joint, detail } if joint == "q2" && detail.contains("det R = -1")),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn axis_not_unit() {
+    let e = load_err(
+        &mutate(&[(
+            "speed = \"qd2\"\naxis = [-1, 0, 0]",
+            "speed = \"qd2\"\naxis = [-1, 1, 0]",
+        )]),
+        &["`q2`", "unit"],
+    );
+    assert!(
+        matches!(&e.kind, K::AxisNotUnit { joint, axis, norm }
+            if joint == "q2" && *axis == [-1.0, 1.0, 0.0] && (norm - 2f64.sqrt()).abs() < 1e-12),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn moving_joint_without_axis() {
+    let e = load_err(
+        &mutate(&[("speed = \"qd2\"\naxis = [-1, 0, 0]\n", "speed = \"qd2\"\n")]),
+        &["`q2`", "axis"],
+    );
+    assert!(
+        matches!(&e.kind, K::JointSpeed { joint, detail } if joint == "q2" && detail.contains("axis")),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn mass_not_positive() {
+    for (text, value) in [("m2 = 0.0", 0.0), ("m2 = -2.0", -2.0)] {
+        let e = load_err(&mutate(&[("m2 = 2.0", text)]), &["body `2`", "`m2`"]);
+        assert!(
+            matches!(&e.kind, K::NonPositiveMass { body, symbol, value: v }
+                if body == "2" && symbol == "m2" && *v == value),
+            "{:?}",
+            e.kind
+        );
+    }
+}
+
+#[test]
+fn inertia_not_positive_definite() {
+    // I_G[y][y] = YY2 − m(Sx² + Sz²) = −0.01.
+    let e = load_err(
+        &mutate(&[("YY2 = 0.01", "YY2 = -0.01")]),
+        &["body `2`", "not physical"],
+    );
+    assert!(
+        matches!(&e.kind, K::NonPhysicalInertia { body, detail }
+            if body == "2" && detail.contains("not positive definite")),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn inertia_breaks_triangle_inequality() {
+    // I_G = diag(0.03, 0.01, 0.05): positive definite, but 0.03 + 0.01 < 0.05.
+    let e = load_err(
+        &mutate(&[("ZZ2 = 0.05", "ZZ2 = 0.07")]),
+        &["body `2`", "not physical"],
+    );
+    assert!(
+        matches!(&e.kind, K::NonPhysicalInertia { body, detail }
+            if body == "2" && detail.contains("triangle") && !detail.contains("positive definite")),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn undefined_length_symbol() {
+    let e = load_err(
+        &mutate(&[(r#""L1", "-L2""#, r#""L3", "-L2""#)]),
+        &["joint `q2`", "`L3`"],
+    );
+    assert!(
+        matches!(&e.kind, K::UndefinedSymbol { item, symbol } if item == "joint `q2`" && symbol == "L3"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn undefined_body_symbol() {
+    let e = load_err(&mutate(&[("MX1 = 0.0\n", "")]), &["body `1`", "`MX1`"]);
+    assert!(
+        matches!(&e.kind, K::UndefinedSymbol { item, symbol } if item == "body `1`" && symbol == "MX1"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn undefined_gravity_symbol() {
+    let e = load_err(&mutate(&[("g = 9.81\n", "")]), &["gravity", "`g`"]);
+    assert!(
+        matches!(&e.kind, K::UndefinedSymbol { item, symbol } if item == "gravity" && symbol == "g"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn misspelt_parameter_is_undefined_where_used() {
+    // Misspelling a needed parameter: the body's symbol is then missing.
+    let e = load_err(
+        &mutate(&[("XZ2 = 0.0", "XZ_2 = 0.0")]),
+        &["body `2`", "`XZ2`"],
+    );
+    assert!(
+        matches!(&e.kind, K::UndefinedSymbol { item, symbol } if item == "body `2`" && symbol == "XZ2"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn unused_parameter() {
+    // A misspelt extra (`Ll` for `L1`) that nothing uses.
+    let e = load_err(
+        &mutate(&[("L1 = 0.5\n", "L1 = 0.5\nLl = 0.5\n")]),
+        &["`Ll`", "not used"],
+    );
+    assert!(
+        matches!(&e.kind, K::UnknownParameter { name } if name == "Ll"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn bad_length_text() {
+    for bad in ["2*L1", "L 1", "--L1", "", "0.5"] {
+        let e = load_err(
+            &mutate(&[(r#""L1", "-L2""#, &format!(r#""{bad}", "-L2""#))]),
+            &["joint `q2`", &format!("`{bad}`")],
+        );
+        assert!(
+            matches!(&e.kind, K::BadLength { joint, text } if joint == "q2" && text == bad),
+            "{bad:?}: {:?}",
+            e.kind
+        );
+    }
+}
+
+#[test]
+fn non_finite_translation() {
+    let e = load_err(
+        &mutate(&[(
+            r#"translation = [0, "L1", "-L2"]"#,
+            r#"translation = [nan, "L1", "-L2"]"#,
+        )]),
+        &["joint `q2`"],
+    );
+    assert!(
+        matches!(&e.kind, K::BadLength { joint, .. } if joint == "q2"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn speed_driven_twice() {
+    let e = load_err(
+        &mutate(&[(r#"speed = "qd2""#, r#"speed = "qd1""#)]),
+        &["`qd1`", "`q1`", "`q2`"],
+    );
+    assert!(
+        matches!(&e.kind, K::SpeedTwice { speed, first, second }
+            if speed == "qd1" && first == "joint `q1`" && second == "joint `q2`"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn speed_never_driven() {
+    let e = load_err(
+        &mutate(&[(
+            r#"speeds = ["qd1", "qd2"]"#,
+            r#"speeds = ["qd1", "qd2", "qd3"]"#,
+        )]),
+        &["`qd3`"],
+    );
+    assert!(
+        matches!(&e.kind, K::SpeedNever { speed } if speed == "qd3"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn joint_speed_not_listed() {
+    let e = load_err(
+        &mutate(&[(r#"speed = "qd2""#, r#"speed = "qd9""#)]),
+        &["`q2`", "`qd9`"],
+    );
+    assert!(
+        matches!(&e.kind, K::UnknownSpeed { item, speed } if item == "joint `q2`" && speed == "qd9"),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn fixed_joint_with_speed() {
+    let e = load_err(
+        &mutate(&[(
+            "type = \"revolute\"\nparent = \"1\"",
+            "type = \"fixed\"\nparent = \"1\"",
+        )]),
+        &["`q2`", "fixed"],
+    );
+    assert!(
+        matches!(&e.kind, K::JointSpeed { joint, detail }
+            if joint == "q2" && detail.contains("fixed") && detail.contains("qd2")),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn moving_joint_without_speed() {
+    let e = load_err(&mutate(&[("speed = \"qd2\"\n", "")]), &["`q2`", "speed"]);
+    assert!(
+        matches!(&e.kind, K::JointSpeed { joint, detail } if joint == "q2" && detail.contains("speed")),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn gravity_direction_not_unit() {
+    for dir in ["[0, 0, -2]", "[0, 0, 0]", "[nan, 0, -1]", "[inf, 0, 0]"] {
+        let e = load_err(
+            &mutate(&[("direction = [0, 0, -1]", &format!("direction = {dir}"))]),
+            &["gravity", "unit"],
+        );
+        assert!(
+            matches!(&e.kind, K::Invalid { item, detail } if item == "gravity" && detail.contains("unit")),
+            "{dir}: {:?}",
+            e.kind
+        );
+    }
+}
+
+#[test]
+fn non_finite_parameter() {
+    for (text, name) in [("L1 = nan", "L1"), ("L1 = inf", "L1"), ("g = -inf", "g")] {
+        let from = if name == "g" { "g = 9.81" } else { "L1 = 0.5" };
+        let e = load_err(&mutate(&[(from, text)]), &[&format!("`{name}`"), "finite"]);
+        assert!(
+            matches!(&e.kind, K::NonFiniteParameter { name: n, value } if n == name && !value.is_finite()),
+            "{text}: {:?}",
+            e.kind
+        );
+    }
+}
+
+#[test]
+fn non_numeric_parameter() {
+    let e = load_err(
+        &mutate(&[("L1 = 0.5", r#"L1 = "0.5""#)]),
+        &["`L1`", "number"],
+    );
+    assert!(
+        matches!(&e.kind, K::Syntax(s) if s.contains("`L1`") && s.contains("string")),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn wheeled_base_speed_not_listed() {
+    let wheeled = mutate(&[
+        (
+            "[base]\ntype = \"fixed\"\nframe = \"0\"\n",
+            "[base]\ntype = \"wheeled\"\nframe = \"0\"\nx_speed = \"xd\"\npsi_speed = \"psid\"\n\
+             radius = \"R\"\ntrack = \"L\"\nwheel_mass = \"mw\"\nwheel_axle_inertia = \"YYw\"\n\
+             wheel_diametral_inertia = \"ZZw\"\n",
+        ),
+        (
+            "g = 9.81\n",
+            "g = 9.81\nR = 0.25\nL = 0.68\nmw = 4.66\nYYw = 0.1456\nZZw = 0.0751\n",
+        ),
+    ]);
+    let e = load_err(&wheeled, &["`xd`"]);
+    assert!(
+        matches!(&e.kind, K::UnknownSpeed { item, speed } if item.contains("x_speed") && speed == "xd"),
+        "{:?}",
+        e.kind
+    );
+    // With the speeds listed it loads.
+    let ok = wheeled.replacen(
+        r#"speeds = ["qd1", "qd2"]"#,
+        r#"speeds = ["xd", "psid", "qd1", "qd2"]"#,
+        1,
+    );
+    let m = Model::from_toml_str(&ok, FILE).expect("valid wheeled model");
+    assert_eq!(m.dof(), 4);
+    assert!(m.wheeled_base().is_some());
+}
+
+fn models_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models")
+}
+
+#[test]
+fn shipped_models_load() {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(models_dir()).expect("models/ exists") {
+        let path = entry.expect("directory entry").path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let m = Model::from_toml_file(&path)
+                .unwrap_or_else(|e| panic!("{} should load: {e}", path.display()));
+            found.push((m.name.clone(), m.dof(), m.body_count()));
+        }
+    }
+    found.sort();
+    assert_eq!(
+        found,
+        vec![
+            ("krang".to_owned(), 19, 17),
+            ("krang-fixed-wheels".to_owned(), 17, 17),
+            ("two-link".to_owned(), 2, 2),
+        ]
+    );
+}
+
+#[test]
+fn missing_file_is_io_error_naming_the_path() {
+    let path = models_dir().join("no-such-model.toml");
+    let err = Model::from_toml_file(&path).expect_err("the file does not exist");
+    let label = path.display().to_string();
+    assert_eq!(err.file, label);
+    assert!(matches!(err.kind, K::Io(_)), "{:?}", err.kind);
+    let msg = err.to_string();
+    assert!(
+        msg.contains("no-such-model.toml") && msg.contains("cannot read"),
+        "{msg}"
+    );
+}

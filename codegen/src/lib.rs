@@ -4,11 +4,257 @@
 //! [`model`] (description files → validated IR) → [`expr`] (hash-consed expression arena) →
 //! [`kane`] (recursive Kane's derivation with K/D substitution) → [`lower`] (straight-line
 //! programs, dead-code elimination, op counts) → [`emit`] (quote/syn/prettyplease → Rust source).
+//!
+//! A build script generates a dynamics module in one call:
+//!
+//! ```no_run
+//! // build.rs
+//! kanegen::Builder::new("krang.toml").run();
+//! ```
+//!
+//! and the crate includes it with
+//! `include!(concat!(env!("OUT_DIR"), "/krang.rs"));` (the file is named after the model file).
 #![forbid(unsafe_code)]
 
+pub mod emit;
 pub mod expr;
 pub mod kane;
+pub mod lower;
 /// The robot description IR and its loaders (re-exported from `kanegen-model`).
 pub mod model {
     pub use kanegen_model::*;
+}
+
+use std::path::{Path, PathBuf};
+
+pub use kane::{Options, ParamMode};
+
+/// Anything that can go wrong while generating.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The description file is malformed or not physical.
+    #[error(transparent)]
+    Model(#[from] model::ModelError),
+    /// Code emission or writing failed.
+    #[error(transparent)]
+    Emit(#[from] emit::EmitError),
+    /// The build script environment lacks `OUT_DIR`.
+    #[error("OUT_DIR is not set: Builder::build must run inside a cargo build script (or call Builder::out_dir)")]
+    NoOutDir,
+}
+
+/// Everything the generator produced for one model.
+#[derive(Clone, Debug)]
+pub struct Generated {
+    /// The validated model.
+    pub model: model::Model,
+    /// The symbolic derivation.
+    pub derivation: kane::Derivation,
+    /// The straight-line programs.
+    pub lowered: lower::Lowered,
+    /// The formatted Rust source.
+    pub source: String,
+}
+
+/// Run every stage on a loaded model.
+pub fn generate_model(model: model::Model, options: Options) -> Result<Generated, Error> {
+    let derivation = kane::derive(&model, options);
+    let lowered = lower::lower(&derivation);
+    let source = emit::emit(&model, &lowered)?;
+    Ok(Generated {
+        model,
+        derivation,
+        lowered,
+        source,
+    })
+}
+
+/// Load a description file and run every stage.
+pub fn generate(path: impl AsRef<Path>, options: Options) -> Result<Generated, Error> {
+    let model = model::Model::from_toml_file(path)?;
+    generate_model(model, options)
+}
+
+/// Generates a dynamics module from a build script.
+///
+/// ```no_run
+/// kanegen::Builder::new("models/krang.toml")
+///     .baked(false)
+///     .output("krang.rs")
+///     .run();
+/// ```
+#[derive(Clone, Debug)]
+pub struct Builder {
+    model: PathBuf,
+    options: Options,
+    output: Option<String>,
+    out_dir: Option<PathBuf>,
+}
+
+impl Builder {
+    /// Generate from the description file `model` (relative to the crate's manifest directory
+    /// when run from a build script).
+    pub fn new(model: impl Into<PathBuf>) -> Self {
+        Self {
+            model: model.into(),
+            options: Options::default(),
+            output: None,
+            out_dir: None,
+        }
+    }
+
+    /// Fold the model file's parameter values in as constants (default: runtime parameters).
+    pub fn baked(mut self, baked: bool) -> Self {
+        self.options.params = if baked {
+            ParamMode::Baked
+        } else {
+            ParamMode::Runtime
+        };
+        self
+    }
+
+    /// Name of the generated file in the output directory (default: the model file's stem
+    /// plus `.rs`, or `_baked.rs` in baked mode).
+    pub fn output(mut self, file_name: impl Into<String>) -> Self {
+        self.output = Some(file_name.into());
+        self
+    }
+
+    /// Write into `dir` instead of `$OUT_DIR`.
+    pub fn out_dir(mut self, dir: impl Into<PathBuf>) -> Self {
+        self.out_dir = Some(dir.into());
+        self
+    }
+
+    /// Generate and write the module (only if its bytes changed); returns its path. Prints the
+    /// `cargo:rerun-if-changed` line for the model file.
+    pub fn build(&self) -> Result<PathBuf, Error> {
+        let dir = match &self.out_dir {
+            Some(d) => d.clone(),
+            None => PathBuf::from(std::env::var_os("OUT_DIR").ok_or(Error::NoOutDir)?),
+        };
+        println!("cargo:rerun-if-changed={}", self.model.display());
+        let g = generate(&self.model, self.options)?;
+        let name = self.output.clone().unwrap_or_else(|| {
+            let stem = self
+                .model
+                .file_stem()
+                .map(|s| s.to_string_lossy().replace('-', "_"))
+                .unwrap_or_else(|| "model".into());
+            match self.options.params {
+                ParamMode::Runtime => format!("{stem}.rs"),
+                ParamMode::Baked => format!("{stem}_baked.rs"),
+            }
+        });
+        let path = dir.join(name);
+        emit::write_if_changed(&path, &g.source)?;
+        Ok(path)
+    }
+
+    /// [`Builder::build`], and on error print the typed error and fail the build.
+    pub fn run(&self) {
+        if let Err(e) = self.build() {
+            eprintln!("error: kanegen: {e}");
+            println!("cargo::error=kanegen: {e}");
+            std::process::exit(1);
+        }
+    }
+}
+
+/// A per-function summary: K/D counts and op counts, as printed by `kanegen stats`.
+pub fn stats(g: &Generated) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let d = &g.derivation;
+    let k = d.arena.vars().iter().filter(|v| v.kind == expr::VarKind::K).count();
+    let dv = d.arena.vars().len() - k;
+    let _ = writeln!(
+        s,
+        "model {} ({}): {} speeds, {} bodies, {} parameters; parameters {}",
+        g.model.name,
+        g.model.source,
+        g.model.dof(),
+        g.model.body_count(),
+        g.model.params.len(),
+        match d.options.params {
+            ParamMode::Runtime => "at run time",
+            ParamMode::Baked => "baked",
+        }
+    );
+    let _ = writeln!(
+        s,
+        "derivation: {} expression nodes, {} substitution variables ({} K, {} D)",
+        d.arena.len(),
+        d.arena.vars().len(),
+        k,
+        dv
+    );
+    let _ = writeln!(
+        s,
+        "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8}",
+        "function", "K", "D", "temps", "adds", "muls", "divs", "sin/cos", "flops"
+    );
+    let low = &g.lowered;
+    let mut row = |name: &str, p: &lower::Program| {
+        let temps = p.stmts.len() - p.k_vars - p.d_vars;
+        let _ = writeln!(
+            s,
+            "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8}",
+            name,
+            p.k_vars,
+            p.d_vars,
+            temps,
+            p.ops.adds,
+            p.ops.muls,
+            p.ops.divs,
+            p.ops.sincos,
+            p.ops.flops()
+        );
+    };
+    if d.options.params == ParamMode::Runtime {
+        row("precompute (once)", &low.precompute);
+    }
+    for p in &low.functions {
+        row(&p.name, p);
+    }
+    s
+}
+
+/// The substitution listing of a model in the reports' style, function by function.
+pub fn listing(g: &Generated) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "% Substitution listing of `{}` (kanegen {}). K: kinematic, D: inertial/gravity.",
+        g.model.name,
+        emit::GENERATOR_VERSION
+    );
+    let d = &g.derivation;
+    let mut shown = vec![false; d.arena.vars().len()];
+    for f in &d.functions {
+        let roots: Vec<expr::ExprId> = f.entries.iter().map(|e| e.2).collect();
+        let needed = d.arena.reachable_vars(&roots);
+        let _ = writeln!(s, "\n% ---- {} ----", f.name);
+        for (i, info) in d.arena.vars().iter().enumerate() {
+            if needed[i] && !shown[i] {
+                shown[i] = true;
+                let _ = writeln!(
+                    s,
+                    "{} = {};  % {}",
+                    d.arena.atom_name(expr::Atom::Var(i as u32)),
+                    d.arena.display(info.def),
+                    info.label
+                );
+            }
+        }
+        for &(r, c, e) in &f.entries {
+            let lhs = match f.shape {
+                kane::Shape::SymmetricMatrix => format!("M({},{})", r + 1, c + 1),
+                kane::Shape::Vector => format!("{}({})", f.name, r + 1),
+            };
+            let _ = writeln!(s, "{lhs} = {};", d.arena.display(e));
+        }
+    }
+    s
 }

@@ -1,0 +1,717 @@
+//! Emission: lowered programs → Rust source via proc-macro2/quote → syn → prettyplease.
+//!
+//! The generated module is self-contained (it needs only `nalgebra`): speed and parameter names,
+//! a `Params` struct (runtime mode), a `Precomputed` struct of parameter-only terms, the four
+//! free functions `mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, and a wrapper struct
+//! named after the model (`Krang`) holding a parameter set. Statements carry the reports'
+//! style comments (`let k12 = …; // w2.x`). Output is deterministic byte for byte.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use proc_macro2::{Ident, Literal, Span, TokenStream};
+use quote::quote;
+
+use crate::expr::accel_name;
+use crate::kane::{ParamMode, Shape, Signature};
+use crate::lower::{LExpr, Leaf, Lowered, Program};
+use crate::model::{Model, ParamKind};
+
+/// The generator's version, written into every header.
+pub const GENERATOR_VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// Errors of emission.
+#[derive(Debug, thiserror::Error)]
+pub enum EmitError {
+    /// The token stream did not parse as a Rust file (a generator bug).
+    #[error("generated code for model `{model}` does not parse: {message}")]
+    Parse {
+        /// Model name.
+        model: String,
+        /// syn's message.
+        message: String,
+    },
+    /// Writing the output failed.
+    #[error("cannot write {path}: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The OS error.
+        message: String,
+    },
+}
+
+/// `krang-fixed-wheels` → `KrangFixedWheels`.
+pub fn type_name(model: &str) -> String {
+    let mut out = String::new();
+    let mut up = true;
+    for ch in model.chars() {
+        if ch.is_ascii_alphanumeric() {
+            if up {
+                out.extend(ch.to_uppercase());
+            } else {
+                out.push(ch);
+            }
+            up = false;
+        } else {
+            up = true;
+        }
+    }
+    if out.is_empty() || out.starts_with(|c: char| c.is_ascii_digit()) {
+        out.insert_str(0, "Model");
+    }
+    out
+}
+
+fn ident(name: &str) -> Ident {
+    // Model-derived names are sanitised to identifiers.
+    let mut s: String = name
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' })
+        .collect();
+    if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) {
+        s.insert(0, '_');
+    }
+    if syn::parse_str::<Ident>(&s).is_err() {
+        return Ident::new_raw(&s, Span::call_site());
+    }
+    Ident::new(&s, Span::call_site())
+}
+
+fn lit(v: f64) -> Literal {
+    let mut l = Literal::f64_unsuffixed(v.abs());
+    l.set_span(Span::call_site());
+    l
+}
+
+fn idx(i: usize) -> Literal {
+    Literal::usize_unsuffixed(i)
+}
+
+fn signed_lit(v: f64) -> TokenStream {
+    let l = lit(v);
+    if v < 0.0 { quote!(-#l) } else { quote!(#l) }
+}
+
+struct Names<'a> {
+    model: &'a Model,
+    stmt: &'a [crate::lower::Stmt],
+    pre: &'a [String],
+}
+
+impl Names<'_> {
+    fn leaf(&self, l: &Leaf) -> TokenStream {
+        let m = self.model;
+        match *l {
+            Leaf::Const(c) => signed_lit(c),
+            Leaf::Param(p) => {
+                let id = ident(&m.params[p].name);
+                quote!(p.#id)
+            }
+            Leaf::Pre(s) => {
+                let id = ident(&self.pre[s]);
+                quote!(pc.#id)
+            }
+            Leaf::Speed(s) => {
+                let id = ident(&m.speeds[s].name);
+                quote!(#id)
+            }
+            Leaf::Accel(s) => {
+                let id = ident(&accel_name(&m.speeds[s].name));
+                quote!(#id)
+            }
+            Leaf::Sin(s) => {
+                let id = ident(&format!("s_{}", m.speeds[s].coordinate));
+                quote!(#id)
+            }
+            Leaf::Cos(s) => {
+                let id = ident(&format!("c_{}", m.speeds[s].coordinate));
+                quote!(#id)
+            }
+            Leaf::Coord(s) => {
+                let id = ident(&m.speeds[s].coordinate);
+                quote!(#id)
+            }
+            Leaf::Local(i) => {
+                let id = ident(&self.stmt[i].name);
+                quote!(#id)
+            }
+        }
+    }
+
+    /// An expression; `atomic` asks for parentheses around anything that is not a primary.
+    fn expr(&self, e: &LExpr, atomic: bool) -> TokenStream {
+        match e {
+            LExpr::Leaf(Leaf::Const(c)) if *c < 0.0 && atomic => {
+                let l = lit(*c);
+                quote!((-#l))
+            }
+            LExpr::Leaf(l) => self.leaf(l),
+            LExpr::Sum { constant, terms } => {
+                let mut ts = TokenStream::new();
+                for (i, (k, t)) in terms.iter().enumerate() {
+                    let body = if k.abs() == 1.0 {
+                        self.expr(t, false)
+                    } else {
+                        let kl = lit(*k);
+                        let inner = self.expr(t, true);
+                        quote!(#kl * #inner)
+                    };
+                    ts.extend(match (i, *k < 0.0) {
+                        (0, false) => body,
+                        (0, true) => quote!(-#body),
+                        (_, false) => quote!(+ #body),
+                        (_, true) => quote!(- #body),
+                    });
+                }
+                if *constant != 0.0 {
+                    let cl = lit(*constant);
+                    ts.extend(if *constant < 0.0 { quote!(- #cl) } else { quote!(+ #cl) });
+                }
+                if atomic { quote!((#ts)) } else { ts }
+            }
+            LExpr::Prod(f) => {
+                let mut num: Vec<TokenStream> = Vec::new();
+                let mut den: Vec<TokenStream> = Vec::new();
+                for (b, p) in f {
+                    let t = self.expr(b, true);
+                    for _ in 0..p.unsigned_abs() {
+                        if *p > 0 {
+                            num.push(t.clone());
+                        } else {
+                            den.push(t.clone());
+                        }
+                    }
+                }
+                let numt = if num.is_empty() {
+                    quote!(1.0)
+                } else {
+                    let first = &num[0];
+                    let rest = &num[1..];
+                    quote!(#first #(* #rest)*)
+                };
+                let out = if den.is_empty() {
+                    numt
+                } else {
+                    let first = &den[0];
+                    let rest = &den[1..];
+                    if den.len() == 1 {
+                        quote!(#numt / #first)
+                    } else {
+                        quote!(#numt / (#first #(* #rest)*))
+                    }
+                };
+                if atomic { quote!((#out)) } else { out }
+            }
+        }
+    }
+}
+
+/// Statement comments of one program, keyed by local name.
+fn comment_map(p: &Program) -> HashMap<String, String> {
+    p.stmts
+        .iter()
+        .map(|s| (s.name.clone(), s.comment.clone()))
+        .collect()
+}
+
+fn statements(names: &Names<'_>, p: &Program) -> TokenStream {
+    let mut ts = TokenStream::new();
+    for s in &p.stmts {
+        let id = ident(&s.name);
+        let e = names.expr(&s.expr, false);
+        ts.extend(quote!(let #id = #e;));
+    }
+    ts
+}
+
+fn uses(p: &Program, pred: &dyn Fn(&Leaf) -> bool) -> bool {
+    fn walk(e: &LExpr, pred: &dyn Fn(&Leaf) -> bool) -> bool {
+        match e {
+            LExpr::Leaf(l) => pred(l),
+            LExpr::Sum { terms, .. } => terms.iter().any(|(_, t)| walk(t, pred)),
+            LExpr::Prod(f) => f.iter().any(|(b, _)| walk(b, pred)),
+        }
+    }
+    p.stmts.iter().any(|s| walk(&s.expr, pred)) || p.outputs.iter().any(|(_, _, e)| walk(e, pred))
+}
+
+fn function(model: &Model, low: &Lowered, pre: &[String], p: &Program) -> TokenStream {
+    let n = low.dof;
+    let nl = idx(n);
+    let names = Names {
+        model,
+        stmt: &p.stmts,
+        pre,
+    };
+    let fname = ident(&p.name);
+    let doc = format!(" {}", p.doc);
+    let ops = format!(" Generated straight-line code: {}.", p.ops);
+    let runtime = low.params == ParamMode::Runtime;
+    let uses_p = uses(p, &|l| matches!(l, Leaf::Param(_)));
+    let uses_pc = uses(p, &|l| matches!(l, Leaf::Pre(_)));
+    let pname = if uses_p { quote!(p) } else { quote!(_p) };
+    let pcname = if uses_pc { quote!(pc) } else { quote!(_pc) };
+    let param_args = if runtime {
+        quote!(#pname: &Params, #pcname: &Precomputed,)
+    } else {
+        quote!()
+    };
+    let (args, arg_doc) = match p.signature {
+        Signature::Q => (quote!(q: &SVector<f64, #nl>), " `q`: coordinates in the order of [`COORDINATE_NAMES`]."),
+        Signature::QU => (
+            quote!(q: &SVector<f64, #nl>, u: &SVector<f64, #nl>),
+            " `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].",
+        ),
+        Signature::QUUd => (
+            quote!(q: &SVector<f64, #nl>, u: &SVector<f64, #nl>, ud: &SVector<f64, #nl>),
+            " `q`, `u`, `ud`: coordinates, speeds and accelerations in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].",
+        ),
+    };
+    let mut prologue = TokenStream::new();
+    for &s in &p.sincos {
+        let sn = ident(&format!("s_{}", model.speeds[s].coordinate));
+        let cn = ident(&format!("c_{}", model.speeds[s].coordinate));
+        let sl = idx(s);
+        prologue.extend(quote!(let (#sn, #cn) = q[#sl].sin_cos();));
+    }
+    for s in 0..n {
+        if uses(p, &|l| *l == Leaf::Coord(s)) {
+            let id = ident(&model.speeds[s].coordinate);
+            let sl = idx(s);
+            prologue.extend(quote!(let #id = q[#sl];));
+        }
+        if uses(p, &|l| *l == Leaf::Speed(s)) {
+            let id = ident(&model.speeds[s].name);
+            let sl = idx(s);
+            prologue.extend(quote!(let #id = u[#sl];));
+        }
+        if uses(p, &|l| *l == Leaf::Accel(s)) {
+            let id = ident(&accel_name(&model.speeds[s].name));
+            let sl = idx(s);
+            prologue.extend(quote!(let #id = ud[#sl];));
+        }
+    }
+    let body = statements(&names, p);
+    let (ret, outputs) = match p.shape {
+        Shape::SymmetricMatrix => {
+            let mut ts = quote!(let mut m = SMatrix::<f64, #nl, #nl>::zeros(););
+            for (r, c, e) in &p.outputs {
+                if matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0) {
+                    continue;
+                }
+                let v = names.expr(e, false);
+                let off_diagonal = r != c;
+                let (r, c) = (idx(*r), idx(*c));
+                ts.extend(quote!(m[(#r, #c)] = #v;));
+                if off_diagonal {
+                    ts.extend(quote!(m[(#c, #r)] = m[(#r, #c)];));
+                }
+            }
+            ts.extend(quote!(m));
+            (quote!(SMatrix<f64, #nl, #nl>), ts)
+        }
+        Shape::Vector => {
+            let mut ts = quote!(let mut out = SVector::<f64, #nl>::zeros(););
+            for (r, _, e) in &p.outputs {
+                if matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0) {
+                    continue;
+                }
+                let v = names.expr(e, false);
+                let r = idx(*r);
+                ts.extend(quote!(out[#r] = #v;));
+            }
+            ts.extend(quote!(out));
+            (quote!(SVector<f64, #nl>), ts)
+        }
+    };
+    let unused_q = if p.sincos.is_empty() && !(0..n).any(|s| uses(p, &|l| *l == Leaf::Coord(s))) {
+        quote!(let _ = q;)
+    } else {
+        quote!()
+    };
+    quote! {
+        #[doc = #doc]
+        #[doc = ""]
+        #[doc = #arg_doc]
+        #[doc = #ops]
+        #[allow(non_snake_case, unused_variables, clippy::all)]
+        #[inline(never)]
+        pub fn #fname(#param_args #args) -> #ret {
+            #unused_q
+            #prologue
+            #body
+            #outputs
+        }
+    }
+}
+
+fn params_items(model: &Model) -> TokenStream {
+    let np = idx(model.params.len());
+    let fields: Vec<TokenStream> = model
+        .params
+        .iter()
+        .map(|p| {
+            let id = ident(&p.name);
+            let what = match p.kind {
+                ParamKind::Length => "length (m)",
+                ParamKind::Gravity => "gravity acceleration (m/s²)",
+                ParamKind::Inertial => match p.name.chars().next() {
+                    Some('m') => "mass (kg)",
+                    Some('M') => "first moment m·S (kg·m)",
+                    _ => "inertia about the frame origin (kg·m²)",
+                },
+                ParamKind::Wheel => "wheel constant",
+            };
+            let doc = format!(" `{}`: {} (default {:?}).", p.name, what, p.value);
+            quote!(#[doc = #doc] pub #id: f64,)
+        })
+        .collect();
+    let defaults: Vec<TokenStream> = model
+        .params
+        .iter()
+        .map(|p| {
+            let id = ident(&p.name);
+            let v = signed_lit(p.value);
+            quote!(#id: #v,)
+        })
+        .collect();
+    let names: Vec<&str> = model.params.iter().map(|p| p.name.as_str()).collect();
+    let ids: Vec<Ident> = model.params.iter().map(|p| ident(&p.name)).collect();
+    let source = format!(
+        " Model parameters of `{}`, named with the reports' symbols; `Default` holds the values of `{}`.",
+        model.name,
+        file_name(&model.source)
+    );
+    quote! {
+        /// Number of model parameters.
+        pub const PARAM_COUNT: usize = #np;
+
+        #[doc = #source]
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        #[allow(non_snake_case)]
+        pub struct Params {
+            #(#fields)*
+        }
+
+        impl Default for Params {
+            fn default() -> Self {
+                Self { #(#defaults)* }
+            }
+        }
+
+        /// A parameter name that the model does not have.
+        #[derive(Clone, Debug, PartialEq, Eq)]
+        pub struct UnknownParameter {
+            /// The name that was asked for.
+            pub name: String,
+        }
+
+        impl core::fmt::Display for UnknownParameter {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                write!(f, "unknown parameter `{}`; the valid names are listed in Params::NAMES", self.name)
+            }
+        }
+
+        impl std::error::Error for UnknownParameter {}
+
+        impl Params {
+            /// Parameter names in declaration order (the order of [`Params::to_array`]).
+            pub const NAMES: [&'static str; #np] = [#(#names),*];
+
+            /// The value of parameter `name`, or `None` if the model has no such parameter.
+            pub fn get(&self, name: &str) -> Option<f64> {
+                match name {
+                    #(#names => Some(self.#ids),)*
+                    _ => None,
+                }
+            }
+
+            /// Set parameter `name`; an error if the model has no such parameter.
+            pub fn set(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
+                match name {
+                    #(#names => self.#ids = value,)*
+                    _ => return Err(UnknownParameter { name: name.to_owned() }),
+                }
+                Ok(())
+            }
+
+            /// All values in the order of [`Params::NAMES`].
+            pub fn to_array(&self) -> [f64; #np] {
+                [#(self.#ids),*]
+            }
+
+            /// Parameters from values in the order of [`Params::NAMES`].
+            pub fn from_array(v: [f64; #np]) -> Self {
+                let [#(#ids),*] = v;
+                Self { #(#ids),* }
+            }
+        }
+    }
+}
+
+fn file_name(path: &str) -> String {
+    Path::new(path)
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.to_owned())
+}
+
+fn precompute_items(model: &Model, low: &Lowered, pre: &[String]) -> TokenStream {
+    let p = &low.precompute;
+    let names = Names {
+        model,
+        stmt: &p.stmts,
+        pre,
+    };
+    let body = statements(&names, p);
+    let fields: Vec<Ident> = pre.iter().map(|s| ident(s)).collect();
+    let uses_p = uses(p, &|l| matches!(l, Leaf::Param(_)));
+    let pname = if uses_p { quote!(p) } else { quote!(_p) };
+    let ops = format!(" Generated straight-line code: {}.", p.ops);
+    quote! {
+        /// Parameter-only subexpressions of the dynamics, computed once per parameter set.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Precomputed {
+            #(#fields: f64,)*
+        }
+
+        impl Precomputed {
+            /// Compute the parameter-only terms for `p`.
+            #[doc = ""]
+            #[doc = #ops]
+            #[allow(non_snake_case, unused_variables, clippy::all)]
+            pub fn new(#pname: &Params) -> Self {
+                #body
+                Self { #(#fields),* }
+            }
+        }
+    }
+}
+
+fn wrapper_items(model: &Model, low: &Lowered) -> TokenStream {
+    let nl = idx(low.dof);
+    let ty = ident(&type_name(&model.name));
+    let doc = format!(
+        " The dynamics of `{}` with one parameter set: `τ = M(q) u̇ + c(q, u) + g(q)`.",
+        model.name
+    );
+    quote! {
+        #[doc = #doc]
+        ///
+        /// Construction precomputes the parameter-only terms; the evaluation methods are
+        /// allocation-free and cannot fail.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct #ty {
+            params: Params,
+            pre: Precomputed,
+        }
+
+        impl Default for #ty {
+            fn default() -> Self {
+                Self::new(Params::default())
+            }
+        }
+
+        impl #ty {
+            /// The model with parameter set `params`.
+            pub fn new(params: Params) -> Self {
+                Self { pre: Precomputed::new(&params), params }
+            }
+
+            /// The parameter set.
+            pub fn params(&self) -> &Params {
+                &self.params
+            }
+
+            /// Replace the parameter set (recomputes the parameter-only terms).
+            pub fn set_params(&mut self, params: Params) {
+                *self = Self::new(params);
+            }
+
+            /// Mass matrix M(q), symmetric positive definite.
+            #[inline]
+            pub fn mass_matrix(&self, q: &SVector<f64, #nl>) -> SMatrix<f64, #nl, #nl> {
+                mass_matrix(&self.params, &self.pre, q)
+            }
+
+            /// Coriolis and centrifugal vector c(q, u).
+            #[inline]
+            pub fn coriolis(&self, q: &SVector<f64, #nl>, u: &SVector<f64, #nl>) -> SVector<f64, #nl> {
+                coriolis(&self.params, &self.pre, q, u)
+            }
+
+            /// Gravity vector g(q).
+            #[inline]
+            pub fn gravity(&self, q: &SVector<f64, #nl>) -> SVector<f64, #nl> {
+                gravity(&self.params, &self.pre, q)
+            }
+
+            /// Inverse dynamics τ = M(q) u̇ + c(q, u) + g(q), in one generated pass.
+            #[inline]
+            pub fn inverse_dynamics(
+                &self,
+                q: &SVector<f64, #nl>,
+                u: &SVector<f64, #nl>,
+                ud: &SVector<f64, #nl>,
+            ) -> SVector<f64, #nl> {
+                inverse_dynamics(&self.params, &self.pre, q, u, ud)
+            }
+        }
+    }
+}
+
+/// Generate the Rust module for a lowered model. Deterministic: same input, same bytes.
+pub fn emit(model: &Model, low: &Lowered) -> Result<String, EmitError> {
+    let nl = idx(low.dof);
+    let runtime = low.params == ParamMode::Runtime;
+    let pre: Vec<String> = low
+        .pre_slots
+        .iter()
+        .map(|&i| low.precompute.stmts[i].name.clone())
+        .collect();
+    let speed_names: Vec<&str> = model.speeds.iter().map(|s| s.name.as_str()).collect();
+    let coord_names: Vec<&str> = model.speeds.iter().map(|s| s.coordinate.as_str()).collect();
+    let index_consts: Vec<TokenStream> = model
+        .speeds
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let id = ident(&s.coordinate.to_uppercase());
+            let doc = format!(" Index of `{}` in q (and of `{}` in u).", s.coordinate, s.name);
+            let i = idx(i);
+            quote!(#[doc = #doc] pub const #id: usize = #i;)
+        })
+        .collect();
+    let mut items = quote! {
+        use nalgebra::{SMatrix, SVector};
+
+        /// Number of generalized speeds (and coordinates).
+        pub const DOF: usize = #nl;
+        /// Generalized speed names, in the order of `u`.
+        pub const SPEED_NAMES: [&str; #nl] = [#(#speed_names),*];
+        /// Coordinate names, in the order of `q`.
+        pub const COORDINATE_NAMES: [&str; #nl] = [#(#coord_names),*];
+
+        /// Index constants of the coordinates (and of their speeds).
+        pub mod index {
+            #(#index_consts)*
+        }
+    };
+    if runtime {
+        items.extend(params_items(model));
+        items.extend(precompute_items(model, low, &pre));
+    }
+    // Comments per generated function (local names are numbered per function).
+    let mut comments: HashMap<String, HashMap<String, String>> = HashMap::new();
+    comments.insert("new".into(), comment_map(&low.precompute));
+    for p in &low.functions {
+        items.extend(function(model, low, &pre, p));
+        comments.insert(p.name.clone(), comment_map(p));
+    }
+    if runtime {
+        items.extend(wrapper_items(model, low));
+    }
+    let file: syn::File = syn::parse2(items).map_err(|e| EmitError::Parse {
+        model: model.name.clone(),
+        message: e.to_string(),
+    })?;
+    let body = prettyplease::unparse(&file);
+    let mut out = header(model, low);
+    out.push_str(&annotate(&body, &comments));
+    Ok(out)
+}
+
+fn header(model: &Model, low: &Lowered) -> String {
+    let mut h = format!(
+        "// @generated by kanegen {GENERATOR_VERSION} from model `{}` ({}). Do not edit.\n",
+        model.name,
+        file_name(&model.source)
+    );
+    h.push_str(&format!(
+        "// Parameters: {}. Speeds ({}): {}.\n",
+        match low.params {
+            ParamMode::Runtime => "runtime inputs (Params)",
+            ParamMode::Baked => "baked in as constants",
+        },
+        low.dof,
+        model.speeds.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
+    ));
+    h.push_str("// Operation counts per call:\n");
+    if low.params == ParamMode::Runtime {
+        h.push_str(&format!(
+            "//   {:<17} {} (once per parameter set)\n",
+            "Precomputed::new",
+            low.precompute.ops
+        ));
+    }
+    for p in &low.functions {
+        h.push_str(&format!(
+            "//   {:<17} {}; {} K and {} D variables\n",
+            p.name, p.ops, p.k_vars, p.d_vars
+        ));
+    }
+    h.push('\n');
+    h
+}
+
+/// Append `// comment` to every `let NAME = …;` statement of the formatted source, using the
+/// comments of the function the statement is in.
+fn annotate(src: &str, comments: &HashMap<String, HashMap<String, String>>) -> String {
+    let mut out = String::with_capacity(src.len() * 5 / 4);
+    let mut pending: Option<&str> = None;
+    let empty = HashMap::new();
+    let mut current = &empty;
+    for line in src.lines() {
+        let t = line.trim_start();
+        if let Some(rest) = t.strip_prefix("pub fn ") {
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            current = comments.get(&name).unwrap_or(&empty);
+        }
+        if pending.is_none()
+            && let Some(rest) = t.strip_prefix("let ")
+        {
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            if let Some(c) = current.get(&name)
+                && !c.is_empty()
+            {
+                pending = Some(c.as_str());
+            }
+        }
+        out.push_str(line);
+        if let Some(c) = pending
+            && t.ends_with(';')
+        {
+            out.push_str(" // ");
+            out.push_str(c);
+            pending = None;
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// Write `contents` to `path` only if the file does not already hold exactly these bytes.
+/// Returns whether the file was written.
+pub fn write_if_changed(path: &Path, contents: &str) -> Result<bool, EmitError> {
+    if std::fs::read(path).is_ok_and(|old| old == contents.as_bytes()) {
+        return Ok(false);
+    }
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| EmitError::Io {
+            path: dir.display().to_string(),
+            message: e.to_string(),
+        })?;
+    }
+    std::fs::write(path, contents).map_err(|e| EmitError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    Ok(true)
+}

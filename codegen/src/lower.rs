@@ -1,0 +1,568 @@
+//! Lowering: from the derivation's expression DAG to straight-line programs.
+//!
+//! For every generated function only the statements its outputs need are kept (dead-code
+//! elimination through the substitution variables), in topological order. Substitution
+//! variables become `let` statements named `k1, k2, …` (kinematic) and `d1, d2, …` (inertial and
+//! gravity terms), numbered per function; other subexpressions used more than once become `t1, …`
+//! statements (common subexpressions). With runtime parameters, every parameter-only
+//! subexpression moves to a separate *precompute* program that runs once per parameter set
+//! (its results are `pc1, pc2, …`). Each joint's sin/cos is computed once. Op counts are kept
+//! per program.
+
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::fmt;
+
+use crate::expr::{Arena, Atom, ExprId, Node, VarKind};
+use crate::kane::{Derivation, Function, ParamMode, Shape, Signature};
+
+/// A leaf of a lowered expression.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Leaf {
+    /// A number.
+    Const(f64),
+    /// A model parameter (runtime input).
+    Param(usize),
+    /// A precomputed parameter-only value (slot in the precompute program).
+    Pre(usize),
+    /// `u[i]`.
+    Speed(usize),
+    /// `u̇[i]`.
+    Accel(usize),
+    /// `sin(q[i])`.
+    Sin(usize),
+    /// `cos(q[i])`.
+    Cos(usize),
+    /// `q[i]`.
+    Coord(usize),
+    /// An earlier statement of the same program.
+    Local(usize),
+}
+
+/// A lowered expression: a small tree over leaves.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LExpr {
+    /// A leaf.
+    Leaf(Leaf),
+    /// `constant + Σ coef·term`.
+    Sum {
+        /// Constant part.
+        constant: f64,
+        /// `(coefficient, term)`.
+        terms: Vec<(f64, LExpr)>,
+    },
+    /// `Π base^power`.
+    Prod(Vec<(LExpr, i32)>),
+}
+
+/// One `let` statement.
+#[derive(Clone, Debug)]
+pub struct Stmt {
+    /// Local name (`k12`, `d3`, `t4`, `pc7`).
+    pub name: String,
+    /// Right-hand side.
+    pub expr: LExpr,
+    /// What it is (`w2.x`), from the derivation.
+    pub comment: String,
+}
+
+/// Operation counts of a program.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpCount {
+    /// Additions and subtractions.
+    pub adds: usize,
+    /// Multiplications.
+    pub muls: usize,
+    /// Divisions.
+    pub divs: usize,
+    /// `sin_cos` evaluations (one per joint used).
+    pub sincos: usize,
+}
+
+impl OpCount {
+    /// Total floating-point operations (adds + muls + divs).
+    pub fn flops(&self) -> usize {
+        self.adds + self.muls + self.divs
+    }
+}
+
+impl fmt::Display for OpCount {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} adds, {} muls, {} divs, {} sin/cos",
+            self.adds, self.muls, self.divs, self.sincos
+        )
+    }
+}
+
+/// A straight-line program.
+#[derive(Clone, Debug)]
+pub struct Program {
+    /// Function name.
+    pub name: String,
+    /// Doc line.
+    pub doc: String,
+    /// Result shape.
+    pub shape: Shape,
+    /// Inputs.
+    pub signature: Signature,
+    /// Speed indices whose sin/cos the program needs.
+    pub sincos: Vec<usize>,
+    /// Statements in execution order.
+    pub stmts: Vec<Stmt>,
+    /// `(row, col, value)`; for symmetric matrices the upper triangle.
+    pub outputs: Vec<(usize, usize, LExpr)>,
+    /// Operation counts.
+    pub ops: OpCount,
+    /// Number of K and D variables kept.
+    pub k_vars: usize,
+    /// Number of D variables kept.
+    pub d_vars: usize,
+}
+
+/// All programs of a model: the precompute program and one per function.
+#[derive(Clone, Debug)]
+pub struct Lowered {
+    /// Parameter-only values (empty in baked mode); statement `i` of it computes slot `pc{i+1}`
+    /// when listed in [`Lowered::pre_slots`].
+    pub precompute: Program,
+    /// Statement index in `precompute` of every slot, in slot order.
+    pub pre_slots: Vec<usize>,
+    /// The hot-path functions.
+    pub functions: Vec<Program>,
+    /// Number of speeds.
+    pub dof: usize,
+    /// Parameter mode.
+    pub params: ParamMode,
+}
+
+impl Lowered {
+    /// The program called `name`.
+    pub fn function(&self, name: &str) -> Option<&Program> {
+        self.functions.iter().find(|p| p.name == name)
+    }
+}
+
+/// Lower every function of a derivation.
+pub fn lower(d: &Derivation) -> Lowered {
+    let hoist = d.options.params == ParamMode::Runtime;
+    let mut pre = PreSet::default();
+    let functions: Vec<Program> = d
+        .functions
+        .iter()
+        .map(|f| lower_function(&d.arena, f, hoist, &mut pre))
+        .collect();
+    let (precompute, pre_slots) = lower_precompute(&d.arena, &pre);
+    Lowered {
+        precompute,
+        pre_slots,
+        functions,
+        dof: d.dof,
+        params: d.options.params,
+    }
+}
+
+/// Parameter-only nodes needed by the hot programs, in slot order of first request.
+#[derive(Default)]
+struct PreSet {
+    slot: HashMap<ExprId, usize>,
+    nodes: Vec<ExprId>,
+}
+
+impl PreSet {
+    fn get(&mut self, e: ExprId) -> usize {
+        if let Some(&s) = self.slot.get(&e) {
+            return s;
+        }
+        let s = self.nodes.len();
+        self.nodes.push(e);
+        self.slot.insert(e, s);
+        s
+    }
+}
+
+fn is_compound(n: &Node) -> bool {
+    matches!(n, Node::Sum { .. } | Node::Prod(_))
+}
+
+/// Shared machinery: which nodes become statements and how to expand expressions.
+struct Builder<'a> {
+    ar: &'a Arena,
+    /// Nodes that are leaves of this program because they are precomputed (runtime mode).
+    hoist: bool,
+    /// node → statement index.
+    local: HashMap<ExprId, usize>,
+}
+
+impl Builder<'_> {
+    fn is_pre(&self, e: ExprId) -> bool {
+        self.hoist
+            && self.ar.is_param_only(e)
+            && match self.ar.node(e) {
+                Node::Atom(Atom::Var(_)) => true,
+                n => is_compound(n),
+            }
+    }
+
+    fn expand(&self, e: ExprId, top: bool, pre: &mut PreSet) -> LExpr {
+        if !top && let Some(&i) = self.local.get(&e) {
+            return LExpr::Leaf(Leaf::Local(i));
+        }
+        if !top && self.is_pre(e) {
+            return LExpr::Leaf(Leaf::Pre(pre.get(e)));
+        }
+        match self.ar.node(e) {
+            Node::Const(c) => LExpr::Leaf(Leaf::Const(c.get())),
+            Node::Atom(a) => LExpr::Leaf(match *a {
+                Atom::Param(p) => Leaf::Param(p as usize),
+                Atom::Speed(s) => Leaf::Speed(s as usize),
+                Atom::Accel(s) => Leaf::Accel(s as usize),
+                Atom::Sin(s) => Leaf::Sin(s as usize),
+                Atom::Cos(s) => Leaf::Cos(s as usize),
+                Atom::Coord(s) => Leaf::Coord(s as usize),
+                Atom::Var(v) => {
+                    let def = self.ar.vars()[v as usize].def;
+                    match self.local.get(&def) {
+                        Some(&i) => Leaf::Local(i),
+                        None => return self.expand(def, false, pre),
+                    }
+                }
+            }),
+            Node::Sum { constant, terms } => LExpr::Sum {
+                constant: constant.get(),
+                terms: terms
+                    .iter()
+                    .map(|(t, k)| (k.get(), self.expand(*t, false, pre)))
+                    .collect(),
+            },
+            Node::Prod(f) => LExpr::Prod(
+                f.iter()
+                    .map(|(b, p)| (self.expand(*b, false, pre), *p))
+                    .collect(),
+            ),
+        }
+    }
+}
+
+/// Collect the statements of a program computing `roots`.
+///
+/// Returns the statement nodes in topological order: variable definitions (each labelled by its
+/// variable) and common subexpressions.
+fn schedule(ar: &Arena, roots: &[ExprId], is_leaf: &dyn Fn(ExprId) -> bool) -> Vec<(ExprId, Option<u32>)> {
+    // Reachability with parent counting; a variable is a leaf whose definition is a new root.
+    let mut uses: HashMap<ExprId, usize> = HashMap::new();
+    let mut seen: BTreeSet<ExprId> = BTreeSet::new();
+    let mut var_defs: BTreeMap<ExprId, u32> = BTreeMap::new();
+    let mut stack: Vec<ExprId> = roots.to_vec();
+    let mut visit = |e: ExprId, stack: &mut Vec<ExprId>| {
+        if seen.insert(e) {
+            stack.push(e);
+        }
+    };
+    let roots_set: Vec<ExprId> = roots.to_vec();
+    let mut pending = roots_set.clone();
+    stack.clear();
+    for r in pending.drain(..) {
+        visit(r, &mut stack);
+    }
+    while let Some(e) = stack.pop() {
+        if is_leaf(e) {
+            continue;
+        }
+        match ar.node(e) {
+            Node::Atom(Atom::Var(v)) => {
+                let def = ar.vars()[*v as usize].def;
+                var_defs.insert(def, *v);
+                visit(def, &mut stack);
+            }
+            Node::Sum { terms, .. } => {
+                for (t, _) in terms.iter() {
+                    *uses.entry(*t).or_insert(0) += 1;
+                    visit(*t, &mut stack);
+                }
+            }
+            Node::Prod(f) => {
+                for (b, _) in f.iter() {
+                    *uses.entry(*b).or_insert(0) += 1;
+                    visit(*b, &mut stack);
+                }
+            }
+            _ => {}
+        }
+    }
+    for r in &roots_set {
+        *uses.entry(*r).or_insert(0) += 1;
+    }
+    let mut out: Vec<(ExprId, Option<u32>)> = Vec::new();
+    for &e in &seen {
+        if is_leaf(e) {
+            continue;
+        }
+        if let Some(&v) = var_defs.get(&e) {
+            out.push((e, Some(v)));
+        } else if is_compound(ar.node(e)) && uses.get(&e).copied().unwrap_or(0) >= 2 {
+            out.push((e, None));
+        }
+    }
+    out
+}
+
+fn lower_function(ar: &Arena, f: &Function, hoist: bool, pre: &mut PreSet) -> Program {
+    let roots: Vec<ExprId> = f.entries.iter().map(|e| e.2).collect();
+    let mut b = Builder {
+        ar,
+        hoist,
+        local: HashMap::new(),
+    };
+    let is_leaf = |e: ExprId| {
+        hoist
+            && ar.is_param_only(e)
+            && (matches!(ar.node(e), Node::Atom(Atom::Var(_))) || is_compound(ar.node(e)))
+    };
+    let sched = schedule(ar, &roots, &is_leaf);
+    let mut stmts = Vec::new();
+    let (mut nk, mut nd, mut nt) = (0, 0, 0);
+    for (e, var) in sched {
+        let (name, comment) = match var {
+            Some(v) => {
+                let info = &ar.vars()[v as usize];
+                match info.kind {
+                    VarKind::K => {
+                        nk += 1;
+                        (format!("k{nk}"), info.label.clone())
+                    }
+                    VarKind::D => {
+                        nd += 1;
+                        (format!("d{nd}"), info.label.clone())
+                    }
+                }
+            }
+            None => {
+                nt += 1;
+                (format!("t{nt}"), "common subexpression".to_owned())
+            }
+        };
+        let expr = b.expand(e, true, pre);
+        b.local.insert(e, stmts.len());
+        stmts.push(Stmt {
+            name,
+            expr,
+            comment,
+        });
+    }
+    let outputs: Vec<(usize, usize, LExpr)> = f
+        .entries
+        .iter()
+        .map(|&(r, c, e)| (r, c, b.expand(e, false, pre)))
+        .collect();
+    let mut p = Program {
+        name: f.name.to_owned(),
+        doc: f.doc.to_owned(),
+        shape: f.shape,
+        signature: f.signature,
+        sincos: Vec::new(),
+        stmts,
+        outputs,
+        ops: OpCount::default(),
+        k_vars: nk,
+        d_vars: nd,
+    };
+    finish(&mut p);
+    p
+}
+
+fn lower_precompute(ar: &Arena, pre: &PreSet) -> (Program, Vec<usize>) {
+    let mut b = Builder {
+        ar,
+        hoist: false,
+        local: HashMap::new(),
+    };
+    // Every requested node is a statement; so is every variable and shared node below them.
+    let sched = schedule(ar, &pre.nodes, &|_| false);
+    let requested: BTreeSet<ExprId> = pre.nodes.iter().copied().collect();
+    let mut order: Vec<(ExprId, Option<u32>)> = sched;
+    for &e in &pre.nodes {
+        if !order.iter().any(|(x, _)| *x == e) {
+            order.push((e, None));
+        }
+    }
+    order.sort_by_key(|(e, _)| *e);
+    let mut stmts = Vec::new();
+    let mut node_stmt: HashMap<ExprId, usize> = HashMap::new();
+    let mut dummy = PreSet::default();
+    for (i, (e, var)) in order.iter().enumerate() {
+        let comment = match var {
+            Some(v) => ar.vars()[*v as usize].label.clone(),
+            None if requested.contains(e) => "parameter-only term".to_owned(),
+            None => "common subexpression".to_owned(),
+        };
+        let expr = b.expand(*e, true, &mut dummy);
+        b.local.insert(*e, i);
+        node_stmt.insert(*e, i);
+        stmts.push(Stmt {
+            name: format!("pc{}", i + 1),
+            expr,
+            comment,
+        });
+    }
+    // A requested node that is a variable maps to its definition's statement.
+    let slots: Vec<usize> = pre
+        .nodes
+        .iter()
+        .map(|e| {
+            let key = match ar.node(*e) {
+                Node::Atom(Atom::Var(v)) => ar.vars()[*v as usize].def,
+                _ => *e,
+            };
+            node_stmt[&key]
+        })
+        .collect();
+    let mut p = Program {
+        name: "precompute".into(),
+        doc: "Parameter-only subexpressions, computed once per parameter set.".into(),
+        shape: Shape::Vector,
+        signature: Signature::Q,
+        sincos: Vec::new(),
+        stmts,
+        outputs: Vec::new(),
+        ops: OpCount::default(),
+        k_vars: 0,
+        d_vars: 0,
+    };
+    finish(&mut p);
+    (p, slots)
+}
+
+fn count(e: &LExpr, ops: &mut OpCount, trig: &mut BTreeSet<usize>) {
+    match e {
+        LExpr::Leaf(Leaf::Sin(s) | Leaf::Cos(s)) => {
+            trig.insert(*s);
+        }
+        LExpr::Leaf(_) => {}
+        LExpr::Sum { constant, terms } => {
+            ops.adds += terms.len() - 1 + usize::from(*constant != 0.0);
+            for (k, t) in terms {
+                if k.abs() != 1.0 {
+                    ops.muls += 1;
+                }
+                count(t, ops, trig);
+            }
+        }
+        LExpr::Prod(f) => {
+            let pos: i32 = f.iter().filter(|(_, p)| *p > 0).map(|(_, p)| *p).sum();
+            let neg: i32 = f.iter().filter(|(_, p)| *p < 0).map(|(_, p)| -*p).sum();
+            ops.muls += (pos.max(1) - 1) as usize + (neg.max(1) - 1) as usize;
+            if neg > 0 {
+                ops.divs += 1;
+            }
+            for (b, _) in f {
+                count(b, ops, trig);
+            }
+        }
+    }
+}
+
+fn finish(p: &mut Program) {
+    let mut ops = OpCount::default();
+    let mut trig = BTreeSet::new();
+    for s in &p.stmts {
+        count(&s.expr, &mut ops, &mut trig);
+    }
+    for (_, _, e) in &p.outputs {
+        count(e, &mut ops, &mut trig);
+    }
+    ops.sincos = trig.len();
+    p.ops = ops;
+    p.sincos = trig.into_iter().collect();
+}
+
+/// Numeric evaluation of lowered programs (an interpreter, for testing the lowering).
+impl Lowered {
+    /// Values of the precompute slots for parameter values `params`.
+    pub fn precompute_values(&self, params: &[f64]) -> Vec<f64> {
+        let locals = run(&self.precompute, params, &[], &[], &[], &[]);
+        self.pre_slots.iter().map(|&i| locals[i]).collect()
+    }
+
+    /// Evaluate function `name`; dense row-major matrix (both triangles) or vector.
+    pub fn evaluate(&self, name: &str, params: &[f64], q: &[f64], u: &[f64], ud: &[f64]) -> Vec<f64> {
+        let pre = self.precompute_values(params);
+        let p = self.function(name).unwrap_or_else(|| panic!("no function `{name}`"));
+        let locals = run(p, params, &pre, q, u, ud);
+        let n = self.dof;
+        let ctx = EvalCtx {
+            params,
+            pre: &pre,
+            q,
+            u,
+            ud,
+            locals: &locals,
+        };
+        match p.shape {
+            Shape::SymmetricMatrix => {
+                let mut m = vec![0.0; n * n];
+                for (r, c, e) in &p.outputs {
+                    let v = ctx.eval(e);
+                    m[r * n + c] = v;
+                    m[c * n + r] = v;
+                }
+                m
+            }
+            Shape::Vector => {
+                let mut v = vec![0.0; n];
+                for (r, _, e) in &p.outputs {
+                    v[*r] = ctx.eval(e);
+                }
+                v
+            }
+        }
+    }
+}
+
+struct EvalCtx<'a> {
+    params: &'a [f64],
+    pre: &'a [f64],
+    q: &'a [f64],
+    u: &'a [f64],
+    ud: &'a [f64],
+    locals: &'a [f64],
+}
+
+impl EvalCtx<'_> {
+    fn eval(&self, e: &LExpr) -> f64 {
+        match e {
+            LExpr::Leaf(l) => match *l {
+                Leaf::Const(c) => c,
+                Leaf::Param(p) => self.params[p],
+                Leaf::Pre(s) => self.pre[s],
+                Leaf::Speed(s) => self.u[s],
+                Leaf::Accel(s) => self.ud[s],
+                Leaf::Sin(s) => self.q[s].sin(),
+                Leaf::Cos(s) => self.q[s].cos(),
+                Leaf::Coord(s) => self.q[s],
+                Leaf::Local(i) => self.locals[i],
+            },
+            LExpr::Sum { constant, terms } => terms
+                .iter()
+                .fold(*constant, |acc, (k, t)| acc + k * self.eval(t)),
+            LExpr::Prod(f) => f.iter().fold(1.0, |acc, (b, p)| acc * self.eval(b).powi(*p)),
+        }
+    }
+}
+
+fn run(p: &Program, params: &[f64], pre: &[f64], q: &[f64], u: &[f64], ud: &[f64]) -> Vec<f64> {
+    let mut locals: Vec<f64> = Vec::with_capacity(p.stmts.len());
+    for s in &p.stmts {
+        let v = EvalCtx {
+            params,
+            pre,
+            q,
+            u,
+            ud,
+            locals: &locals,
+        }
+        .eval(&s.expr);
+        locals.push(v);
+    }
+    locals
+}

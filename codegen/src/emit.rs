@@ -415,6 +415,7 @@ fn params_items(model: &Model) -> TokenStream {
 
         impl std::error::Error for UnknownParameter {}
 
+        #[allow(non_snake_case)]
         impl Params {
             /// Parameter names in declaration order (the order of [`Params::to_array`]).
             pub const NAMES: [&'static str; #np] = [#(#names),*];

@@ -1,0 +1,7 @@
+//! Generates the dynamics modules from the robot descriptions next to this file.
+fn main() {
+    kanegen::Builder::new("krang.toml").run();
+    kanegen::Builder::new("krang.toml").baked(true).run();
+    kanegen::Builder::new("krang-fixed-wheels.toml").run();
+    kanegen::Builder::new("two-link.toml").run();
+}

@@ -1,0 +1,96 @@
+//! Helpers shared by the workspace-level tests.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+use kanegen_model::Model;
+use kanegen_reference::random::{SplitMix64, uniform_vec};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
+
+/// The repository root.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Load `models/<name>`.
+pub fn model(name: &str) -> Model {
+    Model::from_toml_file(root().join("models").join(name)).expect("model loads")
+}
+
+/// `shared/` beside the repository (absent on a machine without it).
+pub fn shared(rel: &str) -> Option<PathBuf> {
+    let p = root().join("../shared").join(rel);
+    p.exists().then_some(p)
+}
+
+/// `max |a − b| / max(max |b|, floor)`: relative to the largest entry, absolute below `floor`
+/// (vectors such as c can be small by cancellation of large terms).
+pub fn rel_err(a: &[f64], b: &[f64], floor: f64) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let scale = b.iter().fold(floor, |m, x| m.max(x.abs()));
+    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale
+}
+
+/// A deterministic uniform source.
+pub fn rng(seed: u64) -> impl FnMut() -> f64 {
+    let mut r = SplitMix64::new(seed);
+    move || r.next_f64()
+}
+
+/// A random state `(q, u, u̇)`.
+pub fn random_state(uniform: &mut impl FnMut() -> f64, n: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    (
+        uniform_vec(uniform, n, -std::f64::consts::PI, std::f64::consts::PI),
+        uniform_vec(uniform, n, -2.0, 2.0),
+        uniform_vec(uniform, n, -5.0, 5.0),
+    )
+}
+
+/// Fixed-size vector from a slice.
+pub fn sv<const N: usize>(v: &[f64]) -> SVector<f64, N> {
+    SVector::<f64, N>::from_column_slice(v)
+}
+
+/// Column-major data of a fixed-size matrix as a row-major Vec (to compare with DMatrix).
+pub fn rows<const N: usize>(m: &SMatrix<f64, N, N>) -> Vec<f64> {
+    (0..N).flat_map(|r| (0..N).map(move |c| m[(r, c)])).collect()
+}
+
+/// Row-major data of a dynamic matrix.
+pub fn drows(m: &DMatrix<f64>) -> Vec<f64> {
+    (0..m.nrows()).flat_map(|r| (0..m.ncols()).map(move |c| m[(r, c)])).collect()
+}
+
+/// Data of a dynamic vector.
+pub fn dvec(v: &DVector<f64>) -> Vec<f64> {
+    v.iter().copied().collect()
+}
+
+/// The hardware-fitted masses and first moments of Krang (`shared/krang/params`), applied to the
+/// model's bodies (inertias keep their defaults). The 23 entries of the hardware-trained beta
+/// vector are, in order: Base, LWheel, RWheel, Spine, Bracket, L1..L6, lGripper, lgPlate1,
+/// lgPlate2, R1..R6, rGripper, rgPlate1, rgPlate2 (the ideal vector has a 24th, the Kinect, after
+/// Bracket), each `[m, m·cx, m·cy, m·cz]` in the link frame (which coincides with the report's
+/// frame, see MODEL-NOTES). The fitted plates have negative masses; they are not bodies of the
+/// 19-speed model and are left out.
+pub fn hardware_fitted_params(model: &Model) -> Option<Vec<f64>> {
+    let path = shared("krang/params/convergedBetaVector104PosesHardwareTrained.txt")?;
+    let text = std::fs::read_to_string(path).ok()?;
+    let beta: Vec<f64> = text.split_whitespace().map(|t| t.parse().unwrap()).collect();
+    assert_eq!(beta.len(), 92, "23 bodies × [m, MX, MY, MZ]");
+    let bodies = [
+        Some("1"), None, None, Some("2"), Some("3"),
+        Some("4l"), Some("5l"), Some("6l"), Some("7l"), Some("8l"), Some("9l"), Some("10l"), None, None,
+        Some("4r"), Some("5r"), Some("6r"), Some("7r"), Some("8r"), Some("9r"), Some("10r"), None, None,
+    ];
+    let mut p = model.param_values();
+    for (k, b) in bodies.iter().enumerate() {
+        let Some(b) = b else { continue };
+        for (j, prefix) in ["m", "MX", "MY", "MZ"].iter().enumerate() {
+            if let Some(i) = model.param_index(&format!("{prefix}{b}")) {
+                p[i] = beta[4 * k + j];
+            }
+        }
+    }
+    Some(p)
+}

@@ -190,6 +190,114 @@ pub enum ModelErrorKind {
         /// What is wrong.
         detail: String,
     },
+    /// The text is not a readable URDF: XML syntax or nesting, or a missing required element.
+    #[error(
+        "not a readable URDF: {detail}; check the XML (every element closed, one <robot> root) and that every <joint> has a type, <parent link> and <child link>"
+    )]
+    UrdfParse {
+        /// The parser's message.
+        detail: String,
+    },
+    /// A URDF joint names a parent link that the file does not define.
+    #[error(
+        "URDF joint `{joint}`: parent link `{parent}` is not defined; add <link name=\"{parent}\"/> or correct <parent link=\"...\"/>"
+    )]
+    UrdfMissingParentLink {
+        /// The joint.
+        joint: String,
+        /// The link it names as parent.
+        parent: String,
+    },
+    /// A URDF joint names a child link that the file does not define.
+    #[error(
+        "URDF joint `{joint}`: child link `{child}` is not defined; add <link name=\"{child}\"/> or correct <child link=\"...\"/>"
+    )]
+    UrdfMissingChildLink {
+        /// The joint.
+        joint: String,
+        /// The link it names as child.
+        child: String,
+    },
+    /// A URDF link is the child of two joints.
+    #[error(
+        "URDF link `{link}` is the child of two joints, `{first}` and `{second}`; a URDF is a tree: give each link at most one parent joint"
+    )]
+    UrdfTwoParents {
+        /// The link.
+        link: String,
+        /// The first joint naming it as child.
+        first: String,
+        /// The second.
+        second: String,
+    },
+    /// More than one URDF link is no joint's child.
+    #[error(
+        "URDF has {} root links ({}), i.e. links that are no joint's child; a URDF tree has exactly one root: attach the others with a joint (`fixed` if rigid) or remove them",
+        .roots.len(),
+        .roots.join(", ")
+    )]
+    UrdfTwoRoots {
+        /// The root links, in file order.
+        roots: Vec<String>,
+    },
+    /// A URDF joint has a type that URDF does not define.
+    #[error(
+        "URDF joint `{joint}`: unknown joint type `{kind}`; use revolute, continuous, prismatic or fixed"
+    )]
+    UrdfUnknownJointType {
+        /// The joint.
+        joint: String,
+        /// The type as written.
+        kind: String,
+    },
+    /// A numeric URDF attribute is not a finite number (or has the wrong number of entries).
+    #[error(
+        "URDF {element}: {attribute}=\"{text}\" is not {expected}; write finite decimal numbers such as 0.25 or 3.14159 (no units, no expressions)"
+    )]
+    UrdfBadNumber {
+        /// The element, with its enclosing link or joint (`joint \`LJ1\` <origin>`).
+        element: String,
+        /// The attribute.
+        attribute: String,
+        /// The value as written.
+        text: String,
+        /// What was expected (`3 numbers`, `a number`).
+        expected: String,
+    },
+    /// A URDF joint kind (or feature) that the generator cannot represent.
+    #[error("URDF joint `{joint}`: {kind} joints are not supported; {fix}")]
+    UrdfUnsupportedJoint {
+        /// The joint.
+        joint: String,
+        /// `floating`, `planar`, `spherical` or `mimic`.
+        kind: String,
+        /// How to fix the description.
+        fix: String,
+    },
+    /// A URDF link's inertia is physically absurd for its mass (radius of gyration above the limit).
+    #[error(
+        "URDF link `{link}`: inertia is absurd for its mass {mass} kg: radius of gyration {radius:.3} m (largest principal moment {moment} kg·m² about the centre of mass) exceeds {limit} m; correct the <inertial>, list the link in UrdfOptions::drop_links, or set UrdfOptions::absurd_inertia to Drop"
+    )]
+    UrdfAbsurdInertia {
+        /// The link.
+        link: String,
+        /// Its mass.
+        mass: f64,
+        /// The largest principal moment of inertia about the centre of mass.
+        moment: f64,
+        /// `sqrt(moment / mass)`.
+        radius: f64,
+        /// `UrdfOptions::max_radius_of_gyration`.
+        limit: f64,
+    },
+    /// A URDF import option (base declaration, dropped links, gravity) is inconsistent with the file.
+    #[error("URDF import option `{option}`: {detail}")]
+    UrdfBadOption {
+        /// The option (`base.body_link`, `drop_links`, ...).
+        option: String,
+        /// What is wrong and how to fix it.
+        detail: String,
+    },
     /// Anything else about the base or gravity declarations.
     #[error("{item}: {detail}")]
     Invalid {

@@ -288,7 +288,8 @@ impl fmt::Display for Model {
             match &l.joint {
                 None => write!(f, "{indent}{}", l.name)?,
                 Some(j) => {
-                    let t: Vec<String> = j.translation.iter().map(|s| fmt_scalar(s, self)).collect();
+                    let t: Vec<String> =
+                        j.translation.iter().map(|s| fmt_scalar(s, self)).collect();
                     write!(
                         f,
                         "{indent}{} <- {:?} joint `{}` axis {:?} P [{}]",

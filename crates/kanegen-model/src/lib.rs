@@ -8,14 +8,20 @@
 //! the frame origin) as named, symbolic [`Param`]s with default values, so that the generator can
 //! keep them as runtime inputs and the reference recursion can evaluate them.
 //!
-//! Models are loaded from TOML ([`Model::from_toml_file`]) and validated; every failure is a typed
+//! Models are loaded from TOML ([`Model::from_toml_file`]) or imported from URDF
+//! ([`Model::from_urdf_file`], module [`urdf`]) and validated; every failure is a typed
 //! [`ModelError`] naming the file, the item and the fix.
 #![forbid(unsafe_code)]
 
 mod error;
 mod ir;
 mod toml_format;
+pub mod urdf;
 mod validate;
 
 pub use error::{ModelError, ModelErrorKind};
 pub use ir::*;
+pub use urdf::{
+    AbsurdInertia, UrdfBase, UrdfImport, UrdfOptions, WheeledBaseSpec,
+    sanitize as sanitize_urdf_name,
+};

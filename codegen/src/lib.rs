@@ -14,6 +14,14 @@
 //!
 //! and the crate includes it with
 //! `include!(concat!(env!("OUT_DIR"), "/krang.rs"));` (the file is named after the model file).
+//!
+//! Any robot described in URDF works the same way ([`Builder::urdf`], options in
+//! [`model::UrdfOptions`]):
+//!
+//! ```no_run
+//! // build.rs
+//! kanegen::Builder::urdf("robot.urdf", kanegen::model::UrdfOptions::default()).run();
+//! ```
 #![forbid(unsafe_code)]
 
 pub mod emit;
@@ -69,6 +77,28 @@ pub fn generate_model(model: model::Model, options: Options) -> Result<Generated
     })
 }
 
+/// Import a URDF file and run every stage. The import notes (snapped angles, merged and dropped
+/// links, wheel constants) are written as comments after the generated file's header.
+pub fn generate_urdf(
+    path: impl AsRef<Path>,
+    urdf: &model::UrdfOptions,
+    options: Options,
+) -> Result<Generated, Error> {
+    let import = model::UrdfImport::read(path, urdf)?;
+    let mut g = generate_model(import.model, options)?;
+    if !import.notes.is_empty() {
+        let mut notes = String::from("// URDF import notes:\n");
+        for n in &import.notes {
+            notes.push_str(&format!("//   - {n}\n"));
+        }
+        notes.push('\n');
+        // After the header (which ends at the first blank line).
+        let at = g.source.find("\n\n").map_or(0, |i| i + 2);
+        g.source.insert_str(at, &notes);
+    }
+    Ok(g)
+}
+
 /// Load a description file and run every stage.
 pub fn generate(path: impl AsRef<Path>, options: Options) -> Result<Generated, Error> {
     let model = model::Model::from_toml_file(path)?;
@@ -89,6 +119,8 @@ pub struct Builder {
     options: Options,
     output: Option<String>,
     out_dir: Option<PathBuf>,
+    /// `Some` when the model file is a URDF to import with these options.
+    urdf: Option<model::UrdfOptions>,
 }
 
 impl Builder {
@@ -100,6 +132,26 @@ impl Builder {
             options: Options::default(),
             output: None,
             out_dir: None,
+            urdf: None,
+        }
+    }
+
+    /// Generate from the URDF file `path` (relative to the crate's manifest directory when run
+    /// from a build script), imported with `options` (see [`model::urdf`]): the module has the
+    /// same shape as for a TOML model, with URDF-derived names (`Params` fields `m_<link>`,
+    /// `MX_<link>`…, speeds `qd_<joint>`) and a wrapper struct named after the `<robot name>`
+    /// (or [`model::UrdfOptions::name`]).
+    ///
+    /// ```no_run
+    /// use kanegen::model::{UrdfOptions, WheeledBaseSpec};
+    /// kanegen::Builder::urdf("arm.urdf", UrdfOptions::default()).run();
+    /// let base = WheeledBaseSpec::new("JLWheel", "JRWheel", "Base", [0.0, 1.0, 0.0], 0.25);
+    /// kanegen::Builder::urdf("Krang.urdf", UrdfOptions::wheeled(base).drop_links(["lgPlate1"])).run();
+    /// ```
+    pub fn urdf(path: impl Into<PathBuf>, options: model::UrdfOptions) -> Self {
+        Self {
+            urdf: Some(options),
+            ..Self::new(path)
         }
     }
 
@@ -134,7 +186,10 @@ impl Builder {
             None => PathBuf::from(std::env::var_os("OUT_DIR").ok_or(Error::NoOutDir)?),
         };
         println!("cargo:rerun-if-changed={}", self.model.display());
-        let g = generate(&self.model, self.options)?;
+        let g = match &self.urdf {
+            Some(urdf) => generate_urdf(&self.model, urdf, self.options)?,
+            None => generate(&self.model, self.options)?,
+        };
         let name = self.output.clone().unwrap_or_else(|| {
             let stem = self
                 .model

@@ -255,7 +255,7 @@ pub enum ModelErrorKind {
         "URDF {element}: {attribute}=\"{text}\" is not {expected}; write finite decimal numbers such as 0.25 or 3.14159 (no units, no expressions)"
     )]
     UrdfBadNumber {
-        /// The element, with its enclosing link or joint (`joint \`LJ1\` <origin>`).
+        /// The element, with its enclosing link or joint, e.g. ``joint `LJ1` <origin>``.
         element: String,
         /// The attribute.
         attribute: String,

@@ -11,7 +11,7 @@
 //! * **Fixed joints** merge the child link into its parent: the child's inertia is rotated and
 //!   shifted into the parent frame (Huygens–Steiner) and its children are re-attached with the
 //!   composed transform. `floating`, `planar`, `spherical` joints and `<mimic>` are typed errors
-//!   ([`ModelErrorKind::UrdfUnsupportedJoint`]) unless the base declaration replaces them.
+//!   ([`ModelErrorKind::UrdfUnsupportedJoint`](crate::ModelErrorKind::UrdfUnsupportedJoint)) unless the base declaration replaces them.
 //! * **Inertia.** With the `<inertial><origin>` xyz = S and rpy = R, and the URDF inertia I about
 //!   the centre of mass in that frame: `I_G = R I Rᵀ`, `[MX, MY, MZ] = m·S`,
 //!   `J = I_G + m(|S|²·1 − S Sᵀ)` about the link origin (Khalil's standard parameters). A link with
@@ -56,7 +56,7 @@ pub const DEFAULT_MAX_RADIUS_OF_GYRATION: f64 = 5.0;
 /// [`UrdfOptions::max_radius_of_gyration`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum AbsurdInertia {
-    /// Fail with [`ModelErrorKind::UrdfAbsurdInertia`] (the default).
+    /// Fail with [`ModelErrorKind::UrdfAbsurdInertia`](crate::ModelErrorKind::UrdfAbsurdInertia) (the default).
     #[default]
     Error,
     /// Drop the link's inertia (the link stays as a frame), with a note.

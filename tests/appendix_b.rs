@@ -40,7 +40,8 @@ fn generated_two_link_reproduces_appendix_b_printed_a_c_q() {
         let c = Matrix2::new(qdw * m2, (qdw + qdi) * m2, -qdi * m2, 0.0);
         let g = p.g;
         let qq = Vector2::new(
-            p.MZ1 * g * ci - p.MY1 * g * si + p.MZ2 * g * m5 - p.MY2 * g * m6
+            p.MZ1 * g * ci - p.MY1 * g * si + p.MZ2 * g * m5
+                - p.MY2 * g * m6
                 - g * p.m2 * (p.L2 * ci + p.L1 * si),
             p.MZ2 * g * m5 - p.MY2 * g * m6,
         );

@@ -21,9 +21,21 @@ macro_rules! compare {
         let dynamics = gm::$ty::new(gm::Params::from_array(params.clone().try_into().unwrap()));
         let reference = Reference::<f64>::with_params($model, &params);
         let (q, u, ud) = (sv::<$n>($q), sv::<$n>($u), sv::<$n>($ud));
-        let em = rel_err(&rows(&dynamics.mass_matrix(&q)), &drows(&reference.mass_matrix($q)), FLOOR);
-        let ec = rel_err(&dynamics.coriolis(&q, &u).as_slice(), &dvec(&reference.coriolis($q, $u)), FLOOR);
-        let eg = rel_err(&dynamics.gravity(&q).as_slice(), &dvec(&reference.gravity($q)), FLOOR);
+        let em = rel_err(
+            &rows(&dynamics.mass_matrix(&q)),
+            &drows(&reference.mass_matrix($q)),
+            FLOOR,
+        );
+        let ec = rel_err(
+            &dynamics.coriolis(&q, &u).as_slice(),
+            &dvec(&reference.coriolis($q, $u)),
+            FLOOR,
+        );
+        let eg = rel_err(
+            &dynamics.gravity(&q).as_slice(),
+            &dvec(&reference.gravity($q)),
+            FLOOR,
+        );
         let et = rel_err(
             &dynamics.inverse_dynamics(&q, &u, &ud).as_slice(),
             &dvec(&reference.inverse_dynamics($q, $u, $ud)),
@@ -40,7 +52,10 @@ fn worst(acc: &mut [f64; 4], e: [f64; 4]) {
 }
 
 fn check(label: &str, w: [f64; 4]) {
-    eprintln!("{label}: worst relative error M {:.1e} c {:.1e} g {:.1e} tau {:.1e}", w[0], w[1], w[2], w[3]);
+    eprintln!(
+        "{label}: worst relative error M {:.1e} c {:.1e} g {:.1e} tau {:.1e}",
+        w[0], w[1], w[2], w[3]
+    );
     assert!(w.iter().all(|e| *e < TOL), "{label}: {w:?} exceeds {TOL}");
 }
 
@@ -82,7 +97,10 @@ fn krang_generated_matches_reference_with_hardware_fitted_masses() {
     let mut w = [0.0; 4];
     for _ in 0..300 {
         let (q, u, ud) = random_state(&mut r, 19);
-        worst(&mut w, compare!(kd, Krang, 19, &model, p.clone(), &q, &u, &ud));
+        worst(
+            &mut w,
+            compare!(kd, Krang, 19, &model, p.clone(), &q, &u, &ud),
+        );
     }
     check("krang, hardware-fitted masses", w);
 }
@@ -94,7 +112,10 @@ fn krang_default_parameters_match_reference() {
     let mut w = [0.0; 4];
     for _ in 0..200 {
         let (q, u, ud) = random_state(&mut r, 19);
-        worst(&mut w, compare!(kd, Krang, 19, &model, model.param_values(), &q, &u, &ud));
+        worst(
+            &mut w,
+            compare!(kd, Krang, 19, &model, model.param_values(), &q, &u, &ud),
+        );
     }
     check("krang, default parameters", w);
 }
@@ -107,7 +128,19 @@ fn fixed_wheel_generated_matches_reference_on_random_parameters_and_states() {
     for _ in 0..1000 {
         let p = random_physical_params(&model, &mut r);
         let (q, u, ud) = random_state(&mut r, 17);
-        worst(&mut w, compare!(kd::fixed_wheels, KrangFixedWheels, 17, &model, p, &q, &u, &ud));
+        worst(
+            &mut w,
+            compare!(
+                kd::fixed_wheels,
+                KrangFixedWheels,
+                17,
+                &model,
+                p,
+                &q,
+                &u,
+                &ud
+            ),
+        );
     }
     check("krang-fixed-wheels, 1000 random draws", w);
 }
@@ -120,7 +153,10 @@ fn two_link_generated_matches_reference_on_random_parameters_and_states() {
     for _ in 0..1000 {
         let p = random_physical_params(&model, &mut r);
         let (q, u, ud) = random_state(&mut r, 2);
-        worst(&mut w, compare!(kd::two_link, TwoLink, 2, &model, p, &q, &u, &ud));
+        worst(
+            &mut w,
+            compare!(kd::two_link, TwoLink, 2, &model, p, &q, &u, &ud),
+        );
     }
     check("two-link, 1000 random draws", w);
 }
@@ -137,9 +173,21 @@ fn baked_krang_matches_reference_at_default_parameters() {
         worst(
             &mut w,
             [
-                rel_err(&rows(&kd::baked::mass_matrix(&qs)), &drows(&reference.mass_matrix(&q)), FLOOR),
-                rel_err(kd::baked::coriolis(&qs, &us).as_slice(), &dvec(&reference.coriolis(&q, &u)), FLOOR),
-                rel_err(kd::baked::gravity(&qs).as_slice(), &dvec(&reference.gravity(&q)), FLOOR),
+                rel_err(
+                    &rows(&kd::baked::mass_matrix(&qs)),
+                    &drows(&reference.mass_matrix(&q)),
+                    FLOOR,
+                ),
+                rel_err(
+                    kd::baked::coriolis(&qs, &us).as_slice(),
+                    &dvec(&reference.coriolis(&q, &u)),
+                    FLOOR,
+                ),
+                rel_err(
+                    kd::baked::gravity(&qs).as_slice(),
+                    &dvec(&reference.gravity(&q)),
+                    FLOOR,
+                ),
                 rel_err(
                     kd::baked::inverse_dynamics(&qs, &us, &uds).as_slice(),
                     &dvec(&reference.inverse_dynamics(&q, &u, &ud)),

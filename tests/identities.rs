@@ -22,7 +22,10 @@ fn mass_matrix_is_symmetric_positive_definite() {
     for _ in 0..200 {
         let (q, _, _) = random_state(&mut r, 19);
         let m = k.mass_matrix(&sv(&q));
-        assert!((m - m.transpose()).abs().max() == 0.0, "M is exactly symmetric");
+        assert!(
+            (m - m.transpose()).abs().max() == 0.0,
+            "M is exactly symmetric"
+        );
         assert!(m.cholesky().is_some(), "M is positive definite");
     }
 }
@@ -91,5 +94,8 @@ fn params_set_and_get_use_the_reports_symbols() {
     assert!(err.to_string().contains("MX4k"));
     assert_eq!(p.get("nope"), None);
     assert_eq!(Params::from_array(p.to_array()), p);
-    assert_eq!(krang_dynamics::SPEED_NAMES[krang_dynamics::index::Q_IMU], "qd_imu");
+    assert_eq!(
+        krang_dynamics::SPEED_NAMES[krang_dynamics::index::Q_IMU],
+        "qd_imu"
+    );
 }

@@ -67,7 +67,13 @@ fn ident(name: &str) -> Ident {
     // Model-derived names are sanitised to identifiers.
     let mut s: String = name
         .chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect();
     if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) {
         s.insert(0, '_');
@@ -166,7 +172,11 @@ impl Names<'_> {
                 }
                 if *constant != 0.0 {
                     let cl = lit(*constant);
-                    ts.extend(if *constant < 0.0 { quote!(- #cl) } else { quote!(+ #cl) });
+                    ts.extend(if *constant < 0.0 {
+                        quote!(- #cl)
+                    } else {
+                        quote!(+ #cl)
+                    });
                 }
                 if atomic { quote!((#ts)) } else { ts }
             }
@@ -258,7 +268,10 @@ fn function(model: &Model, low: &Lowered, pre: &[String], p: &Program) -> TokenS
         quote!()
     };
     let (args, arg_doc) = match p.signature {
-        Signature::Q => (quote!(q: &SVector<f64, #nl>), " `q`: coordinates in the order of [`COORDINATE_NAMES`]."),
+        Signature::Q => (
+            quote!(q: &SVector<f64, #nl>),
+            " `q`: coordinates in the order of [`COORDINATE_NAMES`].",
+        ),
         Signature::QU => (
             quote!(q: &SVector<f64, #nl>, u: &SVector<f64, #nl>),
             " `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].",
@@ -579,7 +592,10 @@ pub fn emit(model: &Model, low: &Lowered) -> Result<String, EmitError> {
         .enumerate()
         .map(|(i, s)| {
             let id = ident(&s.coordinate.to_uppercase());
-            let doc = format!(" Index of `{}` in q (and of `{}` in u).", s.coordinate, s.name);
+            let doc = format!(
+                " Index of `{}` in q (and of `{}` in u).",
+                s.coordinate, s.name
+            );
             let i = idx(i);
             quote!(#[doc = #doc] pub const #id: usize = #i;)
         })
@@ -636,14 +652,18 @@ fn header(model: &Model, low: &Lowered) -> String {
             ParamMode::Baked => "baked in as constants",
         },
         low.dof,
-        model.speeds.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
+        model
+            .speeds
+            .iter()
+            .map(|s| s.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
     ));
     h.push_str("// Operation counts per call:\n");
     if low.params == ParamMode::Runtime {
         h.push_str(&format!(
             "//   {:<17} {} (once per parameter set)\n",
-            "Precomputed::new",
-            low.precompute.ops
+            "Precomputed::new", low.precompute.ops
         ));
     }
     for p in &low.functions {

@@ -21,6 +21,9 @@
 //!
 //! Every compound component is replaced by a substitution variable as soon as it is formed.
 
+// Index loops over links mirror the recursions of the reports (parent indices, per-link tables).
+#![allow(clippy::needless_range_loop)]
+
 use kanegen_model::{Base, JointKind, Model, Scalar};
 
 use crate::expr::{Arena, Atom, ExprId, Names, VarKind};
@@ -220,7 +223,10 @@ impl Ctx<'_> {
         if let Some(r) = self.rot[l] {
             return r;
         }
-        let j = self.model.links[l].joint.as_ref().expect("non-root link has a joint");
+        let j = self.model.links[l]
+            .joint
+            .as_ref()
+            .expect("non-root link has a joint");
         let a0: M3 = j.rotation.map(|row| row.map(|x| self.ar.constant(x)));
         let r = match (j.kind, j.speed) {
             (JointKind::Revolute, Some(s)) => {
@@ -250,7 +256,9 @@ impl Ctx<'_> {
         let mut out = r;
         for (ri, row) in out.iter_mut().enumerate() {
             for (ci, x) in row.iter_mut().enumerate() {
-                *x = self.ar.subst(*x, VarKind::K, &format!("A{name}({},{})", ri + 1, ci + 1));
+                *x = self
+                    .ar
+                    .subst(*x, VarKind::K, &format!("A{name}({},{})", ri + 1, ci + 1));
             }
         }
         self.rot[l] = Some(out);
@@ -262,7 +270,10 @@ impl Ctx<'_> {
         if let Some(p) = self.pos[l] {
             return p;
         }
-        let j = self.model.links[l].joint.clone().expect("non-root link has a joint");
+        let j = self.model.links[l]
+            .joint
+            .clone()
+            .expect("non-root link has a joint");
         let mut p = j.translation.map(|s| self.scalar(&s));
         if let (JointKind::Prismatic, Some(s)) = (j.kind, j.speed) {
             let q = self.ar.atom(Atom::Coord(s as u32));
@@ -365,7 +376,11 @@ impl Ctx<'_> {
     }
 
     fn axis(&mut self, l: usize) -> V3 {
-        let e = self.model.links[l].joint.as_ref().map(|j| j.axis).unwrap_or([0.0; 3]);
+        let e = self.model.links[l]
+            .joint
+            .as_ref()
+            .map(|j| j.axis)
+            .unwrap_or([0.0; 3]);
         self.consts(e)
     }
 
@@ -396,7 +411,9 @@ impl Ctx<'_> {
         let b = self.ar.product([half, yy, l2, r_2]);
         let c = self.ar.mul(two, zz);
         let kp = self.ar.sum([a, b, c]);
-        let kp = self.ar.subst(kp, VarKind::D, "wheels: mw L^2/2 + YYw L^2/(2R^2) + 2 ZZw");
+        let kp = self
+            .ar
+            .subst(kp, VarKind::D, "wheels: mw L^2/2 + YYw L^2/(2R^2) + 2 ZZw");
         Some((w.x_speed, kx, w.psi_speed, kp))
     }
 
@@ -434,7 +451,9 @@ impl Ctx<'_> {
                 let labels = ["xx", "xy", "xz", "yy", "yz", "zz"];
                 let mut out = j;
                 for (k, x) in out.iter_mut().enumerate() {
-                    *x = self.ar.subst(*x, VarKind::D, &format!("JC{name}.{}", labels[k]));
+                    *x = self
+                        .ar
+                        .subst(*x, VarKind::D, &format!("JC{name}.{}", labels[k]));
                 }
                 out
             });
@@ -465,7 +484,11 @@ impl Ctx<'_> {
                         let terms: Vec<ExprId> =
                             (0..3).map(|k| self.ar.mul(jm[a][k], r[b][k])).collect();
                         let s = self.ar.sum(terms);
-                        *x = self.ar.subst(s, VarKind::D, &format!("JC{name}·Aᵀ({},{})", a + 1, b + 1));
+                        *x = self.ar.subst(
+                            s,
+                            VarKind::D,
+                            &format!("JC{name}·Aᵀ({},{})", a + 1, b + 1),
+                        );
                     }
                 }
                 let idx = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
@@ -474,7 +497,8 @@ impl Ctx<'_> {
                 let two_pu = self.ar.scale(pu, 2.0);
                 let pp = self.dot(&p, &p);
                 for (k, &(a, b)) in idx.iter().enumerate() {
-                    let terms: Vec<ExprId> = (0..3).map(|i| self.ar.mul(r[a][i], t[i][b])).collect();
+                    let terms: Vec<ExprId> =
+                        (0..3).map(|i| self.ar.mul(r[a][i], t[i][b])).collect();
                     let rjr = self.ar.sum(terms);
                     let upa = self.ar.mul(u[a], p[b]);
                     let pua = self.ar.mul(p[a], u[b]);
@@ -503,9 +527,9 @@ impl Ctx<'_> {
         comp[0] = Composite {
             mass: self.ar.subst(root.mass, VarKind::D, &format!("mC{name}")),
             first_moment: self.subst3(root.first_moment, VarKind::D, &format!("MSC{name}")),
-            inertia: root.inertia.map(|j| {
-                j.map(|x| self.ar.subst(x, VarKind::D, &format!("JC{name}")))
-            }),
+            inertia: root
+                .inertia
+                .map(|j| j.map(|x| self.ar.subst(x, VarKind::D, &format!("JC{name}")))),
         };
         comp
     }
@@ -710,7 +734,11 @@ impl Ctx<'_> {
             let p = self.position(l);
             let e = self.axis(l);
             let wi = self.rot_down(&r, &w[i]);
-            let wi = self.subst3(wi, VarKind::K, &format!("w{} in {name}{tag}", self.link_name(i)));
+            let wi = self.subst3(
+                wi,
+                VarKind::K,
+                &format!("w{} in {name}{tag}", self.link_name(i)),
+            );
             let wdi = self.rot_down(&r, &wd[i]);
             let (wj, wdj, extra_a) = match (joint.kind, joint.speed) {
                 (JointKind::Revolute, Some(s)) => {
@@ -741,12 +769,20 @@ impl Ctx<'_> {
             wd[l] = self.subst3(wdj, VarKind::K, &format!("wd{name}{tag}"));
             // a_j = jAi (a_i + α_i × P + ω_i × (ω_i × P)) (+ prismatic terms)
             let wxp = self.cross(&w[i], &p);
-            let wxp = self.subst3(wxp, VarKind::K, &format!("w{}xP{name}{tag}", self.link_name(i)));
+            let wxp = self.subst3(
+                wxp,
+                VarKind::K,
+                &format!("w{}xP{name}{tag}", self.link_name(i)),
+            );
             let t1 = self.cross(&wd[i], &p);
             let t2 = self.cross(&w[i], &wxp);
             let t = self.add3(&a[i], &t1);
             let t = self.add3(&t, &t2);
-            let t = self.subst3(t, VarKind::K, &format!("a{name} in {}{tag}", self.link_name(i)));
+            let t = self.subst3(
+                t,
+                VarKind::K,
+                &format!("a{name} in {}{tag}", self.link_name(i)),
+            );
             let aj = self.rot_down(&r, &t);
             let aj = self.add3(&aj, &extra_a);
             a[l] = self.subst3(aj, VarKind::K, &format!("a{name}{tag}"));
@@ -755,7 +791,9 @@ impl Ctx<'_> {
         let mut f: Vec<V3> = vec![[zero; 3]; links];
         let mut n: Vec<V3> = vec![[zero; 3]; links];
         for l in 0..links {
-            let Some((m, ms, j)) = self.body(l) else { continue };
+            let Some((m, ms, j)) = self.body(l) else {
+                continue;
+            };
             let name = self.link_name(l).to_owned();
             let wxms = self.cross(&w[l], &ms);
             let wxms = self.subst3(wxms, VarKind::D, &format!("w{name}xMS{name}{tag}"));
@@ -825,8 +863,17 @@ impl Derivation {
     /// Evaluate function `name` numerically from the symbolic expressions (no code generation):
     /// a dense row-major `n × n` matrix (both triangles) or an `n`-vector. Parameter values are
     /// used in [`ParamMode::Runtime`]; in baked mode the model's values are already folded in.
-    pub fn evaluate(&self, name: &str, params: &[f64], q: &[f64], u: &[f64], ud: &[f64]) -> Vec<f64> {
-        let f = self.function(name).unwrap_or_else(|| panic!("no function `{name}`"));
+    pub fn evaluate(
+        &self,
+        name: &str,
+        params: &[f64],
+        q: &[f64],
+        u: &[f64],
+        ud: &[f64],
+    ) -> Vec<f64> {
+        let f = self
+            .function(name)
+            .unwrap_or_else(|| panic!("no function `{name}`"));
         let vals = self.arena.eval(&crate::expr::Values { params, q, u, ud });
         let n = self.dof;
         match f.shape {

@@ -47,7 +47,9 @@ pub enum Error {
     #[error(transparent)]
     Emit(#[from] emit::EmitError),
     /// The build script environment lacks `OUT_DIR`.
-    #[error("OUT_DIR is not set: Builder::build must run inside a cargo build script (or call Builder::out_dir)")]
+    #[error(
+        "OUT_DIR is not set: Builder::build must run inside a cargo build script (or call Builder::out_dir)"
+    )]
     NoOutDir,
 }
 
@@ -221,7 +223,12 @@ pub fn stats(g: &Generated) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let d = &g.derivation;
-    let k = d.arena.vars().iter().filter(|v| v.kind == expr::VarKind::K).count();
+    let k = d
+        .arena
+        .vars()
+        .iter()
+        .filter(|v| v.kind == expr::VarKind::K)
+        .count();
     let dv = d.arena.vars().len() - k;
     let _ = writeln!(
         s,

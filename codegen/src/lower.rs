@@ -248,7 +248,11 @@ impl Builder<'_> {
 ///
 /// Returns the statement nodes in topological order: variable definitions (each labelled by its
 /// variable) and common subexpressions.
-fn schedule(ar: &Arena, roots: &[ExprId], is_leaf: &dyn Fn(ExprId) -> bool) -> Vec<(ExprId, Option<u32>)> {
+fn schedule(
+    ar: &Arena,
+    roots: &[ExprId],
+    is_leaf: &dyn Fn(ExprId) -> bool,
+) -> Vec<(ExprId, Option<u32>)> {
     // Reachability with parent counting; a variable is a leaf whose definition is a new root.
     let mut uses: HashMap<ExprId, usize> = HashMap::new();
     let mut seen: BTreeSet<ExprId> = BTreeSet::new();
@@ -485,9 +489,18 @@ impl Lowered {
     }
 
     /// Evaluate function `name`; dense row-major matrix (both triangles) or vector.
-    pub fn evaluate(&self, name: &str, params: &[f64], q: &[f64], u: &[f64], ud: &[f64]) -> Vec<f64> {
+    pub fn evaluate(
+        &self,
+        name: &str,
+        params: &[f64],
+        q: &[f64],
+        u: &[f64],
+        ud: &[f64],
+    ) -> Vec<f64> {
         let pre = self.precompute_values(params);
-        let p = self.function(name).unwrap_or_else(|| panic!("no function `{name}`"));
+        let p = self
+            .function(name)
+            .unwrap_or_else(|| panic!("no function `{name}`"));
         let locals = run(p, params, &pre, q, u, ud);
         let n = self.dof;
         let ctx = EvalCtx {
@@ -545,7 +558,9 @@ impl EvalCtx<'_> {
             LExpr::Sum { constant, terms } => terms
                 .iter()
                 .fold(*constant, |acc, (k, t)| acc + k * self.eval(t)),
-            LExpr::Prod(f) => f.iter().fold(1.0, |acc, (b, p)| acc * self.eval(b).powi(*p)),
+            LExpr::Prod(f) => f
+                .iter()
+                .fold(1.0, |acc, (b, p)| acc * self.eval(b).powi(*p)),
         }
     }
 }

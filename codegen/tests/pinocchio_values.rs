@@ -9,12 +9,19 @@ fn root() -> std::path::PathBuf {
 }
 
 fn vecf(v: &serde_json::Value) -> Vec<f64> {
-    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
 }
 
 fn rel_err(a: &[f64], b: &[f64]) -> f64 {
     let scale = b.iter().fold(1e-300f64, |m, x| m.max(x.abs()));
-    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        / scale
 }
 
 #[test]
@@ -26,35 +33,72 @@ fn symbolic_krang_matches_pinocchio_reference_values() {
     };
     let json: serde_json::Value = serde_json::from_str(&text).unwrap();
     let model = Model::from_toml_file(root().join("models/krang.toml")).unwrap();
-    let d = derive(&model, Options { params: ParamMode::Runtime });
+    let d = derive(
+        &model,
+        Options {
+            params: ParamMode::Runtime,
+        },
+    );
     let low = kanegen::lower::lower(&d);
     for f in &low.functions {
         eprintln!("{}: {} stmts, {}", f.name, f.stmts.len(), f.ops);
     }
-    eprintln!("precompute: {} stmts, {}", low.precompute.stmts.len(), low.precompute.ops);
+    eprintln!(
+        "precompute: {} stmts, {}",
+        low.precompute.stmts.len(),
+        low.precompute.ops
+    );
     for case in json["cases"].as_array().unwrap() {
         let mut params = model.param_values();
         for (k, v) in case["params"].as_object().unwrap() {
-            let i = model.param_index(k).unwrap_or_else(|| panic!("unknown {k}"));
+            let i = model
+                .param_index(k)
+                .unwrap_or_else(|| panic!("unknown {k}"));
             params[i] = v.as_f64().unwrap();
         }
         let q = vecf(&case["q"]);
         let u = vecf(&case["u"]);
         let ud = vecf(&case["ud"]);
         let z = vec![0.0; 19];
-        let m: Vec<f64> = case["M"].as_array().unwrap().iter().flat_map(vecf).collect();
+        let m: Vec<f64> = case["M"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(vecf)
+            .collect();
         let name = case["name"].as_str().unwrap();
         let em = rel_err(&d.evaluate("mass_matrix", &params, &q, &z, &z), &m);
-        let ec = rel_err(&d.evaluate("coriolis", &params, &q, &u, &z), &vecf(&case["c"]));
-        let eg = rel_err(&d.evaluate("gravity", &params, &q, &z, &z), &vecf(&case["g"]));
-        let et = rel_err(&d.evaluate("inverse_dynamics", &params, &q, &u, &ud), &vecf(&case["tau"]));
+        let ec = rel_err(
+            &d.evaluate("coriolis", &params, &q, &u, &z),
+            &vecf(&case["c"]),
+        );
+        let eg = rel_err(
+            &d.evaluate("gravity", &params, &q, &z, &z),
+            &vecf(&case["g"]),
+        );
+        let et = rel_err(
+            &d.evaluate("inverse_dynamics", &params, &q, &u, &ud),
+            &vecf(&case["tau"]),
+        );
         eprintln!("{name}: M {em:.2e} c {ec:.2e} g {eg:.2e} tau {et:.2e}");
         let lm = rel_err(&low.evaluate("mass_matrix", &params, &q, &z, &z), &m);
-        let lc = rel_err(&low.evaluate("coriolis", &params, &q, &u, &z), &vecf(&case["c"]));
-        let lg = rel_err(&low.evaluate("gravity", &params, &q, &z, &z), &vecf(&case["g"]));
-        let lt = rel_err(&low.evaluate("inverse_dynamics", &params, &q, &u, &ud), &vecf(&case["tau"]));
+        let lc = rel_err(
+            &low.evaluate("coriolis", &params, &q, &u, &z),
+            &vecf(&case["c"]),
+        );
+        let lg = rel_err(
+            &low.evaluate("gravity", &params, &q, &z, &z),
+            &vecf(&case["g"]),
+        );
+        let lt = rel_err(
+            &low.evaluate("inverse_dynamics", &params, &q, &u, &ud),
+            &vecf(&case["tau"]),
+        );
         eprintln!("{name} (lowered): M {lm:.2e} c {lc:.2e} g {lg:.2e} tau {lt:.2e}");
-        assert!(lm < 1e-9 && lc < 1e-9 && lg < 1e-9 && lt < 1e-9, "{name} lowered");
+        assert!(
+            lm < 1e-9 && lc < 1e-9 && lg < 1e-9 && lt < 1e-9,
+            "{name} lowered"
+        );
         assert!(em < 1e-9 && ec < 1e-9 && eg < 1e-9 && et < 1e-9, "{name}");
     }
 }

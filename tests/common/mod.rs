@@ -28,7 +28,10 @@ pub fn shared(rel: &str) -> Option<PathBuf> {
 pub fn rel_err(a: &[f64], b: &[f64], floor: f64) -> f64 {
     assert_eq!(a.len(), b.len());
     let scale = b.iter().fold(floor, |m, x| m.max(x.abs()));
-    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        / scale
 }
 
 /// A deterministic uniform source.
@@ -53,12 +56,16 @@ pub fn sv<const N: usize>(v: &[f64]) -> SVector<f64, N> {
 
 /// Column-major data of a fixed-size matrix as a row-major Vec (to compare with DMatrix).
 pub fn rows<const N: usize>(m: &SMatrix<f64, N, N>) -> Vec<f64> {
-    (0..N).flat_map(|r| (0..N).map(move |c| m[(r, c)])).collect()
+    (0..N)
+        .flat_map(|r| (0..N).map(move |c| m[(r, c)]))
+        .collect()
 }
 
 /// Row-major data of a dynamic matrix.
 pub fn drows(m: &DMatrix<f64>) -> Vec<f64> {
-    (0..m.nrows()).flat_map(|r| (0..m.ncols()).map(move |c| m[(r, c)])).collect()
+    (0..m.nrows())
+        .flat_map(|r| (0..m.ncols()).map(move |c| m[(r, c)]))
+        .collect()
 }
 
 /// Data of a dynamic vector.
@@ -76,12 +83,35 @@ pub fn dvec(v: &DVector<f64>) -> Vec<f64> {
 pub fn hardware_fitted_params(model: &Model) -> Option<Vec<f64>> {
     let path = shared("krang/params/convergedBetaVector104PosesHardwareTrained.txt")?;
     let text = std::fs::read_to_string(path).ok()?;
-    let beta: Vec<f64> = text.split_whitespace().map(|t| t.parse().unwrap()).collect();
+    let beta: Vec<f64> = text
+        .split_whitespace()
+        .map(|t| t.parse().unwrap())
+        .collect();
     assert_eq!(beta.len(), 92, "23 bodies × [m, MX, MY, MZ]");
     let bodies = [
-        Some("1"), None, None, Some("2"), Some("3"),
-        Some("4l"), Some("5l"), Some("6l"), Some("7l"), Some("8l"), Some("9l"), Some("10l"), None, None,
-        Some("4r"), Some("5r"), Some("6r"), Some("7r"), Some("8r"), Some("9r"), Some("10r"), None, None,
+        Some("1"),
+        None,
+        None,
+        Some("2"),
+        Some("3"),
+        Some("4l"),
+        Some("5l"),
+        Some("6l"),
+        Some("7l"),
+        Some("8l"),
+        Some("9l"),
+        Some("10l"),
+        None,
+        None,
+        Some("4r"),
+        Some("5r"),
+        Some("6r"),
+        Some("7r"),
+        Some("8r"),
+        Some("9r"),
+        Some("10r"),
+        None,
+        None,
     ];
     let mut p = model.param_values();
     for (k, b) in bodies.iter().enumerate() {

@@ -44,3 +44,9 @@ pub mod fixed_wheels {
 pub mod two_link {
     include!(concat!(env!("OUT_DIR"), "/two_link.rs"));
 }
+
+pub mod forward;
+pub use forward::{Block, MassMatrixCholesky, NotPositiveDefinite, solve_spd};
+
+pub mod actuators;
+pub use actuators::{ACTUATOR_COUNT, ACTUATOR_NAMES, actuator, hardware, saturate, saturate_to};

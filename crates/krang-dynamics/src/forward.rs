@@ -1,0 +1,383 @@
+//! Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))`, allocation-free.
+//!
+//! Krang's mass matrix has a fixed sparsity pattern: the five trunk speeds
+//! `[ẋ, ψ̇, q̇_imu, q̇_w, q̇_torso]` (indices `0..5`) couple to everything, but the left arm
+//! (`5..12`) and the right arm (`12..19`) do not couple to each other: `M[left, right] = 0`
+//! exactly (no body's motion depends on both arms; the generated code never writes those
+//! 98 entries). [`MassMatrixCholesky`] orders the factorisation arms first, so that
+//!
+//! ```text
+//!          ⎡ A_l   0     B_lᵀ  ⎤               ⎡ L_l   0     0     ⎤
+//! P M Pᵀ = ⎢ 0     A_r   B_rᵀ  ⎥ = L Lᵀ,   L = ⎢ 0     L_r   0     ⎥,
+//!          ⎣ B_l   B_r   T     ⎦               ⎣ W_lᵀ  W_rᵀ  L_s   ⎦
+//! ```
+//!
+//! with `A = L Lᵀ` per arm (7×7), `W = L⁻¹ Bᵀ` (7×5) and `L_s` the Cholesky factor of the
+//! 5×5 Schur complement `S = T − W_lᵀ W_l − W_rᵀ W_r`. There is no fill-in: the zero block
+//! stays zero, and the work is two 7×7 and one 5×5 factorisation plus two 7×7 triangular
+//! solves with five right-hand sides: about a third of the flops of a dense 19×19 Cholesky
+//! and solve.
+//! Everything is fixed-size nalgebra on the stack; nothing allocates and nothing panics.
+//!
+//! The fixed-wheel model (17 speeds) uses the generic dense fallback [`solve_spd`].
+
+use core::fmt;
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::Krang;
+use crate::fixed_wheels::KrangFixedWheels;
+
+/// Indices of the trunk speeds `[ẋ, ψ̇, q̇_imu, q̇_w, q̇_torso]` in `u`.
+pub const TRUNK: core::ops::Range<usize> = 0..5;
+/// Indices of the left-arm speeds `q̇_1l … q̇_7l` in `u`.
+pub const LEFT_ARM: core::ops::Range<usize> = 5..12;
+/// Indices of the right-arm speeds `q̇_1r … q̇_7r` in `u`.
+pub const RIGHT_ARM: core::ops::Range<usize> = 12..19;
+
+/// The diagonal block whose factorisation broke down.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Block {
+    /// The left-arm block `M[5..12, 5..12]`.
+    LeftArm,
+    /// The right-arm block `M[12..19, 12..19]`.
+    RightArm,
+    /// The Schur complement onto the trunk block `M[0..5, 0..5]`.
+    Trunk,
+    /// The whole matrix (dense factorisation, [`solve_spd`]).
+    Dense,
+}
+
+/// The mass matrix is not (numerically) positive definite.
+///
+/// With physical parameters M is always symmetric positive definite; this happens with
+/// non-physical parameter sets (negative masses, as in the hardware-trained beta vector),
+/// or with non-finite `q`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct NotPositiveDefinite {
+    /// Where the factorisation failed.
+    pub block: Block,
+}
+
+impl fmt::Display for NotPositiveDefinite {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let what = match self.block {
+            Block::LeftArm => "left-arm block",
+            Block::RightArm => "right-arm block",
+            Block::Trunk => "trunk Schur complement",
+            Block::Dense => "matrix",
+        };
+        write!(f, "mass matrix is not positive definite ({what})")
+    }
+}
+
+impl std::error::Error for NotPositiveDefinite {}
+
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+// The factors are kept as upper-triangular `U = Lᵀ` in nalgebra's column-major storage, so
+// that every inner loop below runs over a contiguous column prefix.
+
+/// Upper Cholesky factor `U` (`A = Uᵀ U`) of an N×N symmetric positive definite matrix;
+/// reads the lower triangle of `A` only. The strict lower triangle of `U` is zero.
+#[inline]
+fn cholesky_upper<const N: usize>(a: &SMatrix<f64, N, N>) -> Option<SMatrix<f64, N, N>> {
+    let mut u = SMatrix::<f64, N, N>::zeros();
+    let s = u.as_mut_slice();
+    for j in 0..N {
+        let cj = j * N;
+        let d = a[(j, j)] - dot(&s[cj..cj + j], &s[cj..cj + j]);
+        if d.is_nan() || d <= 0.0 {
+            return None;
+        }
+        let ujj = d.sqrt();
+        s[cj + j] = ujj;
+        for i in j + 1..N {
+            let ci = i * N;
+            let v = (a[(i, j)] - dot(&s[cj..cj + j], &s[ci..ci + j])) / ujj;
+            s[ci + j] = v;
+        }
+    }
+    Some(u)
+}
+
+/// `b ← U⁻ᵀ b` (= `L⁻¹ b`), column by column.
+#[inline]
+fn forward_subst<const N: usize, const C: usize>(
+    u: &SMatrix<f64, N, N>,
+    b: &mut SMatrix<f64, N, C>,
+) {
+    let us = u.as_slice();
+    for col in b.as_mut_slice().chunks_exact_mut(N) {
+        for i in 0..N {
+            let ci = i * N;
+            col[i] = (col[i] - dot(&us[ci..ci + i], &col[..i])) / us[ci + i];
+        }
+    }
+}
+
+/// `b ← U⁻¹ b` (= `L⁻ᵀ b`).
+#[inline]
+fn backward_subst<const N: usize>(u: &SMatrix<f64, N, N>, b: &mut SVector<f64, N>) {
+    let us = u.as_slice();
+    let y = b.as_mut_slice();
+    for i in (0..N).rev() {
+        let ci = i * N;
+        let xi = y[i] / us[ci + i];
+        y[i] = xi;
+        for (yk, uki) in y[..i].iter_mut().zip(&us[ci..ci + i]) {
+            *yk -= uki * xi;
+        }
+    }
+}
+
+/// Block Cholesky factorisation of Krang's 19×19 mass matrix, arms first (see the
+/// [module docs](self)). Fixed size, `Copy`, no heap.
+///
+/// Reuse one factorisation for several right-hand sides (e.g. `M⁻¹ Jᵀ` in an
+/// operational-space controller) with [`solve`](Self::solve).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MassMatrixCholesky {
+    /// `U_l = L_lᵀ` (upper).
+    u_left: SMatrix<f64, 7, 7>,
+    /// `U_r = L_rᵀ` (upper).
+    u_right: SMatrix<f64, 7, 7>,
+    /// `W_l = L_l⁻¹ M[left, trunk]`.
+    w_left: SMatrix<f64, 7, 5>,
+    /// `W_r = L_r⁻¹ M[right, trunk]`.
+    w_right: SMatrix<f64, 7, 5>,
+    /// `U_s = L_sᵀ` (upper), the factor of the Schur complement.
+    u_trunk: SMatrix<f64, 5, 5>,
+}
+
+impl MassMatrixCholesky {
+    /// Factorises `m`, reading its lower triangle only and assuming `M[left, right] = 0`
+    /// (exactly true of Krang's generated mass matrix; entries there are ignored).
+    ///
+    /// # Errors
+    /// [`NotPositiveDefinite`] if a pivot is not positive (or is NaN).
+    pub fn new(m: &SMatrix<f64, 19, 19>) -> Result<Self, NotPositiveDefinite> {
+        let a_left: SMatrix<f64, 7, 7> = m.fixed_view::<7, 7>(5, 5).into_owned();
+        let a_right: SMatrix<f64, 7, 7> = m.fixed_view::<7, 7>(12, 12).into_owned();
+        let u_left = cholesky_upper(&a_left).ok_or(NotPositiveDefinite {
+            block: Block::LeftArm,
+        })?;
+        let u_right = cholesky_upper(&a_right).ok_or(NotPositiveDefinite {
+            block: Block::RightArm,
+        })?;
+        // W = L⁻¹ M[arm, trunk] (the lower-triangle blocks).
+        let mut w_left: SMatrix<f64, 7, 5> = m.fixed_view::<7, 5>(5, 0).into_owned();
+        let mut w_right: SMatrix<f64, 7, 5> = m.fixed_view::<7, 5>(12, 0).into_owned();
+        forward_subst(&u_left, &mut w_left);
+        forward_subst(&u_right, &mut w_right);
+        // Schur complement S = T − W_lᵀ W_l − W_rᵀ W_r (lower triangle is enough).
+        let mut s: SMatrix<f64, 5, 5> = m.fixed_view::<5, 5>(0, 0).into_owned();
+        let (wl, wr) = (w_left.as_slice(), w_right.as_slice());
+        for j in 0..5 {
+            let (lj, rj) = (&wl[7 * j..7 * j + 7], &wr[7 * j..7 * j + 7]);
+            for i in j..5 {
+                let (li, ri) = (&wl[7 * i..7 * i + 7], &wr[7 * i..7 * i + 7]);
+                s[(i, j)] -= dot(li, lj) + dot(ri, rj);
+            }
+        }
+        let u_trunk = cholesky_upper(&s).ok_or(NotPositiveDefinite {
+            block: Block::Trunk,
+        })?;
+        Ok(Self {
+            u_left,
+            u_right,
+            w_left,
+            w_right,
+            u_trunk,
+        })
+    }
+
+    /// `x = M⁻¹ b`.
+    #[inline]
+    pub fn solve(&self, b: &SVector<f64, 19>) -> SVector<f64, 19> {
+        let mut x = *b;
+        self.solve_mut(&mut x);
+        x
+    }
+
+    /// `b ← M⁻¹ b`, in place.
+    pub fn solve_mut(&self, b: &mut SVector<f64, 19>) {
+        let mut y_left: SVector<f64, 7> = b.fixed_rows::<7>(5).into_owned();
+        let mut y_right: SVector<f64, 7> = b.fixed_rows::<7>(12).into_owned();
+        let mut y_trunk: SVector<f64, 5> = b.fixed_rows::<5>(0).into_owned();
+        // Forward: L y = b.
+        forward_subst(&self.u_left, &mut y_left);
+        forward_subst(&self.u_right, &mut y_right);
+        y_trunk -= self.w_left.tr_mul(&y_left) + self.w_right.tr_mul(&y_right);
+        forward_subst(&self.u_trunk, &mut y_trunk);
+        // Backward: Lᵀ x = y.
+        backward_subst(&self.u_trunk, &mut y_trunk);
+        y_left -= self.w_left * y_trunk;
+        y_right -= self.w_right * y_trunk;
+        backward_subst(&self.u_left, &mut y_left);
+        backward_subst(&self.u_right, &mut y_right);
+        b.fixed_rows_mut::<5>(0).copy_from(&y_trunk);
+        b.fixed_rows_mut::<7>(5).copy_from(&y_left);
+        b.fixed_rows_mut::<7>(12).copy_from(&y_right);
+    }
+
+    /// The factor `L` in the original speed order: `M = L Lᵀ` with `L` lower triangular
+    /// after the permutation `[left arm, right arm, trunk]` (for inspection and tests).
+    pub fn factor(&self) -> SMatrix<f64, 19, 19> {
+        let mut l = SMatrix::<f64, 19, 19>::zeros();
+        l.fixed_view_mut::<7, 7>(5, 5)
+            .copy_from(&self.u_left.transpose());
+        l.fixed_view_mut::<7, 7>(12, 12)
+            .copy_from(&self.u_right.transpose());
+        l.fixed_view_mut::<5, 7>(0, 5)
+            .copy_from(&self.w_left.transpose());
+        l.fixed_view_mut::<5, 7>(0, 12)
+            .copy_from(&self.w_right.transpose());
+        l.fixed_view_mut::<5, 5>(0, 0)
+            .copy_from(&self.u_trunk.transpose());
+        l
+    }
+
+    /// `det M`, the product of the squared diagonal of `L`.
+    pub fn determinant(&self) -> f64 {
+        let mut d = 1.0;
+        for i in 0..7 {
+            d *= self.u_left[(i, i)] * self.u_right[(i, i)];
+        }
+        for i in 0..5 {
+            d *= self.u_trunk[(i, i)];
+        }
+        d * d
+    }
+}
+
+/// Generic dense fallback: `x = A⁻¹ b` for a symmetric positive definite `A` (any fixed
+/// size) by a Cholesky factorisation of the lower triangle. Allocation-free.
+///
+/// # Errors
+/// [`NotPositiveDefinite`] (`block: Block::Dense`) if a pivot is not positive (or is NaN).
+pub fn solve_spd<const N: usize>(
+    a: &SMatrix<f64, N, N>,
+    b: &SVector<f64, N>,
+) -> Result<SVector<f64, N>, NotPositiveDefinite> {
+    let u = cholesky_upper(a).ok_or(NotPositiveDefinite {
+        block: Block::Dense,
+    })?;
+    let mut x = *b;
+    forward_subst(&u, &mut x);
+    backward_subst(&u, &mut x);
+    Ok(x)
+}
+
+impl Krang {
+    /// The block Cholesky factorisation of `M(q)` ([`MassMatrixCholesky`]).
+    ///
+    /// # Errors
+    /// [`NotPositiveDefinite`] for non-physical parameters.
+    #[inline]
+    pub fn mass_matrix_cholesky(
+        &self,
+        q: &SVector<f64, 19>,
+    ) -> Result<MassMatrixCholesky, NotPositiveDefinite> {
+        MassMatrixCholesky::new(&self.mass_matrix(q))
+    }
+
+    /// Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))`.
+    ///
+    /// `tau` are the generalized active forces other than gravity (see
+    /// [`Krang::generalized_forces`] for the map from wheel and joint torques). `c + g` comes
+    /// from one generated inverse-dynamics pass with `u̇ = 0`; `M` is factorised by
+    /// [`MassMatrixCholesky`]. Allocation-free.
+    ///
+    /// # Errors
+    /// [`NotPositiveDefinite`] for non-physical parameters.
+    pub fn try_forward_dynamics(
+        &self,
+        q: &SVector<f64, 19>,
+        u: &SVector<f64, 19>,
+        tau: &SVector<f64, 19>,
+    ) -> Result<SVector<f64, 19>, NotPositiveDefinite> {
+        let bias = self.inverse_dynamics(q, u, &SVector::zeros());
+        let chol = self.mass_matrix_cholesky(q)?;
+        Ok(chol.solve(&(tau - bias)))
+    }
+
+    /// Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))`, as
+    /// [`try_forward_dynamics`](Self::try_forward_dynamics) but infallible: if `M(q)` is not
+    /// positive definite (non-physical parameters) every entry of the result is NaN.
+    ///
+    /// ```
+    /// use krang_dynamics::{Krang, index};
+    /// use nalgebra::SVector;
+    ///
+    /// let k = Krang::default();
+    /// let mut q = SVector::<f64, 19>::zeros();
+    /// q[index::Q_IMU] = 0.3;
+    /// let u = SVector::<f64, 19>::from_element(0.1);
+    /// let tau = SVector::<f64, 19>::zeros();
+    /// let ud = k.forward_dynamics(&q, &u, &tau);
+    /// let back = k.inverse_dynamics(&q, &u, &ud);
+    /// assert!((back - tau).norm() < 1e-9);
+    /// ```
+    #[inline]
+    pub fn forward_dynamics(
+        &self,
+        q: &SVector<f64, 19>,
+        u: &SVector<f64, 19>,
+        tau: &SVector<f64, 19>,
+    ) -> SVector<f64, 19> {
+        self.try_forward_dynamics(q, u, tau)
+            .unwrap_or_else(|_| SVector::from_element(f64::NAN))
+    }
+}
+
+impl Krang {
+    /// The base pitch `q_imu` that puts the centre of mass above the axle, for the waist,
+    /// torso and arm angles of `q` (the balancing equilibrium; `q[Q_IMU]` is ignored).
+    ///
+    /// All bodies rotate rigidly with `q_imu` about the axle, so the potential energy is
+    /// `V = A cos q_imu + B sin q_imu + C` and `g_imu = ∂V/∂q_imu = −A sin q_imu + B cos q_imu`.
+    /// Two gravity evaluations give `B = g_imu(0)` and `A = −g_imu(π/2)`; the maximum of `V`
+    /// (centre of mass above, not below, the axle) is at `atan2(B, A)`. Exact, no iteration.
+    pub fn upright_pitch(&self, q: &SVector<f64, 19>) -> f64 {
+        let mut q = *q;
+        q[crate::index::Q_IMU] = 0.0;
+        let b = self.gravity(&q)[crate::index::Q_IMU];
+        q[crate::index::Q_IMU] = core::f64::consts::FRAC_PI_2;
+        let a = -self.gravity(&q)[crate::index::Q_IMU];
+        b.atan2(a)
+    }
+}
+
+impl KrangFixedWheels {
+    /// Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))` of the fixed-wheel model, by the
+    /// dense fallback [`solve_spd`] (17×17 Cholesky). Allocation-free.
+    ///
+    /// # Errors
+    /// [`NotPositiveDefinite`] for non-physical parameters.
+    pub fn try_forward_dynamics(
+        &self,
+        q: &SVector<f64, 17>,
+        u: &SVector<f64, 17>,
+        tau: &SVector<f64, 17>,
+    ) -> Result<SVector<f64, 17>, NotPositiveDefinite> {
+        let bias = self.inverse_dynamics(q, u, &SVector::zeros());
+        solve_spd(&self.mass_matrix(q), &(tau - bias))
+    }
+
+    /// As [`try_forward_dynamics`](Self::try_forward_dynamics), but NaN-filled instead of an
+    /// error.
+    #[inline]
+    pub fn forward_dynamics(
+        &self,
+        q: &SVector<f64, 17>,
+        u: &SVector<f64, 17>,
+        tau: &SVector<f64, 17>,
+    ) -> SVector<f64, 17> {
+        self.try_forward_dynamics(q, u, tau)
+            .unwrap_or_else(|_| SVector::from_element(f64::NAN))
+    }
+}

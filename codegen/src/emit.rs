@@ -286,7 +286,7 @@ fn function(model: &Model, low: &Lowered, pre: &[String], p: &Program) -> TokenS
         let sn = ident(&format!("s_{}", model.speeds[s].coordinate));
         let cn = ident(&format!("c_{}", model.speeds[s].coordinate));
         let sl = idx(s);
-        prologue.extend(quote!(let (#sn, #cn) = q[#sl].sin_cos();));
+        prologue.extend(quote!(let (#sn, #cn) = sin_cos(q[#sl]);));
     }
     for s in 0..n {
         if uses(p, &|l| *l == Leaf::Coord(s)) {
@@ -600,8 +600,13 @@ pub fn emit(model: &Model, low: &Lowered) -> Result<String, EmitError> {
             quote!(#[doc = #doc] pub const #id: usize = #i;)
         })
         .collect();
+    let trig: TokenStream = crate::trig::SIN_COS_SOURCE
+        .parse()
+        .expect("the sin_cos routine is valid Rust");
     let mut items = quote! {
         use nalgebra::{SMatrix, SVector};
+
+        #trig
 
         /// Number of generalized speeds (and coordinates).
         pub const DOF: usize = #nl;

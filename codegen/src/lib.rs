@@ -28,6 +28,7 @@ pub mod emit;
 pub mod expr;
 pub mod kane;
 pub mod lower;
+pub mod trig;
 /// The robot description IR and its loaders (re-exported from `kanegen-model`).
 pub mod model {
     pub use kanegen_model::*;

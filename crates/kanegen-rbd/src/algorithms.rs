@@ -8,96 +8,21 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::scalar::{
-    M3, S3, V3, add, add6, cross, dot, inertia_shift, mat_mul, rot, rot_t, scale, sym_mul, sym_rot,
-    sym_rot_z,
-};
-use crate::{LinkData, ROOT, Rbd, Scalar};
-
-/// The joint transform child → parent at the current `q`: `R = A' Rot_z(q)` is never formed;
-/// `A'` is applied as a signed permutation when it is one (all of Krang), else as a matrix.
-impl<T: Scalar> LinkData<T> {
-    /// `A' y`.
-    #[inline(always)]
-    fn a_mul(&self, y: V3<T>) -> V3<T> {
-        match &self.perm {
-            Some(p) => p.apply(y),
-            None => rot(&self.a, y),
-        }
-    }
-
-    /// `A'ᵀ y`.
-    #[inline(always)]
-    fn at_mul(&self, y: V3<T>) -> V3<T> {
-        match &self.perm {
-            Some(p) => p.apply_t(y),
-            None => rot_t(&self.a, y),
-        }
-    }
-
-    /// `R x` (child frame → parent frame), given `s = sin q`, `c = cos q`.
-    #[inline(always)]
-    fn up(&self, s: T, c: T, x: V3<T>) -> V3<T> {
-        self.a_mul([c * x[0] - s * x[1], s * x[0] + c * x[1], x[2]])
-    }
-
-    /// `Rᵀ x` (parent frame → child frame).
-    #[inline(always)]
-    fn down(&self, s: T, c: T, x: V3<T>) -> V3<T> {
-        let y = self.at_mul(x);
-        [c * y[0] + s * y[1], c * y[1] - s * y[0], y[2]]
-    }
-
-    /// `W R` for a column-stored `W`.
-    #[inline(always)]
-    fn right_mul(&self, s: T, c: T, w: &M3<T>) -> M3<T> {
-        let x = match &self.perm {
-            Some(p) => p.right_mul(w),
-            None => mat_mul(w, &self.a),
-        };
-        [
-            add(scale(x[0], c), scale(x[1], s)),
-            add(scale(x[1], c), scale(x[0], -s)),
-            x[2],
-        ]
-    }
-
-    /// `R J Rᵀ` for a symmetric `J`.
-    #[inline(always)]
-    fn sym_to_parent(&self, s: T, c: T, j: &S3<T>) -> S3<T> {
-        let jz = sym_rot_z(j, c, s);
-        match &self.perm {
-            Some(p) => p.apply_sym(&jz),
-            None => sym_rot(&self.a, &jz),
-        }
-    }
-
-    /// The translation `p' (+ A' ẑ q for a prismatic joint)`.
-    #[inline(always)]
-    fn trans<const N: usize>(&self, q: &SVector<T, N>) -> V3<T> {
-        if self.prismatic {
-            add(self.p, scale(self.a[2], q[self.speed]))
-        } else {
-            self.p
-        }
-    }
-}
+use crate::scalar::{V3, add, add6, cross, dot, inertia_shift, rot, scale, sym_mul};
+use crate::{ROOT, Rbd, Scalar};
 
 impl<const N: usize, T: Scalar> Rbd<N, T> {
-    /// `sin q_j` and `cos q_j` of every revolute joint (`0`, `1` for prismatic joints),
-    /// computed up front in one independent (vectorizable) batch.
+    /// `sin q_j` and `cos q_j` of every revolute joint (`0`, `1` for prismatic joints) into
+    /// `sn`, `cs`, computed up front in one independent (vectorizable) batch.
     #[inline(always)]
-    fn sin_cos_all(&self, q: &SVector<T, N>) -> ([T; N], [T; N]) {
+    fn sin_cos_all(&self, q: &SVector<T, N>, sn: &mut [T; N], cs: &mut [T; N]) {
         let mut x = [T::zero(); N];
         for (l, xj) in self.links[..self.nl].iter().zip(x.iter_mut()) {
             if !l.prismatic {
                 *xj = q[l.speed];
             }
         }
-        let mut s = [T::zero(); N];
-        let mut c = [T::zero(); N];
-        T::sin_cos_batch(&x, &mut s, &mut c);
-        (s, c)
+        T::sin_cos_batch(&x, sn, cs);
     }
 
     /// The joint-space inertia matrix `M(q)` (composite-rigid-body algorithm).
@@ -110,7 +35,9 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
         let o1 = T::one();
         let nl = self.nl;
         let mut mm = SMatrix::<T, N, N>::zeros();
-        let (sn, cs) = self.sin_cos_all(q);
+        let mut sn = [z; N];
+        let mut cs = [z; N];
+        self.sin_cos_all(q, &mut sn, &mut cs);
         // Rotation and origin of each link in frame 0; linear part (about the frame-0 origin)
         // of its motion subspace, whose angular part is `wr[j][2]` (revolute) or 0 (prismatic).
         let mut wr = [[[z; 3]; 3]; N];
@@ -130,7 +57,7 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
         let mut prev_o = [z; 3];
         for j in 0..nl {
             let l = &self.links[j];
-            let (s, c) = (sn[j], cs[j]);
+            let jr = l.jr(sn[j], cs[j]);
             let p = l.trans(q);
             let (pw, po) = if l.chain {
                 (prev_w, prev_o)
@@ -139,7 +66,7 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
             } else {
                 (wr[l.parent], wo[l.parent])
             };
-            let w = l.right_mul(s, c, &pw);
+            let w = l.right(&jr, &pw);
             let o = if l.offset { add(po, rot(&pw, p)) } else { po };
             let a = w[2];
             sw[j] = if l.prismatic {
@@ -190,10 +117,10 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
             carry_h = [z; 3];
             carry_j = [z; 6];
             if l.parent != ROOT || wheels.is_some() {
-                let (s, c) = (sn[j], cs[j]);
+                let jr = l.jr(sn[j], cs[j]);
                 let p = l.trans(q);
-                let hr = l.up(s, c, h);
-                let jr = l.sym_to_parent(s, c, &jj);
+                let hr = l.up(&jr, h);
+                let jrot = l.sym_up(&jr, &jj);
                 let (mcp, half) = if l.prismatic {
                     let mp = scale(p, l.mc);
                     (mp, scale(mp, nalgebra::convert(0.5)))
@@ -201,7 +128,7 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
                     (l.mc_p, l.half_mc_p)
                 };
                 let dh = add(hr, mcp);
-                let dj = add6(jr, inertia_shift(p, hr, half));
+                let dj = add6(jrot, inertia_shift(p, hr, half));
                 if l.chain {
                     carry_h = dh;
                     carry_j = dj;
@@ -234,7 +161,9 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
         let z = T::zero();
         let nl = self.nl;
         let mut tau = SVector::<T, N>::zeros();
-        let (sn, cs) = self.sin_cos_all(q);
+        let mut sn = [z; N];
+        let mut cs = [z; N];
+        self.sin_cos_all(q, &mut sn, &mut cs);
         let mut w = [[z; 3]; N];
         let mut al = [[z; 3]; N];
         let mut ac = [[z; 3]; N];
@@ -257,7 +186,7 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
         for j in 0..nl {
             let l = &self.links[j];
             let sj = l.speed;
-            let (s, c) = (sn[j], cs[j]);
+            let jr = l.jr(sn[j], cs[j]);
             let (wp, alp, ap) = if l.chain {
                 prev
             } else if l.parent == ROOT {
@@ -272,9 +201,9 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
             } else {
                 ap
             };
-            let ww = l.down(s, c, wp);
-            let aa = l.down(s, c, alp);
-            let mut acc = l.down(s, c, ap);
+            let ww = l.down(&jr, wp);
+            let aa = l.down(&jr, alp);
+            let mut acc = l.down(&jr, ap);
             let uj = u[sj];
             let udj = if UD { ud[sj] } else { z };
             let (om, alpha) = if l.prismatic {
@@ -326,9 +255,9 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
             if l.parent == ROOT && !wheeled {
                 continue;
             }
-            let (s, c) = (sn[j], cs[j]);
-            let fr = l.up(s, c, fj);
-            let mut nr = l.up(s, c, nj);
+            let jr = l.jr(sn[j], cs[j]);
+            let fr = l.up(&jr, fj);
+            let mut nr = l.up(&jr, nj);
             if l.offset {
                 nr = add(nr, cross(l.trans(q), fr));
             }
@@ -374,7 +303,9 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
         let z = T::zero();
         let nl = self.nl;
         let mut tau = SVector::<T, N>::zeros();
-        let (sn, cs) = self.sin_cos_all(q);
+        let mut sn = [z; N];
+        let mut cs = [z; N];
+        self.sin_cos_all(q, &mut sn, &mut cs);
         let mut ac = [[z; 3]; N];
         let mut ch = [[z; 3]; N];
         let g0 = self.root.grav;
@@ -388,7 +319,7 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
             } else {
                 ac[l.parent]
             };
-            let a = l.down(sn[j], cs[j], ap);
+            let a = l.down(&l.jr(sn[j], cs[j]), ap);
             ac[j] = a;
             ch[j] = l.h;
             prev = a;
@@ -414,7 +345,7 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
             } else {
                 l.mc_p
             };
-            let dh = add(l.up(sn[j], cs[j], h), mcp);
+            let dh = add(l.up(&l.jr(sn[j], cs[j]), h), mcp);
             if l.chain {
                 carry = dh;
             } else if l.parent == ROOT {
@@ -451,18 +382,20 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
             let (xd, psid) = (u[wh.x], u[wh.psi]);
             e2 += wh.m_xx * xd * xd + wh.m_psipsi * psid * psid;
         }
-        let (sn, cs) = self.sin_cos_all(q);
+        let mut sn = [z; N];
+        let mut cs = [z; N];
+        self.sin_cos_all(q, &mut sn, &mut cs);
         for j in 0..self.nl {
             let l = &self.links[j];
-            let (s, c) = (sn[j], cs[j]);
+            let jr = l.jr(sn[j], cs[j]);
             let p = l.trans(q);
             let (wp, vp) = if l.parent == ROOT {
                 (w0, v0)
             } else {
                 (w[l.parent], v[l.parent])
             };
-            let mut wj = l.down(s, c, wp);
-            let mut vj = l.down(s, c, add(vp, cross(wp, p)));
+            let mut wj = l.down(&jr, wp);
+            let mut vj = l.down(&jr, add(vp, cross(wp, p)));
             if l.prismatic {
                 vj[2] += u[l.speed];
             } else {

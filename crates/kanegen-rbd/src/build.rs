@@ -4,8 +4,9 @@
 use kanegen_model::{Base, JointKind, Model};
 use nalgebra::{Matrix3, Vector3};
 
+use crate::rot::RotKind;
 use crate::scalar::{M3, S3, Scalar, V3};
-use crate::{AncEntry, Axis, LinkData, ROOT, Rbd, RbdError, RootData, SignedPerm, Wheels};
+use crate::{AncEntry, Axis, LinkData, ROOT, Rbd, RbdError, RootData, Wheels};
 
 /// Classifies a unit axis.
 pub(crate) fn classify(e: [f64; 3]) -> Axis {
@@ -61,18 +62,6 @@ fn signed_perm(a: &Matrix3<f64>) -> Option<([usize; 3], [f64; 3])> {
         sign[r] = a[(r, nz[0])];
     }
     Some((idx, sign))
-}
-
-/// Position of `(a, b)` in `[xx, xy, xz, yy, yz, zz]`.
-fn sym_index(a: usize, b: usize) -> usize {
-    match (a.min(b), a.max(b)) {
-        (0, 0) => 0,
-        (0, 1) => 1,
-        (0, 2) => 2,
-        (1, 1) => 3,
-        (1, 2) => 4,
-        _ => 5,
-    }
 }
 
 /// Inertial parameters `(m, h, J about the origin)` of a (merged) body, in some frame.
@@ -302,7 +291,9 @@ pub(crate) fn build<const N: usize, T: Scalar>(
         speed: 0,
         prismatic: false,
         a: [[z; 3]; 3],
-        perm: None,
+        kind: RotKind::General,
+        g: [z; 3],
+        sym_sign: [z; 6],
         p: [z; 3],
         offset: false,
         m: z,
@@ -316,31 +307,26 @@ pub(crate) fn build<const N: usize, T: Scalar>(
     let mut axes = [Axis::PosZ; N];
     let half = cv(0.5);
     for (j, p) in protos.iter().enumerate() {
-        let perm = signed_perm(&p.a).map(|(idx, sign)| {
-            let mut inv_idx = [0; 3];
-            let mut inv_sign = [z; 3];
-            for a in 0..3 {
-                inv_idx[idx[a]] = a;
-                inv_sign[idx[a]] = cv(sign[a]);
+        let (kind, g, sym_sign) = match signed_perm(&p.a) {
+            Some((idx, sign)) => {
+                // Row a of R = A' Rot_z is sign[a] times row idx[a] of Rot_z.
+                let mut rows = [0; 3];
+                let mut g = [z; 3];
+                for a in 0..3 {
+                    rows[idx[a]] = a;
+                    g[idx[a]] = cv(sign[a]);
+                }
+                let mut sym_sign = [z; 6];
+                for (k, (a, b)) in [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)]
+                    .into_iter()
+                    .enumerate()
+                {
+                    sym_sign[k] = cv(sign[a] * sign[b]);
+                }
+                (RotKind::from_rows(rows), g, sym_sign)
             }
-            let mut sym_idx = [0; 6];
-            let mut sym_sign = [z; 6];
-            for (k, (a, b)) in [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)]
-                .into_iter()
-                .enumerate()
-            {
-                sym_idx[k] = sym_index(idx[a], idx[b]);
-                sym_sign[k] = cv(sign[a] * sign[b]);
-            }
-            SignedPerm {
-                idx,
-                sign: sign.map(cv),
-                inv_idx,
-                inv_sign,
-                sym_idx,
-                sym_sign,
-            }
-        });
+            None => (RotKind::General, [cv(1.0); 3], [cv(1.0); 6]),
+        };
         let pv = v3(&p.p);
         links[j] = LinkData {
             parent: p.parent,
@@ -348,7 +334,9 @@ pub(crate) fn build<const N: usize, T: Scalar>(
             speed: p.speed,
             prismatic: p.prismatic,
             a: m3(&p.a),
-            perm,
+            kind,
+            g,
+            sym_sign,
             p: pv,
             offset: p.prismatic || pv.iter().any(|x| *x != z),
             m: p.body.m,

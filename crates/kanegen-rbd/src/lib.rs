@@ -30,11 +30,12 @@
 //!   (`n_z` or `f_z`) and `ω_j = … + u_j ẑ` costs one addition, with no branch on the axis in the
 //!   hot loops. The change of frame is exact for axis-aligned axes (it only permutes and negates
 //!   numbers), and `M`, `c`, `g`, `τ` do not depend on the choice of link frames.
-//! * **Constant rotations as signed permutations**: when `A'_j` is one (all of Krang) it is
-//!   stored as indices and signs, and applied to vectors, to the columns of a frame-0 rotation and
-//!   to the six entries of a symmetric inertia (`A' (Rot_z J Rot_zᵀ) A'ᵀ`) by selection and sign
-//!   instead of 3×3 products; other rotations fall back to matrices. `R = A' Rot_z(q)` is never
-//!   formed.
+//! * **Constant rotations as signed permutations**: when `A'_j` is one (all of Krang), row `i`
+//!   of `Rot_z(q)` lands, times a sign, in a fixed row of `R = A' Rot_z(q)`; the six possible
+//!   row assignments are compile-time constants (a per-link kind selects one), so
+//!   `R x`, `Rᵀ x`, `W R` and `R J Rᵀ` cost 5 multiplications and 2 additions per vector (and
+//!   `A' (Rot_z J Rot_zᵀ) A'ᵀ` for inertias) with no data-dependent indexing. Other rotations
+//!   fall back to 3×3 products. `R` is never formed.
 //! * Flat fixed-size per-link arrays: parent index, speed index, joint kind, `A'`, translation,
 //!   mass, first moment, inertia, subtree (composite) mass and `m_c·p'`, and for the CRBA each
 //!   link's list of ancestors with the flat indices of the entries of `M` they fill.
@@ -75,6 +76,7 @@
 
 mod algorithms;
 mod build;
+mod rot;
 mod scalar;
 
 use std::fmt;
@@ -163,79 +165,6 @@ pub enum Axis {
     General,
 }
 
-/// A constant rotation `A'` that is a signed permutation: `(A' x)[a] = sign[a] · x[idx[a]]`,
-/// `(A'ᵀ x)[b] = inv_sign[b] · x[inv_idx[b]]` (also column `b` of `A'` is `inv_sign[b]` times
-/// unit vector `inv_idx[b]`), and `A' J A'ᵀ` on the six entries of a symmetric matrix.
-#[derive(Debug, Clone, Copy)]
-struct SignedPerm<T> {
-    idx: [usize; 3],
-    sign: [T; 3],
-    inv_idx: [usize; 3],
-    inv_sign: [T; 3],
-    sym_idx: [usize; 6],
-    sym_sign: [T; 6],
-}
-
-/// `x[i]` for `i < 3`, written as a selection so that a vector held in registers is not
-/// spilled to memory and reloaded at a computed address (which stalls store-to-load forwarding).
-#[inline(always)]
-fn pick<U: Copy>(x: &[U; 3], i: usize) -> U {
-    match i {
-        0 => x[0],
-        1 => x[1],
-        _ => x[2],
-    }
-}
-
-impl<T: Scalar> SignedPerm<T> {
-    /// `A' x`.
-    #[inline(always)]
-    fn apply(&self, x: V3<T>) -> V3<T> {
-        let (i, s) = (&self.idx, &self.sign);
-        [
-            s[0] * pick(&x, i[0]),
-            s[1] * pick(&x, i[1]),
-            s[2] * pick(&x, i[2]),
-        ]
-    }
-
-    /// `A'ᵀ x`.
-    #[inline(always)]
-    fn apply_t(&self, x: V3<T>) -> V3<T> {
-        let (i, s) = (&self.inv_idx, &self.inv_sign);
-        [
-            s[0] * pick(&x, i[0]),
-            s[1] * pick(&x, i[1]),
-            s[2] * pick(&x, i[2]),
-        ]
-    }
-
-    /// `W A'` (columns of `W` permuted and signed).
-    #[inline(always)]
-    fn right_mul(&self, w: &M3<T>) -> M3<T> {
-        let (i, s) = (&self.inv_idx, &self.inv_sign);
-        [
-            scalar::scale(pick(w, i[0]), s[0]),
-            scalar::scale(pick(w, i[1]), s[1]),
-            scalar::scale(pick(w, i[2]), s[2]),
-        ]
-    }
-
-    /// `A' J A'ᵀ`.
-    #[inline(always)]
-    fn apply_sym(&self, j: &S3<T>) -> S3<T> {
-        let (i, s) = (&self.sym_idx, &self.sym_sign);
-        [
-            s[0] * j[i[0]],
-            s[1] * j[i[1]],
-            s[2] * j[i[2]],
-            s[3] * j[i[3]],
-            s[4] * j[i[4]],
-            s[5] * j[i[5]],
-        ]
-    }
-}
-
 /// Everything parameter-dependent about one moving link, in its `+z`-axis frame.
 #[derive(Debug, Clone, Copy)]
 struct LinkData<T> {
@@ -249,8 +178,12 @@ struct LinkData<T> {
     prismatic: bool,
     /// `A'`: constant rotation child → parent, by columns.
     a: M3<T>,
-    /// `A'` as a signed permutation, if it is one.
-    perm: Option<SignedPerm<T>>,
+    /// How `A'` acts: a compile-time signed permutation or a general rotation.
+    kind: rot::RotKind,
+    /// Signs `g_i` of the signed permutation (see [`rot`]); 1 for a general rotation.
+    g: [T; 3],
+    /// Signs `g_{I[a]} g_{I[b]}` of the entries of `R J Rᵀ`.
+    sym_sign: [T; 6],
     /// Constant translation `p'` (parent frame).
     p: V3<T>,
     /// `p' ≠ 0` or prismatic.

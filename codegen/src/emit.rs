@@ -155,7 +155,14 @@ impl Names<'_> {
             LExpr::Leaf(l) => self.leaf(l),
             LExpr::Sum { constant, terms } => {
                 let mut ts = TokenStream::new();
-                for (i, (k, t)) in terms.iter().enumerate() {
+                // Start with a positive term when there is one (`b - a`, not `-a + b`): saves a
+                // negation per statement.
+                let mut terms: Vec<&(f64, LExpr)> = terms.iter().collect();
+                if let Some(first_pos) = terms.iter().position(|(k, _)| *k > 0.0) {
+                    let t = terms.remove(first_pos);
+                    terms.insert(0, t);
+                }
+                for (i, (k, t)) in terms.into_iter().enumerate() {
                     let body = if k.abs() == 1.0 {
                         self.expr(t, false)
                     } else {

@@ -414,14 +414,14 @@ pub fn gravity(p: &Params, pc: &Precomputed, q: &SVector<f64, 2>) -> SVector<f64
     let d1 = p.MY2 * c_q_w + p.MZ2 * s_q_w; // MSC2 in 1.y
     let d2 = p.MY2 * s_q_w - p.MZ2 * c_q_w; // MSC2 in 1.z
     let d3 = d1 + pc.pc1; // MSC1.y
-    let d4 = -d2 + pc.pc3; // MSC1.z
+    let d4 = pc.pc3 - d2; // MSC1.z
     let d5 = c_q_imu * p.g; // gravity acceleration in 1.y
     let d6 = s_q_imu * p.g; // gravity acceleration in 1.z
     let d7 = c_q_w * d5 - s_q_w * d6; // gravity acceleration in 2.y
     let d8 = s_q_w * d5 + c_q_w * d6; // gravity acceleration in 2.z
     let mut out = SVector::<f64, 2>::zeros();
-    out[0] = -d3 * d6 + d4 * d5;
-    out[1] = -p.MY2 * d8 + p.MZ2 * d7;
+    out[0] = d4 * d5 - d3 * d6;
+    out[1] = p.MZ2 * d7 - p.MY2 * d8;
     out
 }
 /// Inverse dynamics τ = M(q) u̇ + c(q, u) + g(q), in one pass.

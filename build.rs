@@ -1,0 +1,23 @@
+//! Generates, for the benchmarks (`benches/dynamics.rs`), the dynamics of the URDF robots into
+//! `$OUT_DIR`: the 7-DOF arm of `models/singlearm.urdf` (runtime parameters and baked) and Krang
+//! imported from `models/Krang.urdf` with its two-wheeled base (runtime parameters).
+//! The TOML Krang models come from `krang-dynamics`.
+use kanegen::model::{UrdfOptions, WheeledBaseSpec};
+
+fn main() {
+    println!("cargo:rerun-if-changed=build.rs");
+    let arm = || kanegen::Builder::urdf("models/singlearm.urdf", UrdfOptions::default());
+    arm().output("singlearm.rs").run();
+    arm().baked(true).output("singlearm_baked.rs").run();
+    kanegen::Builder::urdf("models/Krang.urdf", krang_urdf_options())
+        .output("krang_urdf.rs")
+        .run();
+}
+
+/// The declaration of Krang's wheeled base (as in README "Any robot from URDF" and
+/// `tests/urdf_generated_vs_reference.rs`); the 0.1 g gripper plates are dropped.
+fn krang_urdf_options() -> UrdfOptions {
+    let mut base = WheeledBaseSpec::new("JLWheel", "JRWheel", "Base", [0.0, 1.0, 0.0], 0.25);
+    base.pitch_name = "imu".into();
+    UrdfOptions::wheeled(base).drop_links(["lgPlate1", "lgPlate2", "rgPlate1", "rgPlate2"])
+}

@@ -26,16 +26,21 @@ fn code_blocks(text: &str) -> Vec<String> {
 #[test]
 fn readme_controller_example_is_the_compiled_doc_test() {
     let readme = std::fs::read_to_string(common::root().join("README.md")).unwrap();
-    let lib = std::fs::read_to_string(common::root().join("crates/krang-dynamics/src/lib.rs")).unwrap();
+    let lib =
+        std::fs::read_to_string(common::root().join("crates/krang-dynamics/src/lib.rs")).unwrap();
     let doc: String = lib
         .lines()
         .filter_map(|l| l.strip_prefix("//!"))
         .map(|l| format!("{}\n", l.strip_prefix(' ').unwrap_or(l)))
         .collect();
-    let doc_block = code_blocks(&doc.replace("```\n", "```rust\n").replacen("```rust\n", "```rust\n", 1))
-        .into_iter()
-        .find(|b| b.contains("Krang::new"))
-        .expect("krang-dynamics has a doc example");
+    let doc_block = code_blocks(&doc.replace("```\n", "```rust\n").replacen(
+        "```rust\n",
+        "```rust\n",
+        1,
+    ))
+    .into_iter()
+    .find(|b| b.contains("Krang::new"))
+    .expect("krang-dynamics has a doc example");
     assert!(
         code_blocks(&readme).iter().any(|b| *b == doc_block),
         "README's krang-dynamics example differs from the crate doc test:\n{doc_block}"

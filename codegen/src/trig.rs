@@ -20,7 +20,10 @@ mod tests {
     fn check(x: f64, tol: f64) {
         let (s, c) = fast_sin_cos(x);
         let (se, ce) = x.sin_cos();
-        assert!((s - se).abs() <= tol && (c - ce).abs() <= tol, "x = {x:e}: ({s}, {c}) vs ({se}, {ce})");
+        assert!(
+            (s - se).abs() <= tol && (c - ce).abs() <= tol,
+            "x = {x:e}: ({s}, {c}) vs ({se}, {ce})"
+        );
     }
 
     #[test]
@@ -41,7 +44,9 @@ mod tests {
 
     #[test]
     fn large_tiny_and_special_arguments() {
-        for x in [1e-300, -1e-300, 0.0, -0.0, 1e-8, 1e3, -7.5e4, 8e5, 8.3e5, 1e6, 1e12, -1e300] {
+        for x in [
+            1e-300, -1e-300, 0.0, -0.0, 1e-8, 1e3, -7.5e4, 8e5, 8.3e5, 1e6, 1e12, -1e300,
+        ] {
             check(x, 1e-15);
         }
         assert!(fast_sin_cos(f64::NAN).0.is_nan());

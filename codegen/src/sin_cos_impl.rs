@@ -6,11 +6,11 @@
 #[inline(always)]
 #[allow(clippy::excessive_precision, clippy::unreadable_literal)]
 fn sin_cos(x: f64) -> (f64, f64) {
-    if !(x.abs() < 823_549.0) {
+    if x.is_nan() || x.abs() >= 823_549.0 {
         return x.sin_cos();
     }
     // n = round(x · 2/π) by the 1.5·2⁵² trick (exact for |x·2/π| < 2⁵¹).
-    let shifted = x * 0.636_619_772_367_581_382_43 + 6_755_399_441_055_744.0;
+    let shifted = x * core::f64::consts::FRAC_2_PI + 6_755_399_441_055_744.0;
     let n = shifted - 6_755_399_441_055_744.0;
     let quadrant = shifted.to_bits();
     // r = x − n·π/2 in three parts (π/2 = PIO2_1 + PIO2_2 + PIO2_2T, 33 + 33 + 53 bits).

@@ -16,10 +16,10 @@ use nalgebra::{SMatrix, SVector};
 #[inline(always)]
 #[allow(clippy::excessive_precision, clippy::unreadable_literal)]
 fn sin_cos(x: f64) -> (f64, f64) {
-    if !(x.abs() < 823_549.0) {
+    if x.is_nan() || x.abs() >= 823_549.0 {
         return x.sin_cos();
     }
-    let shifted = x * 0.636_619_772_367_581_382_43 + 6_755_399_441_055_744.0;
+    let shifted = x * core::f64::consts::FRAC_2_PI + 6_755_399_441_055_744.0;
     let n = shifted - 6_755_399_441_055_744.0;
     let quadrant = shifted.to_bits();
     let r1 = x - n * 1.570_796_326_734_125_614_17;

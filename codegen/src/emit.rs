@@ -41,6 +41,26 @@ pub enum EmitError {
     },
 }
 
+/// The floating-point type of a generated module: every matrix, vector, parameter and
+/// literal is of this type.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Scalar {
+    /// `f64` (the default).
+    #[default]
+    F64,
+    /// `f32`; `sin_cos` computes in `f64` and rounds.
+    F32,
+}
+
+impl Scalar {
+    fn ty(self) -> TokenStream {
+        match self {
+            Scalar::F64 => quote!(f64),
+            Scalar::F32 => quote!(f32),
+        }
+    }
+}
+
 /// `krang-fixed-wheels` → `KrangFixedWheels`.
 pub fn type_name(model: &str) -> String {
     let mut out = String::new();
@@ -84,8 +104,12 @@ fn ident(name: &str) -> Ident {
     Ident::new(&s, Span::call_site())
 }
 
-fn lit(v: f64) -> Literal {
-    let mut l = Literal::f64_unsuffixed(v.abs());
+fn lit(v: f64, scalar: Scalar) -> Literal {
+    let mut l = match scalar {
+        Scalar::F64 => Literal::f64_unsuffixed(v.abs()),
+        // The shortest literal that rounds to the same f32.
+        Scalar::F32 => Literal::f32_unsuffixed(v.abs() as f32),
+    };
     l.set_span(Span::call_site());
     l
 }
@@ -94,8 +118,8 @@ fn idx(i: usize) -> Literal {
     Literal::usize_unsuffixed(i)
 }
 
-fn signed_lit(v: f64) -> TokenStream {
-    let l = lit(v);
+fn signed_lit(v: f64, scalar: Scalar) -> TokenStream {
+    let l = lit(v, scalar);
     if v < 0.0 { quote!(-#l) } else { quote!(#l) }
 }
 
@@ -103,13 +127,14 @@ struct Names<'a> {
     model: &'a Model,
     stmt: &'a [crate::lower::Stmt],
     pre: &'a [String],
+    scalar: Scalar,
 }
 
 impl Names<'_> {
     fn leaf(&self, l: &Leaf) -> TokenStream {
         let m = self.model;
         match *l {
-            Leaf::Const(c) => signed_lit(c),
+            Leaf::Const(c) => signed_lit(c, self.scalar),
             Leaf::Param(p) => {
                 let id = ident(&m.params[p].name);
                 quote!(p.#id)
@@ -149,7 +174,7 @@ impl Names<'_> {
     fn expr(&self, e: &LExpr, atomic: bool) -> TokenStream {
         match e {
             LExpr::Leaf(Leaf::Const(c)) if *c < 0.0 && atomic => {
-                let l = lit(*c);
+                let l = lit(*c, self.scalar);
                 quote!((-#l))
             }
             LExpr::Leaf(l) => self.leaf(l),
@@ -166,7 +191,7 @@ impl Names<'_> {
                     let body = if k.abs() == 1.0 {
                         self.expr(t, false)
                     } else {
-                        let kl = lit(*k);
+                        let kl = lit(*k, self.scalar);
                         let inner = self.expr(t, true);
                         quote!(#kl * #inner)
                     };
@@ -178,7 +203,7 @@ impl Names<'_> {
                     });
                 }
                 if *constant != 0.0 {
-                    let cl = lit(*constant);
+                    let cl = lit(*constant, self.scalar);
                     ts.extend(if *constant < 0.0 {
                         quote!(- #cl)
                     } else {
@@ -253,13 +278,21 @@ fn uses(p: &Program, pred: &dyn Fn(&Leaf) -> bool) -> bool {
     p.stmts.iter().any(|s| walk(&s.expr, pred)) || p.outputs.iter().any(|(_, _, e)| walk(e, pred))
 }
 
-fn function(model: &Model, low: &Lowered, pre: &[String], p: &Program) -> TokenStream {
+fn function(
+    model: &Model,
+    low: &Lowered,
+    pre: &[String],
+    p: &Program,
+    scalar: Scalar,
+) -> TokenStream {
     let n = low.dof;
     let nl = idx(n);
+    let t = scalar.ty();
     let names = Names {
         model,
         stmt: &p.stmts,
         pre,
+        scalar,
     };
     let fname = ident(&p.name);
     let doc = format!(" {}", p.doc);
@@ -276,15 +309,15 @@ fn function(model: &Model, low: &Lowered, pre: &[String], p: &Program) -> TokenS
     };
     let (args, arg_doc) = match p.signature {
         Signature::Q => (
-            quote!(q: &SVector<f64, #nl>),
+            quote!(q: &SVector<#t, #nl>),
             " `q`: coordinates in the order of [`COORDINATE_NAMES`].",
         ),
         Signature::QU => (
-            quote!(q: &SVector<f64, #nl>, u: &SVector<f64, #nl>),
+            quote!(q: &SVector<#t, #nl>, u: &SVector<#t, #nl>),
             " `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].",
         ),
         Signature::QUUd => (
-            quote!(q: &SVector<f64, #nl>, u: &SVector<f64, #nl>, ud: &SVector<f64, #nl>),
+            quote!(q: &SVector<#t, #nl>, u: &SVector<#t, #nl>, ud: &SVector<#t, #nl>),
             " `q`, `u`, `ud`: coordinates, speeds and accelerations in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].",
         ),
     };
@@ -315,7 +348,7 @@ fn function(model: &Model, low: &Lowered, pre: &[String], p: &Program) -> TokenS
     let body = statements(&names, p);
     let (ret, outputs) = match p.shape {
         Shape::SymmetricMatrix => {
-            let mut ts = quote!(let mut m = SMatrix::<f64, #nl, #nl>::zeros(););
+            let mut ts = quote!(let mut m = SMatrix::<#t, #nl, #nl>::zeros(););
             for (r, c, e) in &p.outputs {
                 if matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0) {
                     continue;
@@ -329,10 +362,10 @@ fn function(model: &Model, low: &Lowered, pre: &[String], p: &Program) -> TokenS
                 }
             }
             ts.extend(quote!(m));
-            (quote!(SMatrix<f64, #nl, #nl>), ts)
+            (quote!(SMatrix<#t, #nl, #nl>), ts)
         }
         Shape::Vector => {
-            let mut ts = quote!(let mut out = SVector::<f64, #nl>::zeros(););
+            let mut ts = quote!(let mut out = SVector::<#t, #nl>::zeros(););
             for (r, _, e) in &p.outputs {
                 if matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0) {
                     continue;
@@ -342,7 +375,7 @@ fn function(model: &Model, low: &Lowered, pre: &[String], p: &Program) -> TokenS
                 ts.extend(quote!(out[#r] = #v;));
             }
             ts.extend(quote!(out));
-            (quote!(SVector<f64, #nl>), ts)
+            (quote!(SVector<#t, #nl>), ts)
         }
     };
     let unused_q = if p.sincos.is_empty() && !(0..n).any(|s| uses(p, &|l| *l == Leaf::Coord(s))) {
@@ -366,8 +399,9 @@ fn function(model: &Model, low: &Lowered, pre: &[String], p: &Program) -> TokenS
     }
 }
 
-fn params_items(model: &Model) -> TokenStream {
+fn params_items(model: &Model, scalar: Scalar) -> TokenStream {
     let np = idx(model.params.len());
+    let t = scalar.ty();
     let fields: Vec<TokenStream> = model
         .params
         .iter()
@@ -384,7 +418,7 @@ fn params_items(model: &Model) -> TokenStream {
                 ParamKind::Wheel => "wheel constant",
             };
             let doc = format!(" `{}`: {} (default {:?}).", p.name, what, p.value);
-            quote!(#[doc = #doc] pub #id: f64,)
+            quote!(#[doc = #doc] pub #id: #t,)
         })
         .collect();
     let defaults: Vec<TokenStream> = model
@@ -392,7 +426,7 @@ fn params_items(model: &Model) -> TokenStream {
         .iter()
         .map(|p| {
             let id = ident(&p.name);
-            let v = signed_lit(p.value);
+            let v = signed_lit(p.value, scalar);
             quote!(#id: #v,)
         })
         .collect();
@@ -420,20 +454,48 @@ fn params_items(model: &Model) -> TokenStream {
             }
         }
 
-        /// A parameter name that the model does not have.
-        #[derive(Clone, Debug, PartialEq, Eq)]
+        /// A parameter name that the model does not have. Allocation-free (`no_std`): the name
+        /// is kept inline, truncated to [`UnknownParameter::CAPACITY`] bytes.
+        #[derive(Clone, Copy, PartialEq, Eq, Hash)]
         pub struct UnknownParameter {
-            /// The name that was asked for.
-            pub name: String,
+            name: [u8; UnknownParameter::CAPACITY],
+            len: u8,
+        }
+
+        impl UnknownParameter {
+            /// The longest name kept, in bytes (longer names are cut at a character boundary).
+            pub const CAPACITY: usize = 48;
+
+            /// The error for `name` (truncated to [`UnknownParameter::CAPACITY`] bytes).
+            pub fn new(name: &str) -> Self {
+                let mut len = name.len().min(Self::CAPACITY);
+                while !name.is_char_boundary(len) {
+                    len -= 1;
+                }
+                let mut buf = [0u8; Self::CAPACITY];
+                buf[..len].copy_from_slice(&name.as_bytes()[..len]);
+                Self { name: buf, len: len as u8 }
+            }
+
+            /// The name that was asked for (truncated to [`UnknownParameter::CAPACITY`] bytes).
+            pub fn name(&self) -> &str {
+                core::str::from_utf8(&self.name[..usize::from(self.len)]).unwrap_or("")
+            }
+        }
+
+        impl core::fmt::Debug for UnknownParameter {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.debug_struct("UnknownParameter").field("name", &self.name()).finish()
+            }
         }
 
         impl core::fmt::Display for UnknownParameter {
             fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-                write!(f, "unknown parameter `{}`; the valid names are listed in Params::NAMES", self.name)
+                write!(f, "unknown parameter `{}`; the valid names are listed in Params::NAMES", self.name())
             }
         }
 
-        impl std::error::Error for UnknownParameter {}
+        impl core::error::Error for UnknownParameter {}
 
         #[allow(non_snake_case)]
         impl Params {
@@ -441,7 +503,7 @@ fn params_items(model: &Model) -> TokenStream {
             pub const NAMES: [&'static str; #np] = [#(#names),*];
 
             /// The value of parameter `name`, or `None` if the model has no such parameter.
-            pub fn get(&self, name: &str) -> Option<f64> {
+            pub fn get(&self, name: &str) -> Option<#t> {
                 match name {
                     #(#names => Some(self.#ids),)*
                     _ => None,
@@ -449,21 +511,21 @@ fn params_items(model: &Model) -> TokenStream {
             }
 
             /// Set parameter `name`; an error if the model has no such parameter.
-            pub fn set(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
+            pub fn set(&mut self, name: &str, value: #t) -> Result<(), UnknownParameter> {
                 match name {
                     #(#names => self.#ids = value,)*
-                    _ => return Err(UnknownParameter { name: name.to_owned() }),
+                    _ => return Err(UnknownParameter::new(name)),
                 }
                 Ok(())
             }
 
             /// All values in the order of [`Params::NAMES`].
-            pub fn to_array(&self) -> [f64; #np] {
+            pub fn to_array(&self) -> [#t; #np] {
                 [#(self.#ids),*]
             }
 
             /// Parameters from values in the order of [`Params::NAMES`].
-            pub fn from_array(v: [f64; #np]) -> Self {
+            pub fn from_array(v: [#t; #np]) -> Self {
                 let [#(#ids),*] = v;
                 Self { #(#ids),* }
             }
@@ -478,12 +540,14 @@ fn file_name(path: &str) -> String {
         .unwrap_or_else(|| path.to_owned())
 }
 
-fn precompute_items(model: &Model, low: &Lowered, pre: &[String]) -> TokenStream {
+fn precompute_items(model: &Model, low: &Lowered, pre: &[String], scalar: Scalar) -> TokenStream {
     let p = &low.precompute;
+    let t = scalar.ty();
     let names = Names {
         model,
         stmt: &p.stmts,
         pre,
+        scalar,
     };
     let body = statements(&names, p);
     let fields: Vec<Ident> = pre.iter().map(|s| ident(s)).collect();
@@ -494,7 +558,7 @@ fn precompute_items(model: &Model, low: &Lowered, pre: &[String]) -> TokenStream
         /// Parameter-only subexpressions of the dynamics, computed once per parameter set.
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct Precomputed {
-            #(#fields: f64,)*
+            #(#fields: #t,)*
         }
 
         impl Precomputed {
@@ -510,8 +574,9 @@ fn precompute_items(model: &Model, low: &Lowered, pre: &[String]) -> TokenStream
     }
 }
 
-fn wrapper_items(model: &Model, low: &Lowered) -> TokenStream {
+fn wrapper_items(model: &Model, low: &Lowered, scalar: Scalar) -> TokenStream {
     let nl = idx(low.dof);
+    let t = scalar.ty();
     let ty = ident(&type_name(&model.name));
     let doc = format!(
         " The dynamics of `{}` with one parameter set: `τ = M(q) u̇ + c(q, u) + g(q)`.",
@@ -552,19 +617,19 @@ fn wrapper_items(model: &Model, low: &Lowered) -> TokenStream {
 
             /// Mass matrix M(q), symmetric positive definite.
             #[inline]
-            pub fn mass_matrix(&self, q: &SVector<f64, #nl>) -> SMatrix<f64, #nl, #nl> {
+            pub fn mass_matrix(&self, q: &SVector<#t, #nl>) -> SMatrix<#t, #nl, #nl> {
                 mass_matrix(&self.params, &self.pre, q)
             }
 
             /// Coriolis and centrifugal vector c(q, u).
             #[inline]
-            pub fn coriolis(&self, q: &SVector<f64, #nl>, u: &SVector<f64, #nl>) -> SVector<f64, #nl> {
+            pub fn coriolis(&self, q: &SVector<#t, #nl>, u: &SVector<#t, #nl>) -> SVector<#t, #nl> {
                 coriolis(&self.params, &self.pre, q, u)
             }
 
             /// Gravity vector g(q).
             #[inline]
-            pub fn gravity(&self, q: &SVector<f64, #nl>) -> SVector<f64, #nl> {
+            pub fn gravity(&self, q: &SVector<#t, #nl>) -> SVector<#t, #nl> {
                 gravity(&self.params, &self.pre, q)
             }
 
@@ -572,10 +637,10 @@ fn wrapper_items(model: &Model, low: &Lowered) -> TokenStream {
             #[inline]
             pub fn inverse_dynamics(
                 &self,
-                q: &SVector<f64, #nl>,
-                u: &SVector<f64, #nl>,
-                ud: &SVector<f64, #nl>,
-            ) -> SVector<f64, #nl> {
+                q: &SVector<#t, #nl>,
+                u: &SVector<#t, #nl>,
+                ud: &SVector<#t, #nl>,
+            ) -> SVector<#t, #nl> {
                 inverse_dynamics(&self.params, &self.pre, q, u, ud)
             }
         }
@@ -584,6 +649,12 @@ fn wrapper_items(model: &Model, low: &Lowered) -> TokenStream {
 
 /// Generate the Rust module for a lowered model. Deterministic: same input, same bytes.
 pub fn emit(model: &Model, low: &Lowered) -> Result<String, EmitError> {
+    emit_scalar(model, low, Scalar::F64)
+}
+
+/// [`emit`] with the scalar type `scalar`. The module needs only `core` and `nalgebra` (it
+/// builds in `no_std` crates).
+pub fn emit_scalar(model: &Model, low: &Lowered, scalar: Scalar) -> Result<String, EmitError> {
     let nl = idx(low.dof);
     let runtime = low.params == ParamMode::Runtime;
     let pre: Vec<String> = low
@@ -607,9 +678,28 @@ pub fn emit(model: &Model, low: &Lowered) -> Result<String, EmitError> {
             quote!(#[doc = #doc] pub const #id: usize = #i;)
         })
         .collect();
-    let trig: TokenStream = crate::trig::SIN_COS_SOURCE
-        .parse()
-        .expect("the sin_cos routine is valid Rust");
+    let trig: TokenStream = match scalar {
+        Scalar::F64 => crate::trig::SIN_COS_SOURCE
+            .parse()
+            .expect("the sin_cos routine is valid Rust"),
+        Scalar::F32 => {
+            let f64_routine: TokenStream = crate::trig::SIN_COS_SOURCE
+                .replacen("fn sin_cos(", "fn sin_cos_f64(", 1)
+                .parse()
+                .expect("the sin_cos routine is valid Rust");
+            quote! {
+                #f64_routine
+
+                /// `(sin x, cos x)` in `f32`: computed in `f64` and rounded (correctly rounded
+                /// but for double rounding).
+                #[inline(always)]
+                fn sin_cos(x: f32) -> (f32, f32) {
+                    let (s, c) = sin_cos_f64(f64::from(x));
+                    (s as f32, c as f32)
+                }
+            }
+        }
+    };
     let mut items = quote! {
         use nalgebra::{SMatrix, SVector};
 
@@ -628,18 +718,18 @@ pub fn emit(model: &Model, low: &Lowered) -> Result<String, EmitError> {
         }
     };
     if runtime {
-        items.extend(params_items(model));
-        items.extend(precompute_items(model, low, &pre));
+        items.extend(params_items(model, scalar));
+        items.extend(precompute_items(model, low, &pre, scalar));
     }
     // Comments per generated function (local names are numbered per function).
     let mut comments: HashMap<String, HashMap<String, String>> = HashMap::new();
     comments.insert("new".into(), comment_map(&low.precompute));
     for p in &low.functions {
-        items.extend(function(model, low, &pre, p));
+        items.extend(function(model, low, &pre, p, scalar));
         comments.insert(p.name.clone(), comment_map(p));
     }
     if runtime {
-        items.extend(wrapper_items(model, low));
+        items.extend(wrapper_items(model, low, scalar));
     }
     let file: syn::File = syn::parse2(items).map_err(|e| EmitError::Parse {
         model: model.name.clone(),

@@ -36,6 +36,7 @@ pub mod model {
 
 use std::path::{Path, PathBuf};
 
+pub use emit::Scalar;
 pub use kane::{Options, ParamMode};
 
 /// Anything that can go wrong while generating.
@@ -124,6 +125,7 @@ pub struct Builder {
     out_dir: Option<PathBuf>,
     /// `Some` when the model file is a URDF to import with these options.
     urdf: Option<model::UrdfOptions>,
+    scalar: Scalar,
 }
 
 impl Builder {
@@ -136,6 +138,7 @@ impl Builder {
             output: None,
             out_dir: None,
             urdf: None,
+            scalar: Scalar::F64,
         }
     }
 
@@ -168,8 +171,21 @@ impl Builder {
         self
     }
 
+    /// The scalar type of the generated module (default [`Scalar::F64`]). With
+    /// [`Scalar::F32`] every matrix, vector, `Params` field and literal is `f32`, and the
+    /// default file name gets the suffix `_f32.rs`:
+    ///
+    /// ```no_run
+    /// kanegen::Builder::new("krang.toml").scalar(kanegen::Scalar::F32).run(); // krang_f32.rs
+    /// ```
+    pub fn scalar(mut self, scalar: Scalar) -> Self {
+        self.scalar = scalar;
+        self
+    }
+
     /// Name of the generated file in the output directory (default: the model file's stem
-    /// plus `.rs`, or `_baked.rs` in baked mode).
+    /// plus `.rs`, or `_baked.rs` in baked mode; `_f32.rs`, `_baked_f32.rs` for
+    /// [`Scalar::F32`]).
     pub fn output(mut self, file_name: impl Into<String>) -> Self {
         self.output = Some(file_name.into());
         self
@@ -189,19 +205,39 @@ impl Builder {
             None => PathBuf::from(std::env::var_os("OUT_DIR").ok_or(Error::NoOutDir)?),
         };
         println!("cargo:rerun-if-changed={}", self.model.display());
-        let g = match &self.urdf {
+        let mut g = match &self.urdf {
             Some(urdf) => generate_urdf(&self.model, urdf, self.options)?,
             None => generate(&self.model, self.options)?,
         };
+        if self.scalar != Scalar::F64 {
+            // Re-emit, keeping any URDF import notes (the block after the header).
+            let at = g.source.find("\n\n").map_or(0, |i| i + 2);
+            let notes = if g.source[at..].starts_with("// URDF import notes:\n") {
+                let end = g.source[at..]
+                    .find("\n\n")
+                    .map_or(g.source.len(), |i| at + i + 2);
+                g.source[at..end].to_owned()
+            } else {
+                String::new()
+            };
+            let mut source = emit::emit_scalar(&g.model, &g.lowered, self.scalar)?;
+            let at = source.find("\n\n").map_or(0, |i| i + 2);
+            source.insert_str(at, &notes);
+            g.source = source;
+        }
         let name = self.output.clone().unwrap_or_else(|| {
             let stem = self
                 .model
                 .file_stem()
                 .map(|s| s.to_string_lossy().replace('-', "_"))
                 .unwrap_or_else(|| "model".into());
+            let suffix = match self.scalar {
+                Scalar::F64 => "",
+                Scalar::F32 => "_f32",
+            };
             match self.options.params {
-                ParamMode::Runtime => format!("{stem}.rs"),
-                ParamMode::Baked => format!("{stem}_baked.rs"),
+                ParamMode::Runtime => format!("{stem}{suffix}.rs"),
+                ParamMode::Baked => format!("{stem}_baked{suffix}.rs"),
             }
         });
         let path = dir.join(name);

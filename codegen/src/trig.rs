@@ -49,6 +49,16 @@ mod tests {
         ] {
             check(x, 1e-15);
         }
+        // Payne–Hanek range: a spread of magnitudes up to the largest finite value.
+        let mut x = 823_549.0_f64;
+        while x < 1e308 {
+            for y in [x, -x, x * 1.000_001, x * 0.999_999_7] {
+                check(y, 1e-15);
+            }
+            x *= 1.37;
+        }
+        check(f64::MAX, 1e-15);
+        check(823_548.999_999_9, 1e-15);
         assert!(fast_sin_cos(f64::NAN).0.is_nan());
         assert!(fast_sin_cos(f64::INFINITY).1.is_nan());
     }

@@ -71,7 +71,7 @@ impl fmt::Display for NotPositiveDefinite {
     }
 }
 
-impl std::error::Error for NotPositiveDefinite {}
+impl core::error::Error for NotPositiveDefinite {}
 
 #[inline]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -93,7 +93,7 @@ fn cholesky_upper<const N: usize>(a: &SMatrix<f64, N, N>) -> Option<SMatrix<f64,
         if d.is_nan() || d <= 0.0 {
             return None;
         }
-        let ujj = d.sqrt();
+        let ujj = nalgebra::ComplexField::sqrt(d); // `f64::sqrt` needs std
         s[cj + j] = ujj;
         for i in j + 1..N {
             let ci = i * N;
@@ -348,7 +348,7 @@ impl Krang {
         let b = self.gravity(&q)[crate::index::Q_IMU];
         q[crate::index::Q_IMU] = core::f64::consts::FRAC_PI_2;
         let a = -self.gravity(&q)[crate::index::Q_IMU];
-        b.atan2(a)
+        nalgebra::RealField::atan2(b, a)
     }
 }
 

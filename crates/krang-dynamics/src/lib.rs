@@ -26,6 +26,14 @@
 //! ```
 //!
 //! [kanegen]: https://docs.rs/kanegen
+//!
+//! # `f32` and `no_std`
+//!
+//! [`f32`](mod@f32) is the same model in single precision (`krang_dynamics::f32::{Krang,
+//! Params}`), for controllers on FPUs without double precision. Without the default feature
+//! `std` the crate is `#![no_std]`: the generated code needs only `core` and `nalgebra`, and the
+//! hand-written parts take square roots and `atan2` from `libm` through nalgebra.
+#![cfg_attr(not(feature = "std"), no_std)]
 #![forbid(unsafe_code)]
 
 include!(concat!(env!("OUT_DIR"), "/krang.rs"));
@@ -33,6 +41,12 @@ include!(concat!(env!("OUT_DIR"), "/krang.rs"));
 /// Krang with the parameter values of `krang.toml` folded in as constants (faster; no `Params`).
 pub mod baked {
     include!(concat!(env!("OUT_DIR"), "/krang_baked.rs"));
+}
+
+/// Krang in single precision: the module of the crate root with `f32` matrices, vectors and
+/// parameters (`krang_dynamics::f32::{Krang, Params}`).
+pub mod f32 {
+    include!(concat!(env!("OUT_DIR"), "/krang_f32.rs"));
 }
 
 /// Krang on fixed wheels: the 17-DOF tree of seed 002 (frame 0 fixed).

@@ -47,28 +47,9 @@ impl Rng {
         SVector::from_fn(|_, _| self.range(lo, hi))
     }
 
-    /// A uniformly random rotation (unit quaternion).
+    /// A uniformly random rotation (the reference crate's Shoemake construction).
     pub fn rotation(&mut self) -> Matrix3<f64> {
-        let (u1, u2, u3) = (self.next(), self.next(), self.next());
-        let tau = std::f64::consts::TAU;
-        let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-        let (w, x, y, z) = (
-            a * (tau * u2).sin(),
-            a * (tau * u2).cos(),
-            b * (tau * u3).sin(),
-            b * (tau * u3).cos(),
-        );
-        Matrix3::new(
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        )
+        kanegen_reference::random::random_rotation(&mut || self.next())
     }
 }
 

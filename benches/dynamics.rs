@@ -272,49 +272,80 @@ fn check<const N: usize, D: Dynamics<N>>(
     }
 }
 
-/// The four functions of `d` at `<model>/<function>/<variant>`.
-fn bench_variant<const N: usize, D: Dynamics<N>>(
+/// The benchmarked functions.
+#[derive(Clone, Copy)]
+enum Function {
+    MassMatrix,
+    Coriolis,
+    Gravity,
+    InverseDynamics,
+}
+
+impl Function {
+    const ALL: [Self; 4] = [
+        Self::MassMatrix,
+        Self::Coriolis,
+        Self::Gravity,
+        Self::InverseDynamics,
+    ];
+
+    fn name(self) -> &'static str {
+        match self {
+            Self::MassMatrix => "mass_matrix",
+            Self::Coriolis => "coriolis",
+            Self::Gravity => "gravity",
+            Self::InverseDynamics => "inverse_dynamics",
+        }
+    }
+}
+
+/// Function `f` of `d` at `<model>/<function>/<variant>`, cycling through `states`.
+fn bench_one<const N: usize, D: Dynamics<N>>(
     c: &mut Criterion,
     model: &str,
+    f: Function,
     variant: &str,
     d: &D,
     states: &[State<N>],
 ) {
     assert!(states.len().is_power_of_two());
     let mask = states.len() - 1;
-    let id = |function: &str| format!("{model}/{function}/{variant}");
-    c.bench_function(&id("mass_matrix"), |b| {
-        let mut i = 0;
-        b.iter(|| {
-            let s = &states[i & mask];
-            i += 1;
-            black_box(d).mass_matrix(black_box(&s.q))
-        })
-    });
-    c.bench_function(&id("coriolis"), |b| {
-        let mut i = 0;
-        b.iter(|| {
-            let s = &states[i & mask];
-            i += 1;
-            black_box(d).coriolis(black_box(&s.q), black_box(&s.u))
-        })
-    });
-    c.bench_function(&id("gravity"), |b| {
-        let mut i = 0;
-        b.iter(|| {
-            let s = &states[i & mask];
-            i += 1;
-            black_box(d).gravity(black_box(&s.q))
-        })
-    });
-    c.bench_function(&id("inverse_dynamics"), |b| {
-        let mut i = 0;
-        b.iter(|| {
-            let s = &states[i & mask];
-            i += 1;
-            black_box(d).inverse_dynamics(black_box(&s.q), black_box(&s.u), black_box(&s.ud))
-        })
-    });
+    let id = format!("{model}/{}/{variant}", f.name());
+    // One closure per function so that the timed loop has no dispatch on `f`.
+    match f {
+        Function::MassMatrix => c.bench_function(&id, |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let s = &states[i & mask];
+                i += 1;
+                black_box(d).mass_matrix(black_box(&s.q))
+            })
+        }),
+        Function::Coriolis => c.bench_function(&id, |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let s = &states[i & mask];
+                i += 1;
+                black_box(d).coriolis(black_box(&s.q), black_box(&s.u))
+            })
+        }),
+        Function::Gravity => c.bench_function(&id, |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let s = &states[i & mask];
+                i += 1;
+                black_box(d).gravity(black_box(&s.q))
+            })
+        }),
+        Function::InverseDynamics => c.bench_function(&id, |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let s = &states[i & mask];
+                i += 1;
+                black_box(d).inverse_dynamics(black_box(&s.q), black_box(&s.u), black_box(&s.ud))
+            })
+        }),
+    };
 }
 
 /// A model file of the repository.
@@ -338,13 +369,19 @@ fn bench_model<const N: usize, G: Dynamics<N>, B: Dynamics<N>>(
     let rbd = RbdDyn(Rbd::<N>::with_default_params(model).expect("Rbd builds"));
     check(&format!("{name}/generated"), generated, &naive, &states);
     check(&format!("{name}/rbd"), &rbd, &naive, &states);
-    bench_variant(c, name, "generated", generated, &states);
     if let Some(baked) = baked {
         check(&format!("{name}/baked"), baked, &naive, &states);
-        bench_variant(c, name, "baked", baked, &states);
     }
-    bench_variant(c, name, "rbd", &rbd, &states);
-    bench_variant(c, name, "naive", &naive, &states);
+    // The variants of one function back to back, so that the ratios between them see the same
+    // machine (a shared machine's load drifts over minutes).
+    for f in Function::ALL {
+        bench_one(c, name, f, "generated", generated, &states);
+        if let Some(baked) = baked {
+            bench_one(c, name, f, "baked", baked, &states);
+        }
+        bench_one(c, name, f, "rbd", &rbd, &states);
+        bench_one(c, name, f, "naive", &naive, &states);
+    }
 }
 
 fn krang(c: &mut Criterion) {

@@ -6,7 +6,14 @@
 //! ```sh
 //! cargo bench --bench dynamics
 //! cargo run --release --example bench_report               # reads target/criterion
-//! cargo run --release --example bench_report -- DIR        # another criterion directory
+//! cargo run --release --example bench_report -- --dir DIR  # another criterion directory
+//! ```
+//!
+//! On a shared machine, save several runs and take the minimum of their medians:
+//!
+//! ```sh
+//! for r in a b c; do cargo bench --bench dynamics -- --save-baseline $r; done
+//! cargo run --release --example bench_report -- --baselines a,b,c
 //! ```
 //!
 //! Only the standard library, `serde_json` and `kanegen` (for the op counts: every model is
@@ -78,15 +85,14 @@ const BENCHES: [Bench; 4] = [
     },
 ];
 
+const USAGE: &str = "usage: bench_report [--dir CRITERION_DIR] [--baselines NAME,NAME,...]
+
+  --dir        criterion's output directory (default: $CARGO_TARGET_DIR/criterion or target/criterion)
+  --baselines  criterion baselines to read (default: new, the latest run); with several, the
+               minimum of their medians (runs saved with `cargo bench -- --save-baseline NAME`)";
+
 fn main() -> ExitCode {
-    let dir = match std::env::args_os().nth(1) {
-        Some(d) => PathBuf::from(d),
-        None => std::env::var_os("CARGO_TARGET_DIR")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"))
-            .join("criterion"),
-    };
-    match run(&dir) {
+    match args().and_then(|(dir, baselines)| run(&dir, &baselines)) {
         Ok(table) => {
             print!("{table}");
             ExitCode::SUCCESS
@@ -98,12 +104,38 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(dir: &Path) -> Result<String, String> {
+/// `(criterion directory, baselines)` from the command line.
+fn args() -> Result<(PathBuf, Vec<String>), String> {
+    let mut dir = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"))
+        .join("criterion");
+    let mut baselines = vec!["new".to_owned()];
+    let mut it = std::env::args().skip(1);
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--dir" => dir = it.next().ok_or(USAGE)?.into(),
+            "--baselines" => {
+                baselines = it
+                    .next()
+                    .ok_or(USAGE)?
+                    .split(',')
+                    .map(str::to_owned)
+                    .collect()
+            }
+            _ => return Err(USAGE.to_owned()),
+        }
+    }
+    Ok((dir, baselines))
+}
+
+fn run(dir: &Path, baselines: &[String]) -> Result<String, String> {
     let mut medians = BTreeMap::new();
-    collect(dir, &mut medians)?;
+    collect(dir, baselines, &mut medians)?;
     if medians.is_empty() {
         return Err(format!(
-            "no criterion results under {} (run `cargo bench --bench dynamics` first)",
+            "no criterion results ({}) under {} (run `cargo bench --bench dynamics` first)",
+            baselines.join(", "),
             dir.display()
         ));
     }
@@ -132,20 +164,30 @@ fn run(dir: &Path) -> Result<String, String> {
     Ok(out)
 }
 
-/// Every `<dir>/**/new/{benchmark,estimates}.json`: full benchmark id → median (ns).
-fn collect(dir: &Path, medians: &mut BTreeMap<String, f64>) -> Result<(), String> {
-    let entries = match std::fs::read_dir(dir) {
-        Ok(e) => e,
-        Err(e) => return Err(format!("{}: {e}", dir.display())),
-    };
+/// Every `<dir>/**/<baseline>/{benchmark,estimates}.json`: full benchmark id → median (ns),
+/// the minimum over `baselines`.
+fn collect(
+    dir: &Path,
+    baselines: &[String],
+    medians: &mut BTreeMap<String, f64>,
+) -> Result<(), String> {
+    let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     for entry in entries.flatten() {
         let path = entry.path();
-        if !path.is_dir() {
+        let name = entry.file_name();
+        if !path.is_dir() || name == "report" || baselines.iter().any(|b| name == b.as_str()) {
             continue;
         }
-        let new = path.join("new");
-        let (bench, est) = (new.join("benchmark.json"), new.join("estimates.json"));
-        if bench.is_file() && est.is_file() {
+        let mut found = false;
+        for baseline in baselines {
+            let (bench, est) = (
+                path.join(baseline).join("benchmark.json"),
+                path.join(baseline).join("estimates.json"),
+            );
+            if !(bench.is_file() && est.is_file()) {
+                continue;
+            }
+            found = true;
             let id = read_json(&bench)?["full_id"]
                 .as_str()
                 .ok_or_else(|| format!("{}: no full_id", bench.display()))?
@@ -153,9 +195,11 @@ fn collect(dir: &Path, medians: &mut BTreeMap<String, f64>) -> Result<(), String
             let median = read_json(&est)?["median"]["point_estimate"]
                 .as_f64()
                 .ok_or_else(|| format!("{}: no median.point_estimate", est.display()))?;
-            medians.insert(id, median);
-        } else if path.file_name().is_some_and(|n| n != "report") {
-            collect(&path, medians)?;
+            let m = medians.entry(id).or_insert(f64::INFINITY);
+            *m = m.min(median);
+        }
+        if !found {
+            collect(&path, baselines, medians)?;
         }
     }
     Ok(())

@@ -141,6 +141,11 @@ pub struct Arena {
     pub names: Names,
     /// Whether [`Arena::subst`] hoists parameter-only parts into their own variables.
     pub hoist_params: bool,
+    /// Per node: when the current phase first asked for it (`u32::MAX`: not yet), see
+    /// [`Arena::begin_phase`].
+    stamps: Vec<u32>,
+    /// Requests so far in the current phase.
+    clock: u32,
 }
 
 /// Numeric values of the leaves, for [`Arena::eval`].
@@ -167,6 +172,8 @@ impl Arena {
             var_by_def: HashMap::new(),
             names,
             hoist_params: false,
+            stamps: Vec::new(),
+            clock: 0,
         };
         a.constant(0.0);
         a.constant(1.0);
@@ -198,8 +205,32 @@ impl Arena {
         self.param_only[e.index()]
     }
 
+    /// Start a new phase: forget which nodes were asked for so far. The derivation runs one
+    /// phase per generated function, so that each function's statements can be scheduled in
+    /// the order its own recursion forms them, even where it reuses nodes that an earlier
+    /// function created (see [`Arena::phase_order`]).
+    pub fn begin_phase(&mut self) {
+        self.stamps.iter_mut().for_each(|s| *s = u32::MAX);
+        self.clock = 0;
+    }
+
+    /// Per node, when the current phase first asked for it (created it or found it interned);
+    /// `u32::MAX` for nodes it did not ask for.
+    pub fn phase_order(&self) -> Vec<u32> {
+        self.stamps.clone()
+    }
+
+    fn touch(&mut self, id: ExprId) {
+        let s = &mut self.stamps[id.index()];
+        if *s == u32::MAX {
+            *s = self.clock;
+            self.clock += 1;
+        }
+    }
+
     fn intern(&mut self, n: Node) -> ExprId {
         if let Some(&id) = self.map.get(&n) {
+            self.touch(id);
             return id;
         }
         let po = match &n {
@@ -213,6 +244,8 @@ impl Arena {
         let id = ExprId(self.nodes.len() as u32);
         self.nodes.push(n.clone());
         self.param_only.push(po);
+        self.stamps.push(u32::MAX);
+        self.touch(id);
         self.map.insert(n, id);
         id
     }

@@ -79,6 +79,9 @@ pub struct Function {
     pub signature: Signature,
     /// `(row, col, expr)`; col = 0 for vectors.
     pub entries: Vec<(usize, usize, ExprId)>,
+    /// Per arena node, when this function's derivation first asked for it (`u32::MAX`: never):
+    /// the statement order the lowering follows (see [`Arena::begin_phase`]).
+    pub order: Vec<u32>,
 }
 
 /// The symbolic dynamics of a model.
@@ -125,11 +128,24 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
         pos: vec![None; model.links.len()],
     };
     let n = model.dof();
-    let composites = cx.composites(true);
-    let m = cx.mass_matrix(&composites);
+    // The columns of M are formed inside the backward composite pass, each right after its
+    // subtree's composite is complete, so that the generated code uses values soon after it
+    // computes them (short live ranges, fewer register spills). Each function is one arena
+    // phase: its statements are later scheduled in the order its own recursion forms them.
+    cx.ar.begin_phase();
+    let mut columns = Vec::new();
+    let composites = cx.composites(true, Some(&mut columns));
+    let m = cx.mass_matrix(&composites, columns);
+    let m_order = cx.ar.phase_order();
+    cx.ar.begin_phase();
     let g = cx.gravity(&composites);
+    let g_order = cx.ar.phase_order();
+    cx.ar.begin_phase();
     let c = cx.rnea(false, false);
+    let c_order = cx.ar.phase_order();
+    cx.ar.begin_phase();
     let tau = cx.rnea(true, true);
+    let tau_order = cx.ar.phase_order();
     let vector = |v: Vec<ExprId>| v.into_iter().enumerate().map(|(i, e)| (i, 0, e)).collect();
     let functions = vec![
         Function {
@@ -138,6 +154,7 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
             shape: Shape::SymmetricMatrix,
             signature: Signature::Q,
             entries: m,
+            order: m_order,
         },
         Function {
             name: "coriolis",
@@ -145,6 +162,7 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
             shape: Shape::Vector,
             signature: Signature::QU,
             entries: vector(c),
+            order: c_order,
         },
         Function {
             name: "gravity",
@@ -152,6 +170,7 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
             shape: Shape::Vector,
             signature: Signature::Q,
             entries: vector(g),
+            order: g_order,
         },
         Function {
             name: "inverse_dynamics",
@@ -159,6 +178,7 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
             shape: Shape::Vector,
             signature: Signature::QUUd,
             entries: vector(tau),
+            order: tau_order,
         },
     ];
     debug_assert!(functions.iter().all(|f| f.entries.iter().all(|e| e.0 < n)));
@@ -420,7 +440,13 @@ impl Ctx<'_> {
     // ---- composite bodies -----------------------------------------------------------------------
 
     /// Composite mass, first moment and (optionally) inertia of every subtree, in its own frame.
-    fn composites(&mut self, with_inertia: bool) -> Vec<Composite> {
+    /// With `columns`, the mass-matrix column of every joint is formed as soon as the composite
+    /// of its subtree is complete (see [`Ctx::mass_matrix_column`]).
+    fn composites(
+        &mut self,
+        with_inertia: bool,
+        mut columns: Option<&mut Vec<(usize, usize, ExprId)>>,
+    ) -> Vec<Composite> {
         let links = self.model.links.len();
         let zero = self.ar.zero();
         let mut comp: Vec<Composite> = (0..links)
@@ -462,14 +488,20 @@ impl Ctx<'_> {
                 first_moment: msc,
                 inertia,
             };
-            if self.ar.is_zero(mass) && msc.iter().all(|x| self.ar.is_zero(*x)) {
-                continue;
-            }
+            let empty = self.ar.is_zero(mass) && msc.iter().all(|x| self.ar.is_zero(*x));
             let r = self.rotation(c);
             let p = self.position(c);
-            // First moment moved to the parent frame: R·MS + m·p.
+            // First moment moved to the parent frame: R·MS + m·p. (Formed before the column
+            // of M, which may share these terms, so that they carry the composite's label.)
             let u = self.rot_up(&r, &msc);
             let u = self.subst3(u, VarKind::D, &format!("MSC{name} in {pname}"));
+            if let Some(entries) = columns.as_deref_mut() {
+                let composite = comp[c].clone();
+                self.mass_matrix_column(c, &composite, entries);
+            }
+            if empty {
+                continue;
+            }
             let mp = self.scale3(mass, &p);
             let add = self.add3(&u, &mp);
             let new_mass = self.ar.add(comp[parent].mass, mass);
@@ -536,72 +568,86 @@ impl Ctx<'_> {
 
     // ---- mass matrix ----------------------------------------------------------------------------
 
-    fn mass_matrix(&mut self, comp: &[Composite]) -> Vec<(usize, usize, ExprId)> {
-        let mut entries = Vec::new();
+    /// Column `l`'s entries of M (the joint of link `l` against itself and its ancestors): the
+    /// inertia force and moment of the subtree of `l` for a unit acceleration of its joint at
+    /// rest, carried up to the root.
+    fn mass_matrix_column(
+        &mut self,
+        l: usize,
+        c: &Composite,
+        entries: &mut Vec<(usize, usize, ExprId)>,
+    ) {
         let put = |entries: &mut Vec<(usize, usize, ExprId)>, a: usize, b: usize, e: ExprId| {
             entries.push((a.min(b), a.max(b), e));
         };
         let wheeled = self.model.wheeled_base().cloned();
-        // Columns of the joints.
-        for l in 1..self.model.links.len() {
-            let joint = self.model.links[l].joint.clone().expect("non-root");
-            let Some(col) = joint.speed else { continue };
-            let c = &comp[l];
-            let e = self.axis(l);
-            let jc = c.inertia.expect("inertia computed");
-            let name = self.link_name(l).to_owned();
-            // Inertia force and moment about O_l for a unit acceleration of this joint.
-            let (mut f, mut n) = match joint.kind {
-                JointKind::Prismatic => {
-                    let f = self.scale3(c.mass, &e);
-                    let n = self.cross(&c.first_moment, &e);
-                    (f, n)
+        let joint = self.model.links[l].joint.clone().expect("non-root");
+        let Some(col) = joint.speed else { return };
+        let e = self.axis(l);
+        let jc = c.inertia.expect("inertia computed");
+        let name = self.link_name(l).to_owned();
+        // Inertia force and moment about O_l for a unit acceleration of this joint.
+        let (mut f, mut n) = match joint.kind {
+            JointKind::Prismatic => {
+                let f = self.scale3(c.mass, &e);
+                let n = self.cross(&c.first_moment, &e);
+                (f, n)
+            }
+            _ => {
+                let f = self.cross(&e, &c.first_moment);
+                let n = self.sym_mul(&jc, &e);
+                (f, n)
+            }
+        };
+        f = self.subst3(f, VarKind::D, &format!("F(M col {name}) at {name}"));
+        n = self.subst3(n, VarKind::D, &format!("N(M col {name}) at {name}"));
+        let diag = match joint.kind {
+            JointKind::Prismatic => self.dot(&e, &f),
+            _ => self.dot(&e, &n),
+        };
+        put(entries, col, col, diag);
+        let mut k = l;
+        while let Some(parent) = self.model.links[k].parent {
+            let r = self.rotation(k);
+            let p = self.position(k);
+            let fu = self.rot_up(&r, &f);
+            let pname = self.link_name(parent).to_owned();
+            f = self.subst3(fu, VarKind::D, &format!("F(M col {name}) at {pname}"));
+            let nu = self.rot_up(&r, &n);
+            let pxf = self.cross(&p, &f);
+            let nn = self.add3(&nu, &pxf);
+            n = self.subst3(nn, VarKind::D, &format!("N(M col {name}) at {pname}"));
+            k = parent;
+            match self.model.links[k].joint.as_ref() {
+                Some(pj) if pj.speed.is_some() => {
+                    let row = pj.speed.expect("checked");
+                    let ek = self.axis(k);
+                    let v = match pj.kind {
+                        JointKind::Prismatic => self.dot(&ek, &f),
+                        _ => self.dot(&ek, &n),
+                    };
+                    put(entries, row, col, v);
                 }
-                _ => {
-                    let f = self.cross(&e, &c.first_moment);
-                    let n = self.sym_mul(&jc, &e);
-                    (f, n)
-                }
-            };
-            f = self.subst3(f, VarKind::D, &format!("F(M col {name}) at {name}"));
-            n = self.subst3(n, VarKind::D, &format!("N(M col {name}) at {name}"));
-            let diag = match joint.kind {
-                JointKind::Prismatic => self.dot(&e, &f),
-                _ => self.dot(&e, &n),
-            };
-            put(&mut entries, col, col, diag);
-            let mut k = l;
-            while let Some(parent) = self.model.links[k].parent {
-                let r = self.rotation(k);
-                let p = self.position(k);
-                let fu = self.rot_up(&r, &f);
-                let pname = self.link_name(parent).to_owned();
-                f = self.subst3(fu, VarKind::D, &format!("F(M col {name}) at {pname}"));
-                let nu = self.rot_up(&r, &n);
-                let pxf = self.cross(&p, &f);
-                let nn = self.add3(&nu, &pxf);
-                n = self.subst3(nn, VarKind::D, &format!("N(M col {name}) at {pname}"));
-                k = parent;
-                match self.model.links[k].joint.as_ref() {
-                    Some(pj) if pj.speed.is_some() => {
-                        let row = pj.speed.expect("checked");
-                        let ek = self.axis(k);
-                        let v = match pj.kind {
-                            JointKind::Prismatic => self.dot(&ek, &f),
-                            _ => self.dot(&ek, &n),
-                        };
-                        put(&mut entries, row, col, v);
-                    }
-                    Some(_) => {}
-                    None => {
-                        if let Some(w) = &wheeled {
-                            put(&mut entries, w.x_speed, col, f[0]);
-                            put(&mut entries, w.psi_speed, col, n[2]);
-                        }
+                Some(_) => {}
+                None => {
+                    if let Some(w) = &wheeled {
+                        put(entries, w.x_speed, col, f[0]);
+                        put(entries, w.psi_speed, col, n[2]);
                     }
                 }
             }
         }
+    }
+
+    fn mass_matrix(
+        &mut self,
+        comp: &[Composite],
+        mut entries: Vec<(usize, usize, ExprId)>,
+    ) -> Vec<(usize, usize, ExprId)> {
+        let put = |entries: &mut Vec<(usize, usize, ExprId)>, a: usize, b: usize, e: ExprId| {
+            entries.push((a.min(b), a.max(b), e));
+        };
+        let wheeled = self.model.wheeled_base().cloned();
         // The base quasi-velocities.
         if let Some(w) = &wheeled {
             let c = &comp[0];
@@ -686,6 +732,52 @@ impl Ctx<'_> {
 
     // ---- inverse dynamics (backward accumulation of Kane's generalized inertia forces) ------------
 
+    /// Add the force `f[c]` and moment `n[c]` (about `O_c`) of the complete subtree of `c` to
+    /// its parent's.
+    fn accumulate(&mut self, c: usize, f: &mut [V3], n: &mut [V3], tag: &str) {
+        let parent = self.model.links[c].parent.expect("non-root");
+        if f[c].iter().chain(n[c].iter()).all(|x| self.ar.is_zero(*x)) {
+            return;
+        }
+        let cname = self.link_name(c).to_owned();
+        let pname = self.link_name(parent).to_owned();
+        let r = self.rotation(c);
+        let p = self.position(c);
+        let fu = self.rot_up(&r, &f[c]);
+        let fu = self.subst3(fu, VarKind::D, &format!("f{cname} in {pname}{tag}"));
+        let nu = self.rot_up(&r, &n[c]);
+        let pxf = self.cross(&p, &fu);
+        let nf = self.add3(&f[parent], &fu);
+        let nn = self.add3(&n[parent], &nu);
+        let nn = self.add3(&nn, &pxf);
+        f[parent] = self.subst3(nf, VarKind::D, &format!("f{pname}{tag}"));
+        n[parent] = self.subst3(nn, VarKind::D, &format!("n{pname}{tag}"));
+    }
+
+    /// Inertia force and moment about its frame origin of the body on link `l` (if any), from
+    /// the frame's angular velocity `w`, angular acceleration `wd` and origin acceleration `a`.
+    fn body_force(&mut self, l: usize, w: &V3, wd: &V3, a: &V3, tag: &str) -> Option<(V3, V3)> {
+        let (m, ms, j) = self.body(l)?;
+        let name = self.link_name(l).to_owned();
+        let wxms = self.cross(w, &ms);
+        let wxms = self.subst3(wxms, VarKind::D, &format!("w{name}xMS{name}{tag}"));
+        let ma = self.scale3(m, a);
+        let t1 = self.cross(wd, &ms);
+        let t2 = self.cross(w, &wxms);
+        let fl = self.add3(&ma, &t1);
+        let fl = self.add3(&fl, &t2);
+        let fl = self.subst3(fl, VarKind::D, &format!("F{name}{tag}"));
+        let jwd = self.sym_mul(&j, wd);
+        let jw = self.sym_mul(&j, w);
+        let jw = self.subst3(jw, VarKind::D, &format!("J{name}w{name}{tag}"));
+        let wxjw = self.cross(w, &jw);
+        let msxa = self.cross(&ms, a);
+        let nl = self.add3(&jwd, &wxjw);
+        let nl = self.add3(&nl, &msxa);
+        let nl = self.subst3(nl, VarKind::D, &format!("N{name}{tag}"));
+        Some((fl, nl))
+    }
+
     /// τ with the given inputs: `with_accel` keeps u̇ (else u̇ = 0), `with_gravity` folds gravity in.
     fn rnea(&mut self, with_accel: bool, with_gravity: bool) -> Vec<ExprId> {
         let model = self.model;
@@ -725,7 +817,16 @@ impl Ctx<'_> {
         }
         let root = self.link_name(0).to_owned();
         a[0] = self.subst3(a[0], VarKind::K, &format!("a{root}{tag}"));
-        // Forward: seed 002 eqs. 3, 4, 6.
+        // Body inertia forces and moments about the frame origins, each formed in the forward
+        // pass as soon as its body's motion is known (short live ranges in the generated code).
+        let mut f: Vec<V3> = vec![[zero; 3]; links];
+        let mut n: Vec<V3> = vec![[zero; 3]; links];
+        if let Some((fl, nl)) = self.body_force(0, &w[0], &wd[0], &a[0], tag) {
+            (f[0], n[0]) = (fl, nl);
+        }
+        // Forward: seed 002 eqs. 3, 4, 6. (A depth-first interleaving of the forward and
+        // backward passes keeps fewer values live, but measured for Krang it made the compiled
+        // functions larger and slower: their speed is bound by code size.)
         for l in 1..links {
             let i = model.links[l].parent.expect("non-root");
             let joint = model.links[l].joint.clone().expect("non-root");
@@ -786,51 +887,13 @@ impl Ctx<'_> {
             let aj = self.rot_down(&r, &t);
             let aj = self.add3(&aj, &extra_a);
             a[l] = self.subst3(aj, VarKind::K, &format!("a{name}{tag}"));
-        }
-        // Body inertia forces and moments about the frame origins.
-        let mut f: Vec<V3> = vec![[zero; 3]; links];
-        let mut n: Vec<V3> = vec![[zero; 3]; links];
-        for l in 0..links {
-            let Some((m, ms, j)) = self.body(l) else {
-                continue;
-            };
-            let name = self.link_name(l).to_owned();
-            let wxms = self.cross(&w[l], &ms);
-            let wxms = self.subst3(wxms, VarKind::D, &format!("w{name}xMS{name}{tag}"));
-            let ma = self.scale3(m, &a[l]);
-            let t1 = self.cross(&wd[l], &ms);
-            let t2 = self.cross(&w[l], &wxms);
-            let fl = self.add3(&ma, &t1);
-            let fl = self.add3(&fl, &t2);
-            f[l] = self.subst3(fl, VarKind::D, &format!("F{name}{tag}"));
-            let jwd = self.sym_mul(&j, &wd[l]);
-            let jw = self.sym_mul(&j, &w[l]);
-            let jw = self.subst3(jw, VarKind::D, &format!("J{name}w{name}{tag}"));
-            let wxjw = self.cross(&w[l], &jw);
-            let msxa = self.cross(&ms, &a[l]);
-            let nl = self.add3(&jwd, &wxjw);
-            let nl = self.add3(&nl, &msxa);
-            n[l] = self.subst3(nl, VarKind::D, &format!("N{name}{tag}"));
+            if let Some((fl, nl)) = self.body_force(l, &w[l], &wd[l], &a[l], tag) {
+                (f[l], n[l]) = (fl, nl);
+            }
         }
         // Backward accumulation over subtrees.
         for c in (1..links).rev() {
-            let parent = model.links[c].parent.expect("non-root");
-            if f[c].iter().chain(n[c].iter()).all(|x| self.ar.is_zero(*x)) {
-                continue;
-            }
-            let cname = self.link_name(c).to_owned();
-            let pname = self.link_name(parent).to_owned();
-            let r = self.rotation(c);
-            let p = self.position(c);
-            let fu = self.rot_up(&r, &f[c]);
-            let fu = self.subst3(fu, VarKind::D, &format!("f{cname} in {pname}{tag}"));
-            let nu = self.rot_up(&r, &n[c]);
-            let pxf = self.cross(&p, &fu);
-            let nf = self.add3(&f[parent], &fu);
-            let nn = self.add3(&n[parent], &nu);
-            let nn = self.add3(&nn, &pxf);
-            f[parent] = self.subst3(nf, VarKind::D, &format!("f{pname}{tag}"));
-            n[parent] = self.subst3(nn, VarKind::D, &format!("n{pname}{tag}"));
+            self.accumulate(c, &mut f, &mut n, tag);
         }
         let mut out = vec![zero; model.dof()];
         for l in 1..links {

@@ -290,15 +290,15 @@ pub fn stats(g: &Generated) -> String {
     );
     let _ = writeln!(
         s,
-        "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8}",
-        "function", "K", "D", "temps", "adds", "muls", "divs", "sin/cos", "flops"
+        "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>6}",
+        "function", "K", "D", "temps", "adds", "muls", "divs", "sin/cos", "flops", "live"
     );
     let low = &g.lowered;
     let mut row = |name: &str, p: &lower::Program| {
         let temps = p.stmts.len() - p.k_vars - p.d_vars;
         let _ = writeln!(
             s,
-            "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8}",
+            "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>6}",
             name,
             p.k_vars,
             p.d_vars,
@@ -307,7 +307,8 @@ pub fn stats(g: &Generated) -> String {
             p.ops.muls,
             p.ops.divs,
             p.ops.sincos,
-            p.ops.flops()
+            p.ops.flops(),
+            p.max_live()
         );
     };
     if d.options.params == ParamMode::Runtime {

@@ -120,6 +120,59 @@ pub struct Program {
     pub d_vars: usize,
 }
 
+impl Program {
+    /// The largest number of statement values that are live at once (computed and still to be
+    /// read by a later statement or result entry), with every result entry stored right after
+    /// the last statement it reads, as emitted. A measure of register pressure: the statement
+    /// order is chosen to keep it low.
+    pub fn max_live(&self) -> usize {
+        let n = self.stmts.len();
+        // last_read[i]: the position after which statement i is dead.
+        let mut last_read: Vec<usize> = (0..n).collect();
+        let mut reads = Vec::new();
+        for (j, s) in self.stmts.iter().enumerate() {
+            reads.clear();
+            locals(&s.expr, &mut reads);
+            for &i in &reads {
+                last_read[i] = last_read[i].max(j);
+            }
+        }
+        for (_, _, e) in &self.outputs {
+            reads.clear();
+            locals(e, &mut reads);
+            if let Some(&at) = reads.iter().max() {
+                for &i in &reads {
+                    last_read[i] = last_read[i].max(at);
+                }
+            }
+        }
+        // +1 when a value is defined, −1 after its last read.
+        let mut delta = vec![0i64; n + 1];
+        for (i, &l) in last_read.iter().enumerate() {
+            if l > i {
+                delta[i] += 1;
+                delta[l] -= 1;
+            }
+        }
+        let (mut live, mut max) = (0i64, 0i64);
+        for d in delta {
+            live += d;
+            max = max.max(live);
+        }
+        max as usize
+    }
+}
+
+/// The statements an expression reads.
+fn locals(e: &LExpr, out: &mut Vec<usize>) {
+    match e {
+        LExpr::Leaf(Leaf::Local(i)) => out.push(*i),
+        LExpr::Leaf(_) => {}
+        LExpr::Sum { terms, .. } => terms.iter().for_each(|(_, t)| locals(t, out)),
+        LExpr::Prod(f) => f.iter().for_each(|(b, _)| locals(b, out)),
+    }
+}
+
 /// All programs of a model: the precompute program and one per function.
 #[derive(Clone, Debug)]
 pub struct Lowered {
@@ -247,68 +300,133 @@ impl Builder<'_> {
 /// Collect the statements of a program computing `roots`.
 ///
 /// Returns the statement nodes in topological order: variable definitions (each labelled by its
-/// variable) and common subexpressions.
+/// variable) and common subexpressions. With `order` (per node, when the function's derivation
+/// first asked for it), statements follow the derivation's own order and a statement it never
+/// asked for (a definition reached through a cached variable) is placed just before its first
+/// user; without, they follow arena order.
 fn schedule(
     ar: &Arena,
     roots: &[ExprId],
     is_leaf: &dyn Fn(ExprId) -> bool,
+    order: Option<&[u32]>,
 ) -> Vec<(ExprId, Option<u32>)> {
     // Reachability with parent counting; a variable is a leaf whose definition is a new root.
     let mut uses: HashMap<ExprId, usize> = HashMap::new();
     let mut seen: BTreeSet<ExprId> = BTreeSet::new();
     let mut var_defs: BTreeMap<ExprId, u32> = BTreeMap::new();
-    let mut stack: Vec<ExprId> = roots.to_vec();
-    let mut visit = |e: ExprId, stack: &mut Vec<ExprId>| {
-        if seen.insert(e) {
-            stack.push(e);
+    let mut stack: Vec<ExprId> = Vec::new();
+    for &r in roots {
+        if seen.insert(r) {
+            stack.push(r);
         }
-    };
-    let roots_set: Vec<ExprId> = roots.to_vec();
-    let mut pending = roots_set.clone();
-    stack.clear();
-    for r in pending.drain(..) {
-        visit(r, &mut stack);
     }
     while let Some(e) = stack.pop() {
         if is_leaf(e) {
             continue;
         }
+        let mut visit = |c: ExprId, count: bool| {
+            if count {
+                *uses.entry(c).or_insert(0) += 1;
+            }
+            if seen.insert(c) {
+                stack.push(c);
+            }
+        };
         match ar.node(e) {
             Node::Atom(Atom::Var(v)) => {
                 let def = ar.vars()[*v as usize].def;
                 var_defs.insert(def, *v);
-                visit(def, &mut stack);
+                visit(def, false);
             }
-            Node::Sum { terms, .. } => {
-                for (t, _) in terms.iter() {
-                    *uses.entry(*t).or_insert(0) += 1;
-                    visit(*t, &mut stack);
-                }
-            }
-            Node::Prod(f) => {
-                for (b, _) in f.iter() {
-                    *uses.entry(*b).or_insert(0) += 1;
-                    visit(*b, &mut stack);
-                }
-            }
+            Node::Sum { terms, .. } => terms.iter().for_each(|(t, _)| visit(*t, true)),
+            Node::Prod(f) => f.iter().for_each(|(b, _)| visit(*b, true)),
             _ => {}
         }
     }
-    for r in &roots_set {
+    for r in roots {
         *uses.entry(*r).or_insert(0) += 1;
     }
-    let mut out: Vec<(ExprId, Option<u32>)> = Vec::new();
+    let mut stmts: Vec<(ExprId, Option<u32>)> = Vec::new();
     for &e in &seen {
         if is_leaf(e) {
             continue;
         }
         if let Some(&v) = var_defs.get(&e) {
-            out.push((e, Some(v)));
+            stmts.push((e, Some(v)));
         } else if is_compound(ar.node(e)) && uses.get(&e).copied().unwrap_or(0) >= 2 {
-            out.push((e, None));
+            stmts.push((e, None));
+        }
+    }
+    let Some(order) = order else {
+        return stmts;
+    };
+    // Derivation order, then a depth-first pass that puts every statement after the statements
+    // it reads.
+    let is_stmt: HashMap<ExprId, Option<u32>> = stmts.iter().copied().collect();
+    stmts.sort_by_key(|(e, _)| (order[e.index()], *e));
+    let mut placed: BTreeSet<ExprId> = BTreeSet::new();
+    let mut out = Vec::with_capacity(stmts.len());
+    for &(s, _) in &stmts {
+        // Iterative post-order over the statements `s` depends on.
+        let mut work: Vec<(ExprId, bool)> = vec![(s, false)];
+        while let Some((e, expanded)) = work.pop() {
+            if expanded {
+                if placed.insert(e) {
+                    out.push((e, is_stmt[&e]));
+                }
+                continue;
+            }
+            if placed.contains(&e) {
+                continue;
+            }
+            work.push((e, true));
+            let mut deps = Vec::new();
+            statement_deps(ar, e, &is_stmt, is_leaf, &mut deps, true);
+            // Reverse, so that dependencies are placed in the order they are read.
+            for d in deps.into_iter().rev() {
+                if !placed.contains(&d) {
+                    work.push((d, false));
+                }
+            }
         }
     }
     out
+}
+
+/// The statements that statement `e` reads directly (through inline subexpressions and
+/// variables), in reading order.
+fn statement_deps(
+    ar: &Arena,
+    e: ExprId,
+    is_stmt: &HashMap<ExprId, Option<u32>>,
+    is_leaf: &dyn Fn(ExprId) -> bool,
+    out: &mut Vec<ExprId>,
+    top: bool,
+) {
+    if !top && is_stmt.contains_key(&e) {
+        out.push(e);
+        return;
+    }
+    if is_leaf(e) {
+        return;
+    }
+    match ar.node(e) {
+        Node::Atom(Atom::Var(v)) => {
+            let def = ar.vars()[*v as usize].def;
+            statement_deps(ar, def, is_stmt, is_leaf, out, false);
+        }
+        Node::Sum { terms, .. } => {
+            for (t, _) in terms.iter() {
+                statement_deps(ar, *t, is_stmt, is_leaf, out, false);
+            }
+        }
+        Node::Prod(f) => {
+            for (b, _) in f.iter() {
+                statement_deps(ar, *b, is_stmt, is_leaf, out, false);
+            }
+        }
+        _ => {}
+    }
 }
 
 fn lower_function(ar: &Arena, f: &Function, hoist: bool, pre: &mut PreSet) -> Program {
@@ -323,7 +441,7 @@ fn lower_function(ar: &Arena, f: &Function, hoist: bool, pre: &mut PreSet) -> Pr
             && ar.is_param_only(e)
             && (matches!(ar.node(e), Node::Atom(Atom::Var(_))) || is_compound(ar.node(e)))
     };
-    let sched = schedule(ar, &roots, &is_leaf);
+    let sched = schedule(ar, &roots, &is_leaf, Some(&f.order));
     let mut stmts = Vec::new();
     let (mut nk, mut nd, mut nt) = (0, 0, 0);
     for (e, var) in sched {
@@ -382,7 +500,7 @@ fn lower_precompute(ar: &Arena, pre: &PreSet) -> (Program, Vec<usize>) {
         local: HashMap::new(),
     };
     // Every requested node is a statement; so is every variable and shared node below them.
-    let sched = schedule(ar, &pre.nodes, &|_| false);
+    let sched = schedule(ar, &pre.nodes, &|_| false, None);
     let requested: BTreeSet<ExprId> = pre.nodes.iter().copied().collect();
     let mut order: Vec<(ExprId, Option<u32>)> = sched;
     for &e in &pre.nodes {

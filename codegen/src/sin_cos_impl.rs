@@ -2,9 +2,11 @@
 /// and fdlibm's minimax kernels on [−π/4, π/4]; |x| ≥ 2¹⁹·π/2 (never a robot angle) takes a
 /// cold Payne–Hanek reduction against 1280 bits of 2/π. Needs only `core` (no `std`, no
 /// `libm`). Error within about one ulp of the standard library for the angles robots use (a
-/// few ulp for huge arguments); several times faster because both values share one reduction
-/// and the code inlines.
-#[inline(always)]
+/// few ulp for huge arguments); faster because both values share one reduction. Not inlined:
+/// the generated functions are long enough that their speed depends on their code size (one
+/// shared copy instead of one per joint made Krang's mass matrix 11 KB smaller and ~15 %
+/// faster).
+#[inline(never)]
 #[allow(clippy::excessive_precision, clippy::unreadable_literal)]
 fn sin_cos(x: f64) -> (f64, f64) {
     let (r, quadrant) = if x.abs() < 823_549.0 {

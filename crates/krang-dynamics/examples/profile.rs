@@ -1,0 +1,80 @@
+//! A driver for instruction counts and quick timings of the generated functions, for work on the
+//! generator (the published speed figures come from the criterion benchmarks, `cargo bench`).
+//!
+//! ```sh
+//! cargo build --release -p krang-dynamics --example profile
+//! # instructions per call, repeatable on a loaded machine (callgrind counts, it does not time):
+//! valgrind --tool=callgrind --callgrind-out-file=/dev/null \
+//!     target/release/examples/profile mass_matrix 1000
+//! # rough ns per call (the fastest of many batches of 1000 calls):
+//! target/release/examples/profile all 200000
+//! ```
+//!
+//! Arguments: a function (`mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, or `all`) and
+//! the number of calls. States cycle through 64 fixed pseudo-random states.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use krang_dynamics::Krang;
+use nalgebra::SVector;
+
+type V = SVector<f64, 19>;
+
+fn states() -> Vec<(V, V, V)> {
+    // A small LCG: deterministic, dependency-free.
+    let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut next = move || {
+        x = x
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..64)
+        .map(|_| {
+            let q = V::from_fn(|_, _| (2.0 * next() - 1.0) * std::f64::consts::PI);
+            let u = V::from_fn(|_, _| 4.0 * next() - 2.0);
+            let ud = V::from_fn(|_, _| 10.0 * next() - 5.0);
+            (q, u, ud)
+        })
+        .collect()
+}
+
+fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> f64 {
+    let mut acc = 0.0;
+    for i in 0..calls {
+        let (q, u, ud) = &s[i & 63];
+        acc += match f {
+            "mass_matrix" => black_box(k).mass_matrix(black_box(q))[(5, 3)],
+            "coriolis" => black_box(k).coriolis(black_box(q), black_box(u))[7],
+            "gravity" => black_box(k).gravity(black_box(q))[7],
+            "inverse_dynamics" => {
+                black_box(k).inverse_dynamics(black_box(q), black_box(u), black_box(ud))[7]
+            }
+            other => panic!("unknown function `{other}`"),
+        };
+    }
+    acc
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let f = args.get(1).map_or("all", String::as_str);
+    let calls: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(100_000);
+    let k = Krang::default();
+    let s = states();
+    let names = ["mass_matrix", "coriolis", "gravity", "inverse_dynamics"];
+    let list: Vec<&str> = if f == "all" { names.to_vec() } else { vec![f] };
+    for name in list {
+        let mut best = f64::INFINITY;
+        let mut sink = 0.0;
+        // Many short batches: the fastest one is the least disturbed by other work.
+        let batch = 1000.min(calls.max(1));
+        for _ in 0..calls.div_ceil(batch) {
+            let t = Instant::now();
+            sink += run(&k, name, &s, batch);
+            best = best.min(t.elapsed().as_secs_f64() * 1e9 / batch as f64);
+        }
+        println!("{name:<17} {best:8.1} ns/call (fastest batch of {batch}) [{sink:.3e}]");
+    }
+}

@@ -438,7 +438,12 @@ pub fn mass_matrix(
     let d4 = 2.0 * t1 + 2.0 * t2 + pc.pc5; // JC1.xx
     m[(0, 0)] = d4;
     {
-        m.fill_lower_triangle_with_upper_triangle();
+        let s = m.as_mut_slice();
+        for c in 1..2 {
+            for r in 0..c {
+                s[r * 2 + c] = s[c * 2 + r];
+            }
+        }
         m
     }
 }

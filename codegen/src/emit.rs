@@ -48,7 +48,7 @@ pub enum Scalar {
     /// `f64` (the default).
     #[default]
     F64,
-    /// `f32`; `sin_cos` computes in `f64` and rounds.
+    /// `f32`; `sin_cos_n` computes in `f64` and rounds.
     F32,
 }
 
@@ -332,11 +332,22 @@ fn function(
         ),
     };
     let mut prologue = TokenStream::new();
-    for &s in &p.sincos {
-        let sn = ident(&format!("s_{}", model.speeds[s].coordinate));
-        let cn = ident(&format!("c_{}", model.speeds[s].coordinate));
-        let sl = idx(s);
-        prologue.extend(quote!(let (#sn, #cn) = sin_cos(q[#sl]);));
+    if !p.sincos.is_empty() {
+        // One batched call over the joint angles the function needs (vectorized), then the
+        // per-joint names the statements use. `sin_q`/`cos_q` cannot clash with a model name:
+        // they are read only by the bindings right below, which come before every other
+        // binding, and the sine/cosine names all start with `s_`/`c_`.
+        let angles = p.sincos.iter().map(|&s| {
+            let sl = idx(s);
+            quote!(q[#sl])
+        });
+        prologue.extend(quote!(let (sin_q, cos_q) = sin_cos_n([#(#angles),*]);));
+        for (k, &s) in p.sincos.iter().enumerate() {
+            let sn = ident(&format!("s_{}", model.speeds[s].coordinate));
+            let cn = ident(&format!("c_{}", model.speeds[s].coordinate));
+            let kl = idx(k);
+            prologue.extend(quote!(let #sn = sin_q[#kl]; let #cn = cos_q[#kl];));
+        }
     }
     for s in 0..n {
         if uses(p, &|l| *l == Leaf::Coord(s)) {
@@ -723,19 +734,31 @@ pub fn emit_scalar(model: &Model, low: &Lowered, scalar: Scalar) -> Result<Strin
             .parse()
             .expect("the sin_cos routine is valid Rust"),
         Scalar::F32 => {
+            // The f64 routines stay (the batched one renamed); the functions call an `f32`
+            // `sin_cos_n` that widens, calls the f64 batch and rounds.
             let f64_routine: TokenStream = crate::trig::SIN_COS_SOURCE
-                .replacen("fn sin_cos(", "fn sin_cos_f64(", 1)
+                .replacen("fn sin_cos_n<", "fn sin_cos_n_f64<", 1)
                 .parse()
                 .expect("the sin_cos routine is valid Rust");
             quote! {
                 #f64_routine
 
-                /// `(sin x, cos x)` in `f32`: computed in `f64` and rounded (correctly rounded
-                /// but for double rounding).
+                /// `(sin x[k], cos x[k])` in `f32` for every lane: computed in `f64` (batched)
+                /// and rounded (correctly rounded but for double rounding).
                 #[inline(always)]
-                fn sin_cos(x: f32) -> (f32, f32) {
-                    let (s, c) = sin_cos_f64(f64::from(x));
-                    (s as f32, c as f32)
+                #[allow(clippy::needless_range_loop)]
+                fn sin_cos_n<const N: usize>(x: [f32; N]) -> ([f32; N], [f32; N]) {
+                    let mut wide = [0.0; N];
+                    for k in 0..N {
+                        wide[k] = f64::from(x[k]);
+                    }
+                    let (s, c) = sin_cos_n_f64(wide);
+                    let mut out = ([0.0; N], [0.0; N]);
+                    for k in 0..N {
+                        out.0[k] = s[k] as f32;
+                        out.1[k] = c[k] as f32;
+                    }
+                    out
                 }
             }
         }

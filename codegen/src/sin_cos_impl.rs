@@ -1,29 +1,85 @@
+/// Arguments below this magnitude (≈ 2¹⁹·π/2, so that `n·PIO2_1` is exact) take the
+/// Cody–Waite reduction; larger ones (never a robot angle) and non-finite ones take
+/// `reduce_large`.
+const SIN_COS_FAST_BOUND: f64 = 823_549.0;
+
 /// `(sin x, cos x)` for the generated code: Cody–Waite reduction by π/2 (fdlibm's constants)
 /// and fdlibm's minimax kernels on [−π/4, π/4]; |x| ≥ 2¹⁹·π/2 (never a robot angle) takes a
 /// cold Payne–Hanek reduction against 1280 bits of 2/π. Needs only `core` (no `std`, no
 /// `libm`). Error within about one ulp of the standard library for the angles robots use (a
-/// few ulp for huge arguments); faster because both values share one reduction. Not inlined:
-/// the generated functions are long enough that their speed depends on their code size (one
-/// shared copy instead of one per joint made Krang's mass matrix 11 KB smaller and ~15 %
-/// faster).
-#[inline(never)]
-#[allow(clippy::excessive_precision, clippy::unreadable_literal)]
+/// few ulp for huge arguments); several times faster because both values share one reduction
+/// and the code inlines. [`sin_cos_n`] is the batched form the generated functions call.
+#[inline(always)]
 fn sin_cos(x: f64) -> (f64, f64) {
-    let (r, quadrant) = if x.abs() < 823_549.0 {
-        // n = round(x · 2/π) by the 1.5·2⁵² trick (exact for |x·2/π| < 2⁵¹).
-        let shifted = x * core::f64::consts::FRAC_2_PI + 6_755_399_441_055_744.0;
-        let n = shifted - 6_755_399_441_055_744.0;
-        // r = x − n·π/2 in three parts (π/2 = PIO2_1 + PIO2_2 + PIO2_2T, 33 + 33 + 53 bits).
-        let r1 = x - n * 1.570_796_326_734_125_614_17;
-        let w = n * 6.077_100_506_303_965_976_60e-11;
-        let r2 = r1 - w;
-        let w2 = n * 2.022_266_248_795_950_631_54e-21 - ((r1 - r2) - w);
-        (r2 - w2, shifted.to_bits())
+    let (r, quadrant) = if x.abs() < SIN_COS_FAST_BOUND {
+        sin_cos_reduce(x)
     } else {
         reduce_large(x)
     };
+    sin_cos_kernel(r, quadrant)
+}
+
+/// `(sin x[k], cos x[k])` for every lane, bit for bit the values of [`sin_cos`]. When every
+/// |x[k]| is below the Cody–Waite bound (always, for robot angles) the lanes run through one
+/// branch-free loop that the compiler vectorizes (two lanes per SSE2 instruction, four with
+/// AVX2); otherwise (a huge, infinite or NaN lane) the whole batch takes the scalar routine.
+/// Not inlined: the generated functions are long enough that their speed depends on their code
+/// size (one shared copy instead of one per function).
+#[inline(never)]
+#[allow(clippy::needless_range_loop)] // lane loops over parallel arrays: what LLVM vectorizes
+fn sin_cos_n<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
+    let mut fast = true;
+    for &xk in &x {
+        // False for NaN too.
+        fast &= xk.abs() < SIN_COS_FAST_BOUND;
+    }
+    if !fast {
+        return sin_cos_n_slow(x);
+    }
+    // Built in place: returning two separate local arrays as a tuple would copy them.
+    let mut out = ([0.0; N], [0.0; N]);
+    for k in 0..N {
+        let (r, quadrant) = sin_cos_reduce(x[k]);
+        (out.0[k], out.1[k]) = sin_cos_kernel(r, quadrant);
+    }
+    out
+}
+
+/// [`sin_cos_n`] lane by lane through [`sin_cos`] (a batch with a huge or non-finite lane).
+#[cold]
+#[inline(never)]
+#[allow(clippy::needless_range_loop)]
+fn sin_cos_n_slow<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
+    let mut out = ([0.0; N], [0.0; N]);
+    for k in 0..N {
+        (out.0[k], out.1[k]) = sin_cos(x[k]);
+    }
+    out
+}
+
+/// `(r, n)` with `x = n·π/2 + r`, |r| ≤ π/4 (to within rounding), for |x| <
+/// [`SIN_COS_FAST_BOUND`]; only the low two bits of `n` are meaningful.
+#[inline(always)]
+#[allow(clippy::excessive_precision, clippy::unreadable_literal)]
+fn sin_cos_reduce(x: f64) -> (f64, u64) {
+    // n = round(x · 2/π) by the 1.5·2⁵² trick (exact for |x·2/π| < 2⁵¹); the low bits of
+    // `shifted` hold n in two's complement.
+    let shifted = x * core::f64::consts::FRAC_2_PI + 6_755_399_441_055_744.0;
+    let n = shifted - 6_755_399_441_055_744.0;
+    // r = x − n·π/2 in three parts (π/2 = PIO2_1 + PIO2_2 + PIO2_2T, 33 + 33 + 53 bits).
+    let r1 = x - n * 1.570_796_326_734_125_614_17;
+    let w = n * 6.077_100_506_303_965_976_60e-11;
+    let r2 = r1 - w;
+    let w2 = n * 2.022_266_248_795_950_631_54e-21 - ((r1 - r2) - w);
+    (r2 - w2, shifted.to_bits())
+}
+
+/// `(sin x, cos x)` from `x = n·π/2 + r`: fdlibm's `__kernel_sin` / `__kernel_cos` on `r`,
+/// then the quadrant `n mod 4` applied by bit masks (no branches).
+#[inline(always)]
+#[allow(clippy::excessive_precision)]
+fn sin_cos_kernel(r: f64, quadrant: u64) -> (f64, f64) {
     let z = r * r;
-    // fdlibm __kernel_sin / __kernel_cos.
     let s = r + r
         * z
         * (-1.666_666_666_666_663_243_48e-01
@@ -43,14 +99,18 @@ fn sin_cos(x: f64) -> (f64, f64) {
     let hz = 0.5 * z;
     let one_minus_hz = 1.0 - hz;
     let c = one_minus_hz + (((1.0 - one_minus_hz) - hz) + poly_c);
-    // Quadrant: swap on odd n, then flip signs (sin on quadrants 2, 3; cos on 1, 2).
-    let odd = quadrant & 1 == 1;
-    let (a, b) = if odd { (c, s) } else { (s, c) };
-    let sign_a = (quadrant & 2) << 62;
-    let sign_b = ((quadrant + 1) & 2) << 62;
+    // Quadrant n mod 4: 0 → (s, c), 1 → (c, −s), 2 → (−s, −c), 3 → (−c, s). Swap on odd n
+    // (xor with the difference under an all-ones mask), then flip signs (sin on quadrants
+    // 2, 3; cos on 1, 2).
+    let swap = 0u64.wrapping_sub(quadrant & 1);
+    let (sb, cb) = (s.to_bits(), c.to_bits());
+    let t = (sb ^ cb) & swap;
+    let (sin_bits, cos_bits) = (sb ^ t, cb ^ t);
+    let sin_sign = (quadrant & 2) << 62;
+    let cos_sign = (quadrant.wrapping_add(1) & 2) << 62;
     (
-        f64::from_bits(a.to_bits() ^ sign_a),
-        f64::from_bits(b.to_bits() ^ sign_b),
+        f64::from_bits(sin_bits ^ sin_sign),
+        f64::from_bits(cos_bits ^ cos_sign),
     )
 }
 

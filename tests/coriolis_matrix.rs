@@ -12,7 +12,9 @@ use kanegen_reference::Reference;
 use kanegen_reference::random::random_physical_params;
 use krang_dynamics as kd;
 
-#[allow(dead_code)] // the tests use only part of the generated API
+/// The 7-DOF arm generated from `models/singlearm.urdf` by this package's `build.rs` (linted
+/// where it is tested as a crate: `examples/urdf-arm`; here it only hosts the tests).
+#[allow(dead_code, clippy::all)]
 mod arm {
     include!(concat!(env!("OUT_DIR"), "/singlearm.rs"));
 }

@@ -211,7 +211,10 @@ fn read_json(path: &Path) -> Result<serde_json::Value, String> {
 }
 
 fn generate(b: &Bench, params: ParamMode) -> Result<Generated, String> {
-    let options = Options { params };
+    let options = Options {
+        params,
+        ..Options::default()
+    };
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     match &b.source {
         Source::Toml(p) => kanegen::generate(root.join(p), options),

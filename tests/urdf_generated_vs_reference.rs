@@ -1,5 +1,6 @@
 //! URDF models through the generator: the symbolic derivation (`Derivation::evaluate`) and the
-//! lowered programs (`Lowered::evaluate`) against the numeric reference recursion, on random
+//! lowered programs (`Lowered::evaluate`) against the numeric reference recursion (and the
+//! Coriolis matrix: `C u = c`, `Ṁ − 2C` skew-symmetric), on random
 //! physical parameters and states, for every shipped URDF (fixed and two-wheeled bases) and for
 //! small synthetic robots exercising prismatic joints, fixed-joint merging with rotated inertials,
 //! and a wheeled body that is not the URDF root.
@@ -13,6 +14,8 @@ use kanegen_reference::Reference;
 use kanegen_reference::random::random_physical_params;
 
 const TOL: f64 = 1e-10;
+/// Ṁ from Richardson-extrapolated central differences (see `common::mdot_central`).
+const SKEW_TOL: f64 = 1e-8;
 const FUNCTIONS: [&str; 4] = ["mass_matrix", "coriolis", "gravity", "inverse_dynamics"];
 
 fn urdf(name: &str, options: &UrdfOptions) -> Model {
@@ -35,7 +38,7 @@ fn check(label: &str, model: &Model, draws: usize, seed: u64) {
     let g = generate_model(model.clone(), Options::default()).expect("generates");
     let n = model.dof();
     let mut r = rng(seed);
-    let mut worst = [0.0f64; 4];
+    let mut worst = [0.0f64; 6];
     for draw in 0..draws {
         let p = if draw == 0 {
             model.param_values()
@@ -58,15 +61,35 @@ fn check(label: &str, model: &Model, draws: usize, seed: u64) {
                     .max(rel_err(&d, &expected[i], 1.0))
                     .max(rel_err(&l, &expected[i], 1.0));
         }
+        // Coriolis matrix: C u = c, and Ṁ − 2C skew-symmetric (Ṁ by central differences of
+        // the derivation's M along q̇).
+        let mdot = mdot_central(
+            &|q: &[f64]| g.derivation.evaluate("mass_matrix", &p, q, &u, &ud),
+            &q,
+            &coordinate_rates(model, &u),
+            1e-3,
+        );
+        for c in [
+            g.derivation.evaluate("coriolis_matrix", &p, &q, &u, &ud),
+            g.lowered.evaluate("coriolis_matrix", &p, &q, &u, &ud),
+        ] {
+            let cu: Vec<f64> = (0..n)
+                .map(|r| (0..n).map(|k| c[r * n + k] * u[k]).sum())
+                .collect();
+            worst[4] = worst[4].max(rel_err(&cu, &expected[1], 1.0));
+            worst[5] = worst[5].max(skew_defect(&mdot, &c, n, 1.0));
+        }
     }
     eprintln!(
-        "{label} ({n} speeds, {draws} draws): worst relative error M {:.1e} c {:.1e} g {:.1e} tau {:.1e}",
-        worst[0], worst[1], worst[2], worst[3]
+        "{label} ({n} speeds, {draws} draws): worst relative error M {:.1e} c {:.1e} g {:.1e} tau {:.1e}; \
+         C u vs c {:.1e}, skew defect of Mdot - 2C {:.1e}",
+        worst[0], worst[1], worst[2], worst[3], worst[4], worst[5]
     );
     assert!(
-        worst.iter().all(|e| *e < TOL),
+        worst[..5].iter().all(|e| *e < TOL),
         "{label}: {worst:?} exceeds {TOL}"
     );
+    assert!(worst[5] < SKEW_TOL, "{label}: skew defect {:e}", worst[5]);
 }
 
 #[test]

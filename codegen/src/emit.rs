@@ -1,9 +1,9 @@
 //! Emission: lowered programs → Rust source via proc-macro2/quote → syn → prettyplease.
 //!
 //! The generated module is self-contained (it needs only `nalgebra`): speed and parameter names,
-//! a `Params` struct (runtime mode), a `Precomputed` struct of parameter-only terms, the four
-//! free functions `mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, and a wrapper struct
-//! named after the model (`Krang`) holding a parameter set. Statements carry the reports'
+//! a `Params` struct (runtime mode), a `Precomputed` struct of parameter-only terms, the free
+//! functions `mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, `coriolis_matrix`, and
+//! a wrapper struct named after the model (`Krang`) holding a parameter set. Statements carry the reports'
 //! style comments (`let k12 = …; // w2.x`). Output is deterministic byte for byte.
 
 use std::collections::HashMap;
@@ -400,6 +400,21 @@ fn function(
                 }),
             )
         }
+        Shape::Matrix => {
+            for (r, c, e) in &p.outputs {
+                if matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0) {
+                    continue;
+                }
+                let v = names.expr(e, false);
+                let (r, c) = (idx(*r), idx(*c));
+                stores[last_local(e).map_or(0, |i| i + 1)].extend(quote!(m[(#r, #c)] = #v;));
+            }
+            (
+                quote!(SMatrix<#t, #nl, #nl>),
+                quote!(let mut m = SMatrix::<#t, #nl, #nl>::zeros();),
+                quote!(m),
+            )
+        }
         Shape::Vector => {
             for (r, _, e) in &p.outputs {
                 if matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0) {
@@ -633,6 +648,22 @@ fn wrapper_items(model: &Model, low: &Lowered, scalar: Scalar) -> TokenStream {
         " The dynamics of `{}` with one parameter set: `τ = M(q) u̇ + c(q, u) + g(q)`.",
         model.name
     );
+    let coriolis_matrix = if low.function("coriolis_matrix").is_some() {
+        quote! {
+            /// Coriolis matrix C(q, u): `c(q, u) = C(q, u) u`, and `Ṁ − 2C` is
+            /// skew-symmetric (Ṁ along q̇; for a wheeled base x and ψ do not enter M).
+            #[inline]
+            pub fn coriolis_matrix(
+                &self,
+                q: &SVector<#t, #nl>,
+                u: &SVector<#t, #nl>,
+            ) -> SMatrix<#t, #nl, #nl> {
+                coriolis_matrix(&self.params, &self.pre, q, u)
+            }
+        }
+    } else {
+        quote!()
+    };
     quote! {
         #[doc = #doc]
         ///
@@ -694,6 +725,8 @@ fn wrapper_items(model: &Model, low: &Lowered, scalar: Scalar) -> TokenStream {
             ) -> SVector<#t, #nl> {
                 inverse_dynamics(&self.params, &self.pre, q, u, ud)
             }
+
+            #coriolis_matrix
         }
     }
 }

@@ -17,12 +17,17 @@
 //!   composite (subtree) mass, first moment and inertia carried backward, one column per speed,
 //!   only the upper triangle;
 //! * g: composite first moments against the gravity acceleration of each frame;
-//! * wheel terms of DynamicModeling.tex on the ẋ and ψ̇ rows.
+//! * wheel terms of DynamicModeling.tex on the ẋ and ψ̇ rows;
+//! * the Coriolis matrix C (c = C u, Ṁ − 2C skew-symmetric): spatial vectors in body
+//!   coordinates, composite inertia, subtree momentum and subtree inertia rate, three force
+//!   vectors carried backward per (speed, ancestor speed) pair (see `Ctx::coriolis_matrix`).
 //!
 //! Every compound component is replaced by a substitution variable as soon as it is formed.
 
 // Index loops over links mirror the recursions of the reports (parent indices, per-link tables).
 #![allow(clippy::needless_range_loop)]
+
+use std::collections::BTreeMap;
 
 use kanegen_model::{Base, JointKind, Model, Scalar};
 
@@ -40,10 +45,24 @@ pub enum ParamMode {
 }
 
 /// Generator options.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 pub struct Options {
     /// How parameters enter.
     pub params: ParamMode,
+    /// Also derive `coriolis_matrix`, the Coriolis matrix C(q, u) (default `true`). It costs
+    /// about four times the operations of `coriolis` (Krang: ≈ 9,500 flops) and roughly doubles
+    /// the compile time of a large model's generated module; turn it off when only M, c, g and
+    /// τ are needed.
+    pub coriolis_matrix: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            params: ParamMode::default(),
+            coriolis_matrix: true,
+        }
+    }
 }
 
 /// Shape of a generated function's result.
@@ -53,6 +72,8 @@ pub enum Shape {
     SymmetricMatrix,
     /// Vector; entries are `(row, 0)`.
     Vector,
+    /// General (non-symmetric) matrix; entries are `(row, col)`, absent entries are zero.
+    Matrix,
 }
 
 /// Which inputs a function takes besides the parameters.
@@ -89,7 +110,8 @@ pub struct Function {
 pub struct Derivation {
     /// All expressions and substitution variables.
     pub arena: Arena,
-    /// `mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`.
+    /// `mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, and `coriolis_matrix` if
+    /// [`Options::coriolis_matrix`].
     pub functions: Vec<Function>,
     /// Number of speeds.
     pub dof: usize,
@@ -106,6 +128,16 @@ impl Derivation {
 
 type V3 = [ExprId; 3];
 type M3 = [[ExprId; 3]; 3];
+/// A spatial vector: motion `(ω; v)` or force `(n; f)`.
+type V6 = [ExprId; 6];
+
+fn split3(x: &V6) -> (V3, V3) {
+    ([x[0], x[1], x[2]], [x[3], x[4], x[5]])
+}
+
+fn join3(a: &V3, b: &V3) -> V6 {
+    [a[0], a[1], a[2], b[0], b[1], b[2]]
+}
 
 /// Names for the arena's printer, from the model.
 pub fn names_of(model: &Model) -> Names {
@@ -116,7 +148,7 @@ pub fn names_of(model: &Model) -> Names {
     }
 }
 
-/// Derive M (upper triangle), c, g and τ for `model`.
+/// Derive M (upper triangle), c, g, τ and the Coriolis matrix C for `model`.
 pub fn derive(model: &Model, options: Options) -> Derivation {
     let mut arena = Arena::new(names_of(model));
     arena.hoist_params = options.params == ParamMode::Runtime;
@@ -146,8 +178,13 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
     cx.ar.begin_phase();
     let tau = cx.rnea(true, true);
     let tau_order = cx.ar.phase_order();
+    let cm = options.coriolis_matrix.then(|| {
+        cx.ar.begin_phase();
+        let cm = cx.coriolis_matrix(&composites);
+        (cm, cx.ar.phase_order())
+    });
     let vector = |v: Vec<ExprId>| v.into_iter().enumerate().map(|(i, e)| (i, 0, e)).collect();
-    let functions = vec![
+    let mut functions = vec![
         Function {
             name: "mass_matrix",
             doc: "Mass matrix M(q) (symmetric positive definite).",
@@ -181,6 +218,16 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
             order: tau_order,
         },
     ];
+    if let Some((cm, cm_order)) = cm {
+        functions.push(Function {
+            name: "coriolis_matrix",
+            doc: "Coriolis matrix C(q, u): c(q, u) = C(q, u) u, and Ṁ − 2C is skew-symmetric.",
+            shape: Shape::Matrix,
+            signature: Signature::QU,
+            entries: cm,
+            order: cm_order,
+        });
+    }
     debug_assert!(functions.iter().all(|f| f.entries.iter().all(|e| e.0 < n)));
     Derivation {
         arena,
@@ -508,45 +555,7 @@ impl Ctx<'_> {
             let new_ms = self.add3(&comp[parent].first_moment, &add);
             let mut new_inertia = comp[parent].inertia;
             if let (Some(jc), Some(acc)) = (inertia, new_inertia.as_mut()) {
-                // R J Rᵀ in two stages (T = J Rᵀ, then R T).
-                let jm = Self::sym(&jc);
-                let mut t = [[zero; 3]; 3];
-                for (a, row) in t.iter_mut().enumerate() {
-                    for (b, x) in row.iter_mut().enumerate() {
-                        let terms: Vec<ExprId> =
-                            (0..3).map(|k| self.ar.mul(jm[a][k], r[b][k])).collect();
-                        let s = self.ar.sum(terms);
-                        *x = self.ar.subst(
-                            s,
-                            VarKind::D,
-                            &format!("JC{name}·Aᵀ({},{})", a + 1, b + 1),
-                        );
-                    }
-                }
-                let idx = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
-                // −(u pᵀ + p uᵀ) + 2 (p·u) I  and  m (|p|² I − p pᵀ)
-                let pu = self.dot(&p, &u);
-                let two_pu = self.ar.scale(pu, 2.0);
-                let pp = self.dot(&p, &p);
-                for (k, &(a, b)) in idx.iter().enumerate() {
-                    let terms: Vec<ExprId> =
-                        (0..3).map(|i| self.ar.mul(r[a][i], t[i][b])).collect();
-                    let rjr = self.ar.sum(terms);
-                    let upa = self.ar.mul(u[a], p[b]);
-                    let pua = self.ar.mul(p[a], u[b]);
-                    let cross = self.ar.add(upa, pua);
-                    let cross = self.ar.neg(cross);
-                    let ppab = self.ar.mul(p[a], p[b]);
-                    let mterm = if a == b {
-                        let d = self.ar.sub(pp, ppab);
-                        self.ar.mul(mass, d)
-                    } else {
-                        let d = self.ar.neg(ppab);
-                        self.ar.mul(mass, d)
-                    };
-                    let diag = if a == b { two_pu } else { zero };
-                    acc[k] = self.ar.sum([acc[k], rjr, cross, diag, mterm]);
-                }
+                self.add_inertia_to_parent(&r, &p, mass, &u, &jc, &name, "JC", acc);
             }
             comp[parent] = Composite {
                 mass: new_mass,
@@ -564,6 +573,64 @@ impl Ctx<'_> {
                 .map(|j| j.map(|x| self.ar.subst(x, VarKind::D, &format!("JC{name}")))),
         };
         comp
+    }
+
+    /// Add to `acc` (`[XX, XY, XZ, YY, YZ, ZZ]` about the parent's origin, in the parent's
+    /// frame) the inertia `jc` of a child about its own origin, with mass `mass` and first moment
+    /// `u` already rotated into the parent's frame (`u = R·MS`): `R J Rᵀ` in two stages (the
+    /// intermediate `J Rᵀ` gets variables labelled `{prefix}{name}·Aᵀ`) plus the parallel-axis
+    /// terms `−(u pᵀ + p uᵀ) + 2 (p·u) 1 + m (|p|² 1 − p pᵀ)`. Linear in `(m, MS, J)`: with
+    /// `mass = 0` it carries any matrix of the form `[[A, [b]×], [−[b]×, 0]]` (inertia rates).
+    #[allow(clippy::too_many_arguments)]
+    fn add_inertia_to_parent(
+        &mut self,
+        r: &M3,
+        p: &V3,
+        mass: ExprId,
+        u: &V3,
+        jc: &[ExprId; 6],
+        name: &str,
+        prefix: &str,
+        acc: &mut [ExprId; 6],
+    ) {
+        let zero = self.ar.zero();
+        // R J Rᵀ in two stages (T = J Rᵀ, then R T).
+        let jm = Self::sym(jc);
+        let mut t = [[zero; 3]; 3];
+        for (a, row) in t.iter_mut().enumerate() {
+            for (b, x) in row.iter_mut().enumerate() {
+                let terms: Vec<ExprId> = (0..3).map(|k| self.ar.mul(jm[a][k], r[b][k])).collect();
+                let s = self.ar.sum(terms);
+                *x = self.ar.subst(
+                    s,
+                    VarKind::D,
+                    &format!("{prefix}{name}·Aᵀ({},{})", a + 1, b + 1),
+                );
+            }
+        }
+        let idx = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+        // −(u pᵀ + p uᵀ) + 2 (p·u) I  and  m (|p|² I − p pᵀ)
+        let pu = self.dot(p, u);
+        let two_pu = self.ar.scale(pu, 2.0);
+        let pp = self.dot(p, p);
+        for (k, &(a, b)) in idx.iter().enumerate() {
+            let terms: Vec<ExprId> = (0..3).map(|i| self.ar.mul(r[a][i], t[i][b])).collect();
+            let rjr = self.ar.sum(terms);
+            let upa = self.ar.mul(u[a], p[b]);
+            let pua = self.ar.mul(p[a], u[b]);
+            let cross = self.ar.add(upa, pua);
+            let cross = self.ar.neg(cross);
+            let ppab = self.ar.mul(p[a], p[b]);
+            let mterm = if a == b {
+                let d = self.ar.sub(pp, ppab);
+                self.ar.mul(mass, d)
+            } else {
+                let d = self.ar.neg(ppab);
+                self.ar.mul(mass, d)
+            };
+            let diag = if a == b { two_pu } else { zero };
+            acc[k] = self.ar.sum([acc[k], rjr, cross, diag, mterm]);
+        }
     }
 
     // ---- mass matrix ----------------------------------------------------------------------------
@@ -920,6 +987,353 @@ impl Ctx<'_> {
         }
         self.finish(out, if with_accel { "tau" } else { "c" })
     }
+
+    // ---- Coriolis matrix ------------------------------------------------------------------------
+
+    /// `C(q, u)` with `c = C u` and `Ṁ − 2C` skew-symmetric, as `(row, col, expr)` entries.
+    ///
+    /// Spatial vectors in body coordinates: motion `V = (ω; v)` (v of the frame origin), force
+    /// `f = (n; f)` (n about the frame origin). Body k's spatial inertia `I_k` is constant in its
+    /// frame, its body Jacobian `J_k` (`V_k = J_k u`) has the column `ᵏX_j S_j` for every speed j
+    /// on its path to the root (`S_j` constant in the frame of joint j: `(e; 0)` revolute,
+    /// `(0; e)` prismatic, `(0; x̂)` and `(ẑ; 0)` for ẋ, ψ̇ in frame 0), and
+    /// `J̇_k,j = −(V_k − ᵏX_j V_j) × J_k,j`. With `M = Σ J_kᵀ I_k J_k` (plus constant wheel terms),
+    ///
+    /// `C = Σ_k J_kᵀ (I_k J̇_k + B_k J_k)`, `B_k = ½ [(I_k V_k)×̄* + I_k (V_k×) + (V_k×*) I_k]`
+    ///
+    /// (`(h×̄*) m := m ×* h`). B_k is skew-symmetric and `B_k V_k = V_k ×* I_k V_k`, so
+    /// `C u = c` and `C + Cᵀ = Σ (J̇ᵀ I J + Jᵀ I J̇) = Ṁ`. This choice of B (the average of
+    /// `(I V)×̄*` and `I (V×) − (I (V×))ᵀ`) makes `I_k J̇_k,j + B_k J_k,j = I_k ᵏX_j (V_j × S_j) +
+    /// ½ (I_k V_k)×̄* J_k,j + ½ D_k J_k,j` with `D_k = (V_k×*) I_k − I_k (V_k×)`, the rate of
+    /// the inertia in a fixed frame: symmetric, of the inertia form `[[J̇, [ċ]×], [−[ċ]×, 0]]`
+    /// (`J̇ = [ω]× J − J [ω]× + 2 (c·v) 1 − c vᵀ − v cᵀ`, `ċ = ω × c + m v`, c = MS), so it is
+    /// summed over subtrees exactly like composite inertias (with mass 0). Over the subtree of
+    /// the link of speed i, in its frame: `I^c_i` (composite inertia), `h^c_i = Σ I_k V_k`
+    /// (subtree momentum), `D^c_i = Σ D_k`; then
+    ///
+    /// * `h_i = I^c_i (V_i × S_i) + ½ S_i ×* h^c_i + ½ D^c_i S_i`: `C[j, i] = S_j · h_i` for i
+    ///   and every speed j above it (h_i carried up as a force);
+    /// * `G1_i = ½ D^c_i S_i − ½ S_i ×* h^c_i`, `G2_i = I^c_i S_i` (M's column force):
+    ///   `C[i, j] = S_j · G1_i + (V_j × S_j) · G2_i` for every speed j strictly above i
+    ///   (identity `a · (m ×* f) = −(m × a) · f`).
+    ///
+    /// Three force vectors carried per (descendant, ancestor) pair: the cost grows with the sum
+    /// of depths, like M's.
+    fn coriolis_matrix(&mut self, comp: &[Composite]) -> Vec<(usize, usize, ExprId)> {
+        let model = self.model;
+        let links = model.links.len();
+        let zero = self.ar.zero();
+        let half = 0.5;
+        // Velocities of the frames, in their own frames.
+        let vel = self.velocities();
+        // Body momenta h_k = I_k V_k and inertia rates D_k = (ċ_k, J̇_k).
+        let mut hc: Vec<V6> = vec![[zero; 6]; links];
+        let mut dc: Vec<(V3, [ExprId; 6])> = vec![([zero; 3], [zero; 6]); links];
+        for l in 0..links {
+            let Some((m, ms, j)) = self.body(l) else {
+                continue;
+            };
+            let name = self.link_name(l).to_owned();
+            let (w, v) = split3(&vel[l]);
+            // h = (J ω + MS × v; m v + ω × MS); its linear part is also ċ of the inertia rate.
+            let tag = "|ud=0,g=0";
+            let wxms = self.cross(&w, &ms);
+            let wxms = self.subst3(wxms, VarKind::D, &format!("w{name}xMS{name}{tag}"));
+            let jw = self.sym_mul(&j, &w);
+            let jw = self.subst3(jw, VarKind::D, &format!("J{name}w{name}{tag}"));
+            let msxv = self.cross(&ms, &v);
+            let n = self.add3(&jw, &msxv);
+            let mv = self.scale3(m, &v);
+            let f = self.add3(&mv, &wxms);
+            hc[l] = self.subst_force(join3(&n, &f), &format!("h{name}"));
+            // J̇ = W + Wᵀ + 2 (c·v) 1 − (c vᵀ + v cᵀ), W = [ω]× J (c = MS).
+            let jm = Self::sym(&j);
+            let mut wj = [[zero; 3]; 3];
+            for b in 0..3 {
+                let col = [jm[0][b], jm[1][b], jm[2][b]];
+                let x = self.cross(&w, &col);
+                for a in 0..3 {
+                    wj[a][b] = x[a];
+                }
+            }
+            let cv = self.dot(&ms, &v);
+            let two_cv = self.ar.scale(cv, 2.0);
+            let labels = ["xx", "xy", "xz", "yy", "yz", "zz"];
+            let idx = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+            let mut jd = [zero; 6];
+            for (k, &(a, b)) in idx.iter().enumerate() {
+                let cva = self.ar.mul(ms[a], v[b]);
+                let vca = self.ar.mul(v[a], ms[b]);
+                let sym = self.ar.add(cva, vca);
+                let sym = self.ar.neg(sym);
+                let diag = if a == b { two_cv } else { zero };
+                let e = self.ar.sum([wj[a][b], wj[b][a], diag, sym]);
+                jd[k] = self
+                    .ar
+                    .subst(e, VarKind::D, &format!("Jd{name}.{}", labels[k]));
+            }
+            // ċ = ω × MS + m v: the linear momentum.
+            let cd = split3(&hc[l]).1;
+            dc[l] = (cd, jd);
+        }
+        // Subtree sums, backward: momenta as forces, inertia rates as inertias of mass 0. The
+        // first-moment rate ċ of a subtree is its linear momentum (both move up as R·x).
+        let labels = ["xx", "xy", "xz", "yy", "yz", "zz"];
+        for c in (1..links).rev() {
+            let parent = model.links[c].parent.expect("non-root");
+            let name = self.link_name(c).to_owned();
+            let pname = self.link_name(parent).to_owned();
+            hc[c] = self.subst_force(hc[c], &format!("hC{name}"));
+            let jd = dc[c].1;
+            let jd = [0, 1, 2, 3, 4, 5].map(|k| {
+                self.ar
+                    .subst(jd[k], VarKind::D, &format!("JdC{name}.{}", labels[k]))
+            });
+            dc[c] = (split3(&hc[c]).1, jd);
+            if hc[c].iter().chain(jd.iter()).all(|x| self.ar.is_zero(*x)) {
+                continue;
+            }
+            let r = self.rotation(c);
+            let p = self.position(c);
+            let up = self.force_up(c, &hc[c], &format!("hC{name} in {pname}"));
+            hc[parent] = self.add6(&hc[parent], &up);
+            let u = split3(&up).1;
+            let mut pjd = dc[parent].1;
+            self.add_inertia_to_parent(&r, &p, zero, &u, &jd, &name, "JdC", &mut pjd);
+            dc[parent].1 = pjd;
+        }
+        {
+            let name = self.link_name(0).to_owned();
+            hc[0] = self.subst_force(hc[0], &format!("hC{name}"));
+            let jd = dc[0]
+                .1
+                .map(|x| self.ar.subst(x, VarKind::D, &format!("JdC{name}")));
+            dc[0] = (split3(&hc[0]).1, jd);
+        }
+        // The columns (speeds) of every link: a joint's, or the base's ẋ and ψ̇ at the root.
+        let mut cols: Vec<Vec<(usize, V6)>> = vec![Vec::new(); links];
+        if let Some(w) = model.wheeled_base() {
+            let one = self.ar.one();
+            cols[0].push((w.x_speed, [zero, zero, zero, one, zero, zero]));
+            cols[0].push((w.psi_speed, [zero, zero, one, zero, zero, zero]));
+        }
+        for l in 1..links {
+            let joint = model.links[l].joint.as_ref().expect("non-root");
+            let Some(s) = joint.speed else { continue };
+            let e = self.axis(l);
+            let axis = match joint.kind {
+                JointKind::Prismatic => [zero, zero, zero, e[0], e[1], e[2]],
+                _ => [e[0], e[1], e[2], zero, zero, zero],
+            };
+            cols[l].push((s, axis));
+        }
+        // V_l × S for every column, in its frame (the Coriolis bias of a unit speed).
+        let mut vxs: Vec<Vec<V6>> = vec![Vec::new(); links];
+        for l in 0..links {
+            for k in 0..cols[l].len() {
+                let (sp, s) = cols[l][k];
+                let x = self.motion_cross(&vel[l], &s);
+                let label = format!("V{}xS({})", self.link_name(l), model.speeds[sp].name);
+                let x = self.subst_motion(x, &label);
+                vxs[l].push(x);
+            }
+        }
+        let mut entries: BTreeMap<(usize, usize), ExprId> = BTreeMap::new();
+        let put = |entries: &mut BTreeMap<(usize, usize), ExprId>, a: usize, b: usize, e| {
+            let old = entries.insert((a, b), e);
+            debug_assert!(old.is_none(), "C[{a},{b}] set twice");
+        };
+        for l in 0..links {
+            for k in 0..cols[l].len() {
+                let (sp, s) = cols[l][k];
+                let sname = model.speeds[sp].name.clone();
+                let name = self.link_name(l).to_owned();
+                let c = &comp[l];
+                let jc = c.inertia.expect("inertia computed");
+                let ic_vxs = self.inertia_mul(c.mass, &c.first_moment, &jc, &vxs[l][k]);
+                let ic_vxs = self.subst_force(ic_vxs, &format!("IC{name}(VxS({sname}))"));
+                let sxh = self.force_cross(&s, &hc[l]);
+                let sxh = self.subst_force(sxh, &format!("S({sname})x*hC{name}"));
+                let (cd, jd) = dc[l];
+                let ds = self.inertia_mul(zero, &cd, &jd, &s);
+                let ds = self.subst_force(ds, &format!("DC{name}S({sname})"));
+                let mut h = [zero; 6];
+                let mut g1 = [zero; 6];
+                for i in 0..6 {
+                    let a = self.ar.scale(sxh[i], half);
+                    let b = self.ar.scale(ds[i], half);
+                    h[i] = self.ar.sum([ic_vxs[i], a, b]);
+                    g1[i] = self.ar.sub(b, a);
+                }
+                let mut h = self.subst_force(h, &format!("h(C col {sname}) at {name}"));
+                let mut g1 = self.subst_force(g1, &format!("G1(C row {sname}) at {name}"));
+                let g2 = self.inertia_mul(c.mass, &c.first_moment, &jc, &s);
+                let mut g2 = self.subst_force(g2, &format!("G2(C row {sname}) at {name}"));
+                // Speeds of the same frame (the base's ẋ, ψ̇; or the joint itself).
+                for &(sa, sv) in &cols[l] {
+                    let e = self.dot6(&sv, &h);
+                    put(&mut entries, sa, sp, e);
+                }
+                let mut at = l;
+                while let Some(parent) = model.links[at].parent {
+                    let pname = self.link_name(parent).to_owned();
+                    h = self.force_up(at, &h, &format!("h(C col {sname}) at {pname}"));
+                    g1 = self.force_up(at, &g1, &format!("G1(C row {sname}) at {pname}"));
+                    g2 = self.force_up(at, &g2, &format!("G2(C row {sname}) at {pname}"));
+                    at = parent;
+                    for (ka, &(sa, sv)) in cols[at].iter().enumerate() {
+                        let e = self.dot6(&sv, &h);
+                        put(&mut entries, sa, sp, e);
+                        let t1 = self.dot6(&sv, &g1);
+                        let t2 = self.dot6(&vxs[at][ka], &g2);
+                        let e = self.ar.add(t1, t2);
+                        put(&mut entries, sp, sa, e);
+                    }
+                }
+            }
+        }
+        let mut out = Vec::with_capacity(entries.len());
+        for ((a, b), e) in entries {
+            if self.ar.is_zero(e) {
+                continue;
+            }
+            let e = if self.ar.hoist_params {
+                self.ar.hoist(e, &format!("C[{a},{b}]"))
+            } else {
+                e
+            };
+            out.push((a, b, e));
+        }
+        out
+    }
+
+    /// Spatial velocities `(ω; v)` of every frame in its own frame (`v` of the origin).
+    fn velocities(&mut self) -> Vec<V6> {
+        let model = self.model;
+        let links = model.links.len();
+        let zero = self.ar.zero();
+        let mut w: Vec<V3> = vec![[zero; 3]; links];
+        let mut v: Vec<V3> = vec![[zero; 3]; links];
+        if let Some(wb) = model.wheeled_base() {
+            w[0] = [zero, zero, self.ar.atom(Atom::Speed(wb.psi_speed as u32))];
+            v[0] = [self.ar.atom(Atom::Speed(wb.x_speed as u32)), zero, zero];
+        }
+        let tag = "|ud=0,g=0";
+        for l in 1..links {
+            let i = model.links[l].parent.expect("non-root");
+            let joint = model.links[l].joint.clone().expect("non-root");
+            let name = self.link_name(l).to_owned();
+            let iname = self.link_name(i).to_owned();
+            let r = self.rotation(l);
+            let p = self.position(l);
+            let e = self.axis(l);
+            // ω as in the inverse dynamics (same variables).
+            let wi = self.rot_down(&r, &w[i]);
+            let wi = self.subst3(wi, VarKind::K, &format!("w{iname} in {name}{tag}"));
+            let mut vl = {
+                let wxp = self.cross(&w[i], &p);
+                let wxp = self.subst3(wxp, VarKind::K, &format!("w{iname}xP{name}{tag}"));
+                let t = self.add3(&v[i], &wxp);
+                let t = self.subst3(t, VarKind::K, &format!("v{name} in {iname}"));
+                self.rot_down(&r, &t)
+            };
+            let mut wl = wi;
+            match (joint.kind, joint.speed) {
+                (JointKind::Revolute, Some(s)) => {
+                    let u = self.ar.atom(Atom::Speed(s as u32));
+                    let ue = self.scale3(u, &e);
+                    wl = self.add3(&wi, &ue);
+                }
+                (JointKind::Prismatic, Some(s)) => {
+                    let u = self.ar.atom(Atom::Speed(s as u32));
+                    let ue = self.scale3(u, &e);
+                    vl = self.add3(&vl, &ue);
+                }
+                _ => {}
+            }
+            w[l] = self.subst3(wl, VarKind::K, &format!("w{name}{tag}"));
+            v[l] = self.subst3(vl, VarKind::K, &format!("v{name}"));
+        }
+        (0..links)
+            .map(|l| [w[l][0], w[l][1], w[l][2], v[l][0], v[l][1], v[l][2]])
+            .collect()
+    }
+
+    // ---- spatial algebra (motion (ω; v), force (n; f)) ----------------------------------------
+
+    /// Spatial inertia with mass `m`, first moment `c`, inertia `j` about the origin, times the
+    /// motion `x`: `(J x_ω + c × x_v; m x_v − c × x_ω)`. With `m = 0` and `(c, j) = (ċ, J̇)`: D x.
+    fn inertia_mul(&mut self, m: ExprId, c: &V3, j: &[ExprId; 6], x: &V6) -> V6 {
+        let (xw, xv) = split3(x);
+        let jw = self.sym_mul(j, &xw);
+        let cxv = self.cross(c, &xv);
+        let n = self.add3(&jw, &cxv);
+        let mv = self.scale3(m, &xv);
+        let cxw = self.cross(c, &xw);
+        let f = self.sub3(&mv, &cxw);
+        join3(&n, &f)
+    }
+
+    /// Motion cross product `a × b = (ω_a × ω_b; ω_a × v_b + v_a × ω_b)`.
+    fn motion_cross(&mut self, a: &V6, b: &V6) -> V6 {
+        let (aw, av) = split3(a);
+        let (bw, bv) = split3(b);
+        let w = self.cross(&aw, &bw);
+        let t1 = self.cross(&aw, &bv);
+        let t2 = self.cross(&av, &bw);
+        let v = self.add3(&t1, &t2);
+        join3(&w, &v)
+    }
+
+    /// Force cross product `m ×* f = (ω × n + v × f; ω × f)`.
+    fn force_cross(&mut self, m: &V6, f: &V6) -> V6 {
+        let (w, v) = split3(m);
+        let (n, ff) = split3(f);
+        let t1 = self.cross(&w, &n);
+        let t2 = self.cross(&v, &ff);
+        let top = self.add3(&t1, &t2);
+        let bot = self.cross(&w, &ff);
+        join3(&top, &bot)
+    }
+
+    fn dot6(&mut self, a: &V6, b: &V6) -> ExprId {
+        let t: Vec<ExprId> = (0..6).map(|i| self.ar.mul(a[i], b[i])).collect();
+        self.ar.sum(t)
+    }
+
+    fn add6(&mut self, a: &V6, b: &V6) -> V6 {
+        [0, 1, 2, 3, 4, 5].map(|i| self.ar.add(a[i], b[i]))
+    }
+
+    /// Substitution variables (kind D) for a force: `{label}.n.x` … `{label}.f.z`.
+    fn subst_force(&mut self, x: V6, label: &str) -> V6 {
+        let (a, b) = split3(&x);
+        let a = self.subst3(a, VarKind::D, &format!("{label}.n"));
+        let b = self.subst3(b, VarKind::D, &format!("{label}.f"));
+        join3(&a, &b)
+    }
+
+    /// Substitution variables (kind K) for a motion: `{label}.w.x` … `{label}.v.z`.
+    fn subst_motion(&mut self, x: V6, label: &str) -> V6 {
+        let (a, b) = split3(&x);
+        let a = self.subst3(a, VarKind::K, &format!("{label}.w"));
+        let b = self.subst3(b, VarKind::K, &format!("{label}.v"));
+        join3(&a, &b)
+    }
+
+    /// A force of frame `child` moved to its parent: `(R n + P × R f; R f)`.
+    fn force_up(&mut self, child: usize, x: &V6, label: &str) -> V6 {
+        let r = self.rotation(child);
+        let p = self.position(child);
+        let (n, f) = split3(x);
+        let fu = self.rot_up(&r, &f);
+        let fu = self.subst3(fu, VarKind::D, &format!("{label}.f"));
+        let nu = self.rot_up(&r, &n);
+        let pxf = self.cross(&p, &fu);
+        let nn = self.add3(&nu, &pxf);
+        let nn = self.subst3(nn, VarKind::D, &format!("{label}.n"));
+        join3(&nn, &fu)
+    }
 }
 
 impl Derivation {
@@ -945,6 +1359,13 @@ impl Derivation {
                 for &(r, c, e) in &f.entries {
                     m[r * n + c] = vals[e.index()];
                     m[c * n + r] = vals[e.index()];
+                }
+                m
+            }
+            Shape::Matrix => {
+                let mut m = vec![0.0; n * n];
+                for &(r, c, e) in &f.entries {
+                    m[r * n + c] = vals[e.index()];
                 }
                 m
             }

@@ -171,6 +171,21 @@ impl Builder {
         self
     }
 
+    /// Whether the module has `coriolis_matrix`, the Coriolis matrix C(q, u) with
+    /// `c = C u` and `Ṁ − 2C` skew-symmetric (default `true`, so that every generated module
+    /// has the same API). It is about four times the operations of `coriolis` and roughly
+    /// doubles the compile time of a large model's module (Krang: ≈ 9,500 flops, +3 s of
+    /// release compilation per module); build scripts that need only M, c, g and τ can leave it
+    /// out:
+    ///
+    /// ```no_run
+    /// kanegen::Builder::new("krang.toml").coriolis_matrix(false).run();
+    /// ```
+    pub fn coriolis_matrix(mut self, on: bool) -> Self {
+        self.options.coriolis_matrix = on;
+        self
+    }
+
     /// The scalar type of the generated module (default [`Scalar::F64`]). With
     /// [`Scalar::F32`] every matrix, vector, `Params` field and literal is `f32`, and the
     /// default file name gets the suffix `_f32.rs`:
@@ -351,6 +366,7 @@ pub fn listing(g: &Generated) -> String {
         for &(r, c, e) in &f.entries {
             let lhs = match f.shape {
                 kane::Shape::SymmetricMatrix => format!("M({},{})", r + 1, c + 1),
+                kane::Shape::Matrix => format!("C({},{})", r + 1, c + 1),
                 kane::Shape::Vector => format!("{}({})", f.name, r + 1),
             };
             let _ = writeln!(s, "{lhs} = {};", d.arena.display(e));

@@ -606,7 +606,8 @@ impl Lowered {
         self.pre_slots.iter().map(|&i| locals[i]).collect()
     }
 
-    /// Evaluate function `name`; dense row-major matrix (both triangles) or vector.
+    /// Evaluate function `name`; dense row-major matrix (both triangles of a symmetric one) or
+    /// vector.
     pub fn evaluate(
         &self,
         name: &str,
@@ -636,6 +637,13 @@ impl Lowered {
                     let v = ctx.eval(e);
                     m[r * n + c] = v;
                     m[c * n + r] = v;
+                }
+                m
+            }
+            Shape::Matrix => {
+                let mut m = vec![0.0; n * n];
+                for (r, c, e) in &p.outputs {
+                    m[r * n + c] = ctx.eval(e);
                 }
                 m
             }

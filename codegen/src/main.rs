@@ -6,20 +6,23 @@
 //! kanegen listing <model> [--baked]        the substitution listing in the reports' style
 //! kanegen emit    <model> [--baked] [--out FILE]   the generated Rust (stdout or FILE)
 //! ```
+//!
+//! `--no-coriolis-matrix` leaves out the Coriolis matrix (as `Builder::coriolis_matrix(false)`).
 #![forbid(unsafe_code)]
 
 use std::process::ExitCode;
 
 use kanegen::{Options, ParamMode};
 
-const USAGE: &str = "usage: kanegen <show|stats|listing|emit> <model.toml> [--baked] [--out FILE]
+const USAGE: &str = "usage: kanegen <show|stats|listing|emit> <model.toml> [--baked] [--no-coriolis-matrix] [--out FILE]
 
   show     print the validated model: frame tree, speeds, parameters
   stats    print K/D variable counts and operation counts per generated function
   listing  print the substitution listing (K/D variables) in the reports' style
   emit     print the generated Rust module, or write it to --out FILE (only if changed)
 
-  --baked  fold the model file's parameter values in as constants";
+  --baked  fold the model file's parameter values in as constants
+  --no-coriolis-matrix  leave out the Coriolis matrix C(q, u)";
 
 fn main() -> ExitCode {
     match run(std::env::args().skip(1).collect()) {
@@ -34,11 +37,13 @@ fn main() -> ExitCode {
 fn run(args: Vec<String>) -> Result<(), String> {
     let mut positional = Vec::new();
     let mut baked = false;
+    let mut coriolis_matrix = true;
     let mut out = None;
     let mut it = args.into_iter();
     while let Some(a) = it.next() {
         match a.as_str() {
             "--baked" => baked = true,
+            "--no-coriolis-matrix" => coriolis_matrix = false,
             "--out" => out = Some(it.next().ok_or("--out needs a file name")?),
             "-h" | "--help" => {
                 println!("{USAGE}");
@@ -57,6 +62,7 @@ fn run(args: Vec<String>) -> Result<(), String> {
         } else {
             ParamMode::Runtime
         },
+        coriolis_matrix,
     };
     if cmd == "show" {
         let m = kanegen::model::Model::from_toml_file(path).map_err(|e| format!("error: {e}"))?;

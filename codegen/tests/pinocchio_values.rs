@@ -37,6 +37,7 @@ fn symbolic_krang_matches_pinocchio_reference_values() {
         &model,
         Options {
             params: ParamMode::Runtime,
+            ..Options::default()
         },
     );
     let low = kanegen::lower::lower(&d);
@@ -100,5 +101,13 @@ fn symbolic_krang_matches_pinocchio_reference_values() {
             "{name} lowered"
         );
         assert!(em < 1e-9 && ec < 1e-9 && eg < 1e-9 && et < 1e-9, "{name}");
+        // The Coriolis matrix times u is Pinocchio's c.
+        let cm = low.evaluate("coriolis_matrix", &params, &q, &u, &z);
+        let cu: Vec<f64> = (0..19)
+            .map(|r| (0..19).map(|k| cm[r * 19 + k] * u[k]).sum())
+            .collect();
+        let ecm = rel_err(&cu, &vecf(&case["c"]));
+        eprintln!("{name}: C u vs c {ecm:.2e}");
+        assert!(ecm < 1e-9, "{name}: C u");
     }
 }

@@ -23,7 +23,13 @@ const MAX_LIVE: [(&str, usize); 4] = [
 #[test]
 fn krang_programs_keep_few_values_live() {
     for mode in [ParamMode::Runtime, ParamMode::Baked] {
-        let d = derive(&krang(), Options { params: mode });
+        let d = derive(
+            &krang(),
+            Options {
+                params: mode,
+                ..Options::default()
+            },
+        );
         let low = lower(&d);
         for (name, bound) in MAX_LIVE {
             let live = low.function(name).expect("function exists").max_live();

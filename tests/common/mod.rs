@@ -124,3 +124,51 @@ pub fn hardware_fitted_params(model: &Model) -> Option<Vec<f64>> {
     }
     Some(p)
 }
+
+/// `Ṁ = dM(q(t))/dt` along `q̇` by central differences with one Richardson step (error O(h⁴)):
+/// `(4 D(h/2) − D(h)) / 3`, `D(h) = (M(q + h q̇) − M(q − h q̇)) / 2h`. `m` returns a row-major
+/// matrix.
+pub fn mdot_central(m: &dyn Fn(&[f64]) -> Vec<f64>, q: &[f64], qdot: &[f64], h: f64) -> Vec<f64> {
+    let at = |t: f64| -> Vec<f64> {
+        let qt: Vec<f64> = q.iter().zip(qdot).map(|(a, b)| a + t * b).collect();
+        m(&qt)
+    };
+    let d = |h: f64| -> Vec<f64> {
+        at(h)
+            .iter()
+            .zip(at(-h))
+            .map(|(p, n)| (p - n) / (2.0 * h))
+            .collect()
+    };
+    let (coarse, fine) = (d(h), d(h / 2.0));
+    fine.iter()
+        .zip(coarse)
+        .map(|(f, c)| (4.0 * f - c) / 3.0)
+        .collect()
+}
+
+/// `max |Ṁ − (C + Cᵀ)|` of row-major n × n matrices, i.e. the departure of `Ṁ − 2C` from
+/// skew-symmetry (`Ṁ − 2C + (Ṁ − 2C)ᵀ = 2 (Ṁ − C − Cᵀ)`), divided by `max(max |Ṁ|, max |C|,
+/// floor)`.
+pub fn skew_defect(mdot: &[f64], c: &[f64], n: usize, floor: f64) -> f64 {
+    let scale = mdot.iter().chain(c).fold(floor, |s, x| s.max(x.abs()));
+    let mut worst = 0.0f64;
+    for r in 0..n {
+        for k in 0..n {
+            let e = mdot[r * n + k] - c[r * n + k] - c[k * n + r];
+            worst = worst.max(e.abs());
+        }
+    }
+    worst / scale
+}
+
+/// Generalized coordinate rates `q̇` for speeds `u`: the joint coordinates' rates are their
+/// speeds; the wheeled base's x and ψ (quasi-velocities ẋ, ψ̇; they do not enter M) get 0.
+pub fn coordinate_rates(model: &Model, u: &[f64]) -> Vec<f64> {
+    let mut qd = u.to_vec();
+    if let Some(w) = model.wheeled_base() {
+        qd[w.x_speed] = 0.0;
+        qd[w.psi_speed] = 0.0;
+    }
+    qd
+}

@@ -6,6 +6,7 @@
 //   coriolis          10 adds, 22 muls, 0 divs, 1 sin/cos; 1 K and 14 D variables
 //   gravity           8 adds, 14 muls, 0 divs, 2 sin/cos; 0 K and 8 D variables
 //   inverse_dynamics  21 adds, 32 muls, 0 divs, 2 sin/cos; 2 K and 17 D variables
+//   coriolis_matrix   18 adds, 31 muls, 0 divs, 1 sin/cos; 1 K and 21 D variables
 
 use nalgebra::{SMatrix, SVector};
 /// Arguments below this magnitude (≈ 2¹⁹·π/2, so that `n·PIO2_1` is exact) take the
@@ -608,6 +609,54 @@ pub fn inverse_dynamics(
     out[0] = core::hint::black_box(d17);
     out
 }
+/// Coriolis matrix C(q, u): c(q, u) = C(q, u) u, and Ṁ − 2C is skew-symmetric.
+///
+/// `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].
+/// Generated straight-line code: 18 adds, 31 muls, 0 divs, 1 sin/cos.
+#[allow(non_snake_case, unused_variables, clippy::all)]
+#[inline(never)]
+pub fn coriolis_matrix(
+    p: &Params,
+    _pc: &Precomputed,
+    q: &SVector<f64, 2>,
+    u: &SVector<f64, 2>,
+) -> SMatrix<f64, 2, 2> {
+    let (sin_q, cos_q) = sin_cos_n([q[1]]);
+    let s_q_w = sin_q[0];
+    let c_q_w = cos_q[0];
+    let qd_imu = u[0];
+    let qd_w = u[1];
+    let mut m = SMatrix::<f64, 2, 2>::zeros();
+    let d1 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+    let d2 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+    let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
+    let d3 = c_q_w * d1 - s_q_w * d2; // v2.y
+    let d4 = s_q_w * d1 + c_q_w * d2; // v2.z
+    let d5 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
+    let d6 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
+    let d7 = p.m2 * d3; // IC2(VxS(qd_w)).f.z
+    let d8 = p.m2 * d4; // IC2(VxS(qd_w)).f.y
+    let d9 = d5 - d7; // h2.f.y
+    let d10 = d6 + d8; // h2.f.z
+    let t1 = p.MY2 * d3; // common subexpression
+    let t2 = p.MZ2 * d4; // common subexpression
+    let d11 = 2.0 * t1 + 2.0 * t2; // Jd2.xx
+    m[(1, 0)] = -0.5 * d11;
+    let d12 = c_q_w * d9 - s_q_w * d10; // hC2 in 1.f.y
+    let d13 = s_q_w * d9 + c_q_w * d10; // hC2 in 1.f.z
+    let d14 = d11 - 2.0 * (p.L1 * d12) - 2.0 * (p.L2 * d13); // JdC1.xx
+    m[(0, 0)] = -0.5 * d14;
+    let d15 = t1 + t2; // IC2(VxS(qd_w)).n.x
+    let d16 = 0.5 * d11 - d15; // h(C col qd_w) at 2.n.x
+    m[(1, 1)] = -d16;
+    let d17 = d10 - d8; // h(C col qd_w) at 2.f.y
+    let d18 = d9 + d7; // h(C col qd_w) at 2.f.z
+    let d19 = s_q_w * d17 - c_q_w * d18; // h(C col qd_w) at 1.f.z
+    let d20 = c_q_w * d17 + s_q_w * d18; // h(C col qd_w) at 1.f.y
+    let d21 = d16 + p.L1 * d19 - p.L2 * d20; // h(C col qd_w) at 1.n.x
+    m[(0, 1)] = -d21;
+    m
+}
 /// The dynamics of `two-link` with one parameter set: `τ = M(q) u̇ + c(q, u) + g(q)`.
 ///
 /// Construction precomputes the parameter-only terms; the evaluation methods are
@@ -662,5 +711,15 @@ impl TwoLink {
         ud: &SVector<f64, 2>,
     ) -> SVector<f64, 2> {
         inverse_dynamics(&self.params, &self.pre, q, u, ud)
+    }
+    /// Coriolis matrix C(q, u): `c(q, u) = C(q, u) u`, and `Ṁ − 2C` is
+    /// skew-symmetric (Ṁ along q̇; for a wheeled base x and ψ do not enter M).
+    #[inline]
+    pub fn coriolis_matrix(
+        &self,
+        q: &SVector<f64, 2>,
+        u: &SVector<f64, 2>,
+    ) -> SMatrix<f64, 2, 2> {
+        coriolis_matrix(&self.params, &self.pre, q, u)
     }
 }

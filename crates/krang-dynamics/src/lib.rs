@@ -25,6 +25,10 @@
 //! # Ok::<(), krang_dynamics::UnknownParameter>(())
 //! ```
 //!
+//! Every module also has the generated Coriolis matrix (`Krang::coriolis_matrix(&q, &u)`, the
+//! free function `coriolis_matrix` in `baked`): the full `C(q, u)` with `c = C u` and `Ṁ − 2C`
+//! skew-symmetric, for passivity-based controllers (e.g. Slotine–Li `τ = M a_r + C v_r + g − K s`).
+//!
 //! [kanegen]: https://docs.rs/kanegen
 //!
 //! # `f32` and `no_std`

@@ -58,6 +58,11 @@ fn f32_agrees_with_f64_on_random_states() {
             &k64.inverse_dynamics(&q, &u, &ud),
             "inverse_dynamics",
         );
+        close(
+            &k32.coriolis_matrix(&q32, &u32_),
+            &k64.coriolis_matrix(&q, &u),
+            "coriolis_matrix",
+        );
     }
 }
 

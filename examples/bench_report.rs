@@ -149,16 +149,18 @@ fn run(dir: &Path, baselines: &[String]) -> Result<String, String> {
         };
         table(&mut out, b, &runtime, baked.as_ref(), &medians);
     }
-    let sin_cos = ["generated", "std", "rbd"]
+    let sin_cos = ["batched", "generated", "std", "rbd"]
         .map(|v| medians.get(&format!("overhead/sin_cos_x17/{v}")).copied());
     if sin_cos.iter().any(Option::is_some) {
         let _ = writeln!(
             out,
-            "17 × `sin_cos` (Krang's joint angles), ns: generated code's routine {}, \
-             standard library {}, kanegen-rbd's batched kernel {}.\n",
+            "17 × `sin_cos` (Krang's joint angles), ns: generated code's batched routine {}, \
+             its scalar routine (one call per joint) {}, standard library {}, kanegen-rbd's \
+             batched kernel {}.\n",
             ns(sin_cos[0]),
             ns(sin_cos[1]),
-            ns(sin_cos[2])
+            ns(sin_cos[2]),
+            ns(sin_cos[3])
         );
     }
     Ok(out)

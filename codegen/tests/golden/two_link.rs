@@ -28,28 +28,27 @@ fn sin_cos(x: f64) -> (f64, f64) {
     };
     sin_cos_kernel(r, quadrant)
 }
-/// `(sin x[k], cos x[k])` for every lane, bit for bit the values of [`sin_cos`]. When every
-/// |x[k]| is below the Cody–Waite bound (always, for robot angles) the lanes run through one
-/// branch-free loop that the compiler vectorizes (two lanes per SSE2 instruction, four with
-/// AVX2); otherwise (a huge, infinite or NaN lane) the whole batch takes the scalar routine.
-/// Not inlined: the generated functions are long enough that their speed depends on their code
-/// size (one shared copy instead of one per function).
+/// `(sin x[k], cos x[k])` for every lane, bit for bit the values of [`sin_cos`]. Every lane
+/// runs through one branch-free loop that the compiler vectorizes (two lanes per SSE2
+/// instruction, four with AVX2) and that also sets one flag for the whole batch: if a lane is
+/// at or above the Cody–Waite bound or not finite (never, for robot angles), the batch is
+/// recomputed lane by lane by the scalar routine. Not inlined: the generated functions are
+/// long enough that their speed depends on their code size (one shared copy instead of one per
+/// function).
 #[inline(never)]
 #[allow(clippy::needless_range_loop)]
 fn sin_cos_n<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
+    let (mut s, mut c) = ([0.0; N], [0.0; N]);
     let mut fast = true;
-    for &xk in &x {
-        fast &= xk.abs() < SIN_COS_FAST_BOUND;
-    }
-    if !fast {
-        return sin_cos_n_slow(x);
-    }
-    let mut out = ([0.0; N], [0.0; N]);
     for k in 0..N {
         let (r, quadrant) = sin_cos_reduce(x[k]);
-        (out.0[k], out.1[k]) = sin_cos_kernel(r, quadrant);
+        (s[k], c[k]) = sin_cos_kernel(r, quadrant);
+        fast &= x[k].abs() < SIN_COS_FAST_BOUND;
     }
-    out
+    if !fast {
+        (s, c) = sin_cos_n_slow(x);
+    }
+    (s, c)
 }
 /// [`sin_cos_n`] lane by lane through [`sin_cos`] (a batch with a huge or non-finite lane).
 #[cold]

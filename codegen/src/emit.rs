@@ -371,7 +371,7 @@ fn function(
     // what limits their speed).
     let mut stores: Vec<TokenStream> = vec![TokenStream::new(); p.stmts.len() + 1];
     let (ret, init, result) = match p.shape {
-        Shape::SymmetricMatrix => {
+        Shape::SymmetricMatrix | Shape::Matrix => {
             for (r, c, e) in &p.outputs {
                 if matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0) {
                     continue;
@@ -380,15 +380,13 @@ fn function(
                 let (r, c) = (idx(*r), idx(*c));
                 stores[last_local(e).map_or(0, |i| i + 1)].extend(quote!(m[(#r, #c)] = #v;));
             }
-            (
-                quote!(SMatrix<#t, #nl, #nl>),
-                quote!(let mut m = SMatrix::<#t, #nl, #nl>::zeros();),
-                // The lower triangle is copied at the end by a loop over the column-major
-                // storage. Mirrored stores next to the computation, or unrolled copies at the end
-                // (which the compiler turns back into long-lived registers), cost much more
-                // (measured for Krang: 1.2 µs vs 0.8 µs), and nalgebra's generic
-                // `fill_lower_triangle_with_upper_triangle` runs 2800 instructions for Krang's
-                // 171 copies (this loop: about 0.25 µs less).
+            // Symmetric: the lower triangle is copied at the end by a loop over the column-major
+            // storage. Mirrored stores next to the computation, or unrolled copies at the end
+            // (which the compiler turns back into long-lived registers), cost much more
+            // (measured for Krang: 1.2 µs vs 0.8 µs), and nalgebra's generic
+            // `fill_lower_triangle_with_upper_triangle` runs 2800 instructions for Krang's 171
+            // copies (this loop: about 0.25 µs less).
+            let result = if p.shape == Shape::SymmetricMatrix {
                 quote!({
                     let s = m.as_mut_slice();
                     for c in 1..#nl {
@@ -397,22 +395,14 @@ fn function(
                         }
                     }
                     m
-                }),
-            )
-        }
-        Shape::Matrix => {
-            for (r, c, e) in &p.outputs {
-                if matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0) {
-                    continue;
-                }
-                let v = names.expr(e, false);
-                let (r, c) = (idx(*r), idx(*c));
-                stores[last_local(e).map_or(0, |i| i + 1)].extend(quote!(m[(#r, #c)] = #v;));
-            }
+                })
+            } else {
+                quote!(m)
+            };
             (
                 quote!(SMatrix<#t, #nl, #nl>),
                 quote!(let mut m = SMatrix::<#t, #nl, #nl>::zeros();),
-                quote!(m),
+                result,
             )
         }
         Shape::Vector => {

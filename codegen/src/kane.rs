@@ -728,7 +728,9 @@ impl Ctx<'_> {
         let ss = self.ar.mul(sn, sn);
         let ss = self.ar.subst(ss, VarKind::K, &format!("sin² {coord}"));
         let sc = self.ar.mul(sn, cs);
-        let sc = self.ar.subst(sc, VarKind::K, &format!("sin {coord} cos {coord}"));
+        let sc = self
+            .ar
+            .subst(sc, VarKind::K, &format!("sin {coord} cos {coord}"));
         let s2 = self.ar.scale(sc, 2.0);
         let s2 = self.ar.subst(s2, VarKind::K, &format!("sin 2{coord}"));
         let one = self.ar.one();

@@ -12,24 +12,14 @@ fn models() -> PathBuf {
 fn generating_twice_gives_identical_bytes() {
     for name in ["krang.toml", "krang-fixed-wheels.toml", "two-link.toml"] {
         for params in [ParamMode::Runtime, ParamMode::Baked] {
-            let a = generate(
-                models().join(name),
-                Options {
+            let run = || {
+                let options = Options {
                     params,
                     ..Options::default()
-                },
-            )
-            .unwrap()
-            .source;
-            let b = generate(
-                models().join(name),
-                Options {
-                    params,
-                    ..Options::default()
-                },
-            )
-            .unwrap()
-            .source;
+                };
+                generate(models().join(name), options).unwrap().source
+            };
+            let (a, b) = (run(), run());
             assert!(a == b, "{name} {params:?}: two generations differ");
         }
     }

@@ -257,12 +257,17 @@ fn comment_map(p: &Program) -> HashMap<String, String> {
         .collect()
 }
 
-fn statements(names: &Names<'_>, p: &Program) -> TokenStream {
-    let mut ts = TokenStream::new();
-    for s in &p.stmts {
+/// The `let` statements of `p`, with `after[0]` before the first and `after[i + 1]` right after
+/// statement `i` (missing entries: nothing).
+fn statements(names: &Names<'_>, p: &Program, after: &[TokenStream]) -> TokenStream {
+    let mut ts = after.first().cloned().unwrap_or_default();
+    for (i, s) in p.stmts.iter().enumerate() {
         let id = ident(&s.name);
         let e = names.expr(&s.expr, false);
         ts.extend(quote!(let #id = #e;));
+        if let Some(a) = after.get(i + 1) {
+            ts.extend(a.clone());
+        }
     }
     ts
 }
@@ -426,13 +431,7 @@ fn function(
             )
         }
     };
-    let mut body = stores[0].clone();
-    for (i, s) in p.stmts.iter().enumerate() {
-        let id = ident(&s.name);
-        let e = names.expr(&s.expr, false);
-        body.extend(quote!(let #id = #e;));
-        body.extend(stores[i + 1].clone());
-    }
+    let body = statements(&names, p, &stores);
     let unused_q = if p.sincos.is_empty() && !(0..n).any(|s| uses(p, &|l| *l == Leaf::Coord(s))) {
         quote!(let _ = q;)
     } else {
@@ -605,7 +604,7 @@ fn precompute_items(model: &Model, low: &Lowered, pre: &[String], scalar: Scalar
         pre,
         scalar,
     };
-    let body = statements(&names, p);
+    let body = statements(&names, p, &[]);
     let fields: Vec<Ident> = pre.iter().map(|s| ident(s)).collect();
     let uses_p = uses(p, &|l| matches!(l, Leaf::Param(_)));
     let pname = if uses_p { quote!(p) } else { quote!(_p) };

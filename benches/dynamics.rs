@@ -13,7 +13,7 @@
 //!
 //! plus `overhead/sin_cos_x17/{batched,generated,std,rbd}`: the 17 `sin_cos` of Krang's joint
 //! angles, with the batched routine the generator emits into every module
-//! (`kanegen::trig::fast_sin_cos_n`, one call for all angles, as in generated code), with its
+//! (`kanegen_runtime::trig::sin_cos_n`, one call for all angles, as in generated code), with its
 //! scalar fallback that generated code called once per joint before (`fast_sin_cos`, inlined),
 //! with the standard library, and with `kanegen-rbd`'s batched polynomial kernel
 //! (`Scalar::sin_cos_batch`, what `Rbd` calls); each returns an xor of its results' bits.
@@ -410,7 +410,7 @@ fn krang(c: &mut Criterion) {
             let q = black_box(&states[i & mask].q);
             i += 1;
             let x: [f64; 17] = std::array::from_fn(|k| q[k + 2]);
-            let (sin, cos) = kanegen::trig::fast_sin_cos_n(x);
+            let (sin, cos) = kanegen_runtime::trig::sin_cos_n(x);
             fold_bits(&sin, &cos)
         })
     });
@@ -421,7 +421,7 @@ fn krang(c: &mut Criterion) {
             i += 1;
             let (mut sin, mut cos) = ([0.0; 17], [0.0; 17]);
             for k in 0..17 {
-                (sin[k], cos[k]) = kanegen::trig::fast_sin_cos(q[k + 2]);
+                (sin[k], cos[k]) = kanegen_runtime::trig::sin_cos(q[k + 2]);
             }
             fold_bits(&sin, &cos)
         })

@@ -226,7 +226,8 @@ fn generate(b: &Bench, params: ParamMode) -> Result<Generated, String> {
 }
 
 fn ops(g: &Generated, function: &str) -> Option<OpCount> {
-    g.lowered.function(function).map(|p| p.ops)
+    let id = kanegen::FunctionId::from_name(function)?;
+    g.lowered.function(id).map(|p| p.ops)
 }
 
 /// One model's table.

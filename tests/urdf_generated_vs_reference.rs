@@ -8,6 +8,7 @@
 mod common;
 
 use common::*;
+use kanegen::FunctionId;
 use kanegen::{Options, generate_model};
 use kanegen_model::{Model, UrdfOptions, WheeledBaseSpec};
 use kanegen_reference::Reference;
@@ -16,7 +17,12 @@ use kanegen_reference::random::random_physical_params;
 const TOL: f64 = 1e-10;
 /// Ṁ from Richardson-extrapolated central differences (see `common::mdot_central`).
 const SKEW_TOL: f64 = 1e-8;
-const FUNCTIONS: [&str; 4] = ["mass_matrix", "coriolis", "gravity", "inverse_dynamics"];
+const FUNCTIONS: [FunctionId; 4] = [
+    FunctionId::MassMatrix,
+    FunctionId::Coriolis,
+    FunctionId::Gravity,
+    FunctionId::InverseDynamics,
+];
 
 fn urdf(name: &str, options: &UrdfOptions) -> Model {
     Model::from_urdf_file(root().join("models").join(name), options).expect("URDF imports")
@@ -54,8 +60,8 @@ fn check(label: &str, model: &Model, draws: usize, seed: u64) {
             dvec(&reference.inverse_dynamics(&q, &u, &ud)),
         ];
         for (i, f) in FUNCTIONS.iter().enumerate() {
-            let d = g.derivation.evaluate(f, &p, &q, &u, &ud);
-            let l = g.lowered.evaluate(f, &p, &q, &u, &ud);
+            let d = g.derivation.evaluate(*f, &p, &q, &u, &ud);
+            let l = g.lowered.evaluate(*f, &p, &q, &u, &ud);
             worst[i] =
                 worst[i]
                     .max(rel_err(&d, &expected[i], 1.0))
@@ -64,14 +70,19 @@ fn check(label: &str, model: &Model, draws: usize, seed: u64) {
         // Coriolis matrix: C u = c, and Ṁ − 2C skew-symmetric (Ṁ by central differences of
         // the derivation's M along q̇).
         let mdot = mdot_central(
-            &|q: &[f64]| g.derivation.evaluate("mass_matrix", &p, q, &u, &ud),
+            &|q: &[f64]| {
+                g.derivation
+                    .evaluate(FunctionId::MassMatrix, &p, q, &u, &ud)
+            },
             &q,
             &coordinate_rates(model, &u),
             1e-3,
         );
         for c in [
-            g.derivation.evaluate("coriolis_matrix", &p, &q, &u, &ud),
-            g.lowered.evaluate("coriolis_matrix", &p, &q, &u, &ud),
+            g.derivation
+                .evaluate(FunctionId::CoriolisMatrix, &p, &q, &u, &ud),
+            g.lowered
+                .evaluate(FunctionId::CoriolisMatrix, &p, &q, &u, &ud),
         ] {
             let cu: Vec<f64> = (0..n)
                 .map(|r| (0..n).map(|k| c[r * n + k] * u[k]).sum())

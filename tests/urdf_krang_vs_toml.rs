@@ -11,6 +11,7 @@
 mod common;
 
 use common::*;
+use kanegen::FunctionId;
 use kanegen::{Options, generate_model};
 use kanegen_model::{Model, UrdfOptions, WheeledBaseSpec};
 use kanegen_reference::Reference;
@@ -144,11 +145,16 @@ fn symmetric_krang_urdf_equals_krang_toml() {
             dvec(&ru.gravity(&qu)),
             dvec(&ru.inverse_dynamics(&qu, &u, &ud)),
         ];
-        for (i, f) in ["mass_matrix", "coriolis", "gravity", "inverse_dynamics"]
-            .iter()
-            .enumerate()
+        for (i, f) in [
+            FunctionId::MassMatrix,
+            FunctionId::Coriolis,
+            FunctionId::Gravity,
+            FunctionId::InverseDynamics,
+        ]
+        .iter()
+        .enumerate()
         {
-            let generated = g.lowered.evaluate(f, &pu, &qu, &u, &ud);
+            let generated = g.lowered.evaluate(*f, &pu, &qu, &u, &ud);
             worst[i] = worst[i]
                 .max(rel_err(&from_urdf[i], &expected[i], 1.0))
                 .max(rel_err(&generated, &expected[i], 1.0));

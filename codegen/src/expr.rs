@@ -17,6 +17,8 @@
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 
+use crate::naming;
+
 /// Handle of a node in an [`Arena`].
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
 pub struct ExprId(pub u32);
@@ -111,21 +113,11 @@ pub struct Names {
     pub speeds: Vec<String>,
     /// Coordinate names by speed index (`q_imu`).
     pub coords: Vec<String>,
-}
-
-impl Names {
-    /// Name of an acceleration: `qd_imu` → `qdd_imu`, `xd` → `xdd`.
-    pub fn accel(&self, i: usize) -> String {
-        accel_name(&self.speeds[i])
-    }
-}
-
-/// Name of the acceleration of a speed: `qd_imu` → `qdd_imu`, `xd` → `xdd`, `psid` → `psidd`.
-pub fn accel_name(speed: &str) -> String {
-    match speed.strip_prefix("qd") {
-        Some(rest) => format!("qdd{rest}"),
-        None => format!("{speed}d"),
-    }
+    /// Per parameter: whether it is a length (`L1`). A substitution variable that mentions no
+    /// parameter other than lengths is kinematic (K); one that mentions a mass, a first moment,
+    /// an inertia, a wheel constant or gravity is inertial/gravity (D). Missing entries count as
+    /// not lengths.
+    pub lengths: Vec<bool>,
 }
 
 /// The expression arena.
@@ -464,7 +456,7 @@ impl Arena {
         if self.is_simple(core) {
             return self.scale(core, k);
         }
-        let kind = if self.involves_params(core) {
+        let kind = if self.involves_inertia(core) {
             VarKind::D
         } else {
             kind
@@ -473,15 +465,20 @@ impl Arena {
         self.scale(v, k)
     }
 
-    /// Does `e` mention a parameter (directly or through variables)?
-    fn involves_params(&self, e: ExprId) -> bool {
+    /// Does `e` mention a parameter other than a length, or a D variable?
+    fn involves_inertia(&self, e: ExprId) -> bool {
         match self.node(e) {
             Node::Const(_) => false,
-            Node::Atom(Atom::Param(_)) => true,
+            Node::Atom(Atom::Param(p)) => !self
+                .names
+                .lengths
+                .get(*p as usize)
+                .copied()
+                .unwrap_or(false),
             Node::Atom(Atom::Var(v)) => self.vars[*v as usize].kind == VarKind::D,
             Node::Atom(_) => false,
-            Node::Sum { terms, .. } => terms.iter().any(|(t, _)| self.involves_params(*t)),
-            Node::Prod(f) => f.iter().any(|(b, _)| self.involves_params(*b)),
+            Node::Sum { terms, .. } => terms.iter().any(|(t, _)| self.involves_inertia(*t)),
+            Node::Prod(f) => f.iter().any(|(b, _)| self.involves_inertia(*b)),
         }
     }
 
@@ -526,7 +523,7 @@ impl Arena {
                     }
                 }
                 let fixed = self.sum(fixed);
-                let fixed = self.subst(fixed, VarKind::D, &format!("{label} (parameters)"));
+                let fixed = self.subst(fixed, VarKind::K, &format!("{label} (parameters)"));
                 rest.push(fixed);
                 self.sum(rest)
             }
@@ -545,7 +542,7 @@ impl Arena {
         }
         let fixed: Vec<ExprId> = fixed.into_iter().map(|(b, p)| self.powi(b, p)).collect();
         let fixed = self.product(fixed);
-        let fixed = self.subst(fixed, VarKind::D, &format!("{label} (parameters)"));
+        let fixed = self.subst(fixed, VarKind::K, &format!("{label} (parameters)"));
         let mut items = vec![fixed];
         for (b, p) in rest {
             let x = self.powi(b, p);
@@ -586,9 +583,9 @@ impl Arena {
         match a {
             Atom::Param(p) => n.params[p as usize].clone(),
             Atom::Speed(s) => n.speeds[s as usize].clone(),
-            Atom::Accel(s) => n.accel(s as usize),
-            Atom::Sin(s) => format!("s_{}", n.coords[s as usize]),
-            Atom::Cos(s) => format!("c_{}", n.coords[s as usize]),
+            Atom::Accel(s) => naming::accel(&n.speeds[s as usize]),
+            Atom::Sin(s) => naming::sin(&n.coords[s as usize]),
+            Atom::Cos(s) => naming::cos(&n.coords[s as usize]),
             Atom::Coord(s) => n.coords[s as usize].clone(),
             Atom::Var(v) => {
                 let info = &self.vars[v as usize];
@@ -711,7 +708,47 @@ mod tests {
             params: vec!["a".into(), "b".into()],
             speeds: vec!["qd1".into()],
             coords: vec!["q1".into()],
+            lengths: Vec::new(),
         })
+    }
+
+    #[test]
+    fn kinematic_variables_with_lengths_stay_k_and_inertial_ones_are_d() {
+        // Parameter 0 is a length (`L1`), parameter 1 a mass.
+        let mut ar = Arena::new(Names {
+            params: vec!["L1".into(), "m1".into()],
+            speeds: vec!["qd1".into()],
+            coords: vec!["q1".into()],
+            lengths: vec![true, false],
+        });
+        ar.hoist_params = true;
+        let l = ar.atom(Atom::Param(0));
+        let m = ar.atom(Atom::Param(1));
+        let s = ar.atom(Atom::Sin(0));
+        let u = ar.atom(Atom::Speed(0));
+        let su = ar.mul(s, u);
+        let v = ar.mul(l, su);
+        let vl = ar.add(v, u);
+        let k = ar.subst(vl, VarKind::K, "v1.x");
+        let Node::Atom(Atom::Var(kv)) = *ar.node(k) else {
+            panic!("a variable")
+        };
+        assert_eq!(
+            ar.vars()[kv as usize].kind,
+            VarKind::K,
+            "lengths are kinematic"
+        );
+        let f = ar.mul(m, k);
+        let f = ar.add(f, s);
+        let d = ar.subst(f, VarKind::K, "f1.x");
+        let Node::Atom(Atom::Var(dv)) = *ar.node(d) else {
+            panic!("a variable")
+        };
+        assert_eq!(
+            ar.vars()[dv as usize].kind,
+            VarKind::D,
+            "a mass is inertial"
+        );
     }
 
     #[test]

@@ -4,6 +4,8 @@
 //! [`model`] (description files → validated IR) → [`expr`] (hash-consed expression arena) →
 //! [`kane`] (recursive Kane's derivation with K/D substitution) → [`lower`] (straight-line
 //! programs, dead-code elimination, op counts) → [`emit`] (quote/syn/prettyplease → Rust source).
+//! Every stage reads the [`registry`] (which functions exist, their inputs and result shapes)
+//! and the [`options`] (which functions a module gets, how parameters enter, its precision).
 //!
 //! A build script generates a dynamics module in one call:
 //!
@@ -14,6 +16,8 @@
 //!
 //! and the crate includes it with
 //! `include!(concat!(env!("OUT_DIR"), "/krang.rs"));` (the file is named after the model file).
+//! Generated code uses the `kanegen-runtime` crate (batched `sin_cos_n`, `UnknownParameter`,
+//! the `RobotDynamics` trait) and `nalgebra`: add both as dependencies.
 //!
 //! Any robot described in URDF works the same way ([`Builder::urdf`], options in
 //! [`model::UrdfOptions`]):
@@ -28,7 +32,10 @@ pub mod emit;
 pub mod expr;
 pub mod kane;
 pub mod lower;
-pub mod trig;
+pub mod naming;
+pub mod options;
+pub mod registry;
+pub mod report;
 /// The robot description IR and its loaders (re-exported from `kanegen-model`).
 pub mod model {
     pub use kanegen_model::*;
@@ -36,8 +43,10 @@ pub mod model {
 
 use std::path::{Path, PathBuf};
 
-pub use emit::Scalar;
-pub use kane::{Options, ParamMode};
+pub use emit::EmitOptions;
+pub use options::{Options, ParamMode, Precision};
+pub use registry::{FunctionId, FunctionSet};
+pub use report::{listing, stats};
 
 /// Anything that can go wrong while generating.
 #[derive(Debug, thiserror::Error)]
@@ -45,9 +54,17 @@ pub enum Error {
     /// The description file is malformed or not physical.
     #[error(transparent)]
     Model(#[from] model::ModelError),
-    /// Code emission or writing failed.
+    /// The generated code did not parse (a generator bug).
     #[error(transparent)]
     Emit(#[from] emit::EmitError),
+    /// Writing the generated file failed.
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        /// The file or directory.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
     /// The build script environment lacks `OUT_DIR`.
     #[error(
         "OUT_DIR is not set: Builder::build must run inside a cargo build script (or call Builder::out_dir)"
@@ -68,11 +85,20 @@ pub struct Generated {
     pub source: String,
 }
 
-/// Run every stage on a loaded model.
+/// Run every stage on a loaded model (an `f64` module without notes; see [`generate_with`]).
 pub fn generate_model(model: model::Model, options: Options) -> Result<Generated, Error> {
+    generate_with(model, options, &EmitOptions::default())
+}
+
+/// Run every stage on a loaded model, emitting with `emit` (precision, notes).
+pub fn generate_with(
+    model: model::Model,
+    options: Options,
+    emit: &EmitOptions,
+) -> Result<Generated, Error> {
     let derivation = kane::derive(&model, options);
     let lowered = lower::lower(&derivation);
-    let source = emit::emit(&model, &lowered)?;
+    let source = emit::emit(&model, &lowered, emit)?;
     Ok(Generated {
         model,
         derivation,
@@ -88,32 +114,54 @@ pub fn generate_urdf(
     urdf: &model::UrdfOptions,
     options: Options,
 ) -> Result<Generated, Error> {
-    let import = model::UrdfImport::read(path, urdf)?;
-    let mut g = generate_model(import.model, options)?;
-    if !import.notes.is_empty() {
-        let mut notes = String::from("// URDF import notes:\n");
-        for n in &import.notes {
-            notes.push_str(&format!("//   - {n}\n"));
-        }
-        notes.push('\n');
-        // After the header (which ends at the first blank line).
-        let at = g.source.find("\n\n").map_or(0, |i| i + 2);
-        g.source.insert_str(at, &notes);
-    }
-    Ok(g)
+    urdf_with(path.as_ref(), urdf, options, Precision::F64)
 }
 
-/// Load a description file and run every stage.
+fn urdf_with(
+    path: &Path,
+    urdf: &model::UrdfOptions,
+    options: Options,
+    precision: Precision,
+) -> Result<Generated, Error> {
+    let import = model::UrdfImport::read(path, urdf)?;
+    let emit = EmitOptions {
+        precision,
+        notes: import.notes,
+        notes_title: "URDF import notes".into(),
+    };
+    generate_with(import.model, options, &emit)
+}
+
+/// Load a TOML description file and run every stage (f64 module).
 pub fn generate(path: impl AsRef<Path>, options: Options) -> Result<Generated, Error> {
     let model = model::Model::from_toml_file(path)?;
     generate_model(model, options)
 }
 
+/// Write `contents` to `path` only if the file does not already hold exactly these bytes (so
+/// that cargo does not recompile an unchanged module). Returns whether the file was written.
+pub fn write_if_changed(path: &Path, contents: &str) -> Result<bool, Error> {
+    if std::fs::read(path).is_ok_and(|old| old == contents.as_bytes()) {
+        return Ok(false);
+    }
+    let write_error = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| Error::Write { path, source }
+    };
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(write_error(dir))?;
+    }
+    std::fs::write(path, contents).map_err(write_error(path))?;
+    Ok(true)
+}
+
 /// Generates a dynamics module from a build script.
 ///
 /// ```no_run
+/// use kanegen::{FunctionId, FunctionSet};
 /// kanegen::Builder::new("models/krang.toml")
 ///     .baked(false)
+///     .functions(FunctionSet::default().without(FunctionId::CoriolisMatrix))
 ///     .output("krang.rs")
 ///     .run();
 /// ```
@@ -125,20 +173,23 @@ pub struct Builder {
     out_dir: Option<PathBuf>,
     /// `Some` when the model file is a URDF to import with these options.
     urdf: Option<model::UrdfOptions>,
-    scalar: Scalar,
+    precision: Precision,
 }
 
 impl Builder {
-    /// Generate from the description file `model` (relative to the crate's manifest directory
-    /// when run from a build script).
+    /// Generate from the TOML description file `model` (relative to the crate's manifest
+    /// directory when run from a build script). A path ending in `.urdf` is imported with the
+    /// default [`model::UrdfOptions`] (use [`Builder::urdf`] to set them).
     pub fn new(model: impl Into<PathBuf>) -> Self {
+        let model = model.into();
+        let urdf = is_urdf(&model).then(model::UrdfOptions::default);
         Self {
-            model: model.into(),
+            model,
             options: Options::default(),
             output: None,
             out_dir: None,
-            urdf: None,
-            scalar: Scalar::F64,
+            urdf,
+            precision: Precision::F64,
         }
     }
 
@@ -171,36 +222,52 @@ impl Builder {
         self
     }
 
-    /// Whether the module has `coriolis_matrix`, the Coriolis matrix C(q, u) with
-    /// `c = C u` and `Ṁ − 2C` skew-symmetric (default `true`, so that every generated module
-    /// has the same API). It is about four times the operations of `coriolis` and roughly
-    /// doubles the compile time of a large model's module (Krang: ≈ 9,500 flops, +3 s of
-    /// release compilation per module); build scripts that need only M, c, g and τ can leave it
-    /// out:
+    /// Which registry functions the module gets (default [`FunctionSet::default`]: M, c, g, τ
+    /// and the Coriolis matrix). Heavy functions can be left out of modules that do not need
+    /// them; the wrapper type implements a `kanegen-runtime` trait only if the module has all of
+    /// its functions.
+    ///
+    /// ```no_run
+    /// use kanegen::{FunctionId, FunctionSet};
+    /// let set: FunctionSet = [FunctionId::MassMatrix, FunctionId::Gravity].into_iter().collect();
+    /// kanegen::Builder::new("krang.toml").functions(set).run();
+    /// ```
+    pub fn functions(mut self, functions: FunctionSet) -> Self {
+        self.options.functions = functions;
+        self
+    }
+
+    /// Whether the module has `coriolis_matrix`, the Coriolis matrix C(q, u) with `c = C u`
+    /// and `Ṁ − 2C` skew-symmetric (default `true`): shorthand for adding or removing
+    /// [`FunctionId::CoriolisMatrix`] with [`Builder::functions`]. It is about four times the
+    /// operations of `coriolis` and roughly doubles the compile time of a large model's module
+    /// (Krang: ≈ 7,900 flops, +3 s of release compilation per module).
     ///
     /// ```no_run
     /// kanegen::Builder::new("krang.toml").coriolis_matrix(false).run();
     /// ```
     pub fn coriolis_matrix(mut self, on: bool) -> Self {
-        self.options.coriolis_matrix = on;
+        let f = FunctionId::CoriolisMatrix;
+        let set = self.options.functions;
+        self.options.functions = if on { set.with(f) } else { set.without(f) };
         self
     }
 
-    /// The scalar type of the generated module (default [`Scalar::F64`]). With
-    /// [`Scalar::F32`] every matrix, vector, `Params` field and literal is `f32`, and the
+    /// The floating-point type of the generated module (default [`Precision::F64`]). With
+    /// [`Precision::F32`] every matrix, vector, `Params` field and literal is `f32`, and the
     /// default file name gets the suffix `_f32.rs`:
     ///
     /// ```no_run
-    /// kanegen::Builder::new("krang.toml").scalar(kanegen::Scalar::F32).run(); // krang_f32.rs
+    /// kanegen::Builder::new("krang.toml").precision(kanegen::Precision::F32).run(); // krang_f32.rs
     /// ```
-    pub fn scalar(mut self, scalar: Scalar) -> Self {
-        self.scalar = scalar;
+    pub fn precision(mut self, precision: Precision) -> Self {
+        self.precision = precision;
         self
     }
 
     /// Name of the generated file in the output directory (default: the model file's stem
     /// plus `.rs`, or `_baked.rs` in baked mode; `_f32.rs`, `_baked_f32.rs` for
-    /// [`Scalar::F32`]).
+    /// [`Precision::F32`]).
     pub fn output(mut self, file_name: impl Into<String>) -> Self {
         self.output = Some(file_name.into());
         self
@@ -212,6 +279,39 @@ impl Builder {
         self
     }
 
+    /// Run every stage and return the result without writing anything.
+    pub fn generate(&self) -> Result<Generated, Error> {
+        match &self.urdf {
+            Some(urdf) => urdf_with(&self.model, urdf, self.options, self.precision),
+            None => {
+                let model = model::Model::from_toml_file(&self.model)?;
+                let emit = EmitOptions {
+                    precision: self.precision,
+                    ..EmitOptions::default()
+                };
+                generate_with(model, self.options, &emit)
+            }
+        }
+    }
+
+    /// The default output file name (see [`Builder::output`]).
+    fn file_name(&self) -> String {
+        let stem = self
+            .model
+            .file_stem()
+            .map(|s| s.to_string_lossy().replace('-', "_"))
+            .unwrap_or_else(|| "model".into());
+        let baked = match self.options.params {
+            ParamMode::Runtime => "",
+            ParamMode::Baked => "_baked",
+        };
+        let precision = match self.precision {
+            Precision::F64 => "",
+            Precision::F32 => "_f32",
+        };
+        format!("{stem}{baked}{precision}.rs")
+    }
+
     /// Generate and write the module (only if its bytes changed); returns its path. Prints the
     /// `cargo:rerun-if-changed` line for the model file.
     pub fn build(&self) -> Result<PathBuf, Error> {
@@ -220,43 +320,9 @@ impl Builder {
             None => PathBuf::from(std::env::var_os("OUT_DIR").ok_or(Error::NoOutDir)?),
         };
         println!("cargo:rerun-if-changed={}", self.model.display());
-        let mut g = match &self.urdf {
-            Some(urdf) => generate_urdf(&self.model, urdf, self.options)?,
-            None => generate(&self.model, self.options)?,
-        };
-        if self.scalar != Scalar::F64 {
-            // Re-emit, keeping any URDF import notes (the block after the header).
-            let at = g.source.find("\n\n").map_or(0, |i| i + 2);
-            let notes = if g.source[at..].starts_with("// URDF import notes:\n") {
-                let end = g.source[at..]
-                    .find("\n\n")
-                    .map_or(g.source.len(), |i| at + i + 2);
-                g.source[at..end].to_owned()
-            } else {
-                String::new()
-            };
-            let mut source = emit::emit_scalar(&g.model, &g.lowered, self.scalar)?;
-            let at = source.find("\n\n").map_or(0, |i| i + 2);
-            source.insert_str(at, &notes);
-            g.source = source;
-        }
-        let name = self.output.clone().unwrap_or_else(|| {
-            let stem = self
-                .model
-                .file_stem()
-                .map(|s| s.to_string_lossy().replace('-', "_"))
-                .unwrap_or_else(|| "model".into());
-            let suffix = match self.scalar {
-                Scalar::F64 => "",
-                Scalar::F32 => "_f32",
-            };
-            match self.options.params {
-                ParamMode::Runtime => format!("{stem}{suffix}.rs"),
-                ParamMode::Baked => format!("{stem}_baked{suffix}.rs"),
-            }
-        });
-        let path = dir.join(name);
-        emit::write_if_changed(&path, &g.source)?;
+        let g = self.generate()?;
+        let path = dir.join(self.output.clone().unwrap_or_else(|| self.file_name()));
+        write_if_changed(&path, &g.source)?;
         Ok(path)
     }
 
@@ -270,107 +336,8 @@ impl Builder {
     }
 }
 
-/// A per-function summary: K/D counts and op counts, as printed by `kanegen stats`.
-pub fn stats(g: &Generated) -> String {
-    use std::fmt::Write as _;
-    let mut s = String::new();
-    let d = &g.derivation;
-    let k = d
-        .arena
-        .vars()
-        .iter()
-        .filter(|v| v.kind == expr::VarKind::K)
-        .count();
-    let dv = d.arena.vars().len() - k;
-    let _ = writeln!(
-        s,
-        "model {} ({}): {} speeds, {} bodies, {} parameters; parameters {}",
-        g.model.name,
-        g.model.source,
-        g.model.dof(),
-        g.model.body_count(),
-        g.model.params.len(),
-        match d.options.params {
-            ParamMode::Runtime => "at run time",
-            ParamMode::Baked => "baked",
-        }
-    );
-    let _ = writeln!(
-        s,
-        "derivation: {} expression nodes, {} substitution variables ({} K, {} D)",
-        d.arena.len(),
-        d.arena.vars().len(),
-        k,
-        dv
-    );
-    let _ = writeln!(
-        s,
-        "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>6}",
-        "function", "K", "D", "temps", "adds", "muls", "divs", "sin/cos", "flops", "live"
-    );
-    let low = &g.lowered;
-    let mut row = |name: &str, p: &lower::Program| {
-        let temps = p.stmts.len() - p.k_vars - p.d_vars;
-        let _ = writeln!(
-            s,
-            "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>6}",
-            name,
-            p.k_vars,
-            p.d_vars,
-            temps,
-            p.ops.adds,
-            p.ops.muls,
-            p.ops.divs,
-            p.ops.sincos,
-            p.ops.flops(),
-            p.max_live()
-        );
-    };
-    if d.options.params == ParamMode::Runtime {
-        row("precompute (once)", &low.precompute);
-    }
-    for p in &low.functions {
-        row(&p.name, p);
-    }
-    s
-}
-
-/// The substitution listing of a model in the reports' style, function by function.
-pub fn listing(g: &Generated) -> String {
-    use std::fmt::Write as _;
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "% Substitution listing of `{}` (kanegen {}). K: kinematic, D: inertial/gravity.",
-        g.model.name,
-        emit::GENERATOR_VERSION
-    );
-    let d = &g.derivation;
-    let mut shown = vec![false; d.arena.vars().len()];
-    for f in &d.functions {
-        let roots: Vec<expr::ExprId> = f.entries.iter().map(|e| e.2).collect();
-        let needed = d.arena.reachable_vars(&roots);
-        let _ = writeln!(s, "\n% ---- {} ----", f.name);
-        for (i, info) in d.arena.vars().iter().enumerate() {
-            if needed[i] && !shown[i] {
-                shown[i] = true;
-                let _ = writeln!(
-                    s,
-                    "{} = {};  % {}",
-                    d.arena.atom_name(expr::Atom::Var(i as u32)),
-                    d.arena.display(info.def),
-                    info.label
-                );
-            }
-        }
-        for &(r, c, e) in &f.entries {
-            let lhs = match f.shape {
-                kane::Shape::SymmetricMatrix => format!("M({},{})", r + 1, c + 1),
-                kane::Shape::Matrix => format!("C({},{})", r + 1, c + 1),
-                kane::Shape::Vector => format!("{}({})", f.name, r + 1),
-            };
-            let _ = writeln!(s, "{lhs} = {};", d.arena.display(e));
-        }
-    }
-    s
+/// Whether `path` names a URDF file (by its extension, case-insensitive).
+pub fn is_urdf(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
 }

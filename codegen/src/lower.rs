@@ -13,7 +13,9 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::fmt;
 
 use crate::expr::{Arena, Atom, ExprId, Node, VarKind};
-use crate::kane::{Derivation, Function, ParamMode, Shape, Signature};
+use crate::kane::{Derivation, Function};
+use crate::options::ParamMode;
+use crate::registry::{FunctionId, Shape};
 
 /// A leaf of a lowered expression.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,14 +100,8 @@ impl fmt::Display for OpCount {
 /// A straight-line program.
 #[derive(Clone, Debug)]
 pub struct Program {
-    /// Function name.
+    /// Its name in listings and statistics (`mass_matrix`, `precompute`).
     pub name: String,
-    /// Doc line.
-    pub doc: String,
-    /// Result shape.
-    pub shape: Shape,
-    /// Inputs.
-    pub signature: Signature,
     /// Speed indices whose sin/cos the program needs.
     pub sincos: Vec<usize>,
     /// Statements in execution order.
@@ -173,6 +169,15 @@ fn locals(e: &LExpr, out: &mut Vec<usize>) {
     }
 }
 
+/// The program of one registry function.
+#[derive(Clone, Debug)]
+pub struct FunctionProgram {
+    /// Which function (its name, inputs and result shape are in the registry).
+    pub id: FunctionId,
+    /// Its straight-line program; `outputs` are the entries of the result's shape.
+    pub program: Program,
+}
+
 /// All programs of a model: the precompute program and one per function.
 #[derive(Clone, Debug)]
 pub struct Lowered {
@@ -181,8 +186,8 @@ pub struct Lowered {
     pub precompute: Program,
     /// Statement index in `precompute` of every slot, in slot order.
     pub pre_slots: Vec<usize>,
-    /// The hot-path functions.
-    pub functions: Vec<Program>,
+    /// The hot-path functions, in registry order.
+    pub functions: Vec<FunctionProgram>,
     /// Number of speeds.
     pub dof: usize,
     /// Parameter mode.
@@ -190,9 +195,12 @@ pub struct Lowered {
 }
 
 impl Lowered {
-    /// The program called `name`.
-    pub fn function(&self, name: &str) -> Option<&Program> {
-        self.functions.iter().find(|p| p.name == name)
+    /// The program of function `id`, if the module has it.
+    pub fn function(&self, id: FunctionId) -> Option<&Program> {
+        self.functions
+            .iter()
+            .find(|f| f.id == id)
+            .map(|f| &f.program)
     }
 }
 
@@ -200,10 +208,13 @@ impl Lowered {
 pub fn lower(d: &Derivation) -> Lowered {
     let hoist = d.options.params == ParamMode::Runtime;
     let mut pre = PreSet::default();
-    let functions: Vec<Program> = d
+    let functions: Vec<FunctionProgram> = d
         .functions
         .iter()
-        .map(|f| lower_function(&d.arena, f, hoist, &mut pre))
+        .map(|f| FunctionProgram {
+            id: f.id,
+            program: lower_function(&d.arena, f, hoist, &mut pre),
+        })
         .collect();
     let (precompute, pre_slots) = lower_precompute(&d.arena, &pre);
     Lowered {
@@ -239,7 +250,7 @@ fn is_compound(n: &Node) -> bool {
 }
 
 /// Shared machinery: which nodes become statements and how to expand expressions.
-struct Builder<'a> {
+struct ProgramBuilder<'a> {
     ar: &'a Arena,
     /// Nodes that are leaves of this program because they are precomputed (runtime mode).
     hoist: bool,
@@ -247,7 +258,7 @@ struct Builder<'a> {
     local: HashMap<ExprId, usize>,
 }
 
-impl Builder<'_> {
+impl ProgramBuilder<'_> {
     fn is_pre(&self, e: ExprId) -> bool {
         self.hoist
             && self.ar.is_param_only(e)
@@ -431,7 +442,7 @@ fn statement_deps(
 
 fn lower_function(ar: &Arena, f: &Function, hoist: bool, pre: &mut PreSet) -> Program {
     let roots: Vec<ExprId> = f.entries.iter().map(|e| e.2).collect();
-    let mut b = Builder {
+    let mut b = ProgramBuilder {
         ar,
         hoist,
         local: HashMap::new(),
@@ -478,10 +489,7 @@ fn lower_function(ar: &Arena, f: &Function, hoist: bool, pre: &mut PreSet) -> Pr
         .map(|&(r, c, e)| (r, c, b.expand(e, false, pre)))
         .collect();
     let mut p = Program {
-        name: f.name.to_owned(),
-        doc: f.doc.to_owned(),
-        shape: f.shape,
-        signature: f.signature,
+        name: f.id.name().to_owned(),
         sincos: Vec::new(),
         stmts,
         outputs,
@@ -494,7 +502,7 @@ fn lower_function(ar: &Arena, f: &Function, hoist: bool, pre: &mut PreSet) -> Pr
 }
 
 fn lower_precompute(ar: &Arena, pre: &PreSet) -> (Program, Vec<usize>) {
-    let mut b = Builder {
+    let mut b = ProgramBuilder {
         ar,
         hoist: false,
         local: HashMap::new(),
@@ -503,8 +511,11 @@ fn lower_precompute(ar: &Arena, pre: &PreSet) -> (Program, Vec<usize>) {
     let sched = schedule(ar, &pre.nodes, &|_| false, None);
     let requested: BTreeSet<ExprId> = pre.nodes.iter().copied().collect();
     let mut order: Vec<(ExprId, Option<u32>)> = sched;
+    // A requested node that is a variable needs no statement of its own: its slot reads the
+    // statement of its definition (which the schedule holds), not an alias `let pc2 = pc1;`.
+    let scheduled: BTreeSet<ExprId> = order.iter().map(|(e, _)| *e).collect();
     for &e in &pre.nodes {
-        if !order.iter().any(|(x, _)| *x == e) {
+        if !scheduled.contains(&e) && !matches!(ar.node(e), Node::Atom(Atom::Var(_))) {
             order.push((e, None));
         }
     }
@@ -541,9 +552,6 @@ fn lower_precompute(ar: &Arena, pre: &PreSet) -> (Program, Vec<usize>) {
         .collect();
     let mut p = Program {
         name: "precompute".into(),
-        doc: "Parameter-only subexpressions, computed once per parameter set.".into(),
-        shape: Shape::Vector,
-        signature: Signature::Q,
         sincos: Vec::new(),
         stmts,
         outputs: Vec::new(),
@@ -606,11 +614,11 @@ impl Lowered {
         self.pre_slots.iter().map(|&i| locals[i]).collect()
     }
 
-    /// Evaluate function `name`; dense row-major matrix (both triangles of a symmetric one) or
-    /// vector.
+    /// Evaluate function `id`; dense row-major matrix (both triangles of a symmetric one) or
+    /// vector. Panics if the module does not have the function (a test helper).
     pub fn evaluate(
         &self,
-        name: &str,
+        id: FunctionId,
         params: &[f64],
         q: &[f64],
         u: &[f64],
@@ -618,8 +626,8 @@ impl Lowered {
     ) -> Vec<f64> {
         let pre = self.precompute_values(params);
         let p = self
-            .function(name)
-            .unwrap_or_else(|| panic!("no function `{name}`"));
+            .function(id)
+            .unwrap_or_else(|| panic!("the lowered model has no function `{id}`"));
         let locals = run(p, params, &pre, q, u, ud);
         let n = self.dof;
         let ctx = EvalCtx {
@@ -630,7 +638,7 @@ impl Lowered {
             ud,
             locals: &locals,
         };
-        match p.shape {
+        match id.spec().shape {
             Shape::SymmetricMatrix => {
                 let mut m = vec![0.0; n * n];
                 for (r, c, e) in &p.outputs {

@@ -4,6 +4,7 @@
 //! differences of the derivation's M). TOML models (wheeled and fixed base, runtime and baked
 //! parameters) and a small URDF robot with a prismatic joint on a two-wheeled base.
 
+use kanegen::FunctionId;
 use kanegen::model::{Model, UrdfOptions, WheeledBaseSpec};
 use kanegen::{Generated, Options, ParamMode, generate_model};
 use kanegen_reference::Reference;
@@ -47,11 +48,15 @@ fn check(label: &str, g: &Generated, draws: usize, seed: u64) -> [f64; 4] {
         let q = uniform_vec(&mut uniform, n, -pi, pi);
         let u = uniform_vec(&mut uniform, n, -2.0, 2.0);
         let z = vec![0.0; n];
-        let cd = g.derivation.evaluate("coriolis_matrix", &p, &q, &u, &z);
-        let cl = g.lowered.evaluate("coriolis_matrix", &p, &q, &u, &z);
+        let cd = g
+            .derivation
+            .evaluate(FunctionId::CoriolisMatrix, &p, &q, &u, &z);
+        let cl = g
+            .lowered
+            .evaluate(FunctionId::CoriolisMatrix, &p, &q, &u, &z);
         worst[0] = worst[0].max(rel_err(&cl, &cd, 1.0));
         let cu = mat_vec(&cd, &u);
-        let c = g.derivation.evaluate("coriolis", &p, &q, &u, &z);
+        let c = g.derivation.evaluate(FunctionId::Coriolis, &p, &q, &u, &z);
         worst[1] = worst[1].max(rel_err(&cu, &c, 1.0));
         let reference = Reference::<f64>::with_params(model, &p);
         let c_ref: Vec<f64> = reference.coriolis(&q, &u).iter().copied().collect();
@@ -65,7 +70,8 @@ fn check(label: &str, g: &Generated, draws: usize, seed: u64) -> [f64; 4] {
         }
         let m_at = |t: f64| {
             let qt: Vec<f64> = q.iter().zip(&qd).map(|(a, b)| a + t * b).collect();
-            g.derivation.evaluate("mass_matrix", &p, &qt, &z, &z)
+            g.derivation
+                .evaluate(FunctionId::MassMatrix, &p, &qt, &z, &z)
         };
         let d = |h: f64| -> Vec<f64> {
             m_at(h)

@@ -1,8 +1,9 @@
 //! The symbolic derivation, evaluated numerically, against the three Pinocchio cases of
 //! `shared/krang/reference-values.json` (an independent library).
 
-use kanegen::kane::{Options, ParamMode, derive};
+use kanegen::kane::derive;
 use kanegen::model::Model;
+use kanegen::{FunctionId, Options, ParamMode};
 
 fn root() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -42,7 +43,8 @@ fn symbolic_krang_matches_pinocchio_reference_values() {
     );
     let low = kanegen::lower::lower(&d);
     for f in &low.functions {
-        eprintln!("{}: {} stmts, {}", f.name, f.stmts.len(), f.ops);
+        let p = &f.program;
+        eprintln!("{}: {} stmts, {}", p.name, p.stmts.len(), p.ops);
     }
     eprintln!(
         "precompute: {} stmts, {}",
@@ -68,31 +70,34 @@ fn symbolic_krang_matches_pinocchio_reference_values() {
             .flat_map(vecf)
             .collect();
         let name = case["name"].as_str().unwrap();
-        let em = rel_err(&d.evaluate("mass_matrix", &params, &q, &z, &z), &m);
+        let em = rel_err(&d.evaluate(FunctionId::MassMatrix, &params, &q, &z, &z), &m);
         let ec = rel_err(
-            &d.evaluate("coriolis", &params, &q, &u, &z),
+            &d.evaluate(FunctionId::Coriolis, &params, &q, &u, &z),
             &vecf(&case["c"]),
         );
         let eg = rel_err(
-            &d.evaluate("gravity", &params, &q, &z, &z),
+            &d.evaluate(FunctionId::Gravity, &params, &q, &z, &z),
             &vecf(&case["g"]),
         );
         let et = rel_err(
-            &d.evaluate("inverse_dynamics", &params, &q, &u, &ud),
+            &d.evaluate(FunctionId::InverseDynamics, &params, &q, &u, &ud),
             &vecf(&case["tau"]),
         );
         eprintln!("{name}: M {em:.2e} c {ec:.2e} g {eg:.2e} tau {et:.2e}");
-        let lm = rel_err(&low.evaluate("mass_matrix", &params, &q, &z, &z), &m);
+        let lm = rel_err(
+            &low.evaluate(FunctionId::MassMatrix, &params, &q, &z, &z),
+            &m,
+        );
         let lc = rel_err(
-            &low.evaluate("coriolis", &params, &q, &u, &z),
+            &low.evaluate(FunctionId::Coriolis, &params, &q, &u, &z),
             &vecf(&case["c"]),
         );
         let lg = rel_err(
-            &low.evaluate("gravity", &params, &q, &z, &z),
+            &low.evaluate(FunctionId::Gravity, &params, &q, &z, &z),
             &vecf(&case["g"]),
         );
         let lt = rel_err(
-            &low.evaluate("inverse_dynamics", &params, &q, &u, &ud),
+            &low.evaluate(FunctionId::InverseDynamics, &params, &q, &u, &ud),
             &vecf(&case["tau"]),
         );
         eprintln!("{name} (lowered): M {lm:.2e} c {lc:.2e} g {lg:.2e} tau {lt:.2e}");
@@ -102,7 +107,7 @@ fn symbolic_krang_matches_pinocchio_reference_values() {
         );
         assert!(em < 1e-9 && ec < 1e-9 && eg < 1e-9 && et < 1e-9, "{name}");
         // The Coriolis matrix times u is Pinocchio's c.
-        let cm = low.evaluate("coriolis_matrix", &params, &q, &u, &z);
+        let cm = low.evaluate(FunctionId::CoriolisMatrix, &params, &q, &u, &z);
         let cu: Vec<f64> = (0..19)
             .map(|r| (0..19).map(|k| cm[r * 19 + k] * u[k]).sum())
             .collect();

@@ -2,9 +2,10 @@
 //! is what limits the speed of long straight-line code), and scheduling does not change what
 //! they compute.
 
-use kanegen::kane::{Options, ParamMode, derive};
+use kanegen::kane::derive;
 use kanegen::lower::lower;
 use kanegen::model::Model;
+use kanegen::{FunctionId, Options, ParamMode};
 
 fn krang() -> Model {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -13,11 +14,11 @@ fn krang() -> Model {
 
 /// Upper bounds on the values live at once in Krang's programs (with runtime parameters they
 /// are 34, 111, 32 and 111; the bounds leave some room for changes to the derivation).
-const MAX_LIVE: [(&str, usize); 4] = [
-    ("mass_matrix", 45),
-    ("coriolis", 125),
-    ("gravity", 40),
-    ("inverse_dynamics", 125),
+const MAX_LIVE: [(FunctionId, usize); 4] = [
+    (FunctionId::MassMatrix, 45),
+    (FunctionId::Coriolis, 125),
+    (FunctionId::Gravity, 40),
+    (FunctionId::InverseDynamics, 125),
 ];
 
 #[test]
@@ -51,7 +52,12 @@ fn every_statement_follows_the_statements_it_reads() {
     let q: Vec<f64> = (0..19).map(|i| 0.1 * i as f64 - 0.7).collect();
     let u: Vec<f64> = (0..19).map(|i| 0.3 - 0.05 * i as f64).collect();
     let ud: Vec<f64> = (0..19).map(|i| (i as f64 * 0.37).sin()).collect();
-    for name in ["mass_matrix", "coriolis", "gravity", "inverse_dynamics"] {
+    for name in [
+        FunctionId::MassMatrix,
+        FunctionId::Coriolis,
+        FunctionId::Gravity,
+        FunctionId::InverseDynamics,
+    ] {
         let a = low.evaluate(name, &params, &q, &u, &ud);
         let b = d.evaluate(name, &params, &q, &u, &ud);
         let scale = b.iter().fold(1.0f64, |m, x| m.max(x.abs()));

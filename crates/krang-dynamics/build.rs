@@ -3,7 +3,7 @@ fn main() {
     kanegen::Builder::new("krang.toml").run();
     kanegen::Builder::new("krang.toml").baked(true).run();
     kanegen::Builder::new("krang.toml")
-        .scalar(kanegen::Scalar::F32)
+        .precision(kanegen::Precision::F32)
         .run();
     kanegen::Builder::new("krang-fixed-wheels.toml").run();
     kanegen::Builder::new("two-link.toml").run();

@@ -3,9 +3,10 @@
 
 use kanegen_model::{Base, JointKind, Scalar};
 
+use super::Ctx;
 use super::algebra::{M3, V3};
-use super::{Ctx, ParamMode};
 use crate::expr::{Atom, ExprId, VarKind};
+use crate::options::ParamMode;
 
 impl Ctx<'_> {
     pub(super) fn param(&mut self, p: usize) -> ExprId {

@@ -53,78 +53,22 @@ mod gravity;
 mod mass_matrix;
 mod rnea;
 
-use kanegen_model::Model;
+use kanegen_model::{Model, ParamKind};
 
 use crate::expr::{Arena, ExprId, Names};
+use crate::options::Options;
+use crate::registry::{FunctionId, Shape};
 
 use algebra::{M3, V3};
+use composite::Composite;
 
-/// How model parameters enter the generated code.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum ParamMode {
-    /// Parameters are runtime inputs (a `Params` value); parameter-only subexpressions are
-    /// computed once per parameter set, outside the hot path.
-    #[default]
-    Runtime,
-    /// The model file's values are folded in as constants; terms of zero parameters vanish.
-    Baked,
-}
-
-/// Generator options.
-#[derive(Clone, Copy, Debug)]
-pub struct Options {
-    /// How parameters enter.
-    pub params: ParamMode,
-    /// Also derive `coriolis_matrix`, the Coriolis matrix C(q, u) (default `true`). It costs
-    /// about four times the operations of `coriolis` (Krang: ≈ 9,500 flops) and roughly doubles
-    /// the compile time of a large model's generated module; turn it off when only M, c, g and
-    /// τ are needed.
-    pub coriolis_matrix: bool,
-}
-
-impl Default for Options {
-    fn default() -> Self {
-        Self {
-            params: ParamMode::default(),
-            coriolis_matrix: true,
-        }
-    }
-}
-
-/// Shape of a generated function's result.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Shape {
-    /// Symmetric matrix; entries are the upper triangle `(row ≤ col)`.
-    SymmetricMatrix,
-    /// Vector; entries are `(row, 0)`.
-    Vector,
-    /// General (non-symmetric) matrix; entries are `(row, col)`, absent entries are zero.
-    Matrix,
-}
-
-/// Which inputs a function takes besides the parameters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Signature {
-    /// `f(q)`.
-    Q,
-    /// `f(q, u)`.
-    QU,
-    /// `f(q, u, u̇)`.
-    QUUd,
-}
-
-/// One derived function: its name and output entries as expressions in the arena.
+/// One derived registry function: its output entries as expressions in the arena (its name,
+/// inputs and result shape are in the registry).
 #[derive(Clone, Debug)]
 pub struct Function {
-    /// Rust name (`mass_matrix`).
-    pub name: &'static str,
-    /// What it computes, for docs.
-    pub doc: &'static str,
-    /// Result shape.
-    pub shape: Shape,
-    /// Inputs.
-    pub signature: Signature,
-    /// `(row, col, expr)`; col = 0 for vectors.
+    /// Which function.
+    pub id: FunctionId,
+    /// `(row, col, expr)` in the layout of the function's [`Shape`]; col = 0 for vectors.
     pub entries: Vec<(usize, usize, ExprId)>,
     /// Per arena node, when this function's derivation first asked for it (`u32::MAX`: never):
     /// the statement order the lowering follows (see [`Arena::begin_phase`]).
@@ -136,8 +80,7 @@ pub struct Function {
 pub struct Derivation {
     /// All expressions and substitution variables.
     pub arena: Arena,
-    /// `mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, and `coriolis_matrix` if
-    /// [`Options::coriolis_matrix`].
+    /// The functions of [`Options::functions`], in registry order.
     pub functions: Vec<Function>,
     /// Number of speeds.
     pub dof: usize,
@@ -146,9 +89,9 @@ pub struct Derivation {
 }
 
 impl Derivation {
-    /// The function called `name`.
-    pub fn function(&self, name: &str) -> Option<&Function> {
-        self.functions.iter().find(|f| f.name == name)
+    /// The derived function `id`, if [`Options::functions`] asked for it.
+    pub fn function(&self, id: FunctionId) -> Option<&Function> {
+        self.functions.iter().find(|f| f.id == id)
     }
 }
 
@@ -158,13 +101,31 @@ pub fn names_of(model: &Model) -> Names {
         params: model.params.iter().map(|p| p.name.clone()).collect(),
         speeds: model.speeds.iter().map(|s| s.name.clone()).collect(),
         coords: model.speeds.iter().map(|s| s.coordinate.clone()).collect(),
+        lengths: model
+            .params
+            .iter()
+            .map(|p| p.kind == ParamKind::Length)
+            .collect(),
     }
 }
 
-/// Derive M (upper triangle), c, g, τ and the Coriolis matrix C for `model`.
+/// The order in which functions are derived. M comes first: its columns are formed inside the
+/// backward composite pass, each right after its subtree's composite is complete, so that the
+/// generated code uses values soon after it computes them (short live ranges, fewer register
+/// spills); g and C reuse those composites. The order fixes the arena's numbering and with it the
+/// generated code, so it is part of the output's definition.
+const DERIVATION_ORDER: [FunctionId; 5] = [
+    FunctionId::MassMatrix,
+    FunctionId::Gravity,
+    FunctionId::Coriolis,
+    FunctionId::InverseDynamics,
+    FunctionId::CoriolisMatrix,
+];
+
+/// Derive the functions of `options.functions` for `model` (M as its upper triangle).
 pub fn derive(model: &Model, options: Options) -> Derivation {
     let mut arena = Arena::new(names_of(model));
-    arena.hoist_params = options.params == ParamMode::Runtime;
+    arena.hoist_params = options.params.is_runtime();
     let mut cx = Ctx {
         ar: &mut arena,
         model,
@@ -173,80 +134,57 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
         pos: vec![None; model.links.len()],
     };
     let n = model.dof();
-    // The columns of M are formed inside the backward composite pass, each right after its
-    // subtree's composite is complete, so that the generated code uses values soon after it
-    // computes them (short live ranges, fewer register spills). Each function is one arena
-    // phase: its statements are later scheduled in the order its own recursion forms them.
-    cx.ar.begin_phase();
-    let mut columns = Vec::new();
-    let composites = cx.composites(true, Some(&mut columns));
-    let m = cx.mass_matrix(&composites, columns);
-    let m_order = cx.ar.phase_order();
-    cx.ar.begin_phase();
-    let g = cx.gravity(&composites);
-    let g_order = cx.ar.phase_order();
-    cx.ar.begin_phase();
-    let c = cx.rnea(false, false);
-    let c_order = cx.ar.phase_order();
-    cx.ar.begin_phase();
-    let tau = cx.rnea(true, true);
-    let tau_order = cx.ar.phase_order();
-    let cm = options.coriolis_matrix.then(|| {
+    let mut composites = None;
+    let mut functions = Vec::new();
+    for id in DERIVATION_ORDER {
+        if !options.has(id) {
+            continue;
+        }
+        // Each function is one arena phase: its statements are later scheduled in the order its
+        // own recursion forms them.
         cx.ar.begin_phase();
-        let cm = cx.coriolis_matrix(&composites);
-        (cm, cx.ar.phase_order())
-    });
-    let vector = |v: Vec<ExprId>| v.into_iter().enumerate().map(|(i, e)| (i, 0, e)).collect();
-    let mut functions = vec![
-        Function {
-            name: "mass_matrix",
-            doc: "Mass matrix M(q) (symmetric positive definite).",
-            shape: Shape::SymmetricMatrix,
-            signature: Signature::Q,
-            entries: m,
-            order: m_order,
-        },
-        Function {
-            name: "coriolis",
-            doc: "Coriolis and centrifugal vector c(q, u) (velocity-product terms).",
-            shape: Shape::Vector,
-            signature: Signature::QU,
-            entries: vector(c),
-            order: c_order,
-        },
-        Function {
-            name: "gravity",
-            doc: "Gravity vector g(q).",
-            shape: Shape::Vector,
-            signature: Signature::Q,
-            entries: vector(g),
-            order: g_order,
-        },
-        Function {
-            name: "inverse_dynamics",
-            doc: "Inverse dynamics τ = M(q) u̇ + c(q, u) + g(q), in one pass.",
-            shape: Shape::Vector,
-            signature: Signature::QUUd,
-            entries: vector(tau),
-            order: tau_order,
-        },
-    ];
-    if let Some((cm, cm_order)) = cm {
-        functions.push(Function {
-            name: "coriolis_matrix",
-            doc: "Coriolis matrix C(q, u): c(q, u) = C(q, u) u, and Ṁ − 2C is skew-symmetric.",
-            shape: Shape::Matrix,
-            signature: Signature::QU,
-            entries: cm,
-            order: cm_order,
-        });
+        let entries = cx.derive_function(id, &mut composites);
+        let order = cx.ar.phase_order();
+        functions.push(Function { id, entries, order });
     }
+    functions.sort_by_key(|f| f.id);
     debug_assert!(functions.iter().all(|f| f.entries.iter().all(|e| e.0 < n)));
     Derivation {
         arena,
         functions,
         dof: n,
         options,
+    }
+}
+
+impl Ctx<'_> {
+    /// The entries of registry function `id`. `composites`: the subtree inertias, formed by the
+    /// first function that needs them (M forms its columns on the way).
+    fn derive_function(
+        &mut self,
+        id: FunctionId,
+        composites: &mut Option<Vec<Composite>>,
+    ) -> Vec<(usize, usize, ExprId)> {
+        let vector = |v: Vec<ExprId>| v.into_iter().enumerate().map(|(i, e)| (i, 0, e)).collect();
+        match id {
+            FunctionId::MassMatrix => {
+                let mut columns = Vec::new();
+                let comp = self.composites(true, Some(&mut columns));
+                let m = self.mass_matrix(&comp, columns);
+                *composites = Some(comp);
+                m
+            }
+            FunctionId::Gravity => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                vector(self.gravity(comp))
+            }
+            FunctionId::Coriolis => vector(self.rnea(false, false)),
+            FunctionId::InverseDynamics => vector(self.rnea(true, true)),
+            FunctionId::CoriolisMatrix => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                self.coriolis_matrix(comp)
+            }
+        }
     }
 }
 
@@ -261,23 +199,23 @@ struct Ctx<'a> {
 }
 
 impl Derivation {
-    /// Evaluate function `name` numerically from the symbolic expressions (no code generation):
+    /// Evaluate function `id` numerically from the symbolic expressions (no code generation):
     /// a dense row-major `n × n` matrix (both triangles) or an `n`-vector. Parameter values are
-    /// used in [`ParamMode::Runtime`]; in baked mode the model's values are already folded in.
+    /// used in [`ParamMode::Runtime`](crate::options::ParamMode::Runtime); in baked mode the model's values are already folded in.
     pub fn evaluate(
         &self,
-        name: &str,
+        id: FunctionId,
         params: &[f64],
         q: &[f64],
         u: &[f64],
         ud: &[f64],
     ) -> Vec<f64> {
         let f = self
-            .function(name)
-            .unwrap_or_else(|| panic!("no function `{name}`"));
+            .function(id)
+            .unwrap_or_else(|| panic!("the derivation has no function `{id}`"));
         let vals = self.arena.eval(&crate::expr::Values { params, q, u, ud });
         let n = self.dof;
-        match f.shape {
+        match id.spec().shape {
             Shape::SymmetricMatrix => {
                 let mut m = vec![0.0; n * n];
                 for &(r, c, e) in &f.entries {

@@ -3,722 +3,561 @@
 // Operation counts per call:
 //   Precomputed::new  5 adds, 5 muls, 0 divs, 0 sin/cos (once per parameter set)
 //   mass_matrix       6 adds, 8 muls, 0 divs, 1 sin/cos; 0 K and 4 D variables
-//   coriolis          10 adds, 22 muls, 0 divs, 1 sin/cos; 1 K and 14 D variables
+//   coriolis          10 adds, 22 muls, 0 divs, 1 sin/cos; 7 K and 8 D variables
 //   gravity           8 adds, 14 muls, 0 divs, 2 sin/cos; 0 K and 8 D variables
-//   inverse_dynamics  21 adds, 32 muls, 0 divs, 2 sin/cos; 2 K and 17 D variables
-//   coriolis_matrix   18 adds, 31 muls, 0 divs, 1 sin/cos; 1 K and 21 D variables
+//   inverse_dynamics  21 adds, 32 muls, 0 divs, 2 sin/cos; 4 K and 15 D variables
+//   coriolis_matrix   18 adds, 31 muls, 0 divs, 1 sin/cos; 5 K and 17 D variables
 
-use nalgebra::{SMatrix, SVector};
-/// Arguments below this magnitude (≈ 2¹⁹·π/2, so that `n·PIO2_1` is exact) take the
-/// Cody–Waite reduction; larger ones (never a robot angle) and non-finite ones take
-/// `reduce_large`.
-const SIN_COS_FAST_BOUND: f64 = 823_549.0;
-/// `(sin x, cos x)` for the generated code: Cody–Waite reduction by π/2 (fdlibm's constants)
-/// and fdlibm's minimax kernels on [−π/4, π/4]; |x| ≥ 2¹⁹·π/2 (never a robot angle) takes a
-/// cold Payne–Hanek reduction against 1280 bits of 2/π. Needs only `core` (no `std`, no
-/// `libm`). Error within about one ulp of the standard library for the angles robots use (a
-/// few ulp for huge arguments); several times faster because both values share one reduction
-/// and the code inlines. [`sin_cos_n`] is the batched form the generated functions call.
-#[inline(always)]
-fn sin_cos(x: f64) -> (f64, f64) {
-    let (r, quadrant) = if x.abs() < SIN_COS_FAST_BOUND {
-        sin_cos_reduce(x)
-    } else {
-        reduce_large(x)
-    };
-    sin_cos_kernel(r, quadrant)
-}
-/// `(sin x[k], cos x[k])` for every lane, bit for bit the values of [`sin_cos`]. Every lane
-/// runs through one branch-free loop that the compiler vectorizes (two lanes per SSE2
-/// instruction, four with AVX2) and that also sets one flag for the whole batch: if a lane is
-/// at or above the Cody–Waite bound or not finite (never, for robot angles), the batch is
-/// recomputed lane by lane by the scalar routine. Not inlined: the generated functions are
-/// long enough that their speed depends on their code size (one shared copy instead of one per
-/// function).
-#[inline(never)]
-#[allow(clippy::needless_range_loop)]
-fn sin_cos_n<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
-    let (mut s, mut c) = ([0.0; N], [0.0; N]);
-    let mut fast = true;
-    for k in 0..N {
-        let (r, quadrant) = sin_cos_reduce(x[k]);
-        (s[k], c[k]) = sin_cos_kernel(r, quadrant);
-        fast &= x[k].abs() < SIN_COS_FAST_BOUND;
+pub use self::generated::*;
+#[allow(non_snake_case, clippy::all)]
+mod generated {
+    use nalgebra::{SMatrix, SVector};
+    use kanegen_runtime::trig::sin_cos_n;
+    /// Number of generalized speeds (and coordinates).
+    pub const DOF: usize = 2;
+    /// Generalized speed names, in the order of `u`.
+    pub const SPEED_NAMES: [&str; 2] = ["qd_imu", "qd_w"];
+    /// Coordinate names, in the order of `q`.
+    pub const COORDINATE_NAMES: [&str; 2] = ["q_imu", "q_w"];
+    /// Index constants of the coordinates (and of their speeds).
+    pub mod index {
+        /// Index of `q_imu` in q (and of `qd_imu` in u).
+        pub const Q_IMU: usize = 0;
+        /// Index of `q_w` in q (and of `qd_w` in u).
+        pub const Q_W: usize = 1;
     }
-    if !fast {
-        (s, c) = sin_cos_n_slow(x);
+    pub use kanegen_runtime::UnknownParameter;
+    /// Number of model parameters.
+    pub const PARAM_COUNT: usize = 23;
+    /// Model parameters of `two-link`, named with the reports' symbols; `Default` holds the values of `two-link.toml`.
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Params {
+        /// `g`: gravity acceleration (m/s²) (default 9.81).
+        pub g: f64,
+        /// `L1`: length (m) (default 0.499).
+        pub L1: f64,
+        /// `L2`: length (m) (default 0.091).
+        pub L2: f64,
+        /// `m1`: mass (kg) (default 75.767).
+        pub m1: f64,
+        /// `MX1`: first moment m·S (kg·m) (default -0.047581676).
+        pub MX1: f64,
+        /// `MY1`: first moment m·S (kg·m) (default 0.14698798).
+        pub MY1: f64,
+        /// `MZ1`: first moment m·S (kg·m) (default 5.812920007).
+        pub MZ1: f64,
+        /// `XX1`: inertia about the frame origin (kg·m²) (default 2.942658192538247).
+        pub XX1: f64,
+        /// `XY1`: inertia about the frame origin (kg·m²) (default 9.230845144e-5).
+        pub XY1: f64,
+        /// `XZ1`: inertia about the frame origin (kg·m²) (default 0.003650513764396).
+        pub XZ1: f64,
+        /// `YY1`: inertia about the frame origin (kg·m²) (default 2.4034029171495748).
+        pub YY1: f64,
+        /// `YZ1`: inertia about the frame origin (kg·m²) (default -0.01127706481358).
+        pub YZ1: f64,
+        /// `ZZ1`: inertia about the frame origin (kg·m²) (default 1.233515037973728).
+        pub ZZ1: f64,
+        /// `m2`: mass (kg) (default 14.006).
+        pub m2: f64,
+        /// `MX2`: first moment m·S (kg·m) (default -0.717415332).
+        pub MX2: f64,
+        /// `MY2`: first moment m·S (kg·m) (default 0.00483207).
+        pub MY2: f64,
+        /// `MZ2`: first moment m·S (kg·m) (default 1.127847156).
+        pub MZ2: f64,
+        /// `XX2`: inertia about the frame origin (kg·m²) (default 0.560102687148206).
+        pub XX2: f64,
+        /// `XY2`: inertia about the frame origin (kg·m²) (default 0.00024750828954).
+        pub XY2: f64,
+        /// `XZ2`: inertia about the frame origin (kg·m²) (default 0.154799587024632).
+        pub XZ2: f64,
+        /// `YY2`: inertia about the frame origin (kg·m²) (default 0.52999846821976).
+        pub YY2: f64,
+        /// `YZ2`: inertia about the frame origin (kg·m²) (default -0.00059999726882).
+        pub YZ2: f64,
+        /// `ZZ2`: inertia about the frame origin (kg·m²) (default 0.232799115199854).
+        pub ZZ2: f64,
     }
-    (s, c)
-}
-/// [`sin_cos_n`] lane by lane through [`sin_cos`] (a batch with a huge or non-finite lane).
-#[cold]
-#[inline(never)]
-#[allow(clippy::needless_range_loop)]
-fn sin_cos_n_slow<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
-    let mut out = ([0.0; N], [0.0; N]);
-    for k in 0..N {
-        (out.0[k], out.1[k]) = sin_cos(x[k]);
-    }
-    out
-}
-/// `(r, n)` with `x = n·π/2 + r`, |r| ≤ π/4 (to within rounding), for |x| <
-/// [`SIN_COS_FAST_BOUND`]; only the low two bits of `n` are meaningful.
-#[inline(always)]
-#[allow(clippy::excessive_precision, clippy::unreadable_literal)]
-fn sin_cos_reduce(x: f64) -> (f64, u64) {
-    let shifted = x * core::f64::consts::FRAC_2_PI + 6_755_399_441_055_744.0;
-    let n = shifted - 6_755_399_441_055_744.0;
-    let r1 = x - n * 1.570_796_326_734_125_614_17;
-    let w = n * 6.077_100_506_303_965_976_60e-11;
-    let r2 = r1 - w;
-    let w2 = n * 2.022_266_248_795_950_631_54e-21 - ((r1 - r2) - w);
-    (r2 - w2, shifted.to_bits())
-}
-/// `(sin x, cos x)` from `x = n·π/2 + r`: fdlibm's `__kernel_sin` / `__kernel_cos` on `r`,
-/// then the quadrant `n mod 4` applied by bit masks (no branches).
-#[inline(always)]
-#[allow(clippy::excessive_precision)]
-fn sin_cos_kernel(r: f64, quadrant: u64) -> (f64, f64) {
-    let z = r * r;
-    let s = r
-        + r * z
-            * (-1.666_666_666_666_663_243_48e-01
-                + z
-                    * (8.333_333_333_322_489_461_24e-03
-                        + z
-                            * (-1.984_126_982_985_794_931_34e-04
-                                + z
-                                    * (2.755_731_370_707_006_767_89e-06
-                                        + z
-                                            * (-2.505_076_025_340_686_341_95e-08
-                                                + z * 1.589_690_995_211_550_102_21e-10)))));
-    let poly_c = z * z
-        * (4.166_666_666_666_660_190_37e-02
-            + z
-                * (-1.388_888_888_887_410_957_49e-03
-                    + z
-                        * (2.480_158_728_947_672_941_78e-05
-                            + z
-                                * (-2.755_731_435_139_066_330_35e-07
-                                    + z
-                                        * (2.087_572_321_298_174_827_90e-09
-                                            + z * -1.135_964_755_778_819_482_65e-11)))));
-    let hz = 0.5 * z;
-    let one_minus_hz = 1.0 - hz;
-    let c = one_minus_hz + (((1.0 - one_minus_hz) - hz) + poly_c);
-    let swap = 0u64.wrapping_sub(quadrant & 1);
-    let (sb, cb) = (s.to_bits(), c.to_bits());
-    let t = (sb ^ cb) & swap;
-    let (sin_bits, cos_bits) = (sb ^ t, cb ^ t);
-    let sin_sign = (quadrant & 2) << 62;
-    let cos_sign = (quadrant.wrapping_add(1) & 2) << 62;
-    (f64::from_bits(sin_bits ^ sin_sign), f64::from_bits(cos_bits ^ cos_sign))
-}
-/// `(r, n mod 4)` with `x = n·π/2 + r`, |r| ≤ π/4, for huge `x` (NaN for NaN and ±∞): `x·2/π`
-/// modulo 4 in 192-bit fixed point from `x`'s integer mantissa and a 192-bit window of 2/π.
-#[cold]
-#[inline(never)]
-#[allow(clippy::unreadable_literal)]
-fn reduce_large(x: f64) -> (f64, u64) {
-    /// 2/π in binary: bits 1‥1280 after the point, most significant first.
-    const TWO_OVER_PI: [u64; 20] = [
-        0xa2f9836e4e441529, 0xfc2757d1f534ddc0, 0xdb6295993c439041, 0xfe5163abdebbc561,
-        0xb7246e3a424dd2e0, 0x06492eea09d1921c, 0xfe1deb1cb129a73e, 0xe88235f52ebb4484,
-        0xe99c7026b45f7e41, 0x3991d639835339f4, 0x9c845f8bbdf9283b, 0x1ff897ffde05980f,
-        0xef2f118b5a0a6d1f, 0x6d367ecf27cb09b7, 0x4f463f669e5fea2d, 0x7527bac7ebe5f17b,
-        0x3d0739f78a5292ea, 0x6bfb5fb11f8d5d08, 0x56033046fc7b6bab, 0xf0cfbc209af4361d,
-    ];
-    /// Bits p‥p+63 of 2/π (bit 1 is the first after the point; bits p ≤ 0 are zero).
-    fn window(p: i64) -> u64 {
-        if p < 1 {
-            return if 1 - p >= 64 { 0 } else { TWO_OVER_PI[0] >> (1 - p) };
-        }
-        let o = (p - 1) as usize;
-        let (j, sh) = (o / 64, o % 64);
-        if sh == 0 {
-            TWO_OVER_PI[j]
-        } else {
-            (TWO_OVER_PI[j] << sh) | (TWO_OVER_PI[j + 1] >> (64 - sh))
-        }
-    }
-    if !x.is_finite() {
-        return (f64::NAN, 0);
-    }
-    let bits = x.to_bits();
-    let m = (bits & 0x000f_ffff_ffff_ffff) | 0x0010_0000_0000_0000;
-    let k = ((bits >> 52) & 0x7ff) as i64 - 1075;
-    let (w0, w1, w2) = (window(k - 1), window(k + 63), window(k + 127));
-    let lo = u128::from(m) * u128::from(w2);
-    let mid = u128::from(m) * u128::from(w1) + (lo >> 64);
-    let hi = (u128::from(m) * u128::from(w0) + (mid >> 64)) as u64;
-    let mut quadrant = hi >> 62;
-    let mut frac = (u128::from(hi) << 66) | ((mid as u64 as u128) << 2)
-        | ((lo as u64 >> 62) as u128);
-    let mut sign = 1.0;
-    if frac >> 127 == 1 {
-        quadrant += 1;
-        frac = frac.wrapping_neg();
-        sign = -1.0;
-    }
-    let r = sign * (frac as f64 * f64::from_bits(0x37f0_0000_0000_0000))
-        * core::f64::consts::FRAC_PI_2;
-    if x < 0.0 { (-r, quadrant.wrapping_neg() & 3) } else { (r, quadrant) }
-}
-/// Number of generalized speeds (and coordinates).
-pub const DOF: usize = 2;
-/// Generalized speed names, in the order of `u`.
-pub const SPEED_NAMES: [&str; 2] = ["qd_imu", "qd_w"];
-/// Coordinate names, in the order of `q`.
-pub const COORDINATE_NAMES: [&str; 2] = ["q_imu", "q_w"];
-/// Index constants of the coordinates (and of their speeds).
-pub mod index {
-    /// Index of `q_imu` in q (and of `qd_imu` in u).
-    pub const Q_IMU: usize = 0;
-    /// Index of `q_w` in q (and of `qd_w` in u).
-    pub const Q_W: usize = 1;
-}
-/// Number of model parameters.
-pub const PARAM_COUNT: usize = 23;
-/// Model parameters of `two-link`, named with the reports' symbols; `Default` holds the values of `two-link.toml`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[allow(non_snake_case)]
-pub struct Params {
-    /// `g`: gravity acceleration (m/s²) (default 9.81).
-    pub g: f64,
-    /// `L1`: length (m) (default 0.499).
-    pub L1: f64,
-    /// `L2`: length (m) (default 0.091).
-    pub L2: f64,
-    /// `m1`: mass (kg) (default 75.767).
-    pub m1: f64,
-    /// `MX1`: first moment m·S (kg·m) (default -0.047581676).
-    pub MX1: f64,
-    /// `MY1`: first moment m·S (kg·m) (default 0.14698798).
-    pub MY1: f64,
-    /// `MZ1`: first moment m·S (kg·m) (default 5.812920007).
-    pub MZ1: f64,
-    /// `XX1`: inertia about the frame origin (kg·m²) (default 2.942658192538247).
-    pub XX1: f64,
-    /// `XY1`: inertia about the frame origin (kg·m²) (default 9.230845144e-5).
-    pub XY1: f64,
-    /// `XZ1`: inertia about the frame origin (kg·m²) (default 0.003650513764396).
-    pub XZ1: f64,
-    /// `YY1`: inertia about the frame origin (kg·m²) (default 2.4034029171495748).
-    pub YY1: f64,
-    /// `YZ1`: inertia about the frame origin (kg·m²) (default -0.01127706481358).
-    pub YZ1: f64,
-    /// `ZZ1`: inertia about the frame origin (kg·m²) (default 1.233515037973728).
-    pub ZZ1: f64,
-    /// `m2`: mass (kg) (default 14.006).
-    pub m2: f64,
-    /// `MX2`: first moment m·S (kg·m) (default -0.717415332).
-    pub MX2: f64,
-    /// `MY2`: first moment m·S (kg·m) (default 0.00483207).
-    pub MY2: f64,
-    /// `MZ2`: first moment m·S (kg·m) (default 1.127847156).
-    pub MZ2: f64,
-    /// `XX2`: inertia about the frame origin (kg·m²) (default 0.560102687148206).
-    pub XX2: f64,
-    /// `XY2`: inertia about the frame origin (kg·m²) (default 0.00024750828954).
-    pub XY2: f64,
-    /// `XZ2`: inertia about the frame origin (kg·m²) (default 0.154799587024632).
-    pub XZ2: f64,
-    /// `YY2`: inertia about the frame origin (kg·m²) (default 0.52999846821976).
-    pub YY2: f64,
-    /// `YZ2`: inertia about the frame origin (kg·m²) (default -0.00059999726882).
-    pub YZ2: f64,
-    /// `ZZ2`: inertia about the frame origin (kg·m²) (default 0.232799115199854).
-    pub ZZ2: f64,
-}
-impl Default for Params {
-    fn default() -> Self {
-        Self {
-            g: 9.81,
-            L1: 0.499,
-            L2: 0.091,
-            m1: 75.767,
-            MX1: -0.047581676,
-            MY1: 0.14698798,
-            MZ1: 5.812920007,
-            XX1: 2.942658192538247,
-            XY1: 0.00009230845144,
-            XZ1: 0.003650513764396,
-            YY1: 2.4034029171495748,
-            YZ1: -0.01127706481358,
-            ZZ1: 1.233515037973728,
-            m2: 14.006,
-            MX2: -0.717415332,
-            MY2: 0.00483207,
-            MZ2: 1.127847156,
-            XX2: 0.560102687148206,
-            XY2: 0.00024750828954,
-            XZ2: 0.154799587024632,
-            YY2: 0.52999846821976,
-            YZ2: -0.00059999726882,
-            ZZ2: 0.232799115199854,
-        }
-    }
-}
-/// A parameter name that the model does not have. Allocation-free (`no_std`): the name
-/// is kept inline, truncated to [`UnknownParameter::CAPACITY`] bytes.
-#[derive(Clone, Copy, PartialEq, Eq, Hash)]
-pub struct UnknownParameter {
-    name: [u8; UnknownParameter::CAPACITY],
-    len: u8,
-}
-impl UnknownParameter {
-    /// The longest name kept, in bytes (longer names are cut at a character boundary).
-    pub const CAPACITY: usize = 48;
-    /// The error for `name` (truncated to [`UnknownParameter::CAPACITY`] bytes).
-    pub fn new(name: &str) -> Self {
-        let mut len = name.len().min(Self::CAPACITY);
-        while !name.is_char_boundary(len) {
-            len -= 1;
-        }
-        let mut buf = [0u8; Self::CAPACITY];
-        buf[..len].copy_from_slice(&name.as_bytes()[..len]);
-        Self { name: buf, len: len as u8 }
-    }
-    /// The name that was asked for (truncated to [`UnknownParameter::CAPACITY`] bytes).
-    pub fn name(&self) -> &str {
-        core::str::from_utf8(&self.name[..usize::from(self.len)]).unwrap_or("")
-    }
-}
-impl core::fmt::Debug for UnknownParameter {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("UnknownParameter").field("name", &self.name()).finish()
-    }
-}
-impl core::fmt::Display for UnknownParameter {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(
-            f, "unknown parameter `{}`; the valid names are listed in Params::NAMES",
-            self.name()
-        )
-    }
-}
-impl core::error::Error for UnknownParameter {}
-#[allow(non_snake_case)]
-impl Params {
-    /// Parameter names in declaration order (the order of [`Params::to_array`]).
-    pub const NAMES: [&'static str; 23] = [
-        "g",
-        "L1",
-        "L2",
-        "m1",
-        "MX1",
-        "MY1",
-        "MZ1",
-        "XX1",
-        "XY1",
-        "XZ1",
-        "YY1",
-        "YZ1",
-        "ZZ1",
-        "m2",
-        "MX2",
-        "MY2",
-        "MZ2",
-        "XX2",
-        "XY2",
-        "XZ2",
-        "YY2",
-        "YZ2",
-        "ZZ2",
-    ];
-    /// The value of parameter `name`, or `None` if the model has no such parameter.
-    pub fn get(&self, name: &str) -> Option<f64> {
-        match name {
-            "g" => Some(self.g),
-            "L1" => Some(self.L1),
-            "L2" => Some(self.L2),
-            "m1" => Some(self.m1),
-            "MX1" => Some(self.MX1),
-            "MY1" => Some(self.MY1),
-            "MZ1" => Some(self.MZ1),
-            "XX1" => Some(self.XX1),
-            "XY1" => Some(self.XY1),
-            "XZ1" => Some(self.XZ1),
-            "YY1" => Some(self.YY1),
-            "YZ1" => Some(self.YZ1),
-            "ZZ1" => Some(self.ZZ1),
-            "m2" => Some(self.m2),
-            "MX2" => Some(self.MX2),
-            "MY2" => Some(self.MY2),
-            "MZ2" => Some(self.MZ2),
-            "XX2" => Some(self.XX2),
-            "XY2" => Some(self.XY2),
-            "XZ2" => Some(self.XZ2),
-            "YY2" => Some(self.YY2),
-            "YZ2" => Some(self.YZ2),
-            "ZZ2" => Some(self.ZZ2),
-            _ => None,
-        }
-    }
-    /// Set parameter `name`; an error if the model has no such parameter.
-    pub fn set(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
-        match name {
-            "g" => self.g = value,
-            "L1" => self.L1 = value,
-            "L2" => self.L2 = value,
-            "m1" => self.m1 = value,
-            "MX1" => self.MX1 = value,
-            "MY1" => self.MY1 = value,
-            "MZ1" => self.MZ1 = value,
-            "XX1" => self.XX1 = value,
-            "XY1" => self.XY1 = value,
-            "XZ1" => self.XZ1 = value,
-            "YY1" => self.YY1 = value,
-            "YZ1" => self.YZ1 = value,
-            "ZZ1" => self.ZZ1 = value,
-            "m2" => self.m2 = value,
-            "MX2" => self.MX2 = value,
-            "MY2" => self.MY2 = value,
-            "MZ2" => self.MZ2 = value,
-            "XX2" => self.XX2 = value,
-            "XY2" => self.XY2 = value,
-            "XZ2" => self.XZ2 = value,
-            "YY2" => self.YY2 = value,
-            "YZ2" => self.YZ2 = value,
-            "ZZ2" => self.ZZ2 = value,
-            _ => return Err(UnknownParameter::new(name)),
-        }
-        Ok(())
-    }
-    /// All values in the order of [`Params::NAMES`].
-    pub fn to_array(&self) -> [f64; 23] {
-        [
-            self.g,
-            self.L1,
-            self.L2,
-            self.m1,
-            self.MX1,
-            self.MY1,
-            self.MZ1,
-            self.XX1,
-            self.XY1,
-            self.XZ1,
-            self.YY1,
-            self.YZ1,
-            self.ZZ1,
-            self.m2,
-            self.MX2,
-            self.MY2,
-            self.MZ2,
-            self.XX2,
-            self.XY2,
-            self.XZ2,
-            self.YY2,
-            self.YZ2,
-            self.ZZ2,
-        ]
-    }
-    /// Parameters from values in the order of [`Params::NAMES`].
-    pub fn from_array(v: [f64; 23]) -> Self {
-        let [g, L1, L2, m1, MX1, MY1, MZ1, XX1, XY1, XZ1, YY1, YZ1, ZZ1, m2, MX2, MY2,
-        MZ2, XX2, XY2, XZ2, YY2, YZ2, ZZ2] = v;
-        Self {
-            g,
-            L1,
-            L2,
-            m1,
-            MX1,
-            MY1,
-            MZ1,
-            XX1,
-            XY1,
-            XZ1,
-            YY1,
-            YZ1,
-            ZZ1,
-            m2,
-            MX2,
-            MY2,
-            MZ2,
-            XX2,
-            XY2,
-            XZ2,
-            YY2,
-            YZ2,
-            ZZ2,
-        }
-    }
-}
-/// Parameter-only subexpressions of the dynamics, computed once per parameter set.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Precomputed {
-    pc5: f64,
-    pc1: f64,
-    pc3: f64,
-}
-impl Precomputed {
-    /// Compute the parameter-only terms for `p`.
-    ///
-    /// Generated straight-line code: 5 adds, 5 muls, 0 divs, 0 sin/cos.
-    #[allow(non_snake_case, unused_variables, clippy::all)]
-    pub fn new(p: &Params) -> Self {
-        let pc1 = p.MY1 + p.m2 * p.L1; // MSC1.y (parameters)
-        let pc2 = pc1; // parameter-only term
-        let pc3 = p.MZ1 - p.m2 * p.L2; // MSC1.z (parameters)
-        let pc4 = pc3; // parameter-only term
-        let pc5 = p.XX1 + p.XX2 + p.m2 * (p.L1 * p.L1 + p.L2 * p.L2); // JC1.xx (parameters)
-        let pc6 = pc5; // parameter-only term
-        Self { pc5, pc1, pc3 }
-    }
-}
-/// Mass matrix M(q) (symmetric positive definite).
-///
-/// `q`: coordinates in the order of [`COORDINATE_NAMES`].
-/// Generated straight-line code: 6 adds, 8 muls, 0 divs, 1 sin/cos.
-#[allow(non_snake_case, unused_variables, clippy::all)]
-#[inline(never)]
-pub fn mass_matrix(
-    p: &Params,
-    pc: &Precomputed,
-    q: &SVector<f64, 2>,
-) -> SMatrix<f64, 2, 2> {
-    let (sin_q, cos_q) = sin_cos_n([q[1]]);
-    let s_q_w = sin_q[0];
-    let c_q_w = cos_q[0];
-    let mut m = SMatrix::<f64, 2, 2>::zeros();
-    m[(1, 1)] = p.XX2;
-    let d1 = p.MY2 * c_q_w + p.MZ2 * s_q_w; // MSC2 in 1.y
-    let d2 = p.MY2 * s_q_w - p.MZ2 * c_q_w; // MSC2 in 1.z
-    let t1 = p.L1 * d1; // common subexpression
-    let t2 = p.L2 * d2; // common subexpression
-    let d3 = p.XX2 + t1 + t2; // N(M col 2) at 1.x
-    m[(0, 1)] = d3;
-    let d4 = 2.0 * t1 + 2.0 * t2 + pc.pc5; // JC1.xx
-    m[(0, 0)] = d4;
-    {
-        let s = m.as_mut_slice();
-        for c in 1..2 {
-            for r in 0..c {
-                s[r * 2 + c] = s[c * 2 + r];
+    impl Default for Params {
+        fn default() -> Self {
+            Self {
+                g: 9.81,
+                L1: 0.499,
+                L2: 0.091,
+                m1: 75.767,
+                MX1: -0.047581676,
+                MY1: 0.14698798,
+                MZ1: 5.812920007,
+                XX1: 2.942658192538247,
+                XY1: 0.00009230845144,
+                XZ1: 0.003650513764396,
+                YY1: 2.4034029171495748,
+                YZ1: -0.01127706481358,
+                ZZ1: 1.233515037973728,
+                m2: 14.006,
+                MX2: -0.717415332,
+                MY2: 0.00483207,
+                MZ2: 1.127847156,
+                XX2: 0.560102687148206,
+                XY2: 0.00024750828954,
+                XZ2: 0.154799587024632,
+                YY2: 0.52999846821976,
+                YZ2: -0.00059999726882,
+                ZZ2: 0.232799115199854,
             }
         }
-        m
     }
-}
-/// Coriolis and centrifugal vector c(q, u) (velocity-product terms).
-///
-/// `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].
-/// Generated straight-line code: 10 adds, 22 muls, 0 divs, 1 sin/cos.
-#[allow(non_snake_case, unused_variables, clippy::all)]
-#[inline(never)]
-pub fn coriolis(
-    p: &Params,
-    _pc: &Precomputed,
-    q: &SVector<f64, 2>,
-    u: &SVector<f64, 2>,
-) -> SVector<f64, 2> {
-    let (sin_q, cos_q) = sin_cos_n([q[1]]);
-    let s_q_w = sin_q[0];
-    let c_q_w = cos_q[0];
-    let qd_imu = u[0];
-    let qd_w = u[1];
-    let mut out = SVector::<f64, 2>::zeros();
-    let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
-    let d1 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-    let d2 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-    let d3 = qd_imu * d2; // a2 in 1|ud=0,g=0.y
-    let d4 = qd_imu * d1; // a2 in 1|ud=0,g=0.z
-    let d5 = c_q_w * d3 + s_q_w * d4; // a2|ud=0,g=0.y
-    let d6 = s_q_w * d3 - c_q_w * d4; // a2|ud=0,g=0.z
-    let d7 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
-    let d8 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
-    let d9 = p.m2 * d5 + k1 * d8; // F2|ud=0,g=0.y
-    let d10 = p.m2 * d6 + k1 * d7; // F2|ud=0,g=0.z
-    let d11 = p.MY2 * d6 - p.MZ2 * d5; // N2|ud=0,g=0.x
-    out[1] = core::hint::black_box(d11);
-    let d12 = s_q_w * d9 - c_q_w * d10; // f2 in 1|ud=0,g=0.z
-    let d13 = c_q_w * d9 + s_q_w * d10; // f2 in 1|ud=0,g=0.y
-    let d14 = d11 - p.L1 * d12 + p.L2 * d13; // n1|ud=0,g=0.x
-    out[0] = core::hint::black_box(d14);
-    out
-}
-/// Gravity vector g(q).
-///
-/// `q`: coordinates in the order of [`COORDINATE_NAMES`].
-/// Generated straight-line code: 8 adds, 14 muls, 0 divs, 2 sin/cos.
-#[allow(non_snake_case, unused_variables, clippy::all)]
-#[inline(never)]
-pub fn gravity(p: &Params, pc: &Precomputed, q: &SVector<f64, 2>) -> SVector<f64, 2> {
-    let (sin_q, cos_q) = sin_cos_n([q[0], q[1]]);
-    let s_q_imu = sin_q[0];
-    let c_q_imu = cos_q[0];
-    let s_q_w = sin_q[1];
-    let c_q_w = cos_q[1];
-    let mut out = SVector::<f64, 2>::zeros();
-    let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
-    let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
-    let d3 = c_q_w * d1 - s_q_w * d2; // gravity acceleration in 2.y
-    let d4 = s_q_w * d1 + c_q_w * d2; // gravity acceleration in 2.z
-    out[1] = core::hint::black_box(p.MZ2 * d3 - p.MY2 * d4);
-    let d5 = p.MY2 * c_q_w + p.MZ2 * s_q_w; // MSC2 in 1.y
-    let d6 = p.MY2 * s_q_w - p.MZ2 * c_q_w; // MSC2 in 1.z
-    let d7 = d5 + pc.pc1; // MSC1.y
-    let d8 = pc.pc3 - d6; // MSC1.z
-    out[0] = core::hint::black_box(d8 * d1 - d7 * d2);
-    out
-}
-/// Inverse dynamics τ = M(q) u̇ + c(q, u) + g(q), in one pass.
-///
-/// `q`, `u`, `ud`: coordinates, speeds and accelerations in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].
-/// Generated straight-line code: 21 adds, 32 muls, 0 divs, 2 sin/cos.
-#[allow(non_snake_case, unused_variables, clippy::all)]
-#[inline(never)]
-pub fn inverse_dynamics(
-    p: &Params,
-    _pc: &Precomputed,
-    q: &SVector<f64, 2>,
-    u: &SVector<f64, 2>,
-    ud: &SVector<f64, 2>,
-) -> SVector<f64, 2> {
-    let (sin_q, cos_q) = sin_cos_n([q[0], q[1]]);
-    let s_q_imu = sin_q[0];
-    let c_q_imu = cos_q[0];
-    let s_q_w = sin_q[1];
-    let c_q_w = cos_q[1];
-    let qd_imu = u[0];
-    let qdd_imu = ud[0];
-    let qd_w = u[1];
-    let qdd_w = ud[1];
-    let mut out = SVector::<f64, 2>::zeros();
-    let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
-    let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
-    let d3 = p.XX1 * qdd_imu - p.MY1 * d2 + p.MZ1 * d1; // N1.x
-    let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
-    let k2 = qdd_imu + qdd_w; // wd2.x
-    let d4 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-    let d5 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-    let d6 = d1 - qd_imu * d5 - p.L2 * qdd_imu; // a2 in 1.y
-    let d7 = d2 + qd_imu * d4 - p.L1 * qdd_imu; // a2 in 1.z
-    let d8 = c_q_w * d6 - s_q_w * d7; // a2.y
-    let d9 = s_q_w * d6 + c_q_w * d7; // a2.z
-    let d10 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
-    let d11 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
-    let d12 = k1 * d11 - p.m2 * d8 - p.MZ2 * k2; // F2.y
-    let d13 = k1 * d10 - p.m2 * d9 + p.MY2 * k2; // F2.z
-    let d14 = p.XX2 * k2 - p.MY2 * d9 + p.MZ2 * d8; // N2.x
-    out[1] = core::hint::black_box(d14);
-    let d15 = s_q_w * d12 - c_q_w * d13; // f2 in 1.z
-    let d16 = c_q_w * d12 + s_q_w * d13; // f2 in 1.y
-    let d17 = d3 + d14 - p.L1 * d15 + p.L2 * d16; // n1.x
-    out[0] = core::hint::black_box(d17);
-    out
-}
-/// Coriolis matrix C(q, u): c(q, u) = C(q, u) u, and Ṁ − 2C is skew-symmetric.
-///
-/// `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].
-/// Generated straight-line code: 18 adds, 31 muls, 0 divs, 1 sin/cos.
-#[allow(non_snake_case, unused_variables, clippy::all)]
-#[inline(never)]
-pub fn coriolis_matrix(
-    p: &Params,
-    _pc: &Precomputed,
-    q: &SVector<f64, 2>,
-    u: &SVector<f64, 2>,
-) -> SMatrix<f64, 2, 2> {
-    let (sin_q, cos_q) = sin_cos_n([q[1]]);
-    let s_q_w = sin_q[0];
-    let c_q_w = cos_q[0];
-    let qd_imu = u[0];
-    let qd_w = u[1];
-    let mut m = SMatrix::<f64, 2, 2>::zeros();
-    let d1 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-    let d2 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-    let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
-    let d3 = c_q_w * d1 - s_q_w * d2; // v2.y
-    let d4 = s_q_w * d1 + c_q_w * d2; // v2.z
-    let d5 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
-    let d6 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
-    let d7 = p.m2 * d3; // IC2(VxS(qd_w)).f.z
-    let d8 = p.m2 * d4; // IC2(VxS(qd_w)).f.y
-    let d9 = d5 - d7; // h2.f.y
-    let d10 = d6 + d8; // h2.f.z
-    let t1 = p.MY2 * d3; // common subexpression
-    let t2 = p.MZ2 * d4; // common subexpression
-    let d11 = 2.0 * t1 + 2.0 * t2; // Jd2.xx
-    m[(1, 0)] = -0.5 * d11;
-    let d12 = c_q_w * d9 - s_q_w * d10; // hC2 in 1.f.y
-    let d13 = s_q_w * d9 + c_q_w * d10; // hC2 in 1.f.z
-    let d14 = d11 - 2.0 * (p.L1 * d12) - 2.0 * (p.L2 * d13); // JdC1.xx
-    m[(0, 0)] = -0.5 * d14;
-    let d15 = t1 + t2; // IC2(VxS(qd_w)).n.x
-    let d16 = 0.5 * d11 - d15; // h(C col qd_w) at 2.n.x
-    m[(1, 1)] = -d16;
-    let d17 = d10 - d8; // h(C col qd_w) at 2.f.y
-    let d18 = d9 + d7; // h(C col qd_w) at 2.f.z
-    let d19 = s_q_w * d17 - c_q_w * d18; // h(C col qd_w) at 1.f.z
-    let d20 = c_q_w * d17 + s_q_w * d18; // h(C col qd_w) at 1.f.y
-    let d21 = d16 + p.L1 * d19 - p.L2 * d20; // h(C col qd_w) at 1.n.x
-    m[(0, 1)] = -d21;
-    m
-}
-/// The dynamics of `two-link` with one parameter set: `τ = M(q) u̇ + c(q, u) + g(q)`.
-///
-/// Construction precomputes the parameter-only terms; the evaluation methods are
-/// allocation-free and cannot fail.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TwoLink {
-    params: Params,
-    pre: Precomputed,
-}
-impl Default for TwoLink {
-    fn default() -> Self {
-        Self::new(Params::default())
-    }
-}
-impl TwoLink {
-    /// The model with parameter set `params`.
-    pub fn new(params: Params) -> Self {
-        Self {
-            pre: Precomputed::new(&params),
-            params,
+    impl Params {
+        /// Parameter names in declaration order (the order of [`Params::to_array`]).
+        pub const NAMES: [&'static str; 23] = [
+            "g",
+            "L1",
+            "L2",
+            "m1",
+            "MX1",
+            "MY1",
+            "MZ1",
+            "XX1",
+            "XY1",
+            "XZ1",
+            "YY1",
+            "YZ1",
+            "ZZ1",
+            "m2",
+            "MX2",
+            "MY2",
+            "MZ2",
+            "XX2",
+            "XY2",
+            "XZ2",
+            "YY2",
+            "YZ2",
+            "ZZ2",
+        ];
+        /// The value of parameter `name`, or `None` if the model has no such parameter.
+        pub fn get(&self, name: &str) -> Option<f64> {
+            match name {
+                "g" => Some(self.g),
+                "L1" => Some(self.L1),
+                "L2" => Some(self.L2),
+                "m1" => Some(self.m1),
+                "MX1" => Some(self.MX1),
+                "MY1" => Some(self.MY1),
+                "MZ1" => Some(self.MZ1),
+                "XX1" => Some(self.XX1),
+                "XY1" => Some(self.XY1),
+                "XZ1" => Some(self.XZ1),
+                "YY1" => Some(self.YY1),
+                "YZ1" => Some(self.YZ1),
+                "ZZ1" => Some(self.ZZ1),
+                "m2" => Some(self.m2),
+                "MX2" => Some(self.MX2),
+                "MY2" => Some(self.MY2),
+                "MZ2" => Some(self.MZ2),
+                "XX2" => Some(self.XX2),
+                "XY2" => Some(self.XY2),
+                "XZ2" => Some(self.XZ2),
+                "YY2" => Some(self.YY2),
+                "YZ2" => Some(self.YZ2),
+                "ZZ2" => Some(self.ZZ2),
+                _ => None,
+            }
+        }
+        /// Set parameter `name`; an error if the model has no such parameter.
+        pub fn set(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
+            match name {
+                "g" => self.g = value,
+                "L1" => self.L1 = value,
+                "L2" => self.L2 = value,
+                "m1" => self.m1 = value,
+                "MX1" => self.MX1 = value,
+                "MY1" => self.MY1 = value,
+                "MZ1" => self.MZ1 = value,
+                "XX1" => self.XX1 = value,
+                "XY1" => self.XY1 = value,
+                "XZ1" => self.XZ1 = value,
+                "YY1" => self.YY1 = value,
+                "YZ1" => self.YZ1 = value,
+                "ZZ1" => self.ZZ1 = value,
+                "m2" => self.m2 = value,
+                "MX2" => self.MX2 = value,
+                "MY2" => self.MY2 = value,
+                "MZ2" => self.MZ2 = value,
+                "XX2" => self.XX2 = value,
+                "XY2" => self.XY2 = value,
+                "XZ2" => self.XZ2 = value,
+                "YY2" => self.YY2 = value,
+                "YZ2" => self.YZ2 = value,
+                "ZZ2" => self.ZZ2 = value,
+                _ => return Err(UnknownParameter::new(name)),
+            }
+            Ok(())
+        }
+        /// All values in the order of [`Params::NAMES`].
+        pub fn to_array(&self) -> [f64; 23] {
+            [
+                self.g,
+                self.L1,
+                self.L2,
+                self.m1,
+                self.MX1,
+                self.MY1,
+                self.MZ1,
+                self.XX1,
+                self.XY1,
+                self.XZ1,
+                self.YY1,
+                self.YZ1,
+                self.ZZ1,
+                self.m2,
+                self.MX2,
+                self.MY2,
+                self.MZ2,
+                self.XX2,
+                self.XY2,
+                self.XZ2,
+                self.YY2,
+                self.YZ2,
+                self.ZZ2,
+            ]
+        }
+        /// Parameters from values in the order of [`Params::NAMES`].
+        pub fn from_array(v: [f64; 23]) -> Self {
+            let [g, L1, L2, m1, MX1, MY1, MZ1, XX1, XY1, XZ1, YY1, YZ1, ZZ1, m2, MX2,
+            MY2, MZ2, XX2, XY2, XZ2, YY2, YZ2, ZZ2] = v;
+            Self {
+                g,
+                L1,
+                L2,
+                m1,
+                MX1,
+                MY1,
+                MZ1,
+                XX1,
+                XY1,
+                XZ1,
+                YY1,
+                YZ1,
+                ZZ1,
+                m2,
+                MX2,
+                MY2,
+                MZ2,
+                XX2,
+                XY2,
+                XZ2,
+                YY2,
+                YZ2,
+                ZZ2,
+            }
         }
     }
-    /// The parameter set.
-    pub fn params(&self) -> &Params {
-        &self.params
+    /// Parameter-only subexpressions of the dynamics, computed once per parameter set.
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Precomputed {
+        pc3: f64,
+        pc1: f64,
+        pc2: f64,
     }
-    /// Replace the parameter set (recomputes the parameter-only terms).
-    pub fn set_params(&mut self, params: Params) {
-        *self = Self::new(params);
+    impl Precomputed {
+        /// Compute the parameter-only terms for `p`.
+        ///
+        /// Generated straight-line code: 5 adds, 5 muls, 0 divs, 0 sin/cos.
+        pub fn new(p: &Params) -> Self {
+            let pc1 = p.MY1 + p.m2 * p.L1; // MSC1.y (parameters)
+            let pc2 = p.MZ1 - p.m2 * p.L2; // MSC1.z (parameters)
+            let pc3 = p.XX1 + p.XX2 + p.m2 * (p.L1 * p.L1 + p.L2 * p.L2); // JC1.xx (parameters)
+            Self { pc3, pc1, pc2 }
+        }
     }
-    /// Mass matrix M(q), symmetric positive definite.
-    #[inline]
-    pub fn mass_matrix(&self, q: &SVector<f64, 2>) -> SMatrix<f64, 2, 2> {
-        mass_matrix(&self.params, &self.pre, q)
+    /// Mass matrix M(q) (symmetric positive definite).
+    ///
+    /// `q`: coordinates in the order of [`COORDINATE_NAMES`].
+    /// Generated straight-line code: 6 adds, 8 muls, 0 divs, 1 sin/cos.
+    #[inline(never)]
+    pub fn mass_matrix(
+        p: &Params,
+        pc: &Precomputed,
+        q: &SVector<f64, 2>,
+    ) -> SMatrix<f64, 2, 2> {
+        let (sin_q, cos_q) = sin_cos_n([q[1]]);
+        let s_q_w = sin_q[0];
+        let c_q_w = cos_q[0];
+        let mut m = SMatrix::<f64, 2, 2>::zeros();
+        m[(1, 1)] = p.XX2;
+        let d1 = p.MY2 * c_q_w + p.MZ2 * s_q_w; // MSC2 in 1.y
+        let d2 = p.MY2 * s_q_w - p.MZ2 * c_q_w; // MSC2 in 1.z
+        let t1 = p.L1 * d1; // common subexpression
+        let t2 = p.L2 * d2; // common subexpression
+        let d3 = p.XX2 + t1 + t2; // N(M col 2) at 1.x
+        m[(0, 1)] = d3;
+        let d4 = 2.0 * t1 + 2.0 * t2 + pc.pc3; // JC1.xx
+        m[(0, 0)] = d4;
+        {
+            let s = m.as_mut_slice();
+            for c in 1..2 {
+                for r in 0..c {
+                    s[r * 2 + c] = s[c * 2 + r];
+                }
+            }
+            m
+        }
     }
-    /// Coriolis and centrifugal vector c(q, u).
-    #[inline]
-    pub fn coriolis(&self, q: &SVector<f64, 2>, u: &SVector<f64, 2>) -> SVector<f64, 2> {
-        coriolis(&self.params, &self.pre, q, u)
+    /// Coriolis and centrifugal vector c(q, u) (velocity-product terms).
+    ///
+    /// `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].
+    /// Generated straight-line code: 10 adds, 22 muls, 0 divs, 1 sin/cos.
+    #[inline(never)]
+    pub fn coriolis(
+        p: &Params,
+        _pc: &Precomputed,
+        q: &SVector<f64, 2>,
+        u: &SVector<f64, 2>,
+    ) -> SVector<f64, 2> {
+        let (sin_q, cos_q) = sin_cos_n([q[1]]);
+        let s_q_w = sin_q[0];
+        let c_q_w = cos_q[0];
+        let qd_imu = u[0];
+        let qd_w = u[1];
+        let mut out = SVector::<f64, 2>::zeros();
+        let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
+        let k2 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+        let k3 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+        let k4 = qd_imu * k3; // a2 in 1|ud=0,g=0.y
+        let k5 = qd_imu * k2; // a2 in 1|ud=0,g=0.z
+        let k6 = c_q_w * k4 + s_q_w * k5; // a2|ud=0,g=0.y
+        let k7 = s_q_w * k4 - c_q_w * k5; // a2|ud=0,g=0.z
+        let d1 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
+        let d2 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
+        let d3 = p.m2 * k6 + k1 * d2; // F2|ud=0,g=0.y
+        let d4 = p.m2 * k7 + k1 * d1; // F2|ud=0,g=0.z
+        let d5 = p.MY2 * k7 - p.MZ2 * k6; // N2|ud=0,g=0.x
+        out[1] = core::hint::black_box(d5);
+        let d6 = s_q_w * d3 - c_q_w * d4; // f2 in 1|ud=0,g=0.z
+        let d7 = c_q_w * d3 + s_q_w * d4; // f2 in 1|ud=0,g=0.y
+        let d8 = d5 - p.L1 * d6 + p.L2 * d7; // n1|ud=0,g=0.x
+        out[0] = core::hint::black_box(d8);
+        out
     }
     /// Gravity vector g(q).
-    #[inline]
-    pub fn gravity(&self, q: &SVector<f64, 2>) -> SVector<f64, 2> {
-        gravity(&self.params, &self.pre, q)
+    ///
+    /// `q`: coordinates in the order of [`COORDINATE_NAMES`].
+    /// Generated straight-line code: 8 adds, 14 muls, 0 divs, 2 sin/cos.
+    #[inline(never)]
+    pub fn gravity(
+        p: &Params,
+        pc: &Precomputed,
+        q: &SVector<f64, 2>,
+    ) -> SVector<f64, 2> {
+        let (sin_q, cos_q) = sin_cos_n([q[0], q[1]]);
+        let s_q_imu = sin_q[0];
+        let c_q_imu = cos_q[0];
+        let s_q_w = sin_q[1];
+        let c_q_w = cos_q[1];
+        let mut out = SVector::<f64, 2>::zeros();
+        let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
+        let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
+        let d3 = c_q_w * d1 - s_q_w * d2; // gravity acceleration in 2.y
+        let d4 = s_q_w * d1 + c_q_w * d2; // gravity acceleration in 2.z
+        out[1] = core::hint::black_box(p.MZ2 * d3 - p.MY2 * d4);
+        let d5 = p.MY2 * c_q_w + p.MZ2 * s_q_w; // MSC2 in 1.y
+        let d6 = p.MY2 * s_q_w - p.MZ2 * c_q_w; // MSC2 in 1.z
+        let d7 = d5 + pc.pc1; // MSC1.y
+        let d8 = pc.pc2 - d6; // MSC1.z
+        out[0] = core::hint::black_box(d8 * d1 - d7 * d2);
+        out
     }
-    /// Inverse dynamics τ = M(q) u̇ + c(q, u) + g(q), in one generated pass.
-    #[inline]
+    /// Inverse dynamics τ = M(q) u̇ + c(q, u) + g(q), in one pass.
+    ///
+    /// `q`, `u`, `ud`: coordinates, speeds and accelerations in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].
+    /// Generated straight-line code: 21 adds, 32 muls, 0 divs, 2 sin/cos.
+    #[inline(never)]
     pub fn inverse_dynamics(
-        &self,
+        p: &Params,
+        _pc: &Precomputed,
         q: &SVector<f64, 2>,
         u: &SVector<f64, 2>,
         ud: &SVector<f64, 2>,
     ) -> SVector<f64, 2> {
-        inverse_dynamics(&self.params, &self.pre, q, u, ud)
+        let (sin_q, cos_q) = sin_cos_n([q[0], q[1]]);
+        let s_q_imu = sin_q[0];
+        let c_q_imu = cos_q[0];
+        let s_q_w = sin_q[1];
+        let c_q_w = cos_q[1];
+        let qd_imu = u[0];
+        let qdd_imu = ud[0];
+        let qd_w = u[1];
+        let qdd_w = ud[1];
+        let mut out = SVector::<f64, 2>::zeros();
+        let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
+        let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
+        let d3 = p.XX1 * qdd_imu - p.MY1 * d2 + p.MZ1 * d1; // N1.x
+        let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
+        let k2 = qdd_imu + qdd_w; // wd2.x
+        let k3 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+        let k4 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+        let d4 = d1 - qd_imu * k4 - p.L2 * qdd_imu; // a2 in 1.y
+        let d5 = d2 + qd_imu * k3 - p.L1 * qdd_imu; // a2 in 1.z
+        let d6 = c_q_w * d4 - s_q_w * d5; // a2.y
+        let d7 = s_q_w * d4 + c_q_w * d5; // a2.z
+        let d8 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
+        let d9 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
+        let d10 = k1 * d9 - p.m2 * d6 - p.MZ2 * k2; // F2.y
+        let d11 = k1 * d8 - p.m2 * d7 + p.MY2 * k2; // F2.z
+        let d12 = p.XX2 * k2 - p.MY2 * d7 + p.MZ2 * d6; // N2.x
+        out[1] = core::hint::black_box(d12);
+        let d13 = s_q_w * d10 - c_q_w * d11; // f2 in 1.z
+        let d14 = c_q_w * d10 + s_q_w * d11; // f2 in 1.y
+        let d15 = d3 + d12 - p.L1 * d13 + p.L2 * d14; // n1.x
+        out[0] = core::hint::black_box(d15);
+        out
     }
-    /// Coriolis matrix C(q, u): `c(q, u) = C(q, u) u`, and `Ṁ − 2C` is
-    /// skew-symmetric (Ṁ along q̇; for a wheeled base x and ψ do not enter M).
-    #[inline]
+    /// Coriolis matrix C(q, u): c(q, u) = C(q, u) u, and Ṁ − 2C is skew-symmetric.
+    ///
+    /// `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].
+    /// Generated straight-line code: 18 adds, 31 muls, 0 divs, 1 sin/cos.
+    #[inline(never)]
     pub fn coriolis_matrix(
-        &self,
+        p: &Params,
+        _pc: &Precomputed,
         q: &SVector<f64, 2>,
         u: &SVector<f64, 2>,
     ) -> SMatrix<f64, 2, 2> {
-        coriolis_matrix(&self.params, &self.pre, q, u)
+        let (sin_q, cos_q) = sin_cos_n([q[1]]);
+        let s_q_w = sin_q[0];
+        let c_q_w = cos_q[0];
+        let qd_imu = u[0];
+        let qd_w = u[1];
+        let mut m = SMatrix::<f64, 2, 2>::zeros();
+        let k1 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+        let k2 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+        let k3 = qd_imu + qd_w; // w2|ud=0,g=0.x
+        let k4 = c_q_w * k1 - s_q_w * k2; // v2.y
+        let k5 = s_q_w * k1 + c_q_w * k2; // v2.z
+        let d1 = p.MZ2 * k3; // w2xMS2|ud=0,g=0.y
+        let d2 = p.MY2 * k3; // w2xMS2|ud=0,g=0.z
+        let d3 = p.m2 * k4; // IC2(VxS(qd_w)).f.z
+        let d4 = p.m2 * k5; // IC2(VxS(qd_w)).f.y
+        let d5 = d1 - d3; // h2.f.y
+        let d6 = d2 + d4; // h2.f.z
+        let t1 = p.MY2 * k4; // common subexpression
+        let t2 = p.MZ2 * k5; // common subexpression
+        let d7 = 2.0 * t1 + 2.0 * t2; // Jd2.xx
+        m[(1, 0)] = -0.5 * d7;
+        let d8 = c_q_w * d5 - s_q_w * d6; // hC2 in 1.f.y
+        let d9 = s_q_w * d5 + c_q_w * d6; // hC2 in 1.f.z
+        let d10 = d7 - 2.0 * (p.L1 * d8) - 2.0 * (p.L2 * d9); // JdC1.xx
+        m[(0, 0)] = -0.5 * d10;
+        let d11 = t1 + t2; // IC2(VxS(qd_w)).n.x
+        let d12 = 0.5 * d7 - d11; // h(C col qd_w) at 2.n.x
+        m[(1, 1)] = -d12;
+        let d13 = d6 - d4; // h(C col qd_w) at 2.f.y
+        let d14 = d5 + d3; // h(C col qd_w) at 2.f.z
+        let d15 = s_q_w * d13 - c_q_w * d14; // h(C col qd_w) at 1.f.z
+        let d16 = c_q_w * d13 + s_q_w * d14; // h(C col qd_w) at 1.f.y
+        let d17 = d12 + p.L1 * d15 - p.L2 * d16; // h(C col qd_w) at 1.n.x
+        m[(0, 1)] = -d17;
+        m
+    }
+    /// The dynamics of `two-link` with one parameter set: `τ = M(q) u̇ + c(q, u) + g(q)`.
+    ///
+    /// Construction precomputes the parameter-only terms; the evaluation methods are
+    /// allocation-free and cannot fail.
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct TwoLink {
+        params: Params,
+        pre: Precomputed,
+    }
+    impl Default for TwoLink {
+        fn default() -> Self {
+            Self::new(Params::default())
+        }
+    }
+    impl TwoLink {
+        /// The model with parameter set `params`.
+        pub fn new(params: Params) -> Self {
+            Self {
+                pre: Precomputed::new(&params),
+                params,
+            }
+        }
+        /// The parameter set.
+        pub fn params(&self) -> &Params {
+            &self.params
+        }
+        /// Replace the parameter set (recomputes the parameter-only terms).
+        pub fn set_params(&mut self, params: Params) {
+            *self = Self::new(params);
+        }
+        /// Mass matrix M(q) (symmetric positive definite).
+        #[inline]
+        pub fn mass_matrix(&self, q: &SVector<f64, 2>) -> SMatrix<f64, 2, 2> {
+            mass_matrix(&self.params, &self.pre, q)
+        }
+        /// Coriolis and centrifugal vector c(q, u) (velocity-product terms).
+        #[inline]
+        pub fn coriolis(
+            &self,
+            q: &SVector<f64, 2>,
+            u: &SVector<f64, 2>,
+        ) -> SVector<f64, 2> {
+            coriolis(&self.params, &self.pre, q, u)
+        }
+        /// Gravity vector g(q).
+        #[inline]
+        pub fn gravity(&self, q: &SVector<f64, 2>) -> SVector<f64, 2> {
+            gravity(&self.params, &self.pre, q)
+        }
+        /// Inverse dynamics τ = M(q) u̇ + c(q, u) + g(q), in one pass.
+        #[inline]
+        pub fn inverse_dynamics(
+            &self,
+            q: &SVector<f64, 2>,
+            u: &SVector<f64, 2>,
+            ud: &SVector<f64, 2>,
+        ) -> SVector<f64, 2> {
+            inverse_dynamics(&self.params, &self.pre, q, u, ud)
+        }
+        /// Coriolis matrix C(q, u): c(q, u) = C(q, u) u, and Ṁ − 2C is skew-symmetric.
+        #[inline]
+        pub fn coriolis_matrix(
+            &self,
+            q: &SVector<f64, 2>,
+            u: &SVector<f64, 2>,
+        ) -> SMatrix<f64, 2, 2> {
+            coriolis_matrix(&self.params, &self.pre, q, u)
+        }
+    }
+    impl kanegen_runtime::RobotDynamics<DOF> for TwoLink {
+        type Scalar = f64;
+        const SPEED_NAMES: [&'static str; DOF] = SPEED_NAMES;
+        const COORDINATE_NAMES: [&'static str; DOF] = COORDINATE_NAMES;
+        fn mass_matrix(&self, q: &SVector<f64, 2>) -> SMatrix<f64, 2, 2> {
+            mass_matrix(&self.params, &self.pre, q)
+        }
+        fn coriolis(&self, q: &SVector<f64, 2>, u: &SVector<f64, 2>) -> SVector<f64, 2> {
+            coriolis(&self.params, &self.pre, q, u)
+        }
+        fn gravity(&self, q: &SVector<f64, 2>) -> SVector<f64, 2> {
+            gravity(&self.params, &self.pre, q)
+        }
+        fn inverse_dynamics(
+            &self,
+            q: &SVector<f64, 2>,
+            u: &SVector<f64, 2>,
+            ud: &SVector<f64, 2>,
+        ) -> SVector<f64, 2> {
+            inverse_dynamics(&self.params, &self.pre, q, u, ud)
+        }
+    }
+    impl kanegen_runtime::CoriolisMatrix<DOF> for TwoLink {
+        fn coriolis_matrix(
+            &self,
+            q: &SVector<f64, 2>,
+            u: &SVector<f64, 2>,
+        ) -> SMatrix<f64, 2, 2> {
+            coriolis_matrix(&self.params, &self.pre, q, u)
+        }
     }
 }

@@ -1,0 +1,239 @@
+//! One generated function: signature, inputs, the batched sines and cosines, the statements, and
+//! the result stores.
+
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::print::{Printer, ident, idx};
+use super::{Context, scalar_type};
+use crate::lower::{FunctionProgram, LExpr, Leaf, Program};
+use crate::naming;
+use crate::registry::{Inputs, Shape};
+
+/// The statement with the highest index that `e` reads, if any.
+fn last_local(e: &LExpr) -> Option<usize> {
+    match e {
+        LExpr::Leaf(Leaf::Local(i)) => Some(*i),
+        LExpr::Leaf(_) => None,
+        LExpr::Sum { terms, .. } => terms.iter().filter_map(|(_, t)| last_local(t)).max(),
+        LExpr::Prod(f) => f.iter().filter_map(|(b, _)| last_local(b)).max(),
+    }
+}
+
+/// Whether any statement or result of `p` reads a leaf satisfying `pred`.
+pub(super) fn uses(p: &Program, pred: &dyn Fn(&Leaf) -> bool) -> bool {
+    fn walk(e: &LExpr, pred: &dyn Fn(&Leaf) -> bool) -> bool {
+        match e {
+            LExpr::Leaf(l) => pred(l),
+            LExpr::Sum { terms, .. } => terms.iter().any(|(_, t)| walk(t, pred)),
+            LExpr::Prod(f) => f.iter().any(|(b, _)| walk(b, pred)),
+        }
+    }
+    p.stmts.iter().any(|s| walk(&s.expr, pred)) || p.outputs.iter().any(|(_, _, e)| walk(e, pred))
+}
+
+/// The state arguments of a function with `inputs`, and their doc line.
+pub(super) fn state_args(cx: &Context<'_>, inputs: Inputs) -> (TokenStream, &'static str) {
+    let t = scalar_type(cx.precision);
+    let nl = idx(cx.low.dof);
+    match inputs {
+        Inputs::Q => (
+            quote!(q: &SVector<#t, #nl>),
+            " `q`: coordinates in the order of [`COORDINATE_NAMES`].",
+        ),
+        Inputs::QU => (
+            quote!(q: &SVector<#t, #nl>, u: &SVector<#t, #nl>),
+            " `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].",
+        ),
+        Inputs::QUUd => (
+            quote!(q: &SVector<#t, #nl>, u: &SVector<#t, #nl>, ud: &SVector<#t, #nl>),
+            " `q`, `u`, `ud`: coordinates, speeds and accelerations in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].",
+        ),
+    }
+}
+
+/// The bindings of the inputs a function reads: one batched `sin_cos_n` call over the joint
+/// angles (vectorized), then per-joint names, coordinates, speeds and accelerations.
+fn prologue(cx: &Context<'_>, p: &Program) -> TokenStream {
+    let speeds = &cx.model.speeds;
+    let mut ts = TokenStream::new();
+    if !p.sincos.is_empty() {
+        // `sin_q`/`cos_q` cannot clash with a model name: they are read only by the bindings
+        // right below, which come before every other binding, and the sine/cosine names all
+        // start with `s_`/`c_`.
+        let angles = p.sincos.iter().map(|&s| {
+            let sl = idx(s);
+            quote!(q[#sl])
+        });
+        ts.extend(quote!(let (sin_q, cos_q) = sin_cos_n([#(#angles),*]);));
+        for (k, &s) in p.sincos.iter().enumerate() {
+            let sn = ident(&naming::sin(&speeds[s].coordinate));
+            let cn = ident(&naming::cos(&speeds[s].coordinate));
+            let kl = idx(k);
+            let reads_sin = uses(p, &|l| *l == Leaf::Sin(s));
+            let reads_cos = uses(p, &|l| *l == Leaf::Cos(s));
+            if reads_sin {
+                ts.extend(quote!(let #sn = sin_q[#kl];));
+            }
+            if reads_cos {
+                ts.extend(quote!(let #cn = cos_q[#kl];));
+            }
+        }
+    }
+    for (s, speed) in speeds.iter().enumerate() {
+        let sl = idx(s);
+        if uses(p, &|l| *l == Leaf::Coord(s)) {
+            let id = ident(&speed.coordinate);
+            ts.extend(quote!(let #id = q[#sl];));
+        }
+        if uses(p, &|l| *l == Leaf::Speed(s)) {
+            let id = ident(&speed.name);
+            ts.extend(quote!(let #id = u[#sl];));
+        }
+        if uses(p, &|l| *l == Leaf::Accel(s)) {
+            let id = ident(&naming::accel(&speed.name));
+            ts.extend(quote!(let #id = ud[#sl];));
+        }
+    }
+    ts
+}
+
+/// The result: its type, its initialisation, the stores placed after the statements they read
+/// (`stores[i + 1]` right after statement `i`), and the final expression.
+struct Result {
+    ty: TokenStream,
+    init: TokenStream,
+    stores: Vec<TokenStream>,
+    value: TokenStream,
+}
+
+/// Every result entry is stored right after the last statement it reads, so that values leave
+/// registers as soon as they are final (the programs are long; register pressure is what limits
+/// their speed).
+fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) -> Result {
+    let t = scalar_type(cx.precision);
+    let nl = idx(cx.low.dof);
+    let mut stores: Vec<TokenStream> = vec![TokenStream::new(); p.stmts.len() + 1];
+    let nonzero = p
+        .outputs
+        .iter()
+        .filter(|(_, _, e)| !matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0));
+    match shape {
+        Shape::SymmetricMatrix | Shape::Matrix => {
+            for (r, c, e) in nonzero {
+                let v = printer.expr(e, false);
+                let (r, c) = (idx(*r), idx(*c));
+                stores[last_local(e).map_or(0, |i| i + 1)].extend(quote!(m[(#r, #c)] = #v;));
+            }
+            // Symmetric: the lower triangle is copied at the end by a loop over the column-major
+            // storage. Mirrored stores next to the computation, or unrolled copies at the end
+            // (which the compiler turns back into long-lived registers), cost much more
+            // (measured for Krang: 1.2 µs vs 0.8 µs), and nalgebra's generic
+            // `fill_lower_triangle_with_upper_triangle` runs 2800 instructions for Krang's 171
+            // copies (this loop: about 0.25 µs less).
+            let value = if shape == Shape::SymmetricMatrix {
+                quote!({
+                    let s = m.as_mut_slice();
+                    for c in 1..#nl {
+                        for r in 0..c {
+                            s[r * #nl + c] = s[c * #nl + r];
+                        }
+                    }
+                    m
+                })
+            } else {
+                quote!(m)
+            };
+            Result {
+                ty: quote!(SMatrix<#t, #nl, #nl>),
+                init: quote!(let mut m = SMatrix::<#t, #nl, #nl>::zeros();),
+                stores,
+                value,
+            }
+        }
+        Shape::Vector => {
+            for (r, _, e) in nonzero {
+                let v = printer.expr(e, false);
+                let r = idx(*r);
+                // `black_box` keeps LLVM's SLP vectorizer from packing the stores of adjacent
+                // entries (and the expression trees behind them) into two-lane vectors: for
+                // Krang's inverse dynamics that packing added ~25 % code of shuffles and spills
+                // and doubled the time (1.17 µs vs 0.64 µs). (Krang's c got ~5 % slower.)
+                stores[last_local(e).map_or(0, |i| i + 1)]
+                    .extend(quote!(out[#r] = core::hint::black_box(#v);));
+            }
+            Result {
+                ty: quote!(SVector<#t, #nl>),
+                init: quote!(let mut out = SVector::<#t, #nl>::zeros();),
+                stores,
+                value: quote!(out),
+            }
+        }
+    }
+}
+
+/// The free function of registry function `f`.
+pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
+    let spec = f.id.spec();
+    let p = &f.program;
+    let printer = Printer {
+        model: cx.model,
+        stmts: &p.stmts,
+        pre: &cx.pre,
+        precision: cx.precision,
+    };
+    let fname = ident(spec.name);
+    let doc = format!(" {}", spec.doc);
+    let ops = format!(" Generated straight-line code: {}.", p.ops);
+    let param_args = if cx.low.params.is_runtime() {
+        let pname = if uses(p, &|l| matches!(l, Leaf::Param(_))) {
+            quote!(p)
+        } else {
+            quote!(_p)
+        };
+        let pcname = if uses(p, &|l| matches!(l, Leaf::Pre(_))) {
+            quote!(pc)
+        } else {
+            quote!(_pc)
+        };
+        quote!(#pname: &Params, #pcname: &Precomputed,)
+    } else {
+        quote!()
+    };
+    let (args, arg_doc) = state_args(cx, spec.inputs);
+    let prologue = prologue(cx, p);
+    let Result {
+        ty,
+        init,
+        stores,
+        value,
+    } = result(cx, &printer, p, spec.shape);
+    let body = printer.statements(&stores);
+    let n = cx.low.dof;
+    let reads = |leaf: fn(usize) -> Leaf| (0..n).any(|s| uses(p, &|l| *l == leaf(s)));
+    let reads_q = !p.sincos.is_empty() || reads(Leaf::Coord);
+    let mut unused = TokenStream::new();
+    if !reads_q {
+        unused.extend(quote!(let _ = q;));
+    }
+    if spec.inputs.needs_u() && !reads(Leaf::Speed) {
+        unused.extend(quote!(let _ = u;));
+    }
+    if spec.inputs.needs_ud() && !reads(Leaf::Accel) {
+        unused.extend(quote!(let _ = ud;));
+    }
+    quote! {
+        #[doc = #doc]
+        #[doc = ""]
+        #[doc = #arg_doc]
+        #[doc = #ops]
+        #[inline(never)]
+        pub fn #fname(#param_args #args) -> #ty {
+            #unused
+            #prologue
+            #init
+            #body
+            #value
+        }
+    }
+}

@@ -1,0 +1,332 @@
+//! The items of a generated module besides the functions: names and indices, `Params`,
+//! `Precomputed`, the wrapper type with one method per registry function, and the
+//! `kanegen-runtime` trait implementations.
+
+use proc_macro2::{Ident, TokenStream};
+use quote::quote;
+
+use super::function::{state_args, uses};
+use super::print::{Printer, ident, idx, signed_lit};
+use super::{Context, file_name, scalar_type};
+use crate::lower::{Leaf, Program};
+use crate::model::ParamKind;
+use crate::naming;
+use crate::registry::{FunctionSpec, Inputs, RuntimeTrait};
+
+/// `DOF`, `SPEED_NAMES`, `COORDINATE_NAMES` and the `index` constants.
+pub(super) fn names(cx: &Context<'_>) -> TokenStream {
+    let model = cx.model;
+    let nl = idx(cx.low.dof);
+    let speed_names: Vec<&str> = model.speeds.iter().map(|s| s.name.as_str()).collect();
+    let coord_names: Vec<&str> = model.speeds.iter().map(|s| s.coordinate.as_str()).collect();
+    let index_consts = model.speeds.iter().enumerate().map(|(i, s)| {
+        let id = ident(&s.coordinate.to_uppercase());
+        let doc = format!(
+            " Index of `{}` in q (and of `{}` in u).",
+            s.coordinate, s.name
+        );
+        let i = idx(i);
+        quote!(#[doc = #doc] pub const #id: usize = #i;)
+    });
+    quote! {
+        /// Number of generalized speeds (and coordinates).
+        pub const DOF: usize = #nl;
+        /// Generalized speed names, in the order of `u`.
+        pub const SPEED_NAMES: [&str; #nl] = [#(#speed_names),*];
+        /// Coordinate names, in the order of `q`.
+        pub const COORDINATE_NAMES: [&str; #nl] = [#(#coord_names),*];
+
+        /// Index constants of the coordinates (and of their speeds).
+        pub mod index {
+            #(#index_consts)*
+        }
+    }
+}
+
+fn param_doc(p: &crate::model::Param) -> String {
+    let what = match p.kind {
+        ParamKind::Length => "length (m)",
+        ParamKind::Gravity => "gravity acceleration (m/s²)",
+        ParamKind::Inertial => match p.name.chars().next() {
+            Some('m') => "mass (kg)",
+            Some('M') => "first moment m·S (kg·m)",
+            _ => "inertia about the frame origin (kg·m²)",
+        },
+        ParamKind::Wheel => "wheel constant",
+    };
+    format!(" `{}`: {} (default {:?}).", p.name, what, p.value)
+}
+
+/// `Params` (runtime mode): one field per model parameter, access by name, arrays.
+pub(super) fn params(cx: &Context<'_>) -> TokenStream {
+    let model = cx.model;
+    let np = idx(model.params.len());
+    let t = scalar_type(cx.precision);
+    let ids: Vec<Ident> = model.params.iter().map(|p| ident(&p.name)).collect();
+    let docs = model.params.iter().map(param_doc);
+    let values = model
+        .params
+        .iter()
+        .map(|p| signed_lit(p.value, cx.precision));
+    let names: Vec<&str> = model.params.iter().map(|p| p.name.as_str()).collect();
+    let source = format!(
+        " Model parameters of `{}`, named with the reports' symbols; `Default` holds the values of `{}`.",
+        model.name,
+        file_name(&model.source)
+    );
+    quote! {
+        pub use kanegen_runtime::UnknownParameter;
+
+        /// Number of model parameters.
+        pub const PARAM_COUNT: usize = #np;
+
+        #[doc = #source]
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Params {
+            #(#[doc = #docs] pub #ids: #t,)*
+        }
+
+        impl Default for Params {
+            fn default() -> Self {
+                Self { #(#ids: #values,)* }
+            }
+        }
+
+        impl Params {
+            /// Parameter names in declaration order (the order of [`Params::to_array`]).
+            pub const NAMES: [&'static str; #np] = [#(#names),*];
+
+            /// The value of parameter `name`, or `None` if the model has no such parameter.
+            pub fn get(&self, name: &str) -> Option<#t> {
+                match name {
+                    #(#names => Some(self.#ids),)*
+                    _ => None,
+                }
+            }
+
+            /// Set parameter `name`; an error if the model has no such parameter.
+            pub fn set(&mut self, name: &str, value: #t) -> Result<(), UnknownParameter> {
+                match name {
+                    #(#names => self.#ids = value,)*
+                    _ => return Err(UnknownParameter::new(name)),
+                }
+                Ok(())
+            }
+
+            /// All values in the order of [`Params::NAMES`].
+            pub fn to_array(&self) -> [#t; #np] {
+                [#(self.#ids),*]
+            }
+
+            /// Parameters from values in the order of [`Params::NAMES`].
+            pub fn from_array(v: [#t; #np]) -> Self {
+                let [#(#ids),*] = v;
+                Self { #(#ids),* }
+            }
+        }
+    }
+}
+
+/// `Precomputed` (runtime mode): the parameter-only terms, computed once per parameter set.
+pub(super) fn precomputed(cx: &Context<'_>) -> TokenStream {
+    let p: &Program = &cx.low.precompute;
+    let t = scalar_type(cx.precision);
+    let printer = Printer {
+        model: cx.model,
+        stmts: &p.stmts,
+        pre: &cx.pre,
+        precision: cx.precision,
+    };
+    let body = printer.statements(&[]);
+    let fields: Vec<Ident> = cx.pre.iter().map(|s| ident(s)).collect();
+    let pname = if uses(p, &|l| matches!(l, Leaf::Param(_))) {
+        quote!(p)
+    } else {
+        quote!(_p)
+    };
+    let ops = format!(" Generated straight-line code: {}.", p.ops);
+    quote! {
+        /// Parameter-only subexpressions of the dynamics, computed once per parameter set.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Precomputed {
+            #(#fields: #t,)*
+        }
+
+        impl Precomputed {
+            /// Compute the parameter-only terms for `p`.
+            #[doc = ""]
+            #[doc = #ops]
+            pub fn new(#pname: &Params) -> Self {
+                #body
+                Self { #(#fields),* }
+            }
+        }
+    }
+}
+
+/// The argument names of a function with `inputs`, as passed on by a wrapper.
+fn arg_names(inputs: Inputs) -> TokenStream {
+    match inputs {
+        Inputs::Q => quote!(q),
+        Inputs::QU => quote!(q, u),
+        Inputs::QUUd => quote!(q, u, ud),
+    }
+}
+
+/// The return type of a registry function.
+fn return_type(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
+    let t = scalar_type(cx.precision);
+    let nl = idx(cx.low.dof);
+    match spec.shape {
+        crate::registry::Shape::Vector => quote!(SVector<#t, #nl>),
+        _ => quote!(SMatrix<#t, #nl, #nl>),
+    }
+}
+
+/// A call of the free function of `spec` from a method of the wrapper.
+fn forward_call(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
+    let f = ident(spec.name);
+    let args = arg_names(spec.inputs);
+    if cx.low.params.is_runtime() {
+        quote!(#f(&self.params, &self.pre, #args))
+    } else {
+        quote!(#f(#args))
+    }
+}
+
+/// One method of the wrapper per generated function.
+fn methods(cx: &Context<'_>) -> TokenStream {
+    cx.low
+        .functions
+        .iter()
+        .map(|f| {
+            let spec = f.id.spec();
+            let name = ident(spec.name);
+            let doc = format!(" {}", spec.doc);
+            let (args, _) = state_args(cx, spec.inputs);
+            let ret = return_type(cx, spec);
+            let call = forward_call(cx, spec);
+            quote! {
+                #[doc = #doc]
+                #[inline]
+                pub fn #name(&self, #args) -> #ret {
+                    #call
+                }
+            }
+        })
+        .collect()
+}
+
+/// The wrapper type named after the model: with runtime parameters it holds a parameter set and
+/// its precomputed terms; baked, it is a unit struct.
+pub(super) fn wrapper(cx: &Context<'_>) -> TokenStream {
+    let model = cx.model;
+    let ty = ident(&naming::type_name(&model.name));
+    let methods = methods(cx);
+    if !cx.low.params.is_runtime() {
+        let doc = format!(
+            " The dynamics of `{}` with the parameter values of `{}` folded in as constants.",
+            model.name,
+            file_name(&model.source)
+        );
+        return quote! {
+            #[doc = #doc]
+            ///
+            /// The evaluation methods are allocation-free and cannot fail.
+            #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+            pub struct #ty;
+
+            impl #ty {
+                #methods
+            }
+        };
+    }
+    let doc = format!(
+        " The dynamics of `{}` with one parameter set: `τ = M(q) u̇ + c(q, u) + g(q)`.",
+        model.name
+    );
+    quote! {
+        #[doc = #doc]
+        ///
+        /// Construction precomputes the parameter-only terms; the evaluation methods are
+        /// allocation-free and cannot fail.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct #ty {
+            params: Params,
+            pre: Precomputed,
+        }
+
+        impl Default for #ty {
+            fn default() -> Self {
+                Self::new(Params::default())
+            }
+        }
+
+        impl #ty {
+            /// The model with parameter set `params`.
+            pub fn new(params: Params) -> Self {
+                Self { pre: Precomputed::new(&params), params }
+            }
+
+            /// The parameter set.
+            pub fn params(&self) -> &Params {
+                &self.params
+            }
+
+            /// Replace the parameter set (recomputes the parameter-only terms).
+            pub fn set_params(&mut self, params: Params) {
+                *self = Self::new(params);
+            }
+
+            #methods
+        }
+    }
+}
+
+/// The `kanegen-runtime` traits whose functions the module has all of.
+pub(super) fn trait_impls(cx: &Context<'_>) -> TokenStream {
+    let ty = ident(&naming::type_name(&cx.model.name));
+    let t = scalar_type(cx.precision);
+    let mut out = TokenStream::new();
+    let mut implemented = Vec::new();
+    for tr in RuntimeTrait::ALL {
+        let specs: Vec<&FunctionSpec> = crate::registry::FUNCTIONS
+            .iter()
+            .filter(|s| s.runtime_trait == Some(tr))
+            .collect();
+        let complete = specs
+            .iter()
+            .all(|s| cx.low.functions.iter().any(|f| f.id == s.id));
+        // A trait's supertrait (RobotDynamics) must be implemented first.
+        let supertrait_ok =
+            tr == RuntimeTrait::RobotDynamics || implemented.contains(&RuntimeTrait::RobotDynamics);
+        if !complete || !supertrait_ok {
+            continue;
+        }
+        implemented.push(tr);
+        let trait_name = ident(tr.name());
+        let items = specs.iter().map(|spec| {
+            let name = ident(spec.name);
+            let (args, _) = state_args(cx, spec.inputs);
+            let ret = return_type(cx, spec);
+            let call = forward_call(cx, spec);
+            quote!(fn #name(&self, #args) -> #ret { #call })
+        });
+        let assoc = if tr == RuntimeTrait::RobotDynamics {
+            quote! {
+                type Scalar = #t;
+                const SPEED_NAMES: [&'static str; DOF] = SPEED_NAMES;
+                const COORDINATE_NAMES: [&'static str; DOF] = COORDINATE_NAMES;
+            }
+        } else {
+            quote!()
+        };
+        out.extend(quote! {
+            impl kanegen_runtime::#trait_name<DOF> for #ty {
+                #assoc
+                #(#items)*
+            }
+        });
+    }
+    out
+}

@@ -1,0 +1,196 @@
+//! Emission: lowered programs → Rust source via proc-macro2/quote → syn → prettyplease.
+//!
+//! A pure function of its inputs ([`emit`]): the model, the lowered programs and
+//! [`EmitOptions`] (precision, import notes) give the formatted source; writing files is the
+//! caller's business. The generated module holds speed and parameter names, a `Params` struct
+//! and a `Precomputed` struct of parameter-only terms (runtime parameters), one free function
+//! per lowered registry function, a wrapper type named after the model (`Krang`) with one method
+//! per function, and the `kanegen-runtime` traits it satisfies. What every module shares (the
+//! batched `sin_cos_n`, `UnknownParameter`, the traits) comes from the `kanegen-runtime` crate.
+//! Statements carry the reports' style comments (`let k12 = …; // w2.x`). Output is
+//! deterministic byte for byte.
+//!
+//! Files: `print.rs` (expressions, identifiers, literals), `function.rs` (one generated
+//! function), `items.rs` (names, `Params`, `Precomputed`, wrapper, trait impls), `annotate.rs`
+//! (statement comments), this file (the module and its header).
+
+mod annotate;
+mod function;
+mod items;
+mod print;
+
+use std::path::Path;
+
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use crate::lower::Lowered;
+use crate::model::Model;
+use crate::options::{ParamMode, Precision};
+
+/// The generator's version, written into every header.
+pub const GENERATOR_VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// The generated token stream did not parse as a Rust file (a generator bug).
+#[derive(Debug, thiserror::Error)]
+#[error("generated code for model `{model}` does not parse: {message}")]
+pub struct EmitError {
+    /// Model name.
+    pub model: String,
+    /// syn's message.
+    pub message: String,
+}
+
+/// What the emitter is told besides the model and the programs.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct EmitOptions {
+    /// The floating-point type of the module.
+    pub precision: Precision,
+    /// Lines written as comments after the header (e.g. URDF import notes: snapped angles,
+    /// merged and dropped links), under the heading `notes_title`.
+    pub notes: Vec<String>,
+    /// Heading of the notes block (`URDF import notes`).
+    pub notes_title: String,
+}
+
+/// What every part of the emitter reads.
+pub(crate) struct Context<'a> {
+    model: &'a Model,
+    low: &'a Lowered,
+    precision: Precision,
+    /// Field names of the precomputed values, by slot.
+    pre: Vec<String>,
+}
+
+fn scalar_type(precision: Precision) -> TokenStream {
+    match precision {
+        Precision::F64 => quote!(f64),
+        Precision::F32 => quote!(f32),
+    }
+}
+
+fn file_name(path: &str) -> String {
+    Path::new(path)
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.to_owned())
+}
+
+/// Generate the Rust module for a lowered model. Deterministic: same input, same bytes. The
+/// module needs `nalgebra` and `kanegen-runtime` (both build in `no_std` crates).
+pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<String, EmitError> {
+    let cx = Context {
+        model,
+        low,
+        precision: options.precision,
+        pre: low
+            .pre_slots
+            .iter()
+            .map(|&i| low.precompute.stmts[i].name.clone())
+            .collect(),
+    };
+    let runtime = low.params.is_runtime();
+    let mut items = quote!(
+        use nalgebra::{SMatrix, SVector};
+    );
+    if low.functions.iter().any(|f| !f.program.sincos.is_empty()) {
+        items.extend(match cx.precision {
+            Precision::F64 => quote!(
+                use kanegen_runtime::trig::sin_cos_n;
+            ),
+            Precision::F32 => quote!(
+                use kanegen_runtime::trig::sin_cos_n_f32 as sin_cos_n;
+            ),
+        });
+    }
+    items.extend(items::names(&cx));
+    let mut labels = annotate::Labels::default();
+    if runtime {
+        items.extend(items::params(&cx));
+        items.extend(items::precomputed(&cx));
+        labels.add("new", &low.precompute);
+    }
+    for f in &low.functions {
+        items.extend(function::function(&cx, f));
+        labels.add(f.id.name(), &f.program);
+    }
+    items.extend(items::wrapper(&cx));
+    items.extend(items::trait_impls(&cx));
+    // Model names (`MX4l`, `q_1L`) are not snake case, and straight-line code trips clippy's
+    // style lints (long functions, many arguments, literal precision): one allowance for the
+    // whole generated module instead of one per item.
+    let module = quote! {
+        pub use self::generated::*;
+
+        #[allow(non_snake_case, clippy::all)]
+        mod generated {
+            #items
+        }
+    };
+    let file: syn::File = syn::parse2(module).map_err(|e| EmitError {
+        model: model.name.clone(),
+        message: e.to_string(),
+    })?;
+    let body = prettyplease::unparse(&file);
+    let mut out = header(model, low);
+    if !options.notes.is_empty() {
+        out.push_str(&format!("// {}:\n", options.notes_title));
+        for n in &options.notes {
+            out.push_str(&format!("//   - {}\n", comment_text(n)));
+        }
+        out.push('\n');
+    }
+    out.push_str(&labels.apply(&body));
+    Ok(out)
+}
+
+/// `s` made safe for a `//` comment: control characters (a newline would end the comment and
+/// let the rest of the line be compiled) are written as escapes.
+fn comment_text(s: &str) -> String {
+    s.chars()
+        .flat_map(|c| {
+            if c.is_control() {
+                c.escape_default().collect::<Vec<_>>()
+            } else {
+                vec![c]
+            }
+        })
+        .collect()
+}
+
+fn header(model: &Model, low: &Lowered) -> String {
+    let mut h = format!(
+        "// @generated by kanegen {GENERATOR_VERSION} from model `{}` ({}). Do not edit.\n",
+        comment_text(&model.name),
+        comment_text(&file_name(&model.source))
+    );
+    let speeds: Vec<&str> = model.speeds.iter().map(|s| s.name.as_str()).collect();
+    h.push_str(&format!(
+        "// Parameters: {}. Speeds ({}): {}.\n",
+        match low.params {
+            ParamMode::Runtime => "runtime inputs (Params)",
+            ParamMode::Baked => "baked in as constants",
+        },
+        low.dof,
+        comment_text(&speeds.join(", "))
+    ));
+    h.push_str("// Operation counts per call:\n");
+    if low.params.is_runtime() {
+        h.push_str(&format!(
+            "//   {:<17} {} (once per parameter set)\n",
+            "Precomputed::new", low.precompute.ops
+        ));
+    }
+    for f in &low.functions {
+        let p = &f.program;
+        h.push_str(&format!(
+            "//   {:<17} {}; {} K and {} D variables\n",
+            f.id.name(),
+            p.ops,
+            p.k_vars,
+            p.d_vars
+        ));
+    }
+    h.push('\n');
+    h
+}

@@ -1,0 +1,53 @@
+//! What a generated module looks like: how parameters enter, which functions it has, and its
+//! floating-point precision. Decided once (by [`Builder`](crate::Builder) or the CLI) and read by
+//! every stage.
+
+use crate::registry::{FunctionId, FunctionSet};
+
+/// How model parameters enter the generated code.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ParamMode {
+    /// Parameters are runtime inputs (a `Params` value); parameter-only subexpressions are
+    /// computed once per parameter set, outside the hot path.
+    #[default]
+    Runtime,
+    /// The model file's values are folded in as constants; terms of zero parameters vanish.
+    Baked,
+}
+
+impl ParamMode {
+    /// Whether parameters are runtime inputs.
+    pub fn is_runtime(self) -> bool {
+        self == ParamMode::Runtime
+    }
+}
+
+/// The floating-point type of a generated module: every matrix, vector, parameter and literal
+/// is of this type.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Precision {
+    /// `f64` (the default).
+    #[default]
+    F64,
+    /// `f32`; sines and cosines are computed in `f64` and rounded.
+    F32,
+}
+
+/// Generator options: what the derivation, the lowering and the emitter produce.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Options {
+    /// How parameters enter.
+    pub params: ParamMode,
+    /// Which registry functions the module gets (default: [`FunctionSet::default`]). The
+    /// Coriolis matrix costs about four times the operations of `coriolis` (Krang: ≈ 7,900
+    /// flops) and roughly doubles the compile time of a large model's module; leave it out when
+    /// only M, c, g and τ are needed.
+    pub functions: FunctionSet,
+}
+
+impl Options {
+    /// Whether the module gets function `f`.
+    pub fn has(&self, f: FunctionId) -> bool {
+        self.functions.contains(f)
+    }
+}

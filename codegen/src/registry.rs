@@ -1,0 +1,346 @@
+//! The function registry: one typed list of the functions a generated module can have.
+//!
+//! Every stage reads this list instead of keeping its own: [`kane`](crate::kane) derives the
+//! functions of a [`FunctionSet`] (one derivation step per [`FunctionId`]),
+//! [`lower`](crate::lower) turns each into a straight-line program, [`emit`](crate::emit)
+//! writes the free function, the wrapper method and the `kanegen-runtime` trait implementations
+//! from its [`FunctionSpec`], and `kanegen stats` prints one row per entry.
+//!
+//! Adding a function: add a variant to [`FunctionId`], its entry to [`FUNCTIONS`] (name, doc,
+//! inputs, result shape, whether it is in the default set), and its derivation step in
+//! `kane/mod.rs` (`Ctx::derive_function`). Emission, the wrapper method, `stats`, the CLI's
+//! `--functions` and `Builder::functions` follow from the entry.
+
+use std::fmt;
+
+/// Identifies one function of the registry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum FunctionId {
+    /// Mass matrix M(q).
+    MassMatrix,
+    /// Coriolis and centrifugal vector c(q, u).
+    Coriolis,
+    /// Gravity vector g(q).
+    Gravity,
+    /// Inverse dynamics τ = M u̇ + c + g.
+    InverseDynamics,
+    /// Coriolis matrix C(q, u).
+    CoriolisMatrix,
+}
+
+/// Shape of a generated function's result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// Symmetric N×N matrix; entries are the upper triangle `(row ≤ col)`.
+    SymmetricMatrix,
+    /// N-vector; entries are `(row, 0)`.
+    Vector,
+    /// General (non-symmetric) N×N matrix; entries are `(row, col)`, absent entries are zero.
+    Matrix,
+}
+
+/// Which state inputs a function takes (besides the parameters).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Inputs {
+    /// `f(q)`.
+    Q,
+    /// `f(q, u)`.
+    QU,
+    /// `f(q, u, u̇)`.
+    QUUd,
+}
+
+impl Inputs {
+    /// Whether the function reads the speeds `u`.
+    pub fn needs_u(self) -> bool {
+        !matches!(self, Inputs::Q)
+    }
+
+    /// Whether the function reads the accelerations `u̇`.
+    pub fn needs_ud(self) -> bool {
+        matches!(self, Inputs::QUUd)
+    }
+}
+
+/// The `kanegen-runtime` trait a function belongs to: generated robots implement a trait when
+/// their module has all of its functions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RuntimeTrait {
+    /// `kanegen_runtime::RobotDynamics` (M, c, g, τ).
+    RobotDynamics,
+    /// `kanegen_runtime::CoriolisMatrix` (C; requires `RobotDynamics`).
+    CoriolisMatrix,
+}
+
+impl RuntimeTrait {
+    /// The traits in implementation order (a trait's supertraits first).
+    pub const ALL: [RuntimeTrait; 2] = [RuntimeTrait::RobotDynamics, RuntimeTrait::CoriolisMatrix];
+
+    /// The trait's name in `kanegen_runtime`.
+    pub fn name(self) -> &'static str {
+        match self {
+            RuntimeTrait::RobotDynamics => "RobotDynamics",
+            RuntimeTrait::CoriolisMatrix => "CoriolisMatrix",
+        }
+    }
+}
+
+/// Everything the stages need to know about one function.
+#[derive(Clone, Copy, Debug)]
+pub struct FunctionSpec {
+    /// Which function.
+    pub id: FunctionId,
+    /// The Rust name of the free function and the wrapper method (`mass_matrix`).
+    pub name: &'static str,
+    /// The symbol of its result in listings (`M`, `c`, `τ`).
+    pub symbol: &'static str,
+    /// One-line documentation of the generated function.
+    pub doc: &'static str,
+    /// State inputs.
+    pub inputs: Inputs,
+    /// Result shape.
+    pub shape: Shape,
+    /// Whether [`FunctionSet::default`] includes it.
+    pub default: bool,
+    /// The runtime trait it implements, if any.
+    pub runtime_trait: Option<RuntimeTrait>,
+}
+
+/// The registry, in the order generated modules define the functions.
+pub const FUNCTIONS: [FunctionSpec; 5] = [
+    FunctionSpec {
+        id: FunctionId::MassMatrix,
+        name: "mass_matrix",
+        symbol: "M",
+        doc: "Mass matrix M(q) (symmetric positive definite).",
+        inputs: Inputs::Q,
+        shape: Shape::SymmetricMatrix,
+        default: true,
+        runtime_trait: Some(RuntimeTrait::RobotDynamics),
+    },
+    FunctionSpec {
+        id: FunctionId::Coriolis,
+        name: "coriolis",
+        symbol: "c",
+        doc: "Coriolis and centrifugal vector c(q, u) (velocity-product terms).",
+        inputs: Inputs::QU,
+        shape: Shape::Vector,
+        default: true,
+        runtime_trait: Some(RuntimeTrait::RobotDynamics),
+    },
+    FunctionSpec {
+        id: FunctionId::Gravity,
+        name: "gravity",
+        symbol: "g",
+        doc: "Gravity vector g(q).",
+        inputs: Inputs::Q,
+        shape: Shape::Vector,
+        default: true,
+        runtime_trait: Some(RuntimeTrait::RobotDynamics),
+    },
+    FunctionSpec {
+        id: FunctionId::InverseDynamics,
+        name: "inverse_dynamics",
+        symbol: "tau",
+        doc: "Inverse dynamics τ = M(q) u̇ + c(q, u) + g(q), in one pass.",
+        inputs: Inputs::QUUd,
+        shape: Shape::Vector,
+        default: true,
+        runtime_trait: Some(RuntimeTrait::RobotDynamics),
+    },
+    FunctionSpec {
+        id: FunctionId::CoriolisMatrix,
+        name: "coriolis_matrix",
+        symbol: "C",
+        doc: "Coriolis matrix C(q, u): c(q, u) = C(q, u) u, and Ṁ − 2C is skew-symmetric.",
+        inputs: Inputs::QU,
+        shape: Shape::Matrix,
+        default: true,
+        runtime_trait: Some(RuntimeTrait::CoriolisMatrix),
+    },
+];
+
+impl FunctionId {
+    /// Every function, in registry order.
+    pub const ALL: [FunctionId; 5] = [
+        FunctionId::MassMatrix,
+        FunctionId::Coriolis,
+        FunctionId::Gravity,
+        FunctionId::InverseDynamics,
+        FunctionId::CoriolisMatrix,
+    ];
+
+    /// The registry entry.
+    pub fn spec(self) -> &'static FunctionSpec {
+        &FUNCTIONS[self as usize]
+    }
+
+    /// The Rust name (`mass_matrix`).
+    pub fn name(self) -> &'static str {
+        self.spec().name
+    }
+
+    /// The function whose Rust name is `name`.
+    pub fn from_name(name: &str) -> Option<FunctionId> {
+        FunctionId::ALL.into_iter().find(|f| f.name() == name)
+    }
+}
+
+impl fmt::Display for FunctionId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A set of registry functions: which functions a generated module gets.
+///
+/// ```
+/// use kanegen::{FunctionId, FunctionSet};
+/// let set = FunctionSet::default().without(FunctionId::CoriolisMatrix);
+/// assert!(set.contains(FunctionId::MassMatrix) && !set.contains(FunctionId::CoriolisMatrix));
+/// assert_eq!("mass_matrix,gravity".parse::<FunctionSet>().unwrap().len(), 2);
+/// ```
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct FunctionSet(u32);
+
+impl FunctionSet {
+    /// No function.
+    pub const EMPTY: FunctionSet = FunctionSet(0);
+
+    /// Every registry function.
+    pub fn all() -> Self {
+        FunctionId::ALL.into_iter().collect()
+    }
+
+    /// This set and `f`.
+    #[must_use]
+    pub fn with(self, f: FunctionId) -> Self {
+        FunctionSet(self.0 | 1 << f as u32)
+    }
+
+    /// This set without `f`.
+    #[must_use]
+    pub fn without(self, f: FunctionId) -> Self {
+        FunctionSet(self.0 & !(1 << f as u32))
+    }
+
+    /// Whether `f` is in the set.
+    pub fn contains(self, f: FunctionId) -> bool {
+        self.0 & (1 << f as u32) != 0
+    }
+
+    /// The functions of the set, in registry order.
+    pub fn iter(self) -> impl Iterator<Item = FunctionId> {
+        FunctionId::ALL
+            .into_iter()
+            .filter(move |&f| self.contains(f))
+    }
+
+    /// Number of functions.
+    pub fn len(self) -> usize {
+        self.0.count_ones() as usize
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+}
+
+impl Default for FunctionSet {
+    /// The functions whose registry entry says `default` (today: all of them).
+    fn default() -> Self {
+        FUNCTIONS
+            .iter()
+            .filter(|s| s.default)
+            .map(|s| s.id)
+            .collect()
+    }
+}
+
+impl FromIterator<FunctionId> for FunctionSet {
+    fn from_iter<I: IntoIterator<Item = FunctionId>>(iter: I) -> Self {
+        iter.into_iter().fold(FunctionSet::EMPTY, FunctionSet::with)
+    }
+}
+
+impl fmt::Debug for FunctionSet {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_set().entries(self.iter()).finish()
+    }
+}
+
+impl fmt::Display for FunctionSet {
+    /// Comma-separated Rust names, in registry order (the form [`str::parse`] reads).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let names: Vec<&str> = self.iter().map(FunctionId::name).collect();
+        f.write_str(&names.join(","))
+    }
+}
+
+/// A function name that is not in the registry.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "unknown function `{name}`; the generated functions are: {}",
+    known_names()
+)]
+pub struct UnknownFunction {
+    /// The name that was asked for.
+    pub name: String,
+}
+
+fn known_names() -> String {
+    FunctionSet::all().to_string().replace(',', ", ")
+}
+
+impl std::str::FromStr for FunctionSet {
+    type Err = UnknownFunction;
+
+    /// Comma-separated Rust names (`mass_matrix,gravity`); `all` for every function, `default`
+    /// for the default set.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let mut set = FunctionSet::EMPTY;
+        for name in s.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+            set = match name {
+                "all" => set.union(FunctionSet::all()),
+                "default" => set.union(FunctionSet::default()),
+                _ => set.with(FunctionId::from_name(name).ok_or_else(|| UnknownFunction {
+                    name: name.to_owned(),
+                })?),
+            };
+        }
+        Ok(set)
+    }
+}
+
+impl FunctionSet {
+    /// Both sets' functions.
+    #[must_use]
+    pub fn union(self, other: FunctionSet) -> Self {
+        FunctionSet(self.0 | other.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn registry_entries_are_in_id_order() {
+        for (i, s) in FUNCTIONS.iter().enumerate() {
+            assert_eq!(s.id as usize, i, "{}", s.name);
+            assert_eq!(FunctionId::ALL[i], s.id);
+            assert_eq!(FunctionId::from_name(s.name), Some(s.id));
+        }
+    }
+
+    #[test]
+    fn function_sets_parse_and_print_in_registry_order() {
+        let set: FunctionSet = "gravity, mass_matrix".parse().unwrap();
+        assert_eq!(set.to_string(), "mass_matrix,gravity");
+        assert_eq!("all".parse::<FunctionSet>().unwrap(), FunctionSet::all());
+        let err = "mass_matrix,jacobian".parse::<FunctionSet>().unwrap_err();
+        assert_eq!(err.name, "jacobian");
+        assert!(err.to_string().contains("coriolis_matrix"));
+    }
+}

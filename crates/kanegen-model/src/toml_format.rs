@@ -132,8 +132,7 @@ impl Model {
     pub fn from_toml_file(path: impl AsRef<Path>) -> Result<Model, ModelError> {
         let path = path.as_ref();
         let label = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| ModelError::new(&label, K::Io(e.to_string())))?;
+        let text = std::fs::read_to_string(path).map_err(|e| ModelError::new(&label, K::Io(e)))?;
         Self::from_toml_str(&text, &label)
     }
 
@@ -312,13 +311,10 @@ fn build(f: File, file: &str) -> Result<Model, K> {
     // Gravity.
     let gsym = syms.lookup("gravity", &f.gravity.symbol, ParamKind::Gravity)?;
     let dir = f.gravity.direction;
-    let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
-    if !n.is_finite() || (n - 1.0).abs() > 1e-9 {
-        return Err(K::Invalid {
-            item: "gravity".into(),
-            detail: format!("direction {dir:?} is not a unit vector (norm {n}); normalise it"),
-        });
-    }
+    validate::check_gravity_direction(dir).map_err(|detail| K::Invalid {
+        item: "gravity".into(),
+        detail,
+    })?;
 
     // Frames and joints: a tree rooted at the base frame.
     let mut joint_names: Vec<&str> = Vec::new();
@@ -446,7 +442,7 @@ fn build(f: File, file: &str) -> Result<Model, K> {
         }
     }
     if let Some(i) = syms.used.iter().position(|u| !u) {
-        return Err(K::UnknownParameter {
+        return Err(K::UnusedParameter {
             name: syms.params[i].name.clone(),
         });
     }

@@ -43,8 +43,9 @@
 //! # Hot paths
 //!
 //! No allocation, no dynamic dispatch, `[T; N]` stack arrays. The sines and cosines of all joint
-//! angles are computed first, in one independent batch (for `f64` a branch-free polynomial kernel,
-//! [`sin_cos_f64`], that the compiler vectorizes; within one ulp of the standard library). Along a
+//! angles are computed first, in one independent batch (for `f64` the branch-free polynomial
+//! kernel of generated code, [`kanegen_runtime::trig::sin_cos_n`], that the compiler vectorizes;
+//! within one ulp of the standard library; [`sin_cos_f64`] is its scalar form). Along a
 //! chain (`parent = j − 1`) the parent's state is passed in registers rather than through memory.
 //! The CRBA accumulates composite inertias in the link frames, takes each `F_j = I_j^c S_j` to
 //! frame 0 once and fills column `j` of `M` with 6-term dot products `S_k · F_j` against the

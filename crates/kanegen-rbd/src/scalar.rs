@@ -18,23 +18,19 @@ pub trait Scalar: RealField + Copy {
 }
 
 impl Scalar for f64 {
+    /// [`kanegen_runtime::trig::sin_cos`] (the routine of generated code).
     #[inline(always)]
     fn sin_cos_joint(self) -> (Self, Self) {
-        self.sin_cos()
+        kanegen_runtime::trig::sin_cos(self)
     }
 
-    /// A branch-free polynomial kernel the compiler vectorizes across the batch (SSE2: two
-    /// angles per instruction), then the standard library for the rare `|x| ≥ 2¹⁹`.
+    /// [`kanegen_runtime::trig::sin_cos_n`], the batch of generated code: a branch-free
+    /// polynomial kernel the compiler vectorizes across the batch (SSE2: two angles per
+    /// instruction), with a cold lane-by-lane path for a batch holding `|x| ≥ 2¹⁹·π/2` or a
+    /// non-finite angle.
     #[inline(always)]
     fn sin_cos_batch<const N: usize>(x: &[Self; N], s: &mut [Self; N], c: &mut [Self; N]) {
-        for k in 0..N {
-            (s[k], c[k]) = sin_cos_kernel(x[k]);
-        }
-        for k in 0..N {
-            if x[k].abs() >= SIN_COS_KERNEL_BOUND || x[k].is_nan() {
-                (s[k], c[k]) = x[k].sin_cos();
-            }
-        }
+        (*s, *c) = kanegen_runtime::trig::sin_cos_n(*x);
     }
 }
 
@@ -45,65 +41,13 @@ impl Scalar for f32 {
     }
 }
 
-/// Arguments below this magnitude are handled by [`sin_cos_f64`]'s polynomial kernel.
-const SIN_COS_KERNEL_BOUND: f64 = 524_288.0;
-
-/// `(sin x, cos x)` for `f64`: one shared Cody–Waite reduction by π/2 and the fdlibm
-/// (Sun Microsystems) minimax kernels on `[−π/4, π/4]`, within about one ulp of the correctly
-/// rounded result. Arguments with `|x| ≥ 2¹⁹` (or not finite) go to the standard library.
+/// `(sin x, cos x)` for `f64`: [`kanegen_runtime::trig::sin_cos`], the routine generated code
+/// uses (one shared Cody–Waite reduction by π/2 and the fdlibm minimax kernels on
+/// `[−π/4, π/4]`; Payne–Hanek reduction for `|x| ≥ 2¹⁹·π/2`), within about one ulp of the
+/// correctly rounded result for joint angles. NaN for NaN and ±∞.
 #[inline]
 pub fn sin_cos_f64(x: f64) -> (f64, f64) {
-    if x.abs() < SIN_COS_KERNEL_BOUND {
-        sin_cos_kernel(x)
-    } else {
-        x.sin_cos()
-    }
-}
-
-/// The branch-free kernel of [`sin_cos_f64`], valid for `|x| < 2¹⁹`.
-#[inline(always)]
-fn sin_cos_kernel(x: f64) -> (f64, f64) {
-    // The fdlibm constants (shortest round-trip decimal forms).
-    // π/2 split as P1 (33 significant bits, so n·P1 is exact for |n| < 2²⁰) + P1T.
-    const P1: f64 = 1.570_796_326_734_125_6;
-    const P1T: f64 = 6.077_100_506_506_192e-11;
-    const TWO_OVER_PI: f64 = std::f64::consts::FRAC_2_PI;
-    // 1.5·2⁵²: adding it rounds to an integer n held in the low mantissa bits.
-    const ROUND: f64 = 6_755_399_441_055_744.0;
-    const S1: f64 = -0.166_666_666_666_666_32;
-    const S2: f64 = 0.008_333_333_333_322_49;
-    const S3: f64 = -0.000_198_412_698_298_579_5;
-    const S4: f64 = 2.755_731_370_707_006_8e-6;
-    const S5: f64 = -2.505_076_025_340_686_3e-8;
-    const S6: f64 = 1.589_690_995_211_55e-10;
-    const C1: f64 = 0.041_666_666_666_666_6;
-    const C2: f64 = -0.001_388_888_888_887_411;
-    const C3: f64 = 2.480_158_728_947_673e-5;
-    const C4: f64 = -2.755_731_435_139_066_3e-7;
-    const C5: f64 = 2.087_572_321_298_175e-9;
-    const C6: f64 = -1.135_964_755_778_819_5e-11;
-    let t = x * TWO_OVER_PI + ROUND;
-    // n mod 4 in the low bits of t (two's complement, so negative n work too).
-    let k = t.to_bits();
-    let n = t - ROUND;
-    let r = (x - n * P1) - n * P1T;
-    let z = r * r;
-    let sin_r = r + (z * r) * (S1 + z * (S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)))));
-    let hz = 0.5 * z;
-    let w = 1.0 - hz;
-    let cos_r = w
-        + (((1.0 - w) - hz) + (z * z) * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6))))));
-    // Quadrant n mod 4: 0 → (s, c), 1 → (c, −s), 2 → (−s, −c), 3 → (−c, s).
-    let swap = 0u64.wrapping_sub(k & 1);
-    let (sb, cb) = (sin_r.to_bits(), cos_r.to_bits());
-    let sin_bits = (sb & !swap) | (cb & swap);
-    let cos_bits = (cb & !swap) | (sb & swap);
-    let sin_sign = (k & 2) << 62;
-    let cos_sign = (k.wrapping_add(1) & 2) << 62;
-    (
-        f64::from_bits(sin_bits ^ sin_sign),
-        f64::from_bits(cos_bits ^ cos_sign),
-    )
+    kanegen_runtime::trig::sin_cos(x)
 }
 
 /// A 3-vector.

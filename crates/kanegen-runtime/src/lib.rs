@@ -1,0 +1,113 @@
+//! The runtime shared by all code that [kanegen](https://github.com/kanegen/kanegen) generates:
+//! what every generated module would otherwise carry its own copy of, as generated protobuf code
+//! uses `prost`.
+//!
+//! - [`trig`]: the batched `sin`/`cos` of the joint angles, [`trig::sin_cos_n`] (`f64`) and
+//!   [`trig::sin_cos_n_f32`] (`f32`), that each generated function calls once; a `core`-only,
+//!   branch-free fdlibm kernel that the compiler vectorizes.
+//! - [`UnknownParameter`]: the allocation-free error of a generated `Params::set` for a name
+//!   the model does not have.
+//! - [`RobotDynamics`] (and [`CoriolisMatrix`], for modules generated with the Coriolis
+//!   matrix): the trait every generated robot type implements, so that a controller can be
+//!   written once for any generated robot.
+//!
+//! `#![no_std]`, no `unsafe`, no dependency but [`nalgebra`] (re-exported: its vector and
+//! matrix types are the trait's argument types).
+//!
+//! # How generated code uses it
+//!
+//! A generated module (for a robot called `TwoLink`, say) imports the routines instead of
+//! defining them, and implements the traits on its robot type by forwarding to its inherent
+//! methods:
+//!
+//! ```text
+//! use kanegen_runtime::trig::sin_cos_n;            // f32 modules: sin_cos_n_f32 as sin_cos_n
+//! pub use kanegen_runtime::UnknownParameter;       // the error of Params::set
+//!
+//! impl kanegen_runtime::RobotDynamics<2> for TwoLink {
+//!     type Scalar = f64;
+//!     const SPEED_NAMES: [&'static str; 2] = SPEED_NAMES;
+//!     const COORDINATE_NAMES: [&'static str; 2] = COORDINATE_NAMES;
+//!     fn mass_matrix(&self, q: &SVector<f64, 2>) -> SMatrix<f64, 2, 2> { self.mass_matrix(q) }
+//!     // … coriolis, gravity, inverse_dynamics; CoriolisMatrix if generated
+//! }
+//! ```
+//!
+//! The crate that includes the generated code depends on `kanegen-runtime` (and on the same
+//! `nalgebra`). A generic controller then works for every generated robot. Here it is run on a
+//! hand-written pendulum that implements the trait as generated code does:
+//!
+//! ```
+//! use kanegen_runtime::RobotDynamics;
+//! use nalgebra::{SMatrix, SVector};
+//!
+//! /// A point mass `m` on a massless rod of length `l`; `q` is the angle from straight down.
+//! struct Pendulum {
+//!     m: f64,
+//!     l: f64,
+//!     g: f64,
+//! }
+//!
+//! impl RobotDynamics<1> for Pendulum {
+//!     type Scalar = f64;
+//!     const SPEED_NAMES: [&'static str; 1] = ["qd"];
+//!     const COORDINATE_NAMES: [&'static str; 1] = ["q"];
+//!
+//!     fn mass_matrix(&self, _q: &SVector<f64, 1>) -> SMatrix<f64, 1, 1> {
+//!         SMatrix::from_element(self.m * self.l * self.l)
+//!     }
+//!     fn coriolis(&self, _q: &SVector<f64, 1>, _u: &SVector<f64, 1>) -> SVector<f64, 1> {
+//!         SVector::zeros()
+//!     }
+//!     fn gravity(&self, q: &SVector<f64, 1>) -> SVector<f64, 1> {
+//!         SVector::from_element(self.m * self.g * self.l * q[0].sin())
+//!     }
+//!     fn inverse_dynamics(
+//!         &self,
+//!         q: &SVector<f64, 1>,
+//!         u: &SVector<f64, 1>,
+//!         ud: &SVector<f64, 1>,
+//!     ) -> SVector<f64, 1> {
+//!         self.mass_matrix(q) * ud + self.coriolis(q, u) + self.gravity(q)
+//!     }
+//! }
+//!
+//! /// Computed-torque control, written once for any robot: the torque that gives the
+//! /// acceleration `u̇ = kp (q_ref − q) − kd u`.
+//! fn computed_torque<R: RobotDynamics<N>, const N: usize>(
+//!     robot: &R,
+//!     q: &SVector<R::Scalar, N>,
+//!     u: &SVector<R::Scalar, N>,
+//!     q_ref: &SVector<R::Scalar, N>,
+//!     (kp, kd): (R::Scalar, R::Scalar),
+//! ) -> SVector<R::Scalar, N> {
+//!     let ud = (q_ref - q) * kp - u * kd;
+//!     robot.inverse_dynamics(q, u, &ud)
+//! }
+//!
+//! let pendulum = Pendulum { m: 2.0, l: 0.5, g: 9.81 };
+//! let (q, u) = (SVector::from([0.3]), SVector::from([0.0]));
+//! // At the reference and at rest: exactly the torque that holds it against gravity.
+//! let tau = computed_torque(&pendulum, &q, &u, &q, (25.0, 10.0));
+//! assert_eq!(tau, pendulum.gravity(&q));
+//! // Below the reference: gravity plus M·kp·(q_ref − q).
+//! let tau = computed_torque(&pendulum, &q, &u, &SVector::from([0.5]), (25.0, 10.0));
+//! assert!((tau[0] - (9.81 * 0.3_f64.sin() + 0.5 * 25.0 * 0.2)).abs() < 1e-12);
+//! assert_eq!(Pendulum::SPEED_NAMES, ["qd"]);
+//! ```
+//!
+//! # Features
+//!
+//! - `std` (default): forwards `nalgebra/std`. Without it the crate needs only `core`
+//!   (nalgebra's math goes through `libm`); the crate itself is `#![no_std]` either way.
+
+#![no_std]
+#![forbid(unsafe_code)]
+
+mod dynamics;
+pub mod trig;
+mod unknown_parameter;
+
+pub use dynamics::{CoriolisMatrix, RobotDynamics};
+pub use nalgebra;
+pub use unknown_parameter::UnknownParameter;

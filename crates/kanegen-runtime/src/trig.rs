@@ -1,0 +1,225 @@
+//! The sines and cosines of the joint angles, as the generated functions compute them.
+//!
+//! Every generated function calls [`sin_cos_n`] once, on all the joint angles it needs
+//! (`f32` modules call [`sin_cos_n_f32`]); [`sin_cos`] is the scalar routine the batch falls
+//! back to for a batch with a huge or non-finite lane. All of them need only `core` (no `std`,
+//! no `libm`) and give, for a given argument, the same bits on every platform with IEEE-754
+//! `f64` arithmetic (no fused multiply-add is introduced by the compiler).
+//!
+//! Accuracy: within about one ulp of the standard library for the angles robots use; a few ulp
+//! for huge arguments (`|x| ≥ 2¹⁹·π/2`); NaN for NaN and ±∞.
+
+/// Arguments below this magnitude (≈ 2¹⁹·π/2, so that `n·PIO2_1` is exact) take the
+/// Cody–Waite reduction; larger ones (never a robot angle) and non-finite ones take
+/// `reduce_large`.
+pub const SIN_COS_FAST_BOUND: f64 = 823_549.0;
+
+/// `(sin x, cos x)` for the generated code: Cody–Waite reduction by π/2 (fdlibm's constants)
+/// and fdlibm's minimax kernels on [−π/4, π/4]; |x| ≥ 2¹⁹·π/2 (never a robot angle) takes a
+/// cold Payne–Hanek reduction against 1280 bits of 2/π. Needs only `core` (no `std`, no
+/// `libm`). Error within about one ulp of the standard library for the angles robots use (a
+/// few ulp for huge arguments); several times faster because both values share one reduction
+/// and the code inlines. [`sin_cos_n`] is the batched form the generated functions call.
+#[inline(always)]
+pub fn sin_cos(x: f64) -> (f64, f64) {
+    let (r, quadrant) = if x.abs() < SIN_COS_FAST_BOUND {
+        sin_cos_reduce(x)
+    } else {
+        reduce_large(x)
+    };
+    sin_cos_kernel(r, quadrant)
+}
+
+/// `(sin x[k], cos x[k])` for every lane, bit for bit the values of [`sin_cos`]. Every lane
+/// runs through one branch-free loop that the compiler vectorizes (two lanes per SSE2
+/// instruction, four with AVX2) and that also sets one flag for the whole batch: if a lane is
+/// at or above the Cody–Waite bound or not finite (never, for robot angles), the batch is
+/// recomputed lane by lane by the scalar routine. Not inlined: the generated functions are
+/// long enough that their speed depends on their code size (one shared copy instead of one per
+/// function).
+#[inline(never)]
+#[allow(clippy::needless_range_loop)] // lane loops over parallel arrays: what LLVM vectorizes
+pub fn sin_cos_n<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
+    // The check sits inside the loop and the fallback takes and returns arrays by value: a
+    // separate check loop gets 512-bit compares under AVX-512 (which slowed the batch by a
+    // third there), and passing the arrays by reference keeps them from being built in place.
+    let (mut s, mut c) = ([0.0; N], [0.0; N]);
+    let mut fast = true;
+    for k in 0..N {
+        let (r, quadrant) = sin_cos_reduce(x[k]);
+        (s[k], c[k]) = sin_cos_kernel(r, quadrant);
+        // False for NaN too. Huge and non-finite lanes give garbage above, never a panic.
+        fast &= x[k].abs() < SIN_COS_FAST_BOUND;
+    }
+    if !fast {
+        (s, c) = sin_cos_n_slow(x);
+    }
+    (s, c)
+}
+
+/// [`sin_cos_n`] lane by lane through [`sin_cos`] (a batch with a huge or non-finite lane).
+#[cold]
+#[inline(never)]
+#[allow(clippy::needless_range_loop)]
+fn sin_cos_n_slow<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
+    let mut out = ([0.0; N], [0.0; N]);
+    for k in 0..N {
+        (out.0[k], out.1[k]) = sin_cos(x[k]);
+    }
+    out
+}
+
+/// `(sin x[k], cos x[k])` in `f32` for every lane: computed in `f64` (batched, by
+/// [`sin_cos_n`]) and rounded (correctly rounded but for double rounding). What the generated
+/// functions of `f32` modules call.
+#[inline(always)]
+#[allow(clippy::needless_range_loop)]
+pub fn sin_cos_n_f32<const N: usize>(x: [f32; N]) -> ([f32; N], [f32; N]) {
+    let mut wide = [0.0; N];
+    for k in 0..N {
+        wide[k] = f64::from(x[k]);
+    }
+    let (s, c) = sin_cos_n(wide);
+    let mut out = ([0.0; N], [0.0; N]);
+    for k in 0..N {
+        out.0[k] = s[k] as f32;
+        out.1[k] = c[k] as f32;
+    }
+    out
+}
+
+/// `(r, n)` with `x = n·π/2 + r`, |r| ≤ π/4 (to within rounding), for |x| <
+/// [`SIN_COS_FAST_BOUND`]; only the low two bits of `n` are meaningful.
+#[inline(always)]
+#[allow(clippy::excessive_precision, clippy::unreadable_literal)]
+fn sin_cos_reduce(x: f64) -> (f64, u64) {
+    // n = round(x · 2/π) by the 1.5·2⁵² trick (exact for |x·2/π| < 2⁵¹); the low bits of
+    // `shifted` hold n in two's complement.
+    let shifted = x * core::f64::consts::FRAC_2_PI + 6_755_399_441_055_744.0;
+    let n = shifted - 6_755_399_441_055_744.0;
+    // r = x − n·π/2 in three parts (π/2 = PIO2_1 + PIO2_2 + PIO2_2T, 33 + 33 + 53 bits).
+    let r1 = x - n * 1.570_796_326_734_125_614_17;
+    let w = n * 6.077_100_506_303_965_976_60e-11;
+    let r2 = r1 - w;
+    let w2 = n * 2.022_266_248_795_950_631_54e-21 - ((r1 - r2) - w);
+    (r2 - w2, shifted.to_bits())
+}
+
+/// `(sin x, cos x)` from `x = n·π/2 + r`: fdlibm's `__kernel_sin` / `__kernel_cos` on `r`,
+/// then the quadrant `n mod 4` applied by bit masks (no branches).
+#[inline(always)]
+#[allow(clippy::excessive_precision)]
+fn sin_cos_kernel(r: f64, quadrant: u64) -> (f64, f64) {
+    let z = r * r;
+    let s = r + r
+        * z
+        * (-1.666_666_666_666_663_243_48e-01
+            + z * (8.333_333_333_322_489_461_24e-03
+                + z * (-1.984_126_982_985_794_931_34e-04
+                    + z * (2.755_731_370_707_006_767_89e-06
+                        + z * (-2.505_076_025_340_686_341_95e-08
+                            + z * 1.589_690_995_211_550_102_21e-10)))));
+    let poly_c = z
+        * z
+        * (4.166_666_666_666_660_190_37e-02
+            + z * (-1.388_888_888_887_410_957_49e-03
+                + z * (2.480_158_728_947_672_941_78e-05
+                    + z * (-2.755_731_435_139_066_330_35e-07
+                        + z * (2.087_572_321_298_174_827_90e-09
+                            + z * -1.135_964_755_778_819_482_65e-11)))));
+    let hz = 0.5 * z;
+    let one_minus_hz = 1.0 - hz;
+    let c = one_minus_hz + (((1.0 - one_minus_hz) - hz) + poly_c);
+    // Quadrant n mod 4: 0 → (s, c), 1 → (c, −s), 2 → (−s, −c), 3 → (−c, s). Swap on odd n
+    // (xor with the difference under an all-ones mask), then flip signs (sin on quadrants
+    // 2, 3; cos on 1, 2).
+    let swap = 0u64.wrapping_sub(quadrant & 1);
+    let (sb, cb) = (s.to_bits(), c.to_bits());
+    let t = (sb ^ cb) & swap;
+    let (sin_bits, cos_bits) = (sb ^ t, cb ^ t);
+    let sin_sign = (quadrant & 2) << 62;
+    let cos_sign = (quadrant.wrapping_add(1) & 2) << 62;
+    (
+        f64::from_bits(sin_bits ^ sin_sign),
+        f64::from_bits(cos_bits ^ cos_sign),
+    )
+}
+
+/// `(r, n mod 4)` with `x = n·π/2 + r`, |r| ≤ π/4, for huge `x` (NaN for NaN and ±∞): `x·2/π`
+/// modulo 4 in 192-bit fixed point from `x`'s integer mantissa and a 192-bit window of 2/π.
+#[cold]
+#[inline(never)]
+#[allow(clippy::unreadable_literal)]
+fn reduce_large(x: f64) -> (f64, u64) {
+    /// 2/π in binary: bits 1‥1280 after the point, most significant first.
+    const TWO_OVER_PI: [u64; 20] = [
+        0xa2f9836e4e441529,
+        0xfc2757d1f534ddc0,
+        0xdb6295993c439041,
+        0xfe5163abdebbc561,
+        0xb7246e3a424dd2e0,
+        0x06492eea09d1921c,
+        0xfe1deb1cb129a73e,
+        0xe88235f52ebb4484,
+        0xe99c7026b45f7e41,
+        0x3991d639835339f4,
+        0x9c845f8bbdf9283b,
+        0x1ff897ffde05980f,
+        0xef2f118b5a0a6d1f,
+        0x6d367ecf27cb09b7,
+        0x4f463f669e5fea2d,
+        0x7527bac7ebe5f17b,
+        0x3d0739f78a5292ea,
+        0x6bfb5fb11f8d5d08,
+        0x56033046fc7b6bab,
+        0xf0cfbc209af4361d,
+    ];
+    /// Bits p‥p+63 of 2/π (bit 1 is the first after the point; bits p ≤ 0 are zero).
+    fn window(p: i64) -> u64 {
+        if p < 1 {
+            return if 1 - p >= 64 {
+                0
+            } else {
+                TWO_OVER_PI[0] >> (1 - p)
+            };
+        }
+        let o = (p - 1) as usize;
+        let (j, sh) = (o / 64, o % 64);
+        if sh == 0 {
+            TWO_OVER_PI[j]
+        } else {
+            (TWO_OVER_PI[j] << sh) | (TWO_OVER_PI[j + 1] >> (64 - sh))
+        }
+    }
+    if !x.is_finite() {
+        return (f64::NAN, 0);
+    }
+    // |x| = m·2^k with an integer m < 2⁵³ (here |x| ≥ 2¹⁹, so x is normal and k ≥ −33).
+    let bits = x.to_bits();
+    let m = (bits & 0x000f_ffff_ffff_ffff) | 0x0010_0000_0000_0000;
+    let k = ((bits >> 52) & 0x7ff) as i64 - 1075;
+    // Bits i ≤ k − 2 of 2/π contribute multiples of 4 to m·2^k·2/π: take bits k − 1 … k + 190,
+    // so that (m·W mod 2¹⁹²)/2¹⁹⁰ = |x|·2/π mod 4 up to 2⁻¹³⁸.
+    let (w0, w1, w2) = (window(k - 1), window(k + 63), window(k + 127));
+    let lo = u128::from(m) * u128::from(w2);
+    let mid = u128::from(m) * u128::from(w1) + (lo >> 64);
+    let hi = (u128::from(m) * u128::from(w0) + (mid >> 64)) as u64;
+    let mut quadrant = hi >> 62;
+    let mut frac =
+        (u128::from(hi) << 66) | ((mid as u64 as u128) << 2) | ((lo as u64 >> 62) as u128);
+    let mut sign = 1.0;
+    if frac >> 127 == 1 {
+        // Round to the nearest quadrant: fraction f − 1 ∈ [−1/2, 0).
+        quadrant += 1;
+        frac = frac.wrapping_neg();
+        sign = -1.0;
+    }
+    // 0x37f0… is 2⁻¹²⁸.
+    let r =
+        sign * (frac as f64 * f64::from_bits(0x37f0_0000_0000_0000)) * core::f64::consts::FRAC_PI_2;
+    if x < 0.0 {
+        (-r, quadrant.wrapping_neg() & 3)
+    } else {
+        (r, quadrant)
+    }
+}

@@ -1,0 +1,209 @@
+//! Accuracy of the `trig` routines: within an ulp of `std` on robot angles, a few ulp on huge
+//! ones, NaN for non-finite ones; the batched routine bit for bit the scalar one in every lane
+//! (whichever path the batch takes); the `f32` batch the rounded `f64` batch.
+
+use kanegen_runtime::trig::{SIN_COS_FAST_BOUND, sin_cos, sin_cos_n, sin_cos_n_f32};
+
+fn check(x: f64, tol: f64) {
+    let (s, c) = sin_cos(x);
+    let (se, ce) = x.sin_cos();
+    assert!(
+        (s - se).abs() <= tol && (c - ce).abs() <= tol,
+        "x = {x:e}: ({s}, {c}) vs ({se}, {ce})"
+    );
+}
+
+fn same(a: f64, b: f64) -> bool {
+    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+}
+
+/// The batched routine on `x`: every lane within `tol` of `std` and bit for bit the scalar
+/// routine's value.
+fn check_batch<const N: usize>(x: [f64; N], tol: f64) {
+    let (s, c) = sin_cos_n(x);
+    for k in 0..N {
+        let (s1, c1) = sin_cos(x[k]);
+        assert!(
+            same(s[k], s1) && same(c[k], c1),
+            "lane {k} of {N}, x = {:e}: batched ({}, {}) vs scalar ({s1}, {c1})",
+            x[k],
+            s[k],
+            c[k]
+        );
+        if x[k].is_finite() {
+            let (se, ce) = x[k].sin_cos();
+            assert!(
+                (s[k] - se).abs() <= tol && (c[k] - ce).abs() <= tol,
+                "lane {k} of {N}, x = {:e}: ({}, {}) vs ({se}, {ce})",
+                x[k],
+                s[k],
+                c[k]
+            );
+        } else {
+            assert!(
+                s[k].is_nan() && c[k].is_nan(),
+                "lane {k} of {N}: {:e}",
+                x[k]
+            );
+        }
+    }
+}
+
+/// `check_batch` on consecutive windows of `xs` with batch sizes that leave every possible
+/// remainder for vectors of 2, 4 and 8 lanes.
+fn check_batches(xs: &[f64], tol: f64) {
+    fn windows<const N: usize>(xs: &[f64], tol: f64) {
+        for w in xs.windows(N).step_by(N.max(1) / 2 + 1) {
+            check_batch::<N>(w.try_into().unwrap(), tol);
+        }
+    }
+    windows::<1>(xs, tol);
+    windows::<2>(xs, tol);
+    windows::<3>(xs, tol);
+    windows::<4>(xs, tol);
+    windows::<5>(xs, tol);
+    windows::<7>(xs, tol);
+    windows::<8>(xs, tol);
+    windows::<9>(xs, tol);
+    windows::<17>(xs, tol);
+    windows::<19>(xs, tol);
+}
+
+fn robot_angles() -> Vec<f64> {
+    // Dense sweep of |x| ≤ 50 plus every quadrant boundary neighbourhood.
+    let mut xs = Vec::new();
+    let mut x = -50.0;
+    while x <= 50.0 {
+        xs.push(x);
+        x += 0.000_37;
+    }
+    for k in -64..=64 {
+        let b = k as f64 * std::f64::consts::FRAC_PI_2;
+        for d in [0.0, 1e-12, -1e-12, 1e-6, -1e-6, 0.3] {
+            xs.push(b + d);
+        }
+    }
+    xs
+}
+
+#[test]
+fn agrees_with_std_within_an_ulp_on_robot_angles() {
+    for x in robot_angles() {
+        check(x, 2.3e-16);
+    }
+}
+
+#[test]
+fn batched_agrees_with_std_and_scalar_on_robot_angles() {
+    check_batches(&robot_angles(), 2.3e-16);
+    check_batch([0.0; 0], 0.0);
+    // (Like the scalar routine, sin(−0) comes out as +0.)
+    assert_eq!(sin_cos_n([0.0, -0.0]), ([0.0, 0.0], [1.0, 1.0]));
+}
+
+fn large_and_tiny() -> Vec<f64> {
+    let mut xs = vec![
+        1e-300, -1e-300, 0.0, -0.0, 1e-8, 1e3, -7.5e4, 8e5, 8.3e5, 1e6, 1e12, -1e300,
+    ];
+    // Payne–Hanek range: a spread of magnitudes up to the largest finite value.
+    let mut x = 823_549.0_f64;
+    while x < 1e308 {
+        xs.extend([x, -x, x * 1.000_001, x * 0.999_999_7]);
+        x *= 1.37;
+    }
+    xs.extend([f64::MAX, -f64::MAX, 823_548.999_999_9, -823_548.999_999_9]);
+    xs
+}
+
+#[test]
+fn large_tiny_and_special_arguments() {
+    for x in large_and_tiny() {
+        check(x, 1e-15);
+    }
+    assert!(sin_cos(f64::NAN).0.is_nan());
+    assert!(sin_cos(f64::INFINITY).1.is_nan());
+}
+
+#[test]
+fn batched_large_tiny_and_special_arguments() {
+    check_batches(&large_and_tiny(), 1e-15);
+    // One huge or non-finite lane among robot angles, at every position of a batch of 17
+    // (the whole batch then takes the scalar routine) and of smaller batches.
+    let angles: [f64; 17] = core::array::from_fn(|k| 0.37 * k as f64 - 3.1);
+    for odd in [
+        f64::NAN,
+        -f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        823_549.0,
+        -823_549.0,
+        1e22,
+        f64::MAX,
+    ] {
+        for k in 0..17 {
+            let mut x = angles;
+            x[k] = odd;
+            check_batch(x, 1e-15);
+            let mut y = [x[k], 1e-300, -2.5];
+            y.rotate_left(k % 3);
+            check_batch(y, 1e-15);
+        }
+    }
+    // All lanes just below the bound: the vectorized path.
+    check_batch(
+        [823_548.999_999_9, -823_548.999_999_9, 823_548.5, 1e-310],
+        1e-15,
+    );
+}
+
+#[test]
+fn both_sides_of_the_fast_bound() {
+    // ≈ 2¹⁹·π/2: below it `n·PIO2_1` is exact; at and above it the Payne–Hanek path.
+    let below = f64::from_bits(SIN_COS_FAST_BOUND.to_bits() - 1);
+    check_batch([below, -below, 1.0], 1e-15);
+    check_batch([SIN_COS_FAST_BOUND, -SIN_COS_FAST_BOUND, 1.0], 1e-15);
+    check(SIN_COS_FAST_BOUND, 1e-15);
+    check(below, 1e-15);
+}
+
+/// The `f32` batch on `x`: every lane the `f64` batch's value rounded to `f32`.
+fn check_batch_f32<const N: usize>(x: [f32; N]) {
+    let (s, c) = sin_cos_n_f32(x);
+    let (sw, cw) = sin_cos_n(x.map(f64::from));
+    for k in 0..N {
+        assert!(
+            (s[k].to_bits() == (sw[k] as f32).to_bits() || (s[k].is_nan() && sw[k].is_nan()))
+                && (c[k].to_bits() == (cw[k] as f32).to_bits()
+                    || (c[k].is_nan() && cw[k].is_nan())),
+            "lane {k} of {N}, x = {:e}: ({}, {}) vs ({}, {})",
+            x[k],
+            s[k],
+            c[k],
+            sw[k],
+            cw[k]
+        );
+        if x[k].is_finite() {
+            let (se, ce) = x[k].sin_cos();
+            // Within an f32 ulp (and a bit, for std's f32 rounding) of std.
+            assert!(
+                (s[k] - se).abs() <= 1.2e-7 && (c[k] - ce).abs() <= 1.2e-7,
+                "lane {k} of {N}, x = {:e}: ({}, {}) vs std ({se}, {ce})",
+                x[k],
+                s[k],
+                c[k]
+            );
+        }
+    }
+}
+
+#[test]
+fn f32_batch_is_the_rounded_f64_batch() {
+    let mut x = -40.0_f32;
+    while x <= 40.0 {
+        check_batch_f32([x, x * 0.5, -x, x + 0.1, 0.0, -0.0, 1e-30]);
+        x += 0.013;
+    }
+    check_batch_f32([f32::NAN, 1.0, f32::INFINITY, -2.0, 1e30, f32::MAX]);
+    check_batch_f32([0.0_f32; 0]);
+    assert_eq!(sin_cos_n_f32([0.0, -0.0]), ([0.0, 0.0], [1.0, 1.0]));
+}

@@ -270,9 +270,9 @@ impl Speeds {
     }
 }
 
-fn parse_length(entry: &LengthEntry, joint: &str, syms: &mut Symbols) -> Result<Scalar, K> {
+fn parse_length(entry: &LengthEntry, joint: &str, syms: &mut Symbols) -> Result<Length, K> {
     match entry {
-        LengthEntry::Number(v) if v.is_finite() => Ok(Scalar::number(*v)),
+        LengthEntry::Number(v) if v.is_finite() => Ok(Length::number(*v)),
         LengthEntry::Number(v) => Err(K::BadLength {
             joint: joint.to_owned(),
             text: v.to_string(),
@@ -295,7 +295,7 @@ fn parse_length(entry: &LengthEntry, joint: &str, syms: &mut Symbols) -> Result<
                 });
             }
             let p = syms.lookup(&format!("joint `{joint}`"), name, ParamKind::Length)?;
-            Ok(Scalar {
+            Ok(Length {
                 coef,
                 symbol: Some(p),
             })
@@ -427,8 +427,7 @@ fn build_frames(
     let child_of = index_joints(joints, base_frame)?;
     let mut links = vec![Link {
         name: base_frame.to_owned(),
-        parent: None,
-        joint: None,
+        mount: None,
         body: None,
     }];
     let mut placed: HashMap<String, usize> = HashMap::from([(base_frame.to_owned(), 0)]);
@@ -444,8 +443,7 @@ fn build_frames(
                     placed.insert(j.child.clone(), links.len());
                     links.push(Link {
                         name: j.child.clone(),
-                        parent: Some(p),
-                        joint: Some(joint),
+                        mount: Some(Mount { parent: p, joint }),
                         body: None,
                     });
                 }
@@ -524,14 +522,9 @@ fn add_bodies(
 /// The joint of a `[[joint]]` section: kind, driven speed, axis, rotation and translation, each
 /// checked.
 fn build_joint(j: &JointSection, syms: &mut Symbols, speeds: &mut Speeds) -> Result<Joint, K> {
-    let kind = match j.kind {
-        JointType::Revolute => JointKind::Revolute,
-        JointType::Prismatic => JointKind::Prismatic,
-        JointType::Fixed => JointKind::Fixed,
-    };
-    let speed = match (kind, &j.speed) {
-        (JointKind::Fixed, None) => None,
-        (JointKind::Fixed, Some(s)) => {
+    let kind = match (j.kind, &j.speed) {
+        (JointType::Fixed, None) => JointKind::Fixed,
+        (JointType::Fixed, Some(s)) => {
             return Err(K::JointSpeed {
                 joint: j.name.clone(),
                 detail: format!("a fixed joint drives no speed; remove `speed = \"{s}\"`"),
@@ -545,7 +538,13 @@ fn build_joint(j: &JointSection, syms: &mut Symbols, speeds: &mut Speeds) -> Res
                         .into(),
             });
         }
-        (_, Some(s)) => Some(speeds.drive(s, format!("joint `{}`", j.name), &j.name)?),
+        (moving, Some(s)) => {
+            let speed = speeds.drive(s, format!("joint `{}`", j.name), &j.name)?;
+            match moving {
+                JointType::Prismatic => JointKind::Prismatic { speed },
+                _ => JointKind::Revolute { speed },
+            }
+        }
     };
     let axis = match (kind, j.axis) {
         (_, Some(a)) => a,
@@ -571,6 +570,5 @@ fn build_joint(j: &JointSection, syms: &mut Symbols, speeds: &mut Speeds) -> Res
         axis,
         rotation: j.rotation,
         translation,
-        speed,
     })
 }

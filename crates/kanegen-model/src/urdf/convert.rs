@@ -34,8 +34,7 @@ pub(super) fn convert(
         None => {
             ir.links.push(Link {
                 name: r.tree.link(r.cut.top).name.clone(),
-                parent: None,
-                joint: None,
+                mount: None,
                 body: None,
             });
             ir.ir_index.insert(r.cut.top, 0);
@@ -277,6 +276,7 @@ fn add_moving_joints(ir: &mut Ir, r: &Resolved<'_>) {
         let p = tree.parent_of(k);
         let t = cl.in_rep(p).then(&r.origin[k].expect("origin"));
         let axis = Vector3::from(j.axis.xyz.0).normalize();
+        let speed = ir.speeds.len();
         ir.speeds.push(Speed {
             name: sanitize_identifier(&format!("qd_{}", j.name)),
             coordinate: sanitize_identifier(&format!("q_{}", j.name)),
@@ -284,18 +284,19 @@ fn add_moving_joints(ir: &mut Ir, r: &Resolved<'_>) {
         ir.ir_index.insert(l, ir.links.len());
         ir.links.push(Link {
             name: tree.link(l).name.clone(),
-            parent: Some(ir.ir_index[&cl.rep(p)]),
-            joint: Some(Joint {
-                name: j.name.clone(),
-                kind: if j.joint_type == urdf_rs::JointType::Prismatic {
-                    JointKind::Prismatic
-                } else {
-                    JointKind::Revolute
+            mount: Some(Mount {
+                parent: ir.ir_index[&cl.rep(p)],
+                joint: Joint {
+                    name: j.name.clone(),
+                    kind: if j.joint_type == urdf_rs::JointType::Prismatic {
+                        JointKind::Prismatic { speed }
+                    } else {
+                        JointKind::Revolute { speed }
+                    },
+                    axis: [axis.x, axis.y, axis.z].map(clean),
+                    rotation: rows(&t.r),
+                    translation: numbers(t.p),
                 },
-                axis: [axis.x, axis.y, axis.z].map(clean),
-                rotation: rows(&t.r),
-                translation: numbers(t.p),
-                speed: Some(ir.speeds.len() - 1),
             }),
             body: None,
         });
@@ -429,11 +430,9 @@ fn assemble(
             direction: opts.gravity_direction,
         },
     };
-    for l in &model.links {
-        if let Some(j) = &l.joint {
-            validate::check_axis(&j.name, j.axis)?;
-            validate::check_rotation(&j.name, &j.rotation)?;
-        }
+    for (_, _, m) in model.mounted_links() {
+        validate::check_axis(&m.joint.name, m.joint.axis)?;
+        validate::check_rotation(&m.joint.name, &m.joint.rotation)?;
     }
     validate::check_physics(&model)?;
     Ok(model)

@@ -5,7 +5,7 @@ use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::ir::Scalar;
+use crate::ir::Length;
 
 /// A rigid transform: the pose of a frame in another (rotation `r`, origin `p`).
 #[derive(Debug, Clone, Copy)]
@@ -172,6 +172,6 @@ pub(super) fn rows(r: &Matrix3<f64>) -> [[f64; 3]; 3] {
 }
 
 /// A translation as IR lengths (plain numbers), dust removed.
-pub(super) fn numbers(v: Vector3<f64>) -> [Scalar; 3] {
-    [v.x, v.y, v.z].map(|x| Scalar::number(clean(x)))
+pub(super) fn numbers(v: Vector3<f64>) -> [Length; 3] {
+    [v.x, v.y, v.z].map(|x| Length::number(clean(x)))
 }

@@ -433,21 +433,21 @@ pub(super) fn add_base(
     });
     ir.links.push(Link {
         name: "0".into(),
-        parent: None,
-        joint: None,
+        mount: None,
         body: None,
     });
     let body = r.cut.body;
     ir.links.push(Link {
         name: r.tree.link(body).name.clone(),
-        parent: Some(0),
-        joint: Some(Joint {
-            name: w.pitch_name.clone(),
-            kind: JointKind::Revolute,
-            axis: [wg.axis.x, wg.axis.y, wg.axis.z],
-            rotation: rows(&wg.a01),
-            translation: numbers(wg.p01),
-            speed: Some(2),
+        mount: Some(Mount {
+            parent: 0,
+            joint: Joint {
+                name: w.pitch_name.clone(),
+                kind: JointKind::Revolute { speed: 2 },
+                axis: [wg.axis.x, wg.axis.y, wg.axis.z],
+                rotation: rows(&wg.a01),
+                translation: numbers(wg.p01),
+            },
         }),
         body: None,
     });

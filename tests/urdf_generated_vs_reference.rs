@@ -213,7 +213,7 @@ fn synthetic_segway_with_the_body_below_the_root() {
     );
     let m = Model::from_urdf_str(SEGWAY, "segway.urdf", &UrdfOptions::wheeled(spec)).unwrap();
     assert_eq!(m.dof(), 4);
-    let pitch = m.links[1].joint.as_ref().unwrap();
+    let pitch = m.links[1].joint().unwrap();
     // y0 toward the left wheel = +y of chassis; z0 = +z; x0 = y0 × z0 = +x.
     assert_eq!(
         pitch.rotation,

@@ -1,5 +1,7 @@
 //! 3-vector and 3×3 algebra, and spatial (6-vector) algebra: motions `(ω; v)`, forces `(n; f)`.
 
+use kanegen_model::Joint;
+
 use super::Ctx;
 use crate::expr::{ExprId, VarKind};
 
@@ -148,9 +150,9 @@ impl Ctx<'_> {
     }
 
     /// A force of frame `child` moved to its parent: `(R n + P × R f; R f)`.
-    pub(super) fn force_up(&mut self, child: usize, x: &V6, label: &str) -> V6 {
-        let r = self.rotation(child);
-        let p = self.position(child);
+    pub(super) fn force_up(&mut self, child: usize, joint: &Joint, x: &V6, label: &str) -> V6 {
+        let r = self.rotation(child, joint);
+        let p = self.position(child, joint);
         let (n, f) = split3(x);
         let fu = self.rot_up(&r, &f);
         let fu = self.subst3(fu, VarKind::D, &format!("{label}.f"));

@@ -1,6 +1,6 @@
 //! Composite (subtree) mass, first moment and inertia, accumulated backward.
 
-use kanegen_model::JointKind;
+use kanegen_model::{Joint, JointKind};
 
 use super::Ctx;
 use super::algebra::{AXES, M3, V3};
@@ -41,8 +41,9 @@ impl Ctx<'_> {
                 };
             }
         }
-        for c in (1..links).rev() {
-            let parent = self.model.links[c].parent.expect("non-root");
+        let model = self.model;
+        for (c, _, mount) in model.mounted_links().rev() {
+            let parent = mount.parent;
             let name = self.link_name(c).to_owned();
             let pname = self.link_name(parent).to_owned();
             // Finalise the child's composite as substitution variables.
@@ -65,15 +66,15 @@ impl Ctx<'_> {
                 inertia,
             };
             let empty = self.ar.is_zero(mass) && msc.iter().all(|x| self.ar.is_zero(*x));
-            let r = self.rotation(c);
-            let p = self.position(c);
+            let r = self.rotation(c, &mount.joint);
+            let p = self.position(c, &mount.joint);
             // First moment moved to the parent frame: R·MS + m·p. (Formed before the column
             // of M, which may share these terms, so that they carry the composite's label.)
             let u = self.rot_up(&r, &msc);
             let u = self.subst3(u, VarKind::D, &format!("MSC{name} in {pname}"));
             if let Some(entries) = columns.as_deref_mut() {
                 let composite = comp[c].clone();
-                self.mass_matrix_column(c, &composite, entries);
+                self.mass_matrix_column(c, &mount.joint, &composite, entries);
             }
             if empty {
                 continue;
@@ -84,7 +85,8 @@ impl Ctx<'_> {
             let new_ms = self.add3(&comp[parent].first_moment, &add);
             let mut new_inertia = comp[parent].inertia;
             if let (Some(jc), Some(acc)) = (inertia, new_inertia.as_mut()) {
-                self.add_inertia_to_parent(c, &r, &p, mass, &u, &jc, &name, "JC", acc);
+                let joint = &mount.joint;
+                self.add_inertia_to_parent(joint, &r, &p, mass, &u, &jc, &name, "JC", acc);
             }
             comp[parent] = Composite {
                 mass: new_mass,
@@ -113,7 +115,7 @@ impl Ctx<'_> {
     #[allow(clippy::too_many_arguments)]
     pub(super) fn add_inertia_to_parent(
         &mut self,
-        child: usize,
+        joint: &Joint,
         r: &M3,
         p: &V3,
         mass: ExprId,
@@ -124,7 +126,7 @@ impl Ctx<'_> {
         acc: &mut [ExprId; 6],
     ) {
         let zero = self.ar.zero();
-        let rjr = self.rotate_inertia(child, r, jc, &format!("{prefix}{name}"));
+        let rjr = self.rotate_inertia(joint, r, jc, &format!("{prefix}{name}"));
         let idx = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
         // −(u pᵀ + p uᵀ) + 2 (p·u) I  and  m (|p|² I − p pᵀ)
         let pu = self.dot(p, u);
@@ -149,7 +151,7 @@ impl Ctx<'_> {
         }
     }
 
-    /// `R J Rᵀ` for the rotation `r = iAj` of link `child` and a symmetric `j`
+    /// `R J Rᵀ` for the rotation `r = iAj` of the child frame of `joint` and a symmetric `j`
     /// (`[XX, XY, XZ, YY, YZ, ZZ]`). For a revolute joint about a coordinate axis whose constant
     /// part `iAj(0)` is a signed permutation (every joint of Krang), the rotation about the axis
     /// uses double angles: in the plane `(i, j)` normal to the axis, with `d = Jii − Jjj` and
@@ -158,21 +160,20 @@ impl Ctx<'_> {
     /// computed in two stages, `T = J Rᵀ` (variables `{label}·Aᵀ`) and `R T`.
     pub(super) fn rotate_inertia(
         &mut self,
-        child: usize,
+        joint: &Joint,
         r: &M3,
         j: &[ExprId; 6],
         label: &str,
     ) -> [ExprId; 6] {
         let idx = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
         let jm = Self::sym(j);
-        let joint = self.model.links[child].joint.clone().expect("non-root");
         let signed_permutation = joint.rotation.iter().all(|row| {
             row.iter().filter(|x| **x != 0.0).count() == 1
                 && row.iter().all(|x| [-1.0, 0.0, 1.0].contains(x))
         });
         let axis = (0..3).find(|&k| joint.axis[k].abs() == 1.0);
-        if let (JointKind::Revolute, Some(s), true, Some(k)) =
-            (joint.kind, joint.speed, signed_permutation, axis)
+        if let (JointKind::Revolute { speed: s }, true, Some(k)) =
+            (joint.kind, signed_permutation, axis)
         {
             let sigma = joint.axis[k];
             let (i, jx) = ((k + 1) % 3, (k + 2) % 3);

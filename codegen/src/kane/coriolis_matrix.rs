@@ -151,8 +151,9 @@ impl Ctx<'_> {
     /// first-moment rate ċ of a subtree is its linear momentum (both move up as R·x).
     fn subtree_momenta(&mut self, hc: &mut [V6], dc: &mut [Rate]) {
         let zero = self.ar.zero();
-        for c in (1..hc.len()).rev() {
-            let parent = self.model.links[c].parent.expect("non-root");
+        let model = self.model;
+        for (c, _, mount) in model.mounted_links().rev() {
+            let parent = mount.parent;
             let name = self.link_name(c).to_owned();
             let pname = self.link_name(parent).to_owned();
             self.finish_subtree(c, hc, dc);
@@ -160,13 +161,14 @@ impl Ctx<'_> {
             if hc[c].iter().chain(jd.iter()).all(|x| self.ar.is_zero(*x)) {
                 continue;
             }
-            let r = self.rotation(c);
-            let p = self.position(c);
-            let up = self.force_up(c, &hc[c], &format!("hC{name} in {pname}"));
+            let r = self.rotation(c, &mount.joint);
+            let p = self.position(c, &mount.joint);
+            let up = self.force_up(c, &mount.joint, &hc[c], &format!("hC{name} in {pname}"));
             hc[parent] = self.add6(&hc[parent], &up);
             let u = split3(&up).1;
             let mut pjd = dc[parent].1;
-            self.add_inertia_to_parent(c, &r, &p, zero, &u, &jd, &name, "JdC", &mut pjd);
+            let joint = &mount.joint;
+            self.add_inertia_to_parent(joint, &r, &p, zero, &u, &jd, &name, "JdC", &mut pjd);
             dc[parent].1 = pjd;
         }
         self.finish_subtree(0, hc, dc);
@@ -202,12 +204,13 @@ impl Ctx<'_> {
             cols[0].push((w.x_speed, [zero, zero, zero, one, zero, zero]));
             cols[0].push((w.psi_speed, [zero, zero, one, zero, zero, zero]));
         }
-        for l in 1..links {
-            let joint = model.links[l].joint.as_ref().expect("non-root");
-            let Some(s) = joint.speed else { continue };
+        for (l, _, mount) in model.mounted_links() {
+            let Some(s) = mount.joint.speed() else {
+                continue;
+            };
             let e = self.axis(l);
-            let axis = match joint.kind {
-                JointKind::Prismatic => [zero, zero, zero, e[0], e[1], e[2]],
+            let axis = match mount.joint.kind {
+                JointKind::Prismatic { .. } => [zero, zero, zero, e[0], e[1], e[2]],
                 _ => [e[0], e[1], e[2], zero, zero, zero],
             };
             cols[l].push((s, axis));
@@ -282,13 +285,13 @@ impl Ctx<'_> {
             let e = self.dot6(&sv, &h);
             put(entries, sa, sp, e);
         }
-        let mut at = l;
-        while let Some(parent) = self.model.links[at].parent {
-            let pname = self.link_name(parent).to_owned();
-            h = self.force_up(at, &h, &format!("h(C col {sname}) at {pname}"));
-            g1 = self.force_up(at, &g1, &format!("G1(C row {sname}) at {pname}"));
-            g2 = self.force_up(at, &g2, &format!("G2(C row {sname}) at {pname}"));
-            at = parent;
+        let model = self.model;
+        for (child, mount) in model.path_to_base(l) {
+            let (at, joint) = (mount.parent, &mount.joint);
+            let pname = self.link_name(at).to_owned();
+            h = self.force_up(child, joint, &h, &format!("h(C col {sname}) at {pname}"));
+            g1 = self.force_up(child, joint, &g1, &format!("G1(C row {sname}) at {pname}"));
+            g2 = self.force_up(child, joint, &g2, &format!("G2(C row {sname}) at {pname}"));
             for (ka, &(sa, sv)) in sub.cols[at].iter().enumerate() {
                 let e = self.dot6(&sv, &h);
                 put(entries, sa, sp, e);
@@ -312,13 +315,12 @@ impl Ctx<'_> {
             v[0] = [self.ar.atom(Atom::Speed(wb.x_speed as u32)), zero, zero];
         }
         let tag = "|ud=0,g=0";
-        for l in 1..links {
-            let i = model.links[l].parent.expect("non-root");
-            let joint = model.links[l].joint.clone().expect("non-root");
+        for (l, _, mount) in model.mounted_links() {
+            let i = mount.parent;
             let name = self.link_name(l).to_owned();
             let iname = self.link_name(i).to_owned();
-            let r = self.rotation(l);
-            let p = self.position(l);
+            let r = self.rotation(l, &mount.joint);
+            let p = self.position(l, &mount.joint);
             let e = self.axis(l);
             // ω as in the inverse dynamics (same variables).
             let wi = self.rot_down(&r, &w[i]);
@@ -331,18 +333,18 @@ impl Ctx<'_> {
                 self.rot_down(&r, &t)
             };
             let mut wl = wi;
-            match (joint.kind, joint.speed) {
-                (JointKind::Revolute, Some(s)) => {
+            match mount.joint.kind {
+                JointKind::Revolute { speed: s } => {
                     let u = self.ar.atom(Atom::Speed(s as u32));
                     let ue = self.scale3(u, &e);
                     wl = self.add3(&wi, &ue);
                 }
-                (JointKind::Prismatic, Some(s)) => {
+                JointKind::Prismatic { speed: s } => {
                     let u = self.ar.atom(Atom::Speed(s as u32));
                     let ue = self.scale3(u, &e);
                     vl = self.add3(&vl, &ue);
                 }
-                _ => {}
+                JointKind::Fixed => {}
             }
             w[l] = self.subst3(wl, VarKind::K, &format!("w{name}{tag}"));
             v[l] = self.subst3(vl, VarKind::K, &format!("v{name}"));

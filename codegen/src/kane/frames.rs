@@ -1,7 +1,7 @@
 //! Leaves and model data: parameters, joint rotations and positions (cached K variables),
 //! bodies, gravity, joint axes and the wheel terms.
 
-use kanegen_model::{Base, JointKind, Scalar};
+use kanegen_model::{Base, Joint, JointKind, Length};
 
 use super::Ctx;
 use super::algebra::{M3, V3};
@@ -16,7 +16,7 @@ impl Ctx<'_> {
         }
     }
 
-    pub(super) fn scalar(&mut self, s: &Scalar) -> ExprId {
+    pub(super) fn length(&mut self, s: &Length) -> ExprId {
         let c = self.ar.constant(s.coef);
         match s.symbol {
             None => c,
@@ -35,18 +35,14 @@ impl Ctx<'_> {
         &self.model.links[l].name
     }
 
-    /// `iAj(q)` of link `l` (rows), cached.
-    pub(super) fn rotation(&mut self, l: usize) -> M3 {
+    /// `iAj(q)` of link `l`, attached to its parent by `j` (rows), cached.
+    pub(super) fn rotation(&mut self, l: usize, j: &Joint) -> M3 {
         if let Some(r) = self.rot[l] {
             return r;
         }
-        let j = self.model.links[l]
-            .joint
-            .as_ref()
-            .expect("non-root link has a joint");
         let a0: M3 = j.rotation.map(|row| row.map(|x| self.ar.constant(x)));
-        let r = match (j.kind, j.speed) {
-            (JointKind::Revolute, Some(s)) => {
+        let r = match j.kind {
+            JointKind::Revolute { speed: s } => {
                 let sn = self.ar.atom(Atom::Sin(s as u32));
                 let cs = self.ar.atom(Atom::Cos(s as u32));
                 let e = j.axis;
@@ -82,17 +78,13 @@ impl Ctx<'_> {
         out
     }
 
-    /// `iPj(q)` of link `l`, cached.
-    pub(super) fn position(&mut self, l: usize) -> V3 {
+    /// `iPj(q)` of link `l`, attached to its parent by `j`, cached.
+    pub(super) fn position(&mut self, l: usize, j: &Joint) -> V3 {
         if let Some(p) = self.pos[l] {
             return p;
         }
-        let j = self.model.links[l]
-            .joint
-            .clone()
-            .expect("non-root link has a joint");
-        let mut p = j.translation.map(|s| self.scalar(&s));
-        if let (JointKind::Prismatic, Some(s)) = (j.kind, j.speed) {
+        let mut p = j.translation.map(|s| self.length(&s));
+        if let JointKind::Prismatic { speed: s } = j.kind {
             let q = self.ar.atom(Atom::Coord(s as u32));
             let dir = [0, 1, 2].map(|r| (0..3).map(|c| j.rotation[r][c] * j.axis[c]).sum::<f64>());
             for (r, pr) in p.iter_mut().enumerate() {
@@ -123,8 +115,7 @@ impl Ctx<'_> {
 
     pub(super) fn axis(&mut self, l: usize) -> V3 {
         let e = self.model.links[l]
-            .joint
-            .as_ref()
+            .joint()
             .map(|j| j.axis)
             .unwrap_or([0.0; 3]);
         self.consts(e)

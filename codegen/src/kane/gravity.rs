@@ -15,20 +15,21 @@ impl Ctx<'_> {
         let g0 = self.gravity_vector();
         let mut acc: Vec<V3> = vec![[zero; 3]; self.model.links.len()];
         acc[0] = [0, 1, 2].map(|i| self.ar.neg(g0[i]));
-        for l in 1..self.model.links.len() {
-            let parent = self.model.links[l].parent.expect("non-root");
-            let r = self.rotation(l);
-            let a = self.rot_down(&r, &acc[parent]);
+        let model = self.model;
+        for (l, _, mount) in model.mounted_links() {
+            let r = self.rotation(l, &mount.joint);
+            let a = self.rot_down(&r, &acc[mount.parent]);
             let name = self.link_name(l).to_owned();
             acc[l] = self.subst3(a, VarKind::D, &format!("gravity acceleration in {name}"));
         }
-        for l in 1..self.model.links.len() {
-            let joint = self.model.links[l].joint.clone().expect("non-root");
-            let Some(row) = joint.speed else { continue };
+        for (l, _, mount) in model.mounted_links() {
+            let Some(row) = mount.joint.speed() else {
+                continue;
+            };
             let e = self.axis(l);
             let c = &comp[l];
-            out[row] = match joint.kind {
-                JointKind::Prismatic => {
+            out[row] = match mount.joint.kind {
+                JointKind::Prismatic { .. } => {
                     let d = self.dot(&e, &acc[l]);
                     self.ar.mul(c.mass, d)
                 }

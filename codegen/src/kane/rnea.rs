@@ -1,24 +1,31 @@
 //! Inverse dynamics τ and the Coriolis vector c: a forward pass for the frames' motion and
 //! the bodies' inertia forces, then a backward accumulation of Kane's generalized inertia forces.
 
-use kanegen_model::{Joint, JointKind};
+use kanegen_model::{Joint, JointKind, Mount};
 
 use super::Ctx;
 use super::algebra::V3;
 use crate::expr::{Arena, Atom, ExprId, VarKind};
 
 impl Ctx<'_> {
-    /// Add the force `f[c]` and moment `n[c]` (about `O_c`) of the complete subtree of `c` to
-    /// its parent's.
-    pub(super) fn accumulate(&mut self, c: usize, f: &mut [V3], n: &mut [V3], tag: &str) {
-        let parent = self.model.links[c].parent.expect("non-root");
+    /// Add the force `f[c]` and moment `n[c]` (about `O_c`) of the complete subtree of `c`
+    /// (attached by `mount`) to its parent's.
+    pub(super) fn accumulate(
+        &mut self,
+        c: usize,
+        mount: &Mount,
+        f: &mut [V3],
+        n: &mut [V3],
+        tag: &str,
+    ) {
+        let parent = mount.parent;
         if f[c].iter().chain(n[c].iter()).all(|x| self.ar.is_zero(*x)) {
             return;
         }
         let cname = self.link_name(c).to_owned();
         let pname = self.link_name(parent).to_owned();
-        let r = self.rotation(c);
-        let p = self.position(c);
+        let r = self.rotation(c, &mount.joint);
+        let p = self.position(c, &mount.joint);
         let fu = self.rot_up(&r, &f[c]);
         let fu = self.subst3(fu, VarKind::D, &format!("f{cname} in {pname}{tag}"));
         let nu = self.rot_up(&r, &n[c]);
@@ -63,7 +70,8 @@ impl Ctx<'_> {
 
     /// τ with the given inputs: `with_accel` keeps u̇ (else u̇ = 0), `with_gravity` folds gravity in.
     pub(super) fn rnea(&mut self, with_accel: bool, with_gravity: bool) -> Vec<ExprId> {
-        let links = self.model.links.len();
+        let model = self.model;
+        let links = model.links.len();
         let zero = self.ar.zero();
         let inputs = Inputs::new(with_accel, with_gravity);
         let tag = inputs.tag;
@@ -78,16 +86,16 @@ impl Ctx<'_> {
         // Forward: seed 002 eqs. 3, 4, 6. (A depth-first interleaving of the forward and
         // backward passes keeps fewer values live, but measured for Krang it made the compiled
         // functions larger and slower: their speed is bound by code size.)
-        for l in 1..links {
-            self.forward_motion(l, &mut motion, inputs);
+        for (l, _, mount) in model.mounted_links() {
+            self.forward_motion(l, mount, &mut motion, inputs);
             let (w, wd, a) = (motion.w[l], motion.wd[l], motion.a[l]);
             if let Some((fl, nl)) = self.body_force(l, &w, &wd, &a, tag) {
                 (f[l], n[l]) = (fl, nl);
             }
         }
         // Backward accumulation over subtrees.
-        for c in (1..links).rev() {
-            self.accumulate(c, &mut f, &mut n, tag);
+        for (c, _, mount) in model.mounted_links().rev() {
+            self.accumulate(c, mount, &mut f, &mut n, tag);
         }
         let out = self.generalized_forces(&f, &n, with_accel);
         self.finish(out, if with_accel { "tau" } else { "c" })
@@ -126,13 +134,12 @@ impl Ctx<'_> {
 
     /// The forward step to link `l` from its parent (seed 002 eqs. 3, 4, 6): its `ω`, `α` and
     /// origin acceleration.
-    fn forward_motion(&mut self, l: usize, motion: &mut Motion, inputs: Inputs) {
+    fn forward_motion(&mut self, l: usize, mount: &Mount, motion: &mut Motion, inputs: Inputs) {
         let tag = inputs.tag;
-        let i = self.model.links[l].parent.expect("non-root");
-        let joint = self.model.links[l].joint.clone().expect("non-root");
+        let (i, joint) = (mount.parent, &mount.joint);
         let name = self.link_name(l).to_owned();
-        let r = self.rotation(l);
-        let p = self.position(l);
+        let r = self.rotation(l, joint);
+        let p = self.position(l, joint);
         let e = self.axis(l);
         let wi = self.rot_down(&r, &motion.w[i]);
         let wi = self.subst3(
@@ -141,7 +148,7 @@ impl Ctx<'_> {
             &format!("w{} in {name}{tag}", self.link_name(i)),
         );
         let wdi = self.rot_down(&r, &motion.wd[i]);
-        let (wj, wdj, extra_a) = self.joint_motion(&joint, &e, &wi, &wdi, inputs);
+        let (wj, wdj, extra_a) = self.joint_motion(joint, &e, &wi, &wdi, inputs);
         motion.w[l] = self.subst3(wj, VarKind::K, &format!("w{name}{tag}"));
         motion.wd[l] = self.subst3(wdj, VarKind::K, &format!("wd{name}{tag}"));
         // a_j = jAi (a_i + α_i × P + ω_i × (ω_i × P)) (+ prismatic terms)
@@ -177,8 +184,8 @@ impl Ctx<'_> {
         inputs: Inputs,
     ) -> (V3, V3, V3) {
         let zero = self.ar.zero();
-        match (joint.kind, joint.speed) {
-            (JointKind::Revolute, Some(s)) => {
+        match joint.kind {
+            JointKind::Revolute { speed: s } => {
                 let u = inputs.speed(self.ar, s);
                 let ud = inputs.accel(self.ar, s);
                 let ue = self.scale3(u, e);
@@ -190,7 +197,7 @@ impl Ctx<'_> {
                 let wdj = self.add3(&t, &uwxe);
                 (wj, wdj, [zero; 3])
             }
-            (JointKind::Prismatic, Some(s)) => {
+            JointKind::Prismatic { speed: s } => {
                 let u = inputs.speed(self.ar, s);
                 let ud = inputs.accel(self.ar, s);
                 let ude = self.scale3(ud, e);
@@ -200,7 +207,7 @@ impl Ctx<'_> {
                 let extra = self.add3(&ude, &cor);
                 (*wi, *wdi, extra)
             }
-            _ => (*wi, *wdi, [zero; 3]),
+            JointKind::Fixed => (*wi, *wdi, [zero; 3]),
         }
     }
 
@@ -209,20 +216,19 @@ impl Ctx<'_> {
     /// terms (times ẍ, ψ̈ with `with_accel`) on the base's ẋ and ψ̇ rows.
     fn generalized_forces(&mut self, f: &[V3], n: &[V3], with_accel: bool) -> Vec<ExprId> {
         let model = self.model;
-        let links = model.links.len();
         let zero = self.ar.zero();
         let mut out = vec![zero; model.dof()];
-        for l in 1..links {
-            let joint = model.links[l].joint.clone().expect("non-root");
-            let Some(row) = joint.speed else { continue };
+        for (l, _, mount) in model.mounted_links() {
+            let Some(row) = mount.joint.speed() else {
+                continue;
+            };
             let e = self.axis(l);
-            out[row] = match joint.kind {
-                JointKind::Prismatic => self.dot(&e, &f[l]),
+            out[row] = match mount.joint.kind {
+                JointKind::Prismatic { .. } => self.dot(&e, &f[l]),
                 _ => self.dot(&e, &n[l]),
             };
         }
-        if model.wheeled_base().is_some() {
-            let (xs, kx, ps, kp) = self.wheel_terms().expect("wheeled");
+        if let Some((xs, kx, ps, kp)) = self.wheel_terms() {
             out[xs] = f[0][0];
             out[ps] = n[0][2];
             if with_accel {

@@ -3,7 +3,7 @@
 use thiserror::Error;
 
 /// A model file could not be loaded: where ([`ModelError::file`]) and what ([`ModelError::kind`]).
-#[derive(Debug, Clone, PartialEq, Error)]
+#[derive(Debug, Error)]
 #[error("{file}: {kind}")]
 pub struct ModelError {
     /// The description file (or the label given to an in-memory description).
@@ -22,12 +22,14 @@ impl ModelError {
 }
 
 /// What is wrong with a description. Each message names the offending item and how to fix it.
-#[derive(Debug, Clone, PartialEq, Error)]
+///
+/// The error of a file that cannot be read keeps the [`std::io::Error`] as its source.
+#[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum ModelErrorKind {
-    /// The file could not be read.
+    /// The file could not be read (the message repeats the I/O error, which is also the source).
     #[error("cannot read the file: {0}")]
-    Io(String),
+    Io(#[source] std::io::Error),
     /// The file is not valid TOML, or does not have the shape of a model description.
     #[error("malformed description: {0}")]
     Syntax(String),
@@ -128,11 +130,11 @@ pub enum ModelErrorKind {
         /// The missing symbol.
         symbol: String,
     },
-    /// A parameter that nothing uses (most often a misspelt name).
+    /// A parameter that is declared but that nothing uses (most often a misspelt name).
     #[error(
-        "parameter `{name}` is not used by any joint, body, base or gravity; remove it or correct its name"
+        "parameter `{name}` is declared but not used by any joint, body, base or gravity; remove it or correct its name"
     )]
-    UnknownParameter {
+    UnusedParameter {
         /// The parameter.
         name: String,
     },

@@ -39,16 +39,16 @@ pub struct Speed {
     pub coordinate: String,
 }
 
-/// A scalar that is either a number or `coef · symbol` (a length such as `-L2`).
+/// A length in a joint translation: a number, or `coef · symbol` (such as `L1` or `-L2`).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Scalar {
+pub struct Length {
     /// The factor (±1 for `L1`/`-L2`, or the value itself when `symbol` is `None`).
     pub coef: f64,
     /// The parameter multiplied by `coef`, if any.
     pub symbol: Option<ParamId>,
 }
 
-impl Scalar {
+impl Length {
     /// A plain number.
     pub fn number(v: f64) -> Self {
         Self {
@@ -71,15 +71,40 @@ impl Scalar {
     }
 }
 
-/// The kind of a joint.
+/// How a joint moves; a moving joint drives one generalized speed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum JointKind {
-    /// Rotation about the axis by the coordinate.
-    Revolute,
-    /// Translation along the axis by the coordinate.
-    Prismatic,
+    /// Rotation about the axis by the coordinate of `speed`.
+    Revolute {
+        /// Index into [`Model::speeds`] of the speed this joint drives.
+        speed: usize,
+    },
+    /// Translation along the axis by the coordinate of `speed`.
+    Prismatic {
+        /// Index into [`Model::speeds`] of the speed this joint drives.
+        speed: usize,
+    },
     /// No motion; the child frame is rigidly attached.
     Fixed,
+}
+
+impl JointKind {
+    /// The speed a moving joint drives; `None` for a fixed joint.
+    pub fn speed(self) -> Option<usize> {
+        match self {
+            JointKind::Revolute { speed } | JointKind::Prismatic { speed } => Some(speed),
+            JointKind::Fixed => None,
+        }
+    }
+
+    /// `Revolute`, `Prismatic` or `Fixed`.
+    pub fn name(self) -> &'static str {
+        match self {
+            JointKind::Revolute { .. } => "Revolute",
+            JointKind::Prismatic { .. } => "Prismatic",
+            JointKind::Fixed => "Fixed",
+        }
+    }
 }
 
 /// The joint that attaches a frame to its parent.
@@ -87,16 +112,21 @@ pub enum JointKind {
 pub struct Joint {
     /// Joint name; for moving joints the name of its coordinate (`q1l`).
     pub name: String,
-    /// Revolute, prismatic or fixed.
+    /// Revolute or prismatic (with the speed it drives), or fixed.
     pub kind: JointKind,
     /// Unit axis `e_j` in the child frame.
     pub axis: [f64; 3],
     /// `iAj(0)`: columns are the child's unit vectors in the parent frame; stored by rows.
     pub rotation: [[f64; 3]; 3],
     /// `iPj`: the child origin in the parent frame.
-    pub translation: [Scalar; 3],
-    /// Index into [`Model::speeds`] of the speed this joint drives (`None` for fixed joints).
-    pub speed: Option<usize>,
+    pub translation: [Length; 3],
+}
+
+impl Joint {
+    /// The speed the joint drives; `None` for a fixed joint.
+    pub fn speed(&self) -> Option<usize> {
+        self.kind.speed()
+    }
 }
 
 /// Khalil's standard inertial parameters of one body, as parameter indices.
@@ -112,17 +142,36 @@ pub struct Body {
     pub inertia: [ParamId; 6],
 }
 
-/// A frame of the tree. `links[0]` is the base frame.
+/// How a frame other than the base frame hangs from its parent.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mount {
+    /// Index of the parent link (always smaller than the index of the link it mounts).
+    pub parent: usize,
+    /// The joint to the parent.
+    pub joint: Joint,
+}
+
+/// A frame of the tree. `links[0]` is the base frame, the only one without a [`Mount`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Link {
     /// Frame name (`0`, `1`, `4l`).
     pub name: String,
-    /// Index of the parent link (always smaller than this link's index); `None` for the base frame.
-    pub parent: Option<usize>,
-    /// The joint to the parent; `None` for the base frame.
-    pub joint: Option<Joint>,
+    /// The parent and the joint to it; `None` for the base frame.
+    pub mount: Option<Mount>,
     /// The rigid body fixed in this frame, if any.
     pub body: Option<Body>,
+}
+
+impl Link {
+    /// Index of the parent link; `None` for the base frame.
+    pub fn parent(&self) -> Option<usize> {
+        self.mount.as_ref().map(|m| m.parent)
+    }
+
+    /// The joint to the parent; `None` for the base frame.
+    pub fn joint(&self) -> Option<&Joint> {
+        self.mount.as_ref().map(|m| &m.joint)
+    }
 }
 
 /// The two-wheeled inverted-pendulum base of DynamicModeling.tex.
@@ -218,8 +267,28 @@ impl Model {
     /// Indices of the children of link `i`, in order.
     pub fn children(&self, i: usize) -> Vec<usize> {
         (0..self.links.len())
-            .filter(|&c| self.links[c].parent == Some(i))
+            .filter(|&c| self.links[c].parent() == Some(i))
             .collect()
+    }
+
+    /// The frames other than the base frame, parents first, each with its index and its mount.
+    pub fn mounted_links(&self) -> impl DoubleEndedIterator<Item = (usize, &Link, &Mount)> {
+        self.links
+            .iter()
+            .enumerate()
+            .filter_map(|(i, l)| l.mount.as_ref().map(|m| (i, l, m)))
+    }
+
+    /// The mounts on the path from link `l` up to the base frame, each with the index of the
+    /// link it mounts: `(l, mount of l)`, then its parent's, ...; empty for the base frame.
+    pub fn path_to_base(&self, l: usize) -> impl Iterator<Item = (usize, &Mount)> {
+        let mut at = Some(l);
+        std::iter::from_fn(move || {
+            let k = at?;
+            let m = self.links[k].mount.as_ref()?;
+            at = Some(m.parent);
+            Some((k, m))
+        })
     }
 
     /// The wheeled base, if the model has one.
@@ -236,7 +305,7 @@ impl Model {
     }
 }
 
-fn fmt_scalar(s: &Scalar, m: &Model) -> String {
+fn fmt_length(s: &Length, m: &Model) -> String {
     match s.symbol {
         None => format!("{}", s.coef),
         Some(p) if s.coef == 1.0 => m.params[p].name.clone(),
@@ -275,31 +344,22 @@ impl fmt::Display for Model {
         )?;
         writeln!(f, "frames ({}):", self.links.len())?;
         for (i, l) in self.links.iter().enumerate() {
-            let depth = {
-                let mut d = 0;
-                let mut k = i;
-                while let Some(p) = self.links[k].parent {
-                    d += 1;
-                    k = p;
-                }
-                d
-            };
-            let indent = "  ".repeat(depth + 1);
-            match &l.joint {
+            let indent = "  ".repeat(self.path_to_base(i).count() + 1);
+            match l.joint() {
                 None => write!(f, "{indent}{}", l.name)?,
                 Some(j) => {
                     let t: Vec<String> =
-                        j.translation.iter().map(|s| fmt_scalar(s, self)).collect();
+                        j.translation.iter().map(|s| fmt_length(s, self)).collect();
                     write!(
                         f,
-                        "{indent}{} <- {:?} joint `{}` axis {:?} P [{}]",
+                        "{indent}{} <- {} joint `{}` axis {:?} P [{}]",
                         l.name,
-                        j.kind,
+                        j.kind.name(),
                         j.name,
                         j.axis,
                         t.join(", ")
                     )?;
-                    if let Some(s) = j.speed {
+                    if let Some(s) = j.speed() {
                         write!(f, " speed {}", self.speeds[s].name)?;
                     }
                 }

@@ -14,14 +14,13 @@
 #![forbid(unsafe_code)]
 
 mod error;
+mod ident;
 mod ir;
 mod toml_format;
 pub mod urdf;
 mod validate;
 
 pub use error::{ModelError, ModelErrorKind};
+pub use ident::sanitize_identifier;
 pub use ir::*;
-pub use urdf::{
-    AbsurdInertia, UrdfBase, UrdfImport, UrdfOptions, WheeledBaseSpec,
-    sanitize as sanitize_urdf_name,
-};
+pub use urdf::{AbsurdInertia, UrdfBase, UrdfImport, UrdfOptions, WheeledBaseSpec};

@@ -132,8 +132,7 @@ impl Model {
     pub fn from_toml_file(path: impl AsRef<Path>) -> Result<Model, ModelError> {
         let path = path.as_ref();
         let label = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| ModelError::new(&label, K::Io(e.to_string())))?;
+        let text = std::fs::read_to_string(path).map_err(|e| ModelError::new(&label, K::Io(e)))?;
         Self::from_toml_str(&text, &label)
     }
 
@@ -153,6 +152,42 @@ struct Symbols {
 }
 
 impl Symbols {
+    /// The `[parameters]` table, in file order; every value a finite number.
+    fn from_table(table: &toml::Table) -> Result<Self, K> {
+        let mut syms = Symbols {
+            params: Vec::new(),
+            index: HashMap::new(),
+            used: Vec::new(),
+        };
+        for (name, value) in table {
+            let v = match value {
+                toml::Value::Float(x) => *x,
+                toml::Value::Integer(i) => *i as f64,
+                other => {
+                    return Err(K::Syntax(format!(
+                        "parameter `{name}` must be a number, found {}",
+                        other.type_str()
+                    )));
+                }
+            };
+            if !v.is_finite() {
+                return Err(K::NonFiniteParameter {
+                    name: name.clone(),
+                    value: v,
+                });
+            }
+            syms.index.insert(name.clone(), syms.params.len());
+            syms.params.push(Param {
+                name: name.clone(),
+                value: v,
+                kind: ParamKind::Length,
+            });
+            syms.used.push(false);
+        }
+        Ok(syms)
+    }
+
+    /// The parameter `name`, used by `item` as a `kind`.
     fn lookup(&mut self, item: &str, name: &str, kind: ParamKind) -> Result<ParamId, K> {
         let &i = self.index.get(name).ok_or_else(|| K::UndefinedSymbol {
             item: item.to_owned(),
@@ -162,11 +197,82 @@ impl Symbols {
         self.params[i].kind = kind;
         Ok(i)
     }
+
+    /// The parameters, if every one is used.
+    fn finish(self) -> Result<Vec<Param>, K> {
+        if let Some(i) = self.used.iter().position(|u| !u) {
+            return Err(K::UnusedParameter {
+                name: self.params[i].name.clone(),
+            });
+        }
+        Ok(self.params)
+    }
 }
 
-fn parse_length(entry: &LengthEntry, joint: &str, syms: &mut Symbols) -> Result<Scalar, K> {
+/// The generalized speeds of `[model] speeds` and who drives each (a joint or the base).
+struct Speeds {
+    list: Vec<Speed>,
+    driver: Vec<Option<String>>,
+}
+
+impl Speeds {
+    /// The listed speeds, in order; names must be unique.
+    fn new(names: &[String]) -> Result<Self, K> {
+        let mut list: Vec<Speed> = Vec::new();
+        for s in names {
+            if list.iter().any(|x| &x.name == s) {
+                return Err(K::Duplicate {
+                    what: "speed",
+                    name: s.clone(),
+                });
+            }
+            list.push(Speed {
+                name: s.clone(),
+                coordinate: String::new(),
+            });
+        }
+        Ok(Self {
+            driver: vec![None; list.len()],
+            list,
+        })
+    }
+
+    /// `who` drives `speed`, the rate of `coordinate`; its index. A speed is driven once.
+    fn drive(&mut self, speed: &str, who: String, coordinate: &str) -> Result<usize, K> {
+        let i = self
+            .list
+            .iter()
+            .position(|s| s.name == speed)
+            .ok_or_else(|| K::UnknownSpeed {
+                item: who.clone(),
+                speed: speed.to_owned(),
+            })?;
+        if let Some(first) = &self.driver[i] {
+            return Err(K::SpeedTwice {
+                speed: speed.to_owned(),
+                first: first.clone(),
+                second: who,
+            });
+        }
+        self.driver[i] = Some(who);
+        self.list[i].coordinate = coordinate.to_owned();
+        Ok(i)
+    }
+
+    /// The speeds, if every one is driven.
+    fn finish(self) -> Result<Vec<Speed>, K> {
+        if let Some(i) = self.driver.iter().position(Option::is_none) {
+            return Err(K::SpeedNever {
+                speed: self.list[i].name.clone(),
+            });
+        }
+        Ok(self.list)
+    }
+}
+
+fn parse_length(entry: &LengthEntry, joint: &str, syms: &mut Symbols) -> Result<Length, K> {
     match entry {
-        LengthEntry::Number(v) if v.is_finite() => Ok(Scalar::number(*v)),
+        LengthEntry::Number(v) if v.is_finite() => Ok(Length::number(*v)),
         LengthEntry::Number(v) => Err(K::BadLength {
             joint: joint.to_owned(),
             text: v.to_string(),
@@ -189,7 +295,7 @@ fn parse_length(entry: &LengthEntry, joint: &str, syms: &mut Symbols) -> Result<
                 });
             }
             let p = syms.lookup(&format!("joint `{joint}`"), name, ParamKind::Length)?;
-            Ok(Scalar {
+            Ok(Length {
                 coef,
                 symbol: Some(p),
             })
@@ -197,78 +303,48 @@ fn parse_length(entry: &LengthEntry, joint: &str, syms: &mut Symbols) -> Result<
     }
 }
 
+/// The model of a parsed description: parameters, speeds, base, gravity, the frame tree and the
+/// bodies, each checked.
 fn build(f: File, file: &str) -> Result<Model, K> {
-    // Parameters, in file order.
-    let mut syms = Symbols {
-        params: Vec::new(),
-        index: HashMap::new(),
-        used: Vec::new(),
-    };
-    for (name, value) in &f.parameters {
-        let v = match value {
-            toml::Value::Float(x) => *x,
-            toml::Value::Integer(i) => *i as f64,
-            other => {
-                return Err(K::Syntax(format!(
-                    "parameter `{name}` must be a number, found {}",
-                    other.type_str()
-                )));
-            }
-        };
-        if !v.is_finite() {
-            return Err(K::NonFiniteParameter {
-                name: name.clone(),
-                value: v,
-            });
-        }
-        syms.index.insert(name.clone(), syms.params.len());
-        syms.params.push(Param {
-            name: name.clone(),
-            value: v,
-            kind: ParamKind::Length,
-        });
-        syms.used.push(false);
-    }
+    let mut syms = Symbols::from_table(&f.parameters)?;
+    let mut speeds = Speeds::new(&f.model.speeds)?;
+    let (base_frame, base) = build_base(&f.base, &mut syms, &mut speeds)?;
 
-    // Speeds.
-    let mut speeds: Vec<Speed> = Vec::new();
-    for s in &f.model.speeds {
-        if speeds.iter().any(|x| &x.name == s) {
-            return Err(K::Duplicate {
-                what: "speed",
-                name: s.clone(),
-            });
-        }
-        speeds.push(Speed {
-            name: s.clone(),
-            coordinate: String::new(),
-        });
-    }
-    // Who drives each speed (for SpeedTwice / SpeedNever).
-    let mut driver: Vec<Option<String>> = vec![None; speeds.len()];
-    let mut drive = |speed: &str, who: String, coordinate: &str, speeds: &mut Vec<Speed>| {
-        let i = speeds
-            .iter()
-            .position(|s| s.name == speed)
-            .ok_or_else(|| K::UnknownSpeed {
-                item: who.clone(),
-                speed: speed.to_owned(),
-            })?;
-        if let Some(first) = &driver[i] {
-            return Err(K::SpeedTwice {
-                speed: speed.to_owned(),
-                first: first.clone(),
-                second: who,
-            });
-        }
-        driver[i] = Some(who);
-        speeds[i].coordinate = coordinate.to_owned();
-        Ok(i)
-    };
+    let gsym = syms.lookup("gravity", &f.gravity.symbol, ParamKind::Gravity)?;
+    let dir = f.gravity.direction;
+    validate::check_gravity_direction(dir).map_err(|detail| K::Invalid {
+        item: "gravity".into(),
+        detail,
+    })?;
 
-    // Base.
-    let (base_frame, base) = match &f.base {
-        BaseSection::Fixed { frame } => (frame.clone(), None),
+    let (mut links, placed) = build_frames(&f.joints, &base_frame, &mut syms, &mut speeds)?;
+    add_bodies(&f.bodies, &placed, &mut links, &mut syms)?;
+
+    let model = Model {
+        name: f.model.name,
+        description: f.model.description,
+        source: file.to_owned(),
+        speeds: speeds.finish()?,
+        params: syms.finish()?,
+        links,
+        base,
+        gravity: Gravity {
+            symbol: gsym,
+            direction: dir,
+        },
+    };
+    validate::check_physics(&model)?;
+    Ok(model)
+}
+
+/// The base frame's name and the base (a wheeled base drives its two speeds).
+fn build_base(
+    section: &BaseSection,
+    syms: &mut Symbols,
+    speeds: &mut Speeds,
+) -> Result<(String, Base), K> {
+    match section {
+        BaseSection::Fixed { frame } => Ok((frame.clone(), Base::Fixed)),
         BaseSection::Wheeled {
             frame,
             x_speed,
@@ -280,18 +356,8 @@ fn build(f: File, file: &str) -> Result<Model, K> {
             wheel_diametral_inertia,
         } => {
             let item = "base";
-            let xs = drive(
-                x_speed,
-                "the wheeled base (x_speed)".into(),
-                "x",
-                &mut speeds,
-            )?;
-            let ps = drive(
-                psi_speed,
-                "the wheeled base (psi_speed)".into(),
-                "psi",
-                &mut speeds,
-            )?;
+            let xs = speeds.drive(x_speed, "the wheeled base (x_speed)".into(), "x")?;
+            let ps = speeds.drive(psi_speed, "the wheeled base (psi_speed)".into(), "psi")?;
             let w = WheeledBase {
                 x_speed: xs,
                 psi_speed: ps,
@@ -305,25 +371,20 @@ fn build(f: File, file: &str) -> Result<Model, K> {
                     ParamKind::Wheel,
                 )?,
             };
-            (frame.clone(), Some(w))
+            Ok((frame.clone(), Base::Wheeled(w)))
         }
-    };
-
-    // Gravity.
-    let gsym = syms.lookup("gravity", &f.gravity.symbol, ParamKind::Gravity)?;
-    let dir = f.gravity.direction;
-    let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
-    if !n.is_finite() || (n - 1.0).abs() > 1e-9 {
-        return Err(K::Invalid {
-            item: "gravity".into(),
-            detail: format!("direction {dir:?} is not a unit vector (norm {n}); normalise it"),
-        });
     }
+}
 
-    // Frames and joints: a tree rooted at the base frame.
+/// Checks the joint and frame names: joints unique, no joint's child is the base frame, each
+/// frame the child of one joint, every parent defined. The joint index by child frame.
+fn index_joints<'a>(
+    joints: &'a [JointSection],
+    base_frame: &str,
+) -> Result<HashMap<&'a str, usize>, K> {
     let mut joint_names: Vec<&str> = Vec::new();
     let mut child_of: HashMap<&str, usize> = HashMap::new();
-    for (k, j) in f.joints.iter().enumerate() {
+    for (k, j) in joints.iter().enumerate() {
         if joint_names.contains(&j.name.as_str()) {
             return Err(K::Duplicate {
                 what: "joint",
@@ -344,7 +405,7 @@ fn build(f: File, file: &str) -> Result<Model, K> {
             });
         }
     }
-    for j in &f.joints {
+    for j in joints {
         if j.parent != base_frame && !child_of.contains_key(j.parent.as_str()) {
             return Err(K::UnknownParent {
                 joint: j.name.clone(),
@@ -352,28 +413,37 @@ fn build(f: File, file: &str) -> Result<Model, K> {
             });
         }
     }
-    // Topological order: repeatedly place the joints whose parent is placed, in file order.
+    Ok(child_of)
+}
+
+/// The frames in topological order (the base frame first, then repeatedly the joints whose parent
+/// is placed, in file order), and the index of each frame by name.
+fn build_frames(
+    joints: &[JointSection],
+    base_frame: &str,
+    syms: &mut Symbols,
+    speeds: &mut Speeds,
+) -> Result<(Vec<Link>, HashMap<String, usize>), K> {
+    let child_of = index_joints(joints, base_frame)?;
     let mut links = vec![Link {
-        name: base_frame.clone(),
-        parent: None,
-        joint: None,
+        name: base_frame.to_owned(),
+        mount: None,
         body: None,
     }];
-    let mut placed: HashMap<String, usize> = HashMap::from([(base_frame.clone(), 0)]);
-    let mut remaining: Vec<usize> = (0..f.joints.len()).collect();
+    let mut placed: HashMap<String, usize> = HashMap::from([(base_frame.to_owned(), 0)]);
+    let mut remaining: Vec<usize> = (0..joints.len()).collect();
     while !remaining.is_empty() {
         let before = remaining.len();
         let mut next = Vec::new();
         for k in remaining {
-            let j = &f.joints[k];
+            let j = &joints[k];
             match placed.get(&j.parent) {
                 Some(&p) => {
-                    let joint = build_joint(j, &mut syms, &mut drive, &mut speeds)?;
+                    let joint = build_joint(j, syms, speeds)?;
                     placed.insert(j.child.clone(), links.len());
                     links.push(Link {
                         name: j.child.clone(),
-                        parent: Some(p),
-                        joint: Some(joint),
+                        mount: Some(Mount { parent: p, joint }),
                         body: None,
                     });
                 }
@@ -385,12 +455,12 @@ fn build(f: File, file: &str) -> Result<Model, K> {
             // from one of them until a joint repeats; that joint is on a cycle (the first unplaced
             // joint may merely hang off one).
             let mut k = next[0];
-            let mut seen = vec![false; f.joints.len()];
+            let mut seen = vec![false; joints.len()];
             while !seen[k] {
                 seen[k] = true;
-                k = child_of[f.joints[k].parent.as_str()];
+                k = child_of[joints[k].parent.as_str()];
             }
-            let j = &f.joints[k];
+            let j = &joints[k];
             return Err(K::Cycle {
                 joint: j.name.clone(),
                 frame: j.child.clone(),
@@ -398,10 +468,19 @@ fn build(f: File, file: &str) -> Result<Model, K> {
         }
         remaining = next;
     }
+    Ok((links, placed))
+}
 
-    // Bodies.
+/// Attaches the bodies to their frames (`placed`: frame index by name); each body's symbols are
+/// its prefixes (`m`, `MX`, ..., `ZZ`) followed by its name.
+fn add_bodies(
+    bodies: &[BodySection],
+    placed: &HashMap<String, usize>,
+    links: &mut [Link],
+    syms: &mut Symbols,
+) -> Result<(), K> {
     let mut body_names: Vec<String> = Vec::new();
-    for b in &f.bodies {
+    for b in bodies {
         let name = b.name.clone().unwrap_or_else(|| b.frame.clone());
         let Some(&li) = placed.get(&b.frame) else {
             return Err(K::UnknownFrame {
@@ -437,56 +516,15 @@ fn build(f: File, file: &str) -> Result<Model, K> {
         body_names.push(name);
         links[li].body = Some(body);
     }
-
-    for (i, s) in speeds.iter().enumerate() {
-        if driver[i].is_none() {
-            return Err(K::SpeedNever {
-                speed: s.name.clone(),
-            });
-        }
-    }
-    if let Some(i) = syms.used.iter().position(|u| !u) {
-        return Err(K::UnknownParameter {
-            name: syms.params[i].name.clone(),
-        });
-    }
-
-    let model = Model {
-        name: f.model.name,
-        description: f.model.description,
-        source: file.to_owned(),
-        params: syms.params,
-        speeds,
-        links,
-        base: match base {
-            Some(w) => Base::Wheeled(w),
-            None => Base::Fixed,
-        },
-        gravity: Gravity {
-            symbol: gsym,
-            direction: dir,
-        },
-    };
-    validate::check_physics(&model)?;
-    Ok(model)
+    Ok(())
 }
 
-type Drive<'a> = dyn FnMut(&str, String, &str, &mut Vec<Speed>) -> Result<usize, K> + 'a;
-
-fn build_joint(
-    j: &JointSection,
-    syms: &mut Symbols,
-    drive: &mut Drive<'_>,
-    speeds: &mut Vec<Speed>,
-) -> Result<Joint, K> {
-    let kind = match j.kind {
-        JointType::Revolute => JointKind::Revolute,
-        JointType::Prismatic => JointKind::Prismatic,
-        JointType::Fixed => JointKind::Fixed,
-    };
-    let speed = match (kind, &j.speed) {
-        (JointKind::Fixed, None) => None,
-        (JointKind::Fixed, Some(s)) => {
+/// The joint of a `[[joint]]` section: kind, driven speed, axis, rotation and translation, each
+/// checked.
+fn build_joint(j: &JointSection, syms: &mut Symbols, speeds: &mut Speeds) -> Result<Joint, K> {
+    let kind = match (j.kind, &j.speed) {
+        (JointType::Fixed, None) => JointKind::Fixed,
+        (JointType::Fixed, Some(s)) => {
             return Err(K::JointSpeed {
                 joint: j.name.clone(),
                 detail: format!("a fixed joint drives no speed; remove `speed = \"{s}\"`"),
@@ -500,7 +538,13 @@ fn build_joint(
                         .into(),
             });
         }
-        (_, Some(s)) => Some(drive(s, format!("joint `{}`", j.name), &j.name, speeds)?),
+        (moving, Some(s)) => {
+            let speed = speeds.drive(s, format!("joint `{}`", j.name), &j.name)?;
+            match moving {
+                JointType::Prismatic => JointKind::Prismatic { speed },
+                _ => JointKind::Revolute { speed },
+            }
+        }
     };
     let axis = match (kind, j.axis) {
         (_, Some(a)) => a,
@@ -526,6 +570,5 @@ fn build_joint(
         axis,
         rotation: j.rotation,
         translation,
-        speed,
     })
 }

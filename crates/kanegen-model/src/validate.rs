@@ -8,18 +8,38 @@ use crate::ir::{Body, Model};
 /// Tolerance on orthonormality, determinant and unit norms.
 pub const TOLERANCE: f64 = 1e-9;
 
+/// The norm of `v` if `v` is not a unit vector within [`TOLERANCE`] (a non-finite entry gives a
+/// non-finite norm); `None` if it is one.
+fn norm_unless_unit(v: [f64; 3]) -> Option<f64> {
+    let norm = Vector3::from(v).norm();
+    (!norm.is_finite() || (norm - 1.0).abs() > TOLERANCE).then_some(norm)
+}
+
+/// Checks that a joint axis is a unit vector.
 pub(crate) fn check_axis(joint: &str, axis: [f64; 3]) -> Result<(), K> {
-    let norm = Vector3::from(axis).norm();
-    if !norm.is_finite() || (norm - 1.0).abs() > TOLERANCE {
-        return Err(K::AxisNotUnit {
+    match norm_unless_unit(axis) {
+        Some(norm) => Err(K::AxisNotUnit {
             joint: joint.to_owned(),
             axis,
             norm,
-        });
+        }),
+        None => Ok(()),
     }
-    Ok(())
 }
 
+/// Checks that the direction of gravity is a unit vector (the same rule for TOML and URDF
+/// models). The error is the detail for the caller's typed error, which names the item:
+/// `direction [0.0, 0.0, -2.0] is not a unit vector (norm 2); normalise it`.
+pub(crate) fn check_gravity_direction(direction: [f64; 3]) -> Result<(), String> {
+    match norm_unless_unit(direction) {
+        Some(norm) => Err(format!(
+            "direction {direction:?} is not a unit vector (norm {norm}); normalise it"
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Checks that `rows` is a proper rotation (orthonormal, determinant +1).
 pub(crate) fn check_rotation(joint: &str, rows: &[[f64; 3]; 3]) -> Result<(), K> {
     let r = Matrix3::from_fn(|i, j| rows[i][j]);
     let err = (r * r.transpose() - Matrix3::identity()).abs().max();
@@ -57,6 +77,8 @@ pub fn principal_moments_about_com(body: &Body, p: &[f64]) -> [f64; 3] {
     v
 }
 
+/// Checks every body: positive mass, and an inertia about the centre of mass that is positive
+/// definite and satisfies the triangle inequality.
 pub(crate) fn check_physics(model: &Model) -> Result<(), K> {
     let p = model.param_values();
     for link in &model.links {

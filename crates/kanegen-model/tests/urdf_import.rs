@@ -114,8 +114,12 @@ fn rpy_axes_kinds_and_names() {
         speeds,
         [("qd_shoulder", "q_shoulder"), ("qd_slide", "q_slide")]
     );
-    let j = m.links[1].joint.as_ref().unwrap();
-    assert_eq!(j.kind, JointKind::Revolute, "continuous = revolute");
+    let j = m.links[1].joint().unwrap();
+    assert_eq!(
+        j.kind,
+        JointKind::Revolute { speed: 0 },
+        "continuous = revolute"
+    );
     assert_eq!(j.axis, [0.0, 0.0, 1.0], "axis normalised");
     assert!(close(&j.rotation, &rows(&rpy(0.3, -0.5, 1.1)), 1e-15));
     assert_eq!(
@@ -184,8 +188,8 @@ fn fixed_joints_merge_inertia_and_reattach_children() {
         );
     }
     // The slider hangs from the merged flange: composed transform, prismatic axis normalised.
-    let jt = m.links[2].joint.as_ref().unwrap();
-    assert_eq!(jt.kind, JointKind::Prismatic);
+    let jt = m.links[2].joint().unwrap();
+    assert_eq!(jt.kind, JointKind::Prismatic { speed: 1 });
     let s = std::f64::consts::FRAC_1_SQRT_2;
     assert!((jt.axis[0] - s).abs() < 1e-15 && (jt.axis[1] - s).abs() < 1e-15 && jt.axis[2] == 0.0);
     let r_slide = r_mount * rpy(0.0, std::f64::consts::FRAC_PI_2, 0.0);
@@ -203,7 +207,7 @@ fn fixed_joints_merge_inertia_and_reattach_children() {
 fn angles_are_snapped_by_default_and_kept_on_request() {
     let text = ARM.replace("rpy=\"0 1.5708 0\"", "rpy=\"3.1416 1.5708 -3.14\"");
     let snapped = UrdfImport::parse(&text, "arm.urdf", &UrdfOptions::default()).unwrap();
-    let r = snapped.model.links[2].joint.as_ref().unwrap().rotation;
+    let r = snapped.model.links[2].joint().unwrap().rotation;
     let r_mount = rpy(0.5, 0.25, -1.0);
     let exact = r_mount
         * rpy(
@@ -237,7 +241,7 @@ fn angles_are_snapped_by_default_and_kept_on_request() {
         },
     )
     .unwrap();
-    let r = raw.links[2].joint.as_ref().unwrap().rotation;
+    let r = raw.links[2].joint().unwrap().rotation;
     assert!(close(
         &r,
         &rows(&(r_mount * rpy(3.1416, 1.5708, -3.14))),
@@ -255,7 +259,7 @@ fn angles_are_snapped_by_default_and_kept_on_request() {
         },
     )
     .unwrap();
-    let r = raw.links[2].joint.as_ref().unwrap().rotation;
+    let r = raw.links[2].joint().unwrap().rotation;
     assert!(close(
         &r,
         &rows(&(r_mount * rpy(0.0, std::f64::consts::FRAC_PI_2, 0.0))),
@@ -305,7 +309,7 @@ fn krang_wheeled_base_reproduces_the_frames_of_seed_002() {
     assert_eq!(m.speeds[0].coordinate, "x");
     assert_eq!(m.speeds[1].coordinate, "psi");
     assert_eq!(m.links[0].name, "0");
-    let pitch = m.links[1].joint.as_ref().unwrap();
+    let pitch = m.links[1].joint().unwrap();
     assert_eq!(m.links[1].name, "Base");
     assert_eq!(
         pitch.rotation,

@@ -526,10 +526,10 @@ fn unused_parameter() {
     // A misspelt extra (`Ll` for `L1`) that nothing uses.
     let e = load_err(
         &mutate(&[("L1 = 0.5\n", "L1 = 0.5\nLl = 0.5\n")]),
-        &["`Ll`", "not used"],
+        &["`Ll`", "declared but not used"],
     );
     assert!(
-        matches!(&e.kind, K::UnknownParameter { name } if name == "Ll"),
+        matches!(&e.kind, K::UnusedParameter { name } if name == "Ll"),
         "{:?}",
         e.kind
     );
@@ -740,7 +740,17 @@ fn missing_file_is_io_error_naming_the_path() {
     let err = Model::from_toml_file(&path).expect_err("the file does not exist");
     let label = path.display().to_string();
     assert_eq!(err.file, label);
-    assert!(matches!(err.kind, K::Io(_)), "{:?}", err.kind);
+    assert!(
+        matches!(&err.kind, K::Io(io) if io.kind() == std::io::ErrorKind::NotFound),
+        "{:?}",
+        err.kind
+    );
+    // The I/O error is kept as the source, not only as text.
+    let source = std::error::Error::source(&err.kind).expect("the I/O error is the source");
+    assert!(
+        source.downcast_ref::<std::io::Error>().is_some(),
+        "{source}"
+    );
     let msg = err.to_string();
     assert!(
         msg.contains("no-such-model.toml") && msg.contains("cannot read"),

@@ -1,7 +1,7 @@
 //! Construction of an [`Rbd`]: parameter evaluation, merging of fixed joints, and the change of
 //! every moving frame to one whose joint axis is `+z`.
 
-use kanegen_model::{Base, JointKind, Model};
+use kanegen_model::{Base, JointKind, Model, Mount};
 use nalgebra::{Matrix3, Vector3};
 
 use crate::rot::RotKind;
@@ -182,10 +182,10 @@ pub(crate) fn build<const N: usize, T: Scalar>(
     let mut protos: Vec<Proto<T>> = Vec::new();
     let mut root_body = Inertial::<T>::zero();
     for (k, link) in model.links.iter().enumerate() {
-        match (k, link.parent, &link.joint) {
-            (0, None, _) => eff.push((ROOT, Matrix3::identity(), Vector3::zeros())),
-            (_, Some(pi), Some(joint)) if pi < k => {
-                let (r_par, a_par, t_par) = eff[pi];
+        match (k, &link.mount) {
+            (0, None) => eff.push((ROOT, Matrix3::identity(), Vector3::zeros())),
+            (_, Some(Mount { parent: pi, joint })) if *pi < k => {
+                let (r_par, a_par, t_par) = eff[*pi];
                 let a0 = Matrix3::from_fn(|r, c| joint.rotation[r][c]);
                 let p0 = Vector3::from_fn(|r, _| {
                     let s = joint.translation[r];
@@ -197,17 +197,14 @@ pub(crate) fn build<const N: usize, T: Scalar>(
                 let p_eff = a_par.map(cv) * p0 + t_par;
                 match joint.kind {
                     JointKind::Fixed => eff.push((r_par, a_par * a0, p_eff)),
-                    kind => {
-                        let s = joint.speed.ok_or_else(|| {
-                            bad(&link.name, "a moving joint without a speed".into())
-                        })?;
+                    JointKind::Revolute { speed: s } | JointKind::Prismatic { speed: s } => {
                         drive(s, &format!("joint `{}`", joint.name))?;
                         let axis = classify(joint.axis);
                         let c = canonical_frame(axis, joint.axis);
                         protos.push(Proto {
                             parent: r_par,
                             speed: s,
-                            prismatic: kind == JointKind::Prismatic,
+                            prismatic: matches!(joint.kind, JointKind::Prismatic { .. }),
                             axis,
                             a: a_par * a0 * c,
                             p: p_eff,

@@ -231,7 +231,7 @@ struct RootData<T> {
 ///
 /// Build once per parameter vector with [`Rbd::new`]; every evaluation is then allocation-free.
 /// `q`, `u`, `u̇` and all results are in `model.speeds` order; the coordinate of joint `j` is
-/// `q[joint.speed]` (the wheeled base's `x`, `ψ` do not enter).
+/// `q[joint.speed()]` (the wheeled base's `x`, `ψ` do not enter).
 #[derive(Debug, Clone)]
 pub struct Rbd<const N: usize, T = f64> {
     /// Number of moving links.

@@ -59,8 +59,6 @@ struct JointData<T> {
     rotation0: Matrix3<T>,
     /// Constant part of `iPj`.
     translation: Vector3<T>,
-    /// Index of the joint's speed (and coordinate) in `q`/`u`.
-    speed: Option<usize>,
 }
 
 /// Khalil's standard inertial parameters of one body, converted to `T`.
@@ -158,9 +156,8 @@ impl<T: RealField + Copy> Reference<T> {
             .links
             .iter()
             .map(|link| {
-                let (Some(parent), Some(j)) = (link.parent, link.joint.as_ref()) else {
-                    return None;
-                };
+                let mount = link.mount.as_ref()?;
+                let j = &mount.joint;
                 let translation = Vector3::from_fn(|r, _| {
                     let s = j.translation[r];
                     match s.symbol {
@@ -169,15 +166,11 @@ impl<T: RealField + Copy> Reference<T> {
                     }
                 });
                 Some(JointData {
-                    parent,
+                    parent: mount.parent,
                     kind: j.kind,
                     axis: Vector3::from_fn(|r, _| cst(j.axis[r])),
                     rotation0: Matrix3::from_fn(|r, c| cst(j.rotation[r][c])),
                     translation,
-                    speed: match j.kind {
-                        JointKind::Fixed => None,
-                        _ => j.speed,
-                    },
                 })
             })
             .collect();
@@ -262,23 +255,20 @@ impl<T: RealField + Copy> Reference<T> {
                     rotation: Matrix3::identity(),
                     translation: Vector3::zeros(),
                 },
-                Some(j) => {
-                    let qj = j.speed.map_or(T::zero(), |s| q[s]);
-                    match j.kind {
-                        JointKind::Revolute => Transform {
-                            rotation: j.rotation0 * axis_rotation(&j.axis, qj),
-                            translation: j.translation,
-                        },
-                        JointKind::Prismatic => Transform {
-                            rotation: j.rotation0,
-                            translation: j.translation + j.rotation0 * j.axis * qj,
-                        },
-                        JointKind::Fixed => Transform {
-                            rotation: j.rotation0,
-                            translation: j.translation,
-                        },
-                    }
-                }
+                Some(j) => match j.kind {
+                    JointKind::Revolute { speed } => Transform {
+                        rotation: j.rotation0 * axis_rotation(&j.axis, q[speed]),
+                        translation: j.translation,
+                    },
+                    JointKind::Prismatic { speed } => Transform {
+                        rotation: j.rotation0,
+                        translation: j.translation + j.rotation0 * j.axis * q[speed],
+                    },
+                    JointKind::Fixed => Transform {
+                        rotation: j.rotation0,
+                        translation: j.translation,
+                    },
+                },
             })
             .collect()
     }
@@ -333,7 +323,6 @@ impl<T: RealField + Copy> Reference<T> {
                 translation: p,
             } = tf[k];
             let at = a.transpose(); // jAi
-            let (uj, udj) = j.speed.map_or((T::zero(), T::zero()), |s| (u[s], ud[s]));
             let e = j.axis;
             // The parent's angular velocity, in frame j.
             let w_parent = at * parent.omega;
@@ -345,12 +334,14 @@ impl<T: RealField + Copy> Reference<T> {
                     + parent.alpha.cross(&p)
                     + parent.omega.cross(&parent.omega.cross(&p)));
             match j.kind {
-                JointKind::Revolute => {
+                JointKind::Revolute { speed } => {
+                    let (uj, udj) = (u[speed], ud[speed]);
                     // Eqs. 3 and 4.
                     omega += e * uj;
                     alpha += e * udj + w_parent.cross(&e) * uj;
                 }
-                JointKind::Prismatic => {
+                JointKind::Prismatic { speed } => {
+                    let (uj, udj) = (u[speed], ud[speed]);
                     // The child origin slides along e_j at rate u_j relative to the parent:
                     // relative velocity u e, relative acceleration u̇ e, Coriolis 2 ω × (u e).
                     let two: T = cst(2.0);
@@ -393,12 +384,10 @@ impl<T: RealField + Copy> Reference<T> {
             let at = tf[k].rotation.transpose();
             let mut w = at * wi;
             let mut v = at * (vi + wi.cross(&tf[k].translation));
-            if j.speed == Some(r) {
-                match j.kind {
-                    JointKind::Revolute => w += j.axis,
-                    JointKind::Prismatic => v += j.axis,
-                    JointKind::Fixed => {}
-                }
+            match j.kind {
+                JointKind::Revolute { speed } if speed == r => w += j.axis,
+                JointKind::Prismatic { speed } if speed == r => v += j.axis,
+                _ => {}
             }
             out.push((w, v));
         }

@@ -199,7 +199,7 @@ impl Kinematics {
         };
         let mut links = Vec::new();
         for link in &model.links {
-            let (rotation, axis, translation, coordinate) = match &link.joint {
+            let (rotation, axis, translation, coordinate) = match link.joint() {
                 None => (
                     Matrix3::identity(),
                     Vector3::zeros(),
@@ -216,9 +216,11 @@ impl Kinematics {
                         };
                     }
                     let coordinate = match j.kind {
-                        JointKind::Revolute => j.speed,
+                        JointKind::Revolute { speed } => Some(speed),
                         JointKind::Fixed => None,
-                        JointKind::Prismatic => return Err("prismatic joint in krang.toml".into()),
+                        JointKind::Prismatic { .. } => {
+                            return Err("prismatic joint in krang.toml".into());
+                        }
                     };
                     (
                         Matrix3::from_fn(|i, k| r[i][k]),
@@ -240,7 +242,7 @@ impl Kinematics {
                 )),
             };
             links.push(FkLink {
-                parent: link.parent,
+                parent: link.parent(),
                 rotation,
                 axis,
                 translation,

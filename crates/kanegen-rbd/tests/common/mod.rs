@@ -122,8 +122,9 @@ fn axis_angle(e: [f64; 3], angle: f64) -> Matrix3<f64> {
     Matrix3::identity() + k * angle.sin() + k * k * (1.0 - angle.cos())
 }
 
-/// A joint on the path from the base to a link: world axis, world origin, speed index, kind.
-type PathJoint = (Vector3<f64>, Vector3<f64>, usize, JointKind);
+/// A moving joint on the path from the base to a link: world axis, world origin, kind (with the
+/// speed).
+type PathJoint = (Vector3<f64>, Vector3<f64>, JointKind);
 
 /// The kinetic energy computed directly, body by body, without any recursion: each link's
 /// pose in frame 0 from the product of its joints' 4×4 transforms (raw model frames), its
@@ -143,23 +144,21 @@ pub fn direct_kinetic_energy(model: &Model, params: &[f64], q: &[f64], u: &[f64]
     let mut rot = vec![Matrix3::identity(); n];
     let mut org = vec![Vector3::zeros(); n];
     let mut path: Vec<Vec<PathJoint>> = vec![Vec::new(); n];
-    for k in 1..n {
-        let link = &model.links[k];
-        let pi = link.parent.expect("non-root link has a parent");
-        let j = link.joint.as_ref().expect("non-root link has a joint");
+    for (k, _, mount) in model.mounted_links() {
+        let (pi, j) = (mount.parent, &mount.joint);
         let a0 = Matrix3::from_fn(|r, c| j.rotation[r][c]);
         let p0 = Vector3::from_fn(|r, _| j.translation[r].eval(params));
         let e = Vector3::from(j.axis);
         let (a, p) = match j.kind {
-            JointKind::Revolute => (a0 * axis_angle(j.axis, q[j.speed.unwrap()]), p0),
-            JointKind::Prismatic => (a0, p0 + a0 * e * q[j.speed.unwrap()]),
+            JointKind::Revolute { speed } => (a0 * axis_angle(j.axis, q[speed]), p0),
+            JointKind::Prismatic { speed } => (a0, p0 + a0 * e * q[speed]),
             JointKind::Fixed => (a0, p0),
         };
         rot[k] = rot[pi] * a;
         org[k] = org[pi] + rot[pi] * p;
         let mut pth = path[pi].clone();
-        if let Some(s) = j.speed {
-            pth.push((rot[k] * e, org[k], s, j.kind));
+        if j.speed().is_some() {
+            pth.push((rot[k] * e, org[k], j.kind));
         }
         path[k] = pth;
     }
@@ -170,13 +169,13 @@ pub fn direct_kinetic_energy(model: &Model, params: &[f64], q: &[f64], u: &[f64]
         };
         let mut w = w0;
         let mut v = v0 + w0.cross(&org[k]);
-        for (e, o, s, kind) in &path[k] {
-            match kind {
-                JointKind::Revolute => {
-                    w += e * u[*s];
-                    v += e.cross(&(org[k] - o)) * u[*s];
+        for (e, o, kind) in &path[k] {
+            match *kind {
+                JointKind::Revolute { speed } => {
+                    w += e * u[speed];
+                    v += e.cross(&(org[k] - o)) * u[speed];
                 }
-                JointKind::Prismatic => v += e * u[*s],
+                JointKind::Prismatic { speed } => v += e * u[speed],
                 JointKind::Fixed => {}
             }
         }

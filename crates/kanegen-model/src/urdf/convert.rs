@@ -1,0 +1,439 @@
+//! The conversion driver: the parsed URDF, resolved against the options ([`resolve`]), becomes
+//! the IR (base, moving joints, bodies) and is validated.
+
+use std::collections::{HashMap, HashSet};
+
+use nalgebra::Vector3;
+
+use super::inertia::{Clusters, Inertial, link_inertial, merge};
+use super::transform::{Notes, Tf, clean, finite3, numbers, pose_tf, rows};
+use super::tree::{Tree, is_moving, type_name};
+use super::wheeled::{self, BaseCut};
+use super::{UrdfBase, UrdfImport, UrdfOptions, bad_option};
+use crate::error::ModelErrorKind as K;
+use crate::ident::sanitize_identifier;
+use crate::ir::*;
+use crate::validate;
+
+/// Converts a parsed URDF to a validated model, with the import notes.
+pub(super) fn convert(
+    robot: &urdf_rs::Robot,
+    file: &str,
+    opts: &UrdfOptions,
+) -> Result<UrdfImport, K> {
+    opts.check()?;
+    let mut notes = Notes::default();
+    let r = resolve(robot, opts, &mut notes)?;
+    let wheel = match &opts.base {
+        UrdfBase::Wheeled(w) => Some((w, wheeled::wheel_geometry(w, &r, &mut notes)?)),
+        UrdfBase::Fixed => None,
+    };
+    let mut ir = Ir::new(opts.gravity);
+    let base = match &wheel {
+        Some((w, wg)) => wheeled::add_base(&mut ir, w, wg, &r)?,
+        None => {
+            ir.links.push(Link {
+                name: r.tree.link(r.cut.top).name.clone(),
+                mount: None,
+                body: None,
+            });
+            ir.ir_index.insert(r.cut.top, 0);
+            Base::Fixed
+        }
+    };
+    add_moving_joints(&mut ir, &r);
+    add_bodies(&mut ir, &r, matches!(base, Base::Fixed), &mut notes)?;
+    let model = assemble(ir, base, robot, file, opts)?;
+    Ok(UrdfImport {
+        model,
+        notes: notes.finish(),
+    })
+}
+
+/// The URDF with the options applied: what is kept, where the base is, the joint origins, the
+/// link inertials and the rigid clusters.
+pub(super) struct Resolved<'a> {
+    /// The URDF's link/joint graph.
+    pub(super) tree: Tree<'a>,
+    /// Per link: removed by [`UrdfOptions::drop_links`].
+    pub(super) dropped: Vec<bool>,
+    /// The top of the kept tree, the body link and the wheels.
+    pub(super) cut: BaseCut,
+    /// The kept links, depth first from the top (wheel subtrees included, dropped links not).
+    kept: Vec<usize>,
+    /// Per joint: its origin, for the joints above the kept links other than the top.
+    pub(super) origin: Vec<Option<Tf>>,
+    /// Per kept link: its inertial data (`None` without mass or when dropped as absurd).
+    pub(super) inertial: Vec<Option<Inertial>>,
+    /// The rigid clusters (links joined by fixed joints).
+    pub(super) clusters: Clusters,
+}
+
+/// Applies the options to the URDF's tree: dropped links, the base cut, the checks of the kept
+/// joints, the joint origins, the link inertials and the rigid clusters.
+fn resolve<'a>(
+    robot: &'a urdf_rs::Robot,
+    opts: &UrdfOptions,
+    notes: &mut Notes,
+) -> Result<Resolved<'a>, K> {
+    let tree = Tree::new(robot)?;
+    let n = robot.links.len();
+    let root = tree.root()?;
+    let dropped = dropped_links(&tree, root, opts, notes)?;
+    let cut = match &opts.base {
+        UrdfBase::Wheeled(w) => BaseCut::wheeled(w, &tree, &dropped, notes)?,
+        UrdfBase::Fixed => BaseCut::fixed(root, n),
+    };
+    let kept = tree.preorder(cut.top, &|k| !dropped[tree.child_of(k)]);
+    check_joints(
+        &tree,
+        &kept,
+        &cut,
+        matches!(opts.base, UrdfBase::Wheeled(_)),
+    )?;
+
+    // Joint origins (snapping noted once per joint).
+    let mut origin: Vec<Option<Tf>> = vec![None; robot.joints.len()];
+    for &l in &kept {
+        if l == cut.top {
+            continue;
+        }
+        let k = tree.parent_joint[l].expect("non-top link has a joint");
+        let j = tree.joint(k);
+        origin[k] = Some(pose_tf(
+            &j.origin,
+            opts.snap_angles,
+            &format!("joint `{}` <origin>", j.name),
+            notes,
+        ));
+    }
+
+    // Per-link inertials (checks of the options included).
+    let mut inertial: Vec<Option<Inertial>> = vec![None; n];
+    for &l in &kept {
+        inertial[l] = link_inertial(tree.link(l), opts, notes)?;
+    }
+
+    let clusters = Clusters::new(&tree, &kept, cut.top, cut.body, &origin);
+    Ok(Resolved {
+        tree,
+        dropped,
+        cut,
+        kept,
+        origin,
+        inertial,
+        clusters,
+    })
+}
+
+/// Per link: is it removed by [`UrdfOptions::drop_links`] (with its subtree)? One note per listed
+/// link.
+fn dropped_links(
+    tree: &Tree<'_>,
+    root: usize,
+    opts: &UrdfOptions,
+    notes: &mut Notes,
+) -> Result<Vec<bool>, K> {
+    let mut dropped = vec![false; tree.parent_joint.len()];
+    for name in &opts.drop_links {
+        let Some(&i) = tree.index.get(name.as_str()) else {
+            return Err(bad_option(
+                "drop_links",
+                format!("the URDF has no link `{name}`; list existing link names"),
+            ));
+        };
+        if i == root {
+            return Err(bad_option(
+                "drop_links",
+                format!("`{name}` is the root link and cannot be dropped"),
+            ));
+        }
+        let sub = tree.preorder(i, &|_| true);
+        let names: Vec<&str> = sub.iter().map(|&l| tree.link(l).name.as_str()).collect();
+        let mass: f64 = sub.iter().map(|&l| tree.link(l).inertial.mass.value).sum();
+        notes.push(format!(
+            "dropped (drop_links): {} ({mass} kg in all)",
+            names.join(", ")
+        ));
+        for l in sub {
+            dropped[l] = true;
+        }
+    }
+    Ok(dropped)
+}
+
+/// Checks the joints above the kept links (other than the top and the wheel joints), in file
+/// order: supported kinds, no `<mimic>`, finite numbers, a nonzero axis for moving joints.
+fn check_joints(tree: &Tree<'_>, kept: &[usize], cut: &BaseCut, wheeled: bool) -> Result<(), K> {
+    let mut is_kept = vec![false; tree.parent_joint.len()];
+    for &l in kept {
+        is_kept[l] = true;
+    }
+    for (k, j) in tree.joints().iter().enumerate() {
+        let c = tree.child_of(k);
+        if !is_kept[c] || c == cut.top || cut.wheel_joints.contains(&k) {
+            continue;
+        }
+        use urdf_rs::JointType as J;
+        match j.joint_type {
+            J::Floating | J::Planar | J::Spherical => {
+                let fix = match (&j.joint_type, wheeled) {
+                    (J::Spherical, _) => "model it as three revolute joints with massless links between them, or make it fixed".to_owned(),
+                    (_, false) => "the generator has fixed and two-wheeled bases: make it fixed, or declare a wheeled base (UrdfBase::Wheeled) whose body link hangs from it".to_owned(),
+                    (_, true) => "only the joint directly above the wheeled base's body link (through fixed joints) is replaced by the base; make this one fixed".to_owned(),
+                };
+                return Err(K::UrdfUnsupportedJoint {
+                    joint: j.name.clone(),
+                    kind: type_name(&j.joint_type).into(),
+                    fix,
+                });
+            }
+            _ => {}
+        }
+        if let Some(mimic) = &j.mimic
+            && is_moving(&j.joint_type)
+        {
+            return Err(K::UrdfUnsupportedJoint {
+                joint: j.name.clone(),
+                kind: "mimic".into(),
+                fix: format!(
+                    "the joint copies `{}` (<mimic>), a constraint the generator cannot represent; remove <mimic> to make it an independent coordinate, or make it fixed",
+                    mimic.joint
+                ),
+            });
+        }
+        let axis = j.axis.xyz.0;
+        if !finite3(j.origin.xyz.0) || !finite3(j.origin.rpy.0) || !finite3(axis) {
+            return Err(K::UrdfBadNumber {
+                element: format!("joint `{}` <origin>/<axis>", j.name),
+                attribute: "xyz/rpy".into(),
+                text: format!("{:?} {:?} {:?}", j.origin.xyz.0, j.origin.rpy.0, axis),
+                expected: "finite numbers".into(),
+            });
+        }
+        if is_moving(&j.joint_type) && Vector3::from(axis).norm() == 0.0 {
+            return Err(K::Invalid {
+                item: format!("URDF joint `{}`", j.name),
+                detail: "<axis xyz=\"0 0 0\"> has no direction; give a nonzero axis".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The IR under construction.
+pub(super) struct Ir {
+    /// Parameters; the first is the gravity magnitude `g`.
+    params: Vec<Param>,
+    /// Generalized speeds in the order of `u`.
+    pub(super) speeds: Vec<Speed>,
+    /// Frames, parents first.
+    pub(super) links: Vec<Link>,
+    /// The IR frame of each URDF link that is one (the representatives of the rigid clusters).
+    pub(super) ir_index: HashMap<usize, usize>,
+    /// The gravity magnitude `g`.
+    gravity: ParamId,
+}
+
+impl Ir {
+    /// No frames or speeds yet; the parameter `g` with the default value `gravity`.
+    fn new(gravity: f64) -> Self {
+        let mut ir = Self {
+            params: Vec::new(),
+            speeds: Vec::new(),
+            links: Vec::new(),
+            ir_index: HashMap::new(),
+            gravity: 0,
+        };
+        ir.gravity = ir.param("g".into(), gravity, ParamKind::Gravity);
+        ir
+    }
+
+    /// Adds a parameter (`-0.0` stored as `0.0`) and returns its index.
+    pub(super) fn param(&mut self, name: String, value: f64, kind: ParamKind) -> ParamId {
+        self.params.push(Param {
+            name,
+            value: if value == 0.0 { 0.0 } else { value },
+            kind,
+        });
+        self.params.len() - 1
+    }
+}
+
+/// Adds a frame, a joint and a speed per moving URDF joint, depth first; each joint hangs from
+/// the frame of its parent link's rigid cluster.
+fn add_moving_joints(ir: &mut Ir, r: &Resolved<'_>) {
+    let (tree, cl) = (&r.tree, &r.clusters);
+    for &l in &r.kept {
+        if l == r.cut.top || r.cut.wheel_part[l] {
+            continue;
+        }
+        let k = tree.parent_joint[l].expect("joint");
+        let j = tree.joint(k);
+        if !is_moving(&j.joint_type) {
+            continue;
+        }
+        let p = tree.parent_of(k);
+        let t = cl.in_rep(p).then(&r.origin[k].expect("origin"));
+        let axis = Vector3::from(j.axis.xyz.0).normalize();
+        let speed = ir.speeds.len();
+        ir.speeds.push(Speed {
+            name: sanitize_identifier(&format!("qd_{}", j.name)),
+            coordinate: sanitize_identifier(&format!("q_{}", j.name)),
+        });
+        ir.ir_index.insert(l, ir.links.len());
+        ir.links.push(Link {
+            name: tree.link(l).name.clone(),
+            mount: Some(Mount {
+                parent: ir.ir_index[&cl.rep(p)],
+                joint: Joint {
+                    name: j.name.clone(),
+                    kind: if j.joint_type == urdf_rs::JointType::Prismatic {
+                        JointKind::Prismatic { speed }
+                    } else {
+                        JointKind::Revolute { speed }
+                    },
+                    axis: [axis.x, axis.y, axis.z].map(clean),
+                    rotation: rows(&t.r),
+                    translation: numbers(t.p),
+                },
+            }),
+            body: None,
+        });
+    }
+}
+
+/// Gives each frame the body of its rigid cluster: the merged inertia of its links about the
+/// frame, with a note per merge. Links fixed to a fixed base frame carry no dynamics (a note).
+fn add_bodies(ir: &mut Ir, r: &Resolved<'_>, fixed_base: bool, notes: &mut Notes) -> Result<(), K> {
+    let (tree, cl) = (&r.tree, &r.clusters);
+    let mut members: HashMap<usize, Vec<usize>> = HashMap::new();
+    for &l in &r.kept {
+        if !r.cut.wheel_part[l] {
+            members.entry(cl.rep(l)).or_default().push(l);
+        }
+    }
+    let mut body_names: HashSet<String> = HashSet::new();
+    let mut rep_of_ir: Vec<Option<usize>> = vec![None; ir.links.len()];
+    for (&rep, &i) in &ir.ir_index {
+        rep_of_ir[i] = Some(rep);
+    }
+    for (li, rep) in rep_of_ir.into_iter().enumerate() {
+        let Some(rep) = rep else {
+            continue;
+        };
+        let group = &members[&rep];
+        let items: Vec<(Tf, Inertial)> = group
+            .iter()
+            .filter_map(|&l| r.inertial[l].map(|i| (cl.in_rep(l), i)))
+            .collect();
+        let mass: f64 = items.iter().map(|(_, i)| i.m).sum();
+        let others: Vec<&str> = group
+            .iter()
+            .filter(|&&l| l != rep)
+            .map(|&l| tree.link(l).name.as_str())
+            .collect();
+        if fixed_base && li == 0 {
+            if !others.is_empty() || mass > 0.0 {
+                notes.push(format!(
+                    "fixed to the base frame `{}` (no effect on the dynamics, {mass} kg ignored): {}",
+                    tree.link(rep).name,
+                    group
+                        .iter()
+                        .map(|&l| tree.link(l).name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+            }
+            continue;
+        }
+        if !others.is_empty() {
+            notes.push(format!(
+                "merged into `{}` through fixed joints: {}",
+                tree.link(rep).name,
+                others.join(", ")
+            ));
+        }
+        if items.is_empty() || mass == 0.0 {
+            continue;
+        }
+        let (m, ms, j) = merge(&items);
+        let link_name = &tree.link(rep).name;
+        let s = sanitize_identifier(link_name);
+        if !body_names.insert(s.clone()) {
+            return Err(K::Duplicate {
+                what: "body name (link name sanitised to an identifier)",
+                name: s,
+            });
+        }
+        let mut sym = |prefix: &str, v: f64| {
+            let name = sanitize_identifier(&format!("{prefix}_{link_name}"));
+            ir.param(name, v, ParamKind::Inertial)
+        };
+        let body = Body {
+            name: s,
+            mass: sym("m", m),
+            first_moment: [sym("MX", ms.x), sym("MY", ms.y), sym("MZ", ms.z)],
+            inertia: [
+                sym("XX", j[(0, 0)]),
+                sym("XY", j[(0, 1)]),
+                sym("XZ", j[(0, 2)]),
+                sym("YY", j[(1, 1)]),
+                sym("YZ", j[(1, 2)]),
+                sym("ZZ", j[(2, 2)]),
+            ],
+        };
+        ir.links[li].body = Some(body);
+    }
+    Ok(())
+}
+
+/// The model from the IR: distinct coordinate identifiers, name and description, and the checks
+/// of a TOML model (unit axes, proper rotations, positive masses, physical inertias).
+fn assemble(
+    ir: Ir,
+    base: Base,
+    robot: &urdf_rs::Robot,
+    file: &str,
+    opts: &UrdfOptions,
+) -> Result<Model, K> {
+    // Generated identifiers must be distinct (index constants are the upper-cased coordinates).
+    let mut seen: HashMap<String, &str> = HashMap::new();
+    for s in &ir.speeds {
+        if let Some(first) = seen.insert(s.coordinate.to_uppercase(), &s.coordinate) {
+            return Err(K::Duplicate {
+                what: "coordinate (joint names sanitised and compared case-insensitively)",
+                name: format!("{first} / {}", s.coordinate),
+            });
+        }
+    }
+    let name = opts.name.clone().unwrap_or_else(|| robot.name.clone());
+    let description = format!(
+        "imported from URDF robot `{}`: {} speeds, {} base",
+        robot.name,
+        ir.speeds.len(),
+        match base {
+            Base::Fixed => "fixed",
+            Base::Wheeled(_) => "two-wheeled",
+        }
+    );
+    let model = Model {
+        name,
+        description,
+        source: file.to_owned(),
+        params: ir.params,
+        speeds: ir.speeds,
+        links: ir.links,
+        base,
+        gravity: Gravity {
+            symbol: ir.gravity,
+            direction: opts.gravity_direction,
+        },
+    };
+    for (_, _, m) in model.mounted_links() {
+        validate::check_axis(&m.joint.name, m.joint.axis)?;
+        validate::check_rotation(&m.joint.name, &m.joint.rotation)?;
+    }
+    validate::check_physics(&model)?;
+    Ok(model)
+}

@@ -3,24 +3,10 @@
 //! [`expr`](crate::expr) (listings) and by [`emit`](crate::emit) (Rust source), so that a
 //! listing and the generated code use the same names.
 
-/// A model name as a Rust identifier: ASCII letters, digits and `_` are kept, every other
-/// character becomes `_`, and a name that is empty or starts with a digit gets a leading `_`
-/// (keywords are made raw identifiers by the emitter).
+/// A model name as a Rust identifier: the one sanitiser of the workspace,
+/// [`kanegen_model::sanitize_identifier`] (keywords are made raw identifiers by the emitter).
 pub fn identifier(name: &str) -> String {
-    let mut s: String = name
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) {
-        s.insert(0, '_');
-    }
-    s
+    kanegen_model::sanitize_identifier(name)
 }
 
 /// Name of the acceleration of a speed: `qd_imu` → `qdd_imu`, `xd` → `xdd`, `psid` → `psidd`.

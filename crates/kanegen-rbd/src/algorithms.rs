@@ -151,6 +151,11 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
     }
 
     /// Recursive Newton–Euler. `UD`: include `u̇`; `GRAV`: include gravity.
+    ///
+    /// One function of ~125 lines on purpose: the forward and backward passes share per-link
+    /// temporaries that the optimiser keeps in registers, and this is the benchmark baseline
+    /// whose speed the README's tables report (helpers would need `#[inline(always)]` and
+    /// re-measurement to be an equal baseline).
     #[inline(always)]
     fn rnea<const UD: bool, const GRAV: bool>(
         &self,

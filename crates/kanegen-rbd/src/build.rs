@@ -141,10 +141,31 @@ fn s3<T: Scalar>(j: &Matrix3<T>) -> S3<T> {
     ]
 }
 
-pub(crate) fn build<const N: usize, T: Scalar>(
-    model: &Model,
-    params: &[T],
-) -> Result<Rbd<N, T>, RbdError> {
+/// Which speeds some joint (or the wheeled base) drives; each exactly once.
+struct Driven(Vec<bool>);
+
+impl Driven {
+    fn drive(&mut self, s: usize, who: &str) -> Result<(), RbdError> {
+        if s >= self.0.len() || self.0[s] {
+            return Err(RbdError::BadSpeeds {
+                detail: format!("{who}: speed index {s} is out of range or driven twice"),
+            });
+        }
+        self.0[s] = true;
+        Ok(())
+    }
+
+    fn check_all(&self, model: &Model) -> Result<(), RbdError> {
+        match self.0.iter().position(|d| !d) {
+            Some(s) => Err(RbdError::BadSpeeds {
+                detail: format!("speed `{}` is driven by no joint", model.speeds[s].name),
+            }),
+            None => Ok(()),
+        }
+    }
+}
+
+fn check_sizes<const N: usize>(model: &Model, params: usize) -> Result<(), RbdError> {
     if model.dof() != N {
         return Err(RbdError::DofMismatch {
             model: model.name.clone(),
@@ -152,30 +173,24 @@ pub(crate) fn build<const N: usize, T: Scalar>(
             requested: N,
         });
     }
-    if params.len() != model.params.len() {
+    if params != model.params.len() {
         return Err(RbdError::ParamCount {
             expected: model.params.len(),
-            given: params.len(),
+            given: params,
         });
     }
+    Ok(())
+}
+
+/// The moving links (fixed joints merged into the moving link or root they hang from, every
+/// moving frame turned so that its axis is `+z`) and the bodies rigidly attached to the root.
+fn moving_links<T: Scalar>(
+    model: &Model,
+    params: &[T],
+    driven: &mut Driven,
+) -> Result<(Vec<Proto<T>>, Inertial<T>), RbdError> {
     let cv = |x: f64| -> T { nalgebra::convert(x) };
     let param = |id: usize| -> T { params[id] };
-    let bad = |link: &str, detail: String| RbdError::BadTree {
-        link: link.to_owned(),
-        detail,
-    };
-
-    let mut driven = vec![false; N];
-    let mut drive = |s: usize, who: &str| -> Result<(), RbdError> {
-        if s >= N || driven[s] {
-            return Err(RbdError::BadSpeeds {
-                detail: format!("{who}: speed index {s} is out of range or driven twice"),
-            });
-        }
-        driven[s] = true;
-        Ok(())
-    };
-
     // For each model link: the moving link (or ROOT) it is rigidly attached to, and the
     // transform x_that = A x_this + t into that link's +z-axis frame.
     let mut eff: Vec<(usize, Matrix3<f64>, Vector3<T>)> = Vec::with_capacity(model.links.len());
@@ -198,7 +213,7 @@ pub(crate) fn build<const N: usize, T: Scalar>(
                 match joint.kind {
                     JointKind::Fixed => eff.push((r_par, a_par * a0, p_eff)),
                     JointKind::Revolute { speed: s } | JointKind::Prismatic { speed: s } => {
-                        drive(s, &format!("joint `{}`", joint.name))?;
+                        driven.drive(s, &format!("joint `{}`", joint.name))?;
                         let axis = classify(joint.axis);
                         let c = canonical_frame(axis, joint.axis);
                         protos.push(Proto {
@@ -215,10 +230,11 @@ pub(crate) fn build<const N: usize, T: Scalar>(
                 }
             }
             _ => {
-                return Err(bad(
-                    &link.name,
-                    "links must be in topological order with links[0] the only root".into(),
-                ));
+                return Err(RbdError::BadTree {
+                    link: link.name.clone(),
+                    detail: "links must be in topological order with links[0] the only root"
+                        .into(),
+                });
             }
         }
         if let Some(b) = &link.body {
@@ -239,39 +255,42 @@ pub(crate) fn build<const N: usize, T: Scalar>(
             }
         }
     }
+    Ok((protos, root_body))
+}
 
-    let wheels = match &model.base {
-        Base::Fixed => None,
-        Base::Wheeled(w) => {
-            drive(w.x_speed, "the wheeled base's x speed")?;
-            drive(w.psi_speed, "the wheeled base's psi speed")?;
-            let (r, l, mw, yy, zz) = (
-                param(w.radius),
-                param(w.track),
-                param(w.wheel_mass),
-                param(w.wheel_axle_inertia),
-                param(w.wheel_diametral_inertia),
-            );
-            let two = cv(2.0);
-            Some(Wheels {
-                x: w.x_speed,
-                psi: w.psi_speed,
-                m_xx: two * mw + two * yy / (r * r),
-                m_psipsi: mw * l * l / two + yy * l * l / (two * r * r) + two * zz,
-            })
-        }
+/// The constant wheel terms of a wheeled base.
+fn wheels<T: Scalar>(
+    model: &Model,
+    params: &[T],
+    driven: &mut Driven,
+) -> Result<Option<Wheels<T>>, RbdError> {
+    let Base::Wheeled(w) = &model.base else {
+        return Ok(None);
     };
-    if let Some(s) = driven.iter().position(|d| !d) {
-        return Err(RbdError::BadSpeeds {
-            detail: format!("speed `{}` is driven by no joint", model.speeds[s].name),
-        });
-    }
+    driven.drive(w.x_speed, "the wheeled base's x speed")?;
+    driven.drive(w.psi_speed, "the wheeled base's psi speed")?;
+    let param = |id: usize| -> T { params[id] };
+    let (r, l, mw, yy, zz) = (
+        param(w.radius),
+        param(w.track),
+        param(w.wheel_mass),
+        param(w.wheel_axle_inertia),
+        param(w.wheel_diametral_inertia),
+    );
+    let two: T = nalgebra::convert(2.0);
+    Ok(Some(Wheels {
+        x: w.x_speed,
+        psi: w.psi_speed,
+        m_xx: two * mw + two * yy / (r * r),
+        m_psipsi: mw * l * l / two + yy * l * l / (two * r * r) + two * zz,
+    }))
+}
 
-    // Subtree masses.
-    let nl = protos.len();
+/// Subtree masses of the moving links, and the root's.
+fn subtree_masses<T: Scalar>(protos: &[Proto<T>], root_body: &Inertial<T>) -> (Vec<T>, T) {
     let mut mc: Vec<T> = protos.iter().map(|p| p.body.m).collect();
     let mut mc_root = root_body.m;
-    for j in (0..nl).rev() {
+    for j in (0..protos.len()).rev() {
         match protos[j].parent {
             ROOT => mc_root += mc[j],
             p => {
@@ -280,9 +299,59 @@ pub(crate) fn build<const N: usize, T: Scalar>(
             }
         }
     }
+    (mc, mc_root)
+}
 
+/// The hot-path data of a moving link: its rotation kind (signed permutations are applied
+/// without forming the matrix), offset, body and subtree mass.
+fn link_data<T: Scalar>(p: &Proto<T>, j: usize, mc: T) -> LinkData<T> {
+    let cv = |x: f64| -> T { nalgebra::convert(x) };
     let z = T::zero();
-    let blank = LinkData {
+    let (kind, g, sym_sign) = match signed_perm(&p.a) {
+        Some((idx, sign)) => {
+            // Row a of R = A' Rot_z is sign[a] times row idx[a] of Rot_z.
+            let mut rows = [0; 3];
+            let mut g = [z; 3];
+            for a in 0..3 {
+                rows[idx[a]] = a;
+                g[idx[a]] = cv(sign[a]);
+            }
+            let mut sym_sign = [z; 6];
+            for (k, (a, b)) in [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)]
+                .into_iter()
+                .enumerate()
+            {
+                sym_sign[k] = cv(sign[a] * sign[b]);
+            }
+            (RotKind::from_rows(rows), g, sym_sign)
+        }
+        None => (RotKind::General, [cv(1.0); 3], [cv(1.0); 6]),
+    };
+    let pv = v3(&p.p);
+    LinkData {
+        parent: p.parent,
+        chain: p.parent != ROOT && p.parent + 1 == j,
+        speed: p.speed,
+        prismatic: p.prismatic,
+        a: m3(&p.a),
+        kind,
+        g,
+        sym_sign,
+        p: pv,
+        offset: p.prismatic || pv.iter().any(|x| *x != z),
+        m: p.body.m,
+        h: v3(&p.body.h),
+        j: s3(&p.body.j),
+        mc,
+        mc_p: v3(&(p.p * mc)),
+        half_mc_p: v3(&(p.p * (mc * cv(0.5)))),
+    }
+}
+
+/// A link with every field zero (the unused tail of the fixed-size link array).
+fn blank_link<T: Scalar>() -> LinkData<T> {
+    let z = T::zero();
+    LinkData {
         parent: ROOT,
         chain: false,
         speed: 0,
@@ -299,53 +368,15 @@ pub(crate) fn build<const N: usize, T: Scalar>(
         mc: z,
         mc_p: [z; 3],
         half_mc_p: [z; 3],
-    };
-    let mut links = [blank; N];
-    let mut axes = [Axis::PosZ; N];
-    let half = cv(0.5);
-    for (j, p) in protos.iter().enumerate() {
-        let (kind, g, sym_sign) = match signed_perm(&p.a) {
-            Some((idx, sign)) => {
-                // Row a of R = A' Rot_z is sign[a] times row idx[a] of Rot_z.
-                let mut rows = [0; 3];
-                let mut g = [z; 3];
-                for a in 0..3 {
-                    rows[idx[a]] = a;
-                    g[idx[a]] = cv(sign[a]);
-                }
-                let mut sym_sign = [z; 6];
-                for (k, (a, b)) in [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)]
-                    .into_iter()
-                    .enumerate()
-                {
-                    sym_sign[k] = cv(sign[a] * sign[b]);
-                }
-                (RotKind::from_rows(rows), g, sym_sign)
-            }
-            None => (RotKind::General, [cv(1.0); 3], [cv(1.0); 6]),
-        };
-        let pv = v3(&p.p);
-        links[j] = LinkData {
-            parent: p.parent,
-            chain: p.parent != ROOT && p.parent + 1 == j,
-            speed: p.speed,
-            prismatic: p.prismatic,
-            a: m3(&p.a),
-            kind,
-            g,
-            sym_sign,
-            p: pv,
-            offset: p.prismatic || pv.iter().any(|x| *x != z),
-            m: p.body.m,
-            h: v3(&p.body.h),
-            j: s3(&p.body.j),
-            mc: mc[j],
-            mc_p: v3(&(p.p * mc[j])),
-            half_mc_p: v3(&(p.p * (mc[j] * half))),
-        };
-        axes[j] = p.axis;
     }
-    // Ancestor lists for the CRBA (nearest first), plus the base speeds of a wheeled base.
+}
+
+/// Ancestor lists for the CRBA (nearest first), plus the base speeds of a wheeled base.
+fn ancestor_lists<const N: usize, T: Scalar>(
+    links: &[LinkData<T>; N],
+    nl: usize,
+    wheels: Option<&Wheels<T>>,
+) -> ([[AncEntry; N]; N], [usize; N]) {
     let mut anc = [[AncEntry::default(); N]; N];
     let mut anc_len = [0; N];
     let entry = |k: usize, sk: usize, sj: usize| AncEntry {
@@ -361,15 +392,37 @@ pub(crate) fn build<const N: usize, T: Scalar>(
             list.push(entry(k, links[k].speed, sj));
             k = links[k].parent;
         }
-        if let Some(w) = &wheels {
+        if let Some(w) = wheels {
             list.push(entry(nl, w.x, sj));
             list.push(entry(nl + 1, w.psi, sj));
         }
         anc_len[j] = list.len();
         anc[j][..list.len()].copy_from_slice(&list);
     }
+    (anc, anc_len)
+}
+
+pub(crate) fn build<const N: usize, T: Scalar>(
+    model: &Model,
+    params: &[T],
+) -> Result<Rbd<N, T>, RbdError> {
+    check_sizes::<N>(model, params.len())?;
+    let mut driven = Driven(vec![false; N]);
+    let (protos, root_body) = moving_links(model, params, &mut driven)?;
+    let wheels = wheels(model, params, &mut driven)?;
+    driven.check_all(model)?;
+    let nl = protos.len();
+    let (mc, mc_root) = subtree_masses(&protos, &root_body);
+    let mut links = [blank_link(); N];
+    let mut axes = [Axis::PosZ; N];
+    for (j, p) in protos.iter().enumerate() {
+        links[j] = link_data(p, j, mc[j]);
+        axes[j] = p.axis;
+    }
+    let (anc, anc_len) = ancestor_lists(&links, nl, wheels.as_ref());
+    let cv = |x: f64| -> T { nalgebra::convert(x) };
     let g = model.gravity.direction.map(cv);
-    let gm = param(model.gravity.symbol);
+    let gm = params[model.gravity.symbol];
     Ok(Rbd {
         nl,
         links,

@@ -232,8 +232,7 @@ fn moving_links<T: Scalar>(
             _ => {
                 return Err(RbdError::BadTree {
                     link: link.name.clone(),
-                    detail: "links must be in topological order with links[0] the only root"
-                        .into(),
+                    detail: "links must be in topological order with links[0] the only root".into(),
                 });
             }
         }

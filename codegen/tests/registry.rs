@@ -1,0 +1,178 @@
+//! The function registry: a module gets exactly the functions asked for, through every stage
+//! (derivation, lowering, free functions, wrapper methods, runtime traits, stats, CLI).
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use kanegen::model::{UrdfOptions, WheeledBaseSpec};
+use kanegen::registry::FUNCTIONS;
+use kanegen::{Builder, FunctionId, FunctionSet, Options, generate};
+
+fn models() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models")
+}
+
+fn kanegen(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_kanegen"))
+        .args(args)
+        .current_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .output()
+        .expect("the CLI runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn a_module_gets_only_the_functions_asked_for() {
+    let set: FunctionSet = [FunctionId::MassMatrix, FunctionId::Gravity]
+        .into_iter()
+        .collect();
+    let options = Options {
+        functions: set,
+        ..Options::default()
+    };
+    let g = generate(models().join("two-link.toml"), options).unwrap();
+    let ids: Vec<FunctionId> = g.derivation.functions.iter().map(|f| f.id).collect();
+    assert_eq!(ids, [FunctionId::MassMatrix, FunctionId::Gravity]);
+    let ids: Vec<FunctionId> = g.lowered.functions.iter().map(|f| f.id).collect();
+    assert_eq!(ids, [FunctionId::MassMatrix, FunctionId::Gravity]);
+    for spec in &FUNCTIONS {
+        let free = format!("pub fn {}(", spec.name);
+        let method = format!("pub fn {}(\n            &self", spec.name);
+        let has = set.contains(spec.id);
+        assert_eq!(g.source.contains(&free), has, "{}", spec.name);
+        assert_eq!(
+            g.source.contains(&method) || g.source.contains(&format!("pub fn {}(&self", spec.name)),
+            has,
+            "wrapper method {}",
+            spec.name
+        );
+        assert_eq!(
+            kanegen::stats(&g).contains(spec.name),
+            has,
+            "stats row {}",
+            spec.name
+        );
+    }
+    // M, c, g and τ together make `RobotDynamics`: without c and τ the wrapper does not claim it.
+    assert!(!g.source.contains("RobotDynamics"));
+    let full = generate(models().join("two-link.toml"), Options::default()).unwrap();
+    assert!(
+        full.source
+            .contains("impl kanegen_runtime::RobotDynamics<DOF> for TwoLink")
+    );
+    assert!(
+        full.source
+            .contains("impl kanegen_runtime::CoriolisMatrix<DOF> for TwoLink")
+    );
+}
+
+#[test]
+fn functions_derived_without_the_mass_matrix_compute_the_same_values() {
+    let set: FunctionSet = [FunctionId::Gravity, FunctionId::CoriolisMatrix]
+        .into_iter()
+        .collect();
+    let part = generate(
+        models().join("krang.toml"),
+        Options {
+            functions: set,
+            ..Options::default()
+        },
+    )
+    .unwrap();
+    let full = generate(models().join("krang.toml"), Options::default()).unwrap();
+    let params = full.model.param_values();
+    let q: Vec<f64> = (0..19).map(|i| 0.13 * i as f64 - 0.9).collect();
+    let u: Vec<f64> = (0..19).map(|i| 0.4 - 0.03 * i as f64).collect();
+    let ud = vec![0.0; 19];
+    for id in set.iter() {
+        let a = part.lowered.evaluate(id, &params, &q, &u, &ud);
+        let b = full.lowered.evaluate(id, &params, &q, &u, &ud);
+        let scale = b.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() <= 1e-13 * scale, "{id}: {x} vs {y}");
+        }
+    }
+}
+
+#[test]
+fn coriolis_matrix_switch_is_the_registry_entry() {
+    let dir = std::env::temp_dir().join(format!("kanegen-registry-{}", std::process::id()));
+    let a = Builder::new(models().join("two-link.toml"))
+        .coriolis_matrix(false)
+        .out_dir(&dir)
+        .output("a.rs")
+        .build()
+        .unwrap();
+    let b = Builder::new(models().join("two-link.toml"))
+        .functions(FunctionSet::default().without(FunctionId::CoriolisMatrix))
+        .out_dir(&dir)
+        .output("b.rs")
+        .build()
+        .unwrap();
+    let (a, b) = (
+        std::fs::read_to_string(a).unwrap(),
+        std::fs::read_to_string(b).unwrap(),
+    );
+    assert_eq!(a, b);
+    assert!(!a.contains("coriolis_matrix"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn cli_reads_urdf_with_the_builders_import_options() {
+    let (ok, stats, err) = kanegen(&["stats", "models/singlearm.urdf"]);
+    assert!(ok, "{err}");
+    assert!(
+        stats.contains("7 speeds") && stats.contains("coriolis_matrix"),
+        "{stats}"
+    );
+
+    let (ok, cli, err) = kanegen(&[
+        "emit",
+        "models/Krang.urdf",
+        "--wheeled",
+        "JLWheel,JRWheel,Base",
+        "--up",
+        "0,1,0",
+        "--radius",
+        "0.25",
+        "--pitch-name",
+        "imu",
+        "--drop-links",
+        "lgPlate1,lgPlate2,rgPlate1,rgPlate2",
+        "--functions",
+        "gravity",
+    ]);
+    assert!(ok, "{err}");
+    let mut base = WheeledBaseSpec::new("JLWheel", "JRWheel", "Base", [0.0, 1.0, 0.0], 0.25);
+    base.pitch_name = "imu".into();
+    let options =
+        UrdfOptions::wheeled(base).drop_links(["lgPlate1", "lgPlate2", "rgPlate1", "rgPlate2"]);
+    let built = Builder::urdf(models().join("Krang.urdf"), options)
+        .functions([FunctionId::Gravity].into_iter().collect())
+        .generate()
+        .unwrap();
+    assert_eq!(cli, built.source);
+    assert!(cli.contains("// URDF import notes:"));
+    assert!(cli.contains("pub fn gravity(") && !cli.contains("pub fn mass_matrix("));
+}
+
+#[test]
+fn cli_rejects_unknown_functions_and_urdf_options_on_toml() {
+    let (ok, _, err) = kanegen(&["stats", "models/two-link.toml", "--functions", "jacobian"]);
+    assert!(!ok);
+    assert!(
+        err.contains("unknown function `jacobian`") && err.contains("mass_matrix"),
+        "{err}"
+    );
+    let (ok, _, err) = kanegen(&["stats", "models/two-link.toml", "--wheeled", "a,b,c"]);
+    assert!(!ok);
+    assert!(err.contains(".urdf"), "{err}");
+    let (ok, _, err) = kanegen(&["stats", "models/singlearm.urdf", "--radius", "0.2"]);
+    assert!(!ok);
+    assert!(err.contains("--wheeled"), "{err}");
+}

@@ -15,7 +15,7 @@ use std::fmt;
 use crate::expr::{Arena, Atom, ExprId, Node, VarKind};
 use crate::kane::{Derivation, Function};
 use crate::options::ParamMode;
-use crate::registry::{FunctionId, Shape};
+use crate::registry::FunctionId;
 
 /// A leaf of a lowered expression.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -206,7 +206,7 @@ impl Lowered {
 
 /// Lower every function of a derivation.
 pub fn lower(d: &Derivation) -> Lowered {
-    let hoist = d.options.params == ParamMode::Runtime;
+    let hoist = d.options.params.is_runtime();
     let mut pre = PreSet::default();
     let functions: Vec<FunctionProgram> = d
         .functions
@@ -629,7 +629,6 @@ impl Lowered {
             .function(id)
             .unwrap_or_else(|| panic!("the lowered model has no function `{id}`"));
         let locals = run(p, params, &pre, q, u, ud);
-        let n = self.dof;
         let ctx = EvalCtx {
             params,
             pre: &pre,
@@ -638,31 +637,8 @@ impl Lowered {
             ud,
             locals: &locals,
         };
-        match id.spec().shape {
-            Shape::SymmetricMatrix => {
-                let mut m = vec![0.0; n * n];
-                for (r, c, e) in &p.outputs {
-                    let v = ctx.eval(e);
-                    m[r * n + c] = v;
-                    m[c * n + r] = v;
-                }
-                m
-            }
-            Shape::Matrix => {
-                let mut m = vec![0.0; n * n];
-                for (r, c, e) in &p.outputs {
-                    m[r * n + c] = ctx.eval(e);
-                }
-                m
-            }
-            Shape::Vector => {
-                let mut v = vec![0.0; n];
-                for (r, _, e) in &p.outputs {
-                    v[*r] = ctx.eval(e);
-                }
-                v
-            }
-        }
+        let entries = p.outputs.iter().map(|(r, c, e)| (*r, *c, ctx.eval(e)));
+        id.spec().shape.dense(self.dof, entries)
     }
 }
 

@@ -50,6 +50,29 @@ pub enum Inputs {
     QUUd,
 }
 
+impl Shape {
+    /// The dense value of a result of this shape with `n` speeds from its entries: a row-major
+    /// `n × n` matrix (both triangles of a symmetric one) or an `n`-vector.
+    pub fn dense(
+        self,
+        n: usize,
+        entries: impl IntoIterator<Item = (usize, usize, f64)>,
+    ) -> Vec<f64> {
+        let mut out = vec![0.0; if self == Shape::Vector { n } else { n * n }];
+        for (r, c, v) in entries {
+            match self {
+                Shape::SymmetricMatrix => {
+                    out[r * n + c] = v;
+                    out[c * n + r] = v;
+                }
+                Shape::Matrix => out[r * n + c] = v,
+                Shape::Vector => out[r] = v,
+            }
+        }
+        out
+    }
+}
+
 impl Inputs {
     /// Whether the function reads the speeds `u`.
     pub fn needs_u(self) -> bool {

@@ -57,7 +57,7 @@ use kanegen_model::{Model, ParamKind};
 
 use crate::expr::{Arena, ExprId, Names};
 use crate::options::Options;
-use crate::registry::{FunctionId, Shape};
+use crate::registry::FunctionId;
 
 use algebra::{M3, V3};
 use composite::Composite;
@@ -68,7 +68,7 @@ use composite::Composite;
 pub struct Function {
     /// Which function.
     pub id: FunctionId,
-    /// `(row, col, expr)` in the layout of the function's [`Shape`]; col = 0 for vectors.
+    /// `(row, col, expr)` in the layout of the function's [`Shape`](crate::registry::Shape); col = 0 for vectors.
     pub entries: Vec<(usize, usize, ExprId)>,
     /// Per arena node, when this function's derivation first asked for it (`u32::MAX`: never):
     /// the statement order the lowering follows (see [`Arena::begin_phase`]).
@@ -214,30 +214,7 @@ impl Derivation {
             .function(id)
             .unwrap_or_else(|| panic!("the derivation has no function `{id}`"));
         let vals = self.arena.eval(&crate::expr::Values { params, q, u, ud });
-        let n = self.dof;
-        match id.spec().shape {
-            Shape::SymmetricMatrix => {
-                let mut m = vec![0.0; n * n];
-                for &(r, c, e) in &f.entries {
-                    m[r * n + c] = vals[e.index()];
-                    m[c * n + r] = vals[e.index()];
-                }
-                m
-            }
-            Shape::Matrix => {
-                let mut m = vec![0.0; n * n];
-                for &(r, c, e) in &f.entries {
-                    m[r * n + c] = vals[e.index()];
-                }
-                m
-            }
-            Shape::Vector => {
-                let mut v = vec![0.0; n];
-                for &(r, _, e) in &f.entries {
-                    v[r] = vals[e.index()];
-                }
-                v
-            }
-        }
+        let entries = f.entries.iter().map(|&(r, c, e)| (r, c, vals[e.index()]));
+        id.spec().shape.dense(self.dof, entries)
     }
 }

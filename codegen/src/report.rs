@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use crate::Generated;
 use crate::expr::{Atom, ExprId, VarKind};
 use crate::lower::Program;
-use crate::registry::Shape;
+use crate::registry::{Dim, Shape};
 
 /// A per-function summary: K/D counts and op counts, as printed by `kanegen stats`.
 pub fn stats(g: &Generated) -> String {
@@ -97,10 +97,13 @@ pub fn listing(g: &Generated) -> String {
         }
         for &(r, c, e) in &f.entries {
             let lhs = match spec.shape {
-                Shape::SymmetricMatrix | Shape::Matrix => {
-                    format!("{}({},{})", spec.symbol, r + 1, c + 1)
-                }
-                Shape::Vector => format!("{}({})", spec.symbol, r + 1),
+                Shape::Scalar => spec.symbol.to_owned(),
+                Shape::Vector
+                | Shape::Dense {
+                    cols: Dim::Fixed(1),
+                    ..
+                } => format!("{}({})", spec.symbol, r + 1),
+                _ => format!("{}({},{})", spec.symbol, r + 1, c + 1),
             };
             let _ = writeln!(s, "{lhs} = {};", d.arena.display(e));
         }

@@ -151,6 +151,60 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
                 value,
             }
         }
+        Shape::Dense { rows, cols } => {
+            let (r, c) = (idx(rows.size(cx.low.dof)), idx(cols.size(cx.low.dof)));
+            for (r, c, e) in nonzero {
+                let v = printer.expr(e, false);
+                let (r, c) = (idx(*r), idx(*c));
+                stores[last_local(e).map_or(0, |i| i + 1)].extend(quote!(m[(#r, #c)] = #v;));
+            }
+            Result {
+                ty: result_type(cx, shape),
+                init: quote!(let mut m = SMatrix::<#t, #r, #c>::zeros();),
+                stores,
+                value: quote!(m),
+            }
+        }
+        Shape::Scalar => {
+            // The one entry is the function's value, after every statement.
+            let value = p.outputs.first().map_or_else(
+                || printer.expr(&LExpr::Leaf(Leaf::Const(0.0)), false),
+                |(_, _, e)| printer.expr(e, false),
+            );
+            Result {
+                ty: result_type(cx, shape),
+                init: TokenStream::new(),
+                stores,
+                value,
+            }
+        }
+        Shape::Isometry => {
+            for (r, c, e) in nonzero {
+                let v = printer.expr(e, false);
+                let store = if *c < 3 {
+                    let (r, c) = (idx(*r), idx(*c));
+                    quote!(rot[(#r, #c)] = #v;)
+                } else {
+                    let r = idx(*r);
+                    quote!(pos[#r] = #v;)
+                };
+                stores[last_local(e).map_or(0, |i| i + 1)].extend(store);
+            }
+            Result {
+                ty: result_type(cx, shape),
+                init: quote! {
+                    let mut rot = nalgebra::Matrix3::<#t>::zeros();
+                    let mut pos = nalgebra::Vector3::<#t>::zeros();
+                },
+                stores,
+                value: quote!(nalgebra::Isometry3::from_parts(
+                    nalgebra::Translation3::from(pos),
+                    nalgebra::UnitQuaternion::from_rotation_matrix(
+                        &nalgebra::Rotation3::from_matrix_unchecked(rot),
+                    ),
+                )),
+            }
+        }
         Shape::Vector => {
             for (r, _, e) in nonzero {
                 let v = printer.expr(e, false);
@@ -169,6 +223,20 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
                 value: quote!(out),
             }
         }
+    }
+}
+
+/// The Rust type of a result of `shape` (`SMatrix<f64, 19, 19>`, `SVector<f64, 3>`, `f64`,
+/// `nalgebra::Isometry3<f64>`).
+pub(super) fn result_type(cx: &Context<'_>, shape: Shape) -> TokenStream {
+    let t = scalar_type(cx.precision);
+    let (rows, cols) = shape.size(cx.low.dof);
+    let (r, c) = (idx(rows), idx(cols));
+    match shape {
+        Shape::Scalar => quote!(#t),
+        Shape::Isometry => quote!(nalgebra::Isometry3<#t>),
+        _ if cols == 1 => quote!(SVector<#t, #r>),
+        _ => quote!(SMatrix<#t, #r, #c>),
     }
 }
 

@@ -5,7 +5,7 @@
 use proc_macro2::{Ident, TokenStream};
 use quote::quote;
 
-use super::function::{state_args, uses};
+use super::function::{result_type, state_args, uses};
 use super::print::{Printer, ident, idx, signed_lit};
 use super::{Context, file_name, scalar_type};
 use crate::lower::{Leaf, Program};
@@ -175,12 +175,7 @@ fn arg_names(inputs: Inputs) -> TokenStream {
 
 /// The return type of a registry function.
 fn return_type(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
-    let t = scalar_type(cx.precision);
-    let nl = idx(cx.low.dof);
-    match spec.shape {
-        crate::registry::Shape::Vector => quote!(SVector<#t, #nl>),
-        _ => quote!(SMatrix<#t, #nl, #nl>),
-    }
+    result_type(cx, spec.shape)
 }
 
 /// A call of the free function of `spec` from a method of the wrapper.

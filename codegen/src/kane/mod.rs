@@ -38,6 +38,7 @@
 //! | `gravity.rs` | g |
 //! | `rnea.rs` | c and τ: forward motion pass, body inertia forces, backward accumulation |
 //! | `coriolis_matrix.rs` | C: frame velocities, subtree momenta and inertia rates, columns |
+//! | `kinematics.rs` | frames in frame 0 (`⁰A`, `⁰p`), centre of mass, its Jacobian and bias acceleration, energies |
 //!
 //! The arena records the order in which each phase first asks for a node and the lowering
 //! schedules statements in that order: moving arena calls around changes the generated code.
@@ -50,6 +51,7 @@ mod composite;
 mod coriolis_matrix;
 mod frames;
 mod gravity;
+mod kinematics;
 mod mass_matrix;
 mod rnea;
 
@@ -113,13 +115,19 @@ pub fn names_of(model: &Model) -> Names {
 /// backward composite pass, each right after its subtree's composite is complete, so that the
 /// generated code uses values soon after it computes them (short live ranges, fewer register
 /// spills); g and C reuse those composites. The order fixes the arena's numbering and with it the
-/// generated code, so it is part of the output's definition.
-const DERIVATION_ORDER: [FunctionId; 5] = [
+/// generated code, so it is part of the output's definition. The opt-in kinematics come last, so
+/// that they do not change the dynamics' code.
+const DERIVATION_ORDER: [FunctionId; 10] = [
     FunctionId::MassMatrix,
     FunctionId::Gravity,
     FunctionId::Coriolis,
     FunctionId::InverseDynamics,
     FunctionId::CoriolisMatrix,
+    FunctionId::CenterOfMass,
+    FunctionId::ComJacobian,
+    FunctionId::ComBiasAcceleration,
+    FunctionId::KineticEnergy,
+    FunctionId::PotentialEnergy,
 ];
 
 /// Derive the functions of `options.functions` for `model` (M as its upper triangle).
@@ -132,6 +140,8 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
         options,
         rot: vec![None; model.links.len()],
         pos: vec![None; model.links.len()],
+        root_rot: vec![None; model.links.len()],
+        root_pos: vec![None; model.links.len()],
     };
     let n = model.dof();
     let mut composites = None;
@@ -148,7 +158,10 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
         functions.push(Function { id, entries, order });
     }
     functions.sort_by_key(|f| f.id);
-    debug_assert!(functions.iter().all(|f| f.entries.iter().all(|e| e.0 < n)));
+    debug_assert!(functions.iter().all(|f| {
+        let (rows, cols) = f.id.spec().shape.size(n);
+        f.entries.iter().all(|e| e.0 < rows && e.1 < cols)
+    }));
     Derivation {
         arena,
         functions,
@@ -184,6 +197,23 @@ impl Ctx<'_> {
                 let comp = composites.get_or_insert_with(|| self.composites(true, None));
                 self.coriolis_matrix(comp)
             }
+            FunctionId::CenterOfMass => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                vector(self.center_of_mass(comp).to_vec())
+            }
+            FunctionId::ComJacobian => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                self.com_jacobian(comp)
+            }
+            FunctionId::ComBiasAcceleration => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                vector(self.com_bias_acceleration(comp).to_vec())
+            }
+            FunctionId::KineticEnergy => vec![(0, 0, self.kinetic_energy())],
+            FunctionId::PotentialEnergy => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                vec![(0, 0, self.potential_energy(comp))]
+            }
         }
     }
 }
@@ -196,11 +226,17 @@ struct Ctx<'a> {
     options: Options,
     rot: Vec<Option<M3>>,
     pos: Vec<Option<V3>>,
+    /// `⁰A_l(q)`: the rotation of frame l relative to frame 0, cached.
+    root_rot: Vec<Option<M3>>,
+    /// `⁰p_l(q)`: the origin of frame l in frame 0, cached.
+    #[allow(dead_code)] // read by the frame functions
+    root_pos: Vec<Option<V3>>,
 }
 
 impl Derivation {
     /// Evaluate function `id` numerically from the symbolic expressions (no code generation):
-    /// a dense row-major `n × n` matrix (both triangles) or an `n`-vector. Parameter values are
+    /// the row-major dense value of its [`Shape`](crate::registry::Shape) (an `n × n` matrix
+    /// with both triangles, an `n`-vector, a `3 × n` Jacobian, a scalar, …). Parameter values are
     /// used in [`ParamMode::Runtime`](crate::options::ParamMode::Runtime); in baked mode the model's values are already folded in.
     pub fn evaluate(
         &self,

@@ -36,6 +36,12 @@ pub enum FunctionId {
     KineticEnergy,
     /// Potential energy V(q).
     PotentialEnergy,
+    /// Pose of a body frame relative to frame 0.
+    FramePose,
+    /// Jacobian of a body frame (linear velocity of its origin, angular velocity).
+    FrameJacobian,
+    /// Acceleration of a body frame at `u̇ = 0`.
+    FrameBiasAcceleration,
 }
 
 /// One dimension of a [`Shape::Dense`] result: the number of speeds N, or a constant.
@@ -178,10 +184,13 @@ pub struct FunctionSpec {
     pub default: bool,
     /// The runtime trait it implements, if any.
     pub runtime_trait: Option<RuntimeTrait>,
+    /// Whether it takes a body frame (`frame: Frame`): one straight-line program per frame of
+    /// the model and a dispatcher.
+    pub per_frame: bool,
 }
 
 /// The registry, in the order generated modules define the functions.
-pub const FUNCTIONS: [FunctionSpec; 10] = [
+pub const FUNCTIONS: [FunctionSpec; 13] = [
     FunctionSpec {
         id: FunctionId::MassMatrix,
         name: "mass_matrix",
@@ -191,6 +200,7 @@ pub const FUNCTIONS: [FunctionSpec; 10] = [
         shape: Shape::SymmetricMatrix,
         default: true,
         runtime_trait: Some(RuntimeTrait::RobotDynamics),
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::Coriolis,
@@ -201,6 +211,7 @@ pub const FUNCTIONS: [FunctionSpec; 10] = [
         shape: Shape::Vector,
         default: true,
         runtime_trait: Some(RuntimeTrait::RobotDynamics),
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::Gravity,
@@ -211,6 +222,7 @@ pub const FUNCTIONS: [FunctionSpec; 10] = [
         shape: Shape::Vector,
         default: true,
         runtime_trait: Some(RuntimeTrait::RobotDynamics),
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::InverseDynamics,
@@ -221,6 +233,7 @@ pub const FUNCTIONS: [FunctionSpec; 10] = [
         shape: Shape::Vector,
         default: true,
         runtime_trait: Some(RuntimeTrait::RobotDynamics),
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::CoriolisMatrix,
@@ -231,6 +244,7 @@ pub const FUNCTIONS: [FunctionSpec; 10] = [
         shape: Shape::Matrix,
         default: true,
         runtime_trait: Some(RuntimeTrait::CoriolisMatrix),
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::CenterOfMass,
@@ -244,6 +258,7 @@ pub const FUNCTIONS: [FunctionSpec; 10] = [
         },
         default: false,
         runtime_trait: None,
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::ComJacobian,
@@ -257,6 +272,7 @@ pub const FUNCTIONS: [FunctionSpec; 10] = [
         },
         default: false,
         runtime_trait: None,
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::ComBiasAcceleration,
@@ -270,6 +286,7 @@ pub const FUNCTIONS: [FunctionSpec; 10] = [
         },
         default: false,
         runtime_trait: None,
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::KineticEnergy,
@@ -280,6 +297,7 @@ pub const FUNCTIONS: [FunctionSpec; 10] = [
         shape: Shape::Scalar,
         default: false,
         runtime_trait: None,
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::PotentialEnergy,
@@ -290,12 +308,52 @@ pub const FUNCTIONS: [FunctionSpec; 10] = [
         shape: Shape::Scalar,
         default: false,
         runtime_trait: None,
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::FramePose,
+        name: "frame_pose",
+        symbol: "T0",
+        doc: "Pose of a body frame relative to frame 0 (for a wheeled base: the heading frame at the axle midpoint; x and ψ do not enter).",
+        inputs: Inputs::Q,
+        shape: Shape::Isometry,
+        default: false,
+        runtime_trait: None,
+        per_frame: true,
+    },
+    FunctionSpec {
+        id: FunctionId::FrameJacobian,
+        name: "frame_jacobian",
+        symbol: "J",
+        doc: "Jacobian of a body frame: rows 0–2 the velocity of its origin, rows 3–5 its angular velocity, relative to the ground, in frame 0's axes, as `J u`.",
+        inputs: Inputs::Q,
+        shape: Shape::Dense {
+            rows: Dim::Fixed(6),
+            cols: Dim::N,
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: true,
+    },
+    FunctionSpec {
+        id: FunctionId::FrameBiasAcceleration,
+        name: "frame_bias_acceleration",
+        symbol: "a0",
+        doc: "Classical acceleration of a body frame's origin (rows 0–2) and its angular acceleration (rows 3–5) at `u̇ = 0`, relative to the ground, in frame 0's axes: the acceleration is `J u̇ + bias`.",
+        inputs: Inputs::QU,
+        shape: Shape::Dense {
+            rows: Dim::Fixed(6),
+            cols: Dim::Fixed(1),
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: true,
     },
 ];
 
 impl FunctionId {
     /// Every function, in registry order.
-    pub const ALL: [FunctionId; 10] = [
+    pub const ALL: [FunctionId; 13] = [
         FunctionId::MassMatrix,
         FunctionId::Coriolis,
         FunctionId::Gravity,
@@ -306,6 +364,9 @@ impl FunctionId {
         FunctionId::ComBiasAcceleration,
         FunctionId::KineticEnergy,
         FunctionId::PotentialEnergy,
+        FunctionId::FramePose,
+        FunctionId::FrameJacobian,
+        FunctionId::FrameBiasAcceleration,
     ];
 
     /// The registry entry.

@@ -62,7 +62,7 @@ pub fn stats(g: &Generated) -> String {
         row("precompute (once)", &g.lowered.precompute);
     }
     for f in &g.lowered.functions {
-        row(f.id.name(), &f.program);
+        row(&f.program.name, &f.program);
     }
     s
 }
@@ -82,7 +82,11 @@ pub fn listing(g: &Generated) -> String {
         let spec = f.id.spec();
         let roots: Vec<ExprId> = f.entries.iter().map(|e| e.2).collect();
         let needed = d.arena.reachable_vars(&roots);
-        let _ = writeln!(s, "\n% ---- {} ----", spec.name);
+        match f.frame {
+            Some(l) => writeln!(s, "\n% ---- {} [{}] ----", spec.name, d.frame_names[l]),
+            None => writeln!(s, "\n% ---- {} ----", spec.name),
+        }
+        .expect("writing to a String");
         for (i, info) in d.arena.vars().iter().enumerate() {
             if needed[i] && !shown[i] {
                 shown[i] = true;

@@ -8,7 +8,11 @@
 //! * along a trajectory `q(t) = q + u t + ½ u̇ t²` (and, for the wheeled base, the ground
 //!   position of frame 0 integrated from `ẋ` and `ψ`), `J u` is the time derivative of the
 //!   centre of mass in the ground frame and `J u̇ + bias` its second derivative (both rotated
-//!   into frame 0's axes).
+//!   into frame 0's axes);
+//! * every body frame's pose equals the reference's frames, its Jacobian times `u` and its bias
+//!   equal the reference's velocities and accelerations, and along a trajectory `J u` is the
+//!   derivative of the frame's ground pose (origin and rotation) and `J u̇ + bias` the second
+//!   derivative.
 
 use kanegen::model::{Model, UrdfOptions};
 use kanegen::{FunctionId, FunctionSet, Generated, Options, generate_model};
@@ -98,16 +102,31 @@ impl Case {
 
     /// Function `id` through the lowered programs, checked against the derivation's evaluator.
     fn eval(&self, id: FunctionId, q: &[f64], u: &[f64], ud: &[f64]) -> Vec<f64> {
+        self.eval_at(id, None, q, u, ud)
+    }
+
+    /// [`Case::eval`] for body frame `frame` of a per-frame function.
+    fn eval_at(
+        &self,
+        id: FunctionId,
+        frame: Option<usize>,
+        q: &[f64],
+        u: &[f64],
+        ud: &[f64],
+    ) -> Vec<f64> {
         // The derivation's evaluator computes every node: inputs the function does not read
         // are zeros.
         let zero = vec![0.0; self.dof()];
         let u = if u.is_empty() { &zero[..] } else { u };
         let ud = if ud.is_empty() { &zero[..] } else { ud };
-        let low = self.generated.lowered.evaluate(id, &self.params, q, u, ud);
+        let low = self
+            .generated
+            .lowered
+            .evaluate_at(id, frame, &self.params, q, u, ud);
         let sym = self
             .generated
             .derivation
-            .evaluate(id, &self.params, q, u, ud);
+            .evaluate_at(id, frame, &self.params, q, u, ud);
         let err = rel_err(&low, &sym, 1.0);
         assert!(
             err < 1e-11,
@@ -282,6 +301,122 @@ fn com_jacobian_and_bias_are_the_derivatives_of_the_ground_com() {
             assert!(err < 1e-5, "{}: J u vs d/dt CoM {err:e}", c.name);
             let err = (jud + bias - acc).abs().max() / acc.abs().max().max(1.0);
             assert!(err < 1e-4, "{}: J u̇ + bias vs d²/dt² CoM {err:e}", c.name);
+        }
+    }
+}
+
+/// The pose `(⁰A, ⁰p)` of frame `l` from `frame_pose` (row-major `[R | p]`).
+fn pose(c: &Case, l: usize, q: &[f64]) -> (Matrix3<f64>, Vector3<f64>) {
+    let x = c.eval_at(FunctionId::FramePose, Some(l), q, &[], &[]);
+    let r = Matrix3::from_fn(|i, j| x[i * 4 + j]);
+    (r, Vector3::new(x[3], x[7], x[11]))
+}
+
+/// `(J_v u, J_ω u)` of frame `l` for speeds `x`.
+fn twist(c: &Case, l: usize, q: &[f64], x: &[f64]) -> (Vector3<f64>, Vector3<f64>) {
+    let j = c.eval_at(FunctionId::FrameJacobian, Some(l), q, &[], &[]);
+    let t = mul(&j, x, 6);
+    (v3(&t[..3]), v3(&t[3..]))
+}
+
+fn close(a: Vector3<f64>, b: Vector3<f64>, tol: f64) -> bool {
+    (a - b).abs().max() <= tol * b.abs().max().max(1.0)
+}
+
+#[test]
+fn frames_match_the_reference_recursion() {
+    for mut c in cases() {
+        for _ in 0..5 {
+            let (q, u, ud) = c.state();
+            let zero = vec![0.0; c.dof()];
+            let states = c.reference.frame_states(&q, &u, &zero);
+            for (l, s) in states.iter().enumerate() {
+                let (r, p) = pose(&c, l, &q);
+                let name = &c.model.links[l].name;
+                assert!(
+                    (r - s.rotation).abs().max() < 1e-12,
+                    "{} {name}: rotation",
+                    c.name
+                );
+                assert!(close(p, s.position, 1e-12), "{} {name}: position", c.name);
+                let (v, w) = twist(&c, l, &q, &u);
+                assert!(
+                    close(v, s.rotation * s.velocity, 1e-11),
+                    "{} {name}: J_v u",
+                    c.name
+                );
+                assert!(
+                    close(w, s.rotation * s.omega, 1e-11),
+                    "{} {name}: J_ω u",
+                    c.name
+                );
+                let b = c.eval_at(FunctionId::FrameBiasAcceleration, Some(l), &q, &u, &ud);
+                let (a, al) = (s.rotation * s.acceleration, s.rotation * s.alpha);
+                assert!(
+                    close(v3(&b[..3]), a, 1e-11),
+                    "{} {name}: linear bias",
+                    c.name
+                );
+                assert!(
+                    close(v3(&b[3..]), al, 1e-11),
+                    "{} {name}: angular bias",
+                    c.name
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn frame_jacobians_and_biases_are_the_derivatives_of_the_ground_pose() {
+    for mut c in cases() {
+        for _ in 0..3 {
+            let (q, u, ud) = c.state();
+            let h = 1e-3;
+            let (_, psi) = c.base_at(&q, &u, &ud, 0.0);
+            let back = rz(psi).transpose();
+            for l in 0..c.model.links.len() {
+                let name = &c.model.links[l].name;
+                // The origin in the ground frame.
+                let origin = |t: f64| {
+                    let (qt, _) = at(&q, &u, &ud, t);
+                    c.to_ground(&q, &u, &ud, t, pose(&c, l, &qt).1)
+                };
+                let (vel, acc) = derivatives(h, origin);
+                let (v, _) = twist(&c, l, &q, &u);
+                let (jv, jw) = twist(&c, l, &q, &ud);
+                let b = c.eval_at(FunctionId::FrameBiasAcceleration, Some(l), &q, &u, &[]);
+                assert!(close(v, back * vel, 1e-5), "{} {name}: J_v u", c.name);
+                assert!(
+                    close(jv + v3(&b[..3]), back * acc, 1e-4),
+                    "{} {name}: a",
+                    c.name
+                );
+                // The rotation in the ground frame: ω× = Ṙ Rᵀ.
+                let rot = |t: f64| {
+                    let (qt, _) = at(&q, &u, &ud, t);
+                    let (_, psi) = c.base_at(&q, &u, &ud, t);
+                    rz(psi) * pose(&c, l, &qt).0
+                };
+                let h1 = h / 10.0;
+                let wx = (rot(h1) - rot(-h1)) / (2.0 * h1) * rot(0.0).transpose();
+                let omega = Vector3::new(wx[(2, 1)], wx[(0, 2)], wx[(1, 0)]);
+                let (_, w) = twist(&c, l, &q, &u);
+                assert!(close(w, back * omega, 1e-5), "{} {name}: J_ω u", c.name);
+                // α: the derivative of the ground angular velocity.
+                let ground_omega = |t: f64| {
+                    let (qt, ut) = at(&q, &u, &ud, t);
+                    let (_, psi) = c.base_at(&q, &u, &ud, t);
+                    rz(psi) * twist(&c, l, &qt, &ut).1
+                };
+                // A first derivative: a smaller step (its error is O(h²), its rounding O(ε/h)).
+                let (alpha, _) = derivatives(h / 10.0, ground_omega);
+                assert!(
+                    close(jw + v3(&b[3..]), back * alpha, 1e-5),
+                    "{} {name}: α",
+                    c.name
+                );
+            }
         }
     }
 }

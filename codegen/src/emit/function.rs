@@ -107,6 +107,11 @@ struct Result {
     value: TokenStream,
 }
 
+/// `mut` for a result binding that is stored to, nothing for one that stays zero.
+fn binding(stored: bool) -> TokenStream {
+    if stored { quote!(mut) } else { quote!() }
+}
+
 /// Every result entry is stored right after the last statement it reads, so that values leave
 /// registers as soon as they are final (the programs are long; register pressure is what limits
 /// their speed).
@@ -153,6 +158,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
         }
         Shape::Dense { rows, cols } => {
             let (r, c) = (idx(rows.size(cx.low.dof)), idx(cols.size(cx.low.dof)));
+            let mutable = binding(nonzero.clone().next().is_some());
             for (r, c, e) in nonzero {
                 let v = printer.expr(e, false);
                 let (r, c) = (idx(*r), idx(*c));
@@ -160,7 +166,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
             }
             Result {
                 ty: result_type(cx, shape),
-                init: quote!(let mut m = SMatrix::<#t, #r, #c>::zeros();),
+                init: quote!(let #mutable m = SMatrix::<#t, #r, #c>::zeros();),
                 stores,
                 value: quote!(m),
             }
@@ -179,6 +185,8 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
             }
         }
         Shape::Isometry => {
+            let rot_mut = binding(nonzero.clone().any(|(_, c, _)| *c < 3));
+            let pos_mut = binding(nonzero.clone().any(|(_, c, _)| *c == 3));
             for (r, c, e) in nonzero {
                 let v = printer.expr(e, false);
                 let store = if *c < 3 {
@@ -193,8 +201,8 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
             Result {
                 ty: result_type(cx, shape),
                 init: quote! {
-                    let mut rot = nalgebra::Matrix3::<#t>::zeros();
-                    let mut pos = nalgebra::Vector3::<#t>::zeros();
+                    let #rot_mut rot = nalgebra::Matrix3::<#t>::zeros();
+                    let #pos_mut pos = nalgebra::Vector3::<#t>::zeros();
                 },
                 stores,
                 value: quote!(nalgebra::Isometry3::from_parts(
@@ -250,8 +258,14 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         pre: &cx.pre,
         precision: cx.precision,
     };
-    let fname = ident(spec.name);
-    let doc = format!(" {}", spec.doc);
+    let fname = ident(&super::frames::rust_name(cx, f));
+    let doc = match f.frame {
+        Some(l) => format!(
+            " {} Frame `{}` (see [`Frame`]).",
+            spec.doc, cx.model.links[l].name
+        ),
+        None => format!(" {}", spec.doc),
+    };
     let ops = format!(" Generated straight-line code: {}.", p.ops);
     let param_args = if cx.low.params.is_runtime() {
         let pname = if uses(p, &|l| matches!(l, Leaf::Param(_))) {

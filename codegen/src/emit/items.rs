@@ -165,7 +165,7 @@ pub(super) fn precomputed(cx: &Context<'_>) -> TokenStream {
 }
 
 /// The argument names of a function with `inputs`, as passed on by a wrapper.
-fn arg_names(inputs: Inputs) -> TokenStream {
+pub(super) fn arg_names(inputs: Inputs) -> TokenStream {
     match inputs {
         Inputs::Q => quote!(q),
         Inputs::QU => quote!(q, u),
@@ -181,7 +181,10 @@ fn return_type(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
 /// A call of the free function of `spec` from a method of the wrapper.
 fn forward_call(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
     let f = ident(spec.name);
-    let args = arg_names(spec.inputs);
+    let mut args = arg_names(spec.inputs);
+    if spec.per_frame {
+        args.extend(quote!(, frame));
+    }
     if cx.low.params.is_runtime() {
         quote!(#f(&self.params, &self.pre, #args))
     } else {
@@ -194,11 +197,16 @@ fn methods(cx: &Context<'_>) -> TokenStream {
     cx.low
         .functions
         .iter()
+        // One method per function (a per-frame function has one program per frame).
+        .filter(|f| f.frame.is_none_or(|l| l == 0))
         .map(|f| {
             let spec = f.id.spec();
             let name = ident(spec.name);
             let doc = format!(" {}", spec.doc);
-            let (args, _) = state_args(cx, spec.inputs);
+            let (mut args, _) = state_args(cx, spec.inputs);
+            if spec.per_frame {
+                args.extend(quote!(, frame: Frame));
+            }
             let ret = return_type(cx, spec);
             let call = forward_call(cx, spec);
             quote! {

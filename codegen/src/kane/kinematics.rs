@@ -53,7 +53,6 @@ impl Ctx<'_> {
     }
 
     /// `⁰p_l(q)`: the origin of frame `l` in frame 0, cached as K variables `0P{l}`.
-    #[allow(dead_code)] // read by the frame functions
     pub(super) fn root_position(&mut self, l: usize) -> V3 {
         if let Some(p) = self.root_pos[l] {
             return p;
@@ -193,5 +192,73 @@ impl Ctx<'_> {
         let v = self.dot(&g0, &comp[0].first_moment);
         let v = self.ar.neg(v);
         self.finish(vec![v], "V")[0]
+    }
+
+    /// The pose of frame `l` relative to frame 0 ([`Shape::Isometry`](crate::registry::Shape)
+    /// entries): `(r, c)` of `⁰A_l` and `(r, 3)` of `⁰p_l`.
+    pub(super) fn frame_pose(&mut self, l: usize) -> Vec<(usize, usize, ExprId)> {
+        let a = self.root_rotation(l);
+        let p = self.root_position(l);
+        (0..3)
+            .flat_map(|r| (0..3).map(move |c| (r, c, a[r][c])).chain([(r, 3, p[r])]))
+            .collect()
+    }
+
+    /// The Jacobian of frame `l`, `(row, col, expr)`: rows 0–2 the partial velocities of its
+    /// origin, rows 3–5 its partial angular velocities, in frame 0's axes. A revolute joint k on
+    /// the path to the root gives `(⁰e_k × (⁰p_l − ⁰p_k); ⁰e_k)`, a prismatic one `(⁰e_k; 0)`
+    /// with `⁰e_k = ⁰A_k e_k`; the wheeled base's `ẋ` column is `([1, 0, 0]; 0)` and its `ψ̇`
+    /// column `(ẑ × ⁰p_l; ẑ)`.
+    pub(super) fn frame_jacobian(&mut self, l: usize) -> Vec<(usize, usize, ExprId)> {
+        let model = self.model;
+        let p = self.root_position(l);
+        let (zero, one) = (self.ar.zero(), self.ar.one());
+        let mut entries = Vec::new();
+        let mut column = |col: usize, lin: V3, ang: V3| {
+            let rows = lin.into_iter().chain(ang).enumerate();
+            entries.extend(rows.map(|(r, e)| (r, col, e)));
+        };
+        for (k, mount) in model.path_to_base(l) {
+            let Some(col) = mount.joint.speed() else {
+                continue;
+            };
+            let e = self.axis(k);
+            let a = self.root_rotation(k);
+            let e0 = self.rot_up(&a, &e);
+            if let JointKind::Prismatic { .. } = mount.joint.kind {
+                column(col, e0, [zero; 3]);
+            } else {
+                let pk = self.root_position(k);
+                let d = self.sub3(&p, &pk);
+                let d = self.subst3(
+                    d,
+                    VarKind::K,
+                    &format!("0P{} − 0P{}", self.link_name(l), self.link_name(k)),
+                );
+                let lin = self.cross(&e0, &d);
+                column(col, lin, e0);
+            }
+        }
+        if let Some(w) = model.wheeled_base() {
+            column(w.x_speed, [one, zero, zero], [zero; 3]);
+            let py = self.ar.neg(p[1]);
+            column(w.psi_speed, [py, p[0], zero], [zero, zero, one]);
+        }
+        entries
+    }
+
+    /// The acceleration of frame `l` at `u̇ = 0` (the motion pass of `c`: classical origin
+    /// acceleration and angular acceleration in frame `l`), rotated into frame 0's axes: rows
+    /// 0–2 linear, 3–5 angular.
+    pub(super) fn frame_bias_acceleration(&mut self, l: usize) -> Vec<(usize, usize, ExprId)> {
+        let motion = self.bias_motion();
+        let a = self.root_rotation(l);
+        let lin = self.rot_up(&a, &motion.a[l]);
+        let ang = self.rot_up(&a, &motion.wd[l]);
+        lin.into_iter()
+            .chain(ang)
+            .enumerate()
+            .map(|(r, e)| (r, 0, e))
+            .collect()
     }
 }

@@ -83,7 +83,6 @@ impl Ctx<'_> {
 
     /// Every frame's motion at `u̇ = 0` without gravity (the variables `c` uses): `(ω, α, a)`
     /// of each frame in its own axes; `a` is the classical acceleration of its origin.
-    #[allow(dead_code)] // read by the frame functions
     pub(super) fn bias_motion(&mut self) -> Motion {
         let inputs = Inputs::new(false, false);
         let mut motion = self.base_motion(inputs);

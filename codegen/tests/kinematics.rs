@@ -420,3 +420,37 @@ fn frame_jacobians_and_biases_are_the_derivatives_of_the_ground_pose() {
         }
     }
 }
+
+/// A point mass `δm` at the origin of frame `l` (the body's mass grows, its first moment about
+/// the origin does not) adds `−J_vᵀ (δm g0)` to the reference recursion's generalized gravity
+/// forces: `Jᵀ f` for the force `f = δm g0` at the frame, an independent check of the Jacobian's
+/// columns as generalized forces.
+#[test]
+fn jacobian_transpose_maps_a_force_at_the_frame_to_generalized_forces() {
+    for mut c in cases() {
+        let n = c.dof();
+        let g0: Vec<f64> = {
+            let g = c.params[c.model.gravity.symbol];
+            c.model.gravity.direction.iter().map(|d| g * d).collect()
+        };
+        let links = c.model.links.clone();
+        for (l, link) in links.iter().enumerate() {
+            let Some(body) = &link.body else { continue };
+            let dm = 0.7;
+            let mut heavier = c.params.clone();
+            heavier[body.mass] += dm;
+            let with = Reference::with_params(&c.model, &heavier);
+            let (q, _, _) = c.state();
+            let dg: Vec<f64> = (with.gravity(&q) - c.reference.gravity(&q))
+                .iter()
+                .copied()
+                .collect();
+            let j = c.eval_at(FunctionId::FrameJacobian, Some(l), &q, &[], &[]);
+            let jtf: Vec<f64> = (0..n)
+                .map(|col| -(0..3).map(|r| j[r * n + col] * dm * g0[r]).sum::<f64>())
+                .collect();
+            let err = rel_err(&jtf, &dg, 1e-3);
+            assert!(err < 1e-10, "{} {}: Jᵀ f {err:e}", c.name, link.name);
+        }
+    }
+}

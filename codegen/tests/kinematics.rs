@@ -1,5 +1,6 @@
 //! The kinematics and energies of the registry (opt-in functions), on Krang (wheeled base), the
-//! fixed-wheel tree, the two-link model and the URDF arm, with random parameters and states,
+//! fixed-wheel tree, the two-link model, the URDF arm and a small URDF with a prismatic joint
+//! (oblique axes, tilted gravity), with random parameters and states,
 //! through the derivation's and the lowering's evaluators:
 //!
 //! * `kinetic_energy = ½ uᵀ M u` and the reference recursion's kinetic energy;
@@ -34,9 +35,39 @@ fn models_dir() -> std::path::PathBuf {
     std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models")
 }
 
+/// A small URDF with an oblique prismatic joint between oblique revolute joints, a fixed-joint
+/// merge and a tilted gravity direction.
+const SLIDER: &str = r#"<robot name="slider">
+  <link name="world"/>
+  <link name="post"><inertial><origin xyz="0 0.1 0.3" rpy="0.2 0.1 0"/><mass value="3"/>
+    <inertia ixx="0.1" ixy="0.01" ixz="0" iyy="0.12" iyz="0" izz="0.04"/></inertial></link>
+  <link name="sled"><inertial><origin xyz="0.05 0 0.02"/><mass value="1.1"/>
+    <inertia ixx="0.003" ixy="0" ixz="0" iyy="0.004" iyz="0" izz="0.002"/></inertial></link>
+  <link name="bracket"><inertial><origin xyz="0 0.02 0"/><mass value="0.3"/>
+    <inertia ixx="0.0002" ixy="0" ixz="0" iyy="0.0002" iyz="0" izz="0.0001"/></inertial></link>
+  <link name="tool"><inertial><origin xyz="0 0 0.07"/><mass value="0.5"/>
+    <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.0005"/></inertial></link>
+  <joint name="turn" type="continuous"><parent link="world"/><child link="post"/>
+    <origin xyz="0.1 0 0.2" rpy="0 0 0.4"/><axis xyz="0 0.6 0.8"/></joint>
+  <joint name="slide" type="prismatic"><parent link="post"/><child link="sled"/>
+    <origin xyz="0 0.1 0.5" rpy="0.3 0 0"/><axis xyz="1 0 1"/>
+    <limit lower="0" upper="0.5" effort="1" velocity="1"/></joint>
+  <joint name="fix" type="fixed"><parent link="sled"/><child link="bracket"/>
+    <origin xyz="0.1 0 0" rpy="0 0.5 0"/></joint>
+  <joint name="tilt" type="revolute"><parent link="bracket"/><child link="tool"/>
+    <origin xyz="0 0 0.05"/><axis xyz="0.8 0 0.6"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+</robot>"#;
+
 fn case(name: &'static str, seed: u64) -> Case {
     let path = models_dir().join(name);
-    let model = if name.ends_with(".urdf") {
+    let model = if name == "slider.urdf" {
+        let options = UrdfOptions {
+            gravity_direction: [0.0, -0.6, -0.8],
+            ..UrdfOptions::default()
+        };
+        Model::from_urdf_str(SLIDER, name, &options).expect("URDF imports")
+    } else if name.ends_with(".urdf") {
         Model::from_urdf_file(&path, &UrdfOptions::default()).expect("URDF imports")
     } else {
         Model::from_toml_file(&path).expect("model loads")
@@ -60,13 +91,14 @@ fn case(name: &'static str, seed: u64) -> Case {
     }
 }
 
-/// The four models of the tests.
+/// The models of the tests.
 fn cases() -> Vec<Case> {
     [
         "krang.toml",
         "krang-fixed-wheels.toml",
         "two-link.toml",
         "singlearm.urdf",
+        "slider.urdf",
     ]
     .into_iter()
     .enumerate()

@@ -107,6 +107,58 @@ struct Result {
     value: TokenStream,
 }
 
+/// The result entries of `p` that are not the constant zero (the result starts zeroed).
+fn nonzero_outputs(p: &Program) -> impl Iterator<Item = &(usize, usize, LExpr)> + Clone {
+    p.outputs
+        .iter()
+        .filter(|(_, _, e)| !matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0))
+}
+
+/// Add `store` to the stores placed right after the last statement `e` reads.
+fn store_after(stores: &mut [TokenStream], e: &LExpr, store: TokenStream) {
+    stores[last_local(e).map_or(0, |i| i + 1)].extend(store);
+}
+
+/// The result of an [`Shape::Isometry`] function: rotation and translation stored like a
+/// matrix's entries, then one `Isometry3` (its rotation as a unit quaternion, by
+/// `UnitQuaternion::from_rotation_matrix`).
+fn isometry(
+    cx: &Context<'_>,
+    printer: &Printer<'_>,
+    p: &Program,
+    mut stores: Vec<TokenStream>,
+) -> Result {
+    let t = scalar_type(cx.precision);
+    let nonzero: Vec<_> = nonzero_outputs(p).collect();
+    let rot_mut = binding(nonzero.iter().any(|(_, c, _)| *c < 3));
+    let pos_mut = binding(nonzero.iter().any(|(_, c, _)| *c == 3));
+    for (r, c, e) in nonzero {
+        let v = printer.expr(e, false);
+        let store = if *c < 3 {
+            let (r, c) = (idx(*r), idx(*c));
+            quote!(rot[(#r, #c)] = #v;)
+        } else {
+            let r = idx(*r);
+            quote!(pos[#r] = #v;)
+        };
+        store_after(&mut stores, e, store);
+    }
+    Result {
+        ty: result_type(cx, Shape::Isometry),
+        init: quote! {
+            let #rot_mut rot = nalgebra::Matrix3::<#t>::zeros();
+            let #pos_mut pos = nalgebra::Vector3::<#t>::zeros();
+        },
+        stores,
+        value: quote!(nalgebra::Isometry3::from_parts(
+            nalgebra::Translation3::from(pos),
+            nalgebra::UnitQuaternion::from_rotation_matrix(
+                &nalgebra::Rotation3::from_matrix_unchecked(rot),
+            ),
+        )),
+    }
+}
+
 /// `mut` for a result binding that is stored to, nothing for one that stays zero.
 fn binding(stored: bool) -> TokenStream {
     if stored { quote!(mut) } else { quote!() }
@@ -119,16 +171,13 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
     let t = scalar_type(cx.precision);
     let nl = idx(cx.low.dof);
     let mut stores: Vec<TokenStream> = vec![TokenStream::new(); p.stmts.len() + 1];
-    let nonzero = p
-        .outputs
-        .iter()
-        .filter(|(_, _, e)| !matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0));
+    let nonzero = nonzero_outputs(p);
     match shape {
         Shape::SymmetricMatrix | Shape::Matrix => {
             for (r, c, e) in nonzero {
                 let v = printer.expr(e, false);
                 let (r, c) = (idx(*r), idx(*c));
-                stores[last_local(e).map_or(0, |i| i + 1)].extend(quote!(m[(#r, #c)] = #v;));
+                store_after(&mut stores, e, quote!(m[(#r, #c)] = #v;));
             }
             // Symmetric: the lower triangle is copied at the end by a loop over the column-major
             // storage. Mirrored stores next to the computation, or unrolled copies at the end
@@ -162,7 +211,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
             for (r, c, e) in nonzero {
                 let v = printer.expr(e, false);
                 let (r, c) = (idx(*r), idx(*c));
-                stores[last_local(e).map_or(0, |i| i + 1)].extend(quote!(m[(#r, #c)] = #v;));
+                store_after(&mut stores, e, quote!(m[(#r, #c)] = #v;));
             }
             Result {
                 ty: result_type(cx, shape),
@@ -184,35 +233,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
                 value,
             }
         }
-        Shape::Isometry => {
-            let rot_mut = binding(nonzero.clone().any(|(_, c, _)| *c < 3));
-            let pos_mut = binding(nonzero.clone().any(|(_, c, _)| *c == 3));
-            for (r, c, e) in nonzero {
-                let v = printer.expr(e, false);
-                let store = if *c < 3 {
-                    let (r, c) = (idx(*r), idx(*c));
-                    quote!(rot[(#r, #c)] = #v;)
-                } else {
-                    let r = idx(*r);
-                    quote!(pos[#r] = #v;)
-                };
-                stores[last_local(e).map_or(0, |i| i + 1)].extend(store);
-            }
-            Result {
-                ty: result_type(cx, shape),
-                init: quote! {
-                    let #rot_mut rot = nalgebra::Matrix3::<#t>::zeros();
-                    let #pos_mut pos = nalgebra::Vector3::<#t>::zeros();
-                },
-                stores,
-                value: quote!(nalgebra::Isometry3::from_parts(
-                    nalgebra::Translation3::from(pos),
-                    nalgebra::UnitQuaternion::from_rotation_matrix(
-                        &nalgebra::Rotation3::from_matrix_unchecked(rot),
-                    ),
-                )),
-            }
-        }
+        Shape::Isometry => isometry(cx, printer, p, stores),
         Shape::Vector => {
             for (r, _, e) in nonzero {
                 let v = printer.expr(e, false);
@@ -221,8 +242,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
                 // entries (and the expression trees behind them) into two-lane vectors: for
                 // Krang's inverse dynamics that packing added ~25 % code of shuffles and spills
                 // and doubled the time (1.17 µs vs 0.64 µs). (Krang's c got ~5 % slower.)
-                stores[last_local(e).map_or(0, |i| i + 1)]
-                    .extend(quote!(out[#r] = core::hint::black_box(#v);));
+                store_after(&mut stores, e, quote!(out[#r] = core::hint::black_box(#v);));
             }
             Result {
                 ty: quote!(SVector<#t, #nl>),

@@ -1,6 +1,7 @@
 //! Generates, for the benchmarks (`benches/dynamics.rs`), the dynamics of the URDF robots into
 //! `$OUT_DIR`: the 7-DOF arm of `models/singlearm.urdf` (runtime parameters and baked) and Krang
-//! imported from `models/Krang.urdf` with its two-wheeled base (runtime parameters).
+//! imported from `models/Krang.urdf` with its two-wheeled base (runtime parameters); and, for
+//! `tests/kinematics.rs`, the arm and the two-link model with every registry function.
 //! The TOML Krang models come from `krang-dynamics`.
 use kanegen::model::{UrdfOptions, WheeledBaseSpec};
 
@@ -9,6 +10,22 @@ fn main() {
     let arm = || kanegen::Builder::urdf("models/singlearm.urdf", UrdfOptions::default());
     arm().output("singlearm.rs").run();
     arm().baked(true).output("singlearm_baked.rs").run();
+    // Every registry function (the opt-in kinematics and energies included), for
+    // `tests/kinematics.rs`.
+    arm()
+        .functions(kanegen::FunctionSet::all())
+        .output("singlearm_all.rs")
+        .run();
+    kanegen::Builder::new("models/two-link.toml")
+        .functions(kanegen::FunctionSet::all())
+        .output("two_link_all.rs")
+        .run();
+    kanegen::Builder::new("models/two-link.toml")
+        .functions(kanegen::FunctionSet::all())
+        .baked(true)
+        .precision(kanegen::Precision::F32)
+        .output("two_link_all_baked_f32.rs")
+        .run();
     kanegen::Builder::urdf("models/Krang.urdf", krang_urdf_options())
         .output("krang_urdf.rs")
         .run();

@@ -174,6 +174,8 @@ fn locals(e: &LExpr, out: &mut Vec<usize>) {
 pub struct FunctionProgram {
     /// Which function (its name, inputs and result shape are in the registry).
     pub id: FunctionId,
+    /// The body frame (link index) of a per-frame function, else `None`.
+    pub frame: Option<usize>,
     /// Its straight-line program; `outputs` are the entries of the result's shape.
     pub program: Program,
 }
@@ -195,11 +197,17 @@ pub struct Lowered {
 }
 
 impl Lowered {
-    /// The program of function `id`, if the module has it.
+    /// The program of function `id`, if the module has it (frame 0's of a per-frame function).
     pub fn function(&self, id: FunctionId) -> Option<&Program> {
+        self.function_at(id, None)
+    }
+
+    /// The program of function `id` for body frame `frame` (a link index; `None` for a function
+    /// without frames), if the module has it.
+    pub fn function_at(&self, id: FunctionId, frame: Option<usize>) -> Option<&Program> {
         self.functions
             .iter()
-            .find(|f| f.id == id)
+            .find(|f| f.id == id && (frame.is_none() || f.frame == frame))
             .map(|f| &f.program)
     }
 }
@@ -211,9 +219,16 @@ pub fn lower(d: &Derivation) -> Lowered {
     let functions: Vec<FunctionProgram> = d
         .functions
         .iter()
-        .map(|f| FunctionProgram {
-            id: f.id,
-            program: lower_function(&d.arena, f, hoist, &mut pre),
+        .map(|f| {
+            let mut program = lower_function(&d.arena, f, hoist, &mut pre);
+            if let Some(l) = f.frame {
+                program.name = format!("{}[{}]", f.id.name(), d.frame_names[l]);
+            }
+            FunctionProgram {
+                id: f.id,
+                frame: f.frame,
+                program,
+            }
         })
         .collect();
     let (precompute, pre_slots) = lower_precompute(&d.arena, &pre);
@@ -624,9 +639,23 @@ impl Lowered {
         u: &[f64],
         ud: &[f64],
     ) -> Vec<f64> {
+        self.evaluate_at(id, None, params, q, u, ud)
+    }
+
+    /// [`Lowered::evaluate`] for body frame `frame` (a link index) of a per-frame function
+    /// (`None`: frame 0, or a function without frames).
+    pub fn evaluate_at(
+        &self,
+        id: FunctionId,
+        frame: Option<usize>,
+        params: &[f64],
+        q: &[f64],
+        u: &[f64],
+        ud: &[f64],
+    ) -> Vec<f64> {
         let pre = self.precompute_values(params);
         let p = self
-            .function(id)
+            .function_at(id, frame)
             .unwrap_or_else(|| panic!("the lowered model has no function `{id}`"));
         let locals = run(p, params, &pre, q, u, ud);
         let ctx = EvalCtx {

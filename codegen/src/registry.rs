@@ -26,6 +26,41 @@ pub enum FunctionId {
     InverseDynamics,
     /// Coriolis matrix C(q, u).
     CoriolisMatrix,
+    /// Centre of mass of the whole robot in frame 0.
+    CenterOfMass,
+    /// Jacobian of the centre of mass (its partial velocities).
+    ComJacobian,
+    /// Acceleration of the centre of mass at `u̇ = 0`.
+    ComBiasAcceleration,
+    /// Kinetic energy T(q, u).
+    KineticEnergy,
+    /// Potential energy V(q).
+    PotentialEnergy,
+    /// Pose of a body frame relative to frame 0.
+    FramePose,
+    /// Jacobian of a body frame (linear velocity of its origin, angular velocity).
+    FrameJacobian,
+    /// Acceleration of a body frame at `u̇ = 0`.
+    FrameBiasAcceleration,
+}
+
+/// One dimension of a [`Shape::Dense`] result: the number of speeds N, or a constant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dim {
+    /// The model's number of speeds.
+    N,
+    /// A fixed size (3 for a point, 6 for a twist).
+    Fixed(usize),
+}
+
+impl Dim {
+    /// The size for a model with `n` speeds.
+    pub fn size(self, n: usize) -> usize {
+        match self {
+            Dim::N => n,
+            Dim::Fixed(k) => k,
+        }
+    }
 }
 
 /// Shape of a generated function's result.
@@ -37,6 +72,19 @@ pub enum Shape {
     Vector,
     /// General (non-symmetric) N×N matrix; entries are `(row, col)`, absent entries are zero.
     Matrix,
+    /// A `rows × cols` matrix (`SMatrix`; `SVector` when `cols` is 1); entries are
+    /// `(row, col)`, absent entries are zero.
+    Dense {
+        /// Number of rows.
+        rows: Dim,
+        /// Number of columns.
+        cols: Dim,
+    },
+    /// A scalar; its one entry is `(0, 0)`.
+    Scalar,
+    /// A rigid transform (`Isometry3`): entries `(r, c)` of the rotation for `c < 3` and the
+    /// translation as `(r, 3)`; its dense value is the row-major 3×4 matrix `[R | p]`.
+    Isometry,
 }
 
 /// Which state inputs a function takes (besides the parameters).
@@ -51,22 +99,31 @@ pub enum Inputs {
 }
 
 impl Shape {
-    /// The dense value of a result of this shape with `n` speeds from its entries: a row-major
-    /// `n × n` matrix (both triangles of a symmetric one) or an `n`-vector.
+    /// `(rows, cols)` of a result of this shape with `n` speeds (a vector is one column).
+    pub fn size(self, n: usize) -> (usize, usize) {
+        match self {
+            Shape::SymmetricMatrix | Shape::Matrix => (n, n),
+            Shape::Vector => (n, 1),
+            Shape::Dense { rows, cols } => (rows.size(n), cols.size(n)),
+            Shape::Scalar => (1, 1),
+            Shape::Isometry => (3, 4),
+        }
+    }
+
+    /// The dense value of a result of this shape with `n` speeds from its entries: its
+    /// row-major `rows × cols` matrix (both triangles of a symmetric one; an `n`-vector, a
+    /// 3-vector or a scalar for one column).
     pub fn dense(
         self,
         n: usize,
         entries: impl IntoIterator<Item = (usize, usize, f64)>,
     ) -> Vec<f64> {
-        let mut out = vec![0.0; if self == Shape::Vector { n } else { n * n }];
+        let (rows, cols) = self.size(n);
+        let mut out = vec![0.0; rows * cols];
         for (r, c, v) in entries {
-            match self {
-                Shape::SymmetricMatrix => {
-                    out[r * n + c] = v;
-                    out[c * n + r] = v;
-                }
-                Shape::Matrix => out[r * n + c] = v,
-                Shape::Vector => out[r] = v,
+            out[r * cols + c] = v;
+            if self == Shape::SymmetricMatrix {
+                out[c * cols + r] = v;
             }
         }
         out
@@ -127,10 +184,13 @@ pub struct FunctionSpec {
     pub default: bool,
     /// The runtime trait it implements, if any.
     pub runtime_trait: Option<RuntimeTrait>,
+    /// Whether it takes a body frame (`frame: Frame`): one straight-line program per frame of
+    /// the model and a dispatcher.
+    pub per_frame: bool,
 }
 
 /// The registry, in the order generated modules define the functions.
-pub const FUNCTIONS: [FunctionSpec; 5] = [
+pub const FUNCTIONS: [FunctionSpec; 13] = [
     FunctionSpec {
         id: FunctionId::MassMatrix,
         name: "mass_matrix",
@@ -140,6 +200,7 @@ pub const FUNCTIONS: [FunctionSpec; 5] = [
         shape: Shape::SymmetricMatrix,
         default: true,
         runtime_trait: Some(RuntimeTrait::RobotDynamics),
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::Coriolis,
@@ -150,6 +211,7 @@ pub const FUNCTIONS: [FunctionSpec; 5] = [
         shape: Shape::Vector,
         default: true,
         runtime_trait: Some(RuntimeTrait::RobotDynamics),
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::Gravity,
@@ -160,6 +222,7 @@ pub const FUNCTIONS: [FunctionSpec; 5] = [
         shape: Shape::Vector,
         default: true,
         runtime_trait: Some(RuntimeTrait::RobotDynamics),
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::InverseDynamics,
@@ -170,6 +233,7 @@ pub const FUNCTIONS: [FunctionSpec; 5] = [
         shape: Shape::Vector,
         default: true,
         runtime_trait: Some(RuntimeTrait::RobotDynamics),
+        per_frame: false,
     },
     FunctionSpec {
         id: FunctionId::CoriolisMatrix,
@@ -180,17 +244,129 @@ pub const FUNCTIONS: [FunctionSpec; 5] = [
         shape: Shape::Matrix,
         default: true,
         runtime_trait: Some(RuntimeTrait::CoriolisMatrix),
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::CenterOfMass,
+        name: "center_of_mass",
+        symbol: "rG",
+        doc: "Centre of mass of the whole robot (wheels included) in frame 0 (for a wheeled base: the heading frame at the axle midpoint).",
+        inputs: Inputs::Q,
+        shape: Shape::Dense {
+            rows: Dim::Fixed(3),
+            cols: Dim::Fixed(1),
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::ComJacobian,
+        name: "com_jacobian",
+        symbol: "JG",
+        doc: "Jacobian of the centre of mass: its velocity relative to the ground, in frame 0's axes, is `J u`.",
+        inputs: Inputs::Q,
+        shape: Shape::Dense {
+            rows: Dim::Fixed(3),
+            cols: Dim::N,
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::ComBiasAcceleration,
+        name: "com_bias_acceleration",
+        symbol: "aG0",
+        doc: "Acceleration of the centre of mass at `u̇ = 0` (relative to the ground, in frame 0's axes): the acceleration is `J u̇ + bias`.",
+        inputs: Inputs::QU,
+        shape: Shape::Dense {
+            rows: Dim::Fixed(3),
+            cols: Dim::Fixed(1),
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::KineticEnergy,
+        name: "kinetic_energy",
+        symbol: "T",
+        doc: "Kinetic energy `T = ½ uᵀ M(q) u` (wheels included).",
+        inputs: Inputs::QU,
+        shape: Shape::Scalar,
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::PotentialEnergy,
+        name: "potential_energy",
+        symbol: "V",
+        doc: "Potential energy of gravity, zero with the centre of mass at the height of frame 0's origin: `∂V/∂q = g(q)`.",
+        inputs: Inputs::Q,
+        shape: Shape::Scalar,
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::FramePose,
+        name: "frame_pose",
+        symbol: "T0",
+        doc: "Pose of a body frame relative to frame 0 (for a wheeled base: the heading frame at the axle midpoint; x and ψ do not enter).",
+        inputs: Inputs::Q,
+        shape: Shape::Isometry,
+        default: false,
+        runtime_trait: None,
+        per_frame: true,
+    },
+    FunctionSpec {
+        id: FunctionId::FrameJacobian,
+        name: "frame_jacobian",
+        symbol: "J",
+        doc: "Jacobian of a body frame: rows 0–2 the velocity of its origin, rows 3–5 its angular velocity, relative to the ground, in frame 0's axes, as `J u`.",
+        inputs: Inputs::Q,
+        shape: Shape::Dense {
+            rows: Dim::Fixed(6),
+            cols: Dim::N,
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: true,
+    },
+    FunctionSpec {
+        id: FunctionId::FrameBiasAcceleration,
+        name: "frame_bias_acceleration",
+        symbol: "a0",
+        doc: "Classical acceleration of a body frame's origin (rows 0–2) and its angular acceleration (rows 3–5) at `u̇ = 0`, relative to the ground, in frame 0's axes: the acceleration is `J u̇ + bias`.",
+        inputs: Inputs::QU,
+        shape: Shape::Dense {
+            rows: Dim::Fixed(6),
+            cols: Dim::Fixed(1),
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: true,
     },
 ];
 
 impl FunctionId {
     /// Every function, in registry order.
-    pub const ALL: [FunctionId; 5] = [
+    pub const ALL: [FunctionId; 13] = [
         FunctionId::MassMatrix,
         FunctionId::Coriolis,
         FunctionId::Gravity,
         FunctionId::InverseDynamics,
         FunctionId::CoriolisMatrix,
+        FunctionId::CenterOfMass,
+        FunctionId::ComJacobian,
+        FunctionId::ComBiasAcceleration,
+        FunctionId::KineticEnergy,
+        FunctionId::PotentialEnergy,
+        FunctionId::FramePose,
+        FunctionId::FrameJacobian,
+        FunctionId::FrameBiasAcceleration,
     ];
 
     /// The registry entry.
@@ -271,7 +447,8 @@ impl FunctionSet {
 }
 
 impl Default for FunctionSet {
-    /// The functions whose registry entry says `default` (today: all of them).
+    /// The functions whose registry entry says `default`: the dynamics (M, c, g, τ, C); the
+    /// kinematics and energies are opt-in.
     fn default() -> Self {
         FUNCTIONS
             .iter()

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use crate::Generated;
 use crate::expr::{Atom, ExprId, VarKind};
 use crate::lower::Program;
-use crate::registry::Shape;
+use crate::registry::{Dim, Shape};
 
 /// A per-function summary: K/D counts and op counts, as printed by `kanegen stats`.
 pub fn stats(g: &Generated) -> String {
@@ -62,7 +62,7 @@ pub fn stats(g: &Generated) -> String {
         row("precompute (once)", &g.lowered.precompute);
     }
     for f in &g.lowered.functions {
-        row(f.id.name(), &f.program);
+        row(&f.program.name, &f.program);
     }
     s
 }
@@ -82,7 +82,11 @@ pub fn listing(g: &Generated) -> String {
         let spec = f.id.spec();
         let roots: Vec<ExprId> = f.entries.iter().map(|e| e.2).collect();
         let needed = d.arena.reachable_vars(&roots);
-        let _ = writeln!(s, "\n% ---- {} ----", spec.name);
+        match f.frame {
+            Some(l) => writeln!(s, "\n% ---- {} [{}] ----", spec.name, d.frame_names[l]),
+            None => writeln!(s, "\n% ---- {} ----", spec.name),
+        }
+        .expect("writing to a String");
         for (i, info) in d.arena.vars().iter().enumerate() {
             if needed[i] && !shown[i] {
                 shown[i] = true;
@@ -97,10 +101,13 @@ pub fn listing(g: &Generated) -> String {
         }
         for &(r, c, e) in &f.entries {
             let lhs = match spec.shape {
-                Shape::SymmetricMatrix | Shape::Matrix => {
-                    format!("{}({},{})", spec.symbol, r + 1, c + 1)
-                }
-                Shape::Vector => format!("{}({})", spec.symbol, r + 1),
+                Shape::Scalar => spec.symbol.to_owned(),
+                Shape::Vector
+                | Shape::Dense {
+                    cols: Dim::Fixed(1),
+                    ..
+                } => format!("{}({})", spec.symbol, r + 1),
+                _ => format!("{}({},{})", spec.symbol, r + 1, c + 1),
             };
             let _ = writeln!(s, "{lhs} = {};", d.arena.display(e));
         }

@@ -176,3 +176,52 @@ fn cli_rejects_unknown_functions_and_urdf_options_on_toml() {
     assert!(!ok);
     assert!(err.contains("--wheeled"), "{err}");
 }
+
+#[test]
+fn kinematics_are_opt_in_listed_by_stats_and_the_same_without_the_dynamics() {
+    let default = FunctionSet::default();
+    for spec in &FUNCTIONS {
+        assert_eq!(default.contains(spec.id), spec.default, "{}", spec.name);
+        assert!(FunctionSet::all().contains(spec.id));
+    }
+    assert!(!default.contains(FunctionId::FrameJacobian));
+    let (ok, out, err) = kanegen(&["stats", "models/krang.toml", "--functions", "all"]);
+    assert!(ok, "{err}");
+    for row in [
+        "center_of_mass",
+        "com_bias_acceleration",
+        "kinetic_energy",
+        "frame_pose[0]",
+        "frame_jacobian[10l]",
+        "frame_bias_acceleration[10r]",
+    ] {
+        assert!(out.contains(row), "{row} in\n{out}");
+    }
+    // Derived alone (no M composites, no motion pass of c to reuse), the same values.
+    let kinematics: FunctionSet = FUNCTIONS
+        .iter()
+        .filter(|s| !s.default)
+        .map(|s| s.id)
+        .collect();
+    let with = |functions| {
+        let options = Options {
+            functions,
+            ..Options::default()
+        };
+        generate(models().join("krang.toml"), options).unwrap()
+    };
+    let (part, full) = (with(kinematics), with(FunctionSet::all()));
+    let params = full.model.param_values();
+    let q: Vec<f64> = (0..19).map(|i| 0.21 * i as f64 - 1.3).collect();
+    let u: Vec<f64> = (0..19).map(|i| 0.7 - 0.05 * i as f64).collect();
+    let hand = full.model.link_index("10l");
+    for id in kinematics.iter() {
+        let frame = id.spec().per_frame.then_some(hand).flatten();
+        let a = part.lowered.evaluate_at(id, frame, &params, &q, &u, &[]);
+        let b = full.lowered.evaluate_at(id, frame, &params, &q, &u, &[]);
+        let scale = b.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() <= 1e-13 * scale, "{id}: {x} vs {y}");
+        }
+    }
+}

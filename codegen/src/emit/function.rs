@@ -107,6 +107,63 @@ struct Result {
     value: TokenStream,
 }
 
+/// The result entries of `p` that are not the constant zero (the result starts zeroed).
+fn nonzero_outputs(p: &Program) -> impl Iterator<Item = &(usize, usize, LExpr)> + Clone {
+    p.outputs
+        .iter()
+        .filter(|(_, _, e)| !matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0))
+}
+
+/// Add `store` to the stores placed right after the last statement `e` reads.
+fn store_after(stores: &mut [TokenStream], e: &LExpr, store: TokenStream) {
+    stores[last_local(e).map_or(0, |i| i + 1)].extend(store);
+}
+
+/// The result of an [`Shape::Isometry`] function: rotation and translation stored like a
+/// matrix's entries, then one `Isometry3` (its rotation as a unit quaternion, by
+/// `UnitQuaternion::from_rotation_matrix`).
+fn isometry(
+    cx: &Context<'_>,
+    printer: &Printer<'_>,
+    p: &Program,
+    mut stores: Vec<TokenStream>,
+) -> Result {
+    let t = scalar_type(cx.precision);
+    let nonzero: Vec<_> = nonzero_outputs(p).collect();
+    let rot_mut = binding(nonzero.iter().any(|(_, c, _)| *c < 3));
+    let pos_mut = binding(nonzero.iter().any(|(_, c, _)| *c == 3));
+    for (r, c, e) in nonzero {
+        let v = printer.expr(e, false);
+        let store = if *c < 3 {
+            let (r, c) = (idx(*r), idx(*c));
+            quote!(rot[(#r, #c)] = #v;)
+        } else {
+            let r = idx(*r);
+            quote!(pos[#r] = #v;)
+        };
+        store_after(&mut stores, e, store);
+    }
+    Result {
+        ty: result_type(cx, Shape::Isometry),
+        init: quote! {
+            let #rot_mut rot = nalgebra::Matrix3::<#t>::zeros();
+            let #pos_mut pos = nalgebra::Vector3::<#t>::zeros();
+        },
+        stores,
+        value: quote!(nalgebra::Isometry3::from_parts(
+            nalgebra::Translation3::from(pos),
+            nalgebra::UnitQuaternion::from_rotation_matrix(
+                &nalgebra::Rotation3::from_matrix_unchecked(rot),
+            ),
+        )),
+    }
+}
+
+/// `mut` for a result binding that is stored to, nothing for one that stays zero.
+fn binding(stored: bool) -> TokenStream {
+    if stored { quote!(mut) } else { quote!() }
+}
+
 /// Every result entry is stored right after the last statement it reads, so that values leave
 /// registers as soon as they are final (the programs are long; register pressure is what limits
 /// their speed).
@@ -114,16 +171,13 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
     let t = scalar_type(cx.precision);
     let nl = idx(cx.low.dof);
     let mut stores: Vec<TokenStream> = vec![TokenStream::new(); p.stmts.len() + 1];
-    let nonzero = p
-        .outputs
-        .iter()
-        .filter(|(_, _, e)| !matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0));
+    let nonzero = nonzero_outputs(p);
     match shape {
         Shape::SymmetricMatrix | Shape::Matrix => {
             for (r, c, e) in nonzero {
                 let v = printer.expr(e, false);
                 let (r, c) = (idx(*r), idx(*c));
-                stores[last_local(e).map_or(0, |i| i + 1)].extend(quote!(m[(#r, #c)] = #v;));
+                store_after(&mut stores, e, quote!(m[(#r, #c)] = #v;));
             }
             // Symmetric: the lower triangle is copied at the end by a loop over the column-major
             // storage. Mirrored stores next to the computation, or unrolled copies at the end
@@ -151,6 +205,35 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
                 value,
             }
         }
+        Shape::Dense { rows, cols } => {
+            let (r, c) = (idx(rows.size(cx.low.dof)), idx(cols.size(cx.low.dof)));
+            let mutable = binding(nonzero.clone().next().is_some());
+            for (r, c, e) in nonzero {
+                let v = printer.expr(e, false);
+                let (r, c) = (idx(*r), idx(*c));
+                store_after(&mut stores, e, quote!(m[(#r, #c)] = #v;));
+            }
+            Result {
+                ty: result_type(cx, shape),
+                init: quote!(let #mutable m = SMatrix::<#t, #r, #c>::zeros();),
+                stores,
+                value: quote!(m),
+            }
+        }
+        Shape::Scalar => {
+            // The one entry is the function's value, after every statement.
+            let value = p.outputs.first().map_or_else(
+                || printer.expr(&LExpr::Leaf(Leaf::Const(0.0)), false),
+                |(_, _, e)| printer.expr(e, false),
+            );
+            Result {
+                ty: result_type(cx, shape),
+                init: TokenStream::new(),
+                stores,
+                value,
+            }
+        }
+        Shape::Isometry => isometry(cx, printer, p, stores),
         Shape::Vector => {
             for (r, _, e) in nonzero {
                 let v = printer.expr(e, false);
@@ -159,8 +242,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
                 // entries (and the expression trees behind them) into two-lane vectors: for
                 // Krang's inverse dynamics that packing added ~25 % code of shuffles and spills
                 // and doubled the time (1.17 µs vs 0.64 µs). (Krang's c got ~5 % slower.)
-                stores[last_local(e).map_or(0, |i| i + 1)]
-                    .extend(quote!(out[#r] = core::hint::black_box(#v);));
+                store_after(&mut stores, e, quote!(out[#r] = core::hint::black_box(#v);));
             }
             Result {
                 ty: quote!(SVector<#t, #nl>),
@@ -169,6 +251,20 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
                 value: quote!(out),
             }
         }
+    }
+}
+
+/// The Rust type of a result of `shape` (`SMatrix<f64, 19, 19>`, `SVector<f64, 3>`, `f64`,
+/// `nalgebra::Isometry3<f64>`).
+pub(super) fn result_type(cx: &Context<'_>, shape: Shape) -> TokenStream {
+    let t = scalar_type(cx.precision);
+    let (rows, cols) = shape.size(cx.low.dof);
+    let (r, c) = (idx(rows), idx(cols));
+    match shape {
+        Shape::Scalar => quote!(#t),
+        Shape::Isometry => quote!(nalgebra::Isometry3<#t>),
+        _ if cols == 1 => quote!(SVector<#t, #r>),
+        _ => quote!(SMatrix<#t, #r, #c>),
     }
 }
 
@@ -182,8 +278,14 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         pre: &cx.pre,
         precision: cx.precision,
     };
-    let fname = ident(spec.name);
-    let doc = format!(" {}", spec.doc);
+    let fname = ident(&super::frames::rust_name(cx, f));
+    let doc = match f.frame {
+        Some(l) => format!(
+            " {} Frame `{}` (see [`Frame`]).",
+            spec.doc, cx.model.links[l].name
+        ),
+        None => format!(" {}", spec.doc),
+    };
     let ops = format!(" Generated straight-line code: {}.", p.ops);
     let param_args = if cx.low.params.is_runtime() {
         let pname = if uses(p, &|l| matches!(l, Leaf::Param(_))) {

@@ -5,7 +5,7 @@
 use proc_macro2::{Ident, TokenStream};
 use quote::quote;
 
-use super::function::{state_args, uses};
+use super::function::{result_type, state_args, uses};
 use super::print::{Printer, ident, idx, signed_lit};
 use super::{Context, file_name, scalar_type};
 use crate::lower::{Leaf, Program};
@@ -165,7 +165,7 @@ pub(super) fn precomputed(cx: &Context<'_>) -> TokenStream {
 }
 
 /// The argument names of a function with `inputs`, as passed on by a wrapper.
-fn arg_names(inputs: Inputs) -> TokenStream {
+pub(super) fn arg_names(inputs: Inputs) -> TokenStream {
     match inputs {
         Inputs::Q => quote!(q),
         Inputs::QU => quote!(q, u),
@@ -175,18 +175,16 @@ fn arg_names(inputs: Inputs) -> TokenStream {
 
 /// The return type of a registry function.
 fn return_type(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
-    let t = scalar_type(cx.precision);
-    let nl = idx(cx.low.dof);
-    match spec.shape {
-        crate::registry::Shape::Vector => quote!(SVector<#t, #nl>),
-        _ => quote!(SMatrix<#t, #nl, #nl>),
-    }
+    result_type(cx, spec.shape)
 }
 
 /// A call of the free function of `spec` from a method of the wrapper.
 fn forward_call(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
     let f = ident(spec.name);
-    let args = arg_names(spec.inputs);
+    let mut args = arg_names(spec.inputs);
+    if spec.per_frame {
+        args.extend(quote!(, frame));
+    }
     if cx.low.params.is_runtime() {
         quote!(#f(&self.params, &self.pre, #args))
     } else {
@@ -199,11 +197,16 @@ fn methods(cx: &Context<'_>) -> TokenStream {
     cx.low
         .functions
         .iter()
+        // One method per function (a per-frame function has one program per frame).
+        .filter(|f| f.frame.is_none_or(|l| l == 0))
         .map(|f| {
             let spec = f.id.spec();
             let name = ident(spec.name);
             let doc = format!(" {}", spec.doc);
-            let (args, _) = state_args(cx, spec.inputs);
+            let (mut args, _) = state_args(cx, spec.inputs);
+            if spec.per_frame {
+                args.extend(quote!(, frame: Frame));
+            }
             let ret = return_type(cx, spec);
             let call = forward_call(cx, spec);
             quote! {

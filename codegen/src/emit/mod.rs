@@ -15,6 +15,7 @@
 //! (statement comments), this file (the module and its header).
 
 mod annotate;
+mod frames;
 mod function;
 mod items;
 mod print;
@@ -110,9 +111,22 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         items.extend(items::precomputed(&cx));
         labels.add("new", &low.precompute);
     }
-    for f in &low.functions {
+    let names: Vec<String> = low
+        .functions
+        .iter()
+        .map(|f| frames::rust_name(&cx, f))
+        .collect();
+    if low.functions.iter().any(|f| f.frame.is_some()) {
+        items.extend(frames::frame_type(&cx));
+    }
+    for (i, f) in low.functions.iter().enumerate() {
         items.extend(function::function(&cx, f));
-        labels.add(f.id.name(), &f.program);
+        labels.add(&names[i], &f.program);
+        // After a per-frame function's last frame, its dispatcher.
+        let last = low.functions.get(i + 1).is_none_or(|next| next.id != f.id);
+        if f.frame.is_some() && last {
+            items.extend(frames::dispatcher(&cx, f.id));
+        }
     }
     items.extend(items::wrapper(&cx));
     items.extend(items::trait_impls(&cx));
@@ -185,10 +199,7 @@ fn header(model: &Model, low: &Lowered) -> String {
         let p = &f.program;
         h.push_str(&format!(
             "//   {:<17} {}; {} K and {} D variables\n",
-            f.id.name(),
-            p.ops,
-            p.k_vars,
-            p.d_vars
+            p.name, p.ops, p.k_vars, p.d_vars
         ));
     }
     h.push('\n');

@@ -38,6 +38,7 @@
 //! | `gravity.rs` | g |
 //! | `rnea.rs` | c and τ: forward motion pass, body inertia forces, backward accumulation |
 //! | `coriolis_matrix.rs` | C: frame velocities, subtree momenta and inertia rates, columns |
+//! | `kinematics.rs` | frames in frame 0 (`⁰A`, `⁰p`), centre of mass, its Jacobian and bias acceleration, energies |
 //!
 //! The arena records the order in which each phase first asks for a node and the lowering
 //! schedules statements in that order: moving arena calls around changes the generated code.
@@ -50,6 +51,7 @@ mod composite;
 mod coriolis_matrix;
 mod frames;
 mod gravity;
+mod kinematics;
 mod mass_matrix;
 mod rnea;
 
@@ -68,6 +70,9 @@ use composite::Composite;
 pub struct Function {
     /// Which function.
     pub id: FunctionId,
+    /// The body frame (link index) of a per-frame function
+    /// ([`FunctionSpec::per_frame`](crate::registry::FunctionSpec::per_frame)), else `None`.
+    pub frame: Option<usize>,
     /// `(row, col, expr)` in the layout of the function's [`Shape`](crate::registry::Shape); col = 0 for vectors.
     pub entries: Vec<(usize, usize, ExprId)>,
     /// Per arena node, when this function's derivation first asked for it (`u32::MAX`: never):
@@ -86,12 +91,23 @@ pub struct Derivation {
     pub dof: usize,
     /// Options used.
     pub options: Options,
+    /// The body frames' names (the model's links, in order): the frames of the per-frame
+    /// functions.
+    pub frame_names: Vec<String>,
 }
 
 impl Derivation {
-    /// The derived function `id`, if [`Options::functions`] asked for it.
+    /// The derived function `id`, if [`Options::functions`] asked for it (frame 0's program of
+    /// a per-frame function).
     pub fn function(&self, id: FunctionId) -> Option<&Function> {
         self.functions.iter().find(|f| f.id == id)
+    }
+
+    /// The derived function `id` for body frame `frame` (`None` for a function without frames).
+    pub fn function_at(&self, id: FunctionId, frame: Option<usize>) -> Option<&Function> {
+        self.functions
+            .iter()
+            .find(|f| f.id == id && (frame.is_none() || f.frame == frame))
     }
 }
 
@@ -113,13 +129,22 @@ pub fn names_of(model: &Model) -> Names {
 /// backward composite pass, each right after its subtree's composite is complete, so that the
 /// generated code uses values soon after it computes them (short live ranges, fewer register
 /// spills); g and C reuse those composites. The order fixes the arena's numbering and with it the
-/// generated code, so it is part of the output's definition.
-const DERIVATION_ORDER: [FunctionId; 5] = [
+/// generated code, so it is part of the output's definition. The opt-in kinematics come last, so
+/// that they do not change the dynamics' code.
+const DERIVATION_ORDER: [FunctionId; 13] = [
     FunctionId::MassMatrix,
     FunctionId::Gravity,
     FunctionId::Coriolis,
     FunctionId::InverseDynamics,
     FunctionId::CoriolisMatrix,
+    FunctionId::CenterOfMass,
+    FunctionId::ComJacobian,
+    FunctionId::ComBiasAcceleration,
+    FunctionId::KineticEnergy,
+    FunctionId::PotentialEnergy,
+    FunctionId::FramePose,
+    FunctionId::FrameJacobian,
+    FunctionId::FrameBiasAcceleration,
 ];
 
 /// Derive the functions of `options.functions` for `model` (M as its upper triangle).
@@ -132,6 +157,8 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
         options,
         rot: vec![None; model.links.len()],
         pos: vec![None; model.links.len()],
+        root_rot: vec![None; model.links.len()],
+        root_pos: vec![None; model.links.len()],
     };
     let n = model.dof();
     let mut composites = None;
@@ -140,20 +167,39 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
         if !options.has(id) {
             continue;
         }
-        // Each function is one arena phase: its statements are later scheduled in the order its
-        // own recursion forms them.
-        cx.ar.begin_phase();
-        let entries = cx.derive_function(id, &mut composites);
-        let order = cx.ar.phase_order();
-        functions.push(Function { id, entries, order });
+        // Each function (each frame of a per-frame function) is one arena phase: its statements
+        // are later scheduled in the order its own recursion forms them.
+        let frames: Vec<Option<usize>> = if id.spec().per_frame {
+            (0..model.links.len()).map(Some).collect()
+        } else {
+            vec![None]
+        };
+        for frame in frames {
+            cx.ar.begin_phase();
+            let entries = match frame {
+                Some(l) => cx.derive_frame_function(id, l),
+                None => cx.derive_function(id, &mut composites),
+            };
+            let order = cx.ar.phase_order();
+            functions.push(Function {
+                id,
+                frame,
+                entries,
+                order,
+            });
+        }
     }
-    functions.sort_by_key(|f| f.id);
-    debug_assert!(functions.iter().all(|f| f.entries.iter().all(|e| e.0 < n)));
+    functions.sort_by_key(|f| (f.id, f.frame));
+    debug_assert!(functions.iter().all(|f| {
+        let (rows, cols) = f.id.spec().shape.size(n);
+        f.entries.iter().all(|e| e.0 < rows && e.1 < cols)
+    }));
     Derivation {
         arena,
         functions,
         dof: n,
         options,
+        frame_names: model.links.iter().map(|l| l.name.clone()).collect(),
     }
 }
 
@@ -184,6 +230,38 @@ impl Ctx<'_> {
                 let comp = composites.get_or_insert_with(|| self.composites(true, None));
                 self.coriolis_matrix(comp)
             }
+            FunctionId::CenterOfMass => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                vector(self.center_of_mass(comp).to_vec())
+            }
+            FunctionId::ComJacobian => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                self.com_jacobian(comp)
+            }
+            FunctionId::ComBiasAcceleration => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                vector(self.com_bias_acceleration(comp).to_vec())
+            }
+            FunctionId::KineticEnergy => vec![(0, 0, self.kinetic_energy())],
+            FunctionId::PotentialEnergy => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                vec![(0, 0, self.potential_energy(comp))]
+            }
+            FunctionId::FramePose
+            | FunctionId::FrameJacobian
+            | FunctionId::FrameBiasAcceleration => {
+                unreachable!("per-frame functions are derived by `derive_frame_function`")
+            }
+        }
+    }
+
+    /// The entries of per-frame registry function `id` for body frame `l`.
+    fn derive_frame_function(&mut self, id: FunctionId, l: usize) -> Vec<(usize, usize, ExprId)> {
+        match id {
+            FunctionId::FramePose => self.frame_pose(l),
+            FunctionId::FrameJacobian => self.frame_jacobian(l),
+            FunctionId::FrameBiasAcceleration => self.frame_bias_acceleration(l),
+            _ => unreachable!("`{id}` is not a per-frame function"),
         }
     }
 }
@@ -196,11 +274,16 @@ struct Ctx<'a> {
     options: Options,
     rot: Vec<Option<M3>>,
     pos: Vec<Option<V3>>,
+    /// `⁰A_l(q)`: the rotation of frame l relative to frame 0, cached.
+    root_rot: Vec<Option<M3>>,
+    /// `⁰p_l(q)`: the origin of frame l in frame 0, cached.
+    root_pos: Vec<Option<V3>>,
 }
 
 impl Derivation {
     /// Evaluate function `id` numerically from the symbolic expressions (no code generation):
-    /// a dense row-major `n × n` matrix (both triangles) or an `n`-vector. Parameter values are
+    /// the row-major dense value of its [`Shape`](crate::registry::Shape) (an `n × n` matrix
+    /// with both triangles, an `n`-vector, a `3 × n` Jacobian, a scalar, …). Parameter values are
     /// used in [`ParamMode::Runtime`](crate::options::ParamMode::Runtime); in baked mode the model's values are already folded in.
     pub fn evaluate(
         &self,
@@ -210,8 +293,22 @@ impl Derivation {
         u: &[f64],
         ud: &[f64],
     ) -> Vec<f64> {
+        self.evaluate_at(id, None, params, q, u, ud)
+    }
+
+    /// [`Derivation::evaluate`] for body frame `frame` (a link index) of a per-frame function
+    /// (`None`: frame 0, or a function without frames).
+    pub fn evaluate_at(
+        &self,
+        id: FunctionId,
+        frame: Option<usize>,
+        params: &[f64],
+        q: &[f64],
+        u: &[f64],
+        ud: &[f64],
+    ) -> Vec<f64> {
         let f = self
-            .function(id)
+            .function_at(id, frame)
             .unwrap_or_else(|| panic!("the derivation has no function `{id}`"));
         let vals = self.arena.eval(&crate::expr::Values { params, q, u, ud });
         let entries = f.entries.iter().map(|&(r, c, e)| (r, c, vals[e.index()]));

@@ -70,10 +70,36 @@ impl Ctx<'_> {
 
     /// τ with the given inputs: `with_accel` keeps u̇ (else u̇ = 0), `with_gravity` folds gravity in.
     pub(super) fn rnea(&mut self, with_accel: bool, with_gravity: bool) -> Vec<ExprId> {
+        let (f, n) = self.inertia_forces(Inputs::new(with_accel, with_gravity));
+        let out = self.generalized_forces(&f, &n, with_accel);
+        self.finish(out, if with_accel { "tau" } else { "c" })
+    }
+
+    /// `Σ_k m_k a_Gk` over every body at `u̇ = 0` without gravity, in frame 0: the total inertia
+    /// force of the motion pass that `c` uses (the bodies only, not the wheels).
+    pub(super) fn bias_inertia_force(&mut self) -> V3 {
+        self.inertia_forces(Inputs::new(false, false)).0[0]
+    }
+
+    /// Every frame's motion at `u̇ = 0` without gravity (the variables `c` uses): `(ω, α, a)`
+    /// of each frame in its own axes; `a` is the classical acceleration of its origin.
+    pub(super) fn bias_motion(&mut self) -> Motion {
+        let inputs = Inputs::new(false, false);
+        let mut motion = self.base_motion(inputs);
+        let model = self.model;
+        for (l, _, mount) in model.mounted_links() {
+            self.forward_motion(l, mount, &mut motion, inputs);
+        }
+        motion
+    }
+
+    /// The subtree inertia forces `f` and moments `n` (about each frame's origin, in its axes)
+    /// of every frame for the motion of `inputs`: the forward motion pass, body inertia forces
+    /// and the backward accumulation (`f[0]`, `n[0]`: the whole robot's).
+    fn inertia_forces(&mut self, inputs: Inputs) -> (Vec<V3>, Vec<V3>) {
         let model = self.model;
         let links = model.links.len();
         let zero = self.ar.zero();
-        let inputs = Inputs::new(with_accel, with_gravity);
         let tag = inputs.tag;
         let mut motion = self.base_motion(inputs);
         // Body inertia forces and moments about the frame origins, each formed in the forward
@@ -97,8 +123,7 @@ impl Ctx<'_> {
         for (c, _, mount) in model.mounted_links().rev() {
             self.accumulate(c, mount, &mut f, &mut n, tag);
         }
-        let out = self.generalized_forces(&f, &n, with_accel);
-        self.finish(out, if with_accel { "tau" } else { "c" })
+        (f, n)
     }
 
     /// The motion of the root frame (the wheeled base's `ω0 = [0,0,ψ̇]`, `α0 = [0,0,ψ̈]`,
@@ -285,8 +310,8 @@ impl Inputs {
 
 /// Every frame's angular velocity `w`, angular acceleration `wd` and origin acceleration `a`,
 /// in its own frame.
-struct Motion {
-    w: Vec<V3>,
-    wd: Vec<V3>,
-    a: Vec<V3>,
+pub(super) struct Motion {
+    pub(super) w: Vec<V3>,
+    pub(super) wd: Vec<V3>,
+    pub(super) a: Vec<V3>,
 }

@@ -1,0 +1,67 @@
+//! Krang's generated kinematics and energies (the opt-in registry functions enabled in
+//! `build.rs`): the centre of mass above the axle at the upright pitch, `T = ½ uᵀ M u`,
+//! `∂V/∂q = g`, and a hand's Jacobian against its pose. (Derivative identities with the base's
+//! motion, on every frame and several models: `codegen/tests/kinematics.rs`.)
+
+use krang_dynamics::{DOF, Frame, Krang, index};
+use nalgebra::SVector;
+
+type V = SVector<f64, DOF>;
+
+/// Deterministic, varied states: `(q, u)`.
+fn states() -> impl Iterator<Item = (V, V)> {
+    (0..20).map(|k| {
+        let k = f64::from(k);
+        let q = V::from_fn(|i, _| (1.3 * i as f64 + 0.7 * k).sin() * 2.5);
+        let u = V::from_fn(|i, _| (0.9 * i as f64 - 1.1 * k).cos() * 1.5);
+        (q, u)
+    })
+}
+
+#[test]
+fn the_centre_of_mass_is_above_the_axle_at_the_upright_pitch() {
+    let k = Krang::default();
+    for (mut q, _) in states() {
+        q[index::Q_IMU] = k.upright_pitch(&q);
+        let com = k.center_of_mass(&q);
+        assert!(com.x.abs() < 1e-12, "{com}");
+        assert!(com.z > 0.0, "{com}");
+    }
+}
+
+#[test]
+fn energies_are_half_u_m_u_and_the_potential_of_g() {
+    let k = Krang::default();
+    for (q, u) in states() {
+        let t = k.kinetic_energy(&q, &u);
+        let half_umu = 0.5 * u.dot(&(k.mass_matrix(&q) * u));
+        assert!((t - half_umu).abs() < 1e-12 * half_umu.abs().max(1.0));
+        let g = k.gravity(&q);
+        let h = 1e-6;
+        for i in 0..DOF {
+            let (mut qp, mut qm) = (q, q);
+            qp[i] += h;
+            qm[i] -= h;
+            let dv = (k.potential_energy(&qp) - k.potential_energy(&qm)) / (2.0 * h);
+            assert!((dv - g[i]).abs() < 1e-6 * g.amax().max(1.0), "row {i}");
+        }
+    }
+}
+
+#[test]
+fn a_hand_frame_moves_with_its_jacobian() {
+    let k = Krang::default();
+    let hand = Frame::from_name("10l").expect("Krang has the frame 10l");
+    assert_eq!(hand.name(), "10l");
+    assert!(Frame::ALL.contains(&hand));
+    for (q, mut u) in states() {
+        // Frame 0 at rest, so that the pose relative to it is the pose in the ground.
+        u[index::X] = 0.0;
+        u[index::PSI] = 0.0;
+        let h = 1e-6;
+        let p = |t: f64| k.frame_pose(&(q + u * t), hand).translation.vector;
+        let v = (p(h) - p(-h)) / (2.0 * h);
+        let ju = k.frame_jacobian(&q, hand) * u;
+        assert!((ju.fixed_rows::<3>(0) - v).amax() < 1e-7, "{ju} {v}");
+    }
+}

@@ -8,8 +8,8 @@
 //! - [`UnknownParameter`]: the allocation-free error of a generated `Params::set` for a name
 //!   the model does not have; [`InvalidParameter`], the error of `Params::validate`, and the
 //!   checks it runs ([`validate`]).
-//! - [`params_struct!`]: the macro a generated `Params` is defined with, which derives `serde`
-//!   with the `serde` feature; [`params_from_model_toml`] (feature `toml`) reads the parameter
+//! - [`params_serde!`]: the macro a generated module invokes after its `Params`, which
+//!   implements `serde`'s traits with the `serde` feature; [`params_from_model_toml`] (feature `toml`) reads the parameter
 //!   values of a model file at run time.
 //! - [`RobotDynamics`] (and [`CoriolisMatrix`], for modules generated with the Coriolis
 //!   matrix): the trait every generated robot type implements, so that a controller can be
@@ -113,7 +113,7 @@
 //! `serde::Serialize` and `serde::Deserialize` (missing fields keep their defaults, unknown
 //! ones are errors), so identified parameters load from TOML, JSON or any serde format. The
 //! feature belongs to `kanegen-runtime`, not to the crate that includes the generated code:
-//! generated code defines `Params` through [`params_struct!`], whose expansion depends on it.
+//! generated code invokes [`params_serde!`], whose expansion depends on it.
 //! A crate such as `krang-dynamics` forwards it as its own `serde` feature.
 //!
 //! # Features
@@ -133,7 +133,8 @@ extern crate std;
 
 mod dynamics;
 mod invalid_parameter;
-mod serde_support;
+#[doc(hidden)]
+pub mod serde_support;
 pub mod trig;
 mod unknown_parameter;
 

@@ -1,40 +1,125 @@
 //! `serde` for the generated `Params`, switched on by this crate's `serde` feature.
 //!
-//! A generated module wraps its `Params` definition in [`params_struct!`](crate::params_struct).
-//! With the feature the macro adds `#[derive(Serialize, Deserialize)]` through the `serde`
-//! this crate re-exports (`kanegen_runtime::serde`), with `#[serde(default,
-//! deny_unknown_fields)]`: a file lists the parameters it changes (the others keep the values of
-//! the model file the module was generated from), and a misspelt name is an error. Without the
-//! feature the macro emits the struct unchanged. So the switch is the feature of
-//! `kanegen-runtime`, not of the crate that includes the generated code: that crate neither
-//! declares a feature nor depends on `serde` for it.
+//! A generated module invokes [`params_serde!`](crate::params_serde) after its `Params`. With
+//! the feature the macro implements `Serialize` (a map from parameter name to value, in the
+//! order of `Params::NAMES`) and `Deserialize` (from such a map: names left out keep their
+//! defaults, an unknown name is an error) through the `serde` this crate re-exports, using only
+//! `NAMES`, `to_array`, `set` and `Default` of the generated `Params`. Without the feature the
+//! macro expands to nothing. So the switch is the feature of `kanegen-runtime`, not of the crate
+//! that includes the generated code: that crate neither declares a feature nor depends on
+//! `serde` for it.
 
-/// Defines a generated `Params` struct; with the `serde` feature of `kanegen-runtime` it also
-/// derives `serde::Serialize` and `serde::Deserialize` (with `#[serde(default,
-/// deny_unknown_fields)]`, so the struct must implement `Default`). See the
-/// [module docs](crate#parameters-as-data).
+/// Implements `serde::Serialize` and `serde::Deserialize` for a generated `Params` (with
+/// scalar `f64` or `f32`) when `kanegen-runtime`'s `serde` feature is on; nothing otherwise.
+/// See the [crate docs](crate#parameters-as-data).
 #[cfg(feature = "serde")]
 #[macro_export]
-macro_rules! params_struct {
-    ($(#[$meta:meta])* $vis:vis struct $name:ident { $($body:tt)* }) => {
-        $(#[$meta])*
-        #[derive($crate::serde::Serialize, $crate::serde::Deserialize)]
-        #[serde(crate = "kanegen_runtime::serde", default, deny_unknown_fields)]
-        $vis struct $name { $($body)* }
+macro_rules! params_serde {
+    ($params:ident, $scalar:ty) => {
+        impl $crate::serde::Serialize for $params {
+            fn serialize<S: $crate::serde::Serializer>(
+                &self,
+                serializer: S,
+            ) -> ::core::result::Result<S::Ok, S::Error> {
+                $crate::serde_support::serialize(&Self::NAMES, &self.to_array(), serializer)
+            }
+        }
+
+        impl<'de> $crate::serde::Deserialize<'de> for $params {
+            fn deserialize<D: $crate::serde::Deserializer<'de>>(
+                deserializer: D,
+            ) -> ::core::result::Result<Self, D::Error> {
+                let mut params = <Self as ::core::default::Default>::default();
+                $crate::serde_support::deserialize::<$scalar, D>(
+                    &Self::NAMES,
+                    deserializer,
+                    |name, value| {
+                        let _known = params.set(name, value).is_ok();
+                    },
+                )?;
+                ::core::result::Result::Ok(params)
+            }
+        }
     };
 }
 
-/// Defines a generated `Params` struct; with the `serde` feature of `kanegen-runtime` it also
-/// derives `serde::Serialize` and `serde::Deserialize` (with `#[serde(default,
-/// deny_unknown_fields)]`, so the struct must implement `Default`). See the
-/// [module docs](crate#parameters-as-data).
+/// Implements `serde::Serialize` and `serde::Deserialize` for a generated `Params` (with
+/// scalar `f64` or `f32`) when `kanegen-runtime`'s `serde` feature is on; nothing otherwise.
+/// See the [crate docs](crate#parameters-as-data).
 #[cfg(not(feature = "serde"))]
 #[macro_export]
-macro_rules! params_struct {
-    ($(#[$meta:meta])* $vis:vis struct $name:ident { $($body:tt)* }) => {
-        $(#[$meta])*
-        $vis struct $name { $($body)* }
-    };
+macro_rules! params_serde {
+    ($params:ident, $scalar:ty) => {};
+}
+
+/// `values` as a map from `names` (the body of a generated `Params`' `Serialize`).
+#[cfg(feature = "serde")]
+pub fn serialize<T: serde::Serialize, S: serde::Serializer>(
+    names: &[&str],
+    values: &[T],
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeMap;
+    let mut map = serializer.serialize_map(Some(names.len()))?;
+    for (name, value) in names.iter().zip(values) {
+        map.serialize_entry(name, value)?;
+    }
+    map.end()
+}
+
+/// Reads a map from parameter names (each one of `names`, or an `unknown field` error) to
+/// values and hands each pair to `set` (the body of a generated `Params`' `Deserialize`).
+/// Allocation-free: keys are matched as they are read.
+#[cfg(feature = "serde")]
+pub fn deserialize<'de, T, D>(
+    names: &'static [&'static str],
+    deserializer: D,
+    set: impl FnMut(&'static str, T),
+) -> Result<(), D::Error>
+where
+    T: serde::Deserialize<'de>,
+    D: serde::Deserializer<'de>,
+{
+    use core::marker::PhantomData;
+    use serde::de::{DeserializeSeed, Error, MapAccess, Visitor};
+
+    /// A key: the index of its name in `names`.
+    struct Key(&'static [&'static str]);
+    impl<'de> DeserializeSeed<'de> for Key {
+        type Value = usize;
+        fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<usize, D::Error> {
+            d.deserialize_str(self)
+        }
+    }
+    impl Visitor<'_> for Key {
+        type Value = usize;
+        fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+            f.write_str("a parameter name")
+        }
+        fn visit_str<E: Error>(self, name: &str) -> Result<usize, E> {
+            self.0
+                .iter()
+                .position(|n| *n == name)
+                .ok_or_else(|| E::unknown_field(name, self.0))
+        }
+    }
+
+    struct Table<T, F>(&'static [&'static str], F, PhantomData<T>);
+    impl<'de, T: serde::Deserialize<'de>, F: FnMut(&'static str, T)> Visitor<'de> for Table<T, F> {
+        type Value = ();
+        fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+            f.write_str("a table of parameter values by name")
+        }
+        fn visit_map<A: MapAccess<'de>>(mut self, mut map: A) -> Result<(), A::Error> {
+            while let Some(i) = map.next_key_seed(Key(self.0))? {
+                let value = map.next_value::<T>()?;
+                (self.1)(self.0[i], value);
+            }
+            Ok(())
+        }
+    }
+
+    deserializer.deserialize_map(Table(names, set, PhantomData))
 }
 
 /// The error of [`params_from_model_toml`]: the text is not TOML, has no `[parameters]` table,

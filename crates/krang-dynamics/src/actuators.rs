@@ -64,10 +64,12 @@ pub mod actuator {
     pub const WAIST: usize = 2;
     /// Torso torque `τ_torso` (drives `q_torso`).
     pub const TORSO: usize = 3;
-    /// First left-arm joint `τ_1l`; the left arm is `LEFT_ARM .. LEFT_ARM + 7`.
-    pub const LEFT_ARM: usize = 4;
-    /// First right-arm joint `τ_1r`; the right arm is `RIGHT_ARM .. RIGHT_ARM + 7`.
-    pub const RIGHT_ARM: usize = 11;
+    /// The left-arm joint torques `τ_1l … τ_7l` (a range, as
+    /// [`forward::LEFT_ARM`](crate::forward::LEFT_ARM) is in `u`).
+    pub const LEFT_ARM: core::ops::Range<usize> = 4..11;
+    /// The right-arm joint torques `τ_1r … τ_7r` (a range, as
+    /// [`forward::RIGHT_ARM`](crate::forward::RIGHT_ARM) is in `u`).
+    pub const RIGHT_ARM: core::ops::Range<usize> = 11..18;
 }
 
 impl Krang {

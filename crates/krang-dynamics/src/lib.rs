@@ -25,40 +25,86 @@
 //! # Ok::<(), krang_dynamics::UnknownParameter>(())
 //! ```
 //!
-//! Every module also has the generated Coriolis matrix (`Krang::coriolis_matrix(&q, &u)`, the
-//! free function `coriolis_matrix` in `baked`): the full `C(q, u)` with `c = C u` and `Ṁ − 2C`
-//! skew-symmetric, for passivity-based controllers (e.g. Slotine–Li `τ = M a_r + C v_r + g − K s`).
+//! `index` names every coordinate (`index::Q_IMU`, in `q`) and every speed (`index::QD_IMU`, in
+//! `u`, `u̇` and `τ`; the same number). A group of joints has one name wherever it appears, a
+//! range of indices into the vector at hand: [`forward::LEFT_ARM`] (`5..12` in `u`),
+//! [`actuator::LEFT_ARM`] (`4..11` in the actuator vector).
 //!
 //! [kanegen]: https://docs.rs/kanegen
 //!
+//! # Features: optional modules and compile time
+//!
+//! Each generated module is one generator call in `build.rs` and about 100–300 KB of Rust to
+//! compile, so the optional ones are features (the README's "Build time and features" has the
+//! measured build times). Default: `std` and the f64 Krang model above (M, c, g, inverse
+//! dynamics), with forward dynamics and the actuator map.
+//!
+//! | feature | adds |
+//! |---|---|
+//! | `std` (default) | `std` for nalgebra; without it the crate is `#![no_std]` |
+//! | `coriolis-matrix` | `coriolis_matrix(&q, &u)`, the Coriolis matrix `C(q, u)` with `c = C u` and `Ṁ − 2C` skew-symmetric (Slotine–Li `τ = M a_r + C v_r + g − K s`), and the `CoriolisMatrix` trait, in every module built; about doubles each module's compile time |
+//! | `baked` | `baked`: the parameter values of `krang.toml` folded in as constants |
+//! | `f32` | `f32::{Krang, Params}`: single precision, sin/cos computed in `f32` too |
+//! | `fixed-wheels` | `fixed_wheels::KrangFixedWheels` (17 speeds) and its forward dynamics |
+//! | `two-link` | `two_link::TwoLink`, seed 002 Appendix B |
+//! | `full` | all of the above but `std`, `serde`, `toml` |
+//! | `serde` | `Serialize`/`Deserialize` for every `Params` (`no_std`-compatible) |
+//! | `toml` | `params_from_model_toml`: `Params` from a model file's `[parameters]` at run time |
+//!
+//! # Parameters as data
+//!
+//! `Params::validate` checks that a parameter set is physical (finite values, positive masses,
+//! inertias within the triangle inequalities about the centre of mass, positive wheel radius and
+//! track). With the `serde` feature, identified parameters load from any serde format; fields
+//! left out keep the values of `krang.toml`, unknown names are errors:
+//!
+//! ```
+//! # #[cfg(feature = "serde")] {
+//! let p: krang_dynamics::Params = serde_json::from_str(r#"{ "m4l": 4.5, "MX4l": 0.12 }"#)?;
+//! assert_eq!((p.m4l, p.MX4l, p.g), (4.5, 0.12, 9.81));
+//! p.validate()?;
+//! let bad: krang_dynamics::Params = serde_json::from_str(r#"{ "m4l": -1.0 }"#)?;
+//! assert_eq!(bad.validate().unwrap_err().name(), "m4l");
+//! assert!(serde_json::from_str::<krang_dynamics::Params>(r#"{ "m4k": 1.0 }"#).is_err());
+//! # }
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! # `f32` and `no_std`
 //!
-//! [`f32`](mod@f32) is the same model in single precision (`krang_dynamics::f32::{Krang,
-//! Params}`), for controllers on FPUs without double precision. Without the default feature
-//! `std` the crate is `#![no_std]`: the generated code needs only `core` and `nalgebra`, and the
-//! hand-written parts take square roots and `atan2` from `libm` through nalgebra.
+//! The `f32` module (feature `f32`) is the same model in single precision
+//! (`krang_dynamics::f32::{Krang, Params}`) for controllers on FPUs without double precision:
+//! its sines and cosines are computed in `f32` too (`kanegen_runtime::trig::sin_cos_n_f32`,
+//! within an ulp of the correctly rounded value), so it needs no `f64` arithmetic. Without the
+//! default feature `std` the crate is `#![no_std]`: the generated code needs only `core` and
+//! `nalgebra`, and the hand-written parts take square roots and `atan2` from `libm` through
+//! nalgebra.
 #![cfg_attr(not(feature = "std"), no_std)]
 #![forbid(unsafe_code)]
 
 include!(concat!(env!("OUT_DIR"), "/krang.rs"));
 
 /// Krang with the parameter values of `krang.toml` folded in as constants (faster; no `Params`).
+#[cfg(feature = "baked")]
 pub mod baked {
     include!(concat!(env!("OUT_DIR"), "/krang_baked.rs"));
 }
 
 /// Krang in single precision: the module of the crate root with `f32` matrices, vectors and
 /// parameters (`krang_dynamics::f32::{Krang, Params}`).
+#[cfg(feature = "f32")]
 pub mod f32 {
     include!(concat!(env!("OUT_DIR"), "/krang_f32.rs"));
 }
 
 /// Krang on fixed wheels: the 17-DOF tree of seed 002 (frame 0 fixed).
+#[cfg(feature = "fixed-wheels")]
 pub mod fixed_wheels {
     include!(concat!(env!("OUT_DIR"), "/krang_fixed_wheels.rs"));
 }
 
 /// Seed 002 Appendix B: the two-link model (bodies 1 and 2, frame 0 fixed).
+#[cfg(feature = "two-link")]
 pub mod two_link {
     include!(concat!(env!("OUT_DIR"), "/two_link.rs"));
 }
@@ -68,3 +114,11 @@ pub use forward::{Block, MassMatrixCholesky, NotPositiveDefinite, solve_spd};
 
 pub mod actuators;
 pub use actuators::{ACTUATOR_COUNT, ACTUATOR_NAMES, actuator, hardware, saturate, saturate_to};
+
+/// What a controller uses besides the model: the traits every generated robot implements (so
+/// that `Krang` works with generic controller code), the errors of `Params`, and nalgebra.
+#[cfg(feature = "coriolis-matrix")]
+pub use kanegen_runtime::CoriolisMatrix;
+pub use kanegen_runtime::{InvalidParameter, Problem, RobotDynamics, nalgebra};
+#[cfg(feature = "toml")]
+pub use kanegen_runtime::{ModelFileError, params_from_model_toml};

@@ -63,7 +63,14 @@ fn what(model: &Model, id: usize) -> &'static str {
         }
         (ParamKind::Wheel, "m") => "track width",
         (ParamKind::Wheel, "kg") => "wheel mass",
-        (ParamKind::Wheel, _) => "wheel inertia",
+        (ParamKind::Wheel, _)
+            if model
+                .wheeled_base()
+                .is_some_and(|w| w.wheel_axle_inertia == id) =>
+        {
+            "wheel inertia about the axle"
+        }
+        (ParamKind::Wheel, _) => "wheel inertia about a diameter",
         (_, "kg") => "mass",
         (_, "kg·m") => "first moment m·S",
         _ => "inertia about the frame origin",
@@ -118,9 +125,10 @@ fn frames(m: &Model, s: &mut String) {
 /// Whether speed `i` is a linear one (a prismatic joint's, or the wheeled base's ẋ).
 fn speed_is_linear(m: &Model, i: usize) -> bool {
     m.wheeled_base().is_some_and(|w| w.x_speed == i)
-        || m.links.iter().filter_map(|l| l.joint()).any(|j| {
-            matches!(j.kind, kanegen::model::JointKind::Prismatic { speed } if speed == i)
-        })
+        || m.links
+            .iter()
+            .filter_map(|l| l.joint())
+            .any(|j| matches!(j.kind, kanegen::model::JointKind::Prismatic { speed } if speed == i))
 }
 
 /// The text of `kanegen show`.

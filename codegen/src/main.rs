@@ -25,6 +25,11 @@ use std::process::ExitCode;
 use kanegen::model::{Model, UrdfImport, UrdfOptions, WheeledBaseSpec};
 use kanegen::{Builder, FunctionSet};
 
+/// The reminder after a command-line error.
+const SHORT_USAGE: &str =
+    "usage: kanegen <show|stats|listing|emit> <model.toml|model.urdf> [options]
+(`kanegen --help` lists the commands and the options each one takes)";
+
 const USAGE: &str = "usage: kanegen <show|stats|listing|emit> <model.toml|model.urdf> [options]
 
   show     print the validated model: frame tree, speeds, parameters
@@ -73,7 +78,7 @@ fn main() -> ExitCode {
     match run(std::env::args().skip(1).collect()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Usage(msg)) => {
-            eprintln!("error: {msg}\n\n{USAGE}");
+            eprintln!("error: {msg}\n{SHORT_USAGE}");
             ExitCode::from(2)
         }
         Err(Failure::Error(msg)) => {
@@ -88,9 +93,9 @@ fn main() -> ExitCode {
 fn output(text: &str) -> Result<(), Failure> {
     let mut out = std::io::stdout().lock();
     match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            Err(Failure::Error(format!("error: writing to standard output: {e}")))
-        }
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Failure::Error(format!(
+            "error: writing to standard output: {e}"
+        ))),
         _ => Ok(()),
     }
 }
@@ -312,9 +317,14 @@ const FLAGS: [&str; 3] = ["--baked", "--no-coriolis-matrix", "--f32"];
 
 /// Whether `arg` is one of the options of the command line.
 fn is_option(arg: &str) -> bool {
-    [Command::Show, Command::Stats, Command::Listing, Command::Emit]
-        .iter()
-        .any(|c| c.takes(arg))
+    [
+        Command::Show,
+        Command::Stats,
+        Command::Listing,
+        Command::Emit,
+    ]
+    .iter()
+    .any(|c| c.takes(arg))
 }
 
 impl Args {

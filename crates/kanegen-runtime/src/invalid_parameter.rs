@@ -79,7 +79,11 @@ pub fn check_finite<T: Copy + Into<f64>>(
     names: &[&str],
     values: &[T],
 ) -> Result<(), InvalidParameter> {
-    match names.iter().zip(values).find(|(_, v)| !(**v).into().is_finite()) {
+    match names
+        .iter()
+        .zip(values)
+        .find(|(_, v)| !(**v).into().is_finite())
+    {
         Some((name, _)) => Err(InvalidParameter::new(name, Problem::NotFinite)),
         None => Ok(()),
     }
@@ -143,9 +147,8 @@ pub fn check_body(
     let tol = rel_tol * scale;
     let diagonal = (0..3).all(|i| sigma(i, i) >= -tol);
     let minor = |a: usize, b: usize| sigma(a, a) * sigma(b, b) - sigma(a, b) * sigma(a, b);
-    let minors = minor(0, 1) >= -tol * scale
-        && minor(0, 2) >= -tol * scale
-        && minor(1, 2) >= -tol * scale;
+    let minors =
+        minor(0, 1) >= -tol * scale && minor(0, 2) >= -tol * scale && minor(1, 2) >= -tol * scale;
     let det = sigma(0, 0) * (sigma(1, 1) * sigma(2, 2) - sigma(1, 2) * sigma(1, 2))
         - sigma(0, 1) * (sigma(0, 1) * sigma(2, 2) - sigma(1, 2) * sigma(0, 2))
         + sigma(0, 2) * (sigma(0, 1) * sigma(1, 2) - sigma(1, 1) * sigma(0, 2));

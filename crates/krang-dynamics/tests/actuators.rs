@@ -78,7 +78,10 @@ fn each_joint_torque_acts_on_its_own_row_only() {
     }
     assert_eq!(ACTUATOR_NAMES[actuator::LEFT_ARM.start], "tau_1l");
     assert_eq!(ACTUATOR_NAMES[actuator::RIGHT_ARM.end - 1], "tau_7r");
-    assert_eq!(SPEED_NAMES[krang_dynamics::forward::RIGHT_ARM.start], "qd1r");
+    assert_eq!(
+        SPEED_NAMES[krang_dynamics::forward::RIGHT_ARM.start],
+        "qd1r"
+    );
 }
 
 #[test]

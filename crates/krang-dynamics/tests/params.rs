@@ -28,7 +28,13 @@ fn validate_names_the_non_finite_parameter() {
 
 #[test]
 fn validate_rejects_non_positive_masses_and_wheel_constants() {
-    for (name, value) in [("m4l", 0.0), ("m1", -2.0), ("R", 0.0), ("L", -0.68), ("mw", 0.0)] {
+    for (name, value) in [
+        ("m4l", 0.0),
+        ("m1", -2.0),
+        ("R", 0.0),
+        ("L", -0.68),
+        ("mw", 0.0),
+    ] {
         let mut p = Params::default();
         p.set(name, value).unwrap();
         assert_eq!(

@@ -110,7 +110,8 @@ columns (per call of each generated function; `precompute` runs once per paramet
   adds, muls, divs   floating-point additions (and subtractions), multiplications, divisions
   sin/cos  joint angles whose sine and cosine are needed (computed together in one batched call)
   flops    adds + muls + divs
-  live     the most intermediate values alive at once (register pressure; spills above ~16)
+  live     the most intermediate values alive at once (register pressure: x86-64 has 16
+           vector registers, more live values spill to the stack)
 next:
   kanegen listing MODEL                 the K/D substitution listing of every function
   kanegen emit MODEL --out FILE         the generated Rust module

@@ -9,8 +9,8 @@
 //!   the model does not have; [`InvalidParameter`], the error of `Params::validate`, and the
 //!   checks it runs ([`validate`]).
 //! - [`params_serde!`]: the macro a generated module invokes after its `Params`, which
-//!   implements `serde`'s traits with the `serde` feature; [`params_from_model_toml`] (feature `toml`) reads the parameter
-//!   values of a model file at run time.
+//!   implements `serde`'s traits with the `serde` feature; `params_from_model_toml` (feature
+//!   `toml`) reads the parameter values of a model file at run time.
 //! - [`RobotDynamics`] (and [`CoriolisMatrix`], for modules generated with the Coriolis
 //!   matrix): the trait every generated robot type implements, so that a controller can be
 //!   written once for any generated robot.
@@ -122,7 +122,7 @@
 //!   (nalgebra's math goes through `libm`); the crate itself is `#![no_std]` either way.
 //! - `serde`: `Serialize`/`Deserialize` for every generated `Params` (`no_std`-compatible);
 //!   re-exports `serde`.
-//! - `toml` (implies `serde` and `std`): [`params_from_model_toml`], the `[parameters]` table
+//! - `toml` (implies `serde` and `std`): `params_from_model_toml`, the `[parameters]` table
 //!   of a model description file as a generated `Params`, at run time.
 
 #![no_std]

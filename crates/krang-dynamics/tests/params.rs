@@ -61,8 +61,10 @@ fn validate_rejects_inertias_that_break_the_triangle_inequality() {
     assert!(e.to_string().contains("triangle inequality"), "{e}");
     // A first moment too large for the inertia about the frame origin: the shift to the
     // centre of mass makes a principal moment negative.
-    let mut p = two_link::Params::default();
-    p.MX2 = 5.0;
+    let p = two_link::Params {
+        MX2: 5.0,
+        ..two_link::Params::default()
+    };
     assert_eq!(p.validate().unwrap_err().name(), "2");
     // A thin rod (principal moments 0, I, I) sits on the boundary: valid.
     let mut p = two_link::Params::default();

@@ -349,73 +349,30 @@ struct Sample {
     work_gravity: f64,
 }
 
-/// State of (a): `[q (19), u (19), ∫ uᵀg dt, X0, Y0]`.
-type StateA = SVector<f64, 41>;
+/// Reference energies of run (a), for its plots.
+struct Energies {
+    k0: f64,
+    v0: f64,
+    e0: f64,
+    ke_max: f64,
+    drift: f64,
+}
 
-fn falling(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>) -> Res<Summary> {
-    let k = Krang::default();
-    let fk = Kinematics::new(k.params())?;
-    let mut q0 = pose();
-    let up = k.upright_pitch(&q0);
-    q0[index::Q_IMU] = up;
-    let com = fk.centre_of_mass(&q0);
-    q0[index::Q_IMU] = up + cfg.tilt;
-
-    let rhs = |_t: f64, s: &StateA| -> StateA {
-        let q: SVector<f64, 19> = s.fixed_rows::<19>(0).into_owned();
-        let u: SVector<f64, 19> = s.fixed_rows::<19>(19).into_owned();
-        let ud = k.forward_dynamics(&q, &u, &SVector::zeros());
-        let mut d = StateA::zeros();
-        d.fixed_rows_mut::<19>(0).copy_from(&u); // q̇ = u (x, ψ: quasi-coordinates)
-        d.fixed_rows_mut::<19>(19).copy_from(&ud);
-        d[38] = u.dot(&k.gravity(&q));
-        let psi = q[index::PSI];
-        d[39] = u[index::X] * psi.cos();
-        d[40] = u[index::X] * psi.sin();
-        d
-    };
-    let sample = |t: f64, s: &StateA| -> Sample {
-        let q: SVector<f64, 19> = s.fixed_rows::<19>(0).into_owned();
-        let u: SVector<f64, 19> = s.fixed_rows::<19>(19).into_owned();
-        Sample {
-            t,
-            tilt: q[index::Q_IMU] - up,
-            psi: q[index::PSI],
-            x: s[39],
-            y: s[40],
-            kinetic: 0.5 * u.dot(&(k.mass_matrix(&q) * u)),
-            potential: fk.potential(&q),
-            work_gravity: s[38],
-        }
-    };
-
-    let mut s = StateA::zeros();
-    s.fixed_rows_mut::<19>(0).copy_from(&q0);
-    let steps = (cfg.duration / cfg.fall_step).round() as usize;
-    // Record about every millisecond.
-    let every = ((1e-3 / cfg.fall_step).round() as usize).max(1);
-    let mut log = vec![sample(0.0, &s)];
-    let mut max_speed: f64 = 0.0;
-    for n in 0..steps {
-        s = rk4(rhs, n as f64 * cfg.fall_step, &s, cfg.fall_step);
-        max_speed = max_speed.max(s.fixed_rows::<14>(19 + index::Q1L).amax());
-        max_speed = max_speed.max(s.fixed_rows::<3>(19 + index::Q_IMU).amax());
-        if (n + 1) % every == 0 || n + 1 == steps {
-            log.push(sample((n + 1) as f64 * cfg.fall_step, &s));
-        }
-    }
-
-    let (k0, v0) = (log[0].kinetic, log[0].potential);
-    let e0 = k0 + v0;
-    let ke_max = log.iter().map(|p| p.kinetic).fold(0.0, f64::max);
-    let worst = |f: &dyn Fn(&Sample) -> f64| log.iter().map(|p| f(p).abs()).fold(0.0, f64::max);
-    let drift = worst(&|p| p.kinetic + p.potential - e0);
-    let power = worst(&|p| p.kinetic - k0 + p.work_gravity);
-    let grad = worst(&|p| p.potential - v0 - p.work_gravity);
-    let tilt_min = log.iter().map(|p| p.tilt).fold(f64::INFINITY, f64::min);
-    let tilt_max = log.iter().map(|p| p.tilt).fold(f64::NEG_INFINITY, f64::max);
-
-    // Plots.
+/// The plots of run (a): pitch, heading and position, energy.
+fn falling_plots(
+    dir: &Path,
+    cfg: &Config,
+    log: &[Sample],
+    energies: Energies,
+    files: &mut Vec<PathBuf>,
+) -> Res<()> {
+    let Energies {
+        k0,
+        v0,
+        e0,
+        ke_max,
+        drift,
+    } = energies;
     let time = |f: &dyn Fn(&Sample) -> f64| -> Vec<(f64, f64)> {
         log.iter().map(|p| (p.t, f(p))).collect()
     };
@@ -503,6 +460,88 @@ fn falling(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>) -> Res<Summary> {
         ],
     )?;
     files.push(path);
+    Ok(())
+}
+
+/// State of (a): `[q (19), u (19), ∫ uᵀg dt, X0, Y0]`.
+type StateA = SVector<f64, 41>;
+
+fn falling(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>) -> Res<Summary> {
+    let k = Krang::default();
+    let fk = Kinematics::new(k.params())?;
+    let mut q0 = pose();
+    let up = k.upright_pitch(&q0);
+    q0[index::Q_IMU] = up;
+    let com = fk.centre_of_mass(&q0);
+    q0[index::Q_IMU] = up + cfg.tilt;
+
+    let rhs = |_t: f64, s: &StateA| -> StateA {
+        let q: SVector<f64, 19> = s.fixed_rows::<19>(0).into_owned();
+        let u: SVector<f64, 19> = s.fixed_rows::<19>(19).into_owned();
+        let ud = k.forward_dynamics(&q, &u, &SVector::zeros());
+        let mut d = StateA::zeros();
+        d.fixed_rows_mut::<19>(0).copy_from(&u); // q̇ = u (x, ψ: quasi-coordinates)
+        d.fixed_rows_mut::<19>(19).copy_from(&ud);
+        d[38] = u.dot(&k.gravity(&q));
+        let psi = q[index::PSI];
+        d[39] = u[index::XD] * psi.cos();
+        d[40] = u[index::XD] * psi.sin();
+        d
+    };
+    let sample = |t: f64, s: &StateA| -> Sample {
+        let q: SVector<f64, 19> = s.fixed_rows::<19>(0).into_owned();
+        let u: SVector<f64, 19> = s.fixed_rows::<19>(19).into_owned();
+        Sample {
+            t,
+            tilt: q[index::Q_IMU] - up,
+            psi: q[index::PSI],
+            x: s[39],
+            y: s[40],
+            kinetic: 0.5 * u.dot(&(k.mass_matrix(&q) * u)),
+            potential: fk.potential(&q),
+            work_gravity: s[38],
+        }
+    };
+
+    let mut s = StateA::zeros();
+    s.fixed_rows_mut::<19>(0).copy_from(&q0);
+    let steps = (cfg.duration / cfg.fall_step).round() as usize;
+    // Record about every millisecond.
+    let every = ((1e-3 / cfg.fall_step).round() as usize).max(1);
+    let mut log = vec![sample(0.0, &s)];
+    let mut max_speed: f64 = 0.0;
+    for n in 0..steps {
+        s = rk4(rhs, n as f64 * cfg.fall_step, &s, cfg.fall_step);
+        max_speed = max_speed.max(s.fixed_rows::<14>(19 + index::QD1L).amax());
+        max_speed = max_speed.max(s.fixed_rows::<3>(19 + index::QD_IMU).amax());
+        if (n + 1) % every == 0 || n + 1 == steps {
+            log.push(sample((n + 1) as f64 * cfg.fall_step, &s));
+        }
+    }
+
+    let (k0, v0) = (log[0].kinetic, log[0].potential);
+    let e0 = k0 + v0;
+    let ke_max = log.iter().map(|p| p.kinetic).fold(0.0, f64::max);
+    let worst = |f: &dyn Fn(&Sample) -> f64| log.iter().map(|p| f(p).abs()).fold(0.0, f64::max);
+    let drift = worst(&|p| p.kinetic + p.potential - e0);
+    let power = worst(&|p| p.kinetic - k0 + p.work_gravity);
+    let grad = worst(&|p| p.potential - v0 - p.work_gravity);
+    let tilt_min = log.iter().map(|p| p.tilt).fold(f64::INFINITY, f64::min);
+    let tilt_max = log.iter().map(|p| p.tilt).fold(f64::NEG_INFINITY, f64::max);
+
+    falling_plots(
+        dir,
+        cfg,
+        &log,
+        Energies {
+            k0,
+            v0,
+            e0,
+            ke_max,
+            drift,
+        },
+        files,
+    )?;
 
     Ok(Summary {
         upright_pitch: up,

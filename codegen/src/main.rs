@@ -9,13 +9,26 @@
 //!
 //! `<model>` is a TOML description or a URDF file (`.urdf`, imported with the default
 //! `UrdfOptions` unless the URDF options below are given). Run `kanegen --help` for the options.
+//!
+//! The command line is checked completely before any work: an unknown command, an unknown
+//! option, an option the command does not take or a missing or extra argument is an error
+//! (exit status 2). Output to a closed pipe (`kanegen stats m.toml | head -1`) ends quietly.
 #![forbid(unsafe_code)]
 
+#[path = "cli_show.rs"]
+mod show;
+
+use std::io::Write as _;
 use std::path::Path;
 use std::process::ExitCode;
 
 use kanegen::model::{Model, UrdfImport, UrdfOptions, WheeledBaseSpec};
 use kanegen::{Builder, FunctionSet};
+
+/// The reminder after a command-line error.
+const SHORT_USAGE: &str =
+    "usage: kanegen <show|stats|listing|emit> <model.toml|model.urdf> [options]
+(`kanegen --help` lists the commands and the options each one takes)";
 
 const USAGE: &str = "usage: kanegen <show|stats|listing|emit> <model.toml|model.urdf> [options]
 
@@ -24,7 +37,7 @@ const USAGE: &str = "usage: kanegen <show|stats|listing|emit> <model.toml|model.
   listing  print the substitution listing (K/D variables) in the reports' style
   emit     print the generated Rust module, or write it to --out FILE (only if changed)
 
-options (stats, listing, emit):
+options (stats, listing, emit; `show` takes only the URDF import options):
   --baked                 fold the model file's parameter values in as constants
   --functions LIST        the generated functions, comma-separated (default: `default`;
                           `all`, or names: mass_matrix,coriolis,gravity,inverse_dynamics,coriolis_matrix)
@@ -41,20 +54,180 @@ URDF import options (.urdf models; see kanegen_model::UrdfOptions):
   --drop-links A,B        links to leave out (e.g. Krang's gripper plates)
   --name NAME             the model (and wrapper type) name (default: <robot name>)";
 
+/// How the command failed.
+enum Failure {
+    /// A bad command line: the message and the usage (exit status 2).
+    Usage(String),
+    /// The command failed: the message (exit status 1).
+    Error(String),
+}
+
+impl From<String> for Failure {
+    fn from(msg: String) -> Self {
+        Failure::Usage(msg)
+    }
+}
+
+impl From<&str> for Failure {
+    fn from(msg: &str) -> Self {
+        Failure::Usage(msg.to_owned())
+    }
+}
+
 fn main() -> ExitCode {
     match run(std::env::args().skip(1).collect()) {
         Ok(()) => ExitCode::SUCCESS,
-        Err(msg) => {
+        Err(Failure::Usage(msg)) => {
+            eprintln!("error: {msg}\n{SHORT_USAGE}");
+            ExitCode::from(2)
+        }
+        Err(Failure::Error(msg)) => {
             eprintln!("{msg}");
             ExitCode::FAILURE
         }
     }
 }
 
+/// Write `text` to standard output. A closed pipe (the reader, such as `head`, has exited) is
+/// not an error: the output is simply not wanted any more.
+fn output(text: &str) -> Result<(), Failure> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Failure::Error(format!(
+            "error: writing to standard output: {e}"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// What `stats` prints after its table: the columns, and what to run next.
+const STATS_LEGEND: &str = "
+columns (per call of each generated function; `precompute` runs once per parameter set):
+  K        substitution variables for kinematic quantities (rotations, velocities,
+           accelerations), as in the Krang reports
+  D        substitution variables for inertial and gravity terms (forces, moments, M entries)
+  temps    other named intermediate values of the straight-line code
+  adds, muls, divs   floating-point additions (and subtractions), multiplications, divisions
+  sin/cos  joint angles whose sine and cosine are needed (computed together in one batched call)
+  flops    adds + muls + divs
+  live     the most intermediate values alive at once (register pressure: x86-64 has 16
+           vector registers, more live values spill to the stack)
+next:
+  kanegen listing MODEL                 the K/D substitution listing of every function
+  kanegen emit MODEL --out FILE         the generated Rust module
+  kanegen stats MODEL --functions LIST  only some functions (`default`, `all`, or names)
+  kanegen stats MODEL --baked           with the parameter values folded in
+";
+
+fn run(args: Vec<String>) -> Result<(), Failure> {
+    let Some(args) = parse(args)? else {
+        return output(&format!("{USAGE}\n"));
+    };
+    let (cmd, path) = (args.command, args.model.as_str());
+    let urdf = kanegen::is_urdf(Path::new(path));
+    if !urdf && args.has_urdf_options() {
+        return Err(
+            format!("URDF import options apply to .urdf models only (`{path}` is TOML)").into(),
+        );
+    }
+    let urdf_options = args.urdf_options()?;
+    let error = |e: &dyn std::fmt::Display| Failure::Error(format!("error: {e}"));
+    if cmd == Command::Show {
+        let model = if urdf {
+            UrdfImport::read(path, &urdf_options).map(|i| i.model)
+        } else {
+            Model::from_toml_file(path)
+        };
+        return output(&show::model(&model.map_err(|e| error(&e))?));
+    }
+    let mut builder = if urdf {
+        Builder::urdf(path, urdf_options)
+    } else {
+        Builder::new(path)
+    }
+    .baked(args.baked);
+    if let Some(set) = args.functions {
+        builder = builder.functions(set);
+    }
+    if args.no_coriolis_matrix {
+        builder = builder.coriolis_matrix(false);
+    }
+    if args.f32 {
+        builder = builder.precision(kanegen::Precision::F32);
+    }
+    let start = std::time::Instant::now();
+    let g = builder.generate().map_err(|e| error(&e))?;
+    let elapsed = start.elapsed();
+    match cmd {
+        Command::Stats => output(&format!(
+            "{}generation time: {:.0} ms\n{STATS_LEGEND}",
+            kanegen::stats(&g),
+            elapsed.as_secs_f64() * 1e3
+        )),
+        Command::Listing => output(&kanegen::listing(&g)),
+        _ => match &args.out {
+            Some(f) => {
+                let written =
+                    kanegen::write_if_changed(Path::new(f), &g.source).map_err(|e| error(&e))?;
+                eprintln!("{f}: {}", if written { "written" } else { "unchanged" });
+                Ok(())
+            }
+            None => output(&g.source),
+        },
+    }
+}
+
+/// The command.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Command {
+    Show,
+    Stats,
+    Listing,
+    Emit,
+}
+
+impl Command {
+    fn parse(s: &str) -> Option<Self> {
+        Some(match s {
+            "show" => Command::Show,
+            "stats" => Command::Stats,
+            "listing" => Command::Listing,
+            "emit" => Command::Emit,
+            _ => return None,
+        })
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Command::Show => "show",
+            Command::Stats => "stats",
+            Command::Listing => "listing",
+            Command::Emit => "emit",
+        }
+    }
+
+    /// Whether the command takes `option` (one of the options of [`parse`]).
+    fn takes(self, option: &str) -> bool {
+        const URDF: [&str; 7] = [
+            "--wheeled",
+            "--up",
+            "--radius",
+            "--track",
+            "--pitch-name",
+            "--drop-links",
+            "--name",
+        ];
+        const GENERATOR: [&str; 3] = ["--baked", "--functions", "--no-coriolis-matrix"];
+        URDF.contains(&option)
+            || (self != Command::Show && GENERATOR.contains(&option))
+            || (self == Command::Emit && ["--f32", "--out"].contains(&option))
+    }
+}
+
 /// The parsed command line.
-#[derive(Default)]
 struct Args {
-    positional: Vec<String>,
+    command: Command,
+    model: String,
     baked: bool,
     functions: Option<FunctionSet>,
     no_coriolis_matrix: bool,
@@ -79,48 +252,112 @@ fn numbers<const N: usize>(option: &str, s: &str) -> Result<[f64; N], String> {
         .map_err(|_| format!("{option} expects {N} comma-separated numbers, got `{s}`"))
 }
 
+/// The command line, checked completely: `None` for `--help`. The command comes first, so that
+/// an unknown command is reported before anything else; every option must be one the command
+/// takes.
 fn parse(args: Vec<String>) -> Result<Option<Args>, String> {
-    let mut a = Args::default();
+    if args.iter().any(|a| a == "-h" || a == "--help") {
+        return Ok(None);
+    }
     let mut it = args.into_iter();
+    let command = match it.next() {
+        None => return Err("no command given".into()),
+        Some(c) => Command::parse(&c).ok_or_else(|| {
+            if c.starts_with('-') {
+                format!("expected a command before `{c}`")
+            } else {
+                format!("unknown command `{c}`")
+            }
+        })?,
+    };
+    let mut a = Args {
+        command,
+        model: String::new(),
+        baked: false,
+        functions: None,
+        no_coriolis_matrix: false,
+        f32: false,
+        out: None,
+        wheeled: None,
+        up: None,
+        radius: None,
+        track: None,
+        pitch_name: None,
+        drop_links: Vec::new(),
+        name: None,
+    };
     while let Some(arg) = it.next() {
-        let mut value = |what: &str| it.next().ok_or(format!("{arg} needs {what}"));
-        match arg.as_str() {
-            "-h" | "--help" => return Ok(None),
-            "--baked" => a.baked = true,
-            "--no-coriolis-matrix" => a.no_coriolis_matrix = true,
-            "--f32" => a.f32 = true,
-            "--out" => a.out = Some(value("a file name")?),
-            "--functions" => {
-                a.functions = Some(
-                    value("a list of functions")?
-                        .parse()
-                        .map_err(|e| format!("{e}"))?,
-                )
+        if !arg.starts_with('-') {
+            if !a.model.is_empty() {
+                return Err(format!("unexpected argument `{arg}` (one model file)"));
             }
-            "--wheeled" => {
-                let v = value("LEFT_JOINT,RIGHT_JOINT,BODY_LINK")?;
-                let parts: Vec<String> = v.split(',').map(|s| s.trim().to_owned()).collect();
-                a.wheeled = Some(parts.try_into().map_err(|_| {
-                    format!("--wheeled expects LEFT_JOINT,RIGHT_JOINT,BODY_LINK, got `{v}`")
-                })?);
-            }
-            "--up" => a.up = Some(numbers::<3>("--up", &value("X,Y,Z")?)?),
-            "--radius" => a.radius = Some(numbers::<1>("--radius", &value("a number")?)?[0]),
-            "--track" => a.track = Some(numbers::<1>("--track", &value("a number")?)?[0]),
-            "--pitch-name" => a.pitch_name = Some(value("a name")?),
-            "--drop-links" => {
-                let v = value("a list of links")?;
-                a.drop_links = v.split(',').map(|s| s.trim().to_owned()).collect();
-            }
-            "--name" => a.name = Some(value("a name")?),
-            s if s.starts_with('-') => return Err(format!("unknown option `{s}`\n\n{USAGE}")),
-            _ => a.positional.push(arg),
+            a.model = arg;
+            continue;
         }
+        if !is_option(&arg) {
+            return Err(format!("unknown option `{arg}`"));
+        }
+        if !command.takes(&arg) {
+            return Err(format!("`{}` does not take `{arg}`", command.name()));
+        }
+        let value = if FLAGS.contains(&arg.as_str()) {
+            None
+        } else {
+            it.next()
+        };
+        a.set(&arg, value)?;
+    }
+    if a.model.is_empty() {
+        return Err(format!("`{}` needs a model file", command.name()));
     }
     Ok(Some(a))
 }
 
+/// The options that take no value.
+const FLAGS: [&str; 3] = ["--baked", "--no-coriolis-matrix", "--f32"];
+
+/// Whether `arg` is one of the options of the command line.
+fn is_option(arg: &str) -> bool {
+    [
+        Command::Show,
+        Command::Stats,
+        Command::Listing,
+        Command::Emit,
+    ]
+    .iter()
+    .any(|c| c.takes(arg))
+}
+
 impl Args {
+    /// Apply option `arg` with its value (`None` for the flags, which take none).
+    fn set(&mut self, arg: &str, value: Option<String>) -> Result<(), String> {
+        let value = || value.clone().ok_or(format!("{arg} needs a value"));
+        match arg {
+            "--baked" => self.baked = true,
+            "--no-coriolis-matrix" => self.no_coriolis_matrix = true,
+            "--f32" => self.f32 = true,
+            "--out" => self.out = Some(value()?),
+            "--functions" => self.functions = Some(value()?.parse().map_err(|e| format!("{e}"))?),
+            "--wheeled" => {
+                let v = value()?;
+                let parts: Vec<String> = v.split(',').map(|s| s.trim().to_owned()).collect();
+                self.wheeled = Some(parts.try_into().map_err(|_| {
+                    format!("--wheeled expects LEFT_JOINT,RIGHT_JOINT,BODY_LINK, got `{v}`")
+                })?);
+            }
+            "--up" => self.up = Some(numbers::<3>("--up", &value()?)?),
+            "--radius" => self.radius = Some(numbers::<1>("--radius", &value()?)?[0]),
+            "--track" => self.track = Some(numbers::<1>("--track", &value()?)?[0]),
+            "--pitch-name" => self.pitch_name = Some(value()?),
+            "--drop-links" => {
+                self.drop_links = value()?.split(',').map(|s| s.trim().to_owned()).collect();
+            }
+            "--name" => self.name = Some(value()?),
+            _ => return Err(format!("unknown option `{arg}`")),
+        }
+        Ok(())
+    }
+
     /// The URDF import options given on the command line.
     fn urdf_options(&self) -> Result<UrdfOptions, String> {
         let mut o = match &self.wheeled {
@@ -166,70 +403,4 @@ impl Args {
             || !self.drop_links.is_empty()
             || self.name.is_some()
     }
-}
-
-fn run(args: Vec<String>) -> Result<(), String> {
-    let Some(args) = parse(args)? else {
-        println!("{USAGE}");
-        return Ok(());
-    };
-    let [cmd, path] = args.positional.as_slice() else {
-        return Err(USAGE.to_owned());
-    };
-    if !["show", "stats", "listing", "emit"].contains(&cmd.as_str()) {
-        return Err(format!("unknown command `{cmd}`\n\n{USAGE}"));
-    }
-    let urdf = kanegen::is_urdf(Path::new(path));
-    if !urdf && args.has_urdf_options() {
-        return Err(format!(
-            "URDF import options apply to .urdf models only (`{path}` is TOML)"
-        ));
-    }
-    if cmd != "emit" && (args.out.is_some() || args.f32) {
-        return Err(format!("--out and --f32 apply to `emit` only\n\n{USAGE}"));
-    }
-    let urdf_options = args.urdf_options()?;
-    if cmd == "show" {
-        let model = if urdf {
-            UrdfImport::read(path, &urdf_options).map(|i| i.model)
-        } else {
-            Model::from_toml_file(path)
-        };
-        print!("{}", model.map_err(|e| format!("error: {e}"))?);
-        return Ok(());
-    }
-    let mut builder = if urdf {
-        Builder::urdf(path, urdf_options)
-    } else {
-        Builder::new(path)
-    }
-    .baked(args.baked);
-    if let Some(set) = args.functions {
-        builder = builder.functions(set);
-    }
-    if args.no_coriolis_matrix {
-        builder = builder.coriolis_matrix(false);
-    }
-    if args.f32 {
-        builder = builder.precision(kanegen::Precision::F32);
-    }
-    let start = std::time::Instant::now();
-    let g = builder.generate().map_err(|e| format!("error: {e}"))?;
-    let elapsed = start.elapsed();
-    match cmd.as_str() {
-        "stats" => {
-            print!("{}", kanegen::stats(&g));
-            println!("generation time: {:.0} ms", elapsed.as_secs_f64() * 1e3);
-        }
-        "listing" => print!("{}", kanegen::listing(&g)),
-        _ => match &args.out {
-            Some(f) => {
-                let written = kanegen::write_if_changed(Path::new(f), &g.source)
-                    .map_err(|e| format!("error: {e}"))?;
-                eprintln!("{f}: {}", if written { "written" } else { "unchanged" });
-            }
-            None => print!("{}", g.source),
-        },
-    }
-    Ok(())
 }

@@ -29,7 +29,7 @@ pub enum Precision {
     /// `f64` (the default).
     #[default]
     F64,
-    /// `f32`; sines and cosines are computed in `f64` and rounded.
+    /// `f32`, sines and cosines included (`kanegen_runtime::trig::sin_cos_n_f32`).
     F32,
 }
 

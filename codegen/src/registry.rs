@@ -497,13 +497,14 @@ impl std::str::FromStr for FunctionSet {
     type Err = UnknownFunction;
 
     /// Comma-separated Rust names (`mass_matrix,gravity`); `all` for every function, `default`
-    /// for the default set.
+    /// for the default set, `kinematics` for [`FunctionSet::kinematics`].
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let mut set = FunctionSet::EMPTY;
         for name in s.split(',').map(str::trim).filter(|n| !n.is_empty()) {
             set = match name {
                 "all" => set.union(FunctionSet::all()),
                 "default" => set.union(FunctionSet::default()),
+                "kinematics" => set.union(FunctionSet::kinematics()),
                 _ => set.with(FunctionId::from_name(name).ok_or_else(|| UnknownFunction {
                     name: name.to_owned(),
                 })?),
@@ -518,6 +519,23 @@ impl FunctionSet {
     #[must_use]
     pub fn union(self, other: FunctionSet) -> Self {
         FunctionSet(self.0 | other.0)
+    }
+
+    /// The kinematics and energies: centre of mass, its Jacobian and bias acceleration, kinetic
+    /// and potential energy, and the per-frame pose, Jacobian and bias acceleration.
+    pub fn kinematics() -> Self {
+        [
+            FunctionId::CenterOfMass,
+            FunctionId::ComJacobian,
+            FunctionId::ComBiasAcceleration,
+            FunctionId::KineticEnergy,
+            FunctionId::PotentialEnergy,
+            FunctionId::FramePose,
+            FunctionId::FrameJacobian,
+            FunctionId::FrameBiasAcceleration,
+        ]
+        .into_iter()
+        .collect()
     }
 }
 

@@ -1,13 +1,62 @@
-//! Generates the dynamics modules from the robot descriptions next to this file.
+//! Generates the optional dynamics modules from the robot descriptions next to this file: one
+//! generator call per module, each behind its feature of the crate (Cargo compiles the script
+//! with `--cfg feature="..."` and sets `CARGO_FEATURE_<NAME>`, `-` as `_`). Without features
+//! this script does nothing and `kanegen` is not even a build dependency: the default module
+//! (f64 Krang with M, c, g and inverse dynamics) is pre-generated in `src/generated/krang.rs`
+//! (`tests/pregenerated.rs` checks it against the generator). With `coriolis-matrix` or
+//! `kinematics` the Krang module is generated here instead, with those functions.
 fn main() {
-    // The opt-in kinematics and energies (centre of mass, frames, T, V) on the main module.
-    kanegen::Builder::new("krang.toml")
-        .functions(kanegen::FunctionSet::all())
-        .run();
-    kanegen::Builder::new("krang.toml").baked(true).run();
-    kanegen::Builder::new("krang.toml")
-        .precision(kanegen::Precision::F32)
-        .run();
-    kanegen::Builder::new("krang-fixed-wheels.toml").run();
-    kanegen::Builder::new("two-link.toml").run();
+    #[cfg(any(
+        feature = "coriolis-matrix",
+        feature = "kinematics",
+        feature = "baked",
+        feature = "f32",
+        feature = "fixed-wheels",
+        feature = "two-link"
+    ))]
+    generate();
+}
+
+#[cfg(any(
+    feature = "coriolis-matrix",
+    feature = "kinematics",
+    feature = "baked",
+    feature = "f32",
+    feature = "fixed-wheels",
+    feature = "two-link"
+))]
+fn generate() {
+    use kanegen::{FunctionId, FunctionSet};
+    let enabled = |feature: &str| std::env::var_os(format!("CARGO_FEATURE_{feature}")).is_some();
+    let coriolis_matrix = enabled("CORIOLIS_MATRIX");
+    let kinematics = enabled("KINEMATICS");
+    let builder = |model: &str| kanegen::Builder::new(model).coriolis_matrix(coriolis_matrix);
+    if coriolis_matrix || kinematics {
+        // The main module, with the Coriolis matrix and/or the kinematics and energies (centre
+        // of mass, frames, T, V).
+        let mut functions = FunctionSet::default().without(FunctionId::CoriolisMatrix);
+        if coriolis_matrix {
+            functions = functions.with(FunctionId::CoriolisMatrix);
+        }
+        if kinematics {
+            functions = functions.union(FunctionSet::kinematics());
+        }
+        kanegen::Builder::new("krang.toml")
+            .functions(functions)
+            .run();
+    }
+    if enabled("BAKED") {
+        builder("krang.toml").baked(true).run();
+    }
+    if enabled("F32") {
+        builder("krang.toml")
+            .precision(kanegen::Precision::F32)
+            .run();
+    }
+    if enabled("FIXED_WHEELS") {
+        builder("krang-fixed-wheels.toml").run();
+    }
+    if enabled("TWO_LINK") {
+        builder("two-link.toml").run();
+    }
 }

@@ -13,21 +13,35 @@ use crate::model::ParamKind;
 use crate::naming;
 use crate::registry::{FunctionSpec, Inputs, RuntimeTrait};
 
-/// `DOF`, `SPEED_NAMES`, `COORDINATE_NAMES` and the `index` constants.
+/// `DOF`, `SPEED_NAMES`, `COORDINATE_NAMES` and the `index` constants: one per coordinate
+/// (`Q_IMU`) and one per speed (`QD_IMU`), the same index, unless the speed's constant would
+/// repeat a name already taken.
 pub(super) fn names(cx: &Context<'_>) -> TokenStream {
     let model = cx.model;
     let nl = idx(cx.low.dof);
     let speed_names: Vec<&str> = model.speeds.iter().map(|s| s.name.as_str()).collect();
     let coord_names: Vec<&str> = model.speeds.iter().map(|s| s.coordinate.as_str()).collect();
-    let index_consts = model.speeds.iter().enumerate().map(|(i, s)| {
+    let mut taken: Vec<String> = model
+        .speeds
+        .iter()
+        .map(|s| ident(&s.coordinate.to_uppercase()).to_string())
+        .collect();
+    let mut index_consts = Vec::new();
+    for (i, s) in model.speeds.iter().enumerate() {
         let id = ident(&s.coordinate.to_uppercase());
-        let doc = format!(
-            " Index of `{}` in q (and of `{}` in u).",
-            s.coordinate, s.name
-        );
+        let doc = format!(" Index of the coordinate `{}` in q.", s.coordinate);
         let i = idx(i);
-        quote!(#[doc = #doc] pub const #id: usize = #i;)
-    });
+        index_consts.push(quote!(#[doc = #doc] pub const #id: usize = #i;));
+        let speed_id = ident(&s.name.to_uppercase());
+        if !taken.contains(&speed_id.to_string()) {
+            taken.push(speed_id.to_string());
+            let doc = format!(
+                " Index of the speed `{}` in u, u̇ and τ (the rate of `{}`).",
+                s.name, s.coordinate
+            );
+            index_consts.push(quote!(#[doc = #doc] pub const #speed_id: usize = #i;));
+        }
+    }
     quote! {
         /// Number of generalized speeds (and coordinates).
         pub const DOF: usize = #nl;
@@ -36,7 +50,8 @@ pub(super) fn names(cx: &Context<'_>) -> TokenStream {
         /// Coordinate names, in the order of `q`.
         pub const COORDINATE_NAMES: [&str; #nl] = [#(#coord_names),*];
 
-        /// Index constants of the coordinates (and of their speeds).
+        /// Index constants: of each coordinate in `q` (`Q_IMU`) and of its speed in `u`, `u̇`
+        /// and `τ` (`QD_IMU`); a coordinate and its speed have the same index.
         pub mod index {
             #(#index_consts)*
         }
@@ -69,6 +84,7 @@ pub(super) fn params(cx: &Context<'_>) -> TokenStream {
         .iter()
         .map(|p| signed_lit(p.value, cx.precision));
     let names: Vec<&str> = model.params.iter().map(|p| p.name.as_str()).collect();
+    let validate = validate(cx);
     let source = format!(
         " Model parameters of `{}`, named with the reports' symbols; `Default` holds the values of `{}`.",
         model.name,
@@ -81,10 +97,15 @@ pub(super) fn params(cx: &Context<'_>) -> TokenStream {
         pub const PARAM_COUNT: usize = #np;
 
         #[doc = #source]
+        ///
+        /// With the `serde` feature of `kanegen-runtime`: `Serialize` and `Deserialize`, as a
+        /// map from name to value (missing names keep their defaults, unknown names are errors).
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct Params {
             #(#[doc = #docs] pub #ids: #t,)*
         }
+
+        kanegen_runtime::params_serde!(Params, #t);
 
         impl Default for Params {
             fn default() -> Self {
@@ -123,6 +144,57 @@ pub(super) fn params(cx: &Context<'_>) -> TokenStream {
                 let [#(#ids),*] = v;
                 Self { #(#ids),* }
             }
+
+            #validate
+        }
+    }
+}
+
+/// `Params::validate`: every value finite, then the checks of each body and of the wheels.
+fn validate(cx: &Context<'_>) -> TokenStream {
+    let model = cx.model;
+    let field = |id: usize| {
+        let f = ident(&model.params[id].name);
+        quote!(f64::from(self.#f))
+    };
+    let rel_tol = match cx.precision {
+        crate::Precision::F64 => 1e-9,
+        crate::Precision::F32 => 1e-5,
+    };
+    let bodies = model.links.iter().filter_map(|l| l.body.as_ref()).map(|b| {
+        let name = b.name.as_str();
+        let mass_name = model.params[b.mass].name.as_str();
+        let m = field(b.mass);
+        let ms = b.first_moment.map(field);
+        let j = b.inertia.map(field);
+        quote!(v::check_body(#name, #mass_name, #m, [#(#ms),*], [#(#j),*], #rel_tol)?;)
+    });
+    let wheels = model.wheeled_base().map(|w| {
+        let positive = [w.radius, w.track, w.wheel_mass].map(|id| {
+            let (name, value) = (model.params[id].name.as_str(), field(id));
+            quote!(v::check_positive(#name, #value)?;)
+        });
+        let non_negative = [w.wheel_axle_inertia, w.wheel_diametral_inertia].map(|id| {
+            let (name, value) = (model.params[id].name.as_str(), field(id));
+            quote!(v::check_non_negative(#name, #value)?;)
+        });
+        quote!(#(#positive)* #(#non_negative)*)
+    });
+    quote! {
+        /// Checks that the parameters describe a physical robot: every value finite, every
+        /// body's mass positive and its inertia about the centre of mass within the triangle
+        /// inequalities (`kanegen_runtime::validate::check_body`), the wheel radius, track and
+        /// wheel mass positive and the wheel inertias non-negative.
+        ///
+        /// # Errors
+        /// The first violation, as a [`kanegen_runtime::InvalidParameter`] naming the
+        /// parameter (or the body).
+        pub fn validate(&self) -> Result<(), kanegen_runtime::InvalidParameter> {
+            use kanegen_runtime::validate as v;
+            v::check_finite(&Self::NAMES, &self.to_array())?;
+            #(#bodies)*
+            #wheels
+            Ok(())
         }
     }
 }

@@ -19,17 +19,25 @@ mod generated {
     pub const SPEED_NAMES: [&str; 2] = ["qd_imu", "qd_w"];
     /// Coordinate names, in the order of `q`.
     pub const COORDINATE_NAMES: [&str; 2] = ["q_imu", "q_w"];
-    /// Index constants of the coordinates (and of their speeds).
+    /// Index constants: of each coordinate in `q` (`Q_IMU`) and of its speed in `u`, `u̇`
+    /// and `τ` (`QD_IMU`); a coordinate and its speed have the same index.
     pub mod index {
-        /// Index of `q_imu` in q (and of `qd_imu` in u).
+        /// Index of the coordinate `q_imu` in q.
         pub const Q_IMU: usize = 0;
-        /// Index of `q_w` in q (and of `qd_w` in u).
+        /// Index of the speed `qd_imu` in u, u̇ and τ (the rate of `q_imu`).
+        pub const QD_IMU: usize = 0;
+        /// Index of the coordinate `q_w` in q.
         pub const Q_W: usize = 1;
+        /// Index of the speed `qd_w` in u, u̇ and τ (the rate of `q_w`).
+        pub const QD_W: usize = 1;
     }
     pub use kanegen_runtime::UnknownParameter;
     /// Number of model parameters.
     pub const PARAM_COUNT: usize = 23;
     /// Model parameters of `two-link`, named with the reports' symbols; `Default` holds the values of `two-link.toml`.
+    ///
+    /// With the `serde` feature of `kanegen-runtime`: `Serialize` and `Deserialize`, as a
+    /// map from name to value (missing names keep their defaults, unknown names are errors).
     #[derive(Clone, Copy, Debug, PartialEq)]
     pub struct Params {
         /// `g`: gravity acceleration (m/s²) (default 9.81).
@@ -79,6 +87,7 @@ mod generated {
         /// `ZZ2`: inertia about the frame origin (kg·m²) (default 0.232799115199854).
         pub ZZ2: f64,
     }
+    kanegen_runtime::params_serde!(Params, f64);
     impl Default for Params {
         fn default() -> Self {
             Self {
@@ -251,6 +260,49 @@ mod generated {
                 YZ2,
                 ZZ2,
             }
+        }
+        /// Checks that the parameters describe a physical robot: every value finite, every
+        /// body's mass positive and its inertia about the centre of mass within the triangle
+        /// inequalities (`kanegen_runtime::validate::check_body`), the wheel radius, track and
+        /// wheel mass positive and the wheel inertias non-negative.
+        ///
+        /// # Errors
+        /// The first violation, as a [`kanegen_runtime::InvalidParameter`] naming the
+        /// parameter (or the body).
+        pub fn validate(&self) -> Result<(), kanegen_runtime::InvalidParameter> {
+            use kanegen_runtime::validate as v;
+            v::check_finite(&Self::NAMES, &self.to_array())?;
+            v::check_body(
+                "1",
+                "m1",
+                f64::from(self.m1),
+                [f64::from(self.MX1), f64::from(self.MY1), f64::from(self.MZ1)],
+                [
+                    f64::from(self.XX1),
+                    f64::from(self.XY1),
+                    f64::from(self.XZ1),
+                    f64::from(self.YY1),
+                    f64::from(self.YZ1),
+                    f64::from(self.ZZ1),
+                ],
+                0.000000001f64,
+            )?;
+            v::check_body(
+                "2",
+                "m2",
+                f64::from(self.m2),
+                [f64::from(self.MX2), f64::from(self.MY2), f64::from(self.MZ2)],
+                [
+                    f64::from(self.XX2),
+                    f64::from(self.XY2),
+                    f64::from(self.XZ2),
+                    f64::from(self.YY2),
+                    f64::from(self.YZ2),
+                    f64::from(self.ZZ2),
+                ],
+                0.000000001f64,
+            )?;
+            Ok(())
         }
     }
     /// Parameter-only subexpressions of the dynamics, computed once per parameter set.

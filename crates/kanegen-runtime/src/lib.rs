@@ -6,13 +6,17 @@
 //!   [`trig::sin_cos_n_f32`] (`f32`), that each generated function calls once; a `core`-only,
 //!   branch-free fdlibm kernel that the compiler vectorizes.
 //! - [`UnknownParameter`]: the allocation-free error of a generated `Params::set` for a name
-//!   the model does not have.
+//!   the model does not have; [`InvalidParameter`], the error of `Params::validate`, and the
+//!   checks it runs ([`validate`]).
+//! - [`params_serde!`]: the macro a generated module invokes after its `Params`, which
+//!   implements `serde`'s traits with the `serde` feature; `params_from_model_toml` (feature
+//!   `toml`) reads the parameter values of a model file at run time.
 //! - [`RobotDynamics`] (and [`CoriolisMatrix`], for modules generated with the Coriolis
 //!   matrix): the trait every generated robot type implements, so that a controller can be
 //!   written once for any generated robot.
 //!
 //! `#![no_std]`, no `unsafe`, no dependency but [`nalgebra`] (re-exported: its vector and
-//! matrix types are the trait's argument types).
+//! matrix types are the trait's argument types) and, behind features, `serde` and `toml`.
 //!
 //! # How generated code uses it
 //!
@@ -96,18 +100,56 @@
 //! assert_eq!(Pendulum::SPEED_NAMES, ["qd"]);
 //! ```
 //!
+//! # Parameters as data
+//!
+//! Every generated `Params` (one field per model parameter, named with the model's symbols)
+//! has `validate()`, which checks what a parameter set needs to be physical and returns the
+//! first violation as an [`InvalidParameter`]: every value finite, every body's mass positive
+//! and its inertia about the centre of mass within the triangle inequalities
+//! ([`validate::check_body`]), a wheeled base's radius, track and wheel mass positive and its
+//! wheel inertias non-negative.
+//!
+//! With the `serde` feature of this crate, every generated `Params` implements
+//! `serde::Serialize` and `serde::Deserialize` (missing fields keep their defaults, unknown
+//! ones are errors), so identified parameters load from TOML, JSON or any serde format. The
+//! feature belongs to `kanegen-runtime`, not to the crate that includes the generated code:
+//! generated code invokes [`params_serde!`], whose expansion depends on it.
+//! A crate such as `krang-dynamics` forwards it as its own `serde` feature.
+//!
 //! # Features
 //!
 //! - `std` (default): forwards `nalgebra/std`. Without it the crate needs only `core`
 //!   (nalgebra's math goes through `libm`); the crate itself is `#![no_std]` either way.
+//! - `serde`: `Serialize`/`Deserialize` for every generated `Params` (`no_std`-compatible);
+//!   re-exports `serde`.
+//! - `toml` (implies `serde` and `std`): `params_from_model_toml`, the `[parameters]` table
+//!   of a model description file as a generated `Params`, at run time.
 
 #![no_std]
 #![forbid(unsafe_code)]
 
+#[cfg(feature = "std")]
+extern crate std;
+
 mod dynamics;
+mod invalid_parameter;
+#[doc(hidden)]
+pub mod serde_support;
 pub mod trig;
 mod unknown_parameter;
 
 pub use dynamics::{CoriolisMatrix, RobotDynamics};
+pub use invalid_parameter::{InvalidParameter, Problem};
 pub use nalgebra;
+#[cfg(feature = "serde")]
+pub use serde;
+#[cfg(feature = "toml")]
+pub use serde_support::{ModelFileError, params_from_model_toml};
 pub use unknown_parameter::UnknownParameter;
+
+/// The checks of a generated `Params::validate` (see the [crate docs](crate#parameters-as-data)).
+pub mod validate {
+    pub use crate::invalid_parameter::{
+        check_body, check_finite, check_non_negative, check_positive,
+    };
+}

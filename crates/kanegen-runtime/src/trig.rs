@@ -1,13 +1,14 @@
 //! The sines and cosines of the joint angles, as the generated functions compute them.
 //!
 //! Every generated function calls [`sin_cos_n`] once, on all the joint angles it needs
-//! (`f32` modules call [`sin_cos_n_f32`]); [`sin_cos`] is the scalar routine the batch falls
-//! back to for a batch with a huge or non-finite lane. All of them need only `core` (no `std`,
-//! no `libm`) and give, for a given argument, the same bits on every platform with IEEE-754
-//! `f64` arithmetic (no fused multiply-add is introduced by the compiler).
+//! (`f32` modules call [`sin_cos_n_f32`], which computes in `f32`); [`sin_cos`] is the scalar
+//! routine the batch falls back to for a batch with a huge or non-finite lane. All of them need
+//! only `core` (no `std`, no `libm`) and give, for a given argument, the same bits on every
+//! platform with IEEE-754 arithmetic (no fused multiply-add is introduced by the compiler).
 //!
-//! Accuracy: within about one ulp of the standard library for the angles robots use; a few ulp
-//! for huge arguments (`|x| ≥ 2¹⁹·π/2`); NaN for NaN and ±∞.
+//! Accuracy: `f64`, within about one ulp of the standard library for the angles robots use; a
+//! few ulp for huge arguments (`|x| ≥ 2¹⁹·π/2`); NaN for NaN and ±∞. `f32`: absolute error
+//! below 8·10⁻⁸, within one ulp of the correctly rounded result (measured by `tests/trig.rs`).
 
 /// Arguments below this magnitude (≈ 2¹⁹·π/2, so that `n·PIO2_1` is exact) take the
 /// Cody–Waite reduction; larger ones (never a robot angle) and non-finite ones take
@@ -69,23 +70,91 @@ fn sin_cos_n_slow<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
     out
 }
 
-/// `(sin x[k], cos x[k])` in `f32` for every lane: computed in `f64` (batched, by
-/// [`sin_cos_n`]) and rounded (correctly rounded but for double rounding). What the generated
-/// functions of `f32` modules call.
-#[inline(always)]
+/// `f32` arguments below this magnitude take the single-precision Cody–Waite reduction of
+/// [`sin_cos_n_f32`] (π/2 in three parts of 8, 11 and 24 bits, exact products for
+/// `|n| < 2¹³`); larger ones (never a robot angle) and non-finite ones are computed in `f64`.
+pub const SIN_COS_F32_FAST_BOUND: f32 = 8192.0;
+
+/// `(sin x[k], cos x[k])` in `f32` for every lane, computed in `f32` throughout: a
+/// three-part Cody–Waite reduction by π/2 and Cephes' single-precision minimax kernels on
+/// [−π/4, π/4], branch-free as [`sin_cos_n`], with a cold per-lane `f64` fallback for a batch
+/// with a lane at or above [`SIN_COS_F32_FAST_BOUND`] or not finite. What the generated
+/// functions of `f32` modules call, so that they need no double-precision arithmetic (a
+/// single-precision FPU, such as a Cortex-M4F's).
+///
+/// Accuracy, measured against the `f64` [`sin_cos`] by `tests/trig.rs` (every 10⁻⁴ rad of
+/// |x| ≤ 100, the neighbours of multiples of π/4, and |x| < 8192): absolute error below
+/// 8·10⁻⁸, within 1 ulp of the correctly rounded `f32` result wherever that is at least 10⁻³
+/// in magnitude (near a zero of sin or cos the absolute error is about 10⁻¹², a few ulp of
+/// the tiny result).
+#[inline(never)]
 #[allow(clippy::needless_range_loop)]
 pub fn sin_cos_n_f32<const N: usize>(x: [f32; N]) -> ([f32; N], [f32; N]) {
-    let mut wide = [0.0; N];
+    let (mut s, mut c) = ([0.0; N], [0.0; N]);
+    let mut fast = true;
     for k in 0..N {
-        wide[k] = f64::from(x[k]);
+        let (r, quadrant) = sin_cos_reduce_f32(x[k]);
+        (s[k], c[k]) = sin_cos_kernel_f32(r, quadrant);
+        fast &= x[k].abs() < SIN_COS_F32_FAST_BOUND;
     }
-    let (s, c) = sin_cos_n(wide);
+    if !fast {
+        (s, c) = sin_cos_n_f32_slow(x);
+    }
+    (s, c)
+}
+
+/// [`sin_cos_n_f32`] lane by lane in `f64` through [`sin_cos`] (a batch with a huge or
+/// non-finite lane).
+#[cold]
+#[inline(never)]
+#[allow(clippy::needless_range_loop)]
+fn sin_cos_n_f32_slow<const N: usize>(x: [f32; N]) -> ([f32; N], [f32; N]) {
     let mut out = ([0.0; N], [0.0; N]);
     for k in 0..N {
-        out.0[k] = s[k] as f32;
-        out.1[k] = c[k] as f32;
+        let (s, c) = sin_cos(f64::from(x[k]));
+        (out.0[k], out.1[k]) = (s as f32, c as f32);
     }
     out
+}
+
+/// `(r, n)` with `x = n·π/2 + r`, |r| ≤ π/4 (to within rounding), in `f32`, for |x| <
+/// [`SIN_COS_F32_FAST_BOUND`]; only the low two bits of `n` are meaningful.
+#[inline(always)]
+#[allow(clippy::excessive_precision)]
+fn sin_cos_reduce_f32(x: f32) -> (f32, u32) {
+    // n = round(x · 2/π) by the 1.5·2²³ trick (exact for |x·2/π| < 2²²).
+    let shifted = x * core::f32::consts::FRAC_2_PI + 12_582_912.0;
+    let n = shifted - 12_582_912.0;
+    // π/2 = 1.5703125 + 4.837512969970703125e-4 + 7.54978995489188216e-8 (Cephes' DP1..DP3
+    // times two): the first two products are exact for |n| < 2¹³.
+    let r = ((x - n * 1.570_312_5) - n * 4.837_512_969_970_703_125e-4)
+        - n * 7.549_789_954_891_882_16e-8;
+    (r, shifted.to_bits())
+}
+
+/// `(sin x, cos x)` in `f32` from `x = n·π/2 + r`: Cephes' `sinf`/`cosf` kernels on `r`,
+/// then the quadrant `n mod 4` applied by bit masks as in the `f64` kernel.
+#[inline(always)]
+#[allow(clippy::excessive_precision)]
+fn sin_cos_kernel_f32(r: f32, quadrant: u32) -> (f32, f32) {
+    let z = r * r;
+    let s = ((-1.951_529_589_1e-4 * z + 8.332_160_873_6e-3) * z - 1.666_665_461_1e-1) * z * r + r;
+    let c = ((2.443_315_711_809_948e-5 * z - 1.388_731_625_493_765e-3) * z
+        + 4.166_664_568_298_827e-2)
+        * z
+        * z
+        - 0.5 * z
+        + 1.0;
+    let swap = 0u32.wrapping_sub(quadrant & 1);
+    let (sb, cb) = (s.to_bits(), c.to_bits());
+    let t = (sb ^ cb) & swap;
+    let (sin_bits, cos_bits) = (sb ^ t, cb ^ t);
+    let sin_sign = (quadrant & 2) << 30;
+    let cos_sign = (quadrant.wrapping_add(1) & 2) << 30;
+    (
+        f32::from_bits(sin_bits ^ sin_sign),
+        f32::from_bits(cos_bits ^ cos_sign),
+    )
 }
 
 /// `(r, n)` with `x = n·π/2 + r`, |r| ≤ π/4 (to within rounding), for |x| <

@@ -7,16 +7,19 @@
 //!     computed here by forward kinematics from `krang.toml` (independently of the generated
 //!     gravity vector), and the power balance `Δ(½ uᵀ M u) = −∫ uᵀ g dt` is integrated too.
 //! (b) The fixed-wheel model (17 speeds): base pitch held, waist, torso and both arms tracking
-//!     sinusoids under computed-torque control `τ = M(q)(q̈d + Kd ė + Kp e) + c + g` (one
+//!     sinusoids under computed-torque control `τ = M(q)(q̈_des + Kd ė + Kp e) + c + g`, with
+//!     `e = q_des − q` (`_des` for desired: `qd` names a speed everywhere else; one
 //!     generated inverse-dynamics pass), computed at 1 kHz and held between samples, from an
 //!     initial error of 0.05 rad per joint; once with the exact model and once with a controller
 //!     that does not know about a 1 kg payload in each gripper.
 //!
 //! ```text
-//! cargo run --release -p krang-dynamics --example simulate -- [DIR]   (default target/plots)
+//! cargo run --release -p krang-dynamics --features fixed-wheels --example simulate -- [DIR]
 //! ```
-//! writes `pitch.png`, `heading.png`, `energy.png` and `tracking.png` to DIR and prints the
-//! energy drift. Text is drawn from the font8x8 bitmap font, so no system font is needed.
+//! writes `pitch.png`, `heading.png`, `energy.png` and `tracking.png` to DIR (default
+//! `target/plots`) and prints the energy drift. The README's images are regenerated with
+//! `DIR = docs/plots`. Text is drawn from the font8x8 bitmap font, so no system font is
+//! needed; legends sit to the right of the plot area, outside the data.
 
 use std::error::Error;
 use std::path::{Path, PathBuf};
@@ -346,6 +349,120 @@ struct Sample {
     work_gravity: f64,
 }
 
+/// Reference energies of run (a), for its plots.
+struct Energies {
+    k0: f64,
+    v0: f64,
+    e0: f64,
+    ke_max: f64,
+    drift: f64,
+}
+
+/// The plots of run (a): pitch, heading and position, energy.
+fn falling_plots(
+    dir: &Path,
+    cfg: &Config,
+    log: &[Sample],
+    energies: Energies,
+    files: &mut Vec<PathBuf>,
+) -> Res<()> {
+    let Energies {
+        k0,
+        v0,
+        e0,
+        ke_max,
+        drift,
+    } = energies;
+    let time = |f: &dyn Fn(&Sample) -> f64| -> Vec<(f64, f64)> {
+        log.iter().map(|p| (p.t, f(p))).collect()
+    };
+    let (half_pi, end) = (std::f64::consts::FRAC_PI_2, cfg.duration);
+    let path = dir.join("pitch.png");
+    figure(
+        &path,
+        (1000, 520),
+        &[Panel {
+            title: format!("(a) released {} rad from upright, zero torque", cfg.tilt),
+            y_label: "base pitch from upright, q_imu - q_imu,upright (rad)",
+            series: vec![
+                Series::line("base pitch from upright", BLUE_, time(&|p| p.tilt)),
+                Series::dashed(
+                    "base horizontal (+-pi/2)",
+                    GREY,
+                    vec![(0.0, half_pi), (end, half_pi)],
+                ),
+                Series::dashed("", GREY, vec![(0.0, -half_pi), (end, -half_pi)]),
+            ],
+        }],
+    )?;
+    files.push(path);
+
+    let path = dir.join("heading.png");
+    figure(
+        &path,
+        (1000, 760),
+        &[
+            Panel {
+                title: "(a) heading".into(),
+                y_label: "heading ψ (rad)",
+                series: vec![Series::line("heading ψ", BLUE_, time(&|p| p.psi))],
+            },
+            Panel {
+                title: "(a) axle midpoint on the ground".into(),
+                y_label: "position in the ground plane (m)",
+                series: vec![
+                    Series::line("x of the axle midpoint", RED_, time(&|p| p.x)),
+                    Series::line("y of the axle midpoint", GREEN_, time(&|p| p.y)),
+                ],
+            },
+        ],
+    )?;
+    files.push(path);
+
+    let path = dir.join("energy.png");
+    figure(
+        &path,
+        (1000, 760),
+        &[
+            Panel {
+                title: "(a) energy; potential V by forward kinematics".into(),
+                y_label: "energy (J)",
+                series: vec![
+                    Series::line("kinetic ½u'Mu", RED_, time(&|p| p.kinetic)),
+                    Series::line("potential V - V(0)", GREEN_, time(&|p| p.potential - v0)),
+                    Series::line(
+                        "total E - E(0)",
+                        BLUE_,
+                        time(&|p| p.kinetic + p.potential - e0),
+                    ),
+                ],
+            },
+            Panel {
+                title: format!(
+                    "(a) relative drift, max {:.1e} (h = {} ms)",
+                    drift / ke_max,
+                    cfg.fall_step * 1e3
+                ),
+                y_label: "(E - E(0)) / max kinetic energy (dimensionless)",
+                series: vec![
+                    Series::line(
+                        "total energy",
+                        BLUE_,
+                        time(&|p| (p.kinetic + p.potential - e0) / ke_max),
+                    ),
+                    Series::dashed(
+                        "power balance: ½u'Mu + int u'g dt",
+                        ORANGE,
+                        time(&|p| (p.kinetic - k0 + p.work_gravity) / ke_max),
+                    ),
+                ],
+            },
+        ],
+    )?;
+    files.push(path);
+    Ok(())
+}
+
 /// State of (a): `[q (19), u (19), ∫ uᵀg dt, X0, Y0]`.
 type StateA = SVector<f64, 41>;
 
@@ -367,8 +484,8 @@ fn falling(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>) -> Res<Summary> {
         d.fixed_rows_mut::<19>(19).copy_from(&ud);
         d[38] = u.dot(&k.gravity(&q));
         let psi = q[index::PSI];
-        d[39] = u[index::X] * psi.cos();
-        d[40] = u[index::X] * psi.sin();
+        d[39] = u[index::XD] * psi.cos();
+        d[40] = u[index::XD] * psi.sin();
         d
     };
     let sample = |t: f64, s: &StateA| -> Sample {
@@ -395,8 +512,8 @@ fn falling(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>) -> Res<Summary> {
     let mut max_speed: f64 = 0.0;
     for n in 0..steps {
         s = rk4(rhs, n as f64 * cfg.fall_step, &s, cfg.fall_step);
-        max_speed = max_speed.max(s.fixed_rows::<14>(19 + index::Q1L).amax());
-        max_speed = max_speed.max(s.fixed_rows::<3>(19 + index::Q_IMU).amax());
+        max_speed = max_speed.max(s.fixed_rows::<14>(19 + index::QD1L).amax());
+        max_speed = max_speed.max(s.fixed_rows::<3>(19 + index::QD_IMU).amax());
         if (n + 1) % every == 0 || n + 1 == steps {
             log.push(sample((n + 1) as f64 * cfg.fall_step, &s));
         }
@@ -412,94 +529,19 @@ fn falling(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>) -> Res<Summary> {
     let tilt_min = log.iter().map(|p| p.tilt).fold(f64::INFINITY, f64::min);
     let tilt_max = log.iter().map(|p| p.tilt).fold(f64::NEG_INFINITY, f64::max);
 
-    // Plots.
-    let time = |f: &dyn Fn(&Sample) -> f64| -> Vec<(f64, f64)> {
-        log.iter().map(|p| (p.t, f(p))).collect()
-    };
-    let (half_pi, end) = (std::f64::consts::FRAC_PI_2, cfg.duration);
-    let path = dir.join("pitch.png");
-    figure(
-        &path,
-        (1000, 520),
-        &[Panel {
-            title: format!("(a) released {} rad from upright, zero torque", cfg.tilt),
-            y_label: "pitch q_imu - upright (rad)",
-            series: vec![
-                Series::line("base pitch from upright", BLUE_, time(&|p| p.tilt)),
-                Series::dashed(
-                    "base horizontal (+-pi/2)",
-                    GREY,
-                    vec![(0.0, half_pi), (end, half_pi)],
-                ),
-                Series::dashed("", GREY, vec![(0.0, -half_pi), (end, -half_pi)]),
-            ],
-        }],
+    falling_plots(
+        dir,
+        cfg,
+        &log,
+        Energies {
+            k0,
+            v0,
+            e0,
+            ke_max,
+            drift,
+        },
+        files,
     )?;
-    files.push(path);
-
-    let path = dir.join("heading.png");
-    figure(
-        &path,
-        (1000, 760),
-        &[
-            Panel {
-                title: "(a) heading".into(),
-                y_label: "ψ (rad)",
-                series: vec![Series::line("heading ψ", BLUE_, time(&|p| p.psi))],
-            },
-            Panel {
-                title: "(a) axle midpoint on the ground".into(),
-                y_label: "m",
-                series: vec![
-                    Series::line("X0", RED_, time(&|p| p.x)),
-                    Series::line("Y0", GREEN_, time(&|p| p.y)),
-                ],
-            },
-        ],
-    )?;
-    files.push(path);
-
-    let path = dir.join("energy.png");
-    figure(
-        &path,
-        (1000, 760),
-        &[
-            Panel {
-                title: "(a) energy; potential V by forward kinematics".into(),
-                y_label: "J",
-                series: vec![
-                    Series::line("kinetic ½u'Mu", RED_, time(&|p| p.kinetic)),
-                    Series::line("potential V - V(0)", GREEN_, time(&|p| p.potential - v0)),
-                    Series::line(
-                        "total E - E(0)",
-                        BLUE_,
-                        time(&|p| p.kinetic + p.potential - e0),
-                    ),
-                ],
-            },
-            Panel {
-                title: format!(
-                    "(a) relative drift, max {:.1e} (h = {} ms)",
-                    drift / ke_max,
-                    cfg.fall_step * 1e3
-                ),
-                y_label: "(E - E(0)) / max kinetic energy",
-                series: vec![
-                    Series::line(
-                        "total energy",
-                        BLUE_,
-                        time(&|p| (p.kinetic + p.potential - e0) / ke_max),
-                    ),
-                    Series::dashed(
-                        "power balance: ½u'Mu + int u'g dt",
-                        ORANGE,
-                        time(&|p| (p.kinetic - k0 + p.work_gravity) / ke_max),
-                    ),
-                ],
-            },
-        ],
-    )?;
-    files.push(path);
 
     Ok(Summary {
         upright_pitch: up,
@@ -527,7 +569,7 @@ fn falling(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>) -> Res<Summary> {
 // ---------------------------------------------------------------------------------------------
 // (b) Computed-torque tracking on fixed wheels.
 
-/// Desired trajectory of the 17 fixed-wheel joints: `(q_d, q̇_d, q̈_d)`. Waist, torso and arm
+/// Desired trajectory of the 17 fixed-wheel joints: `(q_des, q̇_des, q̈_des)`. Waist, torso and arm
 /// joints follow sinusoids about `q_home`; the base pitch leans so that the centre of mass
 /// of the desired pose stays above the axle (else holding the base would take several times
 /// what the wheel motors can give).
@@ -539,8 +581,8 @@ fn desired(
     use fixed_wheels::index as fw;
     let joints = |t: f64| {
         let mut q = *q_home;
-        let mut qd = SVector::<f64, 17>::zeros();
-        let mut qdd = SVector::<f64, 17>::zeros();
+        let mut rate = SVector::<f64, 17>::zeros();
+        let mut accel = SVector::<f64, 17>::zeros();
         for j in fw::Q_W..17 {
             // Amplitude 0.15–0.45 rad, frequency 0.2–0.6 Hz, a different phase per joint.
             let a = 0.15 + 0.3 * ((j * 7) % 5) as f64 / 4.0;
@@ -548,16 +590,16 @@ fn desired(
             let phi = j as f64;
             let (s, c) = (w * t + phi).sin_cos();
             q[j] += a * (s - phi.sin());
-            qd[j] = a * w * c;
-            qdd[j] = -a * w * w * s;
+            rate[j] = a * w * c;
+            accel[j] = -a * w * w * s;
         }
-        (q, qd, qdd)
+        (q, rate, accel)
     };
     let pitch = |q: &SVector<f64, 17>| {
         let q19 = SVector::<f64, 19>::from_fn(|i, _| if i < 2 { 0.0 } else { q[i - 2] });
         upright.upright_pitch(&q19)
     };
-    let (mut q, mut qd, mut qdd) = joints(t);
+    let (mut q, mut rate, mut accel) = joints(t);
     // Central differences for the pitch's rates (smooth; error ~1e-7 rad/s²).
     let dt = 1e-3;
     let (p0, pm, pp) = (
@@ -566,14 +608,14 @@ fn desired(
         pitch(&joints(t + dt).0),
     );
     q[fw::Q_IMU] = p0;
-    qd[fw::Q_IMU] = (pp - pm) / (2.0 * dt);
-    qdd[fw::Q_IMU] = (pp - 2.0 * p0 + pm) / (dt * dt);
-    (q, qd, qdd)
+    rate[fw::Q_IMU] = (pp - pm) / (2.0 * dt);
+    accel[fw::Q_IMU] = (pp - 2.0 * p0 + pm) / (dt * dt);
+    (q, rate, accel)
 }
 
 /// The result of one tracking run.
 struct Track {
-    /// `(t, q_d − q)` samples.
+    /// `(t, q_des − q)` samples.
     log: Vec<(f64, SVector<f64, 17>)>,
     /// Largest `|τ_i| / limit_i` of each joint after the first 0.1 s (demand, before clamping).
     ratio: [f64; 17],
@@ -619,16 +661,16 @@ fn track(
         let t = n as f64 * h;
         let q: SVector<f64, 17> = x.fixed_rows::<17>(0).into_owned();
         let u: SVector<f64, 17> = x.fixed_rows::<17>(17).into_owned();
-        let (q_d, qd_d, qdd_d) = desired(upright, q_home, t);
-        let e = q_d - q;
+        let (q_des, u_des, ud_des) = desired(upright, q_home, t);
+        let e = q_des - q;
         if n % every == 0 || n == steps {
             log.push((t, e));
         }
         if n == steps {
             break;
         }
-        // τ = M(q)(q̈d + Kd ė + Kp e) + c(q, u) + g(q): one inverse-dynamics pass.
-        let v = qdd_d + (qd_d - u) * kd + e * kp;
+        // τ = M(q)(q̈_des + Kd ė + Kp e) + c(q, u) + g(q): one inverse-dynamics pass.
+        let v = ud_des + (u_des - u) * kd + e * kp;
         let demand = controller.inverse_dynamics(&q, &u, &v);
         if t >= 0.1 {
             for j in 0..17 {
@@ -707,45 +749,57 @@ fn tracking(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>, summary: &mut Su
     summary.saturated_steps = exact.saturated_steps;
     summary.last_saturated = exact.last_saturated;
 
-    let groups: [(&'static str, RGBColor, std::ops::Range<usize>); 5] = [
-        ("base pitch q_imu", BLACK_, 0..1),
-        ("waist q_w", ORANGE, 1..2),
-        ("torso q_torso", GREEN_, 2..3),
-        ("left arm q1l..q7l", RED_, 3..10),
-        ("right arm q1r..q7r", BLUE_, 10..17),
+    // One panel per group, a distinct colour per joint (tab10 colours).
+    let per_joint = |names: &[&'static str], first: usize| -> Vec<Series> {
+        names
+            .iter()
+            .enumerate()
+            .map(|(n, name)| {
+                let j = first + n;
+                Series::line(
+                    name,
+                    PALETTE[n % PALETTE.len()],
+                    exact.log.iter().map(|(t, e)| (*t, e[j])).collect(),
+                )
+            })
+            .collect()
+    };
+    let trunk = per_joint(&["base pitch q_imu", "waist q_w", "torso q_torso"], 0);
+    // (font8x8's `l` is hard to tell from `1`: the panel titles name the coordinates.)
+    let joints = [
+        "joint 1", "joint 2", "joint 3", "joint 4", "joint 5", "joint 6", "joint 7",
     ];
-    let mut series = Vec::new();
-    for (name, color, range) in groups {
-        for (n, j) in range.enumerate() {
-            let label = if n == 0 { name } else { "" };
-            series.push(Series::line(
-                label,
-                color,
-                exact.log.iter().map(|(t, e)| (*t, e[j])).collect(),
-            ));
-        }
-    }
+    let left = per_joint(&joints, 3);
+    let right = per_joint(&joints, 10);
     let log10_max = |log: &[(f64, SVector<f64, 17>)]| -> Vec<(f64, f64)> {
         log.iter()
             .map(|(t, e)| (*t, e.amax().max(1e-16).log10()))
             .collect()
     };
     let path = dir.join("tracking.png");
+    let hz = 1.0 / cfg.control_step;
     figure(
         &path,
-        (1000, 760),
+        (1000, 1400),
         &[
             Panel {
-                title: format!(
-                    "(b) fixed wheels, computed torque at {:.0} Hz",
-                    1.0 / cfg.control_step
-                ),
-                y_label: "tracking error qd - q (rad), exact model",
-                series,
+                title: format!("(b) fixed wheels, computed torque at {hz:.0} Hz: trunk"),
+                y_label: "tracking error q_des - q (rad), exact model",
+                series: trunk,
+            },
+            Panel {
+                title: "(b) left arm, joints 1-7 = q1l..q7l".into(),
+                y_label: "tracking error q_des - q (rad), exact model",
+                series: left,
+            },
+            Panel {
+                title: "(b) right arm, joints 1-7 = q1r..q7r".into(),
+                y_label: "tracking error q_des - q (rad), exact model",
+                series: right,
             },
             Panel {
                 title: "(b) largest joint error; exact model: 1 kHz hold only".into(),
-                y_label: "log10 max abs(qd - q) (rad)",
+                y_label: "log10 of max |q_des - q| over the joints (q in rad)",
                 series: vec![
                     Series::line("exact model", BLUE_, log10_max(&exact.log)),
                     Series::line(
@@ -772,6 +826,16 @@ const ORANGE: RGBColor = RGBColor(255, 127, 14);
 const BLACK_: RGBColor = RGBColor(0, 0, 0);
 const GREY: RGBColor = RGBColor(140, 140, 140);
 const GRID: RGBColor = RGBColor(225, 225, 225);
+/// Distinct line colours (matplotlib's tab10 without grey), one per joint of a panel.
+const PALETTE: [RGBColor; 7] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+];
 
 struct Series {
     label: &'static str,
@@ -886,6 +950,24 @@ fn figure(path: &Path, size: (u32, u32), panels: &[Panel]) -> Res<()> {
     Ok(())
 }
 
+/// Legend entries laid out in rows below the plot, within `width` pixels: `(row, x offset)`
+/// of each labelled series.
+fn legend_layout(panel: &Panel, width: i32) -> Vec<(&Series, i32, i32)> {
+    let (mut row, mut x) = (0, 0);
+    let mut out = Vec::new();
+    for s in panel.series.iter().filter(|s| !s.label.is_empty()) {
+        let w = text_width(s.label) + 64;
+        if x > 0 && x + w > width {
+            (row, x) = (row + 1, 0);
+        }
+        out.push((s, row, x));
+        x += w;
+    }
+    out
+}
+
+/// One panel: the plot, its axes, and the legend in rows below the time axis (outside the
+/// data).
 fn draw_panel(root: &Area, area: &Area, panel: &Panel) -> Res<()> {
     let (ax, ay) = area.get_base_pixel();
     let (aw, _) = area.dim_in_pixel();
@@ -910,11 +992,15 @@ fn draw_panel(root: &Area, area: &Area, panel: &Panel) -> Res<()> {
     let pad = 0.06 * (y1 - y0);
     let (y0, y1) = (y0 - pad, y1 + pad);
 
+    // The legend goes in rows below the time axis, outside the data.
+    let h = 8 * TEXT;
+    let legend = legend_layout(panel, aw as i32 - 180);
+    let rows = legend.iter().map(|(_, r, _)| r + 1).max().unwrap_or(0);
     let mut chart = ChartBuilder::on(area)
         .margin_left(150)
-        .margin_right(30)
+        .margin_right(40)
         .margin_top(72)
-        .margin_bottom(62)
+        .margin_bottom(62 + rows as u32 * (h as u32 + 8))
         .build_cartesian_2d(x0..x1, y0..y1)?;
 
     let (xt, xs) = ticks(x0, x1);
@@ -951,7 +1037,6 @@ fn draw_panel(root: &Area, area: &Area, panel: &Panel) -> Res<()> {
     )))?;
 
     // Text: title, tick labels, axis labels, legend.
-    let h = 8 * TEXT;
     text(root, &panel.title, (ax + 16, ay + 12), &BLACK_)?;
     for &t in &xt {
         let (px, py) = chart.backend_coord(&(t, y0));
@@ -978,38 +1063,14 @@ fn draw_panel(root: &Area, area: &Area, panel: &Panel) -> Res<()> {
     let (_, top) = chart.backend_coord(&(x0, y1));
     text(root, panel.y_label, (ax + 16, top - h - 8), &BLACK_)?;
 
-    // Legend in the top-right corner of the plot.
-    let entries: Vec<&Series> = panel
-        .series
-        .iter()
-        .filter(|s| !s.label.is_empty())
-        .collect();
-    if !entries.is_empty() {
-        let width = entries
-            .iter()
-            .map(|s| text_width(s.label))
-            .max()
-            .unwrap_or(0)
-            + 56;
-        let height = entries.len() as i32 * (h + 8) + 8;
-        let (right, top) = chart.backend_coord(&(x1, y1));
-        let (lx, ly) = (right - width - 10, top + 10);
-        root.draw(&Rectangle::new(
-            [(lx, ly), (lx + width, ly + height)],
-            WHITE.mix(0.85).filled(),
+    // Legend: rows below the time axis label.
+    for (s, row, x) in legend {
+        let (lx, y) = (ax + 150 + x, bottom + 24 + 2 * h + row * (h + 8));
+        root.draw(&PathElement::new(
+            vec![(lx, y + h / 2), (lx + 32, y + h / 2)],
+            s.color.stroke_width(3),
         ))?;
-        root.draw(&Rectangle::new(
-            [(lx, ly), (lx + width, ly + height)],
-            GREY.stroke_width(1),
-        ))?;
-        for (n, s) in entries.iter().enumerate() {
-            let y = ly + 8 + n as i32 * (h + 8);
-            root.draw(&PathElement::new(
-                vec![(lx + 8, y + h / 2), (lx + 40, y + h / 2)],
-                s.color.stroke_width(3),
-            ))?;
-            text(root, s.label, (lx + 48, y), &BLACK_)?;
-        }
+        text(root, s.label, (lx + 40, y), &BLACK_)?;
     }
     Ok(())
 }

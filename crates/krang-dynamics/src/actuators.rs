@@ -64,10 +64,12 @@ pub mod actuator {
     pub const WAIST: usize = 2;
     /// Torso torque `τ_torso` (drives `q_torso`).
     pub const TORSO: usize = 3;
-    /// First left-arm joint `τ_1l`; the left arm is `LEFT_ARM .. LEFT_ARM + 7`.
-    pub const LEFT_ARM: usize = 4;
-    /// First right-arm joint `τ_1r`; the right arm is `RIGHT_ARM .. RIGHT_ARM + 7`.
-    pub const RIGHT_ARM: usize = 11;
+    /// The left-arm joint torques `τ_1l … τ_7l` (a range, as
+    /// [`forward::LEFT_ARM`](crate::forward::LEFT_ARM) is in `u`).
+    pub const LEFT_ARM: core::ops::Range<usize> = 4..11;
+    /// The right-arm joint torques `τ_1r … τ_7r` (a range, as
+    /// [`forward::RIGHT_ARM`](crate::forward::RIGHT_ARM) is in `u`).
+    pub const RIGHT_ARM: core::ops::Range<usize> = 11..18;
 }
 
 impl Krang {
@@ -76,12 +78,12 @@ impl Krang {
     pub fn actuator_matrix(&self) -> SMatrix<f64, 19, ACTUATOR_COUNT> {
         let (r, l) = (self.params().R, self.params().L);
         let mut b = SMatrix::<f64, 19, ACTUATOR_COUNT>::zeros();
-        b[(index::X, actuator::WHEEL_L)] = 1.0 / r;
-        b[(index::X, actuator::WHEEL_R)] = 1.0 / r;
-        b[(index::PSI, actuator::WHEEL_L)] = -l / (2.0 * r);
-        b[(index::PSI, actuator::WHEEL_R)] = l / (2.0 * r);
-        b[(index::Q_IMU, actuator::WHEEL_L)] = -1.0;
-        b[(index::Q_IMU, actuator::WHEEL_R)] = -1.0;
+        b[(index::XD, actuator::WHEEL_L)] = 1.0 / r;
+        b[(index::XD, actuator::WHEEL_R)] = 1.0 / r;
+        b[(index::PSID, actuator::WHEEL_L)] = -l / (2.0 * r);
+        b[(index::PSID, actuator::WHEEL_R)] = l / (2.0 * r);
+        b[(index::QD_IMU, actuator::WHEEL_L)] = -1.0;
+        b[(index::QD_IMU, actuator::WHEEL_R)] = -1.0;
         // Waist, torso and the 14 arm joints: actuator j drives speed j + 1.
         for j in actuator::WAIST..ACTUATOR_COUNT {
             b[(j + 1, j)] = 1.0;
@@ -103,18 +105,18 @@ impl Krang {
     /// a[0] = 2.0; // τ_L
     /// a[1] = 2.0; // τ_R
     /// let tau = k.generalized_forces(&a);
-    /// assert_eq!(tau[index::X], 4.0 / k.params().R);
-    /// assert_eq!(tau[index::PSI], 0.0);
-    /// assert_eq!(tau[index::Q_IMU], -4.0);
+    /// assert_eq!(tau[index::XD], 4.0 / k.params().R);
+    /// assert_eq!(tau[index::PSID], 0.0);
+    /// assert_eq!(tau[index::QD_IMU], -4.0);
     /// ```
     pub fn generalized_forces(&self, actuators: &SVector<f64, ACTUATOR_COUNT>) -> SVector<f64, 19> {
         let (r, l) = (self.params().R, self.params().L);
         let (tl, tr) = (actuators[actuator::WHEEL_L], actuators[actuator::WHEEL_R]);
         let mut tau = SVector::<f64, 19>::zeros();
-        tau[index::X] = (tl + tr) / r;
-        tau[index::PSI] = l / (2.0 * r) * (tr - tl);
-        tau[index::Q_IMU] = -(tl + tr);
-        tau.fixed_rows_mut::<16>(index::Q_W)
+        tau[index::XD] = (tl + tr) / r;
+        tau[index::PSID] = l / (2.0 * r) * (tr - tl);
+        tau[index::QD_IMU] = -(tl + tr);
+        tau.fixed_rows_mut::<16>(index::QD_W)
             .copy_from(&actuators.fixed_rows::<16>(actuator::WAIST));
         tau
     }
@@ -126,10 +128,10 @@ impl Krang {
     pub fn actuator_velocities(&self, u: &SVector<f64, 19>) -> SVector<f64, ACTUATOR_COUNT> {
         let (r, l) = (self.params().R, self.params().L);
         let mut v = SVector::<f64, ACTUATOR_COUNT>::zeros();
-        v[actuator::WHEEL_L] = u[index::X] / r - l / (2.0 * r) * u[index::PSI] - u[index::Q_IMU];
-        v[actuator::WHEEL_R] = u[index::X] / r + l / (2.0 * r) * u[index::PSI] - u[index::Q_IMU];
+        v[actuator::WHEEL_L] = u[index::XD] / r - l / (2.0 * r) * u[index::PSID] - u[index::QD_IMU];
+        v[actuator::WHEEL_R] = u[index::XD] / r + l / (2.0 * r) * u[index::PSID] - u[index::QD_IMU];
         v.fixed_rows_mut::<16>(actuator::WAIST)
-            .copy_from(&u.fixed_rows::<16>(index::Q_W));
+            .copy_from(&u.fixed_rows::<16>(index::QD_W));
         v
     }
 }

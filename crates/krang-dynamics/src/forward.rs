@@ -19,13 +19,15 @@
 //! and solve.
 //! Everything is fixed-size nalgebra on the stack; nothing allocates and nothing panics.
 //!
-//! The fixed-wheel model (17 speeds) uses the generic dense fallback [`solve_spd`].
+//! The fixed-wheel model (17 speeds, feature `fixed-wheels`) uses the generic dense fallback
+//! [`solve_spd`].
 
 use core::fmt;
 
 use nalgebra::{SMatrix, SVector};
 
 use crate::Krang;
+#[cfg(feature = "fixed-wheels")]
 use crate::fixed_wheels::KrangFixedWheels;
 
 /// Indices of the trunk speeds `[ẋ, ψ̇, q̇_imu, q̇_w, q̇_torso]` in `u`.
@@ -352,6 +354,7 @@ impl Krang {
     }
 }
 
+#[cfg(feature = "fixed-wheels")]
 impl KrangFixedWheels {
     /// Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))` of the fixed-wheel model, by the
     /// dense fallback [`solve_spd`] (17×17 Cholesky). Allocation-free.

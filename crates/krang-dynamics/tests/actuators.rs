@@ -76,9 +76,12 @@ fn each_joint_torque_acts_on_its_own_row_only() {
             SPEED_NAMES[row]
         );
     }
-    assert_eq!(ACTUATOR_NAMES[actuator::LEFT_ARM], "tau_1l");
-    assert_eq!(ACTUATOR_NAMES[actuator::RIGHT_ARM + 6], "tau_7r");
-    assert_eq!(SPEED_NAMES[actuator::RIGHT_ARM + 1], "qd1r");
+    assert_eq!(ACTUATOR_NAMES[actuator::LEFT_ARM.start], "tau_1l");
+    assert_eq!(ACTUATOR_NAMES[actuator::RIGHT_ARM.end - 1], "tau_7r");
+    assert_eq!(
+        SPEED_NAMES[krang_dynamics::forward::RIGHT_ARM.start],
+        "qd1r"
+    );
 }
 
 #[test]
@@ -142,7 +145,7 @@ fn saturate_clamps_to_the_peak_torques() {
     let s = saturate_to(&big, &hardware::NOMINAL_TORQUES);
     assert_eq!(s[actuator::WAIST], 432.0);
     assert_eq!(s[actuator::TORSO], -216.0);
-    assert_eq!(s[actuator::LEFT_ARM + 6], 4.5);
+    assert_eq!(s[actuator::LEFT_ARM.end - 1], 4.5);
 }
 
 #[test]
@@ -277,4 +280,35 @@ fn hardware_constants_match_the_cfg_files() {
             assert_eq!(w, hardware::BLY343D);
         }
     }
+}
+
+#[test]
+fn arm_ranges_name_the_same_joints_in_the_actuator_vector_and_in_u() {
+    use krang_dynamics::forward;
+    let b = Krang::default().actuator_matrix();
+    for (arm, speeds) in [
+        (actuator::LEFT_ARM, forward::LEFT_ARM),
+        (actuator::RIGHT_ARM, forward::RIGHT_ARM),
+    ] {
+        assert_eq!(arm.len(), 7);
+        for (j, i) in arm.zip(speeds) {
+            assert_eq!(b[(i, j)], 1.0, "actuator {j} drives speed {i}");
+            assert_eq!(
+                ACTUATOR_NAMES[j].trim_start_matches("tau_"),
+                SPEED_NAMES[i].trim_start_matches("qd")
+            );
+        }
+    }
+}
+
+#[test]
+fn index_names_speeds_as_well_as_coordinates() {
+    assert_eq!((index::XD, index::PSID), (index::X, index::PSI));
+    assert_eq!((index::QD_IMU, index::QD_W), (index::Q_IMU, index::Q_W));
+    assert_eq!(index::QD7R, index::Q7R);
+    for (i, name) in SPEED_NAMES.iter().enumerate() {
+        assert_eq!(krang_dynamics::SPEED_NAMES[i], *name);
+    }
+    assert_eq!(SPEED_NAMES[index::QD_TORSO], "qd_torso");
+    assert_eq!(SPEED_NAMES[index::PSID], "psid");
 }

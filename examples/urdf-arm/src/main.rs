@@ -93,4 +93,36 @@ mod tests {
         }
         assert!(worst < 1e-10, "worst relative error {worst:e}");
     }
+
+    /// `Params::validate` accepts the URDF's values and every random physical parameter set of
+    /// the reference's generator, and rejects a negative mass and an inertia that breaks the
+    /// triangle inequality.
+    #[test]
+    fn validate_accepts_physical_parameters_and_rejects_others() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../models/singlearm.urdf");
+        let model = Model::from_urdf_file(path, &UrdfOptions::default()).unwrap();
+        Params::default().validate().unwrap();
+        let mut rng = SplitMix64::new(5);
+        let mut uniform = || rng.next_f64();
+        for _ in 0..500 {
+            let p = random_physical_params(&model, &mut uniform);
+            Params::from_array(p.try_into().unwrap())
+                .validate()
+                .unwrap();
+        }
+        let mut p = Params::default();
+        let mass = Params::NAMES.iter().find(|n| n.starts_with("m_")).unwrap();
+        p.set(mass, -1.0).unwrap();
+        assert_eq!(p.validate().unwrap_err().name(), *mass);
+        let mut p = Params::default();
+        let xx = Params::NAMES.iter().find(|n| n.starts_with("XX_")).unwrap();
+        let zz = xx.replacen("XX", "ZZ", 1);
+        let yy = xx.replacen("XX", "YY", 1);
+        let big = p.get(&yy).unwrap() + p.get(&zz).unwrap() + 1.0;
+        p.set(xx, big).unwrap();
+        assert_eq!(
+            p.validate().unwrap_err().problem(),
+            kanegen_runtime::Problem::InertiaNotPhysical
+        );
+    }
 }

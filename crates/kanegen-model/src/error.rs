@@ -21,6 +21,21 @@ impl ModelError {
     }
 }
 
+/// A name that cannot be used in generated code: which item, its spelling, why and the fix
+/// (the detail of [`ModelErrorKind::BadName`]).
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[error("{item}: `{name}` {problem}; {fix}")]
+pub struct BadName {
+    /// What the name names (``speed of joint `q2` ``, `parameter`, `model name`).
+    pub item: String,
+    /// The name as written (for a URDF: after sanitising).
+    pub name: String,
+    /// Why it cannot be used.
+    pub problem: String,
+    /// How to fix it.
+    pub fix: String,
+}
+
 /// What is wrong with a description. Each message names the offending item and how to fix it.
 ///
 /// The error of a file that cannot be read keeps the [`std::io::Error`] as its source.
@@ -300,6 +315,11 @@ pub enum ModelErrorKind {
         /// What is wrong and how to fix it.
         detail: String,
     },
+    /// A name that reaches generated code (coordinate, speed, parameter, model name) is not an
+    /// identifier, is reserved by generated code, or clashes with another name there (see
+    /// [`names`](crate::names)).
+    #[error("{0}")]
+    BadName(Box<BadName>),
     /// Anything else about the base or gravity declarations.
     #[error("{item}: {detail}")]
     Invalid {

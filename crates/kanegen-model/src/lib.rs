@@ -16,11 +16,12 @@
 mod error;
 mod ident;
 mod ir;
+pub mod names;
 mod toml_format;
 pub mod urdf;
 mod validate;
 
-pub use error::{ModelError, ModelErrorKind};
-pub use ident::sanitize_identifier;
+pub use error::{BadName, ModelError, ModelErrorKind};
+pub use ident::{is_keyword, sanitize_identifier};
 pub use ir::*;
 pub use urdf::{AbsurdInertia, UrdfBase, UrdfImport, UrdfOptions, WheeledBaseSpec};

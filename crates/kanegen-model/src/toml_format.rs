@@ -333,6 +333,7 @@ fn build(f: File, file: &str) -> Result<Model, K> {
             direction: dir,
         },
     };
+    crate::names::check(&model)?;
     validate::check_physics(&model)?;
     Ok(model)
 }

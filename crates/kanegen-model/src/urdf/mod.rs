@@ -21,7 +21,10 @@
 //!   the gravity magnitude is `g`; a moving joint `LJ1` has the coordinate `q_LJ1` and the speed
 //!   `qd_LJ1` (generated index constant `Q_LJ1`). Each of these names, and the body name, is made
 //!   an identifier by [`sanitize_identifier`](crate::sanitize_identifier) (every character other
-//!   than ASCII letters, digits and `_` becomes `_`: link `base-link` gives `m_base_link`).
+//!   than ASCII letters, digits and `_` becomes `_`: link `base-link` gives `m_base_link`), then
+//!   checked by [`Model::check_names`] like the names of a TOML model (names that are equal once
+//!   sanitised or ignoring case, or a `<robot name>` that cannot name the wrapper type, are
+//!   typed errors).
 //! * **Order of u**: depth-first from the root, children in the order their joints appear in the
 //!   file (for a wheeled base `xd`, `psid` and the pitch speed come first).
 //! * **Real-world data** ([`UrdfOptions`]): rotation angles within

@@ -161,6 +161,21 @@ pub enum ModelErrorKind {
         /// Its value.
         value: f64,
     },
+    /// A wheel constant of the wheeled base is not physical (`R` or `L` not positive, `mw`,
+    /// `YYw` or `ZZw` negative).
+    #[error(
+        "wheeled base: `{symbol}` = {value} is {what} and must be {bound}; correct its value in [parameters] (URDF: in the wheel links or the WheeledBaseSpec)"
+    )]
+    NonPhysicalWheel {
+        /// The parameter.
+        symbol: String,
+        /// Its value.
+        value: f64,
+        /// What it is (`the wheel radius`).
+        what: &'static str,
+        /// `positive` or `≥ 0`.
+        bound: &'static str,
+    },
     /// A length entry is neither a finite number nor `[-]SYMBOL`.
     #[error(
         "joint `{joint}`: translation entry `{text}` is neither a finite number nor a length symbol such as `L1` or `-L2`"

@@ -77,9 +77,51 @@ pub fn principal_moments_about_com(body: &Body, p: &[f64]) -> [f64; 3] {
     v
 }
 
-/// Checks every body: positive mass, and an inertia about the centre of mass that is positive
-/// definite and satisfies the triangle inequality.
+/// Checks the parameter values: every one finite, and the wheel constants of a wheeled base
+/// physical (radius `R` and track `L` positive; wheel mass `mw` and moments `YYw`, `ZZw` not
+/// negative).
+fn check_parameters(model: &Model) -> Result<(), K> {
+    if let Some(p) = model.params.iter().find(|p| !p.value.is_finite()) {
+        return Err(K::NonFiniteParameter {
+            name: p.name.clone(),
+            value: p.value,
+        });
+    }
+    let Some(w) = model.wheeled_base() else {
+        return Ok(());
+    };
+    for (id, what, positive) in [
+        (w.radius, "the wheel radius", true),
+        (w.track, "the track width", true),
+        (w.wheel_mass, "the mass of one wheel", false),
+        (
+            w.wheel_axle_inertia,
+            "a wheel's moment about its axle",
+            false,
+        ),
+        (
+            w.wheel_diametral_inertia,
+            "a wheel's moment about a diameter",
+            false,
+        ),
+    ] {
+        let p = &model.params[id];
+        if (positive && p.value <= 0.0) || p.value < 0.0 {
+            return Err(K::NonPhysicalWheel {
+                symbol: p.name.clone(),
+                value: p.value,
+                what,
+                bound: if positive { "positive" } else { "≥ 0" },
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Checks the parameters ([`check_parameters`]) and every body: positive mass, and an inertia
+/// about the centre of mass that is positive definite and satisfies the triangle inequality.
 pub(crate) fn check_physics(model: &Model) -> Result<(), K> {
+    check_parameters(model)?;
     let p = model.param_values();
     for link in &model.links {
         let Some(b) = &link.body else { continue };

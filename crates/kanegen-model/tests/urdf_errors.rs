@@ -458,3 +458,27 @@ fn a_missing_file_is_an_io_error() {
         "{source}"
     );
 }
+
+#[test]
+fn a_zero_track_is_a_non_physical_wheel_constant() {
+    let urdf = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models/Krang.urdf");
+    let mut base = WheeledBaseSpec::new("JLWheel", "JRWheel", "Base", [0.0, 1.0, 0.0], 0.25);
+    base.track = Some(0.0);
+    let opts =
+        UrdfOptions::wheeled(base).drop_links(["lgPlate1", "lgPlate2", "rgPlate1", "rgPlate2"]);
+    let e = Model::from_urdf_file(&urdf, &opts).expect_err("zero track");
+    assert!(
+        matches!(&e.kind, K::NonPhysicalWheel { symbol, value, .. } if symbol == "L" && *value == 0.0),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn a_nan_mass_is_a_bad_number() {
+    let kind = error_of(
+        &mutate(&[("<mass value=\"1.5\"/>", "<mass value=\"NaN\"/>")]),
+        &["link `L2`", "NaN"],
+    );
+    assert!(matches!(kind, K::UrdfBadNumber { .. }), "{kind:?}");
+}

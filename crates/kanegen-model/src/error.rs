@@ -117,8 +117,10 @@ pub enum ModelErrorKind {
         /// Its norm.
         norm: f64,
     },
-    /// A body's mass is zero, negative or not finite.
-    #[error("body `{body}`: mass `{symbol}` = {value} must be positive")]
+    /// A body's mass is negative or not a number, or zero with a nonzero first moment.
+    #[error(
+        "body `{body}`: mass `{symbol}` = {value} must be positive (or zero for a body without first moment, MX = MY = MZ = 0)"
+    )]
     NonPositiveMass {
         /// The body.
         body: String,
@@ -129,7 +131,7 @@ pub enum ModelErrorKind {
     },
     /// The inertia about the centre of mass is not positive definite or breaks the triangle inequality.
     #[error(
-        "body `{body}`: inertia about the centre of mass is not physical ({detail}); principal moments must be positive and each at most the sum of the other two (check the frame-origin inertia XX..ZZ against m and MX..MZ)"
+        "body `{body}`: inertia about the centre of mass is not physical ({detail}); principal moments must be ≥ 0 and each at most the sum of the other two (check the frame-origin inertia XX..ZZ against m and MX..MZ)"
     )]
     NonPhysicalInertia {
         /// The body.
@@ -321,6 +323,29 @@ pub enum ModelErrorKind {
         radius: f64,
         /// `UrdfOptions::max_radius_of_gyration`.
         limit: f64,
+    },
+    /// A URDF link's `<inertial>` is not physical: a negative mass, or an inertia about the
+    /// centre of mass (`ixx` … `izz`) that is not positive semi-definite or breaks the triangle
+    /// inequality by more than `UrdfOptions::inertia_tolerance` (or at all, with
+    /// `NonPhysicalInertia::Error`).
+    #[error("URDF link `{link}` <inertial>: {detail}; {fix}")]
+    UrdfNonPhysicalInertial {
+        /// The link.
+        link: String,
+        /// What is wrong, with the numbers.
+        detail: String,
+        /// How to fix it.
+        fix: String,
+    },
+    /// The mass matrix is singular: some speed moves no mass and no inertia.
+    #[error(
+        "the mass matrix is not positive definite: speed `{speed}` moves no mass or inertia that the speeds before it do not ({detail}); give the links it moves a mass or an inertia about its axis, or make its joint fixed"
+    )]
+    SingularMassMatrix {
+        /// The first speed (in the order of u) whose pivot vanishes.
+        speed: String,
+        /// The pivot and the configuration.
+        detail: String,
     },
     /// A URDF import option (base declaration, dropped links, gravity) is inconsistent with the file.
     #[error("URDF import option `{option}`: {detail}")]

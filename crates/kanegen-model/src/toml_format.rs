@@ -329,7 +329,7 @@ fn build(f: File, file: &str) -> Result<Model, K> {
         },
     };
     crate::names::check(&model)?;
-    validate::check_physics(&model)?;
+    validate::check_physics(&model, validate::TOLERANCE)?;
     Ok(model)
 }
 

@@ -347,23 +347,36 @@ fn names_that_collide_after_sanitising() {
 }
 
 #[test]
-fn negative_mass() {
+fn negative_mass_is_an_error_in_urdf_terms() {
     let kind = error_of(
         &mutate(&[("<mass value=\"1.5\"/>", "<mass value=\"-1.5\"/>")]),
-        &["body `L2`", "must be positive"],
+        &[
+            "URDF link `L2` <inertial>",
+            "<mass value=\"-1.5\"> is negative",
+        ],
     );
-    assert!(matches!(kind, K::NonPositiveMass { .. }), "{kind:?}");
+    assert!(
+        matches!(&kind, K::UrdfNonPhysicalInertial { link, .. } if link == "L2"),
+        "{kind:?}"
+    );
 }
 
 #[test]
-fn validation_still_runs_on_the_merged_bodies() {
-    // Triangle inequality broken: 0.01 + 0.02 < 0.05.
+fn a_non_physical_link_inertia_is_an_error_in_urdf_terms() {
+    // Triangle inequality broken by 40 %: 0.01 + 0.02 < 0.05.
     let kind = error_of(
         &mutate(&[("izz=\"0.02\"", "izz=\"0.05\"")]),
-        &["body `L2`", "triangle inequality"],
+        &[
+            "URDF link `L2` <inertial>",
+            "ixx 0.01",
+            "izz 0.05",
+            "triangle inequality",
+            "40.00 %",
+            "inertia_tolerance",
+        ],
     );
     assert!(
-        matches!(&kind, K::NonPhysicalInertia { body, .. } if body == "L2"),
+        matches!(&kind, K::UrdfNonPhysicalInertial { link, .. } if link == "L2"),
         "{kind:?}"
     );
 }

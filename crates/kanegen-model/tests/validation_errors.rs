@@ -445,7 +445,7 @@ fn mass_not_positive() {
 }
 
 #[test]
-fn inertia_not_positive_definite() {
+fn inertia_not_positive_semi_definite() {
     // I_G[y][y] = YY2 − m(Sx² + Sz²) = −0.01.
     let e = load_err(
         &mutate(&[("YY2 = 0.01", "YY2 = -0.01")]),
@@ -453,7 +453,7 @@ fn inertia_not_positive_definite() {
     );
     assert!(
         matches!(&e.kind, K::NonPhysicalInertia { body, detail }
-            if body == "2" && detail.contains("not positive definite")),
+            if body == "2" && detail.contains("not positive semi-definite")),
         "{:?}",
         e.kind
     );

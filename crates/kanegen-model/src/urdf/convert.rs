@@ -353,7 +353,8 @@ fn add_bodies(ir: &mut Ir, r: &Resolved<'_>, fixed_base: bool, notes: &mut Notes
                 others.join(", ")
             ));
         }
-        if items.is_empty() || mass == 0.0 {
+        // Zero-mass links keep their rotational inertia (UrdfOptions::zero_mass_inertia).
+        if items.is_empty() {
             continue;
         }
         let (m, ms, j) = merge(&items);
@@ -418,6 +419,6 @@ fn assemble(
         validate::check_axis(&m.joint.name, m.joint.axis)?;
         validate::check_rotation(&m.joint.name, &m.joint.rotation)?;
     }
-    validate::check_physics(&model)?;
+    validate::check_physics(&model, opts.inertia_tolerance)?;
     Ok(model)
 }

@@ -495,3 +495,17 @@ fn a_nan_mass_is_a_bad_number() {
     );
     assert!(matches!(kind, K::UrdfBadNumber { .. }), "{kind:?}");
 }
+
+#[test]
+fn deeply_nested_xml_is_a_typed_error_not_a_stack_overflow() {
+    let depth = 200_000;
+    let text = format!(
+        "<robot name=\"r\"><link name=\"a\">{}{}</link></robot>",
+        "<x>".repeat(depth),
+        "</x>".repeat(depth)
+    );
+    let start = std::time::Instant::now();
+    let kind = error_of(&text, &["nested more than 64 levels"]);
+    assert!(matches!(kind, K::UrdfParse { .. }), "{kind:?}");
+    assert!(start.elapsed().as_secs() < 5, "{:?}", start.elapsed());
+}

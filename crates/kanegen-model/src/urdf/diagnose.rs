@@ -43,6 +43,10 @@ const JOINT_TYPES: &[&str] = &[
     "spherical",
 ];
 
+/// Deepest element nesting accepted (a URDF needs about five levels): deeper text is a typed
+/// error instead of overflowing the stack of the recursive XML parser.
+pub(super) const MAX_DEPTH: usize = 64;
+
 /// One start or end tag.
 struct Tag<'a> {
     /// Byte offsets of the tag in the text: `text[start..end]` is `<…>`.
@@ -171,6 +175,14 @@ pub(super) fn diagnose(text: &str) -> Option<K> {
     let mut depth = 0usize;
     let mut context: Option<String> = None;
     for t in &tags {
+        if depth > MAX_DEPTH {
+            return Some(K::UrdfParse {
+                detail: format!(
+                    "elements are nested more than {MAX_DEPTH} levels deep (at <{}>)",
+                    t.name
+                ),
+            });
+        }
         if t.closing {
             depth = depth.saturating_sub(1);
             if depth <= 1 {

@@ -2,17 +2,23 @@
 //! inertia in some direction (point masses, rods, zero-mass rotors), so the loaders check that
 //! the mass matrix as a whole is positive definite.
 //!
-//! The kinetic energy of a body with Khalil's parameters (mass `m`, first moment `MS`, inertia
-//! `J` about the frame origin) whose origin moves with `v` and which turns with `ω` is
-//! `T = ½ m v·v + v·(ω × MS) + ½ ωᵀ J ω` (world components). With the Jacobians `v = Jv u`,
-//! `ω = Jω u`, `M = Σ m JvᵀJv − Jvᵀ[MS]×Jω + Jωᵀ[MS]×Jv + JωᵀJJω`, plus the wheel terms of a
-//! wheeled base. This is independent of the generator and of `kanegen-reference` (which builds M
-//! from inverse dynamics); a test compares the three.
+//! The kinetic energy is `T = ½ Σ_b Vᵀ I_b V` with each body's spatial velocity `V = (ω, v₀)`
+//! (`v₀`: the velocity of the body point at the base frame's origin) and its spatial inertia
+//! about that origin, from Khalil's parameters (mass `m`, first moment `MS`, inertia `J` about
+//! the frame origin `o`, all rotated into the base frame):
+//! `I_b = [[J_O, [h]×], [−[h]×, m·1]]` with `h = m·o + MS` and
+//! `J_O = J − [o]×[MS]× − [MS]×[o]× − m [o]×[o]×`. A joint's motion is the spatial vector
+//! `S = (e, o_j × e)` (revolute about the world axis `e` through `o_j`) or `(0, e)` (prismatic);
+//! a wheeled base's `ẋ`, `ψ̇` move everything by `(0, x̂)` and `(ẑ, 0)` and add the wheel terms.
+//! Then `M[a, b] = S_aᵀ I_c(b) S_b` for `a` on the path from `b` to the base, with `I_c(b)` the
+//! composite inertia of everything `b` moves (the composite-rigid-body algorithm: O(n·depth)).
+//! This is independent of the generator and of `kanegen-reference` (which builds M from inverse
+//! dynamics); a test compares the three.
 
-use nalgebra::{DMatrix, Matrix3, Vector3};
+use nalgebra::{DMatrix, Matrix3, Matrix6, Vector3, Vector6};
 
 use crate::error::ModelErrorKind as K;
-use crate::ir::{JointKind, Model};
+use crate::ir::{Body, JointKind, Model};
 
 /// Pose of every link in the base frame for coordinates `q` (indexed like the speeds) and
 /// parameter values `p`: rotation and origin.
@@ -41,55 +47,91 @@ fn poses(model: &Model, q: &[f64], p: &[f64]) -> Vec<(Matrix3<f64>, Vector3<f64>
     out
 }
 
-/// `[v]×`, the matrix of `v × ·`.
-fn cross_matrix(v: &Vector3<f64>) -> Matrix3<f64> {
-    v.cross_matrix()
+/// The spatial inertia about the base origin of body `b` whose frame has the pose `(r, o)`.
+fn spatial_inertia(b: &Body, (r, o): (Matrix3<f64>, Vector3<f64>), p: &[f64]) -> Matrix6<f64> {
+    let m = p[b.mass];
+    let ms = r * Vector3::from_fn(|k, _| p[b.first_moment[k]]);
+    let [xx, xy, xz, yy, yz, zz] = b.inertia.map(|k| p[k]);
+    let j = r * Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz) * r.transpose();
+    let (ox, msx) = (o.cross_matrix(), ms.cross_matrix());
+    let j_o = j - ox * msx - msx * ox - ox * ox * m;
+    let hx = (o * m + ms).cross_matrix();
+    let mut i = Matrix6::zeros();
+    i.fixed_view_mut::<3, 3>(0, 0).copy_from(&j_o);
+    i.fixed_view_mut::<3, 3>(0, 3).copy_from(&hx);
+    i.fixed_view_mut::<3, 3>(3, 0).copy_from(&(-hx));
+    i.fixed_view_mut::<3, 3>(3, 3)
+        .copy_from(&(Matrix3::identity() * m));
+    i
+}
+
+/// `(ω, v)` as one spatial vector.
+fn spatial(w: Vector3<f64>, v: Vector3<f64>) -> Vector6<f64> {
+    Vector6::new(w.x, w.y, w.z, v.x, v.y, v.z)
 }
 
 /// The mass matrix at coordinates `q` (indexed like the speeds; a wheeled base's `x`, `psi`
-/// entries are not read) for parameter values `p`, from the kinetic energy (see the
-/// [module](self)). Used by validation; the generated code and `kanegen-reference` compute M
-/// independently.
+/// entries are not read) for parameter values `p`, from the kinetic energy by the
+/// composite-rigid-body algorithm (see the [module](self)). Used by validation; the generated
+/// code and `kanegen-reference` compute M independently.
 pub fn kinetic_energy_mass_matrix(model: &Model, q: &[f64], p: &[f64]) -> DMatrix<f64> {
     let n = model.dof();
     let pose = poses(model, q, p);
-    let mut mm = DMatrix::zeros(n, n);
-    for (i, link) in model.links.iter().enumerate() {
-        let Some(b) = &link.body else { continue };
+    // Composite inertias: each link's body plus everything below it (links are parents first).
+    let mut ic: Vec<Matrix6<f64>> = model
+        .links
+        .iter()
+        .zip(&pose)
+        .map(|(l, &x)| {
+            l.body
+                .as_ref()
+                .map_or(Matrix6::zeros(), |b| spatial_inertia(b, x, p))
+        })
+        .collect();
+    for (i, link) in model.links.iter().enumerate().rev() {
+        if let Some(parent) = link.parent() {
+            let child = ic[i];
+            ic[parent] += child;
+        }
+    }
+    // The motion of each moving joint (and of the base's quasi-velocities).
+    let mut motion: Vec<Option<(usize, Vector6<f64>)>> = vec![None; model.links.len()];
+    for (i, _, m) in model.mounted_links() {
         let (r, o) = pose[i];
-        // Jacobians of the origin's velocity and of the angular velocity.
-        let mut jv = DMatrix::<f64>::zeros(3, n);
-        let mut jw = DMatrix::<f64>::zeros(3, n);
-        for (k, m) in model.path_to_base(i) {
-            let (rk, ok) = pose[k];
-            let axis = rk * Vector3::from(m.joint.axis);
-            match m.joint.kind {
-                JointKind::Revolute { speed } => {
-                    jw.fixed_view_mut::<3, 1>(0, speed).copy_from(&axis);
-                    jv.fixed_view_mut::<3, 1>(0, speed)
-                        .copy_from(&axis.cross(&(o - ok)));
-                }
-                JointKind::Prismatic { speed } => {
-                    jv.fixed_view_mut::<3, 1>(0, speed).copy_from(&axis);
-                }
-                JointKind::Fixed => {}
+        let e = r * Vector3::from(m.joint.axis);
+        motion[i] = match m.joint.kind {
+            JointKind::Revolute { speed } => Some((speed, spatial(e, o.cross(&e)))),
+            JointKind::Prismatic { speed } => Some((speed, spatial(Vector3::zeros(), e))),
+            JointKind::Fixed => None,
+        };
+    }
+    let base: Vec<(usize, Vector6<f64>)> = model.wheeled_base().map_or(Vec::new(), |w| {
+        vec![
+            (w.x_speed, spatial(Vector3::zeros(), Vector3::x())),
+            (w.psi_speed, spatial(Vector3::z(), Vector3::zeros())),
+        ]
+    });
+    let mut mm = DMatrix::zeros(n, n);
+    let mut set = |a: usize, b: usize, v: f64| {
+        mm[(a, b)] = v;
+        mm[(b, a)] = v;
+    };
+    for (i, _, _) in model.mounted_links() {
+        let Some((si, s)) = motion[i] else { continue };
+        let f = ic[i] * s;
+        for (k, _) in model.path_to_base(i) {
+            if let Some((sk, sv)) = motion[k] {
+                set(sk, si, sv.dot(&f));
             }
         }
-        if let Some(w) = model.wheeled_base() {
-            let z = Vector3::z();
-            jv.fixed_view_mut::<3, 1>(0, w.x_speed)
-                .copy_from(&Vector3::x());
-            jw.fixed_view_mut::<3, 1>(0, w.psi_speed).copy_from(&z);
-            jv.fixed_view_mut::<3, 1>(0, w.psi_speed)
-                .copy_from(&z.cross(&o));
+        for &(sb, sv) in &base {
+            set(sb, si, sv.dot(&f));
         }
-        let m = p[b.mass];
-        let ms = r * Vector3::from_fn(|k, _| p[b.first_moment[k]]);
-        let [xx, xy, xz, yy, yz, zz] = b.inertia.map(|k| p[k]);
-        let j = r * Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz) * r.transpose();
-        let c = cross_matrix(&ms);
-        let (jvt, jwt) = (jv.transpose(), jw.transpose());
-        mm += &jvt * &jv * m - &jvt * c * &jw + &jwt * c * &jv + &jwt * j * &jw;
+    }
+    for &(sa, va) in &base {
+        for &(sb, vb) in &base {
+            set(sa, sb, va.dot(&(ic[0] * vb)));
+        }
     }
     if let Some(w) = model.wheeled_base() {
         let (r, l, mw) = (p[w.radius], p[w.track], p[w.wheel_mass]);

@@ -10,7 +10,7 @@ mod common;
 use common::*;
 use kanegen::FunctionId;
 use kanegen::{Options, generate_model};
-use kanegen_model::{Model, UrdfOptions, WheeledBaseSpec};
+use kanegen_model::{AngleSnap, Model, UrdfOptions, WheeledBaseSpec};
 use kanegen_reference::Reference;
 use kanegen_reference::random::random_physical_params;
 
@@ -115,7 +115,7 @@ fn singlearm_without_snapping() {
     let m = urdf(
         "singlearm.urdf",
         &UrdfOptions {
-            snap_angles: None,
+            snap_angles: AngleSnap::Off,
             ..UrdfOptions::default()
         },
     );
@@ -225,4 +225,40 @@ fn synthetic_segway_with_the_body_below_the_root() {
     assert_eq!(m.params[w.wheel_axle_inertia].value, 0.04);
     assert_eq!(m.params[w.wheel_diametral_inertia].value, 0.02);
     check("synthetic segway", &m, 200, 6);
+}
+
+/// Point mass, zero-mass rotor (m = 0, J ≠ 0), a slightly non-physical inertia and malformed
+/// visuals (see `kanegen-model`'s URDF import tests): the first draw uses the file's values.
+#[test]
+fn point_masses_and_a_zero_mass_rotor() {
+    let text = include_str!("../crates/kanegen-model/tests/data/tolerant.urdf");
+    let m = Model::from_urdf_str(text, "tolerant.urdf", &UrdfOptions::default()).unwrap();
+    check("tolerant.urdf", &m, 20, 6);
+}
+
+/// The validation's mass matrix (from the kinetic energy, `kinetic_energy_mass_matrix`) is the
+/// reference's (from inverse dynamics), for every shipped model.
+#[test]
+fn the_validation_mass_matrix_is_the_reference_mass_matrix() {
+    let text = include_str!("../crates/kanegen-model/tests/data/tolerant.urdf");
+    let models = [
+        model("krang.toml"),
+        model("krang-fixed-wheels.toml"),
+        model("two-link.toml"),
+        urdf("singlearm.urdf", &UrdfOptions::default()),
+        urdf("Krang.urdf", &krang_options()),
+        Model::from_urdf_str(text, "tolerant.urdf", &UrdfOptions::default()).unwrap(),
+    ];
+    let mut r = rng(7);
+    for m in &models {
+        let p = m.param_values();
+        let reference = Reference::<f64>::with_params(m, &p);
+        for _ in 0..5 {
+            let (q, _, _) = random_state(&mut r, m.dof());
+            let expected = drows(&reference.mass_matrix(&q));
+            let got = drows(&kanegen_model::kinetic_energy_mass_matrix(m, &q, &p));
+            let e = rel_err(&got, &expected, 1.0);
+            assert!(e < 1e-12, "{}: {e:e}", m.name);
+        }
+    }
 }

@@ -96,6 +96,8 @@ pub fn generate_with(
     options: Options,
     emit: &EmitOptions,
 ) -> Result<Generated, Error> {
+    // The loaders check names; a model built in memory is checked here.
+    model.check_names()?;
     let derivation = kane::derive(&model, options);
     let lowered = lower::lower(&derivation);
     let source = emit::emit(&model, &lowered, emit)?;

@@ -7,7 +7,10 @@
 //! statements (common subexpressions). With runtime parameters, every parameter-only
 //! subexpression moves to a separate *precompute* program that runs once per parameter set
 //! (its results are `pc1, pc2, …`). Each joint's sin/cos is computed once. Op counts are kept
-//! per program.
+//! per program. No model name can have these shapes
+//! ([`kanegen_model::names::is_generated_local`], checked by
+//! [`Model::check_names`](kanegen_model::Model::check_names)), so a local never shadows a speed,
+//! coordinate or parameter.
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::fmt;

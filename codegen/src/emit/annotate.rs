@@ -6,12 +6,13 @@
 
 use std::collections::HashMap;
 
+use super::comment_text;
 use crate::lower::Program;
 
 /// Statement labels, by function name and local name.
 #[derive(Default)]
 pub(super) struct Labels<'a> {
-    by_function: HashMap<&'a str, HashMap<&'a str, &'a str>>,
+    by_function: HashMap<&'a str, HashMap<&'a str, String>>,
 }
 
 impl<'a> Labels<'a> {
@@ -21,12 +22,13 @@ impl<'a> Labels<'a> {
             .stmts
             .iter()
             .filter(|s| !s.comment.is_empty())
-            .map(|s| (s.name.as_str(), s.comment.as_str()))
+            .map(|s| (s.name.as_str(), comment_text(&s.comment)))
             .collect();
         self.by_function.insert(function, labels);
     }
 
-    /// `src` with `// label` appended to every labelled `let` statement.
+    /// `src` with `// label` appended to every labelled `let` statement (labels come from model
+    /// names: they are escaped by [`comment_text`]).
     pub fn apply(&self, src: &str) -> String {
         let mut out = String::with_capacity(src.len() * 5 / 4);
         let mut pending: Option<&str> = None;
@@ -40,7 +42,7 @@ impl<'a> Labels<'a> {
             if pending.is_none()
                 && let Some(rest) = t.strip_prefix("let ")
             {
-                pending = current.get(leading_ident(rest)).copied();
+                pending = current.get(leading_ident(rest)).map(String::as_str);
             }
             out.push_str(line);
             if let Some(c) = pending

@@ -32,6 +32,59 @@ pub(super) fn uses(p: &Program, pred: &dyn Fn(&Leaf) -> bool) -> bool {
     p.stmts.iter().any(|s| walk(&s.expr, pred)) || p.outputs.iter().any(|(_, _, e)| walk(e, pred))
 }
 
+/// Calls `f` on every leaf of `e`.
+fn for_each_leaf(e: &LExpr, f: &mut dyn FnMut(&Leaf)) {
+    match e {
+        LExpr::Leaf(l) => f(l),
+        LExpr::Sum { terms, .. } => terms.iter().for_each(|(_, t)| for_each_leaf(t, f)),
+        LExpr::Prod(fs) => fs.iter().for_each(|(b, _)| for_each_leaf(b, f)),
+    }
+}
+
+/// Which inputs a program reads, per speed, from one walk over it. (Asking [`uses`] once per
+/// speed and kind walked the program 5n times: cubic in the length of a chain, since M and C
+/// have n² entries.)
+struct Reads {
+    coord: Vec<bool>,
+    speed: Vec<bool>,
+    accel: Vec<bool>,
+    sin: Vec<bool>,
+    cos: Vec<bool>,
+    param: bool,
+    pre: bool,
+}
+
+impl Reads {
+    fn of(p: &Program, dof: usize) -> Self {
+        let mut r = Reads {
+            coord: vec![false; dof],
+            speed: vec![false; dof],
+            accel: vec![false; dof],
+            sin: vec![false; dof],
+            cos: vec![false; dof],
+            param: false,
+            pre: false,
+        };
+        let mut visit = |l: &Leaf| match *l {
+            Leaf::Coord(s) => r.coord[s] = true,
+            Leaf::Speed(s) => r.speed[s] = true,
+            Leaf::Accel(s) => r.accel[s] = true,
+            Leaf::Sin(s) => r.sin[s] = true,
+            Leaf::Cos(s) => r.cos[s] = true,
+            Leaf::Param(_) => r.param = true,
+            Leaf::Pre(_) => r.pre = true,
+            Leaf::Const(_) | Leaf::Local(_) => {}
+        };
+        for e in p.stmts.iter().map(|s| &s.expr) {
+            for_each_leaf(e, &mut visit);
+        }
+        for (_, _, e) in &p.outputs {
+            for_each_leaf(e, &mut visit);
+        }
+        r
+    }
+}
+
 /// The state arguments of a function with `inputs`, and their doc line.
 pub(super) fn state_args(cx: &Context<'_>, inputs: Inputs) -> (TokenStream, &'static str) {
     let t = scalar_type(cx.precision);
@@ -54,7 +107,7 @@ pub(super) fn state_args(cx: &Context<'_>, inputs: Inputs) -> (TokenStream, &'st
 
 /// The bindings of the inputs a function reads: one batched `sin_cos_n` call over the joint
 /// angles (vectorized), then per-joint names, coordinates, speeds and accelerations.
-fn prologue(cx: &Context<'_>, p: &Program) -> TokenStream {
+fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
     let speeds = &cx.model.speeds;
     let mut ts = TokenStream::new();
     if !p.sincos.is_empty() {
@@ -70,27 +123,25 @@ fn prologue(cx: &Context<'_>, p: &Program) -> TokenStream {
             let sn = ident(&naming::sin(&speeds[s].coordinate));
             let cn = ident(&naming::cos(&speeds[s].coordinate));
             let kl = idx(k);
-            let reads_sin = uses(p, &|l| *l == Leaf::Sin(s));
-            let reads_cos = uses(p, &|l| *l == Leaf::Cos(s));
-            if reads_sin {
+            if reads.sin[s] {
                 ts.extend(quote!(let #sn = sin_q[#kl];));
             }
-            if reads_cos {
+            if reads.cos[s] {
                 ts.extend(quote!(let #cn = cos_q[#kl];));
             }
         }
     }
     for (s, speed) in speeds.iter().enumerate() {
         let sl = idx(s);
-        if uses(p, &|l| *l == Leaf::Coord(s)) {
+        if reads.coord[s] {
             let id = ident(&speed.coordinate);
             ts.extend(quote!(let #id = q[#sl];));
         }
-        if uses(p, &|l| *l == Leaf::Speed(s)) {
+        if reads.speed[s] {
             let id = ident(&speed.name);
             ts.extend(quote!(let #id = u[#sl];));
         }
-        if uses(p, &|l| *l == Leaf::Accel(s)) {
+        if reads.accel[s] {
             let id = ident(&naming::accel(&speed.name));
             ts.extend(quote!(let #id = ud[#sl];));
         }
@@ -278,6 +329,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         pre: &cx.pre,
         precision: cx.precision,
     };
+    let reads = Reads::of(p, cx.low.dof);
     let fname = ident(&super::frames::rust_name(cx, f));
     let doc = match f.frame {
         Some(l) => format!(
@@ -288,22 +340,14 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     };
     let ops = format!(" Generated straight-line code: {}.", p.ops);
     let param_args = if cx.low.params.is_runtime() {
-        let pname = if uses(p, &|l| matches!(l, Leaf::Param(_))) {
-            quote!(p)
-        } else {
-            quote!(_p)
-        };
-        let pcname = if uses(p, &|l| matches!(l, Leaf::Pre(_))) {
-            quote!(pc)
-        } else {
-            quote!(_pc)
-        };
+        let pname = if reads.param { quote!(p) } else { quote!(_p) };
+        let pcname = if reads.pre { quote!(pc) } else { quote!(_pc) };
         quote!(#pname: &Params, #pcname: &Precomputed,)
     } else {
         quote!()
     };
     let (args, arg_doc) = state_args(cx, spec.inputs);
-    let prologue = prologue(cx, p);
+    let prologue = prologue(cx, p, &reads);
     let Result {
         ty,
         init,
@@ -311,17 +355,15 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         value,
     } = result(cx, &printer, p, spec.shape);
     let body = printer.statements(&stores);
-    let n = cx.low.dof;
-    let reads = |leaf: fn(usize) -> Leaf| (0..n).any(|s| uses(p, &|l| *l == leaf(s)));
-    let reads_q = !p.sincos.is_empty() || reads(Leaf::Coord);
+    let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
     let mut unused = TokenStream::new();
     if !reads_q {
         unused.extend(quote!(let _ = q;));
     }
-    if spec.inputs.needs_u() && !reads(Leaf::Speed) {
+    if spec.inputs.needs_u() && !reads.speed.contains(&true) {
         unused.extend(quote!(let _ = u;));
     }
-    if spec.inputs.needs_ud() && !reads(Leaf::Accel) {
+    if spec.inputs.needs_ud() && !reads.accel.contains(&true) {
         unused.extend(quote!(let _ = ud;));
     }
     quote! {

@@ -8,14 +8,10 @@ use crate::model::Model;
 use crate::naming;
 use crate::options::Precision;
 
-/// A model-derived name as an identifier: sanitised by [`naming::identifier`], raw (`r#type`)
-/// if it is a keyword.
+/// A model-derived name as an identifier, by [`naming::identifier`] (never a keyword, so never
+/// a raw identifier; the names of a validated model are unchanged).
 pub(super) fn ident(name: &str) -> Ident {
-    let s = naming::identifier(name);
-    if syn::parse_str::<Ident>(&s).is_err() {
-        return Ident::new_raw(&s, Span::call_site());
-    }
-    Ident::new(&s, Span::call_site())
+    Ident::new(&naming::identifier(name), Span::call_site())
 }
 
 /// `|v|` as an unsuffixed literal of the module's precision.

@@ -21,6 +21,21 @@ impl ModelError {
     }
 }
 
+/// A name that cannot be used in generated code: which item, its spelling, why and the fix
+/// (the detail of [`ModelErrorKind::BadName`]).
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[error("{item}: `{name}` {problem}; {fix}")]
+pub struct BadName {
+    /// What the name names (``speed of joint `q2` ``, `parameter`, `model name`).
+    pub item: String,
+    /// The name as written (for a URDF: after sanitising).
+    pub name: String,
+    /// Why it cannot be used.
+    pub problem: String,
+    /// How to fix it.
+    pub fix: String,
+}
+
 /// What is wrong with a description. Each message names the offending item and how to fix it.
 ///
 /// The error of a file that cannot be read keeps the [`std::io::Error`] as its source.
@@ -102,8 +117,10 @@ pub enum ModelErrorKind {
         /// Its norm.
         norm: f64,
     },
-    /// A body's mass is zero, negative or not finite.
-    #[error("body `{body}`: mass `{symbol}` = {value} must be positive")]
+    /// A body's mass is negative or not a number, or zero with a nonzero first moment.
+    #[error(
+        "body `{body}`: mass `{symbol}` = {value} must be positive (or zero for a body without first moment, MX = MY = MZ = 0)"
+    )]
     NonPositiveMass {
         /// The body.
         body: String,
@@ -114,7 +131,7 @@ pub enum ModelErrorKind {
     },
     /// The inertia about the centre of mass is not positive definite or breaks the triangle inequality.
     #[error(
-        "body `{body}`: inertia about the centre of mass is not physical ({detail}); principal moments must be positive and each at most the sum of the other two (check the frame-origin inertia XX..ZZ against m and MX..MZ)"
+        "body `{body}`: inertia about the centre of mass is not physical ({detail}); principal moments must be ≥ 0 and each at most the sum of the other two (check the frame-origin inertia XX..ZZ against m and MX..MZ)"
     )]
     NonPhysicalInertia {
         /// The body.
@@ -145,6 +162,21 @@ pub enum ModelErrorKind {
         name: String,
         /// Its value.
         value: f64,
+    },
+    /// A wheel constant of the wheeled base is not physical (`R` or `L` not positive, `mw`,
+    /// `YYw` or `ZZw` negative).
+    #[error(
+        "wheeled base: `{symbol}` = {value} is {what} and must be {bound}; correct its value in [parameters] (URDF: in the wheel links or the WheeledBaseSpec)"
+    )]
+    NonPhysicalWheel {
+        /// The parameter.
+        symbol: String,
+        /// Its value.
+        value: f64,
+        /// What it is (`the wheel radius`).
+        what: &'static str,
+        /// `positive` or `≥ 0`.
+        bound: &'static str,
     },
     /// A length entry is neither a finite number nor `[-]SYMBOL`.
     #[error(
@@ -292,6 +324,29 @@ pub enum ModelErrorKind {
         /// `UrdfOptions::max_radius_of_gyration`.
         limit: f64,
     },
+    /// A URDF link's `<inertial>` is not physical: a negative mass, or an inertia about the
+    /// centre of mass (`ixx` … `izz`) that is not positive semi-definite or breaks the triangle
+    /// inequality by more than `UrdfOptions::inertia_tolerance` (or at all, with
+    /// `NonPhysicalInertia::Error`).
+    #[error("URDF link `{link}` <inertial>: {detail}; {fix}")]
+    UrdfNonPhysicalInertial {
+        /// The link.
+        link: String,
+        /// What is wrong, with the numbers.
+        detail: String,
+        /// How to fix it.
+        fix: String,
+    },
+    /// The mass matrix is singular: some speed moves no mass and no inertia.
+    #[error(
+        "the mass matrix is not positive definite: speed `{speed}` moves no mass or inertia that the speeds before it do not ({detail}); give the links it moves a mass or an inertia about its axis, or make its joint fixed"
+    )]
+    SingularMassMatrix {
+        /// The first speed (in the order of u) whose pivot vanishes.
+        speed: String,
+        /// The pivot and the configuration.
+        detail: String,
+    },
     /// A URDF import option (base declaration, dropped links, gravity) is inconsistent with the file.
     #[error("URDF import option `{option}`: {detail}")]
     UrdfBadOption {
@@ -300,6 +355,11 @@ pub enum ModelErrorKind {
         /// What is wrong and how to fix it.
         detail: String,
     },
+    /// A name that reaches generated code (coordinate, speed, parameter, model name) is not an
+    /// identifier, is reserved by generated code, or clashes with another name there (see
+    /// [`names`](crate::names)).
+    #[error("{0}")]
+    BadName(Box<BadName>),
     /// Anything else about the base or gravity declarations.
     #[error("{item}: {detail}")]
     Invalid {

@@ -1,8 +1,20 @@
 //! Model names as Rust identifiers: the one rule shared by the URDF importer and code emission.
 
-/// Words that are Rust keywords but cannot be written as raw identifiers (`r#self` is not valid
-/// Rust), nor is `_` an identifier; [`sanitize_identifier`] appends `_` to them.
-const NOT_RAW: &[&str] = &["_", "crate", "self", "Self", "super"];
+/// Rust's strict and reserved keywords of every edition (2015–2024), and `_`: none of them is
+/// an identifier that generated code may bind (`r#self`, `r#Self`, `r#_` do not even exist as
+/// raw identifiers).
+const KEYWORDS: &[&str] = &[
+    "_", "abstract", "as", "async", "await", "become", "box", "break", "const", "continue",
+    "crate", "do", "dyn", "else", "enum", "extern", "false", "final", "fn", "for", "gen", "if",
+    "impl", "in", "let", "loop", "macro", "match", "mod", "move", "mut", "override", "priv", "pub",
+    "ref", "return", "self", "Self", "static", "struct", "super", "trait", "true", "try", "type",
+    "typeof", "unsafe", "unsized", "use", "virtual", "where", "while", "yield",
+];
+
+/// Whether `name` is a Rust keyword (of any edition) or `_`.
+pub fn is_keyword(name: &str) -> bool {
+    KEYWORDS.contains(&name)
+}
 
 /// A name (of a parameter, speed, coordinate, link or joint) as a Rust identifier.
 ///
@@ -11,14 +23,13 @@ const NOT_RAW: &[&str] = &["_", "crate", "self", "Self", "super"];
 /// 1. every character other than an ASCII letter, an ASCII digit or `_` becomes `_`
 ///    (`base-link` → `base_link`, `Gelenk_ä` → `Gelenk__`);
 /// 2. if the result is empty or starts with a digit, `_` is put in front (`4l` → `_4l`);
-/// 3. if the result is `_`, `crate`, `self`, `Self` or `super` (which are no identifiers and
-///    cannot be raw identifiers either), `_` is appended (`self` → `self_`; `-`, `_` and the empty name
-///    → `__`).
+/// 3. if the result is a Rust keyword or `_` ([`is_keyword`]), `_` is appended (`self` →
+///    `self_`, `type` → `type_`; `-`, `_` and the empty name → `__`).
 ///
 /// Names that already are identifiers, such as `MX4l`, `qd_imu` or `q_LJ1`, are returned
-/// unchanged. The result is an identifier, or another Rust keyword such as `type` or `fn`, which
-/// generated code writes as a raw identifier (`r#type`). Distinct names can give the same result
-/// (`a-b` and `a_b`); callers that need distinct identifiers check for that.
+/// unchanged; the result is always an identifier and never a keyword. Distinct names can give
+/// the same result (`a-b` and `a_b`): [`Model::check_names`](crate::Model::check_names) reports
+/// that.
 pub fn sanitize_identifier(name: &str) -> String {
     let mut s: String = name
         .chars()
@@ -33,7 +44,7 @@ pub fn sanitize_identifier(name: &str) -> String {
     if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) {
         s.insert(0, '_');
     }
-    if NOT_RAW.contains(&s.as_str()) {
+    if is_keyword(&s) {
         s.push('_');
     }
     s
@@ -45,7 +56,7 @@ mod tests {
 
     #[test]
     fn identifiers_are_kept() {
-        for name in ["MX4l", "qd_imu", "q_LJ1", "g", "_x", "type", "Params"] {
+        for name in ["MX4l", "qd_imu", "q_LJ1", "g", "_x", "Params", "types"] {
             assert_eq!(id(name), name);
         }
     }
@@ -64,7 +75,9 @@ mod tests {
     }
 
     #[test]
-    fn words_that_cannot_be_raw_identifiers_get_an_underscore_appended() {
+    fn keywords_get_an_underscore_appended() {
+        assert_eq!(id("type"), "type_");
+        assert_eq!(id("gen"), "gen_");
         assert_eq!(id("_"), "__");
         assert_eq!(id("-"), "__");
         assert_eq!(id(""), "__");

@@ -16,11 +16,17 @@
 mod error;
 mod ident;
 mod ir;
+mod mass_matrix;
+pub mod names;
 mod toml_format;
 pub mod urdf;
 mod validate;
 
-pub use error::{ModelError, ModelErrorKind};
-pub use ident::sanitize_identifier;
+pub use error::{BadName, ModelError, ModelErrorKind};
+pub use ident::{is_keyword, sanitize_identifier};
 pub use ir::*;
-pub use urdf::{AbsurdInertia, UrdfBase, UrdfImport, UrdfOptions, WheeledBaseSpec};
+pub use mass_matrix::kinetic_energy_mass_matrix;
+pub use urdf::{
+    AbsurdInertia, AngleSnap, NonPhysicalInertia, UrdfBase, UrdfImport, UrdfOptions,
+    WheeledBaseSpec, ZeroMassInertia,
+};

@@ -152,7 +152,8 @@ struct Symbols {
 }
 
 impl Symbols {
-    /// The `[parameters]` table, in file order; every value a finite number.
+    /// The `[parameters]` table, in file order; every value a number (finite: checked with the
+    /// model's other values by `validate::check_physics`).
     fn from_table(table: &toml::Table) -> Result<Self, K> {
         let mut syms = Symbols {
             params: Vec::new(),
@@ -170,12 +171,6 @@ impl Symbols {
                     )));
                 }
             };
-            if !v.is_finite() {
-                return Err(K::NonFiniteParameter {
-                    name: name.clone(),
-                    value: v,
-                });
-            }
             syms.index.insert(name.clone(), syms.params.len());
             syms.params.push(Param {
                 name: name.clone(),
@@ -333,7 +328,8 @@ fn build(f: File, file: &str) -> Result<Model, K> {
             direction: dir,
         },
     };
-    validate::check_physics(&model)?;
+    crate::names::check(&model)?;
+    validate::check_physics(&model, validate::TOLERANCE)?;
     Ok(model)
 }
 

@@ -342,28 +342,41 @@ fn names_that_collide_after_sanitising() {
         ("<child link=\"L2\"/>", "<child link=\"L_1\"/>"),
         ("<parent link=\"L2\"/>", "<parent link=\"L_1\"/>"),
     ]);
-    let kind = error_of(&text, &["`L_1`", "sanitised"]);
-    assert!(matches!(kind, K::Duplicate { .. }), "{kind:?}");
+    let kind = error_of(&text, &["`m_L_1`", "`L-1`", "`L_1`", "sanitising"]);
+    assert!(matches!(kind, K::BadName(_)), "{kind:?}");
 }
 
 #[test]
-fn negative_mass() {
+fn negative_mass_is_an_error_in_urdf_terms() {
     let kind = error_of(
         &mutate(&[("<mass value=\"1.5\"/>", "<mass value=\"-1.5\"/>")]),
-        &["body `L2`", "must be positive"],
+        &[
+            "URDF link `L2` <inertial>",
+            "<mass value=\"-1.5\"> is negative",
+        ],
     );
-    assert!(matches!(kind, K::NonPositiveMass { .. }), "{kind:?}");
+    assert!(
+        matches!(&kind, K::UrdfNonPhysicalInertial { link, .. } if link == "L2"),
+        "{kind:?}"
+    );
 }
 
 #[test]
-fn validation_still_runs_on_the_merged_bodies() {
-    // Triangle inequality broken: 0.01 + 0.02 < 0.05.
+fn a_non_physical_link_inertia_is_an_error_in_urdf_terms() {
+    // Triangle inequality broken by 40 %: 0.01 + 0.02 < 0.05.
     let kind = error_of(
         &mutate(&[("izz=\"0.02\"", "izz=\"0.05\"")]),
-        &["body `L2`", "triangle inequality"],
+        &[
+            "URDF link `L2` <inertial>",
+            "ixx 0.01",
+            "izz 0.05",
+            "triangle inequality",
+            "40.00 %",
+            "inertia_tolerance",
+        ],
     );
     assert!(
-        matches!(&kind, K::NonPhysicalInertia { body, .. } if body == "L2"),
+        matches!(&kind, K::UrdfNonPhysicalInertial { link, .. } if link == "L2"),
         "{kind:?}"
     );
 }
@@ -457,4 +470,42 @@ fn a_missing_file_is_an_io_error() {
         source.downcast_ref::<std::io::Error>().is_some(),
         "{source}"
     );
+}
+
+#[test]
+fn a_zero_track_is_a_non_physical_wheel_constant() {
+    let urdf = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models/Krang.urdf");
+    let mut base = WheeledBaseSpec::new("JLWheel", "JRWheel", "Base", [0.0, 1.0, 0.0], 0.25);
+    base.track = Some(0.0);
+    let opts =
+        UrdfOptions::wheeled(base).drop_links(["lgPlate1", "lgPlate2", "rgPlate1", "rgPlate2"]);
+    let e = Model::from_urdf_file(&urdf, &opts).expect_err("zero track");
+    assert!(
+        matches!(&e.kind, K::NonPhysicalWheel { symbol, value, .. } if symbol == "L" && *value == 0.0),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn a_nan_mass_is_a_bad_number() {
+    let kind = error_of(
+        &mutate(&[("<mass value=\"1.5\"/>", "<mass value=\"NaN\"/>")]),
+        &["link `L2`", "NaN"],
+    );
+    assert!(matches!(kind, K::UrdfBadNumber { .. }), "{kind:?}");
+}
+
+#[test]
+fn deeply_nested_xml_is_a_typed_error_not_a_stack_overflow() {
+    let depth = 200_000;
+    let text = format!(
+        "<robot name=\"r\"><link name=\"a\">{}{}</link></robot>",
+        "<x>".repeat(depth),
+        "</x>".repeat(depth)
+    );
+    let start = std::time::Instant::now();
+    let kind = error_of(&text, &["nested more than 64 levels"]);
+    assert!(matches!(kind, K::UrdfParse { .. }), "{kind:?}");
+    assert!(start.elapsed().as_secs() < 5, "{:?}", start.elapsed());
 }

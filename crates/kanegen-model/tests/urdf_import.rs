@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use kanegen_model::{
-    AbsurdInertia, Base, JointKind, Model, UrdfImport, UrdfOptions, WheeledBaseSpec,
+    AbsurdInertia, AngleSnap, Base, JointKind, Model, UrdfImport, UrdfOptions, WheeledBaseSpec,
 };
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
@@ -224,19 +224,23 @@ fn angles_are_snapped_by_default_and_kept_on_request() {
         "{:?}",
         snapped.notes
     );
-    assert!(
-        snapped
-            .notes
-            .iter()
-            .any(|n| n.contains("2 rotation angles within")),
-        "{:?}",
-        snapped.notes
-    );
+    // Every snap is listed, with the precision it was read at.
+    for note in [
+        "3.1416 snapped to π (3.1416 is π rounded to 4 decimals",
+        "1.5708 snapped to π/2 (1.5708 is π/2 rounded to 4 decimals",
+        "-3.14 snapped to -π (-3.14 is -π rounded to 2 decimals",
+    ] {
+        assert!(
+            snapped.notes.iter().any(|n| n.contains(note)),
+            "{note}: {:?}",
+            snapped.notes
+        );
+    }
     let raw = Model::from_urdf_str(
         &text,
         "arm.urdf",
         &UrdfOptions {
-            snap_angles: None,
+            snap_angles: AngleSnap::Off,
             ..UrdfOptions::default()
         },
     )
@@ -254,7 +258,7 @@ fn angles_are_snapped_by_default_and_kept_on_request() {
         &text,
         "arm.urdf",
         &UrdfOptions {
-            snap_angles: None,
+            snap_angles: AngleSnap::Off,
             ..UrdfOptions::default()
         },
     )
@@ -436,4 +440,183 @@ fn shipped_urdfs_import_without_their_meshes() {
     )
     .unwrap();
     assert!(param(&kept, "ZZ_lGripper") - param(&fixed, "ZZ_lGripper") > 0.15);
+}
+
+#[test]
+fn only_rounded_decimals_of_multiples_of_half_pi_are_snapped() {
+    // A real 1.9e-4 rad yaw, a truncated π, a 1-decimal angle and a 2-decimal angle that is no
+    // rounded multiple of π/2 are kept exactly; 4.7124 (3π/2 rounded) is snapped.
+    let text = ARM.replace("rpy=\"0 1.5708 0\"", "rpy=\"0.00019 3.1415 1.5\"");
+    let import = UrdfImport::parse(&text, "arm.urdf", &UrdfOptions::default()).unwrap();
+    let r = import.model.links[2].joint().unwrap().rotation;
+    let r_mount = rpy(0.5, 0.25, -1.0);
+    assert!(close(
+        &r,
+        &rows(&(r_mount * rpy(0.00019, 3.1415, 1.5))),
+        1e-15
+    ));
+    assert!(
+        !import.notes.iter().any(|n| n.contains("joint `slide`")),
+        "{:?}",
+        import.notes
+    );
+    let text = ARM.replace("rpy=\"0 1.5708 0\"", "rpy=\"4.7124 1.57 0\"");
+    let import = UrdfImport::parse(&text, "arm.urdf", &UrdfOptions::default()).unwrap();
+    let r = import.model.links[2].joint().unwrap().rotation;
+    let exact = rpy(
+        3.0 * std::f64::consts::FRAC_PI_2,
+        std::f64::consts::FRAC_PI_2,
+        0.0,
+    );
+    assert!(close(&r, &rows(&(r_mount * exact)), 1e-15));
+    // The lossy tolerance of earlier versions is an option.
+    let text = ARM.replace("rpy=\"0 1.5708 0\"", "rpy=\"0.00019 0 0\"");
+    let lossy = UrdfOptions {
+        snap_angles: AngleSnap::Within(2e-3),
+        ..UrdfOptions::default()
+    };
+    let import = UrdfImport::parse(&text, "arm.urdf", &lossy).unwrap();
+    let r = import.model.links[2].joint().unwrap().rotation;
+    assert!(close(&r, &rows(&r_mount), 1e-15));
+    assert!(
+        import
+            .notes
+            .iter()
+            .any(|n| n.contains("0.00019 snapped to 0 (within"))
+    );
+}
+
+/// `tests/data/tolerant.urdf`, real-world content: malformed visual, collision and material elements (an empty `<texture/>`,
+/// a `<material>` inside `<geometry>`, a four-number mesh scale, a box with two sizes, a sphere
+/// radius that is no number), a point mass (`upper`), a zero-mass rotor with rotational inertia
+/// (`rotor`) and an inertia that breaks the triangle inequality by 0.99 % (`lower`).
+const TOLERANT: &str = include_str!("data/tolerant.urdf");
+
+/// `TOLERANT` without its visual, collision and material elements.
+fn tolerant_without_visuals() -> String {
+    let mut text = TOLERANT.to_owned();
+    for element in [
+        r#"<material name="grey"><texture/></material>"#,
+        r#"<visual><geometry><mesh filename="package://x/base.dae" scale="1 1 1 1"/><material name="m"/></geometry></visual>"#,
+        r#"<visual><geometry><box size="1 2"/></geometry><material name="red"><color rgba="1 0 0"/><texture/></material></visual>"#,
+        r#"<collision><geometry><sphere radius="oops"/></geometry></collision>"#,
+        "<collision/>",
+    ] {
+        assert_eq!(text.matches(element).count(), 1, "{element}");
+        text = text.replace(element, "");
+    }
+    text
+}
+
+#[test]
+fn visual_collision_and_material_content_never_aborts_an_import() {
+    let with = Model::from_urdf_str(TOLERANT, "t.urdf", &UrdfOptions::default()).unwrap();
+    let without = Model::from_urdf_str(
+        &tolerant_without_visuals(),
+        "t.urdf",
+        &UrdfOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(with, without);
+}
+
+#[test]
+fn point_masses_zero_mass_rotors_and_slightly_non_physical_inertias_load_with_notes() {
+    let import = UrdfImport::parse(TOLERANT, "t.urdf", &UrdfOptions::default()).unwrap();
+    let m = &import.model;
+    assert_eq!((m.dof(), m.body_count()), (3, 3));
+    // The rotor is a body with m = 0 and its inertia.
+    assert_eq!(param(m, "m_rotor"), 0.0);
+    assert_eq!(param(m, "ZZ_rotor"), 0.002);
+    // The point mass: J = m (|S|² 1 − S Sᵀ) about the link origin.
+    assert_eq!(param(m, "XX_upper"), 0.0);
+    assert!((param(m, "YY_upper") - 2.0 * 0.09).abs() < 1e-15);
+    for note in [
+        "link `rotor`: zero mass with a nonzero rotational inertia",
+        "kept as a body with m = 0",
+        "link `lower`: the inertia (ixx 0.01, ixy 0, ixz 0, iyy 0.01, iyz 0, izz 0.0202)",
+        "triangle inequality",
+        "0.99 % of the largest; kept as written",
+    ] {
+        assert!(
+            import.notes.iter().any(|n| n.contains(note)),
+            "{note}: {:?}",
+            import.notes
+        );
+    }
+}
+
+#[test]
+fn inertia_options_make_slight_violations_errors_or_repair_them() {
+    use kanegen_model::{ModelErrorKind as K, NonPhysicalInertia};
+    let strict = UrdfOptions {
+        non_physical_inertia: NonPhysicalInertia::Error,
+        ..UrdfOptions::default()
+    };
+    let e = Model::from_urdf_str(TOLERANT, "t.urdf", &strict).unwrap_err();
+    assert!(
+        matches!(&e.kind, K::UrdfNonPhysicalInertial { link, .. } if link == "lower"),
+        "{:?}",
+        e.kind
+    );
+    let repair = UrdfOptions {
+        non_physical_inertia: NonPhysicalInertia::Repair,
+        ..UrdfOptions::default()
+    };
+    let import = UrdfImport::parse(TOLERANT, "t.urdf", &repair).unwrap();
+    assert!(
+        import.notes.iter().any(|n| n.contains("link `lower`")
+            && n.contains(
+                "repaired to the principal moments 1.006667e-2, 1.006667e-2, 2.013333e-2"
+            )),
+        "{:?}",
+        import.notes
+    );
+    // The repaired inertia about the centre of mass: izz = ixx + iyy exactly.
+    let m = &import.model;
+    let izz = param(m, "ZZ_lower");
+    let (ixx, iyy) = (param(m, "XX_lower"), param(m, "YY_lower") - 1.0 * 0.04);
+    assert!(
+        (izz - 1.0 * 0.04 - (ixx + iyy)).abs() < 1e-15,
+        "{ixx} {iyy} {izz}"
+    );
+    // Beyond the tolerance it is an error whatever the policy.
+    let far = TOLERANT.replace("izz=\"0.0202\"", "izz=\"0.03\"");
+    let e = Model::from_urdf_str(&far, "t.urdf", &repair).unwrap_err();
+    assert!(
+        matches!(e.kind, K::UrdfNonPhysicalInertial { .. }),
+        "{:?}",
+        e.kind
+    );
+}
+
+#[test]
+fn dropping_a_zero_mass_rotor_leaves_its_speed_without_inertia_a_singular_mass_matrix() {
+    use kanegen_model::{ModelErrorKind as K, ZeroMassInertia};
+    let drop = UrdfOptions {
+        zero_mass_inertia: ZeroMassInertia::Drop,
+        ..UrdfOptions::default()
+    };
+    let e = Model::from_urdf_str(TOLERANT, "t.urdf", &drop).unwrap_err();
+    assert!(
+        matches!(&e.kind, K::SingularMassMatrix { speed, .. } if speed == "qd_spin"),
+        "{:?}",
+        e.kind
+    );
+    assert!(
+        e.to_string()
+            .contains("speed `qd_spin` moves no mass or inertia"),
+        "{e}"
+    );
+    // With the rotor kept as a point mass on its own axis, the same.
+    let point = TOLERANT.replace(
+        r#"<mass value="0"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.002"/>"#,
+        r#"<mass value="0.5"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/>"#,
+    );
+    let e = Model::from_urdf_str(&point, "t.urdf", &UrdfOptions::default()).unwrap_err();
+    assert!(
+        matches!(&e.kind, K::SingularMassMatrix { speed, .. } if speed == "qd_spin"),
+        "{:?}",
+        e.kind
+    );
 }

@@ -445,7 +445,7 @@ fn mass_not_positive() {
 }
 
 #[test]
-fn inertia_not_positive_definite() {
+fn inertia_not_positive_semi_definite() {
     // I_G[y][y] = YY2 − m(Sx² + Sz²) = −0.01.
     let e = load_err(
         &mutate(&[("YY2 = 0.01", "YY2 = -0.01")]),
@@ -453,7 +453,7 @@ fn inertia_not_positive_definite() {
     );
     assert!(
         matches!(&e.kind, K::NonPhysicalInertia { body, detail }
-            if body == "2" && detail.contains("not positive definite")),
+            if body == "2" && detail.contains("not positive semi-definite")),
         "{:?}",
         e.kind
     );
@@ -756,4 +756,82 @@ fn missing_file_is_io_error_naming_the_path() {
         msg.contains("no-such-model.toml") && msg.contains("cannot read"),
         "{msg}"
     );
+}
+
+/// `VALID` on a wheeled base with the wheel constants `R`, `L`, `mw`, `YYw`, `ZZw` of `wheel`.
+fn wheeled(wheel: &str) -> String {
+    mutate(&[
+        (
+            "[base]\ntype = \"fixed\"\nframe = \"0\"\n",
+            "[base]\ntype = \"wheeled\"\nframe = \"0\"\nx_speed = \"xd\"\npsi_speed = \"psid\"\n\
+             radius = \"R\"\ntrack = \"L\"\nwheel_mass = \"mw\"\nwheel_axle_inertia = \"YYw\"\n\
+             wheel_diametral_inertia = \"ZZw\"\n",
+        ),
+        ("g = 9.81\n", &format!("g = 9.81\n{wheel}\n")),
+        (
+            r#"speeds = ["qd1", "qd2"]"#,
+            r#"speeds = ["xd", "psid", "qd1", "qd2"]"#,
+        ),
+    ])
+}
+
+#[test]
+fn non_physical_wheel_constants_are_errors() {
+    const GOOD: [(&str, &str); 5] = [
+        ("R", "0.25"),
+        ("L", "0.68"),
+        ("mw", "4.66"),
+        ("YYw", "0.1456"),
+        ("ZZw", "0.0751"),
+    ];
+    let with = |symbol: &str, value: &str| {
+        GOOD.iter()
+            .map(|(s, v)| format!("{s} = {}\n", if *s == symbol { value } else { v }))
+            .collect::<String>()
+    };
+    Model::from_toml_str(&wheeled(&with("", "")), FILE).expect("the wheeled model is valid");
+    for (symbol, value) in [
+        ("R", "0"),
+        ("R", "-0.25"),
+        ("L", "0"),
+        ("mw", "-1"),
+        ("YYw", "-0.1"),
+        ("ZZw", "-0.1"),
+    ] {
+        let e = load_err(
+            &wheeled(&with(symbol, value)),
+            &[&format!("`{symbol}`"), "must be"],
+        );
+        assert!(
+            matches!(&e.kind, K::NonPhysicalWheel { symbol: s, .. } if s == symbol),
+            "{symbol} = {value}: {:?}",
+            e.kind
+        );
+    }
+    // Massless wheels are allowed (their inertia terms vanish).
+    let massless = with("mw", "0")
+        .replace("YYw = 0.1456", "YYw = 0")
+        .replace("ZZw = 0.0751", "ZZw = 0");
+    Model::from_toml_str(&wheeled(&massless), FILE).expect("massless wheels");
+}
+
+#[test]
+fn a_nan_mass_is_an_error() {
+    for (text, name) in [
+        ("m1 = nan", "m1"),
+        ("XX2 = inf", "XX2"),
+        ("MY1 = -inf", "MY1"),
+    ] {
+        let from = format!("{} = ", name);
+        let line = VALID
+            .lines()
+            .find(|l| l.starts_with(&from))
+            .expect("parameter line");
+        let e = load_err(&mutate(&[(line, text)]), &[&format!("`{name}`"), "finite"]);
+        assert!(
+            matches!(&e.kind, K::NonFiniteParameter { name: n, .. } if n == name),
+            "{text}: {:?}",
+            e.kind
+        );
+    }
 }

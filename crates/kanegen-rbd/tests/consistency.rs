@@ -170,7 +170,8 @@ fn krang_fixed_wheels_coriolis_matches_lagrange() {
 
 /// A model exercising what Krang does not have: a body on the (wheeled) base frame, a fixed
 /// joint with a non-permutation rotation carrying a body and a child, a prismatic joint,
-/// non-axis-aligned axes, and speeds in an order unrelated to the link order.
+/// non-axis-aligned axes, and speeds in an order unrelated to the link order. (Speeds are named
+/// apart from their coordinates and from generated locals such as `d2`: the loader checks that.)
 fn synthetic(wheeled: bool) -> Model {
     let frames = ["0", "1", "f", "2", "3", "4"];
     let mut params = String::from("g = 9.81\nL1 = 0.3\nL2 = 0.2\n");
@@ -190,12 +191,12 @@ fn synthetic(wheeled: bool) -> Model {
     let (c30, s30) = (0.866_025_403_784_438_6_f64, 0.5_f64);
     let (speeds, base) = if wheeled {
         (
-            r#"["q3", "xd", "d2", "q1", "psid", "q4"]"#,
+            r#"["qd3", "xd", "qd_x2", "qd1", "psid", "qd4"]"#,
             "type = \"wheeled\"\nframe = \"0\"\nx_speed = \"xd\"\npsi_speed = \"psid\"\nradius = \"R\"\ntrack = \"L\"\nwheel_mass = \"mw\"\nwheel_axle_inertia = \"YYw\"\nwheel_diametral_inertia = \"ZZw\"\n",
         )
     } else {
         (
-            r#"["q3", "d2", "q1", "q4"]"#,
+            r#"["qd3", "qd_x2", "qd1", "qd4"]"#,
             "type = \"fixed\"\nframe = \"0\"\n",
         )
     };
@@ -217,7 +218,7 @@ name = "q1"
 type = "revolute"
 parent = "0"
 child = "1"
-speed = "q1"
+speed = "qd1"
 axis = [0.6, 0, 0.8]
 rotation = [[0, 0, -1], [-1, 0, 0], [0, 1, 0]]
 translation = [0, 0, "L2"]
@@ -231,11 +232,11 @@ rotation = [[{c30}, -{s30}, 0], [{s30}, {c30}, 0], [0, 0, 1]]
 translation = ["L1", 0, 0.1]
 
 [[joint]]
-name = "d2"
+name = "x2"
 type = "prismatic"
 parent = "f"
 child = "2"
-speed = "d2"
+speed = "qd_x2"
 axis = [0, 1, 0]
 rotation = [[1, 0, 0], [0, 0, -1], [0, 1, 0]]
 translation = [0, "-L2", 0]
@@ -245,7 +246,7 @@ name = "q3"
 type = "revolute"
 parent = "2"
 child = "3"
-speed = "q3"
+speed = "qd3"
 axis = [0, 0, -1]
 rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
 translation = [0.05, 0, "L1"]
@@ -255,7 +256,7 @@ name = "q4"
 type = "revolute"
 parent = "1"
 child = "4"
-speed = "q4"
+speed = "qd4"
 axis = [0, 0.6, -0.8]
 rotation = [[0, 1, 0], [1, 0, 0], [0, 0, -1]]
 translation = [0, "L1", 0]

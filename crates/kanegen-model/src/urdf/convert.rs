@@ -1,7 +1,7 @@
 //! The conversion driver: the parsed URDF, resolved against the options ([`resolve`]), becomes
 //! the IR (base, moving joints, bodies) and is validated.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 use nalgebra::Vector3;
 
@@ -313,7 +313,6 @@ fn add_bodies(ir: &mut Ir, r: &Resolved<'_>, fixed_base: bool, notes: &mut Notes
             members.entry(cl.rep(l)).or_default().push(l);
         }
     }
-    let mut body_names: HashSet<String> = HashSet::new();
     let mut rep_of_ir: Vec<Option<usize>> = vec![None; ir.links.len()];
     for (&rep, &i) in &ir.ir_index {
         rep_of_ir[i] = Some(rep);
@@ -354,18 +353,13 @@ fn add_bodies(ir: &mut Ir, r: &Resolved<'_>, fixed_base: bool, notes: &mut Notes
                 others.join(", ")
             ));
         }
-        if items.is_empty() || mass == 0.0 {
+        // Zero-mass links keep their rotational inertia (UrdfOptions::zero_mass_inertia).
+        if items.is_empty() {
             continue;
         }
         let (m, ms, j) = merge(&items);
         let link_name = &tree.link(rep).name;
         let s = sanitize_identifier(link_name);
-        if !body_names.insert(s.clone()) {
-            return Err(K::Duplicate {
-                what: "body name (link name sanitised to an identifier)",
-                name: s,
-            });
-        }
         let mut sym = |prefix: &str, v: f64| {
             let name = sanitize_identifier(&format!("{prefix}_{link_name}"));
             ir.param(name, v, ParamKind::Inertial)
@@ -388,8 +382,8 @@ fn add_bodies(ir: &mut Ir, r: &Resolved<'_>, fixed_base: bool, notes: &mut Notes
     Ok(())
 }
 
-/// The model from the IR: distinct coordinate identifiers, name and description, and the checks
-/// of a TOML model (unit axes, proper rotations, positive masses, physical inertias).
+/// The model from the IR: name and description, and the checks of a TOML model (names, unit
+/// axes, proper rotations, positive masses, physical inertias).
 fn assemble(
     ir: Ir,
     base: Base,
@@ -397,16 +391,6 @@ fn assemble(
     file: &str,
     opts: &UrdfOptions,
 ) -> Result<Model, K> {
-    // Generated identifiers must be distinct (index constants are the upper-cased coordinates).
-    let mut seen: HashMap<String, &str> = HashMap::new();
-    for s in &ir.speeds {
-        if let Some(first) = seen.insert(s.coordinate.to_uppercase(), &s.coordinate) {
-            return Err(K::Duplicate {
-                what: "coordinate (joint names sanitised and compared case-insensitively)",
-                name: format!("{first} / {}", s.coordinate),
-            });
-        }
-    }
     let name = opts.name.clone().unwrap_or_else(|| robot.name.clone());
     let description = format!(
         "imported from URDF robot `{}`: {} speeds, {} base",
@@ -430,10 +414,11 @@ fn assemble(
             direction: opts.gravity_direction,
         },
     };
+    crate::names::check(&model)?;
     for (_, _, m) in model.mounted_links() {
         validate::check_axis(&m.joint.name, m.joint.axis)?;
         validate::check_rotation(&m.joint.name, &m.joint.rotation)?;
     }
-    validate::check_physics(&model)?;
+    validate::check_physics(&model, opts.inertia_tolerance)?;
     Ok(model)
 }

@@ -1,5 +1,6 @@
-//! Diagnosis of malformed URDF text: typed errors for what the URDF parser would only report
-//! generically (an unknown joint type, a number that is not one).
+//! The URDF text before parsing: the elements the generator never needs are removed
+//! ([`without_unused_elements`]), and typed errors are given for what the URDF parser would only
+//! report generically (an unknown joint type, a number that is not one).
 
 use crate::error::ModelErrorKind as K;
 
@@ -26,11 +27,11 @@ const NUMERIC: &[(&str, &[(&str, usize)])] = &[
     ),
     ("dynamics", &[("damping", 1), ("friction", 1)]),
     ("mimic", &[("multiplier", 1), ("offset", 1)]),
-    ("box", &[("size", 3)]),
-    ("cylinder", &[("radius", 1), ("length", 1)]),
-    ("sphere", &[("radius", 1)]),
-    ("mesh", &[("scale", 3)]),
 ];
+
+/// Elements that carry nothing the dynamics need (appearance and collision geometry); removed
+/// with their content before parsing, so that their content is never read.
+const UNUSED: &[&str] = &["visual", "collision", "material"];
 
 const JOINT_TYPES: &[&str] = &[
     "revolute",
@@ -42,8 +43,15 @@ const JOINT_TYPES: &[&str] = &[
     "spherical",
 ];
 
+/// Deepest element nesting accepted (a URDF needs about five levels): deeper text is a typed
+/// error instead of overflowing the stack of the recursive XML parser.
+pub(super) const MAX_DEPTH: usize = 64;
+
 /// One start or end tag.
 struct Tag<'a> {
+    /// Byte offsets of the tag in the text: `text[start..end]` is `<…>`.
+    start: usize,
+    end: usize,
     name: &'a str,
     attrs: Vec<(&'a str, &'a str)>,
     closing: bool,
@@ -72,6 +80,7 @@ fn tags(text: &str) -> Option<Vec<Tag<'_>>> {
         if !rest.starts_with('<') || rest.starts_with("<!") || rest.starts_with("<?") {
             continue;
         }
+        let start = text.len() - rest.len();
         let closing = rest.starts_with("</");
         let mut s = &rest[if closing { 2 } else { 1 }..];
         let name_end = s.find(|c: char| c.is_whitespace() || c == '>' || c == '/')?;
@@ -101,6 +110,8 @@ fn tags(text: &str) -> Option<Vec<Tag<'_>>> {
             s = &v[end + 1..];
         }
         out.push(Tag {
+            start,
+            end: text.len() - s.len(),
             name,
             attrs,
             closing,
@@ -111,6 +122,51 @@ fn tags(text: &str) -> Option<Vec<Tag<'_>>> {
     Some(out)
 }
 
+/// `text` without the [`UNUSED`] elements (each removed with its content; the XML stays well
+/// formed). The text unchanged if it is not tag-shaped or an element is not closed (the URDF
+/// parser then reports the problem).
+pub(super) fn without_unused_elements(text: &str) -> std::borrow::Cow<'_, str> {
+    let Some(tags) = tags(text) else {
+        return text.into();
+    };
+    let mut out = String::new();
+    let mut copied = 0;
+    let mut i = 0;
+    while i < tags.len() {
+        let t = &tags[i];
+        if t.closing || !UNUSED.contains(&t.name) {
+            i += 1;
+            continue;
+        }
+        // The matching end tag: the first `</name>` at this element's depth.
+        let mut end = i;
+        if !t.self_closing {
+            let mut depth = 0usize;
+            end = match tags[i..].iter().position(|u| {
+                if u.name == t.name && !u.self_closing {
+                    if u.closing {
+                        depth -= 1;
+                    } else {
+                        depth += 1;
+                    }
+                }
+                depth == 0
+            }) {
+                Some(k) => i + k,
+                None => return text.into(),
+            };
+        }
+        out.push_str(&text[copied..t.start]);
+        copied = tags[end].end;
+        i = end + 1;
+    }
+    if copied == 0 {
+        return text.into();
+    }
+    out.push_str(&text[copied..]);
+    out.into()
+}
+
 /// A typed error for the malformations that the URDF parser would only report generically: an
 /// unknown joint type, a bad number. `None` if none is found (or the text is not tag-shaped).
 pub(super) fn diagnose(text: &str) -> Option<K> {
@@ -119,6 +175,14 @@ pub(super) fn diagnose(text: &str) -> Option<K> {
     let mut depth = 0usize;
     let mut context: Option<String> = None;
     for t in &tags {
+        if depth > MAX_DEPTH {
+            return Some(K::UrdfParse {
+                detail: format!(
+                    "elements are nested more than {MAX_DEPTH} levels deep (at <{}>)",
+                    t.name
+                ),
+            });
+        }
         if t.closing {
             depth = depth.saturating_sub(1);
             if depth <= 1 {

@@ -5,8 +5,9 @@ use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use super::transform::{Notes, Tf, finite3, rpy_matrix};
 use super::tree::Tree;
-use super::{AbsurdInertia, UrdfOptions};
+use super::{AbsurdInertia, NonPhysicalInertia, UrdfOptions, ZeroMassInertia};
 use crate::error::ModelErrorKind as K;
+use crate::validate;
 
 /// A link's own inertial data in its frame: mass, centre of mass, inertia about the COM.
 #[derive(Debug, Clone, Copy)]
@@ -35,7 +36,11 @@ pub(super) fn merge(items: &[(Tf, Inertial)]) -> (f64, Vector3<f64>, Matrix3<f64
     (m, ms, j)
 }
 
-/// A link's inertial data (`None` for zero mass), after the checks of the options.
+/// A link's inertial data (`None` for none: no mass and no inertia, or dropped by the options),
+/// after the checks of the options: finite numbers, a mass ≥ 0, a physical inertia about the
+/// centre of mass (up to [`UrdfOptions::inertia_tolerance`], as
+/// [`UrdfOptions::non_physical_inertia`] says), a plausible radius of gyration, and the
+/// inertia of a zero-mass link ([`UrdfOptions::zero_mass_inertia`]).
 pub(super) fn link_inertial(
     link: &urdf_rs::Link,
     opts: &UrdfOptions,
@@ -45,13 +50,12 @@ pub(super) fn link_inertial(
     let m = inertial.mass.value;
     let t = &inertial.inertia;
     let nums = [m, t.ixx, t.ixy, t.ixz, t.iyy, t.iyz, t.izz];
-    let element = format!("link `{}` <inertial>", link.name);
     if !nums.iter().all(|x| x.is_finite())
         || !finite3(inertial.origin.xyz.0)
         || !finite3(inertial.origin.rpy.0)
     {
         return Err(K::UrdfBadNumber {
-            element,
+            element: format!("link `{}` <inertial>", link.name),
             attribute: "mass/inertia/origin".into(),
             text: format!(
                 "m {m}, I {nums:?}, xyz {:?}, rpy {:?}",
@@ -60,23 +64,21 @@ pub(super) fn link_inertial(
             expected: "finite numbers".into(),
         });
     }
+    let unphysical = |detail: String, fix: &str| K::UrdfNonPhysicalInertial {
+        link: link.name.clone(),
+        detail,
+        fix: fix.to_owned(),
+    };
     if m < 0.0 {
-        return Err(K::NonPositiveMass {
-            body: link.name.clone(),
-            symbol: "<mass value>".into(),
-            value: m,
-        });
+        return Err(unphysical(
+            format!("<mass value=\"{m}\"> is negative"),
+            "give the link's mass in kg (≥ 0)",
+        ));
     }
     let ic = Matrix3::new(
         t.ixx, t.ixy, t.ixz, t.ixy, t.iyy, t.iyz, t.ixz, t.iyz, t.izz,
     );
-    if m == 0.0 {
-        if ic != Matrix3::zeros() {
-            notes.push(format!(
-                "link `{}`: zero mass with a nonzero inertia; the inertia is ignored",
-                link.name
-            ));
-        }
+    if m == 0.0 && ic == Matrix3::zeros() {
         return Ok(None);
     }
     let rot = rpy_matrix(
@@ -85,38 +87,124 @@ pub(super) fn link_inertial(
         &format!("link `{}` <inertial><origin>", link.name),
         notes,
     );
-    let ig = rot * ic * rot.transpose();
-    let lmax = SymmetricEigen::new(ig).eigenvalues.max();
-    if lmax > 0.0 {
-        let radius = (lmax / m).sqrt();
-        if radius > opts.max_radius_of_gyration {
-            let what = format!(
-                "link `{}`: radius of gyration {radius:.3} m (mass {m} kg, largest principal moment {lmax:.4e} kg·m²) exceeds {} m",
-                link.name, opts.max_radius_of_gyration
-            );
-            match opts.absurd_inertia {
-                AbsurdInertia::Error => {
-                    return Err(K::UrdfAbsurdInertia {
-                        link: link.name.clone(),
-                        mass: m,
-                        moment: lmax,
-                        radius,
-                        limit: opts.max_radius_of_gyration,
-                    });
-                }
-                AbsurdInertia::Drop => {
-                    notes.push(format!("{what}: inertia dropped"));
-                    return Ok(None);
-                }
-                AbsurdInertia::Keep => notes.push(format!("{what}: kept as written")),
-            }
+    let ig = physical_inertia(link, rot * ic * rot.transpose(), opts, notes)?;
+    if m == 0.0 {
+        let what = format!(
+            "link `{}`: zero mass with a nonzero rotational inertia (ixx {}, iyy {}, izz {})",
+            link.name, t.ixx, t.iyy, t.izz
+        );
+        if opts.zero_mass_inertia == ZeroMassInertia::Drop {
+            notes.push(format!("{what}: dropped (zero_mass_inertia = Drop)"));
+            return Ok(None);
         }
+        notes.push(format!("{what}: kept as a body with m = 0"));
+    } else if !absurd_inertia_kept(link, m, &ig, opts, notes)? {
+        return Ok(None);
     }
     Ok(Some(Inertial {
         m,
         c: Vector3::from(inertial.origin.xyz.0),
         ig,
     }))
+}
+
+/// The inertia `ig` about the centre of mass of `link` if it is physical (positive
+/// semi-definite, triangle inequality; point masses and rods are), or slightly non-physical as
+/// [`UrdfOptions::non_physical_inertia`] allows; otherwise the error, in URDF terms.
+fn physical_inertia(
+    link: &urdf_rs::Link,
+    ig: Matrix3<f64>,
+    opts: &UrdfOptions,
+    notes: &mut Notes,
+) -> Result<Matrix3<f64>, K> {
+    let moments = validate::principal_moments(&ig);
+    let (violation, what) = validate::inertia_violation(moments);
+    if violation <= validate::TOLERANCE {
+        return Ok(ig);
+    }
+    let t = &link.inertial.inertia;
+    let [a, b, c] = moments;
+    let detail = format!(
+        "the inertia (ixx {}, ixy {}, ixz {}, iyy {}, iyz {}, izz {}) has the principal moments \
+         {a:.6e}, {b:.6e}, {c:.6e} about the centre of mass: {what}, by {:.2} % of the largest",
+        t.ixx,
+        t.ixy,
+        t.ixz,
+        t.iyy,
+        t.iyz,
+        t.izz,
+        violation * 100.0
+    );
+    if violation > opts.inertia_tolerance || opts.non_physical_inertia == NonPhysicalInertia::Error
+    {
+        return Err(K::UrdfNonPhysicalInertial {
+            link: link.name.clone(),
+            detail,
+            fix: format!(
+                "correct ixx … izz (each principal moment ≥ 0 and at most the sum of the other \
+                 two); violations up to UrdfOptions::inertia_tolerance ({}) load with a note or \
+                 are repaired unless non_physical_inertia is Error",
+                opts.inertia_tolerance
+            ),
+        });
+    }
+    if opts.non_physical_inertia == NonPhysicalInertia::Note {
+        notes.push(format!("link `{}`: {detail}; kept as written", link.name));
+        return Ok(ig);
+    }
+    // Repair: the nearest physical principal moments, principal axes kept.
+    let e = SymmetricEigen::new(ig);
+    let mut order = [0, 1, 2];
+    order.sort_by(|&i, &j| e.eigenvalues[i].total_cmp(&e.eigenvalues[j]));
+    let [l1, l2, l3] = order.map(|i| e.eigenvalues[i].max(0.0));
+    let d = ((l3 - l1 - l2) / 3.0).max(0.0);
+    let fixed = [l1 + d, l2 + d, l3 - d];
+    let mut lambda = Vector3::zeros();
+    for (k, &i) in order.iter().enumerate() {
+        lambda[i] = fixed[k];
+    }
+    notes.push(format!(
+        "link `{}`: {detail}; repaired to the principal moments {:.6e}, {:.6e}, {:.6e}",
+        link.name, fixed[0], fixed[1], fixed[2]
+    ));
+    Ok(e.eigenvectors * Matrix3::from_diagonal(&lambda) * e.eigenvectors.transpose())
+}
+
+/// Whether a link of mass `m > 0` keeps its inertia `ig` under the radius-of-gyration guard
+/// ([`UrdfOptions::max_radius_of_gyration`], [`AbsurdInertia`]); the error if it is absurd.
+fn absurd_inertia_kept(
+    link: &urdf_rs::Link,
+    m: f64,
+    ig: &Matrix3<f64>,
+    opts: &UrdfOptions,
+    notes: &mut Notes,
+) -> Result<bool, K> {
+    let lmax = SymmetricEigen::new(*ig).eigenvalues.max();
+    let radius = (lmax.max(0.0) / m).sqrt();
+    if radius <= opts.max_radius_of_gyration {
+        return Ok(true);
+    }
+    let what = format!(
+        "link `{}`: radius of gyration {radius:.3} m (mass {m} kg, largest principal moment {lmax:.4e} kg·m²) exceeds {} m",
+        link.name, opts.max_radius_of_gyration
+    );
+    match opts.absurd_inertia {
+        AbsurdInertia::Error => Err(K::UrdfAbsurdInertia {
+            link: link.name.clone(),
+            mass: m,
+            moment: lmax,
+            radius,
+            limit: opts.max_radius_of_gyration,
+        }),
+        AbsurdInertia::Drop => {
+            notes.push(format!("{what}: inertia dropped"));
+            Ok(false)
+        }
+        AbsurdInertia::Keep => {
+            notes.push(format!("{what}: kept as written"));
+            Ok(true)
+        }
+    }
 }
 
 /// The rigid clusters (links joined by fixed joints) of the kept tree.

@@ -21,22 +21,32 @@
 //!   the gravity magnitude is `g`; a moving joint `LJ1` has the coordinate `q_LJ1` and the speed
 //!   `qd_LJ1` (generated index constant `Q_LJ1`). Each of these names, and the body name, is made
 //!   an identifier by [`sanitize_identifier`](crate::sanitize_identifier) (every character other
-//!   than ASCII letters, digits and `_` becomes `_`: link `base-link` gives `m_base_link`).
+//!   than ASCII letters, digits and `_` becomes `_`: link `base-link` gives `m_base_link`), then
+//!   checked by [`Model::check_names`] like the names of a TOML model (names that are equal once
+//!   sanitised or ignoring case, or a `<robot name>` that cannot name the wrapper type, are
+//!   typed errors).
 //! * **Order of u**: depth-first from the root, children in the order their joints appear in the
 //!   file (for a wheeled base `xd`, `psid` and the pitch speed come first).
-//! * **Real-world data** ([`UrdfOptions`]): rotation angles within
-//!   [`UrdfOptions::snap_angles`] (default 2·10⁻³ rad) of a multiple of π/2 are snapped to it, so
-//!   that `3.1416`, `1.5708` and `3.14` become exact and the rotations exactly sparse (smaller
-//!   generated code). Links whose inertia has a radius of gyration above
-//!   [`UrdfOptions::max_radius_of_gyration`] (default 5 m; Krang's gripper plates: 0.1 g with
-//!   0.09 kg·m², ~30 m) are an error by default, or dropped/kept ([`AbsurdInertia`]);
-//!   [`UrdfOptions::drop_links`] removes links (with their subtrees) by name. Every snap, merge and
-//!   drop is reported in [`UrdfImport::notes`].
+//! * **What is read**: links, joints and their `<inertial>`s. `<visual>`, `<collision>` and
+//!   `<material>` elements are removed before parsing (never read, so malformed visual content
+//!   never aborts an import); meshes are never opened.
+//! * **Real-world data** ([`UrdfOptions`]): rotation angles written as the rounded decimal of a
+//!   multiple of π/2 (`3.1416`, `1.5708`, `3.14`) are snapped to it ([`AngleSnap::Rounded`], the
+//!   default; everything else is kept exactly), so that the rotations are exactly sparse
+//!   (smaller generated code). A link's inertia about its centre of mass may be positive
+//!   semi-definite (point masses, rods); a slightly non-physical one (within
+//!   [`UrdfOptions::inertia_tolerance`]) loads with a note, or is an error or repaired
+//!   ([`NonPhysicalInertia`]); a zero-mass link keeps its rotational inertia (a body with
+//!   `m = 0`) unless [`ZeroMassInertia::Drop`]. Links whose inertia has a radius of gyration
+//!   above [`UrdfOptions::max_radius_of_gyration`] (default 5 m; Krang's gripper plates: 0.1 g
+//!   with 0.09 kg·m², ~30 m) are an error by default, or dropped/kept ([`AbsurdInertia`]);
+//!   [`UrdfOptions::drop_links`] removes links (with their subtrees) by name. Every snap, merge,
+//!   drop and inertia decision is reported in [`UrdfImport::notes`].
 //! * **Base** ([`UrdfBase`]): fixed (the root link's frame is inertial, z up: gravity
 //!   `[0, 0, −g]`), or the two-wheeled inverted pendulum of [`WheeledBaseSpec`].
 //!
-//! The result passes the same validation as a TOML model (unit axes, proper rotations, positive
-//! masses, physical inertias).
+//! The result passes the same validation as a TOML model (names, unit axes, proper rotations,
+//! physical masses and inertias, a positive definite mass matrix).
 
 mod convert;
 mod diagnose;
@@ -51,10 +61,57 @@ use crate::error::{ModelError, ModelErrorKind as K};
 use crate::ir::*;
 use crate::validate;
 
-/// Default of [`UrdfOptions::snap_angles`]: 2·10⁻³ rad (catches `3.14` for π, 1.6·10⁻³ off).
-pub const DEFAULT_SNAP_TOLERANCE: f64 = 2e-3;
 /// Default of [`UrdfOptions::max_radius_of_gyration`], in metres.
 pub const DEFAULT_MAX_RADIUS_OF_GYRATION: f64 = 5.0;
+/// Default of [`UrdfOptions::inertia_tolerance`]: a link's inertia about its centre of mass may
+/// break positive semi-definiteness or the triangle inequality by 5 % of its largest principal
+/// moment (rounding of CAD exports) and still load, as [`UrdfOptions::non_physical_inertia`] says.
+pub const DEFAULT_INERTIA_TOLERANCE: f64 = 0.05;
+
+/// How rotation angles (joint and inertial `rpy`) are snapped to multiples of π/2.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum AngleSnap {
+    /// Keep every angle exactly as written.
+    Off,
+    /// Snap an angle only if, as written, it is the correctly rounded decimal of a multiple of
+    /// π/2 with at least two decimals: `3.14`, `3.1416`, `1.5708`, `-1.571`, `4.71239` (such a
+    /// number says "π/2" at the precision it was written with; `3.1415`, `1.5`, `0.00019` are
+    /// kept). "As written" is the shortest decimal that reads back as the parsed number
+    /// (trailing zeros do not count). Lossless for real geometry; the default.
+    #[default]
+    Rounded,
+    /// Snap every angle within this many radians of a multiple of π/2 (lossy: a real
+    /// 1.9·10⁻⁴ rad offset is lost under `Within(2e-3)`, the default before `Rounded`).
+    Within(f64),
+}
+
+/// What to do with a link inertia (about its centre of mass) that is slightly non-physical:
+/// not positive semi-definite, or breaking the triangle inequality, by at most
+/// [`UrdfOptions::inertia_tolerance`] of its largest principal moment. Larger violations are
+/// always errors.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum NonPhysicalInertia {
+    /// Load it as written, with a note (the default; the reference libraries load such files).
+    #[default]
+    Note,
+    /// Fail with [`ModelErrorKind::UrdfNonPhysicalInertia`](crate::ModelErrorKind::UrdfNonPhysicalInertia).
+    Error,
+    /// Replace it by the nearest physical inertia (principal moments projected onto
+    /// `λ ≥ 0`, `λ_max ≤ λ_a + λ_b` in the least-squares sense, principal axes kept), with a note.
+    Repair,
+}
+
+/// What to do with the rotational inertia of a link with zero mass.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ZeroMassInertia {
+    /// Keep it: the link is a body with `m = 0` and its inertia `J` (a flywheel, a rotor, or an
+    /// export that lost the mass); noted. The default: dropping it changed M by 14 % on a real
+    /// arm.
+    #[default]
+    Keep,
+    /// Drop it (the link is no body), with a note.
+    Drop,
+}
 
 /// What to do with a link whose radius of gyration `sqrt(λ_max(I_G)/m)` exceeds
 /// [`UrdfOptions::max_radius_of_gyration`].
@@ -146,17 +203,19 @@ impl WheeledBaseSpec {
     }
 }
 
-/// Options of the URDF import. `UrdfOptions::default()` is a fixed base, angles snapped within
-/// 2·10⁻³ rad, nothing dropped, absurd inertias an error, g = 9.81 along −z of the root frame.
+/// Options of the URDF import. `UrdfOptions::default()` is a fixed base, angles snapped only
+/// when written as rounded multiples of π/2 ([`AngleSnap::Rounded`]), nothing dropped, absurd
+/// inertias an error, slightly non-physical ones noted, zero-mass inertias kept, g = 9.81 along
+/// −z of the root frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct UrdfOptions {
     /// Fixed or two-wheeled base.
     pub base: UrdfBase,
     /// Model name (default: the `<robot name>`); the generated wrapper type is named after it.
     pub name: Option<String>,
-    /// Snap rotation angles (joint and inertial rpy) within this many radians of a multiple of
-    /// π/2 to it; `None` keeps them as written.
-    pub snap_angles: Option<f64>,
+    /// How rotation angles (joint and inertial rpy) are snapped to multiples of π/2 (default
+    /// [`AngleSnap::Rounded`]); every snap is noted.
+    pub snap_angles: AngleSnap,
     /// Links to remove, each with its joint and its whole subtree.
     pub drop_links: Vec<String>,
     /// Largest plausible radius of gyration about the centre of mass (m), checked per URDF link
@@ -164,6 +223,13 @@ pub struct UrdfOptions {
     pub max_radius_of_gyration: f64,
     /// What to do with a link above [`UrdfOptions::max_radius_of_gyration`].
     pub absurd_inertia: AbsurdInertia,
+    /// What to do with a slightly non-physical link inertia (default: load it, with a note).
+    pub non_physical_inertia: NonPhysicalInertia,
+    /// How far (relative to the largest principal moment) a link inertia may be non-physical
+    /// and count as slightly so ([`DEFAULT_INERTIA_TOLERANCE`]).
+    pub inertia_tolerance: f64,
+    /// What to do with the rotational inertia of a zero-mass link (default: keep it).
+    pub zero_mass_inertia: ZeroMassInertia,
     /// Default value of the gravity parameter `g` (m/s²).
     pub gravity: f64,
     /// Unit direction of gravity in the root frame (fixed base only; the wheeled base's heading
@@ -176,10 +242,13 @@ impl Default for UrdfOptions {
         Self {
             base: UrdfBase::Fixed,
             name: None,
-            snap_angles: Some(DEFAULT_SNAP_TOLERANCE),
+            snap_angles: AngleSnap::Rounded,
             drop_links: Vec::new(),
             max_radius_of_gyration: DEFAULT_MAX_RADIUS_OF_GYRATION,
             absurd_inertia: AbsurdInertia::Error,
+            non_physical_inertia: NonPhysicalInertia::Note,
+            inertia_tolerance: DEFAULT_INERTIA_TOLERANCE,
+            zero_mass_inertia: ZeroMassInertia::Keep,
             gravity: 9.81,
             gravity_direction: [0.0, 0.0, -1.0],
         }
@@ -225,10 +294,11 @@ impl UrdfImport {
     /// [`Model::source`].
     pub fn parse(text: &str, label: &str, options: &UrdfOptions) -> Result<Self, ModelError> {
         let err = |kind| ModelError::new(label, kind);
-        if let Some(kind) = diagnose::diagnose(text) {
+        let text = diagnose::without_unused_elements(text);
+        if let Some(kind) = diagnose::diagnose(&text) {
             return Err(err(kind));
         }
-        let robot = urdf_rs::read_from_string(text).map_err(|e| {
+        let robot = urdf_rs::read_from_string(&text).map_err(|e| {
             err(K::UrdfParse {
                 detail: e.to_string(),
             })
@@ -268,12 +338,18 @@ impl UrdfOptions {
     /// Checks the options on their own (before the file is looked at).
     fn check(&self) -> Result<(), K> {
         let opts = self;
-        if let Some(t) = opts.snap_angles
+        if let AngleSnap::Within(t) = opts.snap_angles
             && !(t.is_finite() && t >= 0.0)
         {
             return Err(bad_option(
                 "snap_angles",
-                format!("tolerance {t} must be a finite angle ≥ 0 (radians), or None"),
+                format!("tolerance {t} must be a finite angle ≥ 0 (radians)"),
+            ));
+        }
+        if !(opts.inertia_tolerance.is_finite() && opts.inertia_tolerance >= 0.0) {
+            return Err(bad_option(
+                "inertia_tolerance",
+                format!("{} must be a finite fraction ≥ 0", opts.inertia_tolerance),
             ));
         }
         if opts.max_radius_of_gyration.is_nan() || opts.max_radius_of_gyration <= 0.0 {

@@ -1,10 +1,11 @@
-//! Rigid transforms, URDF rpy angles and their snapping to multiples of π/2, and the import notes
-//! (which record the snaps).
+//! Rigid transforms, URDF rpy angles and their snapping to multiples of π/2 ([`AngleSnap`]), and
+//! the import notes (which list every snap).
 
 use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::AngleSnap;
 use crate::ir::Length;
 
 /// A rigid transform: the pose of a frame in another (rotation `r`, origin `p`).
@@ -57,14 +58,10 @@ pub(super) fn clean(x: f64) -> f64 {
     }
 }
 
-/// Snaps up to this size are counted in one note rather than listed (`3.1416` is 7.3·10⁻⁶ off π).
-const SMALL_SNAP: f64 = 1e-4;
-
 /// Import notes under construction.
 #[derive(Default)]
 pub(super) struct Notes {
     lines: Vec<String>,
-    small_snaps: usize,
 }
 
 impl Notes {
@@ -73,17 +70,8 @@ impl Notes {
         self.lines.push(line);
     }
 
-    /// The lines, with the count of small snaps first.
-    pub(super) fn finish(mut self) -> Vec<String> {
-        if self.small_snaps > 0 {
-            self.lines.insert(
-                0,
-                format!(
-                    "{} rotation angles within {SMALL_SNAP:e} rad of a multiple of π/2 (such as 3.1416 or 1.5708) snapped to it",
-                    self.small_snaps
-                ),
-            );
-        }
+    /// The lines, in the order they were added.
+    pub(super) fn finish(self) -> Vec<String> {
         self.lines
     }
 }
@@ -103,35 +91,56 @@ fn fmt_half_pi(k: i64) -> String {
     }
 }
 
-/// `(cos a, sin a)`, exact for multiples of π/2 and for angles snapped to them.
-fn cos_sin(a: f64, snap: Option<f64>, what: &str, notes: &mut Notes) -> (f64, f64) {
+/// The number of decimals of `a` as written: of its shortest decimal that reads back as `a`
+/// (`3.1416` → 4; trailing zeros of the file do not count).
+fn written_decimals(a: f64) -> usize {
+    let written = format!("{a}");
+    written.find('.').map_or(0, |dot| written.len() - dot - 1)
+}
+
+/// Whether `a`, as written, is `exact` correctly rounded to the same number of decimals, at
+/// least two (`3.14`, `3.1416`, `-1.5708` for π, π, −π/2; not `3.1415`, nor `1.5`).
+fn is_rounded_decimal_of(a: f64, exact: f64) -> bool {
+    let d = written_decimals(a);
+    d >= 2 && format!("{exact:.d$}") == format!("{a}")
+}
+
+/// `(cos a, sin a)`, exact for multiples of π/2 and for angles snapped to them (each snap noted).
+fn cos_sin(a: f64, snap: AngleSnap, what: &str, notes: &mut Notes) -> (f64, f64) {
     let k = (a / FRAC_PI_2).round();
     let exact = k * FRAC_PI_2;
     let delta = a - exact;
-    if delta == 0.0 || snap.is_some_and(|t| delta.abs() <= t) {
-        let k = k as i64;
-        if delta.abs() > SMALL_SNAP {
-            notes.push(format!(
-                "{what}: {a} snapped to {} (by {delta:.2e} rad)",
-                fmt_half_pi(k)
-            ));
-        } else if delta != 0.0 {
-            notes.small_snaps += 1;
+    let why = match snap {
+        _ if delta == 0.0 => Some(String::new()),
+        AngleSnap::Rounded if k != 0.0 && is_rounded_decimal_of(a, exact) => Some(format!(
+            " ({a} is {} rounded to {} decimals; {delta:.2e} rad)",
+            fmt_half_pi(k as i64),
+            written_decimals(a)
+        )),
+        AngleSnap::Within(t) if delta.abs() <= t => {
+            Some(format!(" (within {t:e} rad; {delta:.2e} rad)"))
         }
-        return match k.rem_euclid(4) {
-            0 => (1.0, 0.0),
-            1 => (0.0, 1.0),
-            2 => (-1.0, 0.0),
-            _ => (0.0, -1.0),
-        };
+        _ => None,
+    };
+    let Some(why) = why else {
+        return (a.cos(), a.sin());
+    };
+    let k = k as i64;
+    if delta != 0.0 {
+        notes.push(format!("{what}: {a} snapped to {}{why}", fmt_half_pi(k)));
     }
-    (a.cos(), a.sin())
+    match k.rem_euclid(4) {
+        0 => (1.0, 0.0),
+        1 => (0.0, 1.0),
+        2 => (-1.0, 0.0),
+        _ => (0.0, -1.0),
+    }
 }
 
 /// URDF rpy: `R = Rz(y) · Ry(p) · Rx(r)`.
 pub(super) fn rpy_matrix(
     rpy: [f64; 3],
-    snap: Option<f64>,
+    snap: AngleSnap,
     what: &str,
     notes: &mut Notes,
 ) -> Matrix3<f64> {
@@ -149,12 +158,7 @@ pub(super) fn rpy_matrix(
 }
 
 /// A URDF `<origin>` as a transform (its rpy snapped as [`rpy_matrix`] does).
-pub(super) fn pose_tf(
-    pose: &urdf_rs::Pose,
-    snap: Option<f64>,
-    what: &str,
-    notes: &mut Notes,
-) -> Tf {
+pub(super) fn pose_tf(pose: &urdf_rs::Pose, snap: AngleSnap, what: &str, notes: &mut Notes) -> Tf {
     Tf {
         r: rpy_matrix(pose.rpy.0, snap, what, notes),
         p: Vector3::from(pose.xyz.0),

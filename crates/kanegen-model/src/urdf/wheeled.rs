@@ -247,9 +247,17 @@ fn measure_wheel(k: usize, option: &str, r: &Resolved<'_>, notes: &mut Notes) ->
         .filter_map(|l| r.inertial[l].map(|i| (cl.in_top[l], i)))
         .collect();
     let (m, ms, jo) = merge(&items);
-    let consts = if m > 0.0 {
+    // A massless wheel keeps its rotational inertia (UrdfOptions::zero_mass_inertia).
+    let (com, ig) = if m > 0.0 {
         let com = ms / m;
-        let ig = jo - (Matrix3::identity() * com.norm_squared() - com * com.transpose()) * m;
+        (
+            com,
+            jo - (Matrix3::identity() * com.norm_squared() - com * com.transpose()) * m,
+        )
+    } else {
+        (Vector3::zeros(), jo)
+    };
+    let consts = {
         let yy = (a.transpose() * ig * a)[(0, 0)];
         let zz = (ig.trace() - yy) / 2.0;
         // The two diametral principal moments (eigenvalues of I_G restricted to the plane ⟂ a).
@@ -281,8 +289,6 @@ fn measure_wheel(k: usize, option: &str, r: &Resolved<'_>, notes: &mut Notes) ->
             ));
         }
         (m, yy, zz)
-    } else {
-        (0.0, 0.0, 0.0)
     };
     Ok(Wheel {
         centre: t.p,

@@ -1,0 +1,118 @@
+//! What the publishable crates ship: both licence texts, `include` lists that name existing files,
+//! and real copies (no symlinks, which break on Windows checkouts) of the shared model files and
+//! licences that stay identical to the originals at the repository root.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+/// The workspace members, from the root `Cargo.toml`.
+fn members() -> Vec<PathBuf> {
+    let text = std::fs::read_to_string(common::root().join("Cargo.toml")).unwrap();
+    let list = text
+        .split("members = [")
+        .nth(1)
+        .and_then(|rest| rest.split(']').next())
+        .expect("[workspace] members");
+    list.split('"')
+        .skip(1)
+        .step_by(2)
+        .map(|m| common::root().join(m))
+        .collect()
+}
+
+/// The members that are published (no `publish = false`), with their manifests.
+fn publishable() -> Vec<(PathBuf, String)> {
+    let found: Vec<(PathBuf, String)> = members()
+        .into_iter()
+        .map(|dir| {
+            let manifest = std::fs::read_to_string(dir.join("Cargo.toml")).unwrap();
+            (dir, manifest)
+        })
+        .filter(|(_, m)| !m.contains("publish = false"))
+        .collect();
+    assert_eq!(
+        found.len(),
+        6,
+        "kanegen, -model, -reference, -rbd, -runtime, krang-dynamics"
+    );
+    found
+}
+
+/// The quoted strings of the manifest line that starts with `key = `.
+fn strings(manifest: &str, key: &str) -> Vec<String> {
+    manifest
+        .lines()
+        .find(|l| l.starts_with(&format!("{key} = ")))
+        .map(|l| l.split('"').skip(1).step_by(2).map(str::to_owned).collect())
+        .unwrap_or_default()
+}
+
+/// `path` is a regular file (not a symlink) with the bytes of `original`.
+fn assert_real_copy(path: &Path, original: &Path) {
+    let meta =
+        std::fs::symlink_metadata(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(
+        meta.file_type().is_file(),
+        "{} is not a regular file",
+        path.display()
+    );
+    assert!(
+        std::fs::read(path).unwrap() == std::fs::read(original).unwrap(),
+        "{} differs from {}: copy it again",
+        path.display(),
+        original.display()
+    );
+}
+
+#[test]
+fn the_repository_has_both_licence_texts() {
+    let apache = std::fs::read_to_string(common::root().join("LICENSE-APACHE")).unwrap();
+    assert!(apache.contains("Apache License") && apache.contains("Version 2.0, January 2004"));
+    assert!(apache.contains("END OF TERMS AND CONDITIONS"));
+    let mit = std::fs::read_to_string(common::root().join("LICENSE-MIT")).unwrap();
+    assert!(mit.starts_with("MIT License"));
+    let workspace = std::fs::read_to_string(common::root().join("Cargo.toml")).unwrap();
+    assert!(workspace.contains(r#"license = "MIT OR Apache-2.0""#));
+}
+
+#[test]
+fn every_publishable_crate_ships_both_licences_and_its_include_list_exists() {
+    for (dir, manifest) in publishable() {
+        let include = strings(&manifest, "include");
+        assert!(!include.is_empty(), "{}: no include list", dir.display());
+        for licence in ["LICENSE-MIT", "LICENSE-APACHE"] {
+            assert!(
+                include.iter().any(|i| i == licence),
+                "{}: {licence}",
+                dir.display()
+            );
+            assert_real_copy(&dir.join(licence), &common::root().join(licence));
+        }
+        for entry in include.iter().filter(|i| !i.contains('*')) {
+            assert!(
+                dir.join(entry).is_file(),
+                "{}: include names missing {entry}",
+                dir.display()
+            );
+        }
+        for readme in strings(&manifest, "readme") {
+            assert!(
+                dir.join(&readme).is_file(),
+                "{}: readme {readme}",
+                dir.display()
+            );
+        }
+    }
+}
+
+#[test]
+fn krang_dynamics_model_files_are_real_copies_of_models() {
+    let crate_dir = common::root().join("crates/krang-dynamics");
+    for name in ["krang.toml", "krang-fixed-wheels.toml", "two-link.toml"] {
+        assert_real_copy(
+            &crate_dir.join(name),
+            &common::root().join("models").join(name),
+        );
+    }
+}

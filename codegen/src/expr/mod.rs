@@ -12,12 +12,17 @@
 //!
 //! No trigonometric identity is applied, so simplification is exact (only f64 rounding of
 //! constants). Substitution variables ([`Atom::Var`]) name compound subexpressions: the reports'
-//! K (kinematic) and D (inertial/gravity) variables.
+//! K (kinematic) and D (inertial/gravity) variables. [`Arena::diff`] (`diff.rs`) differentiates
+//! exactly, variable by variable.
 
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 
 use crate::naming;
+
+mod diff;
+
+pub use diff::Wrt;
 
 /// Handle of a node in an [`Arena`].
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
@@ -138,6 +143,8 @@ pub struct Arena {
     stamps: Vec<u32>,
     /// Requests so far in the current phase.
     clock: u32,
+    /// Memo of [`Arena::diff`].
+    diff_memo: diff::DiffMemo,
 }
 
 /// Numeric values of the leaves, for [`Arena::eval`].
@@ -166,6 +173,7 @@ impl Arena {
             hoist_params: false,
             stamps: Vec::new(),
             clock: 0,
+            diff_memo: HashMap::new(),
         };
         a.constant(0.0);
         a.constant(1.0);

@@ -17,7 +17,11 @@
 #   4. RUNS times (default 3), alternately: the harness (agreement check on all cases, then
 #      Pinocchio's timings) and the Rust timings; then the table, best of the runs.
 # Environment: PIN_VERSION (default 4.1.0), RUNS (3), CXX (g++), OUT (target/pinocchio),
-# CXXFLAGS_EXTRA (appended to the compiler flags).
+# CXXFLAGS_EXTRA (appended to the compiler flags), RUN_NAME (the results directory under OUT,
+# default `run`). cargo's own variables apply to the Rust side, e.g. for both sides with the
+# machine's instruction set (a separate target directory keeps the default build):
+#   RUSTFLAGS="-C target-cpu=native" CARGO_TARGET_DIR=target/native RUN_NAME=run-native \
+#       benches/pinocchio/run.sh
 # Not part of CI (it downloads). Takes about 5 minutes on a 2-core machine, most of it compiling
 # the harness (Pinocchio's templates) and the Rust example.
 set -euo pipefail
@@ -27,7 +31,7 @@ out="${OUT:-$root/target/pinocchio}"
 pin_version="${PIN_VERSION:-4.1.0}"
 runs="${RUNS:-3}"
 cxx="${CXX:-g++}"
-run_dir="$out/run"
+run_dir="$out/${RUN_NAME:-run}"
 mkdir -p "$run_dir"
 
 echo "== 1. Pinocchio $pin_version from PyPI into $out/venv"
@@ -61,7 +65,7 @@ fi
 
 echo "== 3. Rust side: cargo build --release --example pinocchio_side_by_side"
 (cd "$root" && cargo build --release --quiet --example pinocchio_side_by_side)
-rust="$root/target/release/examples/pinocchio_side_by_side"
+rust="${CARGO_TARGET_DIR:-$root/target}/release/examples/pinocchio_side_by_side"
 "$rust" write "$run_dir"
 
 echo "== 4. agreement and timings, $runs runs alternating Pinocchio and kanegen"

@@ -6,7 +6,11 @@
 //! cargo run --release --example pinocchio_side_by_side -- write DIR   # DIR/cases.txt
 //! cargo run --release --example pinocchio_side_by_side -- time DIR    # appends DIR/kanegen-times.txt
 //! cargo run --release --example pinocchio_side_by_side -- report DIR  # table from both time files
+//! cargo run --release --example pinocchio_side_by_side -- export MODEL FILE  # any model, defaults
 //! ```
+//!
+//! `export` writes any description (TOML, or URDF with the default import options) with its
+//! default parameters in the `kanegen::pinocchio` text format, for use with one's own harness.
 //!
 //! `cases.txt` holds [`CASES`] cases, each one parameter set (case 0: the defaults of
 //! `krang.toml`, then random physical parameters), the model exported for it by
@@ -294,10 +298,35 @@ fn report(dir: &Path) -> Result<(), String> {
     Ok(())
 }
 
+/// Writes `model` (TOML or URDF) with its default parameters in the export's text format.
+fn export(model: &Path, file: &Path) -> Result<(), String> {
+    let m = if model
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+    {
+        Model::from_urdf_file(model, &kanegen_model::UrdfOptions::default())
+    } else {
+        Model::from_toml_file(model)
+    }
+    .map_err(|e| e.to_string())?;
+    let pm = kanegen::pinocchio::export(&m, &m.param_values()).map_err(|e| e.to_string())?;
+    std::fs::write(file, pm.to_text()).map_err(|e| format!("{}: {e}", file.display()))?;
+    println!(
+        "wrote {} ({} joints, {} bodies, nq {}, nv {})",
+        file.display(),
+        pm.joints.len(),
+        pm.bodies.len(),
+        pm.nq,
+        pm.nv
+    );
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: pinocchio_side_by_side <write|time|report> DIR";
+    let usage = "usage: pinocchio_side_by_side <write|time|report> DIR | export MODEL FILE";
     let result = match args.as_slice() {
+        [cmd, model, file] if cmd == "export" => export(Path::new(model), Path::new(file)),
         [cmd, dir] => {
             let dir = PathBuf::from(dir);
             match cmd.as_str() {

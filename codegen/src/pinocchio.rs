@@ -44,7 +44,8 @@
 //! # Text format (version 1)
 //!
 //! Whitespace-separated tokens, one record per line, numbers with Rust's shortest round-trip
-//! formatting (`{:?}`, exact in both directions); rotations by rows:
+//! formatting (`{:?}`, exact in both directions), whitespace inside names replaced by `_`;
+//! rotations by rows:
 //!
 //! ```text
 //! kanegen-pinocchio 1
@@ -466,6 +467,15 @@ pub fn export(model: &Model, params: &[f64]) -> Result<PinocchioModel, ExportErr
     })
 }
 
+/// A name as one token of the text format: whitespace replaced by `_`, never empty.
+fn token(name: &str) -> String {
+    let t: String = name
+        .chars()
+        .map(|c| if c.is_whitespace() { '_' } else { c })
+        .collect();
+    if t.is_empty() { "_".into() } else { t }
+}
+
 fn push_numbers(out: &mut String, xs: impl IntoIterator<Item = f64>) {
     for x in xs {
         let _ = write!(out, " {x:?}");
@@ -481,7 +491,7 @@ impl PinocchioModel {
         let _ = writeln!(
             s,
             "model {} nq {} nv {} dof {}",
-            self.name,
+            token(&self.name),
             self.nq,
             self.nv,
             self.speeds.len()
@@ -491,7 +501,7 @@ impl PinocchioModel {
         let _ = writeln!(s, "\njoints {}", self.joints.len());
         for j in &self.joints {
             let (tag, axis) = j.kind.tag_axis();
-            let _ = write!(s, "joint {} {} {tag}", j.name, j.parent);
+            let _ = write!(s, "joint {} {} {tag}", token(&j.name), j.parent);
             push_numbers(&mut s, axis);
             push_numbers(&mut s, j.rotation.into_iter().flatten());
             push_numbers(&mut s, j.translation);
@@ -499,7 +509,7 @@ impl PinocchioModel {
         }
         let _ = writeln!(s, "bodies {}", self.bodies.len());
         for b in &self.bodies {
-            let _ = write!(s, "body {} {}", b.name, b.joint);
+            let _ = write!(s, "body {} {}", token(&b.name), b.joint);
             push_numbers(&mut s, b.rotation.into_iter().flatten());
             push_numbers(&mut s, b.translation);
             push_numbers(&mut s, [b.mass]);
@@ -511,7 +521,7 @@ impl PinocchioModel {
         push_numbers(&mut s, self.armature.iter().copied());
         let _ = writeln!(s, "\nspeeds {}", self.speeds.len());
         for m in &self.speeds {
-            let _ = writeln!(s, "speed {} {} {:?}", m.name, m.v, m.sign);
+            let _ = writeln!(s, "speed {} {} {:?}", token(&m.name), m.v, m.sign);
         }
         let _ = writeln!(s, "coordinates {}", self.coordinates.len());
         for (c, name) in self.coordinates.iter().zip(&self.coordinate_names) {
@@ -520,7 +530,7 @@ impl PinocchioModel {
                 CoordinateMap::PlanarX { q } => ("planar_x", q, 1.0),
                 CoordinateMap::PlanarPsi { q } => ("planar_psi", q, 1.0),
             };
-            let _ = writeln!(s, "coordinate {name} {kind} {q} {sign:?}");
+            let _ = writeln!(s, "coordinate {} {kind} {q} {sign:?}", token(name));
         }
         s.push_str("end\n");
         s

@@ -126,14 +126,14 @@ fn check_energies(name: &str, m: &Model, draws: usize) {
 
 #[test]
 fn exported_krang_has_the_references_kinetic_and_potential_energy() {
-    check_energies("krang", &model("krang.toml"), 300);
+    check_energies("krang", &model("krang.toml"), 200);
 }
 
 #[test]
 fn exported_fixed_base_models_have_the_references_energies() {
-    check_energies("krang-fixed-wheels", &model("krang-fixed-wheels.toml"), 200);
-    check_energies("two-link", &model("two-link.toml"), 200);
-    check_energies("singlearm", &model("singlearm.urdf"), 200);
+    check_energies("krang-fixed-wheels", &model("krang-fixed-wheels.toml"), 100);
+    check_energies("two-link", &model("two-link.toml"), 100);
+    check_energies("singlearm", &model("singlearm.urdf"), 100);
 }
 
 /// Fixed joints (bodies appended to the moving ancestor), a prismatic joint along a negative
@@ -253,7 +253,7 @@ fn fixed_joints_negative_and_skew_axes_export_exactly() {
     let c = pm.bodies.iter().find(|b| b.name == "c").unwrap();
     assert_eq!((c.joint, c.translation), (2, [0.2, 0.0, -0.3]));
     assert_eq!(pm.joints[2].parent, 2);
-    check_energies("chain", &m, 200);
+    check_energies("chain", &m, 100);
 }
 
 /// A wheeled base with a prismatic lift on a skew axis and a revolute joint on a skew axis.
@@ -290,7 +290,7 @@ fn wheeled_base_with_skew_prismatic_joint_exports_exactly() {
         0.2,
     );
     let m = Model::from_urdf_str(LIFT, "lift.urdf", &UrdfOptions::wheeled(spec)).unwrap();
-    check_energies("lift", &m, 200);
+    check_energies("lift", &m, 100);
 }
 
 #[test]
@@ -346,5 +346,16 @@ fn unexportable_models_are_typed_errors() {
     assert!(
         matches!(err, ExportError::GravityNotVertical { .. }),
         "{err}"
+    );
+}
+
+#[test]
+fn names_with_whitespace_stay_one_token_of_the_text_format() {
+    let mut m = model("two-link.toml");
+    m.name = "two link\trobot".into();
+    let text = export(&m, &m.param_values()).unwrap().to_text();
+    assert!(
+        text.contains("\nmodel two_link_robot nq 2 nv 2 dof 2\n"),
+        "{text}"
     );
 }

@@ -72,11 +72,13 @@ use crate::model::{Base, JointKind, Model};
 pub enum ExportError {
     /// The parameter vector does not fit the model.
     #[error(
-        "model `{model}`: {given} parameter values given, the model has {expected}; pass one value per `Model::params` entry (e.g. `Model::param_values()`)"
+        "model `{model}` ({file}): {given} parameter values given, the model has {expected}; pass one value per `Model::params` entry (e.g. `Model::param_values()`)"
     )]
     ParamCount {
         /// The model name.
         model: String,
+        /// The description file.
+        file: String,
         /// Values given.
         given: usize,
         /// Parameters of the model.
@@ -283,6 +285,7 @@ pub fn export(model: &Model, params: &[f64]) -> Result<PinocchioModel, ExportErr
     if params.len() != model.params.len() {
         return Err(ExportError::ParamCount {
             model: model.name.clone(),
+            file: model.source.clone(),
             given: params.len(),
             expected: model.params.len(),
         });

@@ -16,7 +16,8 @@
 #      code's M, c, g, τ, C);
 #   4. RUNS times (default 3), alternately: the harness (agreement check on all cases, then
 #      Pinocchio's timings) and the Rust timings; then the table, best of the runs.
-# Environment: PIN_VERSION (default 4.1.0), RUNS (3), CXX (g++), OUT (target/pinocchio),
+# Environment: PIN_VERSION (default 4.1.0), EIGEN_VERSION (cmeel-eigen, 3.4.1), RUNS (3),
+# CXX (g++), OUT (target/pinocchio),
 # CXXFLAGS_EXTRA (appended to the compiler flags), RUN_NAME (the results directory under OUT,
 # default `run`). cargo's own variables apply to the Rust side, e.g. for both sides with the
 # machine's instruction set (a separate target directory keeps the default build):
@@ -29,6 +30,7 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 out="${OUT:-$root/target/pinocchio}"
 pin_version="${PIN_VERSION:-4.1.0}"
+eigen_version="${EIGEN_VERSION:-3.4.1}"
 runs="${RUNS:-3}"
 cxx="${CXX:-g++}"
 run_dir="$out/${RUN_NAME:-run}"
@@ -38,7 +40,8 @@ echo "== 1. Pinocchio $pin_version from PyPI into $out/venv"
 if [ ! -x "$out/venv/bin/python" ]; then
     python3 -m venv "$out/venv"
 fi
-"$out/venv/bin/pip" install --quiet --disable-pip-version-check "pin==$pin_version" cmeel-eigen
+"$out/venv/bin/pip" install --quiet --disable-pip-version-check "pin==$pin_version" \
+    "cmeel-eigen==$eigen_version"
 prefix="$("$out/venv/bin/python" -m cmeel cmake 2>/dev/null | head -n 1)"
 if [ ! -f "$prefix/include/pinocchio/config.hpp" ] || [ ! -d "$prefix/include/eigen3" ]; then
     echo "error: no Pinocchio or Eigen headers under $prefix/include (pin and cmeel-eigen wheels)" >&2

@@ -34,6 +34,7 @@ pub mod kane;
 pub mod lower;
 pub mod naming;
 pub mod options;
+pub mod pinocchio;
 pub mod registry;
 pub mod report;
 /// The robot description IR and its loaders (re-exported from `kanegen-model`).

@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# Pinocchio side by side (README "Pinocchio side by side"): Krang (models/krang.toml) in
+# Pinocchio's C++ and in kanegen's generated Rust, checked against each other on random
+# parameters and states, then timed alternately in one run.
+#
+#   benches/pinocchio/run.sh            # from anywhere; everything goes to target/pinocchio
+#
+# Needs python3 (with venv), a C++17 compiler (g++ or clang++; CXX to choose), cargo, and network
+# access to PyPI. Steps:
+#   1. a virtual environment target/pinocchio/venv with Pinocchio from PyPI (`pin`: its wheel
+#      ships the C++ headers through cmeel) and `cmeel-eigen` (Eigen's headers, which the `pin`
+#      wheel does not ship); the include path is `python -m cmeel cmake` + /include;
+#   2. the C++ harness benches/pinocchio/harness.cpp, header-only, -O3 -march=native;
+#   3. the Rust side, examples/pinocchio_side_by_side.rs (release): writes cases.txt (the model
+#      exported by kanegen::pinocchio for 100 parameter sets, one state each, and the generated
+#      code's M, c, g, τ, C);
+#   4. RUNS times (default 3), alternately: the harness (agreement check on all cases, then
+#      Pinocchio's timings) and the Rust timings; then the table, best of the runs.
+# Environment: PIN_VERSION (default 4.1.0), EIGEN_VERSION (cmeel-eigen, 3.4.1), RUNS (3),
+# CXX (g++), OUT (target/pinocchio),
+# CXXFLAGS_EXTRA (appended to the compiler flags), RUN_NAME (the results directory under OUT,
+# default `run`). cargo's own variables apply to the Rust side, e.g. for both sides with the
+# machine's instruction set (a separate target directory keeps the default build):
+#   RUSTFLAGS="-C target-cpu=native" CARGO_TARGET_DIR=target/native RUN_NAME=run-native \
+#       benches/pinocchio/run.sh
+# Not part of CI (it downloads). Takes about 5 minutes on a 2-core machine, most of it compiling
+# the harness (Pinocchio's templates) and the Rust example.
+set -euo pipefail
+
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+out="${OUT:-$root/target/pinocchio}"
+pin_version="${PIN_VERSION:-4.1.0}"
+eigen_version="${EIGEN_VERSION:-3.4.1}"
+runs="${RUNS:-3}"
+cxx="${CXX:-g++}"
+run_dir="$out/${RUN_NAME:-run}"
+mkdir -p "$run_dir"
+
+echo "== 1. Pinocchio $pin_version from PyPI into $out/venv"
+if [ ! -x "$out/venv/bin/python" ]; then
+    python3 -m venv "$out/venv"
+fi
+"$out/venv/bin/pip" install --quiet --disable-pip-version-check "pin==$pin_version" \
+    "cmeel-eigen==$eigen_version"
+prefix="$("$out/venv/bin/python" -m cmeel cmake 2>/dev/null | head -n 1)"
+if [ ! -f "$prefix/include/pinocchio/config.hpp" ] || [ ! -d "$prefix/include/eigen3" ]; then
+    echo "error: no Pinocchio or Eigen headers under $prefix/include (pin and cmeel-eigen wheels)" >&2
+    exit 1
+fi
+echo "headers: $prefix/include ($(grep -m1 'define PINOCCHIO_VERSION ' "$prefix/include/pinocchio/config.hpp"))"
+
+echo "== 2. C++ harness ($cxx -O3 -march=native, header-only Pinocchio)"
+harness="$out/harness"
+flags=(-std=c++17 -O3 -march=native -DNDEBUG
+    # Pinocchio's CMake target pinocchio_headers sets these:
+    -DBOOST_MPL_LIMIT_LIST_SIZE=30 -DBOOST_MPL_LIMIT_VECTOR_SIZE=30
+    -DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS -DBOOST_FUSION_INVOKE_MAX_ARITY=12
+    -w -I"$prefix/include" -I"$prefix/include/eigen3")
+# shellcheck disable=SC2206
+flags+=(${CXXFLAGS_EXTRA:-})
+stamp="$out/harness.flags"
+if [ ! -x "$harness" ] || [ "$root/benches/pinocchio/harness.cpp" -nt "$harness" ] \
+    || [ "$(cat "$stamp" 2>/dev/null)" != "$cxx ${flags[*]}" ]; then
+    echo "compiling (about 2-3 minutes)"
+    "$cxx" "${flags[@]}" "$root/benches/pinocchio/harness.cpp" -o "$harness"
+    echo "$cxx ${flags[*]}" > "$stamp"
+fi
+
+echo "== 3. Rust side: cargo build --release --example pinocchio_side_by_side"
+(cd "$root" && cargo build --release --quiet --example pinocchio_side_by_side)
+rust="${CARGO_TARGET_DIR:-$root/target}/release/examples/pinocchio_side_by_side"
+"$rust" write "$run_dir"
+
+echo "== 4. agreement and timings, $runs runs alternating Pinocchio and kanegen"
+echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | xargs), $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "compilers: $("$cxx" --version | head -n 1); $(rustc --version)"
+rm -f "$run_dir/pinocchio-times.txt" "$run_dir/kanegen-times.txt"
+status=0
+for r in $(seq 1 "$runs"); do
+    echo "-- run $r"
+    "$harness" "$run_dir" || status=$?
+    "$rust" time "$run_dir"
+done
+echo "== table (load $(cut -d' ' -f1-3 /proc/loadavg))"
+"$rust" report "$run_dir"
+if [ "$status" -ne 0 ]; then
+    echo "error: Pinocchio and kanegen disagree (see above)" >&2
+    exit "$status"
+fi

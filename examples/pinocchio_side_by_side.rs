@@ -1,0 +1,348 @@
+//! The Rust side of the Pinocchio comparison (`benches/pinocchio/run.sh`, README "Pinocchio side
+//! by side"): writes Krang (`models/krang.toml`) as a Pinocchio tree with test cases, times the
+//! generated functions, and prints the combined table.
+//!
+//! ```sh
+//! cargo run --release --example pinocchio_side_by_side -- write DIR   # DIR/cases.txt
+//! cargo run --release --example pinocchio_side_by_side -- time DIR    # appends DIR/kanegen-times.txt
+//! cargo run --release --example pinocchio_side_by_side -- report DIR  # table from both time files
+//! cargo run --release --example pinocchio_side_by_side -- export MODEL FILE  # any model, defaults
+//! ```
+//!
+//! `export` writes any description (TOML, or URDF with the default import options) with its
+//! default parameters in the `kanegen::pinocchio` text format, for use with one's own harness.
+//!
+//! `cases.txt` holds [`CASES`] cases, each one parameter set (case 0: the defaults of
+//! `krang.toml`, then random physical parameters), the model exported for it by
+//! `kanegen::pinocchio` (text format in that module's documentation), one random state `q, u, u̇`
+//! and the generated code's `M, c, g, τ, C` for it (shortest round-trip decimals, exact):
+//!
+//! ```text
+//! cases <n> dof <dof>
+//! case <i>
+//! <the model in the kanegen-pinocchio text format, ending with `end`>
+//! q <dof numbers>    u …    ud …
+//! M <dof² numbers, by rows>    c …    g …    tau …    C <dof², by rows>
+//! ```
+//!
+//! The C++ harness (`benches/pinocchio/harness.cpp`) builds a `pinocchio::Model` per case,
+//! compares, and times Pinocchio with case 0's parameters on the states of all cases; `time` times
+//! the generated code (`krang_dynamics::Krang`, runtime parameters, default features plus the
+//! Coriolis matrix) in the same way: per function, [`ROUNDS`] rounds of [`CALLS`] calls cycling
+//! through the states, the fastest round's mean ns per call. Each run appends one line per
+//! function (`name ns`) to the times files; `report` takes the smallest figure of each.
+#![forbid(unsafe_code)]
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::hint::black_box;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use kanegen_model::Model;
+use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
+use krang_dynamics::{Krang, Params};
+use nalgebra::{SMatrix, SVector};
+
+/// Number of cases (parameter sets with one state each).
+const CASES: usize = 100;
+/// Calls per timing round.
+const CALLS: usize = 2000;
+/// Timing rounds per function (the fastest counts).
+const ROUNDS: usize = 200;
+
+type V = SVector<f64, 19>;
+
+/// One case: parameter values (indexed like `Model::params`) and a state.
+struct Case {
+    params: Vec<f64>,
+    q: Vec<f64>,
+    u: Vec<f64>,
+    ud: Vec<f64>,
+}
+
+fn krang_model() -> Result<Model, String> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/krang.toml");
+    Model::from_toml_file(&path).map_err(|e| e.to_string())
+}
+
+/// The cases: deterministic (seeded), so `write` and `time` see the same states.
+fn cases(model: &Model) -> Vec<Case> {
+    let mut rng = SplitMix64::new(2026);
+    let mut uniform = move || rng.next_f64();
+    let n = model.dof();
+    (0..CASES)
+        .map(|i| {
+            let params = if i == 0 {
+                model.param_values()
+            } else {
+                random_physical_params(model, &mut uniform)
+            };
+            Case {
+                params,
+                q: uniform_vec(&mut uniform, n, -std::f64::consts::PI, std::f64::consts::PI),
+                u: uniform_vec(&mut uniform, n, -2.0, 2.0),
+                ud: uniform_vec(&mut uniform, n, -5.0, 5.0),
+            }
+        })
+        .collect()
+}
+
+fn krang(params: &[f64]) -> Result<Krang, String> {
+    let array: [f64; 185] = params
+        .try_into()
+        .map_err(|_| format!("{} parameters, Krang has 185", params.len()))?;
+    Ok(Krang::new(Params::from_array(array)))
+}
+
+fn line(out: &mut String, tag: &str, xs: impl IntoIterator<Item = f64>) {
+    out.push_str(tag);
+    for x in xs {
+        let _ = write!(out, " {x:?}");
+    }
+    out.push('\n');
+}
+
+fn rows(m: &SMatrix<f64, 19, 19>) -> impl Iterator<Item = f64> + '_ {
+    (0..19).flat_map(move |r| (0..19).map(move |c| m[(r, c)]))
+}
+
+fn write(dir: &Path) -> Result<(), String> {
+    let model = krang_model()?;
+    let mut out = format!("cases {CASES} dof {}\n", model.dof());
+    for (i, case) in cases(&model).iter().enumerate() {
+        let pm = kanegen::pinocchio::export(&model, &case.params).map_err(|e| e.to_string())?;
+        let k = krang(&case.params)?;
+        let (q, u, ud) = (
+            V::from_column_slice(&case.q),
+            V::from_column_slice(&case.u),
+            V::from_column_slice(&case.ud),
+        );
+        let _ = writeln!(out, "case {i}");
+        out.push_str(&pm.to_text());
+        line(&mut out, "q", case.q.iter().copied());
+        line(&mut out, "u", case.u.iter().copied());
+        line(&mut out, "ud", case.ud.iter().copied());
+        line(&mut out, "M", rows(&k.mass_matrix(&q)));
+        line(&mut out, "c", k.coriolis(&q, &u).iter().copied());
+        line(&mut out, "g", k.gravity(&q).iter().copied());
+        line(
+            &mut out,
+            "tau",
+            k.inverse_dynamics(&q, &u, &ud).iter().copied(),
+        );
+        line(&mut out, "C", rows(&k.coriolis_matrix(&q, &u)));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let path = dir.join("cases.txt");
+    std::fs::write(&path, out).map_err(|e| format!("{}: {e}", path.display()))?;
+    println!("wrote {} ({CASES} cases)", path.display());
+    Ok(())
+}
+
+/// The fastest round's ns per call of `f` over the states.
+fn time_one(states: &[(V, V, V)], mut f: impl FnMut(&V, &V, &V)) -> f64 {
+    let mut best = f64::INFINITY;
+    for _ in 0..ROUNDS {
+        let start = Instant::now();
+        for i in 0..CALLS {
+            let (q, u, ud) = &states[i % states.len()];
+            f(black_box(q), black_box(u), black_box(ud));
+        }
+        best = best.min(start.elapsed().as_nanos() as f64 / CALLS as f64);
+    }
+    best
+}
+
+fn time(dir: &Path) -> Result<(), String> {
+    let model = krang_model()?;
+    let all = cases(&model);
+    let k = krang(&all[0].params)?;
+    let states: Vec<(V, V, V)> = all
+        .iter()
+        .map(|c| {
+            (
+                V::from_column_slice(&c.q),
+                V::from_column_slice(&c.u),
+                V::from_column_slice(&c.ud),
+            )
+        })
+        .collect();
+    let k = &k;
+    let results = [
+        (
+            "mass_matrix",
+            time_one(&states, |q, _, _| {
+                black_box(black_box(k).mass_matrix(q));
+            }),
+        ),
+        (
+            "coriolis",
+            time_one(&states, |q, u, _| {
+                black_box(black_box(k).coriolis(q, u));
+            }),
+        ),
+        (
+            "gravity",
+            time_one(&states, |q, _, _| {
+                black_box(black_box(k).gravity(q));
+            }),
+        ),
+        (
+            "inverse_dynamics",
+            time_one(&states, |q, u, ud| {
+                black_box(black_box(k).inverse_dynamics(q, u, ud));
+            }),
+        ),
+        (
+            "coriolis_matrix",
+            time_one(&states, |q, u, _| {
+                black_box(black_box(k).coriolis_matrix(q, u));
+            }),
+        ),
+    ];
+    let mut text = String::new();
+    for (name, ns) in results {
+        println!("kanegen {name:<18} {ns:9.1} ns");
+        let _ = writeln!(text, "{name} {ns}");
+    }
+    append(&dir.join("kanegen-times.txt"), &text)
+}
+
+fn append(path: &Path, text: &str) -> Result<(), String> {
+    use std::io::Write as _;
+    std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .and_then(|mut f| f.write_all(text.as_bytes()))
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The smallest figure per name in a times file (`name ns` per line) and the number of runs.
+fn best_times(path: &Path) -> Result<(BTreeMap<String, f64>, usize), String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut best: BTreeMap<String, f64> = BTreeMap::new();
+    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
+    for (n, l) in text.lines().enumerate() {
+        let mut it = l.split_whitespace();
+        let (Some(name), Some(ns), None) = (it.next(), it.next(), it.next()) else {
+            return Err(format!(
+                "{}:{}: expected `name ns`, found `{l}`",
+                path.display(),
+                n + 1
+            ));
+        };
+        let ns: f64 = ns
+            .parse()
+            .map_err(|e| format!("{}:{}: `{ns}`: {e}", path.display(), n + 1))?;
+        let b = best.entry(name.to_owned()).or_insert(f64::INFINITY);
+        *b = b.min(ns);
+        *counts.entry(name.to_owned()).or_default() += 1;
+    }
+    let runs = counts.values().copied().min().unwrap_or(0);
+    Ok((best, runs))
+}
+
+fn report(dir: &Path) -> Result<(), String> {
+    let (ours, our_runs) = best_times(&dir.join("kanegen-times.txt"))?;
+    let (pin, pin_runs) = best_times(&dir.join("pinocchio-times.txt"))?;
+    let rows = [
+        (
+            "`mass_matrix` (M)",
+            "mass_matrix",
+            "`crba` (M, upper triangle)",
+            "crba",
+        ),
+        (
+            "`coriolis` (c)",
+            "coriolis",
+            "`nonLinearEffects` (c + g)",
+            "nle",
+        ),
+        (
+            "`gravity` (g)",
+            "gravity",
+            "`computeGeneralizedGravity`",
+            "gravity",
+        ),
+        (
+            "`inverse_dynamics` (τ)",
+            "inverse_dynamics",
+            "`rnea`",
+            "rnea",
+        ),
+        (
+            "`coriolis_matrix` (C)",
+            "coriolis_matrix",
+            "`computeCoriolisMatrix`",
+            "coriolis_matrix",
+        ),
+    ];
+    println!(
+        "| kanegen (Rust) | ns | Pinocchio (C++) | ns | Pinocchio / kanegen |\n|---|--:|---|--:|--:|"
+    );
+    for (our_label, our_key, pin_label, pin_key) in rows {
+        let (Some(a), Some(b)) = (ours.get(our_key), pin.get(pin_key)) else {
+            return Err(format!("no time for `{our_key}` or `{pin_key}`"));
+        };
+        println!(
+            "| {our_label} | {a:.0} | {pin_label} | {b:.0} | {:.1}× |",
+            b / a
+        );
+    }
+    println!(
+        "\n(best of {our_runs} kanegen and {pin_runs} Pinocchio runs; each figure the fastest round of {ROUNDS} × {CALLS} calls)"
+    );
+    Ok(())
+}
+
+/// Writes `model` (TOML or URDF) with its default parameters in the export's text format.
+fn export(model: &Path, file: &Path) -> Result<(), String> {
+    let m = if model
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+    {
+        Model::from_urdf_file(model, &kanegen_model::UrdfOptions::default())
+    } else {
+        Model::from_toml_file(model)
+    }
+    .map_err(|e| e.to_string())?;
+    let pm = kanegen::pinocchio::export(&m, &m.param_values()).map_err(|e| e.to_string())?;
+    std::fs::write(file, pm.to_text()).map_err(|e| format!("{}: {e}", file.display()))?;
+    println!(
+        "wrote {} ({} joints, {} bodies, nq {}, nv {})",
+        file.display(),
+        pm.joints.len(),
+        pm.bodies.len(),
+        pm.nq,
+        pm.nv
+    );
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let usage = "usage: pinocchio_side_by_side <write|time|report> DIR | export MODEL FILE";
+    let result = match args.as_slice() {
+        [cmd, model, file] if cmd == "export" => export(Path::new(model), Path::new(file)),
+        [cmd, dir] => {
+            let dir = PathBuf::from(dir);
+            match cmd.as_str() {
+                "write" => write(&dir),
+                "time" => time(&dir),
+                "report" => report(&dir),
+                _ => Err(usage.to_owned()),
+            }
+        }
+        _ => Err(usage.to_owned()),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -10,7 +10,13 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let wheeled = UrdfOptions::wheeled(WheeledBaseSpec::new("jwl", "jwr", "l0", [0.0, 0.0, 1.0], 0.2));
+    let wheeled = UrdfOptions::wheeled(WheeledBaseSpec::new(
+        "jwl",
+        "jwr",
+        "l0",
+        [0.0, 0.0, 1.0],
+        0.2,
+    ));
     for options in [UrdfOptions::default(), wheeled] {
         if let Ok(model) = Model::from_urdf_str(text, "fuzz.urdf", &options)
             && model.dof() <= 8

@@ -1,7 +1,8 @@
 //! Property tests (proptest): random valid robot trees — revolute, continuous, prismatic and
 //! fixed joints with random axes (not normalised), offsets and rotations, links with and without
 //! mass, optionally on a two-wheeled base — written as URDF, imported, generated, and the lowered
-//! M, c, g, τ compared with the reference recursion; random mutations of valid files into
+//! M, c, g, τ compared with the reference recursion (and, for fixed bases, g and M with the
+//! energies of the URDF as written, independently of the importer); random mutations of valid files into
 //! invalid ones, each requiring its typed error; arbitrary damage (truncation, deleted or
 //! replaced bytes) of URDF and TOML files, requiring a result and never a panic.
 //!
@@ -10,15 +11,18 @@
 //! that property becomes the comparison with the reference (`Tᵀ M T`).
 
 mod common;
+#[path = "common/raw_urdf.rs"]
+mod raw_urdf;
 
 use std::fmt::Write as _;
 
 use common::*;
 use kanegen::{FunctionId, Options, generate_model};
-use kanegen_model::{Model, ModelErrorKind as K, UrdfOptions, WheeledBaseSpec};
+use kanegen_model::{AngleSnap, Model, ModelErrorKind as K, UrdfOptions, WheeledBaseSpec};
 use kanegen_reference::Reference;
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
+use raw_urdf::RawUrdf;
 
 /// Relative to the largest entry (absolute below 1).
 const TOL: f64 = 1e-10;
@@ -354,6 +358,15 @@ proptest! {
         prop_assert_eq!(model.dof(), moving_joints + base);
         let worst = worst_error(&model, 3, seed);
         prop_assert!(worst < TOL, "worst relative error {:e}\n{}", worst, text);
+        // The import against the URDF as written (fixed bases; angles unsnapped, as the raw
+        // forward kinematics reads them): g = ∂V/∂q and ½ uᵀ M u = T.
+        if tree.wheeled.is_none() {
+            let exact = UrdfOptions { snap_angles: AngleSnap::Off, ..UrdfOptions::default() };
+            let model = Model::from_urdf_str(&text, "random.urdf", &exact)
+                .map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
+            let (eg, et) = RawUrdf::new(&text, &model).energy_errors(&model, 1, seed);
+            prop_assert!(eg < 1e-6 && et < 1e-6, "g {:e} T {:e}\n{}", eg, et, text);
+        }
     }
 
     /// Mimic joints: today a typed `mimic` error naming the joint (the hook for issue 15 item 2:

@@ -96,7 +96,10 @@ pub(crate) fn inertia_violation([a, b, c]: [f64; 3]) -> (f64, &'static str) {
     let triangle = (c - a - b).max(0.0) / scale;
     if a.is_nan() || c.is_nan() {
         (f64::NAN, "not a number")
-    } else if negative > 0.0 {
+    } else if negative > TOLERANCE {
+        // A principal moment of −1e−22 (rounding of a semi-definite inertia such as
+        // 1e−6 · [1 1 1; 1 1 1; 1 1 1]) is no semi-definiteness violation: the condition named
+        // is then the triangle inequality.
         (negative.max(triangle), "not positive semi-definite")
     } else {
         (

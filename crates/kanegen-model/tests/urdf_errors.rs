@@ -381,6 +381,26 @@ fn a_non_physical_link_inertia_is_an_error_in_urdf_terms() {
     );
 }
 
+/// ANYmal B's and HyQ's placeholder inertia `1e-6` in all six entries is semi-definite
+/// (principal moments 0, 0, 3e-6; the eigen-solver gives −2e−22) but breaks the triangle
+/// inequality by 100 %: the error names the triangle inequality, not semi-definiteness.
+#[test]
+fn a_rounding_negative_principal_moment_is_not_called_indefinite() {
+    let kind = error_of(
+        &mutate(&[(
+            r#"<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/>"#,
+            r#"<inertia ixx="0.000001" ixy="0.000001" ixz="0.000001" iyy="0.000001" iyz="0.000001" izz="0.000001"/>"#,
+        )]),
+        &[
+            "URDF link `L2` <inertial>",
+            "triangle inequality",
+            "100.00 %",
+        ],
+    );
+    let msg = format!("{kind}");
+    assert!(!msg.contains("not positive semi-definite"), "{msg}");
+}
+
 #[test]
 fn absurd_inertia_is_an_error_by_default_and_can_be_dropped() {
     // Krang's gripper plates: 0.1 g with 0.09 kg·m² (radius of gyration ~30 m).

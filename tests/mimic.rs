@@ -105,7 +105,7 @@ fn reduced_dynamics_equal_the_unconstrained_tree_projected_by_the_constraint_map
     let n = model.independent_dof();
     let mut r = rng(15);
     let mut worst = [0.0f64; 4];
-    for draw in 0..200 {
+    for draw in 0..100 {
         let p = if draw == 0 {
             model.param_values()
         } else {

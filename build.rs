@@ -1,7 +1,8 @@
 //! Generates, for the benchmarks (`benches/dynamics.rs`), the dynamics of the URDF robots into
 //! `$OUT_DIR`: the 7-DOF arm of `models/singlearm.urdf` (runtime parameters and baked) and Krang
 //! imported from `models/Krang.urdf` with its two-wheeled base (runtime parameters); and, for
-//! `tests/kinematics.rs`, the arm and the two-link model with every registry function.
+//! `tests/kinematics.rs`, the arm and the two-link model with every registry function; for
+//! `tests/mimic.rs`, a gripper with mimic joints.
 //! The TOML Krang models come from `krang-dynamics`.
 use kanegen::model::{UrdfOptions, WheeledBaseSpec};
 
@@ -25,6 +26,12 @@ fn main() {
         .baked(true)
         .precision(kanegen::Precision::F32)
         .output("two_link_all_baked_f32.rs")
+        .run();
+    // A gripper with <mimic> fingers (exact constraints), every registry function, for
+    // `tests/mimic.rs`.
+    kanegen::Builder::urdf("models/mimic_gripper.urdf", UrdfOptions::default())
+        .functions(kanegen::FunctionSet::all())
+        .output("mimic_gripper_all.rs")
         .run();
     kanegen::Builder::urdf("models/Krang.urdf", krang_urdf_options())
         .output("krang_urdf.rs")

@@ -159,8 +159,20 @@ pub(crate) fn model(m: &Model) -> String {
         axis(g.direction)
     );
     frames(m, &mut s);
-    let _ = writeln!(s, "speeds ({}):", m.speeds.len());
+    let _ = writeln!(s, "speeds ({}):", m.independent_dof());
     for (i, sp) in m.speeds.iter().enumerate() {
+        if let Some(mm) = m.mimic_of(i) {
+            let _ = writeln!(
+                s,
+                "  mimic: {} = {} · {} {} {} (dependent, not an input)",
+                sp.coordinate,
+                number(mm.multiplier),
+                m.speeds[mm.master].coordinate,
+                if mm.offset < 0.0 { '-' } else { '+' },
+                number(mm.offset.abs())
+            );
+            continue;
+        }
         let (q, u) = if speed_is_linear(m, i) {
             ("m", "m/s")
         } else {

@@ -15,7 +15,7 @@
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::fmt;
 
-use crate::expr::{Arena, Atom, ExprId, Node, VarKind};
+use crate::expr::{Arena, Atom, ExprId, MimicLeaf, Node, VarKind};
 use crate::kane::{Derivation, Function};
 use crate::options::ParamMode;
 use crate::registry::FunctionId;
@@ -197,6 +197,9 @@ pub struct Lowered {
     pub dof: usize,
     /// Parameter mode.
     pub params: ParamMode,
+    /// The dependent (mimic) speeds whose `sin`/`cos` leaves the programs may read: speed index
+    /// and its angle `a·q[master] + b` (see [`Arena::set_mimic`](crate::expr::Arena::set_mimic)).
+    pub mimic_angles: Vec<(usize, MimicLeaf)>,
 }
 
 impl Lowered {
@@ -241,6 +244,9 @@ pub fn lower(d: &Derivation) -> Lowered {
         functions,
         dof: d.dof,
         params: d.options.params,
+        mimic_angles: (0..d.arena.names.speeds.len())
+            .filter_map(|s| d.arena.mimic(s as u32).map(|m| (s, m)))
+            .collect(),
     }
 }
 
@@ -660,6 +666,7 @@ impl Lowered {
         let p = self
             .function_at(id, frame)
             .unwrap_or_else(|| panic!("the lowered model has no function `{id}`"));
+        let q = &self.expand_angles(q);
         let locals = run(p, params, &pre, q, u, ud);
         let ctx = EvalCtx {
             params,
@@ -671,6 +678,27 @@ impl Lowered {
         };
         let entries = p.outputs.iter().map(|(r, c, e)| (*r, *c, ctx.eval(e)));
         id.spec().shape.dense(self.dof, entries)
+    }
+}
+
+impl Lowered {
+    /// `q` extended by the angles of the dependent (mimic) speeds at their indices, which the
+    /// programs' `sin`/`cos` leaves of those speeds read.
+    pub fn expand_angles(&self, q: &[f64]) -> Vec<f64> {
+        let len = self
+            .mimic_angles
+            .iter()
+            .map(|(s, _)| s + 1)
+            .max()
+            .unwrap_or(0);
+        let mut out = q.to_vec();
+        if out.len() < len {
+            out.resize(len, 0.0);
+        }
+        for (s, m) in &self.mimic_angles {
+            out[*s] = m.multiplier * q[m.master as usize] + m.offset;
+        }
+        out
     }
 }
 

@@ -19,7 +19,7 @@ pub fn stats(g: &Generated) -> String {
         "model {} ({}): {} speeds, {} bodies, {} parameters; parameters {}",
         g.model.name,
         g.model.source,
-        g.model.dof(),
+        g.model.independent_dof(),
         g.model.body_count(),
         g.model.params.len(),
         if d.options.params.is_runtime() {

@@ -4,7 +4,7 @@
 use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::print::{Printer, ident, idx};
+use super::print::{Printer, ident, idx, lit, signed_lit};
 use super::{Context, scalar_type};
 use crate::lower::{FunctionProgram, LExpr, Leaf, Program};
 use crate::naming;
@@ -114,10 +114,33 @@ fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
         // `sin_q`/`cos_q` cannot clash with a model name: they are read only by the bindings
         // right below, which come before every other binding, and the sine/cosine names all
         // start with `s_`/`c_`.
-        let angles = p.sincos.iter().map(|&s| {
-            let sl = idx(s);
-            quote!(q[#sl])
-        });
+        // A dependent (mimic) joint's angle is formed from its master's coordinate.
+        let angles =
+            p.sincos.iter().map(
+                |&s| match cx.low.mimic_angles.iter().find(|(d, _)| *d == s) {
+                    Some((_, m)) => {
+                        let ml = idx(m.master as usize);
+                        let aq = match m.multiplier {
+                            1.0 => quote!(q[#ml]),
+                            -1.0 => quote!(-q[#ml]),
+                            a => {
+                                let a = signed_lit(a, cx.precision);
+                                quote!(#a * q[#ml])
+                            }
+                        };
+                        let b = lit(m.offset.abs(), cx.precision);
+                        match m.offset {
+                            0.0 => aq,
+                            o if o < 0.0 => quote!(#aq - #b),
+                            _ => quote!(#aq + #b),
+                        }
+                    }
+                    None => {
+                        let sl = idx(s);
+                        quote!(q[#sl])
+                    }
+                },
+            );
         ts.extend(quote!(let (sin_q, cos_q) = sin_cos_n([#(#angles),*]);));
         for (k, &s) in p.sincos.iter().enumerate() {
             let sn = ident(&naming::sin(&speeds[s].coordinate));
@@ -329,7 +352,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         pre: &cx.pre,
         precision: cx.precision,
     };
-    let reads = Reads::of(p, cx.low.dof);
+    let reads = Reads::of(p, cx.model.speeds.len());
     let fname = ident(&super::frames::rust_name(cx, f));
     let doc = match f.frame {
         Some(l) => format!(

@@ -19,15 +19,16 @@ use crate::registry::{FunctionSpec, Inputs, RuntimeTrait};
 pub(super) fn names(cx: &Context<'_>) -> TokenStream {
     let model = cx.model;
     let nl = idx(cx.low.dof);
-    let speed_names: Vec<&str> = model.speeds.iter().map(|s| s.name.as_str()).collect();
-    let coord_names: Vec<&str> = model.speeds.iter().map(|s| s.coordinate.as_str()).collect();
-    let mut taken: Vec<String> = model
-        .speeds
+    // The independent speeds (a mimic joint's dependent speed is not an input).
+    let speeds = &model.speeds[..cx.low.dof];
+    let speed_names: Vec<&str> = speeds.iter().map(|s| s.name.as_str()).collect();
+    let coord_names: Vec<&str> = speeds.iter().map(|s| s.coordinate.as_str()).collect();
+    let mut taken: Vec<String> = speeds
         .iter()
         .map(|s| ident(&s.coordinate.to_uppercase()).to_string())
         .collect();
     let mut index_consts = Vec::new();
-    for (i, s) in model.speeds.iter().enumerate() {
+    for (i, s) in speeds.iter().enumerate() {
         let id = ident(&s.coordinate.to_uppercase());
         let doc = format!(" Index of the coordinate `{}` in q.", s.coordinate);
         let i = idx(i);
@@ -210,7 +211,15 @@ pub(super) fn precomputed(cx: &Context<'_>) -> TokenStream {
         precision: cx.precision,
     };
     let body = printer.statements(&[]);
-    let fields: Vec<Ident> = cx.pre.iter().map(|s| ident(s)).collect();
+    // Two slots can read one statement (a parameter-only variable and its definition, both
+    // requested): one field each statement.
+    let mut seen = std::collections::HashSet::new();
+    let fields: Vec<Ident> = cx
+        .pre
+        .iter()
+        .filter(|s| seen.insert(s.as_str()))
+        .map(|s| ident(s))
+        .collect();
     let pname = if uses(p, &|l| matches!(l, Leaf::Param(_))) {
         quote!(p)
     } else {

@@ -181,7 +181,10 @@ fn header(model: &Model, low: &Lowered) -> String {
         comment_text(&model.name),
         comment_text(&file_name(&model.source))
     );
-    let speeds: Vec<&str> = model.speeds.iter().map(|s| s.name.as_str()).collect();
+    let speeds: Vec<&str> = model.speeds[..low.dof]
+        .iter()
+        .map(|s| s.name.as_str())
+        .collect();
     h.push_str(&format!(
         "// Parameters: {}. Speeds ({}): {}.\n",
         match low.params {

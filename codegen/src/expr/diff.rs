@@ -93,6 +93,17 @@ impl Arena {
                     let s = self.atom(Atom::Sin(i));
                     self.neg(s)
                 }
+                // A dependent (mimic) angle `a·q[m] + b`: the chain rule.
+                (Atom::Sin(i), Wrt::Coord(x)) if self.mimic(i).is_some_and(|m| m.master == x) => {
+                    let k = self.mimic(i).map_or(0.0, |m| m.multiplier);
+                    let c = self.atom(Atom::Cos(i));
+                    self.scale(c, k)
+                }
+                (Atom::Cos(i), Wrt::Coord(x)) if self.mimic(i).is_some_and(|m| m.master == x) => {
+                    let k = self.mimic(i).map_or(0.0, |m| m.multiplier);
+                    let s = self.atom(Atom::Sin(i));
+                    self.scale(s, -k)
+                }
                 (Atom::Var(v), _) => {
                     let info = self.vars[v as usize].clone();
                     let dd = d(self, info.def);

@@ -145,6 +145,20 @@ pub struct Arena {
     clock: u32,
     /// Memo of [`Arena::diff`].
     diff_memo: diff::DiffMemo,
+    /// Per speed index: the mimic constraint `q = a·q_master + b` of a dependent speed (see
+    /// [`Arena::set_mimic`]), `None` for an independent one.
+    mimics: Vec<Option<MimicLeaf>>,
+}
+
+/// A dependent coordinate `q = multiplier · q[master] + offset` (a mimic joint).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MimicLeaf {
+    /// The independent speed index.
+    pub master: u32,
+    /// The factor `a`.
+    pub multiplier: f64,
+    /// The offset `b`.
+    pub offset: f64,
 }
 
 /// Numeric values of the leaves, for [`Arena::eval`].
@@ -174,6 +188,7 @@ impl Arena {
             stamps: Vec::new(),
             clock: 0,
             diff_memo: HashMap::new(),
+            mimics: Vec::new(),
         };
         a.constant(0.0);
         a.constant(1.0);
@@ -262,9 +277,67 @@ impl Arena {
     pub fn one(&self) -> ExprId {
         ExprId(1)
     }
-    /// A leaf.
+    /// A leaf. For a dependent speed `i` ([`Arena::set_mimic`]) the leaves are expressions of its
+    /// master's: `u[i] = a·u[m]`, `u̇[i] = a·u̇[m]`, `q[i] = a·q[m] + b`, and for `a = ±1, b = 0`
+    /// `sin q[i] = ±sin q[m]`, `cos q[i] = cos q[m]`; otherwise `sin q[i]`, `cos q[i]` stay leaves,
+    /// whose angle `a·q[m] + b` the generated code forms before its batched sine and cosine
+    /// ([`Arena::mimic`]).
     pub fn atom(&mut self, a: Atom) -> ExprId {
+        if let Some(e) = self.mimic_atom(a) {
+            return e;
+        }
         self.intern(Node::Atom(a))
+    }
+
+    /// Declares speed `speed` dependent: `q[speed] = m.multiplier · q[m.master] + m.offset` (and
+    /// its speed and acceleration `a` times the master's). Call before building expressions.
+    pub fn set_mimic(&mut self, speed: u32, m: MimicLeaf) {
+        let s = speed as usize;
+        if self.mimics.len() <= s {
+            self.mimics.resize(s + 1, None);
+        }
+        self.mimics[s] = Some(m);
+    }
+
+    /// The mimic constraint of speed `s`, if it is dependent.
+    pub fn mimic(&self, s: u32) -> Option<MimicLeaf> {
+        self.mimics.get(s as usize).copied().flatten()
+    }
+
+    /// The angle of `sin`/`cos` leaf `s` given the coordinates (`q[s]`, or `a·q[m] + b` for a
+    /// dependent speed).
+    pub fn angle(&self, q: &[f64], s: u32) -> f64 {
+        match self.mimic(s) {
+            Some(m) => m.multiplier * q[m.master as usize] + m.offset,
+            None => q[s as usize],
+        }
+    }
+
+    /// The expression of a dependent speed's leaf, if it is not a leaf of its own.
+    fn mimic_atom(&mut self, a: Atom) -> Option<ExprId> {
+        let (s, ctor): (u32, fn(u32) -> Atom) = match a {
+            Atom::Speed(s) => (s, Atom::Speed),
+            Atom::Accel(s) => (s, Atom::Accel),
+            Atom::Coord(s) => (s, Atom::Coord),
+            Atom::Sin(s) => (s, Atom::Sin),
+            Atom::Cos(s) => (s, Atom::Cos),
+            Atom::Param(_) | Atom::Var(_) => return None,
+        };
+        let m = self.mimic(s)?;
+        let (k, b) = (m.multiplier, m.offset);
+        let pure_sign = b == 0.0 && (k == 1.0 || k == -1.0);
+        let master = self.intern(Node::Atom(ctor(m.master)));
+        Some(match a {
+            Atom::Speed(_) | Atom::Accel(_) => self.scale(master, k),
+            Atom::Coord(_) => {
+                let t = self.scale(master, k);
+                let b = self.constant(b);
+                self.add(t, b)
+            }
+            Atom::Sin(_) if pure_sign => self.scale(master, k),
+            Atom::Cos(_) if pure_sign => master,
+            _ => return None,
+        })
     }
 
     /// The value of `e` if it is a constant.
@@ -569,8 +642,8 @@ impl Arena {
                     Atom::Param(p) => v.params[p as usize],
                     Atom::Speed(s) => v.u[s as usize],
                     Atom::Accel(s) => v.ud[s as usize],
-                    Atom::Sin(s) => v.q[s as usize].sin(),
-                    Atom::Cos(s) => v.q[s as usize].cos(),
+                    Atom::Sin(s) => self.angle(v.q, s).sin(),
+                    Atom::Cos(s) => self.angle(v.q, s).cos(),
                     Atom::Coord(s) => v.q[s as usize],
                     Atom::Var(k) => out[self.vars[k as usize].def.index()],
                 },

@@ -53,6 +53,7 @@ mod frames;
 mod gravity;
 mod kinematics;
 mod mass_matrix;
+mod mimic;
 mod rnea;
 
 use kanegen_model::{Model, ParamKind};
@@ -151,6 +152,7 @@ const DERIVATION_ORDER: [FunctionId; 13] = [
 pub fn derive(model: &Model, options: Options) -> Derivation {
     let mut arena = Arena::new(names_of(model));
     arena.hoist_params = options.params.is_runtime();
+    mimic::declare(&mut arena, model);
     let mut cx = Ctx {
         ar: &mut arena,
         model,
@@ -160,7 +162,9 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
         root_rot: vec![None; model.links.len()],
         root_pos: vec![None; model.links.len()],
     };
-    let n = model.dof();
+    // Results have the independent speeds (the derivation runs on all speeds of the tree and
+    // `mimic::project` reduces them).
+    let n = model.independent_dof();
     let mut composites = None;
     let mut functions = Vec::new();
     for id in DERIVATION_ORDER {
@@ -180,6 +184,7 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
                 Some(l) => cx.derive_frame_function(id, l),
                 None => cx.derive_function(id, &mut composites),
             };
+            let entries = mimic::project(cx.ar, model, id.spec().shape, entries);
             let order = cx.ar.phase_order();
             functions.push(Function {
                 id,
@@ -310,6 +315,7 @@ impl Derivation {
         let f = self
             .function_at(id, frame)
             .unwrap_or_else(|| panic!("the derivation has no function `{id}`"));
+        // Sines and cosines of dependent (mimic) angles are formed from `q` by the arena.
         let vals = self.arena.eval(&crate::expr::Values { params, q, u, ud });
         let entries = f.entries.iter().map(|&(r, c, e)| (r, c, vals[e.index()]));
         id.spec().shape.dense(self.dof, entries)

@@ -347,6 +347,16 @@ pub enum ModelErrorKind {
         /// The pivot and the configuration.
         detail: String,
     },
+    /// A URDF `<mimic>` joint whose constraint cannot be represented: its master joint is missing,
+    /// fixed, dropped or part of the wheeled base, the mimic joints form a cycle, or the
+    /// multiplier or offset is not a finite number.
+    #[error("URDF joint `{joint}` <mimic>: {detail}")]
+    UrdfBadMimic {
+        /// The mimic joint.
+        joint: String,
+        /// What is wrong and how to fix it.
+        detail: String,
+    },
     /// A URDF import option (base declaration, dropped links, gravity) is inconsistent with the file.
     #[error("URDF import option `{option}`: {detail}")]
     UrdfBadOption {

@@ -236,12 +236,25 @@ pub struct Model {
     pub base: Base,
     /// Gravity.
     pub gravity: Gravity,
+    /// Mimic constraints (URDF `<mimic>`): each makes one speed of [`Model::speeds`] dependent,
+    /// `q_dep = multiplier · q_master + offset`. The dependent speeds are the last
+    /// `mimics.len()` entries of `speeds`, in the order of this list; without constraints (the
+    /// usual case) the model is an ordinary tree. Read without the constraints, the model is the
+    /// unconstrained tree with an independent coordinate per joint (what Pinocchio builds).
+    pub mimics: Vec<crate::Mimic>,
 }
 
 impl Model {
-    /// Number of generalized speeds.
+    /// Number of generalized speeds of the tree, the dependent speeds of mimic joints included
+    /// (see [`Model::mimics`]; [`Model::independent_dof`] without them).
     pub fn dof(&self) -> usize {
         self.speeds.len()
+    }
+
+    /// Number of independent generalized speeds: [`Model::dof`] minus the mimic constraints.
+    /// Generated code has this many speeds.
+    pub fn independent_dof(&self) -> usize {
+        self.speeds.len() - self.mimics.len()
     }
 
     /// Index of the parameter called `name`.

@@ -17,6 +17,7 @@ mod error;
 mod ident;
 mod ir;
 mod mass_matrix;
+mod mimic;
 pub mod names;
 mod toml_format;
 pub mod urdf;
@@ -26,6 +27,7 @@ pub use error::{BadName, ModelError, ModelErrorKind};
 pub use ident::{is_keyword, sanitize_identifier};
 pub use ir::*;
 pub use mass_matrix::kinetic_energy_mass_matrix;
+pub use mimic::{Mimic, MimicMode};
 pub use urdf::{
     AbsurdInertia, AngleSnap, NonPhysicalInertia, UrdfBase, UrdfImport, UrdfOptions,
     WheeledBaseSpec, ZeroMassInertia,

@@ -327,6 +327,7 @@ fn build(f: File, file: &str) -> Result<Model, K> {
             symbol: gsym,
             direction: dir,
         },
+        mimics: Vec::new(),
     };
     crate::names::check(&model)?;
     validate::check_physics(&model, validate::TOLERANCE)?;

@@ -244,23 +244,29 @@ fn bad_number_in_an_inertia() {
 }
 
 #[test]
-fn mimic_joint_is_unsupported() {
+fn mimic_joint_of_a_missing_master_is_a_typed_error() {
+    // (A mimic joint of an existing joint imports as an exact constraint: tests/mimic.rs.)
     let kind = error_of(
         &mutate(&[(
             "<axis xyz=\"0 1 0\"/>",
-            "<axis xyz=\"0 1 0\"/><mimic joint=\"j1\" multiplier=\"2\"/>",
+            "<axis xyz=\"0 1 0\"/><mimic joint=\"j9\" multiplier=\"2\"/>",
         )]),
         &[
-            "joint `j2`",
-            "mimic joints are not supported",
-            "copies `j1`",
-            "remove <mimic>",
+            "joint `j2` <mimic>",
+            "master joint `j9`",
+            "not a moving joint",
         ],
     );
     assert!(
-        matches!(&kind, K::UrdfUnsupportedJoint { joint, kind, .. } if joint == "j2" && kind == "mimic"),
+        matches!(&kind, K::UrdfBadMimic { joint, .. } if joint == "j2"),
         "{kind:?}"
     );
+    let ok = import(&mutate(&[(
+        "<axis xyz=\"0 1 0\"/>",
+        "<axis xyz=\"0 1 0\"/><mimic joint=\"j1\" multiplier=\"2\"/>",
+    )]))
+    .expect("a mimic of an existing joint imports");
+    assert_eq!(ok.mimics.len(), 1);
 }
 
 #[test]

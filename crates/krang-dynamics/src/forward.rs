@@ -75,6 +75,49 @@ impl fmt::Display for NotPositiveDefinite {
 
 impl core::error::Error for NotPositiveDefinite {}
 
+/// Why [`Krang::try_forward_dynamics`] has no result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ForwardDynamicsError {
+    /// The mass matrix is not positive definite (non-physical parameters, or non-finite `q`).
+    NotPositiveDefinite(NotPositiveDefinite),
+    /// An input or the result is not finite: an infinite or NaN entry of `q`, `u` or `τ`
+    /// (named), or a result that overflowed (`"u̇"`: e.g. infinite parameters). The result is
+    /// never returned with an infinity or a NaN in it.
+    NotFinite(&'static str),
+}
+
+impl fmt::Display for ForwardDynamicsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NotPositiveDefinite(e) => e.fmt(f),
+            Self::NotFinite(what) => write!(
+                f,
+                "forward dynamics: `{what}` is not finite (an infinity or NaN); check the state, the forces and Params::validate()"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for ForwardDynamicsError {}
+
+impl From<NotPositiveDefinite> for ForwardDynamicsError {
+    fn from(e: NotPositiveDefinite) -> Self {
+        Self::NotPositiveDefinite(e)
+    }
+}
+
+/// `Err(NotFinite(what))` unless every entry of `v` is finite.
+fn finite<const N: usize>(
+    v: &SVector<f64, N>,
+    what: &'static str,
+) -> Result<(), ForwardDynamicsError> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(ForwardDynamicsError::NotFinite(what))
+    }
+}
+
 #[inline]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
@@ -295,21 +338,29 @@ impl Krang {
     /// [`MassMatrixCholesky`]. Allocation-free.
     ///
     /// # Errors
-    /// [`NotPositiveDefinite`] for non-physical parameters.
+    /// [`ForwardDynamicsError::NotPositiveDefinite`] for non-physical parameters;
+    /// [`ForwardDynamicsError::NotFinite`] for an infinite or NaN entry of `q`, `u` or `tau`, or
+    /// a result that is not finite (infinite parameters).
     pub fn try_forward_dynamics(
         &self,
         q: &SVector<f64, 19>,
         u: &SVector<f64, 19>,
         tau: &SVector<f64, 19>,
-    ) -> Result<SVector<f64, 19>, NotPositiveDefinite> {
+    ) -> Result<SVector<f64, 19>, ForwardDynamicsError> {
+        finite(q, "q")?;
+        finite(u, "u")?;
+        finite(tau, "tau")?;
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
         let chol = self.mass_matrix_cholesky(q)?;
-        Ok(chol.solve(&(tau - bias)))
+        let ud = chol.solve(&(tau - bias));
+        finite(&ud, "u̇")?;
+        Ok(ud)
     }
 
     /// Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))`, as
     /// [`try_forward_dynamics`](Self::try_forward_dynamics) but infallible: if `M(q)` is not
-    /// positive definite (non-physical parameters) every entry of the result is NaN.
+    /// positive definite (non-physical parameters) or an input or the result is not finite, every
+    /// entry of the result is NaN.
     ///
     /// ```
     /// use krang_dynamics::{Krang, index};
@@ -360,15 +411,20 @@ impl KrangFixedWheels {
     /// dense fallback [`solve_spd`] (17×17 Cholesky). Allocation-free.
     ///
     /// # Errors
-    /// [`NotPositiveDefinite`] for non-physical parameters.
+    /// As [`Krang::try_forward_dynamics`].
     pub fn try_forward_dynamics(
         &self,
         q: &SVector<f64, 17>,
         u: &SVector<f64, 17>,
         tau: &SVector<f64, 17>,
-    ) -> Result<SVector<f64, 17>, NotPositiveDefinite> {
+    ) -> Result<SVector<f64, 17>, ForwardDynamicsError> {
+        finite(q, "q")?;
+        finite(u, "u")?;
+        finite(tau, "tau")?;
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
-        solve_spd(&self.mass_matrix(q), &(tau - bias))
+        let ud = solve_spd(&self.mass_matrix(q), &(tau - bias))?;
+        finite(&ud, "u̇")?;
+        Ok(ud)
     }
 
     /// As [`try_forward_dynamics`](Self::try_forward_dynamics), but NaN-filled instead of an

@@ -115,7 +115,9 @@ pub mod two_link {
 }
 
 pub mod forward;
-pub use forward::{Block, MassMatrixCholesky, NotPositiveDefinite, solve_spd};
+pub use forward::{
+    Block, ForwardDynamicsError, MassMatrixCholesky, NotPositiveDefinite, solve_spd,
+};
 
 pub mod actuators;
 pub use actuators::{ACTUATOR_COUNT, ACTUATOR_NAMES, actuator, hardware, saturate, saturate_to};

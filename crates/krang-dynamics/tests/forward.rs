@@ -4,7 +4,9 @@
 
 use krang_dynamics::fixed_wheels::{self, KrangFixedWheels};
 use krang_dynamics::forward::{LEFT_ARM, RIGHT_ARM};
-use krang_dynamics::{Block, Krang, MassMatrixCholesky, Params, index, solve_spd};
+use krang_dynamics::{
+    Block, ForwardDynamicsError, Krang, MassMatrixCholesky, Params, index, solve_spd,
+};
 use nalgebra::{SMatrix, SVector};
 
 /// SplitMix64: a tiny deterministic generator (no dev-dependency needed).
@@ -194,7 +196,10 @@ fn non_physical_parameters_are_reported_not_panicked() {
     let q = SVector::<f64, 19>::zeros();
     let u = SVector::<f64, 19>::zeros();
     let err = k.try_forward_dynamics(&q, &u, &u).unwrap_err();
-    assert_eq!(err.block, Block::RightArm);
+    assert!(
+        matches!(err, ForwardDynamicsError::NotPositiveDefinite(e) if e.block == Block::RightArm),
+        "{err:?}"
+    );
     assert!(err.to_string().contains("not positive definite"));
     assert!(k.forward_dynamics(&q, &u, &u).iter().all(|x| x.is_nan()));
     // NaN coordinates propagate as an error too.
@@ -269,4 +274,39 @@ fn upright_pitch_puts_the_centre_of_mass_above_the_axle() {
         qt[index::Q_IMU] += 1e-4;
         assert!(k.gravity(&qt)[index::Q_IMU] < 0.0, "case {case}");
     }
+}
+
+#[test]
+fn infinities_in_the_state_forces_or_parameters_are_errors_not_results() {
+    let q = SVector::<f64, 19>::zeros();
+    let u = SVector::<f64, 19>::zeros();
+    let k = Krang::default();
+    let mut tau = u;
+    tau[index::QD1L] = f64::INFINITY;
+    assert_eq!(
+        k.try_forward_dynamics(&q, &u, &tau),
+        Err(ForwardDynamicsError::NotFinite("tau"))
+    );
+    let mut u_inf = u;
+    u_inf[index::QD_W] = f64::NEG_INFINITY;
+    assert_eq!(
+        k.try_forward_dynamics(&q, &u_inf, &u),
+        Err(ForwardDynamicsError::NotFinite("u"))
+    );
+    let mut q_inf = q;
+    q_inf[index::Q_TORSO] = f64::INFINITY;
+    assert_eq!(
+        k.try_forward_dynamics(&q_inf, &u, &u),
+        Err(ForwardDynamicsError::NotFinite("q"))
+    );
+    // An infinite gravity passes the factorisation (M does not depend on g) and was returned as
+    // Ok(inf/NaN) before: now an error, and NaNs from the infallible form.
+    let mut p = Params::default();
+    p.set("g", f64::INFINITY).unwrap();
+    assert!(p.validate().is_err());
+    let k = Krang::new(p);
+    let err = k.try_forward_dynamics(&q, &u, &u).unwrap_err();
+    assert_eq!(err, ForwardDynamicsError::NotFinite("u̇"));
+    assert!(err.to_string().contains("not finite"));
+    assert!(k.forward_dynamics(&q, &u, &u).iter().all(|x| x.is_nan()));
 }

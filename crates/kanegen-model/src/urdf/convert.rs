@@ -23,6 +23,8 @@ pub(super) fn convert(
 ) -> Result<UrdfImport, K> {
     opts.check()?;
     let mut notes = Notes::default();
+    let (robot, mimics) = super::mimic::prepare(robot, opts.mimic, &mut notes);
+    let robot = robot.as_ref();
     let r = resolve(robot, opts, &mut notes)?;
     let wheel = match &opts.base {
         UrdfBase::Wheeled(w) => Some((w, wheeled::wheel_geometry(w, &r, &mut notes)?)),
@@ -44,6 +46,16 @@ pub(super) fn convert(
     add_moving_joints(&mut ir, &r);
     add_bodies(&mut ir, &r, matches!(base, Base::Fixed), &mut notes)?;
     let model = assemble(ir, base, robot, file, opts)?;
+    let mut mimic_notes = Vec::new();
+    let mut model = model.with_mimics(&mimics, &mut mimic_notes)?;
+    if !model.mimics.is_empty() {
+        model.description = format!(
+            "{} ({} of them dependent: mimic joints)",
+            model.description,
+            model.mimics.len()
+        );
+    }
+    mimic_notes.into_iter().for_each(|n| notes.push(n));
     Ok(UrdfImport {
         model,
         notes: notes.finish(),
@@ -163,7 +175,7 @@ fn dropped_links(
 }
 
 /// Checks the joints above the kept links (other than the top and the wheel joints), in file
-/// order: supported kinds, no `<mimic>`, finite numbers, a nonzero axis for moving joints.
+/// order: supported kinds, finite numbers, a nonzero axis for moving joints.
 fn check_joints(tree: &Tree<'_>, kept: &[usize], cut: &BaseCut, wheeled: bool) -> Result<(), K> {
     let mut is_kept = vec![false; tree.parent_joint.len()];
     for &l in kept {
@@ -189,18 +201,6 @@ fn check_joints(tree: &Tree<'_>, kept: &[usize], cut: &BaseCut, wheeled: bool) -
                 });
             }
             _ => {}
-        }
-        if let Some(mimic) = &j.mimic
-            && is_moving(&j.joint_type)
-        {
-            return Err(K::UrdfUnsupportedJoint {
-                joint: j.name.clone(),
-                kind: "mimic".into(),
-                fix: format!(
-                    "the joint copies `{}` (<mimic>), a constraint the generator cannot represent; remove <mimic> to make it an independent coordinate, or make it fixed",
-                    mimic.joint
-                ),
-            });
         }
         let axis = j.axis.xyz.0;
         if !finite3(j.origin.xyz.0) || !finite3(j.origin.rpy.0) || !finite3(axis) {
@@ -413,6 +413,7 @@ fn assemble(
             symbol: ir.gravity,
             direction: opts.gravity_direction,
         },
+        mimics: Vec::new(),
     };
     crate::names::check(&model)?;
     for (_, _, m) in model.mounted_links() {

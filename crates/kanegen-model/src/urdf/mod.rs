@@ -10,8 +10,12 @@
 //!   `iPj` (numeric constants, no length symbols), and the `<axis>` (normalised) is `e_j`.
 //! * **Fixed joints** merge the child link into its parent: the child's inertia is rotated and
 //!   shifted into the parent frame (Huygens–Steiner) and its children are re-attached with the
-//!   composed transform. `floating`, `planar`, `spherical` joints and `<mimic>` are typed errors
+//!   composed transform. `floating`, `planar`, `spherical` joints are typed errors
 //!   ([`ModelErrorKind::UrdfUnsupportedJoint`](crate::ModelErrorKind::UrdfUnsupportedJoint)) unless the base declaration replaces them.
+//! * **Mimic joints** (`<mimic joint multiplier offset>`): by default exact constraints
+//!   `q = a·q_master + b` in reduced coordinates (the joint has no speed of its own in generated
+//!   code; [`Model::mimics`], module `mimic`); [`UrdfOptions::mimic`] makes them independent
+//!   coordinates (Pinocchio's behaviour) or fixed at their offset ([`MimicMode`]).
 //! * **Inertia.** With the `<inertial><origin>` xyz = S and rpy = R, and the URDF inertia I about
 //!   the centre of mass in that frame: `I_G = R I Rᵀ`, `[MX, MY, MZ] = m·S`,
 //!   `J = I_G + m(|S|²·1 − S Sᵀ)` about the link origin (Khalil's standard parameters). A link with
@@ -51,6 +55,7 @@
 mod convert;
 mod diagnose;
 mod inertia;
+mod mimic;
 mod transform;
 mod tree;
 mod wheeled;
@@ -59,6 +64,7 @@ use std::path::Path;
 
 use crate::error::{ModelError, ModelErrorKind as K};
 use crate::ir::*;
+use crate::mimic::MimicMode;
 use crate::validate;
 
 /// Default of [`UrdfOptions::max_radius_of_gyration`], in metres.
@@ -235,6 +241,8 @@ pub struct UrdfOptions {
     /// Unit direction of gravity in the root frame (fixed base only; the wheeled base's heading
     /// frame has z up, so it must stay `[0, 0, −1]` there).
     pub gravity_direction: [f64; 3],
+    /// What to do with `<mimic>` joints (default: exact constraints, [`MimicMode::Exact`]).
+    pub mimic: MimicMode,
 }
 
 impl Default for UrdfOptions {
@@ -251,6 +259,7 @@ impl Default for UrdfOptions {
             zero_mass_inertia: ZeroMassInertia::Keep,
             gravity: 9.81,
             gravity_direction: [0.0, 0.0, -1.0],
+            mimic: MimicMode::Exact,
         }
     }
 }

@@ -16,7 +16,7 @@ mod raw_urdf;
 
 use common::*;
 use kanegen::{FunctionId, Options, generate_model};
-use kanegen_model::{Model, ModelErrorKind, UrdfImport, UrdfOptions};
+use kanegen_model::{MimicMode, Model, ModelErrorKind, UrdfImport, UrdfOptions};
 use kanegen_reference::Reference;
 use kanegen_reference::random::random_physical_params;
 use raw_urdf::RawUrdf;
@@ -28,8 +28,8 @@ const TOL: f64 = 1e-10;
 struct Entry {
     /// `tests/corpus/<file>.urdf`.
     file: &'static str,
-    /// Generalized speeds after the import (moving joints; `<mimic>` joints counted as
-    /// independent coordinates while the loader rejects them).
+    /// Speeds of the imported tree (every moving joint, `<mimic>` joints included); the
+    /// generated functions take `dof − mimic` independent speeds (exact mimic constraints).
     dof: usize,
     /// Joints with a `<mimic>` element.
     mimic: usize,
@@ -159,14 +159,10 @@ fn text(entry: &Entry) -> String {
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
-/// The hook for mimic joints (issue 15, item 2, built elsewhere): while the loader rejects
-/// `<mimic>`, a file with mimic joints is imported with its `<mimic>` elements removed, i.e. each
-/// mimic joint an independent coordinate — Pinocchio's behaviour. When the loader supports mimic
-/// constraints, load these files unmodified (exact constraints, fewer speeds) and compare with
-/// the reference's constrained model; keep this variant for the independent-coordinate option.
-///
-/// With `fixed`, mimic joints and the joints they copy are made fixed instead (Romeo: its
-/// hands' links are massless, so a hand joint moves nothing and M is singular, a typed error).
+/// A file with its `<mimic>` elements removed, i.e. each mimic joint an independent coordinate —
+/// Pinocchio's behaviour, as `MimicMode::Independent` imports it. With `fixed`, mimic joints and
+/// the joints they copy are made fixed instead (Romeo: its hands' links are massless, so a hand
+/// joint moves nothing and M is singular, a typed error, with or without the constraints).
 fn mimic_as_independent(text: &str, fixed: bool) -> String {
     let mut robot = urdf_rs::read_from_string(text).expect("corpus file parses");
     let masters: Vec<String> = robot
@@ -183,10 +179,11 @@ fn mimic_as_independent(text: &str, fixed: bool) -> String {
     urdf_rs::write_to_string(&robot).expect("urdf-rs writes what it read")
 }
 
-/// The text the corpus imports (mimic joints handled by the hook).
+/// The text the corpus imports: the file as it is (mimic joints as exact constraints), except
+/// for the files whose mimic joints are fixed.
 fn imported_text(entry: &Entry) -> String {
     let text = text(entry);
-    if entry.mimic > 0 {
+    if entry.fix_mimic {
         mimic_as_independent(&text, entry.fix_mimic)
     } else {
         text
@@ -210,10 +207,14 @@ fn options(entry: &Entry) -> UrdfOptions {
 }
 
 /// Worst relative errors of the lowered M, c, g, τ against the reference over `draws` draws
-/// (the first at the file's own parameters).
+/// (the first at the file's own parameters). With mimic joints the reference runs on the whole
+/// tree at the expanded state (`q_all = T q + b`, `u_all = T u`, `u̇_all = T u̇`) and its results
+/// are projected (`Tᵀ M T`, `Tᵀ c`, …).
 fn check(entry: &Entry, draws: usize) -> [f64; 4] {
     let model: Model = import(entry).model;
     assert_eq!(model.dof(), entry.dof, "{}: speeds", entry.file);
+    let constrained = if entry.fix_mimic { 0 } else { entry.mimic };
+    assert_eq!(model.mimics.len(), constrained, "{}: mimics", entry.file);
     let functions = [
         FunctionId::MassMatrix,
         FunctionId::Coriolis,
@@ -227,7 +228,7 @@ fn check(entry: &Entry, draws: usize) -> [f64; 4] {
     let g = generate_model(model.clone(), options)
         .unwrap_or_else(|e| panic!("{}: generation: {e}", entry.file));
     assert!(g.source.contains("pub fn mass_matrix"), "{}", entry.file);
-    let n = model.dof();
+    let n = model.independent_dof();
     let mut r = rng(0xC0 + n as u64);
     let mut worst = [0.0f64; 4];
     for draw in 0..draws {
@@ -238,11 +239,16 @@ fn check(entry: &Entry, draws: usize) -> [f64; 4] {
         };
         let (q, u, ud) = random_state(&mut r, n);
         let reference = Reference::<f64>::with_params(&model, &p);
+        let (qa, ua, uda) = (
+            model.expand_coordinates(&q),
+            model.expand_speeds(&u),
+            model.expand_speeds(&ud),
+        );
         let expected = [
-            drows(&reference.mass_matrix(&q)),
-            dvec(&reference.coriolis(&q, &u)),
-            dvec(&reference.gravity(&q)),
-            dvec(&reference.inverse_dynamics(&q, &u, &ud)),
+            model.project_matrix(&drows(&reference.mass_matrix(&qa))),
+            model.project_forces(&dvec(&reference.coriolis(&qa, &ua))),
+            model.project_forces(&dvec(&reference.gravity(&qa))),
+            model.project_forces(&dvec(&reference.inverse_dynamics(&qa, &ua, &uda))),
         ];
         for (i, f) in functions.iter().enumerate() {
             let l = g.lowered.evaluate(*f, &p, &q, &u, &ud);
@@ -315,20 +321,32 @@ fn romeo_with_independent_mimic_fingers_has_a_singular_mass_matrix() {
     );
 }
 
-/// While `<mimic>` is not supported, the unmodified files with mimic joints are a typed error
-/// naming the joint and the fix (this test changes when mimic constraints land: see
-/// [`mimic_as_independent`]).
+/// The files with mimic joints import with exact constraints by default (one speed fewer per
+/// mimic joint) and as Pinocchio does with `MimicMode::Independent` (every joint a speed).
 #[test]
-fn corpus_files_with_mimic_joints_are_typed_errors_for_now() {
-    for entry in CORPUS.iter().filter(|e| e.mimic > 0) {
-        let err = UrdfImport::parse(&text(entry), entry.file, &UrdfOptions::default())
-            .err()
-            .unwrap_or_else(|| panic!("{}: mimic accepted", entry.file));
-        assert!(
-            matches!(&err.kind, ModelErrorKind::UrdfUnsupportedJoint { kind, .. } if kind == "mimic"),
-            "{}: {err}",
+fn corpus_files_with_mimic_joints_import_with_exact_constraints() {
+    for entry in CORPUS.iter().filter(|e| e.mimic > 0 && !e.fix_mimic) {
+        let exact = UrdfImport::parse(&text(entry), entry.file, &options(entry))
+            .unwrap_or_else(|e| panic!("{}: {e}", entry.file))
+            .model;
+        assert_eq!(exact.dof(), entry.dof, "{}", entry.file);
+        assert_eq!(
+            exact.independent_dof(),
+            entry.dof - entry.mimic,
+            "{}",
             entry.file
         );
+        let independent = UrdfImport::parse(
+            &text(entry),
+            entry.file,
+            &UrdfOptions {
+                mimic: MimicMode::Independent,
+                ..options(entry)
+            },
+        )
+        .unwrap_or_else(|e| panic!("{}: {e}", entry.file))
+        .model;
+        assert_eq!(independent.independent_dof(), entry.dof, "{}", entry.file);
     }
 }
 

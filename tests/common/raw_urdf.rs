@@ -147,7 +147,9 @@ impl RawUrdf {
         )
         .expect("generates");
         let p = model.param_values();
-        let n = model.dof();
+        // Mimic joints: the generated functions take the independent coordinates; the raw
+        // file's energies are taken at the whole tree's expanded state.
+        let n = model.independent_dof();
         let mut r = rng(seed);
         let (mut worst_g, mut worst_t) = (0.0f64, 0.0f64);
         for _ in 0..draws {
@@ -160,7 +162,9 @@ impl RawUrdf {
                     let mut b = q.clone();
                     a[i] += h;
                     b[i] -= h;
-                    (self.potential(&a) - self.potential(&b)) / (2.0 * h)
+                    (self.potential(&model.expand_coordinates(&a))
+                        - self.potential(&model.expand_coordinates(&b)))
+                        / (2.0 * h)
                 })
                 .collect();
             worst_g = worst_g.max(rel_err(&gravity, &grad, 1.0));
@@ -172,7 +176,11 @@ impl RawUrdf {
                         .sum::<f64>()
                 })
                 .sum();
-            let raw_t = self.kinetic(&q, &u, 1e-5);
+            let raw_t = self.kinetic(
+                &model.expand_coordinates(&q),
+                &model.expand_speeds(&u),
+                1e-5,
+            );
             worst_t = worst_t.max((t - raw_t).abs() / t.abs().max(1e-3));
         }
         (worst_g, worst_t)

@@ -21,7 +21,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::Krang;
 use crate::actuators::ACTUATOR_COUNT;
-use crate::forward::{Block, MassMatrixCholesky, NotPositiveDefinite};
+use crate::forward::{MassMatrixCholesky, NotPositiveDefinite};
 
 /// The forward-dynamics derivatives of an `N`-speed model at one state:
 /// `u̇ = FD(q, u, τ)` and its partial derivatives.
@@ -209,7 +209,7 @@ impl crate::fixed_wheels::KrangFixedWheels {
     ) -> Result<ForwardDynamicsDerivatives<17>, NotPositiveDefinite> {
         // nalgebra's dense Cholesky: fixed-size, on the stack.
         let chol = self.mass_matrix(q).cholesky().ok_or(NotPositiveDefinite {
-            block: Block::Dense,
+            block: crate::forward::Block::Dense,
         })?;
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
         let ud = chol.solve(&(tau - bias));

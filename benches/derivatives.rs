@@ -92,8 +92,11 @@ fn bench(c: &mut Criterion) {
     cycle!("id_derivatives/central_differences", |q, u, ud| {
         central_differences(&k, q, u, ud)
     });
-    cycle!("forward_dynamics/generated", |q, u, ud| k
-        .forward_dynamics(q, u, &(ud * 10.0)));
+    cycle!("forward_dynamics/generated", |q, u, ud| k.forward_dynamics(
+        q,
+        u,
+        &(ud * 10.0)
+    ));
     cycle!("fd_derivatives/generated", |q, u, ud| k
         .forward_dynamics_derivatives(q, u, &(ud * 10.0)));
     let a = SVector::<f64, 18>::from_element(1.0);

@@ -45,12 +45,24 @@ fn lqr_example_balances_krang_and_writes_the_plots() {
     assert!(s.wip_closed_loop_radius < 1.0);
     // The full LQR brings the robot back to upright.
     assert!(s.full.max_pitch_error >= cfg.tilt * 0.99);
+    // Over the last of 3 s the pitch is within 0.02 rad (3.3e-3 at 5 s in the full run),
+    // the joints within 0.1 rad of the pose, and no torque was clamped.
     assert!(
-        s.full.final_pitch_error < 0.01,
+        s.full.final_pitch_error < 0.02,
         "{}",
         s.full.final_pitch_error
     );
-    assert!(s.full.final_joint_error < 0.05);
+    assert!(
+        s.full.final_joint_error < 0.1,
+        "{}",
+        s.full.final_joint_error
+    );
+    assert_eq!(s.full.saturated_steps, 0);
+    assert!(
+        s.wip.final_pitch_error < 0.02,
+        "{}",
+        s.wip.final_pitch_error
+    );
     for f in &s.files {
         let bytes = std::fs::read(f).unwrap();
         assert!(bytes.starts_with(b"\x89PNG"), "{}", f.display());

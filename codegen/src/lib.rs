@@ -300,6 +300,21 @@ impl Builder {
         self
     }
 
+    /// Whether the module has `inverse_dynamics_derivatives`, the exact `[∂τ/∂q | ∂τ/∂u]` of
+    /// inverse dynamics (default `false`): shorthand for adding or removing
+    /// [`FunctionId::InverseDynamicsDerivatives`] with [`Builder::functions`]. It is the
+    /// largest generated function (Krang: see README, section "Derivatives").
+    ///
+    /// ```no_run
+    /// kanegen::Builder::new("krang.toml").derivatives(true).run();
+    /// ```
+    pub fn derivatives(mut self, on: bool) -> Self {
+        let f = FunctionId::InverseDynamicsDerivatives;
+        let set = self.options.functions;
+        self.options.functions = if on { set.with(f) } else { set.without(f) };
+        self
+    }
+
     /// The floating-point type of the generated module (default [`Precision::F64`]). With
     /// [`Precision::F32`] every matrix, vector, `Params` field and literal is `f32`, and the
     /// default file name gets the suffix `_f32.rs`:

@@ -42,6 +42,8 @@ pub enum FunctionId {
     FrameJacobian,
     /// Acceleration of a body frame at `u̇ = 0`.
     FrameBiasAcceleration,
+    /// Derivatives of inverse dynamics `[∂τ/∂q | ∂τ/∂u]` (∂τ/∂u̇ = M).
+    InverseDynamicsDerivatives,
 }
 
 /// One dimension of a [`Shape::Dense`] result: the number of speeds N, or a constant.
@@ -51,6 +53,8 @@ pub enum Dim {
     N,
     /// A fixed size (3 for a point, 6 for a twist).
     Fixed(usize),
+    /// Twice the number of speeds: two N-column blocks side by side (`[∂τ/∂q | ∂τ/∂u]`).
+    TwoN,
 }
 
 impl Dim {
@@ -59,6 +63,7 @@ impl Dim {
         match self {
             Dim::N => n,
             Dim::Fixed(k) => k,
+            Dim::TwoN => 2 * n,
         }
     }
 }
@@ -190,7 +195,7 @@ pub struct FunctionSpec {
 }
 
 /// The registry, in the order generated modules define the functions.
-pub const FUNCTIONS: [FunctionSpec; 13] = [
+pub const FUNCTIONS: [FunctionSpec; 14] = [
     FunctionSpec {
         id: FunctionId::MassMatrix,
         name: "mass_matrix",
@@ -348,6 +353,20 @@ pub const FUNCTIONS: [FunctionSpec; 13] = [
         default: false,
         runtime_trait: None,
         per_frame: true,
+    },
+    FunctionSpec {
+        id: FunctionId::InverseDynamicsDerivatives,
+        name: "inverse_dynamics_derivatives",
+        symbol: "dtau",
+        doc: "Derivatives of inverse dynamics τ(q, u, u̇) = M u̇ + c + g: columns `0..N` are ∂τ/∂q (column j: ∂τ/∂q_j), columns `N..2N` are ∂τ/∂u (∂τ/∂u̇ is M). Exact (symbolic), structural zeros omitted.",
+        inputs: Inputs::QUUd,
+        shape: Shape::Dense {
+            rows: Dim::N,
+            cols: Dim::TwoN,
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
     },
 ];
 

@@ -9,6 +9,7 @@ fn main() {
     #[cfg(any(
         feature = "coriolis-matrix",
         feature = "kinematics",
+        feature = "derivatives",
         feature = "baked",
         feature = "f32",
         feature = "fixed-wheels",
@@ -20,6 +21,7 @@ fn main() {
 #[cfg(any(
     feature = "coriolis-matrix",
     feature = "kinematics",
+    feature = "derivatives",
     feature = "baked",
     feature = "f32",
     feature = "fixed-wheels",
@@ -30,8 +32,9 @@ fn generate() {
     let enabled = |feature: &str| std::env::var_os(format!("CARGO_FEATURE_{feature}")).is_some();
     let coriolis_matrix = enabled("CORIOLIS_MATRIX");
     let kinematics = enabled("KINEMATICS");
+    let derivatives = enabled("DERIVATIVES");
     let builder = |model: &str| kanegen::Builder::new(model).coriolis_matrix(coriolis_matrix);
-    if coriolis_matrix || kinematics {
+    if coriolis_matrix || kinematics || derivatives {
         // The main module, with the Coriolis matrix and/or the kinematics and energies (centre
         // of mass, frames, T, V).
         let mut functions = FunctionSet::default().without(FunctionId::CoriolisMatrix);
@@ -40,6 +43,9 @@ fn generate() {
         }
         if kinematics {
             functions = functions.union(FunctionSet::kinematics());
+        }
+        if derivatives {
+            functions = functions.with(FunctionId::InverseDynamicsDerivatives);
         }
         kanegen::Builder::new("krang.toml")
             .functions(functions)
@@ -54,9 +60,11 @@ fn generate() {
             .run();
     }
     if enabled("FIXED_WHEELS") {
-        builder("krang-fixed-wheels.toml").run();
+        builder("krang-fixed-wheels.toml")
+            .derivatives(derivatives)
+            .run();
     }
     if enabled("TWO_LINK") {
-        builder("two-link.toml").run();
+        builder("two-link.toml").derivatives(derivatives).run();
     }
 }

@@ -49,6 +49,7 @@
 mod algebra;
 mod composite;
 mod coriolis_matrix;
+mod derivatives;
 mod frames;
 mod gravity;
 mod kinematics;
@@ -132,7 +133,7 @@ pub fn names_of(model: &Model) -> Names {
 /// spills); g and C reuse those composites. The order fixes the arena's numbering and with it the
 /// generated code, so it is part of the output's definition. The opt-in kinematics come last, so
 /// that they do not change the dynamics' code.
-const DERIVATION_ORDER: [FunctionId; 13] = [
+const DERIVATION_ORDER: [FunctionId; 14] = [
     FunctionId::MassMatrix,
     FunctionId::Gravity,
     FunctionId::Coriolis,
@@ -146,6 +147,7 @@ const DERIVATION_ORDER: [FunctionId; 13] = [
     FunctionId::FramePose,
     FunctionId::FrameJacobian,
     FunctionId::FrameBiasAcceleration,
+    FunctionId::InverseDynamicsDerivatives,
 ];
 
 /// Derive the functions of `options.functions` for `model` (M as its upper triangle).
@@ -252,6 +254,7 @@ impl Ctx<'_> {
                 let comp = composites.get_or_insert_with(|| self.composites(true, None));
                 vec![(0, 0, self.potential_energy(comp))]
             }
+            FunctionId::InverseDynamicsDerivatives => self.inverse_dynamics_derivatives(),
             FunctionId::FramePose
             | FunctionId::FrameJacobian
             | FunctionId::FrameBiasAcceleration => {

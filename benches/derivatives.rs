@@ -1,0 +1,108 @@
+//! Criterion benchmarks of Krang's derivatives (19 speeds, `models/krang.toml`, the model
+//! file's parameters), ids `krang/<what>/<variant>`:
+//!
+//! * `inverse_dynamics/generated`: one generated τ call, the unit of the issue's target;
+//! * `id_derivatives/generated`: the generated `inverse_dynamics_derivatives` (both 19×19
+//!   matrices ∂τ/∂q, ∂τ/∂u);
+//! * `id_derivatives/central_differences`: the same two matrices by central differences of the
+//!   generated τ (2 × 2N = 76 calls; Richardson extrapolation would double that);
+//! * `forward_dynamics/generated`: `Krang::forward_dynamics` (τ with u̇ = 0, M, block Cholesky);
+//! * `fd_derivatives/generated`: `Krang::forward_dynamics_derivatives` (u̇, ∂u̇/∂q, ∂u̇/∂u, M⁻¹);
+//! * `linearize/generated`: `Krang::linearize` (A 38×38, B 38×18).
+//!
+//! Every variant cycles through the same 8 random states, inputs behind `black_box`.
+//!
+//! ```sh
+//! cargo bench --bench derivatives
+//! ```
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use kanegen_reference::random::SplitMix64;
+use krang_dynamics::Krang;
+use nalgebra::{SMatrix, SVector};
+
+type V = SVector<f64, 19>;
+
+/// 8 random states `(q, u, u̇)`: q in [−π, π], u in [−2, 2], u̇ in [−5, 5].
+fn states() -> Vec<(V, V, V)> {
+    let mut r = SplitMix64::new(12);
+    let mut v = |lo: f64, hi: f64| V::from_fn(|_, _| lo + (hi - lo) * r.next_f64());
+    (0..8)
+        .map(|_| {
+            let pi = std::f64::consts::PI;
+            (v(-pi, pi), v(-2.0, 2.0), v(-5.0, 5.0))
+        })
+        .collect()
+}
+
+/// ∂τ/∂q and ∂τ/∂u by central differences of the generated τ (step 1e-6).
+fn central_differences(k: &Krang, q: &V, u: &V, ud: &V) -> SMatrix<f64, 19, 38> {
+    let h = 1e-6;
+    let mut d = SMatrix::<f64, 19, 38>::zeros();
+    for j in 0..19 {
+        let (mut qp, mut qm) = (*q, *q);
+        qp[j] += h;
+        qm[j] -= h;
+        let col = (k.inverse_dynamics(&qp, u, ud) - k.inverse_dynamics(&qm, u, ud)) / (2.0 * h);
+        d.set_column(j, &col);
+        let (mut up, mut um) = (*u, *u);
+        up[j] += h;
+        um[j] -= h;
+        let col = (k.inverse_dynamics(q, &up, ud) - k.inverse_dynamics(q, &um, ud)) / (2.0 * h);
+        d.set_column(19 + j, &col);
+    }
+    d
+}
+
+fn bench(c: &mut Criterion) {
+    let k = Krang::default();
+    let s = states();
+    // Checked before timing: the generated derivatives agree with the differences.
+    for (q, u, ud) in &s {
+        let (g, f) = (
+            k.inverse_dynamics_derivatives(q, u, ud),
+            central_differences(&k, q, u, ud),
+        );
+        assert!((g - f).abs().max() <= 1e-4 * f.abs().max().max(1.0));
+    }
+    let mut g = c.benchmark_group("krang");
+    g.warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(2))
+        .sample_size(50);
+    macro_rules! cycle {
+        ($id:expr, |$q:ident, $u:ident, $ud:ident| $body:expr) => {
+            g.bench_function($id, |b| {
+                let mut i = 0;
+                b.iter(|| {
+                    let ($q, $u, $ud) = &s[i % s.len()];
+                    i += 1;
+                    let ($q, $u, $ud) = (black_box($q), black_box($u), black_box($ud));
+                    black_box($body)
+                })
+            });
+        };
+    }
+    cycle!("inverse_dynamics/generated", |q, u, ud| k
+        .inverse_dynamics(q, u, ud));
+    cycle!("id_derivatives/generated", |q, u, ud| k
+        .inverse_dynamics_derivatives(q, u, ud));
+    cycle!("id_derivatives/central_differences", |q, u, ud| {
+        central_differences(&k, q, u, ud)
+    });
+    cycle!("forward_dynamics/generated", |q, u, ud| k.forward_dynamics(
+        q,
+        u,
+        &(ud * 10.0)
+    ));
+    cycle!("fd_derivatives/generated", |q, u, ud| k
+        .forward_dynamics_derivatives(q, u, &(ud * 10.0)));
+    let a = SVector::<f64, 18>::from_element(1.0);
+    cycle!("linearize/generated", |q, u, _ud| k.linearize(q, u, &a));
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,242 @@
+//! Derivatives of the dynamics for LQR and MPC (feature `derivatives`).
+//!
+//! The generated `inverse_dynamics_derivatives(q, u, u̇)` gives the exact `∂τ/∂q` and `∂τ/∂u`
+//! of `τ = M(q) u̇ + c(q, u) + g(q)` (∂τ/∂u̇ = M). Forward dynamics `u̇ = FD(q, u, τ)` is the
+//! solution of `ID(q, u, u̇) = τ`, so by the implicit function theorem, at `u̇ = FD(q, u, τ)`,
+//!
+//! ```text
+//! ∂u̇/∂q = −M⁻¹ ∂τ/∂q,   ∂u̇/∂u = −M⁻¹ ∂τ/∂u,   ∂u̇/∂τ = M⁻¹
+//! ```
+//!
+//! with the products formed by triangular solves with the block Cholesky factor of M
+//! ([`MassMatrixCholesky`]), never by a dense inverse (M⁻¹ itself is one of the results, from
+//! 19 solves of unit vectors). Everything is fixed-size on the stack.
+//!
+//! [`Krang::linearize`] turns them into the `(A, B)` of `ẋ = f(x, a)` for the state
+//! `x = [q; u]` (38) and the 18 actuator torques `a` of the actuator map (`τ = B_act a`),
+//! with `q̇ = u` (the wheeled base's x and ψ are integrated from ẋ and ψ̇ like every other
+//! coordinate).
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::Krang;
+use crate::actuators::ACTUATOR_COUNT;
+use crate::forward::{MassMatrixCholesky, NotPositiveDefinite};
+
+/// The forward-dynamics derivatives of an `N`-speed model at one state:
+/// `u̇ = FD(q, u, τ)` and its partial derivatives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ForwardDynamicsDerivatives<const N: usize> {
+    /// `u̇ = M⁻¹ (τ − c − g)`, where the derivatives are taken.
+    pub ud: SVector<f64, N>,
+    /// `∂u̇/∂q` (column j: the derivative with respect to `q[j]`).
+    pub dud_dq: SMatrix<f64, N, N>,
+    /// `∂u̇/∂u`.
+    pub dud_du: SMatrix<f64, N, N>,
+    /// `∂u̇/∂τ = M⁻¹` (symmetric positive definite).
+    pub minv: SMatrix<f64, N, N>,
+}
+
+/// Splits the generated `[∂τ/∂q | ∂τ/∂u]` into its two square blocks.
+fn split<const N: usize, const N2: usize>(
+    d: &SMatrix<f64, N, N2>,
+) -> (SMatrix<f64, N, N>, SMatrix<f64, N, N>) {
+    (
+        d.fixed_view::<N, N>(0, 0).into_owned(),
+        d.fixed_view::<N, N>(0, N).into_owned(),
+    )
+}
+
+/// `x ← M⁻¹ x` column by column with Krang's block Cholesky factor.
+fn solve_columns<const C: usize>(chol: &MassMatrixCholesky, x: &mut SMatrix<f64, 19, C>) {
+    for j in 0..C {
+        let mut col: SVector<f64, 19> = x.column(j).into_owned();
+        chol.solve_mut(&mut col);
+        x.set_column(j, &col);
+    }
+}
+
+/// `(A, B)` of `ẋ = f(x, input)` for `x = [q; u]` and `q̇ = u`, from the forward-dynamics
+/// derivatives and `∂u̇/∂input`.
+fn state_space<const N: usize, const X: usize, const I: usize>(
+    fd: &ForwardDynamicsDerivatives<N>,
+    dud_dinput: &SMatrix<f64, N, I>,
+) -> (SMatrix<f64, X, X>, SMatrix<f64, X, I>) {
+    assert_eq!(X, 2 * N, "the state is [q; u]");
+    let mut a = SMatrix::<f64, X, X>::zeros();
+    for i in 0..N {
+        a[(i, N + i)] = 1.0;
+    }
+    a.fixed_view_mut::<N, N>(N, 0).copy_from(&fd.dud_dq);
+    a.fixed_view_mut::<N, N>(N, N).copy_from(&fd.dud_du);
+    let mut b = SMatrix::<f64, X, I>::zeros();
+    b.fixed_view_mut::<N, I>(N, 0).copy_from(dud_dinput);
+    (a, b)
+}
+
+impl Krang {
+    /// `(∂τ/∂q, ∂τ/∂u)` of inverse dynamics at `(q, u, u̇)`: the generated
+    /// [`inverse_dynamics_derivatives`](Self::inverse_dynamics_derivatives) as two 19×19
+    /// matrices. Columns `index::X` and `index::PSI` of ∂τ/∂q are exactly zero (the position
+    /// and heading do not enter the dynamics); ∂τ/∂u̇ is [`mass_matrix`](Self::mass_matrix).
+    pub fn inverse_dynamics_partials(
+        &self,
+        q: &SVector<f64, 19>,
+        u: &SVector<f64, 19>,
+        ud: &SVector<f64, 19>,
+    ) -> (SMatrix<f64, 19, 19>, SMatrix<f64, 19, 19>) {
+        split(&self.inverse_dynamics_derivatives(q, u, ud))
+    }
+
+    /// Forward dynamics and its derivatives at `(q, u, τ)`: `u̇ = FD(q, u, τ)`, `∂u̇/∂q`,
+    /// `∂u̇/∂u` and `M⁻¹ = ∂u̇/∂τ` (see the [module docs](self)). One inverse-dynamics pass,
+    /// one mass matrix and its block Cholesky factor, one derivative pass, 57 triangular
+    /// solve pairs. Allocation-free.
+    ///
+    /// # Errors
+    /// [`NotPositiveDefinite`] for non-physical parameters.
+    pub fn try_forward_dynamics_derivatives(
+        &self,
+        q: &SVector<f64, 19>,
+        u: &SVector<f64, 19>,
+        tau: &SVector<f64, 19>,
+    ) -> Result<ForwardDynamicsDerivatives<19>, NotPositiveDefinite> {
+        let chol = self.mass_matrix_cholesky(q)?;
+        let bias = self.inverse_dynamics(q, u, &SVector::zeros());
+        let ud = chol.solve(&(tau - bias));
+        let (mut dud_dq, mut dud_du) = self.inverse_dynamics_partials(q, u, &ud);
+        dud_dq = -dud_dq;
+        dud_du = -dud_du;
+        solve_columns(&chol, &mut dud_dq);
+        solve_columns(&chol, &mut dud_du);
+        let mut minv = SMatrix::<f64, 19, 19>::identity();
+        solve_columns(&chol, &mut minv);
+        Ok(ForwardDynamicsDerivatives {
+            ud,
+            dud_dq,
+            dud_du,
+            minv,
+        })
+    }
+
+    /// As [`try_forward_dynamics_derivatives`](Self::try_forward_dynamics_derivatives), but
+    /// infallible: for non-physical parameters every entry is NaN.
+    pub fn forward_dynamics_derivatives(
+        &self,
+        q: &SVector<f64, 19>,
+        u: &SVector<f64, 19>,
+        tau: &SVector<f64, 19>,
+    ) -> ForwardDynamicsDerivatives<19> {
+        self.try_forward_dynamics_derivatives(q, u, tau)
+            .unwrap_or_else(|_| nan_derivatives())
+    }
+
+    /// The linearization `(A, B)` of `ẋ = f(x, a)` at `(q, u, a)`, with the state
+    /// `x = [q; u]` (38: `q̇ = u`, `u̇ = FD(q, u, B_act a)`) and the 18 actuator torques `a`
+    /// of [`generalized_forces`](Self::generalized_forces) (`[τL, τR, τ_waist, τ_torso,
+    /// τ_1l … τ_7r]`, N·m): `A = [[0, I], [∂u̇/∂q, ∂u̇/∂u]]`, `B = [[0], [M⁻¹ B_act]]`.
+    /// Not at an equilibrium, `f(x, a)` itself is `[u; FD(q, u, B_act a)]`. NaN-filled for
+    /// non-physical parameters.
+    ///
+    /// ```
+    /// use krang_dynamics::{Krang, index};
+    /// use nalgebra::SVector;
+    ///
+    /// let k = Krang::default();
+    /// let mut q = SVector::<f64, 19>::zeros();
+    /// q[index::Q_IMU] = k.upright_pitch(&q);
+    /// // Hold the pose: the actuator torques that cancel gravity at the joints.
+    /// let g = k.gravity(&q);
+    /// let mut a = SVector::<f64, 18>::zeros();
+    /// for j in 2..18 {
+    ///     a[j] = g[j + 1];
+    /// }
+    /// let (a_mat, b_mat) = k.linearize(&q, &SVector::zeros(), &a);
+    /// assert_eq!(a_mat[(index::Q_IMU, 19 + index::QD_IMU)], 1.0);
+    /// assert!(b_mat.fixed_rows::<19>(0).iter().all(|&x| x == 0.0));
+    /// ```
+    pub fn linearize(
+        &self,
+        q: &SVector<f64, 19>,
+        u: &SVector<f64, 19>,
+        a: &SVector<f64, ACTUATOR_COUNT>,
+    ) -> (SMatrix<f64, 38, 38>, SMatrix<f64, 38, ACTUATOR_COUNT>) {
+        let Ok(chol) = self.mass_matrix_cholesky(q) else {
+            return (
+                SMatrix::from_element(f64::NAN),
+                SMatrix::from_element(f64::NAN),
+            );
+        };
+        let fd = self.forward_dynamics_derivatives(q, u, &self.generalized_forces(a));
+        let mut dud_da = self.actuator_matrix();
+        solve_columns(&chol, &mut dud_da);
+        state_space(&fd, &dud_da)
+    }
+}
+
+fn nan_derivatives<const N: usize>() -> ForwardDynamicsDerivatives<N> {
+    ForwardDynamicsDerivatives {
+        ud: SVector::from_element(f64::NAN),
+        dud_dq: SMatrix::from_element(f64::NAN),
+        dud_du: SMatrix::from_element(f64::NAN),
+        minv: SMatrix::from_element(f64::NAN),
+    }
+}
+
+#[cfg(feature = "fixed-wheels")]
+impl crate::fixed_wheels::KrangFixedWheels {
+    /// `(∂τ/∂q, ∂τ/∂u)` of the fixed-wheel model's inverse dynamics (17×17 each).
+    pub fn inverse_dynamics_partials(
+        &self,
+        q: &SVector<f64, 17>,
+        u: &SVector<f64, 17>,
+        ud: &SVector<f64, 17>,
+    ) -> (SMatrix<f64, 17, 17>, SMatrix<f64, 17, 17>) {
+        split(&self.inverse_dynamics_derivatives(q, u, ud))
+    }
+
+    /// Forward dynamics and its derivatives at `(q, u, τ)` (see
+    /// [`Krang::try_forward_dynamics_derivatives`]), with nalgebra's dense Cholesky (17×17,
+    /// on the stack).
+    ///
+    /// # Errors
+    /// [`NotPositiveDefinite`] for non-physical parameters.
+    pub fn try_forward_dynamics_derivatives(
+        &self,
+        q: &SVector<f64, 17>,
+        u: &SVector<f64, 17>,
+        tau: &SVector<f64, 17>,
+    ) -> Result<ForwardDynamicsDerivatives<17>, NotPositiveDefinite> {
+        // nalgebra's dense Cholesky: fixed-size, on the stack.
+        let chol = self.mass_matrix(q).cholesky().ok_or(NotPositiveDefinite {
+            block: crate::forward::Block::Dense,
+        })?;
+        let bias = self.inverse_dynamics(q, u, &SVector::zeros());
+        let ud = chol.solve(&(tau - bias));
+        let (dtau_dq, dtau_du) = self.inverse_dynamics_partials(q, u, &ud);
+        let dud_dq = -chol.solve(&dtau_dq);
+        let dud_du = -chol.solve(&dtau_du);
+        let minv = chol.inverse();
+        Ok(ForwardDynamicsDerivatives {
+            ud,
+            dud_dq,
+            dud_du,
+            minv,
+        })
+    }
+
+    /// The linearization `(A, B)` of the fixed-wheel model's `ẋ = f(x, τ)` for `x = [q; u]`
+    /// (34) and the 17 joint torques `τ` (every speed is actuated): `A = [[0, I], [∂u̇/∂q,
+    /// ∂u̇/∂u]]`, `B = [[0], [M⁻¹]]`. NaN-filled for non-physical parameters.
+    pub fn linearize(
+        &self,
+        q: &SVector<f64, 17>,
+        u: &SVector<f64, 17>,
+        tau: &SVector<f64, 17>,
+    ) -> (SMatrix<f64, 34, 34>, SMatrix<f64, 34, 17>) {
+        let fd = self
+            .try_forward_dynamics_derivatives(q, u, tau)
+            .unwrap_or_else(|_| nan_derivatives());
+        state_space(&fd, &fd.minv)
+    }
+}

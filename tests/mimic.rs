@@ -289,3 +289,49 @@ fn bad_mimics_are_typed_errors_naming_the_joint() {
             .any(|n| n.contains("mimic joint `left_inner`"))
     );
 }
+
+/// `[∂τ/∂q | ∂τ/∂u]` of the reduced model (columns: the independent speeds; the chain rule
+/// through `q_dep = a q_master + b` included) against central differences of the reduced τ.
+#[test]
+fn inverse_dynamics_derivatives_of_the_reduced_model_match_central_differences() {
+    let model = load(MimicMode::Exact);
+    let g = generated(&model);
+    let n = model.independent_dof();
+    let mut r = rng(0x31A1C);
+    for draw in 0..20 {
+        let p = if draw == 0 {
+            model.param_values()
+        } else {
+            random_physical_params(&model, &mut r)
+        };
+        let (q, u, ud) = random_state(&mut r, n);
+        let d = g
+            .lowered
+            .evaluate(FunctionId::InverseDynamicsDerivatives, &p, &q, &u, &ud);
+        assert_eq!(d.len(), n * 2 * n);
+        let tau = |q: &[f64], u: &[f64]| {
+            g.lowered
+                .evaluate(FunctionId::InverseDynamics, &p, q, u, &ud)
+        };
+        let h = 1e-6;
+        for j in 0..2 * n {
+            let (mut qa, mut qb, mut ua, mut ub) = (q.clone(), q.clone(), u.clone(), u.clone());
+            if j < n {
+                qa[j] += h;
+                qb[j] -= h;
+            } else {
+                ua[j - n] += h;
+                ub[j - n] -= h;
+            }
+            let (ta, tb) = (tau(&qa, &ua), tau(&qb, &ub));
+            for i in 0..n {
+                let fd = (ta[i] - tb[i]) / (2.0 * h);
+                let exact = d[i * 2 * n + j];
+                assert!(
+                    (exact - fd).abs() <= 1e-6 * (1.0 + fd.abs()),
+                    "draw {draw}: d tau_{i} / d x_{j}: {exact} vs {fd}"
+                );
+            }
+        }
+    }
+}

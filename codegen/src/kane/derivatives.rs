@@ -12,9 +12,14 @@ use crate::expr::{ExprId, Wrt};
 
 impl Ctx<'_> {
     /// `[∂τ/∂q | ∂τ/∂u]` as `(row, col, expr)`: column `j` is ∂τ/∂q_j, column `N + j` is ∂τ/∂u_j.
+    ///
+    /// Rows are the tree's speeds (a mimic model's rows are projected afterwards, like τ's);
+    /// columns are the `N` independent speeds only: the arena writes a mimic joint's leaves in
+    /// terms of its master, so the derivative in the master's coordinate already carries the
+    /// chain rule, and the dependent speeds (numbered last) are not inputs.
     pub(super) fn inverse_dynamics_derivatives(&mut self) -> Vec<(usize, usize, ExprId)> {
         let tau = self.rnea(true, true);
-        let n = tau.len();
+        let n = self.model.independent_dof();
         let mut out = Vec::new();
         for (col, wrt) in (0..n as u32)
             .map(Wrt::Coord)

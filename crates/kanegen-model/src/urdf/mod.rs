@@ -58,6 +58,7 @@ mod wheeled;
 use std::path::Path;
 
 use crate::error::{ModelError, ModelErrorKind as K};
+use crate::frames::OperationalFrame;
 use crate::ir::*;
 use crate::validate;
 
@@ -235,6 +236,14 @@ pub struct UrdfOptions {
     /// Unit direction of gravity in the root frame (fixed base only; the wheeled base's heading
     /// frame has z up, so it must stay `[0, 0, −1]` there).
     pub gravity_direction: [f64; 3],
+    /// Keep a frame for every link merged into its parent by fixed joints (default `true`): a
+    /// body-less frame fixed to the merged frame at the link's pose, so `frame_pose` etc. reach
+    /// it (a sensor or tool link of the URDF). Its inertia is merged either way.
+    pub link_frames: bool,
+    /// Tool frames to add ([`OperationalFrame`]: name, parent link, rotation, translation),
+    /// after the URDF's links, in this order; a parent may be any link of the model (merged ones
+    /// included while [`UrdfOptions::link_frames`] is on) or an earlier tool frame.
+    pub frames: Vec<OperationalFrame>,
 }
 
 impl Default for UrdfOptions {
@@ -251,6 +260,8 @@ impl Default for UrdfOptions {
             zero_mass_inertia: ZeroMassInertia::Keep,
             gravity: 9.81,
             gravity_direction: [0.0, 0.0, -1.0],
+            link_frames: true,
+            frames: Vec::new(),
         }
     }
 }
@@ -262,6 +273,12 @@ impl UrdfOptions {
             base: UrdfBase::Wheeled(spec),
             ..Self::default()
         }
+    }
+
+    /// These options with the tool frame `frame` added to [`UrdfOptions::frames`].
+    pub fn frame(mut self, frame: OperationalFrame) -> Self {
+        self.frames.push(frame);
+        self
     }
 
     /// These options with `links` added to [`UrdfOptions::drop_links`].

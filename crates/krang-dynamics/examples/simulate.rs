@@ -829,11 +829,17 @@ fn tracking(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>, summary: &mut Su
 // Plotting: plotters draws the lines; all text comes from the font8x8 bitmap font, so no
 // font feature (and no system font) is needed.
 
+/// A chart colour.
 pub const BLUE_: RGBColor = RGBColor(31, 119, 180);
+/// A chart colour.
 pub const RED_: RGBColor = RGBColor(214, 39, 40);
+/// A chart colour.
 pub const GREEN_: RGBColor = RGBColor(44, 160, 44);
+/// A chart colour.
 pub const ORANGE: RGBColor = RGBColor(255, 127, 14);
+/// A chart colour.
 pub const BLACK_: RGBColor = RGBColor(0, 0, 0);
+/// A chart colour.
 pub const GREY: RGBColor = RGBColor(140, 140, 140);
 const GRID: RGBColor = RGBColor(225, 225, 225);
 /// Distinct line colours (matplotlib's tab10 without grey), one per joint of a panel.

@@ -10,7 +10,10 @@
 //!   `iPj` (numeric constants, no length symbols), and the `<axis>` (normalised) is `e_j`.
 //! * **Fixed joints** merge the child link into its parent: the child's inertia is rotated and
 //!   shifted into the parent frame (Huygens–Steiner) and its children are re-attached with the
-//!   composed transform. `floating`, `planar`, `spherical` joints and `<mimic>` are typed errors
+//!   composed transform. The merged link keeps a body-less frame at its pose in the merged frame
+//!   ([`UrdfOptions::link_frames`], appended after the moving frames), so every link is
+//!   addressable by the kinematics; tool frames are added by [`UrdfOptions::frames`].
+//!   `floating`, `planar`, `spherical` joints and `<mimic>` are typed errors
 //!   ([`ModelErrorKind::UrdfUnsupportedJoint`](crate::ModelErrorKind::UrdfUnsupportedJoint)) unless the base declaration replaces them.
 //! * **Inertia.** With the `<inertial><origin>` xyz = S and rpy = R, and the URDF inertia I about
 //!   the centre of mass in that frame: `I_G = R I Rᵀ`, `[MX, MY, MZ] = m·S`,

@@ -93,7 +93,8 @@ fn axis(a: [f64; 3]) -> String {
 /// The frame tree: each frame under its parent, with its joint and body.
 fn frames(m: &Model, s: &mut String) {
     let _ = writeln!(s, "frames ({}), translations P in m:", m.links.len());
-    for (i, l) in m.links.iter().enumerate() {
+    for i in m.preorder() {
+        let l = &m.links[i];
         let indent = "  ".repeat(m.path_to_base(i).count() + 1);
         let _ = write!(s, "{indent}{}", l.name);
         if let Some(j) = l.joint() {

@@ -221,6 +221,8 @@ pub struct Builder {
     /// `Some` when the model file is a URDF to import with these options.
     urdf: Option<model::UrdfOptions>,
     precision: Precision,
+    /// Tool frames added to the loaded model ([`Builder::frame`]).
+    frames: Vec<model::OperationalFrame>,
 }
 
 impl Builder {
@@ -237,6 +239,7 @@ impl Builder {
             out_dir: None,
             urdf,
             precision: Precision::F64,
+            frames: Vec::new(),
         }
     }
 
@@ -341,12 +344,35 @@ impl Builder {
         self
     }
 
+    /// Adds an operational (tool) frame to the model, after the description's own frames: a
+    /// frame fixed to `frame.parent` at a constant offset (see [`model::OperationalFrame`]). It
+    /// joins the generated `Frame` type and the per-frame functions (`frame_pose`,
+    /// `frame_jacobian`, `frame_bias_acceleration`); a bad name, parent or rotation is a typed
+    /// error of [`Builder::generate`].
+    ///
+    /// ```no_run
+    /// use kanegen::model::OperationalFrame;
+    /// kanegen::Builder::new("arm.urdf")
+    ///     .frame(OperationalFrame::new("tool", "link7", [0.0, 0.0, 0.107]))
+    ///     .run();
+    /// ```
+    pub fn frame(mut self, frame: model::OperationalFrame) -> Self {
+        match &mut self.urdf {
+            Some(urdf) => urdf.frames.push(frame),
+            None => self.frames.push(frame),
+        }
+        self
+    }
+
     /// Run every stage and return the result without writing anything.
     pub fn generate(&self) -> Result<Generated, Error> {
         match &self.urdf {
             Some(urdf) => urdf_with(&self.model, urdf, self.options, self.precision),
             None => {
-                let model = model::Model::from_toml_file(&self.model)?;
+                let mut model = model::Model::from_toml_file(&self.model)?;
+                for f in &self.frames {
+                    model.add_frame(f)?;
+                }
                 let emit = EmitOptions {
                     precision: self.precision,
                     ..EmitOptions::default()

@@ -453,10 +453,12 @@ fn frame_jacobians_and_biases_are_the_derivatives_of_the_ground_pose() {
     }
 }
 
-/// A point mass `δm` at the origin of frame `l` (the body's mass grows, its first moment about
-/// the origin does not) adds `−J_vᵀ (δm g0)` to the reference recursion's generalized gravity
-/// forces: `Jᵀ f` for the force `f = δm g0` at the frame, an independent check of the Jacobian's
-/// columns as generalized forces.
+/// A point mass `δm` at the origin of frame `l` adds `−J_vᵀ (δm g0)` to the reference
+/// recursion's generalized gravity forces: `Jᵀ f` for the force `f = δm g0` at the frame, an
+/// independent check of the Jacobian's columns as generalized forces. The mass is added to the
+/// body the frame is rigidly fixed to (its own, or through fixed joints a parent's: operational
+/// frames and merged URDF links): `m += δm`, `MS += δm p` with `p` the frame's origin in the
+/// body frame (from the reference's frame states).
 #[test]
 fn jacobian_transpose_maps_a_force_at_the_frame_to_generalized_forces() {
     for mut c in cases() {
@@ -467,12 +469,26 @@ fn jacobian_transpose_maps_a_force_at_the_frame_to_generalized_forces() {
         };
         let links = c.model.links.clone();
         for (l, link) in links.iter().enumerate() {
-            let Some(body) = &link.body else { continue };
+            // The body frame `l` is rigidly fixed to.
+            let mut b = l;
+            while links[b].body.is_none() {
+                match &links[b].mount {
+                    Some(m) if m.joint.kind == kanegen::model::JointKind::Fixed => b = m.parent,
+                    _ => break,
+                }
+            }
+            let Some(body) = &links[b].body else { continue };
             let dm = 0.7;
+            let (q, _, _) = c.state();
+            let zero = vec![0.0; n];
+            let states = c.reference.frame_states(&q, &zero, &zero);
+            let p = states[b].rotation.transpose() * (states[l].position - states[b].position);
             let mut heavier = c.params.clone();
             heavier[body.mass] += dm;
+            for (k, &ms) in body.first_moment.iter().enumerate() {
+                heavier[ms] += dm * p[k];
+            }
             let with = Reference::with_params(&c.model, &heavier);
-            let (q, _, _) = c.state();
             let dg: Vec<f64> = (with.gravity(&q) - c.reference.gravity(&q))
                 .iter()
                 .copied()

@@ -370,6 +370,16 @@ pub enum ModelErrorKind {
     /// [`names`](crate::names)).
     #[error("{0}")]
     BadName(Box<BadName>),
+    /// An operational frame (`[[frame]]`, a URDF tool frame, [`Model::add_frame`](crate::Model::add_frame))
+    /// is malformed: an empty or taken name, an unknown parent, a rotation that is not proper or
+    /// a translation that is not finite.
+    #[error("operational frame `{frame}`: {detail}")]
+    BadFrame {
+        /// The frame's name.
+        frame: String,
+        /// What is wrong and how to fix it.
+        detail: String,
+    },
     /// Anything else about the base or gravity declarations.
     #[error("{item}: {detail}")]
     Invalid {

@@ -304,6 +304,19 @@ impl Model {
         })
     }
 
+    /// The link indices depth first from the base frame, children in index order: frames
+    /// appended after their parents' siblings (operational frames, merged URDF links) come right
+    /// after their parents' other children (for listings).
+    pub fn preorder(&self) -> Vec<usize> {
+        let mut order = Vec::with_capacity(self.links.len());
+        let mut stack = vec![0];
+        while let Some(i) = stack.pop() {
+            order.push(i);
+            stack.extend(self.children(i).into_iter().rev());
+        }
+        order
+    }
+
     /// The wheeled base, if the model has one.
     pub fn wheeled_base(&self) -> Option<&WheeledBase> {
         match &self.base {
@@ -356,7 +369,8 @@ impl fmt::Display for Model {
             self.params[g.symbol].name, g.direction
         )?;
         writeln!(f, "frames ({}):", self.links.len())?;
-        for (i, l) in self.links.iter().enumerate() {
+        for i in self.preorder() {
+            let l = &self.links[i];
             let indent = "  ".repeat(self.path_to_base(i).count() + 1);
             match l.joint() {
                 None => write!(f, "{indent}{}", l.name)?,

@@ -14,6 +14,7 @@
 #![forbid(unsafe_code)]
 
 mod error;
+mod frames;
 mod ident;
 mod ir;
 mod mass_matrix;
@@ -24,6 +25,7 @@ pub mod urdf;
 mod validate;
 
 pub use error::{BadName, ModelError, ModelErrorKind};
+pub use frames::OperationalFrame;
 pub use ident::{is_keyword, sanitize_identifier};
 pub use ir::*;
 pub use mass_matrix::kinetic_energy_mass_matrix;

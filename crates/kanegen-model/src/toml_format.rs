@@ -30,7 +30,16 @@
 //!
 //! [[body]]
 //! frame = "1"                           # symbols m1, MX1..MZ1, XX1..ZZ1 (suffix = name, default frame)
+//!
+//! [[frame]]                             # an operational frame: fixed to a frame, no body
+//! name = "tool"
+//! parent = "1"                          # a joint's child frame, the base frame or an earlier [[frame]]
+//! rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]   # parentAframe by rows (default: identity)
+//! translation = [0, 0, "L1"]            # the origin in the parent frame: numbers or [-]SYMBOL
 //! ```
+//!
+//! Operational frames are appended after the joints' frames, in file order (see
+//! [`OperationalFrame`](crate::OperationalFrame)).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -52,6 +61,22 @@ struct File {
     joints: Vec<JointSection>,
     #[serde(default, rename = "body")]
     bodies: Vec<BodySection>,
+    #[serde(default, rename = "frame")]
+    frames: Vec<FrameSection>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FrameSection {
+    name: String,
+    parent: String,
+    #[serde(default = "identity")]
+    rotation: [[f64; 3]; 3],
+    translation: [LengthEntry; 3],
+}
+
+fn identity() -> [[f64; 3]; 3] {
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
 }
 
 #[derive(Debug, Deserialize)]
@@ -314,8 +339,20 @@ fn build(f: File, file: &str) -> Result<Model, K> {
 
     let (mut links, placed) = build_frames(&f.joints, &base_frame, &mut syms, &mut speeds)?;
     add_bodies(&f.bodies, &placed, &mut links, &mut syms)?;
+    let frame_offsets = f
+        .frames
+        .iter()
+        .map(|fr| {
+            let t = &fr.translation;
+            Ok([
+                parse_length(&t[0], &fr.name, &mut syms)?,
+                parse_length(&t[1], &fr.name, &mut syms)?,
+                parse_length(&t[2], &fr.name, &mut syms)?,
+            ])
+        })
+        .collect::<Result<Vec<_>, K>>()?;
 
-    let model = Model {
+    let mut model = Model {
         name: f.model.name,
         description: f.model.description,
         source: file.to_owned(),
@@ -329,6 +366,16 @@ fn build(f: File, file: &str) -> Result<Model, K> {
         },
         mimics: Vec::new(),
     };
+    for (fr, translation) in f.frames.iter().zip(frame_offsets) {
+        crate::frames::add_fixed_frame(
+            &mut model,
+            &fr.name,
+            &fr.parent,
+            fr.rotation,
+            translation,
+            &fr.name,
+        )?;
+    }
     crate::names::check(&model)?;
     validate::check_physics(&model, validate::TOLERANCE)?;
     Ok(model)

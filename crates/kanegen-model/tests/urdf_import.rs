@@ -104,7 +104,11 @@ fn rpy_axes_kinds_and_names() {
     assert_eq!(m.name, "test-arm");
     assert_eq!(m.base, Base::Fixed);
     let names: Vec<&str> = m.links.iter().map(|l| l.name.as_str()).collect();
-    assert_eq!(names, ["world", "upper-arm", "slider"]);
+    // The moving frames first, then the links merged by fixed joints (UrdfOptions::link_frames).
+    assert_eq!(names, ["world", "upper-arm", "slider", "flange", "marker"]);
+    let flange = m.links[3].mount.as_ref().unwrap();
+    assert_eq!((flange.parent, flange.joint.kind), (1, JointKind::Fixed));
+    assert!(m.links[3].body.is_none() && m.links[4].body.is_none());
     let speeds: Vec<(&str, &str)> = m
         .speeds
         .iter()

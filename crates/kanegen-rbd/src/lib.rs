@@ -8,7 +8,9 @@
 //! * [`Rbd::inverse_dynamics`]: the recursive Newton–Euler algorithm (RNEA), `τ(q, u, u̇)`;
 //! * [`Rbd::coriolis`]: RNEA with `u̇ = 0` and no gravity, `c(q, u)`;
 //! * [`Rbd::gravity`]: a gravity-only pass `g(q)` using composite masses and first moments;
-//! * [`Rbd::kinetic_energy`]: `½ uᵀ M u` from the link velocities.
+//! * [`Rbd::kinetic_energy`]: `½ uᵀ M u` from the link velocities;
+//! * [`Rbd::frame_pose`], [`Rbd::frame_jacobian`], [`Rbd::frame_bias_acceleration`]: one frame's
+//!   kinematics ([`RbdFrame`]), a pass down its path only.
 //!
 //! # Formulation
 //!
@@ -77,6 +79,7 @@
 
 mod algorithms;
 mod build;
+mod frames;
 mod rot;
 mod scalar;
 
@@ -84,6 +87,7 @@ use std::fmt;
 
 use kanegen_model::Model;
 
+pub use frames::RbdFrame;
 use scalar::{M3, S3, V3};
 pub use scalar::{Scalar, sin_cos_f64};
 

@@ -3,9 +3,10 @@
 //! (a) The 19-speed Krang released at rest 0.3 rad from upright (centre of mass above the
 //!     axle) with zero wheel and joint torques. The model has no ground contact, so the body
 //!     swings through below the axle like a pendulum on a cart while the free wheels roll.
-//!     Total energy `½ uᵀ M u + V` must be conserved; `V = −Σ g0·(m_k ⁰P_k + ⁰A_k MS_k)` is
-//!     computed here by forward kinematics from `krang.toml` (independently of the generated
-//!     gravity vector), and the power balance `Δ(½ uᵀ M u) = −∫ uᵀ g dt` is integrated too.
+//!     Total energy `T + V` must be conserved, with the generated `kinetic_energy` (`½ uᵀ M u`)
+//!     and `potential_energy`; `V = −Σ g0·(m_k ⁰P_k + ⁰A_k MS_k)` is also computed here by
+//!     forward kinematics from `krang.toml` (independently of the generated code) and compared,
+//!     and the power balance `Δ(½ uᵀ M u) = −∫ uᵀ g dt` is integrated too.
 //! (b) The fixed-wheel model (17 speeds): base pitch held, waist, torso and both arms tracking
 //!     sinusoids under computed-torque control `τ = M(q)(q̈_des + Kd ė + Kp e) + c + g`, with
 //!     `e = q_des − q` (`_des` for desired: `qd` names a speed everywhere else; one
@@ -14,7 +15,7 @@
 //!     that does not know about a 1 kg payload in each gripper.
 //!
 //! ```text
-//! cargo run --release -p krang-dynamics --features fixed-wheels --example simulate -- [DIR]
+//! cargo run --release -p krang-dynamics --features fixed-wheels,kinematics --example simulate -- [DIR]
 //! ```
 //! writes `pitch.png`, `heading.png`, `energy.png` and `tracking.png` to DIR (default
 //! `target/plots`) and prints the energy drift. The README's images are regenerated with
@@ -77,6 +78,9 @@ pub struct Summary {
     /// `max |V_FK(q) − V_FK(q₀) − ∫ uᵀ g dt|` relative to the largest kinetic energy: the
     /// generated g is the gradient of the FK potential along the trajectory.
     pub potential_vs_gravity_relative: f64,
+    /// `max |V_generated − V_FK|` over run (a), relative to the largest kinetic energy: the
+    /// generated `potential_energy` is the FK potential.
+    pub potential_generated_vs_fk_relative: f64,
     /// Largest kinetic energy reached in (a) (J).
     pub max_kinetic_energy: f64,
     /// Largest joint speed reached in (a) (rad/s).
@@ -130,8 +134,10 @@ fn main() -> Res<()> {
         s.energy_drift, s.energy_drift_relative
     );
     println!(
-        "    power balance ½uᵀMu + ∫uᵀg: {:.2e}; V_FK − ∫uᵀg: {:.2e} (relative)",
-        s.power_balance_relative, s.potential_vs_gravity_relative
+        "    power balance ½uᵀMu + ∫uᵀg: {:.2e}; V − ∫uᵀg: {:.2e}; V − V_FK: {:.1e} (relative)",
+        s.power_balance_relative,
+        s.potential_vs_gravity_relative,
+        s.potential_generated_vs_fk_relative
     );
     println!(
         "(b) fixed wheels, computed torque every {} s, sinusoids; {} s",
@@ -311,7 +317,7 @@ impl Kinematics {
 // Integration.
 
 /// One classic Runge–Kutta step of `ẋ = f(t, x)`.
-fn rk4<const N: usize>(
+pub fn rk4<const N: usize>(
     f: impl Fn(f64, &SVector<f64, N>) -> SVector<f64, N>,
     t: f64,
     x: &SVector<f64, N>,
@@ -325,7 +331,7 @@ fn rk4<const N: usize>(
 }
 
 /// The pose of (a): waist and torso straight, asymmetric arms (so that the fall also turns).
-fn pose() -> SVector<f64, 19> {
+pub fn pose() -> SVector<f64, 19> {
     let mut q = SVector::<f64, 19>::zeros();
     q[index::Q_W] = 0.4;
     q[index::Q_TORSO] = 0.2;
@@ -346,6 +352,7 @@ struct Sample {
     y: f64,
     kinetic: f64,
     potential: f64,
+    potential_fk: f64,
     work_gravity: f64,
 }
 
@@ -425,7 +432,7 @@ fn falling_plots(
         (1000, 760),
         &[
             Panel {
-                title: "(a) energy; potential V by forward kinematics".into(),
+                title: "(a) energy (generated T and V)".into(),
                 y_label: "energy (J)",
                 series: vec![
                     Series::line("kinetic ½u'Mu", RED_, time(&|p| p.kinetic)),
@@ -497,8 +504,9 @@ fn falling(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>) -> Res<Summary> {
             psi: q[index::PSI],
             x: s[39],
             y: s[40],
-            kinetic: 0.5 * u.dot(&(k.mass_matrix(&q) * u)),
-            potential: fk.potential(&q),
+            kinetic: k.kinetic_energy(&q, &u),
+            potential: k.potential_energy(&q),
+            potential_fk: fk.potential(&q),
             work_gravity: s[38],
         }
     };
@@ -526,6 +534,7 @@ fn falling(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>) -> Res<Summary> {
     let drift = worst(&|p| p.kinetic + p.potential - e0);
     let power = worst(&|p| p.kinetic - k0 + p.work_gravity);
     let grad = worst(&|p| p.potential - v0 - p.work_gravity);
+    let generated_vs_fk = worst(&|p| p.potential - p.potential_fk);
     let tilt_min = log.iter().map(|p| p.tilt).fold(f64::INFINITY, f64::min);
     let tilt_max = log.iter().map(|p| p.tilt).fold(f64::NEG_INFINITY, f64::max);
 
@@ -551,6 +560,7 @@ fn falling(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>) -> Res<Summary> {
         energy_drift_relative: drift / ke_max,
         power_balance_relative: power / ke_max,
         potential_vs_gravity_relative: grad / ke_max,
+        potential_generated_vs_fk_relative: generated_vs_fk / ke_max,
         max_kinetic_energy: ke_max,
         max_joint_speed: max_speed,
         tilt_range: (tilt_min, tilt_max),
@@ -819,15 +829,21 @@ fn tracking(dir: &Path, cfg: &Config, files: &mut Vec<PathBuf>, summary: &mut Su
 // Plotting: plotters draws the lines; all text comes from the font8x8 bitmap font, so no
 // font feature (and no system font) is needed.
 
-const BLUE_: RGBColor = RGBColor(31, 119, 180);
-const RED_: RGBColor = RGBColor(214, 39, 40);
-const GREEN_: RGBColor = RGBColor(44, 160, 44);
-const ORANGE: RGBColor = RGBColor(255, 127, 14);
-const BLACK_: RGBColor = RGBColor(0, 0, 0);
-const GREY: RGBColor = RGBColor(140, 140, 140);
+/// A chart colour.
+pub const BLUE_: RGBColor = RGBColor(31, 119, 180);
+/// A chart colour.
+pub const RED_: RGBColor = RGBColor(214, 39, 40);
+/// A chart colour.
+pub const GREEN_: RGBColor = RGBColor(44, 160, 44);
+/// A chart colour.
+pub const ORANGE: RGBColor = RGBColor(255, 127, 14);
+/// A chart colour.
+pub const BLACK_: RGBColor = RGBColor(0, 0, 0);
+/// A chart colour.
+pub const GREY: RGBColor = RGBColor(140, 140, 140);
 const GRID: RGBColor = RGBColor(225, 225, 225);
 /// Distinct line colours (matplotlib's tab10 without grey), one per joint of a panel.
-const PALETTE: [RGBColor; 7] = [
+pub const PALETTE: [RGBColor; 7] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
@@ -837,15 +853,21 @@ const PALETTE: [RGBColor; 7] = [
     RGBColor(227, 119, 194),
 ];
 
-struct Series {
-    label: &'static str,
-    color: RGBColor,
-    dashed: bool,
-    points: Vec<(f64, f64)>,
+/// One line of a chart (also used by the `whole_body` example).
+pub struct Series {
+    /// Legend text (empty: no legend entry).
+    pub label: &'static str,
+    /// Line colour.
+    pub color: RGBColor,
+    /// Dashed instead of solid.
+    pub dashed: bool,
+    /// `(x, y)` points.
+    pub points: Vec<(f64, f64)>,
 }
 
 impl Series {
-    fn line(label: &'static str, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
+    /// A solid line.
+    pub fn line(label: &'static str, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
         Self {
             label,
             color,
@@ -854,7 +876,8 @@ impl Series {
         }
     }
 
-    fn dashed(label: &'static str, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
+    /// A dashed line.
+    pub fn dashed(label: &'static str, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
         Self {
             label,
             color,
@@ -864,10 +887,14 @@ impl Series {
     }
 }
 
-struct Panel {
-    title: String,
-    y_label: &'static str,
-    series: Vec<Series>,
+/// One chart of a figure: title, y-axis label (time is the x axis) and lines.
+pub struct Panel {
+    /// Title above the chart.
+    pub title: String,
+    /// The y-axis label, with units.
+    pub y_label: &'static str,
+    /// The lines.
+    pub series: Vec<Series>,
 }
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
@@ -939,7 +966,8 @@ fn tick_label(v: f64, step: f64) -> String {
     format!("{v:.decimals$}")
 }
 
-fn figure(path: &Path, size: (u32, u32), panels: &[Panel]) -> Res<()> {
+/// Writes `panels`, stacked, as a PNG of `size` pixels.
+pub fn figure(path: &Path, size: (u32, u32), panels: &[Panel]) -> Res<()> {
     let root = BitMapBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE)?;
     let areas = root.split_evenly((panels.len(), 1));

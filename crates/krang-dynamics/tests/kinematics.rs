@@ -65,3 +65,35 @@ fn a_hand_frame_moves_with_its_jacobian() {
         assert!((ju.fixed_rows::<3>(0) - v).amax() < 1e-7, "{ju} {v}");
     }
 }
+
+#[test]
+fn the_hands_sit_at_the_gripper_offset_from_the_wrists() {
+    let k = Krang::default();
+    for (name, wrist) in [("left_hand", Frame::F10l), ("right_hand", Frame::F10r)] {
+        let hand = Frame::from_name(name).expect("Krang has the hand frames");
+        assert_eq!(hand.name(), name);
+        for (q, u) in states() {
+            let w = k.frame_pose(&q, wrist);
+            let h = k.frame_pose(&q, hand);
+            // krang.toml: [0, 0, 0.17315] in frame 10, the wrist's axes.
+            let expected = w * nalgebra::Point3::new(0.0, 0.0, 0.17315);
+            assert!((h.translation.vector - expected.coords).amax() < 1e-12);
+            assert!(
+                (h.rotation.to_rotation_matrix().matrix()
+                    - w.rotation.to_rotation_matrix().matrix())
+                .amax()
+                    < 1e-12
+            );
+            // Same angular velocity as the wrist; linear velocity v_w + ω × r.
+            let (jh, jw) = (
+                k.frame_jacobian(&q, hand) * u,
+                k.frame_jacobian(&q, wrist) * u,
+            );
+            let omega = jw.fixed_rows::<3>(3).into_owned();
+            assert!((jh.fixed_rows::<3>(3) - omega).amax() < 1e-12);
+            let r = h.translation.vector - w.translation.vector;
+            let v = jw.fixed_rows::<3>(0) + omega.cross(&r);
+            assert!((jh.fixed_rows::<3>(0) - v).amax() < 1e-10);
+        }
+    }
+}

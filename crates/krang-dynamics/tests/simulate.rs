@@ -2,7 +2,7 @@
 //! checks what the example claims: energy conservation of the zero-torque fall, the upright
 //! pitch by forward kinematics, computed-torque tracking, and the four PNG files.
 //!
-//! The full run is `cargo run --release -p krang-dynamics --example simulate -- DIR`.
+//! The full run is `cargo run --release -p krang-dynamics --features fixed-wheels,kinematics --example simulate -- DIR`.
 
 #[allow(dead_code)]
 #[path = "../examples/simulate.rs"]
@@ -36,6 +36,8 @@ fn simulate_example_conserves_energy_tracks_and_writes_the_plots() {
     assert!(s.power_balance_relative < 1e-6);
     // g is the gradient of the FK potential: V(q) − V(q0) = ∫ uᵀ g dt up to quadrature error.
     assert!(s.potential_vs_gravity_relative < 1e-8);
+    // The generated potential energy is the FK potential of the example.
+    assert!(s.potential_generated_vs_fk_relative < 1e-12);
     // Computed torque: the exact model tracks to what the 1 kHz hold leaves; an unmodelled
     // payload leaves far more.
     assert!(s.tracking_error_exact < 1e-2);

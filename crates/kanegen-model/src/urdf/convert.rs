@@ -45,6 +45,9 @@ pub(super) fn convert(
     };
     add_moving_joints(&mut ir, &r);
     add_bodies(&mut ir, &r, matches!(base, Base::Fixed), &mut notes)?;
+    if opts.link_frames {
+        add_link_frames(&mut ir, &r);
+    }
     let model = assemble(ir, base, robot, file, opts)?;
     let mut mimic_notes = Vec::new();
     let mut model = model.with_mimics(&mimics, &mut mimic_notes)?;
@@ -56,6 +59,16 @@ pub(super) fn convert(
         );
     }
     mimic_notes.into_iter().for_each(|n| notes.push(n));
+    for f in &opts.frames {
+        if let Some(x) = f.translation.iter().find(|x| !x.is_finite()) {
+            return Err(K::BadFrame {
+                frame: f.name.clone(),
+                detail: format!("translation entry {x} is not a finite number (metres)"),
+            });
+        }
+        let t = f.translation.map(Length::number);
+        crate::frames::add_fixed_frame(&mut model, &f.name, &f.parent, f.rotation, t, &f.name)?;
+    }
     Ok(UrdfImport {
         model,
         notes: notes.finish(),
@@ -294,6 +307,41 @@ fn add_moving_joints(ir: &mut Ir, r: &Resolved<'_>) {
                         JointKind::Revolute { speed }
                     },
                     axis: [axis.x, axis.y, axis.z].map(clean),
+                    rotation: rows(&t.r),
+                    translation: numbers(t.p),
+                },
+            }),
+            body: None,
+        });
+    }
+}
+
+/// Adds a body-less frame for every kept link merged into its cluster's frame by fixed joints
+/// (wheels excepted), mounted on that frame by a fixed joint with the link's pose in it (the
+/// composition of the fixed joints' origins), so that its pose survives the inertia merge. The
+/// frames are appended in depth-first order after the moving joints' frames.
+fn add_link_frames(ir: &mut Ir, r: &Resolved<'_>) {
+    let (tree, cl) = (&r.tree, &r.clusters);
+    for &l in &r.kept {
+        if r.cut.wheel_part[l] || ir.ir_index.contains_key(&l) {
+            continue;
+        }
+        let Some(&parent) = ir.ir_index.get(&cl.rep(l)) else {
+            continue;
+        };
+        let t = cl.in_rep(l);
+        let joint = match tree.parent_joint[l] {
+            Some(k) if l != r.cut.top => tree.joint(k).name.clone(),
+            _ => format!("{} (fixed)", tree.link(l).name),
+        };
+        ir.links.push(Link {
+            name: tree.link(l).name.clone(),
+            mount: Some(Mount {
+                parent,
+                joint: Joint {
+                    name: joint,
+                    kind: JointKind::Fixed,
+                    axis: [0.0, 0.0, 1.0],
                     rotation: rows(&t.r),
                     translation: numbers(t.p),
                 },

@@ -10,7 +10,10 @@
 //!   `iPj` (numeric constants, no length symbols), and the `<axis>` (normalised) is `e_j`.
 //! * **Fixed joints** merge the child link into its parent: the child's inertia is rotated and
 //!   shifted into the parent frame (Huygens–Steiner) and its children are re-attached with the
-//!   composed transform. `floating`, `planar`, `spherical` joints are typed errors
+//!   composed transform. The merged link keeps a body-less frame at its pose in the merged frame
+//!   ([`UrdfOptions::link_frames`], appended after the moving frames), so every link is
+//!   addressable by the kinematics; tool frames are added by [`UrdfOptions::frames`].
+//!   `floating`, `planar`, `spherical` joints are typed errors
 //!   ([`ModelErrorKind::UrdfUnsupportedJoint`](crate::ModelErrorKind::UrdfUnsupportedJoint)) unless the base declaration replaces them.
 //! * **Mimic joints** (`<mimic joint multiplier offset>`): by default exact constraints
 //!   `q = a·q_master + b` in reduced coordinates (the joint has no speed of its own in generated
@@ -63,6 +66,7 @@ mod wheeled;
 use std::path::Path;
 
 use crate::error::{ModelError, ModelErrorKind as K};
+use crate::frames::OperationalFrame;
 use crate::ir::*;
 use crate::mimic::MimicMode;
 use crate::validate;
@@ -243,6 +247,14 @@ pub struct UrdfOptions {
     pub gravity_direction: [f64; 3],
     /// What to do with `<mimic>` joints (default: exact constraints, [`MimicMode::Exact`]).
     pub mimic: MimicMode,
+    /// Keep a frame for every link merged into its parent by fixed joints (default `true`): a
+    /// body-less frame fixed to the merged frame at the link's pose, so `frame_pose` etc. reach
+    /// it (a sensor or tool link of the URDF). Its inertia is merged either way.
+    pub link_frames: bool,
+    /// Tool frames to add ([`OperationalFrame`]: name, parent link, rotation, translation),
+    /// after the URDF's links, in this order; a parent may be any link of the model (merged ones
+    /// included while [`UrdfOptions::link_frames`] is on) or an earlier tool frame.
+    pub frames: Vec<OperationalFrame>,
 }
 
 impl Default for UrdfOptions {
@@ -260,6 +272,8 @@ impl Default for UrdfOptions {
             gravity: 9.81,
             gravity_direction: [0.0, 0.0, -1.0],
             mimic: MimicMode::Exact,
+            link_frames: true,
+            frames: Vec::new(),
         }
     }
 }
@@ -271,6 +285,12 @@ impl UrdfOptions {
             base: UrdfBase::Wheeled(spec),
             ..Self::default()
         }
+    }
+
+    /// These options with the tool frame `frame` added to [`UrdfOptions::frames`].
+    pub fn frame(mut self, frame: OperationalFrame) -> Self {
+        self.frames.push(frame);
+        self
     }
 
     /// These options with `links` added to [`UrdfOptions::drop_links`].

@@ -197,6 +197,10 @@ pub struct Lowered {
     pub dof: usize,
     /// Parameter mode.
     pub params: ParamMode,
+    /// Result sizes (speeds, regressor columns).
+    pub sizes: crate::registry::Sizes,
+    /// The regressors' parameters and base parameters (see [`Derivation::regressors`]).
+    pub regressors: crate::kane::Regressors,
 }
 
 impl Lowered {
@@ -241,6 +245,8 @@ pub fn lower(d: &Derivation) -> Lowered {
         functions,
         dof: d.dof,
         params: d.options.params,
+        sizes: d.sizes,
+        regressors: d.regressors.clone(),
     }
 }
 
@@ -670,7 +676,7 @@ impl Lowered {
             locals: &locals,
         };
         let entries = p.outputs.iter().map(|(r, c, e)| (*r, *c, ctx.eval(e)));
-        id.spec().shape.dense(self.dof, entries)
+        id.spec().shape.dense_in(&self.sizes, entries)
     }
 }
 

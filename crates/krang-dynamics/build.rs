@@ -3,12 +3,13 @@
 //! with `--cfg feature="..."` and sets `CARGO_FEATURE_<NAME>`, `-` as `_`). Without features
 //! this script does nothing and `kanegen` is not even a build dependency: the default module
 //! (f64 Krang with M, c, g and inverse dynamics) is pre-generated in `src/generated/krang.rs`
-//! (`tests/pregenerated.rs` checks it against the generator). With `coriolis-matrix` or
-//! `kinematics` the Krang module is generated here instead, with those functions.
+//! (`tests/pregenerated.rs` checks it against the generator). With `coriolis-matrix`,
+//! `kinematics` or `regressors` the Krang module is generated here instead, with those functions.
 fn main() {
     #[cfg(any(
         feature = "coriolis-matrix",
         feature = "kinematics",
+        feature = "regressors",
         feature = "baked",
         feature = "f32",
         feature = "fixed-wheels",
@@ -20,6 +21,7 @@ fn main() {
 #[cfg(any(
     feature = "coriolis-matrix",
     feature = "kinematics",
+    feature = "regressors",
     feature = "baked",
     feature = "f32",
     feature = "fixed-wheels",
@@ -30,8 +32,9 @@ fn generate() {
     let enabled = |feature: &str| std::env::var_os(format!("CARGO_FEATURE_{feature}")).is_some();
     let coriolis_matrix = enabled("CORIOLIS_MATRIX");
     let kinematics = enabled("KINEMATICS");
+    let regressors = enabled("REGRESSORS");
     let builder = |model: &str| kanegen::Builder::new(model).coriolis_matrix(coriolis_matrix);
-    if coriolis_matrix || kinematics {
+    if coriolis_matrix || kinematics || regressors {
         // The main module, with the Coriolis matrix and/or the kinematics and energies (centre
         // of mass, frames, T, V).
         let mut functions = FunctionSet::default().without(FunctionId::CoriolisMatrix);
@@ -40,6 +43,9 @@ fn generate() {
         }
         if kinematics {
             functions = functions.union(FunctionSet::kinematics());
+        }
+        if regressors {
+            functions = functions.union(FunctionSet::regressors());
         }
         kanegen::Builder::new("krang.toml")
             .functions(functions)
@@ -54,7 +60,17 @@ fn generate() {
             .run();
     }
     if enabled("FIXED_WHEELS") {
-        builder("krang-fixed-wheels.toml").run();
+        // With `regressors`: the arm's identification example uses the fixed-wheel tree's.
+        let mut functions = FunctionSet::default();
+        if !coriolis_matrix {
+            functions = functions.without(FunctionId::CoriolisMatrix);
+        }
+        if regressors {
+            functions = functions.union(FunctionSet::regressors());
+        }
+        builder("krang-fixed-wheels.toml")
+            .functions(functions)
+            .run();
     }
     if enabled("TWO_LINK") {
         builder("two-link.toml").run();

@@ -54,6 +54,13 @@ pub struct BaseParameters {
     pub check_residual: f64,
 }
 
+impl Regressors {
+    /// π and β of `model` (no base parameters).
+    pub fn of(model: &Model) -> Self {
+        layout(model)
+    }
+}
+
 impl BaseParameters {
     /// The base parameters' values from the full parameter vector.
     pub fn values(&self, full: &[f64]) -> Vec<f64> {

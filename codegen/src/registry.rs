@@ -94,6 +94,13 @@ impl Sizes {
     }
 }
 
+impl Sizes {
+    /// The number of columns of function `id`'s result (1 for a vector or scalar).
+    pub fn size_of(&self, id: FunctionId) -> usize {
+        id.spec().shape.size_in(self).1
+    }
+}
+
 impl Dim {
     /// The size for a model with `n` speeds (the regressors' parameter counts are 0 here: use
     /// [`Dim::size_in`] for them).

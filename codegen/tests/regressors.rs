@@ -405,3 +405,179 @@ fn baked_regressors_equal_the_runtime_ones_at_the_model_values() {
         );
     }
 }
+
+/// Least squares `A x = b` (QR of the stacked rows) and the estimate's standard deviations from
+/// the residual variance.
+fn least_squares(a: &DMatrix<f64>, b: &nalgebra::DVector<f64>) -> (Vec<f64>, Vec<f64>, f64) {
+    let x = a
+        .clone()
+        .svd(true, true)
+        .solve(b, 1e-12)
+        .expect("SVD solves");
+    let r = a * &x - b;
+    let dof = (a.nrows() - a.ncols()) as f64;
+    let sigma2 = r.norm_squared() / dof;
+    let cov = (a.transpose() * a).try_inverse().expect("full column rank");
+    let std = (0..a.ncols())
+        .map(|i| (sigma2 * cov[(i, i)]).sqrt())
+        .collect();
+    (x.iter().copied().collect(), std, sigma2.sqrt())
+}
+
+/// Identify the base parameters from `samples` (state, measured generalized forces) with the
+/// base regressor `id`: the estimate, its standard deviations and the residual's RMS.
+fn identify(
+    g: &Generated,
+    id: FunctionId,
+    params: &[f64],
+    samples: &[(Draw, Vec<f64>)],
+) -> (Vec<f64>, Vec<f64>, f64) {
+    let n = g.model.dof();
+    let b = g.lowered.sizes.size_of(id);
+    let mut a = DMatrix::zeros(samples.len() * n, b);
+    let mut rhs = nalgebra::DVector::zeros(samples.len() * n);
+    for (s, (d, tau)) in samples.iter().enumerate() {
+        let y = g.lowered.evaluate(id, params, &d.q, &d.u, &d.ud);
+        for row in 0..n {
+            for c in 0..b {
+                a[(s * n + row, c)] = y[row * b + c];
+            }
+            rhs[s * n + row] = tau[row];
+        }
+    }
+    least_squares(&a, &rhs)
+}
+
+/// Gaussian noise (Box–Muller) of standard deviation `sigma`.
+fn gauss(uniform: &mut impl FnMut() -> f64, sigma: f64) -> f64 {
+    let (a, b) = (uniform().max(1e-300), uniform());
+    sigma * (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+}
+
+#[test]
+fn krang_beta_vector_is_identified_from_static_poses() {
+    // As the lab did on hardware: static poses (u = u̇ = 0), the measured torques are g(q) plus
+    // noise; here also the pitch is measured with noise. 120 poses.
+    let (model, g) = cached(0);
+    let reg = &g.derivation.regressors;
+    let base = reg.base_beta.as_ref().unwrap();
+    let mut r = SplitMix64::new(404);
+    let mut uniform = move || r.next_f64();
+    let truth = draw_with(model, &mut uniform, true).params;
+    let beta: Vec<f64> = reg.beta.iter().map(|&p| truth[p]).collect();
+    let expect = base.values(&beta);
+    let n = model.dof();
+    for (torque_noise, pitch_noise) in [(0.0, 0.0), (0.5, 2e-3)] {
+        let mut samples = Vec::new();
+        for _ in 0..120 {
+            let q = uniform_vec(&mut uniform, n, -1.5, 1.5);
+            let zero = vec![0.0; n];
+            let mut tau = g
+                .lowered
+                .evaluate(FunctionId::Gravity, &truth, &q, &zero, &zero);
+            tau.iter_mut()
+                .for_each(|t| *t += gauss(&mut uniform, torque_noise));
+            let mut measured = q.clone();
+            measured[2] += gauss(&mut uniform, pitch_noise); // q_imu
+            samples.push((
+                Draw {
+                    params: truth.clone(),
+                    q: measured,
+                    u: zero.clone(),
+                    ud: zero,
+                },
+                tau,
+            ));
+        }
+        let (est, std, rms) = identify(g, FunctionId::BaseGravityRegressor, &truth, &samples);
+        let worst_sigma = est
+            .iter()
+            .zip(&expect)
+            .zip(&std)
+            .map(|((e, x), s)| (e - x).abs() / s.max(1e-300))
+            .fold(0.0f64, f64::max);
+        let worst_rel = est
+            .iter()
+            .zip(&expect)
+            .map(|(e, x)| (e - x).abs() / x.abs().max(1e-2))
+            .fold(0.0f64, f64::max);
+        println!(
+            "Krang β_b ({} of {}), noise {torque_noise} N·m, {pitch_noise} rad: residual RMS {rms:.2e}, worst error {worst_rel:.1e} relative, {worst_sigma:.1} σ",
+            expect.len(),
+            beta.len()
+        );
+        if torque_noise == 0.0 {
+            assert!(worst_rel <= 1e-9, "{worst_rel:e}");
+        } else {
+            assert!(worst_sigma <= 5.0, "{worst_sigma}");
+        }
+    }
+}
+
+#[test]
+fn fixed_wheel_base_parameters_are_identified_from_an_exciting_trajectory() {
+    // Every joint follows a sum of three sinusoids (a Fourier excitation); τ = Y_b π_b + noise.
+    let (model, g) = cached(1);
+    let reg = &g.derivation.regressors;
+    let base = reg.base.as_ref().unwrap();
+    let mut r = SplitMix64::new(505);
+    let mut uniform = move || r.next_f64();
+    let truth = draw_with(model, &mut uniform, true).params;
+    let pi: Vec<f64> = reg.inertial.iter().map(|&p| truth[p]).collect();
+    let expect = base.values(&pi);
+    let n = model.dof();
+    let coef: Vec<[(f64, f64); 3]> = (0..n)
+        .map(|_| [0; 3].map(|_| (uniform() - 0.5, 2.0 * uniform() + 0.3)))
+        .collect();
+    for noise in [0.0, 0.2] {
+        let samples: Vec<(Draw, Vec<f64>)> = (0..300)
+            .map(|k| {
+                let t = 0.02 * k as f64;
+                let (mut q, mut u, mut ud) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+                for j in 0..n {
+                    for &(a, w) in &coef[j] {
+                        q[j] += a * (w * t).sin();
+                        u[j] += a * w * (w * t).cos();
+                        ud[j] -= a * w * w * (w * t).sin();
+                    }
+                }
+                let mut tau = g
+                    .lowered
+                    .evaluate(FunctionId::InverseDynamics, &truth, &q, &u, &ud);
+                tau.iter_mut()
+                    .for_each(|x| *x += gauss(&mut uniform, noise));
+                (
+                    Draw {
+                        params: truth.clone(),
+                        q,
+                        u,
+                        ud,
+                    },
+                    tau,
+                )
+            })
+            .collect();
+        let (est, std, rms) = identify(g, FunctionId::BaseRegressor, &truth, &samples);
+        let worst_sigma = est
+            .iter()
+            .zip(&expect)
+            .zip(&std)
+            .map(|((e, x), s)| (e - x).abs() / s.max(1e-300))
+            .fold(0.0f64, f64::max);
+        let worst_rel = est
+            .iter()
+            .zip(&expect)
+            .map(|(e, x)| (e - x).abs() / x.abs().max(1e-2))
+            .fold(0.0f64, f64::max);
+        println!(
+            "fixed wheels π_b ({} of {}), noise {noise} N·m: residual RMS {rms:.2e}, worst error {worst_rel:.1e} relative, {worst_sigma:.1} σ",
+            expect.len(),
+            pi.len()
+        );
+        if noise == 0.0 {
+            assert!(worst_rel <= 1e-9, "{worst_rel:e}");
+        } else {
+            assert!(worst_sigma <= 5.0, "{worst_sigma}");
+        }
+    }
+}

@@ -581,3 +581,21 @@ fn fixed_wheel_base_parameters_are_identified_from_an_exciting_trajectory() {
         }
     }
 }
+
+#[test]
+fn stats_and_listing_print_the_base_parameters() {
+    let (_, g) = cached(2);
+    let stats = kanegen::stats(g);
+    assert!(
+        stats.contains("base parameters of the inverse-dynamics regressor: 6 of 20"),
+        "{stats}"
+    );
+    assert!(stats.contains("  XXR1 = XX1 + 0.257282*m2"), "{stats}");
+    assert!(stats.contains("base parameters of the gravity regressor: 4 of 8"));
+    let listing = kanegen::listing(g);
+    assert!(listing.contains("% MYR1 = MY1 + 0.499*m2"), "{listing}");
+    // Without base regressors nothing is printed.
+    let model = load("two-link.toml");
+    let plain = generate_model(model, Options::default()).unwrap();
+    assert!(!kanegen::stats(&plain).contains("base parameters"));
+}

@@ -200,6 +200,10 @@ pub struct Lowered {
     /// The dependent (mimic) speeds whose `sin`/`cos` leaves the programs may read: speed index
     /// and its angle `a·q[master] + b` (see [`Arena::set_mimic`](crate::expr::Arena::set_mimic)).
     pub mimic_angles: Vec<(usize, MimicLeaf)>,
+    /// Result sizes (speeds, regressor columns).
+    pub sizes: crate::registry::Sizes,
+    /// The regressors' parameters and base parameters (see [`Derivation::regressors`]).
+    pub regressors: crate::kane::Regressors,
 }
 
 impl Lowered {
@@ -247,6 +251,8 @@ pub fn lower(d: &Derivation) -> Lowered {
         mimic_angles: (0..d.arena.names.speeds.len())
             .filter_map(|s| d.arena.mimic(s as u32).map(|m| (s, m)))
             .collect(),
+        sizes: d.sizes,
+        regressors: d.regressors.clone(),
     }
 }
 
@@ -677,7 +683,7 @@ impl Lowered {
             locals: &locals,
         };
         let entries = p.outputs.iter().map(|(r, c, e)| (*r, *c, ctx.eval(e)));
-        id.spec().shape.dense(self.dof, entries)
+        id.spec().shape.dense_in(&self.sizes, entries)
     }
 }
 

@@ -44,6 +44,14 @@ pub enum FunctionId {
     FrameBiasAcceleration,
     /// Derivatives of inverse dynamics `[∂τ/∂q | ∂τ/∂u]` (∂τ/∂u̇ = M).
     InverseDynamicsDerivatives,
+    /// Inverse-dynamics regressor Y(q, u, u̇) with τ = Y π (π: the inertial parameters).
+    InverseDynamicsRegressor,
+    /// Gravity regressor Y_g(q) with g = Y_g β (β: mass and first moments per body).
+    GravityRegressor,
+    /// Base regressor: the identifiable columns of Y, τ = Y_b π_b.
+    BaseRegressor,
+    /// Base gravity regressor: the identifiable columns of Y_g, g = Y_gb β_b.
+    BaseGravityRegressor,
 }
 
 /// One dimension of a [`Shape::Dense`] result: the number of speeds N, or a constant.
@@ -55,15 +63,65 @@ pub enum Dim {
     Fixed(usize),
     /// Twice the number of speeds: two N-column blocks side by side (`[∂τ/∂q | ∂τ/∂u]`).
     TwoN,
+    /// The number P of inertial parameters π (`INERTIAL_NAMES`).
+    Inertial,
+    /// The number of gravity parameters β (4 per body: m, MX, MY, MZ).
+    Beta,
+    /// The number B of base parameters (`BASE_PARAMETER_NAMES`).
+    Base,
+    /// The number of base gravity parameters (`BASE_BETA_NAMES`).
+    BaseBeta,
+}
+
+/// The sizes a [`Dim`] can name for one model: the speeds and the regressors' parameter counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Sizes {
+    /// Number of speeds N.
+    pub dof: usize,
+    /// Number of inertial parameters P.
+    pub inertial: usize,
+    /// Number of gravity parameters (4 per body).
+    pub beta: usize,
+    /// Number of base parameters B (0 unless derived).
+    pub base: usize,
+    /// Number of base gravity parameters (0 unless derived).
+    pub base_beta: usize,
+}
+
+impl Sizes {
+    /// Sizes of a model with `n` speeds and no regressor parameters.
+    pub fn dof(n: usize) -> Self {
+        Sizes {
+            dof: n,
+            ..Sizes::default()
+        }
+    }
+}
+
+impl Sizes {
+    /// The number of columns of function `id`'s result (1 for a vector or scalar).
+    pub fn size_of(&self, id: FunctionId) -> usize {
+        id.spec().shape.size_in(self).1
+    }
 }
 
 impl Dim {
-    /// The size for a model with `n` speeds.
+    /// The size for a model with `n` speeds (the regressors' parameter counts are 0 here: use
+    /// [`Dim::size_in`] for them).
     pub fn size(self, n: usize) -> usize {
+        self.size_in(&Sizes::dof(n))
+    }
+
+    /// The size for a model of sizes `s`.
+    pub fn size_in(self, s: &Sizes) -> usize {
         match self {
-            Dim::N => n,
+            Dim::N => s.dof,
             Dim::Fixed(k) => k,
-            Dim::TwoN => 2 * n,
+            Dim::TwoN => 2 * s.dof,
+            Dim::Inertial => s.inertial,
+            Dim::Beta => s.beta,
+            Dim::Base => s.base,
+            Dim::BaseBeta => s.base_beta,
         }
     }
 }
@@ -104,12 +162,19 @@ pub enum Inputs {
 }
 
 impl Shape {
-    /// `(rows, cols)` of a result of this shape with `n` speeds (a vector is one column).
+    /// `(rows, cols)` of a result of this shape with `n` speeds (a vector is one column; the
+    /// regressors' parameter dimensions count 0 here, see [`Shape::size_in`]).
     pub fn size(self, n: usize) -> (usize, usize) {
+        self.size_in(&Sizes::dof(n))
+    }
+
+    /// `(rows, cols)` of a result of this shape for a model of sizes `s`.
+    pub fn size_in(self, s: &Sizes) -> (usize, usize) {
+        let n = s.dof;
         match self {
             Shape::SymmetricMatrix | Shape::Matrix => (n, n),
             Shape::Vector => (n, 1),
-            Shape::Dense { rows, cols } => (rows.size(n), cols.size(n)),
+            Shape::Dense { rows, cols } => (rows.size_in(s), cols.size_in(s)),
             Shape::Scalar => (1, 1),
             Shape::Isometry => (3, 4),
         }
@@ -123,7 +188,16 @@ impl Shape {
         n: usize,
         entries: impl IntoIterator<Item = (usize, usize, f64)>,
     ) -> Vec<f64> {
-        let (rows, cols) = self.size(n);
+        self.dense_in(&Sizes::dof(n), entries)
+    }
+
+    /// [`Shape::dense`] for a model of sizes `s` (regressors).
+    pub fn dense_in(
+        self,
+        s: &Sizes,
+        entries: impl IntoIterator<Item = (usize, usize, f64)>,
+    ) -> Vec<f64> {
+        let (rows, cols) = self.size_in(s);
         let mut out = vec![0.0; rows * cols];
         for (r, c, v) in entries {
             out[r * cols + c] = v;
@@ -195,7 +269,7 @@ pub struct FunctionSpec {
 }
 
 /// The registry, in the order generated modules define the functions.
-pub const FUNCTIONS: [FunctionSpec; 14] = [
+pub const FUNCTIONS: [FunctionSpec; 18] = [
     FunctionSpec {
         id: FunctionId::MassMatrix,
         name: "mass_matrix",
@@ -368,6 +442,62 @@ pub const FUNCTIONS: [FunctionSpec; 14] = [
         runtime_trait: None,
         per_frame: false,
     },
+    FunctionSpec {
+        id: FunctionId::InverseDynamicsRegressor,
+        name: "inverse_dynamics_regressor",
+        symbol: "Y",
+        doc: "Inverse-dynamics regressor Y(q, u, u̇): τ = Y π with π the inertial parameters in the order of `INERTIAL_NAMES` (`Params::inertial_vector`); exact derivatives ∂τ/∂π, independent of π.",
+        inputs: Inputs::QUUd,
+        shape: Shape::Dense {
+            rows: Dim::N,
+            cols: Dim::Inertial,
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::GravityRegressor,
+        name: "gravity_regressor",
+        symbol: "Yg",
+        doc: "Gravity regressor Y_g(q): g = Y_g β with β the masses and first moments (m, MX, MY, MZ per body, in the body frames) in the order of `BETA_NAMES` (`Params::beta_vector`).",
+        inputs: Inputs::Q,
+        shape: Shape::Dense {
+            rows: Dim::N,
+            cols: Dim::Beta,
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::BaseRegressor,
+        name: "base_regressor",
+        symbol: "Yb",
+        doc: "Base regressor Y_b(q, u, u̇): the identifiable columns of the inverse-dynamics regressor, τ = Y_b π_b with π_b = `base_parameters(&Params)` in the order of `BASE_PARAMETER_NAMES` (full column rank on generic trajectories).",
+        inputs: Inputs::QUUd,
+        shape: Shape::Dense {
+            rows: Dim::N,
+            cols: Dim::Base,
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::BaseGravityRegressor,
+        name: "base_gravity_regressor",
+        symbol: "Ygb",
+        doc: "Base gravity regressor: the identifiable columns of the gravity regressor, g = Y_gb β_b with β_b = `base_beta(&Params)` in the order of `BASE_BETA_NAMES`.",
+        inputs: Inputs::Q,
+        shape: Shape::Dense {
+            rows: Dim::N,
+            cols: Dim::BaseBeta,
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
 ];
 
 impl FunctionId {
@@ -510,6 +640,7 @@ impl std::str::FromStr for FunctionSet {
                 "all" => set.union(FunctionSet::all()),
                 "default" => set.union(FunctionSet::default()),
                 "kinematics" => set.union(FunctionSet::kinematics()),
+                "regressors" => set.union(FunctionSet::regressors()),
                 _ => set.with(FunctionId::from_name(name).ok_or_else(|| UnknownFunction {
                     name: name.to_owned(),
                 })?),
@@ -538,6 +669,18 @@ impl FunctionSet {
             FunctionId::FramePose,
             FunctionId::FrameJacobian,
             FunctionId::FrameBiasAcceleration,
+        ]
+        .into_iter()
+        .collect()
+    }
+
+    /// The regressors: inverse dynamics and gravity, full and base.
+    pub fn regressors() -> Self {
+        [
+            FunctionId::InverseDynamicsRegressor,
+            FunctionId::GravityRegressor,
+            FunctionId::BaseRegressor,
+            FunctionId::BaseGravityRegressor,
         ]
         .into_iter()
         .collect()

@@ -64,6 +64,49 @@ pub fn stats(g: &Generated) -> String {
     for f in &g.lowered.functions {
         row(&f.program.name, &f.program);
     }
+    s.push_str(&base_parameters(g));
+    s
+}
+
+/// The base parameters of the module's base regressors, in the reports' style: one line per
+/// base parameter with its grouping (`XXR4l = XX4l - YY4l`), then the parameters that do not
+/// act at all. Empty without base regressors.
+pub fn base_parameters(g: &Generated) -> String {
+    let mut s = String::new();
+    let reg = &g.derivation.regressors;
+    for (base, params, what) in [
+        (&reg.base, &reg.inertial, "inverse-dynamics regressor"),
+        (&reg.base_beta, &reg.beta, "gravity regressor"),
+    ] {
+        let Some(b) = base else { continue };
+        let grouped = b.groups.iter().filter(|g| g.len() > 1).count();
+        let _ = writeln!(
+            s,
+            "base parameters of the {what}: {} of {} ({} grouped, {} without effect; \
+             rank of {} stacked random states, grouping checked on 10 others to {:.1e})",
+            b.names.len(),
+            params.len(),
+            grouped,
+            b.unidentifiable.len(),
+            b.states,
+            b.check_residual
+        );
+        for (name, group) in b.names.iter().zip(&b.groups) {
+            let _ = writeln!(
+                s,
+                "  {}",
+                crate::kane::group_text(&g.model, params, name, group)
+            );
+        }
+        if !b.unidentifiable.is_empty() {
+            let names: Vec<&str> = b
+                .unidentifiable
+                .iter()
+                .map(|&i| g.model.params[params[i]].name.as_str())
+                .collect();
+            let _ = writeln!(s, "  without effect: {}", names.join(" "));
+        }
+    }
     s
 }
 
@@ -110,6 +153,13 @@ pub fn listing(g: &Generated) -> String {
                 _ => format!("{}({},{})", spec.symbol, r + 1, c + 1),
             };
             let _ = writeln!(s, "{lhs} = {};", d.arena.display(e));
+        }
+    }
+    let base = base_parameters(g);
+    if !base.is_empty() {
+        let _ = writeln!(s, "\n% ---- base parameters ----");
+        for line in base.lines() {
+            let _ = writeln!(s, "% {}", line.trim_start());
         }
     }
     s

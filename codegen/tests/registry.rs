@@ -214,8 +214,8 @@ fn kinematics_are_opt_in_listed_by_stats_and_the_same_without_the_dynamics() {
     let hand = full.model.link_index("10l");
     for id in kinematics.iter() {
         let frame = id.spec().per_frame.then_some(hand).flatten();
-        let a = part.lowered.evaluate_at(id, frame, &params, &q, &u, &[]);
-        let b = full.lowered.evaluate_at(id, frame, &params, &q, &u, &[]);
+        let a = part.lowered.evaluate_at(id, frame, &params, &q, &u, &u);
+        let b = full.lowered.evaluate_at(id, frame, &params, &q, &u, &u);
         let scale = b.iter().fold(1.0f64, |m, x| m.max(x.abs()));
         for (x, y) in a.iter().zip(&b) {
             assert!((x - y).abs() <= 1e-13 * scale, "{id}: {x} vs {y}");

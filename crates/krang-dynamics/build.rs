@@ -3,13 +3,14 @@
 //! with `--cfg feature="..."` and sets `CARGO_FEATURE_<NAME>`, `-` as `_`). Without features
 //! this script does nothing and `kanegen` is not even a build dependency: the default module
 //! (f64 Krang with M, c, g and inverse dynamics) is pre-generated in `src/generated/krang.rs`
-//! (`tests/pregenerated.rs` checks it against the generator). With `coriolis-matrix` or
-//! `kinematics` the Krang module is generated here instead, with those functions.
+//! (`tests/pregenerated.rs` checks it against the generator). With `coriolis-matrix`,
+//! `kinematics` or `regressors` the Krang module is generated here instead, with those functions.
 fn main() {
     #[cfg(any(
         feature = "coriolis-matrix",
         feature = "kinematics",
         feature = "derivatives",
+        feature = "regressors",
         feature = "baked",
         feature = "f32",
         feature = "fixed-wheels",
@@ -22,6 +23,7 @@ fn main() {
     feature = "coriolis-matrix",
     feature = "kinematics",
     feature = "derivatives",
+    feature = "regressors",
     feature = "baked",
     feature = "f32",
     feature = "fixed-wheels",
@@ -33,8 +35,9 @@ fn generate() {
     let coriolis_matrix = enabled("CORIOLIS_MATRIX");
     let kinematics = enabled("KINEMATICS");
     let derivatives = enabled("DERIVATIVES");
+    let regressors = enabled("REGRESSORS");
     let builder = |model: &str| kanegen::Builder::new(model).coriolis_matrix(coriolis_matrix);
-    if coriolis_matrix || kinematics || derivatives {
+    if coriolis_matrix || kinematics || derivatives || regressors {
         // The main module, with the Coriolis matrix and/or the kinematics and energies (centre
         // of mass, frames, T, V).
         let mut functions = FunctionSet::default().without(FunctionId::CoriolisMatrix);
@@ -46,6 +49,9 @@ fn generate() {
         }
         if derivatives {
             functions = functions.with(FunctionId::InverseDynamicsDerivatives);
+        }
+        if regressors {
+            functions = functions.union(FunctionSet::regressors());
         }
         kanegen::Builder::new("krang.toml")
             .functions(functions)
@@ -60,8 +66,19 @@ fn generate() {
             .run();
     }
     if enabled("FIXED_WHEELS") {
+        // With `regressors`: the arm's identification example uses the fixed-wheel tree's.
+        let mut functions = FunctionSet::default();
+        if !coriolis_matrix {
+            functions = functions.without(FunctionId::CoriolisMatrix);
+        }
+        if derivatives {
+            functions = functions.with(FunctionId::InverseDynamicsDerivatives);
+        }
+        if regressors {
+            functions = functions.union(FunctionSet::regressors());
+        }
         builder("krang-fixed-wheels.toml")
-            .derivatives(derivatives)
+            .functions(functions)
             .run();
     }
     if enabled("TWO_LINK") {

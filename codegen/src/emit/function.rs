@@ -280,7 +280,10 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
             }
         }
         Shape::Dense { rows, cols } => {
-            let (r, c) = (idx(rows.size(cx.low.dof)), idx(cols.size(cx.low.dof)));
+            let (r, c) = (
+                idx(rows.size_in(&cx.low.sizes)),
+                idx(cols.size_in(&cx.low.sizes)),
+            );
             let mutable = binding(nonzero.clone().next().is_some());
             for (r, c, e) in nonzero {
                 let v = printer.expr(e, false);
@@ -332,7 +335,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
 /// `nalgebra::Isometry3<f64>`).
 pub(super) fn result_type(cx: &Context<'_>, shape: Shape) -> TokenStream {
     let t = scalar_type(cx.precision);
-    let (rows, cols) = shape.size(cx.low.dof);
+    let (rows, cols) = shape.size_in(&cx.low.sizes);
     let (r, c) = (idx(rows), idx(cols));
     match shape {
         Shape::Scalar => quote!(#t),

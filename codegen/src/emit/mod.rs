@@ -19,6 +19,7 @@ mod frames;
 mod function;
 mod items;
 mod print;
+mod regressors;
 
 use std::path::Path;
 
@@ -111,6 +112,7 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         items.extend(items::precomputed(&cx));
         labels.add("new", &low.precompute);
     }
+    items.extend(regressors::items(&cx));
     let names: Vec<String> = low
         .functions
         .iter()

@@ -235,6 +235,31 @@ impl Arena {
         self.stamps.clone()
     }
 
+    /// Ask for `e` and everything it reads (through substitution variables) in the current
+    /// phase, children first: a phase that reuses expressions another phase built (the base
+    /// regressors reuse the regressors' columns) schedules them in this order.
+    pub fn touch_tree(&mut self, e: ExprId) {
+        let mut stack = vec![(e, false)];
+        while let Some((n, done)) = stack.pop() {
+            if self.stamps[n.index()] != u32::MAX {
+                continue;
+            }
+            if done {
+                self.touch(n);
+                continue;
+            }
+            stack.push((n, true));
+            match self.node(n) {
+                Node::Sum { terms, .. } => {
+                    stack.extend(terms.iter().rev().map(|(t, _)| (*t, false)))
+                }
+                Node::Prod(f) => stack.extend(f.iter().rev().map(|(b, _)| (*b, false))),
+                Node::Atom(Atom::Var(v)) => stack.push((self.vars[*v as usize].def, false)),
+                Node::Const(_) | Node::Atom(_) => {}
+            }
+        }
+    }
+
     fn touch(&mut self, id: ExprId) {
         let s = &mut self.stamps[id.index()];
         if *s == u32::MAX {

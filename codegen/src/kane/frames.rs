@@ -12,6 +12,11 @@ impl Ctx<'_> {
     pub(super) fn param(&mut self, p: usize) -> ExprId {
         match self.options.params {
             ParamMode::Runtime => self.ar.atom(Atom::Param(p as u32)),
+            ParamMode::Baked
+                if self.keep_inertial && super::regressor::is_regression_param(self.model, p) =>
+            {
+                self.ar.atom(Atom::Param(p as u32))
+            }
             ParamMode::Baked => self.ar.constant(self.model.params[p].value),
         }
     }

@@ -39,6 +39,7 @@
 //! | `rnea.rs` | c and τ: forward motion pass, body inertia forces, backward accumulation |
 //! | `coriolis_matrix.rs` | C: frame velocities, subtree momenta and inertia rates, columns |
 //! | `kinematics.rs` | frames in frame 0 (`⁰A`, `⁰p`), centre of mass, its Jacobian and bias acceleration, energies |
+//! | `regressor.rs` | regressors `∂τ/∂π`, `∂g/∂β` (by [`Arena::diff`]) and their base parameters |
 //!
 //! The arena records the order in which each phase first asks for a node and the lowering
 //! schedules statements in that order: moving arena calls around changes the generated code.
@@ -55,16 +56,18 @@ mod gravity;
 mod kinematics;
 mod mass_matrix;
 mod mimic;
+mod regressor;
 mod rnea;
 
 use kanegen_model::{Model, ParamKind};
 
 use crate::expr::{Arena, ExprId, Names};
 use crate::options::Options;
-use crate::registry::FunctionId;
+use crate::registry::{FunctionId, Sizes};
 
 use algebra::{M3, V3};
 use composite::Composite;
+pub use regressor::{BaseParameters, Regressors, group_text};
 
 /// One derived registry function: its output entries as expressions in the arena (its name,
 /// inputs and result shape are in the registry).
@@ -82,6 +85,9 @@ pub struct Function {
     pub order: Vec<u32>,
 }
 
+/// A function's `(row, col, expression)` entries.
+type Entries = Vec<(usize, usize, ExprId)>;
+
 /// The symbolic dynamics of a model.
 #[derive(Clone, Debug)]
 pub struct Derivation {
@@ -96,6 +102,11 @@ pub struct Derivation {
     /// The body frames' names (the model's links, in order): the frames of the per-frame
     /// functions.
     pub frame_names: Vec<String>,
+    /// The regressors' parameters (π, β) and, when a base regressor is derived, the base
+    /// parameters.
+    pub regressors: Regressors,
+    /// The result sizes (speeds, regressor columns).
+    pub sizes: Sizes,
 }
 
 impl Derivation {
@@ -133,7 +144,7 @@ pub fn names_of(model: &Model) -> Names {
 /// spills); g and C reuse those composites. The order fixes the arena's numbering and with it the
 /// generated code, so it is part of the output's definition. The opt-in kinematics come last, so
 /// that they do not change the dynamics' code.
-const DERIVATION_ORDER: [FunctionId; 14] = [
+const DERIVATION_ORDER: [FunctionId; 18] = [
     FunctionId::MassMatrix,
     FunctionId::Gravity,
     FunctionId::Coriolis,
@@ -148,6 +159,10 @@ const DERIVATION_ORDER: [FunctionId; 14] = [
     FunctionId::FrameJacobian,
     FunctionId::FrameBiasAcceleration,
     FunctionId::InverseDynamicsDerivatives,
+    FunctionId::InverseDynamicsRegressor,
+    FunctionId::GravityRegressor,
+    FunctionId::BaseRegressor,
+    FunctionId::BaseGravityRegressor,
 ];
 
 /// Derive the functions of `options.functions` for `model` (M as its upper triangle).
@@ -163,12 +178,15 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
         pos: vec![None; model.links.len()],
         root_rot: vec![None; model.links.len()],
         root_pos: vec![None; model.links.len()],
+        keep_inertial: false,
     };
     // Results have the independent speeds (the derivation runs on all speeds of the tree and
     // `mimic::project` reduces them).
     let n = model.independent_dof();
     let mut composites = None;
     let mut functions = Vec::new();
+    let mut regressors = regressor::layout(model);
+    let mut full: [Option<Entries>; 2] = [None, None];
     for id in DERIVATION_ORDER {
         if !options.has(id) {
             continue;
@@ -182,9 +200,16 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
         };
         for frame in frames {
             cx.ar.begin_phase();
-            let entries = match frame {
-                Some(l) => cx.derive_frame_function(id, l),
-                None => cx.derive_function(id, &mut composites),
+            let entries = match (frame, id) {
+                (Some(l), _) => cx.derive_frame_function(id, l),
+                (
+                    None,
+                    FunctionId::InverseDynamicsRegressor
+                    | FunctionId::GravityRegressor
+                    | FunctionId::BaseRegressor
+                    | FunctionId::BaseGravityRegressor,
+                ) => cx.derive_regressor(id, &mut regressors, &mut full),
+                (None, _) => cx.derive_function(id, &mut composites),
             };
             let entries = mimic::project(cx.ar, model, id.spec().shape, entries);
             let order = cx.ar.phase_order();
@@ -197,8 +222,15 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
         }
     }
     functions.sort_by_key(|f| (f.id, f.frame));
+    let sizes = Sizes {
+        dof: n,
+        inertial: regressors.inertial.len(),
+        beta: regressors.beta.len(),
+        base: regressors.base.as_ref().map_or(0, |b| b.names.len()),
+        base_beta: regressors.base_beta.as_ref().map_or(0, |b| b.names.len()),
+    };
     debug_assert!(functions.iter().all(|f| {
-        let (rows, cols) = f.id.spec().shape.size(n);
+        let (rows, cols) = f.id.spec().shape.size_in(&sizes);
         f.entries.iter().all(|e| e.0 < rows && e.1 < cols)
     }));
     Derivation {
@@ -207,6 +239,8 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
         dof: n,
         options,
         frame_names: model.links.iter().map(|l| l.name.clone()).collect(),
+        regressors,
+        sizes,
     }
 }
 
@@ -260,7 +294,70 @@ impl Ctx<'_> {
             | FunctionId::FrameBiasAcceleration => {
                 unreachable!("per-frame functions are derived by `derive_frame_function`")
             }
+            FunctionId::InverseDynamicsRegressor
+            | FunctionId::GravityRegressor
+            | FunctionId::BaseRegressor
+            | FunctionId::BaseGravityRegressor => {
+                unreachable!("regressors are derived by `derive_regressor`")
+            }
         }
+    }
+
+    /// The entries of a regressor function. `full`: Y and Y_g once derived (the base
+    /// regressors are their identifiable columns).
+    fn derive_regressor(
+        &mut self,
+        id: FunctionId,
+        reg: &mut Regressors,
+        full: &mut [Option<Entries>; 2],
+    ) -> Entries {
+        let gravity = matches!(
+            id,
+            FunctionId::GravityRegressor | FunctionId::BaseGravityRegressor
+        );
+        let k = usize::from(gravity);
+        let entries = match full[k].clone() {
+            Some(e) => {
+                // Ask for the nodes again in this phase, for its statement order.
+                for &(_, _, x) in &e {
+                    self.ar.touch_tree(x);
+                }
+                e
+            }
+            None => {
+                let e = if gravity {
+                    self.gravity_regressor(&reg.beta.clone())
+                } else {
+                    self.inertial_regressor(&reg.inertial.clone())
+                };
+                full[k] = Some(e.clone());
+                e
+            }
+        };
+        if matches!(
+            id,
+            FunctionId::InverseDynamicsRegressor | FunctionId::GravityRegressor
+        ) {
+            return entries;
+        }
+        let params = if gravity { &reg.beta } else { &reg.inertial };
+        let base = regressor::base_parameters(self.ar, self.model, &entries, params);
+        let column: std::collections::HashMap<usize, usize> = base
+            .groups
+            .iter()
+            .enumerate()
+            .map(|(b, g)| (g[0].0, b))
+            .collect();
+        let out = entries
+            .iter()
+            .filter_map(|&(r, c, e)| column.get(&c).map(|&b| (r, b, e)))
+            .collect();
+        if gravity {
+            reg.base_beta = Some(base);
+        } else {
+            reg.base = Some(base);
+        }
+        out
     }
 
     /// The entries of per-frame registry function `id` for body frame `l`.
@@ -286,6 +383,9 @@ struct Ctx<'a> {
     root_rot: Vec<Option<M3>>,
     /// `⁰p_l(q)`: the origin of frame l in frame 0, cached.
     root_pos: Vec<Option<V3>>,
+    /// Keep the regressor parameters (inertial, wheel mass and inertias) as symbols even with
+    /// baked parameters: set while a regressor's dynamics are derived.
+    keep_inertial: bool,
 }
 
 impl Derivation {
@@ -321,6 +421,6 @@ impl Derivation {
         // Sines and cosines of dependent (mimic) angles are formed from `q` by the arena.
         let vals = self.arena.eval(&crate::expr::Values { params, q, u, ud });
         let entries = f.entries.iter().map(|&(r, c, e)| (r, c, vals[e.index()]));
-        id.spec().shape.dense(self.dof, entries)
+        id.spec().shape.dense_in(&self.sizes, entries)
     }
 }

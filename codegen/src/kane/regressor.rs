@@ -175,7 +175,10 @@ impl Rng {
     }
 }
 
-/// The dense regressor (`rows × cols`, row-major) of `entries` at one random state.
+/// The dense regressor (`independent_dof × cols`, row-major) of `entries` at one random state.
+/// `entries` are the whole tree's rows; a mimic model's are projected by the constraint map
+/// (`Tᵀ Y`, as the generated function is), so that the base parameters are those of the reduced
+/// model.
 fn regressor_at(
     ar: &Arena,
     entries: &[(usize, usize, ExprId)],
@@ -194,9 +197,11 @@ fn regressor_at(
         u: &u,
         ud: &ud,
     });
-    let mut y = vec![0.0; n * cols];
+    let map = model.constraint_map();
+    let mut y = vec![0.0; model.independent_dof() * cols];
     for &(r, c, e) in entries {
-        y[r * cols + c] = vals[e.index()];
+        let (row, factor) = map[r];
+        y[row * cols + c] += factor * vals[e.index()];
     }
     y
 }
@@ -208,7 +213,7 @@ pub(super) fn base_parameters(
     entries: &[(usize, usize, ExprId)],
     params: &[usize],
 ) -> BaseParameters {
-    let n = model.dof().max(1);
+    let n = model.independent_dof().max(1);
     let cols = params.len();
     let states = (3 * cols / n + 10).max(30);
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);

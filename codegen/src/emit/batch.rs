@@ -5,8 +5,8 @@
 //! The statements are printed exactly as for the single-state function: parameters and
 //! literals stay `f64` and `Lanes` implements the operators with `f64` on either side, so lane
 //! `l` of every value is the single-state value at state `l`, bit for bit. Only the bindings of
-//! the inputs (gathered per coordinate, sines and cosines lane by lane) and the result stores
-//! (one per lane) differ. `L` is a const generic: one emitted body for every batch size.
+//! the inputs (transposed to lane-major order, sines and cosines lane by lane) and the result
+//! stores (into a lane-major buffer, transposed at the end) differ. `L` is a const generic: one emitted body for every batch size.
 
 use proc_macro2::TokenStream;
 use quote::quote;
@@ -51,6 +51,16 @@ fn args(cx: &Context<'_>, inputs: Inputs) -> TokenStream {
 fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
     let speeds = &cx.model.speeds;
     let mut ts = TokenStream::new();
+    let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
+    if reads_q {
+        ts.extend(quote!(let q = kanegen_runtime::lanes::inputs(q);));
+    }
+    if reads.speed.contains(&true) {
+        ts.extend(quote!(let u = kanegen_runtime::lanes::inputs(u);));
+    }
+    if reads.accel.contains(&true) {
+        ts.extend(quote!(let ud = kanegen_runtime::lanes::inputs(ud);));
+    }
     for &s in &p.sincos {
         let sl = idx(s);
         let sn = if reads.sin[s] {
@@ -65,21 +75,21 @@ fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
         } else {
             quote!(_)
         };
-        ts.extend(quote!(let (#sn, #cn) = kanegen_runtime::lanes::sin_cos(Lanes::gather(q, #sl));));
+        ts.extend(quote!(let (#sn, #cn) = kanegen_runtime::lanes::sin_cos(q[#sl]);));
     }
     for (s, speed) in speeds.iter().enumerate() {
         let sl = idx(s);
         if reads.coord[s] {
             let id = ident(&speed.coordinate);
-            ts.extend(quote!(let #id = Lanes::gather(q, #sl);));
+            ts.extend(quote!(let #id = q[#sl];));
         }
         if reads.speed[s] {
             let id = ident(&speed.name);
-            ts.extend(quote!(let #id = Lanes::gather(u, #sl);));
+            ts.extend(quote!(let #id = u[#sl];));
         }
         if reads.accel[s] {
             let id = ident(&naming::accel(&speed.name));
-            ts.extend(quote!(let #id = Lanes::gather(ud, #sl);));
+            ts.extend(quote!(let #id = ud[#sl];));
         }
     }
     ts
@@ -120,24 +130,16 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     let store_after = |stores: &mut [TokenStream], e: &LExpr, store: TokenStream| {
         stores[last_local(e).map_or(0, |i| i + 1)].extend(store);
     };
-    let vector = spec.shape == Shape::Vector;
     for (r, c, e) in nonzero_outputs(p) {
         let v = printer.expr(e, false);
-        let r = idx(*r);
-        let store = if vector {
-            quote!(kanegen_runtime::lanes::set_vector(&mut out, #r, #v);)
-        } else {
-            let c = idx(*c);
-            quote!(kanegen_runtime::lanes::set_matrix(&mut out, #r, #c, #v);)
-        };
+        let (r, c) = (idx(*r), idx(*c));
+        let store = quote!(buf[#c][#r] = kanegen_runtime::lanes::lanes(#v););
         store_after(&mut stores, e, store);
     }
     let statements = printer.statements(&stores);
-    let mirror = if spec.shape == Shape::SymmetricMatrix {
-        quote!(kanegen_runtime::lanes::mirror_upper(&mut out);)
-    } else {
-        quote!()
-    };
+    let symmetric = spec.shape == Shape::SymmetricMatrix;
+    let (rows, cols) = spec.shape.size(cx.low.dof);
+    let (rows, cols) = (idx(rows), idx(cols));
     let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
     let mut unused = TokenStream::new();
     if !reads_q {
@@ -153,10 +155,9 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         #unused
         #prologue
         #[allow(unused_mut)]
-        let mut out = [<#ty>::zeros(); L];
+        let mut buf = kanegen_runtime::lanes::buffer::<L, #rows, #cols>();
         #statements
-        #mirror
-        out
+        kanegen_runtime::lanes::results(&mut buf, #symmetric)
     };
     let body = if cx.isa_dispatch {
         quote!(kanegen_runtime::isa::dispatch(#[inline(always)] || { #body }))
@@ -167,7 +168,6 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         #[doc = #doc]
         #[inline(never)]
         pub fn #name<const L: usize>(#param_args #state) -> [#ty; L] {
-            use kanegen_runtime::lanes::Lanes;
             #body
         }
     }

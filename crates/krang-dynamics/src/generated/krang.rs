@@ -4763,66 +4763,32 @@ mod generated {
         pc: &Precomputed,
         q: &[SVector<f64, 19>; L],
     ) -> [SMatrix<f64, 19, 19>; L] {
-        use kanegen_runtime::lanes::Lanes;
         kanegen_runtime::isa::dispatch(
             #[inline(always)]
             || {
-                let (s_q_imu, c_q_imu) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 2),
-                );
-                let (s_q_w, c_q_w) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 3),
-                );
-                let (s_q_torso, c_q_torso) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 4),
-                );
-                let (s_q1l, c_q1l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 5),
-                );
-                let (s_q2l, c_q2l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 6),
-                );
-                let (s_q3l, c_q3l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 7),
-                );
-                let (s_q4l, c_q4l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 8),
-                );
-                let (s_q5l, c_q5l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 9),
-                );
-                let (s_q6l, c_q6l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 10),
-                );
-                let (s_q7l, c_q7l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 11),
-                );
-                let (s_q1r, c_q1r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 12),
-                );
-                let (s_q2r, c_q2r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 13),
-                );
-                let (s_q3r, c_q3r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 14),
-                );
-                let (s_q4r, c_q4r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 15),
-                );
-                let (s_q5r, c_q5r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 16),
-                );
-                let (s_q6r, c_q6r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 17),
-                );
-                let (s_q7r, c_q7r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 18),
-                );
+                let q = kanegen_runtime::lanes::inputs(q);
+                let (s_q_imu, c_q_imu) = kanegen_runtime::lanes::sin_cos(q[2]);
+                let (s_q_w, c_q_w) = kanegen_runtime::lanes::sin_cos(q[3]);
+                let (s_q_torso, c_q_torso) = kanegen_runtime::lanes::sin_cos(q[4]);
+                let (s_q1l, c_q1l) = kanegen_runtime::lanes::sin_cos(q[5]);
+                let (s_q2l, c_q2l) = kanegen_runtime::lanes::sin_cos(q[6]);
+                let (s_q3l, c_q3l) = kanegen_runtime::lanes::sin_cos(q[7]);
+                let (s_q4l, c_q4l) = kanegen_runtime::lanes::sin_cos(q[8]);
+                let (s_q5l, c_q5l) = kanegen_runtime::lanes::sin_cos(q[9]);
+                let (s_q6l, c_q6l) = kanegen_runtime::lanes::sin_cos(q[10]);
+                let (s_q7l, c_q7l) = kanegen_runtime::lanes::sin_cos(q[11]);
+                let (s_q1r, c_q1r) = kanegen_runtime::lanes::sin_cos(q[12]);
+                let (s_q2r, c_q2r) = kanegen_runtime::lanes::sin_cos(q[13]);
+                let (s_q3r, c_q3r) = kanegen_runtime::lanes::sin_cos(q[14]);
+                let (s_q4r, c_q4r) = kanegen_runtime::lanes::sin_cos(q[15]);
+                let (s_q5r, c_q5r) = kanegen_runtime::lanes::sin_cos(q[16]);
+                let (s_q6r, c_q6r) = kanegen_runtime::lanes::sin_cos(q[17]);
+                let (s_q7r, c_q7r) = kanegen_runtime::lanes::sin_cos(q[18]);
                 #[allow(unused_mut)]
-                let mut out = [<SMatrix<f64, 19, 19>>::zeros(); L];
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 0, pc.pc69);
-                kanegen_runtime::lanes::set_matrix(&mut out, 11, 11, p.ZZ10l);
-                kanegen_runtime::lanes::set_matrix(&mut out, 18, 18, p.ZZ10r);
+                let mut buf = kanegen_runtime::lanes::buffer::<L, 19, 19>();
+                buf[0][0] = kanegen_runtime::lanes::lanes(pc.pc69);
+                buf[11][11] = kanegen_runtime::lanes::lanes(p.ZZ10l);
+                buf[18][18] = kanegen_runtime::lanes::lanes(p.ZZ10r);
                 let d1 = p.MX10r * s_q7r - p.MY10r * c_q7r;
                 let d2 = p.MX10r * c_q7r + p.MY10r * s_q7r;
                 let t1 = p.XZ10r * c_q7r;
@@ -4832,55 +4798,55 @@ mod generated {
                 let t5 = p.L9 * d2;
                 let t6 = p.L9 * d1;
                 let d3 = t1 + t2 - t5;
-                kanegen_runtime::lanes::set_matrix(&mut out, 17, 18, -d3);
+                buf[18][17] = kanegen_runtime::lanes::lanes(-d3);
                 let d4 = t3 - t4 - t6;
                 let d5 = d2 * s_q6r;
                 let d6 = d2 * c_q6r;
                 let d7 = p.ZZ10r * c_q6r - d4 * s_q6r;
-                kanegen_runtime::lanes::set_matrix(&mut out, 16, 18, d7);
+                buf[18][16] = kanegen_runtime::lanes::lanes(d7);
                 let d8 = p.ZZ10r * s_q6r + d4 * c_q6r;
                 let d9 = d1 * c_q5r + d6 * s_q5r;
                 let d10 = d1 * s_q5r - d6 * c_q5r;
                 let d11 = d3 * c_q5r - d8 * s_q5r + p.L8 * d10;
-                kanegen_runtime::lanes::set_matrix(&mut out, 15, 18, -d11);
+                buf[18][15] = kanegen_runtime::lanes::lanes(-d11);
                 let d12 = d3 * s_q5r + d8 * c_q5r - p.L8 * d9;
                 let d13 = d5 * c_q4r - d10 * s_q4r;
                 let d14 = d5 * s_q4r + d10 * c_q4r;
                 let d15 = d7 * c_q4r - d12 * s_q4r;
-                kanegen_runtime::lanes::set_matrix(&mut out, 14, 18, d15);
+                buf[18][14] = kanegen_runtime::lanes::lanes(d15);
                 let d16 = d7 * s_q4r + d12 * c_q4r;
                 let d17 = d9 * c_q3r - d14 * s_q3r;
                 let d18 = d9 * s_q3r + d14 * c_q3r;
                 let d19 = d11 * c_q3r - d16 * s_q3r + p.L7 * d18;
-                kanegen_runtime::lanes::set_matrix(&mut out, 13, 18, -d19);
+                buf[18][13] = kanegen_runtime::lanes::lanes(-d19);
                 let d20 = d11 * s_q3r + d16 * c_q3r - p.L7 * d17;
                 let d21 = d13 * c_q2r - d18 * s_q2r;
                 let d22 = d13 * s_q2r + d18 * c_q2r;
                 let d23 = d15 * c_q2r - d20 * s_q2r;
-                kanegen_runtime::lanes::set_matrix(&mut out, 12, 18, d23);
+                buf[18][12] = kanegen_runtime::lanes::lanes(d23);
                 let d24 = d15 * s_q2r + d20 * c_q2r;
                 let d25 = d17 * c_q1r - d22 * s_q1r;
                 let d26 = d17 * s_q1r + d22 * c_q1r;
                 let d27 = d23 - p.L5 * d26;
                 let d28 = d19 * c_q1r - d24 * s_q1r + p.L6 * d26;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 18, d28);
+                buf[18][4] = kanegen_runtime::lanes::lanes(d28);
                 let d29 = d19 * s_q1r + d24 * c_q1r - p.L6 * d25 + d21 * p.L5;
                 let d30 = d21 * c_q_torso + d26 * s_q_torso;
                 let d31 = d21 * s_q_torso - d26 * c_q_torso;
                 let d32 = d27 * c_q_torso + d29 * s_q_torso + p.L3 * d31 - d25 * p.L4;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 18, d32);
+                buf[18][3] = kanegen_runtime::lanes::lanes(d32);
                 let d33 = d28 + p.L4 * d30;
                 let d34 = d27 * s_q_torso - d29 * c_q_torso - p.L3 * d30;
                 let d35 = d25 * s_q_w - d31 * c_q_w;
                 let d36 = d25 * c_q_w + d31 * s_q_w;
                 let d37 = d33 * s_q_w - d34 * c_q_w + d30 * p.L1;
                 let d38 = d32 - p.L1 * d35 + p.L2 * d36;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 18, d38);
+                buf[18][2] = kanegen_runtime::lanes::lanes(d38);
                 let d39 = d33 * c_q_w + d34 * s_q_w - d30 * p.L2;
                 let d40 = d36 * s_q_imu + d35 * c_q_imu;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 18, -d40);
+                buf[18][0] = kanegen_runtime::lanes::lanes(-d40);
                 let d41 = d39 * c_q_imu - d37 * s_q_imu;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 18, -d41);
+                buf[18][1] = kanegen_runtime::lanes::lanes(-d41);
                 let d42 = p.MX9r - d2;
                 let d43 = p.MZ9r + d1;
                 let k1 = s_q7r * s_q7r;
@@ -4891,14 +4857,14 @@ mod generated {
                 let d46 = p.XZ9r - p.XY10r * k3 - k2 * pc.pc3;
                 let d47 = p.YZ9r - t3 + t4 + t6;
                 let d48 = pc.pc7 - d44;
-                kanegen_runtime::lanes::set_matrix(&mut out, 17, 17, d48);
+                buf[17][17] = kanegen_runtime::lanes::lanes(d48);
                 let d49 = d44 + pc.pc8;
                 let d50 = c_q6r * pc.pc2 + s_q6r * d43;
                 let d51 = s_q6r * pc.pc2 - c_q6r * d43;
                 let t7 = c_q6r * d45;
                 let t8 = s_q6r * d46;
                 let d52 = t7 + t8;
-                kanegen_runtime::lanes::set_matrix(&mut out, 16, 17, -d52);
+                buf[17][16] = kanegen_runtime::lanes::lanes(-d52);
                 let t9 = s_q6r * d45;
                 let t10 = c_q6r * d46;
                 let d53 = t9 - t10;
@@ -4906,44 +4872,44 @@ mod generated {
                 let d55 = c_q5r * d50;
                 let d56 = s_q5r * d48 + c_q5r * d53 - p.L8 * d54;
                 let d57 = c_q5r * d48 - s_q5r * d53 - p.L8 * d55;
-                kanegen_runtime::lanes::set_matrix(&mut out, 15, 17, d57);
+                buf[17][15] = kanegen_runtime::lanes::lanes(d57);
                 let d58 = c_q4r * d51 + s_q4r * d55;
                 let d59 = s_q4r * d51 - c_q4r * d55;
                 let d60 = c_q4r * d52 - s_q4r * d56;
-                kanegen_runtime::lanes::set_matrix(&mut out, 14, 17, -d60);
+                buf[17][14] = kanegen_runtime::lanes::lanes(-d60);
                 let d61 = s_q4r * d52 + c_q4r * d56;
                 let d62 = s_q3r * d54 + c_q3r * d59;
                 let d63 = c_q3r * d54 - s_q3r * d59;
                 let d64 = s_q3r * d57 + c_q3r * d61 - p.L7 * d63;
                 let d65 = c_q3r * d57 - s_q3r * d61 + p.L7 * d62;
-                kanegen_runtime::lanes::set_matrix(&mut out, 13, 17, d65);
+                buf[17][13] = kanegen_runtime::lanes::lanes(d65);
                 let d66 = c_q2r * d58 - s_q2r * d62;
                 let d67 = s_q2r * d58 + c_q2r * d62;
                 let d68 = c_q2r * d60 - s_q2r * d64;
-                kanegen_runtime::lanes::set_matrix(&mut out, 12, 17, -d68);
+                buf[17][12] = kanegen_runtime::lanes::lanes(-d68);
                 let d69 = s_q2r * d60 + c_q2r * d64;
                 let d70 = c_q1r * d63 - s_q1r * d67;
                 let d71 = s_q1r * d63 + c_q1r * d67;
                 let d72 = c_q1r * d65 - s_q1r * d69 + p.L6 * d71;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 17, -d72);
+                buf[17][4] = kanegen_runtime::lanes::lanes(-d72);
                 let d73 = s_q1r * d65 + c_q1r * d69 - p.L6 * d70 + p.L5 * d66;
                 let d74 = d68 - p.L5 * d71;
                 let d75 = c_q_torso * d66 + s_q_torso * d71;
                 let d76 = s_q_torso * d66 - c_q_torso * d71;
                 let d77 = c_q_torso * d74 + s_q_torso * d73 + p.L3 * d76 - p.L4 * d70;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 17, -d77);
+                buf[17][3] = kanegen_runtime::lanes::lanes(-d77);
                 let d78 = d72 + p.L4 * d75;
                 let d79 = s_q_torso * d74 - c_q_torso * d73 - p.L3 * d75;
                 let d80 = c_q_w * d70 + s_q_w * d76;
                 let d81 = s_q_w * d70 - c_q_w * d76;
                 let d82 = d77 - p.L1 * d81 + p.L2 * d80;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 17, -d82);
+                buf[17][2] = kanegen_runtime::lanes::lanes(-d82);
                 let d83 = c_q_w * d78 + s_q_w * d79 - p.L2 * d75;
                 let d84 = s_q_w * d78 - c_q_w * d79 + p.L1 * d75;
                 let d85 = s_q_imu * d80 + c_q_imu * d81;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 17, d85);
+                buf[17][0] = kanegen_runtime::lanes::lanes(d85);
                 let d86 = c_q_imu * d83 - s_q_imu * d84;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 17, d86);
+                buf[17][1] = kanegen_runtime::lanes::lanes(d86);
                 let d87 = p.MX8r - d42;
                 let d88 = p.MY8r - d50;
                 let d89 = p.MZ8r - d51;
@@ -4958,7 +4924,7 @@ mod generated {
                 let d95 = p.YZ8r + d47 * k6 + k5 * d90;
                 let d96 = p.ZZ8r + d49 + d91;
                 let d97 = pc.pc10 - d91;
-                kanegen_runtime::lanes::set_matrix(&mut out, 16, 16, d97);
+                buf[16][16] = kanegen_runtime::lanes::lanes(d97);
                 let d98 = s_q5r * d87 + c_q5r * d89;
                 let d99 = c_q5r * d87 - s_q5r * d89;
                 let t11 = c_q5r * d93;
@@ -4968,46 +4934,46 @@ mod generated {
                 let t15 = p.L8 * d99;
                 let t16 = p.L8 * d98;
                 let d100 = t11 - t12 - t15;
-                kanegen_runtime::lanes::set_matrix(&mut out, 15, 16, -d100);
+                buf[16][15] = kanegen_runtime::lanes::lanes(-d100);
                 let d101 = t13 + t14 - t16;
                 let d102 = s_q4r * d99;
                 let d103 = c_q4r * d99;
                 let d104 = c_q4r * d97 - s_q4r * d101;
-                kanegen_runtime::lanes::set_matrix(&mut out, 14, 16, d104);
+                buf[16][14] = kanegen_runtime::lanes::lanes(d104);
                 let d105 = s_q4r * d97 + c_q4r * d101;
                 let d106 = c_q3r * d98 + s_q3r * d103;
                 let d107 = s_q3r * d98 - c_q3r * d103;
                 let d108 = c_q3r * d100 - s_q3r * d105 + p.L7 * d107;
-                kanegen_runtime::lanes::set_matrix(&mut out, 13, 16, -d108);
+                buf[16][13] = kanegen_runtime::lanes::lanes(-d108);
                 let d109 = s_q3r * d100 + c_q3r * d105 - p.L7 * d106;
                 let d110 = c_q2r * d102 - s_q2r * d107;
                 let d111 = s_q2r * d102 + c_q2r * d107;
                 let d112 = c_q2r * d104 - s_q2r * d109;
-                kanegen_runtime::lanes::set_matrix(&mut out, 12, 16, d112);
+                buf[16][12] = kanegen_runtime::lanes::lanes(d112);
                 let d113 = s_q2r * d104 + c_q2r * d109;
                 let d114 = c_q1r * d106 - s_q1r * d111;
                 let d115 = s_q1r * d106 + c_q1r * d111;
                 let d116 = d112 - p.L5 * d115;
                 let d117 = c_q1r * d108 - s_q1r * d113 + p.L6 * d115;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 16, d117);
+                buf[16][4] = kanegen_runtime::lanes::lanes(d117);
                 let d118 = s_q1r * d108 + c_q1r * d113 - p.L6 * d114 + p.L5 * d110;
                 let d119 = c_q_torso * d110 + s_q_torso * d115;
                 let d120 = s_q_torso * d110 - c_q_torso * d115;
                 let d121 = c_q_torso * d116 + s_q_torso * d118 + p.L3 * d120
                     - p.L4 * d114;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 16, d121);
+                buf[16][3] = kanegen_runtime::lanes::lanes(d121);
                 let d122 = d117 + p.L4 * d119;
                 let d123 = s_q_torso * d116 - c_q_torso * d118 - p.L3 * d119;
                 let d124 = s_q_w * d114 - c_q_w * d120;
                 let d125 = c_q_w * d114 + s_q_w * d120;
                 let d126 = s_q_w * d122 - c_q_w * d123 + p.L1 * d119;
                 let d127 = d121 - p.L1 * d124 + p.L2 * d125;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 16, d127);
+                buf[16][2] = kanegen_runtime::lanes::lanes(d127);
                 let d128 = c_q_w * d122 + s_q_w * d123 - p.L2 * d119;
                 let d129 = s_q_imu * d125 + c_q_imu * d124;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 16, -d129);
+                buf[16][0] = kanegen_runtime::lanes::lanes(-d129);
                 let d130 = c_q_imu * d128 - s_q_imu * d126;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 16, -d130);
+                buf[16][1] = kanegen_runtime::lanes::lanes(-d130);
                 let d131 = p.MX7r - d99;
                 let d132 = p.MZ7r + d98;
                 let k7 = s_q5r * s_q5r;
@@ -5022,14 +4988,14 @@ mod generated {
                 let d138 = p.YZ7r - t13 - t14 + t16;
                 let d139 = pc.pc13 - d88;
                 let d140 = d92 - d134 + 2.0 * t17 + pc.pc14;
-                kanegen_runtime::lanes::set_matrix(&mut out, 15, 15, d140);
+                buf[15][15] = kanegen_runtime::lanes::lanes(d140);
                 let d141 = d96 + d134 + 2.0 * t17 + pc.pc15;
                 let d142 = c_q4r * d139 + s_q4r * d132;
                 let d143 = s_q4r * d139 - c_q4r * d132;
                 let t18 = c_q4r * d135;
                 let t19 = s_q4r * d136;
                 let d144 = t18 + t19;
-                kanegen_runtime::lanes::set_matrix(&mut out, 14, 15, -d144);
+                buf[15][14] = kanegen_runtime::lanes::lanes(-d144);
                 let t20 = s_q4r * d135;
                 let t21 = c_q4r * d136;
                 let d145 = t20 - t21;
@@ -5037,35 +5003,35 @@ mod generated {
                 let d147 = c_q3r * d142;
                 let d148 = s_q3r * d140 + c_q3r * d145 - p.L7 * d146;
                 let d149 = c_q3r * d140 - s_q3r * d145 - p.L7 * d147;
-                kanegen_runtime::lanes::set_matrix(&mut out, 13, 15, d149);
+                buf[15][13] = kanegen_runtime::lanes::lanes(d149);
                 let d150 = c_q2r * d143 + s_q2r * d147;
                 let d151 = s_q2r * d143 - c_q2r * d147;
                 let d152 = c_q2r * d144 - s_q2r * d148;
-                kanegen_runtime::lanes::set_matrix(&mut out, 12, 15, -d152);
+                buf[15][12] = kanegen_runtime::lanes::lanes(-d152);
                 let d153 = s_q2r * d144 + c_q2r * d148;
                 let d154 = c_q1r * d146 - s_q1r * d151;
                 let d155 = s_q1r * d146 + c_q1r * d151;
                 let d156 = c_q1r * d149 - s_q1r * d153 + p.L6 * d155;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 15, -d156);
+                buf[15][4] = kanegen_runtime::lanes::lanes(-d156);
                 let d157 = s_q1r * d149 + c_q1r * d153 - p.L6 * d154 + p.L5 * d150;
                 let d158 = d152 - p.L5 * d155;
                 let d159 = c_q_torso * d150 + s_q_torso * d155;
                 let d160 = s_q_torso * d150 - c_q_torso * d155;
                 let d161 = c_q_torso * d158 + s_q_torso * d157 + p.L3 * d160
                     - p.L4 * d154;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 15, -d161);
+                buf[15][3] = kanegen_runtime::lanes::lanes(-d161);
                 let d162 = d156 + p.L4 * d159;
                 let d163 = s_q_torso * d158 - c_q_torso * d157 - p.L3 * d159;
                 let d164 = c_q_w * d154 + s_q_w * d160;
                 let d165 = s_q_w * d154 - c_q_w * d160;
                 let d166 = d161 - p.L1 * d165 + p.L2 * d164;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 15, -d166);
+                buf[15][2] = kanegen_runtime::lanes::lanes(-d166);
                 let d167 = c_q_w * d162 + s_q_w * d163 - p.L2 * d159;
                 let d168 = s_q_w * d162 - c_q_w * d163 + p.L1 * d159;
                 let d169 = s_q_imu * d164 + c_q_imu * d165;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 15, d169);
+                buf[15][0] = kanegen_runtime::lanes::lanes(d169);
                 let d170 = c_q_imu * d167 - s_q_imu * d168;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 15, d170);
+                buf[15][1] = kanegen_runtime::lanes::lanes(d170);
                 let d171 = p.MX6r - d131;
                 let d172 = p.MY6r - d142;
                 let d173 = p.MZ6r - d143;
@@ -5078,7 +5044,7 @@ mod generated {
                 let d177 = p.XY6r + t18 + t19;
                 let d178 = p.XZ6r + t20 - t21;
                 let d179 = p.YY6r + d137 - d175;
-                kanegen_runtime::lanes::set_matrix(&mut out, 14, 14, d179);
+                buf[14][14] = kanegen_runtime::lanes::lanes(d179);
                 let d180 = p.YZ6r + d138 * k12 + k11 * d174;
                 let d181 = p.ZZ6r + d141 + d175;
                 let d182 = s_q3r * d171 + c_q3r * d173;
@@ -5090,36 +5056,36 @@ mod generated {
                 let t26 = p.L7 * d183;
                 let t27 = p.L7 * d182;
                 let d184 = t22 - t23 - t26;
-                kanegen_runtime::lanes::set_matrix(&mut out, 13, 14, -d184);
+                buf[14][13] = kanegen_runtime::lanes::lanes(-d184);
                 let d185 = t24 + t25 - t27;
                 let d186 = s_q2r * d183;
                 let d187 = c_q2r * d183;
                 let d188 = c_q2r * d179 - s_q2r * d185;
-                kanegen_runtime::lanes::set_matrix(&mut out, 12, 14, d188);
+                buf[14][12] = kanegen_runtime::lanes::lanes(d188);
                 let d189 = s_q2r * d179 + c_q2r * d185;
                 let d190 = c_q1r * d182 + s_q1r * d187;
                 let d191 = s_q1r * d182 - c_q1r * d187;
                 let d192 = d188 - p.L5 * d191;
                 let d193 = c_q1r * d184 - s_q1r * d189 + p.L6 * d191;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 14, d193);
+                buf[14][4] = kanegen_runtime::lanes::lanes(d193);
                 let d194 = s_q1r * d184 + c_q1r * d189 - p.L6 * d190 + p.L5 * d186;
                 let d195 = c_q_torso * d186 + s_q_torso * d191;
                 let d196 = s_q_torso * d186 - c_q_torso * d191;
                 let d197 = c_q_torso * d192 + s_q_torso * d194 + p.L3 * d196
                     - p.L4 * d190;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 14, d197);
+                buf[14][3] = kanegen_runtime::lanes::lanes(d197);
                 let d198 = d193 + p.L4 * d195;
                 let d199 = s_q_torso * d192 - c_q_torso * d194 - p.L3 * d195;
                 let d200 = s_q_w * d190 - c_q_w * d196;
                 let d201 = c_q_w * d190 + s_q_w * d196;
                 let d202 = s_q_w * d198 - c_q_w * d199 + p.L1 * d195;
                 let d203 = d197 - p.L1 * d200 + p.L2 * d201;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 14, d203);
+                buf[14][2] = kanegen_runtime::lanes::lanes(d203);
                 let d204 = c_q_w * d198 + s_q_w * d199 - p.L2 * d195;
                 let d205 = s_q_imu * d201 + c_q_imu * d200;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 14, -d205);
+                buf[14][0] = kanegen_runtime::lanes::lanes(-d205);
                 let d206 = c_q_imu * d204 - s_q_imu * d202;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 14, -d206);
+                buf[14][1] = kanegen_runtime::lanes::lanes(-d206);
                 let d207 = p.MX5r - d183;
                 let d208 = p.MZ5r + d182;
                 let k13 = s_q3r * s_q3r;
@@ -5134,40 +5100,40 @@ mod generated {
                 let d214 = p.YZ5r - t24 - t25 + t27;
                 let d215 = pc.pc19 - d172;
                 let d216 = d176 - d210 + 2.0 * t28 + pc.pc20;
-                kanegen_runtime::lanes::set_matrix(&mut out, 13, 13, d216);
+                buf[13][13] = kanegen_runtime::lanes::lanes(d216);
                 let d217 = d181 + d210 + 2.0 * t28 + pc.pc21;
                 let d218 = c_q2r * d215 + s_q2r * d208;
                 let d219 = s_q2r * d215 - c_q2r * d208;
                 let t29 = c_q2r * d211;
                 let t30 = s_q2r * d212;
                 let d220 = t29 + t30;
-                kanegen_runtime::lanes::set_matrix(&mut out, 12, 13, -d220);
+                buf[13][12] = kanegen_runtime::lanes::lanes(-d220);
                 let t31 = s_q2r * d211;
                 let t32 = c_q2r * d212;
                 let d221 = t31 - t32;
                 let d222 = s_q1r * d218;
                 let d223 = c_q1r * d218;
                 let d224 = c_q1r * d216 - s_q1r * d221 - p.L6 * d223;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 13, -d224);
+                buf[13][4] = kanegen_runtime::lanes::lanes(-d224);
                 let d225 = s_q1r * d216 + c_q1r * d221 - p.L6 * d222 + p.L5 * d219;
                 let d226 = d220 + p.L5 * d223;
                 let d227 = c_q_torso * d219 - s_q_torso * d223;
                 let d228 = s_q_torso * d219 + c_q_torso * d223;
                 let d229 = c_q_torso * d226 + s_q_torso * d225 + p.L3 * d228
                     - p.L4 * d222;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 13, -d229);
+                buf[13][3] = kanegen_runtime::lanes::lanes(-d229);
                 let d230 = d224 + p.L4 * d227;
                 let d231 = s_q_torso * d226 - c_q_torso * d225 - p.L3 * d227;
                 let d232 = c_q_w * d222 + s_q_w * d228;
                 let d233 = s_q_w * d222 - c_q_w * d228;
                 let d234 = d229 - p.L1 * d233 + p.L2 * d232;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 13, -d234);
+                buf[13][2] = kanegen_runtime::lanes::lanes(-d234);
                 let d235 = c_q_w * d230 + s_q_w * d231 - p.L2 * d227;
                 let d236 = s_q_w * d230 - c_q_w * d231 + p.L1 * d227;
                 let d237 = s_q_imu * d232 + c_q_imu * d233;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 13, d237);
+                buf[13][0] = kanegen_runtime::lanes::lanes(d237);
                 let d238 = c_q_imu * d235 - s_q_imu * d236;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 13, d238);
+                buf[13][1] = kanegen_runtime::lanes::lanes(d238);
                 let d239 = p.MX4r - d207;
                 let d240 = p.MY4r - d218;
                 let d241 = p.MZ4r - d219;
@@ -5180,7 +5146,7 @@ mod generated {
                 let d245 = p.XY4r + t29 + t30;
                 let d246 = p.XZ4r + t31 - t32;
                 let d247 = p.YY4r + d213 - d243;
-                kanegen_runtime::lanes::set_matrix(&mut out, 12, 12, d247);
+                buf[12][12] = kanegen_runtime::lanes::lanes(d247);
                 let d248 = p.YZ4r + d214 * k18 + k17 * d242;
                 let d249 = p.ZZ4r + d217 + d243;
                 let d250 = c_q1r * d239 - s_q1r * d241;
@@ -5194,25 +5160,25 @@ mod generated {
                 let t39 = p.L6 * d251;
                 let d252 = d247 + t37;
                 let d253 = t33 - t34 - t38;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 12, d253);
+                buf[12][4] = kanegen_runtime::lanes::lanes(d253);
                 let d254 = t35 + t36 - t39;
                 let d255 = s_q_torso * d250;
                 let d256 = c_q_torso * d250;
                 let d257 = c_q_torso * d252 + s_q_torso * d254 + p.L3 * d256
                     - p.L4 * d251;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 12, d257);
+                buf[12][3] = kanegen_runtime::lanes::lanes(d257);
                 let d258 = d253 - p.L4 * d255;
                 let d259 = s_q_torso * d252 - c_q_torso * d254 + p.L3 * d255;
                 let d260 = s_q_w * d251 - c_q_w * d256;
                 let d261 = c_q_w * d251 + s_q_w * d256;
                 let d262 = s_q_w * d258 - c_q_w * d259 - p.L1 * d255;
                 let d263 = d257 - p.L1 * d260 + p.L2 * d261;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 12, d263);
+                buf[12][2] = kanegen_runtime::lanes::lanes(d263);
                 let d264 = c_q_w * d258 + s_q_w * d259 + p.L2 * d255;
                 let d265 = s_q_imu * d261 + c_q_imu * d260;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 12, -d265);
+                buf[12][0] = kanegen_runtime::lanes::lanes(-d265);
                 let d266 = c_q_imu * d264 - s_q_imu * d262;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 12, -d266);
+                buf[12][1] = kanegen_runtime::lanes::lanes(-d266);
                 let k19 = s_q1r * s_q1r;
                 let k20 = s_q1r * c_q1r;
                 let k21 = 2.0 * k19 - 1.0;
@@ -5228,56 +5194,56 @@ mod generated {
                 let t45 = p.L9 * d270;
                 let t46 = p.L9 * d269;
                 let d271 = t41 + t42 - t45;
-                kanegen_runtime::lanes::set_matrix(&mut out, 10, 11, -d271);
+                buf[11][10] = kanegen_runtime::lanes::lanes(-d271);
                 let d272 = t43 - t44 - t46;
                 let d273 = d270 * s_q6l;
                 let d274 = d270 * c_q6l;
                 let d275 = p.ZZ10l * c_q6l - d272 * s_q6l;
-                kanegen_runtime::lanes::set_matrix(&mut out, 9, 11, d275);
+                buf[11][9] = kanegen_runtime::lanes::lanes(d275);
                 let d276 = p.ZZ10l * s_q6l + d272 * c_q6l;
                 let d277 = d269 * c_q5l + d274 * s_q5l;
                 let d278 = d269 * s_q5l - d274 * c_q5l;
                 let d279 = d271 * c_q5l - d276 * s_q5l + p.L8 * d278;
-                kanegen_runtime::lanes::set_matrix(&mut out, 8, 11, -d279);
+                buf[11][8] = kanegen_runtime::lanes::lanes(-d279);
                 let d280 = d271 * s_q5l + d276 * c_q5l - p.L8 * d277;
                 let d281 = d273 * c_q4l - d278 * s_q4l;
                 let d282 = d273 * s_q4l + d278 * c_q4l;
                 let d283 = d275 * c_q4l - d280 * s_q4l;
-                kanegen_runtime::lanes::set_matrix(&mut out, 7, 11, d283);
+                buf[11][7] = kanegen_runtime::lanes::lanes(d283);
                 let d284 = d275 * s_q4l + d280 * c_q4l;
                 let d285 = d277 * c_q3l - d282 * s_q3l;
                 let d286 = d277 * s_q3l + d282 * c_q3l;
                 let d287 = d279 * c_q3l - d284 * s_q3l + p.L7 * d286;
-                kanegen_runtime::lanes::set_matrix(&mut out, 6, 11, -d287);
+                buf[11][6] = kanegen_runtime::lanes::lanes(-d287);
                 let d288 = d279 * s_q3l + d284 * c_q3l - p.L7 * d285;
                 let d289 = d281 * c_q2l - d286 * s_q2l;
                 let d290 = d281 * s_q2l + d286 * c_q2l;
                 let d291 = d283 * c_q2l - d288 * s_q2l;
-                kanegen_runtime::lanes::set_matrix(&mut out, 5, 11, d291);
+                buf[11][5] = kanegen_runtime::lanes::lanes(d291);
                 let d292 = d283 * s_q2l + d288 * c_q2l;
                 let d293 = d285 * s_q1l + d290 * c_q1l;
                 let d294 = d285 * c_q1l - d290 * s_q1l;
                 let d295 = d287 * s_q1l + d292 * c_q1l - p.L6 * d294 + p.L5 * d289;
                 let d296 = d291 - p.L5 * d293;
                 let d297 = d287 * c_q1l - d292 * s_q1l + p.L6 * d293;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 11, d297);
+                buf[11][4] = kanegen_runtime::lanes::lanes(d297);
                 let d298 = c_q_torso * d289 + s_q_torso * d293;
                 let d299 = s_q_torso * d289 - c_q_torso * d293;
                 let d300 = c_q_torso * d296 + s_q_torso * d295 + p.L3 * d299
                     + p.L4 * d294;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 11, -d300);
+                buf[11][3] = kanegen_runtime::lanes::lanes(-d300);
                 let d301 = s_q_torso * d296 - c_q_torso * d295 - p.L3 * d298;
                 let d302 = d297 - p.L4 * d298;
                 let d303 = s_q_w * d294 + c_q_w * d299;
                 let d304 = c_q_w * d294 - s_q_w * d299;
                 let d305 = d300 + p.L1 * d303 - p.L2 * d304;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 11, -d305);
+                buf[11][2] = kanegen_runtime::lanes::lanes(-d305);
                 let d306 = s_q_w * d302 + c_q_w * d301 - p.L1 * d298;
                 let d307 = c_q_w * d302 - s_q_w * d301 + p.L2 * d298;
                 let d308 = s_q_imu * d304 + c_q_imu * d303;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 11, -d308);
+                buf[11][0] = kanegen_runtime::lanes::lanes(-d308);
                 let d309 = c_q_imu * d307 - s_q_imu * d306;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 11, -d309);
+                buf[11][1] = kanegen_runtime::lanes::lanes(-d309);
                 let d310 = p.MX9l - d270;
                 let d311 = p.MZ9l + d269;
                 let k22 = s_q7l * s_q7l;
@@ -5288,14 +5254,14 @@ mod generated {
                 let d314 = p.XZ9l - p.XY10l * k24 - k23 * pc.pc26;
                 let d315 = p.YZ9l - t43 + t44 + t46;
                 let d316 = pc.pc30 - d312;
-                kanegen_runtime::lanes::set_matrix(&mut out, 10, 10, d316);
+                buf[10][10] = kanegen_runtime::lanes::lanes(d316);
                 let d317 = d312 + pc.pc31;
                 let d318 = c_q6l * pc.pc25 + s_q6l * d311;
                 let d319 = s_q6l * pc.pc25 - c_q6l * d311;
                 let t47 = c_q6l * d313;
                 let t48 = s_q6l * d314;
                 let d320 = t47 + t48;
-                kanegen_runtime::lanes::set_matrix(&mut out, 9, 10, -d320);
+                buf[10][9] = kanegen_runtime::lanes::lanes(-d320);
                 let t49 = s_q6l * d313;
                 let t50 = c_q6l * d314;
                 let d321 = t49 - t50;
@@ -5303,45 +5269,45 @@ mod generated {
                 let d323 = c_q5l * d318;
                 let d324 = s_q5l * d316 + c_q5l * d321 - p.L8 * d322;
                 let d325 = c_q5l * d316 - s_q5l * d321 - p.L8 * d323;
-                kanegen_runtime::lanes::set_matrix(&mut out, 8, 10, d325);
+                buf[10][8] = kanegen_runtime::lanes::lanes(d325);
                 let d326 = c_q4l * d319 + s_q4l * d323;
                 let d327 = s_q4l * d319 - c_q4l * d323;
                 let d328 = c_q4l * d320 - s_q4l * d324;
-                kanegen_runtime::lanes::set_matrix(&mut out, 7, 10, -d328);
+                buf[10][7] = kanegen_runtime::lanes::lanes(-d328);
                 let d329 = s_q4l * d320 + c_q4l * d324;
                 let d330 = s_q3l * d322 + c_q3l * d327;
                 let d331 = c_q3l * d322 - s_q3l * d327;
                 let d332 = s_q3l * d325 + c_q3l * d329 - p.L7 * d331;
                 let d333 = c_q3l * d325 - s_q3l * d329 + p.L7 * d330;
-                kanegen_runtime::lanes::set_matrix(&mut out, 6, 10, d333);
+                buf[10][6] = kanegen_runtime::lanes::lanes(d333);
                 let d334 = c_q2l * d326 - s_q2l * d330;
                 let d335 = s_q2l * d326 + c_q2l * d330;
                 let d336 = c_q2l * d328 - s_q2l * d332;
-                kanegen_runtime::lanes::set_matrix(&mut out, 5, 10, -d336);
+                buf[10][5] = kanegen_runtime::lanes::lanes(-d336);
                 let d337 = s_q2l * d328 + c_q2l * d332;
                 let d338 = c_q1l * d331 - s_q1l * d335;
                 let d339 = s_q1l * d331 + c_q1l * d335;
                 let d340 = d336 - p.L5 * d339;
                 let d341 = c_q1l * d333 - s_q1l * d337 + p.L6 * d339;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 10, -d341);
+                buf[10][4] = kanegen_runtime::lanes::lanes(-d341);
                 let d342 = s_q1l * d333 + c_q1l * d337 - p.L6 * d338 + p.L5 * d334;
                 let d343 = c_q_torso * d334 + s_q_torso * d339;
                 let d344 = s_q_torso * d334 - c_q_torso * d339;
                 let d345 = d341 - p.L4 * d343;
                 let d346 = c_q_torso * d340 + s_q_torso * d342 + p.L3 * d344
                     + p.L4 * d338;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 10, d346);
+                buf[10][3] = kanegen_runtime::lanes::lanes(d346);
                 let d347 = s_q_torso * d340 - c_q_torso * d342 - p.L3 * d343;
                 let d348 = c_q_w * d338 - s_q_w * d344;
                 let d349 = s_q_w * d338 + c_q_w * d344;
                 let d350 = c_q_w * d345 - s_q_w * d347 + p.L2 * d343;
                 let d351 = d346 + p.L1 * d349 - p.L2 * d348;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 10, d351);
+                buf[10][2] = kanegen_runtime::lanes::lanes(d351);
                 let d352 = s_q_w * d345 + c_q_w * d347 - p.L1 * d343;
                 let d353 = s_q_imu * d348 + c_q_imu * d349;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 10, d353);
+                buf[10][0] = kanegen_runtime::lanes::lanes(d353);
                 let d354 = c_q_imu * d350 - s_q_imu * d352;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 10, d354);
+                buf[10][1] = kanegen_runtime::lanes::lanes(d354);
                 let d355 = p.MX8l - d310;
                 let d356 = p.MY8l - d318;
                 let d357 = p.MZ8l - d319;
@@ -5356,7 +5322,7 @@ mod generated {
                 let d363 = p.YZ8l + d315 * k27 + k26 * d358;
                 let d364 = p.ZZ8l + d317 + d359;
                 let d365 = pc.pc33 - d359;
-                kanegen_runtime::lanes::set_matrix(&mut out, 9, 9, d365);
+                buf[9][9] = kanegen_runtime::lanes::lanes(d365);
                 let d366 = s_q5l * d355 + c_q5l * d357;
                 let d367 = c_q5l * d355 - s_q5l * d357;
                 let t51 = c_q5l * d361;
@@ -5366,46 +5332,46 @@ mod generated {
                 let t55 = p.L8 * d367;
                 let t56 = p.L8 * d366;
                 let d368 = t51 - t52 - t55;
-                kanegen_runtime::lanes::set_matrix(&mut out, 8, 9, -d368);
+                buf[9][8] = kanegen_runtime::lanes::lanes(-d368);
                 let d369 = t53 + t54 - t56;
                 let d370 = s_q4l * d367;
                 let d371 = c_q4l * d367;
                 let d372 = c_q4l * d365 - s_q4l * d369;
-                kanegen_runtime::lanes::set_matrix(&mut out, 7, 9, d372);
+                buf[9][7] = kanegen_runtime::lanes::lanes(d372);
                 let d373 = s_q4l * d365 + c_q4l * d369;
                 let d374 = c_q3l * d366 + s_q3l * d371;
                 let d375 = s_q3l * d366 - c_q3l * d371;
                 let d376 = c_q3l * d368 - s_q3l * d373 + p.L7 * d375;
-                kanegen_runtime::lanes::set_matrix(&mut out, 6, 9, -d376);
+                buf[9][6] = kanegen_runtime::lanes::lanes(-d376);
                 let d377 = s_q3l * d368 + c_q3l * d373 - p.L7 * d374;
                 let d378 = c_q2l * d370 - s_q2l * d375;
                 let d379 = s_q2l * d370 + c_q2l * d375;
                 let d380 = c_q2l * d372 - s_q2l * d377;
-                kanegen_runtime::lanes::set_matrix(&mut out, 5, 9, d380);
+                buf[9][5] = kanegen_runtime::lanes::lanes(d380);
                 let d381 = s_q2l * d372 + c_q2l * d377;
                 let d382 = s_q1l * d374 + c_q1l * d379;
                 let d383 = c_q1l * d374 - s_q1l * d379;
                 let d384 = s_q1l * d376 + c_q1l * d381 - p.L6 * d383 + p.L5 * d378;
                 let d385 = d380 - p.L5 * d382;
                 let d386 = c_q1l * d376 - s_q1l * d381 + p.L6 * d382;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 9, d386);
+                buf[9][4] = kanegen_runtime::lanes::lanes(d386);
                 let d387 = c_q_torso * d378 + s_q_torso * d382;
                 let d388 = s_q_torso * d378 - c_q_torso * d382;
                 let d389 = c_q_torso * d385 + s_q_torso * d384 + p.L3 * d388
                     + p.L4 * d383;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 9, -d389);
+                buf[9][3] = kanegen_runtime::lanes::lanes(-d389);
                 let d390 = s_q_torso * d385 - c_q_torso * d384 - p.L3 * d387;
                 let d391 = d386 - p.L4 * d387;
                 let d392 = s_q_w * d383 + c_q_w * d388;
                 let d393 = c_q_w * d383 - s_q_w * d388;
                 let d394 = d389 + p.L1 * d392 - p.L2 * d393;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 9, -d394);
+                buf[9][2] = kanegen_runtime::lanes::lanes(-d394);
                 let d395 = s_q_w * d391 + c_q_w * d390 - p.L1 * d387;
                 let d396 = c_q_w * d391 - s_q_w * d390 + p.L2 * d387;
                 let d397 = s_q_imu * d393 + c_q_imu * d392;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 9, -d397);
+                buf[9][0] = kanegen_runtime::lanes::lanes(-d397);
                 let d398 = c_q_imu * d396 - s_q_imu * d395;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 9, -d398);
+                buf[9][1] = kanegen_runtime::lanes::lanes(-d398);
                 let d399 = p.MX7l - d367;
                 let d400 = p.MZ7l + d366;
                 let k28 = s_q5l * s_q5l;
@@ -5420,14 +5386,14 @@ mod generated {
                 let d406 = p.YZ7l - t53 - t54 + t56;
                 let d407 = pc.pc36 - d356;
                 let d408 = d360 - d402 + 2.0 * t57 + pc.pc37;
-                kanegen_runtime::lanes::set_matrix(&mut out, 8, 8, d408);
+                buf[8][8] = kanegen_runtime::lanes::lanes(d408);
                 let d409 = d364 + d402 + 2.0 * t57 + pc.pc38;
                 let d410 = c_q4l * d407 + s_q4l * d400;
                 let d411 = s_q4l * d407 - c_q4l * d400;
                 let t58 = c_q4l * d403;
                 let t59 = s_q4l * d404;
                 let d412 = t58 + t59;
-                kanegen_runtime::lanes::set_matrix(&mut out, 7, 8, -d412);
+                buf[8][7] = kanegen_runtime::lanes::lanes(-d412);
                 let t60 = s_q4l * d403;
                 let t61 = c_q4l * d404;
                 let d413 = t60 - t61;
@@ -5435,35 +5401,35 @@ mod generated {
                 let d415 = c_q3l * d410;
                 let d416 = s_q3l * d408 + c_q3l * d413 - p.L7 * d414;
                 let d417 = c_q3l * d408 - s_q3l * d413 - p.L7 * d415;
-                kanegen_runtime::lanes::set_matrix(&mut out, 6, 8, d417);
+                buf[8][6] = kanegen_runtime::lanes::lanes(d417);
                 let d418 = c_q2l * d411 + s_q2l * d415;
                 let d419 = s_q2l * d411 - c_q2l * d415;
                 let d420 = c_q2l * d412 - s_q2l * d416;
-                kanegen_runtime::lanes::set_matrix(&mut out, 5, 8, -d420);
+                buf[8][5] = kanegen_runtime::lanes::lanes(-d420);
                 let d421 = s_q2l * d412 + c_q2l * d416;
                 let d422 = c_q1l * d414 - s_q1l * d419;
                 let d423 = s_q1l * d414 + c_q1l * d419;
                 let d424 = d420 - p.L5 * d423;
                 let d425 = c_q1l * d417 - s_q1l * d421 + p.L6 * d423;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 8, -d425);
+                buf[8][4] = kanegen_runtime::lanes::lanes(-d425);
                 let d426 = s_q1l * d417 + c_q1l * d421 - p.L6 * d422 + p.L5 * d418;
                 let d427 = c_q_torso * d418 + s_q_torso * d423;
                 let d428 = s_q_torso * d418 - c_q_torso * d423;
                 let d429 = d425 - p.L4 * d427;
                 let d430 = c_q_torso * d424 + s_q_torso * d426 + p.L3 * d428
                     + p.L4 * d422;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 8, d430);
+                buf[8][3] = kanegen_runtime::lanes::lanes(d430);
                 let d431 = s_q_torso * d424 - c_q_torso * d426 - p.L3 * d427;
                 let d432 = c_q_w * d422 - s_q_w * d428;
                 let d433 = s_q_w * d422 + c_q_w * d428;
                 let d434 = c_q_w * d429 - s_q_w * d431 + p.L2 * d427;
                 let d435 = d430 + p.L1 * d433 - p.L2 * d432;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 8, d435);
+                buf[8][2] = kanegen_runtime::lanes::lanes(d435);
                 let d436 = s_q_w * d429 + c_q_w * d431 - p.L1 * d427;
                 let d437 = s_q_imu * d432 + c_q_imu * d433;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 8, d437);
+                buf[8][0] = kanegen_runtime::lanes::lanes(d437);
                 let d438 = c_q_imu * d434 - s_q_imu * d436;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 8, d438);
+                buf[8][1] = kanegen_runtime::lanes::lanes(d438);
                 let d439 = p.MX6l - d399;
                 let d440 = p.MY6l - d410;
                 let d441 = p.MZ6l - d411;
@@ -5476,7 +5442,7 @@ mod generated {
                 let d445 = p.XY6l + t58 + t59;
                 let d446 = p.XZ6l + t60 - t61;
                 let d447 = p.YY6l + d405 - d443;
-                kanegen_runtime::lanes::set_matrix(&mut out, 7, 7, d447);
+                buf[7][7] = kanegen_runtime::lanes::lanes(d447);
                 let d448 = p.YZ6l + d406 * k33 + k32 * d442;
                 let d449 = p.ZZ6l + d409 + d443;
                 let d450 = s_q3l * d439 + c_q3l * d441;
@@ -5488,36 +5454,36 @@ mod generated {
                 let t66 = p.L7 * d451;
                 let t67 = p.L7 * d450;
                 let d452 = t62 - t63 - t66;
-                kanegen_runtime::lanes::set_matrix(&mut out, 6, 7, -d452);
+                buf[7][6] = kanegen_runtime::lanes::lanes(-d452);
                 let d453 = t64 + t65 - t67;
                 let d454 = s_q2l * d451;
                 let d455 = c_q2l * d451;
                 let d456 = c_q2l * d447 - s_q2l * d453;
-                kanegen_runtime::lanes::set_matrix(&mut out, 5, 7, d456);
+                buf[7][5] = kanegen_runtime::lanes::lanes(d456);
                 let d457 = s_q2l * d447 + c_q2l * d453;
                 let d458 = s_q1l * d450 - c_q1l * d455;
                 let d459 = c_q1l * d450 + s_q1l * d455;
                 let d460 = s_q1l * d452 + c_q1l * d457 - p.L6 * d459 + p.L5 * d454;
                 let d461 = d456 - p.L5 * d458;
                 let d462 = c_q1l * d452 - s_q1l * d457 + p.L6 * d458;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 7, d462);
+                buf[7][4] = kanegen_runtime::lanes::lanes(d462);
                 let d463 = c_q_torso * d454 + s_q_torso * d458;
                 let d464 = s_q_torso * d454 - c_q_torso * d458;
                 let d465 = c_q_torso * d461 + s_q_torso * d460 + p.L3 * d464
                     + p.L4 * d459;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 7, -d465);
+                buf[7][3] = kanegen_runtime::lanes::lanes(-d465);
                 let d466 = s_q_torso * d461 - c_q_torso * d460 - p.L3 * d463;
                 let d467 = d462 - p.L4 * d463;
                 let d468 = s_q_w * d459 + c_q_w * d464;
                 let d469 = c_q_w * d459 - s_q_w * d464;
                 let d470 = d465 + p.L1 * d468 - p.L2 * d469;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 7, -d470);
+                buf[7][2] = kanegen_runtime::lanes::lanes(-d470);
                 let d471 = s_q_w * d467 + c_q_w * d466 - p.L1 * d463;
                 let d472 = c_q_w * d467 - s_q_w * d466 + p.L2 * d463;
                 let d473 = s_q_imu * d469 + c_q_imu * d468;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 7, -d473);
+                buf[7][0] = kanegen_runtime::lanes::lanes(-d473);
                 let d474 = c_q_imu * d472 - s_q_imu * d471;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 7, -d474);
+                buf[7][1] = kanegen_runtime::lanes::lanes(-d474);
                 let d475 = p.MX5l - d451;
                 let d476 = p.MZ5l + d450;
                 let k34 = s_q3l * s_q3l;
@@ -5532,14 +5498,14 @@ mod generated {
                 let d482 = p.YZ5l - t64 - t65 + t67;
                 let d483 = pc.pc42 - d440;
                 let d484 = d444 - d478 + 2.0 * t68 + pc.pc43;
-                kanegen_runtime::lanes::set_matrix(&mut out, 6, 6, d484);
+                buf[6][6] = kanegen_runtime::lanes::lanes(d484);
                 let d485 = d449 + d478 + 2.0 * t68 + pc.pc44;
                 let d486 = c_q2l * d483 + s_q2l * d476;
                 let d487 = s_q2l * d483 - c_q2l * d476;
                 let t69 = c_q2l * d479;
                 let t70 = s_q2l * d480;
                 let d488 = t69 + t70;
-                kanegen_runtime::lanes::set_matrix(&mut out, 5, 6, -d488);
+                buf[6][5] = kanegen_runtime::lanes::lanes(-d488);
                 let t71 = s_q2l * d479;
                 let t72 = c_q2l * d480;
                 let d489 = t71 - t72;
@@ -5547,25 +5513,25 @@ mod generated {
                 let d491 = c_q1l * d486;
                 let d492 = d488 + p.L5 * d491;
                 let d493 = c_q1l * d484 - s_q1l * d489 - p.L6 * d491;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 6, -d493);
+                buf[6][4] = kanegen_runtime::lanes::lanes(-d493);
                 let d494 = s_q1l * d484 + c_q1l * d489 - p.L6 * d490 + p.L5 * d487;
                 let d495 = c_q_torso * d487 - s_q_torso * d491;
                 let d496 = s_q_torso * d487 + c_q_torso * d491;
                 let d497 = d493 - p.L4 * d495;
                 let d498 = c_q_torso * d492 + s_q_torso * d494 + p.L3 * d496
                     + p.L4 * d490;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 6, d498);
+                buf[6][3] = kanegen_runtime::lanes::lanes(d498);
                 let d499 = s_q_torso * d492 - c_q_torso * d494 - p.L3 * d495;
                 let d500 = c_q_w * d490 - s_q_w * d496;
                 let d501 = s_q_w * d490 + c_q_w * d496;
                 let d502 = c_q_w * d497 - s_q_w * d499 + p.L2 * d495;
                 let d503 = d498 + p.L1 * d501 - p.L2 * d500;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 6, d503);
+                buf[6][2] = kanegen_runtime::lanes::lanes(d503);
                 let d504 = s_q_w * d497 + c_q_w * d499 - p.L1 * d495;
                 let d505 = s_q_imu * d500 + c_q_imu * d501;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 6, d505);
+                buf[6][0] = kanegen_runtime::lanes::lanes(d505);
                 let d506 = c_q_imu * d502 - s_q_imu * d504;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 6, d506);
+                buf[6][1] = kanegen_runtime::lanes::lanes(d506);
                 let d507 = p.MX4l - d475;
                 let d508 = p.MY4l - d486;
                 let d509 = p.MZ4l - d487;
@@ -5578,7 +5544,7 @@ mod generated {
                 let d513 = p.XY4l + t69 + t70;
                 let d514 = p.XZ4l + t71 - t72;
                 let d515 = p.YY4l + d481 - d511;
-                kanegen_runtime::lanes::set_matrix(&mut out, 5, 5, d515);
+                buf[5][5] = kanegen_runtime::lanes::lanes(d515);
                 let d516 = p.YZ4l + d482 * k39 + k38 * d510;
                 let d517 = p.ZZ4l + d485 + d511;
                 let d518 = c_q1l * d507 - s_q1l * d509;
@@ -5593,24 +5559,24 @@ mod generated {
                 let d520 = t75 + t76 - t79;
                 let d521 = d515 + t77;
                 let d522 = t73 - t74 - t78;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 5, d522);
+                buf[5][4] = kanegen_runtime::lanes::lanes(d522);
                 let d523 = s_q_torso * d518;
                 let d524 = c_q_torso * d518;
                 let d525 = c_q_torso * d521 + s_q_torso * d520 + p.L3 * d524
                     + p.L4 * d519;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 5, -d525);
+                buf[5][3] = kanegen_runtime::lanes::lanes(-d525);
                 let d526 = s_q_torso * d521 - c_q_torso * d520 + p.L3 * d523;
                 let d527 = d522 + p.L4 * d523;
                 let d528 = s_q_w * d519 + c_q_w * d524;
                 let d529 = c_q_w * d519 - s_q_w * d524;
                 let d530 = d525 + p.L1 * d528 - p.L2 * d529;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 5, -d530);
+                buf[5][2] = kanegen_runtime::lanes::lanes(-d530);
                 let d531 = s_q_w * d527 + c_q_w * d526 + p.L1 * d523;
                 let d532 = c_q_w * d527 - s_q_w * d526 - p.L2 * d523;
                 let d533 = s_q_imu * d529 + c_q_imu * d528;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 5, -d533);
+                buf[5][0] = kanegen_runtime::lanes::lanes(-d533);
                 let d534 = c_q_imu * d532 - s_q_imu * d531;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 5, -d534);
+                buf[5][1] = kanegen_runtime::lanes::lanes(-d534);
                 let d535 = p.MZ3 + d251 - d519;
                 let k40 = s_q1l * s_q1l;
                 let k41 = s_q1l * c_q1l;
@@ -5627,7 +5593,7 @@ mod generated {
                 let d543 = t34 - t33 + t38 + p.L5 * d240 + t73 - t74 - t78 - p.L5 * d508
                     + pc.pc50;
                 let d544 = d244 - d268 + 2.0 * t40 + d512 - d537 + 2.0 * t80 + pc.pc51;
-                kanegen_runtime::lanes::set_matrix(&mut out, 4, 4, d544);
+                buf[4][4] = kanegen_runtime::lanes::lanes(d544);
                 let d545 = d249 + 2.0 * t37 + d268 + 2.0 * t40 + d517 + 2.0 * t77 + d537
                     + 2.0 * t80 + pc.pc52;
                 let d546 = c_q_torso * d540 - s_q_torso * d535;
@@ -5640,19 +5606,19 @@ mod generated {
                 let t86 = p.L4 * d547;
                 let t87 = p.L3 * d547;
                 let d548 = t81 - t82 - t85;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 4, -d548);
+                buf[4][3] = kanegen_runtime::lanes::lanes(-d548);
                 let d549 = t83 + t84 - t87;
                 let d550 = d544 - t86;
                 let d551 = s_q_w * d546;
                 let d552 = c_q_w * d546;
                 let d553 = d548 - p.L1 * d552 - p.L2 * d551;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 4, -d553);
+                buf[4][2] = kanegen_runtime::lanes::lanes(-d553);
                 let d554 = s_q_w * d550 + c_q_w * d549 - p.L1 * d547;
                 let d555 = c_q_w * d550 - s_q_w * d549 + p.L2 * d547;
                 let d556 = s_q_imu * d551 - c_q_imu * d552;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 4, -d556);
+                buf[4][0] = kanegen_runtime::lanes::lanes(-d556);
                 let d557 = c_q_imu * d555 - s_q_imu * d554;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 4, -d557);
+                buf[4][1] = kanegen_runtime::lanes::lanes(-d557);
                 let d558 = p.MX2 - d546;
                 let k43 = s_q_torso * s_q_torso;
                 let k44 = s_q_torso * c_q_torso;
@@ -5665,7 +5631,7 @@ mod generated {
                 let d563 = d541 + pc.pc54;
                 let d564 = pc.pc55 - d547;
                 let d565 = d542 - 2.0 * t86 - d560 + 2.0 * t88 + pc.pc56;
-                kanegen_runtime::lanes::set_matrix(&mut out, 3, 3, d565);
+                buf[3][3] = kanegen_runtime::lanes::lanes(d565);
                 let d566 = d544 - 2.0 * t86 + pc.pc57;
                 let d567 = t87 - t83 - t84 - p.L4 * d541 + pc.pc58;
                 let d568 = d545 + d560 + 2.0 * t88 + pc.pc59;
@@ -5679,14 +5645,14 @@ mod generated {
                 let t93 = p.L1 * d569;
                 let t94 = p.L2 * d570;
                 let d572 = d565 + t93 + t94;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 3, d572);
+                buf[3][2] = kanegen_runtime::lanes::lanes(d572);
                 let d573 = t89 + t90;
                 let d574 = s_q_imu * d570 - c_q_imu * d569;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 3, -d574);
+                buf[3][0] = kanegen_runtime::lanes::lanes(-d574);
                 let d575 = c_q_imu * d573 - s_q_imu * d571;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 3, -d575);
+                buf[3][1] = kanegen_runtime::lanes::lanes(-d575);
                 let d576 = p.MX1 + d558;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 1, d576);
+                buf[1][0] = kanegen_runtime::lanes::lanes(d576);
                 let k46 = s_q_w * s_q_w;
                 let k47 = s_q_w * c_q_w;
                 let k48 = 2.0 * k46 - 1.0;
@@ -5697,22 +5663,21 @@ mod generated {
                 let d581 = d569 + pc.pc61;
                 let d582 = pc.pc62 - d570;
                 let d583 = d565 + 2.0 * t93 + 2.0 * t94 + pc.pc63;
-                kanegen_runtime::lanes::set_matrix(&mut out, 2, 2, d583);
+                buf[2][2] = kanegen_runtime::lanes::lanes(d583);
                 let d584 = d566 + 2.0 * t94 - d578 + pc.pc64;
                 let d585 = p.L2 * d569 - d567 * k48 - k47 * d577 + p.L1 * d570 + pc.pc65;
                 let d586 = d568 + 2.0 * t93 + d578 + pc.pc66;
                 let d587 = c_q_imu * d581 + s_q_imu * d582;
-                kanegen_runtime::lanes::set_matrix(&mut out, 0, 2, d587);
+                buf[2][0] = kanegen_runtime::lanes::lanes(d587);
                 let d588 = c_q_imu * d579 + s_q_imu * d580;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 2, -d588);
+                buf[2][1] = kanegen_runtime::lanes::lanes(-d588);
                 let k49 = s_q_imu * s_q_imu;
                 let k50 = s_q_imu * c_q_imu;
                 let d589 = d584 - d586;
                 let d590 = k49 * d589 - 2.0 * (d585 * k50);
                 let d591 = d584 - d590;
-                kanegen_runtime::lanes::set_matrix(&mut out, 1, 1, d591 + pc.pc68);
-                kanegen_runtime::lanes::mirror_upper(&mut out);
-                out
+                buf[1][1] = kanegen_runtime::lanes::lanes(d591 + pc.pc68);
+                kanegen_runtime::lanes::results(&mut buf, true)
             },
         )
     }
@@ -5724,82 +5689,49 @@ mod generated {
         q: &[SVector<f64, 19>; L],
         u: &[SVector<f64, 19>; L],
     ) -> [SVector<f64, 19>; L] {
-        use kanegen_runtime::lanes::Lanes;
         kanegen_runtime::isa::dispatch(
             #[inline(always)]
             || {
-                let (s_q_imu, c_q_imu) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 2),
-                );
-                let (s_q_w, c_q_w) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 3),
-                );
-                let (s_q_torso, c_q_torso) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 4),
-                );
-                let (s_q1l, c_q1l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 5),
-                );
-                let (s_q2l, c_q2l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 6),
-                );
-                let (s_q3l, c_q3l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 7),
-                );
-                let (s_q4l, c_q4l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 8),
-                );
-                let (s_q5l, c_q5l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 9),
-                );
-                let (s_q6l, c_q6l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 10),
-                );
-                let (s_q7l, c_q7l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 11),
-                );
-                let (s_q1r, c_q1r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 12),
-                );
-                let (s_q2r, c_q2r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 13),
-                );
-                let (s_q3r, c_q3r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 14),
-                );
-                let (s_q4r, c_q4r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 15),
-                );
-                let (s_q5r, c_q5r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 16),
-                );
-                let (s_q6r, c_q6r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 17),
-                );
-                let (s_q7r, c_q7r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 18),
-                );
-                let xd = Lanes::gather(u, 0);
-                let psid = Lanes::gather(u, 1);
-                let qd_imu = Lanes::gather(u, 2);
-                let qd_w = Lanes::gather(u, 3);
-                let qd_torso = Lanes::gather(u, 4);
-                let qd1l = Lanes::gather(u, 5);
-                let qd2l = Lanes::gather(u, 6);
-                let qd3l = Lanes::gather(u, 7);
-                let qd4l = Lanes::gather(u, 8);
-                let qd5l = Lanes::gather(u, 9);
-                let qd6l = Lanes::gather(u, 10);
-                let qd7l = Lanes::gather(u, 11);
-                let qd1r = Lanes::gather(u, 12);
-                let qd2r = Lanes::gather(u, 13);
-                let qd3r = Lanes::gather(u, 14);
-                let qd4r = Lanes::gather(u, 15);
-                let qd5r = Lanes::gather(u, 16);
-                let qd6r = Lanes::gather(u, 17);
-                let qd7r = Lanes::gather(u, 18);
+                let q = kanegen_runtime::lanes::inputs(q);
+                let u = kanegen_runtime::lanes::inputs(u);
+                let (s_q_imu, c_q_imu) = kanegen_runtime::lanes::sin_cos(q[2]);
+                let (s_q_w, c_q_w) = kanegen_runtime::lanes::sin_cos(q[3]);
+                let (s_q_torso, c_q_torso) = kanegen_runtime::lanes::sin_cos(q[4]);
+                let (s_q1l, c_q1l) = kanegen_runtime::lanes::sin_cos(q[5]);
+                let (s_q2l, c_q2l) = kanegen_runtime::lanes::sin_cos(q[6]);
+                let (s_q3l, c_q3l) = kanegen_runtime::lanes::sin_cos(q[7]);
+                let (s_q4l, c_q4l) = kanegen_runtime::lanes::sin_cos(q[8]);
+                let (s_q5l, c_q5l) = kanegen_runtime::lanes::sin_cos(q[9]);
+                let (s_q6l, c_q6l) = kanegen_runtime::lanes::sin_cos(q[10]);
+                let (s_q7l, c_q7l) = kanegen_runtime::lanes::sin_cos(q[11]);
+                let (s_q1r, c_q1r) = kanegen_runtime::lanes::sin_cos(q[12]);
+                let (s_q2r, c_q2r) = kanegen_runtime::lanes::sin_cos(q[13]);
+                let (s_q3r, c_q3r) = kanegen_runtime::lanes::sin_cos(q[14]);
+                let (s_q4r, c_q4r) = kanegen_runtime::lanes::sin_cos(q[15]);
+                let (s_q5r, c_q5r) = kanegen_runtime::lanes::sin_cos(q[16]);
+                let (s_q6r, c_q6r) = kanegen_runtime::lanes::sin_cos(q[17]);
+                let (s_q7r, c_q7r) = kanegen_runtime::lanes::sin_cos(q[18]);
+                let xd = u[0];
+                let psid = u[1];
+                let qd_imu = u[2];
+                let qd_w = u[3];
+                let qd_torso = u[4];
+                let qd1l = u[5];
+                let qd2l = u[6];
+                let qd3l = u[7];
+                let qd4l = u[8];
+                let qd5l = u[9];
+                let qd6l = u[10];
+                let qd7l = u[11];
+                let qd1r = u[12];
+                let qd2r = u[13];
+                let qd3r = u[14];
+                let qd4r = u[15];
+                let qd5r = u[16];
+                let qd6r = u[17];
+                let qd7r = u[18];
                 #[allow(unused_mut)]
-                let mut out = [<SVector<f64, 19>>::zeros(); L];
+                let mut buf = kanegen_runtime::lanes::buffer::<L, 19, 1>();
                 let k1 = xd * psid;
                 let k2 = c_q_imu * psid;
                 let k3 = s_q_imu * psid;
@@ -6078,7 +6010,7 @@ mod generated {
                     + k90 * d116 + p.MZ10l * k100 + p.MX10l * k98;
                 let d119 = p.XZ10l * k93 + p.YZ10l * k94 - p.ZZ10l * k86 - k90 * d115
                     + k91 * d114 + p.MX10l * k101 - p.MY10l * k100;
-                kanegen_runtime::lanes::set_vector(&mut out, 11, d119);
+                buf[0][11] = kanegen_runtime::lanes::lanes(d119);
                 let k102 = c_q1r * k21 - s_q1r * k20;
                 let k103 = s_q1r * k21 + c_q1r * k20;
                 let k104 = s_q1r * k9 + c_q1r * k23 - k102 * qd1r;
@@ -6273,7 +6205,7 @@ mod generated {
                     + k158 * d200 + p.MZ10r * k168 - p.MX10r * k166;
                 let d203 = p.XZ10r * k161 + p.YZ10r * k162 + p.ZZ10r * k153 - k158 * d199
                     + k159 * d198 + p.MX10r * k169 - p.MY10r * k168;
-                kanegen_runtime::lanes::set_vector(&mut out, 18, d203);
+                buf[0][18] = kanegen_runtime::lanes::lanes(d203);
                 let d204 = c_q7r * d195 + s_q7r * d196;
                 let d205 = s_q7r * d195 - c_q7r * d196;
                 let d206 = d183 + d204;
@@ -6281,7 +6213,7 @@ mod generated {
                 let d208 = d185 - d205;
                 let d209 = d190 + d203;
                 let d210 = d189 + c_q7r * d201 + s_q7r * d202 + p.L9 * d205;
-                kanegen_runtime::lanes::set_vector(&mut out, 17, -d210);
+                buf[0][17] = kanegen_runtime::lanes::lanes(-d210);
                 let d211 = d191 - s_q7r * d201 + c_q7r * d202 + p.L9 * d204;
                 let d212 = c_q6r * d207 + s_q6r * d208;
                 let d213 = s_q6r * d207 - c_q6r * d208;
@@ -6290,7 +6222,7 @@ mod generated {
                 let d216 = d173 + d212;
                 let d217 = d177 + d210;
                 let d218 = d178 + c_q6r * d209 + s_q6r * d211;
-                kanegen_runtime::lanes::set_vector(&mut out, 16, d218);
+                buf[0][16] = kanegen_runtime::lanes::lanes(d218);
                 let d219 = d179 + s_q6r * d209 - c_q6r * d211;
                 let d220 = c_q5r * d215 + s_q5r * d214;
                 let d221 = s_q5r * d215 - c_q5r * d214;
@@ -6299,7 +6231,7 @@ mod generated {
                 let d224 = d161 - d221;
                 let d225 = d166 + d218;
                 let d226 = d165 + c_q5r * d217 - s_q5r * d219 + p.L8 * d221;
-                kanegen_runtime::lanes::set_vector(&mut out, 15, -d226);
+                buf[0][15] = kanegen_runtime::lanes::lanes(-d226);
                 let d227 = d167 - s_q5r * d217 - c_q5r * d219 + p.L8 * d220;
                 let d228 = c_q4r * d223 + s_q4r * d224;
                 let d229 = s_q4r * d223 - c_q4r * d224;
@@ -6308,7 +6240,7 @@ mod generated {
                 let d232 = d149 + d228;
                 let d233 = d153 + d226;
                 let d234 = d154 + c_q4r * d225 + s_q4r * d227;
-                kanegen_runtime::lanes::set_vector(&mut out, 14, d234);
+                buf[0][14] = kanegen_runtime::lanes::lanes(d234);
                 let d235 = d155 + s_q4r * d225 - c_q4r * d227;
                 let d236 = c_q3r * d231 + s_q3r * d230;
                 let d237 = s_q3r * d231 - c_q3r * d230;
@@ -6317,7 +6249,7 @@ mod generated {
                 let d240 = d137 - d237;
                 let d241 = d142 + d234;
                 let d242 = d141 + c_q3r * d233 - s_q3r * d235 + p.L7 * d237;
-                kanegen_runtime::lanes::set_vector(&mut out, 13, -d242);
+                buf[0][13] = kanegen_runtime::lanes::lanes(-d242);
                 let d243 = d143 - s_q3r * d233 - c_q3r * d235 + p.L7 * d236;
                 let d244 = c_q2r * d239 + s_q2r * d240;
                 let d245 = s_q2r * d239 - c_q2r * d240;
@@ -6326,7 +6258,7 @@ mod generated {
                 let d248 = d125 + d244;
                 let d249 = d129 + d242;
                 let d250 = d130 + c_q2r * d241 + s_q2r * d243;
-                kanegen_runtime::lanes::set_vector(&mut out, 12, d250);
+                buf[0][12] = kanegen_runtime::lanes::lanes(d250);
                 let d251 = d131 + s_q2r * d241 - c_q2r * d243;
                 let d252 = c_q1r * d247 + s_q1r * d246;
                 let d253 = s_q1r * d247 - c_q1r * d246;
@@ -6341,7 +6273,7 @@ mod generated {
                 let d262 = d99 + d260;
                 let d263 = d106 + d119;
                 let d264 = d105 + c_q7l * d117 + s_q7l * d118 + p.L9 * d261;
-                kanegen_runtime::lanes::set_vector(&mut out, 10, -d264);
+                buf[0][10] = kanegen_runtime::lanes::lanes(-d264);
                 let d265 = d107 - s_q7l * d117 + c_q7l * d118 + p.L9 * d260;
                 let d266 = d100 + d111;
                 let d267 = d101 + d261;
@@ -6352,14 +6284,14 @@ mod generated {
                 let d272 = d89 + d262;
                 let d273 = d93 + d264;
                 let d274 = d94 + c_q6l * d263 + s_q6l * d265;
-                kanegen_runtime::lanes::set_vector(&mut out, 9, d274);
+                buf[0][9] = kanegen_runtime::lanes::lanes(d274);
                 let d275 = d95 + s_q6l * d263 - c_q6l * d265;
                 let d276 = c_q5l * d272 + s_q5l * d271;
                 let d277 = s_q5l * d272 - c_q5l * d271;
                 let d278 = d75 + d276;
                 let d279 = d82 + d274;
                 let d280 = d81 + c_q5l * d273 - s_q5l * d275 + p.L8 * d277;
-                kanegen_runtime::lanes::set_vector(&mut out, 8, -d280);
+                buf[0][8] = kanegen_runtime::lanes::lanes(-d280);
                 let d281 = d83 - s_q5l * d273 - c_q5l * d275 + p.L8 * d276;
                 let d282 = d76 + d270;
                 let d283 = d77 + d277;
@@ -6370,14 +6302,14 @@ mod generated {
                 let d288 = d65 + d278;
                 let d289 = d69 + d280;
                 let d290 = d70 + c_q4l * d279 + s_q4l * d281;
-                kanegen_runtime::lanes::set_vector(&mut out, 7, d290);
+                buf[0][7] = kanegen_runtime::lanes::lanes(d290);
                 let d291 = d71 + s_q4l * d279 - c_q4l * d281;
                 let d292 = c_q3l * d288 + s_q3l * d287;
                 let d293 = s_q3l * d288 - c_q3l * d287;
                 let d294 = d51 + d292;
                 let d295 = d58 + d290;
                 let d296 = d57 + c_q3l * d289 - s_q3l * d291 + p.L7 * d293;
-                kanegen_runtime::lanes::set_vector(&mut out, 6, -d296);
+                buf[0][6] = kanegen_runtime::lanes::lanes(-d296);
                 let d297 = d59 - s_q3l * d289 - c_q3l * d291 + p.L7 * d292;
                 let d298 = d52 + d286;
                 let d299 = d53 + d293;
@@ -6388,14 +6320,14 @@ mod generated {
                 let d304 = d41 + d294;
                 let d305 = d45 + d296;
                 let d306 = d46 + c_q2l * d295 + s_q2l * d297;
-                kanegen_runtime::lanes::set_vector(&mut out, 5, d306);
+                buf[0][5] = kanegen_runtime::lanes::lanes(d306);
                 let d307 = d47 + s_q2l * d295 - c_q2l * d297;
                 let d308 = s_q1l * d304 - c_q1l * d303;
                 let d309 = c_q1l * d304 + s_q1l * d303;
                 let d310 = d254 + d302;
                 let d311 = d255 - d306 + p.L5 * d308;
                 let d312 = d256 - c_q1l * d305 + s_q1l * d307 - p.L6 * d308;
-                kanegen_runtime::lanes::set_vector(&mut out, 4, -d312);
+                buf[0][4] = kanegen_runtime::lanes::lanes(-d312);
                 let d313 = d257 + s_q1l * d305 + c_q1l * d307 - p.L6 * d309
                     - p.L5 * d302;
                 let d314 = d258 + d309;
@@ -6407,7 +6339,7 @@ mod generated {
                 let d320 = d17 + d317;
                 let d321 = d21 + c_q_torso * d311 - s_q_torso * d313 + p.L3 * d317
                     - p.L4 * d314;
-                kanegen_runtime::lanes::set_vector(&mut out, 3, d321);
+                buf[0][3] = kanegen_runtime::lanes::lanes(d321);
                 let d322 = d22 - d312 + p.L4 * d316;
                 let d323 = d23 + s_q_torso * d311 + c_q_torso * d313 - p.L3 * d316;
                 let d324 = s_q_w * d319 - c_q_w * d320;
@@ -6415,14 +6347,14 @@ mod generated {
                 let d326 = d4 - d325;
                 let d327 = d5 + d324;
                 let d328 = d9 + d321 - p.L1 * d324 + p.L2 * d325;
-                kanegen_runtime::lanes::set_vector(&mut out, 2, d328);
+                buf[0][2] = kanegen_runtime::lanes::lanes(d328);
                 let d329 = d10 + c_q_w * d322 + s_q_w * d323 - p.L2 * d318;
                 let d330 = d11 - s_q_w * d322 + c_q_w * d323 - p.L1 * d318;
                 let d331 = s_q_imu * d326 - c_q_imu * d327;
-                kanegen_runtime::lanes::set_vector(&mut out, 0, d331);
+                buf[0][0] = kanegen_runtime::lanes::lanes(d331);
                 let d332 = c_q_imu * d329 + s_q_imu * d330;
-                kanegen_runtime::lanes::set_vector(&mut out, 1, -d332);
-                out
+                buf[0][1] = kanegen_runtime::lanes::lanes(-d332);
+                kanegen_runtime::lanes::results(&mut buf, false)
             },
         )
     }
@@ -6433,63 +6365,29 @@ mod generated {
         pc: &Precomputed,
         q: &[SVector<f64, 19>; L],
     ) -> [SVector<f64, 19>; L] {
-        use kanegen_runtime::lanes::Lanes;
         kanegen_runtime::isa::dispatch(
             #[inline(always)]
             || {
-                let (s_q_imu, c_q_imu) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 2),
-                );
-                let (s_q_w, c_q_w) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 3),
-                );
-                let (s_q_torso, c_q_torso) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 4),
-                );
-                let (s_q1l, c_q1l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 5),
-                );
-                let (s_q2l, c_q2l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 6),
-                );
-                let (s_q3l, c_q3l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 7),
-                );
-                let (s_q4l, c_q4l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 8),
-                );
-                let (s_q5l, c_q5l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 9),
-                );
-                let (s_q6l, c_q6l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 10),
-                );
-                let (s_q7l, c_q7l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 11),
-                );
-                let (s_q1r, c_q1r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 12),
-                );
-                let (s_q2r, c_q2r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 13),
-                );
-                let (s_q3r, c_q3r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 14),
-                );
-                let (s_q4r, c_q4r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 15),
-                );
-                let (s_q5r, c_q5r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 16),
-                );
-                let (s_q6r, c_q6r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 17),
-                );
-                let (s_q7r, c_q7r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 18),
-                );
+                let q = kanegen_runtime::lanes::inputs(q);
+                let (s_q_imu, c_q_imu) = kanegen_runtime::lanes::sin_cos(q[2]);
+                let (s_q_w, c_q_w) = kanegen_runtime::lanes::sin_cos(q[3]);
+                let (s_q_torso, c_q_torso) = kanegen_runtime::lanes::sin_cos(q[4]);
+                let (s_q1l, c_q1l) = kanegen_runtime::lanes::sin_cos(q[5]);
+                let (s_q2l, c_q2l) = kanegen_runtime::lanes::sin_cos(q[6]);
+                let (s_q3l, c_q3l) = kanegen_runtime::lanes::sin_cos(q[7]);
+                let (s_q4l, c_q4l) = kanegen_runtime::lanes::sin_cos(q[8]);
+                let (s_q5l, c_q5l) = kanegen_runtime::lanes::sin_cos(q[9]);
+                let (s_q6l, c_q6l) = kanegen_runtime::lanes::sin_cos(q[10]);
+                let (s_q7l, c_q7l) = kanegen_runtime::lanes::sin_cos(q[11]);
+                let (s_q1r, c_q1r) = kanegen_runtime::lanes::sin_cos(q[12]);
+                let (s_q2r, c_q2r) = kanegen_runtime::lanes::sin_cos(q[13]);
+                let (s_q3r, c_q3r) = kanegen_runtime::lanes::sin_cos(q[14]);
+                let (s_q4r, c_q4r) = kanegen_runtime::lanes::sin_cos(q[15]);
+                let (s_q5r, c_q5r) = kanegen_runtime::lanes::sin_cos(q[16]);
+                let (s_q6r, c_q6r) = kanegen_runtime::lanes::sin_cos(q[17]);
+                let (s_q7r, c_q7r) = kanegen_runtime::lanes::sin_cos(q[18]);
                 #[allow(unused_mut)]
-                let mut out = [<SVector<f64, 19>>::zeros(); L];
+                let mut buf = kanegen_runtime::lanes::buffer::<L, 19, 1>();
                 let d1 = c_q_imu * p.g;
                 let d2 = s_q_imu * p.g;
                 let d3 = c_q_w * d1 - s_q_w * d2;
@@ -6510,9 +6408,7 @@ mod generated {
                 let d18 = s_q6l * d13 - c_q6l * d16;
                 let d19 = c_q7l * d15 + s_q7l * d18;
                 let d20 = s_q7l * d15 - c_q7l * d18;
-                kanegen_runtime::lanes::set_vector(
-                    &mut out,
-                    11,
+                buf[0][11] = kanegen_runtime::lanes::lanes(
                     p.MY10l * d19 - p.MX10l * d20,
                 );
                 let d21 = c_q1r * d3 - s_q1r * d6;
@@ -6529,107 +6425,97 @@ mod generated {
                 let d32 = s_q6r * d27 + c_q6r * d30;
                 let d33 = c_q7r * d29 - s_q7r * d32;
                 let d34 = s_q7r * d29 + c_q7r * d32;
-                kanegen_runtime::lanes::set_vector(
-                    &mut out,
-                    18,
+                buf[0][18] = kanegen_runtime::lanes::lanes(
                     p.MY10r * d33 - p.MX10r * d34,
                 );
                 let d35 = p.MX10r * s_q7r - p.MY10r * c_q7r;
                 let d36 = p.MX10r * c_q7r + p.MY10r * s_q7r;
                 let d37 = p.MX9r - d36;
                 let d38 = p.MZ9r + d35;
-                kanegen_runtime::lanes::set_vector(
-                    &mut out,
-                    17,
-                    pc.pc2 * d32 - d38 * d31,
-                );
+                buf[0][17] = kanegen_runtime::lanes::lanes(pc.pc2 * d32 - d38 * d31);
                 let d39 = c_q6r * pc.pc2 + s_q6r * d38;
                 let d40 = s_q6r * pc.pc2 - c_q6r * d38;
                 let d41 = p.MX8r - d37;
                 let d42 = p.MY8r - d39;
                 let d43 = p.MZ8r - d40;
-                kanegen_runtime::lanes::set_vector(&mut out, 16, -d43 * d29 - d41 * d30);
+                buf[0][16] = kanegen_runtime::lanes::lanes(-d43 * d29 - d41 * d30);
                 let d44 = s_q5r * d41 + c_q5r * d43;
                 let d45 = c_q5r * d41 - s_q5r * d43;
                 let d46 = p.MX7r - d45;
                 let d47 = p.MZ7r + d44;
                 let d48 = pc.pc13 - d42;
-                kanegen_runtime::lanes::set_vector(&mut out, 15, d48 * d28 - d47 * d27);
+                buf[0][15] = kanegen_runtime::lanes::lanes(d48 * d28 - d47 * d27);
                 let d49 = c_q4r * d48 + s_q4r * d47;
                 let d50 = s_q4r * d48 - c_q4r * d47;
                 let d51 = p.MX6r - d46;
                 let d52 = p.MY6r - d49;
                 let d53 = p.MZ6r - d50;
-                kanegen_runtime::lanes::set_vector(&mut out, 14, -d53 * d25 - d51 * d26);
+                buf[0][14] = kanegen_runtime::lanes::lanes(-d53 * d25 - d51 * d26);
                 let d54 = s_q3r * d51 + c_q3r * d53;
                 let d55 = c_q3r * d51 - s_q3r * d53;
                 let d56 = p.MX5r - d55;
                 let d57 = p.MZ5r + d54;
                 let d58 = pc.pc19 - d52;
-                kanegen_runtime::lanes::set_vector(&mut out, 13, d58 * d24 - d57 * d23);
+                buf[0][13] = kanegen_runtime::lanes::lanes(d58 * d24 - d57 * d23);
                 let d59 = c_q2r * d58 + s_q2r * d57;
                 let d60 = s_q2r * d58 - c_q2r * d57;
                 let d61 = p.MX4r - d56;
                 let d62 = p.MY4r - d59;
                 let d63 = p.MZ4r - d60;
-                kanegen_runtime::lanes::set_vector(&mut out, 12, -d63 * d21 - d61 * d22);
+                buf[0][12] = kanegen_runtime::lanes::lanes(-d63 * d21 - d61 * d22);
                 let d64 = c_q1r * d61 - s_q1r * d63;
                 let d65 = s_q1r * d61 + c_q1r * d63;
                 let d66 = p.MX10l * s_q7l - p.MY10l * c_q7l;
                 let d67 = p.MX10l * c_q7l + p.MY10l * s_q7l;
                 let d68 = p.MX9l - d67;
                 let d69 = p.MZ9l + d66;
-                kanegen_runtime::lanes::set_vector(
-                    &mut out,
-                    10,
-                    d69 * d17 - pc.pc25 * d18,
-                );
+                buf[0][10] = kanegen_runtime::lanes::lanes(d69 * d17 - pc.pc25 * d18);
                 let d70 = c_q6l * pc.pc25 + s_q6l * d69;
                 let d71 = s_q6l * pc.pc25 - c_q6l * d69;
                 let d72 = p.MX8l - d68;
                 let d73 = p.MY8l - d70;
                 let d74 = p.MZ8l - d71;
-                kanegen_runtime::lanes::set_vector(&mut out, 9, -d74 * d15 - d72 * d16);
+                buf[0][9] = kanegen_runtime::lanes::lanes(-d74 * d15 - d72 * d16);
                 let d75 = s_q5l * d72 + c_q5l * d74;
                 let d76 = c_q5l * d72 - s_q5l * d74;
                 let d77 = p.MX7l - d76;
                 let d78 = p.MZ7l + d75;
                 let d79 = pc.pc36 - d73;
-                kanegen_runtime::lanes::set_vector(&mut out, 8, d78 * d13 - d79 * d14);
+                buf[0][8] = kanegen_runtime::lanes::lanes(d78 * d13 - d79 * d14);
                 let d80 = c_q4l * d79 + s_q4l * d78;
                 let d81 = s_q4l * d79 - c_q4l * d78;
                 let d82 = p.MX6l - d77;
                 let d83 = p.MY6l - d80;
                 let d84 = p.MZ6l - d81;
-                kanegen_runtime::lanes::set_vector(&mut out, 7, -d84 * d11 - d82 * d12);
+                buf[0][7] = kanegen_runtime::lanes::lanes(-d84 * d11 - d82 * d12);
                 let d85 = s_q3l * d82 + c_q3l * d84;
                 let d86 = c_q3l * d82 - s_q3l * d84;
                 let d87 = p.MX5l - d86;
                 let d88 = p.MZ5l + d85;
                 let d89 = pc.pc42 - d83;
-                kanegen_runtime::lanes::set_vector(&mut out, 6, d88 * d9 - d89 * d10);
+                buf[0][6] = kanegen_runtime::lanes::lanes(d88 * d9 - d89 * d10);
                 let d90 = c_q2l * d89 + s_q2l * d88;
                 let d91 = s_q2l * d89 - c_q2l * d88;
                 let d92 = p.MX4l - d87;
                 let d93 = p.MY4l - d90;
                 let d94 = p.MZ4l - d91;
-                kanegen_runtime::lanes::set_vector(&mut out, 5, -d94 * d7 - d92 * d8);
+                buf[0][5] = kanegen_runtime::lanes::lanes(-d94 * d7 - d92 * d8);
                 let d95 = c_q1l * d92 - s_q1l * d94;
                 let d96 = s_q1l * d92 + c_q1l * d94;
                 let d97 = p.MZ3 + d65 - d96;
                 let d98 = d93 - d62 + pc.pc47;
-                kanegen_runtime::lanes::set_vector(&mut out, 4, d97 * d5 - d98 * d6);
+                buf[0][4] = kanegen_runtime::lanes::lanes(d97 * d5 - d98 * d6);
                 let d99 = d64 + d95 + pc.pc48;
                 let d100 = s_q_torso * d98 + c_q_torso * d97;
                 let d101 = d99 + pc.pc54;
                 let d102 = pc.pc55 - d100;
-                kanegen_runtime::lanes::set_vector(&mut out, 3, d102 * d3 - d101 * d4);
+                buf[0][3] = kanegen_runtime::lanes::lanes(d102 * d3 - d101 * d4);
                 let d103 = c_q_w * d101 + s_q_w * d102;
                 let d104 = s_q_w * d101 - c_q_w * d102;
                 let d105 = d103 + pc.pc61;
                 let d106 = pc.pc62 - d104;
-                kanegen_runtime::lanes::set_vector(&mut out, 2, d106 * d1 - d105 * d2);
-                out
+                buf[0][2] = kanegen_runtime::lanes::lanes(d106 * d1 - d105 * d2);
+                kanegen_runtime::lanes::results(&mut buf, false)
             },
         )
     }
@@ -6642,101 +6528,69 @@ mod generated {
         u: &[SVector<f64, 19>; L],
         ud: &[SVector<f64, 19>; L],
     ) -> [SVector<f64, 19>; L] {
-        use kanegen_runtime::lanes::Lanes;
         kanegen_runtime::isa::dispatch(
             #[inline(always)]
             || {
-                let (s_q_imu, c_q_imu) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 2),
-                );
-                let (s_q_w, c_q_w) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 3),
-                );
-                let (s_q_torso, c_q_torso) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 4),
-                );
-                let (s_q1l, c_q1l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 5),
-                );
-                let (s_q2l, c_q2l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 6),
-                );
-                let (s_q3l, c_q3l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 7),
-                );
-                let (s_q4l, c_q4l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 8),
-                );
-                let (s_q5l, c_q5l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 9),
-                );
-                let (s_q6l, c_q6l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 10),
-                );
-                let (s_q7l, c_q7l) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 11),
-                );
-                let (s_q1r, c_q1r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 12),
-                );
-                let (s_q2r, c_q2r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 13),
-                );
-                let (s_q3r, c_q3r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 14),
-                );
-                let (s_q4r, c_q4r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 15),
-                );
-                let (s_q5r, c_q5r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 16),
-                );
-                let (s_q6r, c_q6r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 17),
-                );
-                let (s_q7r, c_q7r) = kanegen_runtime::lanes::sin_cos(
-                    Lanes::gather(q, 18),
-                );
-                let xd = Lanes::gather(u, 0);
-                let xdd = Lanes::gather(ud, 0);
-                let psid = Lanes::gather(u, 1);
-                let psidd = Lanes::gather(ud, 1);
-                let qd_imu = Lanes::gather(u, 2);
-                let qdd_imu = Lanes::gather(ud, 2);
-                let qd_w = Lanes::gather(u, 3);
-                let qdd_w = Lanes::gather(ud, 3);
-                let qd_torso = Lanes::gather(u, 4);
-                let qdd_torso = Lanes::gather(ud, 4);
-                let qd1l = Lanes::gather(u, 5);
-                let qdd1l = Lanes::gather(ud, 5);
-                let qd2l = Lanes::gather(u, 6);
-                let qdd2l = Lanes::gather(ud, 6);
-                let qd3l = Lanes::gather(u, 7);
-                let qdd3l = Lanes::gather(ud, 7);
-                let qd4l = Lanes::gather(u, 8);
-                let qdd4l = Lanes::gather(ud, 8);
-                let qd5l = Lanes::gather(u, 9);
-                let qdd5l = Lanes::gather(ud, 9);
-                let qd6l = Lanes::gather(u, 10);
-                let qdd6l = Lanes::gather(ud, 10);
-                let qd7l = Lanes::gather(u, 11);
-                let qdd7l = Lanes::gather(ud, 11);
-                let qd1r = Lanes::gather(u, 12);
-                let qdd1r = Lanes::gather(ud, 12);
-                let qd2r = Lanes::gather(u, 13);
-                let qdd2r = Lanes::gather(ud, 13);
-                let qd3r = Lanes::gather(u, 14);
-                let qdd3r = Lanes::gather(ud, 14);
-                let qd4r = Lanes::gather(u, 15);
-                let qdd4r = Lanes::gather(ud, 15);
-                let qd5r = Lanes::gather(u, 16);
-                let qdd5r = Lanes::gather(ud, 16);
-                let qd6r = Lanes::gather(u, 17);
-                let qdd6r = Lanes::gather(ud, 17);
-                let qd7r = Lanes::gather(u, 18);
-                let qdd7r = Lanes::gather(ud, 18);
+                let q = kanegen_runtime::lanes::inputs(q);
+                let u = kanegen_runtime::lanes::inputs(u);
+                let ud = kanegen_runtime::lanes::inputs(ud);
+                let (s_q_imu, c_q_imu) = kanegen_runtime::lanes::sin_cos(q[2]);
+                let (s_q_w, c_q_w) = kanegen_runtime::lanes::sin_cos(q[3]);
+                let (s_q_torso, c_q_torso) = kanegen_runtime::lanes::sin_cos(q[4]);
+                let (s_q1l, c_q1l) = kanegen_runtime::lanes::sin_cos(q[5]);
+                let (s_q2l, c_q2l) = kanegen_runtime::lanes::sin_cos(q[6]);
+                let (s_q3l, c_q3l) = kanegen_runtime::lanes::sin_cos(q[7]);
+                let (s_q4l, c_q4l) = kanegen_runtime::lanes::sin_cos(q[8]);
+                let (s_q5l, c_q5l) = kanegen_runtime::lanes::sin_cos(q[9]);
+                let (s_q6l, c_q6l) = kanegen_runtime::lanes::sin_cos(q[10]);
+                let (s_q7l, c_q7l) = kanegen_runtime::lanes::sin_cos(q[11]);
+                let (s_q1r, c_q1r) = kanegen_runtime::lanes::sin_cos(q[12]);
+                let (s_q2r, c_q2r) = kanegen_runtime::lanes::sin_cos(q[13]);
+                let (s_q3r, c_q3r) = kanegen_runtime::lanes::sin_cos(q[14]);
+                let (s_q4r, c_q4r) = kanegen_runtime::lanes::sin_cos(q[15]);
+                let (s_q5r, c_q5r) = kanegen_runtime::lanes::sin_cos(q[16]);
+                let (s_q6r, c_q6r) = kanegen_runtime::lanes::sin_cos(q[17]);
+                let (s_q7r, c_q7r) = kanegen_runtime::lanes::sin_cos(q[18]);
+                let xd = u[0];
+                let xdd = ud[0];
+                let psid = u[1];
+                let psidd = ud[1];
+                let qd_imu = u[2];
+                let qdd_imu = ud[2];
+                let qd_w = u[3];
+                let qdd_w = ud[3];
+                let qd_torso = u[4];
+                let qdd_torso = ud[4];
+                let qd1l = u[5];
+                let qdd1l = ud[5];
+                let qd2l = u[6];
+                let qdd2l = ud[6];
+                let qd3l = u[7];
+                let qdd3l = ud[7];
+                let qd4l = u[8];
+                let qdd4l = ud[8];
+                let qd5l = u[9];
+                let qdd5l = ud[9];
+                let qd6l = u[10];
+                let qdd6l = ud[10];
+                let qd7l = u[11];
+                let qdd7l = ud[11];
+                let qd1r = u[12];
+                let qdd1r = ud[12];
+                let qd2r = u[13];
+                let qdd2r = ud[13];
+                let qd3r = u[14];
+                let qdd3r = ud[14];
+                let qd4r = u[15];
+                let qdd4r = ud[15];
+                let qd5r = u[16];
+                let qdd5r = ud[16];
+                let qd6r = u[17];
+                let qdd6r = ud[17];
+                let qd7r = u[18];
+                let qdd7r = ud[18];
                 #[allow(unused_mut)]
-                let mut out = [<SVector<f64, 19>>::zeros(); L];
+                let mut buf = kanegen_runtime::lanes::buffer::<L, 19, 1>();
                 let k1 = xd * psid;
                 let k2 = c_q_imu * psid;
                 let k3 = s_q_imu * psid;
@@ -7031,7 +6885,7 @@ mod generated {
                     - p.YZ10l * k74 + p.MZ10l * d142 + p.MX10l * d139;
                 let d155 = k69 * d151 - k70 * d150 - p.XZ10l * k73 + p.YZ10l * k72
                     - p.ZZ10l * k74 + p.MX10l * d143 - p.MY10l * d142;
-                kanegen_runtime::lanes::set_vector(&mut out, 11, -d155);
+                buf[0][11] = kanegen_runtime::lanes::lanes(-d155);
                 let k77 = c_q1r * k18 - s_q1r * k17;
                 let k78 = s_q1r * k18 + c_q1r * k17;
                 let k79 = k19 - qdd1r;
@@ -7231,7 +7085,7 @@ mod generated {
                     + p.XZ10r * k120 - p.MY10r * d250 + p.MZ10r * d253;
                 let d264 = k118 * d261 - k119 * d260 - p.XZ10r * k123 + p.YZ10r * k121
                     + p.ZZ10r * k120 - p.MX10r * d253 + p.MY10r * d252;
-                kanegen_runtime::lanes::set_vector(&mut out, 18, -d264);
+                buf[0][18] = kanegen_runtime::lanes::lanes(-d264);
                 let d265 = k122 * d260 + k118 * d262 + p.XY10r * k123 - p.YY10r * k121
                     - p.YZ10r * k120 + p.MZ10r * d252 - p.MX10r * d250;
                 let d266 = s_q7r * d257 + c_q7r * d258;
@@ -7241,7 +7095,7 @@ mod generated {
                 let d270 = d241 + d267;
                 let d271 = d242 - d266;
                 let d272 = d247 + c_q7r * d263 - s_q7r * d265 + p.L9 * d266;
-                kanegen_runtime::lanes::set_vector(&mut out, 17, d272);
+                buf[0][17] = kanegen_runtime::lanes::lanes(d272);
                 let d273 = d248 + d264;
                 let d274 = c_q6r * d268 - s_q6r * d271;
                 let d275 = s_q6r * d268 + c_q6r * d271;
@@ -7251,7 +7105,7 @@ mod generated {
                 let d279 = d228 + d275;
                 let d280 = d233 - d272;
                 let d281 = d234 - c_q6r * d273 + s_q6r * d269;
-                kanegen_runtime::lanes::set_vector(&mut out, 16, d281);
+                buf[0][16] = kanegen_runtime::lanes::lanes(d281);
                 let d282 = c_q5r * d278 - s_q5r * d279;
                 let d283 = s_q5r * d278 + c_q5r * d279;
                 let d284 = d209 - d276;
@@ -7259,7 +7113,7 @@ mod generated {
                 let d286 = d210 - d282;
                 let d287 = d211 + d283;
                 let d288 = d216 - c_q5r * d280 - s_q5r * d277 - p.L8 * d283;
-                kanegen_runtime::lanes::set_vector(&mut out, 15, d288);
+                buf[0][15] = kanegen_runtime::lanes::lanes(d288);
                 let d289 = d217 - d281;
                 let d290 = c_q4r * d284 - s_q4r * d287;
                 let d291 = s_q4r * d284 + c_q4r * d287;
@@ -7269,7 +7123,7 @@ mod generated {
                 let d295 = d197 + d291;
                 let d296 = d202 - d288;
                 let d297 = d203 - c_q4r * d289 + s_q4r * d285;
-                kanegen_runtime::lanes::set_vector(&mut out, 14, d297);
+                buf[0][14] = kanegen_runtime::lanes::lanes(d297);
                 let d298 = c_q3r * d294 - s_q3r * d295;
                 let d299 = s_q3r * d294 + c_q3r * d295;
                 let d300 = d178 - d292;
@@ -7277,7 +7131,7 @@ mod generated {
                 let d302 = d179 - d298;
                 let d303 = d180 + d299;
                 let d304 = d185 - c_q3r * d296 - s_q3r * d293 - p.L7 * d299;
-                kanegen_runtime::lanes::set_vector(&mut out, 13, d304);
+                buf[0][13] = kanegen_runtime::lanes::lanes(d304);
                 let d305 = d186 - d297;
                 let d306 = c_q2r * d300 - s_q2r * d303;
                 let d307 = s_q2r * d300 + c_q2r * d303;
@@ -7287,7 +7141,7 @@ mod generated {
                 let d311 = d166 + d307;
                 let d312 = d171 - d304;
                 let d313 = d172 - c_q2r * d305 + s_q2r * d301;
-                kanegen_runtime::lanes::set_vector(&mut out, 12, d313);
+                buf[0][12] = kanegen_runtime::lanes::lanes(d313);
                 let d314 = c_q1r * d310 - s_q1r * d311;
                 let d315 = s_q1r * d310 + c_q1r * d311;
                 let d316 = d37 - d308;
@@ -7303,7 +7157,7 @@ mod generated {
                 let d326 = d132 + d322;
                 let d327 = d137 - d155;
                 let d328 = d136 - c_q7l * d153 - s_q7l * d154 - p.L9 * d322;
-                kanegen_runtime::lanes::set_vector(&mut out, 10, -d328);
+                buf[0][10] = kanegen_runtime::lanes::lanes(-d328);
                 let d329 = d138 + s_q7l * d153 - c_q7l * d154 - p.L9 * d323;
                 let d330 = c_q6l * d325 + s_q6l * d326;
                 let d331 = s_q6l * d325 - c_q6l * d326;
@@ -7313,7 +7167,7 @@ mod generated {
                 let d335 = d117 + d330;
                 let d336 = d118 + d331;
                 let d337 = d124 + c_q6l * d327 + s_q6l * d329;
-                kanegen_runtime::lanes::set_vector(&mut out, 9, d337);
+                buf[0][9] = kanegen_runtime::lanes::lanes(d337);
                 let d338 = s_q5l * d332 - c_q5l * d336;
                 let d339 = c_q5l * d332 + s_q5l * d336;
                 let d340 = d99 - d339;
@@ -7321,7 +7175,7 @@ mod generated {
                 let d342 = d101 + d338;
                 let d343 = d106 + d337;
                 let d344 = d105 - c_q5l * d333 + s_q5l * d334 - p.L8 * d338;
-                kanegen_runtime::lanes::set_vector(&mut out, 8, -d344);
+                buf[0][8] = kanegen_runtime::lanes::lanes(-d344);
                 let d345 = d107 + s_q5l * d333 + c_q5l * d334 - p.L8 * d339;
                 let d346 = c_q4l * d341 + s_q4l * d342;
                 let d347 = s_q4l * d341 - c_q4l * d342;
@@ -7331,7 +7185,7 @@ mod generated {
                 let d351 = d86 + d346;
                 let d352 = d87 + d347;
                 let d353 = d93 + c_q4l * d343 + s_q4l * d345;
-                kanegen_runtime::lanes::set_vector(&mut out, 7, d353);
+                buf[0][7] = kanegen_runtime::lanes::lanes(d353);
                 let d354 = s_q3l * d348 - c_q3l * d352;
                 let d355 = c_q3l * d348 + s_q3l * d352;
                 let d356 = d68 - d355;
@@ -7339,7 +7193,7 @@ mod generated {
                 let d358 = d70 + d354;
                 let d359 = d75 + d353;
                 let d360 = d74 - c_q3l * d349 + s_q3l * d350 - p.L7 * d354;
-                kanegen_runtime::lanes::set_vector(&mut out, 6, -d360);
+                buf[0][6] = kanegen_runtime::lanes::lanes(-d360);
                 let d361 = d76 + s_q3l * d349 + c_q3l * d350 - p.L7 * d355;
                 let d362 = c_q2l * d357 + s_q2l * d358;
                 let d363 = s_q2l * d357 - c_q2l * d358;
@@ -7349,7 +7203,7 @@ mod generated {
                 let d367 = d55 + d362;
                 let d368 = d56 + d363;
                 let d369 = d62 + c_q2l * d359 + s_q2l * d361;
-                kanegen_runtime::lanes::set_vector(&mut out, 5, d369);
+                buf[0][5] = kanegen_runtime::lanes::lanes(d369);
                 let d370 = c_q1l * d364 + s_q1l * d368;
                 let d371 = s_q1l * d364 - c_q1l * d368;
                 let d372 = d316 - d367;
@@ -7359,7 +7213,7 @@ mod generated {
                 let d375 = d319 - d370;
                 let d376 = d320 + d371;
                 let d377 = d321 - c_q1l * d365 + s_q1l * d366 - p.L6 * d371;
-                kanegen_runtime::lanes::set_vector(&mut out, 4, d377);
+                buf[0][4] = kanegen_runtime::lanes::lanes(d377);
                 let d378 = c_q_torso * d372 + s_q_torso * d376;
                 let d379 = s_q_torso * d372 - c_q_torso * d376;
                 let d380 = d21 - d375;
@@ -7368,7 +7222,7 @@ mod generated {
                 let d383 = d23 + d379;
                 let d384 = d28 + c_q_torso * d373 - s_q_torso * d374 + p.L3 * d379
                     - p.L4 * d375;
-                kanegen_runtime::lanes::set_vector(&mut out, 3, d384);
+                buf[0][3] = kanegen_runtime::lanes::lanes(d384);
                 let d385 = d29 + d377 + p.L4 * d378;
                 let d386 = c_q_w * d380 - s_q_w * d383;
                 let d387 = s_q_w * d380 + c_q_w * d383;
@@ -7376,13 +7230,13 @@ mod generated {
                 let d389 = d11 + s_q_w * d385 + c_q_w * d381 + p.L1 * d382;
                 let d390 = d7 + d387;
                 let d391 = d12 + d384 + p.L1 * d387 - p.L2 * d386;
-                kanegen_runtime::lanes::set_vector(&mut out, 2, d391);
+                buf[0][2] = kanegen_runtime::lanes::lanes(d391);
                 let d392 = d13 + c_q_w * d385 - s_q_w * d381 - p.L2 * d382;
                 let d393 = s_q_imu * d388 + c_q_imu * d390;
-                kanegen_runtime::lanes::set_vector(&mut out, 0, d393 + pc.pc67 * xdd);
+                buf[0][0] = kanegen_runtime::lanes::lanes(d393 + pc.pc67 * xdd);
                 let d394 = c_q_imu * d392 - s_q_imu * d389;
-                kanegen_runtime::lanes::set_vector(&mut out, 1, pc.pc68 * psidd - d394);
-                out
+                buf[0][1] = kanegen_runtime::lanes::lanes(pc.pc68 * psidd - d394);
+                kanegen_runtime::lanes::results(&mut buf, false)
             },
         )
     }

@@ -76,8 +76,24 @@ fn check_batch<const L: usize>(k: &kd::Krang, q: &[V; L], u: &[V; L], ud: &[V; L
     }
 }
 
+/// Runs `f` on a thread with a large stack: unoptimised (debug) builds keep every statement's
+/// `Lanes<L>` value in its own stack slot (Krang's batched M at L = 8: thousands of 64-byte
+/// locals), more than a test thread's default 2 MB. Optimised builds need a few KB.
+fn with_big_stack(f: impl FnOnce() + Send + 'static) {
+    std::thread::Builder::new()
+        .stack_size(512 << 20)
+        .spawn(f)
+        .unwrap()
+        .join()
+        .unwrap();
+}
+
 #[test]
 fn batched_functions_equal_the_single_state_functions_bit_for_bit() {
+    with_big_stack(batched_equal_single);
+}
+
+fn batched_equal_single() {
     let model = model("krang.toml");
     let mut uniform = rng(14);
     for isa in Isa::ALL.into_iter().filter(|&i| isa::available(i)) {

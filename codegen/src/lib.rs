@@ -290,7 +290,9 @@ impl Builder {
     /// -> [SMatrix; L]` and likewise for every function with a vector or matrix result and no
     /// frame argument (free functions and wrapper methods), the single-state statements
     /// evaluated at `L` states per call in SIMD lanes, bit for bit the single-state results.
-    /// Generic in `L`: nothing is compiled for a batch size nobody calls.
+    /// Generic in `L`: nothing is compiled for a batch size nobody calls. Unoptimised builds
+    /// keep every statement's lanes on the stack (Krang at `L = 8`: more than a thread's
+    /// default 2 MB); optimised builds need a few KB.
     ///
     /// ```no_run
     /// kanegen::Builder::new("krang.toml").batch(true).run();

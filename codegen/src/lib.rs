@@ -161,20 +161,20 @@ pub fn generate_urdf(
     urdf: &model::UrdfOptions,
     options: Options,
 ) -> Result<Generated, Error> {
-    urdf_with(path.as_ref(), urdf, options, Precision::F64)
+    urdf_with(path.as_ref(), urdf, options, EmitOptions::default())
 }
 
 fn urdf_with(
     path: &Path,
     urdf: &model::UrdfOptions,
     options: Options,
-    precision: Precision,
+    emit: EmitOptions,
 ) -> Result<Generated, Error> {
     let import = model::UrdfImport::read(path, urdf)?;
     let emit = EmitOptions {
-        precision,
         notes: import.notes,
         notes_title: "URDF import notes".into(),
+        ..emit
     };
     generate_with(import.model, options, &emit)
 }
@@ -223,6 +223,8 @@ pub struct Builder {
     precision: Precision,
     /// Tool frames added to the loaded model ([`Builder::frame`]).
     frames: Vec<model::OperationalFrame>,
+    isa_dispatch: bool,
+    batch: bool,
 }
 
 impl Builder {
@@ -240,6 +242,8 @@ impl Builder {
             urdf,
             precision: Precision::F64,
             frames: Vec::new(),
+            isa_dispatch: true,
+            batch: false,
         }
     }
 
@@ -330,6 +334,46 @@ impl Builder {
         self
     }
 
+    /// Run-time instruction-set dispatch (default `true`): every generated function is
+    /// compiled for the baseline target and for x86-64-v3 (AVX2 + FMA), and the copy the CPU
+    /// supports runs (`kanegen_runtime::isa`, detected once). Turn it off to get one copy per
+    /// function (half the code) when the crate is built with `-C target-cpu=…` anyway; the
+    /// runtime's `dispatch` feature turns it off for every module of a build. Both copies give
+    /// the same bits (Rust does not fuse multiply-adds on its own).
+    ///
+    /// ```no_run
+    /// kanegen::Builder::new("krang.toml").isa_dispatch(false).run();
+    /// ```
+    pub fn isa_dispatch(mut self, on: bool) -> Self {
+        self.isa_dispatch = on;
+        self
+    }
+
+    /// Batched functions (default `false`; `f64` modules): `mass_matrix_batch(p, pc, &[q; L])
+    /// -> [SMatrix; L]` and likewise for every function with a vector or matrix result and no
+    /// frame argument (free functions and wrapper methods), the single-state statements
+    /// evaluated at `L` states per call in SIMD lanes, bit for bit the single-state results.
+    /// Generic in `L`: nothing is compiled for a batch size nobody calls. Unoptimised builds
+    /// keep every statement's lanes on the stack (Krang at `L = 8`: more than a thread's
+    /// default 2 MB); optimised builds need a few KB.
+    ///
+    /// ```no_run
+    /// kanegen::Builder::new("krang.toml").batch(true).run();
+    /// ```
+    pub fn batch(mut self, on: bool) -> Self {
+        self.batch = on;
+        self
+    }
+
+    fn emit_options(&self) -> EmitOptions {
+        EmitOptions {
+            precision: self.precision,
+            isa_dispatch: self.isa_dispatch,
+            batch: self.batch,
+            ..EmitOptions::default()
+        }
+    }
+
     /// Name of the generated file in the output directory (default: the model file's stem
     /// plus `.rs`, or `_baked.rs` in baked mode; `_f32.rs`, `_baked_f32.rs` for
     /// [`Precision::F32`]).
@@ -367,17 +411,13 @@ impl Builder {
     /// Run every stage and return the result without writing anything.
     pub fn generate(&self) -> Result<Generated, Error> {
         match &self.urdf {
-            Some(urdf) => urdf_with(&self.model, urdf, self.options, self.precision),
+            Some(urdf) => urdf_with(&self.model, urdf, self.options, self.emit_options()),
             None => {
                 let mut model = model::Model::from_toml_file(&self.model)?;
                 for f in &self.frames {
                     model.add_frame(f)?;
                 }
-                let emit = EmitOptions {
-                    precision: self.precision,
-                    ..EmitOptions::default()
-                };
-                generate_with(model, self.options, &emit)
+                generate_with(model, self.options, &self.emit_options())
             }
         }
     }

@@ -55,10 +55,11 @@ fn generate() {
         }
         kanegen::Builder::new("krang.toml")
             .functions(functions)
+            .batch(true)
             .run();
     }
     if enabled("BAKED") {
-        builder("krang.toml").baked(true).run();
+        builder("krang.toml").baked(true).batch(true).run();
     }
     if enabled("F32") {
         builder("krang.toml")

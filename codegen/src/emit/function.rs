@@ -11,7 +11,7 @@ use crate::naming;
 use crate::registry::{Inputs, Shape};
 
 /// The statement with the highest index that `e` reads, if any.
-fn last_local(e: &LExpr) -> Option<usize> {
+pub(super) fn last_local(e: &LExpr) -> Option<usize> {
     match e {
         LExpr::Leaf(Leaf::Local(i)) => Some(*i),
         LExpr::Leaf(_) => None,
@@ -44,18 +44,18 @@ fn for_each_leaf(e: &LExpr, f: &mut dyn FnMut(&Leaf)) {
 /// Which inputs a program reads, per speed, from one walk over it. (Asking [`uses`] once per
 /// speed and kind walked the program 5n times: cubic in the length of a chain, since M and C
 /// have n² entries.)
-struct Reads {
-    coord: Vec<bool>,
-    speed: Vec<bool>,
-    accel: Vec<bool>,
-    sin: Vec<bool>,
-    cos: Vec<bool>,
-    param: bool,
-    pre: bool,
+pub(super) struct Reads {
+    pub(super) coord: Vec<bool>,
+    pub(super) speed: Vec<bool>,
+    pub(super) accel: Vec<bool>,
+    pub(super) sin: Vec<bool>,
+    pub(super) cos: Vec<bool>,
+    pub(super) param: bool,
+    pub(super) pre: bool,
 }
 
 impl Reads {
-    fn of(p: &Program, dof: usize) -> Self {
+    pub(super) fn of(p: &Program, dof: usize) -> Self {
         let mut r = Reads {
             coord: vec![false; dof],
             speed: vec![false; dof],
@@ -182,7 +182,7 @@ struct Result {
 }
 
 /// The result entries of `p` that are not the constant zero (the result starts zeroed).
-fn nonzero_outputs(p: &Program) -> impl Iterator<Item = &(usize, usize, LExpr)> + Clone {
+pub(super) fn nonzero_outputs(p: &Program) -> impl Iterator<Item = &(usize, usize, LExpr)> + Clone {
     p.outputs
         .iter()
         .filter(|(_, _, e)| !matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0))
@@ -392,6 +392,21 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     if spec.inputs.needs_ud() && !reads.accel.contains(&true) {
         unused.extend(quote!(let _ = ud;));
     }
+    let body = quote! {
+        #unused
+        #prologue
+        #init
+        #body
+        #value
+    };
+    // With dispatch the body is compiled twice, for the baseline and for x86-64-v3, and
+    // `kanegen_runtime::isa::dispatch` runs the copy for the CPU (the closure and everything
+    // in it inline into each copy).
+    let body = if cx.isa_dispatch {
+        quote!(kanegen_runtime::isa::dispatch(#[inline(always)] || { #body }))
+    } else {
+        body
+    };
     quote! {
         #[doc = #doc]
         #[doc = ""]
@@ -399,11 +414,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         #[doc = #ops]
         #[inline(never)]
         pub fn #fname(#param_args #args) -> #ty {
-            #unused
-            #prologue
-            #init
             #body
-            #value
         }
     }
 }

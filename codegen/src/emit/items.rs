@@ -255,7 +255,7 @@ pub(super) fn arg_names(inputs: Inputs) -> TokenStream {
 }
 
 /// The return type of a registry function.
-fn return_type(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
+pub(super) fn return_type(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
     result_type(cx, spec.shape)
 }
 
@@ -303,10 +303,13 @@ fn methods(cx: &Context<'_>) -> TokenStream {
 
 /// The wrapper type named after the model: with runtime parameters it holds a parameter set and
 /// its precomputed terms; baked, it is a unit struct.
-pub(super) fn wrapper(cx: &Context<'_>) -> TokenStream {
+pub(super) fn wrapper(cx: &Context<'_>, batched: bool) -> TokenStream {
     let model = cx.model;
     let ty = ident(&naming::type_name(&model.name));
-    let methods = methods(cx);
+    let mut methods = methods(cx);
+    if batched {
+        methods.extend(super::batch::methods(cx));
+    }
     if !cx.low.params.is_runtime() {
         let doc = format!(
             " The dynamics of `{}` with the parameter values of `{}` folded in as constants.",

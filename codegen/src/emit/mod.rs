@@ -15,6 +15,7 @@
 //! (statement comments), this file (the module and its header).
 
 mod annotate;
+mod batch;
 mod frames;
 mod function;
 mod items;
@@ -44,8 +45,18 @@ pub struct EmitError {
 }
 
 /// What the emitter is told besides the model and the programs.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct EmitOptions {
+    /// Run-time instruction-set dispatch (default `true`): every generated function is compiled
+    /// for the baseline target and for x86-64-v3 (AVX2 + FMA), and
+    /// `kanegen_runtime::isa::dispatch` runs the best copy the CPU supports (a plain call in
+    /// builds without the runtime's `dispatch` feature, on other architectures and when the
+    /// crate is compiled with `-C target-cpu` that has AVX2 and FMA). Off: one copy.
+    pub isa_dispatch: bool,
+    /// Batched functions (default `false`): `mass_matrix_batch`, `coriolis_batch`, … for `L`
+    /// states per call (`f64` modules; every function whose result is a vector or matrix and
+    /// that takes no frame), the single-state statements over `kanegen_runtime::lanes::Lanes`.
+    pub batch: bool,
     /// The floating-point type of the module.
     pub precision: Precision,
     /// Lines written as comments after the header (e.g. URDF import notes: snapped angles,
@@ -55,11 +66,25 @@ pub struct EmitOptions {
     pub notes_title: String,
 }
 
+impl Default for EmitOptions {
+    fn default() -> Self {
+        Self {
+            isa_dispatch: true,
+            batch: false,
+            precision: Precision::default(),
+            notes: Vec::new(),
+            notes_title: String::new(),
+        }
+    }
+}
+
 /// What every part of the emitter reads.
 pub(crate) struct Context<'a> {
     model: &'a Model,
     low: &'a Lowered,
     precision: Precision,
+    /// See [`EmitOptions::isa_dispatch`].
+    isa_dispatch: bool,
     /// Field names of the precomputed values, by slot.
     pre: Vec<String>,
 }
@@ -85,6 +110,7 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         model,
         low,
         precision: options.precision,
+        isa_dispatch: options.isa_dispatch,
         pre: low
             .pre_slots
             .iter()
@@ -130,7 +156,13 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
             items.extend(frames::dispatcher(&cx, f.id));
         }
     }
-    items.extend(items::wrapper(&cx));
+    let batched = options.batch && cx.precision == Precision::F64;
+    if batched {
+        for f in &low.functions {
+            items.extend(batch::function(&cx, f));
+        }
+    }
+    items.extend(items::wrapper(&cx, batched));
     items.extend(items::trait_impls(&cx));
     // Model names (`MX4l`, `q_1L`) are not snake case, and straight-line code trips clippy's
     // style lints (long functions, many arguments, literal precision): one allowance for the

@@ -333,28 +333,33 @@ mod generated {
         pc: &Precomputed,
         q: &SVector<f64, 2>,
     ) -> SMatrix<f64, 2, 2> {
-        let (sin_q, cos_q) = sin_cos_n([q[1]]);
-        let s_q_w = sin_q[0];
-        let c_q_w = cos_q[0];
-        let mut m = SMatrix::<f64, 2, 2>::zeros();
-        m[(1, 1)] = p.XX2;
-        let d1 = p.MY2 * c_q_w + p.MZ2 * s_q_w; // MSC2 in 1.y
-        let d2 = p.MY2 * s_q_w - p.MZ2 * c_q_w; // MSC2 in 1.z
-        let t1 = p.L1 * d1; // common subexpression
-        let t2 = p.L2 * d2; // common subexpression
-        let d3 = p.XX2 + t1 + t2; // N(M col 2) at 1.x
-        m[(0, 1)] = d3;
-        let d4 = 2.0 * t1 + 2.0 * t2 + pc.pc3; // JC1.xx
-        m[(0, 0)] = d4;
-        {
-            let s = m.as_mut_slice();
-            for c in 1..2 {
-                for r in 0..c {
-                    s[r * 2 + c] = s[c * 2 + r];
+        kanegen_runtime::isa::dispatch(
+            #[inline(always)]
+            || {
+                let (sin_q, cos_q) = sin_cos_n([q[1]]);
+                let s_q_w = sin_q[0];
+                let c_q_w = cos_q[0];
+                let mut m = SMatrix::<f64, 2, 2>::zeros();
+                m[(1, 1)] = p.XX2;
+                let d1 = p.MY2 * c_q_w + p.MZ2 * s_q_w; // MSC2 in 1.y
+                let d2 = p.MY2 * s_q_w - p.MZ2 * c_q_w; // MSC2 in 1.z
+                let t1 = p.L1 * d1; // common subexpression
+                let t2 = p.L2 * d2; // common subexpression
+                let d3 = p.XX2 + t1 + t2; // N(M col 2) at 1.x
+                m[(0, 1)] = d3;
+                let d4 = 2.0 * t1 + 2.0 * t2 + pc.pc3; // JC1.xx
+                m[(0, 0)] = d4;
+                {
+                    let s = m.as_mut_slice();
+                    for c in 1..2 {
+                        for r in 0..c {
+                            s[r * 2 + c] = s[c * 2 + r];
+                        }
+                    }
+                    m
                 }
-            }
-            m
-        }
+            },
+        )
     }
     /// Coriolis and centrifugal vector c(q, u) (velocity-product terms).
     ///
@@ -367,30 +372,35 @@ mod generated {
         q: &SVector<f64, 2>,
         u: &SVector<f64, 2>,
     ) -> SVector<f64, 2> {
-        let (sin_q, cos_q) = sin_cos_n([q[1]]);
-        let s_q_w = sin_q[0];
-        let c_q_w = cos_q[0];
-        let qd_imu = u[0];
-        let qd_w = u[1];
-        let mut out = SVector::<f64, 2>::zeros();
-        let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
-        let k2 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-        let k3 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-        let k4 = qd_imu * k3; // a2 in 1|ud=0,g=0.y
-        let k5 = qd_imu * k2; // a2 in 1|ud=0,g=0.z
-        let k6 = c_q_w * k4 + s_q_w * k5; // a2|ud=0,g=0.y
-        let k7 = s_q_w * k4 - c_q_w * k5; // a2|ud=0,g=0.z
-        let d1 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
-        let d2 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
-        let d3 = p.m2 * k6 + k1 * d2; // F2|ud=0,g=0.y
-        let d4 = p.m2 * k7 + k1 * d1; // F2|ud=0,g=0.z
-        let d5 = p.MY2 * k7 - p.MZ2 * k6; // N2|ud=0,g=0.x
-        out[1] = core::hint::black_box(d5);
-        let d6 = s_q_w * d3 - c_q_w * d4; // f2 in 1|ud=0,g=0.z
-        let d7 = c_q_w * d3 + s_q_w * d4; // f2 in 1|ud=0,g=0.y
-        let d8 = d5 - p.L1 * d6 + p.L2 * d7; // n1|ud=0,g=0.x
-        out[0] = core::hint::black_box(d8);
-        out
+        kanegen_runtime::isa::dispatch(
+            #[inline(always)]
+            || {
+                let (sin_q, cos_q) = sin_cos_n([q[1]]);
+                let s_q_w = sin_q[0];
+                let c_q_w = cos_q[0];
+                let qd_imu = u[0];
+                let qd_w = u[1];
+                let mut out = SVector::<f64, 2>::zeros();
+                let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
+                let k2 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+                let k3 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+                let k4 = qd_imu * k3; // a2 in 1|ud=0,g=0.y
+                let k5 = qd_imu * k2; // a2 in 1|ud=0,g=0.z
+                let k6 = c_q_w * k4 + s_q_w * k5; // a2|ud=0,g=0.y
+                let k7 = s_q_w * k4 - c_q_w * k5; // a2|ud=0,g=0.z
+                let d1 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
+                let d2 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
+                let d3 = p.m2 * k6 + k1 * d2; // F2|ud=0,g=0.y
+                let d4 = p.m2 * k7 + k1 * d1; // F2|ud=0,g=0.z
+                let d5 = p.MY2 * k7 - p.MZ2 * k6; // N2|ud=0,g=0.x
+                out[1] = core::hint::black_box(d5);
+                let d6 = s_q_w * d3 - c_q_w * d4; // f2 in 1|ud=0,g=0.z
+                let d7 = c_q_w * d3 + s_q_w * d4; // f2 in 1|ud=0,g=0.y
+                let d8 = d5 - p.L1 * d6 + p.L2 * d7; // n1|ud=0,g=0.x
+                out[0] = core::hint::black_box(d8);
+                out
+            },
+        )
     }
     /// Gravity vector g(q).
     ///
@@ -402,23 +412,28 @@ mod generated {
         pc: &Precomputed,
         q: &SVector<f64, 2>,
     ) -> SVector<f64, 2> {
-        let (sin_q, cos_q) = sin_cos_n([q[0], q[1]]);
-        let s_q_imu = sin_q[0];
-        let c_q_imu = cos_q[0];
-        let s_q_w = sin_q[1];
-        let c_q_w = cos_q[1];
-        let mut out = SVector::<f64, 2>::zeros();
-        let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
-        let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
-        let d3 = c_q_w * d1 - s_q_w * d2; // gravity acceleration in 2.y
-        let d4 = s_q_w * d1 + c_q_w * d2; // gravity acceleration in 2.z
-        out[1] = core::hint::black_box(p.MZ2 * d3 - p.MY2 * d4);
-        let d5 = p.MY2 * c_q_w + p.MZ2 * s_q_w; // MSC2 in 1.y
-        let d6 = p.MY2 * s_q_w - p.MZ2 * c_q_w; // MSC2 in 1.z
-        let d7 = d5 + pc.pc1; // MSC1.y
-        let d8 = pc.pc2 - d6; // MSC1.z
-        out[0] = core::hint::black_box(d8 * d1 - d7 * d2);
-        out
+        kanegen_runtime::isa::dispatch(
+            #[inline(always)]
+            || {
+                let (sin_q, cos_q) = sin_cos_n([q[0], q[1]]);
+                let s_q_imu = sin_q[0];
+                let c_q_imu = cos_q[0];
+                let s_q_w = sin_q[1];
+                let c_q_w = cos_q[1];
+                let mut out = SVector::<f64, 2>::zeros();
+                let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
+                let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
+                let d3 = c_q_w * d1 - s_q_w * d2; // gravity acceleration in 2.y
+                let d4 = s_q_w * d1 + c_q_w * d2; // gravity acceleration in 2.z
+                out[1] = core::hint::black_box(p.MZ2 * d3 - p.MY2 * d4);
+                let d5 = p.MY2 * c_q_w + p.MZ2 * s_q_w; // MSC2 in 1.y
+                let d6 = p.MY2 * s_q_w - p.MZ2 * c_q_w; // MSC2 in 1.z
+                let d7 = d5 + pc.pc1; // MSC1.y
+                let d8 = pc.pc2 - d6; // MSC1.z
+                out[0] = core::hint::black_box(d8 * d1 - d7 * d2);
+                out
+            },
+        )
     }
     /// Inverse dynamics τ = M(q) u̇ + c(q, u) + g(q), in one pass.
     ///
@@ -432,38 +447,43 @@ mod generated {
         u: &SVector<f64, 2>,
         ud: &SVector<f64, 2>,
     ) -> SVector<f64, 2> {
-        let (sin_q, cos_q) = sin_cos_n([q[0], q[1]]);
-        let s_q_imu = sin_q[0];
-        let c_q_imu = cos_q[0];
-        let s_q_w = sin_q[1];
-        let c_q_w = cos_q[1];
-        let qd_imu = u[0];
-        let qdd_imu = ud[0];
-        let qd_w = u[1];
-        let qdd_w = ud[1];
-        let mut out = SVector::<f64, 2>::zeros();
-        let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
-        let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
-        let d3 = p.XX1 * qdd_imu - p.MY1 * d2 + p.MZ1 * d1; // N1.x
-        let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
-        let k2 = qdd_imu + qdd_w; // wd2.x
-        let k3 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-        let k4 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-        let d4 = d1 - qd_imu * k4 - p.L2 * qdd_imu; // a2 in 1.y
-        let d5 = d2 + qd_imu * k3 - p.L1 * qdd_imu; // a2 in 1.z
-        let d6 = c_q_w * d4 - s_q_w * d5; // a2.y
-        let d7 = s_q_w * d4 + c_q_w * d5; // a2.z
-        let d8 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
-        let d9 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
-        let d10 = k1 * d9 - p.m2 * d6 - p.MZ2 * k2; // F2.y
-        let d11 = k1 * d8 - p.m2 * d7 + p.MY2 * k2; // F2.z
-        let d12 = p.XX2 * k2 - p.MY2 * d7 + p.MZ2 * d6; // N2.x
-        out[1] = core::hint::black_box(d12);
-        let d13 = s_q_w * d10 - c_q_w * d11; // f2 in 1.z
-        let d14 = c_q_w * d10 + s_q_w * d11; // f2 in 1.y
-        let d15 = d3 + d12 - p.L1 * d13 + p.L2 * d14; // n1.x
-        out[0] = core::hint::black_box(d15);
-        out
+        kanegen_runtime::isa::dispatch(
+            #[inline(always)]
+            || {
+                let (sin_q, cos_q) = sin_cos_n([q[0], q[1]]);
+                let s_q_imu = sin_q[0];
+                let c_q_imu = cos_q[0];
+                let s_q_w = sin_q[1];
+                let c_q_w = cos_q[1];
+                let qd_imu = u[0];
+                let qdd_imu = ud[0];
+                let qd_w = u[1];
+                let qdd_w = ud[1];
+                let mut out = SVector::<f64, 2>::zeros();
+                let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
+                let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
+                let d3 = p.XX1 * qdd_imu - p.MY1 * d2 + p.MZ1 * d1; // N1.x
+                let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
+                let k2 = qdd_imu + qdd_w; // wd2.x
+                let k3 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+                let k4 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+                let d4 = d1 - qd_imu * k4 - p.L2 * qdd_imu; // a2 in 1.y
+                let d5 = d2 + qd_imu * k3 - p.L1 * qdd_imu; // a2 in 1.z
+                let d6 = c_q_w * d4 - s_q_w * d5; // a2.y
+                let d7 = s_q_w * d4 + c_q_w * d5; // a2.z
+                let d8 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
+                let d9 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
+                let d10 = k1 * d9 - p.m2 * d6 - p.MZ2 * k2; // F2.y
+                let d11 = k1 * d8 - p.m2 * d7 + p.MY2 * k2; // F2.z
+                let d12 = p.XX2 * k2 - p.MY2 * d7 + p.MZ2 * d6; // N2.x
+                out[1] = core::hint::black_box(d12);
+                let d13 = s_q_w * d10 - c_q_w * d11; // f2 in 1.z
+                let d14 = c_q_w * d10 + s_q_w * d11; // f2 in 1.y
+                let d15 = d3 + d12 - p.L1 * d13 + p.L2 * d14; // n1.x
+                out[0] = core::hint::black_box(d15);
+                out
+            },
+        )
     }
     /// Coriolis matrix C(q, u): c(q, u) = C(q, u) u, and Ṁ − 2C is skew-symmetric.
     ///
@@ -476,41 +496,46 @@ mod generated {
         q: &SVector<f64, 2>,
         u: &SVector<f64, 2>,
     ) -> SMatrix<f64, 2, 2> {
-        let (sin_q, cos_q) = sin_cos_n([q[1]]);
-        let s_q_w = sin_q[0];
-        let c_q_w = cos_q[0];
-        let qd_imu = u[0];
-        let qd_w = u[1];
-        let mut m = SMatrix::<f64, 2, 2>::zeros();
-        let k1 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-        let k2 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-        let k3 = qd_imu + qd_w; // w2|ud=0,g=0.x
-        let k4 = c_q_w * k1 - s_q_w * k2; // v2.y
-        let k5 = s_q_w * k1 + c_q_w * k2; // v2.z
-        let d1 = p.MZ2 * k3; // w2xMS2|ud=0,g=0.y
-        let d2 = p.MY2 * k3; // w2xMS2|ud=0,g=0.z
-        let d3 = p.m2 * k4; // IC2(VxS(qd_w)).f.z
-        let d4 = p.m2 * k5; // IC2(VxS(qd_w)).f.y
-        let d5 = d1 - d3; // h2.f.y
-        let d6 = d2 + d4; // h2.f.z
-        let t1 = p.MY2 * k4; // common subexpression
-        let t2 = p.MZ2 * k5; // common subexpression
-        let d7 = 2.0 * t1 + 2.0 * t2; // Jd2.xx
-        m[(1, 0)] = -0.5 * d7;
-        let d8 = c_q_w * d5 - s_q_w * d6; // hC2 in 1.f.y
-        let d9 = s_q_w * d5 + c_q_w * d6; // hC2 in 1.f.z
-        let d10 = d7 - 2.0 * (p.L1 * d8) - 2.0 * (p.L2 * d9); // JdC1.xx
-        m[(0, 0)] = -0.5 * d10;
-        let d11 = t1 + t2; // IC2(VxS(qd_w)).n.x
-        let d12 = 0.5 * d7 - d11; // h(C col qd_w) at 2.n.x
-        m[(1, 1)] = -d12;
-        let d13 = d6 - d4; // h(C col qd_w) at 2.f.y
-        let d14 = d5 + d3; // h(C col qd_w) at 2.f.z
-        let d15 = s_q_w * d13 - c_q_w * d14; // h(C col qd_w) at 1.f.z
-        let d16 = c_q_w * d13 + s_q_w * d14; // h(C col qd_w) at 1.f.y
-        let d17 = d12 + p.L1 * d15 - p.L2 * d16; // h(C col qd_w) at 1.n.x
-        m[(0, 1)] = -d17;
-        m
+        kanegen_runtime::isa::dispatch(
+            #[inline(always)]
+            || {
+                let (sin_q, cos_q) = sin_cos_n([q[1]]);
+                let s_q_w = sin_q[0];
+                let c_q_w = cos_q[0];
+                let qd_imu = u[0];
+                let qd_w = u[1];
+                let mut m = SMatrix::<f64, 2, 2>::zeros();
+                let k1 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+                let k2 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+                let k3 = qd_imu + qd_w; // w2|ud=0,g=0.x
+                let k4 = c_q_w * k1 - s_q_w * k2; // v2.y
+                let k5 = s_q_w * k1 + c_q_w * k2; // v2.z
+                let d1 = p.MZ2 * k3; // w2xMS2|ud=0,g=0.y
+                let d2 = p.MY2 * k3; // w2xMS2|ud=0,g=0.z
+                let d3 = p.m2 * k4; // IC2(VxS(qd_w)).f.z
+                let d4 = p.m2 * k5; // IC2(VxS(qd_w)).f.y
+                let d5 = d1 - d3; // h2.f.y
+                let d6 = d2 + d4; // h2.f.z
+                let t1 = p.MY2 * k4; // common subexpression
+                let t2 = p.MZ2 * k5; // common subexpression
+                let d7 = 2.0 * t1 + 2.0 * t2; // Jd2.xx
+                m[(1, 0)] = -0.5 * d7;
+                let d8 = c_q_w * d5 - s_q_w * d6; // hC2 in 1.f.y
+                let d9 = s_q_w * d5 + c_q_w * d6; // hC2 in 1.f.z
+                let d10 = d7 - 2.0 * (p.L1 * d8) - 2.0 * (p.L2 * d9); // JdC1.xx
+                m[(0, 0)] = -0.5 * d10;
+                let d11 = t1 + t2; // IC2(VxS(qd_w)).n.x
+                let d12 = 0.5 * d7 - d11; // h(C col qd_w) at 2.n.x
+                m[(1, 1)] = -d12;
+                let d13 = d6 - d4; // h(C col qd_w) at 2.f.y
+                let d14 = d5 + d3; // h(C col qd_w) at 2.f.z
+                let d15 = s_q_w * d13 - c_q_w * d14; // h(C col qd_w) at 1.f.z
+                let d16 = c_q_w * d13 + s_q_w * d14; // h(C col qd_w) at 1.f.y
+                let d17 = d12 + p.L1 * d15 - p.L2 * d16; // h(C col qd_w) at 1.n.x
+                m[(0, 1)] = -d17;
+                m
+            },
+        )
     }
     /// The dynamics of `two-link` with one parameter set: `τ = M(q) u̇ + c(q, u) + g(q)`.
     ///

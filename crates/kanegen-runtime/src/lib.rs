@@ -15,7 +15,10 @@
 //!   matrix): the trait every generated robot type implements, so that a controller can be
 //!   written once for any generated robot.
 //!
-//! `#![no_std]`, no `unsafe`, no dependency but [`nalgebra`] (re-exported: its vector and
+//! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA), the
+//!   crate's one `unsafe` block; [`lanes`]: the lane type of the batched functions.
+//!
+//! `#![no_std]`, one `unsafe` block ([`isa::dispatch`]), no dependency but [`nalgebra`] (re-exported: its vector and
 //! matrix types are the trait's argument types) and, behind features, `serde` and `toml`.
 //!
 //! # How generated code uses it
@@ -122,17 +125,22 @@
 //!   (nalgebra's math goes through `libm`); the crate itself is `#![no_std]` either way.
 //! - `serde`: `Serialize`/`Deserialize` for every generated `Params` (`no_std`-compatible);
 //!   re-exports `serde`.
+//! - `dispatch` (default; needs `std` for feature detection): every generated function is
+//!   compiled for the baseline and for x86-64-v3 and the best copy runs ([`isa`]).
 //! - `toml` (implies `serde` and `std`): `params_from_model_toml`, the `[parameters]` table
 //!   of a model description file as a generated `Params`, at run time.
 
 #![no_std]
-#![forbid(unsafe_code)]
+// One `unsafe` block, in `isa::dispatch` (calling the x86-64-v3 copy after feature detection).
+#![deny(unsafe_code)]
 
 #[cfg(feature = "std")]
 extern crate std;
 
 mod dynamics;
 mod invalid_parameter;
+pub mod isa;
+pub mod lanes;
 #[doc(hidden)]
 pub mod serde_support;
 pub mod trig;

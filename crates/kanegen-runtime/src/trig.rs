@@ -38,9 +38,21 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
 /// recomputed lane by lane by the scalar routine. Not inlined: the generated functions are
 /// long enough that their speed depends on their code size (one shared copy instead of one per
 /// function).
+///
+/// Compiled for the baseline and for x86-64-v3 (four lanes per AVX2 instruction) and run with
+/// the instruction set of [`crate::isa::dispatch`]; both give the same bits.
 #[inline(never)]
-#[allow(clippy::needless_range_loop)] // lane loops over parallel arrays: what LLVM vectorizes
 pub fn sin_cos_n<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
+    crate::isa::dispatch(
+        #[inline(always)]
+        || sin_cos_n_lanes(x),
+    )
+}
+
+/// The lane loop of [`sin_cos_n`], inlined into each instruction set's copy.
+#[inline(always)]
+#[allow(clippy::needless_range_loop)] // lane loops over parallel arrays: what LLVM vectorizes
+fn sin_cos_n_lanes<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
     // The check sits inside the loop and the fallback takes and returns arrays by value: a
     // separate check loop gets 512-bit compares under AVX-512 (which slowed the batch by a
     // third there), and passing the arrays by reference keeps them from being built in place.

@@ -10,8 +10,11 @@
 //! target/release/examples/profile all 200000
 //! ```
 //!
-//! Arguments: a function (`mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, or `all`) and
-//! the number of calls. States cycle through 64 fixed pseudo-random states.
+//! Arguments: a function (`mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, or `all`;
+//! a suffix `_b4` or `_b8` calls the batched form with 4 or 8 states, counted as one call), the
+//! number of calls, and optionally the instruction set (`baseline` or `x86-64-v3`; default: the
+//! best the CPU has, see `kanegen_runtime::isa`). States cycle through 64 fixed pseudo-random
+//! states.
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -51,16 +54,60 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> f64 {
             "inverse_dynamics" => {
                 black_box(k).inverse_dynamics(black_box(q), black_box(u), black_box(ud))[7]
             }
+            "mass_matrix_b4" => {
+                black_box(k).mass_matrix_batch(black_box(&batch::<4>(s, i)))[1][(5, 3)]
+            }
+            "mass_matrix_b8" => {
+                black_box(k).mass_matrix_batch(black_box(&batch::<8>(s, i)))[1][(5, 3)]
+            }
+            "coriolis_b4" => {
+                let (q, u) = (batch::<4>(s, i), batch_u::<4>(s, i));
+                black_box(k).coriolis_batch(black_box(&q), black_box(&u))[1][7]
+            }
+            "coriolis_b8" => {
+                let (q, u) = (batch::<8>(s, i), batch_u::<8>(s, i));
+                black_box(k).coriolis_batch(black_box(&q), black_box(&u))[1][7]
+            }
+            "gravity_b4" => black_box(k).gravity_batch(black_box(&batch::<4>(s, i)))[1][7],
+            "gravity_b8" => black_box(k).gravity_batch(black_box(&batch::<8>(s, i)))[1][7],
+            "inverse_dynamics_b4" => {
+                let (q, u) = (batch::<4>(s, i), batch_u::<4>(s, i));
+                black_box(k).inverse_dynamics_batch(black_box(&q), black_box(&u), black_box(&u))[1]
+                    [7]
+            }
+            "inverse_dynamics_b8" => {
+                let (q, u) = (batch::<8>(s, i), batch_u::<8>(s, i));
+                black_box(k).inverse_dynamics_batch(black_box(&q), black_box(&u), black_box(&u))[1]
+                    [7]
+            }
             other => panic!("unknown function `{other}`"),
         };
     }
     acc
 }
 
+/// `L` consecutive states' coordinates, from state `i`.
+fn batch<const L: usize>(s: &[(V, V, V)], i: usize) -> [V; L] {
+    std::array::from_fn(|l| s[(i + l) & 63].0)
+}
+
+/// `L` consecutive states' speeds, from state `i`.
+fn batch_u<const L: usize>(s: &[(V, V, V)], i: usize) -> [V; L] {
+    std::array::from_fn(|l| s[(i + l) & 63].1)
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let f = args.get(1).map_or("all", String::as_str);
     let calls: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(100_000);
+    if let Some(isa) = args.get(3) {
+        let isa = kanegen_runtime::isa::Isa::ALL
+            .into_iter()
+            .find(|i| i.name() == isa)
+            .unwrap_or_else(|| panic!("unknown instruction set `{isa}`"));
+        kanegen_runtime::isa::select(isa).unwrap();
+    }
+    eprintln!("instruction set: {}", kanegen_runtime::isa::active());
     let k = Krang::default();
     let s = states();
     let names = ["mass_matrix", "coriolis", "gravity", "inverse_dynamics"];

@@ -144,3 +144,7 @@ pub use kanegen_runtime::CoriolisMatrix;
 pub use kanegen_runtime::{InvalidParameter, Problem, RobotDynamics, nalgebra};
 #[cfg(feature = "toml")]
 pub use kanegen_runtime::{ModelFileError, params_from_model_toml};
+/// Run-time instruction-set dispatch of the generated functions (which copy runs:
+/// `isa::active()`; `isa::select` for benchmarks) and the lane type of the batched functions
+/// (`Krang::mass_matrix_batch`, …).
+pub use kanegen_runtime::{isa, lanes};

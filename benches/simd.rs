@@ -1,0 +1,137 @@
+//! Issue 14: the generated Krang functions with each instruction set of the run-time dispatch
+//! (`baseline`, `x86-64-v3`: AVX2 + FMA) and batched at 4 and 8 states per call.
+//!
+//! ```sh
+//! cargo bench --bench simd                 # ≈ 2 minutes
+//! ```
+//!
+//! Ids: `simd/<function>/<isa>` (one state per call) and `simd/<function>/<isa>/batch<L>` (one
+//! call of `<function>_batch` with `L` states: divide by `L` for the time per state). The
+//! states cycle through 64 random ones.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use krang_dynamics::Krang;
+use krang_dynamics::isa::{self, Isa};
+use nalgebra::SVector;
+
+type V = SVector<f64, 19>;
+
+fn states() -> Vec<(V, V, V)> {
+    let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut next = move || {
+        x = x
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..64)
+        .map(|_| {
+            let q = V::from_fn(|_, _| (2.0 * next() - 1.0) * std::f64::consts::PI);
+            let u = V::from_fn(|_, _| 4.0 * next() - 2.0);
+            let ud = V::from_fn(|_, _| 10.0 * next() - 5.0);
+            (q, u, ud)
+        })
+        .collect()
+}
+
+/// `L` consecutive states from state `i`, as the batched functions take them.
+fn batch<const L: usize>(s: &[(V, V, V)], i: usize) -> ([V; L], [V; L], [V; L]) {
+    (
+        std::array::from_fn(|l| s[(i + l) & 63].0),
+        std::array::from_fn(|l| s[(i + l) & 63].1),
+        std::array::from_fn(|l| s[(i + l) & 63].2),
+    )
+}
+
+fn bench_batch<const L: usize>(c: &mut Criterion, k: &Krang, s: &[(V, V, V)], tag: &str) {
+    let batches: Vec<_> = (0..64).step_by(L).map(|i| batch::<L>(s, i)).collect();
+    let n = batches.len();
+    let mut i = 0;
+    c.bench_function(&format!("simd/mass_matrix/{tag}/batch{L}"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            black_box(k).mass_matrix_batch(black_box(&batches[i].0))
+        })
+    });
+    c.bench_function(&format!("simd/coriolis/{tag}/batch{L}"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            let (q, u, _) = &batches[i];
+            black_box(k).coriolis_batch(black_box(q), black_box(u))
+        })
+    });
+    c.bench_function(&format!("simd/gravity/{tag}/batch{L}"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            black_box(k).gravity_batch(black_box(&batches[i].0))
+        })
+    });
+    c.bench_function(&format!("simd/inverse_dynamics/{tag}/batch{L}"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            let (q, u, ud) = &batches[i];
+            black_box(k).inverse_dynamics_batch(black_box(q), black_box(u), black_box(ud))
+        })
+    });
+}
+
+fn simd(c: &mut Criterion) {
+    let k = Krang::default();
+    let s = states();
+    for isa in Isa::ALL.into_iter().filter(|&i| isa::available(i)) {
+        isa::select(isa).unwrap();
+        let tag = isa.name();
+        let mut i = 0;
+        c.bench_function(&format!("simd/mass_matrix/{tag}"), |b| {
+            b.iter(|| {
+                i = (i + 1) & 63;
+                black_box(&k).mass_matrix(black_box(&s[i].0))
+            })
+        });
+        c.bench_function(&format!("simd/coriolis/{tag}"), |b| {
+            b.iter(|| {
+                i = (i + 1) & 63;
+                black_box(&k).coriolis(black_box(&s[i].0), black_box(&s[i].1))
+            })
+        });
+        c.bench_function(&format!("simd/gravity/{tag}"), |b| {
+            b.iter(|| {
+                i = (i + 1) & 63;
+                black_box(&k).gravity(black_box(&s[i].0))
+            })
+        });
+        c.bench_function(&format!("simd/inverse_dynamics/{tag}"), |b| {
+            b.iter(|| {
+                i = (i + 1) & 63;
+                let (q, u, ud) = &s[i];
+                black_box(&k).inverse_dynamics(black_box(q), black_box(u), black_box(ud))
+            })
+        });
+        c.bench_function(&format!("simd/coriolis_matrix/{tag}"), |b| {
+            b.iter(|| {
+                i = (i + 1) & 63;
+                black_box(&k).coriolis_matrix(black_box(&s[i].0), black_box(&s[i].1))
+            })
+        });
+        bench_batch::<4>(c, &k, &s, tag);
+        bench_batch::<8>(c, &k, &s, tag);
+    }
+    isa::select(isa::detected()).unwrap();
+}
+
+fn config() -> Criterion {
+    Criterion::default()
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(1))
+        .sample_size(30)
+}
+
+criterion_group! {
+    name = benches;
+    config = config();
+    targets = simd
+}
+criterion_main!(benches);

@@ -1,0 +1,252 @@
+//! Run-time instruction-set dispatch: the one place where generated code picks the best
+//! instruction set the CPU has.
+//!
+//! Cargo builds for the baseline of the target (x86-64: SSE2, no AVX, no FMA) unless told
+//! otherwise, while the CPUs controllers run on have AVX2 and FMA (x86-64-v3) or more. Every
+//! generated function (and [`crate::trig::sin_cos_n`]) is therefore compiled twice, for the
+//! baseline and for x86-64-v3, and [`dispatch`] chooses between the two copies at every call
+//! by one relaxed atomic load of the instruction set detected once, at the first call
+//! ([`active`]).
+//!
+//! How: the generated function's body is `#[inline(always)]` and is passed to [`dispatch`] as
+//! an `#[inline(always)]` closure. [`dispatch`] calls it directly (the baseline copy) or through
+//! a function compiled with `#[target_feature(enable = "avx,avx2,fma,…")]`, into which LLVM
+//! inlines the closure and the body: that copy of the body is compiled for AVX2 with the
+//! three-operand VEX encodings and 256-bit vectors where LLVM vectorizes. Calling a
+//! `#[target_feature]` function needs `unsafe` (the CPU must have the features); this module
+//! holds the crate's only `unsafe` block, right after the check that the features are present.
+//!
+//! Results: Rust never fuses `a * b + c` into a fused multiply-add on its own, so the x86-64-v3
+//! copy computes the same operations in the same order as the baseline one and gives **the same
+//! bits** (tested: `tests/isa.rs` in `kanegen-runtime`, and the generated functions in the
+//! workspace's `tests/isa_dispatch.rs`). Code that calls `mul_add` explicitly would differ in
+//! the last bits; generated code does not (yet).
+//!
+//! When there is nothing to choose, [`dispatch`] is a plain call and compiles to the body alone:
+//! - without the `dispatch` feature (on by default; turn it off with
+//!   `default-features = false, features = ["std"]`), or without `std` (feature detection needs
+//!   the operating system: `no_std` builds run the baseline copy);
+//! - on other architectures (aarch64's baseline already has NEON and FMA instructions);
+//! - when the crate is compiled with AVX2 and FMA enabled anyway (`-C target-cpu=native` or
+//!   `-C target-cpu=x86-64-v3`): the baseline copy *is* the AVX2 copy.
+//!
+//! Generators can also leave dispatch out of a module (`kanegen::Builder::isa_dispatch(false)`).
+//!
+//! ```
+//! use kanegen_runtime::isa::{self, Isa};
+//!
+//! // What the CPU has, and what generated functions use (the same unless `select`ed).
+//! let best = isa::detected();
+//! assert_eq!(isa::active(), best);
+//! assert!(isa::available(Isa::Baseline));
+//! // A generated function's shape: the body inlined into each copy.
+//! #[inline(always)]
+//! fn body(x: &[f64; 4]) -> f64 {
+//!     x.iter().map(|v| v * v).sum()
+//! }
+//! let x = [1.0, 2.0, 3.0, 4.0];
+//! let y = isa::dispatch(#[inline(always)] || body(&x));
+//! assert_eq!(y, 30.0);
+//! // Force the baseline copy (benchmarks, tests), then go back to the best one.
+//! isa::select(Isa::Baseline).unwrap();
+//! assert_eq!(isa::dispatch(#[inline(always)] || body(&x)), y);
+//! isa::select(best).unwrap();
+//! ```
+
+use core::sync::atomic::{AtomicU8, Ordering};
+
+/// An instruction set a generated function can run with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Isa {
+    /// The compilation target's own features (x86-64: SSE2, or whatever `-C target-cpu`
+    /// enabled; aarch64: NEON).
+    Baseline,
+    /// x86-64-v3: AVX, AVX2, FMA, BMI1, BMI2, LZCNT, F16C, POPCNT (Intel Haswell, AMD Excavator
+    /// and later).
+    X86_64V3,
+}
+
+impl Isa {
+    /// Every instruction set, from the most widely available.
+    pub const ALL: [Isa; 2] = [Isa::Baseline, Isa::X86_64V3];
+
+    /// `"baseline"`, `"x86-64-v3"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Isa::Baseline => "baseline",
+            Isa::X86_64V3 => "x86-64-v3",
+        }
+    }
+
+    fn code(self) -> u8 {
+        match self {
+            Isa::Baseline => BASELINE,
+            Isa::X86_64V3 => V3,
+        }
+    }
+}
+
+impl core::fmt::Display for Isa {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// [`select`] asked for an instruction set that this CPU lacks, or that this build cannot
+/// dispatch to (no `std`, the `dispatch` feature off, another architecture).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct IsaUnavailable {
+    /// The instruction set asked for.
+    pub isa: Isa,
+}
+
+impl core::fmt::Display for IsaUnavailable {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "instruction set {} is not available: the CPU lacks it, or this build of \
+             kanegen-runtime cannot dispatch to it (it needs the features `std` and `dispatch` \
+             and an x86-64 target); use isa::detected() for the best available one",
+            self.isa
+        )
+    }
+}
+
+impl core::error::Error for IsaUnavailable {}
+
+const UNKNOWN: u8 = 0;
+const BASELINE: u8 = 1;
+const V3: u8 = 2;
+
+/// The instruction set [`dispatch`] uses: [`UNKNOWN`] until the first call detects it.
+static ACTIVE: AtomicU8 = AtomicU8::new(UNKNOWN);
+
+/// Whether this build dispatches at all (see the module docs).
+macro_rules! if_dispatching {
+    ($($item:item)*) => {$(
+        #[cfg(all(
+            feature = "dispatch",
+            feature = "std",
+            target_arch = "x86_64",
+            not(all(target_feature = "avx2", target_feature = "fma"))
+        ))]
+        $item
+    )*};
+}
+
+macro_rules! if_not_dispatching {
+    ($($item:item)*) => {$(
+        #[cfg(not(all(
+            feature = "dispatch",
+            feature = "std",
+            target_arch = "x86_64",
+            not(all(target_feature = "avx2", target_feature = "fma"))
+        )))]
+        $item
+    )*};
+}
+
+if_dispatching! {
+    fn v3_present() -> bool {
+        std::arch::is_x86_feature_detected!("avx")
+            && std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma")
+            && std::arch::is_x86_feature_detected!("bmi1")
+            && std::arch::is_x86_feature_detected!("bmi2")
+            && std::arch::is_x86_feature_detected!("lzcnt")
+            && std::arch::is_x86_feature_detected!("f16c")
+            && std::arch::is_x86_feature_detected!("popcnt")
+    }
+
+    /// Whether this CPU can run `isa`'s copy.
+    pub fn available(isa: Isa) -> bool {
+        match isa {
+            Isa::Baseline => true,
+            Isa::X86_64V3 => v3_present(),
+        }
+    }
+
+    /// `f()` compiled with x86-64-v3's features (LLVM inlines `f` here when it is
+    /// `#[inline(always)]`).
+    #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,f16c,popcnt")]
+    #[inline]
+    fn run_v3<R, F: FnOnce() -> R>(f: F) -> R {
+        f()
+    }
+
+    /// Calls `f` with the [`active`] instruction set: compiled twice, for the baseline and
+    /// for x86-64-v3, when `f` (and what it calls) is `#[inline(always)]`. See the module docs.
+    #[inline(always)]
+    pub fn dispatch<R, F: FnOnce() -> R>(f: F) -> R {
+        if active_code() == V3 {
+            // SAFETY: `ACTIVE` holds `V3` only after `v3_present()` found every feature
+            // `run_v3` is compiled with (`detect` and `select` check it before storing), so the
+            // CPU executes its instructions. The one `unsafe` block of the crate.
+            #[allow(unsafe_code)]
+            unsafe {
+                return run_v3(f);
+            }
+        }
+        f()
+    }
+}
+
+if_not_dispatching! {
+    /// Whether this CPU can run `isa`'s copy (this build has only the baseline one).
+    pub fn available(isa: Isa) -> bool {
+        isa == Isa::Baseline
+    }
+
+    /// Calls `f`: this build has one copy of every function (see the module docs).
+    #[inline(always)]
+    pub fn dispatch<R, F: FnOnce() -> R>(f: F) -> R {
+        f()
+    }
+}
+
+/// The best instruction set this CPU and this build can dispatch to.
+pub fn detected() -> Isa {
+    if available(Isa::X86_64V3) {
+        Isa::X86_64V3
+    } else {
+        Isa::Baseline
+    }
+}
+
+#[inline(always)]
+fn active_code() -> u8 {
+    match ACTIVE.load(Ordering::Relaxed) {
+        UNKNOWN => detect(),
+        code => code,
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn detect() -> u8 {
+    let code = detected().code();
+    // A concurrent `select` wins: keep what is there if it is no longer UNKNOWN.
+    match ACTIVE.compare_exchange(UNKNOWN, code, Ordering::Relaxed, Ordering::Relaxed) {
+        Ok(_) => code,
+        Err(current) => current,
+    }
+}
+
+/// The instruction set [`dispatch`] uses: [`detected`] at the first call, unless [`select`]ed.
+pub fn active() -> Isa {
+    match active_code() {
+        V3 => Isa::X86_64V3,
+        _ => Isa::Baseline,
+    }
+}
+
+/// Make [`dispatch`] use `isa` from now on, in every thread (for benchmarks and tests that
+/// compare the copies; results are the same bits either way). An error if this CPU or build
+/// cannot run it; nothing changes then.
+pub fn select(isa: Isa) -> Result<(), IsaUnavailable> {
+    if !available(isa) {
+        return Err(IsaUnavailable { isa });
+    }
+    ACTIVE.store(isa.code(), Ordering::Relaxed);
+    Ok(())
+}

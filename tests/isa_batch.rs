@@ -1,0 +1,171 @@
+//! Run-time instruction-set dispatch and batched evaluation (issue 14): the x86-64-v3 copy of
+//! every generated function gives the baseline copy's bits, and every batched function gives
+//! the single-state function's bits in every lane, for batch sizes 1, 3 (odd), 4 and 8, with
+//! both instruction sets, on random parameter sets and states (angles of all sizes, including
+//! a huge one that takes the slow sin/cos path in one lane).
+
+mod common;
+
+use common::*;
+use kanegen_model::Model;
+use kanegen_reference::random::random_physical_params;
+use krang_dynamics as kd;
+use krang_dynamics::isa::{self, Isa};
+use nalgebra::SVector;
+
+type V = SVector<f64, 19>;
+
+fn krang(model: &Model, uniform: &mut impl FnMut() -> f64) -> kd::Krang {
+    let p = random_physical_params(model, uniform);
+    kd::Krang::new(kd::Params::from_array(p.try_into().unwrap()))
+}
+
+fn states<const L: usize>(uniform: &mut impl FnMut() -> f64) -> ([V; L], [V; L], [V; L]) {
+    let mut q = [V::zeros(); L];
+    let mut u = [V::zeros(); L];
+    let mut ud = [V::zeros(); L];
+    for l in 0..L {
+        let (a, b, c) = random_state(uniform, 19);
+        (q[l], u[l], ud[l]) = (sv(&a), sv(&b), sv(&c));
+    }
+    (q, u, ud)
+}
+
+/// Bitwise equality (`==` would accept `0.0 == -0.0` and reject equal NaNs).
+fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+/// Every batched function of `k` at `L` states equals its single-state function in each lane.
+fn check_batch<const L: usize>(k: &kd::Krang, q: &[V; L], u: &[V; L], ud: &[V; L]) {
+    let m = k.mass_matrix_batch(q);
+    let c = k.coriolis_batch(q, u);
+    let g = k.gravity_batch(q);
+    let t = k.inverse_dynamics_batch(q, u, ud);
+    let cm = k.coriolis_matrix_batch(q, u);
+    let mb = kd::baked::mass_matrix_batch(q);
+    let tb = kd::baked::inverse_dynamics_batch(q, u, ud);
+    for l in 0..L {
+        let (ql, ul, udl) = (&q[l], &u[l], &ud[l]);
+        assert!(
+            same_bits(m[l].as_slice(), k.mass_matrix(ql).as_slice()),
+            "M lane {l} of {L}"
+        );
+        assert!(
+            same_bits(c[l].as_slice(), k.coriolis(ql, ul).as_slice()),
+            "c lane {l}"
+        );
+        assert!(
+            same_bits(g[l].as_slice(), k.gravity(ql).as_slice()),
+            "g lane {l}"
+        );
+        let tl = k.inverse_dynamics(ql, ul, udl);
+        assert!(same_bits(t[l].as_slice(), tl.as_slice()), "τ lane {l}");
+        let cml = k.coriolis_matrix(ql, ul);
+        assert!(same_bits(cm[l].as_slice(), cml.as_slice()), "C lane {l}");
+        let mbl = kd::baked::mass_matrix(ql);
+        assert!(
+            same_bits(mb[l].as_slice(), mbl.as_slice()),
+            "baked M lane {l}"
+        );
+        let tbl = kd::baked::inverse_dynamics(ql, ul, udl);
+        assert!(
+            same_bits(tb[l].as_slice(), tbl.as_slice()),
+            "baked τ lane {l}"
+        );
+    }
+}
+
+/// Runs `f` on a thread with a large stack: unoptimised (debug) builds keep every statement's
+/// `Lanes<L>` value in its own stack slot (Krang's batched M at L = 8: thousands of 64-byte
+/// locals), more than a test thread's default 2 MB. Optimised builds need a few KB.
+fn with_big_stack(f: impl FnOnce() + Send + 'static) {
+    std::thread::Builder::new()
+        .stack_size(512 << 20)
+        .spawn(f)
+        .unwrap()
+        .join()
+        .unwrap();
+}
+
+#[test]
+fn batched_functions_equal_the_single_state_functions_bit_for_bit() {
+    with_big_stack(batched_equal_single);
+}
+
+fn batched_equal_single() {
+    let model = model("krang.toml");
+    let mut uniform = rng(14);
+    for isa in Isa::ALL.into_iter().filter(|&i| isa::available(i)) {
+        isa::select(isa).unwrap();
+        for draw in 0..30 {
+            let k = krang(&model, &mut uniform);
+            let (q1, u1, ud1) = states::<1>(&mut uniform);
+            check_batch(&k, &q1, &u1, &ud1);
+            let (q3, u3, ud3) = states::<3>(&mut uniform);
+            check_batch(&k, &q3, &u3, &ud3);
+            let (mut q4, u4, ud4) = states::<4>(&mut uniform);
+            if draw % 5 == 0 {
+                // One lane with a huge angle: that batch takes the per-lane slow sin/cos.
+                q4[2][kd::index::Q1L] = 1.0e7;
+            }
+            check_batch(&k, &q4, &u4, &ud4);
+            let (q8, u8, ud8) = states::<8>(&mut uniform);
+            check_batch(&k, &q8, &u8, &ud8);
+        }
+    }
+    isa::select(isa::detected()).unwrap();
+}
+
+#[test]
+fn dispatched_copies_give_the_baseline_bits() {
+    let model = model("krang.toml");
+    let mut uniform = rng(1414);
+    let best = isa::detected();
+    assert_eq!(isa::available(Isa::X86_64V3), best == Isa::X86_64V3);
+    if best == Isa::Baseline {
+        eprintln!("note: this CPU or build has only the baseline copy; nothing to compare");
+        return;
+    }
+    for _ in 0..200 {
+        let k = krang(&model, &mut uniform);
+        let (q, u, ud) = random_state(&mut uniform, 19);
+        let (q, u, ud): (V, V, V) = (sv(&q), sv(&u), sv(&ud));
+        let eval = |isa: Isa| {
+            isa::select(isa).unwrap();
+            let mut out = Vec::new();
+            out.extend_from_slice(k.mass_matrix(&q).as_slice());
+            out.extend_from_slice(k.coriolis(&q, &u).as_slice());
+            out.extend_from_slice(k.gravity(&q).as_slice());
+            out.extend_from_slice(k.inverse_dynamics(&q, &u, &ud).as_slice());
+            out.extend_from_slice(k.coriolis_matrix(&q, &u).as_slice());
+            out.extend_from_slice(kd::baked::coriolis(&q, &u).as_slice());
+            let f = kd::fixed_wheels::KrangFixedWheels::default();
+            let qf = SVector::<f64, 17>::from_fn(|i, _| q[i + 2]);
+            out.extend_from_slice(f.mass_matrix(&qf).as_slice());
+            let (s, c) = kanegen_runtime::trig::sin_cos_n(q.into());
+            out.extend_from_slice(&s);
+            out.extend_from_slice(&c);
+            out
+        };
+        let base = eval(Isa::Baseline);
+        let v3 = eval(best);
+        assert!(same_bits(&base, &v3), "{best} differs from the baseline");
+    }
+    isa::select(best).unwrap();
+}
+
+#[test]
+fn selecting_an_instruction_set_the_cpu_lacks_is_an_error() {
+    for isa in Isa::ALL {
+        match isa::select(isa) {
+            Ok(()) => assert!(isa::available(isa)),
+            Err(e) => {
+                assert!(!isa::available(isa));
+                assert!(e.to_string().contains(isa.name()), "{e}");
+            }
+        }
+    }
+    isa::select(isa::detected()).unwrap();
+    assert_eq!(isa::active(), isa::detected());
+}

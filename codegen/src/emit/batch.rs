@@ -19,10 +19,13 @@ use crate::lower::{FunctionProgram, LExpr, Program};
 use crate::naming;
 use crate::registry::{FunctionSpec, Inputs, Shape};
 
-/// Whether `f` gets a batched form: a vector or matrix result and no frame argument.
+/// Whether `f` gets a batched form: the dynamics (M, c, g, τ and C: the functions of the
+/// runtime's traits), a vector or matrix result and no frame argument. The opt-in kinematics,
+/// derivatives and regressors have none (their single-state code is already long).
 fn batched(f: &FunctionProgram) -> bool {
     let spec = f.id.spec();
     f.frame.is_none()
+        && spec.runtime_trait.is_some()
         && !spec.per_frame
         && matches!(
             spec.shape,
@@ -138,7 +141,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     }
     let statements = printer.statements(&stores);
     let symmetric = spec.shape == Shape::SymmetricMatrix;
-    let (rows, cols) = spec.shape.size(cx.low.dof);
+    let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
     let (rows, cols) = (idx(rows), idx(cols));
     let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
     let mut unused = TokenStream::new();

@@ -22,18 +22,24 @@
 //!   modules' position servos.
 //!
 //! ```text
-//! cargo run --release -p krang-dynamics --features derivatives --example lqr -- [DIR]
+//! cargo run --release -p krang-dynamics --features derivatives,fixed-wheels,kinematics --example lqr -- [DIR]
 //! ```
 //! writes `lqr_pitch.png`, `lqr_position.png`, `lqr_heading.png` and `lqr_torques.png` to DIR
 //! (default `target/plots`; the README's images: `DIR = docs/plots`).
 
-mod plot;
-
+use std::error::Error;
 use std::path::{Path, PathBuf};
 
 use krang_dynamics::{ACTUATOR_COUNT, Krang, actuator, index, saturate};
 use nalgebra::{DMatrix, SVector};
-use plot::{BLUE_, GREEN_, ORANGE, Panel, RED_, Res, Series, figure};
+
+// The charts: the `simulate` example's drawing code (also used by `whole_body`).
+#[allow(dead_code)]
+#[path = "../simulate.rs"]
+mod simulate;
+use simulate::{BLUE_, GREEN_, ORANGE, Panel, RED_, Series, figure};
+
+type Res<T> = Result<T, Box<dyn Error>>;
 
 /// Settings of the run.
 #[derive(Debug, Clone, Copy)]

@@ -12,7 +12,7 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::Context;
-use super::function::{Reads, last_local, nonzero_outputs};
+use super::function::{Reads, last_local, nonzero_outputs, unused_inputs};
 use super::items::{arg_names, return_type};
 use super::print::{Printer, ident, idx};
 use crate::lower::{FunctionProgram, LExpr, Program};
@@ -143,17 +143,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     let symmetric = spec.shape == Shape::SymmetricMatrix;
     let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
     let (rows, cols) = (idx(rows), idx(cols));
-    let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
-    let mut unused = TokenStream::new();
-    if !reads_q {
-        unused.extend(quote!(let _ = q;));
-    }
-    if spec.inputs.needs_u() && !reads.speed.contains(&true) {
-        unused.extend(quote!(let _ = u;));
-    }
-    if spec.inputs.needs_ud() && !reads.accel.contains(&true) {
-        unused.extend(quote!(let _ = ud;));
-    }
+    let unused = unused_inputs(spec, p, &reads);
     let body = quote! {
         #unused
         #prologue

@@ -381,17 +381,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         value,
     } = result(cx, &printer, p, spec.shape);
     let body = printer.statements(&stores);
-    let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
-    let mut unused = TokenStream::new();
-    if !reads_q {
-        unused.extend(quote!(let _ = q;));
-    }
-    if spec.inputs.needs_u() && !reads.speed.contains(&true) {
-        unused.extend(quote!(let _ = u;));
-    }
-    if spec.inputs.needs_ud() && !reads.accel.contains(&true) {
-        unused.extend(quote!(let _ = ud;));
-    }
+    let unused = unused_inputs(spec, p, &reads);
     let body = quote! {
         #unused
         #prologue
@@ -417,4 +407,26 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
             #body
         }
     }
+}
+
+/// `let _ = q;` (and `u`, `ud`) for the inputs a function's program never reads, so that the
+/// generated signature stays uniform without unused-variable warnings (single-state and batched
+/// forms alike).
+pub(super) fn unused_inputs(
+    spec: &crate::registry::FunctionSpec,
+    p: &Program,
+    reads: &Reads,
+) -> TokenStream {
+    let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
+    let mut unused = TokenStream::new();
+    if !reads_q {
+        unused.extend(quote!(let _ = q;));
+    }
+    if spec.inputs.needs_u() && !reads.speed.contains(&true) {
+        unused.extend(quote!(let _ = u;));
+    }
+    if spec.inputs.needs_ud() && !reads.accel.contains(&true) {
+        unused.extend(quote!(let _ = ud;));
+    }
+    unused
 }

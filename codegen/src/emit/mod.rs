@@ -19,8 +19,10 @@ mod batch;
 mod frames;
 mod function;
 mod items;
+mod layout;
 mod print;
 mod regressors;
+mod text;
 
 use std::path::Path;
 
@@ -87,6 +89,8 @@ pub(crate) struct Context<'a> {
     isa_dispatch: bool,
     /// Field names of the precomputed values, by slot.
     pre: Vec<String>,
+    /// The statement blocks of the functions, spliced in after formatting (`text.rs`).
+    blocks: text::Blocks,
 }
 
 fn scalar_type(precision: Precision) -> TokenStream {
@@ -116,6 +120,7 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
             .iter()
             .map(|&i| low.precompute.stmts[i].name.clone())
             .collect(),
+        blocks: text::Blocks::default(),
     };
     let runtime = low.params.is_runtime();
     let mut items = quote!(
@@ -139,17 +144,12 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         labels.add("new", &low.precompute);
     }
     items.extend(regressors::items(&cx));
-    let names: Vec<String> = low
-        .functions
-        .iter()
-        .map(|f| frames::rust_name(&cx, f))
-        .collect();
     if low.functions.iter().any(|f| f.frame.is_some()) {
         items.extend(frames::frame_type(&cx));
     }
     for (i, f) in low.functions.iter().enumerate() {
+        // Its statements carry their labels in their block (`text.rs`).
         items.extend(function::function(&cx, f));
-        labels.add(&names[i], &f.program);
         // After a per-frame function's last frame, its dispatcher.
         let last = low.functions.get(i + 1).is_none_or(|next| next.id != f.id);
         if f.frame.is_some() && last {
@@ -188,7 +188,13 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         }
         out.push('\n');
     }
-    out.push_str(&labels.apply(&body));
+    let body = labels.apply(&body);
+    let blocks = cx.blocks.take();
+    let body = text::splice(&body, &blocks).map_err(|message| EmitError {
+        model: model.name.clone(),
+        message,
+    })?;
+    out.push_str(&body);
     Ok(out)
 }
 

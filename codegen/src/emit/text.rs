@@ -1,0 +1,471 @@
+//! Statement blocks printed as text, spliced into the formatted module.
+//!
+//! The module's items go through proc-macro2 → syn → prettyplease. The straight-line
+//! statements of the generated functions (almost all of a large model's bytes: 47 MB for a
+//! 200-link chain) are not built as tokens: each statement is printed directly as the line
+//! prettyplease would print for it ([`Printer::expr_text`]), and the function body holds a
+//! placeholder statement `__kanegen_block!(N);` where the block goes. After formatting,
+//! [`splice`] replaces every placeholder line by its block at the placeholder's indentation.
+//! A statement longer than prettyplease's line (at that indentation) is formatted by
+//! prettyplease on its own, so that the output stays byte for byte what formatting the whole
+//! module at once gave (checked by the tests below, the golden file and the pre-generated Krang
+//! module). Tokens, syntax trees and the formatter's buffers of a whole module took most of
+//! the generator's time and memory on large models.
+
+use std::cell::RefCell;
+use std::fmt::Write as _;
+
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::comment_text;
+use super::print::{Printer, lit};
+use crate::lower::{LExpr, Leaf};
+use crate::naming;
+
+/// prettyplease's line width ([`MARGIN`] columns including the indentation, at least
+/// [`MIN_SPACE`] after it): a statement that fits stays on one line.
+const MARGIN: usize = 89;
+/// See [`MARGIN`].
+const MIN_SPACE: usize = 60;
+
+/// The name of the placeholder macro (a statement `__kanegen_block!(N);` in the token stream).
+const PLACEHOLDER: &str = "__kanegen_block!(";
+
+/// One statement of a block: its code on one line (`let d5 = c_q7r * d3 + s_q7r * d4;`), and
+/// the label written after it as a comment (escaped; empty: none).
+struct Line {
+    code: String,
+    label: String,
+}
+
+/// A block of statements, in order.
+#[derive(Default)]
+pub(super) struct Block {
+    lines: Vec<Line>,
+}
+
+impl Block {
+    /// Add a statement; `label` (raw model text, escaped here) is written after it as a
+    /// comment unless it is empty.
+    pub(super) fn push(&mut self, code: String, label: &str) {
+        let label = if label.is_empty() {
+            String::new()
+        } else {
+            comment_text(label)
+        };
+        self.lines.push(Line { code, label });
+    }
+
+    /// Number of bytes the block takes at indentation `indent` (an estimate for capacity).
+    fn len_at(&self, indent: usize) -> usize {
+        self.lines
+            .iter()
+            .map(|l| indent + l.code.len() + l.label.len() + 5)
+            .sum()
+    }
+}
+
+/// The blocks of a module, by placeholder number.
+#[derive(Default)]
+pub(super) struct Blocks(RefCell<Vec<Block>>);
+
+impl Blocks {
+    /// Keep `block` and return its placeholder statement.
+    pub(super) fn placeholder(&self, block: Block) -> TokenStream {
+        let mut blocks = self.0.borrow_mut();
+        let n = proc_macro2::Literal::usize_unsuffixed(blocks.len());
+        blocks.push(block);
+        quote!(__kanegen_block!(#n);)
+    }
+
+    /// The blocks, in placeholder order.
+    pub(super) fn take(&self) -> Vec<Block> {
+        std::mem::take(&mut self.0.borrow_mut())
+    }
+}
+
+impl Printer<'_> {
+    /// The statements of the program as a block: `let NAME = EXPR; // label`, with `after[0]`
+    /// before the first and `after[i + 1]` right after statement `i` (stores, printed by
+    /// [`Printer::expr_text`]). The text form of [`Printer::statements`] plus the labels.
+    pub(super) fn statement_block(&self, after: Vec<Vec<String>>) -> Block {
+        let mut block = Block::default();
+        let mut after = after.into_iter();
+        for code in after.next().unwrap_or_default() {
+            block.push(code, "");
+        }
+        let mut code = String::new();
+        for s in self.stmts {
+            code.clear();
+            code.push_str("let ");
+            code.push_str(&naming::identifier(&s.name));
+            code.push_str(" = ");
+            self.expr_text(&s.expr, false, &mut code);
+            code.push(';');
+            block.push(code.clone(), &s.comment);
+            for store in after.next().unwrap_or_default() {
+                block.push(store, "");
+            }
+        }
+        block
+    }
+
+    /// Appends the text prettyplease prints for [`Printer::expr`]`(e, atomic)` on one line.
+    pub(super) fn expr_text(&self, e: &LExpr, atomic: bool, out: &mut String) {
+        match e {
+            LExpr::Leaf(Leaf::Const(c)) if *c < 0.0 && atomic => {
+                out.push_str("(-");
+                push_lit(out, *c, self);
+                out.push(')');
+            }
+            LExpr::Leaf(l) => self.leaf_text(l, out),
+            LExpr::Sum { constant, terms } => {
+                if atomic {
+                    out.push('(');
+                }
+                self.sum_text(*constant, terms, out);
+                if atomic {
+                    out.push(')');
+                }
+            }
+            LExpr::Prod(f) => {
+                if atomic {
+                    out.push('(');
+                }
+                self.product_text(f, out);
+                if atomic {
+                    out.push(')');
+                }
+            }
+        }
+    }
+
+    fn leaf_text(&self, l: &Leaf, out: &mut String) {
+        let m = self.model;
+        let derived;
+        let name: &str = match *l {
+            Leaf::Const(c) => {
+                if c < 0.0 {
+                    out.push('-');
+                }
+                push_lit(out, c, self);
+                return;
+            }
+            Leaf::Param(p) => {
+                out.push_str("p.");
+                &m.params[p].name
+            }
+            Leaf::Pre(s) => {
+                out.push_str("pc.");
+                &self.pre[s]
+            }
+            Leaf::Speed(s) => &m.speeds[s].name,
+            Leaf::Accel(s) => {
+                derived = naming::accel(&m.speeds[s].name);
+                &derived
+            }
+            Leaf::Sin(s) => {
+                derived = naming::sin(&m.speeds[s].coordinate);
+                &derived
+            }
+            Leaf::Cos(s) => {
+                derived = naming::cos(&m.speeds[s].coordinate);
+                &derived
+            }
+            Leaf::Coord(s) => &m.speeds[s].coordinate,
+            Leaf::Local(i) => &self.stmts[i].name,
+        };
+        out.push_str(&naming::identifier(name));
+    }
+
+    fn sum_text(&self, constant: f64, terms: &[(f64, LExpr)], out: &mut String) {
+        // The order of `Printer::sum`: the first positive term first.
+        let first = terms.iter().position(|(k, _)| *k > 0.0).unwrap_or(0);
+        let order = std::iter::once(first).chain((0..terms.len()).filter(|&i| i != first));
+        for (i, j) in order.enumerate() {
+            let Some((k, t)) = terms.get(j) else { break };
+            match (i, *k < 0.0) {
+                (0, false) => {}
+                (0, true) => out.push('-'),
+                (_, false) => out.push_str(" + "),
+                (_, true) => out.push_str(" - "),
+            }
+            if k.abs() == 1.0 {
+                self.expr_text(t, false, out);
+            } else {
+                push_lit(out, *k, self);
+                out.push_str(" * ");
+                self.expr_text(t, true, out);
+            }
+        }
+        if constant != 0.0 {
+            out.push_str(if constant < 0.0 { " - " } else { " + " });
+            push_lit(out, constant, self);
+        }
+    }
+
+    fn product_text(&self, f: &[(LExpr, i32)], out: &mut String) {
+        let mut first = true;
+        for (b, p) in f.iter().filter(|(_, p)| *p > 0) {
+            for _ in 0..*p {
+                if !first {
+                    out.push_str(" * ");
+                }
+                first = false;
+                self.expr_text(b, true, out);
+            }
+        }
+        if first {
+            out.push_str("1.0");
+        }
+        let den: usize = f
+            .iter()
+            .filter(|(_, p)| *p < 0)
+            .map(|(_, p)| p.unsigned_abs() as usize)
+            .sum();
+        if den == 0 {
+            return;
+        }
+        out.push_str(" / ");
+        if den > 1 {
+            out.push('(');
+        }
+        let mut first = true;
+        for (b, p) in f.iter().filter(|(_, p)| *p < 0) {
+            for _ in 0..p.unsigned_abs() {
+                if !first {
+                    out.push_str(" * ");
+                }
+                first = false;
+                self.expr_text(b, true, out);
+            }
+        }
+        if den > 1 {
+            out.push(')');
+        }
+    }
+}
+
+/// `|v|` as the literal of [`lit`] (the same text as its token).
+fn push_lit(out: &mut String, v: f64, p: &Printer<'_>) {
+    let _ = write!(out, "{}", lit(v, p.precision));
+}
+
+/// Whether a statement of `len` bytes stays on one line at indentation `indent`.
+fn fits(indent: usize, len: usize) -> bool {
+    len <= MARGIN.saturating_sub(indent).max(MIN_SPACE)
+}
+
+/// prettyplease's formatting of the statement `code` at indentation `indent` (a multiple of 4,
+/// at least 4), one string per line with the indentation. `None` if `code` does not parse (a
+/// generator bug, reported by the caller).
+fn format_long(indent: usize, code: &str) -> Option<Vec<String>> {
+    let depth = indent / 4;
+    let mut src = String::from("fn f() {");
+    for _ in 1..depth {
+        src.push('{');
+    }
+    src.push_str(code);
+    for _ in 0..depth {
+        src.push('}');
+    }
+    let file: syn::File = syn::parse_str(&src).ok()?;
+    let text = prettyplease::unparse(&file);
+    let lines: Vec<&str> = text.lines().collect();
+    let inner = lines.get(depth..lines.len().checked_sub(depth)?)?;
+    Some(inner.iter().map(|l| (*l).to_owned()).collect())
+}
+
+/// The block number of a placeholder line (`__kanegen_block!(7);` → 7), if it is one.
+fn placeholder_number(trimmed: &str) -> Option<usize> {
+    trimmed
+        .strip_prefix(PLACEHOLDER)?
+        .strip_suffix(");")?
+        .parse()
+        .ok()
+}
+
+/// `src` (formatted) with every placeholder line replaced by its block, at the placeholder's
+/// indentation. Errors name a statement that does not parse (a generator bug).
+pub(super) fn splice(src: &str, blocks: &[Block]) -> Result<String, String> {
+    let extra: usize = blocks.iter().map(|b| b.len_at(16)).sum();
+    let mut out = String::with_capacity(src.len() + extra);
+    for line in src.lines() {
+        let trimmed = line.trim_start();
+        let indent = line.len() - trimmed.len();
+        let Some(block) = placeholder_number(trimmed).and_then(|n| blocks.get(n)) else {
+            out.push_str(line);
+            out.push('\n');
+            continue;
+        };
+        for l in &block.lines {
+            if fits(indent, l.code.len()) {
+                out.extend(std::iter::repeat_n(' ', indent));
+                out.push_str(&l.code);
+            } else {
+                let lines = super::layout::layout(indent, &l.code)
+                    .or_else(|| format_long(indent, &l.code))
+                    .ok_or_else(|| format!("statement `{}` does not parse", l.code))?;
+                out.push_str(&lines.join("\n"));
+            }
+            if !l.label.is_empty() {
+                out.push_str(" // ");
+                out.push_str(&l.label);
+            }
+            out.push('\n');
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::layout::layout;
+    use crate::emit::print::Printer;
+    use crate::options::{Options, ParamMode, Precision};
+    use crate::registry::{FunctionId, FunctionSet};
+
+    /// prettyplease's text of `tokens` as a statement at indentation `indent`.
+    fn formatted(indent: usize, tokens: TokenStream) -> String {
+        format_long(indent, &tokens.to_string())
+            .expect("parses")
+            .join("\n")
+    }
+
+    /// Every statement and result entry of every function of `model`, for each
+    /// `(parameters, functions, precision)` and indentation: the text printer gives what
+    /// prettyplease prints for the tokens, on one line wherever it fits, and [`layout`] what it
+    /// prints elsewhere.
+    fn check_model(
+        path: &str,
+        variants: &[(ParamMode, FunctionSet, Precision)],
+        indents: &[usize],
+    ) {
+        let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+        let model = crate::model::Model::from_toml_file(format!("{root}/{path}")).unwrap();
+        for &(params, functions, precision) in variants {
+            let options = Options { params, functions };
+            let d = crate::kane::derive(&model, options);
+            let low = crate::lower::lower(&d);
+            let pre: Vec<String> = low
+                .pre_slots
+                .iter()
+                .map(|&i| low.precompute.stmts[i].name.clone())
+                .collect();
+            let programs =
+                std::iter::once(&low.precompute).chain(low.functions.iter().map(|f| &f.program));
+            for p in programs {
+                let printer = Printer {
+                    model: &model,
+                    stmts: &p.stmts,
+                    pre: &pre,
+                    precision,
+                };
+                // Statements, and result entries as `let`, matrix and vector stores.
+                let mut cases: Vec<(String, TokenStream)> = Vec::new();
+                for s in &p.stmts {
+                    let id = crate::emit::print::ident(&s.name);
+                    let tokens = printer.expr(&s.expr, false);
+                    let mut text = format!("let {id} = ");
+                    printer.expr_text(&s.expr, false, &mut text);
+                    cases.push((format!("{text};"), quote!(let #id = #tokens;)));
+                }
+                for (r, c, e) in &p.outputs {
+                    let tokens = printer.expr(e, false);
+                    let mut v = String::new();
+                    printer.expr_text(e, false, &mut v);
+                    let (ri, ci) = (
+                        proc_macro2::Literal::usize_unsuffixed(*r),
+                        proc_macro2::Literal::usize_unsuffixed(*c),
+                    );
+                    cases.push((format!("let out = {v};"), quote!(let out = #tokens;)));
+                    cases.push((
+                        format!("m[({r}, {c})] = {v};"),
+                        quote!(m[(#ri, #ci)] = #tokens;),
+                    ));
+                    cases.push((format!("pos[{r}] = {v};"), quote!(pos[#ri] = #tokens;)));
+                }
+                for (text, tokens) in cases {
+                    for &indent in indents {
+                        let want = formatted(indent, tokens.clone());
+                        let got = if fits(indent, text.len()) {
+                            format!("{}{text}", " ".repeat(indent))
+                        } else {
+                            layout(indent, &text)
+                                .expect("in the small language")
+                                .join("\n")
+                        };
+                        assert_eq!(got, want, "{path}, {}", p.name);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn text_printer_matches_prettyplease_on_every_statement_of_krang() {
+        // The derivatives have the longest statements; the regressors add nothing new and are
+        // slow to derive in a debug build.
+        let most = FunctionSet::all()
+            .without(FunctionId::InverseDynamicsRegressor)
+            .without(FunctionId::GravityRegressor)
+            .without(FunctionId::BaseRegressor)
+            .without(FunctionId::BaseGravityRegressor);
+        check_model(
+            "models/krang.toml",
+            &[
+                (ParamMode::Runtime, most, Precision::F64),
+                (ParamMode::Baked, FunctionSet::default(), Precision::F32),
+            ],
+            &[16],
+        );
+    }
+
+    #[test]
+    fn text_printer_matches_prettyplease_on_every_statement_of_the_two_link_model() {
+        let all = FunctionSet::all();
+        check_model(
+            "models/two-link.toml",
+            &[
+                (ParamMode::Runtime, all, Precision::F64),
+                (ParamMode::Baked, all, Precision::F32),
+            ],
+            &[8, 16, 40],
+        );
+    }
+
+    #[test]
+    fn long_statements_break_like_prettyplease_at_every_length() {
+        // Sums of growing length around the line width: the break decision at the margin.
+        let mut e = String::from("let d1 = a0");
+        for i in 1..40 {
+            e.push_str(&format!(" + b{i} * c{i}"));
+            let code = format!("{e};");
+            for indent in [4, 8, 16, 28, 32, 44] {
+                let tokens: TokenStream = code.parse().unwrap();
+                let want = formatted(indent, tokens);
+                if fits(indent, code.len()) {
+                    assert_eq!(want, format!("{}{code}", " ".repeat(indent)), "{indent}");
+                } else {
+                    assert!(want.lines().count() > 1, "{indent}: {want}");
+                }
+                assert_eq!(layout(indent, &code).unwrap().join("\n"), want, "{indent}");
+            }
+        }
+    }
+
+    #[test]
+    fn placeholders_are_replaced_at_their_indentation() {
+        let mut b = Block::default();
+        b.push("let k1 = a * b;".into(), "w1.x\nfn injected() {}");
+        b.push("m[(0, 1)] = k1;".into(), "");
+        let src = "fn f() {\n    __kanegen_block!(0);\n    m\n}\n";
+        let out = splice(src, &[b]).unwrap();
+        assert_eq!(
+            out,
+            "fn f() {\n    let k1 = a * b; // w1.x\\nfn injected() {}\n    m[(0, 1)] = k1;\n    m\n}\n"
+        );
+    }
+}

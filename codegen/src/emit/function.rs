@@ -186,9 +186,9 @@ struct Result {
 type Stores = Vec<Vec<String>>;
 
 /// `e` as text ([`Printer::expr_text`]).
-fn text(printer: &Printer<'_>, e: &LExpr) -> String {
+fn text(cx: &Context<'_>, printer: &Printer<'_>, e: &LExpr) -> String {
     let mut s = String::new();
-    printer.expr_text(e, false, &mut s);
+    printer.expr_text(&cx.leaf_names, e, false, &mut s);
     s
 }
 
@@ -213,7 +213,7 @@ fn isometry(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, mut stores: St
     let rot_mut = binding(nonzero.iter().any(|(_, c, _)| *c < 3));
     let pos_mut = binding(nonzero.iter().any(|(_, c, _)| *c == 3));
     for (r, c, e) in nonzero {
-        let v = text(printer, e);
+        let v = text(cx, printer, e);
         let store = if *c < 3 {
             format!("rot[({r}, {c})] = {v};")
         } else {
@@ -253,7 +253,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
     match shape {
         Shape::SymmetricMatrix | Shape::Matrix => {
             for (r, c, e) in nonzero {
-                let v = text(printer, e);
+                let v = text(cx, printer, e);
                 store_after(&mut stores, e, format!("m[({r}, {c})] = {v};"));
             }
             // Symmetric: the lower triangle is copied at the end by a loop over the column-major
@@ -289,7 +289,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
             );
             let mutable = binding(nonzero.clone().next().is_some());
             for (r, c, e) in nonzero {
-                let v = text(printer, e);
+                let v = text(cx, printer, e);
                 store_after(&mut stores, e, format!("m[({r}, {c})] = {v};"));
             }
             Result {
@@ -315,7 +315,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
         Shape::Isometry => isometry(cx, printer, p, stores),
         Shape::Vector => {
             for (r, _, e) in nonzero {
-                let v = text(printer, e);
+                let v = text(cx, printer, e);
                 // `black_box` keeps LLVM's SLP vectorizer from packing the stores of adjacent
                 // entries (and the expression trees behind them) into two-lane vectors: for
                 // Krang's inverse dynamics that packing added ~25 % code of shuffles and spills
@@ -386,7 +386,9 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         value,
     } = result(cx, &printer, p, spec.shape);
     // The statements are printed as text and spliced in after formatting (`text.rs`).
-    let body = cx.blocks.placeholder(printer.statement_block(stores));
+    let body = cx
+        .blocks
+        .placeholder(printer.statement_block(&cx.leaf_names, stores));
     let unused = unused_inputs(spec, p, &reads);
     let body = quote! {
         #unused

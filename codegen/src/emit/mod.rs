@@ -91,6 +91,8 @@ pub(crate) struct Context<'a> {
     pre: Vec<String>,
     /// The statement blocks of the functions, spliced in after formatting (`text.rs`).
     blocks: text::Blocks,
+    /// The model's leaves as printed in statement blocks.
+    leaf_names: text::LeafNames,
 }
 
 fn scalar_type(precision: Precision) -> TokenStream {
@@ -121,6 +123,7 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
             .map(|&i| low.precompute.stmts[i].name.clone())
             .collect(),
         blocks: text::Blocks::default(),
+        leaf_names: text::LeafNames::new(model),
     };
     let runtime = low.params.is_runtime();
     let mut items = quote!(
@@ -204,6 +207,11 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
 /// `\u{202e}`). Every comment text that comes from input (header, notes, statement labels)
 /// goes through this function.
 pub(crate) fn comment_text(s: &str) -> String {
+    let escaped =
+        |c: char| c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}');
+    if !s.chars().any(escaped) {
+        return s.to_owned();
+    }
     s.chars()
         .flat_map(|c| {
             if c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}') {

@@ -21,6 +21,7 @@ use quote::quote;
 use super::comment_text;
 use super::print::{Printer, lit};
 use crate::lower::{LExpr, Leaf};
+use crate::model::Model;
 use crate::naming;
 
 /// prettyplease's line width ([`MARGIN`] columns including the indentation, at least
@@ -85,11 +86,47 @@ impl Blocks {
     }
 }
 
+/// The identifiers of the model's leaves as they are printed (`p.` and `pc.` prefixes
+/// aside), made once per module instead of once per leaf.
+pub(super) struct LeafNames {
+    params: Vec<String>,
+    speeds: Vec<String>,
+    accels: Vec<String>,
+    sins: Vec<String>,
+    coss: Vec<String>,
+    coords: Vec<String>,
+}
+
+impl LeafNames {
+    /// The names of `model`'s parameters and of its speeds' leaves.
+    pub(super) fn new(model: &Model) -> Self {
+        let speeds = |f: &dyn Fn(&crate::model::Speed) -> String| -> Vec<String> {
+            model
+                .speeds
+                .iter()
+                .map(|s| naming::identifier(&f(s)))
+                .collect()
+        };
+        Self {
+            params: model
+                .params
+                .iter()
+                .map(|p| naming::identifier(&p.name))
+                .collect(),
+            speeds: speeds(&|s| s.name.clone()),
+            accels: speeds(&|s| naming::accel(&s.name)),
+            sins: speeds(&|s| naming::sin(&s.coordinate)),
+            coss: speeds(&|s| naming::cos(&s.coordinate)),
+            coords: speeds(&|s| s.coordinate.clone()),
+        }
+    }
+}
+
 impl Printer<'_> {
     /// The statements of the program as a block: `let NAME = EXPR; // label`, with `after[0]`
     /// before the first and `after[i + 1]` right after statement `i` (stores, printed by
     /// [`Printer::expr_text`]). The text form of [`Printer::statements`] plus the labels.
-    pub(super) fn statement_block(&self, after: Vec<Vec<String>>) -> Block {
+    pub(super) fn statement_block(&self, names: &LeafNames, after: Vec<Vec<String>>) -> Block {
         let mut block = Block::default();
         let mut after = after.into_iter();
         for code in after.next().unwrap_or_default() {
@@ -98,10 +135,11 @@ impl Printer<'_> {
         let mut code = String::new();
         for s in self.stmts {
             code.clear();
+            // Statement names are generated identifiers (`k12`, `d5`).
             code.push_str("let ");
-            code.push_str(&naming::identifier(&s.name));
+            code.push_str(&s.name);
             code.push_str(" = ");
-            self.expr_text(&s.expr, false, &mut code);
+            self.expr_text(names, &s.expr, false, &mut code);
             code.push(';');
             block.push(code.clone(), &s.comment);
             for store in after.next().unwrap_or_default() {
@@ -112,19 +150,19 @@ impl Printer<'_> {
     }
 
     /// Appends the text prettyplease prints for [`Printer::expr`]`(e, atomic)` on one line.
-    pub(super) fn expr_text(&self, e: &LExpr, atomic: bool, out: &mut String) {
+    pub(super) fn expr_text(&self, names: &LeafNames, e: &LExpr, atomic: bool, out: &mut String) {
         match e {
             LExpr::Leaf(Leaf::Const(c)) if *c < 0.0 && atomic => {
                 out.push_str("(-");
                 push_lit(out, *c, self);
                 out.push(')');
             }
-            LExpr::Leaf(l) => self.leaf_text(l, out),
+            LExpr::Leaf(l) => self.leaf_text(names, l, out),
             LExpr::Sum { constant, terms } => {
                 if atomic {
                     out.push('(');
                 }
-                self.sum_text(*constant, terms, out);
+                self.sum_text(names, *constant, terms, out);
                 if atomic {
                     out.push(')');
                 }
@@ -133,7 +171,7 @@ impl Printer<'_> {
                 if atomic {
                     out.push('(');
                 }
-                self.product_text(f, out);
+                self.product_text(names, f, out);
                 if atomic {
                     out.push(')');
                 }
@@ -141,9 +179,7 @@ impl Printer<'_> {
         }
     }
 
-    fn leaf_text(&self, l: &Leaf, out: &mut String) {
-        let m = self.model;
-        let derived;
+    fn leaf_text(&self, names: &LeafNames, l: &Leaf, out: &mut String) {
         let name: &str = match *l {
             Leaf::Const(c) => {
                 if c < 0.0 {
@@ -154,32 +190,24 @@ impl Printer<'_> {
             }
             Leaf::Param(p) => {
                 out.push_str("p.");
-                &m.params[p].name
+                &names.params[p]
             }
+            // Precomputed slots and statements have generated names (`pc3`, `k12`).
             Leaf::Pre(s) => {
                 out.push_str("pc.");
                 &self.pre[s]
             }
-            Leaf::Speed(s) => &m.speeds[s].name,
-            Leaf::Accel(s) => {
-                derived = naming::accel(&m.speeds[s].name);
-                &derived
-            }
-            Leaf::Sin(s) => {
-                derived = naming::sin(&m.speeds[s].coordinate);
-                &derived
-            }
-            Leaf::Cos(s) => {
-                derived = naming::cos(&m.speeds[s].coordinate);
-                &derived
-            }
-            Leaf::Coord(s) => &m.speeds[s].coordinate,
             Leaf::Local(i) => &self.stmts[i].name,
+            Leaf::Speed(s) => &names.speeds[s],
+            Leaf::Accel(s) => &names.accels[s],
+            Leaf::Sin(s) => &names.sins[s],
+            Leaf::Cos(s) => &names.coss[s],
+            Leaf::Coord(s) => &names.coords[s],
         };
-        out.push_str(&naming::identifier(name));
+        out.push_str(name);
     }
 
-    fn sum_text(&self, constant: f64, terms: &[(f64, LExpr)], out: &mut String) {
+    fn sum_text(&self, names: &LeafNames, constant: f64, terms: &[(f64, LExpr)], out: &mut String) {
         // The order of `Printer::sum`: the first positive term first.
         let first = terms.iter().position(|(k, _)| *k > 0.0).unwrap_or(0);
         let order = std::iter::once(first).chain((0..terms.len()).filter(|&i| i != first));
@@ -192,11 +220,11 @@ impl Printer<'_> {
                 (_, true) => out.push_str(" - "),
             }
             if k.abs() == 1.0 {
-                self.expr_text(t, false, out);
+                self.expr_text(names, t, false, out);
             } else {
                 push_lit(out, *k, self);
                 out.push_str(" * ");
-                self.expr_text(t, true, out);
+                self.expr_text(names, t, true, out);
             }
         }
         if constant != 0.0 {
@@ -205,7 +233,7 @@ impl Printer<'_> {
         }
     }
 
-    fn product_text(&self, f: &[(LExpr, i32)], out: &mut String) {
+    fn product_text(&self, names: &LeafNames, f: &[(LExpr, i32)], out: &mut String) {
         let mut first = true;
         for (b, p) in f.iter().filter(|(_, p)| *p > 0) {
             for _ in 0..*p {
@@ -213,7 +241,7 @@ impl Printer<'_> {
                     out.push_str(" * ");
                 }
                 first = false;
-                self.expr_text(b, true, out);
+                self.expr_text(names, b, true, out);
             }
         }
         if first {
@@ -238,7 +266,7 @@ impl Printer<'_> {
                     out.push_str(" * ");
                 }
                 first = false;
-                self.expr_text(b, true, out);
+                self.expr_text(names, b, true, out);
             }
         }
         if den > 1 {
@@ -345,6 +373,7 @@ mod tests {
     ) {
         let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
         let model = crate::model::Model::from_toml_file(format!("{root}/{path}")).unwrap();
+        let names = LeafNames::new(&model);
         for &(params, functions, precision) in variants {
             let options = Options { params, functions };
             let d = crate::kane::derive(&model, options);
@@ -369,13 +398,13 @@ mod tests {
                     let id = crate::emit::print::ident(&s.name);
                     let tokens = printer.expr(&s.expr, false);
                     let mut text = format!("let {id} = ");
-                    printer.expr_text(&s.expr, false, &mut text);
+                    printer.expr_text(&names, &s.expr, false, &mut text);
                     cases.push((format!("{text};"), quote!(let #id = #tokens;)));
                 }
                 for (r, c, e) in &p.outputs {
                     let tokens = printer.expr(e, false);
                     let mut v = String::new();
-                    printer.expr_text(e, false, &mut v);
+                    printer.expr_text(&names, e, false, &mut v);
                     let (ri, ci) = (
                         proc_macro2::Literal::usize_unsuffixed(*r),
                         proc_macro2::Literal::usize_unsuffixed(*c),

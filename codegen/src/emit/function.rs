@@ -386,9 +386,15 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         value,
     } = result(cx, &printer, p, spec.shape);
     // The statements are printed as text and spliced in after formatting (`text.rs`).
-    let body = cx
-        .blocks
-        .placeholder(printer.statement_block(&cx.leaf_names, stores));
+    // A scalar result is the final expression; every other entry is stored in the block.
+    let outputs: Vec<&LExpr> = nonzero_outputs(p).map(|(_, _, e)| e).collect();
+    let (stored, read_at_end) = if spec.shape == Shape::Scalar {
+        (Vec::new(), outputs)
+    } else {
+        (outputs, Vec::new())
+    };
+    let block = printer.statement_block(&cx.leaf_names, stores, &stored, &read_at_end);
+    let body = cx.blocks.placeholder(block);
     let unused = unused_inputs(spec, p, &reads);
     let body = quote! {
         #unused

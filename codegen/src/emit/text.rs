@@ -33,11 +33,28 @@ const MIN_SPACE: usize = 60;
 /// The name of the placeholder macro (a statement `__kanegen_block!(N);` in the token stream).
 const PLACEHOLDER: &str = "__kanegen_block!(";
 
-/// One statement of a block: its code on one line (`let d5 = c_q7r * d3 + s_q7r * d4;`), and
+/// Functions with more statements than this have their statements in blocks of
+/// [`SPLIT_CHUNK`] statements (`let (k5, d7) = { …; (k5, d7) };`): rustc's debug info nests one
+/// lexical scope per `let`, and its DWARF writer recursed through thousands of them until it
+/// overflowed its stack (a 25-link chain's module, Krang's derivatives and regressors). A block
+/// ends the nesting; what later statements read leaves it as a tuple, which optimised code does
+/// not see (the values stay in registers). Every function of Krang's default module (at most
+/// 2,556 statements, its Coriolis matrix) is below the threshold and unchanged; its derivatives
+/// (≈ 9,000) and regressors (≈ 3,600) are split. Functions of ≈ 3,000 statements compile with
+/// debug info (`tests/big_tree.rs`: c and τ of a 100-DOF tree).
+pub const SPLIT_ABOVE: usize = 3000;
+/// Statements per block of a split function (see [`SPLIT_ABOVE`]).
+pub const SPLIT_CHUNK: usize = 500;
+
+/// One line of a block: a statement on one line (`let d5 = c_q7r * d3 + s_q7r * d4;`), laid out
+/// like prettyplease at splice time, or a line written as it is (`raw`: the start and end of a
+/// block of a split function); `depth` levels of indentation deeper than the placeholder, and
 /// the label written after it as a comment (escaped; empty: none).
 struct Line {
     code: String,
     label: String,
+    depth: usize,
+    raw: bool,
 }
 
 /// A block of statements, in order.
@@ -55,14 +72,29 @@ impl Block {
         } else {
             comment_text(label)
         };
-        self.lines.push(Line { code, label });
+        self.lines.push(Line {
+            code,
+            label,
+            depth: 0,
+            raw: false,
+        });
+    }
+
+    /// Add a line written as it is, `depth` levels deeper than the placeholder.
+    fn push_raw(&mut self, code: String, depth: usize) {
+        self.lines.push(Line {
+            code,
+            label: String::new(),
+            depth,
+            raw: true,
+        });
     }
 
     /// Number of bytes the block takes at indentation `indent` (an estimate for capacity).
     fn len_at(&self, indent: usize) -> usize {
         self.lines
             .iter()
-            .map(|l| indent + l.code.len() + l.label.len() + 5)
+            .map(|l| indent + 4 * l.depth + l.code.len() + l.label.len() + 5)
             .sum()
     }
 }
@@ -126,27 +158,113 @@ impl Printer<'_> {
     /// The statements of the program as a block: `let NAME = EXPR; // label`, with `after[0]`
     /// before the first and `after[i + 1]` right after statement `i` (stores, printed by
     /// [`Printer::expr_text`]). The text form of [`Printer::statements`] plus the labels.
-    pub(super) fn statement_block(&self, names: &LeafNames, after: Vec<Vec<String>>) -> Block {
+    /// `stored` are the expressions of the stores (each stored right after the last statement
+    /// it reads), `read_at_end` what the function reads after the block (a scalar result):
+    /// a function of more than [`SPLIT_ABOVE`] statements is split into blocks, and a block
+    /// passes on the values that later statements, stores or the end read.
+    pub(super) fn statement_block(
+        &self,
+        names: &LeafNames,
+        after: Vec<Vec<String>>,
+        stored: &[&LExpr],
+        read_at_end: &[&LExpr],
+    ) -> Block {
+        let n = self.stmts.len();
+        let chunk = if n > SPLIT_ABOVE {
+            SPLIT_CHUNK
+        } else {
+            n.max(1)
+        };
+        let last_use = if n > SPLIT_ABOVE {
+            self.last_uses(stored, read_at_end)
+        } else {
+            Vec::new()
+        };
         let mut block = Block::default();
         let mut after = after.into_iter();
         for code in after.next().unwrap_or_default() {
             block.push(code, "");
         }
         let mut code = String::new();
-        for s in self.stmts {
-            code.clear();
-            // Statement names are generated identifiers (`k12`, `d5`).
-            code.push_str("let ");
-            code.push_str(&s.name);
-            code.push_str(" = ");
-            self.expr_text(names, &s.expr, false, &mut code);
-            code.push(';');
-            block.push(code.clone(), &s.comment);
-            for store in after.next().unwrap_or_default() {
-                block.push(store, "");
+        for start in (0..n).step_by(chunk) {
+            let end = (start + chunk).min(n);
+            let split = n > SPLIT_ABOVE;
+            // The values of this block that are read after it.
+            let live: Vec<&str> = if split {
+                (start..end)
+                    .filter(|&i| last_use[i] >= end)
+                    .map(|i| self.stmts[i].name.as_str())
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            if split {
+                let head = match live.as_slice() {
+                    [] => "{".to_owned(),
+                    [one] => format!("let {one} = {{"),
+                    _ => format!("let ({}) = {{", live.join(", ")),
+                };
+                block.push_raw(head, 0);
+            }
+            let depth = usize::from(split);
+            for s in &self.stmts[start..end] {
+                // Statement names are generated identifiers (`k12`, `d5`).
+                code.clear();
+                code.push_str("let ");
+                code.push_str(&s.name);
+                code.push_str(" = ");
+                self.expr_text(names, &s.expr, false, &mut code);
+                code.push(';');
+                block.push(code.clone(), &s.comment);
+                block.lines.last_mut().expect("pushed").depth = depth;
+                for store in after.next().unwrap_or_default() {
+                    block.push(store, "");
+                    block.lines.last_mut().expect("pushed").depth = depth;
+                }
+            }
+            if split {
+                match live.as_slice() {
+                    [] => block.push_raw("}".to_owned(), 0),
+                    [one] => {
+                        block.push_raw((*one).to_owned(), 1);
+                        block.push_raw("};".to_owned(), 0);
+                    }
+                    _ => {
+                        block.push_raw(format!("({})", live.join(", ")), 1);
+                        block.push_raw("};".to_owned(), 0);
+                    }
+                }
             }
         }
         block
+    }
+
+    /// Per statement, the position of its last reader: a statement's index, the statement a
+    /// store follows, or `n` for the end.
+    fn last_uses(&self, stored: &[&LExpr], read_at_end: &[&LExpr]) -> Vec<usize> {
+        let n = self.stmts.len();
+        let mut last: Vec<usize> = (0..n).collect();
+        let mut reads = Vec::new();
+        let mut mark = |e: &LExpr, at: Option<usize>, last: &mut Vec<usize>| {
+            reads.clear();
+            locals_of(e, &mut reads);
+            let at = at.or_else(|| reads.iter().copied().max());
+            if let Some(at) = at {
+                for &i in &reads {
+                    last[i] = last[i].max(at);
+                }
+            }
+        };
+        for (j, s) in self.stmts.iter().enumerate() {
+            mark(&s.expr, Some(j), &mut last);
+        }
+        for e in stored {
+            mark(e, None, &mut last);
+        }
+        for e in read_at_end {
+            mark(e, Some(n), &mut last);
+        }
+        last
     }
 
     /// Appends the text prettyplease prints for [`Printer::expr`]`(e, atomic)` on one line.
@@ -275,6 +393,16 @@ impl Printer<'_> {
     }
 }
 
+/// The statements `e` reads.
+fn locals_of(e: &LExpr, out: &mut Vec<usize>) {
+    match e {
+        LExpr::Leaf(Leaf::Local(i)) => out.push(*i),
+        LExpr::Leaf(_) => {}
+        LExpr::Sum { terms, .. } => terms.iter().for_each(|(_, t)| locals_of(t, out)),
+        LExpr::Prod(f) => f.iter().for_each(|(b, _)| locals_of(b, out)),
+    }
+}
+
 /// `|v|` as the literal of [`lit`] (the same text as its token).
 fn push_lit(out: &mut String, v: f64, p: &Printer<'_>) {
     let _ = write!(out, "{}", lit(v, p.precision));
@@ -305,6 +433,34 @@ fn format_long(indent: usize, code: &str) -> Option<Vec<String>> {
     Some(inner.iter().map(|l| (*l).to_owned()).collect())
 }
 
+/// A raw line at indentation `at`; a tuple pattern or value that does not fit (`let (k1, k2,
+/// …) = {`, `(k1, k2, …)`) gets one name per line with a trailing comma, as rustfmt and
+/// prettyplease break tuples.
+fn push_raw(out: &mut String, at: usize, code: &str) {
+    let pad = |out: &mut String, n: usize| out.extend(std::iter::repeat_n(' ', n));
+    let split = code
+        .find('(')
+        .zip(code.rfind(')'))
+        .filter(|_| !fits(at, code.len()));
+    let Some((open, close)) = split else {
+        pad(out, at);
+        out.push_str(code);
+        out.push('\n');
+        return;
+    };
+    pad(out, at);
+    out.push_str(&code[..=open]);
+    out.push('\n');
+    for name in code[open + 1..close].split(", ") {
+        pad(out, at + 4);
+        out.push_str(name);
+        out.push_str(",\n");
+    }
+    pad(out, at);
+    out.push_str(&code[close..]);
+    out.push('\n');
+}
+
 /// The block number of a placeholder line (`__kanegen_block!(7);` → 7), if it is one.
 fn placeholder_number(trimmed: &str) -> Option<usize> {
     trimmed
@@ -328,12 +484,17 @@ pub(super) fn splice(src: &str, blocks: &[Block]) -> Result<String, String> {
             continue;
         };
         for l in &block.lines {
-            if fits(indent, l.code.len()) {
-                out.extend(std::iter::repeat_n(' ', indent));
+            let at = indent + 4 * l.depth;
+            if l.raw {
+                push_raw(&mut out, at, &l.code);
+                continue;
+            }
+            if fits(at, l.code.len()) {
+                out.extend(std::iter::repeat_n(' ', at));
                 out.push_str(&l.code);
             } else {
-                let lines = super::layout::layout(indent, &l.code)
-                    .or_else(|| format_long(indent, &l.code))
+                let lines = super::layout::layout(at, &l.code)
+                    .or_else(|| format_long(at, &l.code))
                     .ok_or_else(|| format!("statement `{}` does not parse", l.code))?;
                 out.push_str(&lines.join("\n"));
             }

@@ -393,7 +393,12 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     } else {
         (outputs, Vec::new())
     };
-    let block = printer.statement_block(&cx.leaf_names, stores, &stored, &read_at_end);
+    let block = printer.statement_block(
+        &cx.leaf_names,
+        stores,
+        (&stored, &read_at_end),
+        cx.split_above,
+    );
     let body = cx.blocks.placeholder(block);
     let unused = unused_inputs(spec, p, &reads);
     let body = quote! {

@@ -66,7 +66,14 @@ pub struct EmitOptions {
     pub notes: Vec<String>,
     /// Heading of the notes block (`URDF import notes`).
     pub notes_title: String,
+    /// Functions with more statements than this are split into blocks of 500 (default
+    /// [`SPLIT_ABOVE`]: 2,600), so that rustc's debug info does not overflow its stack on them
+    /// (see [`SPLIT_ABOVE`]); `usize::MAX` never splits. Lower it if a debug build of a
+    /// generated module still crashes rustc.
+    pub split_above: usize,
 }
+
+pub use text::SPLIT_ABOVE;
 
 impl Default for EmitOptions {
     fn default() -> Self {
@@ -76,6 +83,7 @@ impl Default for EmitOptions {
             precision: Precision::default(),
             notes: Vec::new(),
             notes_title: String::new(),
+            split_above: SPLIT_ABOVE,
         }
     }
 }
@@ -93,6 +101,8 @@ pub(crate) struct Context<'a> {
     blocks: text::Blocks,
     /// The model's leaves as printed in statement blocks.
     leaf_names: text::LeafNames,
+    /// See [`EmitOptions::split_above`].
+    split_above: usize,
 }
 
 fn scalar_type(precision: Precision) -> TokenStream {
@@ -124,6 +134,7 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
             .collect(),
         blocks: text::Blocks::default(),
         leaf_names: text::LeafNames::new(model),
+        split_above: options.split_above,
     };
     let runtime = low.params.is_runtime();
     let mut items = quote!(

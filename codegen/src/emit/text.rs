@@ -33,16 +33,16 @@ const MIN_SPACE: usize = 60;
 /// The name of the placeholder macro (a statement `__kanegen_block!(N);` in the token stream).
 const PLACEHOLDER: &str = "__kanegen_block!(";
 
-/// Functions with more statements than this have their statements in blocks of
-/// [`SPLIT_CHUNK`] statements (`let (k5, d7) = { …; (k5, d7) };`): rustc's debug info nests one
-/// lexical scope per `let`, and its DWARF writer recursed through thousands of them until it
-/// overflowed its stack (a 25-link chain's module, Krang's derivatives and regressors). A block
-/// ends the nesting; what later statements read leaves it as a tuple, which optimised code does
-/// not see (the values stay in registers). Every function of Krang's default module (at most
-/// 2,556 statements, its Coriolis matrix) is below the threshold and unchanged; its derivatives
-/// (≈ 9,000) and regressors (≈ 3,600) are split. Functions of ≈ 3,000 statements compile with
-/// debug info (`tests/big_tree.rs`: c and τ of a 100-DOF tree).
-pub const SPLIT_ABOVE: usize = 3000;
+/// The default of [`EmitOptions::split_above`](super::EmitOptions::split_above): functions with
+/// more statements than this have their statements in blocks of [`SPLIT_CHUNK`] statements
+/// (`let (k5, d7) = { …; (k5, d7) };`). rustc's debug info nests one lexical scope per `let`,
+/// and its DWARF writer recursed through them until it overflowed its stack (SIGSEGV): measured
+/// with rustc 1.95 and the ISA-dispatch closures, 2,556 statements compiled (Krang's Coriolis
+/// matrix) and 2,850 crashed (c of a 100-DOF tree). A block ends the nesting; what later
+/// statements read leaves it as a tuple, which optimised code does not see. Every function of
+/// Krang's default module is at most 2,556 statements and stays as it was; its derivatives
+/// (≈ 9,000) and regressors (≈ 3,600) are split.
+pub const SPLIT_ABOVE: usize = 2600;
 /// Statements per block of a split function (see [`SPLIT_ABOVE`]).
 pub const SPLIT_CHUNK: usize = 500;
 
@@ -160,22 +160,20 @@ impl Printer<'_> {
     /// [`Printer::expr_text`]). The text form of [`Printer::statements`] plus the labels.
     /// `stored` are the expressions of the stores (each stored right after the last statement
     /// it reads), `read_at_end` what the function reads after the block (a scalar result):
-    /// a function of more than [`SPLIT_ABOVE`] statements is split into blocks, and a block
-    /// passes on the values that later statements, stores or the end read.
+    /// a function of more than `split_above` statements is split into blocks (see
+    /// [`SPLIT_ABOVE`]), and a block passes on the values that later statements, stores or the
+    /// end read.
     pub(super) fn statement_block(
         &self,
         names: &LeafNames,
         after: Vec<Vec<String>>,
-        stored: &[&LExpr],
-        read_at_end: &[&LExpr],
+        (stored, read_at_end): (&[&LExpr], &[&LExpr]),
+        split_above: usize,
     ) -> Block {
         let n = self.stmts.len();
-        let chunk = if n > SPLIT_ABOVE {
-            SPLIT_CHUNK
-        } else {
-            n.max(1)
-        };
-        let last_use = if n > SPLIT_ABOVE {
+        let split = n > split_above;
+        let chunk = if split { SPLIT_CHUNK } else { n.max(1) };
+        let last_use = if split {
             self.last_uses(stored, read_at_end)
         } else {
             Vec::new()
@@ -188,7 +186,6 @@ impl Printer<'_> {
         let mut code = String::new();
         for start in (0..n).step_by(chunk) {
             let end = (start + chunk).min(n);
-            let split = n > SPLIT_ABOVE;
             // The values of this block that are read after it.
             let live: Vec<&str> = if split {
                 (start..end)
@@ -644,6 +641,55 @@ mod tests {
                 assert_eq!(layout(indent, &code).unwrap().join("\n"), want, "{indent}");
             }
         }
+    }
+
+    #[test]
+    fn split_functions_are_valid_rust_with_every_block_passing_on_what_is_read_later() {
+        // Krang's default module split into blocks of 500 above 100 statements: it parses, and
+        // every name a statement reads is bound before it (in its block or passed on by an
+        // earlier one), which the tuple values and patterns make rustc check in
+        // `tests/big_tree.rs`; here: the split module differs from the unsplit one only by
+        // the blocks' lines and indentation.
+        let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+        let model =
+            crate::model::Model::from_toml_file(format!("{root}/models/krang.toml")).unwrap();
+        let emit = |split_above| {
+            let options = crate::EmitOptions {
+                split_above,
+                ..crate::EmitOptions::default()
+            };
+            crate::generate_with(model.clone(), Options::default(), &options)
+                .unwrap()
+                .source
+        };
+        let split = emit(100);
+        let whole = emit(usize::MAX);
+        assert_eq!(
+            whole,
+            emit(SPLIT_ABOVE),
+            "Krang's default module is not split"
+        );
+        syn::parse_file(&split).expect("the split module parses");
+        let blocks = split.lines().filter(|l| l.ends_with(" = {")).count();
+        assert!(blocks >= 5, "{blocks} blocks");
+        // The same statements and stores in the same order (line breaks may differ: the
+        // blocks' statements are indented one level deeper).
+        let statements = |src: &str| -> Vec<String> {
+            src.split_whitespace()
+                .collect::<String>()
+                .split(';')
+                .filter_map(|s| {
+                    let s = s.rsplit("//").next().unwrap_or(s);
+                    let at = s
+                        .find("letk")
+                        .or(s.find("letd"))
+                        .or(s.find("lett"))
+                        .or(s.find("m[("))?;
+                    Some(s[at..].to_owned())
+                })
+                .collect()
+        };
+        assert_eq!(statements(&split), statements(&whole));
     }
 
     #[test]

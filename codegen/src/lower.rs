@@ -351,7 +351,7 @@ fn schedule(
     ar: &Arena,
     roots: &[ExprId],
     is_leaf: &dyn Fn(ExprId) -> bool,
-    order: Option<&[u32]>,
+    order: Option<&[ExprId]>,
 ) -> Vec<(ExprId, Option<u32>)> {
     // Reachability with parent counting; a variable is a leaf whose definition is a new root.
     // (Hash tables keyed by node, not arrays over the arena: a module can have hundreds of
@@ -410,7 +410,13 @@ fn schedule(
     // Derivation order, then a depth-first pass that puts every statement after the statements
     // it reads.
     let is_stmt: FxHashMap<ExprId, Option<u32>> = stmts.iter().copied().collect();
-    stmts.sort_by_key(|(e, _)| (order[e.index()], *e));
+    let rank: FxHashMap<ExprId, u32> = order
+        .iter()
+        .filter(|e| is_stmt.contains_key(e))
+        .enumerate()
+        .map(|(i, e)| (*e, i as u32))
+        .collect();
+    stmts.sort_by_key(|(e, _)| (rank.get(e).copied().unwrap_or(u32::MAX), *e));
     let mut placed: FxHashSet<ExprId> = FxHashSet::default();
     let mut out = Vec::with_capacity(stmts.len());
     let mut deps = Vec::new();

@@ -147,6 +147,10 @@ pub struct Arena {
     stamps: Vec<u32>,
     /// Requests so far in the current phase.
     clock: u32,
+    /// The nodes the current phase asked for, in the order it first asked (`stamps` of these
+    /// are their positions): a phase is reset and read in time proportional to what it asked
+    /// for, not to the arena (hundreds of per-frame phases over a large arena).
+    touched: Vec<ExprId>,
     /// Memo of [`Arena::diff`].
     diff_memo: diff::DiffMemo,
     /// Per speed index: the mimic constraint `q = a·q_master + b` of a dependent speed (see
@@ -191,6 +195,7 @@ impl Arena {
             hoist_params: false,
             stamps: Vec::new(),
             clock: 0,
+            touched: Vec::new(),
             diff_memo: Default::default(),
             mimics: Vec::new(),
         };
@@ -229,14 +234,16 @@ impl Arena {
     /// the order its own recursion forms them, even where it reuses nodes that an earlier
     /// function created (see [`Arena::phase_order`]).
     pub fn begin_phase(&mut self) {
-        self.stamps.iter_mut().for_each(|s| *s = u32::MAX);
+        for e in self.touched.drain(..) {
+            self.stamps[e.index()] = u32::MAX;
+        }
         self.clock = 0;
     }
 
-    /// Per node, when the current phase first asked for it (created it or found it interned);
-    /// `u32::MAX` for nodes it did not ask for.
-    pub fn phase_order(&self) -> Vec<u32> {
-        self.stamps.clone()
+    /// The nodes the current phase asked for (created or found interned), in the order it first
+    /// asked for them.
+    pub fn phase_order(&self) -> Vec<ExprId> {
+        self.touched.clone()
     }
 
     /// Ask for `e` and everything it reads (through substitution variables) in the current
@@ -269,6 +276,7 @@ impl Arena {
         if *s == u32::MAX {
             *s = self.clock;
             self.clock += 1;
+            self.touched.push(id);
         }
     }
 

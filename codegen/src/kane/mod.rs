@@ -80,9 +80,9 @@ pub struct Function {
     pub frame: Option<usize>,
     /// `(row, col, expr)` in the layout of the function's [`Shape`](crate::registry::Shape); col = 0 for vectors.
     pub entries: Vec<(usize, usize, ExprId)>,
-    /// Per arena node, when this function's derivation first asked for it (`u32::MAX`: never):
-    /// the statement order the lowering follows (see [`Arena::begin_phase`]).
-    pub order: Vec<u32>,
+    /// The arena nodes this function's derivation asked for, in the order it first asked for
+    /// them: the statement order the lowering follows (see [`Arena::begin_phase`]).
+    pub order: Vec<ExprId>,
 }
 
 /// A function's `(row, col, expression)` entries.

@@ -21,6 +21,7 @@ use std::fmt::Write as _;
 use crate::naming;
 
 mod diff;
+pub mod modular;
 
 pub use diff::Wrt;
 

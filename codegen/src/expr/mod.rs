@@ -22,6 +22,7 @@ use crate::naming;
 
 mod diff;
 pub mod modular;
+mod partial;
 
 pub use diff::Wrt;
 

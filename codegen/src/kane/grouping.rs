@@ -238,10 +238,18 @@ fn least_squares(a: &mut [f64], m: usize, k: usize, b: &mut [f64], d: usize) -> 
         let vn2: f64 = col[j..].iter().map(|v| v * v).sum();
         diag[j] = alpha;
         let v = &col[j..];
+        // Plain index loops: this runs in build scripts, usually unoptimised, where iterator
+        // adapters cost several times more.
         let reflect = |c: &mut [f64]| {
-            let s: f64 = v.iter().zip(&c[j..]).map(|(a, b)| a * b).sum();
+            let c = &mut c[j..];
+            let mut s = 0.0;
+            for i in 0..v.len() {
+                s += v[i] * c[i];
+            }
             let f = 2.0 * s / vn2;
-            c[j..].iter_mut().zip(v).for_each(|(x, vi)| *x -= f * vi);
+            for i in 0..v.len() {
+                c[i] -= f * v[i];
+            }
         };
         for l in 0..k - j - 1 {
             reflect(&mut rest[l * m..(l + 1) * m]);
@@ -278,6 +286,8 @@ pub(super) struct Problem<'a> {
     pub unidentifiable: &'a [usize],
     /// Whether the parameters are baked (lengths folded into constants).
     pub baked: bool,
+    /// The arena nodes the regressor reads ([`Arena::needed_nodes`]).
+    pub needed: &'a [bool],
 }
 
 impl Problem<'_> {
@@ -292,7 +302,15 @@ impl Problem<'_> {
         let mut b = vec![0.0; m * d];
         let mut rng = Rng(0x5851_f42d_4c95_7f2d);
         for s in 0..states {
-            let y = regressor_at(self.ar, self.entries, self.model, values, cols, &mut rng);
+            let y = regressor_at(
+                self.ar,
+                self.entries,
+                self.model,
+                values,
+                self.needed,
+                cols,
+                &mut rng,
+            );
             for r in 0..n {
                 let row = s * n + r;
                 for (j, &c) in self.kept.iter().enumerate() {
@@ -312,7 +330,8 @@ impl Problem<'_> {
     fn fit(&self) -> (Vec<Vec<Coefficient>>, Vec<usize>) {
         let base: Vec<f64> = self.model.params.iter().map(|p| p.value).collect();
         let n = self.model.independent_dof().max(1);
-        let states = (self.kept.len() + self.kept.len() / 2) / n + 3;
+        // Enough rows for the kept columns with a margin (the systems are consistent).
+        let states = (self.kept.len() + self.kept.len() / 4) / n + 2;
         let (k, d) = (self.kept.len(), self.dependent.len());
         let x0 = self.solve(&base, states);
         let geom = if self.baked {

@@ -192,6 +192,7 @@ pub(super) fn regressor_at(
     entries: &[(usize, usize, ExprId)],
     model: &Model,
     params: &[f64],
+    needed: &[bool],
     cols: usize,
     rng: &mut Rng,
 ) -> Vec<f64> {
@@ -199,12 +200,15 @@ pub(super) fn regressor_at(
     let q: Vec<f64> = (0..n).map(|_| rng.sym(std::f64::consts::PI)).collect();
     let u: Vec<f64> = (0..n).map(|_| rng.sym(2.0)).collect();
     let ud: Vec<f64> = (0..n).map(|_| rng.sym(2.0)).collect();
-    let vals = ar.eval(&Values {
-        params,
-        q: &q,
-        u: &u,
-        ud: &ud,
-    });
+    let vals = ar.eval_needed(
+        &Values {
+            params,
+            q: &q,
+            u: &u,
+            ud: &ud,
+        },
+        needed,
+    );
     let map = model.constraint_map();
     let mut y = vec![0.0; model.independent_dof() * cols];
     for &(r, c, e) in entries {
@@ -226,12 +230,14 @@ pub(super) fn base_parameters(
     let cols = params.len();
     let states = (3 * cols / n + 10).max(30);
     let values: Vec<f64> = model.params.iter().map(|p| p.value).collect();
+    let roots: Vec<ExprId> = entries.iter().map(|&(_, _, e)| e).collect();
+    let needed = ar.needed_nodes(&roots);
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     // Column-major stack of `states` regressors.
     let rows = states * n;
     let mut a = vec![vec![0.0; rows]; cols];
     for s in 0..states {
-        let y = regressor_at(ar, entries, model, &values, cols, &mut rng);
+        let y = regressor_at(ar, entries, model, &values, &needed, cols, &mut rng);
         for r in 0..n {
             for c in 0..cols {
                 a[c][s * n + r] = y[r * cols + c];
@@ -314,7 +320,7 @@ pub(super) fn base_parameters(
     // Check the grouping on other states: Y_D = Y_I C.
     let mut worst: f64 = 0.0;
     for _ in 0..10 {
-        let y = regressor_at(ar, entries, model, &values, cols, &mut rng);
+        let y = regressor_at(ar, entries, model, &values, &needed, cols, &mut rng);
         for row in 0..n {
             let yr = &y[row * cols..(row + 1) * cols];
             let scale = yr.iter().map(|v| v.abs()).fold(1e-300, f64::max);
@@ -349,6 +355,7 @@ pub(super) fn base_parameters(
             dependent: &dependent,
             unidentifiable: &unidentifiable,
             baked,
+            needed: &needed,
         },
         &groups,
     );

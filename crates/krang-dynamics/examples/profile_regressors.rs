@@ -62,7 +62,9 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> Result<f64, String>
 
 fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
-    let f = args.next().unwrap_or_else(|| "inverse_dynamics_regressor".into());
+    let f = args
+        .next()
+        .unwrap_or_else(|| "inverse_dynamics_regressor".into());
     let calls: usize = args
         .next()
         .map(|c| c.parse().map_err(|e| format!("calls: {e}")))
@@ -77,6 +79,9 @@ fn main() -> Result<(), String> {
         acc += run(&k, &f, &s, calls.min(1000))?;
         best = best.min(t.elapsed().as_secs_f64() / calls.min(1000) as f64);
     }
-    println!("{f}: {:.0} ns per call (fastest batch; checksum {acc:.3e})", best * 1e9);
+    println!(
+        "{f}: {:.0} ns per call (fastest batch; checksum {acc:.3e})",
+        best * 1e9
+    );
     Ok(())
 }

@@ -634,3 +634,83 @@ pub(super) fn symbolic(
         .collect();
     (out, ex)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn least_squares_solves_a_consistent_tall_system() {
+        // A = [[1, 0], [1, 1], [1, 2]] (column-major), x = [2, -3]: b = [2, -1, -4].
+        let mut a = vec![1.0, 1.0, 1.0, 0.0, 1.0, 2.0];
+        let mut b = vec![2.0, -1.0, -4.0];
+        let x = least_squares(&mut a, 3, 2, &mut b, 1);
+        assert!(
+            (x[0] - 2.0).abs() < 1e-14 && (x[1] + 3.0).abs() < 1e-14,
+            "{x:?}"
+        );
+    }
+
+    #[test]
+    fn snapping_keeps_small_fractions_exact_and_other_numbers_as_they_are() {
+        assert_eq!(snap(0.5 + 1e-13, 1e-9), 0.5);
+        assert_eq!(snap(2.0 / 3.0 + 1e-13, 1e-9), 2.0 / 3.0);
+        assert_eq!(snap(1e-12, 1e-9), 0.0);
+        assert_eq!(snap(0.123456789, 1e-9), 0.123456789);
+    }
+
+    #[test]
+    fn coefficients_evaluate_and_print_in_the_reports_style() {
+        let model = kanegen_model::Model::from_toml_str(
+            r#"
+[model]
+name = "m"
+speeds = ["qd"]
+[base]
+type = "fixed"
+frame = "0"
+[gravity]
+symbol = "g"
+direction = [0, 0, -1]
+[parameters]
+g = 9.81
+L1 = 0.5
+m1 = 1.0
+MX1 = 0.0
+MY1 = 0.0
+MZ1 = 0.0
+XX1 = 0.1
+XY1 = 0.0
+XZ1 = 0.0
+YY1 = 0.1
+YZ1 = 0.0
+ZZ1 = 0.1
+[[joint]]
+name = "q1"
+type = "revolute"
+parent = "0"
+child = "1"
+speed = "qd"
+axis = [1, 0, 0]
+rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+translation = [0, "L1", 0]
+[[body]]
+frame = "1"
+"#,
+            "test.toml",
+        )
+        .expect("model loads");
+        let l1 = model.param_index("L1").unwrap();
+        let c = Coefficient {
+            terms: vec![
+                (1.0, vec![(l1, 2)]),
+                (-2.0, vec![(l1, 1)]),
+                (0.5, vec![(l1, -2)]),
+            ],
+        };
+        assert_eq!(c.text(&model), "L1^2 - 2.0*L1 + 0.5/L1^2");
+        let mut v = model.param_values();
+        v[l1] = 2.0;
+        assert_eq!(c.eval(&v), 4.0 - 4.0 + 0.125);
+    }
+}

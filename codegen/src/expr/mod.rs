@@ -21,6 +21,8 @@ use std::fmt::Write as _;
 use crate::naming;
 
 mod diff;
+pub mod modular;
+mod partial;
 
 pub use diff::Wrt;
 

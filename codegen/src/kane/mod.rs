@@ -40,6 +40,7 @@
 //! | `coriolis_matrix.rs` | C: frame velocities, subtree momenta and inertia rates, columns |
 //! | `kinematics.rs` | frames in frame 0 (`⁰A`, `⁰p`), centre of mass, its Jacobian and bias acceleration, energies |
 //! | `regressor.rs` | regressors `∂τ/∂π`, `∂g/∂β` (by [`Arena::diff`]) and their base parameters |
+//! | `grouping.rs` | the base parameters' groupings as exact expressions of the geometry (fitted, then verified in exact modular arithmetic) |
 //!
 //! The arena records the order in which each phase first asks for a node and the lowering
 //! schedules statements in that order: moving arena calls around changes the generated code.
@@ -53,6 +54,7 @@ mod coriolis_matrix;
 mod derivatives;
 mod frames;
 mod gravity;
+mod grouping;
 mod kinematics;
 mod mass_matrix;
 mod mimic;
@@ -67,6 +69,7 @@ use crate::registry::{FunctionId, Sizes};
 
 use algebra::{M3, V3};
 use composite::Composite;
+pub use grouping::{Coefficient, Exactness, SymbolicGroup, symbolic_group_text};
 pub use regressor::{BaseParameters, Regressors, group_text};
 
 /// One derived registry function: its output entries as expressions in the arena (its name,
@@ -341,7 +344,8 @@ impl Ctx<'_> {
             return entries;
         }
         let params = if gravity { &reg.beta } else { &reg.inertial };
-        let base = regressor::base_parameters(self.ar, self.model, &entries, params);
+        let baked = !matches!(self.options.params, crate::ParamMode::Runtime);
+        let base = regressor::base_parameters(self.ar, self.model, &entries, params, baked);
         let column: std::collections::HashMap<usize, usize> = base
             .groups
             .iter()

@@ -58,6 +58,7 @@ mod mass_matrix;
 mod mimic;
 mod regressor;
 mod rnea;
+mod rnea_derivatives;
 
 use kanegen_model::{Model, ParamKind};
 

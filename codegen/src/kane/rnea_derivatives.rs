@@ -443,6 +443,42 @@ mod tests {
         compare("lift on a wheeled base", &lift, ParamMode::Runtime, 50, 7);
     }
 
+    #[test]
+    fn on_a_tree_the_speed_derivative_is_twice_the_coriolis_matrix() {
+        use crate::registry::{FunctionId, FunctionSet};
+        let toml = |name: &str| Model::from_toml_file(models_dir().join(name)).expect("loads");
+        for (name, model) in [
+            ("fixed wheels", toml("krang-fixed-wheels.toml")),
+            ("two-link", toml("two-link.toml")),
+        ] {
+            let options = Options {
+                params: ParamMode::Runtime,
+                functions: FunctionSet::default()
+                    .with(FunctionId::CoriolisMatrix)
+                    .with(FunctionId::InverseDynamicsDerivatives),
+            };
+            let d = super::super::derive(&model, options);
+            let n = model.dof();
+            let mut rng = SplitMix64::new(8);
+            let mut uni = move || rng.next_f64();
+            for _ in 0..10 {
+                let p = random_physical_params(&model, &mut uni);
+                let q = uniform_vec(&mut uni, n, -3.0, 3.0);
+                let u = uniform_vec(&mut uni, n, -2.0, 2.0);
+                let ud = uniform_vec(&mut uni, n, -2.0, 2.0);
+                let c = d.evaluate(FunctionId::CoriolisMatrix, &p, &q, &u, &ud);
+                let dt = d.evaluate(FunctionId::InverseDynamicsDerivatives, &p, &q, &u, &ud);
+                let scale = c.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                for r in 0..n {
+                    for k in 0..n {
+                        let e = (dt[r * 2 * n + n + k] - 2.0 * c[r * n + k]).abs() / scale;
+                        assert!(e < 1e-12, "{name}: ∂τ_{r}/∂u_{k} vs 2 C[{r},{k}]: {e:e}");
+                    }
+                }
+            }
+        }
+    }
+
     /// A two-wheeled base with a prismatic lift on a skew axis, a revolute joint on a skew axis
     /// below it, and a fixed-joint merge.
     const LIFT: &str = r#"<robot name="lift">

@@ -38,6 +38,7 @@
 //! | `gravity.rs` | g |
 //! | `rnea.rs` | c and τ: forward motion pass, body inertia forces, backward accumulation |
 //! | `coriolis_matrix.rs` | C: frame velocities, subtree momenta and inertia rates, columns |
+//! | `rnea_derivatives.rs` | ∂τ/∂q, ∂τ/∂u: the analytic recursion (four forces per column carried up; `derivatives.rs` keeps forward mode as its test oracle) |
 //! | `kinematics.rs` | frames in frame 0 (`⁰A`, `⁰p`), centre of mass, its Jacobian and bias acceleration, energies |
 //! | `regressor.rs` | regressors `∂τ/∂π`, `∂g/∂β` (by [`Arena::diff`]) and their base parameters |
 //! | `grouping.rs` | the base parameters' groupings as exact expressions of the geometry (fitted, then verified in exact modular arithmetic) |
@@ -60,6 +61,7 @@ mod mass_matrix;
 mod mimic;
 mod regressor;
 mod rnea;
+mod rnea_derivatives;
 
 use kanegen_model::{Model, ParamKind};
 

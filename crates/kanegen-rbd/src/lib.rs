@@ -79,6 +79,8 @@
 
 mod algorithms;
 mod build;
+#[cfg(feature = "dual")]
+mod dual;
 mod frames;
 mod rot;
 mod scalar;
@@ -87,6 +89,8 @@ use std::fmt;
 
 use kanegen_model::Model;
 
+#[cfg(feature = "dual")]
+pub use dual::DualDerivatives;
 pub use frames::RbdFrame;
 use scalar::{M3, S3, V3};
 pub use scalar::{Scalar, sin_cos_f64};

@@ -11,6 +11,7 @@
 //! ```
 //!
 //! Arguments: a function (`mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, or `all`;
+//! `inverse_dynamics_derivatives` with the feature `derivatives`;
 //! a suffix `_b4` or `_b8` calls the batched form with 4 or 8 states, counted as one call), the
 //! number of calls, and optionally the instruction set (`baseline` or `x86-64-v3`; default: the
 //! best the CPU has, see `kanegen_runtime::isa`). States cycle through 64 fixed pseudo-random
@@ -79,6 +80,11 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> f64 {
                 let (q, u) = (batch::<8>(s, i), batch_u::<8>(s, i));
                 black_box(k).inverse_dynamics_batch(black_box(&q), black_box(&u), black_box(&u))[1]
                     [7]
+            }
+            #[cfg(feature = "derivatives")]
+            "inverse_dynamics_derivatives" => {
+                black_box(k).inverse_dynamics_derivatives(black_box(q), black_box(u), black_box(ud))
+                    [(7, 20)]
             }
             other => panic!("unknown function `{other}`"),
         };

@@ -64,6 +64,9 @@ pub fn stats(g: &Generated) -> String {
     for f in &g.lowered.functions {
         row(&f.program.name, &f.program);
     }
+    for c in &g.lowered.combined {
+        row(&c.program.name, &c.program);
+    }
     s.push_str(&base_parameters(g));
     s
 }

@@ -107,7 +107,7 @@ pub(super) fn state_args(cx: &Context<'_>, inputs: Inputs) -> (TokenStream, &'st
 
 /// The bindings of the inputs a function reads: one batched `sin_cos_n` call over the joint
 /// angles (vectorized), then per-joint names, coordinates, speeds and accelerations.
-fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
+pub(super) fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
     let speeds = &cx.model.speeds;
     let mut ts = TokenStream::new();
     if !p.sincos.is_empty() {
@@ -189,7 +189,7 @@ pub(super) fn nonzero_outputs(p: &Program) -> impl Iterator<Item = &(usize, usiz
 }
 
 /// Add `store` to the stores placed right after the last statement `e` reads.
-fn store_after(stores: &mut [TokenStream], e: &LExpr, store: TokenStream) {
+pub(super) fn store_after(stores: &mut [TokenStream], e: &LExpr, store: TokenStream) {
     stores[last_local(e).map_or(0, |i| i + 1)].extend(store);
 }
 

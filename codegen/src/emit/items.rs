@@ -350,6 +350,7 @@ pub(super) fn wrapper(cx: &Context<'_>, batched: bool) -> TokenStream {
     let model = cx.model;
     let ty = ident(&naming::type_name(&model.name));
     let mut methods = methods(cx);
+    methods.extend(super::combined::methods(cx));
     if batched {
         methods.extend(super::batch::methods(cx));
     }

@@ -72,7 +72,12 @@ impl Ctx<'_> {
     pub(super) fn rnea(&mut self, with_accel: bool, with_gravity: bool) -> Vec<ExprId> {
         let (f, n) = self.inertia_forces(Inputs::new(with_accel, with_gravity));
         let out = self.generalized_forces(&f, &n, with_accel);
-        self.finish(out, if with_accel { "tau" } else { "c" })
+        let label = match (with_accel, with_gravity) {
+            (true, _) => "tau",
+            (false, false) => "c",
+            (false, true) => "h",
+        };
+        self.finish(out, label)
     }
 
     /// `Σ_k m_k a_Gk` over every body at `u̇ = 0` without gravity, in frame 0: the total inertia

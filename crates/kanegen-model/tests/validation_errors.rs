@@ -11,7 +11,6 @@ use common::{VALID, mutate};
 
 const FILE: &str = "bad.toml";
 
-
 /// Load `text`, expect an error labelled `bad.toml` whose message names every item of `names`.
 fn load_err(text: &str, names: &[&str]) -> ModelError {
     let err = match Model::from_toml_str(text, FILE) {

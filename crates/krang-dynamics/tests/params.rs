@@ -46,8 +46,11 @@ fn validate_rejects_non_positive_masses_and_wheel_constants() {
             "{name} = {value}"
         );
     }
-    let mut p = Params::default();
-    p.YYw = -0.1; // `set` refuses it (set_refuses_values_that_are_not_finite_or_not_physical)
+    // `set` refuses it (set_refuses_values_that_are_not_finite_or_not_physical).
+    let p = Params {
+        YYw: -0.1,
+        ..Params::default()
+    };
     assert_eq!(
         p.validate().unwrap_err(),
         InvalidParameter::new("YYw", Problem::Negative)

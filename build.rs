@@ -13,8 +13,10 @@ fn main() {
     arm().baked(true).output("singlearm_baked.rs").run();
     // Every registry function (the opt-in kinematics and energies included), for
     // `tests/kinematics.rs`.
+    // With a combined function (`tests/kinematics.rs` checks it against the separate ones).
     arm()
         .functions(kanegen::FunctionSet::all())
+        .combined(arm_terms())
         .output("singlearm_all.rs")
         .run();
     kanegen::Builder::new("models/two-link.toml")
@@ -76,6 +78,27 @@ fn tree_urdf(branches: usize, depth: usize) -> String {
         }
     }
     s + "</robot>\n"
+}
+
+/// A combined function of every part shape (symmetric matrix, vectors, Jacobians, isometry,
+/// scalars) on the arm's end link and a link merged by a fixed joint.
+fn arm_terms() -> kanegen::combined::Combined {
+    use kanegen::FunctionId as F;
+    let mut c = kanegen::combined::Combined::new("arm_terms")
+        .with(F::MassMatrix)
+        .with(F::NonlinearEffects)
+        .with(F::CenterOfMass)
+        .with(F::ComJacobian)
+        .with(F::ComBiasAcceleration)
+        .with(F::KineticEnergy)
+        .with(F::PotentialEnergy);
+    for frame in ["L7_EFF", "Bracket"] {
+        c = c
+            .with_frame(F::FramePose, frame)
+            .with_frame(F::FrameJacobian, frame)
+            .with_frame(F::FrameBiasAcceleration, frame);
+    }
+    c
 }
 
 /// The declaration of Krang's wheeled base (as in README "Any robot from URDF" and

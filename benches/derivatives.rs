@@ -6,6 +6,8 @@
 //!   matrices ∂τ/∂q, ∂τ/∂u);
 //! * `id_derivatives/central_differences`: the same two matrices by central differences of the
 //!   generated τ (2 × 2N = 76 calls; Richardson extrapolation would double that);
+//! * `id_derivatives/rbd_dual`: the same by `kanegen-rbd`'s recursion in `num_dual::Dual64`
+//!   (2N = 38 forward-mode passes of the numeric RNEA);
 //! * `forward_dynamics/generated`: `Krang::forward_dynamics` (τ with u̇ = 0, M, block Cholesky);
 //! * `fd_derivatives/generated`: `Krang::forward_dynamics_derivatives` (u̇, ∂u̇/∂q, ∂u̇/∂u, M⁻¹);
 //! * `linearize/generated`: `Krang::linearize` (A 38×38, B 38×18).
@@ -91,6 +93,15 @@ fn bench(c: &mut Criterion) {
         .inverse_dynamics_derivatives(q, u, ud));
     cycle!("id_derivatives/central_differences", |q, u, ud| {
         central_differences(&k, q, u, ud)
+    });
+    let model = kanegen_model::Model::from_toml_file(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/krang.toml"),
+    )
+    .expect("krang.toml loads");
+    let dual = kanegen_rbd::DualDerivatives::<19>::new(&model, &model.param_values())
+        .expect("the recursion builds");
+    cycle!("id_derivatives/rbd_dual", |q, u, ud| {
+        dual.inverse_dynamics_derivatives(q, u, ud)
     });
     cycle!("forward_dynamics/generated", |q, u, ud| k.forward_dynamics(
         q,

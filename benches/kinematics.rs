@@ -1,11 +1,14 @@
 //! Criterion benchmarks of Krang's generated kinematics (`krang-dynamics`, feature
-//! `kinematics`) against the numeric frame passes of `kanegen-rbd` (`RbdFrame`): both hands'
-//! Jacobians, both hands' pose + Jacobian + bias acceleration, and the CoM Jacobian (generated
-//! only: `kanegen-rbd` has no CoM pass), with one `coriolis` call in the same run for the
-//! target "both hands' Jacobians cost less than one `coriolis` call".
+//! `kinematics`) against the numeric passes of `kanegen-rbd` (`RbdFrame`, `Rbd::com_jacobian`):
+//! both hands' Jacobians, both hands' pose + Jacobian + bias acceleration, and the CoM Jacobian,
+//! with one `coriolis` call in the same run for the target "both hands' Jacobians cost less than
+//! one `coriolis` call"; and a whole-body controller's terms at one state (M, c + g, the CoM, its
+//! Jacobian and bias, both hands' pose, Jacobian and bias) as the combined `whole_body_terms`
+//! against the eleven separate calls, with the 17-angle `sin_cos_n` every call computes.
 //!
 //! Ids `kinematics/<what>/<variant>`: `hands_jacobian`, `hands_pose_jacobian_bias`,
-//! `com_jacobian`, `coriolis`; variants `generated`, `rbd`. Inputs cycle through 8 random
+//! `com_jacobian`, `coriolis` (variants `generated`, `rbd`), `whole_body` (`combined`,
+//! `separate`), `sin_cos_17/generated`. Inputs cycle through 8 random
 //! states behind `black_box`; the variants are checked against each other before timing.
 //!
 //! Also `arm_end/pose_jacobian/{generated,rbd,k}`: the end link of the URDF arm
@@ -57,7 +60,20 @@ fn kinematics(c: &mut Criterion) {
         RbdFrame::new(&model, &params, l).expect("frame")
     });
     let states = states();
-    // The two implementations agree.
+    // The two implementations agree; the combined call equals the separate ones bit for bit.
+    for (q, u) in &states {
+        let dc = (k.com_jacobian(q) - rbd.com_jacobian(q)).amax();
+        assert!(dc < 1e-12, "CoM Jacobian: {dc:e}");
+        let w = k.whole_body_terms(q, u);
+        assert_eq!(w.mass_matrix, k.mass_matrix(q));
+        assert_eq!(w.nonlinear_effects, k.nonlinear_effects(q, u));
+        assert_eq!(w.com_jacobian, k.com_jacobian(q));
+        assert_eq!(w.frame_jacobian_right_hand, k.frame_jacobian(q, hands[1]));
+        assert_eq!(
+            w.frame_bias_acceleration_left_hand,
+            k.frame_bias_acceleration(q, u, hands[0])
+        );
+    }
     for (q, u) in &states {
         for (h, f) in hands.iter().zip(&rbd_hands) {
             let dj = (k.frame_jacobian(q, *h) - rbd.frame_jacobian(q, f)).amax();
@@ -108,6 +124,28 @@ fn kinematics(c: &mut Criterion) {
         rbd.frame_bias_acceleration(q, u, &rbd_hands[i])
     )));
     bench!("com_jacobian/generated", |q, _u| k.com_jacobian(q));
+    bench!("com_jacobian/rbd", |q, _u| rbd.com_jacobian(q));
+    // A whole-body controller's terms at one state: one combined call against the separate
+    // calls (M, c + g, CoM, its Jacobian and bias, both hands' pose, Jacobian and bias).
+    bench!("whole_body/combined", |q, u| k.whole_body_terms(q, u));
+    bench!("whole_body/separate", |q, u| (
+        k.mass_matrix(q),
+        k.nonlinear_effects(q, u),
+        k.center_of_mass(q),
+        k.com_jacobian(q),
+        k.com_bias_acceleration(q, u),
+        hands.map(|h| (
+            k.frame_pose(q, h),
+            k.frame_jacobian(q, h),
+            k.frame_bias_acceleration(q, u, h)
+        ))
+    ));
+    // The trigonometry one call computes: 17 angles (what sharing only sin/cos would save
+    // per call after the first).
+    bench!("sin_cos_17/generated", |q, _u| {
+        let a: [f64; 17] = core::array::from_fn(|i| q[i + 2]);
+        kanegen_runtime::trig::sin_cos_n(a)
+    });
     bench!("coriolis/generated", |q, u| k.coriolis(q, u));
     bench!("coriolis/rbd", |q, u| rbd.coriolis(q, u));
     group.finish();

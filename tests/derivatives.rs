@@ -155,6 +155,49 @@ fn krang_position_and_heading_columns_are_exactly_zero() {
 }
 
 #[test]
+fn dual_number_baseline_equals_the_generated_derivatives() {
+    // kanegen-rbd's recursion in num-dual's Dual64 (2N passes): an independent derivation of
+    // the same two matrices, on random parameters and states.
+    for (name, seed) in [("krang.toml", 1207), ("krang-fixed-wheels.toml", 1208)] {
+        let m = model(name);
+        let mut r = rng(seed);
+        for draw in 0..20 {
+            let p = if draw == 0 {
+                m.param_values()
+            } else {
+                random_physical_params(&m, &mut r)
+            };
+            let (q, u, ud) = random_state(&mut r, m.dof());
+            let (dq, du, gq, gu) = if name == "krang.toml" {
+                let dual = kanegen_rbd::DualDerivatives::<19>::new(&m, &p).unwrap();
+                let (dq, du) = dual.inverse_dynamics_derivatives(&sv(&q), &sv(&u), &sv(&ud));
+                let k = kd::Krang::new(kd::Params::from_array(p.clone().try_into().unwrap()));
+                let (gq, gu) = k.inverse_dynamics_partials(&sv(&q), &sv(&u), &sv(&ud));
+                let f = |x: SMatrix<f64, 19, 19>| x.as_slice().to_vec();
+                (f(dq), f(du), f(gq), f(gu))
+            } else {
+                use kd::fixed_wheels as fw;
+                let dual = kanegen_rbd::DualDerivatives::<17>::new(&m, &p).unwrap();
+                let (dq, du) = dual.inverse_dynamics_derivatives(&sv(&q), &sv(&u), &sv(&ud));
+                let k = fw::KrangFixedWheels::new(fw::Params::from_array(p.try_into().unwrap()));
+                let g = k.inverse_dynamics_derivatives(&sv(&q), &sv(&u), &sv(&ud));
+                let f = |x: SMatrix<f64, 17, 17>| x.as_slice().to_vec();
+                let (gq, gu) = (
+                    g.fixed_columns::<17>(0).into_owned(),
+                    g.fixed_columns::<17>(17).into_owned(),
+                );
+                (f(dq), f(du), f(gq), f(gu))
+            };
+            let (eq, eu) = (mat_err(&gq, &dq), mat_err(&gu, &du));
+            assert!(
+                eq <= 1e-11 && eu <= 1e-11,
+                "{name} draw {draw}: ∂τ/∂q {eq:e}, ∂τ/∂u {eu:e}"
+            );
+        }
+    }
+}
+
+#[test]
 fn coriolis_derivative_is_c_plus_dc_du_u() {
     // c(q, u) = C(q, u) u with C linear in u, so (∂c/∂u) v = C(q, u) v + C(q, v) u.
     let k = kd::Krang::default();

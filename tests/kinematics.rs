@@ -165,3 +165,44 @@ fn baked_f32_kinematics_agree_with_f64() {
         }
     }
 }
+
+#[test]
+fn urdf_arm_combined_function_equals_the_separate_functions_bit_for_bit() {
+    use singlearm_all::{DOF, Frame, Params, SingleArm};
+    let model = Model::from_urdf_file(
+        root().join("models/singlearm.urdf"),
+        &UrdfOptions::default(),
+    )
+    .expect("URDF imports");
+    let mut r = rng(74);
+    let frames = ["L7_EFF", "Bracket"].map(|n| Frame::from_name(n).expect("frame"));
+    for _ in 0..5 {
+        let params = random_physical_params(&model, &mut r);
+        let k = SingleArm::new(Params::from_array(params.try_into().unwrap()));
+        for _ in 0..4 {
+            let (q, u, _) = random_state(&mut r, DOF);
+            let (q, u) = (sv::<DOF>(&q), sv::<DOF>(&u));
+            let w = k.arm_terms(&q, &u);
+            assert_eq!(w.mass_matrix, k.mass_matrix(&q));
+            assert_eq!(w.nonlinear_effects, k.nonlinear_effects(&q, &u));
+            assert_eq!(w.center_of_mass, k.center_of_mass(&q));
+            assert_eq!(w.com_jacobian, k.com_jacobian(&q));
+            assert_eq!(w.com_bias_acceleration, k.com_bias_acceleration(&q, &u));
+            assert_eq!(w.kinetic_energy, k.kinetic_energy(&q, &u));
+            assert_eq!(w.potential_energy, k.potential_energy(&q));
+            let [end, bracket] = frames;
+            assert_eq!(w.frame_pose_l7_eff, k.frame_pose(&q, end));
+            assert_eq!(w.frame_jacobian_l7_eff, k.frame_jacobian(&q, end));
+            assert_eq!(
+                w.frame_bias_acceleration_l7_eff,
+                k.frame_bias_acceleration(&q, &u, end)
+            );
+            assert_eq!(w.frame_pose_bracket, k.frame_pose(&q, bracket));
+            assert_eq!(w.frame_jacobian_bracket, k.frame_jacobian(&q, bracket));
+            assert_eq!(
+                w.frame_bias_acceleration_bracket,
+                k.frame_bias_acceleration(&q, &u, bracket)
+            );
+        }
+    }
+}

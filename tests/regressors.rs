@@ -92,6 +92,18 @@ macro_rules! compiled_regressors {
                 tau_m.as_slice(),
                 1.0,
             ));
+            // With the random geometry too: `base_parameters(&Params)` uses the grouping
+            // coefficients as expressions of the lengths.
+            worst = worst.max(rel_err(
+                (k.base_regressor(&q, &u, &ud) * $m::base_parameters(&p)).as_slice(),
+                tau.as_slice(),
+                1.0,
+            ));
+            worst = worst.max(rel_err(
+                (k.base_gravity_regressor(&q) * $m::base_beta(&p)).as_slice(),
+                grav.as_slice(),
+                1.0,
+            ));
             let ygb = km.base_gravity_regressor(&q);
             worst = worst.max(rel_err(
                 (ygb * $m::base_beta(&pm)).as_slice(),
@@ -154,6 +166,37 @@ fn krang_compiled_regressors_reproduce_tau_and_g() {
         worst = worst.max(rel_err(
             (ygb * krang_dynamics::base_beta(&p)).as_slice(),
             grav.as_slice(),
+            1.0,
+        ));
+    }
+    assert!(worst <= 1e-12, "{worst:e}");
+}
+
+#[test]
+fn krang_base_parameters_follow_the_geometry_of_the_parameter_set() {
+    // Random lengths, wheel radius and track as well as inertial parameters: the grouping
+    // coefficients of `base_parameters(&Params)` are expressions of the geometry.
+    let model = model("krang.toml");
+    let mut r = rng(34);
+    let mut worst: f64 = 0.0;
+    for _ in 0..50 {
+        let p = random_physical_params(&model, &mut r);
+        let p = krang_dynamics::Params::from_array(p.try_into().unwrap());
+        assert_ne!(p.L1, krang_dynamics::Params::default().L1);
+        let k = krang_dynamics::Krang::new(p);
+        let (q, u, ud) = random_state(&mut r, 19);
+        let (q, u, ud) = (sv::<19>(&q), sv::<19>(&u), sv::<19>(&ud));
+        let tau = k.inverse_dynamics(&q, &u, &ud);
+        let yb = k.base_regressor(&q, &u, &ud);
+        worst = worst.max(rel_err(
+            (yb * krang_dynamics::base_parameters(&p)).as_slice(),
+            tau.as_slice(),
+            1.0,
+        ));
+        let ygb = k.base_gravity_regressor(&q);
+        worst = worst.max(rel_err(
+            (ygb * krang_dynamics::base_beta(&p)).as_slice(),
+            k.gravity(&q).as_slice(),
             1.0,
         ));
     }

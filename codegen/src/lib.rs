@@ -28,6 +28,7 @@
 //! ```
 #![forbid(unsafe_code)]
 
+pub mod combined;
 pub mod emit;
 pub mod expr;
 pub mod kane;
@@ -55,6 +56,9 @@ pub enum Error {
     /// The description file is malformed or not physical.
     #[error(transparent)]
     Model(#[from] model::ModelError),
+    /// A combined function names an unknown frame, a taken name, … ([`Builder::combined`]).
+    #[error(transparent)]
+    Combined(#[from] combined::CombinedError),
     /// The generated code did not parse (a generator bug).
     #[error(transparent)]
     Emit(#[from] emit::EmitError),
@@ -97,10 +101,22 @@ pub fn generate_with(
     options: Options,
     emit: &EmitOptions,
 ) -> Result<Generated, Error> {
+    generate_combined(model, options, &[], emit)
+}
+
+/// [`generate_with`], with the combined functions `combined` (see [`combined`] and
+/// [`Builder::combined`]).
+pub fn generate_combined(
+    model: model::Model,
+    options: Options,
+    combined: &[combined::Combined],
+    emit: &EmitOptions,
+) -> Result<Generated, Error> {
     // The loaders check names; a model built in memory is checked here.
     model.check_names()?;
+    let combined = combined::resolve(&model, combined)?;
     let mut progress = Progress::new(&model);
-    let derivation = kane::derive(&model, options);
+    let derivation = kane::derive_with(&model, options, &combined);
     progress.stage(&format!(
         "derived ({} expression nodes, {} substitution variables)",
         derivation.arena.len(),
@@ -161,13 +177,14 @@ pub fn generate_urdf(
     urdf: &model::UrdfOptions,
     options: Options,
 ) -> Result<Generated, Error> {
-    urdf_with(path.as_ref(), urdf, options, EmitOptions::default())
+    urdf_with(path.as_ref(), urdf, options, &[], EmitOptions::default())
 }
 
 fn urdf_with(
     path: &Path,
     urdf: &model::UrdfOptions,
     options: Options,
+    combined: &[combined::Combined],
     emit: EmitOptions,
 ) -> Result<Generated, Error> {
     let import = model::UrdfImport::read(path, urdf)?;
@@ -176,7 +193,7 @@ fn urdf_with(
         notes_title: "URDF import notes".into(),
         ..emit
     };
-    generate_with(import.model, options, &emit)
+    generate_combined(import.model, options, combined, &emit)
 }
 
 /// Load a TOML description file and run every stage (f64 module).
@@ -223,6 +240,8 @@ pub struct Builder {
     precision: Precision,
     /// Tool frames added to the loaded model ([`Builder::frame`]).
     frames: Vec<model::OperationalFrame>,
+    /// Combined functions ([`Builder::combined`]).
+    combined: Vec<combined::Combined>,
     isa_dispatch: bool,
     batch: bool,
     split_above: usize,
@@ -243,6 +262,7 @@ impl Builder {
             urdf,
             precision: Precision::F64,
             frames: Vec::new(),
+            combined: Vec::new(),
             isa_dispatch: true,
             batch: false,
             split_above: emit::SPLIT_ABOVE,
@@ -425,16 +445,45 @@ impl Builder {
         self
     }
 
+    /// Adds a combined function: several registry functions (and frames of the per-frame ones)
+    /// as one straight-line program with one result struct, computing every sine, cosine and
+    /// substitution variable the parts share once (see [`combined`]). The separate functions
+    /// stay as [`Builder::functions`] says; an unknown frame or a taken name is a typed error of
+    /// [`Builder::generate`].
+    ///
+    /// ```no_run
+    /// use kanegen::{FunctionId as F, combined::Combined};
+    /// kanegen::Builder::new("krang.toml")
+    ///     .combined(
+    ///         Combined::new("balance_terms")
+    ///             .with(F::MassMatrix)
+    ///             .with(F::NonlinearEffects)
+    ///             .with(F::ComJacobian)
+    ///             .with(F::ComBiasAcceleration),
+    ///     )
+    ///     .run();
+    /// ```
+    pub fn combined(mut self, combined: combined::Combined) -> Self {
+        self.combined.push(combined);
+        self
+    }
+
     /// Run every stage and return the result without writing anything.
     pub fn generate(&self) -> Result<Generated, Error> {
         match &self.urdf {
-            Some(urdf) => urdf_with(&self.model, urdf, self.options, self.emit_options()),
+            Some(urdf) => urdf_with(
+                &self.model,
+                urdf,
+                self.options,
+                &self.combined,
+                self.emit_options(),
+            ),
             None => {
                 let mut model = model::Model::from_toml_file(&self.model)?;
                 for f in &self.frames {
                     model.add_frame(f)?;
                 }
-                generate_with(model, self.options, &self.emit_options())
+                generate_combined(model, self.options, &self.combined, &self.emit_options())
             }
         }
     }

@@ -206,6 +206,20 @@ pub struct Lowered {
     pub sizes: crate::registry::Sizes,
     /// The regressors' parameters and base parameters (see [`Derivation::regressors`]).
     pub regressors: crate::kane::Regressors,
+    /// The combined functions (see [`crate::combined`]).
+    pub combined: Vec<CombinedProgram>,
+}
+
+/// The program of one combined function: one straight-line program whose outputs are the
+/// parts' entries, one after the other.
+#[derive(Clone, Debug)]
+pub struct CombinedProgram {
+    /// What was asked for, resolved against the model.
+    pub spec: crate::combined::ResolvedCombined,
+    /// The program; `outputs[parts[i].clone()]` are part `i`'s entries.
+    pub program: Program,
+    /// Per part, its range in `program.outputs`.
+    pub parts: Vec<std::ops::Range<usize>>,
 }
 
 impl Lowered {
@@ -243,6 +257,25 @@ pub fn lower(d: &Derivation) -> Lowered {
             }
         })
         .collect();
+    let combined: Vec<CombinedProgram> = d
+        .combined
+        .iter()
+        .map(|c| {
+            let mut parts = Vec::with_capacity(c.parts.len());
+            let mut entries = Vec::new();
+            for p in &c.parts {
+                parts.push(entries.len()..entries.len() + p.len());
+                entries.extend_from_slice(p);
+            }
+            let program =
+                lower_entries(&d.arena, &c.spec.name, &entries, &c.order, hoist, &mut pre);
+            CombinedProgram {
+                spec: c.spec.clone(),
+                program,
+                parts,
+            }
+        })
+        .collect();
     let (precompute, pre_slots) = lower_precompute(&d.arena, &pre);
     Lowered {
         precompute,
@@ -255,6 +288,7 @@ pub fn lower(d: &Derivation) -> Lowered {
             .collect(),
         sizes: d.sizes,
         regressors: d.regressors.clone(),
+        combined,
     }
 }
 
@@ -484,7 +518,19 @@ fn statement_deps(
 }
 
 fn lower_function(ar: &Arena, f: &Function, hoist: bool, pre: &mut PreSet) -> Program {
-    let roots: Vec<ExprId> = f.entries.iter().map(|e| e.2).collect();
+    lower_entries(ar, f.id.name(), &f.entries, &f.order, hoist, pre)
+}
+
+/// The program computing `entries` (its outputs, in order), statements in `order`.
+fn lower_entries(
+    ar: &Arena,
+    name: &str,
+    entries: &[(usize, usize, ExprId)],
+    order: &[ExprId],
+    hoist: bool,
+    pre: &mut PreSet,
+) -> Program {
+    let roots: Vec<ExprId> = entries.iter().map(|e| e.2).collect();
     let mut b = ProgramBuilder {
         ar,
         hoist,
@@ -495,7 +541,7 @@ fn lower_function(ar: &Arena, f: &Function, hoist: bool, pre: &mut PreSet) -> Pr
             && ar.is_param_only(e)
             && (matches!(ar.node(e), Node::Atom(Atom::Var(_))) || is_compound(ar.node(e)))
     };
-    let sched = schedule(ar, &roots, &is_leaf, Some(&f.order));
+    let sched = schedule(ar, &roots, &is_leaf, Some(order));
     let mut stmts = Vec::new();
     let (mut nk, mut nd, mut nt) = (0, 0, 0);
     for (e, var) in sched {
@@ -526,13 +572,12 @@ fn lower_function(ar: &Arena, f: &Function, hoist: bool, pre: &mut PreSet) -> Pr
             comment,
         });
     }
-    let outputs: Vec<(usize, usize, LExpr)> = f
-        .entries
+    let outputs: Vec<(usize, usize, LExpr)> = entries
         .iter()
         .map(|&(r, c, e)| (r, c, b.expand(e, false, pre)))
         .collect();
     let mut p = Program {
-        name: f.id.name().to_owned(),
+        name: name.to_owned(),
         sincos: Vec::new(),
         stmts,
         outputs,
@@ -701,6 +746,43 @@ impl Lowered {
 }
 
 impl Lowered {
+    /// Evaluate combined function `index` (in the order of [`Lowered::combined`]): per part, the
+    /// dense value of its shape as [`Lowered::evaluate`] gives it. Panics if there is no such
+    /// combined function (a test helper).
+    pub fn evaluate_combined(
+        &self,
+        index: usize,
+        params: &[f64],
+        q: &[f64],
+        u: &[f64],
+        ud: &[f64],
+    ) -> Vec<Vec<f64>> {
+        let pre = self.precompute_values(params);
+        let c = &self.combined[index];
+        let p = &c.program;
+        let q = &self.expand_angles(q);
+        let locals = run(p, params, &pre, q, u, ud);
+        let ctx = EvalCtx {
+            params,
+            pre: &pre,
+            q,
+            u,
+            ud,
+            locals: &locals,
+        };
+        c.spec
+            .parts
+            .iter()
+            .zip(&c.parts)
+            .map(|(part, range)| {
+                let entries = p.outputs[range.clone()]
+                    .iter()
+                    .map(|(r, col, e)| (*r, *col, ctx.eval(e)));
+                part.function.spec().shape.dense_in(&self.sizes, entries)
+            })
+            .collect()
+    }
+
     /// `q` extended by the angles of the dependent (mimic) speeds at their indices, which the
     /// programs' `sin`/`cos` leaves of those speeds read.
     pub fn expand_angles(&self, q: &[f64]) -> Vec<f64> {

@@ -52,6 +52,8 @@ pub enum FunctionId {
     BaseRegressor,
     /// Base gravity regressor: the identifiable columns of Y_g, g = Y_gb β_b.
     BaseGravityRegressor,
+    /// Nonlinear effects `h(q, u) = c(q, u) + g(q)` in one pass (inverse dynamics at `u̇ = 0`).
+    NonlinearEffects,
 }
 
 /// One dimension of a [`Shape::Dense`] result: the number of speeds N, or a constant.
@@ -269,7 +271,7 @@ pub struct FunctionSpec {
 }
 
 /// The registry, in the order generated modules define the functions.
-pub const FUNCTIONS: [FunctionSpec; 18] = [
+pub const FUNCTIONS: [FunctionSpec; 19] = [
     FunctionSpec {
         id: FunctionId::MassMatrix,
         name: "mass_matrix",
@@ -494,6 +496,17 @@ pub const FUNCTIONS: [FunctionSpec; 18] = [
             rows: Dim::N,
             cols: Dim::BaseBeta,
         },
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::NonlinearEffects,
+        name: "nonlinear_effects",
+        symbol: "h",
+        doc: "Nonlinear effects h(q, u) = c(q, u) + g(q) in one pass (inverse dynamics at `u̇ = 0`; Pinocchio's `nonLinearEffects`): `τ = M u̇ + h`.",
+        inputs: Inputs::QU,
+        shape: Shape::Vector,
         default: false,
         runtime_trait: None,
         per_frame: false,

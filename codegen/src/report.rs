@@ -64,6 +64,9 @@ pub fn stats(g: &Generated) -> String {
     for f in &g.lowered.functions {
         row(&f.program.name, &f.program);
     }
+    for c in &g.lowered.combined {
+        row(&c.program.name, &c.program);
+    }
     s.push_str(&base_parameters(g));
     s
 }
@@ -91,12 +94,38 @@ pub fn base_parameters(g: &Generated) -> String {
             b.states,
             b.check_residual
         );
-        for (name, group) in b.names.iter().zip(&b.groups) {
+        let ex = &b.exactness;
+        match &ex.skipped {
+            Some(why) => {
+                let _ = writeln!(
+                    s,
+                    "  coefficients: numbers for the model file's geometry (exact check skipped: {why})"
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "  coefficients: exact expressions of the geometry; {} of {} dependencies \
+                     verified exactly (modular arithmetic, {} random points, every leaf random)",
+                    ex.verified, ex.dependencies, ex.points
+                );
+            }
+        }
+        if !ex.numeric_only.is_empty() {
             let _ = writeln!(
                 s,
-                "  {}",
-                crate::kane::group_text(&g.model, params, name, group)
+                "  not exact (numbers for the model file's geometry, checked numerically above; \
+                 rounded constants in the model, e.g. URDF origins and rpy rotations, defeat \
+                 an exact check): {}",
+                ex.numeric_only.join(" ")
             );
+        }
+        for (i, name) in b.names.iter().enumerate() {
+            let text = match b.symbolic.get(i) {
+                Some(group) => crate::kane::symbolic_group_text(&g.model, params, name, group),
+                None => crate::kane::group_text(&g.model, params, name, &b.groups[i]),
+            };
+            let _ = writeln!(s, "  {text}");
         }
         if !b.unidentifiable.is_empty() {
             let names: Vec<&str> = b

@@ -357,6 +357,227 @@ fn two_link_base_parameters_are_the_hand_derived_groupings() {
     // The gravity regressor's: m2 grouped into MY1 and MZ1.
     let bb = reg.base_beta.as_ref().unwrap();
     assert_eq!(bb.names, ["MYR1", "MZR1", "MY2", "MZ2"]);
+    // The same groupings as expressions of the lengths, as derived by hand.
+    let text: Vec<String> = base
+        .names
+        .iter()
+        .zip(&base.symbolic)
+        .map(|(n, g)| kanegen::kane::symbolic_group_text(model, &reg.inertial, n, g))
+        .collect();
+    assert_eq!(
+        text,
+        [
+            "MYR1 = MY1 + L1*m2",
+            "MZR1 = MZ1 - L2*m2",
+            "XXR1 = XX1 + (L1^2 + L2^2)*m2",
+            "MY2 = MY2",
+            "MZ2 = MZ2",
+            "XX2 = XX2"
+        ]
+    );
+    // … and their values for any lengths.
+    let mut rng = SplitMix64::new(31);
+    let mut values = model.param_values();
+    let (i1, i2) = (
+        model.param_index("L1").unwrap(),
+        model.param_index("L2").unwrap(),
+    );
+    for _ in 0..20 {
+        let (l1, l2) = (0.1 + 1.9 * rng.next_f64(), 2.0 * rng.next_f64() - 1.0);
+        values[i1] = l1;
+        values[i2] = l2;
+        let coef = |g: usize, member: &str| {
+            base.symbolic[g]
+                .iter()
+                .find(|(i, _)| *i == pos(member))
+                .map(|(_, c)| c.eval(&values))
+                .unwrap()
+        };
+        assert!((coef(0, "m2") - l1).abs() <= 1e-15);
+        assert!((coef(1, "m2") + l2).abs() <= 1e-15);
+        assert!((coef(2, "m2") - (l1 * l1 + l2 * l2)).abs() <= 1e-14);
+    }
+}
+
+/// The regressor entries `(row, col, expr)` of function `id`.
+fn entries(g: &Generated, id: FunctionId) -> &[(usize, usize, kanegen::expr::ExprId)] {
+    &g.derivation.function(id).unwrap().entries
+}
+
+/// Whether every grouping of `groups` holds exactly at `points` random points (modular
+/// arithmetic, every leaf random: q on the unit circle, u, u̇ and every parameter, lengths
+/// included), and the columns without effect vanish: per group, whether it held.
+fn exact_identity(
+    model: &Model,
+    g: &Generated,
+    id: FunctionId,
+    cols: usize,
+    groups: &[kanegen::kane::SymbolicGroup],
+    without: &[usize],
+    points: usize,
+) -> Vec<bool> {
+    use kanegen::expr::modular::{self, ModValues};
+    let n = model.dof();
+    let mut rng = SplitMix64::new(77);
+    let mut draw = || (rng.next_u64() >> 3) % modular::P;
+    let mut ok = vec![true; groups.len() + 1];
+    let mut done = 0;
+    while done < points {
+        let params: Vec<u64> = (0..model.params.len()).map(|_| draw()).collect();
+        let sin_cos: Option<Vec<_>> = (0..n).map(|_| modular::circle_point(draw())).collect();
+        let (q, u, ud): (Vec<u64>, Vec<u64>, Vec<u64>) = (
+            (0..n).map(|_| draw()).collect(),
+            (0..n).map(|_| draw()).collect(),
+            (0..n).map(|_| draw()).collect(),
+        );
+        let Some(sin_cos) = sin_cos else { continue };
+        let Some(vals) = g.derivation.arena.eval_mod(&ModValues {
+            params: &params,
+            sin_cos: &sin_cos,
+            q: &q,
+            u: &u,
+            ud: &ud,
+        }) else {
+            continue;
+        };
+        let mut y = vec![0u64; n * cols];
+        for &(r, c, e) in entries(g, id) {
+            y[r * cols + c] = modular::add(y[r * cols + c], vals[e.index()]);
+        }
+        // π in the direction that leaves τ unchanged: a group's value is Σ coef · π_member,
+        // so Σ_groups Y_kept · value = Y π for every π: check it for unit vectors of every
+        // dependent member, i.e. Y_member = Σ_groups coef_member Y_kept.
+        for r in 0..n {
+            let yr = &y[r * cols..(r + 1) * cols];
+            let mut members: Vec<usize> = groups
+                .iter()
+                .flat_map(|g| g.iter().skip(1).map(|(i, _)| *i))
+                .collect();
+            members.sort_unstable();
+            members.dedup();
+            for m in members {
+                let mut res = yr[m];
+                let mut involved = Vec::new();
+                for (gi, grp) in groups.iter().enumerate() {
+                    if let Some((_, c)) = grp.iter().skip(1).find(|(i, _)| *i == m) {
+                        let c = c.eval_mod(&params).unwrap();
+                        res = modular::add(res, modular::neg(modular::mul(c, yr[grp[0].0])));
+                        involved.push(gi);
+                    }
+                }
+                if res != 0 {
+                    for gi in involved {
+                        ok[gi] = false;
+                    }
+                }
+            }
+            ok[groups.len()] &= without.iter().all(|&c| yr[c] == 0);
+        }
+        done += 1;
+    }
+    ok
+}
+
+#[test]
+fn every_grouping_is_an_exact_identity_in_the_configuration_and_the_geometry() {
+    // Krang, the fixed-wheel tree and the two-link model have symbolic lengths and exact
+    // rotations: every grouping coefficient is an expression of the lengths (and R, L) and the
+    // groupings hold exactly for any geometry. Checked here independently of the generator's
+    // own check, which must agree.
+    for (i, file) in MODELS.iter().enumerate().take(3) {
+        let (model, g) = cached(i);
+        let reg = &g.derivation.regressors;
+        for (base, params, id) in [
+            (
+                reg.base.as_ref().unwrap(),
+                &reg.inertial,
+                FunctionId::InverseDynamicsRegressor,
+            ),
+            (
+                reg.base_beta.as_ref().unwrap(),
+                &reg.beta,
+                FunctionId::GravityRegressor,
+            ),
+        ] {
+            let name = format!("{file} {id}");
+            let ex = &base.exactness;
+            assert_eq!(ex.skipped, None, "{name}");
+            assert!(ex.numeric_only.is_empty(), "{name}: {:?}", ex.numeric_only);
+            assert_eq!(ex.verified, ex.dependencies, "{name}");
+            assert_eq!(
+                ex.dependencies,
+                params.len() - base.names.len(),
+                "{name}: every column is kept, grouped or without effect"
+            );
+            let ok = exact_identity(
+                model,
+                g,
+                id,
+                params.len(),
+                &base.symbolic,
+                &base.unidentifiable,
+                2,
+            );
+            assert!(ok.iter().all(|&b| b), "{name}: {ok:?}");
+            // At the model file's geometry the expressions are the numeric coefficients.
+            let values = model.param_values();
+            for (sym, num) in base.symbolic.iter().zip(&base.groups) {
+                for &(i, c) in num {
+                    let s = sym.iter().find(|(j, _)| *j == i).unwrap().1.eval(&values);
+                    assert!(
+                        (s - c).abs() <= 1e-12 * c.abs().max(1.0),
+                        "{name}: {s} vs {c}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn the_exact_identity_check_rejects_a_wrong_grouping_coefficient() {
+    // Krang's XXR1 = XX1 + (L1² + L2²) m2 + …: a coefficient off in one length (L1² + L3²),
+    // or off by a rounding-sized amount, is not an identity.
+    let (model, g) = cached(0);
+    let reg = &g.derivation.regressors;
+    let base = reg.base.as_ref().unwrap();
+    let xx = base.names.iter().position(|n| n == "XXR1").unwrap();
+    let m2 = reg
+        .inertial
+        .iter()
+        .position(|&p| model.params[p].name == "m2")
+        .unwrap();
+    let (l2, l3) = (
+        model.param_index("L2").unwrap(),
+        model.param_index("L3").unwrap(),
+    );
+    let check = |groups: &[kanegen::kane::SymbolicGroup]| {
+        exact_identity(
+            model,
+            g,
+            FunctionId::InverseDynamicsRegressor,
+            reg.inertial.len(),
+            groups,
+            &base.unidentifiable,
+            1,
+        )[xx]
+    };
+    assert!(check(&base.symbolic));
+    let mut wrong = base.symbolic.clone();
+    let member = wrong[xx].iter_mut().find(|(i, _)| *i == m2).unwrap();
+    assert_eq!(member.1.text(model), "L1^2 + L2^2");
+    for t in &mut member.1.terms {
+        for f in &mut t.1 {
+            if f.0 == l2 {
+                f.0 = l3;
+            }
+        }
+    }
+    assert!(!check(&wrong));
+    let mut wrong = base.symbolic.clone();
+    let member = wrong[xx].iter_mut().find(|(i, _)| *i == m2).unwrap();
+    member.1.terms[0].0 *= 1.0 + f64::EPSILON;
+    assert!(!check(&wrong));
 }
 
 #[test]
@@ -596,10 +817,14 @@ fn stats_and_listing_print_the_base_parameters() {
         stats.contains("base parameters of the inverse-dynamics regressor: 6 of 20"),
         "{stats}"
     );
-    assert!(stats.contains("  XXR1 = XX1 + 0.257282*m2"), "{stats}");
+    assert!(stats.contains("  XXR1 = XX1 + (L1^2 + L2^2)*m2"), "{stats}");
+    assert!(
+        stats.contains("14 of 14 dependencies verified exactly"),
+        "{stats}"
+    );
     assert!(stats.contains("base parameters of the gravity regressor: 4 of 8"));
     let listing = kanegen::listing(g);
-    assert!(listing.contains("% MYR1 = MY1 + 0.499*m2"), "{listing}");
+    assert!(listing.contains("% MYR1 = MY1 + L1*m2"), "{listing}");
     // Without base regressors nothing is printed.
     let model = load("two-link.toml");
     let plain = generate_model(model, Options::default()).unwrap();

@@ -45,7 +45,9 @@ fn generate() {
             functions = functions.with(FunctionId::CoriolisMatrix);
         }
         if kinematics {
-            functions = functions.union(FunctionSet::kinematics());
+            functions = functions
+                .union(FunctionSet::kinematics())
+                .with(FunctionId::NonlinearEffects);
         }
         if derivatives {
             functions = functions.with(FunctionId::InverseDynamicsDerivatives);
@@ -53,10 +55,13 @@ fn generate() {
         if regressors {
             functions = functions.union(FunctionSet::regressors());
         }
-        kanegen::Builder::new("krang.toml")
+        let mut main = kanegen::Builder::new("krang.toml")
             .functions(functions)
-            .batch(true)
-            .run();
+            .batch(true);
+        if kinematics {
+            main = main.combined(whole_body_terms());
+        }
+        main.run();
     }
     if enabled("BAKED") {
         builder("krang.toml").baked(true).batch(true).run();
@@ -85,4 +90,34 @@ fn generate() {
     if enabled("TWO_LINK") {
         builder("two-link.toml").derivatives(derivatives).run();
     }
+}
+
+/// What a whole-body controller reads every tick at one state, as one generated program
+/// (`Krang::whole_body_terms`): M, `c + g`, the centre of mass with its Jacobian and bias
+/// acceleration, and both hands' poses, Jacobians and bias accelerations.
+#[cfg(any(
+    feature = "coriolis-matrix",
+    feature = "kinematics",
+    feature = "derivatives",
+    feature = "regressors",
+    feature = "baked",
+    feature = "f32",
+    feature = "fixed-wheels",
+    feature = "two-link"
+))]
+fn whole_body_terms() -> kanegen::combined::Combined {
+    use kanegen::FunctionId as F;
+    let mut c = kanegen::combined::Combined::new("whole_body_terms")
+        .with(F::MassMatrix)
+        .with(F::NonlinearEffects)
+        .with(F::CenterOfMass)
+        .with(F::ComJacobian)
+        .with(F::ComBiasAcceleration);
+    for hand in ["left_hand", "right_hand"] {
+        c = c
+            .with_frame(F::FramePose, hand)
+            .with_frame(F::FrameJacobian, hand)
+            .with_frame(F::FrameBiasAcceleration, hand);
+    }
+    c
 }

@@ -107,7 +107,7 @@ pub(super) fn state_args(cx: &Context<'_>, inputs: Inputs) -> (TokenStream, &'st
 
 /// The bindings of the inputs a function reads: one batched `sin_cos_n` call over the joint
 /// angles (vectorized), then per-joint names, coordinates, speeds and accelerations.
-fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
+pub(super) fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
     let speeds = &cx.model.speeds;
     let mut ts = TokenStream::new();
     if !p.sincos.is_empty() {
@@ -200,7 +200,12 @@ pub(super) fn nonzero_outputs(p: &Program) -> impl Iterator<Item = &(usize, usiz
 }
 
 /// Add `store` to the stores placed right after the last statement `e` reads.
-fn store_after(stores: &mut [Vec<String>], e: &LExpr, store: String) {
+pub(super) fn store_after(stores: &mut [TokenStream], e: &LExpr, store: TokenStream) {
+    stores[last_local(e).map_or(0, |i| i + 1)].extend(store);
+}
+
+/// Add the text line `store` to the stores placed right after the last statement `e` reads.
+fn store_text_after(stores: &mut [Vec<String>], e: &LExpr, store: String) {
     stores[last_local(e).map_or(0, |i| i + 1)].push(store);
 }
 
@@ -219,7 +224,7 @@ fn isometry(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, mut stores: St
         } else {
             format!("pos[{r}] = {v};")
         };
-        store_after(&mut stores, e, store);
+        store_text_after(&mut stores, e, store);
     }
     Result {
         ty: result_type(cx, Shape::Isometry),
@@ -254,7 +259,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
         Shape::SymmetricMatrix | Shape::Matrix => {
             for (r, c, e) in nonzero {
                 let v = text(cx, printer, e);
-                store_after(&mut stores, e, format!("m[({r}, {c})] = {v};"));
+                store_text_after(&mut stores, e, format!("m[({r}, {c})] = {v};"));
             }
             // Symmetric: the lower triangle is copied at the end by a loop over the column-major
             // storage. Mirrored stores next to the computation, or unrolled copies at the end
@@ -290,7 +295,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
             let mutable = binding(nonzero.clone().next().is_some());
             for (r, c, e) in nonzero {
                 let v = text(cx, printer, e);
-                store_after(&mut stores, e, format!("m[({r}, {c})] = {v};"));
+                store_text_after(&mut stores, e, format!("m[({r}, {c})] = {v};"));
             }
             Result {
                 ty: result_type(cx, shape),
@@ -320,7 +325,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
                 // entries (and the expression trees behind them) into two-lane vectors: for
                 // Krang's inverse dynamics that packing added ~25 % code of shuffles and spills
                 // and doubled the time (1.17 µs vs 0.64 µs). (Krang's c got ~5 % slower.)
-                store_after(
+                store_text_after(
                     &mut stores,
                     e,
                     format!("out[{r}] = core::hint::black_box({v});"),

@@ -9,7 +9,7 @@ use super::function::{result_type, state_args, uses};
 use super::print::{Printer, ident, idx, signed_lit};
 use super::{Context, file_name, scalar_type};
 use crate::lower::{Leaf, Program};
-use crate::model::ParamKind;
+use crate::model::{Model, ParamKind};
 use crate::naming;
 use crate::registry::{FunctionSpec, Inputs, RuntimeTrait};
 
@@ -86,13 +86,14 @@ pub(super) fn params(cx: &Context<'_>) -> TokenStream {
         .map(|p| signed_lit(p.value, cx.precision));
     let names: Vec<&str> = model.params.iter().map(|p| p.name.as_str()).collect();
     let validate = validate(cx);
+    let checks = set_checks(model);
     let source = format!(
         " Model parameters of `{}`, named with the reports' symbols; `Default` holds the values of `{}`.",
         model.name,
         file_name(&model.source)
     );
     quote! {
-        pub use kanegen_runtime::UnknownParameter;
+        pub use kanegen_runtime::{SetParameterError, UnknownParameter};
 
         /// Number of model parameters.
         pub const PARAM_COUNT: usize = #np;
@@ -126,12 +127,24 @@ pub(super) fn params(cx: &Context<'_>) -> TokenStream {
                 }
             }
 
-            /// Set parameter `name`; an error if the model has no such parameter.
-            pub fn set(&mut self, name: &str, value: #t) -> Result<(), UnknownParameter> {
-                match name {
-                    #(#names => self.#ids = value,)*
-                    _ => return Err(UnknownParameter::new(name)),
-                }
+            /// Set parameter `name` to `value`.
+            ///
+            /// # Errors
+            /// [`SetParameterError::Unknown`] if the model has no such parameter (nothing is
+            /// changed); [`SetParameterError::Invalid`] if `value` is not finite, or is a mass,
+            /// wheel radius, track width or wheel mass that is not positive, or a wheel inertia
+            /// that is negative (nothing is changed). The checks that involve several
+            /// parameters at once (a body's inertia) are [`Params::validate`]'s.
+            pub fn set(&mut self, name: &str, value: #t) -> Result<(), SetParameterError> {
+                use kanegen_runtime::validate as v;
+                let slot = match name {
+                    #(#names => &mut self.#ids,)*
+                    _ => return Err(UnknownParameter::new(name).into()),
+                };
+                let x = f64::from(value);
+                v::check_finite(&[name], &[x])?;
+                #checks
+                *slot = value;
                 Ok(())
             }
 
@@ -147,6 +160,36 @@ pub(super) fn params(cx: &Context<'_>) -> TokenStream {
             }
 
             #validate
+        }
+    }
+}
+
+/// The sign checks `Params::set` makes on the value `x` (an `f64`) of parameter `name`: what
+/// `Params::validate` requires of that parameter alone (positive masses, wheel radius, track and
+/// wheel mass; non-negative wheel inertias).
+fn set_checks(model: &Model) -> TokenStream {
+    let name = |id: usize| model.params[id].name.as_str();
+    let mut positive: Vec<&str> = model
+        .links
+        .iter()
+        .filter_map(|l| l.body.as_ref())
+        .map(|b| name(b.mass))
+        .collect();
+    let mut non_negative = Vec::new();
+    if let Some(w) = model.wheeled_base() {
+        positive.extend([w.radius, w.track, w.wheel_mass].map(name));
+        non_negative.extend([w.wheel_axle_inertia, w.wheel_diametral_inertia].map(name));
+    }
+    let arm = |names: &[&str], check: TokenStream| {
+        (!names.is_empty()).then(|| quote!(#(#names)|* => #check(name, x)?,))
+    };
+    let positive = arm(&positive, quote!(v::check_positive));
+    let non_negative = arm(&non_negative, quote!(v::check_non_negative));
+    quote! {
+        match name {
+            #positive
+            #non_negative
+            _ => {}
         }
     }
 }
@@ -307,6 +350,7 @@ pub(super) fn wrapper(cx: &Context<'_>, batched: bool) -> TokenStream {
     let model = cx.model;
     let ty = ident(&naming::type_name(&model.name));
     let mut methods = methods(cx);
+    methods.extend(super::combined::methods(cx));
     if batched {
         methods.extend(super::batch::methods(cx));
     }

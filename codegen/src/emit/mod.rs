@@ -16,6 +16,7 @@
 
 mod annotate;
 mod batch;
+mod combined;
 mod frames;
 mod function;
 mod items;
@@ -140,7 +141,9 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
     let mut items = quote!(
         use nalgebra::{SMatrix, SVector};
     );
-    if low.functions.iter().any(|f| !f.program.sincos.is_empty()) {
+    if low.functions.iter().any(|f| !f.program.sincos.is_empty())
+        || low.combined.iter().any(|c| !c.program.sincos.is_empty())
+    {
         items.extend(match cx.precision {
             Precision::F64 => quote!(
                 use kanegen_runtime::trig::sin_cos_n;
@@ -169,6 +172,10 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         if f.frame.is_some() && last {
             items.extend(frames::dispatcher(&cx, f.id));
         }
+    }
+    for c in &low.combined {
+        items.extend(combined::items(&cx, c));
+        labels.add(&c.spec.name, &c.program);
     }
     let batched = options.batch && cx.precision == Precision::F64;
     if batched {
@@ -265,6 +272,22 @@ fn header(model: &Model, low: &Lowered) -> String {
         h.push_str(&format!(
             "//   {:<17} {}; {} K and {} D variables\n",
             p.name, p.ops, p.k_vars, p.d_vars
+        ));
+    }
+    for c in &low.combined {
+        let p = &c.program;
+        h.push_str(&format!(
+            "//   {:<17} {}; {} K and {} D variables (combined: {})\n",
+            p.name,
+            p.ops,
+            p.k_vars,
+            p.d_vars,
+            c.spec
+                .parts
+                .iter()
+                .map(|p| p.field.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
         ));
     }
     h.push('\n');

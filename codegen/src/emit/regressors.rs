@@ -7,7 +7,7 @@ use quote::quote;
 
 use super::print::{ident, idx, signed_lit};
 use super::{Context, scalar_type};
-use crate::kane::BaseParameters;
+use crate::kane::{BaseParameters, Coefficient};
 use crate::registry::FunctionId;
 
 /// Whether the module has function `id`.
@@ -158,13 +158,78 @@ fn base_items(
         }
     };
     if cx.low.params.is_runtime() {
-        let doc = format!(" The {what} of a parameter set.");
+        let exact = b.exactness.skipped.is_none() && b.exactness.numeric_only.is_empty();
+        let doc = if exact {
+            format!(
+                " The {what} of a parameter set, with the grouping coefficients of its own geometry (lengths, wheel radius and track): exact expressions, verified at generation time."
+            )
+        } else {
+            format!(
+                " The {what} of a parameter set (grouping coefficients as in [`{from_vector}`] where they are numbers for the model file's geometry only)."
+            )
+        };
+        let values = b.symbolic.iter().map(|g| {
+            let terms = g.iter().map(|(i, c)| {
+                let i = idx(*i);
+                if c.is_one() {
+                    quote!(v[#i])
+                } else {
+                    let c = coefficient_tokens(cx, c);
+                    quote!((#c) * v[#i])
+                }
+            });
+            quote!(#(#terms)+*)
+        });
         out.extend(quote! {
             #[doc = #doc]
             pub fn #from_params(p: &Params) -> SVector<#t, #nb> {
-                #from_vector(&p.#getter())
+                let v = p.#getter();
+                SVector::<#t, #nb>::from([#(#values),*])
             }
         });
     }
     out
+}
+
+/// A grouping coefficient as an expression of the `Params` fields `p.L1`, `p.R`, ….
+fn coefficient_tokens(cx: &Context<'_>, c: &Coefficient) -> TokenStream {
+    let terms = c.terms.iter().map(|(v, m)| {
+        let field = |p: usize| ident(&cx.model.params[p].name);
+        let num: Vec<TokenStream> = m
+            .iter()
+            .filter(|(_, e)| *e > 0)
+            .flat_map(|&(p, e)| {
+                let f = field(p);
+                (0..e).map(move |_| quote!(p.#f))
+            })
+            .collect();
+        let den: Vec<TokenStream> = m
+            .iter()
+            .filter(|(_, e)| *e < 0)
+            .flat_map(|&(p, e)| {
+                let f = field(p);
+                (0..-e).map(move |_| quote!(p.#f))
+            })
+            .collect();
+        let lit = signed_lit(*v, cx.precision);
+        let product = |f: Vec<TokenStream>| {
+            f.into_iter()
+                .reduce(|a, b| quote!(#a * #b))
+                .unwrap_or_default()
+        };
+        let mut t = if num.is_empty() {
+            quote!(#lit)
+        } else if *v == 1.0 {
+            product(num)
+        } else {
+            let n = product(num);
+            quote!(#lit * #n)
+        };
+        if !den.is_empty() {
+            let d = product(den);
+            t = quote!(#t / (#d));
+        }
+        t
+    });
+    quote!(#(#terms)+*)
 }

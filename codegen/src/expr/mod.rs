@@ -23,6 +23,8 @@ use rustc_hash::{FxBuildHasher, FxHashMap};
 use crate::naming;
 
 mod diff;
+pub mod modular;
+mod partial;
 
 pub use diff::Wrt;
 

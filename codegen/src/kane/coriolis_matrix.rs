@@ -79,7 +79,7 @@ impl Ctx<'_> {
 
     /// Every body's momentum `h_k = I_k V_k` and inertia rate `D_k = (ċ_k, J̇_k)`, in its frame
     /// (zero for links without a body).
-    fn body_momenta(&mut self, vel: &[V6]) -> (Vec<V6>, Vec<Rate>) {
+    pub(super) fn body_momenta(&mut self, vel: &[V6]) -> (Vec<V6>, Vec<Rate>) {
         let links = self.model.links.len();
         let zero = self.ar.zero();
         let mut hc: Vec<V6> = vec![[zero; 6]; links];
@@ -149,7 +149,7 @@ impl Ctx<'_> {
 
     /// Subtree sums, backward: momenta as forces, inertia rates as inertias of mass 0. The
     /// first-moment rate ċ of a subtree is its linear momentum (both move up as R·x).
-    fn subtree_momenta(&mut self, hc: &mut [V6], dc: &mut [Rate]) {
+    pub(super) fn subtree_momenta(&mut self, hc: &mut [V6], dc: &mut [Rate]) {
         let zero = self.ar.zero();
         let model = self.model;
         for (c, _, mount) in model.mounted_links().rev() {
@@ -194,7 +194,7 @@ impl Ctx<'_> {
 
     /// The columns (speeds) of every link and their motion subspaces `S` in its frame: a
     /// joint's, or the base's ẋ and ψ̇ at the root.
-    fn speed_columns(&mut self) -> Vec<Vec<(usize, V6)>> {
+    pub(super) fn speed_columns(&mut self) -> Vec<Vec<(usize, V6)>> {
         let model = self.model;
         let links = model.links.len();
         let zero = self.ar.zero();
@@ -219,7 +219,7 @@ impl Ctx<'_> {
     }
 
     /// `V_l × S` for every column, in its frame (the Coriolis bias of a unit speed).
-    fn bias_columns(&mut self, vel: &[V6], cols: &[Vec<(usize, V6)>]) -> Vec<Vec<V6>> {
+    pub(super) fn bias_columns(&mut self, vel: &[V6], cols: &[Vec<(usize, V6)>]) -> Vec<Vec<V6>> {
         let mut vxs: Vec<Vec<V6>> = vec![Vec::new(); cols.len()];
         for l in 0..cols.len() {
             for k in 0..cols[l].len() {
@@ -356,7 +356,7 @@ impl Ctx<'_> {
 }
 
 /// An inertia rate `D = (ċ, J̇)`: first-moment rate and `[XX, XY, XZ, YY, YZ, ZZ]` rate.
-type Rate = (V3, [ExprId; 6]);
+pub(super) type Rate = (V3, [ExprId; 6]);
 
 /// Component suffixes of `[XX, XY, XZ, YY, YZ, ZZ]` labels.
 const LABELS: [&str; 6] = ["xx", "xy", "xz", "yy", "yz", "zz"];

@@ -38,8 +38,10 @@
 //! | `gravity.rs` | g |
 //! | `rnea.rs` | c and τ: forward motion pass, body inertia forces, backward accumulation |
 //! | `coriolis_matrix.rs` | C: frame velocities, subtree momenta and inertia rates, columns |
+//! | `rnea_derivatives.rs` | ∂τ/∂q, ∂τ/∂u: the analytic recursion (four forces per column carried up; `derivatives.rs` keeps forward mode as its test oracle) |
 //! | `kinematics.rs` | frames in frame 0 (`⁰A`, `⁰p`), centre of mass, its Jacobian and bias acceleration, energies |
 //! | `regressor.rs` | regressors `∂τ/∂π`, `∂g/∂β` (by [`Arena::diff`]) and their base parameters |
+//! | `grouping.rs` | the base parameters' groupings as exact expressions of the geometry (fitted, then verified in exact modular arithmetic) |
 //!
 //! The arena records the order in which each phase first asks for a node and the lowering
 //! schedules statements in that order: moving arena calls around changes the generated code.
@@ -53,20 +55,24 @@ mod coriolis_matrix;
 mod derivatives;
 mod frames;
 mod gravity;
+mod grouping;
 mod kinematics;
 mod mass_matrix;
 mod mimic;
 mod regressor;
 mod rnea;
+mod rnea_derivatives;
 
 use kanegen_model::{Model, ParamKind};
 
+use crate::combined::ResolvedCombined;
 use crate::expr::{Arena, ExprId, Names};
 use crate::options::Options;
 use crate::registry::{FunctionId, Sizes};
 
 use algebra::{M3, V3};
 use composite::Composite;
+pub use grouping::{Coefficient, Exactness, SymbolicGroup, symbolic_group_text};
 pub use regressor::{BaseParameters, Regressors, group_text};
 
 /// One derived registry function: its output entries as expressions in the arena (its name,
@@ -107,6 +113,21 @@ pub struct Derivation {
     pub regressors: Regressors,
     /// The result sizes (speeds, regressor columns).
     pub sizes: Sizes,
+    /// The combined functions (one arena phase each; see [`crate::combined`]).
+    pub combined: Vec<CombinedFunction>,
+}
+
+/// One derived combined function: its parts' entries and the statement order of its phase.
+#[derive(Clone, Debug)]
+pub struct CombinedFunction {
+    /// What was asked for, resolved against the model.
+    pub spec: ResolvedCombined,
+    /// Per part (in the order of `spec.parts`), its `(row, col, expr)` entries in the layout of
+    /// the part's [`Shape`](crate::registry::Shape).
+    pub parts: Vec<Vec<(usize, usize, ExprId)>>,
+    /// The arena nodes the combined function's phase asked for, in the order it first asked
+    /// for them (see [`Function::order`]).
+    pub order: Vec<ExprId>,
 }
 
 impl Derivation {
@@ -144,7 +165,7 @@ pub fn names_of(model: &Model) -> Names {
 /// spills); g and C reuse those composites. The order fixes the arena's numbering and with it the
 /// generated code, so it is part of the output's definition. The opt-in kinematics come last, so
 /// that they do not change the dynamics' code.
-const DERIVATION_ORDER: [FunctionId; 18] = [
+const DERIVATION_ORDER: [FunctionId; 19] = [
     FunctionId::MassMatrix,
     FunctionId::Gravity,
     FunctionId::Coriolis,
@@ -163,10 +184,17 @@ const DERIVATION_ORDER: [FunctionId; 18] = [
     FunctionId::GravityRegressor,
     FunctionId::BaseRegressor,
     FunctionId::BaseGravityRegressor,
+    FunctionId::NonlinearEffects,
 ];
 
 /// Derive the functions of `options.functions` for `model` (M as its upper triangle).
 pub fn derive(model: &Model, options: Options) -> Derivation {
+    derive_with(model, options, &[])
+}
+
+/// [`derive`], and the combined functions `combined` (resolved against `model` by
+/// [`crate::combined::resolve`]), each one arena phase after the module's functions.
+pub fn derive_with(model: &Model, options: Options, combined: &[ResolvedCombined]) -> Derivation {
     let mut arena = Arena::new(names_of(model));
     arena.hoist_params = options.params.is_runtime();
     mimic::declare(&mut arena, model);
@@ -221,6 +249,27 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
             });
         }
     }
+    // Each combined function is one phase: its parts are derived again (the arena's hash-consing
+    // and variable cache give the very nodes of the separate functions), so that the one program
+    // computes every shared sine, cosine and variable once.
+    let mut combined_out = Vec::with_capacity(combined.len());
+    for c in combined {
+        cx.ar.begin_phase();
+        let mut parts = Vec::with_capacity(c.parts.len());
+        for part in &c.parts {
+            let id = part.function;
+            let entries = match part.frame {
+                Some(l) => cx.derive_frame_function(id, l),
+                None => cx.derive_function(id, &mut composites),
+            };
+            parts.push(mimic::project(cx.ar, model, id.spec().shape, entries));
+        }
+        combined_out.push(CombinedFunction {
+            spec: c.clone(),
+            parts,
+            order: cx.ar.phase_order(),
+        });
+    }
     functions.sort_by_key(|f| (f.id, f.frame));
     let sizes = Sizes {
         dof: n,
@@ -241,6 +290,7 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
         frame_names: model.links.iter().map(|l| l.name.clone()).collect(),
         regressors,
         sizes,
+        combined: combined_out,
     }
 }
 
@@ -267,6 +317,7 @@ impl Ctx<'_> {
             }
             FunctionId::Coriolis => vector(self.rnea(false, false)),
             FunctionId::InverseDynamics => vector(self.rnea(true, true)),
+            FunctionId::NonlinearEffects => vector(self.rnea(false, true)),
             FunctionId::CoriolisMatrix => {
                 let comp = composites.get_or_insert_with(|| self.composites(true, None));
                 self.coriolis_matrix(comp)
@@ -341,7 +392,8 @@ impl Ctx<'_> {
             return entries;
         }
         let params = if gravity { &reg.beta } else { &reg.inertial };
-        let base = regressor::base_parameters(self.ar, self.model, &entries, params);
+        let baked = !matches!(self.options.params, crate::ParamMode::Runtime);
+        let base = regressor::base_parameters(self.ar, self.model, &entries, params, baked);
         let column: std::collections::HashMap<usize, usize> = base
             .groups
             .iter()

@@ -21,6 +21,7 @@
 use kanegen_model::{Model, ParamKind};
 
 use super::Ctx;
+use super::grouping::{Exactness, SymbolicGroup};
 use crate::expr::{Arena, ExprId, Values, Wrt};
 
 /// Which model parameters the regressors' columns stand for, and the base parameters found.
@@ -52,6 +53,12 @@ pub struct BaseParameters {
     pub states: usize,
     /// Largest relative residual of the grouping `Y_D − Y_I C` on other random states.
     pub check_residual: f64,
+    /// The same groups with their coefficients as exact expressions of the geometry (lengths,
+    /// wheel radius and track; numbers where none enters), parallel to `groups`
+    /// (`super::grouping`).
+    pub symbolic: Vec<SymbolicGroup>,
+    /// How the symbolic groups were verified.
+    pub exactness: Exactness,
 }
 
 impl Regressors {
@@ -158,10 +165,11 @@ impl Ctx<'_> {
 
 /// A small deterministic generator (xorshift64*): the base parameters, and with them the
 /// generated code, must not depend on anything but the model.
-struct Rng(u64);
+pub(super) struct Rng(pub(super) u64);
 
 impl Rng {
-    fn next(&mut self) -> f64 {
+    /// Uniform in `[0, 1)`.
+    pub(super) fn next(&mut self) -> f64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;
@@ -170,33 +178,37 @@ impl Rng {
     }
 
     /// Uniform in `[-a, a]`.
-    fn sym(&mut self, a: f64) -> f64 {
+    pub(super) fn sym(&mut self, a: f64) -> f64 {
         a * (2.0 * self.next() - 1.0)
     }
 }
 
-/// The dense regressor (`independent_dof × cols`, row-major) of `entries` at one random state.
-/// `entries` are the whole tree's rows; a mimic model's are projected by the constraint map
+/// The dense regressor (`independent_dof × cols`, row-major) of `entries` at one random state,
+/// with the model parameter values `params`. `entries` are the whole tree's rows; a mimic model's are projected by the constraint map
 /// (`Tᵀ Y`, as the generated function is), so that the base parameters are those of the reduced
 /// model.
-fn regressor_at(
+pub(super) fn regressor_at(
     ar: &Arena,
     entries: &[(usize, usize, ExprId)],
     model: &Model,
+    params: &[f64],
+    needed: &[bool],
     cols: usize,
     rng: &mut Rng,
 ) -> Vec<f64> {
     let n = model.dof();
-    let params: Vec<f64> = model.params.iter().map(|p| p.value).collect();
     let q: Vec<f64> = (0..n).map(|_| rng.sym(std::f64::consts::PI)).collect();
     let u: Vec<f64> = (0..n).map(|_| rng.sym(2.0)).collect();
     let ud: Vec<f64> = (0..n).map(|_| rng.sym(2.0)).collect();
-    let vals = ar.eval(&Values {
-        params: &params,
-        q: &q,
-        u: &u,
-        ud: &ud,
-    });
+    let vals = ar.eval_needed(
+        &Values {
+            params,
+            q: &q,
+            u: &u,
+            ud: &ud,
+        },
+        needed,
+    );
     let map = model.constraint_map();
     let mut y = vec![0.0; model.independent_dof() * cols];
     for &(r, c, e) in entries {
@@ -212,16 +224,20 @@ pub(super) fn base_parameters(
     model: &Model,
     entries: &[(usize, usize, ExprId)],
     params: &[usize],
+    baked: bool,
 ) -> BaseParameters {
     let n = model.independent_dof().max(1);
     let cols = params.len();
     let states = (3 * cols / n + 10).max(30);
+    let values: Vec<f64> = model.params.iter().map(|p| p.value).collect();
+    let roots: Vec<ExprId> = entries.iter().map(|&(_, _, e)| e).collect();
+    let needed = ar.needed_nodes(&roots);
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     // Column-major stack of `states` regressors.
     let rows = states * n;
     let mut a = vec![vec![0.0; rows]; cols];
     for s in 0..states {
-        let y = regressor_at(ar, entries, model, cols, &mut rng);
+        let y = regressor_at(ar, entries, model, &values, &needed, cols, &mut rng);
         for r in 0..n {
             for c in 0..cols {
                 a[c][s * n + r] = y[r * cols + c];
@@ -304,7 +320,7 @@ pub(super) fn base_parameters(
     // Check the grouping on other states: Y_D = Y_I C.
     let mut worst: f64 = 0.0;
     for _ in 0..10 {
-        let y = regressor_at(ar, entries, model, cols, &mut rng);
+        let y = regressor_at(ar, entries, model, &values, &needed, cols, &mut rng);
         for row in 0..n {
             let yr = &y[row * cols..(row + 1) * cols];
             let scale = yr.iter().map(|v| v.abs()).fold(1e-300, f64::max);
@@ -328,12 +344,29 @@ pub(super) fn base_parameters(
             }
         })
         .collect();
+    let dependent: Vec<usize> = coefficients.iter().map(|(c, _)| *c).collect();
+    let (symbolic, exactness) = super::grouping::symbolic(
+        &super::grouping::Problem {
+            ar,
+            model,
+            entries,
+            params,
+            kept: &kept,
+            dependent: &dependent,
+            unidentifiable: &unidentifiable,
+            baked,
+            needed: &needed,
+        },
+        &groups,
+    );
     BaseParameters {
         names,
         groups,
         unidentifiable,
         states,
         check_residual: worst,
+        symbolic,
+        exactness,
     }
 }
 

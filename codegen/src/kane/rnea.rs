@@ -72,7 +72,12 @@ impl Ctx<'_> {
     pub(super) fn rnea(&mut self, with_accel: bool, with_gravity: bool) -> Vec<ExprId> {
         let (f, n) = self.inertia_forces(Inputs::new(with_accel, with_gravity));
         let out = self.generalized_forces(&f, &n, with_accel);
-        self.finish(out, if with_accel { "tau" } else { "c" })
+        let label = match (with_accel, with_gravity) {
+            (true, _) => "tau",
+            (false, false) => "c",
+            (false, true) => "h",
+        };
+        self.finish(out, label)
     }
 
     /// `Σ_k m_k a_Gk` over every body at `u̇ = 0` without gravity, in frame 0: the total inertia
@@ -97,6 +102,18 @@ impl Ctx<'_> {
     /// of every frame for the motion of `inputs`: the forward motion pass, body inertia forces
     /// and the backward accumulation (`f[0]`, `n[0]`: the whole robot's).
     fn inertia_forces(&mut self, inputs: Inputs) -> (Vec<V3>, Vec<V3>) {
+        let (_, f, n) = self.motion_and_forces(inputs);
+        (f, n)
+    }
+
+    /// τ's motion pass and subtree forces (with u̇ and gravity): every frame's `(ω, α, a)` and
+    /// the subtree force `f` and moment `n` about its origin (the same nodes as τ's).
+    pub(super) fn inverse_dynamics_pass(&mut self) -> (Motion, Vec<V3>, Vec<V3>) {
+        self.motion_and_forces(Inputs::new(true, true))
+    }
+
+    /// [`Ctx::inertia_forces`] with the motion.
+    fn motion_and_forces(&mut self, inputs: Inputs) -> (Motion, Vec<V3>, Vec<V3>) {
         let model = self.model;
         let links = model.links.len();
         let zero = self.ar.zero();
@@ -123,7 +140,7 @@ impl Ctx<'_> {
         for (c, _, mount) in model.mounted_links().rev() {
             self.accumulate(c, mount, &mut f, &mut n, tag);
         }
-        (f, n)
+        (motion, f, n)
     }
 
     /// The motion of the root frame (the wheeled base's `ω0 = [0,0,ψ̇]`, `α0 = [0,0,ψ̈]`,

@@ -31,7 +31,7 @@ mod generated {
         /// Index of the speed `qd_w` in u, u̇ and τ (the rate of `q_w`).
         pub const QD_W: usize = 1;
     }
-    pub use kanegen_runtime::UnknownParameter;
+    pub use kanegen_runtime::{SetParameterError, UnknownParameter};
     /// Number of model parameters.
     pub const PARAM_COUNT: usize = 23;
     /// Model parameters of `two-link`, named with the reports' symbols; `Default` holds the values of `two-link.toml`.
@@ -173,34 +173,49 @@ mod generated {
                 _ => None,
             }
         }
-        /// Set parameter `name`; an error if the model has no such parameter.
-        pub fn set(&mut self, name: &str, value: f64) -> Result<(), UnknownParameter> {
+        /// Set parameter `name` to `value`.
+        ///
+        /// # Errors
+        /// [`SetParameterError::Unknown`] if the model has no such parameter (nothing is
+        /// changed); [`SetParameterError::Invalid`] if `value` is not finite, or is a mass,
+        /// wheel radius, track width or wheel mass that is not positive, or a wheel inertia
+        /// that is negative (nothing is changed). The checks that involve several
+        /// parameters at once (a body's inertia) are [`Params::validate`]'s.
+        pub fn set(&mut self, name: &str, value: f64) -> Result<(), SetParameterError> {
+            use kanegen_runtime::validate as v;
+            let slot = match name {
+                "g" => &mut self.g,
+                "L1" => &mut self.L1,
+                "L2" => &mut self.L2,
+                "m1" => &mut self.m1,
+                "MX1" => &mut self.MX1,
+                "MY1" => &mut self.MY1,
+                "MZ1" => &mut self.MZ1,
+                "XX1" => &mut self.XX1,
+                "XY1" => &mut self.XY1,
+                "XZ1" => &mut self.XZ1,
+                "YY1" => &mut self.YY1,
+                "YZ1" => &mut self.YZ1,
+                "ZZ1" => &mut self.ZZ1,
+                "m2" => &mut self.m2,
+                "MX2" => &mut self.MX2,
+                "MY2" => &mut self.MY2,
+                "MZ2" => &mut self.MZ2,
+                "XX2" => &mut self.XX2,
+                "XY2" => &mut self.XY2,
+                "XZ2" => &mut self.XZ2,
+                "YY2" => &mut self.YY2,
+                "YZ2" => &mut self.YZ2,
+                "ZZ2" => &mut self.ZZ2,
+                _ => return Err(UnknownParameter::new(name).into()),
+            };
+            let x = f64::from(value);
+            v::check_finite(&[name], &[x])?;
             match name {
-                "g" => self.g = value,
-                "L1" => self.L1 = value,
-                "L2" => self.L2 = value,
-                "m1" => self.m1 = value,
-                "MX1" => self.MX1 = value,
-                "MY1" => self.MY1 = value,
-                "MZ1" => self.MZ1 = value,
-                "XX1" => self.XX1 = value,
-                "XY1" => self.XY1 = value,
-                "XZ1" => self.XZ1 = value,
-                "YY1" => self.YY1 = value,
-                "YZ1" => self.YZ1 = value,
-                "ZZ1" => self.ZZ1 = value,
-                "m2" => self.m2 = value,
-                "MX2" => self.MX2 = value,
-                "MY2" => self.MY2 = value,
-                "MZ2" => self.MZ2 = value,
-                "XX2" => self.XX2 = value,
-                "XY2" => self.XY2 = value,
-                "XZ2" => self.XZ2 = value,
-                "YY2" => self.YY2 = value,
-                "YZ2" => self.YZ2 = value,
-                "ZZ2" => self.ZZ2 = value,
-                _ => return Err(UnknownParameter::new(name)),
+                "m1" | "m2" => v::check_positive(name, x)?,
+                _ => {}
             }
+            *slot = value;
             Ok(())
         }
         /// All values in the order of [`Params::NAMES`].

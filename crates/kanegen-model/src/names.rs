@@ -77,6 +77,7 @@ pub const RESERVED_ITEMS: &[&str] = &[
     "Params",
     "Precomputed",
     "UnknownParameter",
+    "SetParameterError",
     "Frame",
     "SMatrix",
     "SVector",

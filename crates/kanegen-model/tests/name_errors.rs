@@ -4,80 +4,8 @@
 
 use kanegen_model::{BadName, Model, ModelErrorKind as K, UrdfOptions};
 
-/// Two revolute links `q1`, `q2` (speeds `qd1`, `qd2`) on a fixed base frame.
-const VALID: &str = r#"
-[model]
-name = "two-link"
-speeds = ["qd1", "qd2"]
-
-[base]
-type = "fixed"
-frame = "0"
-
-[gravity]
-symbol = "g"
-direction = [0, 0, -1]
-
-[parameters]
-g = 9.81
-L1 = 0.5
-m1 = 2.0
-MX1 = 0.0
-MY1 = 0.2
-MZ1 = 0.0
-XX1 = 0.05
-XY1 = 0.0
-XZ1 = 0.0
-YY1 = 0.01
-YZ1 = 0.0
-ZZ1 = 0.05
-m2 = 2.0
-MX2 = 0.0
-MY2 = 0.2
-MZ2 = 0.0
-XX2 = 0.05
-XY2 = 0.0
-XZ2 = 0.0
-YY2 = 0.01
-YZ2 = 0.0
-ZZ2 = 0.05
-
-[[joint]]
-name = "q1"
-type = "revolute"
-parent = "0"
-child = "1"
-speed = "qd1"
-axis = [-1, 0, 0]
-rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
-translation = [0, 0, 0]
-
-[[joint]]
-name = "q2"
-type = "revolute"
-parent = "1"
-child = "2"
-speed = "qd2"
-axis = [-1, 0, 0]
-rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
-translation = [0, "L1", 0]
-
-[[body]]
-frame = "1"
-
-[[body]]
-frame = "2"
-"#;
-
-/// `VALID` with each `(from, to)` applied; every `from` must occur exactly once.
-fn mutate(edits: &[(&str, &str)]) -> String {
-    let mut text = VALID.to_owned();
-    for (from, to) in edits {
-        assert_eq!(text.matches(from).count(), 1, "{from:?} must occur once");
-        text = text.replacen(from, to, 1);
-    }
-    text
-}
+mod common;
+use common::{VALID, mutate};
 
 /// `VALID` with speed `qd1` renamed `to`.
 fn speed1(to: &str) -> String {

@@ -6,89 +6,10 @@ use std::path::PathBuf;
 
 use kanegen_model::{Model, ModelError, ModelErrorKind as K};
 
-/// Two revolute links on a fixed base frame (the shape of seed 002 Appendix B). Both bodies have
-/// m = 2, S = [0, 0.1, 0] and I_G = diag(0.03, 0.01, 0.03), so J = diag(0.05, 0.01, 0.05).
-const VALID: &str = r#"
-[model]
-name = "two-link"
-description = "validation test model"
-speeds = ["qd1", "qd2"]
-
-[base]
-type = "fixed"
-frame = "0"
-
-[gravity]
-symbol = "g"
-direction = [0, 0, -1]
-
-[parameters]
-g = 9.81
-L1 = 0.5
-L2 = 0.1
-m1 = 2.0
-MX1 = 0.0
-MY1 = 0.2
-MZ1 = 0.0
-XX1 = 0.05
-XY1 = 0.0
-XZ1 = 0.0
-YY1 = 0.01
-YZ1 = 0.0
-ZZ1 = 0.05
-m2 = 2.0
-MX2 = 0.0
-MY2 = 0.2
-MZ2 = 0.0
-XX2 = 0.05
-XY2 = 0.0
-XZ2 = 0.0
-YY2 = 0.01
-YZ2 = 0.0
-ZZ2 = 0.05
-
-[[joint]]
-name = "q1"
-type = "revolute"
-parent = "0"
-child = "1"
-speed = "qd1"
-axis = [-1, 0, 0]
-rotation = [[0, 0, -1], [-1, 0, 0], [0, 1, 0]]
-translation = [0, 0, 0]
-
-[[joint]]
-name = "q2"
-type = "revolute"
-parent = "1"
-child = "2"
-speed = "qd2"
-axis = [-1, 0, 0]
-rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
-translation = [0, "L1", "-L2"]
-
-[[body]]
-frame = "1"
-
-[[body]]
-frame = "2"
-"#;
+mod common;
+use common::{VALID, mutate};
 
 const FILE: &str = "bad.toml";
-
-/// `VALID` with each `(from, to)` applied; every `from` must occur exactly once (no silent no-ops).
-fn mutate(edits: &[(&str, &str)]) -> String {
-    let mut text = VALID.to_owned();
-    for (from, to) in edits {
-        assert_eq!(
-            text.matches(from).count(),
-            1,
-            "mutation pattern {from:?} must occur exactly once"
-        );
-        text = text.replacen(from, to, 1);
-    }
-    text
-}
 
 /// Load `text`, expect an error labelled `bad.toml` whose message names every item of `names`.
 fn load_err(text: &str, names: &[&str]) -> ModelError {

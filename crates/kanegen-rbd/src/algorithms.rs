@@ -15,7 +15,7 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
     /// `sin q_j` and `cos q_j` of every revolute joint (`0`, `1` for prismatic joints) into
     /// `sn`, `cs`, computed up front in one independent (vectorizable) batch.
     #[inline(always)]
-    fn sin_cos_all(&self, q: &SVector<T, N>, sn: &mut [T; N], cs: &mut [T; N]) {
+    pub(crate) fn sin_cos_all(&self, q: &SVector<T, N>, sn: &mut [T; N], cs: &mut [T; N]) {
         let mut x = [T::zero(); N];
         for (l, xj) in self.links[..self.nl].iter().zip(x.iter_mut()) {
             if !l.prismatic {

@@ -282,6 +282,7 @@ fn wheels<T: Scalar>(
         psi: w.psi_speed,
         m_xx: two * mw + two * yy / (r * r),
         m_psipsi: mw * l * l / two + yy * l * l / (two * r * r) + two * zz,
+        mass: two * mw,
     }))
 }
 

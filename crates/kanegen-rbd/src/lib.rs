@@ -10,7 +10,9 @@
 //! * [`Rbd::gravity`]: a gravity-only pass `g(q)` using composite masses and first moments;
 //! * [`Rbd::kinetic_energy`]: `½ uᵀ M u` from the link velocities;
 //! * [`Rbd::frame_pose`], [`Rbd::frame_jacobian`], [`Rbd::frame_bias_acceleration`]: one frame's
-//!   kinematics ([`RbdFrame`]), a pass down its path only.
+//!   kinematics ([`RbdFrame`]), a pass down its path only;
+//! * [`Rbd::center_of_mass`], [`Rbd::com_jacobian`]: the whole robot's centre of mass and its
+//!   Jacobian, one forward and one backward pass (subtree first moments).
 //!
 //! # Formulation
 //!
@@ -79,6 +81,9 @@
 
 mod algorithms;
 mod build;
+mod com;
+#[cfg(feature = "dual")]
+mod dual;
 mod frames;
 mod rot;
 mod scalar;
@@ -87,6 +92,8 @@ use std::fmt;
 
 use kanegen_model::Model;
 
+#[cfg(feature = "dual")]
+pub use dual::DualDerivatives;
 pub use frames::RbdFrame;
 use scalar::{M3, S3, V3};
 pub use scalar::{Scalar, sin_cos_f64};
@@ -216,6 +223,8 @@ struct Wheels<T> {
     m_xx: T,
     /// `mw L²/2 + YYw L²/(2R²) + 2 ZZw`.
     m_psipsi: T,
+    /// `2 mw`: both wheels' mass (point masses on the axle, for the centre of mass).
+    mass: T,
 }
 
 /// The base frame: the bodies rigidly attached to it, gravity and the wheels.

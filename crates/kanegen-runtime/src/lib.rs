@@ -5,9 +5,10 @@
 //! - [`trig`]: the batched `sin`/`cos` of the joint angles, [`trig::sin_cos_n`] (`f64`) and
 //!   [`trig::sin_cos_n_f32`] (`f32`), that each generated function calls once; a `core`-only,
 //!   branch-free fdlibm kernel that the compiler vectorizes.
-//! - [`UnknownParameter`]: the allocation-free error of a generated `Params::set` for a name
-//!   the model does not have; [`InvalidParameter`], the error of `Params::validate`, and the
-//!   checks it runs ([`validate`]).
+//! - [`SetParameterError`]: the allocation-free error of a generated `Params::set`, either
+//!   [`UnknownParameter`] (a name the model does not have) or [`InvalidParameter`] (a value
+//!   that is not finite or not physical); [`InvalidParameter`] is also the error of
+//!   `Params::validate`, with the checks it runs ([`validate`]).
 //! - [`params_serde!`]: the macro a generated module invokes after its `Params`, which
 //!   implements `serde`'s traits with the `serde` feature; `params_from_model_toml` (feature
 //!   `toml`) reads the parameter values of a model file at run time.
@@ -29,7 +30,7 @@
 //!
 //! ```text
 //! use kanegen_runtime::trig::sin_cos_n;            // f32 modules: sin_cos_n_f32 as sin_cos_n
-//! pub use kanegen_runtime::UnknownParameter;       // the error of Params::set
+//! pub use kanegen_runtime::{SetParameterError, UnknownParameter}; // errors of Params::set
 //!
 //! impl kanegen_runtime::RobotDynamics<2> for TwoLink {
 //!     type Scalar = f64;
@@ -143,6 +144,7 @@ pub mod isa;
 pub mod lanes;
 #[doc(hidden)]
 pub mod serde_support;
+mod set_parameter_error;
 pub mod trig;
 mod unknown_parameter;
 
@@ -153,6 +155,7 @@ pub use nalgebra;
 pub use serde;
 #[cfg(feature = "toml")]
 pub use serde_support::{ModelFileError, params_from_model_toml};
+pub use set_parameter_error::SetParameterError;
 pub use unknown_parameter::UnknownParameter;
 
 /// The checks of a generated `Params::validate` (see the [crate docs](crate#parameters-as-data)).

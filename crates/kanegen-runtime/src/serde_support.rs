@@ -3,7 +3,7 @@
 //! A generated module invokes [`params_serde!`](crate::params_serde) after its `Params`. With
 //! the feature the macro implements `Serialize` (a map from parameter name to value, in the
 //! order of `Params::NAMES`) and `Deserialize` (from such a map: names left out keep their
-//! defaults, an unknown name is an error) through the `serde` this crate re-exports, using only
+//! defaults, an unknown name or a value `set` refuses is an error) through the `serde` this crate re-exports, using only
 //! `NAMES`, `to_array`, `set` and `Default` of the generated `Params`. Without the feature the
 //! macro expands to nothing. So the switch is the feature of `kanegen-runtime`, not of the crate
 //! that includes the generated code: that crate neither declares a feature nor depends on
@@ -33,9 +33,7 @@ macro_rules! params_serde {
                 $crate::serde_support::deserialize::<$scalar, D>(
                     &Self::NAMES,
                     deserializer,
-                    |name, value| {
-                        let _known = params.set(name, value).is_ok();
-                    },
+                    |name, value| params.set(name, value),
                 )?;
                 ::core::result::Result::Ok(params)
             }
@@ -68,13 +66,14 @@ pub fn serialize<T: serde::Serialize, S: serde::Serializer>(
 }
 
 /// Reads a map from parameter names (each one of `names`, or an `unknown field` error) to
-/// values and hands each pair to `set` (the body of a generated `Params`' `Deserialize`).
+/// values and hands each pair to `set` (the body of a generated `Params`' `Deserialize`); a value
+/// `set` refuses (not finite, not physical) is a custom error that names the parameter.
 /// Allocation-free: keys are matched as they are read.
 #[cfg(feature = "serde")]
 pub fn deserialize<'de, T, D>(
     names: &'static [&'static str],
     deserializer: D,
-    set: impl FnMut(&'static str, T),
+    set: impl FnMut(&'static str, T) -> Result<(), crate::SetParameterError>,
 ) -> Result<(), D::Error>
 where
     T: serde::Deserialize<'de>,
@@ -105,7 +104,11 @@ where
     }
 
     struct Table<T, F>(&'static [&'static str], F, PhantomData<T>);
-    impl<'de, T: serde::Deserialize<'de>, F: FnMut(&'static str, T)> Visitor<'de> for Table<T, F> {
+    impl<'de, T, F> Visitor<'de> for Table<T, F>
+    where
+        T: serde::Deserialize<'de>,
+        F: FnMut(&'static str, T) -> Result<(), crate::SetParameterError>,
+    {
         type Value = ();
         fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
             f.write_str("a table of parameter values by name")
@@ -113,7 +116,7 @@ where
         fn visit_map<A: MapAccess<'de>>(mut self, mut map: A) -> Result<(), A::Error> {
             while let Some(i) = map.next_key_seed(Key(self.0))? {
                 let value = map.next_value::<T>()?;
-                (self.1)(self.0[i], value);
+                (self.1)(self.0[i], value).map_err(A::Error::custom)?;
             }
             Ok(())
         }

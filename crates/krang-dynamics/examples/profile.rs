@@ -11,7 +11,10 @@
 //! ```
 //!
 //! Arguments: a function (`mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, or `all`;
-//! a suffix `_b4` or `_b8` calls the batched form with 4 or 8 states, counted as one call), the
+//! a suffix `_b4` or `_b8` calls the batched form with 4 or 8 states, counted as one call; with
+//! the feature `derivatives` also `inverse_dynamics_derivatives`; with the feature `kinematics`
+//! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
+//! `com_jacobian` and `sin_cos_17`), the
 //! number of calls, and optionally the instruction set (`baseline` or `x86-64-v3`; default: the
 //! best the CPU has, see `kanegen_runtime::isa`). States cycle through 64 fixed pseudo-random
 //! states.
@@ -80,10 +83,57 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> f64 {
                 black_box(k).inverse_dynamics_batch(black_box(&q), black_box(&u), black_box(&u))[1]
                     [7]
             }
-            other => panic!("unknown function `{other}`"),
+            #[cfg(feature = "derivatives")]
+            "inverse_dynamics_derivatives" => {
+                black_box(k).inverse_dynamics_derivatives(black_box(q), black_box(u), black_box(ud))
+                    [(7, 20)]
+            }
+            other => kinematics(k, other, q, u),
         };
     }
     acc
+}
+
+/// The combined `whole_body_terms` and the eleven separate calls it replaces (feature
+/// `kinematics`), and the 17-angle `sin_cos_n` every call computes.
+#[cfg(feature = "kinematics")]
+fn kinematics(k: &Krang, f: &str, q: &V, u: &V) -> f64 {
+    use krang_dynamics::Frame;
+    let hands = [Frame::LeftHand, Frame::RightHand];
+    match f {
+        "whole_body_terms" => {
+            let w = black_box(k).whole_body_terms(black_box(q), black_box(u));
+            w.mass_matrix[(5, 3)] + w.frame_jacobian_right_hand[(2, 9)]
+        }
+        "whole_body_separate" => {
+            let (k, q, u) = (black_box(k), black_box(q), black_box(u));
+            let m = k.mass_matrix(q);
+            let h = k.nonlinear_effects(q, u);
+            let g = k.center_of_mass(q);
+            let jg = k.com_jacobian(q);
+            let bg = k.com_bias_acceleration(q, u);
+            let hs = hands.map(|f| {
+                (
+                    k.frame_pose(q, f),
+                    k.frame_jacobian(q, f),
+                    k.frame_bias_acceleration(q, u, f),
+                )
+            });
+            black_box((&m, &h, &g, &jg, &bg, &hs));
+            m[(5, 3)] + hs[1].1[(2, 9)]
+        }
+        "com_jacobian" => black_box(k).com_jacobian(black_box(q))[(1, 7)],
+        "sin_cos_17" => {
+            let a: [f64; 17] = std::array::from_fn(|i| q[i + 2]);
+            kanegen_runtime::trig::sin_cos_n(black_box(a)).0[3]
+        }
+        other => panic!("unknown function `{other}`"),
+    }
+}
+
+#[cfg(not(feature = "kinematics"))]
+fn kinematics(_: &Krang, other: &str, _: &V, _: &V) -> f64 {
+    panic!("unknown function `{other}` (the kinematics need the feature `kinematics`)")
 }
 
 /// `L` consecutive states' coordinates, from state `i`.

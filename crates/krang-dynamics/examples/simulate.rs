@@ -966,13 +966,18 @@ fn tick_label(v: f64, step: f64) -> String {
     format!("{v:.decimals$}")
 }
 
-/// Writes `panels`, stacked, as a PNG of `size` pixels.
+/// Writes `panels`, stacked, as a PNG of `size` pixels (time on the x axis).
 pub fn figure(path: &Path, size: (u32, u32), panels: &[Panel]) -> Res<()> {
+    figure_over(path, size, panels, "time (s)")
+}
+
+/// Writes `panels`, stacked, as a PNG of `size` pixels, with `x_label` under each x axis.
+pub fn figure_over(path: &Path, size: (u32, u32), panels: &[Panel], x_label: &str) -> Res<()> {
     let root = BitMapBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE)?;
     let areas = root.split_evenly((panels.len(), 1));
     for (panel, area) in panels.iter().zip(&areas) {
-        draw_panel(&root, area, panel)?;
+        draw_panel(&root, area, panel, x_label)?;
     }
     root.present()?;
     Ok(())
@@ -996,7 +1001,7 @@ fn legend_layout(panel: &Panel, width: i32) -> Vec<(&Series, i32, i32)> {
 
 /// One panel: the plot, its axes, and the legend in rows below the time axis (outside the
 /// data).
-fn draw_panel(root: &Area, area: &Area, panel: &Panel) -> Res<()> {
+fn draw_panel(root: &Area, area: &Area, panel: &Panel, x_label: &str) -> Res<()> {
     let (ax, ay) = area.get_base_pixel();
     let (aw, _) = area.dim_in_pixel();
     // Data ranges.
@@ -1076,7 +1081,7 @@ fn draw_panel(root: &Area, area: &Area, panel: &Panel) -> Res<()> {
         let s = tick_label(t, ys);
         text(root, &s, (px - 10 - text_width(&s), py - h / 2), &BLACK_)?;
     }
-    let label = "time (s)";
+    let label = x_label;
     let (_, bottom) = chart.backend_coord(&(x0, y0));
     text(
         root,

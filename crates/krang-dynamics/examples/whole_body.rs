@@ -3,6 +3,11 @@
 //! acceleration, and the hands' poses, Jacobians and bias accelerations (`left_hand`,
 //! `right_hand`, the operational frames of `krang.toml`).
 //!
+//! Every control step reads them from **one** generated call, `Krang::whole_body_terms` (a
+//! combined function, see `build.rs`): the sines and cosines, rotations, positions and motion
+//! pass are computed once for all of them (the values are those of the separate functions, bit
+//! for bit).
+//!
 //! The 19-speed robot (wheeled base, no ground contact other than rolling) starts at rest,
 //! balanced (centre of mass above the axle), arms in the pose of the `simulate` example. The
 //! controller, a task-priority inverse dynamics law run at 1 kHz (torque held between samples),
@@ -246,8 +251,11 @@ struct Targets {
 
 /// The task-priority law at `(q, u)`, time `t`.
 fn control(k: &Krang, cfg: &Config, goal: &Targets, t: f64, q: &V19, u: &V19) -> Control {
-    let m = k.mass_matrix(q);
-    let h = k.inverse_dynamics(q, u, &V19::zeros()); // c + g
+    // Everything the tasks read at this state, from one generated program: sines, cosines,
+    // rotations and the motion pass computed once for M, c + g, the CoM and both hands.
+    let w = k.whole_body_terms(q, u);
+    let m = w.mass_matrix;
+    let h = w.nonlinear_effects; // c + g
     let minv = m.cholesky().expect("M is positive definite").inverse();
     let minv = DMatrix::from_column_slice(19, 19, minv.as_slice());
     let mut tasks = Vec::new();
@@ -262,10 +270,10 @@ fn control(k: &Krang, cfg: &Config, goal: &Targets, t: f64, q: &V19, u: &V19) ->
     });
 
     // 2. Balance: the CoM's forward offset from the axle, relative to frame 0.
-    let com = k.center_of_mass(q);
-    let jg = relative(&k.com_jacobian(q));
+    let com = w.center_of_mass;
+    let jg = relative(&w.com_jacobian);
     let vg = jg * u;
-    let bg = relative_bias(k.com_bias_acceleration(q, u), u, vg, Some(com));
+    let bg = relative_bias(w.com_bias_acceleration, u, vg, Some(com));
     let (kp, kd) = (BALANCE * BALANCE, 2.0 * BALANCE);
     tasks.push(Task {
         a: DMatrix::from_row_slice(1, 19, jg.row(0).transpose().as_slice()),
@@ -280,32 +288,39 @@ fn control(k: &Krang, cfg: &Config, goal: &Targets, t: f64, q: &V19, u: &V19) ->
     let mut errors = [0.0; 3];
     let hands = [
         (
-            Frame::from_name("right_hand"),
+            (
+                w.frame_pose_right_hand,
+                w.frame_jacobian_right_hand,
+                w.frame_bias_acceleration_right_hand,
+            ),
             (pd, goal.right_rotation),
             vd,
             ad,
         ),
         (
-            Frame::from_name("left_hand"),
+            (
+                w.frame_pose_left_hand,
+                w.frame_jacobian_left_hand,
+                w.frame_bias_acceleration_left_hand,
+            ),
             goal.left,
             Vector3::zeros(),
             Vector3::zeros(),
         ),
     ];
-    for (i, (frame, (p_goal, r_goal), v_goal, a_goal)) in hands.into_iter().enumerate() {
-        let frame = frame.expect("krang.toml declares the hands");
-        let pose = k.frame_pose(q, frame);
+    for (i, ((pose, jacobian, bias), (p_goal, r_goal), v_goal, a_goal)) in
+        hands.into_iter().enumerate()
+    {
         let (p, r) = (
             pose.translation.vector,
             *pose.rotation.to_rotation_matrix().matrix(),
         );
-        let j = relative(&k.frame_jacobian(q, frame));
+        let j = relative(&jacobian);
         let twist = j * u;
         let (v, w) = (
             twist.fixed_rows::<3>(0).into_owned(),
             twist.fixed_rows::<3>(3).into_owned(),
         );
-        let bias = k.frame_bias_acceleration(q, u, frame);
         let bl = relative_bias(bias.fixed_rows::<3>(0).into_owned(), u, v, Some(p));
         let ba = relative_bias(bias.fixed_rows::<3>(3).into_owned(), u, w, None);
         let e = p_goal - p;

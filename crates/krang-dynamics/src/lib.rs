@@ -10,7 +10,7 @@
 //! use nalgebra::{SMatrix, SVector};
 //!
 //! let mut p = Params::default();            // the values of models/krang.toml
-//! p.set("MX4l", 0.12)?;                     // reports' symbols; Err if unknown
+//! p.set("MX4l", 0.12)?;                     // reports' symbols; Err if unknown or not finite
 //! assert!(p.set("MX4k", 0.12).is_err());
 //! let k = Krang::new(p);
 //! let mut q = SVector::<f64, 19>::zeros();
@@ -22,7 +22,7 @@
 //! let g: SVector<f64, 19> = k.gravity(&q);
 //! let tau: SVector<f64, 19> = k.inverse_dynamics(&q, &u, &ud); // M ud + c + g, one pass
 //! assert!((tau - (m * ud + c + g)).norm() < 1e-9);
-//! # Ok::<(), krang_dynamics::UnknownParameter>(())
+//! # Ok::<(), krang_dynamics::SetParameterError>(())
 //! ```
 //!
 //! `index` names every coordinate (`index::Q_IMU`, in `q`) and every speed (`index::QD_IMU`, in
@@ -56,16 +56,19 @@
 //! `Params::validate` checks that a parameter set is physical (finite values, positive masses,
 //! inertias within the triangle inequalities about the centre of mass, positive wheel radius and
 //! track). With the `serde` feature, identified parameters load from any serde format; fields
-//! left out keep the values of `krang.toml`, unknown names are errors:
+//! left out keep the values of `krang.toml`; unknown names and values `Params::set` refuses
+//! (not finite, a negative mass) are errors:
 //!
 //! ```
 //! # #[cfg(feature = "serde")] {
 //! let p: krang_dynamics::Params = serde_json::from_str(r#"{ "m4l": 4.5, "MX4l": 0.12 }"#)?;
 //! assert_eq!((p.m4l, p.MX4l, p.g), (4.5, 0.12, 9.81));
 //! p.validate()?;
-//! let bad: krang_dynamics::Params = serde_json::from_str(r#"{ "m4l": -1.0 }"#)?;
-//! assert_eq!(bad.validate().unwrap_err().name(), "m4l");
+//! let bad = serde_json::from_str::<krang_dynamics::Params>(r#"{ "m4l": -1.0 }"#);
+//! assert!(bad.unwrap_err().to_string().contains("`m4l` must be positive"));
 //! assert!(serde_json::from_str::<krang_dynamics::Params>(r#"{ "m4k": 1.0 }"#).is_err());
+//! let bad: krang_dynamics::Params = serde_json::from_str(r#"{ "XX4l": 100.0 }"#)?;
+//! assert_eq!(bad.validate().unwrap_err().name(), "4l"); // the inertia: validate's check
 //! # }
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```

@@ -97,3 +97,57 @@ fn the_hands_sit_at_the_gripper_offset_from_the_wrists() {
         }
     }
 }
+
+/// Parameters away from the defaults (every value scaled by its own factor in [0.8, 1.2]).
+fn varied_params(seed: f64) -> krang_dynamics::Params {
+    let mut v = krang_dynamics::Params::default().to_array();
+    for (i, x) in v.iter_mut().enumerate() {
+        *x *= 1.0 + 0.2 * (1.7 * i as f64 + seed).sin();
+    }
+    krang_dynamics::Params::from_array(v)
+}
+
+#[test]
+fn whole_body_terms_equal_the_separate_functions_bit_for_bit() {
+    use krang_dynamics::isa::{self, Isa};
+    let hands = ["left_hand", "right_hand"].map(|n| Frame::from_name(n).expect("hand frame"));
+    let best = isa::detected();
+    for which in Isa::ALL.into_iter().filter(|i| isa::available(*i)) {
+        isa::select(which).expect("available");
+        for (s, (q, u)) in states().enumerate() {
+            let k = Krang::new(varied_params(s as f64));
+            let w = k.whole_body_terms(&q, &u);
+            assert_eq!(w.mass_matrix, k.mass_matrix(&q));
+            assert_eq!(w.nonlinear_effects, k.nonlinear_effects(&q, &u));
+            assert_eq!(w.center_of_mass, k.center_of_mass(&q));
+            assert_eq!(w.com_jacobian, k.com_jacobian(&q));
+            assert_eq!(w.com_bias_acceleration, k.com_bias_acceleration(&q, &u));
+            let [l, r] = hands;
+            assert_eq!(w.frame_pose_left_hand, k.frame_pose(&q, l));
+            assert_eq!(w.frame_jacobian_left_hand, k.frame_jacobian(&q, l));
+            assert_eq!(
+                w.frame_bias_acceleration_left_hand,
+                k.frame_bias_acceleration(&q, &u, l)
+            );
+            assert_eq!(w.frame_pose_right_hand, k.frame_pose(&q, r));
+            assert_eq!(w.frame_jacobian_right_hand, k.frame_jacobian(&q, r));
+            assert_eq!(
+                w.frame_bias_acceleration_right_hand,
+                k.frame_bias_acceleration(&q, &u, r)
+            );
+        }
+    }
+    isa::select(best).expect("detected");
+}
+
+#[test]
+fn nonlinear_effects_are_inverse_dynamics_at_zero_acceleration() {
+    for (s, (q, u)) in states().enumerate() {
+        let k = Krang::new(varied_params(s as f64));
+        let h = k.nonlinear_effects(&q, &u);
+        let tau = k.inverse_dynamics(&q, &u, &V::zeros());
+        let cg = k.coriolis(&q, &u) + k.gravity(&q);
+        assert!((h - tau).amax() < 1e-12 * tau.amax().max(1.0), "{h} {tau}");
+        assert!((h - cg).amax() < 1e-12 * tau.amax().max(1.0));
+    }
+}

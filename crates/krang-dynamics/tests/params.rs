@@ -1,7 +1,9 @@
 //! Parameters as data: `Params::validate` on every generated model, serde round trips (TOML and
 //! JSON), and the parameter values of a model file read at run time.
 
-use krang_dynamics::{InvalidParameter, Params, Problem, f32 as k32, fixed_wheels, two_link};
+use krang_dynamics::{
+    InvalidParameter, Params, Problem, SetParameterError, f32 as k32, fixed_wheels, two_link,
+};
 
 #[test]
 fn default_parameters_of_every_model_are_valid() {
@@ -35,20 +37,76 @@ fn validate_rejects_non_positive_masses_and_wheel_constants() {
         ("L", -0.68),
         ("mw", 0.0),
     ] {
-        let mut p = Params::default();
-        p.set(name, value).unwrap();
+        let mut values = Params::default().to_array();
+        values[Params::NAMES.iter().position(|n| *n == name).unwrap()] = value;
+        let p = Params::from_array(values);
         assert_eq!(
             p.validate(),
             Err(InvalidParameter::new(name, Problem::NotPositive)),
             "{name} = {value}"
         );
     }
-    let mut p = Params::default();
-    p.set("YYw", -0.1).unwrap();
+    // `set` refuses it (set_refuses_values_that_are_not_finite_or_not_physical).
+    let p = Params {
+        YYw: -0.1,
+        ..Params::default()
+    };
     assert_eq!(
         p.validate().unwrap_err(),
         InvalidParameter::new("YYw", Problem::Negative)
     );
+}
+
+/// Regression: `Params::set` accepted NaN, ±∞ and negative masses (only an unknown name was an
+/// error), so a bad value reached the dynamics unnoticed.
+#[test]
+fn set_refuses_values_that_are_not_finite_or_not_physical() {
+    let invalid = |name: &str, problem| {
+        Err(SetParameterError::Invalid(InvalidParameter::new(
+            name, problem,
+        )))
+    };
+    let mut p = Params::default();
+    for (name, value, problem) in [
+        ("L3", f64::NAN, Problem::NotFinite),
+        ("g", f64::INFINITY, Problem::NotFinite),
+        ("XX4l", f64::NEG_INFINITY, Problem::NotFinite),
+        ("m4l", 0.0, Problem::NotPositive),
+        ("m1", -2.0, Problem::NotPositive),
+        ("R", 0.0, Problem::NotPositive),
+        ("R", -0.25, Problem::NotPositive),
+        ("L", -0.68, Problem::NotPositive),
+        ("mw", 0.0, Problem::NotPositive),
+        ("YYw", -0.1, Problem::Negative),
+    ] {
+        assert_eq!(
+            p.set(name, value),
+            invalid(name, problem),
+            "{name} = {value}"
+        );
+        assert_eq!(
+            p,
+            Params::default(),
+            "a refused value leaves the parameters unchanged"
+        );
+    }
+    // Values only a combination can make unphysical, and signed parameters, are accepted.
+    p.set("MX4l", -0.3).unwrap();
+    p.set("XY4l", -0.01).unwrap();
+    p.set("YYw", 0.0).unwrap();
+    assert_eq!(
+        k32::Params::default().set("m4l", f32::NAN),
+        invalid("m4l", Problem::NotFinite)
+    );
+    let err = p.set("mw", -1.0).unwrap_err();
+    assert_eq!(err.name(), "mw");
+    assert!(err.to_string().contains("must be positive"), "{err}");
+    assert!(core::error::Error::source(&err).is_some());
+    // Deserialising goes through `set`: the same values are errors there.
+    let e = toml::from_str::<Params>("m4l = -4.5\n").unwrap_err();
+    assert!(e.to_string().contains("`m4l` must be positive"), "{e}");
+    let e = serde_json::from_str::<Params>(r#"{"R": 0.0}"#).unwrap_err();
+    assert!(e.to_string().contains("`R` must be positive"), "{e}");
 }
 
 #[test]

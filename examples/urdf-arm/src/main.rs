@@ -112,7 +112,11 @@ mod tests {
         }
         let mut p = Params::default();
         let mass = Params::NAMES.iter().find(|n| n.starts_with("m_")).unwrap();
-        p.set(mass, -1.0).unwrap();
+        assert_eq!(p.set(mass, -1.0).unwrap_err().name(), *mass);
+        let i = Params::NAMES.iter().position(|n| n == mass).unwrap();
+        let mut values = p.to_array();
+        values[i] = -1.0;
+        let p = Params::from_array(values);
         assert_eq!(p.validate().unwrap_err().name(), *mass);
         let mut p = Params::default();
         let xx = Params::NAMES.iter().find(|n| n.starts_with("XX_")).unwrap();

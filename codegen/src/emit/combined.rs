@@ -1,0 +1,218 @@
+//! Combined functions (see [`crate::combined`]): the result struct (one field per part), the free
+//! function (one straight-line program: one batched `sin_cos_n`, every shared statement once,
+//! each part's entries stored into its field right after the last statement they read), and the
+//! wrapper method.
+
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::Context;
+use super::function::{Reads, prologue, result_type, state_args, store_after};
+use super::items::arg_names;
+use super::print::{Printer, ident, idx};
+use super::scalar_type;
+use crate::lower::{CombinedProgram, LExpr, Leaf};
+use crate::registry::Shape;
+
+/// The documentation of part `i`'s field.
+fn field_doc(cx: &Context<'_>, c: &CombinedProgram, i: usize) -> String {
+    let part = &c.spec.parts[i];
+    let spec = part.function.spec();
+    match part.frame {
+        Some(l) => format!(
+            " `{}` of frame `{}`: {}",
+            spec.name, cx.model.links[l].name, spec.doc
+        ),
+        None => format!(" `{}`: {}", spec.name, spec.doc),
+    }
+}
+
+/// The result struct and the free function of combined function `c`.
+pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
+    let t = scalar_type(cx.precision);
+    let p = &c.program;
+    let printer = Printer {
+        model: cx.model,
+        stmts: &p.stmts,
+        pre: &cx.pre,
+        precision: cx.precision,
+    };
+    let reads = Reads::of(p, cx.model.speeds.len());
+    let ty = ident(&c.spec.type_name);
+    let fname = ident(&c.spec.name);
+    let shapes: Vec<Shape> = c
+        .spec
+        .parts
+        .iter()
+        .map(|part| part.function.spec().shape)
+        .collect();
+
+    // The struct.
+    let fields: Vec<_> = c.spec.parts.iter().map(|part| ident(&part.field)).collect();
+    let docs = (0..fields.len()).map(|i| field_doc(cx, c, i));
+    let types = shapes.iter().map(|s| result_type(cx, *s));
+    let struct_doc = format!(
+        " The results of [`{}`]: {}, computed by one straight-line program that shares every sine, cosine and intermediate value between them.",
+        c.spec.name,
+        c.spec
+            .parts
+            .iter()
+            .map(|p| format!("`{}`", p.field))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+
+    // The body: `out` is a tuple with one element per part (an isometry's is `(rotation,
+    // translation)`), filled by stores after the statements they read.
+    let nl = idx(cx.low.dof);
+    let mut stores: Vec<TokenStream> = vec![TokenStream::new(); p.stmts.len() + 1];
+    let mut stored = false;
+    let mut inits = Vec::new();
+    let mut finals = Vec::new();
+    for (i, (shape, range)) in shapes.iter().zip(&c.parts).enumerate() {
+        let k = syn::Index::from(i);
+        let (rows, cols) = shape.size_in(&cx.low.sizes);
+        let (rl, cl) = (idx(rows), idx(cols));
+        let entries: Vec<&(usize, usize, LExpr)> = p.outputs[range.clone()]
+            .iter()
+            .filter(|(_, _, e)| !matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0))
+            .collect();
+        stored |= !entries.is_empty();
+        for &(r, col, ref e) in entries {
+            let v = printer.expr(e, false);
+            let translation = col == 3;
+            let (r, col) = (idx(r), idx(col));
+            let store = match shape {
+                Shape::Vector => quote!(out.#k[#r] = core::hint::black_box(#v);),
+                Shape::Scalar => quote!(out.#k = #v;),
+                Shape::Isometry if translation => quote!(out.#k.1[#r] = #v;),
+                Shape::Isometry => quote!(out.#k.0[(#r, #col)] = #v;),
+                _ => quote!(out.#k[(#r, #col)] = #v;),
+            };
+            store_after(&mut stores, e, store);
+        }
+        let f = &fields[i];
+        match shape {
+            Shape::Scalar => {
+                inits.push(quote!(0.0 as #t));
+                finals.push(quote!(#f: out.#k));
+            }
+            Shape::Isometry => {
+                inits.push(quote!((
+                    nalgebra::Matrix3::<#t>::zeros(),
+                    nalgebra::Vector3::<#t>::zeros()
+                )));
+                finals.push(quote!(#f: nalgebra::Isometry3::from_parts(
+                    nalgebra::Translation3::from(out.#k.1),
+                    nalgebra::UnitQuaternion::from_rotation_matrix(
+                        &nalgebra::Rotation3::from_matrix_unchecked(out.#k.0),
+                    ),
+                )));
+            }
+            Shape::SymmetricMatrix => {
+                inits.push(quote!(SMatrix::<#t, #rl, #cl>::zeros()));
+                // The lower triangle, copied at the end as in the separate `mass_matrix`.
+                finals.push(quote!(#f: {
+                    let mut m = out.#k;
+                    let s = m.as_mut_slice();
+                    for c in 1..#nl {
+                        for r in 0..c {
+                            s[r * #nl + c] = s[c * #nl + r];
+                        }
+                    }
+                    m
+                }));
+            }
+            _ => {
+                inits.push(quote!(SMatrix::<#t, #rl, #cl>::zeros()));
+                finals.push(quote!(#f: out.#k));
+            }
+        }
+    }
+    let body = printer.statements(&stores);
+    let prologue = prologue(cx, p, &reads);
+    let mut unused = TokenStream::new();
+    if p.sincos.is_empty() && !reads.coord.contains(&true) {
+        unused.extend(quote!(let _ = q;));
+    }
+    if c.spec.inputs.needs_u() && !reads.speed.contains(&true) {
+        unused.extend(quote!(let _ = u;));
+    }
+    if c.spec.inputs.needs_ud() && !reads.accel.contains(&true) {
+        unused.extend(quote!(let _ = ud;));
+    }
+    let mutable = if stored { quote!(mut) } else { quote!() };
+    let body = quote! {
+        #unused
+        #prologue
+        let #mutable out = (#(#inits,)*);
+        #body
+        #ty { #(#finals,)* }
+    };
+    let body = if cx.isa_dispatch {
+        quote!(kanegen_runtime::isa::dispatch(#[inline(always)] || { #body }))
+    } else {
+        body
+    };
+    let param_args = if cx.low.params.is_runtime() {
+        let pname = if reads.param { quote!(p) } else { quote!(_p) };
+        let pcname = if reads.pre { quote!(pc) } else { quote!(_pc) };
+        quote!(#pname: &Params, #pcname: &Precomputed,)
+    } else {
+        quote!()
+    };
+    let (args, arg_doc) = state_args(cx, c.spec.inputs);
+    let doc = format!(
+        " Combined function: {} in one straight-line program (every sine, cosine and shared intermediate value computed once); each field equals the separate function's value.",
+        c.spec
+            .parts
+            .iter()
+            .map(|p| format!("`{}`", p.field))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let ops = format!(" Generated straight-line code: {}.", p.ops);
+    quote! {
+        #[doc = #struct_doc]
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct #ty {
+            #(#[doc = #docs] pub #fields: #types,)*
+        }
+
+        #[doc = #doc]
+        #[doc = ""]
+        #[doc = #arg_doc]
+        #[doc = #ops]
+        #[inline(never)]
+        pub fn #fname(#param_args #args) -> #ty {
+            #body
+        }
+    }
+}
+
+/// The wrapper's method of every combined function.
+pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
+    cx.low
+        .combined
+        .iter()
+        .map(|c| {
+            let name = ident(&c.spec.name);
+            let ty = ident(&c.spec.type_name);
+            let (args, _) = state_args(cx, c.spec.inputs);
+            let names = arg_names(c.spec.inputs);
+            let call = if cx.low.params.is_runtime() {
+                quote!(#name(&self.params, &self.pre, #names))
+            } else {
+                quote!(#name(#names))
+            };
+            let doc = format!(" Combined function [`{}`] (free function).", c.spec.name);
+            quote! {
+                #[doc = #doc]
+                #[inline]
+                pub fn #name(&self, #args) -> #ty {
+                    #call
+                }
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,510 @@
+//! Analytic derivatives of inverse dynamics, `∂τ/∂q` and `∂τ/∂u`, in the structure of
+//! Carpentier & Mansard's RNEA derivatives (RSS 2018), derived here in body coordinates and
+//! generated with K/D substitution variables.
+//!
+//! Spatial vectors in the frame of each link, as in `coriolis_matrix.rs`: motion `V = (ω; v)`
+//! (v of the frame origin), force `F = (n; f)` (n about the origin), `S_j` the motion subspace
+//! of speed j (constant in its frame), `V_λ(j)` and `A_λ(j)` the spatial velocity and
+//! acceleration (gravity folded in) of the parent body of joint j, `F_j` the subtree force of
+//! τ's recursion (`τ_j = S_j · F_j`), and over the subtree of j: composite inertia `I^c_j`,
+//! momentum `h^c_j = Σ I_k V_k` and inertia rate `D^c_j = Σ (V_k×*) I_k − I_k (V_k×)`
+//! (symmetric, the same quantities as the Coriolis matrix). Turning q_j turns the whole subtree
+//! of j about S_j; what does not turn with it is the parent's motion, which enters the subtree as
+//! `Ψ̇_j = V_λ(j) × S_j` (velocity) and `Ψ̈_j = A_λ(j) × S_j + V_λ(j) × Ψ̇_j` (acceleration), so a
+//! body k below j has `∂V_k/∂q_j = S_j × V_k + Ψ̇_j`, `∂A_k/∂q_j = S_j × A_k + Ψ̈_j + Ψ̇_j × V_k`
+//! and its force `∂f_k/∂q_j = S_j ×* f_k + I_k Ψ̈_j + D_k Ψ̇_j + Ψ̇_j ×* h_k`; in u_j,
+//! `∂V_k/∂u_j = S_j`, `∂A_k/∂u_j = 2 Ψ̇_j + S_j × V_k` and `∂f_k/∂u_j = 2 I_k Ψ̇_j + D_k S_j +
+//! S_j ×* h_k`. Summed over subtrees (the `S_j ×*` and `S_j ×` parts cancel in `S_i · F_i` for i
+//! below j), for a speed i and a speed j on its path to the root (j above i or j = i):
+//!
+//! * row j, column i (`G_i`, `H_i` carried up from i as forces):
+//!   `∂τ_j/∂q_i = S_j · G_i`, `G_i = S_i ×* F_i + I^c_i Ψ̈_i + D^c_i Ψ̇_i + Ψ̇_i ×* h^c_i`;
+//!   `∂τ_j/∂u_i = S_j · H_i`, `H_i = 2 I^c_i Ψ̇_i + D^c_i S_i + S_i ×* h^c_i`;
+//! * row i, column j above i (`Φ_i`, `Ξ_i` carried up from i):
+//!   `∂τ_i/∂q_j = Φ_i · Ψ̈_j + Ξ_i · Ψ̇_j`, `∂τ_i/∂u_j = 2 Φ_i · Ψ̇_j + Ξ_i · S_j`, with
+//!   `Φ_i = I^c_i S_i` (M's column force) and `Ξ_i = D^c_i S_i − S_i ×* h^c_i`.
+//!
+//! (So ∂τ/∂u is twice the Coriolis matrix of `coriolis_matrix.rs` on a tree: `H = 2h`,
+//! `Ξ = 2 G1`.) The wheeled base's ẋ and ψ̇ are speeds of frame 0 whose `S` is constant in
+//! frame 0 (quasi-velocities): nothing depends on x or ψ, and their u-columns take `V_0 × S`
+//! where a joint has `2 Ψ̇` (`∂A_k/∂u = S × V_k + V_0 × S`: there is no parent motion, and the
+//! bias `V_0 × V_0` of the base vanishes identically).
+//!
+//! Four forces are carried per (speed, ancestor speed) pair, like the three of C, instead of
+//! forward mode's derivative of the whole subtree's motion and forces per input.
+
+use std::collections::BTreeMap;
+
+use kanegen_model::{JointKind, Mount};
+
+use super::Ctx;
+use super::algebra::{V3, V6, join3, split3};
+use crate::expr::{Atom, ExprId, VarKind};
+
+/// What the entries of the speed columns above a link read, per speed of a link, in its frame.
+#[derive(Clone, Copy)]
+struct Column {
+    /// The speed index (of the tree).
+    speed: usize,
+    /// Its motion subspace `S`.
+    s: V6,
+    /// `Ψ̇ = V_λ × S` (joints) or `V_0 × S` (the base's speeds).
+    psid: V6,
+    /// `Ψ̈ = A_λ × S + V_λ × Ψ̇`; `None` for the base's speeds (no coordinate of theirs enters τ).
+    psidd: Option<V6>,
+}
+
+/// The four forces of a column on its way up to the root.
+#[derive(Clone, Copy)]
+struct Carried {
+    /// `Φ = I^c S`.
+    phi: V6,
+    /// `Ξ = D^c S − S ×* h^c`.
+    xi: V6,
+    /// `H`: `S_j · H = ∂τ_j/∂u_i`.
+    h: V6,
+    /// `G`: `S_j · G = ∂τ_j/∂q_i` (`None` for the base's speeds).
+    g: Option<V6>,
+}
+
+impl Ctx<'_> {
+    /// `[∂τ/∂q | ∂τ/∂u]` as `(row, col, expr)` by the analytic recursion of this module: rows are
+    /// the tree's speeds (projected afterwards like τ's), columns the `N` independent speeds (a
+    /// mimic joint's column is added to its master's with the constraint's factor).
+    pub(super) fn inverse_dynamics_derivatives_analytic(&mut self) -> Vec<(usize, usize, ExprId)> {
+        let model = self.model;
+        let links = model.links.len();
+        let (motion, f, n) = self.inverse_dynamics_pass();
+        let comp = self.composites(true, None);
+        let vel = self.velocities();
+        let (mut hc, mut dc) = self.body_momenta(&vel);
+        self.subtree_momenta(&mut hc, &mut dc);
+        let cols = self.speed_columns();
+        let vxs = self.bias_columns(&vel, &cols);
+        // Ψ̇ and Ψ̈ of every speed.
+        let mut columns: Vec<Vec<Column>> = vec![Vec::new(); links];
+        for l in 0..links {
+            for (k, &(speed, s)) in cols[l].iter().enumerate() {
+                let psidd = model.links[l]
+                    .mount
+                    .as_ref()
+                    .map(|mount| self.psidd(l, mount, speed, &s, &vxs[l][k], &motion, &vel));
+                columns[l].push(Column {
+                    speed,
+                    s,
+                    psid: vxs[l][k],
+                    psidd,
+                });
+            }
+        }
+        // (column group, row, tree speed of the column, u-block?, entry) in derivation order.
+        let mut raw: Vec<(usize, usize, usize, bool, ExprId)> = Vec::new();
+        let mut group = 0;
+        for l in 0..links {
+            for k in 0..columns[l].len() {
+                group += 1;
+                let col = columns[l][k];
+                let sname = self.model.speeds[col.speed].name.clone();
+                let mut carried = self.derivative_forces(l, &col, &comp, &hc, &dc, &f, &n);
+                // Rows of the same frame.
+                for a in &columns[l] {
+                    if let Some(g) = carried.g {
+                        let e = self.dot6(&a.s, &g);
+                        raw.push((group, a.speed, col.speed, false, e));
+                    }
+                    let e = self.dot6(&a.s, &carried.h);
+                    raw.push((group, a.speed, col.speed, true, e));
+                }
+                for (child, mount) in model.path_to_base(l) {
+                    let (at, joint) = (mount.parent, &mount.joint);
+                    let pname = self.link_name(at).to_owned();
+                    let up = |cx: &mut Self, x: &V6, what: &str| {
+                        cx.force_up(child, joint, x, &format!("{what}({sname}) at {pname}"))
+                    };
+                    carried = Carried {
+                        phi: up(self, &carried.phi, "Phi"),
+                        xi: up(self, &carried.xi, "Xi"),
+                        h: up(self, &carried.h, "H"),
+                        g: carried.g.map(|g| up(self, &g, "G")),
+                    };
+                    for a in &columns[at] {
+                        if let Some(g) = carried.g {
+                            let e = self.dot6(&a.s, &g);
+                            raw.push((group, a.speed, col.speed, false, e));
+                        }
+                        let e = self.dot6(&a.s, &carried.h);
+                        raw.push((group, a.speed, col.speed, true, e));
+                        if let Some(psidd) = a.psidd {
+                            let t1 = self.dot6(&carried.phi, &psidd);
+                            let t2 = self.dot6(&carried.xi, &a.psid);
+                            let e = self.ar.add(t1, t2);
+                            raw.push((group, col.speed, a.speed, false, e));
+                        }
+                        // 2 Φ·Ψ̇ for a joint, Φ·(V_0 × S) for the base.
+                        let t1 = self.dot6(&carried.phi, &a.psid);
+                        let t1 = if a.psidd.is_some() {
+                            self.ar.scale(t1, 2.0)
+                        } else {
+                            t1
+                        };
+                        let t2 = self.dot6(&carried.xi, &a.s);
+                        let e = self.ar.add(t1, t2);
+                        raw.push((group, col.speed, a.speed, true, e));
+                    }
+                }
+            }
+        }
+        raw.retain(|x| !self.ar.is_zero(x.4));
+        // Schedule: the statements follow the derivation's first requests (`Arena::phase_order`),
+        // and the passes above asked for every subtree quantity before any column. Asking again,
+        // column by column from the last link (leaves first), each column's statements right
+        // after what it reads, keeps Krang's largest number of live values at 259 instead of 767.
+        raw.sort_by_key(|x| std::cmp::Reverse(x.0));
+        self.ar.begin_phase();
+        for x in &raw {
+            self.ar.touch_tree(x.4);
+        }
+        let map = model.constraint_map();
+        let nind = model.independent_dof();
+        let mut acc: BTreeMap<(usize, usize), Vec<ExprId>> = BTreeMap::new();
+        for (_, row, col, u, e) in raw {
+            let (c, k) = map[col];
+            let e = self.ar.scale(e, k);
+            acc.entry((row, c + if u { nind } else { 0 }))
+                .or_default()
+                .push(e);
+        }
+        let mut out = Vec::with_capacity(acc.len());
+        for ((r, c), terms) in acc {
+            let e = self.ar.sum(terms);
+            if self.ar.is_zero(e) {
+                continue;
+            }
+            let e = if self.ar.hoist_params {
+                self.ar.hoist(e, &format!("dtau[{r},{c}]"))
+            } else {
+                e
+            };
+            out.push((r, c, e));
+        }
+        out
+    }
+
+    /// `Ψ̈ = A_λ × S + V_λ × Ψ̇` of the speed of link `l` (its joint's), in its frame: `A_λ`, `V_λ`
+    /// are the parent body's spatial acceleration and velocity at the origin of `l`.
+    #[allow(clippy::too_many_arguments)]
+    fn psidd(
+        &mut self,
+        l: usize,
+        mount: &Mount,
+        speed: usize,
+        s: &V6,
+        psid: &V6,
+        motion: &super::rnea::Motion,
+        vel: &[V6],
+    ) -> V6 {
+        let (i, joint) = (mount.parent, &mount.joint);
+        let name = self.link_name(l).to_owned();
+        let iname = self.link_name(i).to_owned();
+        let r = self.rotation(l, joint);
+        let e = self.axis(l);
+        let u = self.ar.atom(Atom::Speed(speed as u32));
+        // ω and α of the parent in this frame (ω: τ's variable "w{i} in {l}").
+        let wi = self.rot_down(&r, &motion.w[i]);
+        let wi = self.subst3(wi, VarKind::K, &format!("w{iname} in {name}"));
+        let wdi = self.rot_down(&r, &motion.wd[i]);
+        // Velocity and classical acceleration of the parent's point at the origin of l.
+        let (_, vl) = split3(&vel[l]);
+        let (vp, ap): (V3, V3) = match joint.kind {
+            JointKind::Prismatic { .. } => {
+                let ue = self.scale3(u, &e);
+                let vp = self.sub3(&vl, &ue);
+                let ud = self.ar.atom(Atom::Accel(speed as u32));
+                let ude = self.scale3(ud, &e);
+                let wxe = self.cross(&wi, &e);
+                let two_u = self.ar.scale(u, 2.0);
+                let cor = self.scale3(two_u, &wxe);
+                let extra = self.add3(&ude, &cor);
+                (vp, self.sub3(&motion.a[l], &extra))
+            }
+            _ => (vl, motion.a[l]),
+        };
+        // Spatial acceleration of the parent: (α; a − ω × v).
+        let wxv = self.cross(&wi, &vp);
+        let alin = self.sub3(&ap, &wxv);
+        let a_par = join3(&wdi, &alin);
+        let v_par = join3(&wi, &vp);
+        let t1 = self.motion_cross(&a_par, s);
+        let t2 = self.motion_cross(&v_par, psid);
+        let x = self.add6(&t1, &t2);
+        let label = format!("Psidd({})", self.model.speeds[speed].name);
+        self.subst_motion(x, &label)
+    }
+
+    /// The carried forces of column `col` of link `l`, in its frame.
+    #[allow(clippy::too_many_arguments)]
+    fn derivative_forces(
+        &mut self,
+        l: usize,
+        col: &Column,
+        comp: &[super::composite::Composite],
+        hc: &[V6],
+        dc: &[super::coriolis_matrix::Rate],
+        f: &[V3],
+        n: &[V3],
+    ) -> Carried {
+        let zero = self.ar.zero();
+        let sname = self.model.speeds[col.speed].name.clone();
+        let name = self.link_name(l).to_owned();
+        let c = &comp[l];
+        let jc = c.inertia.expect("inertia computed");
+        let s = col.s;
+        let phi = self.inertia_mul(c.mass, &c.first_moment, &jc, &s);
+        let phi = self.subst_force(phi, &format!("Phi({sname}) at {name}"));
+        let sxh = self.force_cross(&s, &hc[l]);
+        let (cd, jd) = dc[l];
+        let ds = self.inertia_mul(zero, &cd, &jd, &s);
+        let xi = self.sub6(&ds, &sxh);
+        let xi = self.subst_force(xi, &format!("Xi({sname}) at {name}"));
+        let p = self.add6(&ds, &sxh);
+        let ic_psid = self.inertia_mul(c.mass, &c.first_moment, &jc, &col.psid);
+        let ic_psid = self.subst_force(ic_psid, &format!("IC{name}(Psid({sname}))"));
+        // 2 I^c Ψ̇ for a joint, I^c (V_0 × S) for the base.
+        let k = if col.psidd.is_some() { 2.0 } else { 1.0 };
+        let h: V6 = [0, 1, 2, 3, 4, 5].map(|i| {
+            let t = self.ar.scale(ic_psid[i], k);
+            self.ar.add(t, p[i])
+        });
+        let h = self.subst_force(h, &format!("H({sname}) at {name}"));
+        let g = col.psidd.map(|psidd| {
+            let fl = join3(&n[l], &f[l]);
+            let sxf = self.force_cross(&s, &fl);
+            let icpsidd = self.inertia_mul(c.mass, &c.first_moment, &jc, &psidd);
+            let dpsid = self.inertia_mul(zero, &cd, &jd, &col.psid);
+            let psidxh = self.force_cross(&col.psid, &hc[l]);
+            let a = self.add6(&sxf, &icpsidd);
+            let b = self.add6(&dpsid, &psidxh);
+            let g = self.add6(&a, &b);
+            self.subst_force(g, &format!("G({sname}) at {name}"))
+        });
+        Carried { phi, xi, h, g }
+    }
+
+    fn sub6(&mut self, a: &V6, b: &V6) -> V6 {
+        [0, 1, 2, 3, 4, 5].map(|i| self.ar.sub(a[i], b[i]))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The analytic recursion against forward mode (`Arena::diff` over τ's recursion, the
+    //! derivation this module replaced): the same matrices to rounding on random parameters and
+    //! states, for every kind of joint and base the models have.
+
+    use kanegen_model::{Model, UrdfOptions, WheeledBaseSpec};
+    use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
+
+    use super::super::{Ctx, mimic, names_of};
+    use crate::expr::{Arena, ExprId, Values};
+    use crate::options::{Options, ParamMode};
+    use crate::registry::{Dim, Shape};
+
+    fn models_dir() -> std::path::PathBuf {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models")
+    }
+
+    /// `[∂τ/∂q | ∂τ/∂u]` (projected onto the independent speeds) by one of the two derivations.
+    fn derive(
+        model: &Model,
+        params: ParamMode,
+        analytic: bool,
+    ) -> (Arena, Vec<(usize, usize, ExprId)>) {
+        let mut arena = Arena::new(names_of(model));
+        arena.hoist_params = params.is_runtime();
+        mimic::declare(&mut arena, model);
+        let links = model.links.len();
+        let mut cx = Ctx {
+            ar: &mut arena,
+            model,
+            options: Options {
+                params,
+                ..Options::default()
+            },
+            rot: vec![None; links],
+            pos: vec![None; links],
+            root_rot: vec![None; links],
+            root_pos: vec![None; links],
+            keep_inertial: false,
+        };
+        let entries = if analytic {
+            cx.inverse_dynamics_derivatives_analytic()
+        } else {
+            cx.inverse_dynamics_derivatives_forward_mode()
+        };
+        let shape = Shape::Dense {
+            rows: Dim::N,
+            cols: Dim::TwoN,
+        };
+        let entries = mimic::project(cx.ar, model, shape, entries);
+        (arena, entries)
+    }
+
+    fn dense(ar: &Arena, entries: &[(usize, usize, ExprId)], n: usize, x: &Values<'_>) -> Vec<f64> {
+        let v = ar.eval(x);
+        let mut out = vec![0.0; n * 2 * n];
+        for &(r, c, e) in entries {
+            out[r * 2 * n + c] = v[e.index()];
+        }
+        out
+    }
+
+    /// Worst `max |analytic − forward| / max(max |forward|, 1)` over `draws` random draws.
+    fn compare(label: &str, model: &Model, params: ParamMode, draws: usize, seed: u64) {
+        let (a, ea) = derive(model, params, true);
+        let (f, ef) = derive(model, params, false);
+        let n = model.independent_dof();
+        let mut rng = SplitMix64::new(seed);
+        let mut uni = move || rng.next_f64();
+        let pi = std::f64::consts::PI;
+        let mut worst = 0.0f64;
+        for draw in 0..draws {
+            let p = if draw == 0 || params == ParamMode::Baked {
+                model.param_values()
+            } else {
+                random_physical_params(model, &mut uni)
+            };
+            let q = uniform_vec(&mut uni, model.dof(), -pi, pi);
+            let u = uniform_vec(&mut uni, model.dof(), -2.0, 2.0);
+            let ud = uniform_vec(&mut uni, model.dof(), -2.0, 2.0);
+            let x = Values {
+                params: &p,
+                q: &q,
+                u: &u,
+                ud: &ud,
+            };
+            let (da, df) = (dense(&a, &ea, n, &x), dense(&f, &ef, n, &x));
+            let scale = df.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+            for (i, (x, y)) in da.iter().zip(&df).enumerate() {
+                let e = (x - y).abs() / scale;
+                assert!(
+                    e < 1e-11,
+                    "{label}: draw {draw}, entry [{}, {}]: analytic {x} vs forward mode {y}",
+                    i / (2 * n),
+                    i % (2 * n)
+                );
+                worst = worst.max(e);
+            }
+        }
+        eprintln!("{label}: {draws} draws, worst relative difference {worst:.1e}");
+    }
+
+    #[test]
+    fn analytic_derivatives_equal_forward_mode_on_trees_and_wheeled_bases() {
+        let toml = |name: &str| Model::from_toml_file(models_dir().join(name)).expect("loads");
+        compare("krang", &toml("krang.toml"), ParamMode::Runtime, 10, 1);
+        compare("krang, baked", &toml("krang.toml"), ParamMode::Baked, 2, 2);
+        compare(
+            "fixed wheels",
+            &toml("krang-fixed-wheels.toml"),
+            ParamMode::Runtime,
+            10,
+            3,
+        );
+        compare(
+            "two-link",
+            &toml("two-link.toml"),
+            ParamMode::Runtime,
+            50,
+            4,
+        );
+        let arm =
+            Model::from_urdf_file(models_dir().join("singlearm.urdf"), &UrdfOptions::default())
+                .expect("imports");
+        compare("arm", &arm, ParamMode::Runtime, 20, 5);
+    }
+
+    #[test]
+    fn analytic_derivatives_equal_forward_mode_with_prismatic_and_mimic_joints() {
+        let gripper = Model::from_urdf_file(
+            models_dir().join("mimic_gripper.urdf"),
+            &UrdfOptions::default(),
+        )
+        .expect("imports");
+        assert!(!gripper.mimics.is_empty());
+        compare("mimic gripper", &gripper, ParamMode::Runtime, 50, 6);
+        let spec = WheeledBaseSpec::new(
+            "left_wheel_joint",
+            "right_wheel_joint",
+            "chassis",
+            [0.0, 0.0, 1.0],
+            0.2,
+        );
+        let lift = Model::from_urdf_str(LIFT, "lift.urdf", &UrdfOptions::wheeled(spec)).unwrap();
+        compare("lift on a wheeled base", &lift, ParamMode::Runtime, 50, 7);
+    }
+
+    #[test]
+    fn on_a_tree_the_speed_derivative_is_twice_the_coriolis_matrix() {
+        use crate::registry::{FunctionId, FunctionSet};
+        let toml = |name: &str| Model::from_toml_file(models_dir().join(name)).expect("loads");
+        for (name, model) in [
+            ("fixed wheels", toml("krang-fixed-wheels.toml")),
+            ("two-link", toml("two-link.toml")),
+        ] {
+            let options = Options {
+                params: ParamMode::Runtime,
+                functions: FunctionSet::default()
+                    .with(FunctionId::CoriolisMatrix)
+                    .with(FunctionId::InverseDynamicsDerivatives),
+            };
+            let d = super::super::derive(&model, options);
+            let n = model.dof();
+            let mut rng = SplitMix64::new(8);
+            let mut uni = move || rng.next_f64();
+            for _ in 0..10 {
+                let p = random_physical_params(&model, &mut uni);
+                let q = uniform_vec(&mut uni, n, -3.0, 3.0);
+                let u = uniform_vec(&mut uni, n, -2.0, 2.0);
+                let ud = uniform_vec(&mut uni, n, -2.0, 2.0);
+                let c = d.evaluate(FunctionId::CoriolisMatrix, &p, &q, &u, &ud);
+                let dt = d.evaluate(FunctionId::InverseDynamicsDerivatives, &p, &q, &u, &ud);
+                let scale = c.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                for r in 0..n {
+                    for k in 0..n {
+                        let e = (dt[r * 2 * n + n + k] - 2.0 * c[r * n + k]).abs() / scale;
+                        assert!(e < 1e-12, "{name}: ∂τ_{r}/∂u_{k} vs 2 C[{r},{k}]: {e:e}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// A two-wheeled base with a prismatic lift on a skew axis, a revolute joint on a skew axis
+    /// below it, and a fixed-joint merge.
+    const LIFT: &str = r#"<robot name="lift">
+  <link name="chassis"><inertial><origin xyz="0.01 0 0.3"/><mass value="20"/>
+    <inertia ixx="1.2" ixy="0" ixz="0.01" iyy="1.1" iyz="0" izz="0.4"/></inertial></link>
+  <link name="left_wheel"><inertial><mass value="2"/>
+    <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.04" iyz="0" izz="0.02"/></inertial></link>
+  <link name="right_wheel"><inertial><mass value="2"/>
+    <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.04" iyz="0" izz="0.02"/></inertial></link>
+  <link name="carriage"><inertial><origin xyz="0.02 0.01 0.1" rpy="0.3 0 0.2"/><mass value="3"/>
+    <inertia ixx="0.05" ixy="0.001" ixz="0" iyy="0.04" iyz="0" izz="0.02"/></inertial></link>
+  <link name="arm"><inertial><origin xyz="0.2 0 0.01"/><mass value="1.5"/>
+    <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/></inertial></link>
+  <link name="tool"><inertial><origin xyz="0.05 0 0"/><mass value="0.4"/>
+    <inertia ixx="0.0004" ixy="0" ixz="0" iyy="0.0005" iyz="0" izz="0.0005"/></inertial></link>
+  <joint name="left_wheel_joint" type="continuous"><parent link="chassis"/><child link="left_wheel"/>
+    <origin xyz="0 0.25 0"/><axis xyz="0 1 0"/></joint>
+  <joint name="right_wheel_joint" type="continuous"><parent link="chassis"/><child link="right_wheel"/>
+    <origin xyz="0 -0.25 0"/><axis xyz="0 1 0"/></joint>
+  <joint name="lift" type="prismatic"><parent link="chassis"/><child link="carriage"/>
+    <origin xyz="0.05 0.02 0.5" rpy="0.1 0.2 0"/><axis xyz="0.3 0 0.954"/>
+    <limit lower="0" upper="0.5" effort="1" velocity="1"/></joint>
+  <joint name="shoulder" type="revolute"><parent link="carriage"/><child link="arm"/>
+    <origin xyz="0 0.1 0.2" rpy="0 0 0.4"/><axis xyz="0 0.6 0.8"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="tool_fix" type="fixed"><parent link="arm"/><child link="tool"/>
+    <origin xyz="0.4 0 0" rpy="0 0.5 0"/></joint>
+</robot>"#;
+}

@@ -1,0 +1,87 @@
+//! A driver for instruction counts of Krang's generated regressors (next to `profile.rs`, which
+//! covers the default functions), for work on the generator.
+//!
+//! ```sh
+//! cargo build --release -p krang-dynamics --features regressors --example profile_regressors
+//! valgrind --tool=callgrind --callgrind-out-file=cg.out \
+//!     target/release/examples/profile_regressors inverse_dynamics_regressor 1000
+//! callgrind_annotate cg.out | head -30
+//! ```
+//!
+//! Arguments: a function (`inverse_dynamics`, `inverse_dynamics_regressor`, `base_regressor`,
+//! `gravity`, `gravity_regressor`, `base_gravity_regressor`) and the number of calls. States
+//! cycle through 64 fixed pseudo-random states. Prints the fastest ns per call of batches of
+//! 1000 calls as a rough figure (the published figures come from `cargo bench --bench
+//! regressors`).
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use krang_dynamics::Krang;
+use nalgebra::SVector;
+
+type V = SVector<f64, 19>;
+
+fn states() -> Vec<(V, V, V)> {
+    let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut next = move || {
+        x = x
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..64)
+        .map(|_| {
+            let q = V::from_fn(|_, _| (2.0 * next() - 1.0) * std::f64::consts::PI);
+            let u = V::from_fn(|_, _| 4.0 * next() - 2.0);
+            let ud = V::from_fn(|_, _| 10.0 * next() - 5.0);
+            (q, u, ud)
+        })
+        .collect()
+}
+
+fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> Result<f64, String> {
+    let mut acc = 0.0;
+    for i in 0..calls {
+        let (q, u, ud) = &s[i & 63];
+        let (q, u, ud) = (black_box(q), black_box(u), black_box(ud));
+        acc += match f {
+            "inverse_dynamics" => black_box(k).inverse_dynamics(q, u, ud)[7],
+            "inverse_dynamics_regressor" => {
+                black_box(k).inverse_dynamics_regressor(q, u, ud)[(7, 60)]
+            }
+            "base_regressor" => black_box(k).base_regressor(q, u, ud)[(7, 40)],
+            "gravity" => black_box(k).gravity(q)[7],
+            "gravity_regressor" => black_box(k).gravity_regressor(q)[(7, 30)],
+            "base_gravity_regressor" => black_box(k).base_gravity_regressor(q)[(7, 20)],
+            _ => return Err(format!("unknown function `{f}`")),
+        };
+    }
+    Ok(acc)
+}
+
+fn main() -> Result<(), String> {
+    let mut args = std::env::args().skip(1);
+    let f = args
+        .next()
+        .unwrap_or_else(|| "inverse_dynamics_regressor".into());
+    let calls: usize = args
+        .next()
+        .map(|c| c.parse().map_err(|e| format!("calls: {e}")))
+        .transpose()?
+        .unwrap_or(1000);
+    let k = Krang::default();
+    let s = states();
+    let mut best = f64::INFINITY;
+    let mut acc = 0.0;
+    for _ in 0..(calls / 1000).max(1) {
+        let t = Instant::now();
+        acc += run(&k, &f, &s, calls.min(1000))?;
+        best = best.min(t.elapsed().as_secs_f64() / calls.min(1000) as f64);
+    }
+    println!(
+        "{f}: {:.0} ns per call (fastest batch; checksum {acc:.3e})",
+        best * 1e9
+    );
+    Ok(())
+}

@@ -2,7 +2,7 @@
 //! `$OUT_DIR`: the 7-DOF arm of `models/singlearm.urdf` (runtime parameters and baked) and Krang
 //! imported from `models/Krang.urdf` with its two-wheeled base (runtime parameters); and, for
 //! `tests/kinematics.rs`, the arm and the two-link model with every registry function; for
-//! `tests/mimic.rs`, a gripper with mimic joints.
+//! `tests/mimic.rs`, a gripper with mimic joints; for `tests/big_tree.rs`, a 100-DOF tree.
 //! The TOML Krang models come from `krang-dynamics`.
 use kanegen::model::{UrdfOptions, WheeledBaseSpec};
 
@@ -38,6 +38,46 @@ fn main() {
     kanegen::Builder::urdf("models/Krang.urdf", krang_urdf_options())
         .output("krang_urdf.rs")
         .run();
+    // A 100-DOF tree (ten branches of ten links), for `tests/big_tree.rs`: its functions are
+    // long enough to be split into blocks, and this debug build (with debug info) compiles it.
+    let out = std::path::PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
+    let tree = out.join("tree10x10.urdf");
+    std::fs::write(&tree, tree_urdf(10, 10)).expect("OUT_DIR is writable");
+    kanegen::Builder::urdf(&tree, UrdfOptions::default())
+        .output("tree10x10.rs")
+        .run();
+}
+
+/// A tree of `branches` serial branches of `depth` revolute links each on a fixed base: joint
+/// axes cycle through z, y, x, every link has an offset origin, a distinct mass and a full
+/// inertia, and the branches leave the base at different yaw angles.
+fn tree_urdf(branches: usize, depth: usize) -> String {
+    let axes = ["0 0 1", "0 1 0", "1 0 0"];
+    let mut s = format!(
+        "<?xml version=\"1.0\"?>\n<robot name=\"tree{branches}x{depth}\">\n<link name=\"base\"/>\n"
+    );
+    let mut k = 0;
+    for b in 0..branches {
+        let mut parent = "base".to_owned();
+        for d in 0..depth {
+            k += 1;
+            let link = format!("b{b}l{d}");
+            let mass = 1.0 + 0.01 * k as f64;
+            let yaw = if d == 0 { 0.3 * b as f64 } else { 0.0 };
+            let axis = axes[(b + d) % 3];
+            s += &format!(
+                "<link name=\"{link}\"><inertial><origin xyz=\"0.01 0.02 0.1\" rpy=\"0 0 0\"/>\
+                 <mass value=\"{mass}\"/><inertia ixx=\"0.02\" ixy=\"0.001\" ixz=\"0\" \
+                 iyy=\"0.03\" iyz=\"0.002\" izz=\"0.01\"/></inertial></link>\n\
+                 <joint name=\"j{b}_{d}\" type=\"revolute\"><parent link=\"{parent}\"/>\
+                 <child link=\"{link}\"/><origin xyz=\"0.01 0.02 0.2\" rpy=\"0 0 {yaw}\"/>\
+                 <axis xyz=\"{axis}\"/><limit lower=\"-3\" upper=\"3\" effort=\"10\" \
+                 velocity=\"1\"/></joint>\n"
+            );
+            parent = link;
+        }
+    }
+    s + "</robot>\n"
 }
 
 /// A combined function of every part shape (symmetric matrix, vectors, Jacobians, isometry,

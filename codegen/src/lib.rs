@@ -244,6 +244,7 @@ pub struct Builder {
     combined: Vec<combined::Combined>,
     isa_dispatch: bool,
     batch: bool,
+    split_above: usize,
 }
 
 impl Builder {
@@ -264,6 +265,7 @@ impl Builder {
             combined: Vec::new(),
             isa_dispatch: true,
             batch: false,
+            split_above: emit::SPLIT_ABOVE,
         }
     }
 
@@ -385,11 +387,26 @@ impl Builder {
         self
     }
 
+    /// Split generated functions of more than `statements` statements into blocks of 500
+    /// (default [`emit::SPLIT_ABOVE`], 2,600): rustc's debug info nests a scope per `let` and
+    /// overflowed its stack on longer functions (`rustc unexpectedly overflowed its stack` in a
+    /// debug build). Lower it if a debug build of the module still crashes; optimised code is
+    /// the same either way (the blocks pass their values on as tuples).
+    ///
+    /// ```no_run
+    /// kanegen::Builder::new("big.urdf").split_functions_above(1000).run();
+    /// ```
+    pub fn split_functions_above(mut self, statements: usize) -> Self {
+        self.split_above = statements;
+        self
+    }
+
     fn emit_options(&self) -> EmitOptions {
         EmitOptions {
             precision: self.precision,
             isa_dispatch: self.isa_dispatch,
             batch: self.batch,
+            split_above: self.split_above,
             ..EmitOptions::default()
         }
     }

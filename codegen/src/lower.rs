@@ -12,8 +12,10 @@
 //! [`Model::check_names`](kanegen_model::Model::check_names)), so a local never shadows a speed,
 //! coordinate or parameter.
 
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::BTreeSet;
 use std::fmt;
+
+use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::expr::{Arena, Atom, ExprId, MimicLeaf, Node, VarKind};
 use crate::kane::{Derivation, Function};
@@ -293,7 +295,7 @@ pub fn lower(d: &Derivation) -> Lowered {
 /// Parameter-only nodes needed by the hot programs, in slot order of first request.
 #[derive(Default)]
 struct PreSet {
-    slot: HashMap<ExprId, usize>,
+    slot: FxHashMap<ExprId, usize>,
     nodes: Vec<ExprId>,
 }
 
@@ -319,7 +321,7 @@ struct ProgramBuilder<'a> {
     /// Nodes that are leaves of this program because they are precomputed (runtime mode).
     hoist: bool,
     /// node → statement index.
-    local: HashMap<ExprId, usize>,
+    local: FxHashMap<ExprId, usize>,
 }
 
 impl ProgramBuilder<'_> {
@@ -383,12 +385,14 @@ fn schedule(
     ar: &Arena,
     roots: &[ExprId],
     is_leaf: &dyn Fn(ExprId) -> bool,
-    order: Option<&[u32]>,
+    order: Option<&[ExprId]>,
 ) -> Vec<(ExprId, Option<u32>)> {
     // Reachability with parent counting; a variable is a leaf whose definition is a new root.
-    let mut uses: HashMap<ExprId, usize> = HashMap::new();
-    let mut seen: BTreeSet<ExprId> = BTreeSet::new();
-    let mut var_defs: BTreeMap<ExprId, u32> = BTreeMap::new();
+    // (Hash tables keyed by node, not arrays over the arena: a module can have hundreds of
+    // small programs, one per frame of a per-frame function, over one large arena.)
+    let mut uses: FxHashMap<ExprId, usize> = FxHashMap::default();
+    let mut seen: FxHashSet<ExprId> = FxHashSet::default();
+    let mut var_defs: FxHashMap<ExprId, u32> = FxHashMap::default();
     let mut stack: Vec<ExprId> = Vec::new();
     for &r in roots {
         if seen.insert(r) {
@@ -421,6 +425,8 @@ fn schedule(
     for r in roots {
         *uses.entry(*r).or_insert(0) += 1;
     }
+    let mut seen: Vec<ExprId> = seen.into_iter().collect();
+    seen.sort_unstable();
     let mut stmts: Vec<(ExprId, Option<u32>)> = Vec::new();
     for &e in &seen {
         if is_leaf(e) {
@@ -437,10 +443,17 @@ fn schedule(
     };
     // Derivation order, then a depth-first pass that puts every statement after the statements
     // it reads.
-    let is_stmt: HashMap<ExprId, Option<u32>> = stmts.iter().copied().collect();
-    stmts.sort_by_key(|(e, _)| (order[e.index()], *e));
-    let mut placed: BTreeSet<ExprId> = BTreeSet::new();
+    let is_stmt: FxHashMap<ExprId, Option<u32>> = stmts.iter().copied().collect();
+    let rank: FxHashMap<ExprId, u32> = order
+        .iter()
+        .filter(|e| is_stmt.contains_key(e))
+        .enumerate()
+        .map(|(i, e)| (*e, i as u32))
+        .collect();
+    stmts.sort_by_key(|(e, _)| (rank.get(e).copied().unwrap_or(u32::MAX), *e));
+    let mut placed: FxHashSet<ExprId> = FxHashSet::default();
     let mut out = Vec::with_capacity(stmts.len());
+    let mut deps = Vec::new();
     for &(s, _) in &stmts {
         // Iterative post-order over the statements `s` depends on.
         let mut work: Vec<(ExprId, bool)> = vec![(s, false)];
@@ -455,10 +468,10 @@ fn schedule(
                 continue;
             }
             work.push((e, true));
-            let mut deps = Vec::new();
+            deps.clear();
             statement_deps(ar, e, &is_stmt, is_leaf, &mut deps, true);
             // Reverse, so that dependencies are placed in the order they are read.
-            for d in deps.into_iter().rev() {
+            for &d in deps.iter().rev() {
                 if !placed.contains(&d) {
                     work.push((d, false));
                 }
@@ -473,7 +486,7 @@ fn schedule(
 fn statement_deps(
     ar: &Arena,
     e: ExprId,
-    is_stmt: &HashMap<ExprId, Option<u32>>,
+    is_stmt: &FxHashMap<ExprId, Option<u32>>,
     is_leaf: &dyn Fn(ExprId) -> bool,
     out: &mut Vec<ExprId>,
     top: bool,
@@ -513,7 +526,7 @@ fn lower_entries(
     ar: &Arena,
     name: &str,
     entries: &[(usize, usize, ExprId)],
-    order: &[u32],
+    order: &[ExprId],
     hoist: bool,
     pre: &mut PreSet,
 ) -> Program {
@@ -521,7 +534,7 @@ fn lower_entries(
     let mut b = ProgramBuilder {
         ar,
         hoist,
-        local: HashMap::new(),
+        local: FxHashMap::default(),
     };
     let is_leaf = |e: ExprId| {
         hoist
@@ -580,7 +593,7 @@ fn lower_precompute(ar: &Arena, pre: &PreSet) -> (Program, Vec<usize>) {
     let mut b = ProgramBuilder {
         ar,
         hoist: false,
-        local: HashMap::new(),
+        local: FxHashMap::default(),
     };
     // Every requested node is a statement; so is every variable and shared node below them.
     let sched = schedule(ar, &pre.nodes, &|_| false, None);
@@ -596,7 +609,7 @@ fn lower_precompute(ar: &Arena, pre: &PreSet) -> (Program, Vec<usize>) {
     }
     order.sort_by_key(|(e, _)| *e);
     let mut stmts = Vec::new();
-    let mut node_stmt: HashMap<ExprId, usize> = HashMap::new();
+    let mut node_stmt: FxHashMap<ExprId, usize> = FxHashMap::default();
     let mut dummy = PreSet::default();
     for (i, (e, var)) in order.iter().enumerate() {
         let comment = match var {

@@ -177,8 +177,19 @@ pub(super) fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStr
 struct Result {
     ty: TokenStream,
     init: TokenStream,
-    stores: Vec<TokenStream>,
+    stores: Stores,
     value: TokenStream,
+}
+
+/// Result stores as text lines (`m[(0, 1)] = d5;`), by position: `stores[i + 1]` right after
+/// statement `i` (see [`Printer::statement_block`]).
+type Stores = Vec<Vec<String>>;
+
+/// `e` as text ([`Printer::expr_text`]).
+fn text(cx: &Context<'_>, printer: &Printer<'_>, e: &LExpr) -> String {
+    let mut s = String::new();
+    printer.expr_text(&cx.leaf_names, e, false, &mut s);
+    s
 }
 
 /// The result entries of `p` that are not the constant zero (the result starts zeroed).
@@ -193,29 +204,27 @@ pub(super) fn store_after(stores: &mut [TokenStream], e: &LExpr, store: TokenStr
     stores[last_local(e).map_or(0, |i| i + 1)].extend(store);
 }
 
+/// Add the text line `store` to the stores placed right after the last statement `e` reads.
+fn store_text_after(stores: &mut [Vec<String>], e: &LExpr, store: String) {
+    stores[last_local(e).map_or(0, |i| i + 1)].push(store);
+}
+
 /// The result of an [`Shape::Isometry`] function: rotation and translation stored like a
 /// matrix's entries, then one `Isometry3` (its rotation as a unit quaternion, by
 /// `UnitQuaternion::from_rotation_matrix`).
-fn isometry(
-    cx: &Context<'_>,
-    printer: &Printer<'_>,
-    p: &Program,
-    mut stores: Vec<TokenStream>,
-) -> Result {
+fn isometry(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, mut stores: Stores) -> Result {
     let t = scalar_type(cx.precision);
     let nonzero: Vec<_> = nonzero_outputs(p).collect();
     let rot_mut = binding(nonzero.iter().any(|(_, c, _)| *c < 3));
     let pos_mut = binding(nonzero.iter().any(|(_, c, _)| *c == 3));
     for (r, c, e) in nonzero {
-        let v = printer.expr(e, false);
+        let v = text(cx, printer, e);
         let store = if *c < 3 {
-            let (r, c) = (idx(*r), idx(*c));
-            quote!(rot[(#r, #c)] = #v;)
+            format!("rot[({r}, {c})] = {v};")
         } else {
-            let r = idx(*r);
-            quote!(pos[#r] = #v;)
+            format!("pos[{r}] = {v};")
         };
-        store_after(&mut stores, e, store);
+        store_text_after(&mut stores, e, store);
     }
     Result {
         ty: result_type(cx, Shape::Isometry),
@@ -244,14 +253,13 @@ fn binding(stored: bool) -> TokenStream {
 fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) -> Result {
     let t = scalar_type(cx.precision);
     let nl = idx(cx.low.dof);
-    let mut stores: Vec<TokenStream> = vec![TokenStream::new(); p.stmts.len() + 1];
+    let mut stores: Stores = vec![Vec::new(); p.stmts.len() + 1];
     let nonzero = nonzero_outputs(p);
     match shape {
         Shape::SymmetricMatrix | Shape::Matrix => {
             for (r, c, e) in nonzero {
-                let v = printer.expr(e, false);
-                let (r, c) = (idx(*r), idx(*c));
-                store_after(&mut stores, e, quote!(m[(#r, #c)] = #v;));
+                let v = text(cx, printer, e);
+                store_text_after(&mut stores, e, format!("m[({r}, {c})] = {v};"));
             }
             // Symmetric: the lower triangle is copied at the end by a loop over the column-major
             // storage. Mirrored stores next to the computation, or unrolled copies at the end
@@ -286,9 +294,8 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
             );
             let mutable = binding(nonzero.clone().next().is_some());
             for (r, c, e) in nonzero {
-                let v = printer.expr(e, false);
-                let (r, c) = (idx(*r), idx(*c));
-                store_after(&mut stores, e, quote!(m[(#r, #c)] = #v;));
+                let v = text(cx, printer, e);
+                store_text_after(&mut stores, e, format!("m[({r}, {c})] = {v};"));
             }
             Result {
                 ty: result_type(cx, shape),
@@ -313,13 +320,16 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
         Shape::Isometry => isometry(cx, printer, p, stores),
         Shape::Vector => {
             for (r, _, e) in nonzero {
-                let v = printer.expr(e, false);
-                let r = idx(*r);
+                let v = text(cx, printer, e);
                 // `black_box` keeps LLVM's SLP vectorizer from packing the stores of adjacent
                 // entries (and the expression trees behind them) into two-lane vectors: for
                 // Krang's inverse dynamics that packing added ~25 % code of shuffles and spills
                 // and doubled the time (1.17 µs vs 0.64 µs). (Krang's c got ~5 % slower.)
-                store_after(&mut stores, e, quote!(out[#r] = core::hint::black_box(#v);));
+                store_text_after(
+                    &mut stores,
+                    e,
+                    format!("out[{r}] = core::hint::black_box({v});"),
+                );
             }
             Result {
                 ty: quote!(SVector<#t, #nl>),
@@ -380,7 +390,21 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         stores,
         value,
     } = result(cx, &printer, p, spec.shape);
-    let body = printer.statements(&stores);
+    // The statements are printed as text and spliced in after formatting (`text.rs`).
+    // A scalar result is the final expression; every other entry is stored in the block.
+    let outputs: Vec<&LExpr> = nonzero_outputs(p).map(|(_, _, e)| e).collect();
+    let (stored, read_at_end) = if spec.shape == Shape::Scalar {
+        (Vec::new(), outputs)
+    } else {
+        (outputs, Vec::new())
+    };
+    let block = printer.statement_block(
+        &cx.leaf_names,
+        stores,
+        (&stored, &read_at_end),
+        cx.split_above,
+    );
+    let body = cx.blocks.placeholder(block);
     let unused = unused_inputs(spec, p, &reads);
     let body = quote! {
         #unused

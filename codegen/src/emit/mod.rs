@@ -20,8 +20,10 @@ mod combined;
 mod frames;
 mod function;
 mod items;
+mod layout;
 mod print;
 mod regressors;
+mod text;
 
 use std::path::Path;
 
@@ -65,7 +67,14 @@ pub struct EmitOptions {
     pub notes: Vec<String>,
     /// Heading of the notes block (`URDF import notes`).
     pub notes_title: String,
+    /// Functions with more statements than this are split into blocks of 500 (default
+    /// [`SPLIT_ABOVE`]: 2,600), so that rustc's debug info does not overflow its stack on them
+    /// (see [`SPLIT_ABOVE`]); `usize::MAX` never splits. Lower it if a debug build of a
+    /// generated module still crashes rustc.
+    pub split_above: usize,
 }
+
+pub use text::SPLIT_ABOVE;
 
 impl Default for EmitOptions {
     fn default() -> Self {
@@ -75,6 +84,7 @@ impl Default for EmitOptions {
             precision: Precision::default(),
             notes: Vec::new(),
             notes_title: String::new(),
+            split_above: SPLIT_ABOVE,
         }
     }
 }
@@ -88,6 +98,12 @@ pub(crate) struct Context<'a> {
     isa_dispatch: bool,
     /// Field names of the precomputed values, by slot.
     pre: Vec<String>,
+    /// The statement blocks of the functions, spliced in after formatting (`text.rs`).
+    blocks: text::Blocks,
+    /// The model's leaves as printed in statement blocks.
+    leaf_names: text::LeafNames,
+    /// See [`EmitOptions::split_above`].
+    split_above: usize,
 }
 
 fn scalar_type(precision: Precision) -> TokenStream {
@@ -117,6 +133,9 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
             .iter()
             .map(|&i| low.precompute.stmts[i].name.clone())
             .collect(),
+        blocks: text::Blocks::default(),
+        leaf_names: text::LeafNames::new(model),
+        split_above: options.split_above,
     };
     let runtime = low.params.is_runtime();
     let mut items = quote!(
@@ -142,17 +161,12 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         labels.add("new", &low.precompute);
     }
     items.extend(regressors::items(&cx));
-    let names: Vec<String> = low
-        .functions
-        .iter()
-        .map(|f| frames::rust_name(&cx, f))
-        .collect();
     if low.functions.iter().any(|f| f.frame.is_some()) {
         items.extend(frames::frame_type(&cx));
     }
     for (i, f) in low.functions.iter().enumerate() {
+        // Its statements carry their labels in their block (`text.rs`).
         items.extend(function::function(&cx, f));
-        labels.add(&names[i], &f.program);
         // After a per-frame function's last frame, its dispatcher.
         let last = low.functions.get(i + 1).is_none_or(|next| next.id != f.id);
         if f.frame.is_some() && last {
@@ -195,7 +209,13 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         }
         out.push('\n');
     }
-    out.push_str(&labels.apply(&body));
+    let body = labels.apply(&body);
+    let blocks = cx.blocks.take();
+    let body = text::splice(&body, &blocks).map_err(|message| EmitError {
+        model: model.name.clone(),
+        message,
+    })?;
+    out.push_str(&body);
     Ok(out)
 }
 
@@ -205,6 +225,11 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
 /// `\u{202e}`). Every comment text that comes from input (header, notes, statement labels)
 /// goes through this function.
 pub(crate) fn comment_text(s: &str) -> String {
+    let escaped =
+        |c: char| c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}');
+    if !s.chars().any(escaped) {
+        return s.to_owned();
+    }
     s.chars()
         .flat_map(|c| {
             if c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}') {

@@ -15,8 +15,10 @@
 //! K (kinematic) and D (inertial/gravity) variables. [`Arena::diff`] (`diff.rs`) differentiates
 //! exactly, variable by variable.
 
-use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
+use std::hash::BuildHasher as _;
+
+use rustc_hash::{FxBuildHasher, FxHashMap};
 
 use crate::naming;
 
@@ -131,11 +133,13 @@ pub struct Names {
 #[derive(Clone, Debug)]
 pub struct Arena {
     nodes: Vec<Node>,
-    map: HashMap<Node, ExprId>,
+    /// The interning table: the hash of every node of `nodes` and its handle (each node is
+    /// stored once, in `nodes`; the hash is kept so that growing the table reads no node).
+    table: hashbrown::HashTable<(u64, ExprId)>,
     /// Per node: depends on parameters and constants only.
     param_only: Vec<bool>,
     vars: Vec<VarInfo>,
-    var_by_def: HashMap<ExprId, u32>,
+    var_by_def: FxHashMap<ExprId, u32>,
     /// Names for printing.
     pub names: Names,
     /// Whether [`Arena::subst`] hoists parameter-only parts into their own variables.
@@ -145,6 +149,10 @@ pub struct Arena {
     stamps: Vec<u32>,
     /// Requests so far in the current phase.
     clock: u32,
+    /// The nodes the current phase asked for, in the order it first asked (`stamps` of these
+    /// are their positions): a phase is reset and read in time proportional to what it asked
+    /// for, not to the arena (hundreds of per-frame phases over a large arena).
+    touched: Vec<ExprId>,
     /// Memo of [`Arena::diff`].
     diff_memo: diff::DiffMemo,
     /// Per speed index: the mimic constraint `q = a·q_master + b` of a dependent speed (see
@@ -181,15 +189,16 @@ impl Arena {
     pub fn new(names: Names) -> Self {
         let mut a = Arena {
             nodes: Vec::new(),
-            map: HashMap::new(),
+            table: hashbrown::HashTable::new(),
             param_only: Vec::new(),
             vars: Vec::new(),
-            var_by_def: HashMap::new(),
+            var_by_def: FxHashMap::default(),
             names,
             hoist_params: false,
             stamps: Vec::new(),
             clock: 0,
-            diff_memo: HashMap::new(),
+            touched: Vec::new(),
+            diff_memo: Default::default(),
             mimics: Vec::new(),
         };
         a.constant(0.0);
@@ -227,14 +236,16 @@ impl Arena {
     /// the order its own recursion forms them, even where it reuses nodes that an earlier
     /// function created (see [`Arena::phase_order`]).
     pub fn begin_phase(&mut self) {
-        self.stamps.iter_mut().for_each(|s| *s = u32::MAX);
+        for e in self.touched.drain(..) {
+            self.stamps[e.index()] = u32::MAX;
+        }
         self.clock = 0;
     }
 
-    /// Per node, when the current phase first asked for it (created it or found it interned);
-    /// `u32::MAX` for nodes it did not ask for.
-    pub fn phase_order(&self) -> Vec<u32> {
-        self.stamps.clone()
+    /// The nodes the current phase asked for (created or found interned), in the order it first
+    /// asked for them.
+    pub fn phase_order(&self) -> Vec<ExprId> {
+        self.touched.clone()
     }
 
     /// Ask for `e` and everything it reads (through substitution variables) in the current
@@ -267,11 +278,17 @@ impl Arena {
         if *s == u32::MAX {
             *s = self.clock;
             self.clock += 1;
+            self.touched.push(id);
         }
     }
 
     fn intern(&mut self, n: Node) -> ExprId {
-        if let Some(&id) = self.map.get(&n) {
+        let hash = FxBuildHasher.hash_one(&n);
+        let nodes = &self.nodes;
+        if let Some(&(_, id)) = self
+            .table
+            .find(hash, |(h, id)| *h == hash && nodes[id.index()] == n)
+        {
             self.touch(id);
             return id;
         }
@@ -284,11 +301,11 @@ impl Arena {
             Node::Prod(f) => f.iter().all(|(b, _)| self.param_only[b.index()]),
         };
         let id = ExprId(self.nodes.len() as u32);
-        self.nodes.push(n.clone());
+        self.nodes.push(n);
         self.param_only.push(po);
         self.stamps.push(u32::MAX);
         self.touch(id);
-        self.map.insert(n, id);
+        self.table.insert_unique(hash, (hash, id), |(h, _)| *h);
         id
     }
 
@@ -406,7 +423,8 @@ impl Arena {
         }
     }
 
-    fn build_sum(&mut self, constant: f64, terms: BTreeMap<ExprId, f64>) -> ExprId {
+    /// `constant + Σ k·t` from terms sorted by `t` without repeats.
+    fn build_sum(&mut self, constant: f64, terms: Vec<(ExprId, f64)>) -> ExprId {
         let terms: Vec<(ExprId, Num)> = terms
             .into_iter()
             .filter(|(_, c)| *c != 0.0)
@@ -424,7 +442,8 @@ impl Arena {
         })
     }
 
-    fn build_prod(&mut self, factors: BTreeMap<ExprId, i32>) -> ExprId {
+    /// `Π b^p` from factors sorted by `b` without repeats.
+    fn build_prod(&mut self, factors: Vec<(ExprId, i32)>) -> ExprId {
         let f: Vec<(ExprId, i32)> = factors.into_iter().filter(|(_, p)| *p != 0).collect();
         match f.as_slice() {
             [] => self.one(),
@@ -436,14 +455,18 @@ impl Arena {
     /// Sum of any number of expressions.
     pub fn sum<I: IntoIterator<Item = ExprId>>(&mut self, items: I) -> ExprId {
         let mut constant = 0.0;
-        let mut acc: BTreeMap<ExprId, f64> = BTreeMap::new();
+        let mut acc: Vec<(ExprId, f64)> = Vec::new();
         for e in items {
-            let (c, terms) = self.linear(e);
-            constant += c;
-            for (t, k) in terms {
-                *acc.entry(t).or_insert(0.0) += k;
+            match self.node(e) {
+                Node::Const(c) => constant += c.get(),
+                Node::Sum { constant: c, terms } => {
+                    constant += c.get();
+                    acc.extend(terms.iter().map(|(t, k)| (*t, k.get())));
+                }
+                _ => acc.push((e, 1.0)),
             }
         }
+        let acc = collect_terms(acc);
         self.build_sum(constant, acc)
     }
 
@@ -472,7 +495,8 @@ impl Arena {
             return e;
         }
         let (c, terms) = self.linear(e);
-        let acc: BTreeMap<ExprId, f64> = terms.into_iter().map(|(t, x)| (t, x * k)).collect();
+        // The terms of one expression are sorted and distinct already.
+        let acc: Vec<(ExprId, f64)> = terms.into_iter().map(|(t, x)| (t, x * k)).collect();
         self.build_sum(c * k, acc)
     }
 
@@ -486,11 +510,9 @@ impl Arena {
         }
         let (ka, fa) = self.monomial(a);
         let (kb, fb) = self.monomial(b);
-        let mut f: BTreeMap<ExprId, i32> = BTreeMap::new();
-        for (base, p) in fa.into_iter().chain(fb) {
-            *f.entry(base).or_insert(0) += p;
-        }
-        let m = self.build_prod(f);
+        let mut f = fa;
+        f.extend(fb);
+        let m = self.build_prod(collect_factors(f));
         self.scale(m, ka * kb)
     }
 
@@ -509,7 +531,7 @@ impl Arena {
             return self.one();
         }
         let (k, f) = self.monomial(e);
-        let f: BTreeMap<ExprId, i32> = f.into_iter().map(|(b, p)| (b, p * n)).collect();
+        let f: Vec<(ExprId, i32)> = f.into_iter().map(|(b, p)| (b, p * n)).collect();
         let m = self.build_prod(f);
         self.scale(m, k.powi(n))
     }
@@ -800,6 +822,34 @@ impl Arena {
         }
         needed
     }
+}
+
+/// Terms sorted by term with repeats merged: the coefficients of equal terms are added in the
+/// order given, starting from zero (what accumulating them in a map did).
+fn collect_terms(mut v: Vec<(ExprId, f64)>) -> Vec<(ExprId, f64)> {
+    // Stable: equal terms keep their order, so their sum rounds the same way.
+    v.sort_by_key(|(t, _)| *t);
+    let mut out: Vec<(ExprId, f64)> = Vec::with_capacity(v.len());
+    for (t, k) in v {
+        match out.last_mut() {
+            Some((last, acc)) if *last == t => *acc += k,
+            _ => out.push((t, 0.0 + k)),
+        }
+    }
+    out
+}
+
+/// Factors sorted by base with the powers of equal bases added.
+fn collect_factors(mut v: Vec<(ExprId, i32)>) -> Vec<(ExprId, i32)> {
+    v.sort_unstable_by_key(|(b, _)| *b);
+    let mut out: Vec<(ExprId, i32)> = Vec::with_capacity(v.len());
+    for (b, p) in v {
+        match out.last_mut() {
+            Some((last, acc)) if *last == b => *acc += p,
+            _ => out.push((b, p)),
+        }
+    }
+    out
 }
 
 /// Shortest round-trip text of a number.

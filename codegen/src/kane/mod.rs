@@ -86,9 +86,9 @@ pub struct Function {
     pub frame: Option<usize>,
     /// `(row, col, expr)` in the layout of the function's [`Shape`](crate::registry::Shape); col = 0 for vectors.
     pub entries: Vec<(usize, usize, ExprId)>,
-    /// Per arena node, when this function's derivation first asked for it (`u32::MAX`: never):
-    /// the statement order the lowering follows (see [`Arena::begin_phase`]).
-    pub order: Vec<u32>,
+    /// The arena nodes this function's derivation asked for, in the order it first asked for
+    /// them: the statement order the lowering follows (see [`Arena::begin_phase`]).
+    pub order: Vec<ExprId>,
 }
 
 /// A function's `(row, col, expression)` entries.
@@ -125,9 +125,9 @@ pub struct CombinedFunction {
     /// Per part (in the order of `spec.parts`), its `(row, col, expr)` entries in the layout of
     /// the part's [`Shape`](crate::registry::Shape).
     pub parts: Vec<Vec<(usize, usize, ExprId)>>,
-    /// Per arena node, when the combined function's phase first asked for it (see
-    /// [`Function::order`]).
-    pub order: Vec<u32>,
+    /// The arena nodes the combined function's phase asked for, in the order it first asked
+    /// for them (see [`Function::order`]).
+    pub order: Vec<ExprId>,
 }
 
 impl Derivation {

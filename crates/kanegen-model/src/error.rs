@@ -45,6 +45,29 @@ pub enum ModelErrorKind {
     /// The file could not be read (the message repeats the I/O error, which is also the source).
     #[error("cannot read the file: {0}")]
     Io(#[source] std::io::Error),
+    /// The description is larger than the loaders accept (a robot description is a few hundred
+    /// kilobytes; meshes are separate files): refused before it is read or parsed.
+    #[error(
+        "the description is {bytes} bytes, more than the {limit} bytes a description may have; check that this is the robot description (meshes and other data belong in files of their own)"
+    )]
+    TooLarge {
+        /// Its size in bytes.
+        bytes: u64,
+        /// The largest size accepted ([`crate::MAX_DESCRIPTION_BYTES`]).
+        limit: u64,
+    },
+    /// URDF elements are nested deeper than the importer accepts (a URDF needs about five
+    /// levels): found by a streaming pre-check, before the recursive URDF parser could overflow
+    /// its stack.
+    #[error(
+        "URDF elements are nested more than {limit} levels deep (at <{element}>); a URDF nests <robot>, <link>/<joint> and their few levels of content: check the XML"
+    )]
+    UrdfTooDeep {
+        /// The element that is one level too deep.
+        element: String,
+        /// The deepest nesting accepted.
+        limit: usize,
+    },
     /// The file is not valid TOML, or does not have the shape of a model description.
     #[error("malformed description: {0}")]
     Syntax(String),

@@ -17,6 +17,7 @@ mod error;
 mod frames;
 mod ident;
 mod ir;
+mod limits;
 mod mass_matrix;
 mod mimic;
 pub mod names;
@@ -28,6 +29,7 @@ pub use error::{BadName, ModelError, ModelErrorKind};
 pub use frames::OperationalFrame;
 pub use ident::{is_keyword, sanitize_identifier};
 pub use ir::*;
+pub use limits::{MAX_DESCRIPTION_BYTES, MAX_URDF_DEPTH};
 pub use mass_matrix::kinetic_energy_mass_matrix;
 pub use mimic::{Mimic, MimicMode};
 pub use urdf::{

@@ -157,13 +157,14 @@ impl Model {
     pub fn from_toml_file(path: impl AsRef<Path>) -> Result<Model, ModelError> {
         let path = path.as_ref();
         let label = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ModelError::new(&label, K::Io(e)))?;
+        let text = crate::limits::read_description(path)?;
         Self::from_toml_str(&text, &label)
     }
 
     /// Parse and validate a TOML description held in memory; `file` labels error messages.
     pub fn from_toml_str(text: &str, file: &str) -> Result<Model, ModelError> {
         let err = |kind| ModelError::new(file, kind);
+        crate::limits::check_size(text.len() as u64).map_err(err)?;
         let parsed: File = toml::from_str(text).map_err(|e| err(K::Syntax(e.to_string())))?;
         build(parsed, file).map_err(err)
     }

@@ -315,7 +315,7 @@ impl UrdfImport {
     pub fn read(path: impl AsRef<Path>, options: &UrdfOptions) -> Result<Self, ModelError> {
         let path = path.as_ref();
         let label = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ModelError::new(&label, K::Io(e)))?;
+        let text = crate::limits::read_description(path)?;
         Self::parse(&text, &label, options)
     }
 
@@ -323,6 +323,9 @@ impl UrdfImport {
     /// [`Model::source`].
     pub fn parse(text: &str, label: &str, options: &UrdfOptions) -> Result<Self, ModelError> {
         let err = |kind| ModelError::new(label, kind);
+        // Limits first: nothing below reads a text that is too large or too deep.
+        crate::limits::check_size(text.len() as u64).map_err(err)?;
+        crate::limits::check_urdf_depth(text).map_err(err)?;
         let text = diagnose::without_unused_elements(text);
         if let Some(kind) = diagnose::diagnose(&text) {
             return Err(err(kind));

@@ -1,0 +1,707 @@
+//! Statement blocks printed as text, spliced into the formatted module.
+//!
+//! The module's items go through proc-macro2 → syn → prettyplease. The straight-line
+//! statements of the generated functions (almost all of a large model's bytes: 47 MB for a
+//! 200-link chain) are not built as tokens: each statement is printed directly as the line
+//! prettyplease would print for it ([`Printer::expr_text`]), and the function body holds a
+//! placeholder statement `__kanegen_block!(N);` where the block goes. After formatting,
+//! [`splice`] replaces every placeholder line by its block at the placeholder's indentation.
+//! A statement longer than prettyplease's line (at that indentation) is formatted by
+//! prettyplease on its own, so that the output stays byte for byte what formatting the whole
+//! module at once gave (checked by the tests below, the golden file and the pre-generated Krang
+//! module). Tokens, syntax trees and the formatter's buffers of a whole module took most of
+//! the generator's time and memory on large models.
+
+use std::cell::RefCell;
+use std::fmt::Write as _;
+
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::comment_text;
+use super::print::{Printer, lit};
+use crate::lower::{LExpr, Leaf};
+use crate::model::Model;
+use crate::naming;
+
+/// prettyplease's line width ([`MARGIN`] columns including the indentation, at least
+/// [`MIN_SPACE`] after it): a statement that fits stays on one line.
+const MARGIN: usize = 89;
+/// See [`MARGIN`].
+const MIN_SPACE: usize = 60;
+
+/// The name of the placeholder macro (a statement `__kanegen_block!(N);` in the token stream).
+const PLACEHOLDER: &str = "__kanegen_block!(";
+
+/// The default of [`EmitOptions::split_above`](super::EmitOptions::split_above): functions with
+/// more statements than this have their statements in blocks of [`SPLIT_CHUNK`] statements
+/// (`let (k5, d7) = { …; (k5, d7) };`). rustc's debug info nests one lexical scope per `let`,
+/// and its DWARF writer recursed through them until it overflowed its stack (SIGSEGV): measured
+/// with rustc 1.95 and the ISA-dispatch closures, 2,556 statements compiled (Krang's Coriolis
+/// matrix) and 2,850 crashed (c of a 100-DOF tree). A block ends the nesting; what later
+/// statements read leaves it as a tuple, which optimised code does not see. Every function of
+/// Krang's default module is at most 2,556 statements and stays as it was; its derivatives
+/// (≈ 9,000) and regressors (≈ 3,600) are split.
+pub const SPLIT_ABOVE: usize = 2600;
+/// Statements per block of a split function (see [`SPLIT_ABOVE`]).
+pub const SPLIT_CHUNK: usize = 500;
+
+/// One line of a block: a statement on one line (`let d5 = c_q7r * d3 + s_q7r * d4;`), laid out
+/// like prettyplease at splice time, or a line written as it is (`raw`: the start and end of a
+/// block of a split function); `depth` levels of indentation deeper than the placeholder, and
+/// the label written after it as a comment (escaped; empty: none).
+struct Line {
+    code: String,
+    label: String,
+    depth: usize,
+    raw: bool,
+}
+
+/// A block of statements, in order.
+#[derive(Default)]
+pub(super) struct Block {
+    lines: Vec<Line>,
+}
+
+impl Block {
+    /// Add a statement; `label` (raw model text, escaped here) is written after it as a
+    /// comment unless it is empty.
+    pub(super) fn push(&mut self, code: String, label: &str) {
+        let label = if label.is_empty() {
+            String::new()
+        } else {
+            comment_text(label)
+        };
+        self.lines.push(Line {
+            code,
+            label,
+            depth: 0,
+            raw: false,
+        });
+    }
+
+    /// Add a line written as it is, `depth` levels deeper than the placeholder.
+    fn push_raw(&mut self, code: String, depth: usize) {
+        self.lines.push(Line {
+            code,
+            label: String::new(),
+            depth,
+            raw: true,
+        });
+    }
+
+    /// Number of bytes the block takes at indentation `indent` (an estimate for capacity).
+    fn len_at(&self, indent: usize) -> usize {
+        self.lines
+            .iter()
+            .map(|l| indent + 4 * l.depth + l.code.len() + l.label.len() + 5)
+            .sum()
+    }
+}
+
+/// The blocks of a module, by placeholder number.
+#[derive(Default)]
+pub(super) struct Blocks(RefCell<Vec<Block>>);
+
+impl Blocks {
+    /// Keep `block` and return its placeholder statement.
+    pub(super) fn placeholder(&self, block: Block) -> TokenStream {
+        let mut blocks = self.0.borrow_mut();
+        let n = proc_macro2::Literal::usize_unsuffixed(blocks.len());
+        blocks.push(block);
+        quote!(__kanegen_block!(#n);)
+    }
+
+    /// The blocks, in placeholder order.
+    pub(super) fn take(&self) -> Vec<Block> {
+        std::mem::take(&mut self.0.borrow_mut())
+    }
+}
+
+/// The identifiers of the model's leaves as they are printed (`p.` and `pc.` prefixes
+/// aside), made once per module instead of once per leaf.
+pub(super) struct LeafNames {
+    params: Vec<String>,
+    speeds: Vec<String>,
+    accels: Vec<String>,
+    sins: Vec<String>,
+    coss: Vec<String>,
+    coords: Vec<String>,
+}
+
+impl LeafNames {
+    /// The names of `model`'s parameters and of its speeds' leaves.
+    pub(super) fn new(model: &Model) -> Self {
+        let speeds = |f: &dyn Fn(&crate::model::Speed) -> String| -> Vec<String> {
+            model
+                .speeds
+                .iter()
+                .map(|s| naming::identifier(&f(s)))
+                .collect()
+        };
+        Self {
+            params: model
+                .params
+                .iter()
+                .map(|p| naming::identifier(&p.name))
+                .collect(),
+            speeds: speeds(&|s| s.name.clone()),
+            accels: speeds(&|s| naming::accel(&s.name)),
+            sins: speeds(&|s| naming::sin(&s.coordinate)),
+            coss: speeds(&|s| naming::cos(&s.coordinate)),
+            coords: speeds(&|s| s.coordinate.clone()),
+        }
+    }
+}
+
+impl Printer<'_> {
+    /// The statements of the program as a block: `let NAME = EXPR; // label`, with `after[0]`
+    /// before the first and `after[i + 1]` right after statement `i` (stores, printed by
+    /// [`Printer::expr_text`]). The text form of [`Printer::statements`] plus the labels.
+    /// `stored` are the expressions of the stores (each stored right after the last statement
+    /// it reads), `read_at_end` what the function reads after the block (a scalar result):
+    /// a function of more than `split_above` statements is split into blocks (see
+    /// [`SPLIT_ABOVE`]), and a block passes on the values that later statements, stores or the
+    /// end read.
+    pub(super) fn statement_block(
+        &self,
+        names: &LeafNames,
+        after: Vec<Vec<String>>,
+        (stored, read_at_end): (&[&LExpr], &[&LExpr]),
+        split_above: usize,
+    ) -> Block {
+        let n = self.stmts.len();
+        let split = n > split_above;
+        let chunk = if split { SPLIT_CHUNK } else { n.max(1) };
+        let last_use = if split {
+            self.last_uses(stored, read_at_end)
+        } else {
+            Vec::new()
+        };
+        let mut block = Block::default();
+        let mut after = after.into_iter();
+        for code in after.next().unwrap_or_default() {
+            block.push(code, "");
+        }
+        let mut code = String::new();
+        for start in (0..n).step_by(chunk) {
+            let end = (start + chunk).min(n);
+            // The values of this block that are read after it.
+            let live: Vec<&str> = if split {
+                (start..end)
+                    .filter(|&i| last_use[i] >= end)
+                    .map(|i| self.stmts[i].name.as_str())
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            if split {
+                let head = match live.as_slice() {
+                    [] => "{".to_owned(),
+                    [one] => format!("let {one} = {{"),
+                    _ => format!("let ({}) = {{", live.join(", ")),
+                };
+                block.push_raw(head, 0);
+            }
+            let depth = usize::from(split);
+            for s in &self.stmts[start..end] {
+                // Statement names are generated identifiers (`k12`, `d5`).
+                code.clear();
+                code.push_str("let ");
+                code.push_str(&s.name);
+                code.push_str(" = ");
+                self.expr_text(names, &s.expr, false, &mut code);
+                code.push(';');
+                block.push(code.clone(), &s.comment);
+                block.lines.last_mut().expect("pushed").depth = depth;
+                for store in after.next().unwrap_or_default() {
+                    block.push(store, "");
+                    block.lines.last_mut().expect("pushed").depth = depth;
+                }
+            }
+            if split {
+                match live.as_slice() {
+                    [] => block.push_raw("}".to_owned(), 0),
+                    [one] => {
+                        block.push_raw((*one).to_owned(), 1);
+                        block.push_raw("};".to_owned(), 0);
+                    }
+                    _ => {
+                        block.push_raw(format!("({})", live.join(", ")), 1);
+                        block.push_raw("};".to_owned(), 0);
+                    }
+                }
+            }
+        }
+        block
+    }
+
+    /// Per statement, the position of its last reader: a statement's index, the statement a
+    /// store follows, or `n` for the end.
+    fn last_uses(&self, stored: &[&LExpr], read_at_end: &[&LExpr]) -> Vec<usize> {
+        let n = self.stmts.len();
+        let mut last: Vec<usize> = (0..n).collect();
+        let mut reads = Vec::new();
+        let mut mark = |e: &LExpr, at: Option<usize>, last: &mut Vec<usize>| {
+            reads.clear();
+            locals_of(e, &mut reads);
+            let at = at.or_else(|| reads.iter().copied().max());
+            if let Some(at) = at {
+                for &i in &reads {
+                    last[i] = last[i].max(at);
+                }
+            }
+        };
+        for (j, s) in self.stmts.iter().enumerate() {
+            mark(&s.expr, Some(j), &mut last);
+        }
+        for e in stored {
+            mark(e, None, &mut last);
+        }
+        for e in read_at_end {
+            mark(e, Some(n), &mut last);
+        }
+        last
+    }
+
+    /// Appends the text prettyplease prints for [`Printer::expr`]`(e, atomic)` on one line.
+    pub(super) fn expr_text(&self, names: &LeafNames, e: &LExpr, atomic: bool, out: &mut String) {
+        match e {
+            LExpr::Leaf(Leaf::Const(c)) if *c < 0.0 && atomic => {
+                out.push_str("(-");
+                push_lit(out, *c, self);
+                out.push(')');
+            }
+            LExpr::Leaf(l) => self.leaf_text(names, l, out),
+            LExpr::Sum { constant, terms } => {
+                if atomic {
+                    out.push('(');
+                }
+                self.sum_text(names, *constant, terms, out);
+                if atomic {
+                    out.push(')');
+                }
+            }
+            LExpr::Prod(f) => {
+                if atomic {
+                    out.push('(');
+                }
+                self.product_text(names, f, out);
+                if atomic {
+                    out.push(')');
+                }
+            }
+        }
+    }
+
+    fn leaf_text(&self, names: &LeafNames, l: &Leaf, out: &mut String) {
+        let name: &str = match *l {
+            Leaf::Const(c) => {
+                if c < 0.0 {
+                    out.push('-');
+                }
+                push_lit(out, c, self);
+                return;
+            }
+            Leaf::Param(p) => {
+                out.push_str("p.");
+                &names.params[p]
+            }
+            // Precomputed slots and statements have generated names (`pc3`, `k12`).
+            Leaf::Pre(s) => {
+                out.push_str("pc.");
+                &self.pre[s]
+            }
+            Leaf::Local(i) => &self.stmts[i].name,
+            Leaf::Speed(s) => &names.speeds[s],
+            Leaf::Accel(s) => &names.accels[s],
+            Leaf::Sin(s) => &names.sins[s],
+            Leaf::Cos(s) => &names.coss[s],
+            Leaf::Coord(s) => &names.coords[s],
+        };
+        out.push_str(name);
+    }
+
+    fn sum_text(&self, names: &LeafNames, constant: f64, terms: &[(f64, LExpr)], out: &mut String) {
+        // The order of `Printer::sum`: the first positive term first.
+        let first = terms.iter().position(|(k, _)| *k > 0.0).unwrap_or(0);
+        let order = std::iter::once(first).chain((0..terms.len()).filter(|&i| i != first));
+        for (i, j) in order.enumerate() {
+            let Some((k, t)) = terms.get(j) else { break };
+            match (i, *k < 0.0) {
+                (0, false) => {}
+                (0, true) => out.push('-'),
+                (_, false) => out.push_str(" + "),
+                (_, true) => out.push_str(" - "),
+            }
+            if k.abs() == 1.0 {
+                self.expr_text(names, t, false, out);
+            } else {
+                push_lit(out, *k, self);
+                out.push_str(" * ");
+                self.expr_text(names, t, true, out);
+            }
+        }
+        if constant != 0.0 {
+            out.push_str(if constant < 0.0 { " - " } else { " + " });
+            push_lit(out, constant, self);
+        }
+    }
+
+    fn product_text(&self, names: &LeafNames, f: &[(LExpr, i32)], out: &mut String) {
+        let mut first = true;
+        for (b, p) in f.iter().filter(|(_, p)| *p > 0) {
+            for _ in 0..*p {
+                if !first {
+                    out.push_str(" * ");
+                }
+                first = false;
+                self.expr_text(names, b, true, out);
+            }
+        }
+        if first {
+            out.push_str("1.0");
+        }
+        let den: usize = f
+            .iter()
+            .filter(|(_, p)| *p < 0)
+            .map(|(_, p)| p.unsigned_abs() as usize)
+            .sum();
+        if den == 0 {
+            return;
+        }
+        out.push_str(" / ");
+        if den > 1 {
+            out.push('(');
+        }
+        let mut first = true;
+        for (b, p) in f.iter().filter(|(_, p)| *p < 0) {
+            for _ in 0..p.unsigned_abs() {
+                if !first {
+                    out.push_str(" * ");
+                }
+                first = false;
+                self.expr_text(names, b, true, out);
+            }
+        }
+        if den > 1 {
+            out.push(')');
+        }
+    }
+}
+
+/// The statements `e` reads.
+fn locals_of(e: &LExpr, out: &mut Vec<usize>) {
+    match e {
+        LExpr::Leaf(Leaf::Local(i)) => out.push(*i),
+        LExpr::Leaf(_) => {}
+        LExpr::Sum { terms, .. } => terms.iter().for_each(|(_, t)| locals_of(t, out)),
+        LExpr::Prod(f) => f.iter().for_each(|(b, _)| locals_of(b, out)),
+    }
+}
+
+/// `|v|` as the literal of [`lit`] (the same text as its token).
+fn push_lit(out: &mut String, v: f64, p: &Printer<'_>) {
+    let _ = write!(out, "{}", lit(v, p.precision));
+}
+
+/// Whether a statement of `len` bytes stays on one line at indentation `indent`.
+fn fits(indent: usize, len: usize) -> bool {
+    len <= MARGIN.saturating_sub(indent).max(MIN_SPACE)
+}
+
+/// prettyplease's formatting of the statement `code` at indentation `indent` (a multiple of 4,
+/// at least 4), one string per line with the indentation. `None` if `code` does not parse (a
+/// generator bug, reported by the caller).
+fn format_long(indent: usize, code: &str) -> Option<Vec<String>> {
+    let depth = indent / 4;
+    let mut src = String::from("fn f() {");
+    for _ in 1..depth {
+        src.push('{');
+    }
+    src.push_str(code);
+    for _ in 0..depth {
+        src.push('}');
+    }
+    let file: syn::File = syn::parse_str(&src).ok()?;
+    let text = prettyplease::unparse(&file);
+    let lines: Vec<&str> = text.lines().collect();
+    let inner = lines.get(depth..lines.len().checked_sub(depth)?)?;
+    Some(inner.iter().map(|l| (*l).to_owned()).collect())
+}
+
+/// A raw line at indentation `at`; a tuple pattern or value that does not fit (`let (k1, k2,
+/// …) = {`, `(k1, k2, …)`) gets one name per line with a trailing comma, as rustfmt and
+/// prettyplease break tuples.
+fn push_raw(out: &mut String, at: usize, code: &str) {
+    let pad = |out: &mut String, n: usize| out.extend(std::iter::repeat_n(' ', n));
+    let split = code
+        .find('(')
+        .zip(code.rfind(')'))
+        .filter(|_| !fits(at, code.len()));
+    let Some((open, close)) = split else {
+        pad(out, at);
+        out.push_str(code);
+        out.push('\n');
+        return;
+    };
+    pad(out, at);
+    out.push_str(&code[..=open]);
+    out.push('\n');
+    for name in code[open + 1..close].split(", ") {
+        pad(out, at + 4);
+        out.push_str(name);
+        out.push_str(",\n");
+    }
+    pad(out, at);
+    out.push_str(&code[close..]);
+    out.push('\n');
+}
+
+/// The block number of a placeholder line (`__kanegen_block!(7);` → 7), if it is one.
+fn placeholder_number(trimmed: &str) -> Option<usize> {
+    trimmed
+        .strip_prefix(PLACEHOLDER)?
+        .strip_suffix(");")?
+        .parse()
+        .ok()
+}
+
+/// `src` (formatted) with every placeholder line replaced by its block, at the placeholder's
+/// indentation. Errors name a statement that does not parse (a generator bug).
+pub(super) fn splice(src: &str, blocks: &[Block]) -> Result<String, String> {
+    let extra: usize = blocks.iter().map(|b| b.len_at(16)).sum();
+    let mut out = String::with_capacity(src.len() + extra);
+    for line in src.lines() {
+        let trimmed = line.trim_start();
+        let indent = line.len() - trimmed.len();
+        let Some(block) = placeholder_number(trimmed).and_then(|n| blocks.get(n)) else {
+            out.push_str(line);
+            out.push('\n');
+            continue;
+        };
+        for l in &block.lines {
+            let at = indent + 4 * l.depth;
+            if l.raw {
+                push_raw(&mut out, at, &l.code);
+                continue;
+            }
+            if fits(at, l.code.len()) {
+                out.extend(std::iter::repeat_n(' ', at));
+                out.push_str(&l.code);
+            } else {
+                let lines = super::layout::layout(at, &l.code)
+                    .or_else(|| format_long(at, &l.code))
+                    .ok_or_else(|| format!("statement `{}` does not parse", l.code))?;
+                out.push_str(&lines.join("\n"));
+            }
+            if !l.label.is_empty() {
+                out.push_str(" // ");
+                out.push_str(&l.label);
+            }
+            out.push('\n');
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::layout::layout;
+    use crate::emit::print::Printer;
+    use crate::options::{Options, ParamMode, Precision};
+    use crate::registry::{FunctionId, FunctionSet};
+
+    /// prettyplease's text of `tokens` as a statement at indentation `indent`.
+    fn formatted(indent: usize, tokens: TokenStream) -> String {
+        format_long(indent, &tokens.to_string())
+            .expect("parses")
+            .join("\n")
+    }
+
+    /// Every statement and result entry of every function of `model`, for each
+    /// `(parameters, functions, precision)` and indentation: the text printer gives what
+    /// prettyplease prints for the tokens, on one line wherever it fits, and [`layout`] what it
+    /// prints elsewhere.
+    fn check_model(
+        path: &str,
+        variants: &[(ParamMode, FunctionSet, Precision)],
+        indents: &[usize],
+    ) {
+        let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+        let model = crate::model::Model::from_toml_file(format!("{root}/{path}")).unwrap();
+        let names = LeafNames::new(&model);
+        for &(params, functions, precision) in variants {
+            let options = Options { params, functions };
+            let d = crate::kane::derive(&model, options);
+            let low = crate::lower::lower(&d);
+            let pre: Vec<String> = low
+                .pre_slots
+                .iter()
+                .map(|&i| low.precompute.stmts[i].name.clone())
+                .collect();
+            let programs =
+                std::iter::once(&low.precompute).chain(low.functions.iter().map(|f| &f.program));
+            for p in programs {
+                let printer = Printer {
+                    model: &model,
+                    stmts: &p.stmts,
+                    pre: &pre,
+                    precision,
+                };
+                // Statements, and result entries as `let`, matrix and vector stores.
+                let mut cases: Vec<(String, TokenStream)> = Vec::new();
+                for s in &p.stmts {
+                    let id = crate::emit::print::ident(&s.name);
+                    let tokens = printer.expr(&s.expr, false);
+                    let mut text = format!("let {id} = ");
+                    printer.expr_text(&names, &s.expr, false, &mut text);
+                    cases.push((format!("{text};"), quote!(let #id = #tokens;)));
+                }
+                for (r, c, e) in &p.outputs {
+                    let tokens = printer.expr(e, false);
+                    let mut v = String::new();
+                    printer.expr_text(&names, e, false, &mut v);
+                    let (ri, ci) = (
+                        proc_macro2::Literal::usize_unsuffixed(*r),
+                        proc_macro2::Literal::usize_unsuffixed(*c),
+                    );
+                    cases.push((format!("let out = {v};"), quote!(let out = #tokens;)));
+                    cases.push((
+                        format!("m[({r}, {c})] = {v};"),
+                        quote!(m[(#ri, #ci)] = #tokens;),
+                    ));
+                    cases.push((format!("pos[{r}] = {v};"), quote!(pos[#ri] = #tokens;)));
+                }
+                for (text, tokens) in cases {
+                    for &indent in indents {
+                        let want = formatted(indent, tokens.clone());
+                        let got = if fits(indent, text.len()) {
+                            format!("{}{text}", " ".repeat(indent))
+                        } else {
+                            layout(indent, &text)
+                                .expect("in the small language")
+                                .join("\n")
+                        };
+                        assert_eq!(got, want, "{path}, {}", p.name);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn text_printer_matches_prettyplease_on_every_statement_of_krang() {
+        // The derivatives have the longest statements; the regressors add nothing new and are
+        // slow to derive in a debug build.
+        let most = FunctionSet::all()
+            .without(FunctionId::InverseDynamicsRegressor)
+            .without(FunctionId::GravityRegressor)
+            .without(FunctionId::BaseRegressor)
+            .without(FunctionId::BaseGravityRegressor);
+        check_model(
+            "models/krang.toml",
+            &[
+                (ParamMode::Runtime, most, Precision::F64),
+                (ParamMode::Baked, FunctionSet::default(), Precision::F32),
+            ],
+            &[16],
+        );
+    }
+
+    #[test]
+    fn text_printer_matches_prettyplease_on_every_statement_of_the_two_link_model() {
+        let all = FunctionSet::all();
+        check_model(
+            "models/two-link.toml",
+            &[
+                (ParamMode::Runtime, all, Precision::F64),
+                (ParamMode::Baked, all, Precision::F32),
+            ],
+            &[8, 16, 40],
+        );
+    }
+
+    #[test]
+    fn long_statements_break_like_prettyplease_at_every_length() {
+        // Sums of growing length around the line width: the break decision at the margin.
+        let mut e = String::from("let d1 = a0");
+        for i in 1..40 {
+            e.push_str(&format!(" + b{i} * c{i}"));
+            let code = format!("{e};");
+            for indent in [4, 8, 16, 28, 32, 44] {
+                let tokens: TokenStream = code.parse().unwrap();
+                let want = formatted(indent, tokens);
+                if fits(indent, code.len()) {
+                    assert_eq!(want, format!("{}{code}", " ".repeat(indent)), "{indent}");
+                } else {
+                    assert!(want.lines().count() > 1, "{indent}: {want}");
+                }
+                assert_eq!(layout(indent, &code).unwrap().join("\n"), want, "{indent}");
+            }
+        }
+    }
+
+    #[test]
+    fn split_functions_are_valid_rust_with_every_block_passing_on_what_is_read_later() {
+        // Krang's default module split into blocks of 500 above 100 statements: it parses, and
+        // every name a statement reads is bound before it (in its block or passed on by an
+        // earlier one), which the tuple values and patterns make rustc check in
+        // `tests/big_tree.rs`; here: the split module differs from the unsplit one only by
+        // the blocks' lines and indentation.
+        let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+        let model =
+            crate::model::Model::from_toml_file(format!("{root}/models/krang.toml")).unwrap();
+        let emit = |split_above| {
+            let options = crate::EmitOptions {
+                split_above,
+                ..crate::EmitOptions::default()
+            };
+            crate::generate_with(model.clone(), Options::default(), &options)
+                .unwrap()
+                .source
+        };
+        let split = emit(100);
+        let whole = emit(usize::MAX);
+        assert_eq!(
+            whole,
+            emit(SPLIT_ABOVE),
+            "Krang's default module is not split"
+        );
+        syn::parse_file(&split).expect("the split module parses");
+        let blocks = split.lines().filter(|l| l.ends_with(" = {")).count();
+        assert!(blocks >= 5, "{blocks} blocks");
+        // The same statements and stores in the same order (line breaks may differ: the
+        // blocks' statements are indented one level deeper).
+        let statements = |src: &str| -> Vec<String> {
+            src.split_whitespace()
+                .collect::<String>()
+                .split(';')
+                .filter_map(|s| {
+                    let s = s.rsplit("//").next().unwrap_or(s);
+                    let at = s
+                        .find("letk")
+                        .or(s.find("letd"))
+                        .or(s.find("lett"))
+                        .or(s.find("m[("))?;
+                    Some(s[at..].to_owned())
+                })
+                .collect()
+        };
+        assert_eq!(statements(&split), statements(&whole));
+    }
+
+    #[test]
+    fn placeholders_are_replaced_at_their_indentation() {
+        let mut b = Block::default();
+        b.push("let k1 = a * b;".into(), "w1.x\nfn injected() {}");
+        b.push("m[(0, 1)] = k1;".into(), "");
+        let src = "fn f() {\n    __kanegen_block!(0);\n    m\n}\n";
+        let out = splice(src, &[b]).unwrap();
+        assert_eq!(
+            out,
+            "fn f() {\n    let k1 = a * b; // w1.x\\nfn injected() {}\n    m[(0, 1)] = k1;\n    m\n}\n"
+        );
+    }
+}

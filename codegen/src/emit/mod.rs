@@ -20,7 +20,6 @@ mod combined;
 mod frames;
 mod function;
 mod items;
-mod layout;
 mod print;
 mod regressors;
 mod text;

@@ -490,8 +490,7 @@ pub(super) fn splice(src: &str, blocks: &[Block]) -> Result<String, String> {
                 out.extend(std::iter::repeat_n(' ', at));
                 out.push_str(&l.code);
             } else {
-                let lines = super::layout::layout(at, &l.code)
-                    .or_else(|| format_long(at, &l.code))
+                let lines = format_long(at, &l.code)
                     .ok_or_else(|| format!("statement `{}` does not parse", l.code))?;
                 out.push_str(&lines.join("\n"));
             }
@@ -508,7 +507,6 @@ pub(super) fn splice(src: &str, blocks: &[Block]) -> Result<String, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::emit::layout::layout;
     use crate::emit::print::Printer;
     use crate::options::{Options, ParamMode, Precision};
     use crate::registry::{FunctionId, FunctionSet};
@@ -522,8 +520,8 @@ mod tests {
 
     /// Every statement and result entry of every function of `model`, for each
     /// `(parameters, functions, precision)` and indentation: the text printer gives what
-    /// prettyplease prints for the tokens, on one line wherever it fits, and [`layout`] what it
-    /// prints elsewhere.
+    /// prettyplease prints for the tokens, on one line wherever it fits (longer statements are
+    /// formatted by prettyplease one by one, [`format_long`]).
     fn check_model(
         path: &str,
         variants: &[(ParamMode, FunctionSet, Precision)],
@@ -580,9 +578,7 @@ mod tests {
                         let got = if fits(indent, text.len()) {
                             format!("{}{text}", " ".repeat(indent))
                         } else {
-                            layout(indent, &text)
-                                .expect("in the small language")
-                                .join("\n")
+                            format_long(indent, &text).expect("parses").join("\n")
                         };
                         assert_eq!(got, want, "{path}, {}", p.name);
                     }
@@ -624,7 +620,7 @@ mod tests {
     }
 
     #[test]
-    fn long_statements_break_like_prettyplease_at_every_length() {
+    fn statements_stay_on_one_line_exactly_where_prettyplease_keeps_them() {
         // Sums of growing length around the line width: the break decision at the margin.
         let mut e = String::from("let d1 = a0");
         for i in 1..40 {
@@ -638,7 +634,6 @@ mod tests {
                 } else {
                     assert!(want.lines().count() > 1, "{indent}: {want}");
                 }
-                assert_eq!(layout(indent, &code).unwrap().join("\n"), want, "{indent}");
             }
         }
     }

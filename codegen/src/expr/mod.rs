@@ -684,27 +684,33 @@ impl Arena {
     /// Evaluate every node; returns values indexed by node.
     pub fn eval(&self, v: &Values<'_>) -> Vec<f64> {
         let mut out = vec![0.0; self.nodes.len()];
-        for (i, n) in self.nodes.iter().enumerate() {
-            out[i] = match n {
-                Node::Const(c) => c.get(),
-                Node::Atom(a) => match *a {
-                    Atom::Param(p) => v.params[p as usize],
-                    Atom::Speed(s) => v.u[s as usize],
-                    Atom::Accel(s) => v.ud[s as usize],
-                    Atom::Sin(s) => self.angle(v.q, s).sin(),
-                    Atom::Cos(s) => self.angle(v.q, s).cos(),
-                    Atom::Coord(s) => v.q[s as usize],
-                    Atom::Var(k) => out[self.vars[k as usize].def.index()],
-                },
-                Node::Sum { constant, terms } => terms
-                    .iter()
-                    .fold(constant.get(), |acc, (t, k)| acc + k.get() * out[t.index()]),
-                Node::Prod(f) => f
-                    .iter()
-                    .fold(1.0, |acc, (b, p)| acc * out[b.index()].powi(*p)),
-            };
+        for i in 0..self.nodes.len() {
+            out[i] = self.eval_node(i, v, &out);
         }
         out
+    }
+
+    /// The value of node `i` from the values `out` of the nodes before it (a node only reads
+    /// nodes with smaller indices).
+    fn eval_node(&self, i: usize, v: &Values<'_>, out: &[f64]) -> f64 {
+        match &self.nodes[i] {
+            Node::Const(c) => c.get(),
+            Node::Atom(a) => match *a {
+                Atom::Param(p) => v.params[p as usize],
+                Atom::Speed(s) => v.u[s as usize],
+                Atom::Accel(s) => v.ud[s as usize],
+                Atom::Sin(s) => self.angle(v.q, s).sin(),
+                Atom::Cos(s) => self.angle(v.q, s).cos(),
+                Atom::Coord(s) => v.q[s as usize],
+                Atom::Var(k) => out[self.vars[k as usize].def.index()],
+            },
+            Node::Sum { constant, terms } => terms
+                .iter()
+                .fold(constant.get(), |acc, (t, k)| acc + k.get() * out[t.index()]),
+            Node::Prod(f) => f
+                .iter()
+                .fold(1.0, |acc, (b, p)| acc * out[b.index()].powi(*p)),
+        }
     }
 
     /// Name of a leaf for printing.

@@ -30,28 +30,8 @@ impl Arena {
     /// others are left at 0.
     pub fn eval_needed(&self, v: &Values<'_>, needed: &[bool]) -> Vec<f64> {
         let mut out = vec![0.0; self.nodes.len()];
-        for (i, n) in self.nodes.iter().enumerate() {
-            if !needed[i] {
-                continue;
-            }
-            out[i] = match n {
-                Node::Const(c) => c.get(),
-                Node::Atom(a) => match *a {
-                    Atom::Param(p) => v.params[p as usize],
-                    Atom::Speed(s) => v.u[s as usize],
-                    Atom::Accel(s) => v.ud[s as usize],
-                    Atom::Sin(s) => self.angle(v.q, s).sin(),
-                    Atom::Cos(s) => self.angle(v.q, s).cos(),
-                    Atom::Coord(s) => v.q[s as usize],
-                    Atom::Var(k) => out[self.vars[k as usize].def.index()],
-                },
-                Node::Sum { constant, terms } => terms
-                    .iter()
-                    .fold(constant.get(), |acc, (t, k)| acc + k.get() * out[t.index()]),
-                Node::Prod(f) => f
-                    .iter()
-                    .fold(1.0, |acc, (b, p)| acc * out[b.index()].powi(*p)),
-            };
+        for i in (0..self.nodes.len()).filter(|&i| needed[i]) {
+            out[i] = self.eval_node(i, v, &out);
         }
         out
     }

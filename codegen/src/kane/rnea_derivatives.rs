@@ -480,31 +480,6 @@ mod tests {
     }
 
     /// A two-wheeled base with a prismatic lift on a skew axis, a revolute joint on a skew axis
-    /// below it, and a fixed-joint merge.
-    const LIFT: &str = r#"<robot name="lift">
-  <link name="chassis"><inertial><origin xyz="0.01 0 0.3"/><mass value="20"/>
-    <inertia ixx="1.2" ixy="0" ixz="0.01" iyy="1.1" iyz="0" izz="0.4"/></inertial></link>
-  <link name="left_wheel"><inertial><mass value="2"/>
-    <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.04" iyz="0" izz="0.02"/></inertial></link>
-  <link name="right_wheel"><inertial><mass value="2"/>
-    <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.04" iyz="0" izz="0.02"/></inertial></link>
-  <link name="carriage"><inertial><origin xyz="0.02 0.01 0.1" rpy="0.3 0 0.2"/><mass value="3"/>
-    <inertia ixx="0.05" ixy="0.001" ixz="0" iyy="0.04" iyz="0" izz="0.02"/></inertial></link>
-  <link name="arm"><inertial><origin xyz="0.2 0 0.01"/><mass value="1.5"/>
-    <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/></inertial></link>
-  <link name="tool"><inertial><origin xyz="0.05 0 0"/><mass value="0.4"/>
-    <inertia ixx="0.0004" ixy="0" ixz="0" iyy="0.0005" iyz="0" izz="0.0005"/></inertial></link>
-  <joint name="left_wheel_joint" type="continuous"><parent link="chassis"/><child link="left_wheel"/>
-    <origin xyz="0 0.25 0"/><axis xyz="0 1 0"/></joint>
-  <joint name="right_wheel_joint" type="continuous"><parent link="chassis"/><child link="right_wheel"/>
-    <origin xyz="0 -0.25 0"/><axis xyz="0 1 0"/></joint>
-  <joint name="lift" type="prismatic"><parent link="chassis"/><child link="carriage"/>
-    <origin xyz="0.05 0.02 0.5" rpy="0.1 0.2 0"/><axis xyz="0.3 0 0.954"/>
-    <limit lower="0" upper="0.5" effort="1" velocity="1"/></joint>
-  <joint name="shoulder" type="revolute"><parent link="carriage"/><child link="arm"/>
-    <origin xyz="0 0.1 0.2" rpy="0 0 0.4"/><axis xyz="0 0.6 0.8"/>
-    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
-  <joint name="tool_fix" type="fixed"><parent link="arm"/><child link="tool"/>
-    <origin xyz="0.4 0 0" rpy="0 0.5 0"/></joint>
-</robot>"#;
+    /// below it, and a fixed-joint merge (shared with `tests/coriolis_matrix.rs`).
+    const LIFT: &str = include_str!("../../tests/data/lift.urdf");
 }

@@ -717,27 +717,42 @@ fn krang_beta_vector_is_identified_from_static_poses() {
             ));
         }
         let (est, std, rms) = identify(g, FunctionId::BaseGravityRegressor, &truth, &samples);
-        let worst_sigma = est
-            .iter()
-            .zip(&expect)
-            .zip(&std)
-            .map(|((e, x), s)| (e - x).abs() / s.max(1e-300))
-            .fold(0.0f64, f64::max);
-        let worst_rel = est
-            .iter()
-            .zip(&expect)
-            .map(|(e, x)| (e - x).abs() / x.abs().max(1e-2))
-            .fold(0.0f64, f64::max);
-        println!(
-            "Krang β_b ({} of {}), noise {torque_noise} N·m, {pitch_noise} rad: residual RMS {rms:.2e}, worst error {worst_rel:.1e} relative, {worst_sigma:.1} σ",
+        let what = format!(
+            "Krang β_b ({} of {}), noise {torque_noise} N·m, {pitch_noise} rad",
             expect.len(),
             beta.len()
         );
-        if torque_noise == 0.0 {
-            assert!(worst_rel <= 1e-9, "{worst_rel:e}");
-        } else {
-            assert!(worst_sigma <= 5.0, "{worst_sigma}");
-        }
+        assert_recovered(&what, (&est, &std, rms), &expect, torque_noise == 0.0);
+    }
+}
+
+/// The estimates `est` (standard deviations `std`, residual RMS `rms`) of an identification
+/// against the true values `expect`: without noise to 1e-9 relative (of `max(|x|, 1e-2)`),
+/// with noise every estimate within 5 standard deviations.
+fn assert_recovered(
+    what: &str,
+    (est, std, rms): (&[f64], &[f64], f64),
+    expect: &[f64],
+    noiseless: bool,
+) {
+    let worst_sigma = est
+        .iter()
+        .zip(expect)
+        .zip(std)
+        .map(|((e, x), s)| (e - x).abs() / s.max(1e-300))
+        .fold(0.0f64, f64::max);
+    let worst_rel = est
+        .iter()
+        .zip(expect)
+        .map(|(e, x)| (e - x).abs() / x.abs().max(1e-2))
+        .fold(0.0f64, f64::max);
+    println!(
+        "{what}: residual RMS {rms:.2e}, worst error {worst_rel:.1e} relative, {worst_sigma:.1} σ"
+    );
+    if noiseless {
+        assert!(worst_rel <= 1e-9, "{worst_rel:e}");
+    } else {
+        assert!(worst_sigma <= 5.0, "{worst_sigma}");
     }
 }
 
@@ -785,27 +800,12 @@ fn fixed_wheel_base_parameters_are_identified_from_an_exciting_trajectory() {
             })
             .collect();
         let (est, std, rms) = identify(g, FunctionId::BaseRegressor, &truth, &samples);
-        let worst_sigma = est
-            .iter()
-            .zip(&expect)
-            .zip(&std)
-            .map(|((e, x), s)| (e - x).abs() / s.max(1e-300))
-            .fold(0.0f64, f64::max);
-        let worst_rel = est
-            .iter()
-            .zip(&expect)
-            .map(|(e, x)| (e - x).abs() / x.abs().max(1e-2))
-            .fold(0.0f64, f64::max);
-        println!(
-            "fixed wheels π_b ({} of {}), noise {noise} N·m: residual RMS {rms:.2e}, worst error {worst_rel:.1e} relative, {worst_sigma:.1} σ",
+        let what = format!(
+            "fixed wheels π_b ({} of {}), noise {noise} N·m",
             expect.len(),
             pi.len()
         );
-        if noise == 0.0 {
-            assert!(worst_rel <= 1e-9, "{worst_rel:e}");
-        } else {
-            assert!(worst_sigma <= 5.0, "{worst_sigma}");
-        }
+        assert_recovered(&what, (&est, &std, rms), &expect, noise == 0.0);
     }
 }
 

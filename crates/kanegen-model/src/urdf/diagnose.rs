@@ -43,87 +43,64 @@ const JOINT_TYPES: &[&str] = &[
     "spherical",
 ];
 
-/// Deepest element nesting accepted (a URDF needs about five levels): deeper text is a typed
-/// error instead of overflowing the stack of the recursive XML parser.
-pub(super) const MAX_DEPTH: usize = 64;
-
 /// One start or end tag.
-struct Tag<'a> {
+struct Tag {
     /// Byte offsets of the tag in the text: `text[start..end]` is `<…>`.
     start: usize,
     end: usize,
-    name: &'a str,
-    attrs: Vec<(&'a str, &'a str)>,
+    name: String,
+    /// Attribute names and their unescaped values.
+    attrs: Vec<(String, String)>,
     closing: bool,
     self_closing: bool,
 }
 
-/// The tags of an XML text, skipping comments, declarations and CDATA; `None` where the text is
-/// not tag-shaped (the URDF parser then reports it).
-fn tags(text: &str) -> Option<Vec<Tag<'_>>> {
+/// The tags of an XML text (quick-xml's events; comments, declarations, CDATA and text
+/// skipped); `None` if the text is not well-formed XML (the URDF parser then reports it).
+fn tags(text: &str) -> Option<Vec<Tag>> {
+    use quick_xml::events::Event;
+    let utf8 = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    let mut reader = quick_xml::Reader::from_str(text);
     let mut out = Vec::new();
-    let mut rest = text;
-    while let Some(i) = rest.find('<') {
-        rest = &rest[i..];
-        for (open, close) in [
-            ("<!--", "-->"),
-            ("<![CDATA[", "]]>"),
-            ("<?", "?>"),
-            ("<!", ">"),
-        ] {
-            if rest.starts_with(open) {
-                let end = rest.find(close)?;
-                rest = &rest[end + close.len()..];
-                break;
+    loop {
+        let start = usize::try_from(reader.buffer_position()).ok()?;
+        let event = reader.read_event().ok()?;
+        let end = usize::try_from(reader.buffer_position()).ok()?;
+        let (element, self_closing) = match &event {
+            Event::Start(e) => (e, false),
+            Event::Empty(e) => (e, true),
+            Event::End(e) => {
+                out.push(Tag {
+                    start,
+                    end,
+                    name: utf8(e.name().as_ref()),
+                    attrs: Vec::new(),
+                    closing: true,
+                    self_closing: false,
+                });
+                continue;
             }
-        }
-        if !rest.starts_with('<') || rest.starts_with("<!") || rest.starts_with("<?") {
-            continue;
-        }
-        let start = text.len() - rest.len();
-        let closing = rest.starts_with("</");
-        let mut s = &rest[if closing { 2 } else { 1 }..];
-        let name_end = s.find(|c: char| c.is_whitespace() || c == '>' || c == '/')?;
-        let name = &s[..name_end];
-        s = &s[name_end..];
+            Event::Eof => return Some(out),
+            _ => continue,
+        };
         let mut attrs = Vec::new();
-        let self_closing;
-        loop {
-            s = s.trim_start();
-            if let Some(r) = s.strip_prefix("/>") {
-                self_closing = true;
-                s = r;
-                break;
-            }
-            if let Some(r) = s.strip_prefix('>') {
-                self_closing = false;
-                s = r;
-                break;
-            }
-            let eq = s.find('=')?;
-            let key = s[..eq].trim();
-            let v = s[eq + 1..].trim_start();
-            let quote = v.chars().next().filter(|c| *c == '"' || *c == '\'')?;
-            let v = &v[1..];
-            let end = v.find(quote)?;
-            attrs.push((key, &v[..end]));
-            s = &v[end + 1..];
+        for a in element.attributes() {
+            let a = a.ok()?;
+            attrs.push((utf8(a.key.as_ref()), a.unescape_value().ok()?.into_owned()));
         }
         out.push(Tag {
             start,
-            end: text.len() - s.len(),
-            name,
+            end,
+            name: utf8(element.name().as_ref()),
             attrs,
-            closing,
+            closing: false,
             self_closing,
         });
-        rest = s;
     }
-    Some(out)
 }
 
 /// `text` without the [`UNUSED`] elements (each removed with its content; the XML stays well
-/// formed). The text unchanged if it is not tag-shaped or an element is not closed (the URDF
+/// formed). The text unchanged if it is not well-formed XML (the URDF
 /// parser then reports the problem).
 pub(super) fn without_unused_elements(text: &str) -> std::borrow::Cow<'_, str> {
     let Some(tags) = tags(text) else {
@@ -134,7 +111,7 @@ pub(super) fn without_unused_elements(text: &str) -> std::borrow::Cow<'_, str> {
     let mut i = 0;
     while i < tags.len() {
         let t = &tags[i];
-        if t.closing || !UNUSED.contains(&t.name) {
+        if t.closing || !UNUSED.contains(&t.name.as_str()) {
             i += 1;
             continue;
         }
@@ -168,21 +145,13 @@ pub(super) fn without_unused_elements(text: &str) -> std::borrow::Cow<'_, str> {
 }
 
 /// A typed error for the malformations that the URDF parser would only report generically: an
-/// unknown joint type, a bad number. `None` if none is found (or the text is not tag-shaped).
+/// unknown joint type, a bad number. `None` if none is found (or the text is not well-formed XML).
 pub(super) fn diagnose(text: &str) -> Option<K> {
     let tags = tags(text)?;
     // Open elements; the enclosing top-level link or joint.
     let mut depth = 0usize;
     let mut context: Option<String> = None;
     for t in &tags {
-        if depth > MAX_DEPTH {
-            return Some(K::UrdfParse {
-                detail: format!(
-                    "elements are nested more than {MAX_DEPTH} levels deep (at <{}>)",
-                    t.name
-                ),
-            });
-        }
         if t.closing {
             depth = depth.saturating_sub(1);
             if depth <= 1 {
@@ -190,7 +159,12 @@ pub(super) fn diagnose(text: &str) -> Option<K> {
             }
             continue;
         }
-        let attr = |k: &str| t.attrs.iter().find(|(a, _)| *a == k).map(|(_, v)| *v);
+        let attr = |k: &str| {
+            t.attrs
+                .iter()
+                .find(|(a, _)| a == k)
+                .map(|(_, v)| v.as_str())
+        };
         if depth == 1 && (t.name == "link" || t.name == "joint") {
             let name = attr("name").unwrap_or("?");
             if t.name == "joint" {
@@ -233,4 +207,43 @@ pub(super) fn diagnose(text: &str) -> Option<K> {
         }
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unused_elements_are_removed_with_their_content_and_nothing_else() {
+        let text = r#"<robot name="r"><!-- <visual> in a comment stays -->
+<link name="a"><visual><geometry><mesh filename="a>b.stl"/></geometry></visual><inertial/></link>
+<link name="b"><collision/><material name="m"><color rgba="1 0 0 1"/></material></link></robot>"#;
+        let out = without_unused_elements(text);
+        assert_eq!(
+            out,
+            r#"<robot name="r"><!-- <visual> in a comment stays -->
+<link name="a"><inertial/></link>
+<link name="b"></link></robot>"#
+        );
+    }
+
+    #[test]
+    fn text_that_is_not_well_formed_xml_is_left_to_the_urdf_parser() {
+        let text = r#"<robot name="r"><link name="a"><visual></link></robot>"#;
+        assert_eq!(without_unused_elements(text), text);
+        assert!(diagnose(text).is_none());
+    }
+
+    #[test]
+    fn a_bad_number_names_its_link_element_and_attribute() {
+        let text = r#"<robot name="r"><link name="arm"><inertial><mass value="1 2"/></inertial></link></robot>"#;
+        let Some(K::UrdfBadNumber {
+            element, attribute, ..
+        }) = diagnose(text)
+        else {
+            panic!("expected a bad-number error");
+        };
+        assert_eq!(element, "link `arm` <mass>");
+        assert_eq!(attribute, "value");
+    }
 }

@@ -142,6 +142,7 @@ mod dynamics;
 mod invalid_parameter;
 pub mod isa;
 pub mod lanes;
+pub mod regressor;
 #[doc(hidden)]
 pub mod serde_support;
 mod set_parameter_error;

@@ -1,0 +1,134 @@
+//! A regressor in loop form (`kane/regressor_loop.rs`): the straight-line part stores every
+//! link's motion and joint transform in a `kin` table (and the wheel columns in the result),
+//! then one call of `kanegen_runtime::regressor::inverse_dynamics_regressor` runs the (speed,
+//! body) pairs over two constant tables.
+
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::function::{Reads, last_local, prologue, result_type, state_args, unused_inputs};
+use super::print::{Printer, idx, signed_lit};
+use super::{Context, scalar_type};
+use crate::kane::KIN;
+use crate::lower::{FunctionProgram, LExpr, Leaf, LoopProgram};
+
+/// The free function of regressor `f` in loop form `lp`.
+pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) -> TokenStream {
+    let spec = f.id.spec();
+    let p = &lp.program;
+    let t = scalar_type(cx.precision);
+    let printer = Printer {
+        model: cx.model,
+        stmts: &p.stmts,
+        pre: &cx.pre,
+        precision: cx.precision,
+    };
+    let reads = Reads::of(p, cx.model.speeds.len());
+    let fname = super::print::ident(&super::frames::rust_name(cx, f));
+    let doc = format!(" {}", spec.doc);
+    let tables = &lp.tables;
+    let ops = format!(
+        " Generated code in loop form: every link's motion straight-line ({}), then a loop over {} (speed, body) pairs (`kanegen_runtime::regressor`, {} flops); {} flops per call in all (straight-line form: {} flops).",
+        p.ops,
+        tables.pairs(),
+        tables.flops(),
+        lp.flops(),
+        f.program.ops.flops(),
+    );
+    let param_args = if cx.low.params.is_runtime() {
+        let pname = if reads.param { quote!(p) } else { quote!(_p) };
+        let pcname = if reads.pre { quote!(pc) } else { quote!(_pc) };
+        quote!(#pname: &Params, #pcname: &Precomputed,)
+    } else {
+        quote!()
+    };
+    let (args, arg_doc) = state_args(cx, spec.inputs);
+    let prologue = prologue(cx, p, &reads);
+    let ty = result_type(cx, spec.shape);
+    let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
+    let (nr, nc) = (idx(rows), idx(cols));
+    // Stores right after the last statement each reads; the `kin` values that are the
+    // constant zero are not stored (the table starts zeroed).
+    let mut stores: Vec<Vec<String>> = vec![Vec::new(); p.stmts.len() + 1];
+    let mut stored: Vec<&LExpr> = Vec::new();
+    let text = |e: &LExpr| {
+        let mut s = String::new();
+        printer.expr_text(&cx.leaf_names, e, false, &mut s);
+        s
+    };
+    for (k, (r, c, e)) in p.outputs.iter().enumerate() {
+        if matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0) {
+            continue;
+        }
+        let line = if k < lp.kin_len {
+            format!("kin[{}][{}] = {};", r / KIN, r % KIN, text(e))
+        } else {
+            format!("m[({r}, {c})] = {};", text(e))
+        };
+        stores[last_local(e).map_or(0, |i| i + 1)].push(line);
+        stored.push(e);
+    }
+    let block = printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above);
+    let body = cx.blocks.placeholder(block);
+    let nl = idx(tables.links.len());
+    let links = tables.links.iter().map(|l| {
+        let parent = idx(l.parent);
+        let columns = l.columns.iter().map(|c| match c {
+            Some(c) => {
+                let c = idx(*c);
+                quote!(#c)
+            }
+            None => quote!(kanegen_runtime::regressor::NO_COLUMN),
+        });
+        quote!(kanegen_runtime::regressor::Link { parent: #parent, columns: [#(#columns),*] })
+    });
+    let ns = idx(tables.steps.len());
+    let steps = tables.steps.iter().map(|s| {
+        let (row, link) = (idx(s.row), idx(s.link));
+        let seed = match s.seed {
+            Some(x) => {
+                let x = x.iter().map(|v| signed_lit(*v, cx.precision));
+                quote!(Some([#(#x),*]))
+            }
+            None => quote!(None),
+        };
+        quote!(kanegen_runtime::regressor::Step { row: #row, link: #link, seed: #seed })
+    });
+    let unused = unused_inputs(spec, p, &reads);
+    let kin_mut = if p.outputs[..lp.kin_len]
+        .iter()
+        .any(|(_, _, e)| !matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0))
+    {
+        quote!(mut)
+    } else {
+        quote!()
+    };
+    let body = quote! {
+        #unused
+        #prologue
+        let mut m = SMatrix::<#t, #nr, #nc>::zeros();
+        let #kin_mut kin = [[0.0; kanegen_runtime::regressor::KIN]; #nl];
+        #body
+        kanegen_runtime::regressor::inverse_dynamics_regressor(&kin, &LINKS, &STEPS, #nr, m.as_mut_slice());
+        m
+    };
+    let body = if cx.isa_dispatch {
+        quote!(kanegen_runtime::isa::dispatch(#[inline(always)] || { #body }))
+    } else {
+        body
+    };
+    quote! {
+        #[doc = #doc]
+        #[doc = ""]
+        #[doc = #arg_doc]
+        #[doc = #ops]
+        #[inline(never)]
+        pub fn #fname(#param_args #args) -> #ty {
+            /// Per link: its parent and its body's result columns.
+            const LINKS: [kanegen_runtime::regressor::Link; #nl] = [#(#links),*];
+            /// The (speed, link) pairs in loop order.
+            const STEPS: [kanegen_runtime::regressor::Step<#t>; #ns] = [#(#steps),*];
+            #body
+        }
+    }
+}

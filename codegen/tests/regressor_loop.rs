@@ -11,7 +11,7 @@ use kanegen::{
 };
 use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
 use kanegen_runtime::regressor::{
-    Link, NO_COLUMN, Step, inverse_dynamics_regressor_with as run_loop,
+    LANES, Link, NO_COLUMN, Seed, inverse_dynamics_regressor_with as run_loop,
 };
 
 fn load(name: &str) -> Model {
@@ -57,30 +57,34 @@ fn loop_value(
         .evaluate_loop_inputs(id, params, q, u, ud)
         .expect("loop form");
     let kin: Vec<[f64; KIN]> = kin.chunks(KIN).map(|c| c.try_into().unwrap()).collect();
+    let (chunks, slots) = tables.chunks();
+    assert_eq!(kanegen::kane::LANES, LANES);
     let links: Vec<Link> = tables
         .links
         .iter()
-        .map(|l| Link {
+        .zip(&chunks)
+        .map(|(l, &(n, slot))| Link {
             parent: l.parent as u16,
             columns: l.columns.map(|c| c.map_or(NO_COLUMN, |c| c as u16)),
+            chunks: n as u16,
+            slot: slot as u16,
         })
         .collect();
-    let steps: Vec<Step<f64>> = tables
-        .steps
-        .iter()
-        .map(|s| Step {
-            row: s.row as u16,
-            link: s.link as u16,
-            seed: s.seed,
+    let seeds: Vec<Seed<f64>> = tables
+        .seeds()
+        .into_iter()
+        .map(|(row, link, phi)| Seed {
+            row: row as u16,
+            link: link as u16,
+            phi,
         })
         .collect();
     let mut out = vec![0.0; rows * cols];
     for (r, c, v) in extra {
         out[c * rows + r] = v;
     }
-    let mut k = vec![[0.0; 9]; links.len()];
-    let mut phi = vec![[0.0; 6]; links.len()];
-    run_loop(&kin, &links, &steps, rows, &mut out, &mut k, &mut phi);
+    let mut phi = vec![[[0.0; LANES]; 6]; slots];
+    run_loop(&kin, &links, &seeds, rows, &mut out, &mut phi);
     // Column-major to row-major.
     (0..rows * cols)
         .map(|i| out[(i % cols) * rows + i / cols])

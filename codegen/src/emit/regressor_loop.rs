@@ -71,7 +71,8 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
     let block = printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above);
     let body = cx.blocks.placeholder(block);
     let nl = idx(tables.links.len());
-    let links = tables.links.iter().map(|l| {
+    let (chunks, slots) = tables.chunks();
+    let links = tables.links.iter().zip(&chunks).map(|(l, &(n, slot))| {
         let parent = idx(l.parent);
         let columns = l.columns.iter().map(|c| match c {
             Some(c) => {
@@ -80,20 +81,17 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
             }
             None => quote!(kanegen_runtime::regressor::NO_COLUMN),
         });
-        quote!(kanegen_runtime::regressor::Link { parent: #parent, columns: [#(#columns),*] })
+        let (n, slot) = (idx(n), idx(slot));
+        quote!(kanegen_runtime::regressor::Link { parent: #parent, columns: [#(#columns),*], chunks: #n, slot: #slot })
     });
-    let ns = idx(tables.steps.len());
-    let steps = tables.steps.iter().map(|s| {
-        let (row, link) = (idx(s.row), idx(s.link));
-        let seed = match s.seed {
-            Some(x) => {
-                let x = x.iter().map(|v| signed_lit(*v, cx.precision));
-                quote!(Some([#(#x),*]))
-            }
-            None => quote!(None),
-        };
-        quote!(kanegen_runtime::regressor::Step { row: #row, link: #link, seed: #seed })
+    let seeds = tables.seeds();
+    let ns = idx(seeds.len());
+    let seeds = seeds.iter().map(|&(row, link, x)| {
+        let (row, link) = (idx(row), idx(link));
+        let x = x.iter().map(|v| signed_lit(*v, cx.precision));
+        quote!(kanegen_runtime::regressor::Seed { row: #row, link: #link, phi: [#(#x),*] })
     });
+    let slots = idx(slots);
     let unused = unused_inputs(spec, p, &reads);
     let kin_mut = if p.outputs[..lp.kin_len]
         .iter()
@@ -103,17 +101,17 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
     } else {
         quote!()
     };
+    // The result is written in place (the closure returns nothing): returned from the
+    // dispatch closure, its 26 KB (Krang) were copied once more.
     let body = quote! {
         #unused
         #prologue
-        let mut m = SMatrix::<#t, #nr, #nc>::zeros();
         let #kin_mut kin = [[0.0; kanegen_runtime::regressor::KIN]; #nl];
         #body
-        kanegen_runtime::regressor::inverse_dynamics_regressor(&kin, &LINKS, &STEPS, #nr, m.as_mut_slice());
-        m
+        kanegen_runtime::regressor::inverse_dynamics_regressor::<_, #nl, #slots>(&kin, &LINKS, &SEEDS, #nr, m.as_mut_slice());
     };
     let body = if cx.isa_dispatch {
-        quote!(kanegen_runtime::isa::dispatch(#[inline(always)] || { #body }))
+        quote!(kanegen_runtime::isa::dispatch(#[inline(always)] || { #body });)
     } else {
         body
     };
@@ -126,9 +124,11 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
         pub fn #fname(#param_args #args) -> #ty {
             /// Per link: its parent and its body's result columns.
             const LINKS: [kanegen_runtime::regressor::Link; #nl] = [#(#links),*];
-            /// The (speed, link) pairs in loop order.
-            const STEPS: [kanegen_runtime::regressor::Step<#t>; #ns] = [#(#steps),*];
+            /// The joints' own partial velocities, by link.
+            const SEEDS: [kanegen_runtime::regressor::Seed<#t>; #ns] = [#(#seeds),*];
+            let mut m = SMatrix::<#t, #nr, #nc>::zeros();
             #body
+            m
         }
     }
 }

@@ -76,7 +76,7 @@ use algebra::{M3, V3};
 use composite::Composite;
 pub use grouping::{Coefficient, Exactness, SymbolicGroup, symbolic_group_text};
 pub use regressor::{BaseParameters, Regressors, group_text};
-pub use regressor_loop::{KIN, LOOP_MIN_PAIRS, LoopLink, LoopStep, RegressorLoop};
+pub use regressor_loop::{KIN, LANES, LOOP_MIN_PAIRS, LoopLink, LoopStep, RegressorLoop};
 
 /// One derived registry function: its output entries as expressions in the arena (its name,
 /// inputs and result shape are in the registry).

@@ -22,6 +22,9 @@ use crate::options::RegressorForm;
 /// Values per link of the loop form's table (`kanegen_runtime::regressor::KIN`).
 pub const KIN: usize = 21;
 
+/// Rows per chunk of the loop (`kanegen_runtime::regressor::LANES`).
+pub const LANES: usize = 4;
+
 /// The fewest (speed, body) pairs for which [`RegressorForm::Auto`] chooses the loop form.
 /// Below it the straight line fits the instruction cache: it costs about 70 flops per pair at
 /// 11–14 bytes of machine code per flop, so 40 pairs are ≈ 35 KB, the size of a 32 KB L1
@@ -80,12 +83,56 @@ impl RegressorLoop {
             .count()
     }
 
-    /// Flops of the loop per call (the runtime kernel's arithmetic: 23 per link with a body,
-    /// 42 per carried step, 71 per written pair).
+    /// Per link, the number of row chunks of [`LANES`] rows (from row 0) that cover every
+    /// speed that moves it, and the index of its first chunk in the scratch; and the total.
+    pub fn chunks(&self) -> (Vec<(usize, usize)>, usize) {
+        let mut hi = vec![0; self.links.len()];
+        for s in &self.steps {
+            hi[s.link] = hi[s.link].max(s.row + 1);
+        }
+        let mut slot = 0;
+        let out = hi
+            .iter()
+            .map(|&h| {
+                let n = h.div_ceil(LANES);
+                slot += n;
+                (n, slot - n)
+            })
+            .collect();
+        (out, slot)
+    }
+
+    /// The seeds (`row`, `link`, partial velocity), sorted by link.
+    pub fn seeds(&self) -> Vec<(usize, usize, [f64; 6])> {
+        let mut s: Vec<_> = self
+            .steps
+            .iter()
+            .filter_map(|s| s.seed.map(|x| (s.row, s.link, x)))
+            .collect();
+        s.sort_by_key(|&(r, l, _)| (l, r));
+        s
+    }
+
+    /// Flops of the loop per call, as the runtime kernel runs them (every lane of a chunk,
+    /// rows that are not a link's ancestors' included): 23 per link with a body, and per chunk
+    /// of [`LANES`] rows 42 per lane to carry it from the parent and 71 per lane for the
+    /// body's entries.
     pub fn flops(&self) -> usize {
-        let links = self.links.iter().filter(|l| l.writes()).count();
-        let carried = self.steps.iter().filter(|s| s.seed.is_none()).count();
-        23 * links + 42 * carried + 71 * self.pairs()
+        let (chunks, _) = self.chunks();
+        let mut flops = 0;
+        for (l, link) in self.links.iter().enumerate() {
+            let (n, _) = chunks[l];
+            let inherited = if link.parent == l {
+                0
+            } else {
+                chunks[link.parent].0.min(n)
+            };
+            flops += 42 * LANES * inherited;
+            if link.writes() && n > 0 {
+                flops += 23 + 71 * LANES * n;
+            }
+        }
+        flops
     }
 }
 

@@ -11,12 +11,17 @@
 //! A generated function computes, straight-line, every link's motion and joint transform (the
 //! [`KIN`] values per link of a `kin` table) and the entries that are not a body's (a wheeled
 //! base's wheel columns), then calls [`inverse_dynamics_regressor`] with two constant tables:
-//! per link its parent and the result columns of its body's parameters ([`Link`]), and the
-//! (row, link) pairs in the order the loop visits them ([`Step`]): per speed, the link its joint
-//! moves (the seed: the joint's own partial velocity, a constant) and then that link's
-//! descendants, each partial velocity carried one joint down from its parent's. The code that
-//! runs per pair is one small loop body instead of one straight line per entry: it stays in the
-//! instruction cache (Krang's straight-line regressor is five times its size).
+//! per link its parent, the result columns of its body's parameters and the rows its partial
+//! velocities can be non-zero in ([`Link`]), and the joints' own partial velocities ([`Seed`]:
+//! speed, link, a constant 6-vector). Links are visited parents first; a link's partial
+//! velocities for all rows are carried one joint down from its parent's at once, in chunks of
+//! [`LANES`] consecutive rows (one transform, four rows: SIMD lanes), then its seeds are set,
+//! then the body's ten columns are formed for the same rows and stored: in the column-major
+//! result four consecutive rows of a column are one contiguous store. Rows a chunk covers that
+//! are not the link's ancestors' have zero partial velocities and store zeros (which those
+//! entries are). The code that runs is one small loop body instead of one straight line per
+//! entry: it stays in the instruction cache (Krang's straight-line regressor is five times its
+//! size).
 //!
 //! Allocation-free and infallible: the scratch arrays are on the stack and an out-of-range
 //! table entry (impossible in generated tables) skips its store instead of panicking.
@@ -32,28 +37,35 @@ pub const KIN: usize = 21;
 /// No result column (a base regressor leaves most of a body's parameters out).
 pub const NO_COLUMN: u16 = u16::MAX;
 
+/// Rows per chunk: the partial velocities of [`LANES`] consecutive rows are carried and dotted
+/// together (AVX2 lanes in the x86-64-v3 copy of a generated function).
+pub const LANES: usize = 4;
+
 /// One link of the kinematic tree, for [`inverse_dynamics_regressor`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Link {
-    /// Index of the parent link (the root's is not read).
+    /// Index of the parent link (the root's own index: it has none).
     pub parent: u16,
     /// Result column of each of the body's ten parameters `m, MX, MY, MZ, XX, XY, XZ, YY, YZ,
     /// ZZ`, or [`NO_COLUMN`] (a link without a body has none).
     pub columns: [u16; 10],
+    /// Number of row chunks ([`LANES`] rows each, from row 0) that cover every speed that
+    /// moves the link (0: none, the link is skipped).
+    pub chunks: u16,
+    /// Index of the link's first chunk in the partial-velocity scratch.
+    pub slot: u16,
 }
 
-/// One (row, link) pair of [`inverse_dynamics_regressor`]'s loop.
+/// The partial velocity of a joint's own link for its speed.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Step<T> {
+pub struct Seed<T> {
     /// The speed (result row).
     pub row: u16,
-    /// The link whose partial velocity for `row` this step forms (and whose body's columns it
-    /// writes).
+    /// The link the joint moves.
     pub link: u16,
-    /// `Some((ω; v))`: the partial velocity of the link's own joint, in its frame (the first
-    /// step of a row); `None`: carried down from the parent's partial velocity for the same row,
-    /// which an earlier step formed.
-    pub seed: Option<[T; 6]>,
+    /// `(ω; v)` in the link's frame (a revolute joint's axis and zero, a prismatic joint's zero
+    /// and axis; a wheeled base's forward and yaw speeds at the root).
+    pub phi: [T; 6],
 }
 
 /// The arithmetic the kernel needs (`f64` and `f32`).
@@ -157,73 +169,136 @@ fn entries<T: Scalar>(phi: &[T; 6], kin: &[T; KIN], k: &[T; 9]) -> [T; 10] {
     ]
 }
 
-/// Add to the column-major `rows × cols` result `out` the body entries of the inverse-dynamics
-/// regressor: for every step of `steps` (in order), the link's partial velocity for the step's
-/// row (its seed, or carried down from its parent's), then the ten entries of its body's
-/// columns ([`Link::columns`]) in that row. `kin` is every link's motion and joint transform
-/// ([`KIN`]). Entries of rows and columns the steps do not reach are left as they are (the
-/// generated function starts from zero and stores the other entries itself).
+/// Partial velocities of one chunk: component-major, `[ω_x, ω_y, ω_z, v_x, v_y, v_z]` each over
+/// [`LANES`] rows.
+pub type Chunk<T> = [[T; LANES]; 6];
+
+/// Write into the column-major `rows × cols` result `out` the body entries of the
+/// inverse-dynamics regressor. `kin` is every link's motion and joint transform ([`KIN`]),
+/// `links` the tree (parents first) and `seeds` the joints' own partial velocities, sorted by
+/// link. `S` is the number of chunk slots (the sum of [`Link::chunks`]). Entries of columns that
+/// are not a body's, and of rows beyond a link's chunks, are left as they are (the generated
+/// function starts from zero and stores the other entries itself).
 ///
-/// Flops per call: 23 per link with a body, 42 per carried step and 71 per written step (see
-/// a generated function's documentation for a model's total).
+/// Flops per call: 23 per link with a body; per chunk, 42 per lane to carry the partial
+/// velocities (none at the root) and 71 per lane for the body's entries (a generated
+/// function's documentation gives a model's total).
 #[inline(always)]
-pub fn inverse_dynamics_regressor<T: Scalar, const NL: usize>(
+pub fn inverse_dynamics_regressor<T: Scalar, const NL: usize, const S: usize>(
     kin: &[[T; KIN]; NL],
     links: &[Link; NL],
-    steps: &[Step<T>],
+    seeds: &[Seed<T>],
     rows: usize,
     out: &mut [T],
 ) {
     let z = T::default();
-    let mut k = [[z; 9]; NL];
-    let mut phi = [[z; 6]; NL];
-    inverse_dynamics_regressor_with(kin, links, steps, rows, out, &mut k, &mut phi);
+    let mut phi = [[[z; LANES]; 6]; S];
+    inverse_dynamics_regressor_with(kin, links, seeds, rows, out, &mut phi);
 }
 
-/// [`inverse_dynamics_regressor`] with the scratch space passed in (one entry per link each):
-/// `k` the bodies' first-moment matrices, `phi` the partial velocities of the current row. For
-/// callers whose number of links is not a constant (tests, interpreters).
+/// [`inverse_dynamics_regressor`] with the partial-velocity scratch passed in (at least the sum
+/// of [`Link::chunks`] chunks), for callers whose sizes are not constants (tests).
 #[inline(always)]
 pub fn inverse_dynamics_regressor_with<T: Scalar>(
     kin: &[[T; KIN]],
     links: &[Link],
-    steps: &[Step<T>],
+    seeds: &[Seed<T>],
     rows: usize,
     out: &mut [T],
-    k: &mut [[T; 9]],
-    phi: &mut [[T; 6]],
+    phi: &mut [Chunk<T>],
 ) {
-    for ((k, kin), link) in k.iter_mut().zip(kin).zip(links) {
-        if link.columns.iter().any(|&c| c != NO_COLUMN) {
-            *k = first_moment_matrix(kin);
-        }
-    }
-    for s in steps {
-        let l = s.link as usize;
-        let (Some(kl), Some(link), Some(kk)) = (kin.get(l), links.get(l), k.get(l)) else {
+    let z = T::default();
+    let mut si = 0;
+    for (l, (link, kl)) in links.iter().zip(kin).enumerate() {
+        let n = link.chunks as usize;
+        let slot = link.slot as usize;
+        if n == 0 {
             continue;
+        }
+        let parent = link.parent as usize;
+        let (from, inherited) = match links.get(parent) {
+            Some(p) if parent != l => (p.slot as usize, p.chunks as usize),
+            _ => (0, 0),
         };
-        let p = match s.seed {
-            Some(seed) => seed,
-            None => match phi.get(link.parent as usize) {
-                Some(parent) => carry(parent, kl),
-                None => continue,
-            },
-        };
-        if let Some(slot) = phi.get_mut(l) {
-            *slot = p;
+        // Carry the parent's chunks one joint down; the rows beyond them start at zero.
+        for j in 0..n {
+            let c = match phi.get(from + j) {
+                Some(pc) if j < inherited => carry_chunk(pc, kl),
+                _ => [[z; LANES]; 6],
+            };
+            if let Some(dst) = phi.get_mut(slot + j) {
+                *dst = c;
+            }
+        }
+        // The link's own joints: their rows are zero in the parent (not its ancestors').
+        while let Some(s) = seeds.get(si) {
+            if s.link as usize != l {
+                break;
+            }
+            let r = s.row as usize;
+            if let Some(c) = phi.get_mut(slot + r / LANES) {
+                for (d, x) in c.iter_mut().zip(s.phi) {
+                    d[r % LANES] = x;
+                }
+            }
+            si += 1;
         }
         if link.columns.iter().all(|&c| c == NO_COLUMN) {
             continue;
         }
-        let y = entries(&p, kl, kk);
-        let row = s.row as usize;
-        for (&c, y) in link.columns.iter().zip(y) {
-            if c != NO_COLUMN {
-                if let Some(o) = out.get_mut(c as usize * rows + row) {
-                    *o = y;
+        let k = first_moment_matrix(kl);
+        for j in 0..n {
+            let Some(c) = phi.get(slot + j) else {
+                break;
+            };
+            let y = entries_chunk(c, kl, &k);
+            let r0 = j * LANES;
+            for (&col, y) in link.columns.iter().zip(y) {
+                if col == NO_COLUMN {
+                    continue;
+                }
+                let at = col as usize * rows + r0;
+                match out.get_mut(at..at + LANES) {
+                    Some(o) if r0 + LANES <= rows => o.copy_from_slice(&y),
+                    _ => {
+                        for (i, &v) in y.iter().enumerate().take(rows.saturating_sub(r0)) {
+                            if let Some(o) = out.get_mut(at + i) {
+                                *o = v;
+                            }
+                        }
+                    }
                 }
             }
         }
     }
+}
+
+/// [`carry`] for the [`LANES`] rows of a chunk.
+#[inline(always)]
+fn carry_chunk<T: Scalar>(pc: &Chunk<T>, kin: &[T; KIN]) -> Chunk<T> {
+    let z = T::default();
+    let mut out = [[z; LANES]; 6];
+    for i in 0..LANES {
+        let p = [pc[0][i], pc[1][i], pc[2][i], pc[3][i], pc[4][i], pc[5][i]];
+        let c = carry(&p, kin);
+        for (o, x) in out.iter_mut().zip(c) {
+            o[i] = x;
+        }
+    }
+    out
+}
+
+/// [`entries`] for the [`LANES`] rows of a chunk: per parameter, its entries in the rows.
+#[inline(always)]
+fn entries_chunk<T: Scalar>(pc: &Chunk<T>, kin: &[T; KIN], k: &[T; 9]) -> [[T; LANES]; 10] {
+    let z = T::default();
+    let mut out = [[z; LANES]; 10];
+    for i in 0..LANES {
+        let p = [pc[0][i], pc[1][i], pc[2][i], pc[3][i], pc[4][i], pc[5][i]];
+        let y = entries(&p, kin, k);
+        for (o, x) in out.iter_mut().zip(y) {
+            o[i] = x;
+        }
+    }
+    out
 }

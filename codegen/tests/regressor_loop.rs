@@ -166,7 +166,7 @@ fn the_loop_form_is_chosen_where_the_straight_line_outgrows_the_instruction_cach
     assert!(
         krang
             .source
-            .contains("kanegen_runtime::regressor::inverse_dynamics_regressor(")
+            .contains("kanegen_runtime::regressor::inverse_dynamics_regressor::<")
     );
     assert!(kanegen::stats(&krang).contains("runs in loop form"));
     let straight = generated(&load("krang.toml"), RegressorForm::StraightLine);

@@ -76,42 +76,9 @@ pub trait Scalar:
 
 impl<T: Copy + Default + Add<Output = T> + Sub<Output = T> + Mul<Output = T>> Scalar for T {}
 
-/// `a × b`.
-#[inline(always)]
-fn cross<T: Scalar>(a: [T; 3], b: [T; 3]) -> [T; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
 #[inline(always)]
 fn v3<T: Scalar>(x: &[T], at: usize) -> [T; 3] {
     [x[at], x[at + 1], x[at + 2]]
-}
-
-/// `Rᵀ x` with `R` row-major at `kin[9..18]`.
-#[inline(always)]
-fn rot_down<T: Scalar>(kin: &[T; KIN], x: [T; 3]) -> [T; 3] {
-    let r = |i: usize, k: usize| kin[9 + 3 * i + k];
-    [
-        r(0, 0) * x[0] + r(1, 0) * x[1] + r(2, 0) * x[2],
-        r(0, 1) * x[0] + r(1, 1) * x[1] + r(2, 1) * x[2],
-        r(0, 2) * x[0] + r(1, 2) * x[1] + r(2, 2) * x[2],
-    ]
-}
-
-/// The partial velocity of a link from its parent's `phi` (parent axes): `ω' = Rᵀ ω`,
-/// `v' = Rᵀ (v + ω × P)`.
-#[inline(always)]
-fn carry<T: Scalar>(phi: &[T; 6], kin: &[T; KIN]) -> [T; 6] {
-    let w = v3(phi, 0);
-    let v = v3(phi, 3);
-    let wxp = cross(w, v3(kin, 18));
-    let w2 = rot_down(kin, w);
-    let v2 = rot_down(kin, [v[0] + wxp[0], v[1] + wxp[1], v[2] + wxp[2]]);
-    [w2[0], w2[1], w2[2], v2[0], v2[1], v2[2]]
 }
 
 /// `K = [α]× + [ω]×[ω]×` (row-major): the first moment's part of the inertia force,
@@ -132,40 +99,6 @@ fn first_moment_matrix<T: Scalar>(kin: &[T; KIN]) -> [T; 9] {
         w[2] * w[0] - al[1],
         w[2] * w[1] + al[0],
         w[2] * w[2] - ww,
-    ]
-}
-
-/// The ten entries `φ · W` of one (row, body) pair: `φ = (w; v)` the body's partial velocity,
-/// `kin` its motion, `k` its [`first_moment_matrix`].
-#[inline(always)]
-fn entries<T: Scalar>(phi: &[T; 6], kin: &[T; KIN], k: &[T; 9]) -> [T; 10] {
-    let w = v3(phi, 0);
-    let v = v3(phi, 3);
-    let om = v3(kin, 0);
-    let al = v3(kin, 3);
-    let a = v3(kin, 6);
-    // m: v · a
-    let m = v[0] * a[0] + v[1] * a[1] + v[2] * a[2];
-    // MS: Kᵀ v + a × w   (v · K MS and w · (MS × a) = MS · (a × w))
-    let axw = cross(a, w);
-    let ms = [
-        k[0] * v[0] + k[3] * v[1] + k[6] * v[2] + axw[0],
-        k[1] * v[0] + k[4] * v[1] + k[7] * v[2] + axw[1],
-        k[2] * v[0] + k[5] * v[1] + k[8] * v[2] + axw[2],
-    ];
-    // J: w · (J α + ω × J ω) = Lᵀ(α) w + Lᵀ(ω) (w × ω), with J x = L(x) (XX, XY, XZ, YY, YZ, ZZ).
-    let x = cross(w, om);
-    [
-        m,
-        ms[0],
-        ms[1],
-        ms[2],
-        al[0] * w[0] + om[0] * x[0],
-        al[1] * w[0] + al[0] * w[1] + om[1] * x[0] + om[0] * x[1],
-        al[2] * w[0] + al[0] * w[2] + om[2] * x[0] + om[0] * x[2],
-        al[1] * w[1] + om[1] * x[1],
-        al[2] * w[1] + al[1] * w[2] + om[2] * x[1] + om[1] * x[2],
-        al[2] * w[2] + om[2] * x[2],
     ]
 }
 
@@ -273,32 +206,101 @@ pub fn inverse_dynamics_regressor_with<T: Scalar>(
     }
 }
 
-/// [`carry`] for the [`LANES`] rows of a chunk.
+/// One value per row of a chunk.
+type V<T> = [T; LANES];
+
 #[inline(always)]
-fn carry_chunk<T: Scalar>(pc: &Chunk<T>, kin: &[T; KIN]) -> Chunk<T> {
-    let z = T::default();
-    let mut out = [[z; LANES]; 6];
-    for i in 0..LANES {
-        let p = [pc[0][i], pc[1][i], pc[2][i], pc[3][i], pc[4][i], pc[5][i]];
-        let c = carry(&p, kin);
-        for (o, x) in out.iter_mut().zip(c) {
-            o[i] = x;
-        }
-    }
-    out
+fn vadd<T: Scalar>(a: V<T>, b: V<T>) -> V<T> {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]
 }
 
-/// [`entries`] for the [`LANES`] rows of a chunk: per parameter, its entries in the rows.
 #[inline(always)]
-fn entries_chunk<T: Scalar>(pc: &Chunk<T>, kin: &[T; KIN], k: &[T; 9]) -> [[T; LANES]; 10] {
-    let z = T::default();
-    let mut out = [[z; LANES]; 10];
-    for i in 0..LANES {
-        let p = [pc[0][i], pc[1][i], pc[2][i], pc[3][i], pc[4][i], pc[5][i]];
-        let y = entries(&p, kin, k);
-        for (o, x) in out.iter_mut().zip(y) {
-            o[i] = x;
-        }
-    }
-    out
+fn vsub<T: Scalar>(a: V<T>, b: V<T>) -> V<T> {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3]]
+}
+
+/// `s · a` (a scalar broadcast to the lanes).
+#[inline(always)]
+fn vscale<T: Scalar>(s: T, a: V<T>) -> V<T> {
+    [s * a[0], s * a[1], s * a[2], s * a[3]]
+}
+
+/// `x · a` with scalar `x` and lane vectors `a`.
+#[inline(always)]
+fn vdot3<T: Scalar>(x: [T; 3], a: [V<T>; 3]) -> V<T> {
+    vadd(
+        vadd(vscale(x[0], a[0]), vscale(x[1], a[1])),
+        vscale(x[2], a[2]),
+    )
+}
+
+/// `s × a` with scalar `s` and lane vectors `a`.
+#[inline(always)]
+fn vcross_sv<T: Scalar>(s: [T; 3], a: [V<T>; 3]) -> [V<T>; 3] {
+    [
+        vsub(vscale(s[1], a[2]), vscale(s[2], a[1])),
+        vsub(vscale(s[2], a[0]), vscale(s[0], a[2])),
+        vsub(vscale(s[0], a[1]), vscale(s[1], a[0])),
+    ]
+}
+
+/// The partial velocities of a chunk's rows carried one joint down from the parent's `pc`:
+/// `ω' = Rᵀ ω`, `v' = Rᵀ (v + ω × P)`, lane-wise (the transform's entries broadcast).
+#[inline(always)]
+fn carry_chunk<T: Scalar>(pc: &Chunk<T>, kin: &[T; KIN]) -> Chunk<T> {
+    let w = [pc[0], pc[1], pc[2]];
+    let v = [pc[3], pc[4], pc[5]];
+    // ω × P = −P × ω
+    let pxw = vcross_sv(v3(kin, 18), w);
+    let v2 = [vsub(v[0], pxw[0]), vsub(v[1], pxw[1]), vsub(v[2], pxw[2])];
+    // Rᵀ x: column i of R dotted with x.
+    let col = |i: usize| [kin[9 + i], kin[12 + i], kin[15 + i]];
+    [
+        vdot3(col(0), w),
+        vdot3(col(1), w),
+        vdot3(col(2), w),
+        vdot3(col(0), v2),
+        vdot3(col(1), v2),
+        vdot3(col(2), v2),
+    ]
+}
+
+/// The ten entries `φ · W` of a body for the rows of a chunk (`φ = (w; v)` its partial
+/// velocities, `kin` its motion, `k` its [`first_moment_matrix`]), lane-wise: per parameter,
+/// its entries in the rows. `m`: `v · a`; `MS`: `Kᵀ v + a × w` (from `v · K MS` and
+/// `w · (MS × a)`); `J`: `w · (J α + ω × J ω) = Lᵀ(α) w + Lᵀ(ω) (w × ω)` with
+/// `J x = L(x) (XX, XY, XZ, YY, YZ, ZZ)`.
+#[inline(always)]
+fn entries_chunk<T: Scalar>(pc: &Chunk<T>, kin: &[T; KIN], k: &[T; 9]) -> [V<T>; 10] {
+    let w = [pc[0], pc[1], pc[2]];
+    let v = [pc[3], pc[4], pc[5]];
+    let om = v3(kin, 0);
+    let al = v3(kin, 3);
+    let a = v3(kin, 6);
+    let m = vdot3(a, v);
+    let axw = vcross_sv(a, w);
+    let ms = |i: usize| vadd(vdot3([k[i], k[3 + i], k[6 + i]], v), axw[i]);
+    // w × ω = −ω × w
+    let oxw = vcross_sv(om, w);
+    let x = [oxw[0], oxw[1], oxw[2]];
+    // Lᵀ(α) w + Lᵀ(ω) (w × ω), the second with x = ω × w = −(w × ω).
+    let sq = |i: usize| vsub(vscale(al[i], w[i]), vscale(om[i], x[i]));
+    let mixed = |i: usize, j: usize| {
+        vsub(
+            vadd(vscale(al[j], w[i]), vscale(al[i], w[j])),
+            vadd(vscale(om[j], x[i]), vscale(om[i], x[j])),
+        )
+    };
+    [
+        m,
+        ms(0),
+        ms(1),
+        ms(2),
+        sq(0),
+        mixed(0, 1),
+        mixed(0, 2),
+        sq(1),
+        mixed(1, 2),
+        sq(2),
+    ]
 }

@@ -186,14 +186,22 @@ pub fn inverse_dynamics_regressor_with<T: Scalar>(
             };
             let y = entries_chunk(c, kl, &k);
             let r0 = j * LANES;
-            for (&col, y) in link.columns.iter().zip(y) {
-                if col == NO_COLUMN {
-                    continue;
+            if r0 + LANES <= rows {
+                // Four rows of a column: one contiguous store.
+                for (&col, y) in link.columns.iter().zip(y) {
+                    let at = col as usize * rows + r0;
+                    if col != NO_COLUMN
+                        && let Some(o) = out.get_mut(at..at + LANES)
+                        && let Ok(o) = <&mut [T; LANES]>::try_from(o)
+                    {
+                        *o = y;
+                    }
                 }
-                let at = col as usize * rows + r0;
-                match out.get_mut(at..at + LANES) {
-                    Some(o) if r0 + LANES <= rows => o.copy_from_slice(&y),
-                    _ => {
+            } else {
+                // The last rows of the result.
+                for (&col, y) in link.columns.iter().zip(y) {
+                    let at = col as usize * rows + r0;
+                    if col != NO_COLUMN {
                         for (i, &v) in y.iter().enumerate().take(rows.saturating_sub(r0)) {
                             if let Some(o) = out.get_mut(at + i) {
                                 *o = v;

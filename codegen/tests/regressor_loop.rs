@@ -79,7 +79,18 @@ fn loop_value(
             phi,
         })
         .collect();
-    let mut out = vec![0.0; rows * cols];
+    // As the generated `…_into` does with a result of unknown content: the columns that are not
+    // a body's zeroed, then their entries stored; the loop must write every other entry (NaN
+    // left anywhere fails the comparison).
+    let mut out = vec![f64::NAN; rows * cols];
+    let body: Vec<usize> = tables
+        .links
+        .iter()
+        .flat_map(|l| l.columns.iter().flatten().copied())
+        .collect();
+    for c in (0..cols).filter(|c| !body.contains(c)) {
+        out[c * rows..(c + 1) * rows].fill(0.0);
+    }
     for (r, c, v) in extra {
         out[c * rows + r] = v;
     }
@@ -120,6 +131,10 @@ fn loop_form_equals_the_straight_line_regressors_on_random_states() {
                 let straight = g.lowered.evaluate(id, &params, &q, &u, &ud);
                 let looped = loop_value(&g, id, n, cols, &params, &q, &u, &ud);
                 let scale = straight.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                assert!(
+                    looped.iter().all(|v| v.is_finite()),
+                    "{name} {id:?}: entry not written"
+                );
                 for (j, (a, b)) in looped.iter().zip(&straight).enumerate() {
                     if (a - b).abs() / scale > 1e-9 && std::env::var("DBG").is_ok() {
                         eprintln!(

@@ -24,7 +24,9 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
         precision: cx.precision,
     };
     let reads = Reads::of(p, cx.model.speeds.len());
-    let fname = super::print::ident(&super::frames::rust_name(cx, f));
+    let name = super::frames::rust_name(cx, f);
+    let fname = super::print::ident(&name);
+    let into = super::print::ident(&format!("{name}_into"));
     let doc = format!(" {}", spec.doc);
     let tables = &lp.tables;
     let ops = format!(
@@ -63,7 +65,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
         let line = if k < lp.kin_len {
             format!("kin[{}][{}] = {};", r / KIN, r % KIN, text(e))
         } else {
-            format!("m[({r}, {c})] = {};", text(e))
+            format!("y[({r}, {c})] = {};", text(e))
         };
         stores[last_local(e).map_or(0, |i| i + 1)].push(line);
         stored.push(e);
@@ -101,34 +103,107 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
     } else {
         quote!()
     };
-    // The result is written in place (the closure returns nothing): returned from the
-    // dispatch closure, its 26 KB (Krang) were copied once more.
+    // Columns that are not a body's: zeroed, then their straight-line entries stored.
+    let body_columns: std::collections::BTreeSet<usize> = tables
+        .links
+        .iter()
+        .flat_map(|l| l.columns.iter().flatten().copied())
+        .collect();
+    let others: Vec<_> = (0..cols)
+        .filter(|c| !body_columns.contains(c))
+        .map(idx)
+        .collect();
+    let zero_others = if others.is_empty() {
+        quote!()
+    } else {
+        quote!(for c in [#(#others),*] { y.column_mut(c).fill(0.0); })
+    };
+    // The result is written in place (the closure returns nothing): returned from the dispatch
+    // closure and then from the function, its 26 KB (Krang) were copied once more.
     let body = quote! {
         #unused
         #prologue
         let #kin_mut kin = [[0.0; kanegen_runtime::regressor::KIN]; #nl];
+        #zero_others
         #body
-        kanegen_runtime::regressor::inverse_dynamics_regressor::<_, #nl, #slots>(&kin, &LINKS, &SEEDS, #nr, m.as_mut_slice());
+        kanegen_runtime::regressor::inverse_dynamics_regressor::<_, #nl, #slots>(&kin, &LINKS, &SEEDS, #nr, y.as_mut_slice());
     };
     let body = if cx.isa_dispatch {
         quote!(kanegen_runtime::isa::dispatch(#[inline(always)] || { #body });)
     } else {
         body
     };
+    let into_doc = format!(
+        " [`{name}`] written into `y` (every entry; nothing to allocate, zero or copy: the fast form for a caller that keeps its result matrix)."
+    );
+    let forward = if cx.low.params.is_runtime() {
+        quote!(p: &Params, pc: &Precomputed,)
+    } else {
+        quote!()
+    };
+    let forward_args = if cx.low.params.is_runtime() {
+        quote!(p, pc,)
+    } else {
+        quote!()
+    };
+    let state = super::items::arg_names(spec.inputs);
     quote! {
         #[doc = #doc]
         #[doc = ""]
         #[doc = #arg_doc]
         #[doc = #ops]
+        #[inline]
+        pub fn #fname(#forward #args) -> #ty {
+            let mut y = SMatrix::<#t, #nr, #nc>::zeros();
+            #into(#forward_args #state, &mut y);
+            y
+        }
+
+        #[doc = #into_doc]
+        #[doc = ""]
+        #[doc = #arg_doc]
         #[inline(never)]
-        pub fn #fname(#param_args #args) -> #ty {
-            /// Per link: its parent and its body's result columns.
+        pub fn #into(#param_args #args, y: &mut SMatrix<#t, #nr, #nc>) {
+            /// Per link: its parent, its body's result columns and its row chunks.
             const LINKS: [kanegen_runtime::regressor::Link; #nl] = [#(#links),*];
             /// The joints' own partial velocities, by link.
             const SEEDS: [kanegen_runtime::regressor::Seed<#t>; #ns] = [#(#seeds),*];
-            let mut m = SMatrix::<#t, #nr, #nc>::zeros();
             #body
-            m
         }
     }
+}
+
+/// The wrapper's methods `…_into(&self, …, y)` of the module's loop-form regressors.
+pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
+    cx.low
+        .functions
+        .iter()
+        .filter(|f| f.looped.is_some())
+        .map(|f| {
+            let spec = f.id.spec();
+            let name = format!("{}_into", spec.name);
+            let into = super::print::ident(&name);
+            let doc = format!(
+                " [`Self::{}`] written into `y` (every entry; nothing to allocate, zero or copy).",
+                spec.name
+            );
+            let (args, _) = state_args(cx, spec.inputs);
+            let t = scalar_type(cx.precision);
+            let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
+            let (nr, nc) = (idx(rows), idx(cols));
+            let state = super::items::arg_names(spec.inputs);
+            let call = if cx.low.params.is_runtime() {
+                quote!(#into(&self.params, &self.pre, #state, y))
+            } else {
+                quote!(#into(#state, y))
+            };
+            quote! {
+                #[doc = #doc]
+                #[inline]
+                pub fn #into(&self, #args, y: &mut SMatrix<#t, #nr, #nc>) {
+                    #call
+                }
+            }
+        })
+        .collect()
 }

@@ -109,9 +109,9 @@ pub type Chunk<T> = [[T; LANES]; 6];
 /// Write into the column-major `rows × cols` result `out` the body entries of the
 /// inverse-dynamics regressor. `kin` is every link's motion and joint transform ([`KIN`]),
 /// `links` the tree (parents first) and `seeds` the joints' own partial velocities, sorted by
-/// link. `S` is the number of chunk slots (the sum of [`Link::chunks`]). Entries of columns that
-/// are not a body's, and of rows beyond a link's chunks, are left as they are (the generated
-/// function starts from zero and stores the other entries itself).
+/// link. `S` is the number of chunk slots (the sum of [`Link::chunks`]). Every entry of the
+/// bodies' columns is written (zeros where no speed moves the body); the columns that are not
+/// a body's are left as they are (the generated function stores them itself).
 ///
 /// Flops per call: 23 per link with a body; per chunk, 42 per lane to carry the partial
 /// velocities (none at the root) and 71 per lane for the body's entries (a generated
@@ -145,6 +145,15 @@ pub fn inverse_dynamics_regressor_with<T: Scalar>(
     for (l, (link, kl)) in links.iter().zip(kin).enumerate() {
         let n = link.chunks as usize;
         let slot = link.slot as usize;
+        // The rows below the link's chunks (not moved by any speed that moves it): zero.
+        for &col in &link.columns {
+            let at = col as usize * rows;
+            if col != NO_COLUMN
+                && let Some(o) = out.get_mut(at + (n * LANES).min(rows)..at + rows)
+            {
+                o.fill(z);
+            }
+        }
         if n == 0 {
             continue;
         }

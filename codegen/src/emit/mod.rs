@@ -172,6 +172,7 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
     for (i, f) in low.functions.iter().enumerate() {
         // Its statements carry their labels in their block (`text.rs`).
         items.extend(function::function(&cx, f));
+        items.extend(regressor_loop::straight_into(&cx, f));
         // After a per-frame function's last frame, its dispatcher.
         let last = low.functions.get(i + 1).is_none_or(|next| next.id != f.id);
         if f.frame.is_some() && last {

@@ -11,6 +11,7 @@ use super::print::{Printer, idx, signed_lit};
 use super::{Context, scalar_type};
 use crate::kane::KIN;
 use crate::lower::{FunctionProgram, LExpr, Leaf, LoopProgram};
+use crate::registry::FunctionId;
 
 /// The free function of regressor `f` in loop form `lp`.
 pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) -> TokenStream {
@@ -173,20 +174,68 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
     }
 }
 
-/// The wrapper's methods `…_into(&self, …, y)` of the module's loop-form regressors.
+/// Whether `f` gets an in-place variant `…_into`: the inverse-dynamics regressor and the base
+/// regressor, in either form (the same API whichever form the model gets).
+fn has_into(f: &FunctionProgram) -> bool {
+    matches!(
+        f.id,
+        FunctionId::InverseDynamicsRegressor | FunctionId::BaseRegressor
+    )
+}
+
+/// The in-place variant `…_into` of a straight-line regressor `f` (nothing for other
+/// functions or a loop form, which [`function`] emits with its own).
+pub(super) fn straight_into(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
+    if !has_into(f) || f.looped.is_some() {
+        return quote!();
+    }
+    let spec = f.id.spec();
+    let name = super::frames::rust_name(cx, f);
+    let fname = super::print::ident(&name);
+    let into = super::print::ident(&format!("{name}_into"));
+    let t = scalar_type(cx.precision);
+    let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
+    let (nr, nc) = (idx(rows), idx(cols));
+    let (args, arg_doc) = state_args(cx, spec.inputs);
+    let state = super::items::arg_names(spec.inputs);
+    let (params, forward) = if cx.low.params.is_runtime() {
+        (quote!(p: &Params, pc: &Precomputed,), quote!(p, pc,))
+    } else {
+        (quote!(), quote!())
+    };
+    let doc = format!(
+        " [`{name}`] written into `y` (the same API as a loop-form regressor's; here it stores the by-value result)."
+    );
+    quote! {
+        #[doc = #doc]
+        #[doc = ""]
+        #[doc = #arg_doc]
+        #[inline]
+        pub fn #into(#params #args, y: &mut SMatrix<#t, #nr, #nc>) {
+            *y = #fname(#forward #state);
+        }
+    }
+}
+
+/// The wrapper's methods `…_into(&self, …, y)` of the module's inverse-dynamics and base
+/// regressors.
 pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
     cx.low
         .functions
         .iter()
-        .filter(|f| f.looped.is_some())
+        .filter(|f| has_into(f))
         .map(|f| {
             let spec = f.id.spec();
             let name = format!("{}_into", spec.name);
             let into = super::print::ident(&name);
-            let doc = format!(
-                " [`Self::{}`] written into `y` (every entry; nothing to allocate, zero or copy).",
-                spec.name
-            );
+            let doc = if f.looped.is_some() {
+                format!(
+                    " [`Self::{}`] written into `y` (every entry; nothing to allocate, zero or copy).",
+                    spec.name
+                )
+            } else {
+                format!(" [`Self::{}`] written into `y`.", spec.name)
+            };
             let (args, _) = state_args(cx, spec.inputs);
             let t = scalar_type(cx.precision);
             let (rows, cols) = spec.shape.size_in(&cx.low.sizes);

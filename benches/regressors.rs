@@ -1,6 +1,7 @@
 //! Krang's regressors (19 speeds, runtime parameters) against the dynamics functions they
 //! replace: `inverse_dynamics_regressor` and `base_regressor` against `inverse_dynamics`,
-//! `gravity_regressor` and `base_gravity_regressor` against `gravity`. 64 random states cycled
+//! `gravity_regressor` and `base_gravity_regressor` against `gravity`; the loop form's in-place
+//! variants `…_into` and the cost of the by-value result alone. 64 random states cycled
 //! through call by call, inputs behind `black_box`.
 //!
 //! ```text
@@ -57,6 +58,28 @@ fn bench(c: &mut Criterion) {
         black_box(&x.1),
         black_box(&x.2)
     ));
+    // The loop form's in-place variants (README, "Regressors: the loop form"): the result
+    // matrix kept by the caller, nothing zeroed or copied per call.
+    let mut y = nalgebra::SMatrix::<f64, 19, 173>::zeros();
+    run!("inverse_dynamics_regressor_into", |x| {
+        k.inverse_dynamics_regressor_into(
+            black_box(&x.0),
+            black_box(&x.1),
+            black_box(&x.2),
+            &mut y,
+        );
+        y[(7, 60)]
+    });
+    let mut yb = nalgebra::SMatrix::<f64, 19, 122>::zeros();
+    run!("base_regressor_into", |x| {
+        k.base_regressor_into(black_box(&x.0), black_box(&x.1), black_box(&x.2), &mut yb);
+        yb[(7, 40)]
+    });
+    // What the by-value functions' 26 KB result costs on its own: zeroed, returned, dropped.
+    run!("result_only_19x173", |x| {
+        let _ = black_box(x);
+        nalgebra::SMatrix::<f64, 19, 173>::zeros()
+    });
     run!("gravity", |x| k.gravity(black_box(&x.0)));
     run!("gravity_regressor", |x| k
         .gravity_regressor(black_box(&x.0)));

@@ -172,6 +172,34 @@ fn krang_compiled_regressors_reproduce_tau_and_g() {
     assert!(worst <= 1e-12, "{worst:e}");
 }
 
+/// Krang's regressors are in loop form (README, "Regressors: the loop form"): the in-place
+/// variants write every entry of a matrix of any content (here NaN and a previous state's
+/// result) and equal the by-value functions bit for bit; the fixed-wheel tree's too.
+#[test]
+fn krang_in_place_regressors_write_every_entry_and_equal_the_by_value_ones() {
+    use krang_dynamics::Krang;
+    use krang_dynamics::fixed_wheels::KrangFixedWheels;
+    let k = Krang::default();
+    let kf = KrangFixedWheels::default();
+    let mut r = rng(34);
+    let mut y = nalgebra::SMatrix::<f64, 19, 173>::from_element(f64::NAN);
+    let mut yb = nalgebra::SMatrix::<f64, 19, 122>::from_element(f64::NAN);
+    for _ in 0..20 {
+        let (q, u, ud) = random_state(&mut r, 19);
+        let (q, u, ud) = (sv::<19>(&q), sv::<19>(&u), sv::<19>(&ud));
+        k.inverse_dynamics_regressor_into(&q, &u, &ud, &mut y);
+        assert_eq!(y, k.inverse_dynamics_regressor(&q, &u, &ud));
+        k.base_regressor_into(&q, &u, &ud, &mut yb);
+        assert_eq!(yb, k.base_regressor(&q, &u, &ud));
+        let (q, u, ud) = random_state(&mut r, 17);
+        let (q, u, ud) = (sv::<17>(&q), sv::<17>(&u), sv::<17>(&ud));
+        let mut yf = kf.inverse_dynamics_regressor(&q, &u, &ud);
+        yf.fill(f64::NAN);
+        kf.inverse_dynamics_regressor_into(&q, &u, &ud, &mut yf);
+        assert_eq!(yf, kf.inverse_dynamics_regressor(&q, &u, &ud));
+    }
+}
+
 #[test]
 fn krang_base_parameters_follow_the_geometry_of_the_parameter_set() {
     // Random lengths, wheel radius and track as well as inertial parameters: the grouping

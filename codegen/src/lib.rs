@@ -46,7 +46,7 @@ pub mod model {
 use std::path::{Path, PathBuf};
 
 pub use emit::EmitOptions;
-pub use options::{Options, ParamMode, Precision};
+pub use options::{Options, ParamMode, Precision, RegressorForm};
 pub use registry::{FunctionId, FunctionSet};
 pub use report::{listing, stats};
 
@@ -116,7 +116,7 @@ pub fn generate_combined(
     model.check_names()?;
     let combined = combined::resolve(&model, combined)?;
     let mut progress = Progress::new(&model);
-    let derivation = kane::derive_with(&model, options, &combined);
+    let derivation = kane::derive_shaped(&model, options, &combined, emit.regressor_form);
     progress.stage(&format!(
         "derived ({} expression nodes, {} substitution variables)",
         derivation.arena.len(),
@@ -245,6 +245,7 @@ pub struct Builder {
     isa_dispatch: bool,
     batch: bool,
     split_above: usize,
+    regressor_form: RegressorForm,
 }
 
 impl Builder {
@@ -266,6 +267,7 @@ impl Builder {
             isa_dispatch: true,
             batch: false,
             split_above: emit::SPLIT_ABOVE,
+            regressor_form: RegressorForm::Auto,
         }
     }
 
@@ -344,6 +346,19 @@ impl Builder {
         self
     }
 
+    /// The code shape of `inverse_dynamics_regressor` and `base_regressor` (default
+    /// [`RegressorForm::Auto`]: a loop over (speed, body) pairs for models where the straight
+    /// line outgrows the instruction cache, e.g. Krang; see README, "Regressors: the loop
+    /// form").
+    ///
+    /// ```no_run
+    /// kanegen::Builder::new("krang.toml").regressor_form(kanegen::RegressorForm::StraightLine).run();
+    /// ```
+    pub fn regressor_form(mut self, form: RegressorForm) -> Self {
+        self.regressor_form = form;
+        self
+    }
+
     /// The floating-point type of the generated module (default [`Precision::F64`]). With
     /// [`Precision::F32`] every matrix, vector, `Params` field and literal is `f32`, and the
     /// default file name gets the suffix `_f32.rs`:
@@ -407,6 +422,7 @@ impl Builder {
             isa_dispatch: self.isa_dispatch,
             batch: self.batch,
             split_above: self.split_above,
+            regressor_form: self.regressor_form,
             ..EmitOptions::default()
         }
     }

@@ -183,6 +183,28 @@ pub struct FunctionProgram {
     pub frame: Option<usize>,
     /// Its straight-line program; `outputs` are the entries of the result's shape.
     pub program: Program,
+    /// The loop form of a regressor, when the derivation chose it: what the emitted function
+    /// runs instead of `program` (which stays the reference for evaluation and counts).
+    pub looped: Option<LoopProgram>,
+}
+
+/// A regressor's loop form, lowered: the straight-line part and the loop's tables.
+#[derive(Clone, Debug)]
+pub struct LoopProgram {
+    /// The straight-line part: `outputs[..kin_len]` are the `kin` table's values (row = slot,
+    /// column 0), the rest result entries stored directly (`(row, column)`).
+    pub program: Program,
+    /// Number of `kin` values ([`crate::kane::KIN`] per link).
+    pub kin_len: usize,
+    /// The loop's tables.
+    pub tables: crate::kane::RegressorLoop,
+}
+
+impl LoopProgram {
+    /// Flops per call: the straight-line part's and the loop's.
+    pub fn flops(&self) -> usize {
+        self.program.ops.flops() + self.tables.flops()
+    }
 }
 
 /// All programs of a model: the precompute program and one per function.
@@ -250,10 +272,22 @@ pub fn lower(d: &Derivation) -> Lowered {
             if let Some(l) = f.frame {
                 program.name = format!("{}[{}]", f.id.name(), d.frame_names[l]);
             }
+            let looped = f.looped.as_ref().map(|l| {
+                let mut entries: Vec<(usize, usize, ExprId)> =
+                    l.kin.iter().enumerate().map(|(i, &e)| (i, 0, e)).collect();
+                entries.extend_from_slice(&l.extra);
+                let name = format!("{} (loop form)", f.id.name());
+                LoopProgram {
+                    program: lower_entries(&d.arena, &name, &entries, &f.order, hoist, &mut pre),
+                    kin_len: l.kin.len(),
+                    tables: l.clone(),
+                }
+            });
             FunctionProgram {
                 id: f.id,
                 frame: f.frame,
                 program,
+                looped,
             }
         })
         .collect();
@@ -742,6 +776,49 @@ impl Lowered {
         };
         let entries = p.outputs.iter().map(|(r, c, e)| (*r, *c, ctx.eval(e)));
         id.spec().shape.dense_in(&self.sizes, entries)
+    }
+}
+
+impl Lowered {
+    /// The straight-line part of function `id`'s loop form at one state, if it has one: the
+    /// `kin` table and the directly stored `(row, column, value)` entries (a test helper; the
+    /// loop itself is `kanegen_runtime::regressor`).
+    #[allow(clippy::type_complexity)]
+    pub fn evaluate_loop_inputs(
+        &self,
+        id: FunctionId,
+        params: &[f64],
+        q: &[f64],
+        u: &[f64],
+        ud: &[f64],
+    ) -> Option<(Vec<f64>, Vec<(usize, usize, f64)>)> {
+        let lp = self
+            .functions
+            .iter()
+            .find(|f| f.id == id)?
+            .looped
+            .as_ref()?;
+        let pre = self.precompute_values(params);
+        let q = &self.expand_angles(q);
+        let p = &lp.program;
+        let locals = run(p, params, &pre, q, u, ud);
+        let ctx = EvalCtx {
+            params,
+            pre: &pre,
+            q,
+            u,
+            ud,
+            locals: &locals,
+        };
+        let kin = p.outputs[..lp.kin_len]
+            .iter()
+            .map(|(_, _, e)| ctx.eval(e))
+            .collect();
+        let extra = p.outputs[lp.kin_len..]
+            .iter()
+            .map(|(r, c, e)| (*r, *c, ctx.eval(e)))
+            .collect();
+        Some((kin, extra))
     }
 }
 

@@ -33,6 +33,23 @@ pub enum Precision {
     F32,
 }
 
+/// The code shape of `inverse_dynamics_regressor` and `base_regressor` (see README,
+/// "Regressors: the loop form"); chosen with [`Builder::regressor_form`](crate::Builder::regressor_form)
+/// or [`EmitOptions::regressor_form`](crate::EmitOptions::regressor_form).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum RegressorForm {
+    /// The loop form for models without mimic joints with at least
+    /// [`LOOP_MIN_PAIRS`](crate::kane::LOOP_MIN_PAIRS) (speed, body) pairs (where the straight
+    /// line outgrows the instruction cache), the straight line otherwise.
+    #[default]
+    Auto,
+    /// One straight-line program per function (every entry its own derivative chain).
+    StraightLine,
+    /// Per-link motion straight-line, the (speed, body) pairs as a loop over a constant table
+    /// (`kanegen_runtime::regressor`). Models with mimic joints keep the straight line.
+    Loop,
+}
+
 /// Generator options: what the derivation, the lowering and the emitter produce.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Options {

@@ -67,6 +67,20 @@ pub fn stats(g: &Generated) -> String {
     for c in &g.lowered.combined {
         row(&c.program.name, &c.program);
     }
+    // What the loop-form regressors run instead of their straight-line rows above.
+    for f in &g.lowered.functions {
+        if let Some(lp) = &f.looped {
+            let _ = writeln!(
+                s,
+                "{} runs in loop form: {} flops straight-line (every link's motion), {} (speed, body) pairs in a loop of {} flops: {} flops per call",
+                f.id.name(),
+                lp.program.ops.flops(),
+                lp.tables.pairs(),
+                lp.tables.flops(),
+                lp.flops()
+            );
+        }
+    }
     s.push_str(&base_parameters(g));
     s
 }

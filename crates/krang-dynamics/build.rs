@@ -57,6 +57,7 @@ fn generate() {
         }
         let mut main = kanegen::Builder::new("krang.toml")
             .functions(functions)
+            .regressor_form(regressor_form())
             .batch(true);
         if kinematics {
             main = main.combined(whole_body_terms());
@@ -89,6 +90,28 @@ fn generate() {
     }
     if enabled("TWO_LINK") {
         builder("two-link.toml").derivatives(derivatives).run();
+    }
+}
+
+/// The regressors' code shape: `KANEGEN_REGRESSOR_FORM=straight-line` (or `loop`) overrides the
+/// generator's choice, to measure one form against the other (README, "Regressors: the loop
+/// form"); unset, the generator's rule (the loop form for Krang).
+#[cfg(any(
+    feature = "coriolis-matrix",
+    feature = "kinematics",
+    feature = "derivatives",
+    feature = "regressors",
+    feature = "baked",
+    feature = "f32",
+    feature = "fixed-wheels",
+    feature = "two-link"
+))]
+fn regressor_form() -> kanegen::RegressorForm {
+    println!("cargo:rerun-if-env-changed=KANEGEN_REGRESSOR_FORM");
+    match std::env::var("KANEGEN_REGRESSOR_FORM").as_deref() {
+        Ok("straight-line") => kanegen::RegressorForm::StraightLine,
+        Ok("loop") => kanegen::RegressorForm::Loop,
+        _ => kanegen::RegressorForm::Auto,
     }
 }
 

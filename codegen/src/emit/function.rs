@@ -357,6 +357,9 @@ pub(super) fn result_type(cx: &Context<'_>, shape: Shape) -> TokenStream {
 
 /// The free function of registry function `f`.
 pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
+    if let Some(lp) = &f.looped {
+        return super::regressor_loop::function(cx, f, lp);
+    }
     let spec = f.id.spec();
     let p = &f.program;
     let printer = Printer {

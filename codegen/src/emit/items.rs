@@ -351,6 +351,7 @@ pub(super) fn wrapper(cx: &Context<'_>, batched: bool) -> TokenStream {
     let ty = ident(&naming::type_name(&model.name));
     let mut methods = methods(cx);
     methods.extend(super::combined::methods(cx));
+    methods.extend(super::regressor_loop::methods(cx));
     if batched {
         methods.extend(super::batch::methods(cx));
     }

@@ -21,6 +21,7 @@ mod frames;
 mod function;
 mod items;
 mod print;
+mod regressor_loop;
 mod regressors;
 mod text;
 
@@ -31,7 +32,7 @@ use quote::quote;
 
 use crate::lower::Lowered;
 use crate::model::Model;
-use crate::options::{ParamMode, Precision};
+use crate::options::{ParamMode, Precision, RegressorForm};
 
 /// The generator's version, written into every header.
 pub const GENERATOR_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -71,6 +72,10 @@ pub struct EmitOptions {
     /// (see [`SPLIT_ABOVE`]); `usize::MAX` never splits. Lower it if a debug build of a
     /// generated module still crashes rustc.
     pub split_above: usize,
+    /// The code shape of `inverse_dynamics_regressor` and `base_regressor` (default
+    /// [`RegressorForm::Auto`]). The derivation reads it ([`crate::generate_with`] passes it
+    /// on): the loop form's tables are derived with the function.
+    pub regressor_form: RegressorForm,
 }
 
 pub use text::SPLIT_ABOVE;
@@ -84,6 +89,7 @@ impl Default for EmitOptions {
             notes: Vec::new(),
             notes_title: String::new(),
             split_above: SPLIT_ABOVE,
+            regressor_form: RegressorForm::default(),
         }
     }
 }
@@ -166,6 +172,7 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
     for (i, f) in low.functions.iter().enumerate() {
         // Its statements carry their labels in their block (`text.rs`).
         items.extend(function::function(&cx, f));
+        items.extend(regressor_loop::straight_into(&cx, f));
         // After a per-frame function's last frame, its dispatcher.
         let last = low.functions.get(i + 1).is_none_or(|next| next.id != f.id);
         if f.frame.is_some() && last {

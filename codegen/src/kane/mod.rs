@@ -41,6 +41,7 @@
 //! | `rnea_derivatives.rs` | ∂τ/∂q, ∂τ/∂u: the analytic recursion (four forces per column carried up; `derivatives.rs` keeps forward mode as its test oracle) |
 //! | `kinematics.rs` | frames in frame 0 (`⁰A`, `⁰p`), centre of mass, its Jacobian and bias acceleration, energies |
 //! | `regressor.rs` | regressors `∂τ/∂π`, `∂g/∂β` (by [`Arena::diff`]) and their base parameters |
+//! | `regressor_loop.rs` | the loop form of Y and the base regressor: per-link motion and joint transforms, the (speed, body) tables of `kanegen_runtime::regressor` |
 //! | `grouping.rs` | the base parameters' groupings as exact expressions of the geometry (fitted, then verified in exact modular arithmetic) |
 //!
 //! The arena records the order in which each phase first asks for a node and the lowering
@@ -60,6 +61,7 @@ mod kinematics;
 mod mass_matrix;
 mod mimic;
 mod regressor;
+mod regressor_loop;
 mod rnea;
 mod rnea_derivatives;
 
@@ -67,13 +69,14 @@ use kanegen_model::{Model, ParamKind};
 
 use crate::combined::ResolvedCombined;
 use crate::expr::{Arena, ExprId, Names};
-use crate::options::Options;
+use crate::options::{Options, RegressorForm};
 use crate::registry::{FunctionId, Sizes};
 
 use algebra::{M3, V3};
 use composite::Composite;
 pub use grouping::{Coefficient, Exactness, SymbolicGroup, symbolic_group_text};
 pub use regressor::{BaseParameters, Regressors, group_text};
+pub use regressor_loop::{KIN, LANES, LOOP_MIN_PAIRS, LoopLink, LoopStep, RegressorLoop};
 
 /// One derived registry function: its output entries as expressions in the arena (its name,
 /// inputs and result shape are in the registry).
@@ -89,6 +92,10 @@ pub struct Function {
     /// The arena nodes this function's derivation asked for, in the order it first asked for
     /// them: the statement order the lowering follows (see [`Arena::begin_phase`]).
     pub order: Vec<ExprId>,
+    /// The loop form of a regressor (`inverse_dynamics_regressor`, `base_regressor`) when
+    /// `regressor_form` chooses it; `entries` are the same function straight-line
+    /// (for evaluation and the base parameters).
+    pub looped: Option<RegressorLoop>,
 }
 
 /// A function's `(row, col, expression)` entries.
@@ -195,6 +202,17 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
 /// [`derive`], and the combined functions `combined` (resolved against `model` by
 /// [`crate::combined::resolve`]), each one arena phase after the module's functions.
 pub fn derive_with(model: &Model, options: Options, combined: &[ResolvedCombined]) -> Derivation {
+    derive_shaped(model, options, combined, RegressorForm::Auto)
+}
+
+/// [`derive_with`], with the regressors' code shape `regressor_form` (the loop form's tables in
+/// [`Function::looped`] when it is chosen).
+pub fn derive_shaped(
+    model: &Model,
+    options: Options,
+    combined: &[ResolvedCombined],
+    regressor_form: RegressorForm,
+) -> Derivation {
     let mut arena = Arena::new(names_of(model));
     arena.hoist_params = options.params.is_runtime();
     mimic::declare(&mut arena, model);
@@ -239,6 +257,7 @@ pub fn derive_with(model: &Model, options: Options, combined: &[ResolvedCombined
                 ) => cx.derive_regressor(id, &mut regressors, &mut full),
                 (None, _) => cx.derive_function(id, &mut composites),
             };
+            let looped = cx.looped_regressor(id, &regressors, &entries, regressor_form);
             let entries = mimic::project(cx.ar, model, id.spec().shape, entries);
             let order = cx.ar.phase_order();
             functions.push(Function {
@@ -246,6 +265,7 @@ pub fn derive_with(model: &Model, options: Options, combined: &[ResolvedCombined
                 frame,
                 entries,
                 order,
+                looped,
             });
         }
     }
@@ -410,6 +430,51 @@ impl Ctx<'_> {
             reg.base = Some(base);
         }
         out
+    }
+
+    /// The loop form of regressor `id` with straight-line `entries`, if it is
+    /// `inverse_dynamics_regressor` or `base_regressor` and `regressor_form` chooses
+    /// the loop for the model (`form`).
+    fn looped_regressor(
+        &mut self,
+        id: FunctionId,
+        reg: &Regressors,
+        entries: &[(usize, usize, ExprId)],
+        form: RegressorForm,
+    ) -> Option<RegressorLoop> {
+        let model = self.model;
+        let pairs = regressor_loop::steps(model)
+            .iter()
+            .filter(|s| model.links[s.link].body.is_some())
+            .count();
+        if !regressor_loop::use_loop(form, model, pairs) {
+            return None;
+        }
+        match id {
+            FunctionId::InverseDynamicsRegressor => {
+                let full: Vec<(usize, usize, ExprId)> = entries.to_vec();
+                Some(self.regressor_loop(&Some, &full))
+            }
+            FunctionId::BaseRegressor => {
+                let base = reg.base.as_ref()?;
+                let column: std::collections::HashMap<usize, usize> = base
+                    .groups
+                    .iter()
+                    .enumerate()
+                    .map(|(b, g)| (g[0].0, b))
+                    .collect();
+                // `entries` are already in the base columns: the straight-line extras are
+                // picked from them by their base column.
+                let inverse: std::collections::HashMap<usize, usize> =
+                    column.iter().map(|(&c, &b)| (b, c)).collect();
+                let full: Vec<(usize, usize, ExprId)> = entries
+                    .iter()
+                    .filter_map(|&(r, b, e)| inverse.get(&b).map(|&c| (r, c, e)))
+                    .collect();
+                Some(self.regressor_loop(&|c| column.get(&c).copied(), &full))
+            }
+            _ => None,
+        }
     }
 
     /// The entries of per-frame registry function `id` for body frame `l`.

@@ -98,6 +98,18 @@ impl Ctx<'_> {
         motion
     }
 
+    /// Every frame's motion with u̇ and gravity (τ's motion pass, the same variables): `(ω, α,
+    /// a − g)` of each frame in its own axes (the regressor's loop form).
+    pub(super) fn full_motion(&mut self) -> Motion {
+        let inputs = Inputs::new(true, true);
+        let mut motion = self.base_motion(inputs);
+        let model = self.model;
+        for (l, _, mount) in model.mounted_links() {
+            self.forward_motion(l, mount, &mut motion, inputs);
+        }
+        motion
+    }
+
     /// The subtree inertia forces `f` and moments `n` (about each frame's origin, in its axes)
     /// of every frame for the motion of `inputs`: the forward motion pass, body inertia forces
     /// and the backward accumulation (`f[0]`, `n[0]`: the whole robot's).

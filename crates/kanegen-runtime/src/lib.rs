@@ -18,6 +18,8 @@
 //!
 //! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA), the
 //!   crate's one `unsafe` block; [`lanes`]: the lane type of the batched functions.
+//! - [`regressor`]: the loop of a loop-form inverse-dynamics regressor (per link and four rows
+//!   at a time, over two generated constant tables).
 //!
 //! `#![no_std]`, one `unsafe` block ([`isa::dispatch`]), no dependency but [`nalgebra`] (re-exported: its vector and
 //! matrix types are the trait's argument types) and, behind features, `serde` and `toml`.
@@ -142,6 +144,7 @@ mod dynamics;
 mod invalid_parameter;
 pub mod isa;
 pub mod lanes;
+pub mod regressor;
 #[doc(hidden)]
 pub mod serde_support;
 mod set_parameter_error;

@@ -9,6 +9,7 @@
 //! ```
 //!
 //! Arguments: a function (`inverse_dynamics`, `inverse_dynamics_regressor`, `base_regressor`,
+//! their in-place loop forms `inverse_dynamics_regressor_into`, `base_regressor_into`,
 //! `gravity`, `gravity_regressor`, `base_gravity_regressor`) and the number of calls. States
 //! cycle through 64 fixed pseudo-random states. Prints the fastest ns per call of batches of
 //! 1000 calls as a rough figure (the published figures come from `cargo bench --bench
@@ -24,6 +25,8 @@ use profile_states::{V, states};
 
 fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> Result<f64, String> {
     let mut acc = 0.0;
+    let mut y = nalgebra::SMatrix::<f64, 19, 173>::zeros();
+    let mut yb = nalgebra::SMatrix::<f64, 19, 122>::zeros();
     for i in 0..calls {
         let (q, u, ud) = &s[i & 63];
         let (q, u, ud) = (black_box(q), black_box(u), black_box(ud));
@@ -33,6 +36,14 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> Result<f64, String>
                 black_box(k).inverse_dynamics_regressor(q, u, ud)[(7, 60)]
             }
             "base_regressor" => black_box(k).base_regressor(q, u, ud)[(7, 40)],
+            "inverse_dynamics_regressor_into" => {
+                black_box(k).inverse_dynamics_regressor_into(q, u, ud, &mut y);
+                y[(7, 60)]
+            }
+            "base_regressor_into" => {
+                black_box(k).base_regressor_into(q, u, ud, &mut yb);
+                yb[(7, 40)]
+            }
             "gravity" => black_box(k).gravity(q)[7],
             "gravity_regressor" => black_box(k).gravity_regressor(q)[(7, 30)],
             "base_gravity_regressor" => black_box(k).base_gravity_regressor(q)[(7, 20)],

@@ -1,0 +1,262 @@
+//! The loop form of the inverse-dynamics regressor and its base regressor (issue 13, speed).
+//!
+//! The straight-line Y is one derivative chain per parameter column (`regressor.rs`): for
+//! Krang 9,950 flops in 135 KB of machine code, which runs from L2 (the L1 instruction cache
+//! holds 32 KB). The loop form computes straight-line only what is per link — every link's
+//! `ω`, `α`, origin acceleration minus gravity (τ's own motion pass, the same K variables),
+//! its joint rotation and origin — into a small table, and runs the per (speed, body) work as a
+//! loop over a generated constant table calling `kanegen_runtime::regressor` (Kane's
+//! `τ_r = Σ_k φ_kr · W_k π_k`: the partial velocity of each body for each speed, carried one
+//! joint down the tree, dotted with the body's 6×10 motion matrix). Entries that are not a
+//! body's (a wheeled base's wheel columns) stay straight-line.
+//!
+//! The rule ([`RegressorForm::Auto`]): the loop form for models without mimic joints with at
+//! least [`LOOP_MIN_PAIRS`] (speed, body) pairs, the straight line otherwise.
+
+use kanegen_model::{JointKind, Model};
+
+use super::Ctx;
+use crate::expr::ExprId;
+use crate::options::RegressorForm;
+
+/// Values per link of the loop form's table (`kanegen_runtime::regressor::KIN`).
+pub const KIN: usize = 21;
+
+/// Rows per chunk of the loop (`kanegen_runtime::regressor::LANES`).
+pub const LANES: usize = 4;
+
+/// The fewest (speed, body) pairs for which [`RegressorForm::Auto`] chooses the loop form.
+/// Below it the straight line fits the instruction cache: it costs about 70 flops per pair at
+/// 11–14 bytes of machine code per flop, so 40 pairs are ≈ 35 KB, the size of a 32 KB L1
+/// instruction cache (the 7-DOF arm: 28 pairs, 1,617 flops, straight-line; Krang: 138).
+pub const LOOP_MIN_PAIRS: usize = 40;
+
+/// A regressor in loop form: what the generated function computes straight-line and the
+/// tables of its loop (see `kanegen_runtime::regressor`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RegressorLoop {
+    /// [`KIN`] expressions per link, in link order.
+    pub kin: Vec<ExprId>,
+    /// Per link: its parent and the result columns of its body's ten parameters.
+    pub links: Vec<LoopLink>,
+    /// The (row, link) pairs in loop order.
+    pub steps: Vec<LoopStep>,
+    /// Result entries outside the bodies' columns (a wheeled base's wheel parameters),
+    /// straight-line: `(row, column, expression)`.
+    pub extra: Vec<(usize, usize, ExprId)>,
+}
+
+/// One link of a [`RegressorLoop`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LoopLink {
+    /// Parent link (the root's own index).
+    pub parent: usize,
+    /// Result column of each of the body's parameters `m, MX, MY, MZ, XX, XY, XZ, YY, YZ, ZZ`.
+    pub columns: [Option<usize>; 10],
+}
+
+/// One (row, link) pair of a [`RegressorLoop`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoopStep {
+    /// Speed (result row).
+    pub row: usize,
+    /// Link.
+    pub link: usize,
+    /// The link's own joint's partial velocity `(ω; v)` in its frame, or `None`: carried from
+    /// the parent's.
+    pub seed: Option<[f64; 6]>,
+}
+
+impl LoopLink {
+    /// Whether the link's body has a column in the result.
+    pub fn writes(&self) -> bool {
+        self.columns.iter().any(Option::is_some)
+    }
+}
+
+impl RegressorLoop {
+    /// The (row, body) pairs whose entries the loop writes.
+    pub fn pairs(&self) -> usize {
+        self.steps
+            .iter()
+            .filter(|s| self.links[s.link].writes())
+            .count()
+    }
+
+    /// Per link, the number of row chunks of [`LANES`] rows (from row 0) that cover every
+    /// speed that moves it, and the index of its first chunk in the scratch; and the total.
+    pub fn chunks(&self) -> (Vec<(usize, usize)>, usize) {
+        let mut hi = vec![0; self.links.len()];
+        for s in &self.steps {
+            hi[s.link] = hi[s.link].max(s.row + 1);
+        }
+        let mut slot = 0;
+        let out = hi
+            .iter()
+            .map(|&h| {
+                let n = h.div_ceil(LANES);
+                slot += n;
+                (n, slot - n)
+            })
+            .collect();
+        (out, slot)
+    }
+
+    /// The seeds (`row`, `link`, partial velocity), sorted by link.
+    pub fn seeds(&self) -> Vec<(usize, usize, [f64; 6])> {
+        let mut s: Vec<_> = self
+            .steps
+            .iter()
+            .filter_map(|s| s.seed.map(|x| (s.row, s.link, x)))
+            .collect();
+        s.sort_by_key(|&(r, l, _)| (l, r));
+        s
+    }
+
+    /// Flops of the loop per call, as the runtime kernel runs them (every lane of a chunk,
+    /// rows that are not a link's ancestors' included): 23 per link with a body, and per chunk
+    /// of [`LANES`] rows 42 per lane to carry it from the parent and 71 per lane for the
+    /// body's entries.
+    pub fn flops(&self) -> usize {
+        let (chunks, _) = self.chunks();
+        let mut flops = 0;
+        for (l, link) in self.links.iter().enumerate() {
+            let (n, _) = chunks[l];
+            let inherited = if link.parent == l {
+                0
+            } else {
+                chunks[link.parent].0.min(n)
+            };
+            flops += 42 * LANES * inherited;
+            if link.writes() && n > 0 {
+                flops += 23 + 71 * LANES * n;
+            }
+        }
+        flops
+    }
+}
+
+/// Whether `form` asks for the loop form of `model`'s regressor with `pairs` (speed, body)
+/// pairs.
+pub(super) fn use_loop(form: RegressorForm, model: &Model, pairs: usize) -> bool {
+    model.mimics.is_empty()
+        && match form {
+            RegressorForm::Auto => pairs >= LOOP_MIN_PAIRS,
+            RegressorForm::Loop => true,
+            RegressorForm::StraightLine => false,
+        }
+}
+
+/// The (row, link) steps of `model`'s tree (no mimic joints): per speed, the link its joint
+/// moves with the joint's partial velocity, then that link's descendants in link order; links
+/// whose subtree has no body are left out.
+pub(super) fn steps(model: &Model) -> Vec<LoopStep> {
+    let nl = model.links.len();
+    // Whether link l's subtree has a body (links are in topological order).
+    let mut needed: Vec<bool> = model.links.iter().map(|l| l.body.is_some()).collect();
+    for l in (1..nl).rev() {
+        if let (Some(p), true) = (model.links[l].parent(), needed[l]) {
+            needed[p] = true;
+        }
+    }
+    let descends = |k: usize, l: usize| k == l || model.path_to_base(k).any(|(_, m)| m.parent == l);
+    let mut seeds: Vec<(usize, usize, [f64; 6])> = Vec::new();
+    if let Some(w) = model.wheeled_base() {
+        seeds.push((w.x_speed, 0, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0]));
+        seeds.push((w.psi_speed, 0, [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]));
+    }
+    for (l, _, mount) in model.mounted_links() {
+        let e = mount.joint.axis;
+        match mount.joint.kind {
+            JointKind::Revolute { speed } => {
+                seeds.push((speed, l, [e[0], e[1], e[2], 0.0, 0.0, 0.0]));
+            }
+            JointKind::Prismatic { speed } => {
+                seeds.push((speed, l, [0.0, 0.0, 0.0, e[0], e[1], e[2]]));
+            }
+            JointKind::Fixed => {}
+        }
+    }
+    seeds.sort_by_key(|s| s.0);
+    let mut out = Vec::new();
+    for (row, l, seed) in seeds {
+        if !needed[l] {
+            continue;
+        }
+        out.push(LoopStep {
+            row,
+            link: l,
+            seed: Some(seed),
+        });
+        for k in l + 1..nl {
+            if needed[k] && descends(k, l) {
+                out.push(LoopStep {
+                    row,
+                    link: k,
+                    seed: None,
+                });
+            }
+        }
+    }
+    out
+}
+
+impl Ctx<'_> {
+    /// The loop form of a regressor whose parameter column `c` of π is result column
+    /// `column(c)` (`None`: left out), with the straight-line `entries` (in π's columns) for
+    /// the entries that are not a body's.
+    pub(super) fn regressor_loop(
+        &mut self,
+        column: &dyn Fn(usize) -> Option<usize>,
+        entries: &[(usize, usize, ExprId)],
+    ) -> RegressorLoop {
+        let model = self.model;
+        let motion = self.full_motion();
+        let zero = self.ar.zero();
+        let one = self.ar.one();
+        let mut kin = Vec::with_capacity(KIN * model.links.len());
+        let mut links = Vec::with_capacity(model.links.len());
+        let mut body = 0;
+        for (l, link) in model.links.iter().enumerate() {
+            kin.extend(motion.w[l]);
+            kin.extend(motion.wd[l]);
+            kin.extend(motion.a[l]);
+            match &link.mount {
+                Some(mount) => {
+                    let r = self.rotation(l, &mount.joint);
+                    let p = self.position(l, &mount.joint);
+                    kin.extend(r.iter().flatten());
+                    kin.extend(p);
+                }
+                None => {
+                    let eye = [[one, zero, zero], [zero, one, zero], [zero, zero, one]];
+                    kin.extend(eye.iter().flatten());
+                    kin.extend([zero; 3]);
+                }
+            }
+            let mut columns = [None; 10];
+            if link.body.is_some() {
+                for (t, c) in columns.iter_mut().enumerate() {
+                    *c = column(10 * body + t);
+                }
+                body += 1;
+            }
+            links.push(LoopLink {
+                parent: link.parent().unwrap_or(l),
+                columns,
+            });
+        }
+        let bodies = 10 * body;
+        let extra = entries
+            .iter()
+            .filter(|&&(_, c, _)| c >= bodies)
+            .filter_map(|&(r, c, e)| column(c).map(|b| (r, b, e)))
+            .collect();
+        RegressorLoop {
+            kin,
+            links,
+            steps: steps(model),
+            extra,
+        }
+    }
+}

@@ -288,7 +288,8 @@ pub fn active() -> Isa {
 }
 
 /// Make [`dispatch`] use `isa` from now on, in every thread (for benchmarks and tests that
-/// compare the copies; results are the same bits either way). An error if this CPU or build
+/// compare the copies; generated functions' results differ in the last bits, as the
+/// x86-64-v3 copy fuses multiply-adds). An error if this CPU or build
 /// cannot run it; nothing changes then.
 pub fn select(isa: Isa) -> Result<(), IsaUnavailable> {
     if !available(isa) {

@@ -375,8 +375,10 @@ impl Builder {
     /// compiled for the baseline target and for x86-64-v3 (AVX2 + FMA), and the copy the CPU
     /// supports runs (`kanegen_runtime::isa`, detected once). Turn it off to get one copy per
     /// function (half the code) when the crate is built with `-C target-cpu=…` anyway; the
-    /// runtime's `dispatch` feature turns it off for every module of a build. Both copies give
-    /// the same bits (Rust does not fuse multiply-adds on its own).
+    /// runtime's `dispatch` feature turns it off for every module of a build. The x86-64-v3 copy
+    /// fuses multiply-adds (`kanegen_runtime::isa::Arith`), so its results differ from the
+    /// baseline copy's in the last bits; without dispatch the one copy fuses them when the crate
+    /// is compiled with FMA (`isa::Native`).
     ///
     /// ```no_run
     /// kanegen::Builder::new("krang.toml").isa_dispatch(false).run();

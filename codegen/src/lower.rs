@@ -83,12 +83,22 @@ pub struct OpCount {
     pub divs: usize,
     /// `sin_cos` evaluations (one per joint used).
     pub sincos: usize,
+    /// Multiply-adds the x86-64-v3 copy fuses (`A::mul_add` in the generated source, see
+    /// [`fusable`]): each is one of the multiplications and one of the additions above,
+    /// executed as one FMA instruction there (the baseline copy still runs both).
+    pub fmas: usize,
 }
 
 impl OpCount {
     /// Total floating-point operations (adds + muls + divs).
     pub fn flops(&self) -> usize {
         self.adds + self.muls + self.divs
+    }
+
+    /// Floating-point instructions of the x86-64-v3 copy: [`OpCount::flops`] less one per
+    /// fused multiply-add.
+    pub fn fused_instructions(&self) -> usize {
+        self.flops() - self.fmas
     }
 }
 
@@ -98,7 +108,11 @@ impl fmt::Display for OpCount {
             f,
             "{} adds, {} muls, {} divs, {} sin/cos",
             self.adds, self.muls, self.divs, self.sincos
-        )
+        )?;
+        if self.fmas > 0 {
+            write!(f, " ({} multiply-adds fused with FMA)", self.fmas)?;
+        }
+        Ok(())
     }
 }
 
@@ -682,7 +696,50 @@ fn lower_precompute(ar: &Arena, pre: &PreSet) -> (Program, Vec<usize>) {
         d_vars: 0,
     };
     finish(&mut p);
+    // Runs once per parameter set, printed without multiply-add chains.
+    p.ops.fmas = 0;
     (p, slots)
+}
+
+/// The order in which a sum's terms are printed and added: the first positive term first (`b -
+/// a`, not `-a + b`: saves a negation), then the others in order.
+pub fn sum_order(terms: &[(f64, LExpr)]) -> impl Iterator<Item = usize> {
+    let first = terms.iter().position(|(k, _)| *k > 0.0).unwrap_or(0);
+    std::iter::once(first)
+        .chain((0..terms.len()).filter(move |&i| i != first))
+        .take(terms.len())
+}
+
+/// Whether the term `k * t` of a sum is a product `x * y` that a multiply-add can take: a
+/// coefficient other than ±1, or a product of at least two factors without a divisor.
+pub fn fusable(k: f64, t: &LExpr) -> bool {
+    k.abs() != 1.0
+        || matches!(t, LExpr::Prod(f)
+            if f.iter().all(|(_, p)| *p > 0) && f.iter().map(|(_, p)| *p).sum::<i32>() >= 2)
+}
+
+/// Which terms of a sum (in [`sum_order`]) the x86-64-v3 copy fuses into a multiply-add with
+/// what is summed before them, the same bits in the baseline copy (`x * y + acc` in the printed
+/// order: see `kanegen_runtime::isa::Arith`):
+/// - the second and later terms that are [`fusable`] (`acc + x * y`);
+/// - the first term, when it is fusable and the second is not (`x * y + t`) or when it is the
+///   only term and a constant follows (`x * y + c`).
+///
+/// The constant is added last, as in the printed sum.
+pub fn fused_terms(constant: f64, terms: &[(f64, LExpr)]) -> Vec<bool> {
+    let order: Vec<usize> = sum_order(terms).collect();
+    let fuse: Vec<bool> = order
+        .iter()
+        .map(|&i| fusable(terms[i].0, &terms[i].1))
+        .collect();
+    let mut out = vec![false; terms.len()];
+    for (j, &i) in order.iter().enumerate().skip(1) {
+        out[i] = fuse[j];
+    }
+    if let Some(&first) = order.first() {
+        out[first] = fuse[0] && order.get(1).map_or(constant != 0.0, |_| !fuse[1]);
+    }
+    out
 }
 
 fn count(e: &LExpr, ops: &mut OpCount, trig: &mut BTreeSet<usize>) {
@@ -693,6 +750,7 @@ fn count(e: &LExpr, ops: &mut OpCount, trig: &mut BTreeSet<usize>) {
         LExpr::Leaf(_) => {}
         LExpr::Sum { constant, terms } => {
             ops.adds += terms.len() - 1 + usize::from(*constant != 0.0);
+            ops.fmas += fused_terms(*constant, terms).iter().filter(|&&f| f).count();
             for (k, t) in terms {
                 if k.abs() != 1.0 {
                     ops.muls += 1;

@@ -110,6 +110,8 @@ columns (per call of each generated function; `precompute` runs once per paramet
   adds, muls, divs   floating-point additions (and subtractions), multiplications, divisions
   sin/cos  joint angles whose sine and cosine are needed (computed together in one batched call)
   flops    adds + muls + divs
+  fma      multiply-adds fused in the x86-64-v3 copy (each one of the muls and one of the
+           adds above, executed as one instruction there: flops - fma instructions)
   live     the most intermediate values alive at once (register pressure: x86-64 has 16
            vector registers, more live values spill to the stack)
 next:

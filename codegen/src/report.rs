@@ -38,14 +38,14 @@ pub fn stats(g: &Generated) -> String {
     );
     let _ = writeln!(
         s,
-        "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>6}",
-        "function", "K", "D", "temps", "adds", "muls", "divs", "sin/cos", "flops", "live"
+        "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>6} {:>6}",
+        "function", "K", "D", "temps", "adds", "muls", "divs", "sin/cos", "flops", "fma", "live"
     );
     let mut row = |name: &str, p: &Program| {
         let temps = p.stmts.len() - p.k_vars - p.d_vars;
         let _ = writeln!(
             s,
-            "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>6}",
+            "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>6} {:>6}",
             name,
             p.k_vars,
             p.d_vars,
@@ -55,6 +55,7 @@ pub fn stats(g: &Generated) -> String {
             p.ops.divs,
             p.ops.sincos,
             p.ops.flops(),
+            p.ops.fmas,
             p.max_live()
         );
     };

@@ -43,6 +43,7 @@ fn stats_explains_its_columns_and_what_to_run_next() {
         "  adds, muls, divs",
         "  sin/cos",
         "  flops",
+        "  fma",
         "  live",
     ] {
         assert!(

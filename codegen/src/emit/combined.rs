@@ -7,7 +7,7 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::Context;
-use super::function::{Reads, prologue, result_type, state_args, store_after};
+use super::function::{Reads, generic_body, prologue, result_type, state_args, store_after};
 use super::items::arg_names;
 use super::print::{Printer, ident, idx};
 use super::scalar_type;
@@ -79,7 +79,7 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
             .collect();
         stored |= !entries.is_empty();
         for &(r, col, ref e) in entries {
-            let v = printer.expr(e, false);
+            let v = printer.expr_fused(&cx.leaf_names, e);
             let translation = col == 3;
             let (r, col) = (idx(r), idx(col));
             let store = match shape {
@@ -129,7 +129,7 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
             }
         }
     }
-    let body = printer.statements(&stores);
+    let body = printer.statements_fused(&cx.leaf_names, &stores);
     let prologue = prologue(cx, p, &reads);
     let mut unused = TokenStream::new();
     if p.sincos.is_empty() && !reads.coord.contains(&true) {
@@ -149,11 +149,6 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
         #body
         #ty { #(#finals,)* }
     };
-    let body = if cx.isa_dispatch {
-        quote!(kanegen_runtime::isa::dispatch(#[inline(always)] || { #body }))
-    } else {
-        body
-    };
     let param_args = if cx.low.params.is_runtime() {
         let pname = if reads.param { quote!(p) } else { quote!(_p) };
         let pcname = if reads.pre { quote!(pc) } else { quote!(_pc) };
@@ -161,9 +156,11 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
     } else {
         quote!()
     };
+    // Generic over the multiply-add, as the separate functions (whose bits it gives).
+    let (param_args, body) = generic_body(cx, c.spec.inputs, param_args, &quote!(#ty), body);
     let (args, arg_doc) = state_args(cx, c.spec.inputs);
     let doc = format!(
-        " Combined function: {} in one straight-line program (every sine, cosine and shared intermediate value computed once); each field equals the separate function's value.",
+        " Combined function: {} in one straight-line program (every sine, cosine and shared intermediate value computed once); each field equals the separate function's value (bit for bit in the baseline copy; in the x86-64-v3 copy, which fuses multiply-adds, to rounding where a product is shared here and inline there).",
         c.spec
             .parts
             .iter()

@@ -185,10 +185,10 @@ struct Result {
 /// statement `i` (see [`Printer::statement_block`]).
 type Stores = Vec<Vec<String>>;
 
-/// `e` as text ([`Printer::expr_text`]).
+/// `e` as text, with multiply-add chains ([`Printer::expr_text_with`]).
 fn text(cx: &Context<'_>, printer: &Printer<'_>, e: &LExpr) -> String {
     let mut s = String::new();
-    printer.expr_text(&cx.leaf_names, e, false, &mut s);
+    printer.expr_text_with(&cx.leaf_names, e, false, true, &mut s);
     s
 }
 
@@ -306,9 +306,15 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
         }
         Shape::Scalar => {
             // The one entry is the function's value, after every statement.
+            // With multiply-add chains, as the statements (the text parses: it is what the
+            // statements print, which the formatted module parses).
             let value = p.outputs.first().map_or_else(
                 || printer.expr(&LExpr::Leaf(Leaf::Const(0.0)), false),
-                |(_, _, e)| printer.expr(e, false),
+                |(_, _, e)| {
+                    text(cx, printer, e)
+                        .parse()
+                        .unwrap_or_else(|_| printer.expr(e, false))
+                },
             );
             Result {
                 ty: result_type(cx, shape),
@@ -406,6 +412,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         stores,
         (&stored, &read_at_end),
         cx.split_above,
+        true,
     );
     let body = cx.blocks.placeholder(block);
     let unused = unused_inputs(spec, p, &reads);
@@ -416,24 +423,59 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         #body
         #value
     };
-    // With dispatch the body is compiled twice, for the baseline and for x86-64-v3, and
-    // `kanegen_runtime::isa::dispatch` runs the copy for the CPU (the closure and everything
-    // in it inline into each copy).
-    let body = if cx.isa_dispatch {
-        quote!(kanegen_runtime::isa::dispatch(#[inline(always)] || { #body }))
-    } else {
-        body
-    };
+    let (outer_params, generic) = generic_body(cx, spec.inputs, param_args, &ty, body);
     quote! {
         #[doc = #doc]
         #[doc = ""]
         #[doc = #arg_doc]
         #[doc = #ops]
         #[inline(never)]
-        pub fn #fname(#param_args #args) -> #ty {
-            #body
+        pub fn #fname(#outer_params #args) -> #ty {
+            #generic
         }
     }
+}
+
+/// A function's parameters (`p: &Params, pc: &Precomputed,` with parameters at run time) and
+/// its body as a generic inner function `body::<A: Arith>` (`A::mul_add` in the statements)
+/// followed by its call. With dispatch it is compiled twice, with `Plain` for the baseline and
+/// with `Fused` for x86-64-v3, and `kanegen_runtime::isa::dispatch_fused` runs the copy for the
+/// CPU (the closures and the body inline into each copy); without, once with `Native` (fused
+/// when the crate is compiled with FMA). `param_args` are the inner function's parameters (`_p`
+/// when it does not read them).
+pub(super) fn generic_body(
+    cx: &Context<'_>,
+    inputs: Inputs,
+    param_args: TokenStream,
+    ty: &TokenStream,
+    body: TokenStream,
+) -> (TokenStream, TokenStream) {
+    let t = scalar_type(cx.precision);
+    let (args, _) = state_args(cx, inputs);
+    let names = super::items::arg_names(inputs);
+    let (outer_params, pass_params) = if cx.low.params.is_runtime() {
+        (quote!(p: &Params, pc: &Precomputed,), quote!(p, pc,))
+    } else {
+        (quote!(), quote!())
+    };
+    let call = if cx.isa_dispatch {
+        quote!(kanegen_runtime::isa::dispatch_fused(
+            #[inline(always)]
+            || body::<kanegen_runtime::isa::Plain>(#pass_params #names),
+            #[inline(always)]
+            || body::<kanegen_runtime::isa::Fused>(#pass_params #names),
+        ))
+    } else {
+        quote!(body::<kanegen_runtime::isa::Native>(#pass_params #names))
+    };
+    let generic = quote! {
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<#t>>(#param_args #args) -> #ty {
+            #body
+        }
+        #call
+    };
+    (outer_params, generic)
 }
 
 /// `let _ = q;` (and `u`, `ud`) for the inputs a function's program never reads, so that the

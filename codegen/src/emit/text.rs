@@ -20,7 +20,7 @@ use quote::quote;
 
 use super::comment_text;
 use super::print::{Printer, lit};
-use crate::lower::{LExpr, Leaf};
+use crate::lower::{LExpr, Leaf, fused_terms, sum_order};
 use crate::model::Model;
 use crate::naming;
 
@@ -162,13 +162,15 @@ impl Printer<'_> {
     /// it reads), `read_at_end` what the function reads after the block (a scalar result):
     /// a function of more than `split_above` statements is split into blocks (see
     /// [`SPLIT_ABOVE`]), and a block passes on the values that later statements, stores or the
-    /// end read.
+    /// end read. With `fma` the statements are printed with multiply-add chains
+    /// ([`Printer::expr_text_with`]).
     pub(super) fn statement_block(
         &self,
         names: &LeafNames,
         after: Vec<Vec<String>>,
         (stored, read_at_end): (&[&LExpr], &[&LExpr]),
         split_above: usize,
+        fma: bool,
     ) -> Block {
         let n = self.stmts.len();
         let split = n > split_above;
@@ -210,7 +212,7 @@ impl Printer<'_> {
                 code.push_str("let ");
                 code.push_str(&s.name);
                 code.push_str(" = ");
-                self.expr_text(names, &s.expr, false, &mut code);
+                self.expr_text_with(names, &s.expr, false, fma, &mut code);
                 code.push(';');
                 block.push(code.clone(), &s.comment);
                 block.lines.last_mut().expect("pushed").depth = depth;
@@ -234,6 +236,29 @@ impl Printer<'_> {
             }
         }
         block
+    }
+
+    /// `e` with multiply-add chains ([`Printer::expr_text_with`]) as tokens, for the token
+    /// printers (combined functions). The text is what the statements print, which the
+    /// formatted module parses; should it not parse, the plain tokens.
+    pub(super) fn expr_fused(&self, names: &LeafNames, e: &LExpr) -> TokenStream {
+        let mut s = String::new();
+        self.expr_text_with(names, e, false, true, &mut s);
+        s.parse().unwrap_or_else(|_| self.expr(e, false))
+    }
+
+    /// [`Printer::statements`] with multiply-add chains ([`Printer::expr_fused`]).
+    pub(super) fn statements_fused(&self, names: &LeafNames, after: &[TokenStream]) -> TokenStream {
+        let mut ts = after.first().cloned().unwrap_or_default();
+        for (i, s) in self.stmts.iter().enumerate() {
+            let id = super::print::ident(&s.name);
+            let e = self.expr_fused(names, &s.expr);
+            ts.extend(quote!(let #id = #e;));
+            if let Some(a) = after.get(i + 1) {
+                ts.extend(a.clone());
+            }
+        }
+        ts
     }
 
     /// Per statement, the position of its last reader: a statement's index, the statement a
@@ -265,8 +290,38 @@ impl Printer<'_> {
     }
 
     /// Appends the text prettyplease prints for [`Printer::expr`]`(e, atomic)` on one line.
+    #[cfg(test)]
     pub(super) fn expr_text(&self, names: &LeafNames, e: &LExpr, atomic: bool, out: &mut String) {
+        self.expr_text_with(names, e, atomic, false, out);
+    }
+
+    /// [`Printer::expr_text`], or with `fma` the sums of products as multiply-add chains for a
+    /// body generic over `A: kanegen_runtime::isa::Arith` (`A::mul_add(x, y, acc)`, the terms
+    /// [`fused_terms`] picks): the same IEEE operations in the same order in the baseline copy.
+    pub(super) fn expr_text_with(
+        &self,
+        names: &LeafNames,
+        e: &LExpr,
+        atomic: bool,
+        fma: bool,
+        out: &mut String,
+    ) {
         match e {
+            LExpr::Sum { constant, terms }
+                if fma && fused_terms(*constant, terms).contains(&true) =>
+            {
+                // A multiply-add chain is a call (a primary expression), unless plain terms
+                // follow it.
+                let mut chain = String::new();
+                let plain_after = self.fused_sum_text(names, *constant, terms, &mut chain);
+                if atomic && plain_after {
+                    out.push('(');
+                    out.push_str(&chain);
+                    out.push(')');
+                } else {
+                    out.push_str(&chain);
+                }
+            }
             LExpr::Leaf(Leaf::Const(c)) if *c < 0.0 && atomic => {
                 out.push_str("(-");
                 push_lit(out, *c, self);
@@ -277,7 +332,7 @@ impl Printer<'_> {
                 if atomic {
                     out.push('(');
                 }
-                self.sum_text(names, *constant, terms, out);
+                self.sum_text(names, *constant, terms, fma, out);
                 if atomic {
                     out.push(')');
                 }
@@ -286,12 +341,107 @@ impl Printer<'_> {
                 if atomic {
                     out.push('(');
                 }
-                self.product_text(names, f, out);
+                self.product_text(names, f, fma, out);
                 if atomic {
                     out.push(')');
                 }
             }
         }
+    }
+
+    /// A sum with [`fused_terms`] as a multiply-add chain (`fma` mode of
+    /// [`Printer::expr_text_with`]); whether plain terms (`+ t`, `+ c`) follow the last call.
+    fn fused_sum_text(
+        &self,
+        names: &LeafNames,
+        constant: f64,
+        terms: &[(f64, LExpr)],
+        out: &mut String,
+    ) -> bool {
+        let fused = fused_terms(constant, terms);
+        // A term with its sign, as the sum prints it first (`-2.0 * t`, `-t`, `t`).
+        let signed = |k: f64, t: &LExpr| {
+            let mut s = String::new();
+            if k < 0.0 {
+                s.push('-');
+            }
+            if k.abs() == 1.0 {
+                self.expr_text_with(names, t, false, true, &mut s);
+            } else {
+                push_lit(&mut s, k, self);
+                s.push_str(" * ");
+                self.expr_text_with(names, t, true, true, &mut s);
+            }
+            s
+        };
+        // A fusable term as the factors `(x, y)` of `x * y` (the sign on `x`).
+        let factors = |k: f64, t: &LExpr| {
+            let (mut x, mut y) = (String::new(), String::new());
+            if k < 0.0 {
+                x.push('-');
+            }
+            if k.abs() != 1.0 {
+                push_lit(&mut x, k, self);
+                // An argument: no parentheses needed.
+                self.expr_text_with(names, t, false, true, &mut y);
+            } else if let LExpr::Prod(f) = t {
+                let all: Vec<&LExpr> = f
+                    .iter()
+                    .flat_map(|(b, p)| std::iter::repeat_n(b, p.unsigned_abs() as usize))
+                    .collect();
+                let (last, rest) = all.split_last().expect("a fusable product");
+                for (i, b) in rest.iter().enumerate() {
+                    if i > 0 {
+                        x.push_str(" * ");
+                    }
+                    self.expr_text_with(names, b, true, true, &mut x);
+                }
+                self.expr_text_with(names, last, false, true, &mut y);
+            }
+            (x, y)
+        };
+        let call = |x: &str, y: &str, acc: &str| format!("A::mul_add({x}, {y}, {acc})");
+        let order: Vec<usize> = sum_order(terms).collect();
+        let (k0, t0) = (terms[order[0]].0, &terms[order[0]].1);
+        let mut plain_after = false;
+        let mut acc = if order.len() == 1 {
+            // `x * y + c`: the constant is the addend.
+            let (x, y) = factors(k0, t0);
+            let mut c = String::new();
+            if constant < 0.0 {
+                c.push('-');
+            }
+            push_lit(&mut c, constant, self);
+            out.push_str(&call(&x, &y, &c));
+            return false;
+        } else if fused[order[0]] {
+            // `x * y + t` with the second term as the addend.
+            let (k1, t1) = (terms[order[1]].0, &terms[order[1]].1);
+            let (x, y) = factors(k0, t0);
+            call(&x, &y, &signed(k1, t1))
+        } else {
+            signed(k0, t0)
+        };
+        let skip = if fused[order[0]] { 2 } else { 1 };
+        for &i in &order[skip..] {
+            let (k, t) = (terms[i].0, &terms[i].1);
+            if fused[i] {
+                let (x, y) = factors(k, t);
+                acc = call(&x, &y, &acc);
+                plain_after = false;
+            } else {
+                acc.push_str(if k < 0.0 { " - " } else { " + " });
+                self.expr_text_with(names, t, false, true, &mut acc);
+                plain_after = true;
+            }
+        }
+        if constant != 0.0 {
+            acc.push_str(if constant < 0.0 { " - " } else { " + " });
+            push_lit(&mut acc, constant, self);
+            plain_after = true;
+        }
+        out.push_str(&acc);
+        plain_after || !acc.starts_with("A::mul_add(")
     }
 
     fn leaf_text(&self, names: &LeafNames, l: &Leaf, out: &mut String) {
@@ -322,7 +472,14 @@ impl Printer<'_> {
         out.push_str(name);
     }
 
-    fn sum_text(&self, names: &LeafNames, constant: f64, terms: &[(f64, LExpr)], out: &mut String) {
+    fn sum_text(
+        &self,
+        names: &LeafNames,
+        constant: f64,
+        terms: &[(f64, LExpr)],
+        fma: bool,
+        out: &mut String,
+    ) {
         // The order of `Printer::sum`: the first positive term first.
         let first = terms.iter().position(|(k, _)| *k > 0.0).unwrap_or(0);
         let order = std::iter::once(first).chain((0..terms.len()).filter(|&i| i != first));
@@ -335,11 +492,11 @@ impl Printer<'_> {
                 (_, true) => out.push_str(" - "),
             }
             if k.abs() == 1.0 {
-                self.expr_text(names, t, false, out);
+                self.expr_text_with(names, t, false, fma, out);
             } else {
                 push_lit(out, *k, self);
                 out.push_str(" * ");
-                self.expr_text(names, t, true, out);
+                self.expr_text_with(names, t, true, fma, out);
             }
         }
         if constant != 0.0 {
@@ -348,7 +505,7 @@ impl Printer<'_> {
         }
     }
 
-    fn product_text(&self, names: &LeafNames, f: &[(LExpr, i32)], out: &mut String) {
+    fn product_text(&self, names: &LeafNames, f: &[(LExpr, i32)], fma: bool, out: &mut String) {
         let mut first = true;
         for (b, p) in f.iter().filter(|(_, p)| *p > 0) {
             for _ in 0..*p {
@@ -356,7 +513,7 @@ impl Printer<'_> {
                     out.push_str(" * ");
                 }
                 first = false;
-                self.expr_text(names, b, true, out);
+                self.expr_text_with(names, b, true, fma, out);
             }
         }
         if first {
@@ -381,7 +538,7 @@ impl Printer<'_> {
                     out.push_str(" * ");
                 }
                 first = false;
-                self.expr_text(names, b, true, out);
+                self.expr_text_with(names, b, true, fma, out);
             }
         }
         if den > 1 {
@@ -672,6 +829,8 @@ mod tests {
         let statements = |src: &str| -> Vec<String> {
             src.split_whitespace()
                 .collect::<String>()
+                // A call broken over lines has a trailing comma.
+                .replace(",)", ")")
                 .split(';')
                 .filter_map(|s| {
                     let s = s.rsplit("//").next().unwrap_or(s);
@@ -685,6 +844,127 @@ mod tests {
                 .collect()
         };
         assert_eq!(statements(&split), statements(&whole));
+    }
+
+    /// The value of a printed expression (`+ - * /`, unary `-`, parentheses, literals,
+    /// `A::mul_add(x, y, acc)` fused or as `x * y + acc`), with the value of each name (`k12`,
+    /// `p.m4`, `s_q1`) from `values` or, the first time it is seen, a random one in [-2, 2].
+    fn value(
+        e: &syn::Expr,
+        values: &mut std::collections::HashMap<String, f64>,
+        rng: &mut impl rand::RngExt,
+        fused: bool,
+    ) -> f64 {
+        use syn::{BinOp, Expr, UnOp};
+        let mut name = |n: String, values: &mut std::collections::HashMap<String, f64>| {
+            *values
+                .entry(n)
+                .or_insert_with(|| rng.random_range(-2.0..2.0))
+        };
+        match e {
+            Expr::Lit(l) => match &l.lit {
+                syn::Lit::Float(f) => f.base10_parse().unwrap(),
+                syn::Lit::Int(i) => i.base10_parse::<i64>().unwrap() as f64,
+                other => panic!("literal {}", quote!(#other)),
+            },
+            Expr::Path(p) => name(quote!(#p).to_string(), values),
+            Expr::Field(f) => name(quote!(#f).to_string(), values),
+            Expr::Paren(p) => value(&p.expr, values, rng, fused),
+            Expr::Unary(u) if matches!(u.op, UnOp::Neg(_)) => -value(&u.expr, values, rng, fused),
+            Expr::Binary(b) => {
+                let (l, r) = (
+                    value(&b.left, values, rng, fused),
+                    value(&b.right, values, rng, fused),
+                );
+                match b.op {
+                    BinOp::Add(_) => l + r,
+                    BinOp::Sub(_) => l - r,
+                    BinOp::Mul(_) => l * r,
+                    BinOp::Div(_) => l / r,
+                    _ => panic!("operator in {}", quote!(#b)),
+                }
+            }
+            Expr::Call(c) => {
+                let f = &c.func;
+                assert_eq!(quote!(#f).to_string(), "A :: mul_add");
+                let a: Vec<f64> = c
+                    .args
+                    .iter()
+                    .map(|a| value(a, values, rng, fused))
+                    .collect();
+                if fused {
+                    a[0].mul_add(a[1], a[2])
+                } else {
+                    a[0] * a[1] + a[2]
+                }
+            }
+            other => panic!("expression {}", quote!(#other)),
+        }
+    }
+
+    #[test]
+    fn multiply_add_chains_give_the_printed_sums_bits_unfused_and_fuse_where_counted() {
+        // Every statement and result entry of Krang's and the two-link model's functions,
+        // printed plain and with multiply-add chains, evaluated on random values: `Plain`
+        // (the baseline copy) gives the plain sum's bits, `Fused` agrees to rounding, and the
+        // chains hold as many `A::mul_add` as `OpCount::fmas` counts.
+        use rand::SeedableRng;
+        let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+        let mut rng = rand::rngs::StdRng::seed_from_u64(14);
+        let (mut fused_total, mut differing) = (0usize, 0usize);
+        for path in ["models/krang.toml", "models/two-link.toml"] {
+            let model = crate::model::Model::from_toml_file(format!("{root}/{path}")).unwrap();
+            let names = LeafNames::new(&model);
+            let options = Options {
+                params: ParamMode::Runtime,
+                functions: FunctionSet::default(),
+            };
+            let low = crate::lower::lower(&crate::kane::derive(&model, options));
+            let pre: Vec<String> = low
+                .pre_slots
+                .iter()
+                .map(|&i| low.precompute.stmts[i].name.clone())
+                .collect();
+            for p in low.functions.iter().map(|f| &f.program) {
+                let printer = Printer {
+                    model: &model,
+                    stmts: &p.stmts,
+                    pre: &pre,
+                    precision: Precision::F64,
+                };
+                // Leaves and statement values (each statement's plain value: every expression
+                // is evaluated three ways on the same inputs).
+                let mut env = std::collections::HashMap::new();
+                let mut calls = 0;
+                let exprs = p
+                    .stmts
+                    .iter()
+                    .map(|s| (Some(&s.name), &s.expr))
+                    .chain(p.outputs.iter().map(|(_, _, e)| (None, e)));
+                for (name, e) in exprs {
+                    let (mut plain, mut fused) = (String::new(), String::new());
+                    printer.expr_text(&names, e, false, &mut plain);
+                    printer.expr_text_with(&names, e, false, true, &mut fused);
+                    calls += fused.matches("A::mul_add(").count();
+                    let plain: syn::Expr = syn::parse_str(&plain).unwrap();
+                    let fused: syn::Expr = syn::parse_str(&fused).unwrap();
+                    let a = value(&plain, &mut env, &mut rng, false);
+                    let b = value(&fused, &mut env, &mut rng, false);
+                    let c = value(&fused, &mut env, &mut rng, true);
+                    assert_eq!(a.to_bits(), b.to_bits(), "{}: {}", p.name, quote!(#fused));
+                    let scale = 1.0 + a.abs().max(c.abs());
+                    assert!((a - c).abs() <= 1e-9 * scale, "{}: {a} vs {c}", p.name);
+                    differing += usize::from(a.to_bits() != c.to_bits());
+                    if let Some(n) = name {
+                        env.insert(n.clone(), a);
+                    }
+                }
+                assert_eq!(calls, p.ops.fmas, "{}: FMAs printed and counted", p.name);
+                fused_total += calls;
+            }
+        }
+        assert!(fused_total > 1000, "{fused_total} multiply-adds fused");
+        assert!(differing > 0, "fusing changed no value");
     }
 
     #[test]

@@ -2,11 +2,11 @@
 // Parameters: runtime inputs (Params). Speeds (2): qd_imu, qd_w.
 // Operation counts per call:
 //   Precomputed::new  5 adds, 5 muls, 0 divs, 0 sin/cos (once per parameter set)
-//   mass_matrix       6 adds, 8 muls, 0 divs, 1 sin/cos; 0 K and 4 D variables
-//   coriolis          10 adds, 22 muls, 0 divs, 1 sin/cos; 7 K and 8 D variables
-//   gravity           8 adds, 14 muls, 0 divs, 2 sin/cos; 0 K and 8 D variables
-//   inverse_dynamics  21 adds, 32 muls, 0 divs, 2 sin/cos; 4 K and 15 D variables
-//   coriolis_matrix   18 adds, 31 muls, 0 divs, 1 sin/cos; 5 K and 17 D variables
+//   mass_matrix       6 adds, 8 muls, 0 divs, 1 sin/cos (3 multiply-adds fused with FMA); 0 K and 4 D variables
+//   coriolis          10 adds, 22 muls, 0 divs, 1 sin/cos (9 multiply-adds fused with FMA); 7 K and 8 D variables
+//   gravity           8 adds, 14 muls, 0 divs, 2 sin/cos (6 multiply-adds fused with FMA); 0 K and 8 D variables
+//   inverse_dynamics  21 adds, 32 muls, 0 divs, 2 sin/cos (18 multiply-adds fused with FMA); 4 K and 15 D variables
+//   coriolis_matrix   18 adds, 31 muls, 0 divs, 1 sin/cos (12 multiply-adds fused with FMA); 5 K and 17 D variables
 
 pub use self::generated::*;
 #[allow(non_snake_case, clippy::all)]
@@ -341,215 +341,259 @@ mod generated {
     /// Mass matrix M(q) (symmetric positive definite).
     ///
     /// `q`: coordinates in the order of [`COORDINATE_NAMES`].
-    /// Generated straight-line code: 6 adds, 8 muls, 0 divs, 1 sin/cos.
+    /// Generated straight-line code: 6 adds, 8 muls, 0 divs, 1 sin/cos (3 multiply-adds fused with FMA).
     #[inline(never)]
     pub fn mass_matrix(
         p: &Params,
         pc: &Precomputed,
         q: &SVector<f64, 2>,
     ) -> SMatrix<f64, 2, 2> {
-        kanegen_runtime::isa::dispatch(
-            #[inline(always)]
-            || {
-                let (sin_q, cos_q) = sin_cos_n([q[1]]);
-                let s_q_w = sin_q[0];
-                let c_q_w = cos_q[0];
-                let mut m = SMatrix::<f64, 2, 2>::zeros();
-                m[(1, 1)] = p.XX2;
-                let d1 = p.MY2 * c_q_w + p.MZ2 * s_q_w; // MSC2 in 1.y
-                let d2 = p.MY2 * s_q_w - p.MZ2 * c_q_w; // MSC2 in 1.z
-                let t1 = p.L1 * d1; // common subexpression
-                let t2 = p.L2 * d2; // common subexpression
-                let d3 = p.XX2 + t1 + t2; // N(M col 2) at 1.x
-                m[(0, 1)] = d3;
-                let d4 = 2.0 * t1 + 2.0 * t2 + pc.pc3; // JC1.xx
-                m[(0, 0)] = d4;
-                {
-                    let s = m.as_mut_slice();
-                    for c in 1..2 {
-                        for r in 0..c {
-                            s[r * 2 + c] = s[c * 2 + r];
-                        }
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+            p: &Params,
+            pc: &Precomputed,
+            q: &SVector<f64, 2>,
+        ) -> SMatrix<f64, 2, 2> {
+            let (sin_q, cos_q) = sin_cos_n([q[1]]);
+            let s_q_w = sin_q[0];
+            let c_q_w = cos_q[0];
+            let mut m = SMatrix::<f64, 2, 2>::zeros();
+            m[(1, 1)] = p.XX2;
+            let d1 = A::mul_add(p.MZ2, s_q_w, p.MY2 * c_q_w); // MSC2 in 1.y
+            let d2 = A::mul_add(-p.MZ2, c_q_w, p.MY2 * s_q_w); // MSC2 in 1.z
+            let t1 = p.L1 * d1; // common subexpression
+            let t2 = p.L2 * d2; // common subexpression
+            let d3 = p.XX2 + t1 + t2; // N(M col 2) at 1.x
+            m[(0, 1)] = d3;
+            let d4 = A::mul_add(2.0, t2, 2.0 * t1) + pc.pc3; // JC1.xx
+            m[(0, 0)] = d4;
+            {
+                let s = m.as_mut_slice();
+                for c in 1..2 {
+                    for r in 0..c {
+                        s[r * 2 + c] = s[c * 2 + r];
                     }
-                    m
                 }
-            },
+                m
+            }
+        }
+        kanegen_runtime::isa::dispatch_fused(
+            #[inline(always)]
+            || body::<kanegen_runtime::isa::Plain>(p, pc, q),
+            #[inline(always)]
+            || body::<kanegen_runtime::isa::Fused>(p, pc, q),
         )
     }
     /// Coriolis and centrifugal vector c(q, u) (velocity-product terms).
     ///
     /// `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].
-    /// Generated straight-line code: 10 adds, 22 muls, 0 divs, 1 sin/cos.
+    /// Generated straight-line code: 10 adds, 22 muls, 0 divs, 1 sin/cos (9 multiply-adds fused with FMA).
     #[inline(never)]
     pub fn coriolis(
         p: &Params,
-        _pc: &Precomputed,
+        pc: &Precomputed,
         q: &SVector<f64, 2>,
         u: &SVector<f64, 2>,
     ) -> SVector<f64, 2> {
-        kanegen_runtime::isa::dispatch(
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+            p: &Params,
+            _pc: &Precomputed,
+            q: &SVector<f64, 2>,
+            u: &SVector<f64, 2>,
+        ) -> SVector<f64, 2> {
+            let (sin_q, cos_q) = sin_cos_n([q[1]]);
+            let s_q_w = sin_q[0];
+            let c_q_w = cos_q[0];
+            let qd_imu = u[0];
+            let qd_w = u[1];
+            let mut out = SVector::<f64, 2>::zeros();
+            let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
+            let k2 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+            let k3 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+            let k4 = qd_imu * k3; // a2 in 1|ud=0,g=0.y
+            let k5 = qd_imu * k2; // a2 in 1|ud=0,g=0.z
+            let k6 = A::mul_add(s_q_w, k5, c_q_w * k4); // a2|ud=0,g=0.y
+            let k7 = A::mul_add(-c_q_w, k5, s_q_w * k4); // a2|ud=0,g=0.z
+            let d1 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
+            let d2 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
+            let d3 = A::mul_add(k1, d2, p.m2 * k6); // F2|ud=0,g=0.y
+            let d4 = A::mul_add(k1, d1, p.m2 * k7); // F2|ud=0,g=0.z
+            let d5 = A::mul_add(-p.MZ2, k6, p.MY2 * k7); // N2|ud=0,g=0.x
+            out[1] = core::hint::black_box(d5);
+            let d6 = A::mul_add(-c_q_w, d4, s_q_w * d3); // f2 in 1|ud=0,g=0.z
+            let d7 = A::mul_add(s_q_w, d4, c_q_w * d3); // f2 in 1|ud=0,g=0.y
+            let d8 = A::mul_add(p.L2, d7, A::mul_add(-p.L1, d6, d5)); // n1|ud=0,g=0.x
+            out[0] = core::hint::black_box(d8);
+            out
+        }
+        kanegen_runtime::isa::dispatch_fused(
             #[inline(always)]
-            || {
-                let (sin_q, cos_q) = sin_cos_n([q[1]]);
-                let s_q_w = sin_q[0];
-                let c_q_w = cos_q[0];
-                let qd_imu = u[0];
-                let qd_w = u[1];
-                let mut out = SVector::<f64, 2>::zeros();
-                let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
-                let k2 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-                let k3 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-                let k4 = qd_imu * k3; // a2 in 1|ud=0,g=0.y
-                let k5 = qd_imu * k2; // a2 in 1|ud=0,g=0.z
-                let k6 = c_q_w * k4 + s_q_w * k5; // a2|ud=0,g=0.y
-                let k7 = s_q_w * k4 - c_q_w * k5; // a2|ud=0,g=0.z
-                let d1 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
-                let d2 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
-                let d3 = p.m2 * k6 + k1 * d2; // F2|ud=0,g=0.y
-                let d4 = p.m2 * k7 + k1 * d1; // F2|ud=0,g=0.z
-                let d5 = p.MY2 * k7 - p.MZ2 * k6; // N2|ud=0,g=0.x
-                out[1] = core::hint::black_box(d5);
-                let d6 = s_q_w * d3 - c_q_w * d4; // f2 in 1|ud=0,g=0.z
-                let d7 = c_q_w * d3 + s_q_w * d4; // f2 in 1|ud=0,g=0.y
-                let d8 = d5 - p.L1 * d6 + p.L2 * d7; // n1|ud=0,g=0.x
-                out[0] = core::hint::black_box(d8);
-                out
-            },
+            || body::<kanegen_runtime::isa::Plain>(p, pc, q, u),
+            #[inline(always)]
+            || body::<kanegen_runtime::isa::Fused>(p, pc, q, u),
         )
     }
     /// Gravity vector g(q).
     ///
     /// `q`: coordinates in the order of [`COORDINATE_NAMES`].
-    /// Generated straight-line code: 8 adds, 14 muls, 0 divs, 2 sin/cos.
+    /// Generated straight-line code: 8 adds, 14 muls, 0 divs, 2 sin/cos (6 multiply-adds fused with FMA).
     #[inline(never)]
     pub fn gravity(
         p: &Params,
         pc: &Precomputed,
         q: &SVector<f64, 2>,
     ) -> SVector<f64, 2> {
-        kanegen_runtime::isa::dispatch(
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+            p: &Params,
+            pc: &Precomputed,
+            q: &SVector<f64, 2>,
+        ) -> SVector<f64, 2> {
+            let (sin_q, cos_q) = sin_cos_n([q[0], q[1]]);
+            let s_q_imu = sin_q[0];
+            let c_q_imu = cos_q[0];
+            let s_q_w = sin_q[1];
+            let c_q_w = cos_q[1];
+            let mut out = SVector::<f64, 2>::zeros();
+            let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
+            let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
+            let d3 = A::mul_add(-s_q_w, d2, c_q_w * d1); // gravity acceleration in 2.y
+            let d4 = A::mul_add(c_q_w, d2, s_q_w * d1); // gravity acceleration in 2.z
+            out[1] = core::hint::black_box(A::mul_add(-p.MY2, d4, p.MZ2 * d3));
+            let d5 = A::mul_add(p.MZ2, s_q_w, p.MY2 * c_q_w); // MSC2 in 1.y
+            let d6 = A::mul_add(-p.MZ2, c_q_w, p.MY2 * s_q_w); // MSC2 in 1.z
+            let d7 = d5 + pc.pc1; // MSC1.y
+            let d8 = pc.pc2 - d6; // MSC1.z
+            out[0] = core::hint::black_box(A::mul_add(-d7, d2, d8 * d1));
+            out
+        }
+        kanegen_runtime::isa::dispatch_fused(
             #[inline(always)]
-            || {
-                let (sin_q, cos_q) = sin_cos_n([q[0], q[1]]);
-                let s_q_imu = sin_q[0];
-                let c_q_imu = cos_q[0];
-                let s_q_w = sin_q[1];
-                let c_q_w = cos_q[1];
-                let mut out = SVector::<f64, 2>::zeros();
-                let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
-                let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
-                let d3 = c_q_w * d1 - s_q_w * d2; // gravity acceleration in 2.y
-                let d4 = s_q_w * d1 + c_q_w * d2; // gravity acceleration in 2.z
-                out[1] = core::hint::black_box(p.MZ2 * d3 - p.MY2 * d4);
-                let d5 = p.MY2 * c_q_w + p.MZ2 * s_q_w; // MSC2 in 1.y
-                let d6 = p.MY2 * s_q_w - p.MZ2 * c_q_w; // MSC2 in 1.z
-                let d7 = d5 + pc.pc1; // MSC1.y
-                let d8 = pc.pc2 - d6; // MSC1.z
-                out[0] = core::hint::black_box(d8 * d1 - d7 * d2);
-                out
-            },
+            || body::<kanegen_runtime::isa::Plain>(p, pc, q),
+            #[inline(always)]
+            || body::<kanegen_runtime::isa::Fused>(p, pc, q),
         )
     }
     /// Inverse dynamics τ = M(q) u̇ + c(q, u) + g(q), in one pass.
     ///
     /// `q`, `u`, `ud`: coordinates, speeds and accelerations in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].
-    /// Generated straight-line code: 21 adds, 32 muls, 0 divs, 2 sin/cos.
+    /// Generated straight-line code: 21 adds, 32 muls, 0 divs, 2 sin/cos (18 multiply-adds fused with FMA).
     #[inline(never)]
     pub fn inverse_dynamics(
         p: &Params,
-        _pc: &Precomputed,
+        pc: &Precomputed,
         q: &SVector<f64, 2>,
         u: &SVector<f64, 2>,
         ud: &SVector<f64, 2>,
     ) -> SVector<f64, 2> {
-        kanegen_runtime::isa::dispatch(
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+            p: &Params,
+            _pc: &Precomputed,
+            q: &SVector<f64, 2>,
+            u: &SVector<f64, 2>,
+            ud: &SVector<f64, 2>,
+        ) -> SVector<f64, 2> {
+            let (sin_q, cos_q) = sin_cos_n([q[0], q[1]]);
+            let s_q_imu = sin_q[0];
+            let c_q_imu = cos_q[0];
+            let s_q_w = sin_q[1];
+            let c_q_w = cos_q[1];
+            let qd_imu = u[0];
+            let qdd_imu = ud[0];
+            let qd_w = u[1];
+            let qdd_w = ud[1];
+            let mut out = SVector::<f64, 2>::zeros();
+            let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
+            let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
+            let d3 = A::mul_add(p.MZ1, d1, A::mul_add(-p.MY1, d2, p.XX1 * qdd_imu)); // N1.x
+            let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
+            let k2 = qdd_imu + qdd_w; // wd2.x
+            let k3 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+            let k4 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+            let d4 = A::mul_add(-p.L2, qdd_imu, A::mul_add(-qd_imu, k4, d1)); // a2 in 1.y
+            let d5 = A::mul_add(-p.L1, qdd_imu, A::mul_add(qd_imu, k3, d2)); // a2 in 1.z
+            let d6 = A::mul_add(-s_q_w, d5, c_q_w * d4); // a2.y
+            let d7 = A::mul_add(c_q_w, d5, s_q_w * d4); // a2.z
+            let d8 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
+            let d9 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
+            let d10 = A::mul_add(-p.MZ2, k2, A::mul_add(-p.m2, d6, k1 * d9)); // F2.y
+            let d11 = A::mul_add(p.MY2, k2, A::mul_add(-p.m2, d7, k1 * d8)); // F2.z
+            let d12 = A::mul_add(p.MZ2, d6, A::mul_add(-p.MY2, d7, p.XX2 * k2)); // N2.x
+            out[1] = core::hint::black_box(d12);
+            let d13 = A::mul_add(-c_q_w, d11, s_q_w * d10); // f2 in 1.z
+            let d14 = A::mul_add(s_q_w, d11, c_q_w * d10); // f2 in 1.y
+            let d15 = A::mul_add(p.L2, d14, A::mul_add(-p.L1, d13, d3 + d12)); // n1.x
+            out[0] = core::hint::black_box(d15);
+            out
+        }
+        kanegen_runtime::isa::dispatch_fused(
             #[inline(always)]
-            || {
-                let (sin_q, cos_q) = sin_cos_n([q[0], q[1]]);
-                let s_q_imu = sin_q[0];
-                let c_q_imu = cos_q[0];
-                let s_q_w = sin_q[1];
-                let c_q_w = cos_q[1];
-                let qd_imu = u[0];
-                let qdd_imu = ud[0];
-                let qd_w = u[1];
-                let qdd_w = ud[1];
-                let mut out = SVector::<f64, 2>::zeros();
-                let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
-                let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
-                let d3 = p.XX1 * qdd_imu - p.MY1 * d2 + p.MZ1 * d1; // N1.x
-                let k1 = qd_imu + qd_w; // w2|ud=0,g=0.x
-                let k2 = qdd_imu + qdd_w; // wd2.x
-                let k3 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-                let k4 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-                let d4 = d1 - qd_imu * k4 - p.L2 * qdd_imu; // a2 in 1.y
-                let d5 = d2 + qd_imu * k3 - p.L1 * qdd_imu; // a2 in 1.z
-                let d6 = c_q_w * d4 - s_q_w * d5; // a2.y
-                let d7 = s_q_w * d4 + c_q_w * d5; // a2.z
-                let d8 = p.MZ2 * k1; // w2xMS2|ud=0,g=0.y
-                let d9 = p.MY2 * k1; // w2xMS2|ud=0,g=0.z
-                let d10 = k1 * d9 - p.m2 * d6 - p.MZ2 * k2; // F2.y
-                let d11 = k1 * d8 - p.m2 * d7 + p.MY2 * k2; // F2.z
-                let d12 = p.XX2 * k2 - p.MY2 * d7 + p.MZ2 * d6; // N2.x
-                out[1] = core::hint::black_box(d12);
-                let d13 = s_q_w * d10 - c_q_w * d11; // f2 in 1.z
-                let d14 = c_q_w * d10 + s_q_w * d11; // f2 in 1.y
-                let d15 = d3 + d12 - p.L1 * d13 + p.L2 * d14; // n1.x
-                out[0] = core::hint::black_box(d15);
-                out
-            },
+            || body::<kanegen_runtime::isa::Plain>(p, pc, q, u, ud),
+            #[inline(always)]
+            || body::<kanegen_runtime::isa::Fused>(p, pc, q, u, ud),
         )
     }
     /// Coriolis matrix C(q, u): c(q, u) = C(q, u) u, and Ṁ − 2C is skew-symmetric.
     ///
     /// `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].
-    /// Generated straight-line code: 18 adds, 31 muls, 0 divs, 1 sin/cos.
+    /// Generated straight-line code: 18 adds, 31 muls, 0 divs, 1 sin/cos (12 multiply-adds fused with FMA).
     #[inline(never)]
     pub fn coriolis_matrix(
         p: &Params,
-        _pc: &Precomputed,
+        pc: &Precomputed,
         q: &SVector<f64, 2>,
         u: &SVector<f64, 2>,
     ) -> SMatrix<f64, 2, 2> {
-        kanegen_runtime::isa::dispatch(
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+            p: &Params,
+            _pc: &Precomputed,
+            q: &SVector<f64, 2>,
+            u: &SVector<f64, 2>,
+        ) -> SMatrix<f64, 2, 2> {
+            let (sin_q, cos_q) = sin_cos_n([q[1]]);
+            let s_q_w = sin_q[0];
+            let c_q_w = cos_q[0];
+            let qd_imu = u[0];
+            let qd_w = u[1];
+            let mut m = SMatrix::<f64, 2, 2>::zeros();
+            let k1 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+            let k2 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+            let k3 = qd_imu + qd_w; // w2|ud=0,g=0.x
+            let k4 = A::mul_add(-s_q_w, k2, c_q_w * k1); // v2.y
+            let k5 = A::mul_add(c_q_w, k2, s_q_w * k1); // v2.z
+            let d1 = p.MZ2 * k3; // w2xMS2|ud=0,g=0.y
+            let d2 = p.MY2 * k3; // w2xMS2|ud=0,g=0.z
+            let d3 = p.m2 * k4; // IC2(VxS(qd_w)).f.z
+            let d4 = p.m2 * k5; // IC2(VxS(qd_w)).f.y
+            let d5 = d1 - d3; // h2.f.y
+            let d6 = d2 + d4; // h2.f.z
+            let t1 = p.MY2 * k4; // common subexpression
+            let t2 = p.MZ2 * k5; // common subexpression
+            let d7 = A::mul_add(2.0, t2, 2.0 * t1); // Jd2.xx
+            m[(1, 0)] = -0.5 * d7;
+            let d8 = A::mul_add(-s_q_w, d6, c_q_w * d5); // hC2 in 1.f.y
+            let d9 = A::mul_add(c_q_w, d6, s_q_w * d5); // hC2 in 1.f.z
+            let d10 = A::mul_add(-2.0, p.L2 * d9, A::mul_add(-2.0, p.L1 * d8, d7)); // JdC1.xx
+            m[(0, 0)] = -0.5 * d10;
+            let d11 = t1 + t2; // IC2(VxS(qd_w)).n.x
+            let d12 = A::mul_add(0.5, d7, -d11); // h(C col qd_w) at 2.n.x
+            m[(1, 1)] = -d12;
+            let d13 = d6 - d4; // h(C col qd_w) at 2.f.y
+            let d14 = d5 + d3; // h(C col qd_w) at 2.f.z
+            let d15 = A::mul_add(-c_q_w, d14, s_q_w * d13); // h(C col qd_w) at 1.f.z
+            let d16 = A::mul_add(s_q_w, d14, c_q_w * d13); // h(C col qd_w) at 1.f.y
+            let d17 = A::mul_add(-p.L2, d16, A::mul_add(p.L1, d15, d12)); // h(C col qd_w) at 1.n.x
+            m[(0, 1)] = -d17;
+            m
+        }
+        kanegen_runtime::isa::dispatch_fused(
             #[inline(always)]
-            || {
-                let (sin_q, cos_q) = sin_cos_n([q[1]]);
-                let s_q_w = sin_q[0];
-                let c_q_w = cos_q[0];
-                let qd_imu = u[0];
-                let qd_w = u[1];
-                let mut m = SMatrix::<f64, 2, 2>::zeros();
-                let k1 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-                let k2 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-                let k3 = qd_imu + qd_w; // w2|ud=0,g=0.x
-                let k4 = c_q_w * k1 - s_q_w * k2; // v2.y
-                let k5 = s_q_w * k1 + c_q_w * k2; // v2.z
-                let d1 = p.MZ2 * k3; // w2xMS2|ud=0,g=0.y
-                let d2 = p.MY2 * k3; // w2xMS2|ud=0,g=0.z
-                let d3 = p.m2 * k4; // IC2(VxS(qd_w)).f.z
-                let d4 = p.m2 * k5; // IC2(VxS(qd_w)).f.y
-                let d5 = d1 - d3; // h2.f.y
-                let d6 = d2 + d4; // h2.f.z
-                let t1 = p.MY2 * k4; // common subexpression
-                let t2 = p.MZ2 * k5; // common subexpression
-                let d7 = 2.0 * t1 + 2.0 * t2; // Jd2.xx
-                m[(1, 0)] = -0.5 * d7;
-                let d8 = c_q_w * d5 - s_q_w * d6; // hC2 in 1.f.y
-                let d9 = s_q_w * d5 + c_q_w * d6; // hC2 in 1.f.z
-                let d10 = d7 - 2.0 * (p.L1 * d8) - 2.0 * (p.L2 * d9); // JdC1.xx
-                m[(0, 0)] = -0.5 * d10;
-                let d11 = t1 + t2; // IC2(VxS(qd_w)).n.x
-                let d12 = 0.5 * d7 - d11; // h(C col qd_w) at 2.n.x
-                m[(1, 1)] = -d12;
-                let d13 = d6 - d4; // h(C col qd_w) at 2.f.y
-                let d14 = d5 + d3; // h(C col qd_w) at 2.f.z
-                let d15 = s_q_w * d13 - c_q_w * d14; // h(C col qd_w) at 1.f.z
-                let d16 = c_q_w * d13 + s_q_w * d14; // h(C col qd_w) at 1.f.y
-                let d17 = d12 + p.L1 * d15 - p.L2 * d16; // h(C col qd_w) at 1.n.x
-                m[(0, 1)] = -d17;
-                m
-            },
+            || body::<kanegen_runtime::isa::Plain>(p, pc, q, u),
+            #[inline(always)]
+            || body::<kanegen_runtime::isa::Fused>(p, pc, q, u),
         )
     }
     /// The dynamics of `two-link` with one parameter set: `τ = M(q) u̇ + c(q, u) + g(q)`.

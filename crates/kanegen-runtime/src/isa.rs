@@ -14,13 +14,20 @@
 //! inlines the closure and the body: that copy of the body is compiled for AVX2 with the
 //! three-operand VEX encodings and 256-bit vectors where LLVM vectorizes. Calling a
 //! `#[target_feature]` function needs `unsafe` (the CPU must have the features); this module
-//! holds the crate's only `unsafe` block, right after the check that the features are present.
+//! holds the crate's only `unsafe` blocks (the same call in [`dispatch`] and [`dispatch_fused`]),
+//! right after the check that the features are present.
 //!
-//! Results: Rust never fuses `a * b + c` into a fused multiply-add on its own, so the x86-64-v3
-//! copy computes the same operations in the same order as the baseline one and gives **the same
-//! bits** (tested: `tests/isa.rs` in `kanegen-runtime`, and the generated functions in the
-//! workspace's `tests/isa_dispatch.rs`). Code that calls `mul_add` explicitly would differ in
-//! the last bits; generated code does not (yet).
+//! Results: Rust never fuses `a * b + c` into a fused multiply-add on its own. Generated
+//! functions therefore print their sums of products as [`Arith::mul_add`] chains in a body
+//! generic over [`Arith`], and [`dispatch_fused`] runs the baseline copy with [`Plain`]
+//! (`x * y + acc`, two roundings: **the same bits** as the sum written out, as before FMA was
+//! used) and the x86-64-v3 copy with [`Fused`] (one `vfmadd`, one rounding). The two copies'
+//! results therefore differ in the last bits: each fused multiply-add skips one rounding, so the
+//! v3 result is within a few units in the last place of the baseline's relative to the size of
+//! the terms summed (measured on Krang's M, c, g, τ and C over random parameters and states:
+//! `tests/isa_batch.rs`, `dispatched_copies_agree_with_the_baseline_to_rounding`, tolerance
+//! 1e-12 of the entry's scale). Bodies passed to [`dispatch`] (no `mul_add`) still give the
+//! baseline's bits in both copies.
 //!
 //! When there is nothing to choose, [`dispatch`] is a plain call and compiles to the body alone:
 //! - without the `dispatch` feature (on by default; turn it off with
@@ -54,6 +61,8 @@
 //! ```
 
 use core::sync::atomic::{AtomicU8, Ordering};
+
+pub use crate::arith::{Arith, Fused, Native, Plain};
 
 /// An instruction set a generated function can run with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -179,15 +188,31 @@ if_dispatching! {
     #[inline(always)]
     pub fn dispatch<R, F: FnOnce() -> R>(f: F) -> R {
         if active_code() == V3 {
-            // SAFETY: `ACTIVE` holds `V3` only after `v3_present()` found every feature
-            // `run_v3` is compiled with (`detect` and `select` check it before storing), so the
-            // CPU executes its instructions. The one `unsafe` block of the crate.
+            // SAFETY: as in `dispatch_fused` below (the same check before the same call).
             #[allow(unsafe_code)]
             unsafe {
                 return run_v3(f);
             }
         }
         f()
+    }
+
+    /// Calls `plain` (compiled for the baseline) or `fused` (compiled for x86-64-v3), by the
+    /// [`active`] instruction set: a generated function passes its body instantiated with
+    /// [`Plain`] and with [`Fused`], so that only the x86-64-v3 copy fuses multiply-adds. See
+    /// the module docs.
+    #[inline(always)]
+    pub fn dispatch_fused<R>(plain: impl FnOnce() -> R, fused: impl FnOnce() -> R) -> R {
+        if active_code() == V3 {
+            // SAFETY: `ACTIVE` holds `V3` only after `v3_present()` found every feature
+            // `run_v3` is compiled with (`detect` and `select` check it before storing), so the
+            // CPU executes its instructions. With `dispatch` above, the crate's only `unsafe`.
+            #[allow(unsafe_code)]
+            unsafe {
+                return run_v3(fused);
+            }
+        }
+        plain()
     }
 }
 
@@ -201,6 +226,28 @@ if_not_dispatching! {
     #[inline(always)]
     pub fn dispatch<R, F: FnOnce() -> R>(f: F) -> R {
         f()
+    }
+
+    /// Calls `fused` when the compilation target has FMA ([`Native`] is [`Fused`]), `plain`
+    /// otherwise: this build has one copy of every function (see the module docs).
+    #[inline(always)]
+    pub fn dispatch_fused<R>(plain: impl FnOnce() -> R, fused: impl FnOnce() -> R) -> R {
+        #[cfg(all(
+            feature = "std",
+            any(target_feature = "fma", target_arch = "aarch64")
+        ))]
+        {
+            let _ = plain;
+            fused()
+        }
+        #[cfg(not(all(
+            feature = "std",
+            any(target_feature = "fma", target_arch = "aarch64")
+        )))]
+        {
+            let _ = fused;
+            plain()
+        }
     }
 }
 
@@ -241,7 +288,8 @@ pub fn active() -> Isa {
 }
 
 /// Make [`dispatch`] use `isa` from now on, in every thread (for benchmarks and tests that
-/// compare the copies; results are the same bits either way). An error if this CPU or build
+/// compare the copies; generated functions' results differ in the last bits, as the
+/// x86-64-v3 copy fuses multiply-adds). An error if this CPU or build
 /// cannot run it; nothing changes then.
 pub fn select(isa: Isa) -> Result<(), IsaUnavailable> {
     if !available(isa) {

@@ -17,11 +17,12 @@
 //!   written once for any generated robot.
 //!
 //! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA), the
-//!   crate's one `unsafe` block; [`lanes`]: the lane type of the batched functions.
+//!   crate's one `unsafe` call (in two functions), and [`isa::Arith`], the multiply-add the
+//!   copies differ in; [`lanes`]: the lane type of the batched functions.
 //! - [`regressor`]: the loop of a loop-form inverse-dynamics regressor (per link and four rows
 //!   at a time, over two generated constant tables).
 //!
-//! `#![no_std]`, one `unsafe` block ([`isa::dispatch`]), no dependency but [`nalgebra`] (re-exported: its vector and
+//! `#![no_std]`, one `unsafe` call ([`isa::dispatch`], [`isa::dispatch_fused`]), no dependency but [`nalgebra`] (re-exported: its vector and
 //! matrix types are the trait's argument types) and, behind features, `serde` and `toml`.
 //!
 //! # How generated code uses it
@@ -134,12 +135,13 @@
 //!   of a model description file as a generated `Params`, at run time.
 
 #![no_std]
-// One `unsafe` block, in `isa::dispatch` (calling the x86-64-v3 copy after feature detection).
+// One `unsafe` call, in `isa::dispatch` and `isa::dispatch_fused` (calling the x86-64-v3 copy after feature detection).
 #![deny(unsafe_code)]
 
 #[cfg(feature = "std")]
 extern crate std;
 
+mod arith;
 mod dynamics;
 mod invalid_parameter;
 pub mod isa;

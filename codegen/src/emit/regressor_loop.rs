@@ -56,7 +56,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
     let mut stored: Vec<&LExpr> = Vec::new();
     let text = |e: &LExpr| {
         let mut s = String::new();
-        printer.expr_text(&cx.leaf_names, e, false, &mut s);
+        printer.expr_text_with(&cx.leaf_names, e, false, false, &mut s);
         s
     };
     for (k, (r, c, e)) in p.outputs.iter().enumerate() {
@@ -71,7 +71,15 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
         stores[last_local(e).map_or(0, |i| i + 1)].push(line);
         stored.push(e);
     }
-    let block = printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above);
+    // Plain arithmetic (no multiply-add chains): the straight-line part is small (Krang: 611
+    // flops) and the body is not generic over `Arith`.
+    let block = printer.statement_block(
+        &cx.leaf_names,
+        stores,
+        (&stored, &[]),
+        cx.split_above,
+        false,
+    );
     let body = cx.blocks.placeholder(block);
     let nl = idx(tables.links.len());
     let (chunks, slots) = tables.chunks();

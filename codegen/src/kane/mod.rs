@@ -62,6 +62,7 @@ mod mimic;
 mod regressor;
 mod rnea;
 mod rnea_derivatives;
+mod rnea_derivatives_loop;
 
 use kanegen_model::{Model, ParamKind};
 
@@ -74,6 +75,7 @@ use algebra::{M3, V3};
 use composite::Composite;
 pub use grouping::{Coefficient, Exactness, SymbolicGroup, symbolic_group_text};
 pub use regressor::{BaseParameters, Regressors, group_text};
+pub use rnea_derivatives_loop::{DerivativeLoop, LoopColumn, LoopLink, LoopSpeed};
 
 /// One derived registry function: its output entries as expressions in the arena (its name,
 /// inputs and result shape are in the registry).
@@ -115,6 +117,21 @@ pub struct Derivation {
     pub sizes: Sizes,
     /// The combined functions (one arena phase each; see [`crate::combined`]).
     pub combined: Vec<CombinedFunction>,
+    /// The looped form of `inverse_dynamics_derivatives` (its own arena phase, after every
+    /// other): derived when the module has the derivatives and the model has no mimic joints.
+    pub derivative_loop: Option<LoopedDerivatives>,
+}
+
+/// The looped form of `inverse_dynamics_derivatives` (`kane/rnea_derivatives_loop.rs`): the
+/// workspace the generated statements fill and the tables the runtime loop runs over.
+#[derive(Clone, Debug)]
+pub struct LoopedDerivatives {
+    /// `(offset, 0, expr)`: the workspace entries.
+    pub entries: Vec<(usize, usize, ExprId)>,
+    /// The statement order of its phase (see [`Function::order`]).
+    pub order: Vec<ExprId>,
+    /// The tables.
+    pub plan: DerivativeLoop,
 }
 
 /// One derived combined function: its parts' entries and the statement order of its phase.
@@ -270,6 +287,19 @@ pub fn derive_with(model: &Model, options: Options, combined: &[ResolvedCombined
             order: cx.ar.phase_order(),
         });
     }
+    // The looped derivatives: one more phase, after every other (the other functions' code is
+    // unchanged).
+    let derivative_loop = (options.has(FunctionId::InverseDynamicsDerivatives)
+        && model.mimics.is_empty())
+    .then(|| {
+        cx.ar.begin_phase();
+        let (entries, plan) = cx.inverse_dynamics_derivatives_looped();
+        LoopedDerivatives {
+            entries,
+            order: cx.ar.phase_order(),
+            plan,
+        }
+    });
     functions.sort_by_key(|f| (f.id, f.frame));
     let sizes = Sizes {
         dof: n,
@@ -291,6 +321,7 @@ pub fn derive_with(model: &Model, options: Options, combined: &[ResolvedCombined
         regressors,
         sizes,
         combined: combined_out,
+        derivative_loop,
     }
 }
 

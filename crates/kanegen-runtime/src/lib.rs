@@ -138,6 +138,7 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod derivative_steps;
 mod dynamics;
 mod invalid_parameter;
 pub mod isa;

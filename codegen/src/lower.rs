@@ -316,16 +316,16 @@ pub fn lower_with(d: &Derivation, form: DerivativesForm) -> Lowered {
         .as_ref()
         .filter(|l| looped && l.plan.fits_u16())
         .map(|l| LoopedProgram {
-        program: lower_entries(
-            &d.arena,
-            "inverse_dynamics_derivatives (looped)",
-            &l.entries,
-            &l.order,
-            hoist,
-            &mut pre,
-        ),
-        plan: l.plan.clone(),
-    });
+            program: lower_entries(
+                &d.arena,
+                "inverse_dynamics_derivatives (looped)",
+                &l.entries,
+                &l.order,
+                hoist,
+                &mut pre,
+            ),
+            plan: l.plan.clone(),
+        });
     let (precompute, pre_slots) = lower_precompute(&d.arena, &pre);
     Lowered {
         precompute,

@@ -57,6 +57,9 @@ pub struct LoopSpeed {
     pub motion: usize,
     /// A joint's speed (`true`) or one of the wheeled base's.
     pub joint: bool,
+    /// `Some(k)` when `S = ±(e_k; 0)` (a rotation about a coordinate axis of the link's frame,
+    /// `k < 3`): `Ψ̇` and `Ψ̈` vanish in components `k` and `3 + k`.
+    pub axis: Option<u8>,
 }
 
 /// One column of a [`DerivativeLoop`].
@@ -118,6 +121,20 @@ impl DerivativeLoop {
 }
 
 impl Ctx<'_> {
+    /// `Some(k)` when `s` is `±(e_k; 0)` exactly (constants), else `None`.
+    fn rotation_axis(&self, s: &[ExprId; 6]) -> Option<u8> {
+        let value = |e: ExprId| self.ar.as_const(e);
+        let mut axis = None;
+        for (k, &e) in s.iter().enumerate() {
+            match value(e) {
+                Some(0.0) => {}
+                Some(v) if k < 3 && v.abs() == 1.0 && axis.is_none() => axis = Some(k as u8),
+                _ => return None,
+            }
+        }
+        axis
+    }
+
     /// The workspace entries `(offset, 0, expr)` and the tables of the looped derivatives (see
     /// the module documentation). Only for models without mimic joints.
     pub(super) fn inverse_dynamics_derivatives_looped(
@@ -180,6 +197,7 @@ impl Ctx<'_> {
                     index: col.speed,
                     motion,
                     joint: col.psidd.is_some(),
+                    axis: self.rotation_axis(&col.s),
                 });
             }
             plan.links.push(LoopLink {
@@ -193,7 +211,9 @@ impl Ctx<'_> {
             for (k, col) in columns[l].iter().enumerate() {
                 let c = self.derivative_forces(l, col, &comp, &hc, &dc, &f, &n);
                 let g = c.g.unwrap_or([zero; 6]);
-                let x: Vec<ExprId> = (0..6).flat_map(|i| [c.phi[i], c.xi[i], c.h[i], g[i]]).collect();
+                let x: Vec<ExprId> = (0..6)
+                    .flat_map(|i| [c.phi[i], c.xi[i], c.h[i], g[i]])
+                    .collect();
                 let forces = push(&mut ws, &x);
                 plan.columns.push(LoopColumn {
                     link: l,
@@ -239,7 +259,10 @@ mod tests {
             functions: FunctionSet::default().with(FunctionId::InverseDynamicsDerivatives),
         };
         let d = super::super::derive(model, options);
-        let looped = d.derivative_loop.as_ref().expect("no mimic joints: looped form derived");
+        let looped = d
+            .derivative_loop
+            .as_ref()
+            .expect("no mimic joints: looped form derived");
         let plan = &looped.plan;
         let u16_of = |x: usize| u16::try_from(x).expect("fits");
         let links: Vec<Link> = plan
@@ -259,6 +282,7 @@ mod tests {
                 index: u16_of(s.index),
                 motion: u16_of(s.motion),
                 joint: s.joint,
+                axis: s.axis.unwrap_or(kanegen_runtime::derivative_steps::DENSE),
             })
             .collect();
         let columns: Vec<Column> = plan
@@ -303,19 +327,25 @@ mod tests {
             for &(k, _, e) in &looped.entries {
                 w[k] = v[e.index()];
             }
-            // Column-major N × 2N.
+            // Column-major N × 2N: the dispatched kernel (the AVX2 copy on x86-64-v3 CPUs)
+            // and the portable one.
             let mut out = vec![0.0; n * 2 * n];
             kanegen_runtime::derivative_steps::run(&tables, &w, &mut out);
+            let mut portable = vec![0.0; n * 2 * n];
+            kanegen_runtime::derivative_steps::run_generic(&tables, &w, &mut portable);
             let scale = straight.iter().fold(1.0f64, |m, v| m.max(v.abs()));
             for r in 0..n {
                 for c in 0..2 * n {
-                    let (a, b) = (out[r + n * c], straight[r * 2 * n + c]);
-                    let e = (a - b).abs() / scale;
-                    assert!(
-                        e < 1e-12,
-                        "{label}: draw {draw}, entry [{r}, {c}]: looped {a} vs straight-line {b}"
-                    );
-                    worst = worst.max(e);
+                    let b = straight[r * 2 * n + c];
+                    for (kernel, a) in [("run", out[r + n * c]), ("portable", portable[r + n * c])]
+                    {
+                        let e = (a - b).abs() / scale;
+                        assert!(
+                            e < 1e-12,
+                            "{label}: draw {draw}, entry [{r}, {c}]: looped ({kernel}) {a} vs straight-line {b}"
+                        );
+                        worst = worst.max(e);
+                    }
                 }
             }
         }
@@ -372,6 +402,10 @@ mod tests {
             params: ParamMode::Runtime,
             functions: FunctionSet::default().with(FunctionId::InverseDynamicsDerivatives),
         };
-        assert!(super::super::derive(&gripper, options).derivative_loop.is_none());
+        assert!(
+            super::super::derive(&gripper, options)
+                .derivative_loop
+                .is_none()
+        );
     }
 }

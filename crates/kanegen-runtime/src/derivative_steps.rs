@@ -15,11 +15,13 @@
 //!   `∂τ_i/∂u_a = k Φ_i · Ψ̇_a + Ξ_i · S_a` (`k = 2` for a joint, 1 for the wheeled base's
 //!   quasi-velocities, whose `Ψ̇` is `V_0 × S`).
 //!
-//! The four forces are kept component-major (`[[T; 4]; 6]`: component `k` of `Φ`, `Ξ`, `H`,
-//! `G` side by side), so that one step is one 4-wide transform: in the x86-64-v3 copy of a
-//! generated function (`isa::dispatch`) the compiler issues it as AVX2 instructions. The loop's
-//! code is a few hundred bytes and is read from the instruction cache on every step, where the
-//! straight-line form of the same steps was read once from L2 (Krang: 233 KB of code).
+//! The four forces are kept component-major (component `k` of `Φ`, `Ξ`, `H`, `G` side by side),
+//! so that one step is one 4-wide transform: one AVX2 register per component in the x86-64-v3
+//! copy ([`run`]). The loop's code is about 2 KB and stays in the instruction cache, where the
+//! straight-line form of the same steps was streamed from L2 on every call (Krang: 233 KB of
+//! code in all). The transforms and dot products are dense (the loop does not know which
+//! entries of an axis-aligned joint's `R`, `P`, `S` vanish): more arithmetic than the
+//! straight-line form's, fewer instructions fetched from beyond L1.
 //!
 //! Allocation-free and infallible; the tables are generated together with the code that fills
 //! the workspace, so every offset is in range.
@@ -54,7 +56,14 @@ pub struct Speed {
     /// A joint speed (`true`) or one of the wheeled base's quasi-velocities (`false`: no
     /// coordinate of its own enters τ, so it has no `Ψ̈` and no q-column).
     pub joint: bool,
+    /// `k` when `S` is the unit rotation about axis `k` of the link's frame, times ±1
+    /// (`S = ±(e_k; 0)`, `k` in 0..3: then `Ψ̇ = V_λ × S` and `Ψ̈` vanish in components `k` and
+    /// `3 + k` and the x86-64-v3 copy reads them as 4-vectors); [`DENSE`] otherwise.
+    pub axis: u8,
 }
+
+/// [`Speed::axis`] of a speed whose `S` is not a rotation about a coordinate axis.
+pub const DENSE: u8 = u8::MAX;
 
 /// One column of the recursion: a speed and its four forces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -160,11 +169,13 @@ where
 /// matrix: they are structural zeros).
 ///
 /// A function of its own, not inlined into the generated function (whose straight-line part
-/// is long). On x86-64 with run-time dispatch ([`crate::isa`]) it runs a copy written with
-/// AVX2 intrinsics when [`crate::isa::active`] is x86-64-v3 (the four lanes in one register:
-/// LLVM does not vectorize the portable form, measured: 46,000 instructions per Krang call
-/// against 10,500), else the portable form. Both do the same operations in the same order
-/// (no fused multiply-adds): the same bits.
+/// is long). On x86-64 it runs a copy written with AVX2 and FMA intrinsics when
+/// [`crate::isa::active`] is x86-64-v3 (or the crate is compiled for AVX2 and FMA): the four
+/// lanes in one register. LLVM does not vectorize the portable form (it splits the lanes into
+/// scalars): Krang's 104 steps take 46,000 instructions in it even in the x86-64-v3 copy,
+/// 21,200 with AVX2 intrinsics and 18,600 with AVX2 and FMA (callgrind). Elsewhere the
+/// portable form runs. The two copies differ in the last bits (the fused multiply-adds round
+/// once); the straight-line part of the generated function is the same in both.
 #[inline(never)]
 pub fn run(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
     #[cfg(all(
@@ -182,7 +193,11 @@ pub fn run(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
             return avx2::steps(plan, w, out);
         }
     }
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx2", target_feature = "fma"))]
+    #[cfg(all(
+        target_arch = "x86_64",
+        target_feature = "avx2",
+        target_feature = "fma"
+    ))]
     return avx2::steps(plan, w, out);
     #[allow(unreachable_code)]
     steps(plan, w, out)
@@ -253,8 +268,8 @@ where
     }
 }
 
-/// The steps with AVX2 intrinsics: the portable [`steps`] with `L4<f64>` as one `__m256d`,
-/// the same operations in the same order.
+/// The steps with AVX2 and FMA intrinsics: the portable [`steps`] with `L4<f64>` as one
+/// `__m256d`, a multiply and an add fused where the portable form has them in sequence.
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use core::arch::x86_64::{
@@ -263,7 +278,7 @@ mod avx2 {
         _mm256_set1_pd,
     };
 
-    use super::{NO_PARENT, Plan};
+    use super::{NO_PARENT, Plan, Speed};
 
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
@@ -287,31 +302,99 @@ mod avx2 {
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
     fn dots(x: &[f64], f: &[__m256d; 6]) -> [f64; 4] {
-        let x = [0, 1, 2, 3, 4, 5].map(|k| _mm256_set1_pd(x[k]));
-        let a = _mm256_fmadd_pd(f[1], x[1], _mm256_mul_pd(f[0], x[0]));
-        let b = _mm256_fmadd_pd(f[3], x[3], _mm256_mul_pd(f[2], x[2]));
-        let c = _mm256_fmadd_pd(f[5], x[5], _mm256_mul_pd(f[4], x[4]));
+        let a = _mm256_fmadd_pd(
+            f[1],
+            _mm256_set1_pd(x[1]),
+            _mm256_mul_pd(f[0], _mm256_set1_pd(x[0])),
+        );
+        let b = _mm256_fmadd_pd(
+            f[3],
+            _mm256_set1_pd(x[3]),
+            _mm256_mul_pd(f[2], _mm256_set1_pd(x[2])),
+        );
+        let c = _mm256_fmadd_pd(
+            f[5],
+            _mm256_set1_pd(x[5]),
+            _mm256_mul_pd(f[4], _mm256_set1_pd(x[4])),
+        );
         lanes(_mm256_add_pd(_mm256_add_pd(a, b), c))
     }
 
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
     fn up(t: &[f64], f: &[__m256d; 6]) -> [__m256d; 6] {
-        let t = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11].map(|k| _mm256_set1_pd(t[k]));
-        let rot = |x: &[__m256d], i: usize| {
-            let a = _mm256_fmadd_pd(x[1], t[3 * i + 1], _mm256_mul_pd(x[0], t[3 * i]));
-            _mm256_fmadd_pd(x[2], t[3 * i + 2], a)
-        };
-        let (p0, p1, p2) = (t[9], t[10], t[11]);
-        let (f0, f1, f2) = (rot(&f[3..6], 0), rot(&f[3..6], 1), rot(&f[3..6], 2));
-        // R n + (a pa − b pb): two fused operations per component.
-        let cross = |r: __m256d, a: __m256d, pa: __m256d, b: __m256d, pb: __m256d| {
-            _mm256_fmadd_pd(a, pa, _mm256_fnmadd_pd(b, pb, r))
-        };
-        let n0 = cross(rot(&f[0..3], 0), f2, p1, f1, p2);
-        let n1 = cross(rot(&f[0..3], 1), f0, p2, f2, p0);
-        let n2 = cross(rot(&f[0..3], 2), f1, p0, f0, p1);
+        let t = &t[..12];
+        // Row i of R times (x0, x1, x2).
+        macro_rules! rot {
+            ($i:expr, $x0:expr, $x1:expr, $x2:expr) => {{
+                let a = _mm256_fmadd_pd(
+                    $x1,
+                    _mm256_set1_pd(t[3 * $i + 1]),
+                    _mm256_mul_pd($x0, _mm256_set1_pd(t[3 * $i])),
+                );
+                _mm256_fmadd_pd($x2, _mm256_set1_pd(t[3 * $i + 2]), a)
+            }};
+        }
+        let (p0, p1, p2) = (
+            _mm256_set1_pd(t[9]),
+            _mm256_set1_pd(t[10]),
+            _mm256_set1_pd(t[11]),
+        );
+        let f0 = rot!(0, f[3], f[4], f[5]);
+        let f1 = rot!(1, f[3], f[4], f[5]);
+        let f2 = rot!(2, f[3], f[4], f[5]);
+        // R n + P × R f: two fused operations per component.
+        let n0 = _mm256_fmadd_pd(f2, p1, _mm256_fnmadd_pd(f1, p2, rot!(0, f[0], f[1], f[2])));
+        let n1 = _mm256_fmadd_pd(f0, p2, _mm256_fnmadd_pd(f2, p0, rot!(1, f[0], f[1], f[2])));
+        let n2 = _mm256_fmadd_pd(f1, p0, _mm256_fnmadd_pd(f0, p1, rot!(2, f[0], f[1], f[2])));
         [n0, n1, n2, f0, f1, f2]
+    }
+
+    /// `Σ_j x[j] f[j]` over the four components `j` other than `k` and `3 + k`.
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn dots4<const K: usize>(x: &[f64], f: &[__m256d; 6]) -> [f64; 4] {
+        let (a, b) = ((K + 1) % 3, (K + 2) % 3);
+        let p = _mm256_fmadd_pd(
+            f[b],
+            _mm256_set1_pd(x[b]),
+            _mm256_mul_pd(f[a], _mm256_set1_pd(x[a])),
+        );
+        let q = _mm256_fmadd_pd(
+            f[3 + b],
+            _mm256_set1_pd(x[3 + b]),
+            _mm256_mul_pd(f[3 + a], _mm256_set1_pd(x[3 + a])),
+        );
+        lanes(_mm256_add_pd(p, q))
+    }
+
+    /// The dot products a speed `a` reads: `S·F`, `Ψ̇·F` and (joints) `Ψ̈·F`, from the motions
+    /// at `m` (`S = ±e_k` read as one component when `a.axis` is `k`).
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn reads<const K: usize>(w: &[f64], m: usize, a: &Speed, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
+        let ds = lanes(_mm256_mul_pd(f[K], _mm256_set1_pd(w[m + K])));
+        let dpd = dots4::<K>(&w[m + 6..m + 12], f);
+        let dpdd = if a.joint {
+            dots4::<K>(&w[m + 12..m + 18], f)
+        } else {
+            [0.0; 4]
+        };
+        [ds, dpd, dpdd]
+    }
+
+    /// [`reads`] for any `S`.
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn reads_dense(w: &[f64], m: usize, a: &Speed, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
+        let ds = dots(&w[m..m + 6], f);
+        let dpd = dots(&w[m + 6..m + 12], f);
+        let dpdd = if a.joint {
+            dots(&w[m + 12..m + 18], f)
+        } else {
+            [0.0; 4]
+        };
+        [ds, dpd, dpdd]
     }
 
     /// See [`super::steps`].
@@ -321,7 +404,14 @@ mod avx2 {
         for col in plan.columns {
             let o = usize::from(col.forces);
             let x = &w[o..o + 24];
-            let mut f = [0, 1, 2, 3, 4, 5].map(|k| load(&x[4 * k..4 * k + 4]));
+            let mut f = [
+                load(&x[0..4]),
+                load(&x[4..8]),
+                load(&x[8..12]),
+                load(&x[12..16]),
+                load(&x[16..20]),
+                load(&x[20..24]),
+            ];
             let this = plan.speeds[usize::from(col.speed)];
             let ci = usize::from(this.index);
             let mut l = usize::from(col.link);
@@ -346,15 +436,18 @@ mod avx2 {
                 let parent = plan.links[l];
                 for a in &plan.speeds[usize::from(parent.first)..usize::from(parent.end)] {
                     let m = usize::from(a.motion);
-                    let ds = dots(&w[m..m + 6], &f);
-                    let dpd = dots(&w[m + 6..m + 12], &f);
+                    let [ds, dpd, dpdd] = match a.axis {
+                        0 => reads::<0>(w, m, a, &f),
+                        1 => reads::<1>(w, m, a, &f),
+                        2 => reads::<2>(w, m, a, &f),
+                        _ => reads_dense(w, m, a, &f),
+                    };
                     let ai = usize::from(a.index);
                     if this.joint {
                         out[ai + n * ci] = ds[3];
                     }
                     out[ai + n * (n + ci)] = ds[2];
                     if a.joint {
-                        let dpdd = dots(&w[m + 12..m + 18], &f);
                         out[ci + n * ai] = dpdd[0] + dpd[1];
                         out[ci + n * (n + ai)] = (dpd[0] + dpd[0]) + ds[1];
                     } else {

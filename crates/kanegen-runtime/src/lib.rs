@@ -17,9 +17,12 @@
 //!   written once for any generated robot.
 //!
 //! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA), the
-//!   crate's one `unsafe` block; [`lanes`]: the lane type of the batched functions.
+//!   crate's first `unsafe` block; [`lanes`]: the lane type of the batched functions.
+//! - [`derivative_steps`]: the loop of the looped `inverse_dynamics_derivatives` (the
+//!   (column, ancestor) steps of the analytic recursion over generated tables); its AVX2 copy
+//!   is called from the crate's second `unsafe` block.
 //!
-//! `#![no_std]`, one `unsafe` block ([`isa::dispatch`]), no dependency but [`nalgebra`] (re-exported: its vector and
+//! `#![no_std]`, two `unsafe` blocks ([`isa::dispatch`], [`derivative_steps::run`]), no dependency but [`nalgebra`] (re-exported: its vector and
 //! matrix types are the trait's argument types) and, behind features, `serde` and `toml`.
 //!
 //! # How generated code uses it

@@ -58,7 +58,7 @@ pub struct LoopSpeed {
     /// A joint's speed (`true`) or one of the wheeled base's.
     pub joint: bool,
     /// `Some(k)` when `S = ±(e_k; 0)` (a rotation about a coordinate axis of the link's frame,
-    /// `k < 3`): `Ψ̇` and `Ψ̈` vanish in components `k` and `3 + k`.
+    /// `k < 3`): `Ψ̇ = V_λ × S` vanishes in components `k` and `3 + k`.
     pub axis: Option<u8>,
 }
 

@@ -57,8 +57,9 @@ pub struct Speed {
     /// coordinate of its own enters τ, so it has no `Ψ̈` and no q-column).
     pub joint: bool,
     /// `k` when `S` is the unit rotation about axis `k` of the link's frame, times ±1
-    /// (`S = ±(e_k; 0)`, `k` in 0..3: then `Ψ̇ = V_λ × S` and `Ψ̈` vanish in components `k` and
-    /// `3 + k` and the x86-64-v3 copy reads them as 4-vectors); [`DENSE`] otherwise.
+    /// (`S = ±(e_k; 0)`, `k` in 0..3: then `Ψ̇ = V_λ × S` vanishes in components `k` and
+    /// `3 + k` and the x86-64-v3 copy reads `S` as one component and `Ψ̇` as four);
+    /// [`DENSE`] otherwise.
     pub axis: u8,
 }
 
@@ -369,14 +370,15 @@ mod avx2 {
     }
 
     /// The dot products a speed `a` reads: `S·F`, `Ψ̇·F` and (joints) `Ψ̈·F`, from the motions
-    /// at `m` (`S = ±e_k` read as one component when `a.axis` is `k`).
+    /// at `m` (`S = ±e_k` read as one component and `Ψ̇` as four when `a.axis` is `k`).
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
     fn reads<const K: usize>(w: &[f64], m: usize, a: &Speed, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
         let ds = lanes(_mm256_mul_pd(f[K], _mm256_set1_pd(w[m + K])));
         let dpd = dots4::<K>(&w[m + 6..m + 12], f);
+        // Ψ̈ = A_λ × S + V_λ × Ψ̇ has all six components in general.
         let dpdd = if a.joint {
-            dots4::<K>(&w[m + 12..m + 18], f)
+            dots(&w[m + 12..m + 18], f)
         } else {
             [0.0; 4]
         };

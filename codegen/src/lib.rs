@@ -46,7 +46,7 @@ pub mod model {
 use std::path::{Path, PathBuf};
 
 pub use emit::EmitOptions;
-pub use options::{Options, ParamMode, Precision, RegressorForm};
+pub use options::{DerivativesForm, Options, ParamMode, Precision, RegressorForm};
 pub use registry::{FunctionId, FunctionSet};
 pub use report::{listing, stats};
 
@@ -122,7 +122,7 @@ pub fn generate_combined(
         derivation.arena.len(),
         derivation.arena.vars().len()
     ));
-    let lowered = lower::lower(&derivation);
+    let lowered = lower::lower_with(&derivation, emit.derivatives_form);
     progress.stage("lowered to straight-line programs");
     let source = emit::emit(&model, &lowered, emit)?;
     progress.stage(&format!("emitted ({} bytes of Rust)", source.len()));
@@ -246,6 +246,7 @@ pub struct Builder {
     batch: bool,
     split_above: usize,
     regressor_form: RegressorForm,
+    derivatives_form: DerivativesForm,
 }
 
 impl Builder {
@@ -268,6 +269,7 @@ impl Builder {
             batch: false,
             split_above: emit::SPLIT_ABOVE,
             regressor_form: RegressorForm::Auto,
+            derivatives_form: DerivativesForm::Auto,
         }
     }
 
@@ -418,8 +420,26 @@ impl Builder {
         self
     }
 
+    /// How `inverse_dynamics_derivatives` is emitted (default [`DerivativesForm::Auto`]: looped
+    /// for models whose straight-line derivatives exceed
+    /// [`options::LOOPED_ABOVE_FLOPS`], such as Krang; straight-line for small models and
+    /// models with mimic joints). Both forms give the same matrices to rounding (README,
+    /// "Derivatives: the looped form").
+    ///
+    /// ```no_run
+    /// kanegen::Builder::new("krang.toml")
+    ///     .derivatives(true)
+    ///     .derivatives_form(kanegen::DerivativesForm::StraightLine)
+    ///     .run();
+    /// ```
+    pub fn derivatives_form(mut self, form: DerivativesForm) -> Self {
+        self.derivatives_form = form;
+        self
+    }
+
     fn emit_options(&self) -> EmitOptions {
         EmitOptions {
+            derivatives_form: self.derivatives_form,
             precision: self.precision,
             isa_dispatch: self.isa_dispatch,
             batch: self.batch,

@@ -19,7 +19,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::expr::{Arena, Atom, ExprId, MimicLeaf, Node, VarKind};
 use crate::kane::{Derivation, Function};
-use crate::options::ParamMode;
+use crate::options::{DerivativesForm, LOOPED_ABOVE_FLOPS, ParamMode};
 use crate::registry::FunctionId;
 
 /// A leaf of a lowered expression.
@@ -244,6 +244,22 @@ pub struct Lowered {
     pub regressors: crate::kane::Regressors,
     /// The combined functions (see [`crate::combined`]).
     pub combined: Vec<CombinedProgram>,
+    /// The looped form of `inverse_dynamics_derivatives` (see
+    /// [`Derivation::derivative_loop`]): the program filling its workspace and the tables;
+    /// `Some` when that form is chosen (see [`lower_with`]) and emitted instead of the
+    /// straight-line program of [`Lowered::functions`] (which the batched form, `listing` and
+    /// the interpreter keep using).
+    pub derivative_loop: Option<LoopedProgram>,
+}
+
+/// The program of the looped `inverse_dynamics_derivatives`: its outputs `(offset, 0, value)`
+/// are the workspace entries that `kanegen_runtime::derivative_steps::run` reads with `plan`.
+#[derive(Clone, Debug)]
+pub struct LoopedProgram {
+    /// The straight-line part.
+    pub program: Program,
+    /// The tables of the loop.
+    pub plan: crate::kane::DerivativeLoop,
 }
 
 /// The program of one combined function: one straight-line program whose outputs are the
@@ -274,8 +290,16 @@ impl Lowered {
     }
 }
 
-/// Lower every function of a derivation.
+/// Lower every function of a derivation (`inverse_dynamics_derivatives` in the form
+/// [`DerivativesForm::Auto`] chooses).
 pub fn lower(d: &Derivation) -> Lowered {
+    lower_with(d, DerivativesForm::Auto)
+}
+
+/// [`lower`], with `inverse_dynamics_derivatives` in form `form` where the model allows it
+/// (see [`DerivativesForm`]): [`Lowered::derivative_loop`] is `Some` when the looped form is
+/// chosen.
+pub fn lower_with(d: &Derivation, form: DerivativesForm) -> Lowered {
     let hoist = d.options.params.is_runtime();
     let mut pre = PreSet::default();
     let functions: Vec<FunctionProgram> = d
@@ -324,6 +348,32 @@ pub fn lower(d: &Derivation) -> Lowered {
             }
         })
         .collect();
+    // After every other program: the precomputed slots of the others keep their numbers.
+    let straight_flops = functions
+        .iter()
+        .find(|f| f.id == FunctionId::InverseDynamicsDerivatives)
+        .map_or(0, |f| f.program.ops.flops());
+    let looped = match form {
+        DerivativesForm::StraightLine => false,
+        DerivativesForm::Looped => true,
+        DerivativesForm::Auto => straight_flops > LOOPED_ABOVE_FLOPS,
+    };
+    // The runtime's tables hold u16 offsets: larger models keep the straight-line form.
+    let derivative_loop = d
+        .derivative_loop
+        .as_ref()
+        .filter(|l| looped && l.plan.fits_u16())
+        .map(|l| LoopedProgram {
+            program: lower_entries(
+                &d.arena,
+                "inverse_dynamics_derivatives (looped)",
+                &l.entries,
+                &l.order,
+                hoist,
+                &mut pre,
+            ),
+            plan: l.plan.clone(),
+        });
     let (precompute, pre_slots) = lower_precompute(&d.arena, &pre);
     Lowered {
         precompute,
@@ -337,6 +387,7 @@ pub fn lower(d: &Derivation) -> Lowered {
         sizes: d.sizes,
         regressors: d.regressors.clone(),
         combined,
+        derivative_loop,
     }
 }
 

@@ -50,6 +50,28 @@ pub enum RegressorForm {
     Loop,
 }
 
+/// How `inverse_dynamics_derivatives` is emitted (`Builder::derivatives_form`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum DerivativesForm {
+    /// [`DerivativesForm::Looped`] when the model allows it and the straight-line form has more
+    /// than [`LOOPED_ABOVE_FLOPS`] flops (its code would not fit a 32 KB instruction cache),
+    /// else [`DerivativesForm::StraightLine`] (the default).
+    #[default]
+    Auto,
+    /// One straight-line program (every (column, ancestor) step unrolled).
+    StraightLine,
+    /// Per-link and per-column quantities straight-line into a workspace, then the
+    /// O(columns × ancestors) steps as a loop over generated tables
+    /// (`kanegen_runtime::derivative_steps`). Models with mimic joints keep the straight-line
+    /// form (the tables do not express the constraint's sums).
+    Looped,
+}
+
+/// [`DerivativesForm::Auto`] loops above this many flops of the straight-line form: about
+/// 32 KB of x86-64 code, the size of a level-1 instruction cache (straight-line derivative
+/// code takes about 16 bytes per flop: Krang's 14,728 flops are 233 KB).
+pub const LOOPED_ABOVE_FLOPS: usize = 2_000;
+
 /// Generator options: what the derivation, the lowering and the emitter produce.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Options {

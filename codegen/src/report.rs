@@ -68,6 +68,17 @@ pub fn stats(g: &Generated) -> String {
     for c in &g.lowered.combined {
         row(&c.program.name, &c.program);
     }
+    if let Some(l) = &g.lowered.derivative_loop {
+        row("  looped: setup", &l.program);
+        let _ = writeln!(
+            s,
+            "  looped: loop     {} steps up, workspace {} values; {} flops in the loop (dense 4-wide transforms), {} in all (the emitted form)",
+            l.plan.steps(),
+            l.plan.workspace,
+            l.plan.flops(),
+            l.program.ops.flops() + l.plan.flops(),
+        );
+    }
     // What the loop-form regressors run instead of their straight-line rows above.
     for f in &g.lowered.functions {
         if let Some(lp) = &f.looped {

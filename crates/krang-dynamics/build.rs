@@ -36,7 +36,19 @@ fn generate() {
     let kinematics = enabled("KINEMATICS");
     let derivatives = enabled("DERIVATIVES");
     let regressors = enabled("REGRESSORS");
-    let builder = |model: &str| kanegen::Builder::new(model).coriolis_matrix(coriolis_matrix);
+    // For measurements only: `KANEGEN_DERIVATIVES_FORM=straight-line` (or `looped`) overrides
+    // the generator's choice of the derivatives' form (README, "Derivatives: the looped form").
+    println!("cargo:rerun-if-env-changed=KANEGEN_DERIVATIVES_FORM");
+    let form = match std::env::var("KANEGEN_DERIVATIVES_FORM").as_deref() {
+        Ok("straight-line") => kanegen::DerivativesForm::StraightLine,
+        Ok("looped") => kanegen::DerivativesForm::Looped,
+        _ => kanegen::DerivativesForm::Auto,
+    };
+    let builder = |model: &str| {
+        kanegen::Builder::new(model)
+            .coriolis_matrix(coriolis_matrix)
+            .derivatives_form(form)
+    };
     if coriolis_matrix || kinematics || derivatives || regressors {
         // The main module, with the Coriolis matrix and/or the kinematics and energies (centre
         // of mass, frames, T, V).
@@ -58,6 +70,7 @@ fn generate() {
         let mut main = kanegen::Builder::new("krang.toml")
             .functions(functions)
             .regressor_form(regressor_form())
+            .derivatives_form(form)
             .batch(true);
         if kinematics {
             main = main.combined(whole_body_terms());

@@ -183,10 +183,10 @@ struct Result {
 
 /// Result stores as text lines (`m[(0, 1)] = d5;`), by position: `stores[i + 1]` right after
 /// statement `i` (see [`Printer::statement_block`]).
-type Stores = Vec<Vec<String>>;
+pub(super) type Stores = Vec<Vec<String>>;
 
 /// `e` as text, with multiply-add chains ([`Printer::expr_text_with`]).
-fn text(cx: &Context<'_>, printer: &Printer<'_>, e: &LExpr) -> String {
+pub(super) fn text(cx: &Context<'_>, printer: &Printer<'_>, e: &LExpr) -> String {
     let mut s = String::new();
     printer.expr_text_with(&cx.leaf_names, e, false, true, &mut s);
     s
@@ -205,7 +205,7 @@ pub(super) fn store_after(stores: &mut [TokenStream], e: &LExpr, store: TokenStr
 }
 
 /// Add the text line `store` to the stores placed right after the last statement `e` reads.
-fn store_text_after(stores: &mut [Vec<String>], e: &LExpr, store: String) {
+pub(super) fn store_text_after(stores: &mut [Vec<String>], e: &LExpr, store: String) {
     stores[last_local(e).map_or(0, |i| i + 1)].push(store);
 }
 

@@ -17,6 +17,7 @@
 mod annotate;
 mod batch;
 mod combined;
+mod derivative_loop;
 mod frames;
 mod function;
 mod items;
@@ -32,7 +33,8 @@ use quote::quote;
 
 use crate::lower::Lowered;
 use crate::model::Model;
-use crate::options::{ParamMode, Precision, RegressorForm};
+use crate::options::{DerivativesForm, ParamMode, Precision, RegressorForm};
+use crate::registry::FunctionId;
 
 /// The generator's version, written into every header.
 pub const GENERATOR_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -76,6 +78,10 @@ pub struct EmitOptions {
     /// [`RegressorForm::Auto`]). The derivation reads it ([`crate::generate_with`] passes it
     /// on): the loop form's tables are derived with the function.
     pub regressor_form: RegressorForm,
+    /// How `inverse_dynamics_derivatives` is emitted (default [`DerivativesForm::Auto`]). Read
+    /// by the lowering ([`crate::lower::lower_with`]): the emitter emits the looped form when
+    /// [`Lowered::derivative_loop`] is `Some`.
+    pub derivatives_form: DerivativesForm,
 }
 
 pub use text::SPLIT_ABOVE;
@@ -90,6 +96,7 @@ impl Default for EmitOptions {
             notes_title: String::new(),
             split_above: SPLIT_ABOVE,
             regressor_form: RegressorForm::default(),
+            derivatives_form: DerivativesForm::default(),
         }
     }
 }
@@ -171,7 +178,12 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
     }
     for (i, f) in low.functions.iter().enumerate() {
         // Its statements carry their labels in their block (`text.rs`).
-        items.extend(function::function(&cx, f));
+        match &low.derivative_loop {
+            Some(looped) if f.id == FunctionId::InverseDynamicsDerivatives => {
+                items.extend(derivative_loop::function(&cx, f, looped));
+            }
+            _ => items.extend(function::function(&cx, f)),
+        }
         items.extend(regressor_loop::straight_into(&cx, f));
         // After a per-frame function's last frame, its dispatcher.
         let last = low.functions.get(i + 1).is_none_or(|next| next.id != f.id);

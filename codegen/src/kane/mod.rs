@@ -39,6 +39,7 @@
 //! | `rnea.rs` | c and τ: forward motion pass, body inertia forces, backward accumulation |
 //! | `coriolis_matrix.rs` | C: frame velocities, subtree momenta and inertia rates, columns |
 //! | `rnea_derivatives.rs` | ∂τ/∂q, ∂τ/∂u: the analytic recursion (four forces per column carried up; `derivatives.rs` keeps forward mode as its test oracle) |
+//! | `rnea_derivatives_loop.rs` | the looped form of the same: per-link and per-column quantities into a workspace, tables for `kanegen_runtime::derivative_steps` |
 //! | `kinematics.rs` | frames in frame 0 (`⁰A`, `⁰p`), centre of mass, its Jacobian and bias acceleration, energies |
 //! | `regressor.rs` | regressors `∂τ/∂π`, `∂g/∂β` (by [`Arena::diff`]) and their base parameters |
 //! | `regressor_loop.rs` | the loop form of Y and the base regressor: per-link motion and joint transforms, the (speed, body) tables of `kanegen_runtime::regressor` |
@@ -64,6 +65,7 @@ mod regressor;
 mod regressor_loop;
 mod rnea;
 mod rnea_derivatives;
+mod rnea_derivatives_loop;
 
 use kanegen_model::{Model, ParamKind};
 
@@ -77,6 +79,7 @@ use composite::Composite;
 pub use grouping::{Coefficient, Exactness, SymbolicGroup, symbolic_group_text};
 pub use regressor::{BaseParameters, Regressors, group_text};
 pub use regressor_loop::{KIN, LANES, LOOP_MIN_PAIRS, LoopLink, LoopStep, RegressorLoop};
+pub use rnea_derivatives_loop::{DerivativeLink, DerivativeLoop, LoopColumn, LoopSpeed};
 
 /// One derived registry function: its output entries as expressions in the arena (its name,
 /// inputs and result shape are in the registry).
@@ -122,6 +125,21 @@ pub struct Derivation {
     pub sizes: Sizes,
     /// The combined functions (one arena phase each; see [`crate::combined`]).
     pub combined: Vec<CombinedFunction>,
+    /// The looped form of `inverse_dynamics_derivatives` (its own arena phase, after every
+    /// other): derived when the module has the derivatives and the model has no mimic joints.
+    pub derivative_loop: Option<LoopedDerivatives>,
+}
+
+/// The looped form of `inverse_dynamics_derivatives` (`kane/rnea_derivatives_loop.rs`): the
+/// workspace the generated statements fill and the tables the runtime loop runs over.
+#[derive(Clone, Debug)]
+pub struct LoopedDerivatives {
+    /// `(offset, 0, expr)`: the workspace entries.
+    pub entries: Vec<(usize, usize, ExprId)>,
+    /// The statement order of its phase (see [`Function::order`]).
+    pub order: Vec<ExprId>,
+    /// The tables.
+    pub plan: DerivativeLoop,
 }
 
 /// One derived combined function: its parts' entries and the statement order of its phase.
@@ -290,6 +308,19 @@ pub fn derive_shaped(
             order: cx.ar.phase_order(),
         });
     }
+    // The looped derivatives: one more phase, after every other (the other functions' code is
+    // unchanged).
+    let derivative_loop = (options.has(FunctionId::InverseDynamicsDerivatives)
+        && model.mimics.is_empty())
+    .then(|| {
+        cx.ar.begin_phase();
+        let (entries, plan) = cx.inverse_dynamics_derivatives_looped();
+        LoopedDerivatives {
+            entries,
+            order: cx.ar.phase_order(),
+            plan,
+        }
+    });
     functions.sort_by_key(|f| (f.id, f.frame));
     let sizes = Sizes {
         dof: n,
@@ -311,6 +342,7 @@ pub fn derive_shaped(
         regressors,
         sizes,
         combined: combined_out,
+        derivative_loop,
     }
 }
 

@@ -41,30 +41,46 @@ use super::Ctx;
 use super::algebra::{V3, V6, join3, split3};
 use crate::expr::{Atom, ExprId, VarKind};
 
+/// The quantities both forms of the derivatives start from ([`Ctx::derivative_setup`]).
+pub(super) struct Setup {
+    /// Per link, its speeds.
+    pub(super) columns: Vec<Vec<Column>>,
+    /// Composite inertias.
+    pub(super) comp: Vec<super::composite::Composite>,
+    /// Subtree momenta `h^c`.
+    pub(super) hc: Vec<V6>,
+    /// Subtree inertia rates `D^c`.
+    pub(super) dc: Vec<super::coriolis_matrix::Rate>,
+    /// τ's subtree forces.
+    pub(super) f: Vec<V3>,
+    /// τ's subtree moments.
+    pub(super) n: Vec<V3>,
+}
+
 /// What the entries of the speed columns above a link read, per speed of a link, in its frame.
 #[derive(Clone, Copy)]
-struct Column {
+pub(super) struct Column {
     /// The speed index (of the tree).
-    speed: usize,
+    pub(super) speed: usize,
     /// Its motion subspace `S`.
-    s: V6,
+    pub(super) s: V6,
     /// `Ψ̇ = V_λ × S` (joints) or `V_0 × S` (the base's speeds).
-    psid: V6,
+    pub(super) psid: V6,
     /// `Ψ̈ = A_λ × S + V_λ × Ψ̇`; `None` for the base's speeds (no coordinate of theirs enters τ).
-    psidd: Option<V6>,
+    pub(super) psidd: Option<V6>,
 }
 
 /// The four forces of a column on its way up to the root.
 #[derive(Clone, Copy)]
-struct Carried {
+pub(super) struct Carried {
     /// `Φ = I^c S`.
-    phi: V6,
+    pub(super) phi: V6,
     /// `Ξ = D^c S − S ×* h^c`.
-    xi: V6,
+    pub(super) xi: V6,
     /// `H`: `S_j · H = ∂τ_j/∂u_i`.
-    h: V6,
+    pub(super) h: V6,
     /// `G`: `S_j · G = ∂τ_j/∂q_i` (`None` for the base's speeds).
-    g: Option<V6>,
+    pub(super) g: Option<V6>,
 }
 
 impl Ctx<'_> {
@@ -74,29 +90,14 @@ impl Ctx<'_> {
     pub(super) fn inverse_dynamics_derivatives_analytic(&mut self) -> Vec<(usize, usize, ExprId)> {
         let model = self.model;
         let links = model.links.len();
-        let (motion, f, n) = self.inverse_dynamics_pass();
-        let comp = self.composites(true, None);
-        let vel = self.velocities();
-        let (mut hc, mut dc) = self.body_momenta(&vel);
-        self.subtree_momenta(&mut hc, &mut dc);
-        let cols = self.speed_columns();
-        let vxs = self.bias_columns(&vel, &cols);
-        // Ψ̇ and Ψ̈ of every speed.
-        let mut columns: Vec<Vec<Column>> = vec![Vec::new(); links];
-        for l in 0..links {
-            for (k, &(speed, s)) in cols[l].iter().enumerate() {
-                let psidd = model.links[l]
-                    .mount
-                    .as_ref()
-                    .map(|mount| self.psidd(l, mount, speed, &s, &vxs[l][k], &motion, &vel));
-                columns[l].push(Column {
-                    speed,
-                    s,
-                    psid: vxs[l][k],
-                    psidd,
-                });
-            }
-        }
+        let Setup {
+            columns,
+            comp,
+            hc,
+            dc,
+            f,
+            n,
+        } = self.derivative_setup();
         // (column group, row, tree speed of the column, u-block?, entry) in derivation order.
         let mut raw: Vec<(usize, usize, usize, bool, ExprId)> = Vec::new();
         let mut group = 0;
@@ -190,6 +191,45 @@ impl Ctx<'_> {
         out
     }
 
+    /// What both forms of the derivatives read, in this order (the arena's order is the
+    /// generated code's): τ's pass, the composite inertias, the subtree momenta and inertia
+    /// rates, and per link its speeds with `S`, `Ψ̇`, `Ψ̈`.
+    pub(super) fn derivative_setup(&mut self) -> Setup {
+        let model = self.model;
+        let links = model.links.len();
+        let (motion, f, n) = self.inverse_dynamics_pass();
+        let comp = self.composites(true, None);
+        let vel = self.velocities();
+        let (mut hc, mut dc) = self.body_momenta(&vel);
+        self.subtree_momenta(&mut hc, &mut dc);
+        let cols = self.speed_columns();
+        let vxs = self.bias_columns(&vel, &cols);
+        // Ψ̇ and Ψ̈ of every speed.
+        let mut columns: Vec<Vec<Column>> = vec![Vec::new(); links];
+        for l in 0..links {
+            for (k, &(speed, s)) in cols[l].iter().enumerate() {
+                let psidd = model.links[l]
+                    .mount
+                    .as_ref()
+                    .map(|mount| self.psidd(l, mount, speed, &s, &vxs[l][k], &motion, &vel));
+                columns[l].push(Column {
+                    speed,
+                    s,
+                    psid: vxs[l][k],
+                    psidd,
+                });
+            }
+        }
+        Setup {
+            columns,
+            comp,
+            hc,
+            dc,
+            f,
+            n,
+        }
+    }
+
     /// `Ψ̈ = A_λ × S + V_λ × Ψ̇` of the speed of link `l` (its joint's), in its frame: `A_λ`, `V_λ`
     /// are the parent body's spatial acceleration and velocity at the origin of `l`.
     #[allow(clippy::too_many_arguments)]
@@ -243,7 +283,7 @@ impl Ctx<'_> {
 
     /// The carried forces of column `col` of link `l`, in its frame.
     #[allow(clippy::too_many_arguments)]
-    fn derivative_forces(
+    pub(super) fn derivative_forces(
         &mut self,
         l: usize,
         col: &Column,

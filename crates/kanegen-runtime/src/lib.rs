@@ -17,12 +17,16 @@
 //!   written once for any generated robot.
 //!
 //! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA), the
-//!   crate's one `unsafe` call (in two functions), and [`isa::Arith`], the multiply-add the
-//!   copies differ in; [`lanes`]: the lane type of the batched functions.
+//!   crate's `unsafe` calls (see below), and [`isa::Arith`], the multiply-add the copies
+//!   differ in; [`lanes`]: the lane type of the batched functions.
 //! - [`regressor`]: the loop of a loop-form inverse-dynamics regressor (per link and four rows
 //!   at a time, over two generated constant tables).
+//! - [`derivative_steps`]: the loop of the looped `inverse_dynamics_derivatives` (the
+//!   (column, ancestor) steps of the analytic recursion over generated tables); its AVX2 copy
+//!   is called from the crate's second `unsafe` block.
 //!
-//! `#![no_std]`, one `unsafe` call ([`isa::dispatch`], [`isa::dispatch_fused`]), no dependency but [`nalgebra`] (re-exported: its vector and
+//! `#![no_std]`, `unsafe` only to call code compiled for x86-64-v3 after the CPU was checked
+//! ([`isa::dispatch`], [`isa::dispatch_fused`], [`derivative_steps::run`]), no dependency but [`nalgebra`] (re-exported: its vector and
 //! matrix types are the trait's argument types) and, behind features, `serde` and `toml`.
 //!
 //! # How generated code uses it
@@ -142,6 +146,7 @@
 extern crate std;
 
 mod arith;
+pub mod derivative_steps;
 mod dynamics;
 mod invalid_parameter;
 pub mod isa;

@@ -1,0 +1,462 @@
+//! The looped part of generated inverse-dynamics derivatives `[∂τ/∂q | ∂τ/∂u]`: the
+//! O(columns × ancestors) steps of the analytic recursion, run as one loop over a generated
+//! table instead of straight-line code.
+//!
+//! The generated function computes, straight-line, everything that is per link or per column
+//! into a workspace `w` (one flat array of the scalar type): each link's transform to its
+//! parent, each speed's motion subspace `S`, `Ψ̇` and `Ψ̈`, and each column's four spatial forces
+//! `Φ`, `Ξ`, `H`, `G` in its own frame. [`run`] then carries the four forces of every column up
+//! to the root, one [`Link`] at a time, and writes the entries each ancestor speed reads from
+//! them (the formulas are those of the generator's `kane/rnea_derivatives.rs`):
+//!
+//! * row `a` (an ancestor speed or a speed of the column's own link), column `i`:
+//!   `∂τ_a/∂q_i = S_a · G_i` and `∂τ_a/∂u_i = S_a · H_i`;
+//! * row `i`, column `a` (ancestors only): `∂τ_i/∂q_a = Φ_i · Ψ̈_a + Ξ_i · Ψ̇_a` and
+//!   `∂τ_i/∂u_a = k Φ_i · Ψ̇_a + Ξ_i · S_a` (`k = 2` for a joint, 1 for the wheeled base's
+//!   quasi-velocities, whose `Ψ̇` is `V_0 × S`).
+//!
+//! The four forces are kept component-major (component `k` of `Φ`, `Ξ`, `H`, `G` side by side),
+//! so that one step is one 4-wide transform: one AVX2 register per component in the x86-64-v3
+//! copy ([`run`]). The loop's code is about 2 KB and stays in the instruction cache, where the
+//! straight-line form of the same steps was streamed from L2 on every call (Krang: 233 KB of
+//! code in all). The transforms and dot products are dense (the loop does not know which
+//! entries of an axis-aligned joint's `R`, `P`, `S` vanish): more arithmetic than the
+//! straight-line form's, fewer instructions fetched from beyond L1.
+//!
+//! Allocation-free and infallible; the tables are generated together with the code that fills
+//! the workspace, so every offset is in range.
+
+use core::ops::{Add, Mul, Sub};
+
+/// Marker of a link without a parent (the root) in [`Link::parent`].
+pub const NO_PARENT: u16 = u16::MAX;
+
+/// One link of the tree, in the generated order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Link {
+    /// Index of the parent link in [`Plan::links`], [`NO_PARENT`] for the root.
+    pub parent: u16,
+    /// Offset in the workspace of the link's transform to its parent: the rotation `R`
+    /// (parent ← link, 9 entries by rows) followed by the origin `P` of the link in its
+    /// parent (3 entries). Unused for the root.
+    pub transform: u16,
+    /// The link's speeds: the range `first..end` of [`Plan::speeds`].
+    pub first: u16,
+    /// End of the link's range of [`Plan::speeds`].
+    pub end: u16,
+}
+
+/// One speed of the tree (a row and a column of the result).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Speed {
+    /// Its index in the result (row `index`; columns `index` and `N + index`).
+    pub index: u16,
+    /// Offset in the workspace of `S`, `Ψ̇`, `Ψ̈` (6 entries each, in the link's frame).
+    pub motion: u16,
+    /// A joint speed (`true`) or one of the wheeled base's quasi-velocities (`false`: no
+    /// coordinate of its own enters τ, so it has no `Ψ̈` and no q-column).
+    pub joint: bool,
+    /// `k` when `S` is the unit rotation about axis `k` of the link's frame, times ±1
+    /// (`S = ±(e_k; 0)`, `k` in 0..3: then `Ψ̇ = V_λ × S` vanishes in components `k` and
+    /// `3 + k` and the x86-64-v3 copy reads `S` as one component and `Ψ̇` as four);
+    /// [`DENSE`] otherwise.
+    pub axis: u8,
+}
+
+/// [`Speed::axis`] of a speed whose `S` is not a rotation about a coordinate axis.
+pub const DENSE: u8 = u8::MAX;
+
+/// One column of the recursion: a speed and its four forces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Column {
+    /// The link of the speed, index in [`Plan::links`].
+    pub link: u16,
+    /// The speed, index in [`Plan::speeds`].
+    pub speed: u16,
+    /// Offset in the workspace of the four forces `Φ`, `Ξ`, `H`, `G`, component-major (24
+    /// entries: `w[forces + 4 k + j]` is component `k` of force `j`).
+    pub forces: u16,
+}
+
+/// The generated tables of one model.
+#[derive(Clone, Copy, Debug)]
+pub struct Plan<'a> {
+    /// Number of independent speeds N: the result is `N × 2N`, column-major.
+    pub dof: usize,
+    /// The links.
+    pub links: &'a [Link],
+    /// The speeds, grouped by link.
+    pub speeds: &'a [Speed],
+    /// The columns, in the order they are run.
+    pub columns: &'a [Column],
+}
+
+/// Four lanes: one component of the four forces `Φ`, `Ξ`, `H`, `G`.
+#[derive(Clone, Copy)]
+struct L4<T>([T; 4]);
+
+impl<T> L4<T>
+where
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
+{
+    #[inline(always)]
+    fn load(w: &[T]) -> Self {
+        L4([w[0], w[1], w[2], w[3]])
+    }
+
+    /// `x · self`.
+    #[inline(always)]
+    fn scale(self, x: T) -> Self {
+        let a = self.0;
+        L4([x * a[0], x * a[1], x * a[2], x * a[3]])
+    }
+
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        let (a, b) = (self.0, o.0);
+        L4([a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]])
+    }
+
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        let (a, b) = (self.0, o.0);
+        L4([a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3]])
+    }
+}
+
+/// Component-major forces: `f[k]` holds component `k` (`n.x, n.y, n.z, f.x, f.y, f.z`) of
+/// `Φ`, `Ξ`, `H`, `G`.
+type Forces<T> = [L4<T>; 6];
+
+/// `Σ_k x[k] f[k]`: the four dot products of a motion `x` with the four forces.
+#[inline(always)]
+fn dots<T>(x: &[T], f: &Forces<T>) -> L4<T>
+where
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
+{
+    let x = [x[0], x[1], x[2], x[3], x[4], x[5]];
+    let a = f[0].scale(x[0]).add(f[1].scale(x[1]));
+    let b = f[2].scale(x[2]).add(f[3].scale(x[3]));
+    let c = f[4].scale(x[4]).add(f[5].scale(x[5]));
+    a.add(b).add(c)
+}
+
+/// The four forces moved from a link to its parent: `(R n + P × R f; R f)`, `t` = `R` by rows
+/// then `P`.
+#[inline(always)]
+fn up<T>(t: &[T], f: &Forces<T>) -> Forces<T>
+where
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
+{
+    let t: [T; 12] = [
+        t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8], t[9], t[10], t[11],
+    ];
+    let rot = |x: &[L4<T>], i: usize| {
+        x[0].scale(t[3 * i])
+            .add(x[1].scale(t[3 * i + 1]))
+            .add(x[2].scale(t[3 * i + 2]))
+    };
+    let (p0, p1, p2) = (t[9], t[10], t[11]);
+    let (f0, f1, f2) = (rot(&f[3..6], 0), rot(&f[3..6], 1), rot(&f[3..6], 2));
+    let n0 = rot(&f[0..3], 0).add(f2.scale(p1).sub(f1.scale(p2)));
+    let n1 = rot(&f[0..3], 1).add(f0.scale(p2).sub(f2.scale(p0)));
+    let n2 = rot(&f[0..3], 2).add(f1.scale(p0).sub(f0.scale(p1)));
+    [n0, n1, n2, f0, f1, f2]
+}
+
+/// Runs the steps of `plan` on the workspace `w` and writes the entries of
+/// `[∂τ/∂q | ∂τ/∂u]` into `out` (column-major `N × 2N`, e.g. `SMatrix::as_mut_slice`).
+/// Entries that no column reaches are left as they are (the generated function passes a zeroed
+/// matrix: they are structural zeros).
+///
+/// A function of its own, not inlined into the generated function (whose straight-line part
+/// is long). On x86-64 it runs a copy written with AVX2 and FMA intrinsics when
+/// [`crate::isa::active`] is x86-64-v3 (or the crate is compiled for AVX2 and FMA): the four
+/// lanes in one register. LLVM does not vectorize the portable form (it splits the lanes into
+/// scalars): Krang's 104 steps take 46,000 instructions in it even in the x86-64-v3 copy,
+/// 21,200 with AVX2 intrinsics and 18,600 with AVX2 and FMA (callgrind). Elsewhere the
+/// portable form runs. The two copies differ in the last bits (the fused multiply-adds round
+/// once); the straight-line part of the generated function is the same in both.
+#[inline(never)]
+pub fn run(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
+    #[cfg(all(
+        feature = "dispatch",
+        feature = "std",
+        target_arch = "x86_64",
+        not(all(target_feature = "avx2", target_feature = "fma"))
+    ))]
+    if crate::isa::active() == crate::isa::Isa::X86_64V3 {
+        // SAFETY: `isa::active` is x86-64-v3 only when the CPU has AVX and AVX2 (it checks
+        // every feature of x86-64-v3 before selecting it), the features `avx2::steps` is
+        // compiled with.
+        #[allow(unsafe_code)]
+        unsafe {
+            return avx2::steps(plan, w, out);
+        }
+    }
+    #[cfg(all(
+        target_arch = "x86_64",
+        target_feature = "avx2",
+        target_feature = "fma"
+    ))]
+    return avx2::steps(plan, w, out);
+    #[allow(unreachable_code)]
+    steps(plan, w, out)
+}
+
+/// [`run`] for any scalar type (`f32` modules), in the portable form.
+#[inline(never)]
+pub fn run_generic<T>(plan: &Plan<'_>, w: &[T], out: &mut [T])
+where
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
+{
+    steps(plan, w, out)
+}
+
+/// The loop of [`run`].
+#[inline(always)]
+fn steps<T>(plan: &Plan<'_>, w: &[T], out: &mut [T])
+where
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
+{
+    let n = plan.dof;
+    for col in plan.columns {
+        let o = usize::from(col.forces);
+        let x = &w[o..o + 24];
+        let mut f: Forces<T> = [0, 1, 2, 3, 4, 5].map(|k| L4::load(&x[4 * k..4 * k + 4]));
+        let this = plan.speeds[usize::from(col.speed)];
+        let ci = usize::from(this.index);
+        // Rows of the column's own link: S_a · G, S_a · H.
+        let mut l = usize::from(col.link);
+        let link = plan.links[l];
+        for a in &plan.speeds[usize::from(link.first)..usize::from(link.end)] {
+            let m = usize::from(a.motion);
+            let ds = dots(&w[m..m + 6], &f);
+            let ai = usize::from(a.index);
+            if this.joint {
+                out[ai + n * ci] = ds.0[3];
+            }
+            out[ai + n * (n + ci)] = ds.0[2];
+        }
+        // Up to the root: every ancestor speed reads the four forces in its frame.
+        loop {
+            let link = plan.links[l];
+            if link.parent == NO_PARENT {
+                break;
+            }
+            let t = usize::from(link.transform);
+            f = up(&w[t..t + 12], &f);
+            l = usize::from(link.parent);
+            let parent = plan.links[l];
+            for a in &plan.speeds[usize::from(parent.first)..usize::from(parent.end)] {
+                let m = usize::from(a.motion);
+                let ds = dots(&w[m..m + 6], &f);
+                let dpd = dots(&w[m + 6..m + 12], &f);
+                let ai = usize::from(a.index);
+                if this.joint {
+                    out[ai + n * ci] = ds.0[3];
+                }
+                out[ai + n * (n + ci)] = ds.0[2];
+                if a.joint {
+                    let dpdd = dots(&w[m + 12..m + 18], &f);
+                    out[ci + n * ai] = dpdd.0[0] + dpd.0[1];
+                    out[ci + n * (n + ai)] = (dpd.0[0] + dpd.0[0]) + ds.0[1];
+                } else {
+                    out[ci + n * (n + ai)] = dpd.0[0] + ds.0[1];
+                }
+            }
+        }
+    }
+}
+
+/// The steps with AVX2 and FMA intrinsics: the portable [`steps`] with `L4<f64>` as one
+/// `__m256d`, a multiply and an add fused where the portable form has them in sequence.
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use core::arch::x86_64::{
+        __m256d, _mm_cvtsd_f64, _mm_unpackhi_pd, _mm256_add_pd, _mm256_castpd256_pd128,
+        _mm256_extractf128_pd, _mm256_fmadd_pd, _mm256_fnmadd_pd, _mm256_mul_pd, _mm256_set_pd,
+        _mm256_set1_pd,
+    };
+
+    use super::{NO_PARENT, Plan, Speed};
+
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn load(x: &[f64]) -> __m256d {
+        _mm256_set_pd(x[3], x[2], x[1], x[0])
+    }
+
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn lanes(v: __m256d) -> [f64; 4] {
+        let lo = _mm256_castpd256_pd128(v);
+        let hi = _mm256_extractf128_pd::<1>(v);
+        [
+            _mm_cvtsd_f64(lo),
+            _mm_cvtsd_f64(_mm_unpackhi_pd(lo, lo)),
+            _mm_cvtsd_f64(hi),
+            _mm_cvtsd_f64(_mm_unpackhi_pd(hi, hi)),
+        ]
+    }
+
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn dots(x: &[f64], f: &[__m256d; 6]) -> [f64; 4] {
+        let a = _mm256_fmadd_pd(
+            f[1],
+            _mm256_set1_pd(x[1]),
+            _mm256_mul_pd(f[0], _mm256_set1_pd(x[0])),
+        );
+        let b = _mm256_fmadd_pd(
+            f[3],
+            _mm256_set1_pd(x[3]),
+            _mm256_mul_pd(f[2], _mm256_set1_pd(x[2])),
+        );
+        let c = _mm256_fmadd_pd(
+            f[5],
+            _mm256_set1_pd(x[5]),
+            _mm256_mul_pd(f[4], _mm256_set1_pd(x[4])),
+        );
+        lanes(_mm256_add_pd(_mm256_add_pd(a, b), c))
+    }
+
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn up(t: &[f64], f: &[__m256d; 6]) -> [__m256d; 6] {
+        let t = &t[..12];
+        // Row i of R times (x0, x1, x2).
+        macro_rules! rot {
+            ($i:expr, $x0:expr, $x1:expr, $x2:expr) => {{
+                let a = _mm256_fmadd_pd(
+                    $x1,
+                    _mm256_set1_pd(t[3 * $i + 1]),
+                    _mm256_mul_pd($x0, _mm256_set1_pd(t[3 * $i])),
+                );
+                _mm256_fmadd_pd($x2, _mm256_set1_pd(t[3 * $i + 2]), a)
+            }};
+        }
+        let (p0, p1, p2) = (
+            _mm256_set1_pd(t[9]),
+            _mm256_set1_pd(t[10]),
+            _mm256_set1_pd(t[11]),
+        );
+        let f0 = rot!(0, f[3], f[4], f[5]);
+        let f1 = rot!(1, f[3], f[4], f[5]);
+        let f2 = rot!(2, f[3], f[4], f[5]);
+        // R n + P × R f: two fused operations per component.
+        let n0 = _mm256_fmadd_pd(f2, p1, _mm256_fnmadd_pd(f1, p2, rot!(0, f[0], f[1], f[2])));
+        let n1 = _mm256_fmadd_pd(f0, p2, _mm256_fnmadd_pd(f2, p0, rot!(1, f[0], f[1], f[2])));
+        let n2 = _mm256_fmadd_pd(f1, p0, _mm256_fnmadd_pd(f0, p1, rot!(2, f[0], f[1], f[2])));
+        [n0, n1, n2, f0, f1, f2]
+    }
+
+    /// `Σ_j x[j] f[j]` over the four components `j` other than `k` and `3 + k`.
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn dots4<const K: usize>(x: &[f64], f: &[__m256d; 6]) -> [f64; 4] {
+        let (a, b) = ((K + 1) % 3, (K + 2) % 3);
+        let p = _mm256_fmadd_pd(
+            f[b],
+            _mm256_set1_pd(x[b]),
+            _mm256_mul_pd(f[a], _mm256_set1_pd(x[a])),
+        );
+        let q = _mm256_fmadd_pd(
+            f[3 + b],
+            _mm256_set1_pd(x[3 + b]),
+            _mm256_mul_pd(f[3 + a], _mm256_set1_pd(x[3 + a])),
+        );
+        lanes(_mm256_add_pd(p, q))
+    }
+
+    /// The dot products a speed `a` reads: `S·F`, `Ψ̇·F` and (joints) `Ψ̈·F`, from the motions
+    /// at `m` (`S = ±e_k` read as one component and `Ψ̇` as four when `a.axis` is `k`).
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn reads<const K: usize>(w: &[f64], m: usize, a: &Speed, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
+        let ds = lanes(_mm256_mul_pd(f[K], _mm256_set1_pd(w[m + K])));
+        let dpd = dots4::<K>(&w[m + 6..m + 12], f);
+        // Ψ̈ = A_λ × S + V_λ × Ψ̇ has all six components in general.
+        let dpdd = if a.joint {
+            dots(&w[m + 12..m + 18], f)
+        } else {
+            [0.0; 4]
+        };
+        [ds, dpd, dpdd]
+    }
+
+    /// [`reads`] for any `S`.
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn reads_dense(w: &[f64], m: usize, a: &Speed, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
+        let ds = dots(&w[m..m + 6], f);
+        let dpd = dots(&w[m + 6..m + 12], f);
+        let dpdd = if a.joint {
+            dots(&w[m + 12..m + 18], f)
+        } else {
+            [0.0; 4]
+        };
+        [ds, dpd, dpdd]
+    }
+
+    /// See [`super::steps`].
+    #[target_feature(enable = "avx,avx2,fma")]
+    pub(super) fn steps(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
+        let n = plan.dof;
+        for col in plan.columns {
+            let o = usize::from(col.forces);
+            let x = &w[o..o + 24];
+            let mut f = [
+                load(&x[0..4]),
+                load(&x[4..8]),
+                load(&x[8..12]),
+                load(&x[12..16]),
+                load(&x[16..20]),
+                load(&x[20..24]),
+            ];
+            let this = plan.speeds[usize::from(col.speed)];
+            let ci = usize::from(this.index);
+            let mut l = usize::from(col.link);
+            let link = plan.links[l];
+            for a in &plan.speeds[usize::from(link.first)..usize::from(link.end)] {
+                let m = usize::from(a.motion);
+                let ds = dots(&w[m..m + 6], &f);
+                let ai = usize::from(a.index);
+                if this.joint {
+                    out[ai + n * ci] = ds[3];
+                }
+                out[ai + n * (n + ci)] = ds[2];
+            }
+            loop {
+                let link = plan.links[l];
+                if link.parent == NO_PARENT {
+                    break;
+                }
+                let t = usize::from(link.transform);
+                f = up(&w[t..t + 12], &f);
+                l = usize::from(link.parent);
+                let parent = plan.links[l];
+                for a in &plan.speeds[usize::from(parent.first)..usize::from(parent.end)] {
+                    let m = usize::from(a.motion);
+                    let [ds, dpd, dpdd] = match a.axis {
+                        0 => reads::<0>(w, m, a, &f),
+                        1 => reads::<1>(w, m, a, &f),
+                        2 => reads::<2>(w, m, a, &f),
+                        _ => reads_dense(w, m, a, &f),
+                    };
+                    let ai = usize::from(a.index);
+                    if this.joint {
+                        out[ai + n * ci] = ds[3];
+                    }
+                    out[ai + n * (n + ci)] = ds[2];
+                    if a.joint {
+                        out[ci + n * ai] = dpdd[0] + dpd[1];
+                        out[ci + n * (n + ai)] = (dpd[0] + dpd[0]) + ds[1];
+                    } else {
+                        out[ci + n * (n + ai)] = dpd[0] + ds[1];
+                    }
+                }
+            }
+        }
+    }
+}

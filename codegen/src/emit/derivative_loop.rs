@@ -7,8 +7,8 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::function::{
-    Reads, Stores, nonzero_outputs, prologue, result_type, state_args, store_text_after,
-    unused_inputs,
+    Reads, Stores, generic_body, nonzero_outputs, prologue, result_type, state_args,
+    store_text_after, text, unused_inputs,
 };
 use super::print::{Printer, ident, idx, lit};
 use super::{Context, scalar_type};
@@ -111,19 +111,12 @@ pub(super) fn function(
     let prologue = prologue(cx, p, &reads);
     let mut stores: Stores = vec![Vec::new(); p.stmts.len() + 1];
     for (k, _, e) in nonzero_outputs(p) {
-        // Plain arithmetic: this body is not generic over `Arith` (no multiply-add chains).
-        let mut v = String::new();
-        printer.expr_text_with(&cx.leaf_names, e, false, false, &mut v);
+        let v = text(cx, &printer, e);
         store_text_after(&mut stores, e, format!("w[{k}] = {v};"));
     }
     let stored: Vec<&LExpr> = nonzero_outputs(p).map(|(_, _, e)| e).collect();
-    let block = printer.statement_block(
-        &cx.leaf_names,
-        stores,
-        (&stored, &[]),
-        cx.split_above,
-        false,
-    );
+    let block =
+        printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true);
     let body = cx.blocks.placeholder(block);
     let unused = unused_inputs(spec, p, &reads);
     let t = scalar_type(cx.precision);
@@ -147,11 +140,9 @@ pub(super) fn function(
         #run(&#tables_name, &w, m.as_mut_slice());
         m
     };
-    let body = if cx.isa_dispatch {
-        quote!(kanegen_runtime::isa::dispatch(#[inline(always)] || { #body }))
-    } else {
-        body
-    };
+    // Multiply-add chains in the straight-line part: fused in the x86-64-v3 copy, like every
+    // single-state function (`generic_body`).
+    let (outer_params, generic) = generic_body(cx, spec.inputs, param_args, &ty, body);
     let tables = tables(&looped.plan);
     quote! {
         #tables
@@ -161,8 +152,8 @@ pub(super) fn function(
         #[doc = #arg_doc]
         #[doc = #ops]
         #[inline(never)]
-        pub fn #fname(#param_args #args) -> #ty {
-            #body
+        pub fn #fname(#outer_params #args) -> #ty {
+            #generic
         }
     }
 }

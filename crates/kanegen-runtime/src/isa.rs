@@ -14,8 +14,9 @@
 //! inlines the closure and the body: that copy of the body is compiled for AVX2 with the
 //! three-operand VEX encodings and 256-bit vectors where LLVM vectorizes. Calling a
 //! `#[target_feature]` function needs `unsafe` (the CPU must have the features); this module
-//! holds the crate's only `unsafe` blocks (the same call in [`dispatch`] and [`dispatch_fused`]),
-//! right after the check that the features are present.
+//! holds that call (the same in [`dispatch`] and [`dispatch_fused`]), right after the check that
+//! the features are present; the crate's only other `unsafe` block is the same kind of call in
+//! [`crate::derivative_steps::run`] (its AVX2 kernel, after [`active`] reported x86-64-v3).
 //!
 //! Results: Rust never fuses `a * b + c` into a fused multiply-add on its own. Generated
 //! functions therefore print their sums of products as [`Arith::mul_add`] chains in a body
@@ -206,7 +207,7 @@ if_dispatching! {
         if active_code() == V3 {
             // SAFETY: `ACTIVE` holds `V3` only after `v3_present()` found every feature
             // `run_v3` is compiled with (`detect` and `select` check it before storing), so the
-            // CPU executes its instructions. With `dispatch` above, the crate's only `unsafe`.
+            // CPU executes its instructions. The same call as in `dispatch` above.
             #[allow(unsafe_code)]
             unsafe {
                 return run_v3(fused);

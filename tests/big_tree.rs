@@ -24,6 +24,19 @@ fn model() -> Model {
 
 #[test]
 fn split_functions_of_a_100_dof_tree_match_the_reference() {
+    // Unoptimised, every statement of a 100-DOF function keeps its own stack slot, and each
+    // function is compiled with both instruction-set copies of its body (README "Big models"):
+    // with incremental compilation (CI's clean build) that overflowed the 2 MB of a test
+    // thread. Optimised builds need a few KB.
+    std::thread::Builder::new()
+        .stack_size(256 << 20)
+        .spawn(check_against_the_reference)
+        .expect("a thread can be spawned")
+        .join()
+        .expect("the checks pass");
+}
+
+fn check_against_the_reference() {
     assert_eq!(N, 100);
     let model = model();
     let robot = tree::Tree10x10::new(tree::Params::default());

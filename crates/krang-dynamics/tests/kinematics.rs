@@ -107,31 +107,51 @@ fn varied_params(seed: f64) -> krang_dynamics::Params {
     krang_dynamics::Params::from_array(v)
 }
 
+/// Bit for bit in the baseline copy; in the x86-64-v3 copy, which fuses multiply-adds, a
+/// product that is a shared statement in one program and inline in the other is fused in only
+/// one of them, so there the parts agree to 10⁻¹² of each result's largest entry.
 #[test]
-fn whole_body_terms_equal_the_separate_functions_bit_for_bit() {
+fn whole_body_terms_equal_the_separate_functions_bit_for_bit_in_the_baseline_copy() {
     use krang_dynamics::isa::{self, Isa};
     let hands = ["left_hand", "right_hand"].map(|n| Frame::from_name(n).expect("hand frame"));
     let best = isa::detected();
     for which in Isa::ALL.into_iter().filter(|i| isa::available(*i)) {
         isa::select(which).expect("available");
+        let exact = which == Isa::Baseline;
+        macro_rules! same {
+            ($a:expr, $b:expr) => {{
+                let (a, b) = ($a, $b);
+                if exact {
+                    assert_eq!(a, b);
+                } else {
+                    assert!((a - b).amax() <= 1e-12 * b.amax().max(1.0), "{a} {b}");
+                }
+            }};
+        }
         for (s, (q, u)) in states().enumerate() {
             let k = Krang::new(varied_params(s as f64));
             let w = k.whole_body_terms(&q, &u);
-            assert_eq!(w.mass_matrix, k.mass_matrix(&q));
-            assert_eq!(w.nonlinear_effects, k.nonlinear_effects(&q, &u));
-            assert_eq!(w.center_of_mass, k.center_of_mass(&q));
-            assert_eq!(w.com_jacobian, k.com_jacobian(&q));
-            assert_eq!(w.com_bias_acceleration, k.com_bias_acceleration(&q, &u));
+            same!(w.mass_matrix, k.mass_matrix(&q));
+            same!(w.nonlinear_effects, k.nonlinear_effects(&q, &u));
+            same!(w.center_of_mass, k.center_of_mass(&q));
+            same!(w.com_jacobian, k.com_jacobian(&q));
+            same!(w.com_bias_acceleration, k.com_bias_acceleration(&q, &u));
             let [l, r] = hands;
-            assert_eq!(w.frame_pose_left_hand, k.frame_pose(&q, l));
-            assert_eq!(w.frame_jacobian_left_hand, k.frame_jacobian(&q, l));
-            assert_eq!(
+            same!(
+                w.frame_pose_left_hand.to_homogeneous(),
+                k.frame_pose(&q, l).to_homogeneous()
+            );
+            same!(w.frame_jacobian_left_hand, k.frame_jacobian(&q, l));
+            same!(
                 w.frame_bias_acceleration_left_hand,
                 k.frame_bias_acceleration(&q, &u, l)
             );
-            assert_eq!(w.frame_pose_right_hand, k.frame_pose(&q, r));
-            assert_eq!(w.frame_jacobian_right_hand, k.frame_jacobian(&q, r));
-            assert_eq!(
+            same!(
+                w.frame_pose_right_hand.to_homogeneous(),
+                k.frame_pose(&q, r).to_homogeneous()
+            );
+            same!(w.frame_jacobian_right_hand, k.frame_jacobian(&q, r));
+            same!(
                 w.frame_bias_acceleration_right_hand,
                 k.frame_bias_acceleration(&q, &u, r)
             );

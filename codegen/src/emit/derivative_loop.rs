@@ -7,7 +7,7 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::function::{
-    Reads, Stores, generic_body, nonzero_outputs, prologue, result_type, state_args,
+    Reads, Stores, generic_body, nonzero_outputs, param_args, prologue, result_type, state_args,
     store_text_after, text, unused_inputs,
 };
 use super::print::{Printer, ident, idx, lit};
@@ -100,13 +100,7 @@ pub(super) fn function(
         looped.plan.steps(),
         looped.plan.flops()
     );
-    let param_args = if cx.low.params.is_runtime() {
-        let pname = if reads.param { quote!(p) } else { quote!(_p) };
-        let pcname = if reads.pre { quote!(pc) } else { quote!(_pc) };
-        quote!(#pname: &Params, #pcname: &Precomputed,)
-    } else {
-        quote!()
-    };
+    let param_args = param_args(cx, &reads);
     let (args, arg_doc) = state_args(cx, spec.inputs);
     let prologue = prologue(cx, p, &reads);
     let mut stores: Stores = vec![Vec::new(); p.stmts.len() + 1];

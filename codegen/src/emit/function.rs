@@ -384,13 +384,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         None => format!(" {}", spec.doc),
     };
     let ops = format!(" Generated straight-line code: {}.", p.ops);
-    let param_args = if cx.low.params.is_runtime() {
-        let pname = if reads.param { quote!(p) } else { quote!(_p) };
-        let pcname = if reads.pre { quote!(pc) } else { quote!(_pc) };
-        quote!(#pname: &Params, #pcname: &Precomputed,)
-    } else {
-        quote!()
-    };
+    let param_args = param_args(cx, &reads);
     let (args, arg_doc) = state_args(cx, spec.inputs);
     let prologue = prologue(cx, p, &reads);
     let Result {
@@ -433,6 +427,18 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         pub fn #fname(#outer_params #args) -> #ty {
             #generic
         }
+    }
+}
+
+/// The parameter arguments of a function body (`p: &Params, pc: &Precomputed,` with parameters
+/// at run time, `_p`/`_pc` where the body does not read them; nothing when they are baked).
+pub(super) fn param_args(cx: &Context<'_>, reads: &Reads) -> TokenStream {
+    if cx.low.params.is_runtime() {
+        let pname = if reads.param { quote!(p) } else { quote!(_p) };
+        let pcname = if reads.pre { quote!(pc) } else { quote!(_pc) };
+        quote!(#pname: &Params, #pcname: &Precomputed,)
+    } else {
+        quote!()
     }
 }
 

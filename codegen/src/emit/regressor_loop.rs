@@ -6,7 +6,9 @@
 use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::function::{Reads, last_local, prologue, result_type, state_args, unused_inputs};
+use super::function::{
+    Reads, last_local, param_args, prologue, result_type, state_args, unused_inputs,
+};
 use super::print::{Printer, idx, signed_lit};
 use super::{Context, scalar_type};
 use crate::kane::KIN;
@@ -38,13 +40,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
         lp.flops(),
         f.program.ops.flops(),
     );
-    let param_args = if cx.low.params.is_runtime() {
-        let pname = if reads.param { quote!(p) } else { quote!(_p) };
-        let pcname = if reads.pre { quote!(pc) } else { quote!(_pc) };
-        quote!(#pname: &Params, #pcname: &Precomputed,)
-    } else {
-        quote!()
-    };
+    let param_args = param_args(cx, &reads);
     let (args, arg_doc) = state_args(cx, spec.inputs);
     let prologue = prologue(cx, p, &reads);
     let ty = result_type(cx, spec.shape);

@@ -72,8 +72,8 @@ pub fn stats(g: &Generated) -> String {
         row("  looped: setup", &l.program);
         let _ = writeln!(
             s,
-            "  looped: loop     {} (column, speed) pairs in frame 0, workspace {} values; {} flops in the loop (dense lanes), {} in all (the emitted form)",
-            l.plan.pairs(),
+            "  looped: loop     {} steps up, workspace {} values; {} flops in the loop (dense 4-wide transforms), {} in all (the emitted form)",
+            l.plan.steps(),
             l.plan.workspace,
             l.plan.flops(),
             l.program.ops.flops() + l.plan.flops(),

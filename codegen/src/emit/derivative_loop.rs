@@ -40,8 +40,15 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
         quote!(kanegen_runtime::derivative_steps::Link { parent: #parent, transform: #t, first: #a, end: #b })
     });
     let speeds = plan.speeds.iter().map(|s| {
-        let (i, m) = (u16_of(s.index), u16_of(s.motion));
-        quote!(kanegen_runtime::derivative_steps::Speed { index: #i, motion: #m })
+        let (i, m, j) = (u16_of(s.index), u16_of(s.motion), s.joint);
+        let axis = match s.axis {
+            Some(k) => {
+                let k = proc_macro2::Literal::u8_unsuffixed(k);
+                quote!(#k)
+            }
+            None => quote!(kanegen_runtime::derivative_steps::DENSE),
+        };
+        quote!(kanegen_runtime::derivative_steps::Speed { index: #i, motion: #m, joint: #j, axis: #axis })
     });
     let columns = plan.columns.iter().map(|c| {
         let (l, s, f) = (u16_of(c.link), u16_of(c.speed), u16_of(c.forces));
@@ -50,11 +57,11 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
     let name = ident(TABLES);
     let dof = idx(plan.dof);
     let doc = format!(
-        " The tables of `inverse_dynamics_derivatives`'s loop: {} links, {} speeds, {} columns, {} (column, speed) pairs; a workspace of {} values.",
+        " The tables of `inverse_dynamics_derivatives`'s loop: {} links, {} speeds, {} columns, {} steps up; a workspace of {} values.",
         plan.links.len(),
         plan.speeds.len(),
         plan.columns.len(),
-        plan.pairs(),
+        plan.steps(),
         plan.workspace
     );
     quote! {
@@ -87,10 +94,10 @@ pub(super) fn function(
     let fname = ident(spec.name);
     let doc = format!(" {}", spec.doc);
     let ops = format!(
-        " Generated code: {} straight-line (per link and per column, into a workspace of {} values), then a loop over {} (column, speed) pairs of `{TABLES}` (`kanegen_runtime::derivative_steps::run`, {} flops).",
+        " Generated code: {} straight-line (per link and per column, into a workspace of {} values), then a loop of {} steps over `{TABLES}` (`kanegen_runtime::derivative_steps::run`, {} flops).",
         p.ops,
         looped.plan.workspace,
-        looped.plan.pairs(),
+        looped.plan.steps(),
         looped.plan.flops()
     );
     let param_args = param_args(cx, &reads);

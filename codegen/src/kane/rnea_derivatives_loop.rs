@@ -2,21 +2,19 @@
 //! `rnea_derivatives.rs`, split into a straight-line part and a loop.
 //!
 //! The straight-line part (generated statements, as every function's) computes what is per
-//! link or per column into a workspace: each link's pose in frame 0 (`⁰R`, `⁰p`), each speed's
-//! `S`, `Ψ̇`, `Ψ̈` moved to frame 0 (`ω₀ = ⁰R ω`, `v₀ = ⁰R v + ⁰p × ω₀`: sparse for
-//! axis-aligned joints, whose `S` in frame 0 is a column of `⁰R` and `⁰p ×` that), and each
-//! column's four forces `Φ`, `Ξ`, `H`, `G` in its own frame (τ's pass, composite inertias,
-//! subtree momenta and inertia rates come first, as in the straight-line form). The
-//! O(columns × ancestors) part is `kanegen_runtime::derivative_steps::run` over the generated
-//! [`DerivativeLoop`] tables: it moves each column's forces to frame 0 once and reads them with
-//! every speed on the column's path to the root — dot products of a motion and a force, the
-//! same in any frame, so no transform per (column, ancestor) step.
+//! link or per column into a workspace: each link's transform to its parent (`R`, `P`), each
+//! speed's `S`, `Ψ̇`, `Ψ̈`, and each column's four forces `Φ`, `Ξ`, `H`, `G` in its own frame
+//! (τ's pass, composite inertias, subtree momenta and inertia rates come first, as in the
+//! straight-line form). The O(columns × ancestors) part, carrying the four forces of each column
+//! up to the root and reading them with every ancestor speed, is
+//! `kanegen_runtime::derivative_steps::run` over the generated [`DerivativeLoop`] tables: one
+//! small loop instead of Krang's ~100 unrolled steps (233 KB of code, beyond the instruction
+//! cache).
 //!
 //! Models with mimic joints keep the straight-line form (their columns and rows are sums over
 //! the constraint's joints; the tables do not express them).
 
 use super::Ctx;
-use super::algebra::{V6, join3, split3};
 use super::rnea_derivatives::Setup;
 use crate::expr::ExprId;
 
@@ -29,11 +27,11 @@ pub struct DerivativeLoop {
     pub dof: usize,
     /// Workspace length.
     pub workspace: usize,
-    /// Per link: parent link (`None` for the root), workspace offset of its pose in frame 0
-    /// (`⁰R` by rows and `⁰p`; links with speeds), and its range of [`DerivativeLoop::speeds`].
+    /// Per link: parent link (`None` for the root), workspace offset of `R` (by rows) and `P`,
+    /// and its range of [`DerivativeLoop::speeds`].
     pub links: Vec<DerivativeLink>,
-    /// The speeds, grouped by link: result index and workspace offset of their motions in
-    /// frame 0.
+    /// The speeds, grouped by link: result index, workspace offset of `S`, `Ψ̇`, `Ψ̈`, and
+    /// whether it is a joint's speed (else the wheeled base's).
     pub speeds: Vec<LoopSpeed>,
     /// The columns in run order: link, index in `speeds`, workspace offset of the forces.
     pub columns: Vec<LoopColumn>,
@@ -44,8 +42,7 @@ pub struct DerivativeLoop {
 pub struct DerivativeLink {
     /// The parent link; `None` for the root.
     pub parent: Option<usize>,
-    /// Workspace offset of the link's pose in frame 0 (`⁰R` by rows, then `⁰p`); 0 for links
-    /// without speeds (not read).
+    /// Workspace offset of the transform to the parent (`R` by rows, then `P`).
     pub transform: usize,
     /// The link's speeds, a range of [`DerivativeLoop::speeds`].
     pub speeds: std::ops::Range<usize>,
@@ -56,10 +53,13 @@ pub struct DerivativeLink {
 pub struct LoopSpeed {
     /// Result row (and column) index.
     pub index: usize,
-    /// Workspace offset of its motions in frame 0, `MOTION_LANES` = 6 lanes per component:
-    /// `[S, S, S, j Ψ̇, k Ψ̇, j Ψ̈]` (`j` = 1 for a joint, 0 for the wheeled base's speeds; `k` =
-    /// 2 for a joint, 1 for the base), see `kanegen_runtime::derivative_steps::Speed::motion`.
+    /// Workspace offset of `S`, `Ψ̇`, `Ψ̈` (6 each).
     pub motion: usize,
+    /// A joint's speed (`true`) or one of the wheeled base's.
+    pub joint: bool,
+    /// `Some(k)` when `S = ±(e_k; 0)` (a rotation about a coordinate axis of the link's frame,
+    /// `k < 3`): `Ψ̇ = V_λ × S` vanishes in components `k` and `3 + k`.
+    pub axis: Option<u8>,
 }
 
 /// One column of a [`DerivativeLoop`].
@@ -74,7 +74,7 @@ pub struct LoopColumn {
 }
 
 impl DerivativeLoop {
-    /// Number of (column, ancestor link) steps up.
+    /// Number of steps up (one force transform of the four forces each).
     pub fn steps(&self) -> usize {
         self.columns
             .iter()
@@ -90,38 +90,23 @@ impl DerivativeLoop {
             .sum()
     }
 
-    /// Number of (column, speed) pairs the loop writes entries for: the speeds of the column's
-    /// own link and of every ancestor link.
-    pub fn pairs(&self) -> usize {
-        self.columns
-            .iter()
-            .map(|c| {
-                let mut n = self.links[c.link].speeds.len();
-                let mut l = c.link;
-                while let Some(p) = self.links[l].parent {
-                    n += self.links[p].speeds.len();
-                    l = p;
-                }
-                n
-            })
-            .sum()
-    }
-
     /// Floating-point operations of the loop per call, as `derivative_steps::run` performs
-    /// them (dense lanes: the zeros of axis-aligned joints are the straight-line part's).
+    /// them (dense: the loop does not skip the zeros of axis-aligned joints).
     pub fn flops(&self) -> usize {
-        // A column's four forces to frame 0: 4 × (R f, R n: 2 × 15; p × f: 9; the sum: 3).
-        let column = 4 * 42;
-        // Own link: the 4-wide chain of 6 products (4 × 11); an ancestor speed adds the
-        // 2-wide chain (2 × 11) and the 2-wide sum.
-        let own = 44;
-        let ancestor = 44 + 22 + 2;
+        // A step: 4 forces × (R f, R n: 2 × 15; P × f: 9; the sum: 3).
+        let step = 4 * 42;
+        // A dot product of a motion with the four forces: 4 × 11.
+        let dots = 44;
         let mut total = 0;
         for c in &self.columns {
-            total += column + self.links[c.link].speeds.len() * own;
+            total += self.links[c.link].speeds.len() * dots;
             let mut l = c.link;
             while let Some(p) = self.links[l].parent {
-                total += self.links[p].speeds.len() * ancestor;
+                total += step;
+                for s in &self.speeds[self.links[p].speeds.clone()] {
+                    // S, Ψ̇ (and Ψ̈) dots, then the sums of the two column entries.
+                    total += if s.joint { 3 * dots + 3 } else { 2 * dots + 1 };
+                }
                 l = p;
             }
         }
@@ -136,17 +121,18 @@ impl DerivativeLoop {
 }
 
 impl Ctx<'_> {
-    /// A motion `(ω; v)` of frame `l` (v of its origin) in frame 0, about frame 0's origin:
-    /// `(⁰R ω; ⁰R v + ⁰p × ⁰R ω)`.
-    fn motion_to_frame0(&mut self, l: usize, x: &V6) -> V6 {
-        let r = self.root_rotation(l);
-        let p = self.root_position(l);
-        let (w, v) = split3(x);
-        let w0 = self.rot_up(&r, &w);
-        let rv = self.rot_up(&r, &v);
-        let pxw = self.cross(&p, &w0);
-        let v0 = self.add3(&rv, &pxw);
-        join3(&w0, &v0)
+    /// `Some(k)` when `s` is `±(e_k; 0)` exactly (constants), else `None`.
+    fn rotation_axis(&self, s: &[ExprId; 6]) -> Option<u8> {
+        let value = |e: ExprId| self.ar.as_const(e);
+        let mut axis = None;
+        for (k, &e) in s.iter().enumerate() {
+            match value(e) {
+                Some(0.0) => {}
+                Some(v) if k < 3 && v.abs() == 1.0 && axis.is_none() => axis = Some(k as u8),
+                _ => return None,
+            }
+        }
+        axis
     }
 
     /// The workspace entries `(offset, 0, expr)` and the tables of the looped derivatives (see
@@ -166,6 +152,15 @@ impl Ctx<'_> {
             n,
         } = self.derivative_setup();
         let zero = self.ar.zero();
+        // Links that a column is carried up from.
+        let mut stepped = vec![false; links];
+        for l in 0..links {
+            if !columns[l].is_empty() {
+                for (child, _) in model.path_to_base(l) {
+                    stepped[child] = true;
+                }
+            }
+        }
         let mut ws: Vec<ExprId> = Vec::new();
         let push = |ws: &mut Vec<ExprId>, xs: &[ExprId]| {
             let at = ws.len();
@@ -179,40 +174,34 @@ impl Ctx<'_> {
             speeds: Vec::new(),
             columns: Vec::new(),
         };
-        // Poses in frame 0 and the speeds' motions in frame 0.
+        // Transforms and motions.
         for l in 0..links {
-            let transform = if columns[l].is_empty() {
-                0
-            } else {
-                let r = self.root_rotation(l);
-                let p = self.root_position(l);
-                let mut t = r.concat().to_vec();
-                t.extend_from_slice(&p);
-                push(&mut ws, &t)
+            let mount = model.links[l].mount.as_ref();
+            let transform = match mount {
+                Some(m) if stepped[l] => {
+                    let r = self.rotation(l, &m.joint);
+                    let p = self.position(l, &m.joint);
+                    let mut t = r.concat().to_vec();
+                    t.extend_from_slice(&p);
+                    push(&mut ws, &t)
+                }
+                _ => 0,
             };
             let first = plan.speeds.len();
             for col in &columns[l] {
-                let s = self.motion_to_frame0(l, &col.s);
-                let psid = self.motion_to_frame0(l, &col.psid);
-                let (joint, psidd) = match col.psidd {
-                    Some(x) => (psid, self.motion_to_frame0(l, &x)),
-                    None => ([zero; 6], [zero; 6]),
-                };
-                let k = if col.psidd.is_some() { 2.0 } else { 1.0 };
-                let lanes: Vec<ExprId> = (0..6)
-                    .flat_map(|c| {
-                        let kpsid = self.ar.scale(psid[c], k);
-                        [s[c], s[c], s[c], joint[c], kpsid, psidd[c]]
-                    })
-                    .collect();
-                let motion = push(&mut ws, &lanes);
+                let mut m = col.s.to_vec();
+                m.extend_from_slice(&col.psid);
+                m.extend_from_slice(&col.psidd.unwrap_or([zero; 6]));
+                let motion = push(&mut ws, &m);
                 plan.speeds.push(LoopSpeed {
                     index: col.speed,
                     motion,
+                    joint: col.psidd.is_some(),
+                    axis: self.rotation_axis(&col.s),
                 });
             }
             plan.links.push(DerivativeLink {
-                parent: model.links[l].mount.as_ref().map(|m| m.parent),
+                parent: mount.map(|m| m.parent),
                 transform,
                 speeds: first..plan.speeds.len(),
             });
@@ -234,7 +223,7 @@ impl Ctx<'_> {
             }
         }
         plan.workspace = ws.len();
-        // Schedule: poses and motions, then the columns from the leaves, each right after
+        // Schedule: transforms and motions, then the columns from the leaves, each right after
         // what it reads.
         self.ar.begin_phase();
         for &e in &ws {
@@ -292,6 +281,8 @@ mod tests {
             .map(|s| Speed {
                 index: u16_of(s.index),
                 motion: u16_of(s.motion),
+                joint: s.joint,
+                axis: s.axis.unwrap_or(kanegen_runtime::derivative_steps::DENSE),
             })
             .collect();
         let columns: Vec<Column> = plan

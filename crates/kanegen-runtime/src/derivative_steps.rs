@@ -1,15 +1,13 @@
 //! The looped part of generated inverse-dynamics derivatives `[∂τ/∂q | ∂τ/∂u]`: the
-//! O(columns × ancestors) entries of the analytic recursion, run as one loop over a generated
+//! O(columns × ancestors) steps of the analytic recursion, run as one loop over a generated
 //! table instead of straight-line code.
 //!
 //! The generated function computes, straight-line, everything that is per link or per column
-//! into a workspace `w` (one flat array of the scalar type): each link's pose in frame 0, each
-//! speed's motion subspace `S`, `Ψ̇` and `Ψ̈` **in frame 0** (as [`MOTION_LANES`] lanes per
-//! component, see [`Speed::motion`]), and each column's four spatial forces `Φ`, `Ξ`, `H`, `G`
-//! in its own link's frame. [`run`] moves the four forces of each column to frame 0 once (one
-//! force transform by the link's pose) and then, for every speed on the column's path to the
-//! root, writes the entries it reads from them (the formulas are those of the generator's
-//! `kane/rnea_derivatives.rs`):
+//! into a workspace `w` (one flat array of the scalar type): each link's transform to its
+//! parent, each speed's motion subspace `S`, `Ψ̇` and `Ψ̈`, and each column's four spatial forces
+//! `Φ`, `Ξ`, `H`, `G` in its own frame. [`run`] then carries the four forces of every column up
+//! to the root, one [`Link`] at a time, and writes the entries each ancestor speed reads from
+//! them (the formulas are those of the generator's `kane/rnea_derivatives.rs`):
 //!
 //! * row `a` (an ancestor speed or a speed of the column's own link), column `i`:
 //!   `∂τ_a/∂q_i = S_a · G_i` and `∂τ_a/∂u_i = S_a · H_i`;
@@ -17,12 +15,13 @@
 //!   `∂τ_i/∂u_a = k Φ_i · Ψ̇_a + Ξ_i · S_a` (`k = 2` for a joint, 1 for the wheeled base's
 //!   quasi-velocities, whose `Ψ̇` is `V_0 × S`).
 //!
-//! Every entry is a dot product of a motion and a force, which does not depend on the frame
-//! both are expressed in: with both in frame 0, an ancestor step is four 12-term dot products
-//! and no transform at all (the forces were carried up link by link before: a dense 6×6
-//! transform of four forces per (column, ancestor) step). The transforms are per column (the
-//! forces, here) and per speed (the motions, in the generated straight-line code, where the
-//! zeros of axis-aligned joints are known).
+//! The four forces are kept component-major (component `k` of `Φ`, `Ξ`, `H`, `G` side by side),
+//! so that one step is one 4-wide transform: one AVX2 register per component in the x86-64-v3
+//! copy ([`run`]). The loop's code is about 2 KB and stays in the instruction cache, where the
+//! straight-line form of the same steps was streamed from L2 on every call (Krang: 233 KB of
+//! code in all). The transforms and dot products are dense (the loop does not know which
+//! entries of an axis-aligned joint's `R`, `P`, `S` vanish): more arithmetic than the
+//! straight-line form's, fewer instructions fetched from beyond L1.
 //!
 //! Allocation-free and infallible; the tables are generated together with the code that fills
 //! the workspace, so every offset is in range.
@@ -32,17 +31,14 @@ use core::ops::{Add, Mul, Sub};
 /// Marker of a link without a parent (the root) in [`Link::parent`].
 pub const NO_PARENT: u16 = u16::MAX;
 
-/// Number of lanes per component of a speed's motions in the workspace (see [`Speed::motion`]).
-pub const MOTION_LANES: usize = 6;
-
 /// One link of the tree, in the generated order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Link {
     /// Index of the parent link in [`Plan::links`], [`NO_PARENT`] for the root.
     pub parent: u16,
-    /// Offset in the workspace of the link's pose in frame 0: the rotation `⁰R` (frame 0 ←
-    /// link, 9 entries by rows) followed by the link's origin `⁰p` in frame 0 (3 entries).
-    /// Read only for links with speeds.
+    /// Offset in the workspace of the link's transform to its parent: the rotation `R`
+    /// (parent ← link, 9 entries by rows) followed by the origin `P` of the link in its
+    /// parent (3 entries). Unused for the root.
     pub transform: u16,
     /// The link's speeds: the range `first..end` of [`Plan::speeds`].
     pub first: u16,
@@ -55,14 +51,20 @@ pub struct Link {
 pub struct Speed {
     /// Its index in the result (row `index`; columns `index` and `N + index`).
     pub index: u16,
-    /// Offset in the workspace of its motions in frame 0, [`MOTION_LANES`] lanes per component
-    /// `c` (`ω.x, ω.y, ω.z, v.x, v.y, v.z`): `w[motion + 6 c ..][..6]` is
-    /// `[S, S, S, j Ψ̇, k Ψ̇, j Ψ̈]` (component `c` of each), `j` = 1 for a joint's speed and 0 for
-    /// the wheeled base's (no coordinate of its own enters τ: no q-column), `k` = 2 for a
-    /// joint and 1 for the base (whose `Ψ̇` is `V_0 × S`). The four lanes `S, S, S, j Ψ̇` meet
-    /// a column's `G, H, Ξ, Ξ` and the two lanes `k Ψ̇, j Ψ̈` its `Φ, Φ`.
+    /// Offset in the workspace of `S`, `Ψ̇`, `Ψ̈` (6 entries each, in the link's frame).
     pub motion: u16,
+    /// A joint speed (`true`) or one of the wheeled base's quasi-velocities (`false`: no
+    /// coordinate of its own enters τ, so it has no `Ψ̈` and no q-column).
+    pub joint: bool,
+    /// `k` when `S` is the unit rotation about axis `k` of the link's frame, times ±1
+    /// (`S = ±(e_k; 0)`, `k` in 0..3: then `Ψ̇ = V_λ × S` vanishes in components `k` and
+    /// `3 + k` and the x86-64-v3 copy reads `S` as one component and `Ψ̇` as four);
+    /// [`DENSE`] otherwise.
+    pub axis: u8,
 }
+
+/// [`Speed::axis`] of a speed whose `S` is not a rotation about a coordinate axis.
+pub const DENSE: u8 = u8::MAX;
 
 /// One column of the recursion: a speed and its four forces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -71,9 +73,8 @@ pub struct Column {
     pub link: u16,
     /// The speed, index in [`Plan::speeds`].
     pub speed: u16,
-    /// Offset in the workspace of the four forces `Φ`, `Ξ`, `H`, `G` in the link's frame,
-    /// component-major (24 entries: `w[forces + 4 k + j]` is component `k` of force `j`; `G`
-    /// is zero for the wheeled base's speeds).
+    /// Offset in the workspace of the four forces `Φ`, `Ξ`, `H`, `G`, component-major (24
+    /// entries: `w[forces + 4 k + j]` is component `k` of force `j`).
     pub forces: u16,
 }
 
@@ -127,10 +128,23 @@ where
 /// `Φ`, `Ξ`, `H`, `G`.
 type Forces<T> = [L4<T>; 6];
 
-/// The four forces moved from a link's frame to frame 0: `(R n + p × R f; R f)`, `t` = the
-/// pose `⁰R` by rows then `⁰p`.
+/// `Σ_k x[k] f[k]`: the four dot products of a motion `x` with the four forces.
 #[inline(always)]
-fn to_frame0<T>(t: &[T], f: &Forces<T>) -> Forces<T>
+fn dots<T>(x: &[T], f: &Forces<T>) -> L4<T>
+where
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
+{
+    let x = [x[0], x[1], x[2], x[3], x[4], x[5]];
+    let a = f[0].scale(x[0]).add(f[1].scale(x[1]));
+    let b = f[2].scale(x[2]).add(f[3].scale(x[3]));
+    let c = f[4].scale(x[4]).add(f[5].scale(x[5]));
+    a.add(b).add(c)
+}
+
+/// The four forces moved from a link to its parent: `(R n + P × R f; R f)`, `t` = `R` by rows
+/// then `P`.
+#[inline(always)]
+fn up<T>(t: &[T], f: &Forces<T>) -> Forces<T>
 where
     T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
 {
@@ -157,12 +171,12 @@ where
 ///
 /// A function of its own, not inlined into the generated function (whose straight-line part
 /// is long). On x86-64 it runs a copy written with AVX2 and FMA intrinsics when
-/// [`crate::isa::active`] is x86-64-v3 (or the crate is compiled for AVX2 and FMA): a
-/// component of the four forces in one register, and an ancestor speed's four entries as one
-/// 4-wide and one 2-wide chain of fused multiply-adds. LLVM does not vectorize the portable
-/// form (it splits the lanes into scalars). Elsewhere the portable form runs. The two copies
-/// differ in the last bits (the fused multiply-adds round once); the straight-line part of the
-/// generated function is the same in both.
+/// [`crate::isa::active`] is x86-64-v3 (or the crate is compiled for AVX2 and FMA): the four
+/// lanes in one register. LLVM does not vectorize the portable form (it splits the lanes into
+/// scalars): Krang's 104 steps take 46,000 instructions in it even in the x86-64-v3 copy,
+/// 21,200 with AVX2 intrinsics and 18,600 with AVX2 and FMA (callgrind). Elsewhere the
+/// portable form runs. The two copies differ in the last bits (the fused multiply-adds round
+/// once); the straight-line part of the generated function is the same in both.
 #[inline(never)]
 pub fn run(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
     #[cfg(all(
@@ -199,17 +213,6 @@ where
     steps(plan, w, out)
 }
 
-/// `Σ_c m[6 c + lane] x[c]` over the six components.
-#[inline(always)]
-fn dot<T>(m: &[T], lane: usize, x: [T; 6]) -> T
-where
-    T: Copy + Add<Output = T> + Mul<Output = T>,
-{
-    let a = m[lane] * x[0] + m[6 + lane] * x[1] + m[12 + lane] * x[2];
-    let b = m[18 + lane] * x[3] + m[24 + lane] * x[4] + m[30 + lane] * x[5];
-    a + b
-}
-
 /// The loop of [`run`].
 #[inline(always)]
 fn steps<T>(plan: &Plan<'_>, w: &[T], out: &mut [T])
@@ -217,41 +220,50 @@ where
     T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
 {
     let n = plan.dof;
-    let len = 6 * MOTION_LANES;
     for col in plan.columns {
         let o = usize::from(col.forces);
         let x = &w[o..o + 24];
-        let f: Forces<T> = [0, 1, 2, 3, 4, 5].map(|k| L4::load(&x[4 * k..4 * k + 4]));
-        let mut l = usize::from(col.link);
-        let t = usize::from(plan.links[l].transform);
-        let f = to_frame0(&w[t..t + 12], &f);
-        let [phi, xi, h, g] = [0, 1, 2, 3].map(|j| f.map(|c| c.0[j]));
-        let ci = usize::from(plan.speeds[usize::from(col.speed)].index);
+        let mut f: Forces<T> = [0, 1, 2, 3, 4, 5].map(|k| L4::load(&x[4 * k..4 * k + 4]));
+        let this = plan.speeds[usize::from(col.speed)];
+        let ci = usize::from(this.index);
         // Rows of the column's own link: S_a · G, S_a · H.
+        let mut l = usize::from(col.link);
         let link = plan.links[l];
         for a in &plan.speeds[usize::from(link.first)..usize::from(link.end)] {
             let m = usize::from(a.motion);
-            let m = &w[m..m + len];
+            let ds = dots(&w[m..m + 6], &f);
             let ai = usize::from(a.index);
-            out[ai + n * ci] = dot(m, 0, g);
-            out[ai + n * (n + ci)] = dot(m, 1, h);
+            if this.joint {
+                out[ai + n * ci] = ds.0[3];
+            }
+            out[ai + n * (n + ci)] = ds.0[2];
         }
-        // Up to the root: every ancestor speed's four entries.
+        // Up to the root: every ancestor speed reads the four forces in its frame.
         loop {
             let link = plan.links[l];
             if link.parent == NO_PARENT {
                 break;
             }
+            let t = usize::from(link.transform);
+            f = up(&w[t..t + 12], &f);
             l = usize::from(link.parent);
             let parent = plan.links[l];
             for a in &plan.speeds[usize::from(parent.first)..usize::from(parent.end)] {
                 let m = usize::from(a.motion);
-                let m = &w[m..m + len];
+                let ds = dots(&w[m..m + 6], &f);
+                let dpd = dots(&w[m + 6..m + 12], &f);
                 let ai = usize::from(a.index);
-                out[ai + n * ci] = dot(m, 0, g);
-                out[ai + n * (n + ci)] = dot(m, 1, h);
-                out[ci + n * (n + ai)] = dot(m, 2, xi) + dot(m, 4, phi);
-                out[ci + n * ai] = dot(m, 3, xi) + dot(m, 5, phi);
+                if this.joint {
+                    out[ai + n * ci] = ds.0[3];
+                }
+                out[ai + n * (n + ci)] = ds.0[2];
+                if a.joint {
+                    let dpdd = dots(&w[m + 12..m + 18], &f);
+                    out[ci + n * ai] = dpdd.0[0] + dpd.0[1];
+                    out[ci + n * (n + ai)] = (dpd.0[0] + dpd.0[0]) + ds.0[1];
+                } else {
+                    out[ci + n * (n + ai)] = dpd.0[0] + ds.0[1];
+                }
             }
         }
     }
@@ -262,13 +274,12 @@ where
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use core::arch::x86_64::{
-        __m128d, __m256d, _mm_add_pd, _mm_cvtsd_f64, _mm_fmadd_pd, _mm_movedup_pd, _mm_mul_pd,
-        _mm_set_pd, _mm_unpackhi_pd, _mm256_add_pd, _mm256_castpd256_pd128, _mm256_extractf128_pd,
-        _mm256_fmadd_pd, _mm256_fnmadd_pd, _mm256_mul_pd, _mm256_permute4x64_pd, _mm256_set_pd,
+        __m256d, _mm_cvtsd_f64, _mm_unpackhi_pd, _mm256_add_pd, _mm256_castpd256_pd128,
+        _mm256_extractf128_pd, _mm256_fmadd_pd, _mm256_fnmadd_pd, _mm256_mul_pd, _mm256_set_pd,
         _mm256_set1_pd,
     };
 
-    use super::{MOTION_LANES, NO_PARENT, Plan};
+    use super::{NO_PARENT, Plan, Speed};
 
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
@@ -278,20 +289,41 @@ mod avx2 {
 
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
-    fn load2(x: &[f64]) -> __m128d {
-        _mm_set_pd(x[1], x[0])
+    fn lanes(v: __m256d) -> [f64; 4] {
+        let lo = _mm256_castpd256_pd128(v);
+        let hi = _mm256_extractf128_pd::<1>(v);
+        [
+            _mm_cvtsd_f64(lo),
+            _mm_cvtsd_f64(_mm_unpackhi_pd(lo, lo)),
+            _mm_cvtsd_f64(hi),
+            _mm_cvtsd_f64(_mm_unpackhi_pd(hi, hi)),
+        ]
     }
 
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
-    fn halves(v: __m128d) -> [f64; 2] {
-        [_mm_cvtsd_f64(v), _mm_cvtsd_f64(_mm_unpackhi_pd(v, v))]
+    fn dots(x: &[f64], f: &[__m256d; 6]) -> [f64; 4] {
+        let a = _mm256_fmadd_pd(
+            f[1],
+            _mm256_set1_pd(x[1]),
+            _mm256_mul_pd(f[0], _mm256_set1_pd(x[0])),
+        );
+        let b = _mm256_fmadd_pd(
+            f[3],
+            _mm256_set1_pd(x[3]),
+            _mm256_mul_pd(f[2], _mm256_set1_pd(x[2])),
+        );
+        let c = _mm256_fmadd_pd(
+            f[5],
+            _mm256_set1_pd(x[5]),
+            _mm256_mul_pd(f[4], _mm256_set1_pd(x[4])),
+        );
+        lanes(_mm256_add_pd(_mm256_add_pd(a, b), c))
     }
 
-    /// See [`super::to_frame0`].
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
-    fn to_frame0(t: &[f64], f: &[__m256d; 6]) -> [__m256d; 6] {
+    fn up(t: &[f64], f: &[__m256d; 6]) -> [__m256d; 6] {
         let t = &t[..12];
         // Row i of R times (x0, x1, x2).
         macro_rules! rot {
@@ -312,51 +344,69 @@ mod avx2 {
         let f0 = rot!(0, f[3], f[4], f[5]);
         let f1 = rot!(1, f[3], f[4], f[5]);
         let f2 = rot!(2, f[3], f[4], f[5]);
-        // R n + p × R f: two fused operations per component.
+        // R n + P × R f: two fused operations per component.
         let n0 = _mm256_fmadd_pd(f2, p1, _mm256_fnmadd_pd(f1, p2, rot!(0, f[0], f[1], f[2])));
         let n1 = _mm256_fmadd_pd(f0, p2, _mm256_fnmadd_pd(f2, p0, rot!(1, f[0], f[1], f[2])));
         let n2 = _mm256_fmadd_pd(f1, p0, _mm256_fnmadd_pd(f0, p1, rot!(2, f[0], f[1], f[2])));
         [n0, n1, n2, f0, f1, f2]
     }
 
-    /// `Σ_c m[6 c ..][..4] ⊙ g[c]`: lanes `[S·G, S·H, S·Ξ, j Ψ̇·Ξ]` of a speed's motions `m`
-    /// against a column's `g[c] = [G, H, Ξ, Ξ]`.
+    /// `Σ_j x[j] f[j]` over the four components `j` other than `k` and `3 + k`.
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
-    fn four(m: &[f64], g: &[__m256d; 6]) -> __m256d {
-        let m = &m[..6 * MOTION_LANES];
-        let a = _mm256_fmadd_pd(load(&m[6..10]), g[1], _mm256_mul_pd(load(&m[0..4]), g[0]));
-        let a = _mm256_fmadd_pd(load(&m[12..16]), g[2], a);
-        let b = _mm256_fmadd_pd(
-            load(&m[24..28]),
-            g[4],
-            _mm256_mul_pd(load(&m[18..22]), g[3]),
+    fn dots4<const K: usize>(x: &[f64], f: &[__m256d; 6]) -> [f64; 4] {
+        let (a, b) = ((K + 1) % 3, (K + 2) % 3);
+        let p = _mm256_fmadd_pd(
+            f[b],
+            _mm256_set1_pd(x[b]),
+            _mm256_mul_pd(f[a], _mm256_set1_pd(x[a])),
         );
-        let b = _mm256_fmadd_pd(load(&m[30..34]), g[5], b);
-        _mm256_add_pd(a, b)
+        let q = _mm256_fmadd_pd(
+            f[3 + b],
+            _mm256_set1_pd(x[3 + b]),
+            _mm256_mul_pd(f[3 + a], _mm256_set1_pd(x[3 + a])),
+        );
+        lanes(_mm256_add_pd(p, q))
     }
 
-    /// `Σ_c m[6 c + 4 ..][..2] ⊙ p[c]`: lanes `[k Ψ̇·Φ, j Ψ̈·Φ]` against `p[c] = [Φ, Φ]`.
+    /// The dot products a speed `a` reads: `S·F`, `Ψ̇·F` and (joints) `Ψ̈·F`, from the motions
+    /// at `m` (`S = ±e_k` read as one component and `Ψ̇` as four when `a.axis` is `k`).
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
-    fn two(m: &[f64], p: &[__m128d; 6]) -> __m128d {
-        let m = &m[..6 * MOTION_LANES];
-        let a = _mm_fmadd_pd(load2(&m[10..12]), p[1], _mm_mul_pd(load2(&m[4..6]), p[0]));
-        let a = _mm_fmadd_pd(load2(&m[16..18]), p[2], a);
-        let b = _mm_fmadd_pd(load2(&m[28..30]), p[4], _mm_mul_pd(load2(&m[22..24]), p[3]));
-        let b = _mm_fmadd_pd(load2(&m[34..36]), p[5], b);
-        _mm_add_pd(a, b)
+    fn reads<const K: usize>(w: &[f64], m: usize, a: &Speed, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
+        let ds = lanes(_mm256_mul_pd(f[K], _mm256_set1_pd(w[m + K])));
+        let dpd = dots4::<K>(&w[m + 6..m + 12], f);
+        // Ψ̈ = A_λ × S + V_λ × Ψ̇ has all six components in general.
+        let dpdd = if a.joint {
+            dots(&w[m + 12..m + 18], f)
+        } else {
+            [0.0; 4]
+        };
+        [ds, dpd, dpdd]
+    }
+
+    /// [`reads`] for any `S`.
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn reads_dense(w: &[f64], m: usize, a: &Speed, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
+        let ds = dots(&w[m..m + 6], f);
+        let dpd = dots(&w[m + 6..m + 12], f);
+        let dpdd = if a.joint {
+            dots(&w[m + 12..m + 18], f)
+        } else {
+            [0.0; 4]
+        };
+        [ds, dpd, dpdd]
     }
 
     /// See [`super::steps`].
     #[target_feature(enable = "avx,avx2,fma")]
     pub(super) fn steps(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
         let n = plan.dof;
-        let len = 6 * MOTION_LANES;
         for col in plan.columns {
             let o = usize::from(col.forces);
             let x = &w[o..o + 24];
-            let f = [
+            let mut f = [
                 load(&x[0..4]),
                 load(&x[4..8]),
                 load(&x[8..12]),
@@ -364,40 +414,47 @@ mod avx2 {
                 load(&x[16..20]),
                 load(&x[20..24]),
             ];
+            let this = plan.speeds[usize::from(col.speed)];
+            let ci = usize::from(this.index);
             let mut l = usize::from(col.link);
-            let t = usize::from(plan.links[l].transform);
-            let f = to_frame0(&w[t..t + 12], &f);
-            // [Φ, Ξ, H, G] → [G, H, Ξ, Ξ] and [Φ, Φ].
-            let g = f.map(|x| _mm256_permute4x64_pd::<0b01_01_10_11>(x));
-            let p = f.map(|x| _mm_movedup_pd(_mm256_castpd256_pd128(x)));
-            let ci = usize::from(plan.speeds[usize::from(col.speed)].index);
             let link = plan.links[l];
             for a in &plan.speeds[usize::from(link.first)..usize::from(link.end)] {
                 let m = usize::from(a.motion);
-                let lo = halves(_mm256_castpd256_pd128(four(&w[m..m + len], &g)));
+                let ds = dots(&w[m..m + 6], &f);
                 let ai = usize::from(a.index);
-                out[ai + n * ci] = lo[0];
-                out[ai + n * (n + ci)] = lo[1];
+                if this.joint {
+                    out[ai + n * ci] = ds[3];
+                }
+                out[ai + n * (n + ci)] = ds[2];
             }
             loop {
                 let link = plan.links[l];
                 if link.parent == NO_PARENT {
                     break;
                 }
+                let t = usize::from(link.transform);
+                f = up(&w[t..t + 12], &f);
                 l = usize::from(link.parent);
                 let parent = plan.links[l];
                 for a in &plan.speeds[usize::from(parent.first)..usize::from(parent.end)] {
                     let m = usize::from(a.motion);
-                    let m = &w[m..m + len];
-                    let s = four(m, &g);
-                    let hi = _mm_add_pd(_mm256_extractf128_pd::<1>(s), two(m, &p));
-                    let lo = halves(_mm256_castpd256_pd128(s));
-                    let hi = halves(hi);
+                    let [ds, dpd, dpdd] = match a.axis {
+                        0 => reads::<0>(w, m, a, &f),
+                        1 => reads::<1>(w, m, a, &f),
+                        2 => reads::<2>(w, m, a, &f),
+                        _ => reads_dense(w, m, a, &f),
+                    };
                     let ai = usize::from(a.index);
-                    out[ai + n * ci] = lo[0];
-                    out[ai + n * (n + ci)] = lo[1];
-                    out[ci + n * (n + ai)] = hi[0];
-                    out[ci + n * ai] = hi[1];
+                    if this.joint {
+                        out[ai + n * ci] = ds[3];
+                    }
+                    out[ai + n * (n + ci)] = ds[2];
+                    if a.joint {
+                        out[ci + n * ai] = dpdd[0] + dpd[1];
+                        out[ci + n * (n + ai)] = (dpd[0] + dpd[0]) + ds[1];
+                    } else {
+                        out[ci + n * (n + ai)] = dpd[0] + ds[1];
+                    }
                 }
             }
         }

@@ -5,7 +5,7 @@
 //! on a result pre-filled with NaN, against the straight-line function on random physical
 //! parameters and states: Krang (wheeled base), the two-link model and the URDF arm.
 
-use kanegen::kane::{KIN, RegressorLoop};
+use kanegen::kane::{CarryFrom, KIN, RegressorLoop};
 use kanegen::model::{Model, UrdfOptions};
 use kanegen::{
     EmitOptions, FunctionId, FunctionSet, Generated, Options, RegressorForm, generate_with,
@@ -13,7 +13,7 @@ use kanegen::{
 use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
 use kanegen_runtime::isa::{Arith, Fused, Plain};
 use kanegen_runtime::regressor::{
-    DENSE_ROTATION, LANES, NO_COLUMN, NO_SEED, NO_SLOT, Plan, Step, ZeroChunk,
+    DENSE_ROTATION, LANES, NO_COLUMN, NO_SEED, NO_SLOT, PREVIOUS, Plan, Step, ZeroChunk,
     inverse_dynamics_regressor_plan,
 };
 
@@ -71,8 +71,12 @@ fn tables(t: &RegressorLoop, rows: usize) -> Tables {
             .map(|s| Step {
                 link: s.link as u16,
                 chunk: s.chunk as u16,
-                slot: s.slot as u16,
-                from: s.from.map_or(NO_SLOT, |f| f as u16),
+                slot: s.slot.map_or(NO_SLOT, |d| d as u16),
+                from: match s.from {
+                    Some(CarryFrom::Slot(f)) => f as u16,
+                    Some(CarryFrom::Previous) => PREVIOUS,
+                    None => NO_SLOT,
+                },
                 seed: s.seed.map_or(NO_SEED, |f| f as u16),
                 rotation: t.joints[s.link]
                     .axis

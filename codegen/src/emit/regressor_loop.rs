@@ -11,7 +11,7 @@ use super::function::{
 };
 use super::print::{Printer, idx, signed_lit};
 use super::{Context, scalar_type};
-use crate::kane::KIN;
+use crate::kane::{CarryFrom, KIN};
 use crate::lower::{FunctionProgram, LExpr, Leaf, LoopProgram};
 use crate::registry::FunctionId;
 
@@ -84,12 +84,20 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
         quote!([#(#columns),*])
     });
     let steps = plan.steps.iter().map(|s| {
-        let (link, chunk, slot) = (idx(s.link), idx(s.chunk), idx(s.slot));
+        let (link, chunk) = (idx(s.link), idx(s.chunk));
+        let slot = match s.slot {
+            Some(d) => {
+                let d = idx(d);
+                quote!(#d)
+            }
+            None => quote!(kanegen_runtime::regressor::NO_SLOT),
+        };
         let from = match s.from {
-            Some(f) => {
+            Some(CarryFrom::Slot(f)) => {
                 let f = idx(f);
                 quote!(#f)
             }
+            Some(CarryFrom::Previous) => quote!(kanegen_runtime::regressor::PREVIOUS),
             None => quote!(kanegen_runtime::regressor::NO_SLOT),
         };
         let seed = match s.seed {

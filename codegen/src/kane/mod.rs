@@ -79,7 +79,8 @@ use composite::Composite;
 pub use grouping::{Coefficient, Exactness, SymbolicGroup, symbolic_group_text};
 pub use regressor::{BaseParameters, Regressors, group_text};
 pub use regressor_loop::{
-    JointShape, KIN, LANES, LOOP_MIN_PAIRS, LoopLink, LoopPlan, LoopStep, PlanStep, RegressorLoop,
+    CarryFrom, JointShape, KIN, LANES, LOOP_MIN_PAIRS, LoopLink, LoopPlan, LoopStep, PlanStep,
+    RegressorLoop,
 };
 pub use rnea_derivatives_loop::{DerivativeLink, DerivativeLoop, LoopColumn, LoopSpeed};
 

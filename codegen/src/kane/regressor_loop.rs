@@ -71,15 +71,25 @@ pub struct PlanStep {
     pub link: usize,
     /// The row chunk (rows `LANES * chunk ..`).
     pub chunk: usize,
-    /// Scratch slot written (the link's depth).
-    pub slot: usize,
-    /// Scratch slot of the parent's partial velocities of these rows, if it has any.
-    pub from: Option<usize>,
+    /// Scratch slot written (the link's depth), or `None` when no step but the next one (which
+    /// takes the value from the previous step directly) reads it.
+    pub slot: Option<usize>,
+    /// Where the parent's partial velocities of these rows are, if it has any.
+    pub from: Option<CarryFrom>,
     /// Index of the chunk of the link's own joints' partial velocities in
     /// [`LoopPlan::seeds`], if its joints move some of these rows.
     pub seed: Option<usize>,
     /// Whether the link's body has result columns.
     pub body: bool,
+}
+
+/// Where a [`PlanStep`] finds its parent's partial velocities.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CarryFrom {
+    /// The step just before (kept in registers by the kernel).
+    Previous,
+    /// A scratch slot.
+    Slot(usize),
 }
 
 /// The loop form's tables as the runtime kernel `kanegen_runtime::regressor::inverse_dynamics_regressor`
@@ -225,7 +235,14 @@ impl RegressorLoop {
                 }
                 let link = &self.links[l];
                 let p = link.parent;
-                let from = (p != l && has[p][chunk]).then_some(depth[p]);
+                let from = (p != l && has[p][chunk]).then(|| {
+                    let prev = steps.last().filter(|s: &&PlanStep| s.chunk == chunk);
+                    if prev.is_some_and(|s| s.link == p) {
+                        CarryFrom::Previous
+                    } else {
+                        CarryFrom::Slot(depth[p])
+                    }
+                });
                 let seed = seed_of.get(&(l, chunk)).copied();
                 let body = link.writes();
                 if from.is_some() {
@@ -247,7 +264,7 @@ impl RegressorLoop {
                 steps.push(PlanStep {
                     link: l,
                     chunk,
-                    slot: depth[l],
+                    slot: Some(depth[l]),
                     from,
                     seed,
                     body,
@@ -258,7 +275,29 @@ impl RegressorLoop {
             .flat_map(|c| (0..nl).map(move |l| (l, c)))
             .filter(|&(l, c)| self.links[l].writes() && !has[l][c])
             .collect();
-        let slots = steps.iter().map(|s| s.slot + 1).max().unwrap_or(0);
+        // A step's slot is needed only by a later step reading it from the scratch.
+        let mut read = vec![false; steps.len()];
+        for (i, s) in steps.iter().enumerate() {
+            if let Some(CarryFrom::Slot(d)) = s.from {
+                // The last earlier step of the same chunk at that depth wrote it.
+                if let Some(j) = (0..i)
+                    .rev()
+                    .find(|&j| steps[j].chunk == s.chunk && steps[j].slot == Some(d))
+                {
+                    read[j] = true;
+                }
+            }
+        }
+        for (s, r) in steps.iter_mut().zip(read) {
+            if !r {
+                s.slot = None;
+            }
+        }
+        let slots = steps
+            .iter()
+            .filter_map(|s| s.slot.map(|d| d + 1))
+            .max()
+            .unwrap_or(0);
         LoopPlan {
             steps,
             seeds,
@@ -437,7 +476,7 @@ impl Ctx<'_> {
                             && (k == r || is(kin[at + 3 * k + c], 0.0))
                     })
             });
-            let offset = !kin[at + 9..].iter().all(|&e| is(e, 0.0));
+            let offset = !kin[at + 9..at + 12].iter().all(|&e| is(e, 0.0));
             joints.push(JointShape { axis, offset });
             let mut columns = [None; 10];
             if link.body.is_some() {

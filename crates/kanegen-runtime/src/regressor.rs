@@ -315,6 +315,10 @@ fn entries_chunk<T: Scalar>(pc: &Chunk<T>, kin: &[T; KIN], k: &[T; 9]) -> [V<T>;
 /// that only the link's own joints move): its partial velocities start from zero.
 pub const NO_SLOT: u16 = u16::MAX;
 
+/// [`Step::from`] of a step whose parent is the step just before it: its partial velocities
+/// are taken from that step directly (registers), not from the scratch.
+pub const PREVIOUS: u16 = u16::MAX - 1;
+
 /// [`Step::seed`] of a step without seeds.
 pub const NO_SEED: u16 = u16::MAX;
 
@@ -333,9 +337,11 @@ pub struct Step {
     pub chunk: u16,
     /// Scratch slot the chunk's partial velocities are written to (the link's depth in the
     /// tree: the steps of a chunk run in depth-first order, so the parent's chunk is in the
-    /// slot one up until the parent's next sibling overwrites it).
+    /// slot one up until the parent's next sibling overwrites it), or [`NO_SLOT`] when only
+    /// the next step reads them (as [`PREVIOUS`]).
     pub slot: u16,
-    /// Scratch slot holding the parent's partial velocities of the same rows, or [`NO_SLOT`].
+    /// Scratch slot holding the parent's partial velocities of the same rows, [`PREVIOUS`]
+    /// (the parent is the step just before), or [`NO_SLOT`] (none: start from zero).
     pub from: u16,
     /// Index in [`Plan::seeds`] of the partial velocities of the link's own joints in these
     /// rows (added to the carried ones, whose lanes for those rows are zero), or [`NO_SEED`].
@@ -431,13 +437,23 @@ pub fn inverse_dynamics_regressor_plan<A, T>(
             store(out, rows, columns, zc.chunk as usize, [[z; LANES]; 10]);
         }
     }
+    // The previous step's partial velocities: a chain of links (an arm) carries them in
+    // registers, and only branch points go through the scratch.
+    let mut prev = [[z; LANES]; 6];
     for st in plan.steps {
         let l = st.link as usize;
         let (Some(kl), Some(columns)) = (kin.get(l), plan.columns.get(l)) else {
             continue;
         };
-        let carried = match phi.get(st.from as usize) {
-            Some(pc) if st.from != NO_SLOT => {
+        let parent = if st.from == PREVIOUS {
+            Some(&prev)
+        } else if st.from == NO_SLOT {
+            None
+        } else {
+            phi.get(st.from as usize)
+        };
+        let carried = match parent {
+            Some(pc) => {
                 macro_rules! axis {
                     ($($code:literal => $rr:literal, $rc:literal;)*) => {
                         match st.rotation {
@@ -465,9 +481,12 @@ pub fn inverse_dynamics_regressor_plan<A, T>(
             }
             _ => carried,
         };
-        if let Some(dst) = phi.get_mut(st.slot as usize) {
+        if st.slot != NO_SLOT
+            && let Some(dst) = phi.get_mut(st.slot as usize)
+        {
             *dst = c;
         }
+        prev = c;
         if st.body {
             let y = entries_fused::<A, T>(&c, kl);
             if st.first != NO_COLUMN {

@@ -1,7 +1,9 @@
 //! A regressor in loop form (`kane/regressor_loop.rs`): the straight-line part stores every
-//! link's motion and joint transform in a `kin` table (and the wheel columns in the result),
-//! then one call of `kanegen_runtime::regressor::inverse_dynamics_regressor` runs the (speed,
-//! body) pairs over two constant tables.
+//! link's motion, joint transform and entry coefficients in a `kin` table (and the wheel columns
+//! in the result), then one call of `kanegen_runtime::regressor::inverse_dynamics_regressor`
+//! runs the (speed, body) pairs over the constant tables of its plan (columns, steps, seeds,
+//! zero chunks). The body is generic over `Arith` and dispatched like the straight-line
+//! functions' (`Plain` baseline, `Fused` x86-64-v3), the kernel included.
 
 use proc_macro2::TokenStream;
 use quote::quote;

@@ -8,20 +8,27 @@
 //! non-zeros. So the ten entries of row r in body k's columns are `φ_kr · W_k` with
 //! `φ_kr = ((ω_k)_r; (v_k)_r)` in body k's frame.
 //!
-//! A generated function computes, straight-line, every link's motion and joint transform (the
-//! [`KIN`] values per link of a `kin` table) and the entries that are not a body's (a wheeled
-//! base's wheel columns), then calls [`inverse_dynamics_regressor`] with two constant tables:
-//! per link its parent, the result columns of its body's parameters and the rows its partial
-//! velocities can be non-zero in ([`Link`]), and the joints' own partial velocities ([`Seed`]:
-//! speed, link, a constant 6-vector). Links are visited parents first; a link's partial
-//! velocities for all rows are carried one joint down from its parent's at once, in chunks of
-//! [`LANES`] consecutive rows (one transform, four rows: SIMD lanes), then its seeds are set,
-//! then the body's ten columns are formed for the same rows and stored: in the column-major
-//! result four consecutive rows of a column are one contiguous store. Rows a chunk covers that
-//! are not the link's ancestors' have zero partial velocities and store zeros (which those
-//! entries are). The code that runs is one small loop body instead of one straight line per
-//! entry: it stays in the instruction cache (Krang's straight-line regressor is five times its
-//! size).
+//! A generated function computes, straight-line, every link's motion, joint transform and the
+//! coefficients of its body's entries (the [`KIN`] values per link of a `kin` table) and the
+//! entries that are not a body's (a wheeled base's wheel columns), then calls
+//! [`inverse_dynamics_regressor`] with a generated [`Plan`]: steps (link, chunk of [`LANES`]
+//! consecutive rows), chunk by chunk and within a chunk depth-first, only for the chunks some
+//! speed of which moves the link. A step carries the parent's partial velocities of its rows one
+//! joint down at once (one transform, four rows: SIMD lanes; specialised for joints whose
+//! rotation is about a coordinate axis, [`Step::rotation`]), adds the link's own joints' partial
+//! velocities ([`Plan::seeds`]) and forms and stores the body's ten columns for the same rows: in
+//! the column-major result four consecutive rows of a column are one contiguous store. A chain
+//! of links passes its partial velocities from step to step ([`PREVIOUS`]); branch points keep
+//! theirs in a small scratch. The body entries in rows no speed of which moves the body are
+//! stored as zeros ([`Plan::zeros`]). The kernel is generic over the multiply-add
+//! ([`crate::isa::Arith`]): a generated function runs it with [`crate::isa::Plain`] in its
+//! baseline copy and with [`crate::isa::Fused`] (`vfmadd` on four lanes) in its x86-64-v3 copy.
+//! The code that runs is one small loop body instead of one straight line per entry: it stays
+//! in the instruction cache (Krang's straight-line regressor is five times its size).
+//!
+//! [`inverse_dynamics_regressor_with`] is the plain form the plan was derived from (every chunk
+//! from row 0, dense transforms, per-link tables [`Link`] and [`Seed`]): the reference the
+//! generator's tests compare with.
 //!
 //! Allocation-free and infallible: the scratch arrays are on the stack and an out-of-range
 //! table entry (impossible in generated tables) skips its store instead of panicking.

@@ -41,6 +41,12 @@ fn generated(model: &Model, form: RegressorForm) -> Generated {
     generate_with(model.clone(), options, &emit).expect("generates")
 }
 
+/// Krang in loop form, generated once per test binary (its debug generation takes seconds).
+fn krang() -> &'static Generated {
+    static KRANG: std::sync::OnceLock<Generated> = std::sync::OnceLock::new();
+    KRANG.get_or_init(|| generated(&load("krang.toml"), RegressorForm::Loop))
+}
+
 /// The runtime tables of `tables` for a result of `rows` rows (as the emitter writes them).
 struct Tables {
     columns: Vec<[u16; 10]>,
@@ -153,7 +159,13 @@ fn plan_kernel_equals_the_straight_line_regressors_with_both_multiply_adds() {
         .enumerate()
     {
         let model = load(name);
-        let g = generated(&model, RegressorForm::Loop);
+        let own;
+        let g = if name == "krang.toml" {
+            krang()
+        } else {
+            own = generated(&model, RegressorForm::Loop);
+            &own
+        };
         let n = model.dof();
         let mut r = SplitMix64::new(71 + i as u64);
         let mut uniform = move || r.next_f64();
@@ -173,8 +185,8 @@ fn plan_kernel_equals_the_straight_line_regressors_with_both_multiply_adds() {
                 let straight = g.lowered.evaluate(id, &params, &q, &u, &ud);
                 let scale = straight.iter().fold(1.0f64, |m, x| m.max(x.abs()));
                 for looped in [
-                    plan_value::<Plain>(&g, id, n, cols, &params, &q, &u, &ud),
-                    plan_value::<Fused>(&g, id, n, cols, &params, &q, &u, &ud),
+                    plan_value::<Plain>(g, id, n, cols, &params, &q, &u, &ud),
+                    plan_value::<Fused>(g, id, n, cols, &params, &q, &u, &ud),
                 ] {
                     assert!(
                         looped.iter().all(|v| v.is_finite()),
@@ -193,7 +205,7 @@ fn plan_kernel_equals_the_straight_line_regressors_with_both_multiply_adds() {
 
 #[test]
 fn krang_plan_skips_the_chunks_no_ancestor_speed_moves_and_specialises_its_joints() {
-    let g = generated(&load("krang.toml"), RegressorForm::Auto);
+    let g = krang();
     let f = g
         .lowered
         .functions

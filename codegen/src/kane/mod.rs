@@ -80,7 +80,7 @@ pub use grouping::{Coefficient, Exactness, SymbolicGroup, symbolic_group_text};
 pub use regressor::{BaseParameters, Regressors, group_text};
 pub use regressor_loop::{
     CarryFrom, JointShape, KIN, LANES, LOOP_MIN_PAIRS, LoopLink, LoopPlan, LoopStep, PlanStep,
-    RegressorLoop,
+    RegressorLoop, first_row,
 };
 pub use rnea_derivatives_loop::{DerivativeLink, DerivativeLoop, LoopColumn, LoopSpeed};
 

@@ -69,7 +69,7 @@ pub struct JointShape {
 pub struct PlanStep {
     /// The link.
     pub link: usize,
-    /// The row chunk (rows `LANES * chunk ..`).
+    /// The row chunk (rows from [`first_row`]`(chunk, rows)`).
     pub chunk: usize,
     /// Scratch slot written (the link's depth), or `None` when no step but the next one (which
     /// takes the value from the previous step directly) reads it.
@@ -99,7 +99,8 @@ pub enum CarryFrom {
 pub struct LoopPlan {
     /// The steps, in order.
     pub steps: Vec<PlanStep>,
-    /// Seed chunks: per lane (row `LANES * chunk + lane`), `(ω; v)` component by component.
+    /// Seed chunks: per lane (row [`first_row`]`(chunk, rows) + lane`), `(ω; v)` component by
+    /// component.
     pub seeds: Vec<[[f64; LANES]; 6]>,
     /// (link, chunk) pairs of bodies with columns whose rows no speed moves.
     pub zeros: Vec<(usize, usize)>,
@@ -189,9 +190,20 @@ impl RegressorLoop {
         let n_chunks = rows.div_ceil(LANES);
         // Which chunks each link's partial velocities can be non-zero in.
         let mut has = vec![vec![false; n_chunks]; nl];
+        // Chunk c covers the rows from `first_row(c)`: the last one ends at the last row (it
+        // overlaps the one before when the rows are not a multiple of LANES, so that every store
+        // is a whole vector; the overlapping rows are computed twice, identically).
+        let windows = |r: usize| {
+            (0..n_chunks).filter(move |&c| {
+                let r0 = first_row(c, rows);
+                r0 <= r && r < r0 + LANES
+            })
+        };
         for s in &self.steps {
             if s.row < rows {
-                has[s.link][s.row / LANES] = true;
+                for c in windows(s.row) {
+                    has[s.link][c] = true;
+                }
             }
         }
         // Children lists and depths (links are in topological order).
@@ -218,12 +230,14 @@ impl RegressorLoop {
             if row >= rows {
                 continue;
             }
-            let i = *seed_of.entry((link, row / LANES)).or_insert_with(|| {
-                seeds.push([[0.0; LANES]; 6]);
-                seeds.len() - 1
-            });
-            for (d, x) in seeds[i].iter_mut().zip(phi) {
-                d[row % LANES] = x;
+            for c in windows(row) {
+                let i = *seed_of.entry((link, c)).or_insert_with(|| {
+                    seeds.push([[0.0; LANES]; 6]);
+                    seeds.len() - 1
+                });
+                for (d, x) in seeds[i].iter_mut().zip(phi) {
+                    d[row - first_row(c, rows)] = x;
+                }
             }
         }
         let mut steps = Vec::new();
@@ -336,6 +350,13 @@ impl RegressorLoop {
         }
         flops
     }
+}
+
+/// The first row of chunk `c` of a result of `rows` rows
+/// (`kanegen_runtime::regressor::first_row`): `LANES · c`, but the last chunk ends at the last
+/// row (overlapping the one before) when there are at least [`LANES`] rows.
+pub fn first_row(c: usize, rows: usize) -> usize {
+    (LANES * c).min(rows.saturating_sub(LANES))
 }
 
 /// Whether `form` asks for the loop form of `model`'s regressor with `pairs` (speed, body)

@@ -340,7 +340,7 @@ pub const DENSE_ROTATION: u8 = u8::MAX;
 pub struct Step {
     /// The link (its `kin` values and its row of [`Plan::columns`]).
     pub link: u16,
-    /// The rows `LANES * chunk .. LANES * (chunk + 1)` (those beyond the result skipped).
+    /// The row chunk: [`LANES`] rows from [`first_row`]`(chunk, rows)`.
     pub chunk: u16,
     /// Scratch slot the chunk's partial velocities are written to (the link's depth in the
     /// tree: the steps of a chunk run in depth-first order, so the parent's chunk is in the
@@ -375,7 +375,7 @@ pub struct Step {
 pub struct ZeroChunk {
     /// The link.
     pub link: u16,
-    /// The rows `LANES * chunk ..`.
+    /// The row chunk (as [`Step::chunk`]).
     pub chunk: u16,
     /// As [`Step::first`].
     pub first: u16,
@@ -680,6 +680,15 @@ where
     ]
 }
 
+/// The first row of chunk `chunk` of a [`Plan`] for a result of `rows` rows: `LANES · chunk`,
+/// but the last chunk ends at the last row (it overlaps the one before when `rows` is not a
+/// multiple of [`LANES`], and those rows are computed twice, identically), so that every store
+/// of a result with at least [`LANES`] rows is a whole vector.
+#[inline(always)]
+pub fn first_row(chunk: usize, rows: usize) -> usize {
+    (chunk * LANES).min(rows.saturating_sub(LANES))
+}
+
 /// [`store`] for the ten consecutive columns from `first`: one bounds check, then stores at
 /// distances that are constants when `rows` is.
 #[inline(always)]
@@ -690,7 +699,7 @@ fn store_consecutive<T: Scalar>(
     chunk: usize,
     y: [V<T>; 10],
 ) {
-    let r0 = chunk * LANES;
+    let r0 = first_row(chunk, rows);
     let at = first as usize * rows + r0;
     if r0 + LANES <= rows {
         if let Some(o) = out.get_mut(at..at + 9 * rows + LANES) {
@@ -719,7 +728,7 @@ fn store_consecutive<T: Scalar>(
 /// Store the ten lane vectors `y` of a body's `columns` in the rows of chunk `chunk`.
 #[inline(always)]
 fn store<T: Scalar>(out: &mut [T], rows: usize, columns: &[u16; 10], chunk: usize, y: [V<T>; 10]) {
-    let r0 = chunk * LANES;
+    let r0 = first_row(chunk, rows);
     if r0 + LANES <= rows {
         // Four rows of a column: one contiguous store.
         for (&col, y) in columns.iter().zip(y) {

@@ -1,7 +1,9 @@
 //! A regressor in loop form (`kane/regressor_loop.rs`): the straight-line part stores every
-//! link's motion and joint transform in a `kin` table (and the wheel columns in the result),
-//! then one call of `kanegen_runtime::regressor::inverse_dynamics_regressor` runs the (speed,
-//! body) pairs over two constant tables.
+//! link's motion, joint transform and entry coefficients in a `kin` table (and the wheel columns
+//! in the result), then one call of `kanegen_runtime::regressor::inverse_dynamics_regressor`
+//! runs the (speed, body) pairs over the constant tables of its plan (columns, steps, seeds,
+//! zero chunks). The body is generic over `Arith` and dispatched like the straight-line
+//! functions' (`Plain` baseline, `Fused` x86-64-v3), the kernel included.
 
 use proc_macro2::TokenStream;
 use quote::quote;
@@ -11,7 +13,7 @@ use super::function::{
 };
 use super::print::{Printer, idx, signed_lit};
 use super::{Context, scalar_type};
-use crate::kane::KIN;
+use crate::kane::{CarryFrom, KIN};
 use crate::lower::{FunctionProgram, LExpr, Leaf, LoopProgram};
 use crate::registry::FunctionId;
 
@@ -33,7 +35,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
     let doc = format!(" {}", spec.doc);
     let tables = &lp.tables;
     let ops = format!(
-        " Generated code in loop form: every link's motion straight-line ({}), then a loop over {} (speed, body) pairs (`kanegen_runtime::regressor`, {} flops); {} flops per call in all (straight-line form: {} flops).",
+        " Generated code in loop form: every link's motion straight-line ({}), then a loop over {} (speed, body) pairs (`kanegen_runtime::regressor`, {} lane flops); {} flops per call in all (straight-line form: {} flops).",
         p.ops,
         tables.pairs(),
         tables.flops(),
@@ -67,20 +69,13 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
         stores[last_local(e).map_or(0, |i| i + 1)].push(line);
         stored.push(e);
     }
-    // Plain arithmetic (no multiply-add chains): the straight-line part is small (Krang: 611
-    // flops) and the body is not generic over `Arith`.
-    let block = printer.statement_block(
-        &cx.leaf_names,
-        stores,
-        (&stored, &[]),
-        cx.split_above,
-        false,
-    );
+    // Multiply-add chains: the body is generic over `Arith` (fused in the x86-64-v3 copy).
+    let block =
+        printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true);
     let body = cx.blocks.placeholder(block);
     let nl = idx(tables.links.len());
-    let (chunks, slots) = tables.chunks();
-    let links = tables.links.iter().zip(&chunks).map(|(l, &(n, slot))| {
-        let parent = idx(l.parent);
+    let plan = tables.plan(rows);
+    let columns = tables.links.iter().map(|l| {
         let columns = l.columns.iter().map(|c| match c {
             Some(c) => {
                 let c = idx(*c);
@@ -88,17 +83,60 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
             }
             None => quote!(kanegen_runtime::regressor::NO_COLUMN),
         });
-        let (n, slot) = (idx(n), idx(slot));
-        quote!(kanegen_runtime::regressor::Link { parent: #parent, columns: [#(#columns),*], chunks: #n, slot: #slot })
+        quote!([#(#columns),*])
     });
-    let seeds = tables.seeds();
-    let ns = idx(seeds.len());
-    let seeds = seeds.iter().map(|&(row, link, x)| {
-        let (row, link) = (idx(row), idx(link));
-        let x = x.iter().map(|v| signed_lit(*v, cx.precision));
-        quote!(kanegen_runtime::regressor::Seed { row: #row, link: #link, phi: [#(#x),*] })
+    let steps = plan.steps.iter().map(|s| {
+        let (link, chunk) = (idx(s.link), idx(s.chunk));
+        let slot = match s.slot {
+            Some(d) => {
+                let d = idx(d);
+                quote!(#d)
+            }
+            None => quote!(kanegen_runtime::regressor::NO_SLOT),
+        };
+        let from = match s.from {
+            Some(CarryFrom::Slot(f)) => {
+                let f = idx(f);
+                quote!(#f)
+            }
+            Some(CarryFrom::Previous) => quote!(kanegen_runtime::regressor::PREVIOUS),
+            None => quote!(kanegen_runtime::regressor::NO_SLOT),
+        };
+        let seed = match s.seed {
+            Some(f) => {
+                let f = idx(f);
+                quote!(#f)
+            }
+            None => quote!(kanegen_runtime::regressor::NO_SEED),
+        };
+        let j = tables.joints[s.link];
+        let rotation = match j.axis {
+            Some((r, c)) => {
+                let code = proc_macro2::Literal::u8_unsuffixed((3 * r + c) as u8);
+                quote!(#code)
+            }
+            None => quote!(kanegen_runtime::regressor::DENSE_ROTATION),
+        };
+        let (offset, body) = (j.offset, s.body);
+        let first = first_column(&tables.links[s.link].columns);
+        quote!(kanegen_runtime::regressor::Step { link: #link, chunk: #chunk, slot: #slot, from: #from, seed: #seed, rotation: #rotation, offset: #offset, body: #body, first: #first })
     });
-    let slots = idx(slots);
+    let ns = idx(plan.steps.len());
+    let nseeds = idx(plan.seeds.len());
+    let seeds = plan.seeds.iter().map(|c| {
+        let comps = c.iter().map(|lanes| {
+            let x = lanes.iter().map(|v| signed_lit(*v, cx.precision));
+            quote!([#(#x),*])
+        });
+        quote!([#(#comps),*])
+    });
+    let nz = idx(plan.zeros.len());
+    let zeros = plan.zeros.iter().map(|&(l, c)| {
+        let first = first_column(&tables.links[l].columns);
+        let (l, c) = (idx(l), idx(c));
+        quote!(kanegen_runtime::regressor::ZeroChunk { link: #l, chunk: #c, first: #first })
+    });
+    let slots = idx(plan.slots);
     let unused = unused_inputs(spec, p, &reads);
     let kin_mut = if p.outputs[..lp.kin_len]
         .iter()
@@ -123,58 +161,100 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
     } else {
         quote!(for c in [#(#others),*] { y.column_mut(c).fill(0.0); })
     };
-    // The result is written in place (the closure returns nothing): returned from the dispatch
-    // closure and then from the function, its 26 KB (Krang) were copied once more.
     let body = quote! {
         #unused
         #prologue
         let #kin_mut kin = [[0.0; kanegen_runtime::regressor::KIN]; #nl];
         #zero_others
         #body
-        kanegen_runtime::regressor::inverse_dynamics_regressor::<_, #nl, #slots>(&kin, &LINKS, &SEEDS, #nr, y.as_mut_slice());
+        let plan = kanegen_runtime::regressor::Plan { columns: &COLUMNS, steps: &STEPS, seeds: &SEEDS, zeros: &ZEROS };
+        kanegen_runtime::regressor::inverse_dynamics_regressor::<A, _, #nl, #slots>(&kin, &plan, #nr, y.as_mut_slice());
     };
-    let body = if cx.isa_dispatch {
-        quote!(kanegen_runtime::isa::dispatch(#[inline(always)] || { #body });)
+    let (pass_params, outer_params) = if cx.low.params.is_runtime() {
+        (quote!(p, pc,), quote!(p: &Params, pc: &Precomputed,))
     } else {
-        body
+        (quote!(), quote!())
+    };
+    let state = super::items::arg_names(spec.inputs);
+    // The body generic over the multiply-add, compiled twice with dispatch (`Plain` for the
+    // baseline, `Fused` for x86-64-v3). Both closures name `y`: it is passed through a `Cell`
+    // that the one closure run takes it from.
+    let call = if cx.isa_dispatch {
+        quote! {
+            let y = core::cell::Cell::new(Some(y));
+            kanegen_runtime::isa::dispatch_fused(
+                #[inline(always)]
+                || {
+                    if let Some(y) = y.take() {
+                        body::<kanegen_runtime::isa::Plain>(#pass_params #state, y)
+                    }
+                },
+                #[inline(always)]
+                || {
+                    if let Some(y) = y.take() {
+                        body::<kanegen_runtime::isa::Fused>(#pass_params #state, y)
+                    }
+                },
+            );
+        }
+    } else {
+        quote!(body::<kanegen_runtime::isa::Native>(#pass_params #state, y);)
     };
     let into_doc = format!(
         " [`{name}`] written into `y` (every entry; nothing to allocate, zero or copy: the fast form for a caller that keeps its result matrix)."
     );
-    let forward = if cx.low.params.is_runtime() {
-        quote!(p: &Params, pc: &Precomputed,)
-    } else {
-        quote!()
-    };
-    let forward_args = if cx.low.params.is_runtime() {
-        quote!(p, pc,)
-    } else {
-        quote!()
-    };
-    let state = super::items::arg_names(spec.inputs);
+    let plan_doc = format!(
+        " The loop's plan: {} steps ((link, four-row chunk) pairs some ancestor speed moves), {} chunks of zeros, {} seed chunks, {} scratch slots; {} lane flops.",
+        plan.steps.len(),
+        plan.zeros.len(),
+        plan.seeds.len(),
+        plan.slots,
+        plan.flops,
+    );
     quote! {
         #[doc = #doc]
         #[doc = ""]
         #[doc = #arg_doc]
         #[doc = #ops]
         #[inline]
-        pub fn #fname(#forward #args) -> #ty {
+        pub fn #fname(#outer_params #args) -> #ty {
             let mut y = SMatrix::<#t, #nr, #nc>::zeros();
-            #into(#forward_args #state, &mut y);
+            #into(#pass_params #state, &mut y);
             y
         }
 
         #[doc = #into_doc]
         #[doc = ""]
         #[doc = #arg_doc]
+        #[doc = #plan_doc]
         #[inline(never)]
-        pub fn #into(#param_args #args, y: &mut SMatrix<#t, #nr, #nc>) {
-            /// Per link: its parent, its body's result columns and its row chunks.
-            const LINKS: [kanegen_runtime::regressor::Link; #nl] = [#(#links),*];
-            /// The joints' own partial velocities, by link.
-            const SEEDS: [kanegen_runtime::regressor::Seed<#t>; #ns] = [#(#seeds),*];
-            #body
+        pub fn #into(#outer_params #args, y: &mut SMatrix<#t, #nr, #nc>) {
+            /// Per link: the result columns of its body's parameters.
+            const COLUMNS: [[u16; 10]; #nl] = [#(#columns),*];
+            /// The (link, row chunk) steps, chunk by chunk, depth-first.
+            const STEPS: [kanegen_runtime::regressor::Step; #ns] = [#(#steps),*];
+            /// The joints' own partial velocities, one chunk each.
+            const SEEDS: [kanegen_runtime::regressor::Chunk<#t>; #nseeds] = [#(#seeds),*];
+            /// The (link, row chunk) pairs whose entries are zero.
+            const ZEROS: [kanegen_runtime::regressor::ZeroChunk; #nz] = [#(#zeros),*];
+            #[inline(always)]
+            fn body<A: kanegen_runtime::isa::Arith<#t>>(#param_args #args, y: &mut SMatrix<#t, #nr, #nc>) {
+                #body
+            }
+            #call
         }
+    }
+}
+
+/// The first of a body's ten result columns when they are consecutive (the kernel's fast
+/// store), else `NO_COLUMN`.
+fn first_column(columns: &[Option<usize>; 10]) -> TokenStream {
+    match columns[0] {
+        Some(c0) if (0..10).all(|t| columns[t] == Some(c0 + t)) => {
+            let c0 = idx(c0);
+            quote!(#c0)
+        }
+        _ => quote!(kanegen_runtime::regressor::NO_COLUMN),
     }
 }
 

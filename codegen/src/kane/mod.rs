@@ -78,7 +78,10 @@ use algebra::{M3, V3};
 use composite::Composite;
 pub use grouping::{Coefficient, Exactness, SymbolicGroup, symbolic_group_text};
 pub use regressor::{BaseParameters, Regressors, group_text};
-pub use regressor_loop::{KIN, LANES, LOOP_MIN_PAIRS, LoopLink, LoopStep, RegressorLoop};
+pub use regressor_loop::{
+    CarryFrom, JointShape, KIN, LANES, LOOP_MIN_PAIRS, LoopLink, LoopPlan, LoopStep, PlanStep,
+    RegressorLoop, first_row,
+};
 pub use rnea_derivatives_loop::{DerivativeLink, DerivativeLoop, LoopColumn, LoopSpeed};
 
 /// One derived registry function: its output entries as expressions in the arena (its name,

@@ -19,8 +19,10 @@ use super::Ctx;
 use crate::expr::ExprId;
 use crate::options::RegressorForm;
 
-/// Values per link of the loop form's table (`kanegen_runtime::regressor::KIN`).
-pub const KIN: usize = 21;
+/// Values per link of the loop form's table (`kanegen_runtime::regressor::KIN`): `ω`, `α`,
+/// `a − g`, the joint rotation `R` (row-major) and origin `P`, then the body's coefficients
+/// `K = [α]× + [ω]×[ω]×` (row-major), `−(a − g)` and `−ω`.
+pub const KIN: usize = 36;
 
 /// Rows per chunk of the loop (`kanegen_runtime::regressor::LANES`).
 pub const LANES: usize = 4;
@@ -44,6 +46,72 @@ pub struct RegressorLoop {
     /// Result entries outside the bodies' columns (a wheeled base's wheel parameters),
     /// straight-line: `(row, column, expression)`.
     pub extra: Vec<(usize, usize, ExprId)>,
+    /// Per link, the structure of its joint transform (what the runtime kernel's carry is
+    /// specialised for).
+    pub joints: Vec<JointShape>,
+}
+
+/// The structure of a link's joint transform in the loop form's `kin` table, found from its
+/// expressions: which entry of the rotation `R` is the constant ±1 (a rotation about a
+/// coordinate axis after a constant signed permutation: Krang's joints) and whether the
+/// origin `P` can be non-zero.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct JointShape {
+    /// `(row, column)` of the constant ±1 entry of `R` whose row and column are otherwise
+    /// constant zeros, or `None` (dense).
+    pub axis: Option<(usize, usize)>,
+    /// Whether some component of `P` is not the constant zero.
+    pub offset: bool,
+}
+
+/// One (link, row chunk) step of the loop form's plan (`kanegen_runtime::regressor::Step`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PlanStep {
+    /// The link.
+    pub link: usize,
+    /// The row chunk (rows from [`first_row`]`(chunk, rows)`).
+    pub chunk: usize,
+    /// Scratch slot written (the link's depth), or `None` when no step but the next one (which
+    /// takes the value from the previous step directly) reads it.
+    pub slot: Option<usize>,
+    /// Where the parent's partial velocities of these rows are, if it has any.
+    pub from: Option<CarryFrom>,
+    /// Index of the chunk of the link's own joints' partial velocities in
+    /// [`LoopPlan::seeds`], if its joints move some of these rows.
+    pub seed: Option<usize>,
+    /// Whether the link's body has result columns.
+    pub body: bool,
+}
+
+/// Where a [`PlanStep`] finds its parent's partial velocities.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CarryFrom {
+    /// The step just before (kept in registers by the kernel).
+    Previous,
+    /// A scratch slot.
+    Slot(usize),
+}
+
+/// The loop form's tables as the runtime kernel `kanegen_runtime::regressor::inverse_dynamics_regressor`
+/// runs them: chunk by chunk, each chunk's links depth-first, only the (link, chunk) pairs some
+/// ancestor speed moves; the others' body entries are stored as zeros.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoopPlan {
+    /// The steps, in order.
+    pub steps: Vec<PlanStep>,
+    /// Seed chunks: per lane (row [`first_row`]`(chunk, rows) + lane`), `(ω; v)` component by
+    /// component.
+    pub seeds: Vec<[[f64; LANES]; 6]>,
+    /// (link, chunk) pairs of bodies with columns whose rows no speed moves.
+    pub zeros: Vec<(usize, usize)>,
+    /// Scratch slots (the deepest step's depth plus one).
+    pub slots: usize,
+    /// Lane flops of the steps per call, as the kernel runs them (a multiply-add counts 2, as
+    /// in the straight-line counts; the links' coefficients are in the straight-line part): per
+    /// step and lane 26 to
+    /// carry through an axis-aligned joint with an offset, 14 without, 42 and 30 dense, none
+    /// from zero; 71 for a body's entries; 6 to add a seed chunk.
+    pub flops: usize,
 }
 
 /// One link of a [`RegressorLoop`].
@@ -113,11 +181,159 @@ impl RegressorLoop {
         s
     }
 
-    /// Flops of the loop per call, as the runtime kernel runs them (every lane of a chunk,
-    /// rows that are not a link's ancestors' included): 23 per link with a body, and per chunk
-    /// of [`LANES`] rows 42 per lane to carry it from the parent and 71 per lane for the
-    /// body's entries.
+    /// The plan of the runtime kernel: per chunk of [`LANES`] rows, the links some speed in
+    /// those rows moves, depth-first (children after their parent, a subtree before the next
+    /// sibling), each carried from its parent's chunk (when the parent has it) and seeded with
+    /// its own joints' partial velocities.
+    pub fn plan(&self, rows: usize) -> LoopPlan {
+        let nl = self.links.len();
+        let n_chunks = rows.div_ceil(LANES);
+        // Which chunks each link's partial velocities can be non-zero in.
+        let mut has = vec![vec![false; n_chunks]; nl];
+        // Chunk c covers the rows from `first_row(c)`: the last one ends at the last row (it
+        // overlaps the one before when the rows are not a multiple of LANES, so that every store
+        // is a whole vector; the overlapping rows are computed twice, identically).
+        let windows = |r: usize| {
+            (0..n_chunks).filter(move |&c| {
+                let r0 = first_row(c, rows);
+                r0 <= r && r < r0 + LANES
+            })
+        };
+        for s in &self.steps {
+            if s.row < rows {
+                for c in windows(s.row) {
+                    has[s.link][c] = true;
+                }
+            }
+        }
+        // Children lists and depths (links are in topological order).
+        let mut children = vec![Vec::new(); nl];
+        let mut depth = vec![0; nl];
+        for (l, link) in self.links.iter().enumerate() {
+            if link.parent != l {
+                children[link.parent].push(l);
+                depth[l] = depth[link.parent] + 1;
+            }
+        }
+        let mut preorder = Vec::with_capacity(nl);
+        let mut stack: Vec<usize> = (0..nl)
+            .rev()
+            .filter(|&l| self.links[l].parent == l)
+            .collect();
+        while let Some(l) = stack.pop() {
+            preorder.push(l);
+            stack.extend(children[l].iter().rev());
+        }
+        let mut seeds = Vec::new();
+        let mut seed_of = std::collections::BTreeMap::new();
+        for (row, link, phi) in self.seeds() {
+            if row >= rows {
+                continue;
+            }
+            for c in windows(row) {
+                let i = *seed_of.entry((link, c)).or_insert_with(|| {
+                    seeds.push([[0.0; LANES]; 6]);
+                    seeds.len() - 1
+                });
+                for (d, x) in seeds[i].iter_mut().zip(phi) {
+                    d[row - first_row(c, rows)] = x;
+                }
+            }
+        }
+        let mut steps = Vec::new();
+        let mut flops = 0;
+        for chunk in 0..n_chunks {
+            for &l in &preorder {
+                if !has[l][chunk] {
+                    continue;
+                }
+                let link = &self.links[l];
+                let p = link.parent;
+                let from = (p != l && has[p][chunk]).then(|| {
+                    let prev = steps.last().filter(|s: &&PlanStep| s.chunk == chunk);
+                    if prev.is_some_and(|s| s.link == p) {
+                        CarryFrom::Previous
+                    } else {
+                        CarryFrom::Slot(depth[p])
+                    }
+                });
+                let seed = seed_of.get(&(l, chunk)).copied();
+                let body = link.writes();
+                if from.is_some() {
+                    let j = self.joints[l];
+                    flops += LANES
+                        * match (j.axis.is_some(), j.offset) {
+                            (true, true) => 26,
+                            (true, false) => 14,
+                            (false, true) => 42,
+                            (false, false) => 30,
+                        };
+                }
+                if seed.is_some() {
+                    flops += 6 * LANES;
+                }
+                if body {
+                    flops += 71 * LANES;
+                }
+                steps.push(PlanStep {
+                    link: l,
+                    chunk,
+                    slot: Some(depth[l]),
+                    from,
+                    seed,
+                    body,
+                });
+            }
+        }
+        let zeros = (0..n_chunks)
+            .flat_map(|c| (0..nl).map(move |l| (l, c)))
+            .filter(|&(l, c)| self.links[l].writes() && !has[l][c])
+            .collect();
+        // A step's slot is needed only by a later step reading it from the scratch.
+        let mut read = vec![false; steps.len()];
+        for (i, s) in steps.iter().enumerate() {
+            if let Some(CarryFrom::Slot(d)) = s.from {
+                // The last earlier step of the same chunk at that depth wrote it.
+                if let Some(j) = (0..i)
+                    .rev()
+                    .find(|&j| steps[j].chunk == s.chunk && steps[j].slot == Some(d))
+                {
+                    read[j] = true;
+                }
+            }
+        }
+        for (s, r) in steps.iter_mut().zip(read) {
+            if !r {
+                s.slot = None;
+            }
+        }
+        let slots = steps
+            .iter()
+            .filter_map(|s| s.slot.map(|d| d + 1))
+            .max()
+            .unwrap_or(0);
+        LoopPlan {
+            steps,
+            seeds,
+            zeros,
+            slots,
+            flops,
+        }
+    }
+
+    /// Lane flops of the loop per call, as the generated code's runtime kernel runs them: the
+    /// flops of its [`RegressorLoop::plan`] (a multiply-add counts once; every lane of a step
+    /// is counted, also rows that do not move the link).
     pub fn flops(&self) -> usize {
+        let rows = self.steps.iter().map(|s| s.row + 1).max().unwrap_or(0);
+        self.plan(rows).flops
+    }
+
+    /// Flops of the loop per call as the plain kernel (`inverse_dynamics_regressor_with`) runs
+    /// them (every lane of a chunk, rows that are not a link's ancestors' included): 23 per
+    /// link with a body, and per chunk of [`LANES`] rows 42 per lane to carry it from the
+    /// parent and 71 per lane for the body's entries.
+    pub fn plain_flops(&self) -> usize {
         let (chunks, _) = self.chunks();
         let mut flops = 0;
         for (l, link) in self.links.iter().enumerate() {
@@ -134,6 +350,13 @@ impl RegressorLoop {
         }
         flops
     }
+}
+
+/// The first row of chunk `c` of a result of `rows` rows
+/// (`kanegen_runtime::regressor::first_row`): `LANES · c`, but the last chunk ends at the last
+/// row (overlapping the one before) when there are at least [`LANES`] rows.
+pub fn first_row(c: usize, rows: usize) -> usize {
+    (LANES * c).min(rows.saturating_sub(LANES))
 }
 
 /// Whether `form` asks for the loop form of `model`'s regressor with `pairs` (speed, body)
@@ -216,6 +439,7 @@ impl Ctx<'_> {
         let one = self.ar.one();
         let mut kin = Vec::with_capacity(KIN * model.links.len());
         let mut links = Vec::with_capacity(model.links.len());
+        let mut joints = Vec::with_capacity(model.links.len());
         let mut body = 0;
         for (l, link) in model.links.iter().enumerate() {
             kin.extend(motion.w[l]);
@@ -234,6 +458,47 @@ impl Ctx<'_> {
                     kin.extend([zero; 3]);
                 }
             }
+            // The coefficients of the body's entries: K = ω ωᵀ − |ω|² I + [α]×, −a, −ω.
+            let (w, al, acc) = (motion.w[l], motion.wd[l], motion.a[l]);
+            for i in 0..3 {
+                for j in 0..3 {
+                    let e = if i == j {
+                        let (a, b) = ((i + 1) % 3, (i + 2) % 3);
+                        let wa = self.ar.mul(w[a], w[a]);
+                        let wb = self.ar.mul(w[b], w[b]);
+                        let s = self.ar.add(wa, wb);
+                        self.ar.neg(s)
+                    } else {
+                        // [α]×: (i, j) = −ε_ijk α_k.
+                        let k = 3 - i - j;
+                        let ww = self.ar.mul(w[i], w[j]);
+                        if (j + 3 - i) % 3 == 1 {
+                            self.ar.sub(ww, al[k])
+                        } else {
+                            self.ar.add(ww, al[k])
+                        }
+                    };
+                    kin.push(e);
+                }
+            }
+            for x in acc.into_iter().chain(w) {
+                let e = self.ar.neg(x);
+                kin.push(e);
+            }
+            // The transform's structure: a constant ±1 entry of R with zeros in its row and
+            // column (an axis-aligned joint), and whether P can be non-zero.
+            let at = kin.len() - 27;
+            let is = |e: ExprId, v: f64| self.ar.as_const(e) == Some(v);
+            let axis = (0..9).map(|i| (i / 3, i % 3)).find(|&(r, c)| {
+                let e = kin[at + 3 * r + c];
+                (is(e, 1.0) || is(e, -1.0))
+                    && (0..3).all(|k| {
+                        (k == c || is(kin[at + 3 * r + k], 0.0))
+                            && (k == r || is(kin[at + 3 * k + c], 0.0))
+                    })
+            });
+            let offset = !kin[at + 9..at + 12].iter().all(|&e| is(e, 0.0));
+            joints.push(JointShape { axis, offset });
             let mut columns = [None; 10];
             if link.body.is_some() {
                 for (t, c) in columns.iter_mut().enumerate() {
@@ -257,6 +522,7 @@ impl Ctx<'_> {
             links,
             steps: steps(model),
             extra,
+            joints,
         }
     }
 }

@@ -20,7 +20,7 @@
 //!   crate's `unsafe` calls (see below), and [`isa::Arith`], the multiply-add the copies
 //!   differ in; [`lanes`]: the lane type of the batched functions.
 //! - [`regressor`]: the loop of a loop-form inverse-dynamics regressor (per link and four rows
-//!   at a time, over two generated constant tables).
+//!   at a time, over a generated plan; generic over [`isa::Arith`]).
 //! - [`derivative_steps`]: the loop of the looped `inverse_dynamics_derivatives` (the
 //!   (column, ancestor) steps of the analytic recursion over generated tables); its AVX2 copy
 //!   is called from the crate's second `unsafe` block.

@@ -464,8 +464,8 @@ pub fn inverse_dynamics_regressor_plan<A, T>(
                 macro_rules! axis {
                     ($($code:literal => $rr:literal, $rc:literal;)*) => {
                         match st.rotation {
-                            $($code => carry_axis::<A, T, $rr, $rc>(pc, kl, st.offset),)*
-                            _ => carry_dense::<A, T>(pc, kl, st.offset),
+                            $($code => carry::<A, T>(pc, kl, st.offset, rt_axis::<A, T, $rr, $rc>),)*
+                            _ => carry::<A, T>(pc, kl, st.offset, rt_dense::<A, T>),
                         }
                     };
                 }
@@ -579,12 +579,13 @@ where
 }
 
 /// The partial velocities of a chunk carried one joint down: `ω' = Rᵀ ω`, `v' = Rᵀ (v + ω ×
-/// P)`, `Rᵀ` specialised by [`rt_axis`].
+/// P)`, `Rᵀ` applied by `rt` ([`rt_axis`] specialised by the joint's axis, or [`rt_dense`]).
 #[inline(always)]
-fn carry_axis<A, T, const RR: usize, const RC: usize>(
+fn carry<A, T>(
     pc: &Chunk<T>,
     kin: &[T; KIN],
     offset: bool,
+    rt: impl Fn(&[T], [V<T>; 3]) -> [V<T>; 3],
 ) -> Chunk<T>
 where
     A: crate::isa::Arith<T>,
@@ -598,28 +599,8 @@ where
         v
     };
     let r = &kin[9..18];
-    let w = rt_axis::<A, T, RR, RC>(r, w);
-    let v = rt_axis::<A, T, RR, RC>(r, v);
-    [w[0], w[1], w[2], v[0], v[1], v[2]]
-}
-
-/// [`carry_axis`] for a dense rotation.
-#[inline(always)]
-fn carry_dense<A, T>(pc: &Chunk<T>, kin: &[T; KIN], offset: bool) -> Chunk<T>
-where
-    A: crate::isa::Arith<T>,
-    T: Scalar,
-{
-    let w = [pc[0], pc[1], pc[2]];
-    let v = [pc[3], pc[4], pc[5]];
-    let v = if offset {
-        add_w_cross_p::<A, T>(kin, &w, v)
-    } else {
-        v
-    };
-    let r = &kin[9..18];
-    let w = rt_dense::<A, T>(r, w);
-    let v = rt_dense::<A, T>(r, v);
+    let w = rt(r, w);
+    let v = rt(r, v);
     [w[0], w[1], w[2], v[0], v[1], v[2]]
 }
 

@@ -316,9 +316,7 @@ pub fn lower_with(d: &Derivation, form: DerivativesForm) -> Lowered {
                 entries.extend_from_slice(&l.extra);
                 let name = format!("{} (loop form)", f.id.name());
                 LoopProgram {
-                    program: lower_entries(
-                        &d.arena, &name, &entries, &f.order, hoist, &mut pre, false,
-                    ),
+                    program: lower_entries(&d.arena, &name, &entries, &f.order, hoist, &mut pre),
                     kin_len: l.kin.len(),
                     tables: l.clone(),
                 }
@@ -341,15 +339,8 @@ pub fn lower_with(d: &Derivation, form: DerivativesForm) -> Lowered {
                 parts.push(entries.len()..entries.len() + p.len());
                 entries.extend_from_slice(p);
             }
-            let program = lower_entries(
-                &d.arena,
-                &c.spec.name,
-                &entries,
-                &c.order,
-                hoist,
-                &mut pre,
-                true,
-            );
+            let program =
+                lower_entries(&d.arena, &c.spec.name, &entries, &c.order, hoist, &mut pre);
             CombinedProgram {
                 spec: c.spec.clone(),
                 program,
@@ -380,7 +371,6 @@ pub fn lower_with(d: &Derivation, form: DerivativesForm) -> Lowered {
                 &l.order,
                 hoist,
                 &mut pre,
-                false,
             ),
             plan: l.plan.clone(),
         });
@@ -590,187 +580,6 @@ fn schedule(
     out
 }
 
-/// How many statements of the ready list [`pressure_order`] compares at each step (the earliest
-/// in the derivation's order): bounds its cost on very long programs (O(n · window)).
-const PRESSURE_WINDOW: usize = 256;
-
-/// The smallest reduction of the most values live at once (in percent) for which
-/// [`pressure_order`] replaces the derivation's order. Measured on Krang (callgrind, both
-/// instruction sets): the mass matrix (39 → 35 live, −10 %) ran 4 % fewer instructions in its
-/// x86-64-v3 copy, 35 % fewer of them addressing the stack; c and τ (111 → 108) ran 1 % more
-/// in one copy and 1 % fewer in the other, g (32 → 31) the same: LLVM's own scheduling and
-/// register allocation decide at that scale.
-const PRESSURE_GAIN_PERCENT: usize = 10;
-
-/// A register-pressure-aware order of a program's statements `sched` (a valid order, e.g. the
-/// derivation's; `roots` are the result entries, each stored right after the last statement it
-/// reads): list scheduling that, at every step, runs the ready statement that leaves the fewest
-/// values live — the one whose operands (and the result entries it completes) are their last
-/// readers, net of the value it defines — preferring the derivation's order among equals.
-/// Returns the new order when it keeps at least [`PRESSURE_GAIN_PERCENT`] % fewer values live
-/// at once than `sched`, else `sched`. Reordering changes no value: every statement and result
-/// entry is computed from the same operands with the same operations.
-fn pressure_order(
-    ar: &Arena,
-    roots: &[ExprId],
-    is_leaf: &dyn Fn(ExprId) -> bool,
-    sched: Vec<(ExprId, Option<u32>)>,
-) -> Vec<(ExprId, Option<u32>)> {
-    let n = sched.len();
-    if n < 3 {
-        return sched;
-    }
-    let is_stmt: FxHashMap<ExprId, Option<u32>> = sched.iter().copied().collect();
-    let index: FxHashMap<ExprId, usize> = sched
-        .iter()
-        .enumerate()
-        .map(|(i, (e, _))| (*e, i))
-        .collect();
-    let mut buf = Vec::new();
-    let mut reads_of = |e: ExprId, top: bool| -> Vec<usize> {
-        buf.clear();
-        statement_deps(ar, e, &is_stmt, is_leaf, &mut buf, top);
-        let mut d: Vec<usize> = buf.iter().map(|x| index[x]).collect();
-        d.sort_unstable();
-        d.dedup();
-        d
-    };
-    let deps: Vec<Vec<usize>> = sched.iter().map(|&(e, _)| reads_of(e, true)).collect();
-    let outs: Vec<Vec<usize>> = roots
-        .iter()
-        .map(|&r| reads_of(r, false))
-        .filter(|d| !d.is_empty())
-        .collect();
-    let mut users: Vec<Vec<usize>> = vec![Vec::new(); n];
-    let mut out_users: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for (s, d) in deps.iter().enumerate() {
-        for &v in d {
-            users[v].push(s);
-        }
-    }
-    for (o, d) in outs.iter().enumerate() {
-        for &v in d {
-            out_users[v].push(o);
-        }
-    }
-    // Unscheduled readers (statements and result entries) per value, unscheduled operands per
-    // statement, unscheduled statements per result entry.
-    let mut remaining: Vec<usize> = (0..n)
-        .map(|i| users[i].len() + out_users[i].len())
-        .collect();
-    let mut unmet: Vec<usize> = deps.iter().map(Vec::len).collect();
-    let mut pending: Vec<usize> = outs.iter().map(Vec::len).collect();
-    let mut ready: BTreeSet<usize> = (0..n).filter(|&i| unmet[i] == 0).collect();
-    let mut order: Vec<usize> = Vec::with_capacity(n);
-    let mut consumed: Vec<(usize, usize)> = Vec::new();
-    while !ready.is_empty() {
-        let mut best: Option<(i64, usize)> = None;
-        for &s in ready.iter().take(PRESSURE_WINDOW) {
-            // Values whose last readers run at this step: s's operands and the operands of the
-            // result entries s completes.
-            consumed.clear();
-            let bump = |v: usize, consumed: &mut Vec<(usize, usize)>| match consumed
-                .iter_mut()
-                .find(|(w, _)| *w == v)
-            {
-                Some((_, c)) => *c += 1,
-                None => consumed.push((v, 1)),
-            };
-            for &v in &deps[s] {
-                bump(v, &mut consumed);
-            }
-            for &o in &out_users[s] {
-                if pending[o] == 1 {
-                    for &v in &outs[o] {
-                        bump(v, &mut consumed);
-                    }
-                }
-            }
-            let mut net: i64 = 0;
-            let mut own = 0;
-            for &(v, c) in &consumed {
-                if v == s {
-                    own = c;
-                } else if c == remaining[v] {
-                    net -= 1;
-                }
-            }
-            if remaining[s] > own {
-                net += 1;
-            }
-            if best.is_none_or(|(b, _)| net < b) {
-                best = Some((net, s));
-            }
-        }
-        let (_, s) = best.expect("the ready list is not empty");
-        ready.remove(&s);
-        order.push(s);
-        for &v in &deps[s] {
-            remaining[v] -= 1;
-        }
-        for &o in &out_users[s] {
-            pending[o] -= 1;
-            if pending[o] == 0 {
-                for &v in &outs[o] {
-                    remaining[v] -= 1;
-                }
-            }
-        }
-        for &u in &users[s] {
-            unmet[u] -= 1;
-            if unmet[u] == 0 {
-                ready.insert(u);
-            }
-        }
-    }
-    debug_assert_eq!(order.len(), n, "every statement is scheduled");
-    let identity: Vec<usize> = (0..n).collect();
-    let before = live_profile(&identity, &deps, &outs);
-    let after = live_profile(&order, &deps, &outs);
-    if order.len() == n && after * 100 <= before * (100 - PRESSURE_GAIN_PERCENT) {
-        order.into_iter().map(|i| sched[i]).collect()
-    } else {
-        sched
-    }
-}
-
-/// The most values live at once when the statements
-/// run in `order` (indices into `deps`, each statement's operands) and every result entry
-/// (`outs`: the statements it reads) is stored right after the last statement it reads, as
-/// [`Program::max_live`] counts.
-fn live_profile(order: &[usize], deps: &[Vec<usize>], outs: &[Vec<usize>]) -> usize {
-    let n = order.len();
-    let mut pos = vec![0usize; n];
-    for (p, &s) in order.iter().enumerate() {
-        pos[s] = p;
-    }
-    let mut last: Vec<usize> = pos.clone();
-    for (s, d) in deps.iter().enumerate() {
-        for &v in d {
-            last[v] = last[v].max(pos[s]);
-        }
-    }
-    for d in outs {
-        let at = d.iter().map(|&v| pos[v]).max().unwrap_or(0);
-        for &v in d {
-            last[v] = last[v].max(at);
-        }
-    }
-    let mut delta = vec![0i64; n + 1];
-    for v in 0..n {
-        if last[v] > pos[v] {
-            delta[pos[v]] += 1;
-            delta[last[v]] -= 1;
-        }
-    }
-    let (mut live, mut max) = (0i64, 0i64);
-    for d in delta {
-        live += d;
-        max = max.max(live);
-    }
-    max as usize
-}
-
 /// The statements that statement `e` reads directly (through inline subexpressions and
 /// variables), in reading order.
 fn statement_deps(
@@ -808,12 +617,10 @@ fn statement_deps(
 }
 
 fn lower_function(ar: &Arena, f: &Function, hoist: bool, pre: &mut PreSet) -> Program {
-    lower_entries(ar, f.id.name(), &f.entries, &f.order, hoist, pre, true)
+    lower_entries(ar, f.id.name(), &f.entries, &f.order, hoist, pre)
 }
 
-/// The program computing `entries` (its outputs, in order), statements in `order` (then, with
-/// `reorder`, in the register-pressure order of [`pressure_order`] where that keeps fewer
-/// values live).
+/// The program computing `entries` (its outputs, in order), statements in `order`.
 fn lower_entries(
     ar: &Arena,
     name: &str,
@@ -821,7 +628,6 @@ fn lower_entries(
     order: &[ExprId],
     hoist: bool,
     pre: &mut PreSet,
-    reorder: bool,
 ) -> Program {
     let roots: Vec<ExprId> = entries.iter().map(|e| e.2).collect();
     let mut b = ProgramBuilder {
@@ -835,11 +641,6 @@ fn lower_entries(
             && (matches!(ar.node(e), Node::Atom(Atom::Var(_))) || is_compound(ar.node(e)))
     };
     let sched = schedule(ar, &roots, &is_leaf, Some(order));
-    let sched = if reorder {
-        pressure_order(ar, &roots, &is_leaf, sched)
-    } else {
-        sched
-    };
     let mut stmts = Vec::new();
     let (mut nk, mut nd, mut nt) = (0, 0, 0);
     for (e, var) in sched {

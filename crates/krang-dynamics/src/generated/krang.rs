@@ -1995,24 +1995,24 @@ mod generated {
         pc42: f64,
         pc43: f64,
         pc44: f64,
+        pc47: f64,
         pc48: f64,
         pc49: f64,
         pc50: f64,
-        pc47: f64,
-        pc52: f64,
         pc51: f64,
-        pc58: f64,
-        pc57: f64,
+        pc52: f64,
+        pc54: f64,
         pc55: f64,
         pc56: f64,
+        pc57: f64,
+        pc58: f64,
         pc59: f64,
-        pc54: f64,
-        pc63: f64,
-        pc65: f64,
-        pc64: f64,
-        pc66: f64,
         pc61: f64,
         pc62: f64,
+        pc63: f64,
+        pc64: f64,
+        pc65: f64,
+        pc66: f64,
         pc69: f64,
         pc68: f64,
         pc67: f64,
@@ -2117,24 +2117,24 @@ mod generated {
                 pc42,
                 pc43,
                 pc44,
+                pc47,
                 pc48,
                 pc49,
                 pc50,
-                pc47,
-                pc52,
                 pc51,
-                pc58,
-                pc57,
+                pc52,
+                pc54,
                 pc55,
                 pc56,
+                pc57,
+                pc58,
                 pc59,
-                pc54,
-                pc63,
-                pc65,
-                pc64,
-                pc66,
                 pc61,
                 pc62,
+                pc63,
+                pc64,
+                pc65,
+                pc66,
                 pc69,
                 pc68,
                 pc67,
@@ -2227,590 +2227,590 @@ mod generated {
                 let d3 = t1 + t2 - t5; // N(M col 10r) at 9r.x
                 m[(17, 18)] = -d3;
                 m[(18, 17)] = m[(17, 18)];
-                let d4 = p.XY9r + t1 + t2 - t5; // JC9r.xy
-                let d5 = t3 - t4 - t6; // N(M col 10r) at 9r.z
-                let d6 = p.YZ9r - t3 + t4 + t6; // JC9r.yz
-                let d7 = d2 * s_q6r; // F(M col 10r) at 8r.y
-                let d8 = d2 * c_q6r; // F(M col 10r) at 8r.z
-                let d9 = p.MX9r - d2; // MSC9r.x
-                let d10 = p.MX8r - d9; // MSC8r.x
-                let d11 = A::mul_add(-d5, s_q6r, p.ZZ10r * c_q6r); // N(M col 10r) at 8r.y
-                m[(16, 18)] = d11;
+                let d4 = t3 - t4 - t6; // N(M col 10r) at 9r.z
+                let d5 = d2 * s_q6r; // F(M col 10r) at 8r.y
+                let d6 = d2 * c_q6r; // F(M col 10r) at 8r.z
+                let d7 = A::mul_add(-d4, s_q6r, p.ZZ10r * c_q6r); // N(M col 10r) at 8r.y
+                m[(16, 18)] = d7;
                 m[(18, 16)] = m[(16, 18)];
-                let d12 = A::mul_add(d5, c_q6r, p.ZZ10r * s_q6r); // N(M col 10r) at 8r.z
-                let d13 = A::mul_add(d8, s_q5r, d1 * c_q5r); // F(M col 10r) at 7r.x
-                let d14 = A::mul_add(-d8, c_q5r, d1 * s_q5r); // F(M col 10r) at 7r.z
-                let d15 = p.MZ9r + d1; // MSC9r.z
-                let d16 = A::mul_add(p.L8, d14, A::mul_add(-d12, s_q5r, d3 * c_q5r)); // N(M col 10r) at 7r.x
-                m[(15, 18)] = -d16;
+                let d8 = A::mul_add(d4, c_q6r, p.ZZ10r * s_q6r); // N(M col 10r) at 8r.z
+                let d9 = A::mul_add(d6, s_q5r, d1 * c_q5r); // F(M col 10r) at 7r.x
+                let d10 = A::mul_add(-d6, c_q5r, d1 * s_q5r); // F(M col 10r) at 7r.z
+                let d11 = A::mul_add(p.L8, d10, A::mul_add(-d8, s_q5r, d3 * c_q5r)); // N(M col 10r) at 7r.x
+                m[(15, 18)] = -d11;
                 m[(18, 15)] = m[(15, 18)];
-                let d17 = A::mul_add(-p.L8, d13, A::mul_add(d12, c_q5r, d3 * s_q5r)); // N(M col 10r) at 7r.z
-                let d18 = A::mul_add(-d14, s_q4r, d7 * c_q4r); // F(M col 10r) at 6r.y
-                let d19 = A::mul_add(d14, c_q4r, d7 * s_q4r); // F(M col 10r) at 6r.z
-                let d20 = A::mul_add(-d17, s_q4r, d11 * c_q4r); // N(M col 10r) at 6r.y
-                m[(14, 18)] = d20;
+                let d12 = A::mul_add(-p.L8, d9, A::mul_add(d8, c_q5r, d3 * s_q5r)); // N(M col 10r) at 7r.z
+                let d13 = A::mul_add(-d10, s_q4r, d5 * c_q4r); // F(M col 10r) at 6r.y
+                let d14 = A::mul_add(d10, c_q4r, d5 * s_q4r); // F(M col 10r) at 6r.z
+                let d15 = A::mul_add(-d12, s_q4r, d7 * c_q4r); // N(M col 10r) at 6r.y
+                m[(14, 18)] = d15;
                 m[(18, 14)] = m[(14, 18)];
-                let d21 = A::mul_add(d17, c_q4r, d11 * s_q4r); // N(M col 10r) at 6r.z
-                let d22 = A::mul_add(-d19, s_q3r, d13 * c_q3r); // F(M col 10r) at 5r.x
-                let d23 = A::mul_add(d19, c_q3r, d13 * s_q3r); // F(M col 10r) at 5r.z
-                let d24 = A::mul_add(p.L7, d23, A::mul_add(-d21, s_q3r, d16 * c_q3r)); // N(M col 10r) at 5r.x
-                m[(13, 18)] = -d24;
+                let d16 = A::mul_add(d12, c_q4r, d7 * s_q4r); // N(M col 10r) at 6r.z
+                let d17 = A::mul_add(-d14, s_q3r, d9 * c_q3r); // F(M col 10r) at 5r.x
+                let d18 = A::mul_add(d14, c_q3r, d9 * s_q3r); // F(M col 10r) at 5r.z
+                let d19 = A::mul_add(p.L7, d18, A::mul_add(-d16, s_q3r, d11 * c_q3r)); // N(M col 10r) at 5r.x
+                m[(13, 18)] = -d19;
                 m[(18, 13)] = m[(13, 18)];
-                let d25 = A::mul_add(-p.L7, d22, A::mul_add(d21, c_q3r, d16 * s_q3r)); // N(M col 10r) at 5r.z
-                let d26 = A::mul_add(-d23, s_q2r, d18 * c_q2r); // F(M col 10r) at 4r.y
-                let d27 = A::mul_add(d23, c_q2r, d18 * s_q2r); // F(M col 10r) at 4r.z
-                let d28 = A::mul_add(-d25, s_q2r, d20 * c_q2r); // N(M col 10r) at 4r.y
-                m[(12, 18)] = d28;
+                let d20 = A::mul_add(-p.L7, d17, A::mul_add(d16, c_q3r, d11 * s_q3r)); // N(M col 10r) at 5r.z
+                let d21 = A::mul_add(-d18, s_q2r, d13 * c_q2r); // F(M col 10r) at 4r.y
+                let d22 = A::mul_add(d18, c_q2r, d13 * s_q2r); // F(M col 10r) at 4r.z
+                let d23 = A::mul_add(-d20, s_q2r, d15 * c_q2r); // N(M col 10r) at 4r.y
+                m[(12, 18)] = d23;
                 m[(18, 12)] = m[(12, 18)];
-                let d29 = A::mul_add(d25, c_q2r, d20 * s_q2r); // N(M col 10r) at 4r.z
-                let d30 = A::mul_add(-d27, s_q1r, d22 * c_q1r); // F(M col 10r) at 3.y
-                let d31 = A::mul_add(d27, c_q1r, d22 * s_q1r); // F(M col 10r) at 3.z
-                let d32 = A::mul_add(-p.L5, d31, d28); // N(M col 10r) at 3.x
-                let d33 = A::mul_add(p.L6, d31, A::mul_add(-d29, s_q1r, d24 * c_q1r)); // N(M col 10r) at 3.y
-                m[(4, 18)] = d33;
+                let d24 = A::mul_add(d20, c_q2r, d15 * s_q2r); // N(M col 10r) at 4r.z
+                let d25 = A::mul_add(-d22, s_q1r, d17 * c_q1r); // F(M col 10r) at 3.y
+                let d26 = A::mul_add(d22, c_q1r, d17 * s_q1r); // F(M col 10r) at 3.z
+                let d27 = A::mul_add(-p.L5, d26, d23); // N(M col 10r) at 3.x
+                let d28 = A::mul_add(p.L6, d26, A::mul_add(-d24, s_q1r, d19 * c_q1r)); // N(M col 10r) at 3.y
+                m[(4, 18)] = d28;
                 m[(18, 4)] = m[(4, 18)];
-                let d34 = A::mul_add(
-                    d26,
+                let d29 = A::mul_add(
+                    d21,
                     p.L5,
-                    A::mul_add(-p.L6, d30, A::mul_add(d29, c_q1r, d24 * s_q1r)),
+                    A::mul_add(-p.L6, d25, A::mul_add(d24, c_q1r, d19 * s_q1r)),
                 ); // N(M col 10r) at 3.z
-                let d35 = A::mul_add(d31, s_q_torso, d26 * c_q_torso); // F(M col 10r) at 2.x
-                let d36 = A::mul_add(-d31, c_q_torso, d26 * s_q_torso); // F(M col 10r) at 2.z
-                let d37 = A::mul_add(p.L4, d35, d33); // N(M col 10r) at 2.y
-                let d38 = A::mul_add(
-                    -d30,
+                let d30 = A::mul_add(d26, s_q_torso, d21 * c_q_torso); // F(M col 10r) at 2.x
+                let d31 = A::mul_add(-d26, c_q_torso, d21 * s_q_torso); // F(M col 10r) at 2.z
+                let d32 = A::mul_add(
+                    -d25,
                     p.L4,
-                    A::mul_add(p.L3, d36, A::mul_add(d34, s_q_torso, d32 * c_q_torso)),
+                    A::mul_add(p.L3, d31, A::mul_add(d29, s_q_torso, d27 * c_q_torso)),
                 ); // N(M col 10r) at 2.x
-                m[(3, 18)] = d38;
+                m[(3, 18)] = d32;
                 m[(18, 3)] = m[(3, 18)];
-                let d39 = A::mul_add(
+                let d33 = A::mul_add(p.L4, d30, d28); // N(M col 10r) at 2.y
+                let d34 = A::mul_add(
                     -p.L3,
-                    d35,
-                    A::mul_add(-d34, c_q_torso, d32 * s_q_torso),
+                    d30,
+                    A::mul_add(-d29, c_q_torso, d27 * s_q_torso),
                 ); // N(M col 10r) at 2.z
-                let d40 = A::mul_add(-d36, c_q_w, d30 * s_q_w); // F(M col 10r) at 1.z
-                let d41 = A::mul_add(d36, s_q_w, d30 * c_q_w); // F(M col 10r) at 1.y
-                let d42 = A::mul_add(p.L2, d41, A::mul_add(-p.L1, d40, d38)); // N(M col 10r) at 1.x
-                m[(2, 18)] = d42;
+                let d35 = A::mul_add(-d31, c_q_w, d25 * s_q_w); // F(M col 10r) at 1.z
+                let d36 = A::mul_add(d31, s_q_w, d25 * c_q_w); // F(M col 10r) at 1.y
+                let d37 = A::mul_add(d30, p.L1, A::mul_add(-d34, c_q_w, d33 * s_q_w)); // N(M col 10r) at 1.z
+                let d38 = A::mul_add(p.L2, d36, A::mul_add(-p.L1, d35, d32)); // N(M col 10r) at 1.x
+                m[(2, 18)] = d38;
                 m[(18, 2)] = m[(2, 18)];
-                let d43 = A::mul_add(d40, c_q_imu, d41 * s_q_imu); // F(M col 10r) at 0.x
-                m[(0, 18)] = -d43;
+                let d39 = A::mul_add(-d30, p.L2, A::mul_add(d34, s_q_w, d33 * c_q_w)); // N(M col 10r) at 1.y
+                let d40 = A::mul_add(d35, c_q_imu, d36 * s_q_imu); // F(M col 10r) at 0.x
+                m[(0, 18)] = -d40;
                 m[(18, 0)] = m[(0, 18)];
-                let d44 = A::mul_add(d35, p.L1, A::mul_add(-d39, c_q_w, d37 * s_q_w)); // N(M col 10r) at 1.z
-                let d45 = A::mul_add(-d35, p.L2, A::mul_add(d39, s_q_w, d37 * c_q_w)); // N(M col 10r) at 1.y
-                let d46 = A::mul_add(-d44, s_q_imu, d45 * c_q_imu); // N(M col 10r) at 0.z
-                m[(1, 18)] = -d46;
+                let d41 = A::mul_add(-d37, s_q_imu, d39 * c_q_imu); // N(M col 10r) at 0.z
+                m[(1, 18)] = -d41;
                 m[(18, 1)] = m[(1, 18)];
+                let d42 = p.MX9r - d2; // MSC9r.x
+                let d43 = p.MZ9r + d1; // MSC9r.z
                 let k1 = s_q7r * s_q7r; // sin² q7r
                 let k2 = s_q7r * c_q7r; // sin q7r cos q7r
                 let k3 = A::mul_add(2.0, k1, -1.0); // cos 2q7r
-                let d47 = A::mul_add(-2.0, p.XY10r * k2, k1 * pc.pc3); // JC10r rotated about z: Jxx − J'xx
-                let d48 = A::mul_add(-k2, pc.pc3, A::mul_add(-p.XY10r, k3, p.XZ9r)); // JC9r.xz
-                let d49 = pc.pc7 - d47; // JC9r.xx
-                m[(17, 17)] = d49;
-                let d50 = d47 + pc.pc8; // JC9r.zz
-                let d51 = A::mul_add(s_q6r, d15, c_q6r * pc.pc2); // MSC9r in 8r.y
-                let d52 = A::mul_add(-c_q6r, d15, s_q6r * pc.pc2); // MSC9r in 8r.z
-                let t7 = c_q6r * d4; // common subexpression
-                let t8 = s_q6r * d4; // common subexpression
-                let t9 = s_q6r * d48; // common subexpression
-                let t10 = c_q6r * d48; // common subexpression
-                let d53 = t7 + t9; // N(M col 9r) at 8r.y
-                m[(16, 17)] = -d53;
+                let d44 = A::mul_add(-2.0, p.XY10r * k2, k1 * pc.pc3); // JC10r rotated about z: Jxx − J'xx
+                let d45 = p.XY9r + t1 + t2 - t5; // JC9r.xy
+                let d46 = A::mul_add(-k2, pc.pc3, A::mul_add(-p.XY10r, k3, p.XZ9r)); // JC9r.xz
+                let d47 = p.YZ9r - t3 + t4 + t6; // JC9r.yz
+                let d48 = pc.pc7 - d44; // JC9r.xx
+                m[(17, 17)] = d48;
+                let d49 = d44 + pc.pc8; // JC9r.zz
+                let d50 = A::mul_add(s_q6r, d43, c_q6r * pc.pc2); // MSC9r in 8r.y
+                let d51 = A::mul_add(-c_q6r, d43, s_q6r * pc.pc2); // MSC9r in 8r.z
+                let t7 = c_q6r * d45; // common subexpression
+                let t8 = s_q6r * d46; // common subexpression
+                let d52 = t7 + t8; // N(M col 9r) at 8r.y
+                m[(16, 17)] = -d52;
                 m[(17, 16)] = m[(16, 17)];
-                let d54 = p.XY8r + t7 + t9; // JC8r.xy
-                let d55 = t8 - t10; // N(M col 9r) at 8r.z
-                let d56 = p.XZ8r + t8 - t10; // JC8r.xz
-                let d57 = s_q5r * d51; // F(M col 9r) at 7r.x
-                let d58 = c_q5r * d51; // F(M col 9r) at 7r.z
-                let d59 = p.MY8r - d51; // MSC8r.y
-                let d60 = A::mul_add(-p.L8, d57, A::mul_add(c_q5r, d55, s_q5r * d49)); // N(M col 9r) at 7r.z
-                let d61 = A::mul_add(-p.L8, d58, A::mul_add(-s_q5r, d55, c_q5r * d49)); // N(M col 9r) at 7r.x
-                m[(15, 17)] = d61;
+                let t9 = s_q6r * d45; // common subexpression
+                let t10 = c_q6r * d46; // common subexpression
+                let d53 = t9 - t10; // N(M col 9r) at 8r.z
+                let d54 = s_q5r * d50; // F(M col 9r) at 7r.x
+                let d55 = c_q5r * d50; // F(M col 9r) at 7r.z
+                let d56 = A::mul_add(-p.L8, d54, A::mul_add(c_q5r, d53, s_q5r * d48)); // N(M col 9r) at 7r.z
+                let d57 = A::mul_add(-p.L8, d55, A::mul_add(-s_q5r, d53, c_q5r * d48)); // N(M col 9r) at 7r.x
+                m[(15, 17)] = d57;
                 m[(17, 15)] = m[(15, 17)];
-                let d62 = p.XX8r + d49; // JC8r.xx
-                let d63 = A::mul_add(s_q4r, d58, c_q4r * d52); // F(M col 9r) at 6r.y
-                let d64 = A::mul_add(-c_q4r, d58, s_q4r * d52); // F(M col 9r) at 6r.z
-                let d65 = p.MZ8r - d52; // MSC8r.z
-                let d66 = A::mul_add(-s_q4r, d60, c_q4r * d53); // N(M col 9r) at 6r.y
-                m[(14, 17)] = -d66;
+                let d58 = A::mul_add(s_q4r, d55, c_q4r * d51); // F(M col 9r) at 6r.y
+                let d59 = A::mul_add(-c_q4r, d55, s_q4r * d51); // F(M col 9r) at 6r.z
+                let d60 = A::mul_add(-s_q4r, d56, c_q4r * d52); // N(M col 9r) at 6r.y
+                m[(14, 17)] = -d60;
                 m[(17, 14)] = m[(14, 17)];
-                let d67 = A::mul_add(c_q4r, d60, s_q4r * d53); // N(M col 9r) at 6r.z
-                let d68 = A::mul_add(c_q3r, d64, s_q3r * d57); // F(M col 9r) at 5r.z
-                let d69 = A::mul_add(-s_q3r, d64, c_q3r * d57); // F(M col 9r) at 5r.x
-                let d70 = A::mul_add(-p.L7, d69, A::mul_add(c_q3r, d67, s_q3r * d61)); // N(M col 9r) at 5r.z
-                let d71 = A::mul_add(p.L7, d68, A::mul_add(-s_q3r, d67, c_q3r * d61)); // N(M col 9r) at 5r.x
-                m[(13, 17)] = d71;
+                let d61 = A::mul_add(c_q4r, d56, s_q4r * d52); // N(M col 9r) at 6r.z
+                let d62 = A::mul_add(c_q3r, d59, s_q3r * d54); // F(M col 9r) at 5r.z
+                let d63 = A::mul_add(-s_q3r, d59, c_q3r * d54); // F(M col 9r) at 5r.x
+                let d64 = A::mul_add(-p.L7, d63, A::mul_add(c_q3r, d61, s_q3r * d57)); // N(M col 9r) at 5r.z
+                let d65 = A::mul_add(p.L7, d62, A::mul_add(-s_q3r, d61, c_q3r * d57)); // N(M col 9r) at 5r.x
+                m[(13, 17)] = d65;
                 m[(17, 13)] = m[(13, 17)];
-                let d72 = A::mul_add(-s_q2r, d68, c_q2r * d63); // F(M col 9r) at 4r.y
-                let d73 = A::mul_add(c_q2r, d68, s_q2r * d63); // F(M col 9r) at 4r.z
-                let d74 = A::mul_add(-s_q2r, d70, c_q2r * d66); // N(M col 9r) at 4r.y
-                m[(12, 17)] = -d74;
+                let d66 = A::mul_add(-s_q2r, d62, c_q2r * d58); // F(M col 9r) at 4r.y
+                let d67 = A::mul_add(c_q2r, d62, s_q2r * d58); // F(M col 9r) at 4r.z
+                let d68 = A::mul_add(-s_q2r, d64, c_q2r * d60); // N(M col 9r) at 4r.y
+                m[(12, 17)] = -d68;
                 m[(17, 12)] = m[(12, 17)];
-                let d75 = A::mul_add(c_q2r, d70, s_q2r * d66); // N(M col 9r) at 4r.z
-                let d76 = A::mul_add(-s_q1r, d73, c_q1r * d69); // F(M col 9r) at 3.y
-                let d77 = A::mul_add(c_q1r, d73, s_q1r * d69); // F(M col 9r) at 3.z
-                let d78 = A::mul_add(-p.L5, d77, d74); // N(M col 9r) at 3.x
-                let d79 = A::mul_add(p.L6, d77, A::mul_add(-s_q1r, d75, c_q1r * d71)); // N(M col 9r) at 3.y
-                m[(4, 17)] = -d79;
+                let d69 = A::mul_add(c_q2r, d64, s_q2r * d60); // N(M col 9r) at 4r.z
+                let d70 = A::mul_add(-s_q1r, d67, c_q1r * d63); // F(M col 9r) at 3.y
+                let d71 = A::mul_add(c_q1r, d67, s_q1r * d63); // F(M col 9r) at 3.z
+                let d72 = A::mul_add(p.L6, d71, A::mul_add(-s_q1r, d69, c_q1r * d65)); // N(M col 9r) at 3.y
+                m[(4, 17)] = -d72;
                 m[(17, 4)] = m[(4, 17)];
-                let d80 = A::mul_add(
+                let d73 = A::mul_add(
                     p.L5,
-                    d72,
-                    A::mul_add(-p.L6, d76, A::mul_add(c_q1r, d75, s_q1r * d71)),
+                    d66,
+                    A::mul_add(-p.L6, d70, A::mul_add(c_q1r, d69, s_q1r * d65)),
                 ); // N(M col 9r) at 3.z
-                let d81 = A::mul_add(s_q_torso, d77, c_q_torso * d72); // F(M col 9r) at 2.x
-                let d82 = A::mul_add(-c_q_torso, d77, s_q_torso * d72); // F(M col 9r) at 2.z
-                let d83 = A::mul_add(p.L4, d81, d79); // N(M col 9r) at 2.y
-                let d84 = A::mul_add(
+                let d74 = A::mul_add(-p.L5, d71, d68); // N(M col 9r) at 3.x
+                let d75 = A::mul_add(s_q_torso, d71, c_q_torso * d66); // F(M col 9r) at 2.x
+                let d76 = A::mul_add(-c_q_torso, d71, s_q_torso * d66); // F(M col 9r) at 2.z
+                let d77 = A::mul_add(
                     -p.L4,
-                    d76,
-                    A::mul_add(p.L3, d82, A::mul_add(s_q_torso, d80, c_q_torso * d78)),
+                    d70,
+                    A::mul_add(p.L3, d76, A::mul_add(s_q_torso, d73, c_q_torso * d74)),
                 ); // N(M col 9r) at 2.x
-                m[(3, 17)] = -d84;
+                m[(3, 17)] = -d77;
                 m[(17, 3)] = m[(3, 17)];
-                let d85 = A::mul_add(
+                let d78 = A::mul_add(p.L4, d75, d72); // N(M col 9r) at 2.y
+                let d79 = A::mul_add(
                     -p.L3,
-                    d81,
-                    A::mul_add(-c_q_torso, d80, s_q_torso * d78),
+                    d75,
+                    A::mul_add(-c_q_torso, d73, s_q_torso * d74),
                 ); // N(M col 9r) at 2.z
-                let d86 = A::mul_add(s_q_w, d82, c_q_w * d76); // F(M col 9r) at 1.y
-                let d87 = A::mul_add(-c_q_w, d82, s_q_w * d76); // F(M col 9r) at 1.z
-                let d88 = A::mul_add(p.L2, d86, A::mul_add(-p.L1, d87, d84)); // N(M col 9r) at 1.x
-                m[(2, 17)] = -d88;
+                let d80 = A::mul_add(s_q_w, d76, c_q_w * d70); // F(M col 9r) at 1.y
+                let d81 = A::mul_add(-c_q_w, d76, s_q_w * d70); // F(M col 9r) at 1.z
+                let d82 = A::mul_add(p.L2, d80, A::mul_add(-p.L1, d81, d77)); // N(M col 9r) at 1.x
+                m[(2, 17)] = -d82;
                 m[(17, 2)] = m[(2, 17)];
-                let d89 = A::mul_add(c_q_imu, d87, s_q_imu * d86); // F(M col 9r) at 0.x
-                m[(0, 17)] = d89;
+                let d83 = A::mul_add(-p.L2, d75, A::mul_add(s_q_w, d79, c_q_w * d78)); // N(M col 9r) at 1.y
+                let d84 = A::mul_add(p.L1, d75, A::mul_add(-c_q_w, d79, s_q_w * d78)); // N(M col 9r) at 1.z
+                let d85 = A::mul_add(c_q_imu, d81, s_q_imu * d80); // F(M col 9r) at 0.x
+                m[(0, 17)] = d85;
                 m[(17, 0)] = m[(0, 17)];
-                let d90 = A::mul_add(-p.L2, d81, A::mul_add(s_q_w, d85, c_q_w * d83)); // N(M col 9r) at 1.y
-                let d91 = A::mul_add(p.L1, d81, A::mul_add(-c_q_w, d85, s_q_w * d83)); // N(M col 9r) at 1.z
-                let d92 = A::mul_add(-s_q_imu, d91, c_q_imu * d90); // N(M col 9r) at 0.z
-                m[(1, 17)] = d92;
+                let d86 = A::mul_add(-s_q_imu, d84, c_q_imu * d83); // N(M col 9r) at 0.z
+                m[(1, 17)] = d86;
                 m[(17, 1)] = m[(1, 17)];
+                let d87 = p.MX8r - d42; // MSC8r.x
+                let d88 = p.MY8r - d50; // MSC8r.y
+                let d89 = p.MZ8r - d51; // MSC8r.z
                 let k4 = s_q6r * s_q6r; // sin² q6r
                 let k5 = s_q6r * c_q6r; // sin q6r cos q6r
                 let k6 = A::mul_add(2.0, k4, -1.0); // cos 2q6r
-                let d93 = pc.pc6 - d50; // JC9r: Jyy − Jzz
-                let d94 = A::mul_add(-2.0, d6 * k5, k4 * d93); // JC9r rotated about x: Jyy − J'yy
-                let d95 = A::mul_add(k5, d93, A::mul_add(d6, k6, p.YZ8r)); // JC8r.yz
-                let d96 = p.ZZ8r + d50 + d94; // JC8r.zz
-                let d97 = pc.pc10 - d94; // JC8r.yy
+                let d90 = pc.pc6 - d49; // JC9r: Jyy − Jzz
+                let d91 = A::mul_add(-2.0, d47 * k5, k4 * d90); // JC9r rotated about x: Jyy − J'yy
+                let d92 = p.XX8r + d48; // JC8r.xx
+                let d93 = p.XY8r + t7 + t8; // JC8r.xy
+                let d94 = p.XZ8r + t9 - t10; // JC8r.xz
+                let d95 = A::mul_add(k5, d90, A::mul_add(d47, k6, p.YZ8r)); // JC8r.yz
+                let d96 = p.ZZ8r + d49 + d91; // JC8r.zz
+                let d97 = pc.pc10 - d91; // JC8r.yy
                 m[(16, 16)] = d97;
-                let d98 = A::mul_add(c_q5r, d65, s_q5r * d10); // MSC8r in 7r.z
-                let d99 = A::mul_add(-s_q5r, d65, c_q5r * d10); // MSC8r in 7r.x
-                let t11 = c_q5r * d54; // common subexpression
-                let t12 = s_q5r * d54; // common subexpression
-                let t13 = s_q5r * d95; // common subexpression
+                let d98 = A::mul_add(c_q5r, d89, s_q5r * d87); // MSC8r in 7r.z
+                let d99 = A::mul_add(-s_q5r, d89, c_q5r * d87); // MSC8r in 7r.x
+                let t11 = c_q5r * d93; // common subexpression
+                let t12 = s_q5r * d95; // common subexpression
+                let t13 = s_q5r * d93; // common subexpression
                 let t14 = c_q5r * d95; // common subexpression
                 let t15 = p.L8 * d99; // common subexpression
                 let t16 = p.L8 * d98; // common subexpression
-                let d100 = t11 - t13 - t15; // N(M col 8r) at 7r.x
+                let d100 = t11 - t12 - t15; // N(M col 8r) at 7r.x
                 m[(15, 16)] = -d100;
                 m[(16, 15)] = m[(15, 16)];
-                let d101 = p.XY7r + t11 - t13 - t15; // JC7r.xy
-                let d102 = t12 + t14 - t16; // N(M col 8r) at 7r.z
-                let d103 = p.YZ7r - t12 - t14 + t16; // JC7r.yz
-                let d104 = s_q4r * d99; // F(M col 8r) at 6r.y
-                let d105 = c_q4r * d99; // F(M col 8r) at 6r.z
-                let d106 = p.MX7r - d99; // MSC7r.x
-                let d107 = p.MX6r - d106; // MSC6r.x
-                let d108 = A::mul_add(-s_q4r, d102, c_q4r * d97); // N(M col 8r) at 6r.y
-                m[(14, 16)] = d108;
+                let d101 = t13 + t14 - t16; // N(M col 8r) at 7r.z
+                let d102 = s_q4r * d99; // F(M col 8r) at 6r.y
+                let d103 = c_q4r * d99; // F(M col 8r) at 6r.z
+                let d104 = A::mul_add(-s_q4r, d101, c_q4r * d97); // N(M col 8r) at 6r.y
+                m[(14, 16)] = d104;
                 m[(16, 14)] = m[(14, 16)];
-                let d109 = A::mul_add(c_q4r, d102, s_q4r * d97); // N(M col 8r) at 6r.z
-                let d110 = p.YY7r + d97; // JC7r.yy
-                let d111 = A::mul_add(s_q3r, d105, c_q3r * d98); // F(M col 8r) at 5r.x
-                let d112 = A::mul_add(-c_q3r, d105, s_q3r * d98); // F(M col 8r) at 5r.z
-                let d113 = p.MZ7r + d98; // MSC7r.z
-                let d114 = A::mul_add(
+                let d105 = A::mul_add(c_q4r, d101, s_q4r * d97); // N(M col 8r) at 6r.z
+                let d106 = A::mul_add(s_q3r, d103, c_q3r * d98); // F(M col 8r) at 5r.x
+                let d107 = A::mul_add(-c_q3r, d103, s_q3r * d98); // F(M col 8r) at 5r.z
+                let d108 = A::mul_add(
                     p.L7,
-                    d112,
-                    A::mul_add(-s_q3r, d109, c_q3r * d100),
+                    d107,
+                    A::mul_add(-s_q3r, d105, c_q3r * d100),
                 ); // N(M col 8r) at 5r.x
-                m[(13, 16)] = -d114;
+                m[(13, 16)] = -d108;
                 m[(16, 13)] = m[(13, 16)];
-                let d115 = A::mul_add(
+                let d109 = A::mul_add(
                     -p.L7,
-                    d111,
-                    A::mul_add(c_q3r, d109, s_q3r * d100),
+                    d106,
+                    A::mul_add(c_q3r, d105, s_q3r * d100),
                 ); // N(M col 8r) at 5r.z
-                let d116 = A::mul_add(-s_q2r, d112, c_q2r * d104); // F(M col 8r) at 4r.y
-                let d117 = A::mul_add(c_q2r, d112, s_q2r * d104); // F(M col 8r) at 4r.z
-                let d118 = A::mul_add(-s_q2r, d115, c_q2r * d108); // N(M col 8r) at 4r.y
-                m[(12, 16)] = d118;
+                let d110 = A::mul_add(-s_q2r, d107, c_q2r * d102); // F(M col 8r) at 4r.y
+                let d111 = A::mul_add(c_q2r, d107, s_q2r * d102); // F(M col 8r) at 4r.z
+                let d112 = A::mul_add(-s_q2r, d109, c_q2r * d104); // N(M col 8r) at 4r.y
+                m[(12, 16)] = d112;
                 m[(16, 12)] = m[(12, 16)];
-                let d119 = A::mul_add(c_q2r, d115, s_q2r * d108); // N(M col 8r) at 4r.z
-                let d120 = A::mul_add(-s_q1r, d117, c_q1r * d111); // F(M col 8r) at 3.y
-                let d121 = A::mul_add(c_q1r, d117, s_q1r * d111); // F(M col 8r) at 3.z
-                let d122 = A::mul_add(-p.L5, d121, d118); // N(M col 8r) at 3.x
-                let d123 = A::mul_add(
+                let d113 = A::mul_add(c_q2r, d109, s_q2r * d104); // N(M col 8r) at 4r.z
+                let d114 = A::mul_add(-s_q1r, d111, c_q1r * d106); // F(M col 8r) at 3.y
+                let d115 = A::mul_add(c_q1r, d111, s_q1r * d106); // F(M col 8r) at 3.z
+                let d116 = A::mul_add(-p.L5, d115, d112); // N(M col 8r) at 3.x
+                let d117 = A::mul_add(
                     p.L6,
-                    d121,
-                    A::mul_add(-s_q1r, d119, c_q1r * d114),
+                    d115,
+                    A::mul_add(-s_q1r, d113, c_q1r * d108),
                 ); // N(M col 8r) at 3.y
-                m[(4, 16)] = d123;
+                m[(4, 16)] = d117;
                 m[(16, 4)] = m[(4, 16)];
-                let d124 = A::mul_add(
+                let d118 = A::mul_add(
                     p.L5,
-                    d116,
-                    A::mul_add(-p.L6, d120, A::mul_add(c_q1r, d119, s_q1r * d114)),
+                    d110,
+                    A::mul_add(-p.L6, d114, A::mul_add(c_q1r, d113, s_q1r * d108)),
                 ); // N(M col 8r) at 3.z
-                let d125 = A::mul_add(s_q_torso, d121, c_q_torso * d116); // F(M col 8r) at 2.x
-                let d126 = A::mul_add(-c_q_torso, d121, s_q_torso * d116); // F(M col 8r) at 2.z
-                let d127 = A::mul_add(p.L4, d125, d123); // N(M col 8r) at 2.y
-                let d128 = A::mul_add(
+                let d119 = A::mul_add(s_q_torso, d115, c_q_torso * d110); // F(M col 8r) at 2.x
+                let d120 = A::mul_add(-c_q_torso, d115, s_q_torso * d110); // F(M col 8r) at 2.z
+                let d121 = A::mul_add(
                     -p.L4,
-                    d120,
-                    A::mul_add(p.L3, d126, A::mul_add(s_q_torso, d124, c_q_torso * d122)),
+                    d114,
+                    A::mul_add(p.L3, d120, A::mul_add(s_q_torso, d118, c_q_torso * d116)),
                 ); // N(M col 8r) at 2.x
-                m[(3, 16)] = d128;
+                m[(3, 16)] = d121;
                 m[(16, 3)] = m[(3, 16)];
-                let d129 = A::mul_add(
+                let d122 = A::mul_add(p.L4, d119, d117); // N(M col 8r) at 2.y
+                let d123 = A::mul_add(
                     -p.L3,
-                    d125,
-                    A::mul_add(-c_q_torso, d124, s_q_torso * d122),
+                    d119,
+                    A::mul_add(-c_q_torso, d118, s_q_torso * d116),
                 ); // N(M col 8r) at 2.z
-                let d130 = A::mul_add(-c_q_w, d126, s_q_w * d120); // F(M col 8r) at 1.z
-                let d131 = A::mul_add(s_q_w, d126, c_q_w * d120); // F(M col 8r) at 1.y
-                let d132 = A::mul_add(p.L2, d131, A::mul_add(-p.L1, d130, d128)); // N(M col 8r) at 1.x
-                m[(2, 16)] = d132;
-                m[(16, 2)] = m[(2, 16)];
-                let d133 = A::mul_add(c_q_imu, d130, s_q_imu * d131); // F(M col 8r) at 0.x
-                m[(0, 16)] = -d133;
-                m[(16, 0)] = m[(0, 16)];
-                let d134 = A::mul_add(
+                let d124 = A::mul_add(-c_q_w, d120, s_q_w * d114); // F(M col 8r) at 1.z
+                let d125 = A::mul_add(s_q_w, d120, c_q_w * d114); // F(M col 8r) at 1.y
+                let d126 = A::mul_add(
                     p.L1,
-                    d125,
-                    A::mul_add(-c_q_w, d129, s_q_w * d127),
+                    d119,
+                    A::mul_add(-c_q_w, d123, s_q_w * d122),
                 ); // N(M col 8r) at 1.z
-                let d135 = A::mul_add(
+                let d127 = A::mul_add(p.L2, d125, A::mul_add(-p.L1, d124, d121)); // N(M col 8r) at 1.x
+                m[(2, 16)] = d127;
+                m[(16, 2)] = m[(2, 16)];
+                let d128 = A::mul_add(
                     -p.L2,
-                    d125,
-                    A::mul_add(s_q_w, d129, c_q_w * d127),
+                    d119,
+                    A::mul_add(s_q_w, d123, c_q_w * d122),
                 ); // N(M col 8r) at 1.y
-                let d136 = A::mul_add(-s_q_imu, d134, c_q_imu * d135); // N(M col 8r) at 0.z
-                m[(1, 16)] = -d136;
+                let d129 = A::mul_add(c_q_imu, d124, s_q_imu * d125); // F(M col 8r) at 0.x
+                m[(0, 16)] = -d129;
+                m[(16, 0)] = m[(0, 16)];
+                let d130 = A::mul_add(-s_q_imu, d126, c_q_imu * d128); // N(M col 8r) at 0.z
+                m[(1, 16)] = -d130;
                 m[(16, 1)] = m[(1, 16)];
+                let d131 = p.MX7r - d99; // MSC7r.x
+                let d132 = p.MZ7r + d98; // MSC7r.z
                 let k7 = s_q5r * s_q5r; // sin² q5r
                 let k8 = s_q5r * c_q5r; // sin q5r cos q5r
                 let k9 = A::mul_add(2.0, k7, -1.0); // cos 2q5r
-                let d137 = d62 - d96; // JC8r: Jzz − Jxx
-                let d138 = A::mul_add(2.0, d56 * k8, k7 * d137); // JC8r rotated about y: Jzz − J'zz
-                let d139 = A::mul_add(-k8, d137, A::mul_add(d56, k9, p.XZ7r)); // JC7r.xz
-                let t17 = p.L8 * d59; // common subexpression
-                let d140 = pc.pc13 - d59; // MSC7r.y
-                let d141 = A::mul_add(2.0, t17, d62 - d138) + pc.pc14; // JC7r.xx
-                m[(15, 15)] = d141;
-                let d142 = A::mul_add(2.0, t17, d96 + d138) + pc.pc15; // JC7r.zz
-                let d143 = A::mul_add(s_q4r, d113, c_q4r * d140); // MSC7r in 6r.y
-                let d144 = A::mul_add(-c_q4r, d113, s_q4r * d140); // MSC7r in 6r.z
-                let t18 = c_q4r * d101; // common subexpression
-                let t19 = s_q4r * d101; // common subexpression
-                let t20 = s_q4r * d139; // common subexpression
-                let t21 = c_q4r * d139; // common subexpression
-                let d145 = t18 + t20; // N(M col 7r) at 6r.y
-                m[(14, 15)] = -d145;
+                let d133 = d92 - d96; // JC8r: Jzz − Jxx
+                let d134 = A::mul_add(2.0, d94 * k8, k7 * d133); // JC8r rotated about y: Jzz − J'zz
+                let t17 = p.L8 * d88; // common subexpression
+                let d135 = p.XY7r + t11 - t12 - t15; // JC7r.xy
+                let d136 = A::mul_add(-k8, d133, A::mul_add(d94, k9, p.XZ7r)); // JC7r.xz
+                let d137 = p.YY7r + d97; // JC7r.yy
+                let d138 = p.YZ7r - t13 - t14 + t16; // JC7r.yz
+                let d139 = pc.pc13 - d88; // MSC7r.y
+                let d140 = A::mul_add(2.0, t17, d92 - d134) + pc.pc14; // JC7r.xx
+                m[(15, 15)] = d140;
+                let d141 = A::mul_add(2.0, t17, d96 + d134) + pc.pc15; // JC7r.zz
+                let d142 = A::mul_add(s_q4r, d132, c_q4r * d139); // MSC7r in 6r.y
+                let d143 = A::mul_add(-c_q4r, d132, s_q4r * d139); // MSC7r in 6r.z
+                let t18 = c_q4r * d135; // common subexpression
+                let t19 = s_q4r * d136; // common subexpression
+                let d144 = t18 + t19; // N(M col 7r) at 6r.y
+                m[(14, 15)] = -d144;
                 m[(15, 14)] = m[(14, 15)];
-                let d146 = p.XY6r + t18 + t20; // JC6r.xy
-                let d147 = t19 - t21; // N(M col 7r) at 6r.z
-                let d148 = p.XZ6r + t19 - t21; // JC6r.xz
-                let d149 = s_q3r * d143; // F(M col 7r) at 5r.x
-                let d150 = c_q3r * d143; // F(M col 7r) at 5r.z
-                let d151 = p.MY6r - d143; // MSC6r.y
-                let d152 = A::mul_add(
+                let t20 = s_q4r * d135; // common subexpression
+                let t21 = c_q4r * d136; // common subexpression
+                let d145 = t20 - t21; // N(M col 7r) at 6r.z
+                let d146 = s_q3r * d142; // F(M col 7r) at 5r.x
+                let d147 = c_q3r * d142; // F(M col 7r) at 5r.z
+                let d148 = A::mul_add(
                     -p.L7,
-                    d149,
-                    A::mul_add(c_q3r, d147, s_q3r * d141),
+                    d146,
+                    A::mul_add(c_q3r, d145, s_q3r * d140),
                 ); // N(M col 7r) at 5r.z
-                let d153 = A::mul_add(
+                let d149 = A::mul_add(
                     -p.L7,
-                    d150,
-                    A::mul_add(-s_q3r, d147, c_q3r * d141),
+                    d147,
+                    A::mul_add(-s_q3r, d145, c_q3r * d140),
                 ); // N(M col 7r) at 5r.x
-                m[(13, 15)] = d153;
+                m[(13, 15)] = d149;
                 m[(15, 13)] = m[(13, 15)];
-                let d154 = p.XX6r + d141; // JC6r.xx
-                let d155 = A::mul_add(s_q2r, d150, c_q2r * d144); // F(M col 7r) at 4r.y
-                let d156 = A::mul_add(-c_q2r, d150, s_q2r * d144); // F(M col 7r) at 4r.z
-                let d157 = p.MZ6r - d144; // MSC6r.z
-                let d158 = A::mul_add(-s_q2r, d152, c_q2r * d145); // N(M col 7r) at 4r.y
-                m[(12, 15)] = -d158;
+                let d150 = A::mul_add(s_q2r, d147, c_q2r * d143); // F(M col 7r) at 4r.y
+                let d151 = A::mul_add(-c_q2r, d147, s_q2r * d143); // F(M col 7r) at 4r.z
+                let d152 = A::mul_add(-s_q2r, d148, c_q2r * d144); // N(M col 7r) at 4r.y
+                m[(12, 15)] = -d152;
                 m[(15, 12)] = m[(12, 15)];
-                let d159 = A::mul_add(c_q2r, d152, s_q2r * d145); // N(M col 7r) at 4r.z
-                let d160 = A::mul_add(-s_q1r, d156, c_q1r * d149); // F(M col 7r) at 3.y
-                let d161 = A::mul_add(c_q1r, d156, s_q1r * d149); // F(M col 7r) at 3.z
-                let d162 = A::mul_add(-p.L5, d161, d158); // N(M col 7r) at 3.x
-                let d163 = A::mul_add(
+                let d153 = A::mul_add(c_q2r, d148, s_q2r * d144); // N(M col 7r) at 4r.z
+                let d154 = A::mul_add(-s_q1r, d151, c_q1r * d146); // F(M col 7r) at 3.y
+                let d155 = A::mul_add(c_q1r, d151, s_q1r * d146); // F(M col 7r) at 3.z
+                let d156 = A::mul_add(
                     p.L6,
-                    d161,
-                    A::mul_add(-s_q1r, d159, c_q1r * d153),
-                ); // N(M col 7r) at 3.y
-                m[(4, 15)] = -d163;
-                m[(15, 4)] = m[(4, 15)];
-                let d164 = A::mul_add(
-                    p.L5,
                     d155,
-                    A::mul_add(-p.L6, d160, A::mul_add(c_q1r, d159, s_q1r * d153)),
+                    A::mul_add(-s_q1r, d153, c_q1r * d149),
+                ); // N(M col 7r) at 3.y
+                m[(4, 15)] = -d156;
+                m[(15, 4)] = m[(4, 15)];
+                let d157 = A::mul_add(
+                    p.L5,
+                    d150,
+                    A::mul_add(-p.L6, d154, A::mul_add(c_q1r, d153, s_q1r * d149)),
                 ); // N(M col 7r) at 3.z
-                let d165 = A::mul_add(s_q_torso, d161, c_q_torso * d155); // F(M col 7r) at 2.x
-                let d166 = A::mul_add(-c_q_torso, d161, s_q_torso * d155); // F(M col 7r) at 2.z
-                let d167 = A::mul_add(p.L4, d165, d163); // N(M col 7r) at 2.y
-                let d168 = A::mul_add(
+                let d158 = A::mul_add(-p.L5, d155, d152); // N(M col 7r) at 3.x
+                let d159 = A::mul_add(s_q_torso, d155, c_q_torso * d150); // F(M col 7r) at 2.x
+                let d160 = A::mul_add(-c_q_torso, d155, s_q_torso * d150); // F(M col 7r) at 2.z
+                let d161 = A::mul_add(
                     -p.L4,
-                    d160,
-                    A::mul_add(p.L3, d166, A::mul_add(s_q_torso, d164, c_q_torso * d162)),
+                    d154,
+                    A::mul_add(p.L3, d160, A::mul_add(s_q_torso, d157, c_q_torso * d158)),
                 ); // N(M col 7r) at 2.x
-                m[(3, 15)] = -d168;
+                m[(3, 15)] = -d161;
                 m[(15, 3)] = m[(3, 15)];
-                let d169 = A::mul_add(
+                let d162 = A::mul_add(p.L4, d159, d156); // N(M col 7r) at 2.y
+                let d163 = A::mul_add(
                     -p.L3,
-                    d165,
-                    A::mul_add(-c_q_torso, d164, s_q_torso * d162),
+                    d159,
+                    A::mul_add(-c_q_torso, d157, s_q_torso * d158),
                 ); // N(M col 7r) at 2.z
-                let d170 = A::mul_add(s_q_w, d166, c_q_w * d160); // F(M col 7r) at 1.y
-                let d171 = A::mul_add(-c_q_w, d166, s_q_w * d160); // F(M col 7r) at 1.z
-                let d172 = A::mul_add(p.L2, d170, A::mul_add(-p.L1, d171, d168)); // N(M col 7r) at 1.x
-                m[(2, 15)] = -d172;
+                let d164 = A::mul_add(s_q_w, d160, c_q_w * d154); // F(M col 7r) at 1.y
+                let d165 = A::mul_add(-c_q_w, d160, s_q_w * d154); // F(M col 7r) at 1.z
+                let d166 = A::mul_add(p.L2, d164, A::mul_add(-p.L1, d165, d161)); // N(M col 7r) at 1.x
+                m[(2, 15)] = -d166;
                 m[(15, 2)] = m[(2, 15)];
-                let d173 = A::mul_add(c_q_imu, d171, s_q_imu * d170); // F(M col 7r) at 0.x
-                m[(0, 15)] = d173;
-                m[(15, 0)] = m[(0, 15)];
-                let d174 = A::mul_add(
+                let d167 = A::mul_add(
                     -p.L2,
-                    d165,
-                    A::mul_add(s_q_w, d169, c_q_w * d167),
+                    d159,
+                    A::mul_add(s_q_w, d163, c_q_w * d162),
                 ); // N(M col 7r) at 1.y
-                let d175 = A::mul_add(
+                let d168 = A::mul_add(
                     p.L1,
-                    d165,
-                    A::mul_add(-c_q_w, d169, s_q_w * d167),
+                    d159,
+                    A::mul_add(-c_q_w, d163, s_q_w * d162),
                 ); // N(M col 7r) at 1.z
-                let d176 = A::mul_add(-s_q_imu, d175, c_q_imu * d174); // N(M col 7r) at 0.z
-                m[(1, 15)] = d176;
+                let d169 = A::mul_add(c_q_imu, d165, s_q_imu * d164); // F(M col 7r) at 0.x
+                m[(0, 15)] = d169;
+                m[(15, 0)] = m[(0, 15)];
+                let d170 = A::mul_add(-s_q_imu, d168, c_q_imu * d167); // N(M col 7r) at 0.z
+                m[(1, 15)] = d170;
                 m[(15, 1)] = m[(1, 15)];
+                let d171 = p.MX6r - d131; // MSC6r.x
+                let d172 = p.MY6r - d142; // MSC6r.y
+                let d173 = p.MZ6r - d143; // MSC6r.z
                 let k10 = s_q4r * s_q4r; // sin² q4r
                 let k11 = s_q4r * c_q4r; // sin q4r cos q4r
                 let k12 = A::mul_add(2.0, k10, -1.0); // cos 2q4r
-                let d177 = d110 - d142; // JC7r: Jyy − Jzz
-                let d178 = A::mul_add(-2.0, d103 * k11, k10 * d177); // JC7r rotated about x: Jyy − J'yy
-                let d179 = A::mul_add(k11, d177, A::mul_add(d103, k12, p.YZ6r)); // JC6r.yz
-                let d180 = p.YY6r + d110 - d178; // JC6r.yy
-                m[(14, 14)] = d180;
-                let d181 = p.ZZ6r + d142 + d178; // JC6r.zz
-                let d182 = A::mul_add(c_q3r, d157, s_q3r * d107); // MSC6r in 5r.z
-                let d183 = A::mul_add(-s_q3r, d157, c_q3r * d107); // MSC6r in 5r.x
-                let t22 = c_q3r * d146; // common subexpression
-                let t23 = s_q3r * d146; // common subexpression
-                let t24 = s_q3r * d179; // common subexpression
-                let t25 = c_q3r * d179; // common subexpression
+                let d174 = d137 - d141; // JC7r: Jyy − Jzz
+                let d175 = A::mul_add(-2.0, d138 * k11, k10 * d174); // JC7r rotated about x: Jyy − J'yy
+                let d176 = p.XX6r + d140; // JC6r.xx
+                let d177 = p.XY6r + t18 + t19; // JC6r.xy
+                let d178 = p.XZ6r + t20 - t21; // JC6r.xz
+                let d179 = p.YY6r + d137 - d175; // JC6r.yy
+                m[(14, 14)] = d179;
+                let d180 = A::mul_add(k11, d174, A::mul_add(d138, k12, p.YZ6r)); // JC6r.yz
+                let d181 = p.ZZ6r + d141 + d175; // JC6r.zz
+                let d182 = A::mul_add(c_q3r, d173, s_q3r * d171); // MSC6r in 5r.z
+                let d183 = A::mul_add(-s_q3r, d173, c_q3r * d171); // MSC6r in 5r.x
+                let t22 = c_q3r * d177; // common subexpression
+                let t23 = s_q3r * d180; // common subexpression
+                let t24 = s_q3r * d177; // common subexpression
+                let t25 = c_q3r * d180; // common subexpression
                 let t26 = p.L7 * d183; // common subexpression
                 let t27 = p.L7 * d182; // common subexpression
-                let d184 = t22 - t24 - t26; // N(M col 6r) at 5r.x
+                let d184 = t22 - t23 - t26; // N(M col 6r) at 5r.x
                 m[(13, 14)] = -d184;
                 m[(14, 13)] = m[(13, 14)];
-                let d185 = p.XY5r + t22 - t24 - t26; // JC5r.xy
-                let d186 = t23 + t25 - t27; // N(M col 6r) at 5r.z
-                let d187 = p.YZ5r - t23 - t25 + t27; // JC5r.yz
-                let d188 = s_q2r * d183; // F(M col 6r) at 4r.y
-                let d189 = c_q2r * d183; // F(M col 6r) at 4r.z
-                let d190 = p.MX5r - d183; // MSC5r.x
-                let d191 = p.MX4r - d190; // MSC4r.x
-                let d192 = A::mul_add(-s_q2r, d186, c_q2r * d180); // N(M col 6r) at 4r.y
-                m[(12, 14)] = d192;
+                let d185 = t24 + t25 - t27; // N(M col 6r) at 5r.z
+                let d186 = s_q2r * d183; // F(M col 6r) at 4r.y
+                let d187 = c_q2r * d183; // F(M col 6r) at 4r.z
+                let d188 = A::mul_add(-s_q2r, d185, c_q2r * d179); // N(M col 6r) at 4r.y
+                m[(12, 14)] = d188;
                 m[(14, 12)] = m[(12, 14)];
-                let d193 = A::mul_add(c_q2r, d186, s_q2r * d180); // N(M col 6r) at 4r.z
-                let d194 = p.YY5r + d180; // JC5r.yy
-                let d195 = A::mul_add(s_q1r, d189, c_q1r * d182); // F(M col 6r) at 3.y
-                let d196 = A::mul_add(-c_q1r, d189, s_q1r * d182); // F(M col 6r) at 3.z
-                let d197 = A::mul_add(-p.L5, d196, d192); // N(M col 6r) at 3.x
-                let d198 = p.MZ5r + d182; // MSC5r.z
-                let d199 = A::mul_add(
+                let d189 = A::mul_add(c_q2r, d185, s_q2r * d179); // N(M col 6r) at 4r.z
+                let d190 = A::mul_add(s_q1r, d187, c_q1r * d182); // F(M col 6r) at 3.y
+                let d191 = A::mul_add(-c_q1r, d187, s_q1r * d182); // F(M col 6r) at 3.z
+                let d192 = A::mul_add(-p.L5, d191, d188); // N(M col 6r) at 3.x
+                let d193 = A::mul_add(
                     p.L6,
-                    d196,
-                    A::mul_add(-s_q1r, d193, c_q1r * d184),
+                    d191,
+                    A::mul_add(-s_q1r, d189, c_q1r * d184),
                 ); // N(M col 6r) at 3.y
-                m[(4, 14)] = d199;
+                m[(4, 14)] = d193;
                 m[(14, 4)] = m[(4, 14)];
-                let d200 = A::mul_add(
+                let d194 = A::mul_add(
                     p.L5,
-                    d188,
-                    A::mul_add(-p.L6, d195, A::mul_add(c_q1r, d193, s_q1r * d184)),
+                    d186,
+                    A::mul_add(-p.L6, d190, A::mul_add(c_q1r, d189, s_q1r * d184)),
                 ); // N(M col 6r) at 3.z
-                let d201 = A::mul_add(s_q_torso, d196, c_q_torso * d188); // F(M col 6r) at 2.x
-                let d202 = A::mul_add(-c_q_torso, d196, s_q_torso * d188); // F(M col 6r) at 2.z
-                let d203 = A::mul_add(p.L4, d201, d199); // N(M col 6r) at 2.y
-                let d204 = A::mul_add(
+                let d195 = A::mul_add(s_q_torso, d191, c_q_torso * d186); // F(M col 6r) at 2.x
+                let d196 = A::mul_add(-c_q_torso, d191, s_q_torso * d186); // F(M col 6r) at 2.z
+                let d197 = A::mul_add(
                     -p.L4,
-                    d195,
-                    A::mul_add(p.L3, d202, A::mul_add(s_q_torso, d200, c_q_torso * d197)),
+                    d190,
+                    A::mul_add(p.L3, d196, A::mul_add(s_q_torso, d194, c_q_torso * d192)),
                 ); // N(M col 6r) at 2.x
-                m[(3, 14)] = d204;
+                m[(3, 14)] = d197;
                 m[(14, 3)] = m[(3, 14)];
-                let d205 = A::mul_add(
+                let d198 = A::mul_add(p.L4, d195, d193); // N(M col 6r) at 2.y
+                let d199 = A::mul_add(
                     -p.L3,
-                    d201,
-                    A::mul_add(-c_q_torso, d200, s_q_torso * d197),
+                    d195,
+                    A::mul_add(-c_q_torso, d194, s_q_torso * d192),
                 ); // N(M col 6r) at 2.z
-                let d206 = A::mul_add(-c_q_w, d202, s_q_w * d195); // F(M col 6r) at 1.z
-                let d207 = A::mul_add(s_q_w, d202, c_q_w * d195); // F(M col 6r) at 1.y
-                let d208 = A::mul_add(p.L2, d207, A::mul_add(-p.L1, d206, d204)); // N(M col 6r) at 1.x
-                m[(2, 14)] = d208;
-                m[(14, 2)] = m[(2, 14)];
-                let d209 = A::mul_add(c_q_imu, d206, s_q_imu * d207); // F(M col 6r) at 0.x
-                m[(0, 14)] = -d209;
-                m[(14, 0)] = m[(0, 14)];
-                let d210 = A::mul_add(
+                let d200 = A::mul_add(-c_q_w, d196, s_q_w * d190); // F(M col 6r) at 1.z
+                let d201 = A::mul_add(s_q_w, d196, c_q_w * d190); // F(M col 6r) at 1.y
+                let d202 = A::mul_add(
                     p.L1,
-                    d201,
-                    A::mul_add(-c_q_w, d205, s_q_w * d203),
+                    d195,
+                    A::mul_add(-c_q_w, d199, s_q_w * d198),
                 ); // N(M col 6r) at 1.z
-                let d211 = A::mul_add(
+                let d203 = A::mul_add(p.L2, d201, A::mul_add(-p.L1, d200, d197)); // N(M col 6r) at 1.x
+                m[(2, 14)] = d203;
+                m[(14, 2)] = m[(2, 14)];
+                let d204 = A::mul_add(
                     -p.L2,
-                    d201,
-                    A::mul_add(s_q_w, d205, c_q_w * d203),
+                    d195,
+                    A::mul_add(s_q_w, d199, c_q_w * d198),
                 ); // N(M col 6r) at 1.y
-                let d212 = A::mul_add(-s_q_imu, d210, c_q_imu * d211); // N(M col 6r) at 0.z
-                m[(1, 14)] = -d212;
+                let d205 = A::mul_add(c_q_imu, d200, s_q_imu * d201); // F(M col 6r) at 0.x
+                m[(0, 14)] = -d205;
+                m[(14, 0)] = m[(0, 14)];
+                let d206 = A::mul_add(-s_q_imu, d202, c_q_imu * d204); // N(M col 6r) at 0.z
+                m[(1, 14)] = -d206;
                 m[(14, 1)] = m[(1, 14)];
+                let d207 = p.MX5r - d183; // MSC5r.x
+                let d208 = p.MZ5r + d182; // MSC5r.z
                 let k13 = s_q3r * s_q3r; // sin² q3r
                 let k14 = s_q3r * c_q3r; // sin q3r cos q3r
                 let k15 = A::mul_add(2.0, k13, -1.0); // cos 2q3r
-                let d213 = d154 - d181; // JC6r: Jzz − Jxx
-                let d214 = A::mul_add(2.0, d148 * k14, k13 * d213); // JC6r rotated about y: Jzz − J'zz
-                let d215 = A::mul_add(-k14, d213, A::mul_add(d148, k15, p.XZ5r)); // JC5r.xz
-                let t28 = p.L7 * d151; // common subexpression
-                let d216 = pc.pc19 - d151; // MSC5r.y
-                let d217 = A::mul_add(2.0, t28, d154 - d214) + pc.pc20; // JC5r.xx
-                m[(13, 13)] = d217;
-                let d218 = A::mul_add(2.0, t28, d181 + d214) + pc.pc21; // JC5r.zz
-                let d219 = A::mul_add(s_q2r, d198, c_q2r * d216); // MSC5r in 4r.y
-                let d220 = A::mul_add(-c_q2r, d198, s_q2r * d216); // MSC5r in 4r.z
-                let t29 = c_q2r * d185; // common subexpression
-                let t30 = s_q2r * d185; // common subexpression
-                let t31 = s_q2r * d215; // common subexpression
-                let t32 = c_q2r * d215; // common subexpression
-                let d221 = t29 + t31; // N(M col 5r) at 4r.y
-                m[(12, 13)] = -d221;
+                let d209 = d176 - d181; // JC6r: Jzz − Jxx
+                let d210 = A::mul_add(2.0, d178 * k14, k13 * d209); // JC6r rotated about y: Jzz − J'zz
+                let t28 = p.L7 * d172; // common subexpression
+                let d211 = p.XY5r + t22 - t23 - t26; // JC5r.xy
+                let d212 = A::mul_add(-k14, d209, A::mul_add(d178, k15, p.XZ5r)); // JC5r.xz
+                let d213 = p.YY5r + d179; // JC5r.yy
+                let d214 = p.YZ5r - t24 - t25 + t27; // JC5r.yz
+                let d215 = pc.pc19 - d172; // MSC5r.y
+                let d216 = A::mul_add(2.0, t28, d176 - d210) + pc.pc20; // JC5r.xx
+                m[(13, 13)] = d216;
+                let d217 = A::mul_add(2.0, t28, d181 + d210) + pc.pc21; // JC5r.zz
+                let d218 = A::mul_add(s_q2r, d208, c_q2r * d215); // MSC5r in 4r.y
+                let d219 = A::mul_add(-c_q2r, d208, s_q2r * d215); // MSC5r in 4r.z
+                let t29 = c_q2r * d211; // common subexpression
+                let t30 = s_q2r * d212; // common subexpression
+                let d220 = t29 + t30; // N(M col 5r) at 4r.y
+                m[(12, 13)] = -d220;
                 m[(13, 12)] = m[(12, 13)];
-                let d222 = p.XY4r + t29 + t31; // JC4r.xy
-                let d223 = t30 - t32; // N(M col 5r) at 4r.z
-                let d224 = p.XZ4r + t30 - t32; // JC4r.xz
-                let d225 = s_q1r * d219; // F(M col 5r) at 3.y
-                let d226 = c_q1r * d219; // F(M col 5r) at 3.z
-                let d227 = A::mul_add(p.L5, d226, d221); // N(M col 5r) at 3.x
-                let d228 = p.MY4r - d219; // MSC4r.y
-                let d229 = A::mul_add(
+                let t31 = s_q2r * d211; // common subexpression
+                let t32 = c_q2r * d212; // common subexpression
+                let d221 = t31 - t32; // N(M col 5r) at 4r.z
+                let d222 = s_q1r * d218; // F(M col 5r) at 3.y
+                let d223 = c_q1r * d218; // F(M col 5r) at 3.z
+                let d224 = A::mul_add(
                     -p.L6,
-                    d226,
-                    A::mul_add(-s_q1r, d223, c_q1r * d217),
+                    d223,
+                    A::mul_add(-s_q1r, d221, c_q1r * d216),
                 ); // N(M col 5r) at 3.y
-                m[(4, 13)] = -d229;
+                m[(4, 13)] = -d224;
                 m[(13, 4)] = m[(4, 13)];
-                let d230 = A::mul_add(
+                let d225 = A::mul_add(
                     p.L5,
-                    d220,
-                    A::mul_add(-p.L6, d225, A::mul_add(c_q1r, d223, s_q1r * d217)),
+                    d219,
+                    A::mul_add(-p.L6, d222, A::mul_add(c_q1r, d221, s_q1r * d216)),
                 ); // N(M col 5r) at 3.z
-                let d231 = p.XX4r + d217; // JC4r.xx
-                let d232 = A::mul_add(-s_q_torso, d226, c_q_torso * d220); // F(M col 5r) at 2.x
-                let d233 = A::mul_add(c_q_torso, d226, s_q_torso * d220); // F(M col 5r) at 2.z
-                let d234 = A::mul_add(p.L4, d232, d229); // N(M col 5r) at 2.y
-                let d235 = p.MZ4r - d220; // MSC4r.z
-                let d236 = A::mul_add(
+                let d226 = A::mul_add(p.L5, d223, d220); // N(M col 5r) at 3.x
+                let d227 = A::mul_add(-s_q_torso, d223, c_q_torso * d219); // F(M col 5r) at 2.x
+                let d228 = A::mul_add(c_q_torso, d223, s_q_torso * d219); // F(M col 5r) at 2.z
+                let d229 = A::mul_add(
                     -p.L4,
-                    d225,
-                    A::mul_add(p.L3, d233, A::mul_add(s_q_torso, d230, c_q_torso * d227)),
+                    d222,
+                    A::mul_add(p.L3, d228, A::mul_add(s_q_torso, d225, c_q_torso * d226)),
                 ); // N(M col 5r) at 2.x
-                m[(3, 13)] = -d236;
+                m[(3, 13)] = -d229;
                 m[(13, 3)] = m[(3, 13)];
-                let d237 = A::mul_add(
+                let d230 = A::mul_add(p.L4, d227, d224); // N(M col 5r) at 2.y
+                let d231 = A::mul_add(
                     -p.L3,
-                    d232,
-                    A::mul_add(-c_q_torso, d230, s_q_torso * d227),
+                    d227,
+                    A::mul_add(-c_q_torso, d225, s_q_torso * d226),
                 ); // N(M col 5r) at 2.z
-                let d238 = A::mul_add(s_q_w, d233, c_q_w * d225); // F(M col 5r) at 1.y
-                let d239 = A::mul_add(-c_q_w, d233, s_q_w * d225); // F(M col 5r) at 1.z
-                let d240 = A::mul_add(p.L2, d238, A::mul_add(-p.L1, d239, d236)); // N(M col 5r) at 1.x
-                m[(2, 13)] = -d240;
+                let d232 = A::mul_add(s_q_w, d228, c_q_w * d222); // F(M col 5r) at 1.y
+                let d233 = A::mul_add(-c_q_w, d228, s_q_w * d222); // F(M col 5r) at 1.z
+                let d234 = A::mul_add(p.L2, d232, A::mul_add(-p.L1, d233, d229)); // N(M col 5r) at 1.x
+                m[(2, 13)] = -d234;
                 m[(13, 2)] = m[(2, 13)];
-                let d241 = A::mul_add(c_q_imu, d239, s_q_imu * d238); // F(M col 5r) at 0.x
-                m[(0, 13)] = d241;
-                m[(13, 0)] = m[(0, 13)];
-                let d242 = A::mul_add(
+                let d235 = A::mul_add(
                     -p.L2,
-                    d232,
-                    A::mul_add(s_q_w, d237, c_q_w * d234),
+                    d227,
+                    A::mul_add(s_q_w, d231, c_q_w * d230),
                 ); // N(M col 5r) at 1.y
-                let d243 = A::mul_add(
+                let d236 = A::mul_add(
                     p.L1,
-                    d232,
-                    A::mul_add(-c_q_w, d237, s_q_w * d234),
+                    d227,
+                    A::mul_add(-c_q_w, d231, s_q_w * d230),
                 ); // N(M col 5r) at 1.z
-                let d244 = A::mul_add(-s_q_imu, d243, c_q_imu * d242); // N(M col 5r) at 0.z
-                m[(1, 13)] = d244;
+                let d237 = A::mul_add(c_q_imu, d233, s_q_imu * d232); // F(M col 5r) at 0.x
+                m[(0, 13)] = d237;
+                m[(13, 0)] = m[(0, 13)];
+                let d238 = A::mul_add(-s_q_imu, d236, c_q_imu * d235); // N(M col 5r) at 0.z
+                m[(1, 13)] = d238;
                 m[(13, 1)] = m[(1, 13)];
+                let d239 = p.MX4r - d207; // MSC4r.x
+                let d240 = p.MY4r - d218; // MSC4r.y
+                let d241 = p.MZ4r - d219; // MSC4r.z
                 let k16 = s_q2r * s_q2r; // sin² q2r
                 let k17 = s_q2r * c_q2r; // sin q2r cos q2r
                 let k18 = A::mul_add(2.0, k16, -1.0); // cos 2q2r
-                let d245 = d194 - d218; // JC5r: Jyy − Jzz
-                let d246 = A::mul_add(-2.0, d187 * k17, k16 * d245); // JC5r rotated about x: Jyy − J'yy
-                let d247 = A::mul_add(k17, d245, A::mul_add(d187, k18, p.YZ4r)); // JC4r.yz
-                let d248 = p.YY4r + d194 - d246; // JC4r.yy
-                m[(12, 12)] = d248;
-                let d249 = p.ZZ4r + d218 + d246; // JC4r.zz
-                let d250 = A::mul_add(-s_q1r, d235, c_q1r * d191); // MSC4r in 3.y
-                let d251 = A::mul_add(c_q1r, d235, s_q1r * d191); // MSC4r in 3.z
-                let t33 = c_q1r * d222; // common subexpression
-                let t34 = s_q1r * d222; // common subexpression
-                let t35 = s_q1r * d247; // common subexpression
-                let t36 = c_q1r * d247; // common subexpression
+                let d242 = d213 - d217; // JC5r: Jyy − Jzz
+                let d243 = A::mul_add(-2.0, d214 * k17, k16 * d242); // JC5r rotated about x: Jyy − J'yy
+                let d244 = p.XX4r + d216; // JC4r.xx
+                let d245 = p.XY4r + t29 + t30; // JC4r.xy
+                let d246 = p.XZ4r + t31 - t32; // JC4r.xz
+                let d247 = p.YY4r + d213 - d243; // JC4r.yy
+                m[(12, 12)] = d247;
+                let d248 = A::mul_add(k17, d242, A::mul_add(d214, k18, p.YZ4r)); // JC4r.yz
+                let d249 = p.ZZ4r + d217 + d243; // JC4r.zz
+                let d250 = A::mul_add(-s_q1r, d241, c_q1r * d239); // MSC4r in 3.y
+                let d251 = A::mul_add(c_q1r, d241, s_q1r * d239); // MSC4r in 3.z
+                let t33 = c_q1r * d245; // common subexpression
+                let t34 = s_q1r * d248; // common subexpression
+                let t35 = s_q1r * d245; // common subexpression
+                let t36 = c_q1r * d248; // common subexpression
                 let t37 = p.L5 * d250; // common subexpression
                 let t38 = p.L6 * d250; // common subexpression
                 let t39 = p.L6 * d251; // common subexpression
-                let d252 = d248 + t37; // N(M col 4r) at 3.x
-                let d253 = t33 - t35 - t38; // N(M col 4r) at 3.y
+                let d252 = d247 + t37; // N(M col 4r) at 3.x
+                let d253 = t33 - t34 - t38; // N(M col 4r) at 3.y
                 m[(4, 12)] = d253;
                 m[(12, 4)] = m[(4, 12)];
-                let d254 = t34 + t36 - t39; // N(M col 4r) at 3.z
+                let d254 = t35 + t36 - t39; // N(M col 4r) at 3.z
                 let d255 = s_q_torso * d250; // F(M col 4r) at 2.x
-                let d256 = A::mul_add(-p.L4, d255, d253); // N(M col 4r) at 2.y
-                let d257 = c_q_torso * d250; // F(M col 4r) at 2.z
-                let d258 = A::mul_add(
+                let d256 = c_q_torso * d250; // F(M col 4r) at 2.z
+                let d257 = A::mul_add(
                     -p.L4,
                     d251,
-                    A::mul_add(p.L3, d257, A::mul_add(s_q_torso, d254, c_q_torso * d252)),
+                    A::mul_add(p.L3, d256, A::mul_add(s_q_torso, d254, c_q_torso * d252)),
                 ); // N(M col 4r) at 2.x
-                m[(3, 12)] = d258;
+                m[(3, 12)] = d257;
                 m[(12, 3)] = m[(3, 12)];
+                let d258 = A::mul_add(-p.L4, d255, d253); // N(M col 4r) at 2.y
                 let d259 = A::mul_add(
                     p.L3,
                     d255,
                     A::mul_add(-c_q_torso, d254, s_q_torso * d252),
                 ); // N(M col 4r) at 2.z
-                let d260 = A::mul_add(-c_q_w, d257, s_q_w * d251); // F(M col 4r) at 1.z
-                let d261 = A::mul_add(s_q_w, d257, c_q_w * d251); // F(M col 4r) at 1.y
-                let d262 = A::mul_add(p.L2, d261, A::mul_add(-p.L1, d260, d258)); // N(M col 4r) at 1.x
-                m[(2, 12)] = d262;
-                m[(12, 2)] = m[(2, 12)];
-                let d263 = A::mul_add(c_q_imu, d260, s_q_imu * d261); // F(M col 4r) at 0.x
-                m[(0, 12)] = -d263;
-                m[(12, 0)] = m[(0, 12)];
-                let d264 = A::mul_add(
+                let d260 = A::mul_add(-c_q_w, d256, s_q_w * d251); // F(M col 4r) at 1.z
+                let d261 = A::mul_add(s_q_w, d256, c_q_w * d251); // F(M col 4r) at 1.y
+                let d262 = A::mul_add(
                     -p.L1,
                     d255,
-                    A::mul_add(-c_q_w, d259, s_q_w * d256),
+                    A::mul_add(-c_q_w, d259, s_q_w * d258),
                 ); // N(M col 4r) at 1.z
-                let d265 = A::mul_add(p.L2, d255, A::mul_add(s_q_w, d259, c_q_w * d256)); // N(M col 4r) at 1.y
-                let d266 = A::mul_add(-s_q_imu, d264, c_q_imu * d265); // N(M col 4r) at 0.z
+                let d263 = A::mul_add(p.L2, d261, A::mul_add(-p.L1, d260, d257)); // N(M col 4r) at 1.x
+                m[(2, 12)] = d263;
+                m[(12, 2)] = m[(2, 12)];
+                let d264 = A::mul_add(p.L2, d255, A::mul_add(s_q_w, d259, c_q_w * d258)); // N(M col 4r) at 1.y
+                let d265 = A::mul_add(c_q_imu, d260, s_q_imu * d261); // F(M col 4r) at 0.x
+                m[(0, 12)] = -d265;
+                m[(12, 0)] = m[(0, 12)];
+                let d266 = A::mul_add(-s_q_imu, d262, c_q_imu * d264); // N(M col 4r) at 0.z
                 m[(1, 12)] = -d266;
                 m[(12, 1)] = m[(1, 12)];
                 let k19 = s_q1r * s_q1r; // sin² q1r
                 let k20 = s_q1r * c_q1r; // sin q1r cos q1r
                 let k21 = A::mul_add(2.0, k19, -1.0); // cos 2q1r
-                let d267 = d231 - d249; // JC4r: Jzz − Jxx
-                let d268 = A::mul_add(2.0, d224 * k20, k19 * d267); // JC4r rotated about y: Jzz − J'zz
-                let t40 = p.L6 * d228; // common subexpression
+                let d267 = d244 - d249; // JC4r: Jzz − Jxx
+                let d268 = A::mul_add(2.0, d246 * k20, k19 * d267); // JC4r rotated about y: Jzz − J'zz
+                let t40 = p.L6 * d240; // common subexpression
                 let d269 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
                 let d270 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
                 let t41 = p.XZ10l * c_q7l; // common subexpression
@@ -2822,795 +2822,795 @@ mod generated {
                 let d271 = t41 + t42 - t45; // N(M col 10l) at 9l.x
                 m[(10, 11)] = -d271;
                 m[(11, 10)] = m[(10, 11)];
-                let d272 = p.XY9l + t41 + t42 - t45; // JC9l.xy
-                let d273 = t43 - t44 - t46; // N(M col 10l) at 9l.z
-                let d274 = p.YZ9l - t43 + t44 + t46; // JC9l.yz
-                let d275 = d270 * s_q6l; // F(M col 10l) at 8l.y
-                let d276 = d270 * c_q6l; // F(M col 10l) at 8l.z
-                let d277 = p.MX9l - d270; // MSC9l.x
-                let d278 = p.MX8l - d277; // MSC8l.x
-                let d279 = A::mul_add(-d273, s_q6l, p.ZZ10l * c_q6l); // N(M col 10l) at 8l.y
-                m[(9, 11)] = d279;
+                let d272 = t43 - t44 - t46; // N(M col 10l) at 9l.z
+                let d273 = d270 * s_q6l; // F(M col 10l) at 8l.y
+                let d274 = d270 * c_q6l; // F(M col 10l) at 8l.z
+                let d275 = A::mul_add(-d272, s_q6l, p.ZZ10l * c_q6l); // N(M col 10l) at 8l.y
+                m[(9, 11)] = d275;
                 m[(11, 9)] = m[(9, 11)];
-                let d280 = A::mul_add(d273, c_q6l, p.ZZ10l * s_q6l); // N(M col 10l) at 8l.z
-                let d281 = A::mul_add(d276, s_q5l, d269 * c_q5l); // F(M col 10l) at 7l.x
-                let d282 = A::mul_add(-d276, c_q5l, d269 * s_q5l); // F(M col 10l) at 7l.z
-                let d283 = p.MZ9l + d269; // MSC9l.z
-                let d284 = A::mul_add(
+                let d276 = A::mul_add(d272, c_q6l, p.ZZ10l * s_q6l); // N(M col 10l) at 8l.z
+                let d277 = A::mul_add(d274, s_q5l, d269 * c_q5l); // F(M col 10l) at 7l.x
+                let d278 = A::mul_add(-d274, c_q5l, d269 * s_q5l); // F(M col 10l) at 7l.z
+                let d279 = A::mul_add(
                     p.L8,
-                    d282,
-                    A::mul_add(-d280, s_q5l, d271 * c_q5l),
+                    d278,
+                    A::mul_add(-d276, s_q5l, d271 * c_q5l),
                 ); // N(M col 10l) at 7l.x
-                m[(8, 11)] = -d284;
+                m[(8, 11)] = -d279;
                 m[(11, 8)] = m[(8, 11)];
-                let d285 = A::mul_add(
+                let d280 = A::mul_add(
                     -p.L8,
-                    d281,
-                    A::mul_add(d280, c_q5l, d271 * s_q5l),
+                    d277,
+                    A::mul_add(d276, c_q5l, d271 * s_q5l),
                 ); // N(M col 10l) at 7l.z
-                let d286 = A::mul_add(-d282, s_q4l, d275 * c_q4l); // F(M col 10l) at 6l.y
-                let d287 = A::mul_add(d282, c_q4l, d275 * s_q4l); // F(M col 10l) at 6l.z
-                let d288 = A::mul_add(-d285, s_q4l, d279 * c_q4l); // N(M col 10l) at 6l.y
-                m[(7, 11)] = d288;
+                let d281 = A::mul_add(-d278, s_q4l, d273 * c_q4l); // F(M col 10l) at 6l.y
+                let d282 = A::mul_add(d278, c_q4l, d273 * s_q4l); // F(M col 10l) at 6l.z
+                let d283 = A::mul_add(-d280, s_q4l, d275 * c_q4l); // N(M col 10l) at 6l.y
+                m[(7, 11)] = d283;
                 m[(11, 7)] = m[(7, 11)];
-                let d289 = A::mul_add(d285, c_q4l, d279 * s_q4l); // N(M col 10l) at 6l.z
-                let d290 = A::mul_add(-d287, s_q3l, d281 * c_q3l); // F(M col 10l) at 5l.x
-                let d291 = A::mul_add(d287, c_q3l, d281 * s_q3l); // F(M col 10l) at 5l.z
-                let d292 = A::mul_add(
+                let d284 = A::mul_add(d280, c_q4l, d275 * s_q4l); // N(M col 10l) at 6l.z
+                let d285 = A::mul_add(-d282, s_q3l, d277 * c_q3l); // F(M col 10l) at 5l.x
+                let d286 = A::mul_add(d282, c_q3l, d277 * s_q3l); // F(M col 10l) at 5l.z
+                let d287 = A::mul_add(
                     p.L7,
-                    d291,
-                    A::mul_add(-d289, s_q3l, d284 * c_q3l),
+                    d286,
+                    A::mul_add(-d284, s_q3l, d279 * c_q3l),
                 ); // N(M col 10l) at 5l.x
-                m[(6, 11)] = -d292;
+                m[(6, 11)] = -d287;
                 m[(11, 6)] = m[(6, 11)];
-                let d293 = A::mul_add(
+                let d288 = A::mul_add(
                     -p.L7,
-                    d290,
-                    A::mul_add(d289, c_q3l, d284 * s_q3l),
+                    d285,
+                    A::mul_add(d284, c_q3l, d279 * s_q3l),
                 ); // N(M col 10l) at 5l.z
-                let d294 = A::mul_add(-d291, s_q2l, d286 * c_q2l); // F(M col 10l) at 4l.y
-                let d295 = A::mul_add(d291, c_q2l, d286 * s_q2l); // F(M col 10l) at 4l.z
-                let d296 = A::mul_add(-d293, s_q2l, d288 * c_q2l); // N(M col 10l) at 4l.y
-                m[(5, 11)] = d296;
+                let d289 = A::mul_add(-d286, s_q2l, d281 * c_q2l); // F(M col 10l) at 4l.y
+                let d290 = A::mul_add(d286, c_q2l, d281 * s_q2l); // F(M col 10l) at 4l.z
+                let d291 = A::mul_add(-d288, s_q2l, d283 * c_q2l); // N(M col 10l) at 4l.y
+                m[(5, 11)] = d291;
                 m[(11, 5)] = m[(5, 11)];
-                let d297 = A::mul_add(d293, c_q2l, d288 * s_q2l); // N(M col 10l) at 4l.z
-                let d298 = A::mul_add(d295, c_q1l, d290 * s_q1l); // F(M col 10l) at 3.z
-                let d299 = A::mul_add(-d295, s_q1l, d290 * c_q1l); // F(M col 10l) at 3.y
-                let d300 = A::mul_add(-p.L5, d298, d296); // N(M col 10l) at 3.x
-                let d301 = A::mul_add(
+                let d292 = A::mul_add(d288, c_q2l, d283 * s_q2l); // N(M col 10l) at 4l.z
+                let d293 = A::mul_add(d290, c_q1l, d285 * s_q1l); // F(M col 10l) at 3.z
+                let d294 = A::mul_add(-d290, s_q1l, d285 * c_q1l); // F(M col 10l) at 3.y
+                let d295 = A::mul_add(
                     p.L5,
-                    d294,
-                    A::mul_add(-p.L6, d299, A::mul_add(d297, c_q1l, d292 * s_q1l)),
+                    d289,
+                    A::mul_add(-p.L6, d294, A::mul_add(d292, c_q1l, d287 * s_q1l)),
                 ); // N(M col 10l) at 3.z
-                let d302 = A::mul_add(
+                let d296 = A::mul_add(-p.L5, d293, d291); // N(M col 10l) at 3.x
+                let d297 = A::mul_add(
                     p.L6,
-                    d298,
-                    A::mul_add(-d297, s_q1l, d292 * c_q1l),
+                    d293,
+                    A::mul_add(-d292, s_q1l, d287 * c_q1l),
                 ); // N(M col 10l) at 3.y
-                m[(4, 11)] = d302;
+                m[(4, 11)] = d297;
                 m[(11, 4)] = m[(4, 11)];
-                let d303 = A::mul_add(s_q_torso, d298, c_q_torso * d294); // F(M col 10l) at 2.x
-                let d304 = A::mul_add(-c_q_torso, d298, s_q_torso * d294); // F(M col 10l) at 2.z
-                let d305 = A::mul_add(-p.L4, d303, d302); // N(M col 10l) at 2.y
-                let d306 = A::mul_add(
+                let d298 = A::mul_add(s_q_torso, d293, c_q_torso * d289); // F(M col 10l) at 2.x
+                let d299 = A::mul_add(-c_q_torso, d293, s_q_torso * d289); // F(M col 10l) at 2.z
+                let d300 = A::mul_add(
                     p.L4,
-                    d299,
-                    A::mul_add(p.L3, d304, A::mul_add(s_q_torso, d301, c_q_torso * d300)),
+                    d294,
+                    A::mul_add(p.L3, d299, A::mul_add(s_q_torso, d295, c_q_torso * d296)),
                 ); // N(M col 10l) at 2.x
-                m[(3, 11)] = -d306;
+                m[(3, 11)] = -d300;
                 m[(11, 3)] = m[(3, 11)];
-                let d307 = A::mul_add(
+                let d301 = A::mul_add(
                     -p.L3,
-                    d303,
-                    A::mul_add(-c_q_torso, d301, s_q_torso * d300),
+                    d298,
+                    A::mul_add(-c_q_torso, d295, s_q_torso * d296),
                 ); // N(M col 10l) at 2.z
-                let d308 = A::mul_add(c_q_w, d304, s_q_w * d299); // F(M col 10l) at 1.z
-                let d309 = A::mul_add(-s_q_w, d304, c_q_w * d299); // F(M col 10l) at 1.y
-                let d310 = A::mul_add(-p.L2, d309, A::mul_add(p.L1, d308, d306)); // N(M col 10l) at 1.x
-                m[(2, 11)] = -d310;
+                let d302 = A::mul_add(-p.L4, d298, d297); // N(M col 10l) at 2.y
+                let d303 = A::mul_add(c_q_w, d299, s_q_w * d294); // F(M col 10l) at 1.z
+                let d304 = A::mul_add(-s_q_w, d299, c_q_w * d294); // F(M col 10l) at 1.y
+                let d305 = A::mul_add(-p.L2, d304, A::mul_add(p.L1, d303, d300)); // N(M col 10l) at 1.x
+                m[(2, 11)] = -d305;
                 m[(11, 2)] = m[(2, 11)];
-                let d311 = A::mul_add(c_q_imu, d308, s_q_imu * d309); // F(M col 10l) at 0.x
-                m[(0, 11)] = -d311;
-                m[(11, 0)] = m[(0, 11)];
-                let d312 = A::mul_add(
+                let d306 = A::mul_add(
                     -p.L1,
-                    d303,
-                    A::mul_add(c_q_w, d307, s_q_w * d305),
+                    d298,
+                    A::mul_add(c_q_w, d301, s_q_w * d302),
                 ); // N(M col 10l) at 1.z
-                let d313 = A::mul_add(
+                let d307 = A::mul_add(
                     p.L2,
-                    d303,
-                    A::mul_add(-s_q_w, d307, c_q_w * d305),
+                    d298,
+                    A::mul_add(-s_q_w, d301, c_q_w * d302),
                 ); // N(M col 10l) at 1.y
-                let d314 = A::mul_add(-s_q_imu, d312, c_q_imu * d313); // N(M col 10l) at 0.z
-                m[(1, 11)] = -d314;
+                let d308 = A::mul_add(c_q_imu, d303, s_q_imu * d304); // F(M col 10l) at 0.x
+                m[(0, 11)] = -d308;
+                m[(11, 0)] = m[(0, 11)];
+                let d309 = A::mul_add(-s_q_imu, d306, c_q_imu * d307); // N(M col 10l) at 0.z
+                m[(1, 11)] = -d309;
                 m[(11, 1)] = m[(1, 11)];
+                let d310 = p.MX9l - d270; // MSC9l.x
+                let d311 = p.MZ9l + d269; // MSC9l.z
                 let k22 = s_q7l * s_q7l; // sin² q7l
                 let k23 = s_q7l * c_q7l; // sin q7l cos q7l
                 let k24 = A::mul_add(2.0, k22, -1.0); // cos 2q7l
-                let d315 = A::mul_add(-2.0, p.XY10l * k23, k22 * pc.pc26); // JC10l rotated about z: Jxx − J'xx
-                let d316 = A::mul_add(-k23, pc.pc26, A::mul_add(-p.XY10l, k24, p.XZ9l)); // JC9l.xz
-                let d317 = pc.pc30 - d315; // JC9l.xx
-                m[(10, 10)] = d317;
-                let d318 = d315 + pc.pc31; // JC9l.zz
-                let d319 = A::mul_add(s_q6l, d283, c_q6l * pc.pc25); // MSC9l in 8l.y
-                let d320 = A::mul_add(-c_q6l, d283, s_q6l * pc.pc25); // MSC9l in 8l.z
-                let t47 = c_q6l * d272; // common subexpression
-                let t48 = s_q6l * d272; // common subexpression
-                let t49 = s_q6l * d316; // common subexpression
-                let t50 = c_q6l * d316; // common subexpression
-                let d321 = t47 + t49; // N(M col 9l) at 8l.y
-                m[(9, 10)] = -d321;
+                let d312 = A::mul_add(-2.0, p.XY10l * k23, k22 * pc.pc26); // JC10l rotated about z: Jxx − J'xx
+                let d313 = p.XY9l + t41 + t42 - t45; // JC9l.xy
+                let d314 = A::mul_add(-k23, pc.pc26, A::mul_add(-p.XY10l, k24, p.XZ9l)); // JC9l.xz
+                let d315 = p.YZ9l - t43 + t44 + t46; // JC9l.yz
+                let d316 = pc.pc30 - d312; // JC9l.xx
+                m[(10, 10)] = d316;
+                let d317 = d312 + pc.pc31; // JC9l.zz
+                let d318 = A::mul_add(s_q6l, d311, c_q6l * pc.pc25); // MSC9l in 8l.y
+                let d319 = A::mul_add(-c_q6l, d311, s_q6l * pc.pc25); // MSC9l in 8l.z
+                let t47 = c_q6l * d313; // common subexpression
+                let t48 = s_q6l * d314; // common subexpression
+                let d320 = t47 + t48; // N(M col 9l) at 8l.y
+                m[(9, 10)] = -d320;
                 m[(10, 9)] = m[(9, 10)];
-                let d322 = p.XY8l + t47 + t49; // JC8l.xy
-                let d323 = t48 - t50; // N(M col 9l) at 8l.z
-                let d324 = p.XZ8l + t48 - t50; // JC8l.xz
-                let d325 = s_q5l * d319; // F(M col 9l) at 7l.x
-                let d326 = c_q5l * d319; // F(M col 9l) at 7l.z
-                let d327 = p.MY8l - d319; // MSC8l.y
-                let d328 = A::mul_add(
+                let t49 = s_q6l * d313; // common subexpression
+                let t50 = c_q6l * d314; // common subexpression
+                let d321 = t49 - t50; // N(M col 9l) at 8l.z
+                let d322 = s_q5l * d318; // F(M col 9l) at 7l.x
+                let d323 = c_q5l * d318; // F(M col 9l) at 7l.z
+                let d324 = A::mul_add(
                     -p.L8,
-                    d325,
-                    A::mul_add(c_q5l, d323, s_q5l * d317),
+                    d322,
+                    A::mul_add(c_q5l, d321, s_q5l * d316),
                 ); // N(M col 9l) at 7l.z
-                let d329 = A::mul_add(
+                let d325 = A::mul_add(
                     -p.L8,
-                    d326,
-                    A::mul_add(-s_q5l, d323, c_q5l * d317),
+                    d323,
+                    A::mul_add(-s_q5l, d321, c_q5l * d316),
                 ); // N(M col 9l) at 7l.x
-                m[(8, 10)] = d329;
+                m[(8, 10)] = d325;
                 m[(10, 8)] = m[(8, 10)];
-                let d330 = p.XX8l + d317; // JC8l.xx
-                let d331 = A::mul_add(s_q4l, d326, c_q4l * d320); // F(M col 9l) at 6l.y
-                let d332 = A::mul_add(-c_q4l, d326, s_q4l * d320); // F(M col 9l) at 6l.z
-                let d333 = p.MZ8l - d320; // MSC8l.z
-                let d334 = A::mul_add(-s_q4l, d328, c_q4l * d321); // N(M col 9l) at 6l.y
-                m[(7, 10)] = -d334;
+                let d326 = A::mul_add(s_q4l, d323, c_q4l * d319); // F(M col 9l) at 6l.y
+                let d327 = A::mul_add(-c_q4l, d323, s_q4l * d319); // F(M col 9l) at 6l.z
+                let d328 = A::mul_add(-s_q4l, d324, c_q4l * d320); // N(M col 9l) at 6l.y
+                m[(7, 10)] = -d328;
                 m[(10, 7)] = m[(7, 10)];
-                let d335 = A::mul_add(c_q4l, d328, s_q4l * d321); // N(M col 9l) at 6l.z
-                let d336 = A::mul_add(c_q3l, d332, s_q3l * d325); // F(M col 9l) at 5l.z
-                let d337 = A::mul_add(-s_q3l, d332, c_q3l * d325); // F(M col 9l) at 5l.x
-                let d338 = A::mul_add(
+                let d329 = A::mul_add(c_q4l, d324, s_q4l * d320); // N(M col 9l) at 6l.z
+                let d330 = A::mul_add(c_q3l, d327, s_q3l * d322); // F(M col 9l) at 5l.z
+                let d331 = A::mul_add(-s_q3l, d327, c_q3l * d322); // F(M col 9l) at 5l.x
+                let d332 = A::mul_add(
                     -p.L7,
-                    d337,
-                    A::mul_add(c_q3l, d335, s_q3l * d329),
+                    d331,
+                    A::mul_add(c_q3l, d329, s_q3l * d325),
                 ); // N(M col 9l) at 5l.z
-                let d339 = A::mul_add(
+                let d333 = A::mul_add(
                     p.L7,
-                    d336,
-                    A::mul_add(-s_q3l, d335, c_q3l * d329),
+                    d330,
+                    A::mul_add(-s_q3l, d329, c_q3l * d325),
                 ); // N(M col 9l) at 5l.x
-                m[(6, 10)] = d339;
+                m[(6, 10)] = d333;
                 m[(10, 6)] = m[(6, 10)];
-                let d340 = A::mul_add(-s_q2l, d336, c_q2l * d331); // F(M col 9l) at 4l.y
-                let d341 = A::mul_add(c_q2l, d336, s_q2l * d331); // F(M col 9l) at 4l.z
-                let d342 = A::mul_add(-s_q2l, d338, c_q2l * d334); // N(M col 9l) at 4l.y
-                m[(5, 10)] = -d342;
+                let d334 = A::mul_add(-s_q2l, d330, c_q2l * d326); // F(M col 9l) at 4l.y
+                let d335 = A::mul_add(c_q2l, d330, s_q2l * d326); // F(M col 9l) at 4l.z
+                let d336 = A::mul_add(-s_q2l, d332, c_q2l * d328); // N(M col 9l) at 4l.y
+                m[(5, 10)] = -d336;
                 m[(10, 5)] = m[(5, 10)];
-                let d343 = A::mul_add(c_q2l, d338, s_q2l * d334); // N(M col 9l) at 4l.z
-                let d344 = A::mul_add(-s_q1l, d341, c_q1l * d337); // F(M col 9l) at 3.y
-                let d345 = A::mul_add(c_q1l, d341, s_q1l * d337); // F(M col 9l) at 3.z
-                let d346 = A::mul_add(-p.L5, d345, d342); // N(M col 9l) at 3.x
-                let d347 = A::mul_add(
+                let d337 = A::mul_add(c_q2l, d332, s_q2l * d328); // N(M col 9l) at 4l.z
+                let d338 = A::mul_add(-s_q1l, d335, c_q1l * d331); // F(M col 9l) at 3.y
+                let d339 = A::mul_add(c_q1l, d335, s_q1l * d331); // F(M col 9l) at 3.z
+                let d340 = A::mul_add(-p.L5, d339, d336); // N(M col 9l) at 3.x
+                let d341 = A::mul_add(
                     p.L6,
-                    d345,
-                    A::mul_add(-s_q1l, d343, c_q1l * d339),
+                    d339,
+                    A::mul_add(-s_q1l, d337, c_q1l * d333),
                 ); // N(M col 9l) at 3.y
-                m[(4, 10)] = -d347;
+                m[(4, 10)] = -d341;
                 m[(10, 4)] = m[(4, 10)];
-                let d348 = A::mul_add(
+                let d342 = A::mul_add(
                     p.L5,
-                    d340,
-                    A::mul_add(-p.L6, d344, A::mul_add(c_q1l, d343, s_q1l * d339)),
+                    d334,
+                    A::mul_add(-p.L6, d338, A::mul_add(c_q1l, d337, s_q1l * d333)),
                 ); // N(M col 9l) at 3.z
-                let d349 = A::mul_add(s_q_torso, d345, c_q_torso * d340); // F(M col 9l) at 2.x
-                let d350 = A::mul_add(-c_q_torso, d345, s_q_torso * d340); // F(M col 9l) at 2.z
-                let d351 = A::mul_add(-p.L4, d349, d347); // N(M col 9l) at 2.y
-                let d352 = A::mul_add(
+                let d343 = A::mul_add(s_q_torso, d339, c_q_torso * d334); // F(M col 9l) at 2.x
+                let d344 = A::mul_add(-c_q_torso, d339, s_q_torso * d334); // F(M col 9l) at 2.z
+                let d345 = A::mul_add(-p.L4, d343, d341); // N(M col 9l) at 2.y
+                let d346 = A::mul_add(
                     p.L4,
-                    d344,
-                    A::mul_add(p.L3, d350, A::mul_add(s_q_torso, d348, c_q_torso * d346)),
+                    d338,
+                    A::mul_add(p.L3, d344, A::mul_add(s_q_torso, d342, c_q_torso * d340)),
                 ); // N(M col 9l) at 2.x
-                m[(3, 10)] = d352;
+                m[(3, 10)] = d346;
                 m[(10, 3)] = m[(3, 10)];
-                let d353 = A::mul_add(
+                let d347 = A::mul_add(
                     -p.L3,
-                    d349,
-                    A::mul_add(-c_q_torso, d348, s_q_torso * d346),
+                    d343,
+                    A::mul_add(-c_q_torso, d342, s_q_torso * d340),
                 ); // N(M col 9l) at 2.z
-                let d354 = A::mul_add(-s_q_w, d350, c_q_w * d344); // F(M col 9l) at 1.y
-                let d355 = A::mul_add(c_q_w, d350, s_q_w * d344); // F(M col 9l) at 1.z
-                let d356 = A::mul_add(-p.L2, d354, A::mul_add(p.L1, d355, d352)); // N(M col 9l) at 1.x
-                m[(2, 10)] = d356;
-                m[(10, 2)] = m[(2, 10)];
-                let d357 = A::mul_add(c_q_imu, d355, s_q_imu * d354); // F(M col 9l) at 0.x
-                m[(0, 10)] = d357;
-                m[(10, 0)] = m[(0, 10)];
-                let d358 = A::mul_add(
+                let d348 = A::mul_add(-s_q_w, d344, c_q_w * d338); // F(M col 9l) at 1.y
+                let d349 = A::mul_add(c_q_w, d344, s_q_w * d338); // F(M col 9l) at 1.z
+                let d350 = A::mul_add(
                     p.L2,
-                    d349,
-                    A::mul_add(-s_q_w, d353, c_q_w * d351),
+                    d343,
+                    A::mul_add(-s_q_w, d347, c_q_w * d345),
                 ); // N(M col 9l) at 1.y
-                let d359 = A::mul_add(
+                let d351 = A::mul_add(-p.L2, d348, A::mul_add(p.L1, d349, d346)); // N(M col 9l) at 1.x
+                m[(2, 10)] = d351;
+                m[(10, 2)] = m[(2, 10)];
+                let d352 = A::mul_add(
                     -p.L1,
-                    d349,
-                    A::mul_add(c_q_w, d353, s_q_w * d351),
+                    d343,
+                    A::mul_add(c_q_w, d347, s_q_w * d345),
                 ); // N(M col 9l) at 1.z
-                let d360 = A::mul_add(-s_q_imu, d359, c_q_imu * d358); // N(M col 9l) at 0.z
-                m[(1, 10)] = d360;
+                let d353 = A::mul_add(c_q_imu, d349, s_q_imu * d348); // F(M col 9l) at 0.x
+                m[(0, 10)] = d353;
+                m[(10, 0)] = m[(0, 10)];
+                let d354 = A::mul_add(-s_q_imu, d352, c_q_imu * d350); // N(M col 9l) at 0.z
+                m[(1, 10)] = d354;
                 m[(10, 1)] = m[(1, 10)];
+                let d355 = p.MX8l - d310; // MSC8l.x
+                let d356 = p.MY8l - d318; // MSC8l.y
+                let d357 = p.MZ8l - d319; // MSC8l.z
                 let k25 = s_q6l * s_q6l; // sin² q6l
                 let k26 = s_q6l * c_q6l; // sin q6l cos q6l
                 let k27 = A::mul_add(2.0, k25, -1.0); // cos 2q6l
-                let d361 = pc.pc29 - d318; // JC9l: Jyy − Jzz
-                let d362 = A::mul_add(-2.0, d274 * k26, k25 * d361); // JC9l rotated about x: Jyy − J'yy
-                let d363 = A::mul_add(k26, d361, A::mul_add(d274, k27, p.YZ8l)); // JC8l.yz
-                let d364 = p.ZZ8l + d318 + d362; // JC8l.zz
-                let d365 = pc.pc33 - d362; // JC8l.yy
+                let d358 = pc.pc29 - d317; // JC9l: Jyy − Jzz
+                let d359 = A::mul_add(-2.0, d315 * k26, k25 * d358); // JC9l rotated about x: Jyy − J'yy
+                let d360 = p.XX8l + d316; // JC8l.xx
+                let d361 = p.XY8l + t47 + t48; // JC8l.xy
+                let d362 = p.XZ8l + t49 - t50; // JC8l.xz
+                let d363 = A::mul_add(k26, d358, A::mul_add(d315, k27, p.YZ8l)); // JC8l.yz
+                let d364 = p.ZZ8l + d317 + d359; // JC8l.zz
+                let d365 = pc.pc33 - d359; // JC8l.yy
                 m[(9, 9)] = d365;
-                let d366 = A::mul_add(c_q5l, d333, s_q5l * d278); // MSC8l in 7l.z
-                let d367 = A::mul_add(-s_q5l, d333, c_q5l * d278); // MSC8l in 7l.x
-                let t51 = c_q5l * d322; // common subexpression
-                let t52 = s_q5l * d322; // common subexpression
-                let t53 = s_q5l * d363; // common subexpression
+                let d366 = A::mul_add(c_q5l, d357, s_q5l * d355); // MSC8l in 7l.z
+                let d367 = A::mul_add(-s_q5l, d357, c_q5l * d355); // MSC8l in 7l.x
+                let t51 = c_q5l * d361; // common subexpression
+                let t52 = s_q5l * d363; // common subexpression
+                let t53 = s_q5l * d361; // common subexpression
                 let t54 = c_q5l * d363; // common subexpression
                 let t55 = p.L8 * d367; // common subexpression
                 let t56 = p.L8 * d366; // common subexpression
-                let d368 = t51 - t53 - t55; // N(M col 8l) at 7l.x
+                let d368 = t51 - t52 - t55; // N(M col 8l) at 7l.x
                 m[(8, 9)] = -d368;
                 m[(9, 8)] = m[(8, 9)];
-                let d369 = p.XY7l + t51 - t53 - t55; // JC7l.xy
-                let d370 = t52 + t54 - t56; // N(M col 8l) at 7l.z
-                let d371 = p.YZ7l - t52 - t54 + t56; // JC7l.yz
-                let d372 = s_q4l * d367; // F(M col 8l) at 6l.y
-                let d373 = c_q4l * d367; // F(M col 8l) at 6l.z
-                let d374 = p.MX7l - d367; // MSC7l.x
-                let d375 = p.MX6l - d374; // MSC6l.x
-                let d376 = A::mul_add(-s_q4l, d370, c_q4l * d365); // N(M col 8l) at 6l.y
-                m[(7, 9)] = d376;
+                let d369 = t53 + t54 - t56; // N(M col 8l) at 7l.z
+                let d370 = s_q4l * d367; // F(M col 8l) at 6l.y
+                let d371 = c_q4l * d367; // F(M col 8l) at 6l.z
+                let d372 = A::mul_add(-s_q4l, d369, c_q4l * d365); // N(M col 8l) at 6l.y
+                m[(7, 9)] = d372;
                 m[(9, 7)] = m[(7, 9)];
-                let d377 = A::mul_add(c_q4l, d370, s_q4l * d365); // N(M col 8l) at 6l.z
-                let d378 = p.YY7l + d365; // JC7l.yy
-                let d379 = A::mul_add(s_q3l, d373, c_q3l * d366); // F(M col 8l) at 5l.x
-                let d380 = A::mul_add(-c_q3l, d373, s_q3l * d366); // F(M col 8l) at 5l.z
-                let d381 = p.MZ7l + d366; // MSC7l.z
-                let d382 = A::mul_add(
+                let d373 = A::mul_add(c_q4l, d369, s_q4l * d365); // N(M col 8l) at 6l.z
+                let d374 = A::mul_add(s_q3l, d371, c_q3l * d366); // F(M col 8l) at 5l.x
+                let d375 = A::mul_add(-c_q3l, d371, s_q3l * d366); // F(M col 8l) at 5l.z
+                let d376 = A::mul_add(
                     p.L7,
-                    d380,
-                    A::mul_add(-s_q3l, d377, c_q3l * d368),
+                    d375,
+                    A::mul_add(-s_q3l, d373, c_q3l * d368),
                 ); // N(M col 8l) at 5l.x
-                m[(6, 9)] = -d382;
+                m[(6, 9)] = -d376;
                 m[(9, 6)] = m[(6, 9)];
-                let d383 = A::mul_add(
+                let d377 = A::mul_add(
                     -p.L7,
-                    d379,
-                    A::mul_add(c_q3l, d377, s_q3l * d368),
+                    d374,
+                    A::mul_add(c_q3l, d373, s_q3l * d368),
                 ); // N(M col 8l) at 5l.z
-                let d384 = A::mul_add(-s_q2l, d380, c_q2l * d372); // F(M col 8l) at 4l.y
-                let d385 = A::mul_add(c_q2l, d380, s_q2l * d372); // F(M col 8l) at 4l.z
-                let d386 = A::mul_add(-s_q2l, d383, c_q2l * d376); // N(M col 8l) at 4l.y
-                m[(5, 9)] = d386;
+                let d378 = A::mul_add(-s_q2l, d375, c_q2l * d370); // F(M col 8l) at 4l.y
+                let d379 = A::mul_add(c_q2l, d375, s_q2l * d370); // F(M col 8l) at 4l.z
+                let d380 = A::mul_add(-s_q2l, d377, c_q2l * d372); // N(M col 8l) at 4l.y
+                m[(5, 9)] = d380;
                 m[(9, 5)] = m[(5, 9)];
-                let d387 = A::mul_add(c_q2l, d383, s_q2l * d376); // N(M col 8l) at 4l.z
-                let d388 = A::mul_add(c_q1l, d385, s_q1l * d379); // F(M col 8l) at 3.z
-                let d389 = A::mul_add(-s_q1l, d385, c_q1l * d379); // F(M col 8l) at 3.y
-                let d390 = A::mul_add(-p.L5, d388, d386); // N(M col 8l) at 3.x
-                let d391 = A::mul_add(
+                let d381 = A::mul_add(c_q2l, d377, s_q2l * d372); // N(M col 8l) at 4l.z
+                let d382 = A::mul_add(c_q1l, d379, s_q1l * d374); // F(M col 8l) at 3.z
+                let d383 = A::mul_add(-s_q1l, d379, c_q1l * d374); // F(M col 8l) at 3.y
+                let d384 = A::mul_add(
                     p.L5,
-                    d384,
-                    A::mul_add(-p.L6, d389, A::mul_add(c_q1l, d387, s_q1l * d382)),
+                    d378,
+                    A::mul_add(-p.L6, d383, A::mul_add(c_q1l, d381, s_q1l * d376)),
                 ); // N(M col 8l) at 3.z
-                let d392 = A::mul_add(
+                let d385 = A::mul_add(-p.L5, d382, d380); // N(M col 8l) at 3.x
+                let d386 = A::mul_add(
                     p.L6,
-                    d388,
-                    A::mul_add(-s_q1l, d387, c_q1l * d382),
+                    d382,
+                    A::mul_add(-s_q1l, d381, c_q1l * d376),
                 ); // N(M col 8l) at 3.y
-                m[(4, 9)] = d392;
+                m[(4, 9)] = d386;
                 m[(9, 4)] = m[(4, 9)];
-                let d393 = A::mul_add(s_q_torso, d388, c_q_torso * d384); // F(M col 8l) at 2.x
-                let d394 = A::mul_add(-c_q_torso, d388, s_q_torso * d384); // F(M col 8l) at 2.z
-                let d395 = A::mul_add(-p.L4, d393, d392); // N(M col 8l) at 2.y
-                let d396 = A::mul_add(
+                let d387 = A::mul_add(s_q_torso, d382, c_q_torso * d378); // F(M col 8l) at 2.x
+                let d388 = A::mul_add(-c_q_torso, d382, s_q_torso * d378); // F(M col 8l) at 2.z
+                let d389 = A::mul_add(
                     p.L4,
-                    d389,
-                    A::mul_add(p.L3, d394, A::mul_add(s_q_torso, d391, c_q_torso * d390)),
+                    d383,
+                    A::mul_add(p.L3, d388, A::mul_add(s_q_torso, d384, c_q_torso * d385)),
                 ); // N(M col 8l) at 2.x
-                m[(3, 9)] = -d396;
+                m[(3, 9)] = -d389;
                 m[(9, 3)] = m[(3, 9)];
-                let d397 = A::mul_add(
+                let d390 = A::mul_add(
                     -p.L3,
-                    d393,
-                    A::mul_add(-c_q_torso, d391, s_q_torso * d390),
+                    d387,
+                    A::mul_add(-c_q_torso, d384, s_q_torso * d385),
                 ); // N(M col 8l) at 2.z
-                let d398 = A::mul_add(c_q_w, d394, s_q_w * d389); // F(M col 8l) at 1.z
-                let d399 = A::mul_add(-s_q_w, d394, c_q_w * d389); // F(M col 8l) at 1.y
-                let d400 = A::mul_add(-p.L2, d399, A::mul_add(p.L1, d398, d396)); // N(M col 8l) at 1.x
-                m[(2, 9)] = -d400;
+                let d391 = A::mul_add(-p.L4, d387, d386); // N(M col 8l) at 2.y
+                let d392 = A::mul_add(c_q_w, d388, s_q_w * d383); // F(M col 8l) at 1.z
+                let d393 = A::mul_add(-s_q_w, d388, c_q_w * d383); // F(M col 8l) at 1.y
+                let d394 = A::mul_add(-p.L2, d393, A::mul_add(p.L1, d392, d389)); // N(M col 8l) at 1.x
+                m[(2, 9)] = -d394;
                 m[(9, 2)] = m[(2, 9)];
-                let d401 = A::mul_add(c_q_imu, d398, s_q_imu * d399); // F(M col 8l) at 0.x
-                m[(0, 9)] = -d401;
-                m[(9, 0)] = m[(0, 9)];
-                let d402 = A::mul_add(
+                let d395 = A::mul_add(
                     -p.L1,
-                    d393,
-                    A::mul_add(c_q_w, d397, s_q_w * d395),
+                    d387,
+                    A::mul_add(c_q_w, d390, s_q_w * d391),
                 ); // N(M col 8l) at 1.z
-                let d403 = A::mul_add(
+                let d396 = A::mul_add(
                     p.L2,
-                    d393,
-                    A::mul_add(-s_q_w, d397, c_q_w * d395),
+                    d387,
+                    A::mul_add(-s_q_w, d390, c_q_w * d391),
                 ); // N(M col 8l) at 1.y
-                let d404 = A::mul_add(-s_q_imu, d402, c_q_imu * d403); // N(M col 8l) at 0.z
-                m[(1, 9)] = -d404;
+                let d397 = A::mul_add(c_q_imu, d392, s_q_imu * d393); // F(M col 8l) at 0.x
+                m[(0, 9)] = -d397;
+                m[(9, 0)] = m[(0, 9)];
+                let d398 = A::mul_add(-s_q_imu, d395, c_q_imu * d396); // N(M col 8l) at 0.z
+                m[(1, 9)] = -d398;
                 m[(9, 1)] = m[(1, 9)];
+                let d399 = p.MX7l - d367; // MSC7l.x
+                let d400 = p.MZ7l + d366; // MSC7l.z
                 let k28 = s_q5l * s_q5l; // sin² q5l
                 let k29 = s_q5l * c_q5l; // sin q5l cos q5l
                 let k30 = A::mul_add(2.0, k28, -1.0); // cos 2q5l
-                let d405 = d330 - d364; // JC8l: Jzz − Jxx
-                let d406 = A::mul_add(2.0, d324 * k29, k28 * d405); // JC8l rotated about y: Jzz − J'zz
-                let d407 = A::mul_add(-k29, d405, A::mul_add(d324, k30, p.XZ7l)); // JC7l.xz
-                let t57 = p.L8 * d327; // common subexpression
-                let d408 = pc.pc36 - d327; // MSC7l.y
-                let d409 = A::mul_add(2.0, t57, d330 - d406) + pc.pc37; // JC7l.xx
-                m[(8, 8)] = d409;
-                let d410 = A::mul_add(2.0, t57, d364 + d406) + pc.pc38; // JC7l.zz
-                let d411 = A::mul_add(s_q4l, d381, c_q4l * d408); // MSC7l in 6l.y
-                let d412 = A::mul_add(-c_q4l, d381, s_q4l * d408); // MSC7l in 6l.z
-                let t58 = c_q4l * d369; // common subexpression
-                let t59 = s_q4l * d369; // common subexpression
-                let t60 = s_q4l * d407; // common subexpression
-                let t61 = c_q4l * d407; // common subexpression
-                let d413 = t58 + t60; // N(M col 7l) at 6l.y
-                m[(7, 8)] = -d413;
+                let d401 = d360 - d364; // JC8l: Jzz − Jxx
+                let d402 = A::mul_add(2.0, d362 * k29, k28 * d401); // JC8l rotated about y: Jzz − J'zz
+                let t57 = p.L8 * d356; // common subexpression
+                let d403 = p.XY7l + t51 - t52 - t55; // JC7l.xy
+                let d404 = A::mul_add(-k29, d401, A::mul_add(d362, k30, p.XZ7l)); // JC7l.xz
+                let d405 = p.YY7l + d365; // JC7l.yy
+                let d406 = p.YZ7l - t53 - t54 + t56; // JC7l.yz
+                let d407 = pc.pc36 - d356; // MSC7l.y
+                let d408 = A::mul_add(2.0, t57, d360 - d402) + pc.pc37; // JC7l.xx
+                m[(8, 8)] = d408;
+                let d409 = A::mul_add(2.0, t57, d364 + d402) + pc.pc38; // JC7l.zz
+                let d410 = A::mul_add(s_q4l, d400, c_q4l * d407); // MSC7l in 6l.y
+                let d411 = A::mul_add(-c_q4l, d400, s_q4l * d407); // MSC7l in 6l.z
+                let t58 = c_q4l * d403; // common subexpression
+                let t59 = s_q4l * d404; // common subexpression
+                let d412 = t58 + t59; // N(M col 7l) at 6l.y
+                m[(7, 8)] = -d412;
                 m[(8, 7)] = m[(7, 8)];
-                let d414 = p.XY6l + t58 + t60; // JC6l.xy
-                let d415 = t59 - t61; // N(M col 7l) at 6l.z
-                let d416 = p.XZ6l + t59 - t61; // JC6l.xz
-                let d417 = s_q3l * d411; // F(M col 7l) at 5l.x
-                let d418 = c_q3l * d411; // F(M col 7l) at 5l.z
-                let d419 = p.MY6l - d411; // MSC6l.y
-                let d420 = A::mul_add(
+                let t60 = s_q4l * d403; // common subexpression
+                let t61 = c_q4l * d404; // common subexpression
+                let d413 = t60 - t61; // N(M col 7l) at 6l.z
+                let d414 = s_q3l * d410; // F(M col 7l) at 5l.x
+                let d415 = c_q3l * d410; // F(M col 7l) at 5l.z
+                let d416 = A::mul_add(
                     -p.L7,
-                    d417,
-                    A::mul_add(c_q3l, d415, s_q3l * d409),
+                    d414,
+                    A::mul_add(c_q3l, d413, s_q3l * d408),
                 ); // N(M col 7l) at 5l.z
-                let d421 = A::mul_add(
+                let d417 = A::mul_add(
                     -p.L7,
-                    d418,
-                    A::mul_add(-s_q3l, d415, c_q3l * d409),
+                    d415,
+                    A::mul_add(-s_q3l, d413, c_q3l * d408),
                 ); // N(M col 7l) at 5l.x
-                m[(6, 8)] = d421;
+                m[(6, 8)] = d417;
                 m[(8, 6)] = m[(6, 8)];
-                let d422 = p.XX6l + d409; // JC6l.xx
-                let d423 = A::mul_add(s_q2l, d418, c_q2l * d412); // F(M col 7l) at 4l.y
-                let d424 = A::mul_add(-c_q2l, d418, s_q2l * d412); // F(M col 7l) at 4l.z
-                let d425 = p.MZ6l - d412; // MSC6l.z
-                let d426 = A::mul_add(-s_q2l, d420, c_q2l * d413); // N(M col 7l) at 4l.y
-                m[(5, 8)] = -d426;
+                let d418 = A::mul_add(s_q2l, d415, c_q2l * d411); // F(M col 7l) at 4l.y
+                let d419 = A::mul_add(-c_q2l, d415, s_q2l * d411); // F(M col 7l) at 4l.z
+                let d420 = A::mul_add(-s_q2l, d416, c_q2l * d412); // N(M col 7l) at 4l.y
+                m[(5, 8)] = -d420;
                 m[(8, 5)] = m[(5, 8)];
-                let d427 = A::mul_add(c_q2l, d420, s_q2l * d413); // N(M col 7l) at 4l.z
-                let d428 = A::mul_add(-s_q1l, d424, c_q1l * d417); // F(M col 7l) at 3.y
-                let d429 = A::mul_add(c_q1l, d424, s_q1l * d417); // F(M col 7l) at 3.z
-                let d430 = A::mul_add(-p.L5, d429, d426); // N(M col 7l) at 3.x
-                let d431 = A::mul_add(
+                let d421 = A::mul_add(c_q2l, d416, s_q2l * d412); // N(M col 7l) at 4l.z
+                let d422 = A::mul_add(-s_q1l, d419, c_q1l * d414); // F(M col 7l) at 3.y
+                let d423 = A::mul_add(c_q1l, d419, s_q1l * d414); // F(M col 7l) at 3.z
+                let d424 = A::mul_add(-p.L5, d423, d420); // N(M col 7l) at 3.x
+                let d425 = A::mul_add(
                     p.L6,
-                    d429,
-                    A::mul_add(-s_q1l, d427, c_q1l * d421),
-                ); // N(M col 7l) at 3.y
-                m[(4, 8)] = -d431;
-                m[(8, 4)] = m[(4, 8)];
-                let d432 = A::mul_add(
-                    p.L5,
                     d423,
-                    A::mul_add(-p.L6, d428, A::mul_add(c_q1l, d427, s_q1l * d421)),
+                    A::mul_add(-s_q1l, d421, c_q1l * d417),
+                ); // N(M col 7l) at 3.y
+                m[(4, 8)] = -d425;
+                m[(8, 4)] = m[(4, 8)];
+                let d426 = A::mul_add(
+                    p.L5,
+                    d418,
+                    A::mul_add(-p.L6, d422, A::mul_add(c_q1l, d421, s_q1l * d417)),
                 ); // N(M col 7l) at 3.z
-                let d433 = A::mul_add(s_q_torso, d429, c_q_torso * d423); // F(M col 7l) at 2.x
-                let d434 = A::mul_add(-c_q_torso, d429, s_q_torso * d423); // F(M col 7l) at 2.z
-                let d435 = A::mul_add(-p.L4, d433, d431); // N(M col 7l) at 2.y
-                let d436 = A::mul_add(
+                let d427 = A::mul_add(s_q_torso, d423, c_q_torso * d418); // F(M col 7l) at 2.x
+                let d428 = A::mul_add(-c_q_torso, d423, s_q_torso * d418); // F(M col 7l) at 2.z
+                let d429 = A::mul_add(-p.L4, d427, d425); // N(M col 7l) at 2.y
+                let d430 = A::mul_add(
                     p.L4,
-                    d428,
-                    A::mul_add(p.L3, d434, A::mul_add(s_q_torso, d432, c_q_torso * d430)),
+                    d422,
+                    A::mul_add(p.L3, d428, A::mul_add(s_q_torso, d426, c_q_torso * d424)),
                 ); // N(M col 7l) at 2.x
-                m[(3, 8)] = d436;
+                m[(3, 8)] = d430;
                 m[(8, 3)] = m[(3, 8)];
-                let d437 = A::mul_add(
+                let d431 = A::mul_add(
                     -p.L3,
-                    d433,
-                    A::mul_add(-c_q_torso, d432, s_q_torso * d430),
+                    d427,
+                    A::mul_add(-c_q_torso, d426, s_q_torso * d424),
                 ); // N(M col 7l) at 2.z
-                let d438 = A::mul_add(-s_q_w, d434, c_q_w * d428); // F(M col 7l) at 1.y
-                let d439 = A::mul_add(c_q_w, d434, s_q_w * d428); // F(M col 7l) at 1.z
-                let d440 = A::mul_add(-p.L2, d438, A::mul_add(p.L1, d439, d436)); // N(M col 7l) at 1.x
-                m[(2, 8)] = d440;
-                m[(8, 2)] = m[(2, 8)];
-                let d441 = A::mul_add(c_q_imu, d439, s_q_imu * d438); // F(M col 7l) at 0.x
-                m[(0, 8)] = d441;
-                m[(8, 0)] = m[(0, 8)];
-                let d442 = A::mul_add(
+                let d432 = A::mul_add(-s_q_w, d428, c_q_w * d422); // F(M col 7l) at 1.y
+                let d433 = A::mul_add(c_q_w, d428, s_q_w * d422); // F(M col 7l) at 1.z
+                let d434 = A::mul_add(
                     p.L2,
-                    d433,
-                    A::mul_add(-s_q_w, d437, c_q_w * d435),
+                    d427,
+                    A::mul_add(-s_q_w, d431, c_q_w * d429),
                 ); // N(M col 7l) at 1.y
-                let d443 = A::mul_add(
+                let d435 = A::mul_add(-p.L2, d432, A::mul_add(p.L1, d433, d430)); // N(M col 7l) at 1.x
+                m[(2, 8)] = d435;
+                m[(8, 2)] = m[(2, 8)];
+                let d436 = A::mul_add(
                     -p.L1,
-                    d433,
-                    A::mul_add(c_q_w, d437, s_q_w * d435),
+                    d427,
+                    A::mul_add(c_q_w, d431, s_q_w * d429),
                 ); // N(M col 7l) at 1.z
-                let d444 = A::mul_add(-s_q_imu, d443, c_q_imu * d442); // N(M col 7l) at 0.z
-                m[(1, 8)] = d444;
+                let d437 = A::mul_add(c_q_imu, d433, s_q_imu * d432); // F(M col 7l) at 0.x
+                m[(0, 8)] = d437;
+                m[(8, 0)] = m[(0, 8)];
+                let d438 = A::mul_add(-s_q_imu, d436, c_q_imu * d434); // N(M col 7l) at 0.z
+                m[(1, 8)] = d438;
                 m[(8, 1)] = m[(1, 8)];
+                let d439 = p.MX6l - d399; // MSC6l.x
+                let d440 = p.MY6l - d410; // MSC6l.y
+                let d441 = p.MZ6l - d411; // MSC6l.z
                 let k31 = s_q4l * s_q4l; // sin² q4l
                 let k32 = s_q4l * c_q4l; // sin q4l cos q4l
                 let k33 = A::mul_add(2.0, k31, -1.0); // cos 2q4l
-                let d445 = d378 - d410; // JC7l: Jyy − Jzz
-                let d446 = A::mul_add(-2.0, d371 * k32, k31 * d445); // JC7l rotated about x: Jyy − J'yy
-                let d447 = A::mul_add(k32, d445, A::mul_add(d371, k33, p.YZ6l)); // JC6l.yz
-                let d448 = p.YY6l + d378 - d446; // JC6l.yy
-                m[(7, 7)] = d448;
-                let d449 = p.ZZ6l + d410 + d446; // JC6l.zz
-                let d450 = A::mul_add(c_q3l, d425, s_q3l * d375); // MSC6l in 5l.z
-                let d451 = A::mul_add(-s_q3l, d425, c_q3l * d375); // MSC6l in 5l.x
-                let t62 = c_q3l * d414; // common subexpression
-                let t63 = s_q3l * d414; // common subexpression
-                let t64 = s_q3l * d447; // common subexpression
-                let t65 = c_q3l * d447; // common subexpression
+                let d442 = d405 - d409; // JC7l: Jyy − Jzz
+                let d443 = A::mul_add(-2.0, d406 * k32, k31 * d442); // JC7l rotated about x: Jyy − J'yy
+                let d444 = p.XX6l + d408; // JC6l.xx
+                let d445 = p.XY6l + t58 + t59; // JC6l.xy
+                let d446 = p.XZ6l + t60 - t61; // JC6l.xz
+                let d447 = p.YY6l + d405 - d443; // JC6l.yy
+                m[(7, 7)] = d447;
+                let d448 = A::mul_add(k32, d442, A::mul_add(d406, k33, p.YZ6l)); // JC6l.yz
+                let d449 = p.ZZ6l + d409 + d443; // JC6l.zz
+                let d450 = A::mul_add(c_q3l, d441, s_q3l * d439); // MSC6l in 5l.z
+                let d451 = A::mul_add(-s_q3l, d441, c_q3l * d439); // MSC6l in 5l.x
+                let t62 = c_q3l * d445; // common subexpression
+                let t63 = s_q3l * d448; // common subexpression
+                let t64 = s_q3l * d445; // common subexpression
+                let t65 = c_q3l * d448; // common subexpression
                 let t66 = p.L7 * d451; // common subexpression
                 let t67 = p.L7 * d450; // common subexpression
-                let d452 = t62 - t64 - t66; // N(M col 6l) at 5l.x
+                let d452 = t62 - t63 - t66; // N(M col 6l) at 5l.x
                 m[(6, 7)] = -d452;
                 m[(7, 6)] = m[(6, 7)];
-                let d453 = p.XY5l + t62 - t64 - t66; // JC5l.xy
-                let d454 = t63 + t65 - t67; // N(M col 6l) at 5l.z
-                let d455 = p.YZ5l - t63 - t65 + t67; // JC5l.yz
-                let d456 = s_q2l * d451; // F(M col 6l) at 4l.y
-                let d457 = c_q2l * d451; // F(M col 6l) at 4l.z
-                let d458 = p.MX5l - d451; // MSC5l.x
-                let d459 = p.MX4l - d458; // MSC4l.x
-                let d460 = A::mul_add(-s_q2l, d454, c_q2l * d448); // N(M col 6l) at 4l.y
-                m[(5, 7)] = d460;
+                let d453 = t64 + t65 - t67; // N(M col 6l) at 5l.z
+                let d454 = s_q2l * d451; // F(M col 6l) at 4l.y
+                let d455 = c_q2l * d451; // F(M col 6l) at 4l.z
+                let d456 = A::mul_add(-s_q2l, d453, c_q2l * d447); // N(M col 6l) at 4l.y
+                m[(5, 7)] = d456;
                 m[(7, 5)] = m[(5, 7)];
-                let d461 = A::mul_add(c_q2l, d454, s_q2l * d448); // N(M col 6l) at 4l.z
-                let d462 = p.YY5l + d448; // JC5l.yy
-                let d463 = A::mul_add(-c_q1l, d457, s_q1l * d450); // F(M col 6l) at 3.z
-                let d464 = A::mul_add(s_q1l, d457, c_q1l * d450); // F(M col 6l) at 3.y
-                let d465 = A::mul_add(-p.L5, d463, d460); // N(M col 6l) at 3.x
-                let d466 = p.MZ5l + d450; // MSC5l.z
-                let d467 = A::mul_add(
+                let d457 = A::mul_add(c_q2l, d453, s_q2l * d447); // N(M col 6l) at 4l.z
+                let d458 = A::mul_add(-c_q1l, d455, s_q1l * d450); // F(M col 6l) at 3.z
+                let d459 = A::mul_add(s_q1l, d455, c_q1l * d450); // F(M col 6l) at 3.y
+                let d460 = A::mul_add(
                     p.L5,
-                    d456,
-                    A::mul_add(-p.L6, d464, A::mul_add(c_q1l, d461, s_q1l * d452)),
+                    d454,
+                    A::mul_add(-p.L6, d459, A::mul_add(c_q1l, d457, s_q1l * d452)),
                 ); // N(M col 6l) at 3.z
-                let d468 = A::mul_add(
+                let d461 = A::mul_add(-p.L5, d458, d456); // N(M col 6l) at 3.x
+                let d462 = A::mul_add(
                     p.L6,
-                    d463,
-                    A::mul_add(-s_q1l, d461, c_q1l * d452),
+                    d458,
+                    A::mul_add(-s_q1l, d457, c_q1l * d452),
                 ); // N(M col 6l) at 3.y
-                m[(4, 7)] = d468;
+                m[(4, 7)] = d462;
                 m[(7, 4)] = m[(4, 7)];
-                let d469 = A::mul_add(s_q_torso, d463, c_q_torso * d456); // F(M col 6l) at 2.x
-                let d470 = A::mul_add(-c_q_torso, d463, s_q_torso * d456); // F(M col 6l) at 2.z
-                let d471 = A::mul_add(-p.L4, d469, d468); // N(M col 6l) at 2.y
-                let d472 = A::mul_add(
+                let d463 = A::mul_add(s_q_torso, d458, c_q_torso * d454); // F(M col 6l) at 2.x
+                let d464 = A::mul_add(-c_q_torso, d458, s_q_torso * d454); // F(M col 6l) at 2.z
+                let d465 = A::mul_add(
                     p.L4,
-                    d464,
-                    A::mul_add(p.L3, d470, A::mul_add(s_q_torso, d467, c_q_torso * d465)),
+                    d459,
+                    A::mul_add(p.L3, d464, A::mul_add(s_q_torso, d460, c_q_torso * d461)),
                 ); // N(M col 6l) at 2.x
-                m[(3, 7)] = -d472;
+                m[(3, 7)] = -d465;
                 m[(7, 3)] = m[(3, 7)];
-                let d473 = A::mul_add(
+                let d466 = A::mul_add(
                     -p.L3,
-                    d469,
-                    A::mul_add(-c_q_torso, d467, s_q_torso * d465),
+                    d463,
+                    A::mul_add(-c_q_torso, d460, s_q_torso * d461),
                 ); // N(M col 6l) at 2.z
-                let d474 = A::mul_add(c_q_w, d470, s_q_w * d464); // F(M col 6l) at 1.z
-                let d475 = A::mul_add(-s_q_w, d470, c_q_w * d464); // F(M col 6l) at 1.y
-                let d476 = A::mul_add(-p.L2, d475, A::mul_add(p.L1, d474, d472)); // N(M col 6l) at 1.x
-                m[(2, 7)] = -d476;
+                let d467 = A::mul_add(-p.L4, d463, d462); // N(M col 6l) at 2.y
+                let d468 = A::mul_add(c_q_w, d464, s_q_w * d459); // F(M col 6l) at 1.z
+                let d469 = A::mul_add(-s_q_w, d464, c_q_w * d459); // F(M col 6l) at 1.y
+                let d470 = A::mul_add(-p.L2, d469, A::mul_add(p.L1, d468, d465)); // N(M col 6l) at 1.x
+                m[(2, 7)] = -d470;
                 m[(7, 2)] = m[(2, 7)];
-                let d477 = A::mul_add(c_q_imu, d474, s_q_imu * d475); // F(M col 6l) at 0.x
-                m[(0, 7)] = -d477;
-                m[(7, 0)] = m[(0, 7)];
-                let d478 = A::mul_add(
+                let d471 = A::mul_add(
                     -p.L1,
-                    d469,
-                    A::mul_add(c_q_w, d473, s_q_w * d471),
+                    d463,
+                    A::mul_add(c_q_w, d466, s_q_w * d467),
                 ); // N(M col 6l) at 1.z
-                let d479 = A::mul_add(
+                let d472 = A::mul_add(
                     p.L2,
-                    d469,
-                    A::mul_add(-s_q_w, d473, c_q_w * d471),
+                    d463,
+                    A::mul_add(-s_q_w, d466, c_q_w * d467),
                 ); // N(M col 6l) at 1.y
-                let d480 = A::mul_add(-s_q_imu, d478, c_q_imu * d479); // N(M col 6l) at 0.z
-                m[(1, 7)] = -d480;
+                let d473 = A::mul_add(c_q_imu, d468, s_q_imu * d469); // F(M col 6l) at 0.x
+                m[(0, 7)] = -d473;
+                m[(7, 0)] = m[(0, 7)];
+                let d474 = A::mul_add(-s_q_imu, d471, c_q_imu * d472); // N(M col 6l) at 0.z
+                m[(1, 7)] = -d474;
                 m[(7, 1)] = m[(1, 7)];
+                let d475 = p.MX5l - d451; // MSC5l.x
+                let d476 = p.MZ5l + d450; // MSC5l.z
                 let k34 = s_q3l * s_q3l; // sin² q3l
                 let k35 = s_q3l * c_q3l; // sin q3l cos q3l
                 let k36 = A::mul_add(2.0, k34, -1.0); // cos 2q3l
-                let d481 = d422 - d449; // JC6l: Jzz − Jxx
-                let d482 = A::mul_add(2.0, d416 * k35, k34 * d481); // JC6l rotated about y: Jzz − J'zz
-                let d483 = A::mul_add(-k35, d481, A::mul_add(d416, k36, p.XZ5l)); // JC5l.xz
-                let t68 = p.L7 * d419; // common subexpression
-                let d484 = pc.pc42 - d419; // MSC5l.y
-                let d485 = A::mul_add(2.0, t68, d422 - d482) + pc.pc43; // JC5l.xx
-                m[(6, 6)] = d485;
-                let d486 = A::mul_add(2.0, t68, d449 + d482) + pc.pc44; // JC5l.zz
-                let d487 = A::mul_add(s_q2l, d466, c_q2l * d484); // MSC5l in 4l.y
-                let d488 = A::mul_add(-c_q2l, d466, s_q2l * d484); // MSC5l in 4l.z
-                let t69 = c_q2l * d453; // common subexpression
-                let t70 = s_q2l * d453; // common subexpression
-                let t71 = s_q2l * d483; // common subexpression
-                let t72 = c_q2l * d483; // common subexpression
-                let d489 = t69 + t71; // N(M col 5l) at 4l.y
-                m[(5, 6)] = -d489;
+                let d477 = d444 - d449; // JC6l: Jzz − Jxx
+                let d478 = A::mul_add(2.0, d446 * k35, k34 * d477); // JC6l rotated about y: Jzz − J'zz
+                let t68 = p.L7 * d440; // common subexpression
+                let d479 = p.XY5l + t62 - t63 - t66; // JC5l.xy
+                let d480 = A::mul_add(-k35, d477, A::mul_add(d446, k36, p.XZ5l)); // JC5l.xz
+                let d481 = p.YY5l + d447; // JC5l.yy
+                let d482 = p.YZ5l - t64 - t65 + t67; // JC5l.yz
+                let d483 = pc.pc42 - d440; // MSC5l.y
+                let d484 = A::mul_add(2.0, t68, d444 - d478) + pc.pc43; // JC5l.xx
+                m[(6, 6)] = d484;
+                let d485 = A::mul_add(2.0, t68, d449 + d478) + pc.pc44; // JC5l.zz
+                let d486 = A::mul_add(s_q2l, d476, c_q2l * d483); // MSC5l in 4l.y
+                let d487 = A::mul_add(-c_q2l, d476, s_q2l * d483); // MSC5l in 4l.z
+                let t69 = c_q2l * d479; // common subexpression
+                let t70 = s_q2l * d480; // common subexpression
+                let d488 = t69 + t70; // N(M col 5l) at 4l.y
+                m[(5, 6)] = -d488;
                 m[(6, 5)] = m[(5, 6)];
-                let d490 = p.XY4l + t69 + t71; // JC4l.xy
-                let d491 = t70 - t72; // N(M col 5l) at 4l.z
-                let d492 = p.XZ4l + t70 - t72; // JC4l.xz
-                let d493 = s_q1l * d487; // F(M col 5l) at 3.y
-                let d494 = c_q1l * d487; // F(M col 5l) at 3.z
-                let d495 = A::mul_add(p.L5, d494, d489); // N(M col 5l) at 3.x
-                let d496 = p.MY4l - d487; // MSC4l.y
-                let d497 = A::mul_add(
+                let t71 = s_q2l * d479; // common subexpression
+                let t72 = c_q2l * d480; // common subexpression
+                let d489 = t71 - t72; // N(M col 5l) at 4l.z
+                let d490 = s_q1l * d486; // F(M col 5l) at 3.y
+                let d491 = c_q1l * d486; // F(M col 5l) at 3.z
+                let d492 = A::mul_add(p.L5, d491, d488); // N(M col 5l) at 3.x
+                let d493 = A::mul_add(
                     -p.L6,
-                    d494,
-                    A::mul_add(-s_q1l, d491, c_q1l * d485),
+                    d491,
+                    A::mul_add(-s_q1l, d489, c_q1l * d484),
                 ); // N(M col 5l) at 3.y
-                m[(4, 6)] = -d497;
+                m[(4, 6)] = -d493;
                 m[(6, 4)] = m[(4, 6)];
-                let d498 = A::mul_add(
+                let d494 = A::mul_add(
                     p.L5,
-                    d488,
-                    A::mul_add(-p.L6, d493, A::mul_add(c_q1l, d491, s_q1l * d485)),
+                    d487,
+                    A::mul_add(-p.L6, d490, A::mul_add(c_q1l, d489, s_q1l * d484)),
                 ); // N(M col 5l) at 3.z
-                let d499 = p.XX4l + d485; // JC4l.xx
-                let d500 = A::mul_add(-s_q_torso, d494, c_q_torso * d488); // F(M col 5l) at 2.x
-                let d501 = A::mul_add(c_q_torso, d494, s_q_torso * d488); // F(M col 5l) at 2.z
-                let d502 = A::mul_add(-p.L4, d500, d497); // N(M col 5l) at 2.y
-                let d503 = p.MZ4l - d488; // MSC4l.z
-                let d504 = A::mul_add(
+                let d495 = A::mul_add(-s_q_torso, d491, c_q_torso * d487); // F(M col 5l) at 2.x
+                let d496 = A::mul_add(c_q_torso, d491, s_q_torso * d487); // F(M col 5l) at 2.z
+                let d497 = A::mul_add(-p.L4, d495, d493); // N(M col 5l) at 2.y
+                let d498 = A::mul_add(
                     p.L4,
-                    d493,
-                    A::mul_add(p.L3, d501, A::mul_add(s_q_torso, d498, c_q_torso * d495)),
+                    d490,
+                    A::mul_add(p.L3, d496, A::mul_add(s_q_torso, d494, c_q_torso * d492)),
                 ); // N(M col 5l) at 2.x
-                m[(3, 6)] = d504;
+                m[(3, 6)] = d498;
                 m[(6, 3)] = m[(3, 6)];
-                let d505 = A::mul_add(
+                let d499 = A::mul_add(
                     -p.L3,
-                    d500,
-                    A::mul_add(-c_q_torso, d498, s_q_torso * d495),
+                    d495,
+                    A::mul_add(-c_q_torso, d494, s_q_torso * d492),
                 ); // N(M col 5l) at 2.z
-                let d506 = A::mul_add(-s_q_w, d501, c_q_w * d493); // F(M col 5l) at 1.y
-                let d507 = A::mul_add(c_q_w, d501, s_q_w * d493); // F(M col 5l) at 1.z
-                let d508 = A::mul_add(-p.L2, d506, A::mul_add(p.L1, d507, d504)); // N(M col 5l) at 1.x
-                m[(2, 6)] = d508;
-                m[(6, 2)] = m[(2, 6)];
-                let d509 = A::mul_add(c_q_imu, d507, s_q_imu * d506); // F(M col 5l) at 0.x
-                m[(0, 6)] = d509;
-                m[(6, 0)] = m[(0, 6)];
-                let d510 = A::mul_add(
+                let d500 = A::mul_add(-s_q_w, d496, c_q_w * d490); // F(M col 5l) at 1.y
+                let d501 = A::mul_add(c_q_w, d496, s_q_w * d490); // F(M col 5l) at 1.z
+                let d502 = A::mul_add(
                     p.L2,
-                    d500,
-                    A::mul_add(-s_q_w, d505, c_q_w * d502),
+                    d495,
+                    A::mul_add(-s_q_w, d499, c_q_w * d497),
                 ); // N(M col 5l) at 1.y
-                let d511 = A::mul_add(
+                let d503 = A::mul_add(-p.L2, d500, A::mul_add(p.L1, d501, d498)); // N(M col 5l) at 1.x
+                m[(2, 6)] = d503;
+                m[(6, 2)] = m[(2, 6)];
+                let d504 = A::mul_add(
                     -p.L1,
-                    d500,
-                    A::mul_add(c_q_w, d505, s_q_w * d502),
+                    d495,
+                    A::mul_add(c_q_w, d499, s_q_w * d497),
                 ); // N(M col 5l) at 1.z
-                let d512 = A::mul_add(-s_q_imu, d511, c_q_imu * d510); // N(M col 5l) at 0.z
-                m[(1, 6)] = d512;
+                let d505 = A::mul_add(c_q_imu, d501, s_q_imu * d500); // F(M col 5l) at 0.x
+                m[(0, 6)] = d505;
+                m[(6, 0)] = m[(0, 6)];
+                let d506 = A::mul_add(-s_q_imu, d504, c_q_imu * d502); // N(M col 5l) at 0.z
+                m[(1, 6)] = d506;
                 m[(6, 1)] = m[(1, 6)];
+                let d507 = p.MX4l - d475; // MSC4l.x
+                let d508 = p.MY4l - d486; // MSC4l.y
+                let d509 = p.MZ4l - d487; // MSC4l.z
                 let k37 = s_q2l * s_q2l; // sin² q2l
                 let k38 = s_q2l * c_q2l; // sin q2l cos q2l
                 let k39 = A::mul_add(2.0, k37, -1.0); // cos 2q2l
-                let d513 = d462 - d486; // JC5l: Jyy − Jzz
-                let d514 = A::mul_add(-2.0, d455 * k38, k37 * d513); // JC5l rotated about x: Jyy − J'yy
-                let d515 = A::mul_add(k38, d513, A::mul_add(d455, k39, p.YZ4l)); // JC4l.yz
-                let d516 = p.YY4l + d462 - d514; // JC4l.yy
-                m[(5, 5)] = d516;
-                let d517 = p.ZZ4l + d486 + d514; // JC4l.zz
-                let d518 = A::mul_add(-s_q1l, d503, c_q1l * d459); // MSC4l in 3.y
-                let d519 = A::mul_add(c_q1l, d503, s_q1l * d459); // MSC4l in 3.z
-                let d520 = d250 + d518 + pc.pc48; // MSC3.y
-                let t73 = c_q1l * d490; // common subexpression
-                let t74 = s_q1l * d490; // common subexpression
-                let t75 = s_q1l * d515; // common subexpression
-                let t76 = c_q1l * d515; // common subexpression
+                let d510 = d481 - d485; // JC5l: Jyy − Jzz
+                let d511 = A::mul_add(-2.0, d482 * k38, k37 * d510); // JC5l rotated about x: Jyy − J'yy
+                let d512 = p.XX4l + d484; // JC4l.xx
+                let d513 = p.XY4l + t69 + t70; // JC4l.xy
+                let d514 = p.XZ4l + t71 - t72; // JC4l.xz
+                let d515 = p.YY4l + d481 - d511; // JC4l.yy
+                m[(5, 5)] = d515;
+                let d516 = A::mul_add(k38, d510, A::mul_add(d482, k39, p.YZ4l)); // JC4l.yz
+                let d517 = p.ZZ4l + d485 + d511; // JC4l.zz
+                let d518 = A::mul_add(-s_q1l, d509, c_q1l * d507); // MSC4l in 3.y
+                let d519 = A::mul_add(c_q1l, d509, s_q1l * d507); // MSC4l in 3.z
+                let t73 = c_q1l * d513; // common subexpression
+                let t74 = s_q1l * d516; // common subexpression
+                let t75 = s_q1l * d513; // common subexpression
+                let t76 = c_q1l * d516; // common subexpression
                 let t77 = p.L5 * d518; // common subexpression
-                let d521 = A::mul_add(2.0, t77, A::mul_add(2.0, t37, d248) + d516)
-                    + pc.pc49; // JC3.xx
-                let d522 = d516 + t77; // N(M col 4l) at 3.x
                 let t78 = p.L6 * d518; // common subexpression
-                let d523 = A::mul_add(
-                    -p.L5,
-                    d496,
-                    A::mul_add(p.L5, d228, t35 - t33 + t38) + t73 - t75 - t78,
-                ) + pc.pc50; // JC3.xy
-                let d524 = t73 - t75 - t78; // N(M col 4l) at 3.y
-                m[(4, 5)] = d524;
+                let t79 = p.L6 * d519; // common subexpression
+                let d520 = t75 + t76 - t79; // N(M col 4l) at 3.z
+                let d521 = d515 + t77; // N(M col 4l) at 3.x
+                let d522 = t73 - t74 - t78; // N(M col 4l) at 3.y
+                m[(4, 5)] = d522;
                 m[(5, 4)] = m[(4, 5)];
-                let d525 = d496 - d228 + pc.pc47; // MSC3.x
-                let t79 = p.L6 * d496; // common subexpression
-                let t80 = p.L6 * d519; // common subexpression
-                let d526 = p.XZ3 - t34 - t36 + t39 - t74 - t76 + t80; // JC3.xz
-                let d527 = t74 + t76 - t80; // N(M col 4l) at 3.z
-                let d528 = s_q_torso * d518; // F(M col 4l) at 2.x
-                let d529 = c_q_torso * d518; // F(M col 4l) at 2.z
-                let d530 = A::mul_add(p.L4, d528, d524); // N(M col 4l) at 2.y
-                let d531 = A::mul_add(
+                let d523 = s_q_torso * d518; // F(M col 4l) at 2.x
+                let d524 = c_q_torso * d518; // F(M col 4l) at 2.z
+                let d525 = A::mul_add(
                     p.L4,
                     d519,
-                    A::mul_add(p.L3, d529, A::mul_add(s_q_torso, d527, c_q_torso * d522)),
+                    A::mul_add(p.L3, d524, A::mul_add(s_q_torso, d520, c_q_torso * d521)),
                 ); // N(M col 4l) at 2.x
-                m[(3, 5)] = -d531;
+                m[(3, 5)] = -d525;
                 m[(5, 3)] = m[(3, 5)];
-                let d532 = A::mul_add(
+                let d526 = A::mul_add(
                     p.L3,
-                    d528,
-                    A::mul_add(-c_q_torso, d527, s_q_torso * d522),
+                    d523,
+                    A::mul_add(-c_q_torso, d520, s_q_torso * d521),
                 ); // N(M col 4l) at 2.z
-                let d533 = A::mul_add(c_q_w, d529, s_q_w * d519); // F(M col 4l) at 1.z
-                let d534 = A::mul_add(-s_q_w, d529, c_q_w * d519); // F(M col 4l) at 1.y
-                let d535 = A::mul_add(-p.L2, d534, A::mul_add(p.L1, d533, d531)); // N(M col 4l) at 1.x
-                m[(2, 5)] = -d535;
+                let d527 = A::mul_add(p.L4, d523, d522); // N(M col 4l) at 2.y
+                let d528 = A::mul_add(c_q_w, d524, s_q_w * d519); // F(M col 4l) at 1.z
+                let d529 = A::mul_add(-s_q_w, d524, c_q_w * d519); // F(M col 4l) at 1.y
+                let d530 = A::mul_add(-p.L2, d529, A::mul_add(p.L1, d528, d525)); // N(M col 4l) at 1.x
+                m[(2, 5)] = -d530;
                 m[(5, 2)] = m[(2, 5)];
-                let d536 = A::mul_add(c_q_imu, d533, s_q_imu * d534); // F(M col 4l) at 0.x
-                m[(0, 5)] = -d536;
-                m[(5, 0)] = m[(0, 5)];
-                let d537 = A::mul_add(p.L1, d528, A::mul_add(c_q_w, d532, s_q_w * d530)); // N(M col 4l) at 1.z
-                let d538 = A::mul_add(
+                let d531 = A::mul_add(p.L1, d523, A::mul_add(c_q_w, d526, s_q_w * d527)); // N(M col 4l) at 1.z
+                let d532 = A::mul_add(
                     -p.L2,
-                    d528,
-                    A::mul_add(-s_q_w, d532, c_q_w * d530),
+                    d523,
+                    A::mul_add(-s_q_w, d526, c_q_w * d527),
                 ); // N(M col 4l) at 1.y
-                let d539 = A::mul_add(-s_q_imu, d537, c_q_imu * d538); // N(M col 4l) at 0.z
-                m[(1, 5)] = -d539;
+                let d533 = A::mul_add(c_q_imu, d528, s_q_imu * d529); // F(M col 4l) at 0.x
+                m[(0, 5)] = -d533;
+                m[(5, 0)] = m[(0, 5)];
+                let d534 = A::mul_add(-s_q_imu, d531, c_q_imu * d532); // N(M col 4l) at 0.z
+                m[(1, 5)] = -d534;
                 m[(5, 1)] = m[(1, 5)];
-                let d540 = p.MZ3 + d251 - d519; // MSC3.z
+                let d535 = p.MZ3 + d251 - d519; // MSC3.z
                 let k40 = s_q1l * s_q1l; // sin² q1l
                 let k41 = s_q1l * c_q1l; // sin q1l cos q1l
                 let k42 = A::mul_add(2.0, k40, -1.0); // cos 2q1l
-                let d541 = d499 - d517; // JC4l: Jzz − Jxx
-                let d542 = A::mul_add(
+                let d536 = d512 - d517; // JC4l: Jzz − Jxx
+                let d537 = A::mul_add(2.0, d514 * k41, k40 * d536); // JC4l rotated about y: Jzz − J'zz
+                let t80 = p.L6 * d508; // common subexpression
+                let d538 = p.XZ3 - t35 - t36 + t39 - t75 - t76 + t79; // JC3.xz
+                let d539 = A::mul_add(
                     p.L5,
                     d519,
                     A::mul_add(
                         -k41,
-                        d541,
+                        d536,
                         A::mul_add(
-                            d492,
+                            d514,
                             k42,
                             A::mul_add(
                                 -p.L5,
                                 d251,
-                                A::mul_add(k20, d267, A::mul_add(-d224, k21, p.YZ3)),
+                                A::mul_add(k20, d267, A::mul_add(-d246, k21, p.YZ3)),
                             ),
                         ),
                     ),
                 ); // JC3.yz
-                let d543 = A::mul_add(2.0, d492 * k41, k40 * d541); // JC4l rotated about y: Jzz − J'zz
+                let d540 = d508 - d240 + pc.pc47; // MSC3.x
+                let d541 = d250 + d518 + pc.pc48; // MSC3.y
+                let d542 = A::mul_add(2.0, t77, A::mul_add(2.0, t37, d247) + d515)
+                    + pc.pc49; // JC3.xx
+                let d543 = A::mul_add(
+                    -p.L5,
+                    d508,
+                    A::mul_add(p.L5, d240, t34 - t33 + t38) + t73 - t74 - t78,
+                ) + pc.pc50; // JC3.xy
                 let d544 = A::mul_add(
                     2.0,
-                    t79,
+                    t80,
+                    A::mul_add(2.0, t40, d244 - d268) + d512 - d537,
+                ) + pc.pc51; // JC3.yy
+                m[(4, 4)] = d544;
+                let d545 = A::mul_add(
+                    2.0,
+                    t80,
                     A::mul_add(
                         2.0,
                         t77,
                         A::mul_add(2.0, t40, A::mul_add(2.0, t37, d249) + d268) + d517,
-                    ) + d543,
+                    ) + d537,
                 ) + pc.pc52; // JC3.zz
-                let d545 = A::mul_add(
-                    2.0,
-                    t79,
-                    A::mul_add(2.0, t40, d231 - d268) + d499 - d543,
-                ) + pc.pc51; // JC3.yy
-                m[(4, 4)] = d545;
-                let d546 = A::mul_add(-s_q_torso, d540, c_q_torso * d525); // MSC3 in 2.x
-                let d547 = A::mul_add(c_q_torso, d540, s_q_torso * d525); // MSC3 in 2.z
-                let t81 = c_q_torso * d523; // common subexpression
-                let t82 = s_q_torso * d523; // common subexpression
-                let t83 = s_q_torso * d542; // common subexpression
-                let t84 = c_q_torso * d542; // common subexpression
+                let d546 = A::mul_add(-s_q_torso, d535, c_q_torso * d540); // MSC3 in 2.x
+                let d547 = A::mul_add(c_q_torso, d535, s_q_torso * d540); // MSC3 in 2.z
+                let t81 = c_q_torso * d543; // common subexpression
+                let t82 = s_q_torso * d539; // common subexpression
+                let t83 = s_q_torso * d543; // common subexpression
+                let t84 = c_q_torso * d539; // common subexpression
                 let t85 = p.L3 * d546; // common subexpression
                 let t86 = p.L4 * d547; // common subexpression
                 let t87 = p.L3 * d547; // common subexpression
-                let d548 = t81 - t83 - t85; // N(M col 3) at 2.x
+                let d548 = t81 - t82 - t85; // N(M col 3) at 2.x
                 m[(3, 4)] = -d548;
                 m[(4, 3)] = m[(3, 4)];
-                let d549 = p.XY2 - t81 + t83 + t85; // JC2.xy
-                let d550 = t82 + t84 - t87; // N(M col 3) at 2.z
-                let d551 = A::mul_add(-p.L4, d520, t87 - t82 - t84) + pc.pc58; // JC2.yz
-                let d552 = d545 - t86; // N(M col 3) at 2.y
-                let d553 = A::mul_add(-2.0, t86, d545) + pc.pc57; // JC2.yy
-                let d554 = s_q_w * d546; // F(M col 3) at 1.y
-                let d555 = c_q_w * d546; // F(M col 3) at 1.z
-                let d556 = A::mul_add(-p.L2, d554, A::mul_add(-p.L1, d555, d548)); // N(M col 3) at 1.x
-                m[(2, 4)] = -d556;
+                let d549 = t83 + t84 - t87; // N(M col 3) at 2.z
+                let d550 = d544 - t86; // N(M col 3) at 2.y
+                let d551 = s_q_w * d546; // F(M col 3) at 1.y
+                let d552 = c_q_w * d546; // F(M col 3) at 1.z
+                let d553 = A::mul_add(-p.L2, d551, A::mul_add(-p.L1, d552, d548)); // N(M col 3) at 1.x
+                m[(2, 4)] = -d553;
                 m[(4, 2)] = m[(2, 4)];
-                let d557 = A::mul_add(-c_q_imu, d555, s_q_imu * d554); // F(M col 3) at 0.x
-                m[(0, 4)] = -d557;
-                m[(4, 0)] = m[(0, 4)];
-                let d558 = A::mul_add(
+                let d554 = A::mul_add(
                     -p.L1,
                     d547,
-                    A::mul_add(c_q_w, d550, s_q_w * d552),
+                    A::mul_add(c_q_w, d549, s_q_w * d550),
                 ); // N(M col 3) at 1.z
-                let d559 = A::mul_add(
+                let d555 = A::mul_add(
                     p.L2,
                     d547,
-                    A::mul_add(-s_q_w, d550, c_q_w * d552),
+                    A::mul_add(-s_q_w, d549, c_q_w * d550),
                 ); // N(M col 3) at 1.y
-                let d560 = A::mul_add(-s_q_imu, d558, c_q_imu * d559); // N(M col 3) at 0.z
-                m[(1, 4)] = -d560;
+                let d556 = A::mul_add(-c_q_imu, d552, s_q_imu * d551); // F(M col 3) at 0.x
+                m[(0, 4)] = -d556;
+                m[(4, 0)] = m[(0, 4)];
+                let d557 = A::mul_add(-s_q_imu, d554, c_q_imu * d555); // N(M col 3) at 0.z
+                m[(1, 4)] = -d557;
                 m[(4, 1)] = m[(1, 4)];
-                let d561 = pc.pc55 - d547; // MSC2.z
-                let d562 = p.MX2 - d546; // MSC2.x
-                let d563 = p.MX1 + d562; // MSC1.x
-                m[(0, 1)] = d563;
-                m[(1, 0)] = m[(0, 1)];
+                let d558 = p.MX2 - d546; // MSC2.x
                 let k43 = s_q_torso * s_q_torso; // sin² q_torso
                 let k44 = s_q_torso * c_q_torso; // sin q_torso cos q_torso
                 let k45 = A::mul_add(2.0, k43, -1.0); // cos 2q_torso
-                let d564 = d521 - d544; // JC3: Jzz − Jxx
-                let d565 = A::mul_add(
+                let d559 = d542 - d545; // JC3: Jzz − Jxx
+                let d560 = A::mul_add(2.0, d538 * k44, k43 * d559); // JC3 rotated about y: Jzz − J'zz
+                let t88 = p.L3 * d541; // common subexpression
+                let d561 = p.XY2 - t81 + t82 + t85; // JC2.xy
+                let d562 = A::mul_add(
                     p.L4,
                     d546,
-                    A::mul_add(k44, d564, A::mul_add(-d526, k45, p.XZ2)),
+                    A::mul_add(k44, d559, A::mul_add(-d538, k45, p.XZ2)),
                 ); // JC2.xz
-                let d566 = A::mul_add(2.0, d526 * k44, k43 * d564); // JC3 rotated about y: Jzz − J'zz
-                let t88 = p.L3 * d520; // common subexpression
-                let d567 = A::mul_add(2.0, t88, A::mul_add(-2.0, t86, d521) - d566)
+                let d563 = d541 + pc.pc54; // MSC2.y
+                let d564 = pc.pc55 - d547; // MSC2.z
+                let d565 = A::mul_add(2.0, t88, A::mul_add(-2.0, t86, d542) - d560)
                     + pc.pc56; // JC2.xx
-                m[(3, 3)] = d567;
-                let d568 = A::mul_add(2.0, t88, d544 + d566) + pc.pc59; // JC2.zz
-                let d569 = d520 + pc.pc54; // MSC2.y
-                let d570 = A::mul_add(s_q_w, d561, c_q_w * d569); // MSC2 in 1.y
-                let d571 = A::mul_add(-c_q_w, d561, s_q_w * d569); // MSC2 in 1.z
-                let d572 = A::mul_add(-c_q_imu, d570, s_q_imu * d571); // F(M col 2) at 0.x
-                m[(0, 3)] = -d572;
-                m[(3, 0)] = m[(0, 3)];
-                let t89 = c_q_w * d549; // common subexpression
-                let t90 = s_q_w * d549; // common subexpression
-                let t91 = s_q_w * d565; // common subexpression
-                let t92 = c_q_w * d565; // common subexpression
-                let d573 = t90 - t92; // N(M col 2) at 1.z
-                let d574 = A::mul_add(p.L2, d562, p.XZ1 - t90 + t92); // JC1.xz
-                let d575 = A::mul_add(-p.L1, d562, p.XY1 + t89 + t91); // JC1.xy
-                let d576 = A::mul_add(s_q_imu, d574, c_q_imu * d575); // N(M col 1) at 0.z
-                m[(1, 2)] = -d576;
-                m[(2, 1)] = m[(1, 2)];
-                let d577 = t89 + t91; // N(M col 2) at 1.y
-                let d578 = A::mul_add(-s_q_imu, d573, c_q_imu * d577); // N(M col 2) at 0.z
-                m[(1, 3)] = -d578;
-                m[(3, 1)] = m[(1, 3)];
-                let t93 = p.L1 * d570; // common subexpression
-                let t94 = p.L2 * d571; // common subexpression
-                let d579 = d567 + t93 + t94; // N(M col 2) at 1.x
-                m[(2, 3)] = d579;
+                m[(3, 3)] = d565;
+                let d566 = A::mul_add(-2.0, t86, d544) + pc.pc57; // JC2.yy
+                let d567 = A::mul_add(-p.L4, d541, t87 - t83 - t84) + pc.pc58; // JC2.yz
+                let d568 = A::mul_add(2.0, t88, d545 + d560) + pc.pc59; // JC2.zz
+                let d569 = A::mul_add(s_q_w, d564, c_q_w * d563); // MSC2 in 1.y
+                let d570 = A::mul_add(-c_q_w, d564, s_q_w * d563); // MSC2 in 1.z
+                let t89 = c_q_w * d561; // common subexpression
+                let t90 = s_q_w * d562; // common subexpression
+                let t91 = s_q_w * d561; // common subexpression
+                let t92 = c_q_w * d562; // common subexpression
+                let d571 = t91 - t92; // N(M col 2) at 1.z
+                let t93 = p.L1 * d569; // common subexpression
+                let t94 = p.L2 * d570; // common subexpression
+                let d572 = d565 + t93 + t94; // N(M col 2) at 1.x
+                m[(2, 3)] = d572;
                 m[(3, 2)] = m[(2, 3)];
-                let d580 = A::mul_add(2.0, t94, A::mul_add(2.0, t93, d567)) + pc.pc63; // JC1.xx
-                m[(2, 2)] = d580;
+                let d573 = t89 + t90; // N(M col 2) at 1.y
+                let d574 = A::mul_add(-c_q_imu, d569, s_q_imu * d570); // F(M col 2) at 0.x
+                m[(0, 3)] = -d574;
+                m[(3, 0)] = m[(0, 3)];
+                let d575 = A::mul_add(-s_q_imu, d571, c_q_imu * d573); // N(M col 2) at 0.z
+                m[(1, 3)] = -d575;
+                m[(3, 1)] = m[(1, 3)];
+                let d576 = p.MX1 + d558; // MSC1.x
+                m[(0, 1)] = d576;
+                m[(1, 0)] = m[(0, 1)];
                 let k46 = s_q_w * s_q_w; // sin² q_w
                 let k47 = s_q_w * c_q_w; // sin q_w cos q_w
                 let k48 = A::mul_add(2.0, k46, -1.0); // cos 2q_w
-                let d581 = d553 - d568; // JC2: Jyy − Jzz
-                let d582 = A::mul_add(-2.0, d551 * k47, k46 * d581); // JC2 rotated about x: Jyy − J'yy
-                let d583 = A::mul_add(
+                let d577 = d566 - d568; // JC2: Jyy − Jzz
+                let d578 = A::mul_add(-2.0, d567 * k47, k46 * d577); // JC2 rotated about x: Jyy − J'yy
+                let d579 = A::mul_add(-p.L1, d558, p.XY1 + t89 + t90); // JC1.xy
+                let d580 = A::mul_add(p.L2, d558, p.XZ1 - t91 + t92); // JC1.xz
+                let d581 = d569 + pc.pc61; // MSC1.y
+                let d582 = pc.pc62 - d570; // MSC1.z
+                let d583 = A::mul_add(2.0, t94, A::mul_add(2.0, t93, d565)) + pc.pc63; // JC1.xx
+                m[(2, 2)] = d583;
+                let d584 = A::mul_add(2.0, t94, d566) - d578 + pc.pc64; // JC1.yy
+                let d585 = A::mul_add(
                     p.L1,
-                    d571,
-                    A::mul_add(-k47, d581, A::mul_add(-d551, k48, p.L2 * d570)),
+                    d570,
+                    A::mul_add(-k47, d577, A::mul_add(-d567, k48, p.L2 * d569)),
                 ) + pc.pc65; // JC1.yz
-                let d584 = A::mul_add(2.0, t94, d553) - d582 + pc.pc64; // JC1.yy
-                let d585 = A::mul_add(2.0, t93, d568) + d582 + pc.pc66; // JC1.zz
-                let d586 = d570 + pc.pc61; // MSC1.y
-                let d587 = pc.pc62 - d571; // MSC1.z
-                let d588 = A::mul_add(s_q_imu, d587, c_q_imu * d586); // MSC1 in 0.z
-                m[(0, 2)] = d588;
+                let d586 = A::mul_add(2.0, t93, d568) + d578 + pc.pc66; // JC1.zz
+                let d587 = A::mul_add(s_q_imu, d582, c_q_imu * d581); // MSC1 in 0.z
+                m[(0, 2)] = d587;
                 m[(2, 0)] = m[(0, 2)];
-                let d589 = d584 - d585; // JC1: Jyy − Jzz
+                let d588 = A::mul_add(s_q_imu, d580, c_q_imu * d579); // N(M col 1) at 0.z
+                m[(1, 2)] = -d588;
+                m[(2, 1)] = m[(1, 2)];
                 let k49 = s_q_imu * s_q_imu; // sin² q_imu
                 let k50 = s_q_imu * c_q_imu; // sin q_imu cos q_imu
-                let d590 = A::mul_add(-2.0, d583 * k50, k49 * d589); // JC1 rotated about x: Jyy − J'yy
+                let d589 = d584 - d586; // JC1: Jyy − Jzz
+                let d590 = A::mul_add(-2.0, d585 * k50, k49 * d589); // JC1 rotated about x: Jyy − J'yy
                 let d591 = d584 - d590; // JC0
                 m[(1, 1)] = d591 + pc.pc68;
             }
@@ -8059,392 +8059,392 @@ mod generated {
                 let t6 = p.L9 * d1;
                 let d3 = t1 + t2 - t5;
                 buf[18][17] = kanegen_runtime::lanes::lanes(-d3);
-                let d4 = p.XY9r + t1 + t2 - t5;
-                let d5 = t3 - t4 - t6;
-                let d6 = p.YZ9r - t3 + t4 + t6;
-                let d7 = d2 * s_q6r;
-                let d8 = d2 * c_q6r;
-                let d9 = p.MX9r - d2;
-                let d10 = p.MX8r - d9;
-                let d11 = p.ZZ10r * c_q6r - d5 * s_q6r;
-                buf[18][16] = kanegen_runtime::lanes::lanes(d11);
-                let d12 = p.ZZ10r * s_q6r + d5 * c_q6r;
-                let d13 = d1 * c_q5r + d8 * s_q5r;
-                let d14 = d1 * s_q5r - d8 * c_q5r;
-                let d15 = p.MZ9r + d1;
-                let d16 = d3 * c_q5r - d12 * s_q5r + p.L8 * d14;
-                buf[18][15] = kanegen_runtime::lanes::lanes(-d16);
-                let d17 = d3 * s_q5r + d12 * c_q5r - p.L8 * d13;
-                let d18 = d7 * c_q4r - d14 * s_q4r;
-                let d19 = d7 * s_q4r + d14 * c_q4r;
-                let d20 = d11 * c_q4r - d17 * s_q4r;
-                buf[18][14] = kanegen_runtime::lanes::lanes(d20);
-                let d21 = d11 * s_q4r + d17 * c_q4r;
-                let d22 = d13 * c_q3r - d19 * s_q3r;
-                let d23 = d13 * s_q3r + d19 * c_q3r;
-                let d24 = d16 * c_q3r - d21 * s_q3r + p.L7 * d23;
-                buf[18][13] = kanegen_runtime::lanes::lanes(-d24);
-                let d25 = d16 * s_q3r + d21 * c_q3r - p.L7 * d22;
-                let d26 = d18 * c_q2r - d23 * s_q2r;
-                let d27 = d18 * s_q2r + d23 * c_q2r;
-                let d28 = d20 * c_q2r - d25 * s_q2r;
-                buf[18][12] = kanegen_runtime::lanes::lanes(d28);
-                let d29 = d20 * s_q2r + d25 * c_q2r;
-                let d30 = d22 * c_q1r - d27 * s_q1r;
-                let d31 = d22 * s_q1r + d27 * c_q1r;
-                let d32 = d28 - p.L5 * d31;
-                let d33 = d24 * c_q1r - d29 * s_q1r + p.L6 * d31;
-                buf[18][4] = kanegen_runtime::lanes::lanes(d33);
-                let d34 = d24 * s_q1r + d29 * c_q1r - p.L6 * d30 + d26 * p.L5;
-                let d35 = d26 * c_q_torso + d31 * s_q_torso;
-                let d36 = d26 * s_q_torso - d31 * c_q_torso;
-                let d37 = d33 + p.L4 * d35;
-                let d38 = d32 * c_q_torso + d34 * s_q_torso + p.L3 * d36 - d30 * p.L4;
-                buf[18][3] = kanegen_runtime::lanes::lanes(d38);
-                let d39 = d32 * s_q_torso - d34 * c_q_torso - p.L3 * d35;
-                let d40 = d30 * s_q_w - d36 * c_q_w;
-                let d41 = d30 * c_q_w + d36 * s_q_w;
-                let d42 = d38 - p.L1 * d40 + p.L2 * d41;
-                buf[18][2] = kanegen_runtime::lanes::lanes(d42);
-                let d43 = d41 * s_q_imu + d40 * c_q_imu;
-                buf[18][0] = kanegen_runtime::lanes::lanes(-d43);
-                let d44 = d37 * s_q_w - d39 * c_q_w + d35 * p.L1;
-                let d45 = d37 * c_q_w + d39 * s_q_w - d35 * p.L2;
-                let d46 = d45 * c_q_imu - d44 * s_q_imu;
-                buf[18][1] = kanegen_runtime::lanes::lanes(-d46);
+                let d4 = t3 - t4 - t6;
+                let d5 = d2 * s_q6r;
+                let d6 = d2 * c_q6r;
+                let d7 = p.ZZ10r * c_q6r - d4 * s_q6r;
+                buf[18][16] = kanegen_runtime::lanes::lanes(d7);
+                let d8 = p.ZZ10r * s_q6r + d4 * c_q6r;
+                let d9 = d1 * c_q5r + d6 * s_q5r;
+                let d10 = d1 * s_q5r - d6 * c_q5r;
+                let d11 = d3 * c_q5r - d8 * s_q5r + p.L8 * d10;
+                buf[18][15] = kanegen_runtime::lanes::lanes(-d11);
+                let d12 = d3 * s_q5r + d8 * c_q5r - p.L8 * d9;
+                let d13 = d5 * c_q4r - d10 * s_q4r;
+                let d14 = d5 * s_q4r + d10 * c_q4r;
+                let d15 = d7 * c_q4r - d12 * s_q4r;
+                buf[18][14] = kanegen_runtime::lanes::lanes(d15);
+                let d16 = d7 * s_q4r + d12 * c_q4r;
+                let d17 = d9 * c_q3r - d14 * s_q3r;
+                let d18 = d9 * s_q3r + d14 * c_q3r;
+                let d19 = d11 * c_q3r - d16 * s_q3r + p.L7 * d18;
+                buf[18][13] = kanegen_runtime::lanes::lanes(-d19);
+                let d20 = d11 * s_q3r + d16 * c_q3r - p.L7 * d17;
+                let d21 = d13 * c_q2r - d18 * s_q2r;
+                let d22 = d13 * s_q2r + d18 * c_q2r;
+                let d23 = d15 * c_q2r - d20 * s_q2r;
+                buf[18][12] = kanegen_runtime::lanes::lanes(d23);
+                let d24 = d15 * s_q2r + d20 * c_q2r;
+                let d25 = d17 * c_q1r - d22 * s_q1r;
+                let d26 = d17 * s_q1r + d22 * c_q1r;
+                let d27 = d23 - p.L5 * d26;
+                let d28 = d19 * c_q1r - d24 * s_q1r + p.L6 * d26;
+                buf[18][4] = kanegen_runtime::lanes::lanes(d28);
+                let d29 = d19 * s_q1r + d24 * c_q1r - p.L6 * d25 + d21 * p.L5;
+                let d30 = d21 * c_q_torso + d26 * s_q_torso;
+                let d31 = d21 * s_q_torso - d26 * c_q_torso;
+                let d32 = d27 * c_q_torso + d29 * s_q_torso + p.L3 * d31 - d25 * p.L4;
+                buf[18][3] = kanegen_runtime::lanes::lanes(d32);
+                let d33 = d28 + p.L4 * d30;
+                let d34 = d27 * s_q_torso - d29 * c_q_torso - p.L3 * d30;
+                let d35 = d25 * s_q_w - d31 * c_q_w;
+                let d36 = d25 * c_q_w + d31 * s_q_w;
+                let d37 = d33 * s_q_w - d34 * c_q_w + d30 * p.L1;
+                let d38 = d32 - p.L1 * d35 + p.L2 * d36;
+                buf[18][2] = kanegen_runtime::lanes::lanes(d38);
+                let d39 = d33 * c_q_w + d34 * s_q_w - d30 * p.L2;
+                let d40 = d36 * s_q_imu + d35 * c_q_imu;
+                buf[18][0] = kanegen_runtime::lanes::lanes(-d40);
+                let d41 = d39 * c_q_imu - d37 * s_q_imu;
+                buf[18][1] = kanegen_runtime::lanes::lanes(-d41);
+                let d42 = p.MX9r - d2;
+                let d43 = p.MZ9r + d1;
                 let k1 = s_q7r * s_q7r;
                 let k2 = s_q7r * c_q7r;
                 let k3 = 2.0 * k1 - 1.0;
-                let d47 = k1 * pc.pc3 - 2.0 * (p.XY10r * k2);
-                let d48 = p.XZ9r - p.XY10r * k3 - k2 * pc.pc3;
-                let d49 = pc.pc7 - d47;
-                buf[17][17] = kanegen_runtime::lanes::lanes(d49);
-                let d50 = d47 + pc.pc8;
-                let d51 = c_q6r * pc.pc2 + s_q6r * d15;
-                let d52 = s_q6r * pc.pc2 - c_q6r * d15;
-                let t7 = c_q6r * d4;
-                let t8 = s_q6r * d4;
-                let t9 = s_q6r * d48;
-                let t10 = c_q6r * d48;
-                let d53 = t7 + t9;
-                buf[17][16] = kanegen_runtime::lanes::lanes(-d53);
-                let d54 = p.XY8r + t7 + t9;
-                let d55 = t8 - t10;
-                let d56 = p.XZ8r + t8 - t10;
-                let d57 = s_q5r * d51;
-                let d58 = c_q5r * d51;
-                let d59 = p.MY8r - d51;
-                let d60 = s_q5r * d49 + c_q5r * d55 - p.L8 * d57;
-                let d61 = c_q5r * d49 - s_q5r * d55 - p.L8 * d58;
-                buf[17][15] = kanegen_runtime::lanes::lanes(d61);
-                let d62 = p.XX8r + d49;
-                let d63 = c_q4r * d52 + s_q4r * d58;
-                let d64 = s_q4r * d52 - c_q4r * d58;
-                let d65 = p.MZ8r - d52;
-                let d66 = c_q4r * d53 - s_q4r * d60;
-                buf[17][14] = kanegen_runtime::lanes::lanes(-d66);
-                let d67 = s_q4r * d53 + c_q4r * d60;
-                let d68 = s_q3r * d57 + c_q3r * d64;
-                let d69 = c_q3r * d57 - s_q3r * d64;
-                let d70 = s_q3r * d61 + c_q3r * d67 - p.L7 * d69;
-                let d71 = c_q3r * d61 - s_q3r * d67 + p.L7 * d68;
-                buf[17][13] = kanegen_runtime::lanes::lanes(d71);
-                let d72 = c_q2r * d63 - s_q2r * d68;
-                let d73 = s_q2r * d63 + c_q2r * d68;
-                let d74 = c_q2r * d66 - s_q2r * d70;
-                buf[17][12] = kanegen_runtime::lanes::lanes(-d74);
-                let d75 = s_q2r * d66 + c_q2r * d70;
-                let d76 = c_q1r * d69 - s_q1r * d73;
-                let d77 = s_q1r * d69 + c_q1r * d73;
-                let d78 = d74 - p.L5 * d77;
-                let d79 = c_q1r * d71 - s_q1r * d75 + p.L6 * d77;
-                buf[17][4] = kanegen_runtime::lanes::lanes(-d79);
-                let d80 = s_q1r * d71 + c_q1r * d75 - p.L6 * d76 + p.L5 * d72;
-                let d81 = c_q_torso * d72 + s_q_torso * d77;
-                let d82 = s_q_torso * d72 - c_q_torso * d77;
-                let d83 = d79 + p.L4 * d81;
-                let d84 = c_q_torso * d78 + s_q_torso * d80 + p.L3 * d82 - p.L4 * d76;
-                buf[17][3] = kanegen_runtime::lanes::lanes(-d84);
-                let d85 = s_q_torso * d78 - c_q_torso * d80 - p.L3 * d81;
-                let d86 = c_q_w * d76 + s_q_w * d82;
-                let d87 = s_q_w * d76 - c_q_w * d82;
-                let d88 = d84 - p.L1 * d87 + p.L2 * d86;
-                buf[17][2] = kanegen_runtime::lanes::lanes(-d88);
-                let d89 = s_q_imu * d86 + c_q_imu * d87;
-                buf[17][0] = kanegen_runtime::lanes::lanes(d89);
-                let d90 = c_q_w * d83 + s_q_w * d85 - p.L2 * d81;
-                let d91 = s_q_w * d83 - c_q_w * d85 + p.L1 * d81;
-                let d92 = c_q_imu * d90 - s_q_imu * d91;
-                buf[17][1] = kanegen_runtime::lanes::lanes(d92);
+                let d44 = k1 * pc.pc3 - 2.0 * (p.XY10r * k2);
+                let d45 = p.XY9r + t1 + t2 - t5;
+                let d46 = p.XZ9r - p.XY10r * k3 - k2 * pc.pc3;
+                let d47 = p.YZ9r - t3 + t4 + t6;
+                let d48 = pc.pc7 - d44;
+                buf[17][17] = kanegen_runtime::lanes::lanes(d48);
+                let d49 = d44 + pc.pc8;
+                let d50 = c_q6r * pc.pc2 + s_q6r * d43;
+                let d51 = s_q6r * pc.pc2 - c_q6r * d43;
+                let t7 = c_q6r * d45;
+                let t8 = s_q6r * d46;
+                let d52 = t7 + t8;
+                buf[17][16] = kanegen_runtime::lanes::lanes(-d52);
+                let t9 = s_q6r * d45;
+                let t10 = c_q6r * d46;
+                let d53 = t9 - t10;
+                let d54 = s_q5r * d50;
+                let d55 = c_q5r * d50;
+                let d56 = s_q5r * d48 + c_q5r * d53 - p.L8 * d54;
+                let d57 = c_q5r * d48 - s_q5r * d53 - p.L8 * d55;
+                buf[17][15] = kanegen_runtime::lanes::lanes(d57);
+                let d58 = c_q4r * d51 + s_q4r * d55;
+                let d59 = s_q4r * d51 - c_q4r * d55;
+                let d60 = c_q4r * d52 - s_q4r * d56;
+                buf[17][14] = kanegen_runtime::lanes::lanes(-d60);
+                let d61 = s_q4r * d52 + c_q4r * d56;
+                let d62 = s_q3r * d54 + c_q3r * d59;
+                let d63 = c_q3r * d54 - s_q3r * d59;
+                let d64 = s_q3r * d57 + c_q3r * d61 - p.L7 * d63;
+                let d65 = c_q3r * d57 - s_q3r * d61 + p.L7 * d62;
+                buf[17][13] = kanegen_runtime::lanes::lanes(d65);
+                let d66 = c_q2r * d58 - s_q2r * d62;
+                let d67 = s_q2r * d58 + c_q2r * d62;
+                let d68 = c_q2r * d60 - s_q2r * d64;
+                buf[17][12] = kanegen_runtime::lanes::lanes(-d68);
+                let d69 = s_q2r * d60 + c_q2r * d64;
+                let d70 = c_q1r * d63 - s_q1r * d67;
+                let d71 = s_q1r * d63 + c_q1r * d67;
+                let d72 = c_q1r * d65 - s_q1r * d69 + p.L6 * d71;
+                buf[17][4] = kanegen_runtime::lanes::lanes(-d72);
+                let d73 = s_q1r * d65 + c_q1r * d69 - p.L6 * d70 + p.L5 * d66;
+                let d74 = d68 - p.L5 * d71;
+                let d75 = c_q_torso * d66 + s_q_torso * d71;
+                let d76 = s_q_torso * d66 - c_q_torso * d71;
+                let d77 = c_q_torso * d74 + s_q_torso * d73 + p.L3 * d76 - p.L4 * d70;
+                buf[17][3] = kanegen_runtime::lanes::lanes(-d77);
+                let d78 = d72 + p.L4 * d75;
+                let d79 = s_q_torso * d74 - c_q_torso * d73 - p.L3 * d75;
+                let d80 = c_q_w * d70 + s_q_w * d76;
+                let d81 = s_q_w * d70 - c_q_w * d76;
+                let d82 = d77 - p.L1 * d81 + p.L2 * d80;
+                buf[17][2] = kanegen_runtime::lanes::lanes(-d82);
+                let d83 = c_q_w * d78 + s_q_w * d79 - p.L2 * d75;
+                let d84 = s_q_w * d78 - c_q_w * d79 + p.L1 * d75;
+                let d85 = s_q_imu * d80 + c_q_imu * d81;
+                buf[17][0] = kanegen_runtime::lanes::lanes(d85);
+                let d86 = c_q_imu * d83 - s_q_imu * d84;
+                buf[17][1] = kanegen_runtime::lanes::lanes(d86);
+                let d87 = p.MX8r - d42;
+                let d88 = p.MY8r - d50;
+                let d89 = p.MZ8r - d51;
                 let k4 = s_q6r * s_q6r;
                 let k5 = s_q6r * c_q6r;
                 let k6 = 2.0 * k4 - 1.0;
-                let d93 = pc.pc6 - d50;
-                let d94 = k4 * d93 - 2.0 * (d6 * k5);
-                let d95 = p.YZ8r + d6 * k6 + k5 * d93;
-                let d96 = p.ZZ8r + d50 + d94;
-                let d97 = pc.pc10 - d94;
+                let d90 = pc.pc6 - d49;
+                let d91 = k4 * d90 - 2.0 * (d47 * k5);
+                let d92 = p.XX8r + d48;
+                let d93 = p.XY8r + t7 + t8;
+                let d94 = p.XZ8r + t9 - t10;
+                let d95 = p.YZ8r + d47 * k6 + k5 * d90;
+                let d96 = p.ZZ8r + d49 + d91;
+                let d97 = pc.pc10 - d91;
                 buf[16][16] = kanegen_runtime::lanes::lanes(d97);
-                let d98 = s_q5r * d10 + c_q5r * d65;
-                let d99 = c_q5r * d10 - s_q5r * d65;
-                let t11 = c_q5r * d54;
-                let t12 = s_q5r * d54;
-                let t13 = s_q5r * d95;
+                let d98 = s_q5r * d87 + c_q5r * d89;
+                let d99 = c_q5r * d87 - s_q5r * d89;
+                let t11 = c_q5r * d93;
+                let t12 = s_q5r * d95;
+                let t13 = s_q5r * d93;
                 let t14 = c_q5r * d95;
                 let t15 = p.L8 * d99;
                 let t16 = p.L8 * d98;
-                let d100 = t11 - t13 - t15;
+                let d100 = t11 - t12 - t15;
                 buf[16][15] = kanegen_runtime::lanes::lanes(-d100);
-                let d101 = p.XY7r + t11 - t13 - t15;
-                let d102 = t12 + t14 - t16;
-                let d103 = p.YZ7r - t12 - t14 + t16;
-                let d104 = s_q4r * d99;
-                let d105 = c_q4r * d99;
-                let d106 = p.MX7r - d99;
-                let d107 = p.MX6r - d106;
-                let d108 = c_q4r * d97 - s_q4r * d102;
-                buf[16][14] = kanegen_runtime::lanes::lanes(d108);
-                let d109 = s_q4r * d97 + c_q4r * d102;
-                let d110 = p.YY7r + d97;
-                let d111 = c_q3r * d98 + s_q3r * d105;
-                let d112 = s_q3r * d98 - c_q3r * d105;
-                let d113 = p.MZ7r + d98;
-                let d114 = c_q3r * d100 - s_q3r * d109 + p.L7 * d112;
-                buf[16][13] = kanegen_runtime::lanes::lanes(-d114);
-                let d115 = s_q3r * d100 + c_q3r * d109 - p.L7 * d111;
-                let d116 = c_q2r * d104 - s_q2r * d112;
-                let d117 = s_q2r * d104 + c_q2r * d112;
-                let d118 = c_q2r * d108 - s_q2r * d115;
-                buf[16][12] = kanegen_runtime::lanes::lanes(d118);
-                let d119 = s_q2r * d108 + c_q2r * d115;
-                let d120 = c_q1r * d111 - s_q1r * d117;
-                let d121 = s_q1r * d111 + c_q1r * d117;
-                let d122 = d118 - p.L5 * d121;
-                let d123 = c_q1r * d114 - s_q1r * d119 + p.L6 * d121;
-                buf[16][4] = kanegen_runtime::lanes::lanes(d123);
-                let d124 = s_q1r * d114 + c_q1r * d119 - p.L6 * d120 + p.L5 * d116;
-                let d125 = c_q_torso * d116 + s_q_torso * d121;
-                let d126 = s_q_torso * d116 - c_q_torso * d121;
-                let d127 = d123 + p.L4 * d125;
-                let d128 = c_q_torso * d122 + s_q_torso * d124 + p.L3 * d126
-                    - p.L4 * d120;
-                buf[16][3] = kanegen_runtime::lanes::lanes(d128);
-                let d129 = s_q_torso * d122 - c_q_torso * d124 - p.L3 * d125;
-                let d130 = s_q_w * d120 - c_q_w * d126;
-                let d131 = c_q_w * d120 + s_q_w * d126;
-                let d132 = d128 - p.L1 * d130 + p.L2 * d131;
-                buf[16][2] = kanegen_runtime::lanes::lanes(d132);
-                let d133 = s_q_imu * d131 + c_q_imu * d130;
-                buf[16][0] = kanegen_runtime::lanes::lanes(-d133);
-                let d134 = s_q_w * d127 - c_q_w * d129 + p.L1 * d125;
-                let d135 = c_q_w * d127 + s_q_w * d129 - p.L2 * d125;
-                let d136 = c_q_imu * d135 - s_q_imu * d134;
-                buf[16][1] = kanegen_runtime::lanes::lanes(-d136);
+                let d101 = t13 + t14 - t16;
+                let d102 = s_q4r * d99;
+                let d103 = c_q4r * d99;
+                let d104 = c_q4r * d97 - s_q4r * d101;
+                buf[16][14] = kanegen_runtime::lanes::lanes(d104);
+                let d105 = s_q4r * d97 + c_q4r * d101;
+                let d106 = c_q3r * d98 + s_q3r * d103;
+                let d107 = s_q3r * d98 - c_q3r * d103;
+                let d108 = c_q3r * d100 - s_q3r * d105 + p.L7 * d107;
+                buf[16][13] = kanegen_runtime::lanes::lanes(-d108);
+                let d109 = s_q3r * d100 + c_q3r * d105 - p.L7 * d106;
+                let d110 = c_q2r * d102 - s_q2r * d107;
+                let d111 = s_q2r * d102 + c_q2r * d107;
+                let d112 = c_q2r * d104 - s_q2r * d109;
+                buf[16][12] = kanegen_runtime::lanes::lanes(d112);
+                let d113 = s_q2r * d104 + c_q2r * d109;
+                let d114 = c_q1r * d106 - s_q1r * d111;
+                let d115 = s_q1r * d106 + c_q1r * d111;
+                let d116 = d112 - p.L5 * d115;
+                let d117 = c_q1r * d108 - s_q1r * d113 + p.L6 * d115;
+                buf[16][4] = kanegen_runtime::lanes::lanes(d117);
+                let d118 = s_q1r * d108 + c_q1r * d113 - p.L6 * d114 + p.L5 * d110;
+                let d119 = c_q_torso * d110 + s_q_torso * d115;
+                let d120 = s_q_torso * d110 - c_q_torso * d115;
+                let d121 = c_q_torso * d116 + s_q_torso * d118 + p.L3 * d120
+                    - p.L4 * d114;
+                buf[16][3] = kanegen_runtime::lanes::lanes(d121);
+                let d122 = d117 + p.L4 * d119;
+                let d123 = s_q_torso * d116 - c_q_torso * d118 - p.L3 * d119;
+                let d124 = s_q_w * d114 - c_q_w * d120;
+                let d125 = c_q_w * d114 + s_q_w * d120;
+                let d126 = s_q_w * d122 - c_q_w * d123 + p.L1 * d119;
+                let d127 = d121 - p.L1 * d124 + p.L2 * d125;
+                buf[16][2] = kanegen_runtime::lanes::lanes(d127);
+                let d128 = c_q_w * d122 + s_q_w * d123 - p.L2 * d119;
+                let d129 = s_q_imu * d125 + c_q_imu * d124;
+                buf[16][0] = kanegen_runtime::lanes::lanes(-d129);
+                let d130 = c_q_imu * d128 - s_q_imu * d126;
+                buf[16][1] = kanegen_runtime::lanes::lanes(-d130);
+                let d131 = p.MX7r - d99;
+                let d132 = p.MZ7r + d98;
                 let k7 = s_q5r * s_q5r;
                 let k8 = s_q5r * c_q5r;
                 let k9 = 2.0 * k7 - 1.0;
-                let d137 = d62 - d96;
-                let d138 = k7 * d137 + 2.0 * (d56 * k8);
-                let d139 = p.XZ7r + d56 * k9 - k8 * d137;
-                let t17 = p.L8 * d59;
-                let d140 = pc.pc13 - d59;
-                let d141 = d62 - d138 + 2.0 * t17 + pc.pc14;
-                buf[15][15] = kanegen_runtime::lanes::lanes(d141);
-                let d142 = d96 + d138 + 2.0 * t17 + pc.pc15;
-                let d143 = c_q4r * d140 + s_q4r * d113;
-                let d144 = s_q4r * d140 - c_q4r * d113;
-                let t18 = c_q4r * d101;
-                let t19 = s_q4r * d101;
-                let t20 = s_q4r * d139;
-                let t21 = c_q4r * d139;
-                let d145 = t18 + t20;
-                buf[15][14] = kanegen_runtime::lanes::lanes(-d145);
-                let d146 = p.XY6r + t18 + t20;
-                let d147 = t19 - t21;
-                let d148 = p.XZ6r + t19 - t21;
-                let d149 = s_q3r * d143;
-                let d150 = c_q3r * d143;
-                let d151 = p.MY6r - d143;
-                let d152 = s_q3r * d141 + c_q3r * d147 - p.L7 * d149;
-                let d153 = c_q3r * d141 - s_q3r * d147 - p.L7 * d150;
-                buf[15][13] = kanegen_runtime::lanes::lanes(d153);
-                let d154 = p.XX6r + d141;
-                let d155 = c_q2r * d144 + s_q2r * d150;
-                let d156 = s_q2r * d144 - c_q2r * d150;
-                let d157 = p.MZ6r - d144;
-                let d158 = c_q2r * d145 - s_q2r * d152;
-                buf[15][12] = kanegen_runtime::lanes::lanes(-d158);
-                let d159 = s_q2r * d145 + c_q2r * d152;
-                let d160 = c_q1r * d149 - s_q1r * d156;
-                let d161 = s_q1r * d149 + c_q1r * d156;
-                let d162 = d158 - p.L5 * d161;
-                let d163 = c_q1r * d153 - s_q1r * d159 + p.L6 * d161;
-                buf[15][4] = kanegen_runtime::lanes::lanes(-d163);
-                let d164 = s_q1r * d153 + c_q1r * d159 - p.L6 * d160 + p.L5 * d155;
-                let d165 = c_q_torso * d155 + s_q_torso * d161;
-                let d166 = s_q_torso * d155 - c_q_torso * d161;
-                let d167 = d163 + p.L4 * d165;
-                let d168 = c_q_torso * d162 + s_q_torso * d164 + p.L3 * d166
-                    - p.L4 * d160;
-                buf[15][3] = kanegen_runtime::lanes::lanes(-d168);
-                let d169 = s_q_torso * d162 - c_q_torso * d164 - p.L3 * d165;
-                let d170 = c_q_w * d160 + s_q_w * d166;
-                let d171 = s_q_w * d160 - c_q_w * d166;
-                let d172 = d168 - p.L1 * d171 + p.L2 * d170;
-                buf[15][2] = kanegen_runtime::lanes::lanes(-d172);
-                let d173 = s_q_imu * d170 + c_q_imu * d171;
-                buf[15][0] = kanegen_runtime::lanes::lanes(d173);
-                let d174 = c_q_w * d167 + s_q_w * d169 - p.L2 * d165;
-                let d175 = s_q_w * d167 - c_q_w * d169 + p.L1 * d165;
-                let d176 = c_q_imu * d174 - s_q_imu * d175;
-                buf[15][1] = kanegen_runtime::lanes::lanes(d176);
+                let d133 = d92 - d96;
+                let d134 = k7 * d133 + 2.0 * (d94 * k8);
+                let t17 = p.L8 * d88;
+                let d135 = p.XY7r + t11 - t12 - t15;
+                let d136 = p.XZ7r + d94 * k9 - k8 * d133;
+                let d137 = p.YY7r + d97;
+                let d138 = p.YZ7r - t13 - t14 + t16;
+                let d139 = pc.pc13 - d88;
+                let d140 = d92 - d134 + 2.0 * t17 + pc.pc14;
+                buf[15][15] = kanegen_runtime::lanes::lanes(d140);
+                let d141 = d96 + d134 + 2.0 * t17 + pc.pc15;
+                let d142 = c_q4r * d139 + s_q4r * d132;
+                let d143 = s_q4r * d139 - c_q4r * d132;
+                let t18 = c_q4r * d135;
+                let t19 = s_q4r * d136;
+                let d144 = t18 + t19;
+                buf[15][14] = kanegen_runtime::lanes::lanes(-d144);
+                let t20 = s_q4r * d135;
+                let t21 = c_q4r * d136;
+                let d145 = t20 - t21;
+                let d146 = s_q3r * d142;
+                let d147 = c_q3r * d142;
+                let d148 = s_q3r * d140 + c_q3r * d145 - p.L7 * d146;
+                let d149 = c_q3r * d140 - s_q3r * d145 - p.L7 * d147;
+                buf[15][13] = kanegen_runtime::lanes::lanes(d149);
+                let d150 = c_q2r * d143 + s_q2r * d147;
+                let d151 = s_q2r * d143 - c_q2r * d147;
+                let d152 = c_q2r * d144 - s_q2r * d148;
+                buf[15][12] = kanegen_runtime::lanes::lanes(-d152);
+                let d153 = s_q2r * d144 + c_q2r * d148;
+                let d154 = c_q1r * d146 - s_q1r * d151;
+                let d155 = s_q1r * d146 + c_q1r * d151;
+                let d156 = c_q1r * d149 - s_q1r * d153 + p.L6 * d155;
+                buf[15][4] = kanegen_runtime::lanes::lanes(-d156);
+                let d157 = s_q1r * d149 + c_q1r * d153 - p.L6 * d154 + p.L5 * d150;
+                let d158 = d152 - p.L5 * d155;
+                let d159 = c_q_torso * d150 + s_q_torso * d155;
+                let d160 = s_q_torso * d150 - c_q_torso * d155;
+                let d161 = c_q_torso * d158 + s_q_torso * d157 + p.L3 * d160
+                    - p.L4 * d154;
+                buf[15][3] = kanegen_runtime::lanes::lanes(-d161);
+                let d162 = d156 + p.L4 * d159;
+                let d163 = s_q_torso * d158 - c_q_torso * d157 - p.L3 * d159;
+                let d164 = c_q_w * d154 + s_q_w * d160;
+                let d165 = s_q_w * d154 - c_q_w * d160;
+                let d166 = d161 - p.L1 * d165 + p.L2 * d164;
+                buf[15][2] = kanegen_runtime::lanes::lanes(-d166);
+                let d167 = c_q_w * d162 + s_q_w * d163 - p.L2 * d159;
+                let d168 = s_q_w * d162 - c_q_w * d163 + p.L1 * d159;
+                let d169 = s_q_imu * d164 + c_q_imu * d165;
+                buf[15][0] = kanegen_runtime::lanes::lanes(d169);
+                let d170 = c_q_imu * d167 - s_q_imu * d168;
+                buf[15][1] = kanegen_runtime::lanes::lanes(d170);
+                let d171 = p.MX6r - d131;
+                let d172 = p.MY6r - d142;
+                let d173 = p.MZ6r - d143;
                 let k10 = s_q4r * s_q4r;
                 let k11 = s_q4r * c_q4r;
                 let k12 = 2.0 * k10 - 1.0;
-                let d177 = d110 - d142;
-                let d178 = k10 * d177 - 2.0 * (d103 * k11);
-                let d179 = p.YZ6r + d103 * k12 + k11 * d177;
-                let d180 = p.YY6r + d110 - d178;
-                buf[14][14] = kanegen_runtime::lanes::lanes(d180);
-                let d181 = p.ZZ6r + d142 + d178;
-                let d182 = s_q3r * d107 + c_q3r * d157;
-                let d183 = c_q3r * d107 - s_q3r * d157;
-                let t22 = c_q3r * d146;
-                let t23 = s_q3r * d146;
-                let t24 = s_q3r * d179;
-                let t25 = c_q3r * d179;
+                let d174 = d137 - d141;
+                let d175 = k10 * d174 - 2.0 * (d138 * k11);
+                let d176 = p.XX6r + d140;
+                let d177 = p.XY6r + t18 + t19;
+                let d178 = p.XZ6r + t20 - t21;
+                let d179 = p.YY6r + d137 - d175;
+                buf[14][14] = kanegen_runtime::lanes::lanes(d179);
+                let d180 = p.YZ6r + d138 * k12 + k11 * d174;
+                let d181 = p.ZZ6r + d141 + d175;
+                let d182 = s_q3r * d171 + c_q3r * d173;
+                let d183 = c_q3r * d171 - s_q3r * d173;
+                let t22 = c_q3r * d177;
+                let t23 = s_q3r * d180;
+                let t24 = s_q3r * d177;
+                let t25 = c_q3r * d180;
                 let t26 = p.L7 * d183;
                 let t27 = p.L7 * d182;
-                let d184 = t22 - t24 - t26;
+                let d184 = t22 - t23 - t26;
                 buf[14][13] = kanegen_runtime::lanes::lanes(-d184);
-                let d185 = p.XY5r + t22 - t24 - t26;
-                let d186 = t23 + t25 - t27;
-                let d187 = p.YZ5r - t23 - t25 + t27;
-                let d188 = s_q2r * d183;
-                let d189 = c_q2r * d183;
-                let d190 = p.MX5r - d183;
-                let d191 = p.MX4r - d190;
-                let d192 = c_q2r * d180 - s_q2r * d186;
-                buf[14][12] = kanegen_runtime::lanes::lanes(d192);
-                let d193 = s_q2r * d180 + c_q2r * d186;
-                let d194 = p.YY5r + d180;
-                let d195 = c_q1r * d182 + s_q1r * d189;
-                let d196 = s_q1r * d182 - c_q1r * d189;
-                let d197 = d192 - p.L5 * d196;
-                let d198 = p.MZ5r + d182;
-                let d199 = c_q1r * d184 - s_q1r * d193 + p.L6 * d196;
-                buf[14][4] = kanegen_runtime::lanes::lanes(d199);
-                let d200 = s_q1r * d184 + c_q1r * d193 - p.L6 * d195 + p.L5 * d188;
-                let d201 = c_q_torso * d188 + s_q_torso * d196;
-                let d202 = s_q_torso * d188 - c_q_torso * d196;
-                let d203 = d199 + p.L4 * d201;
-                let d204 = c_q_torso * d197 + s_q_torso * d200 + p.L3 * d202
-                    - p.L4 * d195;
-                buf[14][3] = kanegen_runtime::lanes::lanes(d204);
-                let d205 = s_q_torso * d197 - c_q_torso * d200 - p.L3 * d201;
-                let d206 = s_q_w * d195 - c_q_w * d202;
-                let d207 = c_q_w * d195 + s_q_w * d202;
-                let d208 = d204 - p.L1 * d206 + p.L2 * d207;
-                buf[14][2] = kanegen_runtime::lanes::lanes(d208);
-                let d209 = s_q_imu * d207 + c_q_imu * d206;
-                buf[14][0] = kanegen_runtime::lanes::lanes(-d209);
-                let d210 = s_q_w * d203 - c_q_w * d205 + p.L1 * d201;
-                let d211 = c_q_w * d203 + s_q_w * d205 - p.L2 * d201;
-                let d212 = c_q_imu * d211 - s_q_imu * d210;
-                buf[14][1] = kanegen_runtime::lanes::lanes(-d212);
+                let d185 = t24 + t25 - t27;
+                let d186 = s_q2r * d183;
+                let d187 = c_q2r * d183;
+                let d188 = c_q2r * d179 - s_q2r * d185;
+                buf[14][12] = kanegen_runtime::lanes::lanes(d188);
+                let d189 = s_q2r * d179 + c_q2r * d185;
+                let d190 = c_q1r * d182 + s_q1r * d187;
+                let d191 = s_q1r * d182 - c_q1r * d187;
+                let d192 = d188 - p.L5 * d191;
+                let d193 = c_q1r * d184 - s_q1r * d189 + p.L6 * d191;
+                buf[14][4] = kanegen_runtime::lanes::lanes(d193);
+                let d194 = s_q1r * d184 + c_q1r * d189 - p.L6 * d190 + p.L5 * d186;
+                let d195 = c_q_torso * d186 + s_q_torso * d191;
+                let d196 = s_q_torso * d186 - c_q_torso * d191;
+                let d197 = c_q_torso * d192 + s_q_torso * d194 + p.L3 * d196
+                    - p.L4 * d190;
+                buf[14][3] = kanegen_runtime::lanes::lanes(d197);
+                let d198 = d193 + p.L4 * d195;
+                let d199 = s_q_torso * d192 - c_q_torso * d194 - p.L3 * d195;
+                let d200 = s_q_w * d190 - c_q_w * d196;
+                let d201 = c_q_w * d190 + s_q_w * d196;
+                let d202 = s_q_w * d198 - c_q_w * d199 + p.L1 * d195;
+                let d203 = d197 - p.L1 * d200 + p.L2 * d201;
+                buf[14][2] = kanegen_runtime::lanes::lanes(d203);
+                let d204 = c_q_w * d198 + s_q_w * d199 - p.L2 * d195;
+                let d205 = s_q_imu * d201 + c_q_imu * d200;
+                buf[14][0] = kanegen_runtime::lanes::lanes(-d205);
+                let d206 = c_q_imu * d204 - s_q_imu * d202;
+                buf[14][1] = kanegen_runtime::lanes::lanes(-d206);
+                let d207 = p.MX5r - d183;
+                let d208 = p.MZ5r + d182;
                 let k13 = s_q3r * s_q3r;
                 let k14 = s_q3r * c_q3r;
                 let k15 = 2.0 * k13 - 1.0;
-                let d213 = d154 - d181;
-                let d214 = k13 * d213 + 2.0 * (d148 * k14);
-                let d215 = p.XZ5r + d148 * k15 - k14 * d213;
-                let t28 = p.L7 * d151;
-                let d216 = pc.pc19 - d151;
-                let d217 = d154 - d214 + 2.0 * t28 + pc.pc20;
-                buf[13][13] = kanegen_runtime::lanes::lanes(d217);
-                let d218 = d181 + d214 + 2.0 * t28 + pc.pc21;
-                let d219 = c_q2r * d216 + s_q2r * d198;
-                let d220 = s_q2r * d216 - c_q2r * d198;
-                let t29 = c_q2r * d185;
-                let t30 = s_q2r * d185;
-                let t31 = s_q2r * d215;
-                let t32 = c_q2r * d215;
-                let d221 = t29 + t31;
-                buf[13][12] = kanegen_runtime::lanes::lanes(-d221);
-                let d222 = p.XY4r + t29 + t31;
-                let d223 = t30 - t32;
-                let d224 = p.XZ4r + t30 - t32;
-                let d225 = s_q1r * d219;
-                let d226 = c_q1r * d219;
-                let d227 = d221 + p.L5 * d226;
-                let d228 = p.MY4r - d219;
-                let d229 = c_q1r * d217 - s_q1r * d223 - p.L6 * d226;
-                buf[13][4] = kanegen_runtime::lanes::lanes(-d229);
-                let d230 = s_q1r * d217 + c_q1r * d223 - p.L6 * d225 + p.L5 * d220;
-                let d231 = p.XX4r + d217;
-                let d232 = c_q_torso * d220 - s_q_torso * d226;
-                let d233 = s_q_torso * d220 + c_q_torso * d226;
-                let d234 = d229 + p.L4 * d232;
-                let d235 = p.MZ4r - d220;
-                let d236 = c_q_torso * d227 + s_q_torso * d230 + p.L3 * d233
-                    - p.L4 * d225;
-                buf[13][3] = kanegen_runtime::lanes::lanes(-d236);
-                let d237 = s_q_torso * d227 - c_q_torso * d230 - p.L3 * d232;
-                let d238 = c_q_w * d225 + s_q_w * d233;
-                let d239 = s_q_w * d225 - c_q_w * d233;
-                let d240 = d236 - p.L1 * d239 + p.L2 * d238;
-                buf[13][2] = kanegen_runtime::lanes::lanes(-d240);
-                let d241 = s_q_imu * d238 + c_q_imu * d239;
-                buf[13][0] = kanegen_runtime::lanes::lanes(d241);
-                let d242 = c_q_w * d234 + s_q_w * d237 - p.L2 * d232;
-                let d243 = s_q_w * d234 - c_q_w * d237 + p.L1 * d232;
-                let d244 = c_q_imu * d242 - s_q_imu * d243;
-                buf[13][1] = kanegen_runtime::lanes::lanes(d244);
+                let d209 = d176 - d181;
+                let d210 = k13 * d209 + 2.0 * (d178 * k14);
+                let t28 = p.L7 * d172;
+                let d211 = p.XY5r + t22 - t23 - t26;
+                let d212 = p.XZ5r + d178 * k15 - k14 * d209;
+                let d213 = p.YY5r + d179;
+                let d214 = p.YZ5r - t24 - t25 + t27;
+                let d215 = pc.pc19 - d172;
+                let d216 = d176 - d210 + 2.0 * t28 + pc.pc20;
+                buf[13][13] = kanegen_runtime::lanes::lanes(d216);
+                let d217 = d181 + d210 + 2.0 * t28 + pc.pc21;
+                let d218 = c_q2r * d215 + s_q2r * d208;
+                let d219 = s_q2r * d215 - c_q2r * d208;
+                let t29 = c_q2r * d211;
+                let t30 = s_q2r * d212;
+                let d220 = t29 + t30;
+                buf[13][12] = kanegen_runtime::lanes::lanes(-d220);
+                let t31 = s_q2r * d211;
+                let t32 = c_q2r * d212;
+                let d221 = t31 - t32;
+                let d222 = s_q1r * d218;
+                let d223 = c_q1r * d218;
+                let d224 = c_q1r * d216 - s_q1r * d221 - p.L6 * d223;
+                buf[13][4] = kanegen_runtime::lanes::lanes(-d224);
+                let d225 = s_q1r * d216 + c_q1r * d221 - p.L6 * d222 + p.L5 * d219;
+                let d226 = d220 + p.L5 * d223;
+                let d227 = c_q_torso * d219 - s_q_torso * d223;
+                let d228 = s_q_torso * d219 + c_q_torso * d223;
+                let d229 = c_q_torso * d226 + s_q_torso * d225 + p.L3 * d228
+                    - p.L4 * d222;
+                buf[13][3] = kanegen_runtime::lanes::lanes(-d229);
+                let d230 = d224 + p.L4 * d227;
+                let d231 = s_q_torso * d226 - c_q_torso * d225 - p.L3 * d227;
+                let d232 = c_q_w * d222 + s_q_w * d228;
+                let d233 = s_q_w * d222 - c_q_w * d228;
+                let d234 = d229 - p.L1 * d233 + p.L2 * d232;
+                buf[13][2] = kanegen_runtime::lanes::lanes(-d234);
+                let d235 = c_q_w * d230 + s_q_w * d231 - p.L2 * d227;
+                let d236 = s_q_w * d230 - c_q_w * d231 + p.L1 * d227;
+                let d237 = s_q_imu * d232 + c_q_imu * d233;
+                buf[13][0] = kanegen_runtime::lanes::lanes(d237);
+                let d238 = c_q_imu * d235 - s_q_imu * d236;
+                buf[13][1] = kanegen_runtime::lanes::lanes(d238);
+                let d239 = p.MX4r - d207;
+                let d240 = p.MY4r - d218;
+                let d241 = p.MZ4r - d219;
                 let k16 = s_q2r * s_q2r;
                 let k17 = s_q2r * c_q2r;
                 let k18 = 2.0 * k16 - 1.0;
-                let d245 = d194 - d218;
-                let d246 = k16 * d245 - 2.0 * (d187 * k17);
-                let d247 = p.YZ4r + d187 * k18 + k17 * d245;
-                let d248 = p.YY4r + d194 - d246;
-                buf[12][12] = kanegen_runtime::lanes::lanes(d248);
-                let d249 = p.ZZ4r + d218 + d246;
-                let d250 = c_q1r * d191 - s_q1r * d235;
-                let d251 = s_q1r * d191 + c_q1r * d235;
-                let t33 = c_q1r * d222;
-                let t34 = s_q1r * d222;
-                let t35 = s_q1r * d247;
-                let t36 = c_q1r * d247;
+                let d242 = d213 - d217;
+                let d243 = k16 * d242 - 2.0 * (d214 * k17);
+                let d244 = p.XX4r + d216;
+                let d245 = p.XY4r + t29 + t30;
+                let d246 = p.XZ4r + t31 - t32;
+                let d247 = p.YY4r + d213 - d243;
+                buf[12][12] = kanegen_runtime::lanes::lanes(d247);
+                let d248 = p.YZ4r + d214 * k18 + k17 * d242;
+                let d249 = p.ZZ4r + d217 + d243;
+                let d250 = c_q1r * d239 - s_q1r * d241;
+                let d251 = s_q1r * d239 + c_q1r * d241;
+                let t33 = c_q1r * d245;
+                let t34 = s_q1r * d248;
+                let t35 = s_q1r * d245;
+                let t36 = c_q1r * d248;
                 let t37 = p.L5 * d250;
                 let t38 = p.L6 * d250;
                 let t39 = p.L6 * d251;
-                let d252 = d248 + t37;
-                let d253 = t33 - t35 - t38;
+                let d252 = d247 + t37;
+                let d253 = t33 - t34 - t38;
                 buf[12][4] = kanegen_runtime::lanes::lanes(d253);
-                let d254 = t34 + t36 - t39;
+                let d254 = t35 + t36 - t39;
                 let d255 = s_q_torso * d250;
-                let d256 = d253 - p.L4 * d255;
-                let d257 = c_q_torso * d250;
-                let d258 = c_q_torso * d252 + s_q_torso * d254 + p.L3 * d257
+                let d256 = c_q_torso * d250;
+                let d257 = c_q_torso * d252 + s_q_torso * d254 + p.L3 * d256
                     - p.L4 * d251;
-                buf[12][3] = kanegen_runtime::lanes::lanes(d258);
+                buf[12][3] = kanegen_runtime::lanes::lanes(d257);
+                let d258 = d253 - p.L4 * d255;
                 let d259 = s_q_torso * d252 - c_q_torso * d254 + p.L3 * d255;
-                let d260 = s_q_w * d251 - c_q_w * d257;
-                let d261 = c_q_w * d251 + s_q_w * d257;
-                let d262 = d258 - p.L1 * d260 + p.L2 * d261;
-                buf[12][2] = kanegen_runtime::lanes::lanes(d262);
-                let d263 = s_q_imu * d261 + c_q_imu * d260;
-                buf[12][0] = kanegen_runtime::lanes::lanes(-d263);
-                let d264 = s_q_w * d256 - c_q_w * d259 - p.L1 * d255;
-                let d265 = c_q_w * d256 + s_q_w * d259 + p.L2 * d255;
-                let d266 = c_q_imu * d265 - s_q_imu * d264;
+                let d260 = s_q_w * d251 - c_q_w * d256;
+                let d261 = c_q_w * d251 + s_q_w * d256;
+                let d262 = s_q_w * d258 - c_q_w * d259 - p.L1 * d255;
+                let d263 = d257 - p.L1 * d260 + p.L2 * d261;
+                buf[12][2] = kanegen_runtime::lanes::lanes(d263);
+                let d264 = c_q_w * d258 + s_q_w * d259 + p.L2 * d255;
+                let d265 = s_q_imu * d261 + c_q_imu * d260;
+                buf[12][0] = kanegen_runtime::lanes::lanes(-d265);
+                let d266 = c_q_imu * d264 - s_q_imu * d262;
                 buf[12][1] = kanegen_runtime::lanes::lanes(-d266);
                 let k19 = s_q1r * s_q1r;
                 let k20 = s_q1r * c_q1r;
                 let k21 = 2.0 * k19 - 1.0;
-                let d267 = d231 - d249;
-                let d268 = k19 * d267 + 2.0 * (d224 * k20);
-                let t40 = p.L6 * d228;
+                let d267 = d244 - d249;
+                let d268 = k19 * d267 + 2.0 * (d246 * k20);
+                let t40 = p.L6 * d240;
                 let d269 = p.MX10l * s_q7l - p.MY10l * c_q7l;
                 let d270 = p.MX10l * c_q7l + p.MY10l * s_q7l;
                 let t41 = p.XZ10l * c_q7l;
@@ -8455,486 +8455,486 @@ mod generated {
                 let t46 = p.L9 * d269;
                 let d271 = t41 + t42 - t45;
                 buf[11][10] = kanegen_runtime::lanes::lanes(-d271);
-                let d272 = p.XY9l + t41 + t42 - t45;
-                let d273 = t43 - t44 - t46;
-                let d274 = p.YZ9l - t43 + t44 + t46;
-                let d275 = d270 * s_q6l;
-                let d276 = d270 * c_q6l;
-                let d277 = p.MX9l - d270;
-                let d278 = p.MX8l - d277;
-                let d279 = p.ZZ10l * c_q6l - d273 * s_q6l;
-                buf[11][9] = kanegen_runtime::lanes::lanes(d279);
-                let d280 = p.ZZ10l * s_q6l + d273 * c_q6l;
-                let d281 = d269 * c_q5l + d276 * s_q5l;
-                let d282 = d269 * s_q5l - d276 * c_q5l;
-                let d283 = p.MZ9l + d269;
-                let d284 = d271 * c_q5l - d280 * s_q5l + p.L8 * d282;
-                buf[11][8] = kanegen_runtime::lanes::lanes(-d284);
-                let d285 = d271 * s_q5l + d280 * c_q5l - p.L8 * d281;
-                let d286 = d275 * c_q4l - d282 * s_q4l;
-                let d287 = d275 * s_q4l + d282 * c_q4l;
-                let d288 = d279 * c_q4l - d285 * s_q4l;
-                buf[11][7] = kanegen_runtime::lanes::lanes(d288);
-                let d289 = d279 * s_q4l + d285 * c_q4l;
-                let d290 = d281 * c_q3l - d287 * s_q3l;
-                let d291 = d281 * s_q3l + d287 * c_q3l;
-                let d292 = d284 * c_q3l - d289 * s_q3l + p.L7 * d291;
-                buf[11][6] = kanegen_runtime::lanes::lanes(-d292);
-                let d293 = d284 * s_q3l + d289 * c_q3l - p.L7 * d290;
-                let d294 = d286 * c_q2l - d291 * s_q2l;
-                let d295 = d286 * s_q2l + d291 * c_q2l;
-                let d296 = d288 * c_q2l - d293 * s_q2l;
-                buf[11][5] = kanegen_runtime::lanes::lanes(d296);
-                let d297 = d288 * s_q2l + d293 * c_q2l;
-                let d298 = d290 * s_q1l + d295 * c_q1l;
-                let d299 = d290 * c_q1l - d295 * s_q1l;
-                let d300 = d296 - p.L5 * d298;
-                let d301 = d292 * s_q1l + d297 * c_q1l - p.L6 * d299 + p.L5 * d294;
-                let d302 = d292 * c_q1l - d297 * s_q1l + p.L6 * d298;
-                buf[11][4] = kanegen_runtime::lanes::lanes(d302);
-                let d303 = c_q_torso * d294 + s_q_torso * d298;
-                let d304 = s_q_torso * d294 - c_q_torso * d298;
-                let d305 = d302 - p.L4 * d303;
-                let d306 = c_q_torso * d300 + s_q_torso * d301 + p.L3 * d304
-                    + p.L4 * d299;
-                buf[11][3] = kanegen_runtime::lanes::lanes(-d306);
-                let d307 = s_q_torso * d300 - c_q_torso * d301 - p.L3 * d303;
-                let d308 = s_q_w * d299 + c_q_w * d304;
-                let d309 = c_q_w * d299 - s_q_w * d304;
-                let d310 = d306 + p.L1 * d308 - p.L2 * d309;
-                buf[11][2] = kanegen_runtime::lanes::lanes(-d310);
-                let d311 = s_q_imu * d309 + c_q_imu * d308;
-                buf[11][0] = kanegen_runtime::lanes::lanes(-d311);
-                let d312 = s_q_w * d305 + c_q_w * d307 - p.L1 * d303;
-                let d313 = c_q_w * d305 - s_q_w * d307 + p.L2 * d303;
-                let d314 = c_q_imu * d313 - s_q_imu * d312;
-                buf[11][1] = kanegen_runtime::lanes::lanes(-d314);
+                let d272 = t43 - t44 - t46;
+                let d273 = d270 * s_q6l;
+                let d274 = d270 * c_q6l;
+                let d275 = p.ZZ10l * c_q6l - d272 * s_q6l;
+                buf[11][9] = kanegen_runtime::lanes::lanes(d275);
+                let d276 = p.ZZ10l * s_q6l + d272 * c_q6l;
+                let d277 = d269 * c_q5l + d274 * s_q5l;
+                let d278 = d269 * s_q5l - d274 * c_q5l;
+                let d279 = d271 * c_q5l - d276 * s_q5l + p.L8 * d278;
+                buf[11][8] = kanegen_runtime::lanes::lanes(-d279);
+                let d280 = d271 * s_q5l + d276 * c_q5l - p.L8 * d277;
+                let d281 = d273 * c_q4l - d278 * s_q4l;
+                let d282 = d273 * s_q4l + d278 * c_q4l;
+                let d283 = d275 * c_q4l - d280 * s_q4l;
+                buf[11][7] = kanegen_runtime::lanes::lanes(d283);
+                let d284 = d275 * s_q4l + d280 * c_q4l;
+                let d285 = d277 * c_q3l - d282 * s_q3l;
+                let d286 = d277 * s_q3l + d282 * c_q3l;
+                let d287 = d279 * c_q3l - d284 * s_q3l + p.L7 * d286;
+                buf[11][6] = kanegen_runtime::lanes::lanes(-d287);
+                let d288 = d279 * s_q3l + d284 * c_q3l - p.L7 * d285;
+                let d289 = d281 * c_q2l - d286 * s_q2l;
+                let d290 = d281 * s_q2l + d286 * c_q2l;
+                let d291 = d283 * c_q2l - d288 * s_q2l;
+                buf[11][5] = kanegen_runtime::lanes::lanes(d291);
+                let d292 = d283 * s_q2l + d288 * c_q2l;
+                let d293 = d285 * s_q1l + d290 * c_q1l;
+                let d294 = d285 * c_q1l - d290 * s_q1l;
+                let d295 = d287 * s_q1l + d292 * c_q1l - p.L6 * d294 + p.L5 * d289;
+                let d296 = d291 - p.L5 * d293;
+                let d297 = d287 * c_q1l - d292 * s_q1l + p.L6 * d293;
+                buf[11][4] = kanegen_runtime::lanes::lanes(d297);
+                let d298 = c_q_torso * d289 + s_q_torso * d293;
+                let d299 = s_q_torso * d289 - c_q_torso * d293;
+                let d300 = c_q_torso * d296 + s_q_torso * d295 + p.L3 * d299
+                    + p.L4 * d294;
+                buf[11][3] = kanegen_runtime::lanes::lanes(-d300);
+                let d301 = s_q_torso * d296 - c_q_torso * d295 - p.L3 * d298;
+                let d302 = d297 - p.L4 * d298;
+                let d303 = s_q_w * d294 + c_q_w * d299;
+                let d304 = c_q_w * d294 - s_q_w * d299;
+                let d305 = d300 + p.L1 * d303 - p.L2 * d304;
+                buf[11][2] = kanegen_runtime::lanes::lanes(-d305);
+                let d306 = s_q_w * d302 + c_q_w * d301 - p.L1 * d298;
+                let d307 = c_q_w * d302 - s_q_w * d301 + p.L2 * d298;
+                let d308 = s_q_imu * d304 + c_q_imu * d303;
+                buf[11][0] = kanegen_runtime::lanes::lanes(-d308);
+                let d309 = c_q_imu * d307 - s_q_imu * d306;
+                buf[11][1] = kanegen_runtime::lanes::lanes(-d309);
+                let d310 = p.MX9l - d270;
+                let d311 = p.MZ9l + d269;
                 let k22 = s_q7l * s_q7l;
                 let k23 = s_q7l * c_q7l;
                 let k24 = 2.0 * k22 - 1.0;
-                let d315 = k22 * pc.pc26 - 2.0 * (p.XY10l * k23);
-                let d316 = p.XZ9l - p.XY10l * k24 - k23 * pc.pc26;
-                let d317 = pc.pc30 - d315;
-                buf[10][10] = kanegen_runtime::lanes::lanes(d317);
-                let d318 = d315 + pc.pc31;
-                let d319 = c_q6l * pc.pc25 + s_q6l * d283;
-                let d320 = s_q6l * pc.pc25 - c_q6l * d283;
-                let t47 = c_q6l * d272;
-                let t48 = s_q6l * d272;
-                let t49 = s_q6l * d316;
-                let t50 = c_q6l * d316;
-                let d321 = t47 + t49;
-                buf[10][9] = kanegen_runtime::lanes::lanes(-d321);
-                let d322 = p.XY8l + t47 + t49;
-                let d323 = t48 - t50;
-                let d324 = p.XZ8l + t48 - t50;
-                let d325 = s_q5l * d319;
-                let d326 = c_q5l * d319;
-                let d327 = p.MY8l - d319;
-                let d328 = s_q5l * d317 + c_q5l * d323 - p.L8 * d325;
-                let d329 = c_q5l * d317 - s_q5l * d323 - p.L8 * d326;
-                buf[10][8] = kanegen_runtime::lanes::lanes(d329);
-                let d330 = p.XX8l + d317;
-                let d331 = c_q4l * d320 + s_q4l * d326;
-                let d332 = s_q4l * d320 - c_q4l * d326;
-                let d333 = p.MZ8l - d320;
-                let d334 = c_q4l * d321 - s_q4l * d328;
-                buf[10][7] = kanegen_runtime::lanes::lanes(-d334);
-                let d335 = s_q4l * d321 + c_q4l * d328;
-                let d336 = s_q3l * d325 + c_q3l * d332;
-                let d337 = c_q3l * d325 - s_q3l * d332;
-                let d338 = s_q3l * d329 + c_q3l * d335 - p.L7 * d337;
-                let d339 = c_q3l * d329 - s_q3l * d335 + p.L7 * d336;
-                buf[10][6] = kanegen_runtime::lanes::lanes(d339);
-                let d340 = c_q2l * d331 - s_q2l * d336;
-                let d341 = s_q2l * d331 + c_q2l * d336;
-                let d342 = c_q2l * d334 - s_q2l * d338;
-                buf[10][5] = kanegen_runtime::lanes::lanes(-d342);
-                let d343 = s_q2l * d334 + c_q2l * d338;
-                let d344 = c_q1l * d337 - s_q1l * d341;
-                let d345 = s_q1l * d337 + c_q1l * d341;
-                let d346 = d342 - p.L5 * d345;
-                let d347 = c_q1l * d339 - s_q1l * d343 + p.L6 * d345;
-                buf[10][4] = kanegen_runtime::lanes::lanes(-d347);
-                let d348 = s_q1l * d339 + c_q1l * d343 - p.L6 * d344 + p.L5 * d340;
-                let d349 = c_q_torso * d340 + s_q_torso * d345;
-                let d350 = s_q_torso * d340 - c_q_torso * d345;
-                let d351 = d347 - p.L4 * d349;
-                let d352 = c_q_torso * d346 + s_q_torso * d348 + p.L3 * d350
-                    + p.L4 * d344;
-                buf[10][3] = kanegen_runtime::lanes::lanes(d352);
-                let d353 = s_q_torso * d346 - c_q_torso * d348 - p.L3 * d349;
-                let d354 = c_q_w * d344 - s_q_w * d350;
-                let d355 = s_q_w * d344 + c_q_w * d350;
-                let d356 = d352 + p.L1 * d355 - p.L2 * d354;
-                buf[10][2] = kanegen_runtime::lanes::lanes(d356);
-                let d357 = s_q_imu * d354 + c_q_imu * d355;
-                buf[10][0] = kanegen_runtime::lanes::lanes(d357);
-                let d358 = c_q_w * d351 - s_q_w * d353 + p.L2 * d349;
-                let d359 = s_q_w * d351 + c_q_w * d353 - p.L1 * d349;
-                let d360 = c_q_imu * d358 - s_q_imu * d359;
-                buf[10][1] = kanegen_runtime::lanes::lanes(d360);
+                let d312 = k22 * pc.pc26 - 2.0 * (p.XY10l * k23);
+                let d313 = p.XY9l + t41 + t42 - t45;
+                let d314 = p.XZ9l - p.XY10l * k24 - k23 * pc.pc26;
+                let d315 = p.YZ9l - t43 + t44 + t46;
+                let d316 = pc.pc30 - d312;
+                buf[10][10] = kanegen_runtime::lanes::lanes(d316);
+                let d317 = d312 + pc.pc31;
+                let d318 = c_q6l * pc.pc25 + s_q6l * d311;
+                let d319 = s_q6l * pc.pc25 - c_q6l * d311;
+                let t47 = c_q6l * d313;
+                let t48 = s_q6l * d314;
+                let d320 = t47 + t48;
+                buf[10][9] = kanegen_runtime::lanes::lanes(-d320);
+                let t49 = s_q6l * d313;
+                let t50 = c_q6l * d314;
+                let d321 = t49 - t50;
+                let d322 = s_q5l * d318;
+                let d323 = c_q5l * d318;
+                let d324 = s_q5l * d316 + c_q5l * d321 - p.L8 * d322;
+                let d325 = c_q5l * d316 - s_q5l * d321 - p.L8 * d323;
+                buf[10][8] = kanegen_runtime::lanes::lanes(d325);
+                let d326 = c_q4l * d319 + s_q4l * d323;
+                let d327 = s_q4l * d319 - c_q4l * d323;
+                let d328 = c_q4l * d320 - s_q4l * d324;
+                buf[10][7] = kanegen_runtime::lanes::lanes(-d328);
+                let d329 = s_q4l * d320 + c_q4l * d324;
+                let d330 = s_q3l * d322 + c_q3l * d327;
+                let d331 = c_q3l * d322 - s_q3l * d327;
+                let d332 = s_q3l * d325 + c_q3l * d329 - p.L7 * d331;
+                let d333 = c_q3l * d325 - s_q3l * d329 + p.L7 * d330;
+                buf[10][6] = kanegen_runtime::lanes::lanes(d333);
+                let d334 = c_q2l * d326 - s_q2l * d330;
+                let d335 = s_q2l * d326 + c_q2l * d330;
+                let d336 = c_q2l * d328 - s_q2l * d332;
+                buf[10][5] = kanegen_runtime::lanes::lanes(-d336);
+                let d337 = s_q2l * d328 + c_q2l * d332;
+                let d338 = c_q1l * d331 - s_q1l * d335;
+                let d339 = s_q1l * d331 + c_q1l * d335;
+                let d340 = d336 - p.L5 * d339;
+                let d341 = c_q1l * d333 - s_q1l * d337 + p.L6 * d339;
+                buf[10][4] = kanegen_runtime::lanes::lanes(-d341);
+                let d342 = s_q1l * d333 + c_q1l * d337 - p.L6 * d338 + p.L5 * d334;
+                let d343 = c_q_torso * d334 + s_q_torso * d339;
+                let d344 = s_q_torso * d334 - c_q_torso * d339;
+                let d345 = d341 - p.L4 * d343;
+                let d346 = c_q_torso * d340 + s_q_torso * d342 + p.L3 * d344
+                    + p.L4 * d338;
+                buf[10][3] = kanegen_runtime::lanes::lanes(d346);
+                let d347 = s_q_torso * d340 - c_q_torso * d342 - p.L3 * d343;
+                let d348 = c_q_w * d338 - s_q_w * d344;
+                let d349 = s_q_w * d338 + c_q_w * d344;
+                let d350 = c_q_w * d345 - s_q_w * d347 + p.L2 * d343;
+                let d351 = d346 + p.L1 * d349 - p.L2 * d348;
+                buf[10][2] = kanegen_runtime::lanes::lanes(d351);
+                let d352 = s_q_w * d345 + c_q_w * d347 - p.L1 * d343;
+                let d353 = s_q_imu * d348 + c_q_imu * d349;
+                buf[10][0] = kanegen_runtime::lanes::lanes(d353);
+                let d354 = c_q_imu * d350 - s_q_imu * d352;
+                buf[10][1] = kanegen_runtime::lanes::lanes(d354);
+                let d355 = p.MX8l - d310;
+                let d356 = p.MY8l - d318;
+                let d357 = p.MZ8l - d319;
                 let k25 = s_q6l * s_q6l;
                 let k26 = s_q6l * c_q6l;
                 let k27 = 2.0 * k25 - 1.0;
-                let d361 = pc.pc29 - d318;
-                let d362 = k25 * d361 - 2.0 * (d274 * k26);
-                let d363 = p.YZ8l + d274 * k27 + k26 * d361;
-                let d364 = p.ZZ8l + d318 + d362;
-                let d365 = pc.pc33 - d362;
+                let d358 = pc.pc29 - d317;
+                let d359 = k25 * d358 - 2.0 * (d315 * k26);
+                let d360 = p.XX8l + d316;
+                let d361 = p.XY8l + t47 + t48;
+                let d362 = p.XZ8l + t49 - t50;
+                let d363 = p.YZ8l + d315 * k27 + k26 * d358;
+                let d364 = p.ZZ8l + d317 + d359;
+                let d365 = pc.pc33 - d359;
                 buf[9][9] = kanegen_runtime::lanes::lanes(d365);
-                let d366 = s_q5l * d278 + c_q5l * d333;
-                let d367 = c_q5l * d278 - s_q5l * d333;
-                let t51 = c_q5l * d322;
-                let t52 = s_q5l * d322;
-                let t53 = s_q5l * d363;
+                let d366 = s_q5l * d355 + c_q5l * d357;
+                let d367 = c_q5l * d355 - s_q5l * d357;
+                let t51 = c_q5l * d361;
+                let t52 = s_q5l * d363;
+                let t53 = s_q5l * d361;
                 let t54 = c_q5l * d363;
                 let t55 = p.L8 * d367;
                 let t56 = p.L8 * d366;
-                let d368 = t51 - t53 - t55;
+                let d368 = t51 - t52 - t55;
                 buf[9][8] = kanegen_runtime::lanes::lanes(-d368);
-                let d369 = p.XY7l + t51 - t53 - t55;
-                let d370 = t52 + t54 - t56;
-                let d371 = p.YZ7l - t52 - t54 + t56;
-                let d372 = s_q4l * d367;
-                let d373 = c_q4l * d367;
-                let d374 = p.MX7l - d367;
-                let d375 = p.MX6l - d374;
-                let d376 = c_q4l * d365 - s_q4l * d370;
-                buf[9][7] = kanegen_runtime::lanes::lanes(d376);
-                let d377 = s_q4l * d365 + c_q4l * d370;
-                let d378 = p.YY7l + d365;
-                let d379 = c_q3l * d366 + s_q3l * d373;
-                let d380 = s_q3l * d366 - c_q3l * d373;
-                let d381 = p.MZ7l + d366;
-                let d382 = c_q3l * d368 - s_q3l * d377 + p.L7 * d380;
-                buf[9][6] = kanegen_runtime::lanes::lanes(-d382);
-                let d383 = s_q3l * d368 + c_q3l * d377 - p.L7 * d379;
-                let d384 = c_q2l * d372 - s_q2l * d380;
-                let d385 = s_q2l * d372 + c_q2l * d380;
-                let d386 = c_q2l * d376 - s_q2l * d383;
-                buf[9][5] = kanegen_runtime::lanes::lanes(d386);
-                let d387 = s_q2l * d376 + c_q2l * d383;
-                let d388 = s_q1l * d379 + c_q1l * d385;
-                let d389 = c_q1l * d379 - s_q1l * d385;
-                let d390 = d386 - p.L5 * d388;
-                let d391 = s_q1l * d382 + c_q1l * d387 - p.L6 * d389 + p.L5 * d384;
-                let d392 = c_q1l * d382 - s_q1l * d387 + p.L6 * d388;
-                buf[9][4] = kanegen_runtime::lanes::lanes(d392);
-                let d393 = c_q_torso * d384 + s_q_torso * d388;
-                let d394 = s_q_torso * d384 - c_q_torso * d388;
-                let d395 = d392 - p.L4 * d393;
-                let d396 = c_q_torso * d390 + s_q_torso * d391 + p.L3 * d394
-                    + p.L4 * d389;
-                buf[9][3] = kanegen_runtime::lanes::lanes(-d396);
-                let d397 = s_q_torso * d390 - c_q_torso * d391 - p.L3 * d393;
-                let d398 = s_q_w * d389 + c_q_w * d394;
-                let d399 = c_q_w * d389 - s_q_w * d394;
-                let d400 = d396 + p.L1 * d398 - p.L2 * d399;
-                buf[9][2] = kanegen_runtime::lanes::lanes(-d400);
-                let d401 = s_q_imu * d399 + c_q_imu * d398;
-                buf[9][0] = kanegen_runtime::lanes::lanes(-d401);
-                let d402 = s_q_w * d395 + c_q_w * d397 - p.L1 * d393;
-                let d403 = c_q_w * d395 - s_q_w * d397 + p.L2 * d393;
-                let d404 = c_q_imu * d403 - s_q_imu * d402;
-                buf[9][1] = kanegen_runtime::lanes::lanes(-d404);
+                let d369 = t53 + t54 - t56;
+                let d370 = s_q4l * d367;
+                let d371 = c_q4l * d367;
+                let d372 = c_q4l * d365 - s_q4l * d369;
+                buf[9][7] = kanegen_runtime::lanes::lanes(d372);
+                let d373 = s_q4l * d365 + c_q4l * d369;
+                let d374 = c_q3l * d366 + s_q3l * d371;
+                let d375 = s_q3l * d366 - c_q3l * d371;
+                let d376 = c_q3l * d368 - s_q3l * d373 + p.L7 * d375;
+                buf[9][6] = kanegen_runtime::lanes::lanes(-d376);
+                let d377 = s_q3l * d368 + c_q3l * d373 - p.L7 * d374;
+                let d378 = c_q2l * d370 - s_q2l * d375;
+                let d379 = s_q2l * d370 + c_q2l * d375;
+                let d380 = c_q2l * d372 - s_q2l * d377;
+                buf[9][5] = kanegen_runtime::lanes::lanes(d380);
+                let d381 = s_q2l * d372 + c_q2l * d377;
+                let d382 = s_q1l * d374 + c_q1l * d379;
+                let d383 = c_q1l * d374 - s_q1l * d379;
+                let d384 = s_q1l * d376 + c_q1l * d381 - p.L6 * d383 + p.L5 * d378;
+                let d385 = d380 - p.L5 * d382;
+                let d386 = c_q1l * d376 - s_q1l * d381 + p.L6 * d382;
+                buf[9][4] = kanegen_runtime::lanes::lanes(d386);
+                let d387 = c_q_torso * d378 + s_q_torso * d382;
+                let d388 = s_q_torso * d378 - c_q_torso * d382;
+                let d389 = c_q_torso * d385 + s_q_torso * d384 + p.L3 * d388
+                    + p.L4 * d383;
+                buf[9][3] = kanegen_runtime::lanes::lanes(-d389);
+                let d390 = s_q_torso * d385 - c_q_torso * d384 - p.L3 * d387;
+                let d391 = d386 - p.L4 * d387;
+                let d392 = s_q_w * d383 + c_q_w * d388;
+                let d393 = c_q_w * d383 - s_q_w * d388;
+                let d394 = d389 + p.L1 * d392 - p.L2 * d393;
+                buf[9][2] = kanegen_runtime::lanes::lanes(-d394);
+                let d395 = s_q_w * d391 + c_q_w * d390 - p.L1 * d387;
+                let d396 = c_q_w * d391 - s_q_w * d390 + p.L2 * d387;
+                let d397 = s_q_imu * d393 + c_q_imu * d392;
+                buf[9][0] = kanegen_runtime::lanes::lanes(-d397);
+                let d398 = c_q_imu * d396 - s_q_imu * d395;
+                buf[9][1] = kanegen_runtime::lanes::lanes(-d398);
+                let d399 = p.MX7l - d367;
+                let d400 = p.MZ7l + d366;
                 let k28 = s_q5l * s_q5l;
                 let k29 = s_q5l * c_q5l;
                 let k30 = 2.0 * k28 - 1.0;
-                let d405 = d330 - d364;
-                let d406 = k28 * d405 + 2.0 * (d324 * k29);
-                let d407 = p.XZ7l + d324 * k30 - k29 * d405;
-                let t57 = p.L8 * d327;
-                let d408 = pc.pc36 - d327;
-                let d409 = d330 - d406 + 2.0 * t57 + pc.pc37;
-                buf[8][8] = kanegen_runtime::lanes::lanes(d409);
-                let d410 = d364 + d406 + 2.0 * t57 + pc.pc38;
-                let d411 = c_q4l * d408 + s_q4l * d381;
-                let d412 = s_q4l * d408 - c_q4l * d381;
-                let t58 = c_q4l * d369;
-                let t59 = s_q4l * d369;
-                let t60 = s_q4l * d407;
-                let t61 = c_q4l * d407;
-                let d413 = t58 + t60;
-                buf[8][7] = kanegen_runtime::lanes::lanes(-d413);
-                let d414 = p.XY6l + t58 + t60;
-                let d415 = t59 - t61;
-                let d416 = p.XZ6l + t59 - t61;
-                let d417 = s_q3l * d411;
-                let d418 = c_q3l * d411;
-                let d419 = p.MY6l - d411;
-                let d420 = s_q3l * d409 + c_q3l * d415 - p.L7 * d417;
-                let d421 = c_q3l * d409 - s_q3l * d415 - p.L7 * d418;
-                buf[8][6] = kanegen_runtime::lanes::lanes(d421);
-                let d422 = p.XX6l + d409;
-                let d423 = c_q2l * d412 + s_q2l * d418;
-                let d424 = s_q2l * d412 - c_q2l * d418;
-                let d425 = p.MZ6l - d412;
-                let d426 = c_q2l * d413 - s_q2l * d420;
-                buf[8][5] = kanegen_runtime::lanes::lanes(-d426);
-                let d427 = s_q2l * d413 + c_q2l * d420;
-                let d428 = c_q1l * d417 - s_q1l * d424;
-                let d429 = s_q1l * d417 + c_q1l * d424;
-                let d430 = d426 - p.L5 * d429;
-                let d431 = c_q1l * d421 - s_q1l * d427 + p.L6 * d429;
-                buf[8][4] = kanegen_runtime::lanes::lanes(-d431);
-                let d432 = s_q1l * d421 + c_q1l * d427 - p.L6 * d428 + p.L5 * d423;
-                let d433 = c_q_torso * d423 + s_q_torso * d429;
-                let d434 = s_q_torso * d423 - c_q_torso * d429;
-                let d435 = d431 - p.L4 * d433;
-                let d436 = c_q_torso * d430 + s_q_torso * d432 + p.L3 * d434
-                    + p.L4 * d428;
-                buf[8][3] = kanegen_runtime::lanes::lanes(d436);
-                let d437 = s_q_torso * d430 - c_q_torso * d432 - p.L3 * d433;
-                let d438 = c_q_w * d428 - s_q_w * d434;
-                let d439 = s_q_w * d428 + c_q_w * d434;
-                let d440 = d436 + p.L1 * d439 - p.L2 * d438;
-                buf[8][2] = kanegen_runtime::lanes::lanes(d440);
-                let d441 = s_q_imu * d438 + c_q_imu * d439;
-                buf[8][0] = kanegen_runtime::lanes::lanes(d441);
-                let d442 = c_q_w * d435 - s_q_w * d437 + p.L2 * d433;
-                let d443 = s_q_w * d435 + c_q_w * d437 - p.L1 * d433;
-                let d444 = c_q_imu * d442 - s_q_imu * d443;
-                buf[8][1] = kanegen_runtime::lanes::lanes(d444);
+                let d401 = d360 - d364;
+                let d402 = k28 * d401 + 2.0 * (d362 * k29);
+                let t57 = p.L8 * d356;
+                let d403 = p.XY7l + t51 - t52 - t55;
+                let d404 = p.XZ7l + d362 * k30 - k29 * d401;
+                let d405 = p.YY7l + d365;
+                let d406 = p.YZ7l - t53 - t54 + t56;
+                let d407 = pc.pc36 - d356;
+                let d408 = d360 - d402 + 2.0 * t57 + pc.pc37;
+                buf[8][8] = kanegen_runtime::lanes::lanes(d408);
+                let d409 = d364 + d402 + 2.0 * t57 + pc.pc38;
+                let d410 = c_q4l * d407 + s_q4l * d400;
+                let d411 = s_q4l * d407 - c_q4l * d400;
+                let t58 = c_q4l * d403;
+                let t59 = s_q4l * d404;
+                let d412 = t58 + t59;
+                buf[8][7] = kanegen_runtime::lanes::lanes(-d412);
+                let t60 = s_q4l * d403;
+                let t61 = c_q4l * d404;
+                let d413 = t60 - t61;
+                let d414 = s_q3l * d410;
+                let d415 = c_q3l * d410;
+                let d416 = s_q3l * d408 + c_q3l * d413 - p.L7 * d414;
+                let d417 = c_q3l * d408 - s_q3l * d413 - p.L7 * d415;
+                buf[8][6] = kanegen_runtime::lanes::lanes(d417);
+                let d418 = c_q2l * d411 + s_q2l * d415;
+                let d419 = s_q2l * d411 - c_q2l * d415;
+                let d420 = c_q2l * d412 - s_q2l * d416;
+                buf[8][5] = kanegen_runtime::lanes::lanes(-d420);
+                let d421 = s_q2l * d412 + c_q2l * d416;
+                let d422 = c_q1l * d414 - s_q1l * d419;
+                let d423 = s_q1l * d414 + c_q1l * d419;
+                let d424 = d420 - p.L5 * d423;
+                let d425 = c_q1l * d417 - s_q1l * d421 + p.L6 * d423;
+                buf[8][4] = kanegen_runtime::lanes::lanes(-d425);
+                let d426 = s_q1l * d417 + c_q1l * d421 - p.L6 * d422 + p.L5 * d418;
+                let d427 = c_q_torso * d418 + s_q_torso * d423;
+                let d428 = s_q_torso * d418 - c_q_torso * d423;
+                let d429 = d425 - p.L4 * d427;
+                let d430 = c_q_torso * d424 + s_q_torso * d426 + p.L3 * d428
+                    + p.L4 * d422;
+                buf[8][3] = kanegen_runtime::lanes::lanes(d430);
+                let d431 = s_q_torso * d424 - c_q_torso * d426 - p.L3 * d427;
+                let d432 = c_q_w * d422 - s_q_w * d428;
+                let d433 = s_q_w * d422 + c_q_w * d428;
+                let d434 = c_q_w * d429 - s_q_w * d431 + p.L2 * d427;
+                let d435 = d430 + p.L1 * d433 - p.L2 * d432;
+                buf[8][2] = kanegen_runtime::lanes::lanes(d435);
+                let d436 = s_q_w * d429 + c_q_w * d431 - p.L1 * d427;
+                let d437 = s_q_imu * d432 + c_q_imu * d433;
+                buf[8][0] = kanegen_runtime::lanes::lanes(d437);
+                let d438 = c_q_imu * d434 - s_q_imu * d436;
+                buf[8][1] = kanegen_runtime::lanes::lanes(d438);
+                let d439 = p.MX6l - d399;
+                let d440 = p.MY6l - d410;
+                let d441 = p.MZ6l - d411;
                 let k31 = s_q4l * s_q4l;
                 let k32 = s_q4l * c_q4l;
                 let k33 = 2.0 * k31 - 1.0;
-                let d445 = d378 - d410;
-                let d446 = k31 * d445 - 2.0 * (d371 * k32);
-                let d447 = p.YZ6l + d371 * k33 + k32 * d445;
-                let d448 = p.YY6l + d378 - d446;
-                buf[7][7] = kanegen_runtime::lanes::lanes(d448);
-                let d449 = p.ZZ6l + d410 + d446;
-                let d450 = s_q3l * d375 + c_q3l * d425;
-                let d451 = c_q3l * d375 - s_q3l * d425;
-                let t62 = c_q3l * d414;
-                let t63 = s_q3l * d414;
-                let t64 = s_q3l * d447;
-                let t65 = c_q3l * d447;
+                let d442 = d405 - d409;
+                let d443 = k31 * d442 - 2.0 * (d406 * k32);
+                let d444 = p.XX6l + d408;
+                let d445 = p.XY6l + t58 + t59;
+                let d446 = p.XZ6l + t60 - t61;
+                let d447 = p.YY6l + d405 - d443;
+                buf[7][7] = kanegen_runtime::lanes::lanes(d447);
+                let d448 = p.YZ6l + d406 * k33 + k32 * d442;
+                let d449 = p.ZZ6l + d409 + d443;
+                let d450 = s_q3l * d439 + c_q3l * d441;
+                let d451 = c_q3l * d439 - s_q3l * d441;
+                let t62 = c_q3l * d445;
+                let t63 = s_q3l * d448;
+                let t64 = s_q3l * d445;
+                let t65 = c_q3l * d448;
                 let t66 = p.L7 * d451;
                 let t67 = p.L7 * d450;
-                let d452 = t62 - t64 - t66;
+                let d452 = t62 - t63 - t66;
                 buf[7][6] = kanegen_runtime::lanes::lanes(-d452);
-                let d453 = p.XY5l + t62 - t64 - t66;
-                let d454 = t63 + t65 - t67;
-                let d455 = p.YZ5l - t63 - t65 + t67;
-                let d456 = s_q2l * d451;
-                let d457 = c_q2l * d451;
-                let d458 = p.MX5l - d451;
-                let d459 = p.MX4l - d458;
-                let d460 = c_q2l * d448 - s_q2l * d454;
-                buf[7][5] = kanegen_runtime::lanes::lanes(d460);
-                let d461 = s_q2l * d448 + c_q2l * d454;
-                let d462 = p.YY5l + d448;
-                let d463 = s_q1l * d450 - c_q1l * d457;
-                let d464 = c_q1l * d450 + s_q1l * d457;
-                let d465 = d460 - p.L5 * d463;
-                let d466 = p.MZ5l + d450;
-                let d467 = s_q1l * d452 + c_q1l * d461 - p.L6 * d464 + p.L5 * d456;
-                let d468 = c_q1l * d452 - s_q1l * d461 + p.L6 * d463;
-                buf[7][4] = kanegen_runtime::lanes::lanes(d468);
-                let d469 = c_q_torso * d456 + s_q_torso * d463;
-                let d470 = s_q_torso * d456 - c_q_torso * d463;
-                let d471 = d468 - p.L4 * d469;
-                let d472 = c_q_torso * d465 + s_q_torso * d467 + p.L3 * d470
-                    + p.L4 * d464;
-                buf[7][3] = kanegen_runtime::lanes::lanes(-d472);
-                let d473 = s_q_torso * d465 - c_q_torso * d467 - p.L3 * d469;
-                let d474 = s_q_w * d464 + c_q_w * d470;
-                let d475 = c_q_w * d464 - s_q_w * d470;
-                let d476 = d472 + p.L1 * d474 - p.L2 * d475;
-                buf[7][2] = kanegen_runtime::lanes::lanes(-d476);
-                let d477 = s_q_imu * d475 + c_q_imu * d474;
-                buf[7][0] = kanegen_runtime::lanes::lanes(-d477);
-                let d478 = s_q_w * d471 + c_q_w * d473 - p.L1 * d469;
-                let d479 = c_q_w * d471 - s_q_w * d473 + p.L2 * d469;
-                let d480 = c_q_imu * d479 - s_q_imu * d478;
-                buf[7][1] = kanegen_runtime::lanes::lanes(-d480);
+                let d453 = t64 + t65 - t67;
+                let d454 = s_q2l * d451;
+                let d455 = c_q2l * d451;
+                let d456 = c_q2l * d447 - s_q2l * d453;
+                buf[7][5] = kanegen_runtime::lanes::lanes(d456);
+                let d457 = s_q2l * d447 + c_q2l * d453;
+                let d458 = s_q1l * d450 - c_q1l * d455;
+                let d459 = c_q1l * d450 + s_q1l * d455;
+                let d460 = s_q1l * d452 + c_q1l * d457 - p.L6 * d459 + p.L5 * d454;
+                let d461 = d456 - p.L5 * d458;
+                let d462 = c_q1l * d452 - s_q1l * d457 + p.L6 * d458;
+                buf[7][4] = kanegen_runtime::lanes::lanes(d462);
+                let d463 = c_q_torso * d454 + s_q_torso * d458;
+                let d464 = s_q_torso * d454 - c_q_torso * d458;
+                let d465 = c_q_torso * d461 + s_q_torso * d460 + p.L3 * d464
+                    + p.L4 * d459;
+                buf[7][3] = kanegen_runtime::lanes::lanes(-d465);
+                let d466 = s_q_torso * d461 - c_q_torso * d460 - p.L3 * d463;
+                let d467 = d462 - p.L4 * d463;
+                let d468 = s_q_w * d459 + c_q_w * d464;
+                let d469 = c_q_w * d459 - s_q_w * d464;
+                let d470 = d465 + p.L1 * d468 - p.L2 * d469;
+                buf[7][2] = kanegen_runtime::lanes::lanes(-d470);
+                let d471 = s_q_w * d467 + c_q_w * d466 - p.L1 * d463;
+                let d472 = c_q_w * d467 - s_q_w * d466 + p.L2 * d463;
+                let d473 = s_q_imu * d469 + c_q_imu * d468;
+                buf[7][0] = kanegen_runtime::lanes::lanes(-d473);
+                let d474 = c_q_imu * d472 - s_q_imu * d471;
+                buf[7][1] = kanegen_runtime::lanes::lanes(-d474);
+                let d475 = p.MX5l - d451;
+                let d476 = p.MZ5l + d450;
                 let k34 = s_q3l * s_q3l;
                 let k35 = s_q3l * c_q3l;
                 let k36 = 2.0 * k34 - 1.0;
-                let d481 = d422 - d449;
-                let d482 = k34 * d481 + 2.0 * (d416 * k35);
-                let d483 = p.XZ5l + d416 * k36 - k35 * d481;
-                let t68 = p.L7 * d419;
-                let d484 = pc.pc42 - d419;
-                let d485 = d422 - d482 + 2.0 * t68 + pc.pc43;
-                buf[6][6] = kanegen_runtime::lanes::lanes(d485);
-                let d486 = d449 + d482 + 2.0 * t68 + pc.pc44;
-                let d487 = c_q2l * d484 + s_q2l * d466;
-                let d488 = s_q2l * d484 - c_q2l * d466;
-                let t69 = c_q2l * d453;
-                let t70 = s_q2l * d453;
-                let t71 = s_q2l * d483;
-                let t72 = c_q2l * d483;
-                let d489 = t69 + t71;
-                buf[6][5] = kanegen_runtime::lanes::lanes(-d489);
-                let d490 = p.XY4l + t69 + t71;
-                let d491 = t70 - t72;
-                let d492 = p.XZ4l + t70 - t72;
-                let d493 = s_q1l * d487;
-                let d494 = c_q1l * d487;
-                let d495 = d489 + p.L5 * d494;
-                let d496 = p.MY4l - d487;
-                let d497 = c_q1l * d485 - s_q1l * d491 - p.L6 * d494;
-                buf[6][4] = kanegen_runtime::lanes::lanes(-d497);
-                let d498 = s_q1l * d485 + c_q1l * d491 - p.L6 * d493 + p.L5 * d488;
-                let d499 = p.XX4l + d485;
-                let d500 = c_q_torso * d488 - s_q_torso * d494;
-                let d501 = s_q_torso * d488 + c_q_torso * d494;
-                let d502 = d497 - p.L4 * d500;
-                let d503 = p.MZ4l - d488;
-                let d504 = c_q_torso * d495 + s_q_torso * d498 + p.L3 * d501
-                    + p.L4 * d493;
-                buf[6][3] = kanegen_runtime::lanes::lanes(d504);
-                let d505 = s_q_torso * d495 - c_q_torso * d498 - p.L3 * d500;
-                let d506 = c_q_w * d493 - s_q_w * d501;
-                let d507 = s_q_w * d493 + c_q_w * d501;
-                let d508 = d504 + p.L1 * d507 - p.L2 * d506;
-                buf[6][2] = kanegen_runtime::lanes::lanes(d508);
-                let d509 = s_q_imu * d506 + c_q_imu * d507;
-                buf[6][0] = kanegen_runtime::lanes::lanes(d509);
-                let d510 = c_q_w * d502 - s_q_w * d505 + p.L2 * d500;
-                let d511 = s_q_w * d502 + c_q_w * d505 - p.L1 * d500;
-                let d512 = c_q_imu * d510 - s_q_imu * d511;
-                buf[6][1] = kanegen_runtime::lanes::lanes(d512);
+                let d477 = d444 - d449;
+                let d478 = k34 * d477 + 2.0 * (d446 * k35);
+                let t68 = p.L7 * d440;
+                let d479 = p.XY5l + t62 - t63 - t66;
+                let d480 = p.XZ5l + d446 * k36 - k35 * d477;
+                let d481 = p.YY5l + d447;
+                let d482 = p.YZ5l - t64 - t65 + t67;
+                let d483 = pc.pc42 - d440;
+                let d484 = d444 - d478 + 2.0 * t68 + pc.pc43;
+                buf[6][6] = kanegen_runtime::lanes::lanes(d484);
+                let d485 = d449 + d478 + 2.0 * t68 + pc.pc44;
+                let d486 = c_q2l * d483 + s_q2l * d476;
+                let d487 = s_q2l * d483 - c_q2l * d476;
+                let t69 = c_q2l * d479;
+                let t70 = s_q2l * d480;
+                let d488 = t69 + t70;
+                buf[6][5] = kanegen_runtime::lanes::lanes(-d488);
+                let t71 = s_q2l * d479;
+                let t72 = c_q2l * d480;
+                let d489 = t71 - t72;
+                let d490 = s_q1l * d486;
+                let d491 = c_q1l * d486;
+                let d492 = d488 + p.L5 * d491;
+                let d493 = c_q1l * d484 - s_q1l * d489 - p.L6 * d491;
+                buf[6][4] = kanegen_runtime::lanes::lanes(-d493);
+                let d494 = s_q1l * d484 + c_q1l * d489 - p.L6 * d490 + p.L5 * d487;
+                let d495 = c_q_torso * d487 - s_q_torso * d491;
+                let d496 = s_q_torso * d487 + c_q_torso * d491;
+                let d497 = d493 - p.L4 * d495;
+                let d498 = c_q_torso * d492 + s_q_torso * d494 + p.L3 * d496
+                    + p.L4 * d490;
+                buf[6][3] = kanegen_runtime::lanes::lanes(d498);
+                let d499 = s_q_torso * d492 - c_q_torso * d494 - p.L3 * d495;
+                let d500 = c_q_w * d490 - s_q_w * d496;
+                let d501 = s_q_w * d490 + c_q_w * d496;
+                let d502 = c_q_w * d497 - s_q_w * d499 + p.L2 * d495;
+                let d503 = d498 + p.L1 * d501 - p.L2 * d500;
+                buf[6][2] = kanegen_runtime::lanes::lanes(d503);
+                let d504 = s_q_w * d497 + c_q_w * d499 - p.L1 * d495;
+                let d505 = s_q_imu * d500 + c_q_imu * d501;
+                buf[6][0] = kanegen_runtime::lanes::lanes(d505);
+                let d506 = c_q_imu * d502 - s_q_imu * d504;
+                buf[6][1] = kanegen_runtime::lanes::lanes(d506);
+                let d507 = p.MX4l - d475;
+                let d508 = p.MY4l - d486;
+                let d509 = p.MZ4l - d487;
                 let k37 = s_q2l * s_q2l;
                 let k38 = s_q2l * c_q2l;
                 let k39 = 2.0 * k37 - 1.0;
-                let d513 = d462 - d486;
-                let d514 = k37 * d513 - 2.0 * (d455 * k38);
-                let d515 = p.YZ4l + d455 * k39 + k38 * d513;
-                let d516 = p.YY4l + d462 - d514;
-                buf[5][5] = kanegen_runtime::lanes::lanes(d516);
-                let d517 = p.ZZ4l + d486 + d514;
-                let d518 = c_q1l * d459 - s_q1l * d503;
-                let d519 = s_q1l * d459 + c_q1l * d503;
-                let d520 = d250 + d518 + pc.pc48;
-                let t73 = c_q1l * d490;
-                let t74 = s_q1l * d490;
-                let t75 = s_q1l * d515;
-                let t76 = c_q1l * d515;
+                let d510 = d481 - d485;
+                let d511 = k37 * d510 - 2.0 * (d482 * k38);
+                let d512 = p.XX4l + d484;
+                let d513 = p.XY4l + t69 + t70;
+                let d514 = p.XZ4l + t71 - t72;
+                let d515 = p.YY4l + d481 - d511;
+                buf[5][5] = kanegen_runtime::lanes::lanes(d515);
+                let d516 = p.YZ4l + d482 * k39 + k38 * d510;
+                let d517 = p.ZZ4l + d485 + d511;
+                let d518 = c_q1l * d507 - s_q1l * d509;
+                let d519 = s_q1l * d507 + c_q1l * d509;
+                let t73 = c_q1l * d513;
+                let t74 = s_q1l * d516;
+                let t75 = s_q1l * d513;
+                let t76 = c_q1l * d516;
                 let t77 = p.L5 * d518;
-                let d521 = d248 + 2.0 * t37 + d516 + 2.0 * t77 + pc.pc49;
-                let d522 = d516 + t77;
                 let t78 = p.L6 * d518;
-                let d523 = t35 - t33 + t38 + p.L5 * d228 + t73 - t75 - t78 - p.L5 * d496
-                    + pc.pc50;
-                let d524 = t73 - t75 - t78;
-                buf[5][4] = kanegen_runtime::lanes::lanes(d524);
-                let d525 = d496 - d228 + pc.pc47;
-                let t79 = p.L6 * d496;
-                let t80 = p.L6 * d519;
-                let d526 = p.XZ3 - t34 - t36 + t39 - t74 - t76 + t80;
-                let d527 = t74 + t76 - t80;
-                let d528 = s_q_torso * d518;
-                let d529 = c_q_torso * d518;
-                let d530 = d524 + p.L4 * d528;
-                let d531 = c_q_torso * d522 + s_q_torso * d527 + p.L3 * d529
+                let t79 = p.L6 * d519;
+                let d520 = t75 + t76 - t79;
+                let d521 = d515 + t77;
+                let d522 = t73 - t74 - t78;
+                buf[5][4] = kanegen_runtime::lanes::lanes(d522);
+                let d523 = s_q_torso * d518;
+                let d524 = c_q_torso * d518;
+                let d525 = c_q_torso * d521 + s_q_torso * d520 + p.L3 * d524
                     + p.L4 * d519;
-                buf[5][3] = kanegen_runtime::lanes::lanes(-d531);
-                let d532 = s_q_torso * d522 - c_q_torso * d527 + p.L3 * d528;
-                let d533 = s_q_w * d519 + c_q_w * d529;
-                let d534 = c_q_w * d519 - s_q_w * d529;
-                let d535 = d531 + p.L1 * d533 - p.L2 * d534;
-                buf[5][2] = kanegen_runtime::lanes::lanes(-d535);
-                let d536 = s_q_imu * d534 + c_q_imu * d533;
-                buf[5][0] = kanegen_runtime::lanes::lanes(-d536);
-                let d537 = s_q_w * d530 + c_q_w * d532 + p.L1 * d528;
-                let d538 = c_q_w * d530 - s_q_w * d532 - p.L2 * d528;
-                let d539 = c_q_imu * d538 - s_q_imu * d537;
-                buf[5][1] = kanegen_runtime::lanes::lanes(-d539);
-                let d540 = p.MZ3 + d251 - d519;
+                buf[5][3] = kanegen_runtime::lanes::lanes(-d525);
+                let d526 = s_q_torso * d521 - c_q_torso * d520 + p.L3 * d523;
+                let d527 = d522 + p.L4 * d523;
+                let d528 = s_q_w * d519 + c_q_w * d524;
+                let d529 = c_q_w * d519 - s_q_w * d524;
+                let d530 = d525 + p.L1 * d528 - p.L2 * d529;
+                buf[5][2] = kanegen_runtime::lanes::lanes(-d530);
+                let d531 = s_q_w * d527 + c_q_w * d526 + p.L1 * d523;
+                let d532 = c_q_w * d527 - s_q_w * d526 - p.L2 * d523;
+                let d533 = s_q_imu * d529 + c_q_imu * d528;
+                buf[5][0] = kanegen_runtime::lanes::lanes(-d533);
+                let d534 = c_q_imu * d532 - s_q_imu * d531;
+                buf[5][1] = kanegen_runtime::lanes::lanes(-d534);
+                let d535 = p.MZ3 + d251 - d519;
                 let k40 = s_q1l * s_q1l;
                 let k41 = s_q1l * c_q1l;
                 let k42 = 2.0 * k40 - 1.0;
-                let d541 = d499 - d517;
-                let d542 = p.YZ3 - d224 * k21 + k20 * d267 - p.L5 * d251 + d492 * k42
-                    - k41 * d541 + p.L5 * d519;
-                let d543 = k40 * d541 + 2.0 * (d492 * k41);
-                let d544 = d249 + 2.0 * t37 + d268 + 2.0 * t40 + d517 + 2.0 * t77 + d543
-                    + 2.0 * t79 + pc.pc52;
-                let d545 = d231 - d268 + 2.0 * t40 + d499 - d543 + 2.0 * t79 + pc.pc51;
-                buf[4][4] = kanegen_runtime::lanes::lanes(d545);
-                let d546 = c_q_torso * d525 - s_q_torso * d540;
-                let d547 = s_q_torso * d525 + c_q_torso * d540;
-                let t81 = c_q_torso * d523;
-                let t82 = s_q_torso * d523;
-                let t83 = s_q_torso * d542;
-                let t84 = c_q_torso * d542;
+                let d536 = d512 - d517;
+                let d537 = k40 * d536 + 2.0 * (d514 * k41);
+                let t80 = p.L6 * d508;
+                let d538 = p.XZ3 - t35 - t36 + t39 - t75 - t76 + t79;
+                let d539 = p.YZ3 - d246 * k21 + k20 * d267 - p.L5 * d251 + d514 * k42
+                    - k41 * d536 + p.L5 * d519;
+                let d540 = d508 - d240 + pc.pc47;
+                let d541 = d250 + d518 + pc.pc48;
+                let d542 = d247 + 2.0 * t37 + d515 + 2.0 * t77 + pc.pc49;
+                let d543 = t34 - t33 + t38 + p.L5 * d240 + t73 - t74 - t78 - p.L5 * d508
+                    + pc.pc50;
+                let d544 = d244 - d268 + 2.0 * t40 + d512 - d537 + 2.0 * t80 + pc.pc51;
+                buf[4][4] = kanegen_runtime::lanes::lanes(d544);
+                let d545 = d249 + 2.0 * t37 + d268 + 2.0 * t40 + d517 + 2.0 * t77 + d537
+                    + 2.0 * t80 + pc.pc52;
+                let d546 = c_q_torso * d540 - s_q_torso * d535;
+                let d547 = s_q_torso * d540 + c_q_torso * d535;
+                let t81 = c_q_torso * d543;
+                let t82 = s_q_torso * d539;
+                let t83 = s_q_torso * d543;
+                let t84 = c_q_torso * d539;
                 let t85 = p.L3 * d546;
                 let t86 = p.L4 * d547;
                 let t87 = p.L3 * d547;
-                let d548 = t81 - t83 - t85;
+                let d548 = t81 - t82 - t85;
                 buf[4][3] = kanegen_runtime::lanes::lanes(-d548);
-                let d549 = p.XY2 - t81 + t83 + t85;
-                let d550 = t82 + t84 - t87;
-                let d551 = t87 - t82 - t84 - p.L4 * d520 + pc.pc58;
-                let d552 = d545 - t86;
-                let d553 = d545 - 2.0 * t86 + pc.pc57;
-                let d554 = s_q_w * d546;
-                let d555 = c_q_w * d546;
-                let d556 = d548 - p.L1 * d555 - p.L2 * d554;
-                buf[4][2] = kanegen_runtime::lanes::lanes(-d556);
-                let d557 = s_q_imu * d554 - c_q_imu * d555;
-                buf[4][0] = kanegen_runtime::lanes::lanes(-d557);
-                let d558 = s_q_w * d552 + c_q_w * d550 - p.L1 * d547;
-                let d559 = c_q_w * d552 - s_q_w * d550 + p.L2 * d547;
-                let d560 = c_q_imu * d559 - s_q_imu * d558;
-                buf[4][1] = kanegen_runtime::lanes::lanes(-d560);
-                let d561 = pc.pc55 - d547;
-                let d562 = p.MX2 - d546;
-                let d563 = p.MX1 + d562;
-                buf[1][0] = kanegen_runtime::lanes::lanes(d563);
+                let d549 = t83 + t84 - t87;
+                let d550 = d544 - t86;
+                let d551 = s_q_w * d546;
+                let d552 = c_q_w * d546;
+                let d553 = d548 - p.L1 * d552 - p.L2 * d551;
+                buf[4][2] = kanegen_runtime::lanes::lanes(-d553);
+                let d554 = s_q_w * d550 + c_q_w * d549 - p.L1 * d547;
+                let d555 = c_q_w * d550 - s_q_w * d549 + p.L2 * d547;
+                let d556 = s_q_imu * d551 - c_q_imu * d552;
+                buf[4][0] = kanegen_runtime::lanes::lanes(-d556);
+                let d557 = c_q_imu * d555 - s_q_imu * d554;
+                buf[4][1] = kanegen_runtime::lanes::lanes(-d557);
+                let d558 = p.MX2 - d546;
                 let k43 = s_q_torso * s_q_torso;
                 let k44 = s_q_torso * c_q_torso;
                 let k45 = 2.0 * k43 - 1.0;
-                let d564 = d521 - d544;
-                let d565 = p.XZ2 - d526 * k45 + k44 * d564 + p.L4 * d546;
-                let d566 = k43 * d564 + 2.0 * (d526 * k44);
-                let t88 = p.L3 * d520;
-                let d567 = d521 - 2.0 * t86 - d566 + 2.0 * t88 + pc.pc56;
-                buf[3][3] = kanegen_runtime::lanes::lanes(d567);
-                let d568 = d544 + d566 + 2.0 * t88 + pc.pc59;
-                let d569 = d520 + pc.pc54;
-                let d570 = c_q_w * d569 + s_q_w * d561;
-                let d571 = s_q_w * d569 - c_q_w * d561;
-                let d572 = s_q_imu * d571 - c_q_imu * d570;
-                buf[3][0] = kanegen_runtime::lanes::lanes(-d572);
-                let t89 = c_q_w * d549;
-                let t90 = s_q_w * d549;
-                let t91 = s_q_w * d565;
-                let t92 = c_q_w * d565;
-                let d573 = t90 - t92;
-                let d574 = p.XZ1 - t90 + t92 + p.L2 * d562;
-                let d575 = p.XY1 + t89 + t91 - p.L1 * d562;
-                let d576 = c_q_imu * d575 + s_q_imu * d574;
-                buf[2][1] = kanegen_runtime::lanes::lanes(-d576);
-                let d577 = t89 + t91;
-                let d578 = c_q_imu * d577 - s_q_imu * d573;
-                buf[3][1] = kanegen_runtime::lanes::lanes(-d578);
-                let t93 = p.L1 * d570;
-                let t94 = p.L2 * d571;
-                let d579 = d567 + t93 + t94;
-                buf[3][2] = kanegen_runtime::lanes::lanes(d579);
-                let d580 = d567 + 2.0 * t93 + 2.0 * t94 + pc.pc63;
-                buf[2][2] = kanegen_runtime::lanes::lanes(d580);
+                let d559 = d542 - d545;
+                let d560 = k43 * d559 + 2.0 * (d538 * k44);
+                let t88 = p.L3 * d541;
+                let d561 = p.XY2 - t81 + t82 + t85;
+                let d562 = p.XZ2 - d538 * k45 + k44 * d559 + p.L4 * d546;
+                let d563 = d541 + pc.pc54;
+                let d564 = pc.pc55 - d547;
+                let d565 = d542 - 2.0 * t86 - d560 + 2.0 * t88 + pc.pc56;
+                buf[3][3] = kanegen_runtime::lanes::lanes(d565);
+                let d566 = d544 - 2.0 * t86 + pc.pc57;
+                let d567 = t87 - t83 - t84 - p.L4 * d541 + pc.pc58;
+                let d568 = d545 + d560 + 2.0 * t88 + pc.pc59;
+                let d569 = c_q_w * d563 + s_q_w * d564;
+                let d570 = s_q_w * d563 - c_q_w * d564;
+                let t89 = c_q_w * d561;
+                let t90 = s_q_w * d562;
+                let t91 = s_q_w * d561;
+                let t92 = c_q_w * d562;
+                let d571 = t91 - t92;
+                let t93 = p.L1 * d569;
+                let t94 = p.L2 * d570;
+                let d572 = d565 + t93 + t94;
+                buf[3][2] = kanegen_runtime::lanes::lanes(d572);
+                let d573 = t89 + t90;
+                let d574 = s_q_imu * d570 - c_q_imu * d569;
+                buf[3][0] = kanegen_runtime::lanes::lanes(-d574);
+                let d575 = c_q_imu * d573 - s_q_imu * d571;
+                buf[3][1] = kanegen_runtime::lanes::lanes(-d575);
+                let d576 = p.MX1 + d558;
+                buf[1][0] = kanegen_runtime::lanes::lanes(d576);
                 let k46 = s_q_w * s_q_w;
                 let k47 = s_q_w * c_q_w;
                 let k48 = 2.0 * k46 - 1.0;
-                let d581 = d553 - d568;
-                let d582 = k46 * d581 - 2.0 * (d551 * k47);
-                let d583 = p.L2 * d570 - d551 * k48 - k47 * d581 + p.L1 * d571 + pc.pc65;
-                let d584 = d553 + 2.0 * t94 - d582 + pc.pc64;
-                let d585 = d568 + 2.0 * t93 + d582 + pc.pc66;
-                let d586 = d570 + pc.pc61;
-                let d587 = pc.pc62 - d571;
-                let d588 = c_q_imu * d586 + s_q_imu * d587;
-                buf[2][0] = kanegen_runtime::lanes::lanes(d588);
-                let d589 = d584 - d585;
+                let d577 = d566 - d568;
+                let d578 = k46 * d577 - 2.0 * (d567 * k47);
+                let d579 = p.XY1 + t89 + t90 - p.L1 * d558;
+                let d580 = p.XZ1 - t91 + t92 + p.L2 * d558;
+                let d581 = d569 + pc.pc61;
+                let d582 = pc.pc62 - d570;
+                let d583 = d565 + 2.0 * t93 + 2.0 * t94 + pc.pc63;
+                buf[2][2] = kanegen_runtime::lanes::lanes(d583);
+                let d584 = d566 + 2.0 * t94 - d578 + pc.pc64;
+                let d585 = p.L2 * d569 - d567 * k48 - k47 * d577 + p.L1 * d570 + pc.pc65;
+                let d586 = d568 + 2.0 * t93 + d578 + pc.pc66;
+                let d587 = c_q_imu * d581 + s_q_imu * d582;
+                buf[2][0] = kanegen_runtime::lanes::lanes(d587);
+                let d588 = c_q_imu * d579 + s_q_imu * d580;
+                buf[2][1] = kanegen_runtime::lanes::lanes(-d588);
                 let k49 = s_q_imu * s_q_imu;
                 let k50 = s_q_imu * c_q_imu;
-                let d590 = k49 * d589 - 2.0 * (d583 * k50);
+                let d589 = d584 - d586;
+                let d590 = k49 * d589 - 2.0 * (d585 * k50);
                 let d591 = d584 - d590;
                 buf[1][1] = kanegen_runtime::lanes::lanes(d591 + pc.pc68);
                 kanegen_runtime::lanes::results(&mut buf, true)

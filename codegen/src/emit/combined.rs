@@ -111,7 +111,7 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
             }
             Shape::SymmetricMatrix => {
                 inits.push(quote!(SMatrix::<#t, #rl, #cl>::zeros()));
-                // The lower triangle, copied at the end as in the separate `mass_matrix`.
+                // The lower triangle, copied at the end (the separate `mass_matrix` stores it as it goes).
                 finals.push(quote!(#f: {
                     let mut m = out.#k;
                     let s = m.as_mut_slice();

@@ -179,6 +179,9 @@ struct Result {
     init: TokenStream,
     stores: Stores,
     value: TokenStream,
+    /// Whether the statements and stores run in a block in which the result binding `m` is
+    /// the `&mut` to it returned by `core::hint::black_box` (see [`result`]).
+    in_memory: bool,
 }
 
 /// Result stores as text lines (`m[(0, 1)] = d5;`), by position: `stores[i + 1]` right after
@@ -233,6 +236,7 @@ fn isometry(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, mut stores: St
             let #pos_mut pos = nalgebra::Vector3::<#t>::zeros();
         },
         stores,
+        in_memory: false,
         value: quote!(nalgebra::Isometry3::from_parts(
             nalgebra::Translation3::from(pos),
             nalgebra::UnitQuaternion::from_rotation_matrix(
@@ -250,6 +254,18 @@ fn binding(stored: bool) -> TokenStream {
 /// Every result entry is stored right after the last statement it reads, so that values leave
 /// registers as soon as they are final (the programs are long; register pressure is what limits
 /// their speed).
+///
+/// An n×n result (M, the Coriolis matrix) is written in memory as it is computed: the
+/// statements run in a block where `m` is `core::hint::black_box(&mut m)`. Without it LLVM's
+/// scalar replacement turns the local matrix into 361 separate values that live (spilled to the
+/// stack) until the function's end, where all of them are reloaded and stored into the result —
+/// and the lower-triangle copy loop of a symmetric matrix was unrolled into 171 more reloads
+/// and stores there (Krang's M, x86-64-v3 copy: 2,867 instructions of which 1,067 addressed the
+/// stack). The cost is a `memset` of the zeroed matrix and a `memcpy` into the return slot
+/// (2.9 KB each for 19 speeds). A symmetric matrix's lower entry is stored right after its
+/// upper one (`m[(3, 5)] = m[(5, 3)];`, which LLVM forwards from the register), so no copy is
+/// left at the end. README "Instruction sets at run time and batched evaluation" has the
+/// measurements. Vectors stay scalar-replaced (19 values: in memory they measured slower).
 fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) -> Result {
     let t = scalar_type(cx.precision);
     let nl = idx(cx.low.dof);
@@ -257,34 +273,20 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
     let nonzero = nonzero_outputs(p);
     match shape {
         Shape::SymmetricMatrix | Shape::Matrix => {
+            let mirror = shape == Shape::SymmetricMatrix;
             for (r, c, e) in nonzero {
                 let v = text(cx, printer, e);
                 store_text_after(&mut stores, e, format!("m[({r}, {c})] = {v};"));
+                if mirror && r != c {
+                    store_text_after(&mut stores, e, format!("m[({c}, {r})] = m[({r}, {c})];"));
+                }
             }
-            // Symmetric: the lower triangle is copied at the end by a loop over the column-major
-            // storage. Mirrored stores next to the computation, or unrolled copies at the end
-            // (which the compiler turns back into long-lived registers), cost much more
-            // (measured for Krang: 1.2 µs vs 0.8 µs), and nalgebra's generic
-            // `fill_lower_triangle_with_upper_triangle` runs 2800 instructions for Krang's 171
-            // copies (this loop: about 0.25 µs less).
-            let value = if shape == Shape::SymmetricMatrix {
-                quote!({
-                    let s = m.as_mut_slice();
-                    for c in 1..#nl {
-                        for r in 0..c {
-                            s[r * #nl + c] = s[c * #nl + r];
-                        }
-                    }
-                    m
-                })
-            } else {
-                quote!(m)
-            };
             Result {
                 ty: quote!(SMatrix<#t, #nl, #nl>),
                 init: quote!(let mut m = SMatrix::<#t, #nl, #nl>::zeros();),
                 stores,
-                value,
+                value: quote!(m),
+                in_memory: true,
             }
         }
         Shape::Dense { rows, cols } => {
@@ -302,6 +304,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
                 init: quote!(let #mutable m = SMatrix::<#t, #r, #c>::zeros();),
                 stores,
                 value: quote!(m),
+                in_memory: false,
             }
         }
         Shape::Scalar => {
@@ -321,6 +324,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
                 init: TokenStream::new(),
                 stores,
                 value,
+                in_memory: false,
             }
         }
         Shape::Isometry => isometry(cx, printer, p, stores),
@@ -342,6 +346,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
                 init: quote!(let mut out = SVector::<#t, #nl>::zeros();),
                 stores,
                 value: quote!(out),
+                in_memory: false,
             }
         }
     }
@@ -392,6 +397,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         init,
         stores,
         value,
+        in_memory,
     } = result(cx, &printer, p, spec.shape);
     // The statements are printed as text and spliced in after formatting (`text.rs`).
     // A scalar result is the final expression; every other entry is stored in the block.
@@ -409,6 +415,14 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         true,
     );
     let body = cx.blocks.placeholder(block);
+    let body = if in_memory {
+        quote!({
+            let m = core::hint::black_box(&mut m);
+            #body
+        })
+    } else {
+        body
+    };
     let unused = unused_inputs(spec, p, &reads);
     let body = quote! {
         #unused

@@ -270,8 +270,15 @@ where
 }
 
 /// The steps with AVX2 and FMA intrinsics: the portable [`steps`] with `L4<f64>` as one
-/// `__m256d`, a multiply and an add fused where the portable form has them in sequence.
-#[cfg(target_arch = "x86_64")]
+/// `__m256d`, a multiply and an add fused where the portable form has them in sequence. Compiled
+/// where [`run`] can call it: with run-time dispatch, or when the crate is built with AVX2 and FMA.
+#[cfg(all(
+    target_arch = "x86_64",
+    any(
+        all(feature = "dispatch", feature = "std"),
+        all(target_feature = "avx2", target_feature = "fma")
+    )
+))]
 mod avx2 {
     use core::arch::x86_64::{
         __m256d, _mm_cvtsd_f64, _mm_unpackhi_pd, _mm256_add_pd, _mm256_castpd256_pd128,

@@ -52,6 +52,51 @@ fn generated(model: &Model, form: RegressorForm) -> Generated {
     generate_with(model.clone(), options, &emit).expect("generates")
 }
 
+/// What both kernels start from: function `id`'s loop tables, its `kin` table evaluated from the
+/// generator's expressions, and a column-major `rows × cols` result as the generated `…_into`
+/// prepares one of unknown content: NaN everywhere, the columns that are not a body's zeroed,
+/// then their entries stored; the kernel must write every other entry (NaN left anywhere fails
+/// the comparison).
+#[allow(clippy::too_many_arguments)]
+fn loop_inputs<'g>(
+    g: &'g Generated,
+    id: FunctionId,
+    rows: usize,
+    cols: usize,
+    params: &[f64],
+    q: &[f64],
+    u: &[f64],
+    ud: &[f64],
+) -> (&'g RegressorLoop, Vec<[f64; KIN]>, Vec<f64>) {
+    let f = g.lowered.functions.iter().find(|f| f.id == id).unwrap();
+    let tables = &f.looped.as_ref().expect("loop form").tables;
+    let (kin, extra) = g
+        .lowered
+        .evaluate_loop_inputs(id, params, q, u, ud)
+        .expect("loop form");
+    let kin = kin.chunks(KIN).map(|c| c.try_into().unwrap()).collect();
+    let mut out = vec![f64::NAN; rows * cols];
+    let body: Vec<usize> = tables
+        .links
+        .iter()
+        .flat_map(|l| l.columns.iter().flatten().copied())
+        .collect();
+    for c in (0..cols).filter(|c| !body.contains(c)) {
+        out[c * rows..(c + 1) * rows].fill(0.0);
+    }
+    for (r, c, v) in extra {
+        out[c * rows + r] = v;
+    }
+    (tables, kin, out)
+}
+
+/// A column-major `rows × cols` result as row-major entries.
+fn row_major(out: &[f64], rows: usize, cols: usize) -> Vec<f64> {
+    (0..rows * cols)
+        .map(|i| out[(i % cols) * rows + i / cols])
+        .collect()
+}
+
 /// Function `id` of `g` evaluated in its loop form: row-major `rows × cols`.
 #[allow(clippy::too_many_arguments)]
 fn loop_value(
@@ -64,13 +109,7 @@ fn loop_value(
     u: &[f64],
     ud: &[f64],
 ) -> Vec<f64> {
-    let f = g.lowered.functions.iter().find(|f| f.id == id).unwrap();
-    let tables = &f.looped.as_ref().expect("loop form").tables;
-    let (kin, extra) = g
-        .lowered
-        .evaluate_loop_inputs(id, params, q, u, ud)
-        .expect("loop form");
-    let kin: Vec<[f64; KIN]> = kin.chunks(KIN).map(|c| c.try_into().unwrap()).collect();
+    let (tables, kin, mut out) = loop_inputs(g, id, rows, cols, params, q, u, ud);
     let (chunks, slots) = tables.chunks();
     assert_eq!(kanegen::kane::LANES, LANES);
     let links: Vec<Link> = tables
@@ -93,27 +132,9 @@ fn loop_value(
             phi,
         })
         .collect();
-    // As the generated `…_into` does with a result of unknown content: the columns that are not
-    // a body's zeroed, then their entries stored; the loop must write every other entry (NaN
-    // left anywhere fails the comparison).
-    let mut out = vec![f64::NAN; rows * cols];
-    let body: Vec<usize> = tables
-        .links
-        .iter()
-        .flat_map(|l| l.columns.iter().flatten().copied())
-        .collect();
-    for c in (0..cols).filter(|c| !body.contains(c)) {
-        out[c * rows..(c + 1) * rows].fill(0.0);
-    }
-    for (r, c, v) in extra {
-        out[c * rows + r] = v;
-    }
     let mut phi = vec![[[0.0; LANES]; 6]; slots];
     run_loop(&kin, &links, &seeds, rows, &mut out, &mut phi);
-    // Column-major to row-major.
-    (0..rows * cols)
-        .map(|i| out[(i % cols) * rows + i / cols])
-        .collect()
+    row_major(&out, rows, cols)
 }
 
 /// The runtime tables of `tables` for a result of `rows` rows (as the emitter writes them).
@@ -188,13 +209,7 @@ fn plan_value<A: Arith<f64>>(
     u: &[f64],
     ud: &[f64],
 ) -> Vec<f64> {
-    let f = g.lowered.functions.iter().find(|f| f.id == id).unwrap();
-    let t = &f.looped.as_ref().expect("loop form").tables;
-    let (kin, extra) = g
-        .lowered
-        .evaluate_loop_inputs(id, params, q, u, ud)
-        .expect("loop form");
-    let kin: Vec<[f64; KIN]> = kin.chunks(KIN).map(|c| c.try_into().unwrap()).collect();
+    let (t, kin, mut out) = loop_inputs(g, id, rows, cols, params, q, u, ud);
     let tb = tables(t, rows);
     let plan = Plan {
         columns: &tb.columns,
@@ -202,23 +217,9 @@ fn plan_value<A: Arith<f64>>(
         seeds: &tb.seeds,
         zeros: &tb.zeros,
     };
-    let mut out = vec![f64::NAN; rows * cols];
-    let body: Vec<usize> = t
-        .links
-        .iter()
-        .flat_map(|l| l.columns.iter().flatten().copied())
-        .collect();
-    for c in (0..cols).filter(|c| !body.contains(c)) {
-        out[c * rows..(c + 1) * rows].fill(0.0);
-    }
-    for (r, c, v) in extra {
-        out[c * rows + r] = v;
-    }
     let mut phi = vec![[[f64::NAN; LANES]; 6]; tb.slots];
     inverse_dynamics_regressor_plan::<A, f64>(&kin, &plan, rows, &mut out, &mut phi);
-    (0..rows * cols)
-        .map(|i| out[(i % cols) * rows + i / cols])
-        .collect()
+    row_major(&out, rows, cols)
 }
 
 #[test]

@@ -304,18 +304,7 @@ fn entries_chunk<T: Scalar>(pc: &Chunk<T>, kin: &[T; KIN], k: &[T; 9]) -> [V<T>;
             vadd(vscale(om[j], x[i]), vscale(om[i], x[j])),
         )
     };
-    [
-        m,
-        ms(0),
-        ms(1),
-        ms(2),
-        sq(0),
-        mixed(0, 1),
-        mixed(0, 2),
-        sq(1),
-        mixed(1, 2),
-        sq(2),
-    ]
+    standard_order(m, ms, sq, mixed)
 }
 
 /// [`Step::from`] of a step whose rows no ancestor speed moves (the root, or a chunk of rows
@@ -647,6 +636,19 @@ where
             vfma::<A, T>(om[j], y[i], vfma::<A, T>(al[i], w[j], vscale(al[j], w[i]))),
         )
     };
+    standard_order(m, ms, sq, mixed)
+}
+
+/// A body's ten entries in the order of its standard parameters (`m`, `MX`, `MY`, `MZ`, `XX`,
+/// `XY`, `XZ`, `YY`, `YZ`, `ZZ`): the mass's, the first moments' (`ms(i)`), the diagonal
+/// inertias' (`sq(i)`) and the products of inertia's (`mixed(i, j)`).
+#[inline(always)]
+fn standard_order<V>(
+    m: V,
+    ms: impl Fn(usize) -> V,
+    sq: impl Fn(usize) -> V,
+    mixed: impl Fn(usize, usize) -> V,
+) -> [V; 10] {
     [
         m,
         ms(0),

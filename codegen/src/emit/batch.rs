@@ -14,7 +14,7 @@ use quote::quote;
 use super::Context;
 use super::function::{Reads, last_local, nonzero_outputs, unused_inputs};
 use super::items::{arg_names, return_type};
-use super::print::{Printer, ident, idx};
+use super::print::{ident, idx};
 use crate::lower::{FunctionProgram, LExpr, Program};
 use crate::naming;
 use crate::registry::{FunctionSpec, Inputs, Shape};
@@ -105,12 +105,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     }
     let spec = f.id.spec();
     let p = &f.program;
-    let printer = Printer {
-        model: cx.model,
-        stmts: &p.stmts,
-        pre: &cx.pre,
-        precision: cx.precision,
-    };
+    let printer = cx.printer(&p.stmts);
     let reads = Reads::of(p, cx.low.dof);
     let name = batch_name(spec);
     let single = spec.name;

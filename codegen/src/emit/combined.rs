@@ -9,7 +9,7 @@ use quote::quote;
 use super::Context;
 use super::function::{Reads, generic_body, prologue, result_type, state_args, store_after};
 use super::items::arg_names;
-use super::print::{Printer, ident, idx};
+use super::print::{ident, idx};
 use super::scalar_type;
 use crate::lower::{CombinedProgram, LExpr, Leaf};
 use crate::registry::Shape;
@@ -31,12 +31,7 @@ fn field_doc(cx: &Context<'_>, c: &CombinedProgram, i: usize) -> String {
 pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
     let t = scalar_type(cx.precision);
     let p = &c.program;
-    let printer = Printer {
-        model: cx.model,
-        stmts: &p.stmts,
-        pre: &cx.pre,
-        precision: cx.precision,
-    };
+    let printer = cx.printer(&p.stmts);
     let reads = Reads::of(p, cx.model.speeds.len());
     let ty = ident(&c.spec.type_name);
     let fname = ident(&c.spec.name);

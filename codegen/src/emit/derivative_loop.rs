@@ -10,7 +10,7 @@ use super::function::{
     Reads, Stores, generic_body, nonzero_outputs, param_args, prologue, result_type, state_args,
     store_text_after, text, unused_inputs,
 };
-use super::print::{Printer, ident, idx, lit};
+use super::print::{ident, idx, lit};
 use super::{Context, scalar_type};
 use crate::kane::DerivativeLoop;
 use crate::lower::{FunctionProgram, LExpr, LoopedProgram};
@@ -84,12 +84,7 @@ pub(super) fn function(
 ) -> TokenStream {
     let spec = f.id.spec();
     let p = &looped.program;
-    let printer = Printer {
-        model: cx.model,
-        stmts: &p.stmts,
-        pre: &cx.pre,
-        precision: cx.precision,
-    };
+    let printer = cx.printer(&p.stmts);
     let reads = Reads::of(p, cx.model.speeds.len());
     let fname = ident(spec.name);
     let doc = format!(" {}", spec.doc);

@@ -373,12 +373,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     }
     let spec = f.id.spec();
     let p = &f.program;
-    let printer = Printer {
-        model: cx.model,
-        stmts: &p.stmts,
-        pre: &cx.pre,
-        precision: cx.precision,
-    };
+    let printer = cx.printer(&p.stmts);
     let reads = Reads::of(p, cx.model.speeds.len());
     let fname = ident(&super::frames::rust_name(cx, f));
     let doc = match f.frame {

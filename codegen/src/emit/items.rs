@@ -6,7 +6,7 @@ use proc_macro2::{Ident, TokenStream};
 use quote::quote;
 
 use super::function::{result_type, state_args, uses};
-use super::print::{Printer, ident, idx, signed_lit};
+use super::print::{ident, idx, signed_lit};
 use super::{Context, file_name, scalar_type};
 use crate::lower::{Leaf, Program};
 use crate::model::{Model, ParamKind};
@@ -247,12 +247,7 @@ fn validate(cx: &Context<'_>) -> TokenStream {
 pub(super) fn precomputed(cx: &Context<'_>) -> TokenStream {
     let p: &Program = &cx.low.precompute;
     let t = scalar_type(cx.precision);
-    let printer = Printer {
-        model: cx.model,
-        stmts: &p.stmts,
-        pre: &cx.pre,
-        precision: cx.precision,
-    };
+    let printer = cx.printer(&p.stmts);
     let body = printer.statements(&[]);
     // Two slots can read one statement (a parameter-only variable and its definition, both
     // requested): one field each statement.

@@ -118,6 +118,18 @@ pub(crate) struct Context<'a> {
     split_above: usize,
 }
 
+impl Context<'_> {
+    /// The expression printer for a program's statements `stmts`.
+    fn printer<'p>(&'p self, stmts: &'p [crate::lower::Stmt]) -> print::Printer<'p> {
+        print::Printer {
+            model: self.model,
+            stmts,
+            pre: &self.pre,
+            precision: self.precision,
+        }
+    }
+}
+
 fn scalar_type(precision: Precision) -> TokenStream {
     match precision {
         Precision::F64 => quote!(f64),

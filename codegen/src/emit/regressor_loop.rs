@@ -11,7 +11,7 @@ use quote::quote;
 use super::function::{
     Reads, last_local, param_args, prologue, result_type, state_args, unused_inputs,
 };
-use super::print::{Printer, idx, signed_lit};
+use super::print::{idx, signed_lit};
 use super::{Context, scalar_type};
 use crate::kane::{CarryFrom, KIN};
 use crate::lower::{FunctionProgram, LExpr, Leaf, LoopProgram};
@@ -22,12 +22,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
     let spec = f.id.spec();
     let p = &lp.program;
     let t = scalar_type(cx.precision);
-    let printer = Printer {
-        model: cx.model,
-        stmts: &p.stmts,
-        pre: &cx.pre,
-        precision: cx.precision,
-    };
+    let printer = cx.printer(&p.stmts);
     let reads = Reads::of(p, cx.model.speeds.len());
     let name = super::frames::rust_name(cx, f);
     let fname = super::print::ident(&name);

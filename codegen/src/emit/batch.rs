@@ -114,13 +114,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
          entry `l` of the inputs, bit for bit (the same statements over \
          [`kanegen_runtime::lanes::Lanes`], vectorized across the states)."
     );
-    let param_args = if cx.low.params.is_runtime() {
-        let pname = if reads.param { quote!(p) } else { quote!(_p) };
-        let pcname = if reads.pre { quote!(pc) } else { quote!(_pc) };
-        quote!(#pname: &Params, #pcname: &Precomputed,)
-    } else {
-        quote!()
-    };
+    let param_args = super::function::param_args(cx, &reads);
     let state = args(cx, spec.inputs);
     let prologue = prologue(cx, p, &reads);
     let ty = return_type(cx, spec);

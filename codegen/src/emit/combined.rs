@@ -144,13 +144,7 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
         #body
         #ty { #(#finals,)* }
     };
-    let param_args = if cx.low.params.is_runtime() {
-        let pname = if reads.param { quote!(p) } else { quote!(_p) };
-        let pcname = if reads.pre { quote!(pc) } else { quote!(_pc) };
-        quote!(#pname: &Params, #pcname: &Precomputed,)
-    } else {
-        quote!()
-    };
+    let param_args = super::function::param_args(cx, &reads);
     // Generic over the multiply-add, as the separate functions (whose bits it gives).
     let (param_args, body) = generic_body(cx, c.spec.inputs, param_args, &quote!(#ty), body);
     let (args, arg_doc) = state_args(cx, c.spec.inputs);

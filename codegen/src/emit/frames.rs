@@ -111,11 +111,7 @@ pub(super) fn dispatcher(cx: &Context<'_>, id: FunctionId) -> TokenStream {
     let doc = format!(" {}", spec.doc);
     let (args, arg_doc) = state_args(cx, spec.inputs);
     let names = arg_names(spec.inputs);
-    let (params, forward) = if cx.low.params.is_runtime() {
-        (quote!(p: &Params, pc: &Precomputed,), quote!(p, pc,))
-    } else {
-        (quote!(), quote!())
-    };
+    let (params, forward) = super::function::outer_params(cx);
     let variants = variants(cx.model);
     let arms = cx.low.functions.iter().filter(|f| f.id == id).map(|f| {
         let l = f.frame.expect("a per-frame program has a frame");

@@ -451,6 +451,16 @@ pub(super) fn param_args(cx: &Context<'_>, reads: &Reads) -> TokenStream {
     }
 }
 
+/// A public function's parameter list (`p: &Params, pc: &Precomputed,` with parameters at run
+/// time, else nothing) and the same names passed on to its inner body (`p, pc,`).
+pub(super) fn outer_params(cx: &Context<'_>) -> (TokenStream, TokenStream) {
+    if cx.low.params.is_runtime() {
+        (quote!(p: &Params, pc: &Precomputed,), quote!(p, pc,))
+    } else {
+        (quote!(), quote!())
+    }
+}
+
 /// A function's parameters (`p: &Params, pc: &Precomputed,` with parameters at run time) and
 /// its body as a generic inner function `body::<A: Arith>` (`A::mul_add` in the statements)
 /// followed by its call. With dispatch it is compiled twice, with `Plain` for the baseline and
@@ -468,11 +478,7 @@ pub(super) fn generic_body(
     let t = scalar_type(cx.precision);
     let (args, _) = state_args(cx, inputs);
     let names = super::items::arg_names(inputs);
-    let (outer_params, pass_params) = if cx.low.params.is_runtime() {
-        (quote!(p: &Params, pc: &Precomputed,), quote!(p, pc,))
-    } else {
-        (quote!(), quote!())
-    };
+    let (outer_params, pass_params) = outer_params(cx);
     let call = if cx.isa_dispatch {
         quote!(kanegen_runtime::isa::dispatch_fused(
             #[inline(always)]

@@ -165,11 +165,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
         let plan = kanegen_runtime::regressor::Plan { columns: &COLUMNS, steps: &STEPS, seeds: &SEEDS, zeros: &ZEROS };
         kanegen_runtime::regressor::inverse_dynamics_regressor::<A, _, #nl, #slots>(&kin, &plan, #nr, y.as_mut_slice());
     };
-    let (pass_params, outer_params) = if cx.low.params.is_runtime() {
-        (quote!(p, pc,), quote!(p: &Params, pc: &Precomputed,))
-    } else {
-        (quote!(), quote!())
-    };
+    let (outer_params, pass_params) = super::function::outer_params(cx);
     let state = super::items::arg_names(spec.inputs);
     // The body generic over the multiply-add, compiled twice with dispatch (`Plain` for the
     // baseline, `Fused` for x86-64-v3). Both closures name `y`: it is passed through a `Cell`

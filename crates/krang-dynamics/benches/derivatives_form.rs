@@ -10,7 +10,8 @@
 //! ```
 //!
 //! Ids `form/inverse_dynamics` and `form/inverse_dynamics_derivatives`; both cycle through the
-//! same 8 random states, inputs behind `black_box`. (The workspace's `benches/derivatives.rs`
+//! profiling examples' 64 fixed pseudo-random states (`examples/profile_states`), inputs behind
+//! `black_box`. (The workspace's `benches/derivatives.rs`
 //! compares the derivatives with central differences and the dual-number recursion.)
 
 use std::hint::black_box;
@@ -18,26 +19,10 @@ use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use krang_dynamics::Krang;
-use nalgebra::SVector;
 
-type V = SVector<f64, 19>;
-
-/// 8 states `(q, u, u̇)` from a fixed linear congruential sequence: q in [−π, π], u in
-/// [−2, 2], u̇ in [−5, 5].
-fn states() -> Vec<(V, V, V)> {
-    let mut x: u64 = 12;
-    let mut next = move || {
-        x = x
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (x >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let mut v = |lo: f64, hi: f64| V::from_fn(|_, _| lo + (hi - lo) * next());
-    let pi = std::f64::consts::PI;
-    (0..8)
-        .map(|_| (v(-pi, pi), v(-2.0, 2.0), v(-5.0, 5.0)))
-        .collect()
-}
+#[path = "../examples/profile_states/mod.rs"]
+mod profile_states;
+use profile_states::states;
 
 fn bench(c: &mut Criterion) {
     let k = Krang::default();

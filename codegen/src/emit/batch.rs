@@ -132,7 +132,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     let symmetric = spec.shape == Shape::SymmetricMatrix;
     let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
     let (rows, cols) = (idx(rows), idx(cols));
-    let unused = unused_inputs(spec, p, &reads);
+    let unused = unused_inputs(spec.inputs, p, &reads);
     let body = quote! {
         #unused
         #prologue

@@ -7,7 +7,9 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::Context;
-use super::function::{Reads, generic_body, prologue, result_type, state_args, store_after};
+use super::function::{
+    Reads, generic_body, prologue, result_type, state_args, store_after, unused_inputs,
+};
 use super::items::arg_names;
 use super::print::{ident, idx};
 use super::scalar_type;
@@ -126,16 +128,7 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
     }
     let body = printer.statements_fused(&cx.leaf_names, &stores);
     let prologue = prologue(cx, p, &reads);
-    let mut unused = TokenStream::new();
-    if p.sincos.is_empty() && !reads.coord.contains(&true) {
-        unused.extend(quote!(let _ = q;));
-    }
-    if c.spec.inputs.needs_u() && !reads.speed.contains(&true) {
-        unused.extend(quote!(let _ = u;));
-    }
-    if c.spec.inputs.needs_ud() && !reads.accel.contains(&true) {
-        unused.extend(quote!(let _ = ud;));
-    }
+    let unused = unused_inputs(c.spec.inputs, p, &reads);
     let mutable = if stored { quote!(mut) } else { quote!() };
     let body = quote! {
         #unused

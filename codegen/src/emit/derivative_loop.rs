@@ -107,7 +107,7 @@ pub(super) fn function(
     let block =
         printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true);
     let body = cx.blocks.placeholder(block);
-    let unused = unused_inputs(spec, p, &reads);
+    let unused = unused_inputs(spec.inputs, p, &reads);
     let t = scalar_type(cx.precision);
     let zero = lit(0.0, cx.precision);
     let len = idx(looped.plan.workspace);

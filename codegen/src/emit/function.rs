@@ -418,7 +418,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     } else {
         body
     };
-    let unused = unused_inputs(spec, p, &reads);
+    let unused = unused_inputs(spec.inputs, p, &reads);
     let body = quote! {
         #unused
         #prologue
@@ -502,20 +502,16 @@ pub(super) fn generic_body(
 /// `let _ = q;` (and `u`, `ud`) for the inputs a function's program never reads, so that the
 /// generated signature stays uniform without unused-variable warnings (single-state and batched
 /// forms alike).
-pub(super) fn unused_inputs(
-    spec: &crate::registry::FunctionSpec,
-    p: &Program,
-    reads: &Reads,
-) -> TokenStream {
+pub(super) fn unused_inputs(inputs: Inputs, p: &Program, reads: &Reads) -> TokenStream {
     let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
     let mut unused = TokenStream::new();
     if !reads_q {
         unused.extend(quote!(let _ = q;));
     }
-    if spec.inputs.needs_u() && !reads.speed.contains(&true) {
+    if inputs.needs_u() && !reads.speed.contains(&true) {
         unused.extend(quote!(let _ = u;));
     }
-    if spec.inputs.needs_ud() && !reads.accel.contains(&true) {
+    if inputs.needs_ud() && !reads.accel.contains(&true) {
         unused.extend(quote!(let _ = ud;));
     }
     unused

@@ -132,7 +132,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
         quote!(kanegen_runtime::regressor::ZeroChunk { link: #l, chunk: #c, first: #first })
     });
     let slots = idx(plan.slots);
-    let unused = unused_inputs(spec, p, &reads);
+    let unused = unused_inputs(spec.inputs, p, &reads);
     let kin_mut = if p.outputs[..lp.kin_len]
         .iter()
         .any(|(_, _, e)| !matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0))

@@ -55,44 +55,30 @@ pub type Native = Fused;
 #[cfg(not(all(feature = "std", any(target_feature = "fma", target_arch = "aarch64"))))]
 pub type Native = Plain;
 
-impl Arith<f64> for Plain {
-    #[inline(always)]
-    fn mul_add(x: f64, y: f64, acc: f64) -> f64 {
-        x * y + acc
-    }
+/// The two implementations for each floating-point type.
+macro_rules! arith {
+    ($($t:ty),*) => {$(
+        impl Arith<$t> for Plain {
+            #[inline(always)]
+            fn mul_add(x: $t, y: $t, acc: $t) -> $t {
+                x * y + acc
+            }
+        }
+
+        impl Arith<$t> for Fused {
+            #[inline(always)]
+            fn mul_add(x: $t, y: $t, acc: $t) -> $t {
+                #[cfg(feature = "std")]
+                {
+                    x.mul_add(y, acc)
+                }
+                #[cfg(not(feature = "std"))]
+                {
+                    x * y + acc
+                }
+            }
+        }
+    )*};
 }
 
-impl Arith<f32> for Plain {
-    #[inline(always)]
-    fn mul_add(x: f32, y: f32, acc: f32) -> f32 {
-        x * y + acc
-    }
-}
-
-impl Arith<f64> for Fused {
-    #[inline(always)]
-    fn mul_add(x: f64, y: f64, acc: f64) -> f64 {
-        #[cfg(feature = "std")]
-        {
-            x.mul_add(y, acc)
-        }
-        #[cfg(not(feature = "std"))]
-        {
-            x * y + acc
-        }
-    }
-}
-
-impl Arith<f32> for Fused {
-    #[inline(always)]
-    fn mul_add(x: f32, y: f32, acc: f32) -> f32 {
-        #[cfg(feature = "std")]
-        {
-            x.mul_add(y, acc)
-        }
-        #[cfg(not(feature = "std"))]
-        {
-            x * y + acc
-        }
-    }
-}
+arith!(f64, f32);

@@ -61,7 +61,6 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
 
     // The body: `out` is a tuple with one element per part (an isometry's is `(rotation,
     // translation)`), filled by stores after the statements they read.
-    let nl = idx(cx.low.dof);
     let mut stores: Vec<TokenStream> = vec![TokenStream::new(); p.stmts.len() + 1];
     let mut stored = false;
     let mut inits = Vec::new();
@@ -77,13 +76,18 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
         stored |= !entries.is_empty();
         for &(r, col, ref e) in entries {
             let v = printer.expr_fused(&cx.leaf_names, e);
-            let translation = col == 3;
+            let (translation, diagonal) = (col == 3, r == col);
             let (r, col) = (idx(r), idx(col));
             let store = match shape {
                 Shape::Vector => quote!(out.#k[#r] = core::hint::black_box(#v);),
                 Shape::Scalar => quote!(out.#k = #v;),
                 Shape::Isometry if translation => quote!(out.#k.1[#r] = #v;),
                 Shape::Isometry => quote!(out.#k.0[(#r, #col)] = #v;),
+                // The lower entry right after its upper twin, as the separate `mass_matrix`.
+                Shape::SymmetricMatrix if !diagonal => quote! {
+                    out.#k[(#r, #col)] = #v;
+                    out.#k[(#col, #r)] = out.#k[(#r, #col)];
+                },
                 _ => quote!(out.#k[(#r, #col)] = #v;),
             };
             store_after(&mut stores, e, store);
@@ -105,20 +109,6 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
                         &nalgebra::Rotation3::from_matrix_unchecked(out.#k.0),
                     ),
                 )));
-            }
-            Shape::SymmetricMatrix => {
-                inits.push(quote!(SMatrix::<#t, #rl, #cl>::zeros()));
-                // The lower triangle, copied at the end (the separate `mass_matrix` stores it as it goes).
-                finals.push(quote!(#f: {
-                    let mut m = out.#k;
-                    let s = m.as_mut_slice();
-                    for c in 1..#nl {
-                        for r in 0..c {
-                            s[r * #nl + c] = s[c * #nl + r];
-                        }
-                    }
-                    m
-                }));
             }
             _ => {
                 inits.push(quote!(SMatrix::<#t, #rl, #cl>::zeros()));

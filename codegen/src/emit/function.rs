@@ -255,8 +255,10 @@ fn binding(stored: bool) -> TokenStream {
 /// registers as soon as they are final (the programs are long; register pressure is what limits
 /// their speed).
 ///
-/// An n×n result (M, the Coriolis matrix) is written in memory as it is computed: the
-/// statements run in a block where `m` is `core::hint::black_box(&mut m)`. Without it LLVM's
+/// An n×n result (M, the Coriolis matrix) is written in memory as it is computed: emitted as
+/// an `_into` function ([`into_pair`]), whose `m` is the caller's `&mut` matrix; otherwise
+/// (a function without that form) the statements run in a block where `m` is
+/// `core::hint::black_box(&mut m)`. Without either LLVM's
 /// scalar replacement turns the local matrix into 361 separate values that live (spilled to the
 /// stack) until the function's end, where all of them are reloaded and stored into the result —
 /// and the lower-triangle copy loop of a symmetric matrix was unrolled into 171 more reloads

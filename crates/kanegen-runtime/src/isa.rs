@@ -14,7 +14,7 @@
 //! inlines the closure and the body: that copy of the body is compiled for AVX2 with the
 //! three-operand VEX encodings and 256-bit vectors where LLVM vectorizes. Calling a
 //! `#[target_feature]` function needs `unsafe` (the CPU must have the features); this module
-//! holds that call (the same in [`dispatch`] and [`dispatch_fused`]), right after the check that
+//! holds that call (the same in [`dispatch`], [`dispatch_fused`] and `dispatch_fused_with`), right after the check that
 //! the features are present; the crate's only other `unsafe` block is the same kind of call in
 //! [`crate::derivative_steps::run`] (its AVX2 kernel, after [`active`] reported x86-64-v3).
 //!

@@ -188,10 +188,11 @@ fn locals(e: &LExpr, out: &mut Vec<usize>) {
     }
 }
 
-/// Reorders the statements of a program with a vector result per subtree: one arm's forward
-/// and backward passes before the other arm's, instead of the forward pass of all frames
-/// before the backward pass of all (which keeps every frame's velocities and accelerations
-/// live until the backward pass reads them).
+/// Reorders the statements of a program whose result entries are indexed by speed (their row:
+/// c, τ, the Coriolis matrix) per subtree: one arm's forward and backward passes before the
+/// other arm's, instead of the forward pass of all frames before the backward pass of all
+/// (which keeps every frame's velocities and accelerations live until the backward pass reads
+/// them).
 ///
 /// Found on the dependency graph alone. The result entries are taken from the last speed to
 /// the first; consecutive entries form one *group* (a chain of joints) while each shares at
@@ -416,7 +417,7 @@ impl Lowered {
 
 /// The functions whose statements are put in [`subtree_order`] after lowering (where that
 /// lowers the values live at once). Only the Coriolis matrix: measured on Krang (README,
-/// "Instruction sets at run time and batched evaluation", "Statement order per subtree"), it
+/// "Instruction sets at run time and batched evaluation", "Single state toward 10× Pinocchio"), it
 /// cut C's values live from 455 to 236, its instructions per call by 2.5 % and its time by
 /// 1–2 %; for c and τ (111 → 83 and 87 live) the instructions moved by −1.8 % and +1.6 % and
 /// the time not at all or up, so they keep the derivation's order.

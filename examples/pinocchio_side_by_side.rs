@@ -170,6 +170,11 @@ fn time(dir: &Path) -> Result<(), String> {
         })
         .collect();
     let k = &k;
+    // The `_into` forms write into a matrix the caller keeps, as Pinocchio writes `data.M`, `data.C`.
+    let (mut m_out, mut c_out) = (
+        SMatrix::<f64, 19, 19>::zeros(),
+        SMatrix::<f64, 19, 19>::zeros(),
+    );
     let results = [
         (
             "mass_matrix",
@@ -199,6 +204,18 @@ fn time(dir: &Path) -> Result<(), String> {
             "coriolis_matrix",
             time_one(&states, |q, u, _| {
                 black_box(black_box(k).coriolis_matrix(q, u));
+            }),
+        ),
+        (
+            "mass_matrix_into",
+            time_one(&states, |q, _, _| {
+                black_box(k).mass_matrix_into(q, black_box(&mut m_out));
+            }),
+        ),
+        (
+            "coriolis_matrix_into",
+            time_one(&states, |q, u, _| {
+                black_box(k).coriolis_matrix_into(q, u, black_box(&mut c_out));
             }),
         ),
     ];
@@ -276,6 +293,18 @@ fn report(dir: &Path) -> Result<(), String> {
         (
             "`coriolis_matrix` (C)",
             "coriolis_matrix",
+            "`computeCoriolisMatrix`",
+            "coriolis_matrix",
+        ),
+        (
+            "`mass_matrix_into` (M, into a kept matrix)",
+            "mass_matrix_into",
+            "`crba` (M, upper triangle)",
+            "crba",
+        ),
+        (
+            "`coriolis_matrix_into` (C, into a kept matrix)",
+            "coriolis_matrix_into",
             "`computeCoriolisMatrix`",
             "coriolis_matrix",
         ),

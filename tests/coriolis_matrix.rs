@@ -210,3 +210,52 @@ fn baked_krang_coriolis_matrix_times_u_equals_coriolis_vector() {
     eprintln!("krang baked: worst relative error of C u vs reference c {worst:.1e}");
     assert!(worst < 1e-10, "{worst:e}");
 }
+
+/// The `_into` forms of the n×n results (`mass_matrix_into`, `coriolis_matrix_into`) write every
+/// entry of the caller's matrix (it starts full of NaN) with the bits of the by-value forms,
+/// with each instruction set this CPU has (baseline and x86-64-v3 copies), on random physical
+/// parameters and states of Krang, and on baked Krang.
+#[test]
+fn into_forms_write_every_entry_with_the_by_value_bits() {
+    use krang_dynamics::isa::{self, Isa};
+    let model = model("krang.toml");
+    let mut r = rng(106);
+    let mut out = nalgebra::SMatrix::<f64, 19, 19>::zeros();
+    let same = |a: &nalgebra::SMatrix<f64, 19, 19>, b: &nalgebra::SMatrix<f64, 19, 19>| {
+        a.iter()
+            .zip(b.iter())
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+    };
+    for set in [Isa::Baseline, Isa::X86_64V3] {
+        if !isa::available(set) {
+            continue;
+        }
+        isa::select(set).unwrap();
+        for draw in 0..20 {
+            let p = if draw == 0 {
+                model.param_values()
+            } else {
+                random_physical_params(&model, &mut r)
+            };
+            let k = kd::Krang::new(kd::Params::from_array(p.try_into().unwrap()));
+            let (q, u, _) = random_state(&mut r, 19);
+            let (qs, us) = (sv::<19>(&q), sv::<19>(&u));
+            out.fill(f64::NAN);
+            k.mass_matrix_into(&qs, &mut out);
+            assert!(same(&out, &k.mass_matrix(&qs)), "M, {set:?}");
+            out.fill(f64::NAN);
+            k.coriolis_matrix_into(&qs, &us, &mut out);
+            assert!(same(&out, &k.coriolis_matrix(&qs, &us)), "C, {set:?}");
+            out.fill(f64::NAN);
+            kd::baked::coriolis_matrix_into(&qs, &us, &mut out);
+            assert!(
+                same(&out, &kd::baked::coriolis_matrix(&qs, &us)),
+                "baked C, {set:?}"
+            );
+            out.fill(f64::NAN);
+            kd::baked::mass_matrix_into(&qs, &mut out);
+            assert!(same(&out, &kd::baked::mass_matrix(&qs)), "baked M, {set:?}");
+        }
+    }
+    isa::select(isa::detected()).unwrap();
+}

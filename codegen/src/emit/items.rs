@@ -328,12 +328,34 @@ fn methods(cx: &Context<'_>) -> TokenStream {
             }
             let ret = return_type(cx, spec);
             let call = forward_call(cx, spec);
+            let into = super::function::has_into(f).then(|| {
+                let into = ident(&format!("{}_into", spec.name));
+                let doc = format!(
+                    " [`{0}`](Self::{0}) written into `out` (every entry), without returning the \
+                     matrix by value.",
+                    spec.name
+                );
+                let names = arg_names(spec.inputs);
+                let pass = if cx.low.params.is_runtime() {
+                    quote!(&self.params, &self.pre,)
+                } else {
+                    quote!()
+                };
+                quote! {
+                    #[doc = #doc]
+                    #[inline]
+                    pub fn #into(&self, #args, out: &mut #ret) {
+                        #into(#pass #names, out)
+                    }
+                }
+            });
             quote! {
                 #[doc = #doc]
                 #[inline]
                 pub fn #name(&self, #args) -> #ret {
                     #call
                 }
+                #into
             }
         })
         .collect()

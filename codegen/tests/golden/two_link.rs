@@ -342,42 +342,55 @@ mod generated {
     ///
     /// `q`: coordinates in the order of [`COORDINATE_NAMES`].
     /// Generated straight-line code: 6 adds, 8 muls, 0 divs, 1 sin/cos (3 multiply-adds fused with FMA).
-    #[inline(never)]
+    /// [`mass_matrix_into`] writes the result into a matrix of the caller's.
+    #[inline]
     pub fn mass_matrix(
         p: &Params,
         pc: &Precomputed,
         q: &SVector<f64, 2>,
     ) -> SMatrix<f64, 2, 2> {
+        let mut m = <SMatrix<f64, 2, 2>>::zeros();
+        mass_matrix_into(p, pc, q, &mut m);
+        m
+    }
+    /// [`mass_matrix`] written into `out` (every entry), without returning the matrix by value: for a caller that keeps its matrix (a controller's workspace), and a little faster.
+    ///
+    /// `q`: coordinates in the order of [`COORDINATE_NAMES`].
+    /// Generated straight-line code: 6 adds, 8 muls, 0 divs, 1 sin/cos (3 multiply-adds fused with FMA).
+    #[inline(never)]
+    pub fn mass_matrix_into(
+        p: &Params,
+        pc: &Precomputed,
+        q: &SVector<f64, 2>,
+        out: &mut SMatrix<f64, 2, 2>,
+    ) {
         #[inline(always)]
         fn body<A: kanegen_runtime::isa::Arith<f64>>(
             p: &Params,
             pc: &Precomputed,
             q: &SVector<f64, 2>,
-        ) -> SMatrix<f64, 2, 2> {
+            m: &mut SMatrix<f64, 2, 2>,
+        ) {
             let (sin_q, cos_q) = sin_cos_n([q[1]]);
             let s_q_w = sin_q[0];
             let c_q_w = cos_q[0];
-            let mut m = SMatrix::<f64, 2, 2>::zeros();
-            {
-                let m = core::hint::black_box(&mut m);
-                m[(1, 1)] = p.XX2;
-                let d1 = A::mul_add(p.MZ2, s_q_w, p.MY2 * c_q_w); // MSC2 in 1.y
-                let d2 = A::mul_add(-p.MZ2, c_q_w, p.MY2 * s_q_w); // MSC2 in 1.z
-                let t1 = p.L1 * d1; // common subexpression
-                let t2 = p.L2 * d2; // common subexpression
-                let d3 = p.XX2 + t1 + t2; // N(M col 2) at 1.x
-                m[(0, 1)] = d3;
-                m[(1, 0)] = m[(0, 1)];
-                let d4 = A::mul_add(2.0, t2, 2.0 * t1) + pc.pc3; // JC1.xx
-                m[(0, 0)] = d4;
-            }
-            m
+            m[(1, 1)] = p.XX2;
+            let d1 = A::mul_add(p.MZ2, s_q_w, p.MY2 * c_q_w); // MSC2 in 1.y
+            let d2 = A::mul_add(-p.MZ2, c_q_w, p.MY2 * s_q_w); // MSC2 in 1.z
+            let t1 = p.L1 * d1; // common subexpression
+            let t2 = p.L2 * d2; // common subexpression
+            let d3 = p.XX2 + t1 + t2; // N(M col 2) at 1.x
+            m[(0, 1)] = d3;
+            m[(1, 0)] = m[(0, 1)];
+            let d4 = A::mul_add(2.0, t2, 2.0 * t1) + pc.pc3; // JC1.xx
+            m[(0, 0)] = d4;
         }
-        kanegen_runtime::isa::dispatch_fused(
+        kanegen_runtime::isa::dispatch_fused_with(
+            out,
             #[inline(always)]
-            || body::<kanegen_runtime::isa::Plain>(p, pc, q),
+            |m| body::<kanegen_runtime::isa::Plain>(p, pc, q, m),
             #[inline(always)]
-            || body::<kanegen_runtime::isa::Fused>(p, pc, q),
+            |m| body::<kanegen_runtime::isa::Fused>(p, pc, q, m),
         )
     }
     /// Coriolis and centrifugal vector c(q, u) (velocity-product terms).
@@ -535,64 +548,78 @@ mod generated {
     ///
     /// `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].
     /// Generated straight-line code: 18 adds, 31 muls, 0 divs, 1 sin/cos (12 multiply-adds fused with FMA).
-    #[inline(never)]
+    /// [`coriolis_matrix_into`] writes the result into a matrix of the caller's.
+    #[inline]
     pub fn coriolis_matrix(
         p: &Params,
         pc: &Precomputed,
         q: &SVector<f64, 2>,
         u: &SVector<f64, 2>,
     ) -> SMatrix<f64, 2, 2> {
+        let mut m = <SMatrix<f64, 2, 2>>::zeros();
+        coriolis_matrix_into(p, pc, q, u, &mut m);
+        m
+    }
+    /// [`coriolis_matrix`] written into `out` (every entry), without returning the matrix by value: for a caller that keeps its matrix (a controller's workspace), and a little faster.
+    ///
+    /// `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].
+    /// Generated straight-line code: 18 adds, 31 muls, 0 divs, 1 sin/cos (12 multiply-adds fused with FMA).
+    #[inline(never)]
+    pub fn coriolis_matrix_into(
+        p: &Params,
+        pc: &Precomputed,
+        q: &SVector<f64, 2>,
+        u: &SVector<f64, 2>,
+        out: &mut SMatrix<f64, 2, 2>,
+    ) {
         #[inline(always)]
         fn body<A: kanegen_runtime::isa::Arith<f64>>(
             p: &Params,
             _pc: &Precomputed,
             q: &SVector<f64, 2>,
             u: &SVector<f64, 2>,
-        ) -> SMatrix<f64, 2, 2> {
+            m: &mut SMatrix<f64, 2, 2>,
+        ) {
             let (sin_q, cos_q) = sin_cos_n([q[1]]);
             let s_q_w = sin_q[0];
             let c_q_w = cos_q[0];
             let qd_imu = u[0];
             let qd_w = u[1];
-            let mut m = SMatrix::<f64, 2, 2>::zeros();
-            {
-                let m = core::hint::black_box(&mut m);
-                let k1 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-                let k2 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-                let k3 = qd_imu + qd_w; // w2|ud=0,g=0.x
-                let k4 = A::mul_add(-s_q_w, k2, c_q_w * k1); // v2.y
-                let k5 = A::mul_add(c_q_w, k2, s_q_w * k1); // v2.z
-                let d1 = p.MZ2 * k3; // w2xMS2|ud=0,g=0.y
-                let d2 = p.MY2 * k3; // w2xMS2|ud=0,g=0.z
-                let d3 = p.m2 * k4; // IC2(VxS(qd_w)).f.z
-                let d4 = p.m2 * k5; // IC2(VxS(qd_w)).f.y
-                let d5 = d1 - d3; // h2.f.y
-                let d6 = d2 + d4; // h2.f.z
-                let t1 = p.MY2 * k4; // common subexpression
-                let t2 = p.MZ2 * k5; // common subexpression
-                let d7 = A::mul_add(2.0, t2, 2.0 * t1); // Jd2.xx
-                m[(1, 0)] = -0.5 * d7;
-                let d8 = A::mul_add(-s_q_w, d6, c_q_w * d5); // hC2 in 1.f.y
-                let d9 = A::mul_add(c_q_w, d6, s_q_w * d5); // hC2 in 1.f.z
-                let d10 = A::mul_add(-2.0, p.L2 * d9, A::mul_add(-2.0, p.L1 * d8, d7)); // JdC1.xx
-                m[(0, 0)] = -0.5 * d10;
-                let d11 = t1 + t2; // IC2(VxS(qd_w)).n.x
-                let d12 = A::mul_add(0.5, d7, -d11); // h(C col qd_w) at 2.n.x
-                m[(1, 1)] = -d12;
-                let d13 = d6 - d4; // h(C col qd_w) at 2.f.y
-                let d14 = d5 + d3; // h(C col qd_w) at 2.f.z
-                let d15 = A::mul_add(-c_q_w, d14, s_q_w * d13); // h(C col qd_w) at 1.f.z
-                let d16 = A::mul_add(s_q_w, d14, c_q_w * d13); // h(C col qd_w) at 1.f.y
-                let d17 = A::mul_add(-p.L2, d16, A::mul_add(p.L1, d15, d12)); // h(C col qd_w) at 1.n.x
-                m[(0, 1)] = -d17;
-            }
-            m
+            let k1 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+            let k2 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+            let k4 = A::mul_add(-s_q_w, k2, c_q_w * k1); // v2.y
+            let k5 = A::mul_add(c_q_w, k2, s_q_w * k1); // v2.z
+            let d3 = p.m2 * k4; // IC2(VxS(qd_w)).f.z
+            let d4 = p.m2 * k5; // IC2(VxS(qd_w)).f.y
+            let t1 = p.MY2 * k4; // common subexpression
+            let t2 = p.MZ2 * k5; // common subexpression
+            let d7 = A::mul_add(2.0, t2, 2.0 * t1); // Jd2.xx
+            m[(1, 0)] = -0.5 * d7;
+            let d11 = t1 + t2; // IC2(VxS(qd_w)).n.x
+            let d12 = A::mul_add(0.5, d7, -d11); // h(C col qd_w) at 2.n.x
+            m[(1, 1)] = -d12;
+            let k3 = qd_imu + qd_w; // w2|ud=0,g=0.x
+            let d1 = p.MZ2 * k3; // w2xMS2|ud=0,g=0.y
+            let d2 = p.MY2 * k3; // w2xMS2|ud=0,g=0.z
+            let d5 = d1 - d3; // h2.f.y
+            let d6 = d2 + d4; // h2.f.z
+            let d8 = A::mul_add(-s_q_w, d6, c_q_w * d5); // hC2 in 1.f.y
+            let d9 = A::mul_add(c_q_w, d6, s_q_w * d5); // hC2 in 1.f.z
+            let d10 = A::mul_add(-2.0, p.L2 * d9, A::mul_add(-2.0, p.L1 * d8, d7)); // JdC1.xx
+            m[(0, 0)] = -0.5 * d10;
+            let d13 = d6 - d4; // h(C col qd_w) at 2.f.y
+            let d14 = d5 + d3; // h(C col qd_w) at 2.f.z
+            let d15 = A::mul_add(-c_q_w, d14, s_q_w * d13); // h(C col qd_w) at 1.f.z
+            let d16 = A::mul_add(s_q_w, d14, c_q_w * d13); // h(C col qd_w) at 1.f.y
+            let d17 = A::mul_add(-p.L2, d16, A::mul_add(p.L1, d15, d12)); // h(C col qd_w) at 1.n.x
+            m[(0, 1)] = -d17;
         }
-        kanegen_runtime::isa::dispatch_fused(
+        kanegen_runtime::isa::dispatch_fused_with(
+            out,
             #[inline(always)]
-            || body::<kanegen_runtime::isa::Plain>(p, pc, q, u),
+            |m| body::<kanegen_runtime::isa::Plain>(p, pc, q, u, m),
             #[inline(always)]
-            || body::<kanegen_runtime::isa::Fused>(p, pc, q, u),
+            |m| body::<kanegen_runtime::isa::Fused>(p, pc, q, u, m),
         )
     }
     /// The dynamics of `two-link` with one parameter set: `τ = M(q) u̇ + c(q, u) + g(q)`.
@@ -630,6 +657,15 @@ mod generated {
         pub fn mass_matrix(&self, q: &SVector<f64, 2>) -> SMatrix<f64, 2, 2> {
             mass_matrix(&self.params, &self.pre, q)
         }
+        /// [`mass_matrix`](Self::mass_matrix) written into `out` (every entry), without returning the matrix by value.
+        #[inline]
+        pub fn mass_matrix_into(
+            &self,
+            q: &SVector<f64, 2>,
+            out: &mut SMatrix<f64, 2, 2>,
+        ) {
+            mass_matrix_into(&self.params, &self.pre, q, out)
+        }
         /// Coriolis and centrifugal vector c(q, u) (velocity-product terms).
         #[inline]
         pub fn coriolis(
@@ -662,6 +698,16 @@ mod generated {
             u: &SVector<f64, 2>,
         ) -> SMatrix<f64, 2, 2> {
             coriolis_matrix(&self.params, &self.pre, q, u)
+        }
+        /// [`coriolis_matrix`](Self::coriolis_matrix) written into `out` (every entry), without returning the matrix by value.
+        #[inline]
+        pub fn coriolis_matrix_into(
+            &self,
+            q: &SVector<f64, 2>,
+            u: &SVector<f64, 2>,
+            out: &mut SMatrix<f64, 2, 2>,
+        ) {
+            coriolis_matrix_into(&self.params, &self.pre, q, u, out)
         }
     }
     impl kanegen_runtime::RobotDynamics<DOF> for TwoLink {

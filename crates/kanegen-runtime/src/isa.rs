@@ -14,7 +14,7 @@
 //! inlines the closure and the body: that copy of the body is compiled for AVX2 with the
 //! three-operand VEX encodings and 256-bit vectors where LLVM vectorizes. Calling a
 //! `#[target_feature]` function needs `unsafe` (the CPU must have the features); this module
-//! holds that call (the same in [`dispatch`] and [`dispatch_fused`]), right after the check that
+//! holds that call (the same in [`dispatch`], [`dispatch_fused`] and `dispatch_fused_with`), right after the check that
 //! the features are present; the crate's only other `unsafe` block is the same kind of call in
 //! [`crate::derivative_steps::run`] (its AVX2 kernel, after [`active`] reported x86-64-v3).
 //!
@@ -215,6 +215,27 @@ if_dispatching! {
         }
         plain()
     }
+
+    /// [`dispatch_fused`] for bodies that take an argument, such as the `&mut` result matrix
+    /// of a generated `_into` function (two closures cannot both hold it).
+    #[inline(always)]
+    pub fn dispatch_fused_with<T, R>(
+        arg: T,
+        plain: impl FnOnce(T) -> R,
+        fused: impl FnOnce(T) -> R,
+    ) -> R {
+        if active_code() == V3 {
+            // SAFETY: as in `dispatch_fused` above (the same check before the same call).
+            #[allow(unsafe_code)]
+            unsafe {
+                return run_v3(
+                    #[inline(always)]
+                    move || fused(arg),
+                );
+            }
+        }
+        plain(arg)
+    }
 }
 
 if_not_dispatching! {
@@ -248,6 +269,32 @@ if_not_dispatching! {
         {
             let _ = fused;
             plain()
+        }
+    }
+
+    /// [`dispatch_fused`] for bodies that take an argument, such as the `&mut` result matrix
+    /// of a generated `_into` function (two closures cannot both hold it).
+    #[inline(always)]
+    pub fn dispatch_fused_with<T, R>(
+        arg: T,
+        plain: impl FnOnce(T) -> R,
+        fused: impl FnOnce(T) -> R,
+    ) -> R {
+        #[cfg(all(
+            feature = "std",
+            any(target_feature = "fma", target_arch = "aarch64")
+        ))]
+        {
+            let _ = plain;
+            fused(arg)
+        }
+        #[cfg(not(all(
+            feature = "std",
+            any(target_feature = "fma", target_arch = "aarch64")
+        )))]
+        {
+            let _ = fused;
+            plain(arg)
         }
     }
 }

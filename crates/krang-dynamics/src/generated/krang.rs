@@ -2145,18 +2145,35 @@ mod generated {
     ///
     /// `q`: coordinates in the order of [`COORDINATE_NAMES`].
     /// Generated straight-line code: 879 adds, 1119 muls, 0 divs, 17 sin/cos (606 multiply-adds fused with FMA).
-    #[inline(never)]
+    /// [`mass_matrix_into`] writes the result into a matrix of the caller's.
+    #[inline]
     pub fn mass_matrix(
         p: &Params,
         pc: &Precomputed,
         q: &SVector<f64, 19>,
     ) -> SMatrix<f64, 19, 19> {
+        let mut m = <SMatrix<f64, 19, 19>>::zeros();
+        mass_matrix_into(p, pc, q, &mut m);
+        m
+    }
+    /// [`mass_matrix`] written into `out` (every entry), without returning the matrix by value: for a caller that keeps its matrix (a controller's workspace), and a little faster.
+    ///
+    /// `q`: coordinates in the order of [`COORDINATE_NAMES`].
+    /// Generated straight-line code: 879 adds, 1119 muls, 0 divs, 17 sin/cos (606 multiply-adds fused with FMA).
+    #[inline(never)]
+    pub fn mass_matrix_into(
+        p: &Params,
+        pc: &Precomputed,
+        q: &SVector<f64, 19>,
+        out: &mut SMatrix<f64, 19, 19>,
+    ) {
         #[inline(always)]
         fn body<A: kanegen_runtime::isa::Arith<f64>>(
             p: &Params,
             pc: &Precomputed,
             q: &SVector<f64, 19>,
-        ) -> SMatrix<f64, 19, 19> {
+            m: &mut SMatrix<f64, 19, 19>,
+        ) {
             let (sin_q, cos_q) = sin_cos_n([
                 q[2],
                 q[3],
@@ -2210,1417 +2227,1310 @@ mod generated {
             let c_q6r = cos_q[15];
             let s_q7r = sin_q[16];
             let c_q7r = cos_q[16];
-            let mut m = SMatrix::<f64, 19, 19>::zeros();
-            {
-                let m = core::hint::black_box(&mut m);
-                m[(0, 0)] = pc.pc69;
-                m[(11, 11)] = p.ZZ10l;
-                m[(18, 18)] = p.ZZ10r;
-                let d1 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
-                let d2 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
-                let t1 = p.XZ10r * c_q7r; // common subexpression
-                let t2 = p.YZ10r * s_q7r; // common subexpression
-                let t3 = p.XZ10r * s_q7r; // common subexpression
-                let t4 = p.YZ10r * c_q7r; // common subexpression
-                let t5 = p.L9 * d2; // common subexpression
-                let t6 = p.L9 * d1; // common subexpression
-                let d3 = t1 + t2 - t5; // N(M col 10r) at 9r.x
-                m[(17, 18)] = -d3;
-                m[(18, 17)] = m[(17, 18)];
-                let d4 = t3 - t4 - t6; // N(M col 10r) at 9r.z
-                let d5 = d2 * s_q6r; // F(M col 10r) at 8r.y
-                let d6 = d2 * c_q6r; // F(M col 10r) at 8r.z
-                let d7 = A::mul_add(-d4, s_q6r, p.ZZ10r * c_q6r); // N(M col 10r) at 8r.y
-                m[(16, 18)] = d7;
-                m[(18, 16)] = m[(16, 18)];
-                let d8 = A::mul_add(d4, c_q6r, p.ZZ10r * s_q6r); // N(M col 10r) at 8r.z
-                let d9 = A::mul_add(d6, s_q5r, d1 * c_q5r); // F(M col 10r) at 7r.x
-                let d10 = A::mul_add(-d6, c_q5r, d1 * s_q5r); // F(M col 10r) at 7r.z
-                let d11 = A::mul_add(p.L8, d10, A::mul_add(-d8, s_q5r, d3 * c_q5r)); // N(M col 10r) at 7r.x
-                m[(15, 18)] = -d11;
-                m[(18, 15)] = m[(15, 18)];
-                let d12 = A::mul_add(-p.L8, d9, A::mul_add(d8, c_q5r, d3 * s_q5r)); // N(M col 10r) at 7r.z
-                let d13 = A::mul_add(-d10, s_q4r, d5 * c_q4r); // F(M col 10r) at 6r.y
-                let d14 = A::mul_add(d10, c_q4r, d5 * s_q4r); // F(M col 10r) at 6r.z
-                let d15 = A::mul_add(-d12, s_q4r, d7 * c_q4r); // N(M col 10r) at 6r.y
-                m[(14, 18)] = d15;
-                m[(18, 14)] = m[(14, 18)];
-                let d16 = A::mul_add(d12, c_q4r, d7 * s_q4r); // N(M col 10r) at 6r.z
-                let d17 = A::mul_add(-d14, s_q3r, d9 * c_q3r); // F(M col 10r) at 5r.x
-                let d18 = A::mul_add(d14, c_q3r, d9 * s_q3r); // F(M col 10r) at 5r.z
-                let d19 = A::mul_add(p.L7, d18, A::mul_add(-d16, s_q3r, d11 * c_q3r)); // N(M col 10r) at 5r.x
-                m[(13, 18)] = -d19;
-                m[(18, 13)] = m[(13, 18)];
-                let d20 = A::mul_add(-p.L7, d17, A::mul_add(d16, c_q3r, d11 * s_q3r)); // N(M col 10r) at 5r.z
-                let d21 = A::mul_add(-d18, s_q2r, d13 * c_q2r); // F(M col 10r) at 4r.y
-                let d22 = A::mul_add(d18, c_q2r, d13 * s_q2r); // F(M col 10r) at 4r.z
-                let d23 = A::mul_add(-d20, s_q2r, d15 * c_q2r); // N(M col 10r) at 4r.y
-                m[(12, 18)] = d23;
-                m[(18, 12)] = m[(12, 18)];
-                let d24 = A::mul_add(d20, c_q2r, d15 * s_q2r); // N(M col 10r) at 4r.z
-                let d25 = A::mul_add(-d22, s_q1r, d17 * c_q1r); // F(M col 10r) at 3.y
-                let d26 = A::mul_add(d22, c_q1r, d17 * s_q1r); // F(M col 10r) at 3.z
-                let d27 = A::mul_add(-p.L5, d26, d23); // N(M col 10r) at 3.x
-                let d28 = A::mul_add(p.L6, d26, A::mul_add(-d24, s_q1r, d19 * c_q1r)); // N(M col 10r) at 3.y
-                m[(4, 18)] = d28;
-                m[(18, 4)] = m[(4, 18)];
-                let d29 = A::mul_add(
-                    d21,
-                    p.L5,
-                    A::mul_add(-p.L6, d25, A::mul_add(d24, c_q1r, d19 * s_q1r)),
-                ); // N(M col 10r) at 3.z
-                let d30 = A::mul_add(d26, s_q_torso, d21 * c_q_torso); // F(M col 10r) at 2.x
-                let d31 = A::mul_add(-d26, c_q_torso, d21 * s_q_torso); // F(M col 10r) at 2.z
-                let d32 = A::mul_add(
-                    -d25,
-                    p.L4,
-                    A::mul_add(p.L3, d31, A::mul_add(d29, s_q_torso, d27 * c_q_torso)),
-                ); // N(M col 10r) at 2.x
-                m[(3, 18)] = d32;
-                m[(18, 3)] = m[(3, 18)];
-                let d33 = A::mul_add(p.L4, d30, d28); // N(M col 10r) at 2.y
-                let d34 = A::mul_add(
-                    -p.L3,
-                    d30,
-                    A::mul_add(-d29, c_q_torso, d27 * s_q_torso),
-                ); // N(M col 10r) at 2.z
-                let d35 = A::mul_add(-d31, c_q_w, d25 * s_q_w); // F(M col 10r) at 1.z
-                let d36 = A::mul_add(d31, s_q_w, d25 * c_q_w); // F(M col 10r) at 1.y
-                let d37 = A::mul_add(d30, p.L1, A::mul_add(-d34, c_q_w, d33 * s_q_w)); // N(M col 10r) at 1.z
-                let d38 = A::mul_add(p.L2, d36, A::mul_add(-p.L1, d35, d32)); // N(M col 10r) at 1.x
-                m[(2, 18)] = d38;
-                m[(18, 2)] = m[(2, 18)];
-                let d39 = A::mul_add(-d30, p.L2, A::mul_add(d34, s_q_w, d33 * c_q_w)); // N(M col 10r) at 1.y
-                let d40 = A::mul_add(d35, c_q_imu, d36 * s_q_imu); // F(M col 10r) at 0.x
-                m[(0, 18)] = -d40;
-                m[(18, 0)] = m[(0, 18)];
-                let d41 = A::mul_add(-d37, s_q_imu, d39 * c_q_imu); // N(M col 10r) at 0.z
-                m[(1, 18)] = -d41;
-                m[(18, 1)] = m[(1, 18)];
-                let d42 = p.MX9r - d2; // MSC9r.x
-                let d43 = p.MZ9r + d1; // MSC9r.z
-                let k1 = s_q7r * s_q7r; // sin² q7r
-                let k2 = s_q7r * c_q7r; // sin q7r cos q7r
-                let k3 = A::mul_add(2.0, k1, -1.0); // cos 2q7r
-                let d44 = A::mul_add(-2.0, p.XY10r * k2, k1 * pc.pc3); // JC10r rotated about z: Jxx − J'xx
-                let d45 = p.XY9r + t1 + t2 - t5; // JC9r.xy
-                let d46 = A::mul_add(-k2, pc.pc3, A::mul_add(-p.XY10r, k3, p.XZ9r)); // JC9r.xz
-                let d47 = p.YZ9r - t3 + t4 + t6; // JC9r.yz
-                let d48 = pc.pc7 - d44; // JC9r.xx
-                m[(17, 17)] = d48;
-                let d49 = d44 + pc.pc8; // JC9r.zz
-                let d50 = A::mul_add(s_q6r, d43, c_q6r * pc.pc2); // MSC9r in 8r.y
-                let d51 = A::mul_add(-c_q6r, d43, s_q6r * pc.pc2); // MSC9r in 8r.z
-                let t7 = c_q6r * d45; // common subexpression
-                let t8 = s_q6r * d46; // common subexpression
-                let d52 = t7 + t8; // N(M col 9r) at 8r.y
-                m[(16, 17)] = -d52;
-                m[(17, 16)] = m[(16, 17)];
-                let t9 = s_q6r * d45; // common subexpression
-                let t10 = c_q6r * d46; // common subexpression
-                let d53 = t9 - t10; // N(M col 9r) at 8r.z
-                let d54 = s_q5r * d50; // F(M col 9r) at 7r.x
-                let d55 = c_q5r * d50; // F(M col 9r) at 7r.z
-                let d56 = A::mul_add(-p.L8, d54, A::mul_add(c_q5r, d53, s_q5r * d48)); // N(M col 9r) at 7r.z
-                let d57 = A::mul_add(-p.L8, d55, A::mul_add(-s_q5r, d53, c_q5r * d48)); // N(M col 9r) at 7r.x
-                m[(15, 17)] = d57;
-                m[(17, 15)] = m[(15, 17)];
-                let d58 = A::mul_add(s_q4r, d55, c_q4r * d51); // F(M col 9r) at 6r.y
-                let d59 = A::mul_add(-c_q4r, d55, s_q4r * d51); // F(M col 9r) at 6r.z
-                let d60 = A::mul_add(-s_q4r, d56, c_q4r * d52); // N(M col 9r) at 6r.y
-                m[(14, 17)] = -d60;
-                m[(17, 14)] = m[(14, 17)];
-                let d61 = A::mul_add(c_q4r, d56, s_q4r * d52); // N(M col 9r) at 6r.z
-                let d62 = A::mul_add(c_q3r, d59, s_q3r * d54); // F(M col 9r) at 5r.z
-                let d63 = A::mul_add(-s_q3r, d59, c_q3r * d54); // F(M col 9r) at 5r.x
-                let d64 = A::mul_add(-p.L7, d63, A::mul_add(c_q3r, d61, s_q3r * d57)); // N(M col 9r) at 5r.z
-                let d65 = A::mul_add(p.L7, d62, A::mul_add(-s_q3r, d61, c_q3r * d57)); // N(M col 9r) at 5r.x
-                m[(13, 17)] = d65;
-                m[(17, 13)] = m[(13, 17)];
-                let d66 = A::mul_add(-s_q2r, d62, c_q2r * d58); // F(M col 9r) at 4r.y
-                let d67 = A::mul_add(c_q2r, d62, s_q2r * d58); // F(M col 9r) at 4r.z
-                let d68 = A::mul_add(-s_q2r, d64, c_q2r * d60); // N(M col 9r) at 4r.y
-                m[(12, 17)] = -d68;
-                m[(17, 12)] = m[(12, 17)];
-                let d69 = A::mul_add(c_q2r, d64, s_q2r * d60); // N(M col 9r) at 4r.z
-                let d70 = A::mul_add(-s_q1r, d67, c_q1r * d63); // F(M col 9r) at 3.y
-                let d71 = A::mul_add(c_q1r, d67, s_q1r * d63); // F(M col 9r) at 3.z
-                let d72 = A::mul_add(p.L6, d71, A::mul_add(-s_q1r, d69, c_q1r * d65)); // N(M col 9r) at 3.y
-                m[(4, 17)] = -d72;
-                m[(17, 4)] = m[(4, 17)];
-                let d73 = A::mul_add(
-                    p.L5,
-                    d66,
-                    A::mul_add(-p.L6, d70, A::mul_add(c_q1r, d69, s_q1r * d65)),
-                ); // N(M col 9r) at 3.z
-                let d74 = A::mul_add(-p.L5, d71, d68); // N(M col 9r) at 3.x
-                let d75 = A::mul_add(s_q_torso, d71, c_q_torso * d66); // F(M col 9r) at 2.x
-                let d76 = A::mul_add(-c_q_torso, d71, s_q_torso * d66); // F(M col 9r) at 2.z
-                let d77 = A::mul_add(
-                    -p.L4,
-                    d70,
-                    A::mul_add(p.L3, d76, A::mul_add(s_q_torso, d73, c_q_torso * d74)),
-                ); // N(M col 9r) at 2.x
-                m[(3, 17)] = -d77;
-                m[(17, 3)] = m[(3, 17)];
-                let d78 = A::mul_add(p.L4, d75, d72); // N(M col 9r) at 2.y
-                let d79 = A::mul_add(
-                    -p.L3,
-                    d75,
-                    A::mul_add(-c_q_torso, d73, s_q_torso * d74),
-                ); // N(M col 9r) at 2.z
-                let d80 = A::mul_add(s_q_w, d76, c_q_w * d70); // F(M col 9r) at 1.y
-                let d81 = A::mul_add(-c_q_w, d76, s_q_w * d70); // F(M col 9r) at 1.z
-                let d82 = A::mul_add(p.L2, d80, A::mul_add(-p.L1, d81, d77)); // N(M col 9r) at 1.x
-                m[(2, 17)] = -d82;
-                m[(17, 2)] = m[(2, 17)];
-                let d83 = A::mul_add(-p.L2, d75, A::mul_add(s_q_w, d79, c_q_w * d78)); // N(M col 9r) at 1.y
-                let d84 = A::mul_add(p.L1, d75, A::mul_add(-c_q_w, d79, s_q_w * d78)); // N(M col 9r) at 1.z
-                let d85 = A::mul_add(c_q_imu, d81, s_q_imu * d80); // F(M col 9r) at 0.x
-                m[(0, 17)] = d85;
-                m[(17, 0)] = m[(0, 17)];
-                let d86 = A::mul_add(-s_q_imu, d84, c_q_imu * d83); // N(M col 9r) at 0.z
-                m[(1, 17)] = d86;
-                m[(17, 1)] = m[(1, 17)];
-                let d87 = p.MX8r - d42; // MSC8r.x
-                let d88 = p.MY8r - d50; // MSC8r.y
-                let d89 = p.MZ8r - d51; // MSC8r.z
-                let k4 = s_q6r * s_q6r; // sin² q6r
-                let k5 = s_q6r * c_q6r; // sin q6r cos q6r
-                let k6 = A::mul_add(2.0, k4, -1.0); // cos 2q6r
-                let d90 = pc.pc6 - d49; // JC9r: Jyy − Jzz
-                let d91 = A::mul_add(-2.0, d47 * k5, k4 * d90); // JC9r rotated about x: Jyy − J'yy
-                let d92 = p.XX8r + d48; // JC8r.xx
-                let d93 = p.XY8r + t7 + t8; // JC8r.xy
-                let d94 = p.XZ8r + t9 - t10; // JC8r.xz
-                let d95 = A::mul_add(k5, d90, A::mul_add(d47, k6, p.YZ8r)); // JC8r.yz
-                let d96 = p.ZZ8r + d49 + d91; // JC8r.zz
-                let d97 = pc.pc10 - d91; // JC8r.yy
-                m[(16, 16)] = d97;
-                let d98 = A::mul_add(c_q5r, d89, s_q5r * d87); // MSC8r in 7r.z
-                let d99 = A::mul_add(-s_q5r, d89, c_q5r * d87); // MSC8r in 7r.x
-                let t11 = c_q5r * d93; // common subexpression
-                let t12 = s_q5r * d95; // common subexpression
-                let t13 = s_q5r * d93; // common subexpression
-                let t14 = c_q5r * d95; // common subexpression
-                let t15 = p.L8 * d99; // common subexpression
-                let t16 = p.L8 * d98; // common subexpression
-                let d100 = t11 - t12 - t15; // N(M col 8r) at 7r.x
-                m[(15, 16)] = -d100;
-                m[(16, 15)] = m[(15, 16)];
-                let d101 = t13 + t14 - t16; // N(M col 8r) at 7r.z
-                let d102 = s_q4r * d99; // F(M col 8r) at 6r.y
-                let d103 = c_q4r * d99; // F(M col 8r) at 6r.z
-                let d104 = A::mul_add(-s_q4r, d101, c_q4r * d97); // N(M col 8r) at 6r.y
-                m[(14, 16)] = d104;
-                m[(16, 14)] = m[(14, 16)];
-                let d105 = A::mul_add(c_q4r, d101, s_q4r * d97); // N(M col 8r) at 6r.z
-                let d106 = A::mul_add(s_q3r, d103, c_q3r * d98); // F(M col 8r) at 5r.x
-                let d107 = A::mul_add(-c_q3r, d103, s_q3r * d98); // F(M col 8r) at 5r.z
-                let d108 = A::mul_add(
-                    p.L7,
-                    d107,
-                    A::mul_add(-s_q3r, d105, c_q3r * d100),
-                ); // N(M col 8r) at 5r.x
-                m[(13, 16)] = -d108;
-                m[(16, 13)] = m[(13, 16)];
-                let d109 = A::mul_add(
-                    -p.L7,
-                    d106,
-                    A::mul_add(c_q3r, d105, s_q3r * d100),
-                ); // N(M col 8r) at 5r.z
-                let d110 = A::mul_add(-s_q2r, d107, c_q2r * d102); // F(M col 8r) at 4r.y
-                let d111 = A::mul_add(c_q2r, d107, s_q2r * d102); // F(M col 8r) at 4r.z
-                let d112 = A::mul_add(-s_q2r, d109, c_q2r * d104); // N(M col 8r) at 4r.y
-                m[(12, 16)] = d112;
-                m[(16, 12)] = m[(12, 16)];
-                let d113 = A::mul_add(c_q2r, d109, s_q2r * d104); // N(M col 8r) at 4r.z
-                let d114 = A::mul_add(-s_q1r, d111, c_q1r * d106); // F(M col 8r) at 3.y
-                let d115 = A::mul_add(c_q1r, d111, s_q1r * d106); // F(M col 8r) at 3.z
-                let d116 = A::mul_add(-p.L5, d115, d112); // N(M col 8r) at 3.x
-                let d117 = A::mul_add(
-                    p.L6,
-                    d115,
-                    A::mul_add(-s_q1r, d113, c_q1r * d108),
-                ); // N(M col 8r) at 3.y
-                m[(4, 16)] = d117;
-                m[(16, 4)] = m[(4, 16)];
-                let d118 = A::mul_add(
-                    p.L5,
-                    d110,
-                    A::mul_add(-p.L6, d114, A::mul_add(c_q1r, d113, s_q1r * d108)),
-                ); // N(M col 8r) at 3.z
-                let d119 = A::mul_add(s_q_torso, d115, c_q_torso * d110); // F(M col 8r) at 2.x
-                let d120 = A::mul_add(-c_q_torso, d115, s_q_torso * d110); // F(M col 8r) at 2.z
-                let d121 = A::mul_add(
-                    -p.L4,
-                    d114,
-                    A::mul_add(p.L3, d120, A::mul_add(s_q_torso, d118, c_q_torso * d116)),
-                ); // N(M col 8r) at 2.x
-                m[(3, 16)] = d121;
-                m[(16, 3)] = m[(3, 16)];
-                let d122 = A::mul_add(p.L4, d119, d117); // N(M col 8r) at 2.y
-                let d123 = A::mul_add(
-                    -p.L3,
-                    d119,
-                    A::mul_add(-c_q_torso, d118, s_q_torso * d116),
-                ); // N(M col 8r) at 2.z
-                let d124 = A::mul_add(-c_q_w, d120, s_q_w * d114); // F(M col 8r) at 1.z
-                let d125 = A::mul_add(s_q_w, d120, c_q_w * d114); // F(M col 8r) at 1.y
-                let d126 = A::mul_add(
-                    p.L1,
-                    d119,
-                    A::mul_add(-c_q_w, d123, s_q_w * d122),
-                ); // N(M col 8r) at 1.z
-                let d127 = A::mul_add(p.L2, d125, A::mul_add(-p.L1, d124, d121)); // N(M col 8r) at 1.x
-                m[(2, 16)] = d127;
-                m[(16, 2)] = m[(2, 16)];
-                let d128 = A::mul_add(
-                    -p.L2,
-                    d119,
-                    A::mul_add(s_q_w, d123, c_q_w * d122),
-                ); // N(M col 8r) at 1.y
-                let d129 = A::mul_add(c_q_imu, d124, s_q_imu * d125); // F(M col 8r) at 0.x
-                m[(0, 16)] = -d129;
-                m[(16, 0)] = m[(0, 16)];
-                let d130 = A::mul_add(-s_q_imu, d126, c_q_imu * d128); // N(M col 8r) at 0.z
-                m[(1, 16)] = -d130;
-                m[(16, 1)] = m[(1, 16)];
-                let d131 = p.MX7r - d99; // MSC7r.x
-                let d132 = p.MZ7r + d98; // MSC7r.z
-                let k7 = s_q5r * s_q5r; // sin² q5r
-                let k8 = s_q5r * c_q5r; // sin q5r cos q5r
-                let k9 = A::mul_add(2.0, k7, -1.0); // cos 2q5r
-                let d133 = d92 - d96; // JC8r: Jzz − Jxx
-                let d134 = A::mul_add(2.0, d94 * k8, k7 * d133); // JC8r rotated about y: Jzz − J'zz
-                let t17 = p.L8 * d88; // common subexpression
-                let d135 = p.XY7r + t11 - t12 - t15; // JC7r.xy
-                let d136 = A::mul_add(-k8, d133, A::mul_add(d94, k9, p.XZ7r)); // JC7r.xz
-                let d137 = p.YY7r + d97; // JC7r.yy
-                let d138 = p.YZ7r - t13 - t14 + t16; // JC7r.yz
-                let d139 = pc.pc13 - d88; // MSC7r.y
-                let d140 = A::mul_add(2.0, t17, d92 - d134) + pc.pc14; // JC7r.xx
-                m[(15, 15)] = d140;
-                let d141 = A::mul_add(2.0, t17, d96 + d134) + pc.pc15; // JC7r.zz
-                let d142 = A::mul_add(s_q4r, d132, c_q4r * d139); // MSC7r in 6r.y
-                let d143 = A::mul_add(-c_q4r, d132, s_q4r * d139); // MSC7r in 6r.z
-                let t18 = c_q4r * d135; // common subexpression
-                let t19 = s_q4r * d136; // common subexpression
-                let d144 = t18 + t19; // N(M col 7r) at 6r.y
-                m[(14, 15)] = -d144;
-                m[(15, 14)] = m[(14, 15)];
-                let t20 = s_q4r * d135; // common subexpression
-                let t21 = c_q4r * d136; // common subexpression
-                let d145 = t20 - t21; // N(M col 7r) at 6r.z
-                let d146 = s_q3r * d142; // F(M col 7r) at 5r.x
-                let d147 = c_q3r * d142; // F(M col 7r) at 5r.z
-                let d148 = A::mul_add(
-                    -p.L7,
-                    d146,
-                    A::mul_add(c_q3r, d145, s_q3r * d140),
-                ); // N(M col 7r) at 5r.z
-                let d149 = A::mul_add(
-                    -p.L7,
-                    d147,
-                    A::mul_add(-s_q3r, d145, c_q3r * d140),
-                ); // N(M col 7r) at 5r.x
-                m[(13, 15)] = d149;
-                m[(15, 13)] = m[(13, 15)];
-                let d150 = A::mul_add(s_q2r, d147, c_q2r * d143); // F(M col 7r) at 4r.y
-                let d151 = A::mul_add(-c_q2r, d147, s_q2r * d143); // F(M col 7r) at 4r.z
-                let d152 = A::mul_add(-s_q2r, d148, c_q2r * d144); // N(M col 7r) at 4r.y
-                m[(12, 15)] = -d152;
-                m[(15, 12)] = m[(12, 15)];
-                let d153 = A::mul_add(c_q2r, d148, s_q2r * d144); // N(M col 7r) at 4r.z
-                let d154 = A::mul_add(-s_q1r, d151, c_q1r * d146); // F(M col 7r) at 3.y
-                let d155 = A::mul_add(c_q1r, d151, s_q1r * d146); // F(M col 7r) at 3.z
-                let d156 = A::mul_add(
-                    p.L6,
-                    d155,
-                    A::mul_add(-s_q1r, d153, c_q1r * d149),
-                ); // N(M col 7r) at 3.y
-                m[(4, 15)] = -d156;
-                m[(15, 4)] = m[(4, 15)];
-                let d157 = A::mul_add(
-                    p.L5,
-                    d150,
-                    A::mul_add(-p.L6, d154, A::mul_add(c_q1r, d153, s_q1r * d149)),
-                ); // N(M col 7r) at 3.z
-                let d158 = A::mul_add(-p.L5, d155, d152); // N(M col 7r) at 3.x
-                let d159 = A::mul_add(s_q_torso, d155, c_q_torso * d150); // F(M col 7r) at 2.x
-                let d160 = A::mul_add(-c_q_torso, d155, s_q_torso * d150); // F(M col 7r) at 2.z
-                let d161 = A::mul_add(
-                    -p.L4,
-                    d154,
-                    A::mul_add(p.L3, d160, A::mul_add(s_q_torso, d157, c_q_torso * d158)),
-                ); // N(M col 7r) at 2.x
-                m[(3, 15)] = -d161;
-                m[(15, 3)] = m[(3, 15)];
-                let d162 = A::mul_add(p.L4, d159, d156); // N(M col 7r) at 2.y
-                let d163 = A::mul_add(
-                    -p.L3,
-                    d159,
-                    A::mul_add(-c_q_torso, d157, s_q_torso * d158),
-                ); // N(M col 7r) at 2.z
-                let d164 = A::mul_add(s_q_w, d160, c_q_w * d154); // F(M col 7r) at 1.y
-                let d165 = A::mul_add(-c_q_w, d160, s_q_w * d154); // F(M col 7r) at 1.z
-                let d166 = A::mul_add(p.L2, d164, A::mul_add(-p.L1, d165, d161)); // N(M col 7r) at 1.x
-                m[(2, 15)] = -d166;
-                m[(15, 2)] = m[(2, 15)];
-                let d167 = A::mul_add(
-                    -p.L2,
-                    d159,
-                    A::mul_add(s_q_w, d163, c_q_w * d162),
-                ); // N(M col 7r) at 1.y
-                let d168 = A::mul_add(
-                    p.L1,
-                    d159,
-                    A::mul_add(-c_q_w, d163, s_q_w * d162),
-                ); // N(M col 7r) at 1.z
-                let d169 = A::mul_add(c_q_imu, d165, s_q_imu * d164); // F(M col 7r) at 0.x
-                m[(0, 15)] = d169;
-                m[(15, 0)] = m[(0, 15)];
-                let d170 = A::mul_add(-s_q_imu, d168, c_q_imu * d167); // N(M col 7r) at 0.z
-                m[(1, 15)] = d170;
-                m[(15, 1)] = m[(1, 15)];
-                let d171 = p.MX6r - d131; // MSC6r.x
-                let d172 = p.MY6r - d142; // MSC6r.y
-                let d173 = p.MZ6r - d143; // MSC6r.z
-                let k10 = s_q4r * s_q4r; // sin² q4r
-                let k11 = s_q4r * c_q4r; // sin q4r cos q4r
-                let k12 = A::mul_add(2.0, k10, -1.0); // cos 2q4r
-                let d174 = d137 - d141; // JC7r: Jyy − Jzz
-                let d175 = A::mul_add(-2.0, d138 * k11, k10 * d174); // JC7r rotated about x: Jyy − J'yy
-                let d176 = p.XX6r + d140; // JC6r.xx
-                let d177 = p.XY6r + t18 + t19; // JC6r.xy
-                let d178 = p.XZ6r + t20 - t21; // JC6r.xz
-                let d179 = p.YY6r + d137 - d175; // JC6r.yy
-                m[(14, 14)] = d179;
-                let d180 = A::mul_add(k11, d174, A::mul_add(d138, k12, p.YZ6r)); // JC6r.yz
-                let d181 = p.ZZ6r + d141 + d175; // JC6r.zz
-                let d182 = A::mul_add(c_q3r, d173, s_q3r * d171); // MSC6r in 5r.z
-                let d183 = A::mul_add(-s_q3r, d173, c_q3r * d171); // MSC6r in 5r.x
-                let t22 = c_q3r * d177; // common subexpression
-                let t23 = s_q3r * d180; // common subexpression
-                let t24 = s_q3r * d177; // common subexpression
-                let t25 = c_q3r * d180; // common subexpression
-                let t26 = p.L7 * d183; // common subexpression
-                let t27 = p.L7 * d182; // common subexpression
-                let d184 = t22 - t23 - t26; // N(M col 6r) at 5r.x
-                m[(13, 14)] = -d184;
-                m[(14, 13)] = m[(13, 14)];
-                let d185 = t24 + t25 - t27; // N(M col 6r) at 5r.z
-                let d186 = s_q2r * d183; // F(M col 6r) at 4r.y
-                let d187 = c_q2r * d183; // F(M col 6r) at 4r.z
-                let d188 = A::mul_add(-s_q2r, d185, c_q2r * d179); // N(M col 6r) at 4r.y
-                m[(12, 14)] = d188;
-                m[(14, 12)] = m[(12, 14)];
-                let d189 = A::mul_add(c_q2r, d185, s_q2r * d179); // N(M col 6r) at 4r.z
-                let d190 = A::mul_add(s_q1r, d187, c_q1r * d182); // F(M col 6r) at 3.y
-                let d191 = A::mul_add(-c_q1r, d187, s_q1r * d182); // F(M col 6r) at 3.z
-                let d192 = A::mul_add(-p.L5, d191, d188); // N(M col 6r) at 3.x
-                let d193 = A::mul_add(
-                    p.L6,
-                    d191,
-                    A::mul_add(-s_q1r, d189, c_q1r * d184),
-                ); // N(M col 6r) at 3.y
-                m[(4, 14)] = d193;
-                m[(14, 4)] = m[(4, 14)];
-                let d194 = A::mul_add(
-                    p.L5,
-                    d186,
-                    A::mul_add(-p.L6, d190, A::mul_add(c_q1r, d189, s_q1r * d184)),
-                ); // N(M col 6r) at 3.z
-                let d195 = A::mul_add(s_q_torso, d191, c_q_torso * d186); // F(M col 6r) at 2.x
-                let d196 = A::mul_add(-c_q_torso, d191, s_q_torso * d186); // F(M col 6r) at 2.z
-                let d197 = A::mul_add(
-                    -p.L4,
-                    d190,
-                    A::mul_add(p.L3, d196, A::mul_add(s_q_torso, d194, c_q_torso * d192)),
-                ); // N(M col 6r) at 2.x
-                m[(3, 14)] = d197;
-                m[(14, 3)] = m[(3, 14)];
-                let d198 = A::mul_add(p.L4, d195, d193); // N(M col 6r) at 2.y
-                let d199 = A::mul_add(
-                    -p.L3,
-                    d195,
-                    A::mul_add(-c_q_torso, d194, s_q_torso * d192),
-                ); // N(M col 6r) at 2.z
-                let d200 = A::mul_add(-c_q_w, d196, s_q_w * d190); // F(M col 6r) at 1.z
-                let d201 = A::mul_add(s_q_w, d196, c_q_w * d190); // F(M col 6r) at 1.y
-                let d202 = A::mul_add(
-                    p.L1,
-                    d195,
-                    A::mul_add(-c_q_w, d199, s_q_w * d198),
-                ); // N(M col 6r) at 1.z
-                let d203 = A::mul_add(p.L2, d201, A::mul_add(-p.L1, d200, d197)); // N(M col 6r) at 1.x
-                m[(2, 14)] = d203;
-                m[(14, 2)] = m[(2, 14)];
-                let d204 = A::mul_add(
-                    -p.L2,
-                    d195,
-                    A::mul_add(s_q_w, d199, c_q_w * d198),
-                ); // N(M col 6r) at 1.y
-                let d205 = A::mul_add(c_q_imu, d200, s_q_imu * d201); // F(M col 6r) at 0.x
-                m[(0, 14)] = -d205;
-                m[(14, 0)] = m[(0, 14)];
-                let d206 = A::mul_add(-s_q_imu, d202, c_q_imu * d204); // N(M col 6r) at 0.z
-                m[(1, 14)] = -d206;
-                m[(14, 1)] = m[(1, 14)];
-                let d207 = p.MX5r - d183; // MSC5r.x
-                let d208 = p.MZ5r + d182; // MSC5r.z
-                let k13 = s_q3r * s_q3r; // sin² q3r
-                let k14 = s_q3r * c_q3r; // sin q3r cos q3r
-                let k15 = A::mul_add(2.0, k13, -1.0); // cos 2q3r
-                let d209 = d176 - d181; // JC6r: Jzz − Jxx
-                let d210 = A::mul_add(2.0, d178 * k14, k13 * d209); // JC6r rotated about y: Jzz − J'zz
-                let t28 = p.L7 * d172; // common subexpression
-                let d211 = p.XY5r + t22 - t23 - t26; // JC5r.xy
-                let d212 = A::mul_add(-k14, d209, A::mul_add(d178, k15, p.XZ5r)); // JC5r.xz
-                let d213 = p.YY5r + d179; // JC5r.yy
-                let d214 = p.YZ5r - t24 - t25 + t27; // JC5r.yz
-                let d215 = pc.pc19 - d172; // MSC5r.y
-                let d216 = A::mul_add(2.0, t28, d176 - d210) + pc.pc20; // JC5r.xx
-                m[(13, 13)] = d216;
-                let d217 = A::mul_add(2.0, t28, d181 + d210) + pc.pc21; // JC5r.zz
-                let d218 = A::mul_add(s_q2r, d208, c_q2r * d215); // MSC5r in 4r.y
-                let d219 = A::mul_add(-c_q2r, d208, s_q2r * d215); // MSC5r in 4r.z
-                let t29 = c_q2r * d211; // common subexpression
-                let t30 = s_q2r * d212; // common subexpression
-                let d220 = t29 + t30; // N(M col 5r) at 4r.y
-                m[(12, 13)] = -d220;
-                m[(13, 12)] = m[(12, 13)];
-                let t31 = s_q2r * d211; // common subexpression
-                let t32 = c_q2r * d212; // common subexpression
-                let d221 = t31 - t32; // N(M col 5r) at 4r.z
-                let d222 = s_q1r * d218; // F(M col 5r) at 3.y
-                let d223 = c_q1r * d218; // F(M col 5r) at 3.z
-                let d224 = A::mul_add(
-                    -p.L6,
-                    d223,
-                    A::mul_add(-s_q1r, d221, c_q1r * d216),
-                ); // N(M col 5r) at 3.y
-                m[(4, 13)] = -d224;
-                m[(13, 4)] = m[(4, 13)];
-                let d225 = A::mul_add(
-                    p.L5,
-                    d219,
-                    A::mul_add(-p.L6, d222, A::mul_add(c_q1r, d221, s_q1r * d216)),
-                ); // N(M col 5r) at 3.z
-                let d226 = A::mul_add(p.L5, d223, d220); // N(M col 5r) at 3.x
-                let d227 = A::mul_add(-s_q_torso, d223, c_q_torso * d219); // F(M col 5r) at 2.x
-                let d228 = A::mul_add(c_q_torso, d223, s_q_torso * d219); // F(M col 5r) at 2.z
-                let d229 = A::mul_add(
-                    -p.L4,
-                    d222,
-                    A::mul_add(p.L3, d228, A::mul_add(s_q_torso, d225, c_q_torso * d226)),
-                ); // N(M col 5r) at 2.x
-                m[(3, 13)] = -d229;
-                m[(13, 3)] = m[(3, 13)];
-                let d230 = A::mul_add(p.L4, d227, d224); // N(M col 5r) at 2.y
-                let d231 = A::mul_add(
-                    -p.L3,
-                    d227,
-                    A::mul_add(-c_q_torso, d225, s_q_torso * d226),
-                ); // N(M col 5r) at 2.z
-                let d232 = A::mul_add(s_q_w, d228, c_q_w * d222); // F(M col 5r) at 1.y
-                let d233 = A::mul_add(-c_q_w, d228, s_q_w * d222); // F(M col 5r) at 1.z
-                let d234 = A::mul_add(p.L2, d232, A::mul_add(-p.L1, d233, d229)); // N(M col 5r) at 1.x
-                m[(2, 13)] = -d234;
-                m[(13, 2)] = m[(2, 13)];
-                let d235 = A::mul_add(
-                    -p.L2,
-                    d227,
-                    A::mul_add(s_q_w, d231, c_q_w * d230),
-                ); // N(M col 5r) at 1.y
-                let d236 = A::mul_add(
-                    p.L1,
-                    d227,
-                    A::mul_add(-c_q_w, d231, s_q_w * d230),
-                ); // N(M col 5r) at 1.z
-                let d237 = A::mul_add(c_q_imu, d233, s_q_imu * d232); // F(M col 5r) at 0.x
-                m[(0, 13)] = d237;
-                m[(13, 0)] = m[(0, 13)];
-                let d238 = A::mul_add(-s_q_imu, d236, c_q_imu * d235); // N(M col 5r) at 0.z
-                m[(1, 13)] = d238;
-                m[(13, 1)] = m[(1, 13)];
-                let d239 = p.MX4r - d207; // MSC4r.x
-                let d240 = p.MY4r - d218; // MSC4r.y
-                let d241 = p.MZ4r - d219; // MSC4r.z
-                let k16 = s_q2r * s_q2r; // sin² q2r
-                let k17 = s_q2r * c_q2r; // sin q2r cos q2r
-                let k18 = A::mul_add(2.0, k16, -1.0); // cos 2q2r
-                let d242 = d213 - d217; // JC5r: Jyy − Jzz
-                let d243 = A::mul_add(-2.0, d214 * k17, k16 * d242); // JC5r rotated about x: Jyy − J'yy
-                let d244 = p.XX4r + d216; // JC4r.xx
-                let d245 = p.XY4r + t29 + t30; // JC4r.xy
-                let d246 = p.XZ4r + t31 - t32; // JC4r.xz
-                let d247 = p.YY4r + d213 - d243; // JC4r.yy
-                m[(12, 12)] = d247;
-                let d248 = A::mul_add(k17, d242, A::mul_add(d214, k18, p.YZ4r)); // JC4r.yz
-                let d249 = p.ZZ4r + d217 + d243; // JC4r.zz
-                let d250 = A::mul_add(-s_q1r, d241, c_q1r * d239); // MSC4r in 3.y
-                let d251 = A::mul_add(c_q1r, d241, s_q1r * d239); // MSC4r in 3.z
-                let t33 = c_q1r * d245; // common subexpression
-                let t34 = s_q1r * d248; // common subexpression
-                let t35 = s_q1r * d245; // common subexpression
-                let t36 = c_q1r * d248; // common subexpression
-                let t37 = p.L5 * d250; // common subexpression
-                let t38 = p.L6 * d250; // common subexpression
-                let t39 = p.L6 * d251; // common subexpression
-                let d252 = d247 + t37; // N(M col 4r) at 3.x
-                let d253 = t33 - t34 - t38; // N(M col 4r) at 3.y
-                m[(4, 12)] = d253;
-                m[(12, 4)] = m[(4, 12)];
-                let d254 = t35 + t36 - t39; // N(M col 4r) at 3.z
-                let d255 = s_q_torso * d250; // F(M col 4r) at 2.x
-                let d256 = c_q_torso * d250; // F(M col 4r) at 2.z
-                let d257 = A::mul_add(
-                    -p.L4,
-                    d251,
-                    A::mul_add(p.L3, d256, A::mul_add(s_q_torso, d254, c_q_torso * d252)),
-                ); // N(M col 4r) at 2.x
-                m[(3, 12)] = d257;
-                m[(12, 3)] = m[(3, 12)];
-                let d258 = A::mul_add(-p.L4, d255, d253); // N(M col 4r) at 2.y
-                let d259 = A::mul_add(
-                    p.L3,
-                    d255,
-                    A::mul_add(-c_q_torso, d254, s_q_torso * d252),
-                ); // N(M col 4r) at 2.z
-                let d260 = A::mul_add(-c_q_w, d256, s_q_w * d251); // F(M col 4r) at 1.z
-                let d261 = A::mul_add(s_q_w, d256, c_q_w * d251); // F(M col 4r) at 1.y
-                let d262 = A::mul_add(
-                    -p.L1,
-                    d255,
-                    A::mul_add(-c_q_w, d259, s_q_w * d258),
-                ); // N(M col 4r) at 1.z
-                let d263 = A::mul_add(p.L2, d261, A::mul_add(-p.L1, d260, d257)); // N(M col 4r) at 1.x
-                m[(2, 12)] = d263;
-                m[(12, 2)] = m[(2, 12)];
-                let d264 = A::mul_add(p.L2, d255, A::mul_add(s_q_w, d259, c_q_w * d258)); // N(M col 4r) at 1.y
-                let d265 = A::mul_add(c_q_imu, d260, s_q_imu * d261); // F(M col 4r) at 0.x
-                m[(0, 12)] = -d265;
-                m[(12, 0)] = m[(0, 12)];
-                let d266 = A::mul_add(-s_q_imu, d262, c_q_imu * d264); // N(M col 4r) at 0.z
-                m[(1, 12)] = -d266;
-                m[(12, 1)] = m[(1, 12)];
-                let k19 = s_q1r * s_q1r; // sin² q1r
-                let k20 = s_q1r * c_q1r; // sin q1r cos q1r
-                let k21 = A::mul_add(2.0, k19, -1.0); // cos 2q1r
-                let d267 = d244 - d249; // JC4r: Jzz − Jxx
-                let d268 = A::mul_add(2.0, d246 * k20, k19 * d267); // JC4r rotated about y: Jzz − J'zz
-                let t40 = p.L6 * d240; // common subexpression
-                let d269 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
-                let d270 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
-                let t41 = p.XZ10l * c_q7l; // common subexpression
-                let t42 = p.YZ10l * s_q7l; // common subexpression
-                let t43 = p.XZ10l * s_q7l; // common subexpression
-                let t44 = p.YZ10l * c_q7l; // common subexpression
-                let t45 = p.L9 * d270; // common subexpression
-                let t46 = p.L9 * d269; // common subexpression
-                let d271 = t41 + t42 - t45; // N(M col 10l) at 9l.x
-                m[(10, 11)] = -d271;
-                m[(11, 10)] = m[(10, 11)];
-                let d272 = t43 - t44 - t46; // N(M col 10l) at 9l.z
-                let d273 = d270 * s_q6l; // F(M col 10l) at 8l.y
-                let d274 = d270 * c_q6l; // F(M col 10l) at 8l.z
-                let d275 = A::mul_add(-d272, s_q6l, p.ZZ10l * c_q6l); // N(M col 10l) at 8l.y
-                m[(9, 11)] = d275;
-                m[(11, 9)] = m[(9, 11)];
-                let d276 = A::mul_add(d272, c_q6l, p.ZZ10l * s_q6l); // N(M col 10l) at 8l.z
-                let d277 = A::mul_add(d274, s_q5l, d269 * c_q5l); // F(M col 10l) at 7l.x
-                let d278 = A::mul_add(-d274, c_q5l, d269 * s_q5l); // F(M col 10l) at 7l.z
-                let d279 = A::mul_add(
-                    p.L8,
-                    d278,
-                    A::mul_add(-d276, s_q5l, d271 * c_q5l),
-                ); // N(M col 10l) at 7l.x
-                m[(8, 11)] = -d279;
-                m[(11, 8)] = m[(8, 11)];
-                let d280 = A::mul_add(
-                    -p.L8,
-                    d277,
-                    A::mul_add(d276, c_q5l, d271 * s_q5l),
-                ); // N(M col 10l) at 7l.z
-                let d281 = A::mul_add(-d278, s_q4l, d273 * c_q4l); // F(M col 10l) at 6l.y
-                let d282 = A::mul_add(d278, c_q4l, d273 * s_q4l); // F(M col 10l) at 6l.z
-                let d283 = A::mul_add(-d280, s_q4l, d275 * c_q4l); // N(M col 10l) at 6l.y
-                m[(7, 11)] = d283;
-                m[(11, 7)] = m[(7, 11)];
-                let d284 = A::mul_add(d280, c_q4l, d275 * s_q4l); // N(M col 10l) at 6l.z
-                let d285 = A::mul_add(-d282, s_q3l, d277 * c_q3l); // F(M col 10l) at 5l.x
-                let d286 = A::mul_add(d282, c_q3l, d277 * s_q3l); // F(M col 10l) at 5l.z
-                let d287 = A::mul_add(
-                    p.L7,
-                    d286,
-                    A::mul_add(-d284, s_q3l, d279 * c_q3l),
-                ); // N(M col 10l) at 5l.x
-                m[(6, 11)] = -d287;
-                m[(11, 6)] = m[(6, 11)];
-                let d288 = A::mul_add(
-                    -p.L7,
-                    d285,
-                    A::mul_add(d284, c_q3l, d279 * s_q3l),
-                ); // N(M col 10l) at 5l.z
-                let d289 = A::mul_add(-d286, s_q2l, d281 * c_q2l); // F(M col 10l) at 4l.y
-                let d290 = A::mul_add(d286, c_q2l, d281 * s_q2l); // F(M col 10l) at 4l.z
-                let d291 = A::mul_add(-d288, s_q2l, d283 * c_q2l); // N(M col 10l) at 4l.y
-                m[(5, 11)] = d291;
-                m[(11, 5)] = m[(5, 11)];
-                let d292 = A::mul_add(d288, c_q2l, d283 * s_q2l); // N(M col 10l) at 4l.z
-                let d293 = A::mul_add(d290, c_q1l, d285 * s_q1l); // F(M col 10l) at 3.z
-                let d294 = A::mul_add(-d290, s_q1l, d285 * c_q1l); // F(M col 10l) at 3.y
-                let d295 = A::mul_add(
-                    p.L5,
-                    d289,
-                    A::mul_add(-p.L6, d294, A::mul_add(d292, c_q1l, d287 * s_q1l)),
-                ); // N(M col 10l) at 3.z
-                let d296 = A::mul_add(-p.L5, d293, d291); // N(M col 10l) at 3.x
-                let d297 = A::mul_add(
-                    p.L6,
-                    d293,
-                    A::mul_add(-d292, s_q1l, d287 * c_q1l),
-                ); // N(M col 10l) at 3.y
-                m[(4, 11)] = d297;
-                m[(11, 4)] = m[(4, 11)];
-                let d298 = A::mul_add(s_q_torso, d293, c_q_torso * d289); // F(M col 10l) at 2.x
-                let d299 = A::mul_add(-c_q_torso, d293, s_q_torso * d289); // F(M col 10l) at 2.z
-                let d300 = A::mul_add(
-                    p.L4,
-                    d294,
-                    A::mul_add(p.L3, d299, A::mul_add(s_q_torso, d295, c_q_torso * d296)),
-                ); // N(M col 10l) at 2.x
-                m[(3, 11)] = -d300;
-                m[(11, 3)] = m[(3, 11)];
-                let d301 = A::mul_add(
-                    -p.L3,
-                    d298,
-                    A::mul_add(-c_q_torso, d295, s_q_torso * d296),
-                ); // N(M col 10l) at 2.z
-                let d302 = A::mul_add(-p.L4, d298, d297); // N(M col 10l) at 2.y
-                let d303 = A::mul_add(c_q_w, d299, s_q_w * d294); // F(M col 10l) at 1.z
-                let d304 = A::mul_add(-s_q_w, d299, c_q_w * d294); // F(M col 10l) at 1.y
-                let d305 = A::mul_add(-p.L2, d304, A::mul_add(p.L1, d303, d300)); // N(M col 10l) at 1.x
-                m[(2, 11)] = -d305;
-                m[(11, 2)] = m[(2, 11)];
-                let d306 = A::mul_add(
-                    -p.L1,
-                    d298,
-                    A::mul_add(c_q_w, d301, s_q_w * d302),
-                ); // N(M col 10l) at 1.z
-                let d307 = A::mul_add(
-                    p.L2,
-                    d298,
-                    A::mul_add(-s_q_w, d301, c_q_w * d302),
-                ); // N(M col 10l) at 1.y
-                let d308 = A::mul_add(c_q_imu, d303, s_q_imu * d304); // F(M col 10l) at 0.x
-                m[(0, 11)] = -d308;
-                m[(11, 0)] = m[(0, 11)];
-                let d309 = A::mul_add(-s_q_imu, d306, c_q_imu * d307); // N(M col 10l) at 0.z
-                m[(1, 11)] = -d309;
-                m[(11, 1)] = m[(1, 11)];
-                let d310 = p.MX9l - d270; // MSC9l.x
-                let d311 = p.MZ9l + d269; // MSC9l.z
-                let k22 = s_q7l * s_q7l; // sin² q7l
-                let k23 = s_q7l * c_q7l; // sin q7l cos q7l
-                let k24 = A::mul_add(2.0, k22, -1.0); // cos 2q7l
-                let d312 = A::mul_add(-2.0, p.XY10l * k23, k22 * pc.pc26); // JC10l rotated about z: Jxx − J'xx
-                let d313 = p.XY9l + t41 + t42 - t45; // JC9l.xy
-                let d314 = A::mul_add(-k23, pc.pc26, A::mul_add(-p.XY10l, k24, p.XZ9l)); // JC9l.xz
-                let d315 = p.YZ9l - t43 + t44 + t46; // JC9l.yz
-                let d316 = pc.pc30 - d312; // JC9l.xx
-                m[(10, 10)] = d316;
-                let d317 = d312 + pc.pc31; // JC9l.zz
-                let d318 = A::mul_add(s_q6l, d311, c_q6l * pc.pc25); // MSC9l in 8l.y
-                let d319 = A::mul_add(-c_q6l, d311, s_q6l * pc.pc25); // MSC9l in 8l.z
-                let t47 = c_q6l * d313; // common subexpression
-                let t48 = s_q6l * d314; // common subexpression
-                let d320 = t47 + t48; // N(M col 9l) at 8l.y
-                m[(9, 10)] = -d320;
-                m[(10, 9)] = m[(9, 10)];
-                let t49 = s_q6l * d313; // common subexpression
-                let t50 = c_q6l * d314; // common subexpression
-                let d321 = t49 - t50; // N(M col 9l) at 8l.z
-                let d322 = s_q5l * d318; // F(M col 9l) at 7l.x
-                let d323 = c_q5l * d318; // F(M col 9l) at 7l.z
-                let d324 = A::mul_add(
-                    -p.L8,
-                    d322,
-                    A::mul_add(c_q5l, d321, s_q5l * d316),
-                ); // N(M col 9l) at 7l.z
-                let d325 = A::mul_add(
-                    -p.L8,
-                    d323,
-                    A::mul_add(-s_q5l, d321, c_q5l * d316),
-                ); // N(M col 9l) at 7l.x
-                m[(8, 10)] = d325;
-                m[(10, 8)] = m[(8, 10)];
-                let d326 = A::mul_add(s_q4l, d323, c_q4l * d319); // F(M col 9l) at 6l.y
-                let d327 = A::mul_add(-c_q4l, d323, s_q4l * d319); // F(M col 9l) at 6l.z
-                let d328 = A::mul_add(-s_q4l, d324, c_q4l * d320); // N(M col 9l) at 6l.y
-                m[(7, 10)] = -d328;
-                m[(10, 7)] = m[(7, 10)];
-                let d329 = A::mul_add(c_q4l, d324, s_q4l * d320); // N(M col 9l) at 6l.z
-                let d330 = A::mul_add(c_q3l, d327, s_q3l * d322); // F(M col 9l) at 5l.z
-                let d331 = A::mul_add(-s_q3l, d327, c_q3l * d322); // F(M col 9l) at 5l.x
-                let d332 = A::mul_add(
-                    -p.L7,
-                    d331,
-                    A::mul_add(c_q3l, d329, s_q3l * d325),
-                ); // N(M col 9l) at 5l.z
-                let d333 = A::mul_add(
-                    p.L7,
-                    d330,
-                    A::mul_add(-s_q3l, d329, c_q3l * d325),
-                ); // N(M col 9l) at 5l.x
-                m[(6, 10)] = d333;
-                m[(10, 6)] = m[(6, 10)];
-                let d334 = A::mul_add(-s_q2l, d330, c_q2l * d326); // F(M col 9l) at 4l.y
-                let d335 = A::mul_add(c_q2l, d330, s_q2l * d326); // F(M col 9l) at 4l.z
-                let d336 = A::mul_add(-s_q2l, d332, c_q2l * d328); // N(M col 9l) at 4l.y
-                m[(5, 10)] = -d336;
-                m[(10, 5)] = m[(5, 10)];
-                let d337 = A::mul_add(c_q2l, d332, s_q2l * d328); // N(M col 9l) at 4l.z
-                let d338 = A::mul_add(-s_q1l, d335, c_q1l * d331); // F(M col 9l) at 3.y
-                let d339 = A::mul_add(c_q1l, d335, s_q1l * d331); // F(M col 9l) at 3.z
-                let d340 = A::mul_add(-p.L5, d339, d336); // N(M col 9l) at 3.x
-                let d341 = A::mul_add(
-                    p.L6,
-                    d339,
-                    A::mul_add(-s_q1l, d337, c_q1l * d333),
-                ); // N(M col 9l) at 3.y
-                m[(4, 10)] = -d341;
-                m[(10, 4)] = m[(4, 10)];
-                let d342 = A::mul_add(
-                    p.L5,
-                    d334,
-                    A::mul_add(-p.L6, d338, A::mul_add(c_q1l, d337, s_q1l * d333)),
-                ); // N(M col 9l) at 3.z
-                let d343 = A::mul_add(s_q_torso, d339, c_q_torso * d334); // F(M col 9l) at 2.x
-                let d344 = A::mul_add(-c_q_torso, d339, s_q_torso * d334); // F(M col 9l) at 2.z
-                let d345 = A::mul_add(-p.L4, d343, d341); // N(M col 9l) at 2.y
-                let d346 = A::mul_add(
-                    p.L4,
-                    d338,
-                    A::mul_add(p.L3, d344, A::mul_add(s_q_torso, d342, c_q_torso * d340)),
-                ); // N(M col 9l) at 2.x
-                m[(3, 10)] = d346;
-                m[(10, 3)] = m[(3, 10)];
-                let d347 = A::mul_add(
-                    -p.L3,
-                    d343,
-                    A::mul_add(-c_q_torso, d342, s_q_torso * d340),
-                ); // N(M col 9l) at 2.z
-                let d348 = A::mul_add(-s_q_w, d344, c_q_w * d338); // F(M col 9l) at 1.y
-                let d349 = A::mul_add(c_q_w, d344, s_q_w * d338); // F(M col 9l) at 1.z
-                let d350 = A::mul_add(
-                    p.L2,
-                    d343,
-                    A::mul_add(-s_q_w, d347, c_q_w * d345),
-                ); // N(M col 9l) at 1.y
-                let d351 = A::mul_add(-p.L2, d348, A::mul_add(p.L1, d349, d346)); // N(M col 9l) at 1.x
-                m[(2, 10)] = d351;
-                m[(10, 2)] = m[(2, 10)];
-                let d352 = A::mul_add(
-                    -p.L1,
-                    d343,
-                    A::mul_add(c_q_w, d347, s_q_w * d345),
-                ); // N(M col 9l) at 1.z
-                let d353 = A::mul_add(c_q_imu, d349, s_q_imu * d348); // F(M col 9l) at 0.x
-                m[(0, 10)] = d353;
-                m[(10, 0)] = m[(0, 10)];
-                let d354 = A::mul_add(-s_q_imu, d352, c_q_imu * d350); // N(M col 9l) at 0.z
-                m[(1, 10)] = d354;
-                m[(10, 1)] = m[(1, 10)];
-                let d355 = p.MX8l - d310; // MSC8l.x
-                let d356 = p.MY8l - d318; // MSC8l.y
-                let d357 = p.MZ8l - d319; // MSC8l.z
-                let k25 = s_q6l * s_q6l; // sin² q6l
-                let k26 = s_q6l * c_q6l; // sin q6l cos q6l
-                let k27 = A::mul_add(2.0, k25, -1.0); // cos 2q6l
-                let d358 = pc.pc29 - d317; // JC9l: Jyy − Jzz
-                let d359 = A::mul_add(-2.0, d315 * k26, k25 * d358); // JC9l rotated about x: Jyy − J'yy
-                let d360 = p.XX8l + d316; // JC8l.xx
-                let d361 = p.XY8l + t47 + t48; // JC8l.xy
-                let d362 = p.XZ8l + t49 - t50; // JC8l.xz
-                let d363 = A::mul_add(k26, d358, A::mul_add(d315, k27, p.YZ8l)); // JC8l.yz
-                let d364 = p.ZZ8l + d317 + d359; // JC8l.zz
-                let d365 = pc.pc33 - d359; // JC8l.yy
-                m[(9, 9)] = d365;
-                let d366 = A::mul_add(c_q5l, d357, s_q5l * d355); // MSC8l in 7l.z
-                let d367 = A::mul_add(-s_q5l, d357, c_q5l * d355); // MSC8l in 7l.x
-                let t51 = c_q5l * d361; // common subexpression
-                let t52 = s_q5l * d363; // common subexpression
-                let t53 = s_q5l * d361; // common subexpression
-                let t54 = c_q5l * d363; // common subexpression
-                let t55 = p.L8 * d367; // common subexpression
-                let t56 = p.L8 * d366; // common subexpression
-                let d368 = t51 - t52 - t55; // N(M col 8l) at 7l.x
-                m[(8, 9)] = -d368;
-                m[(9, 8)] = m[(8, 9)];
-                let d369 = t53 + t54 - t56; // N(M col 8l) at 7l.z
-                let d370 = s_q4l * d367; // F(M col 8l) at 6l.y
-                let d371 = c_q4l * d367; // F(M col 8l) at 6l.z
-                let d372 = A::mul_add(-s_q4l, d369, c_q4l * d365); // N(M col 8l) at 6l.y
-                m[(7, 9)] = d372;
-                m[(9, 7)] = m[(7, 9)];
-                let d373 = A::mul_add(c_q4l, d369, s_q4l * d365); // N(M col 8l) at 6l.z
-                let d374 = A::mul_add(s_q3l, d371, c_q3l * d366); // F(M col 8l) at 5l.x
-                let d375 = A::mul_add(-c_q3l, d371, s_q3l * d366); // F(M col 8l) at 5l.z
-                let d376 = A::mul_add(
-                    p.L7,
-                    d375,
-                    A::mul_add(-s_q3l, d373, c_q3l * d368),
-                ); // N(M col 8l) at 5l.x
-                m[(6, 9)] = -d376;
-                m[(9, 6)] = m[(6, 9)];
-                let d377 = A::mul_add(
-                    -p.L7,
-                    d374,
-                    A::mul_add(c_q3l, d373, s_q3l * d368),
-                ); // N(M col 8l) at 5l.z
-                let d378 = A::mul_add(-s_q2l, d375, c_q2l * d370); // F(M col 8l) at 4l.y
-                let d379 = A::mul_add(c_q2l, d375, s_q2l * d370); // F(M col 8l) at 4l.z
-                let d380 = A::mul_add(-s_q2l, d377, c_q2l * d372); // N(M col 8l) at 4l.y
-                m[(5, 9)] = d380;
-                m[(9, 5)] = m[(5, 9)];
-                let d381 = A::mul_add(c_q2l, d377, s_q2l * d372); // N(M col 8l) at 4l.z
-                let d382 = A::mul_add(c_q1l, d379, s_q1l * d374); // F(M col 8l) at 3.z
-                let d383 = A::mul_add(-s_q1l, d379, c_q1l * d374); // F(M col 8l) at 3.y
-                let d384 = A::mul_add(
-                    p.L5,
-                    d378,
-                    A::mul_add(-p.L6, d383, A::mul_add(c_q1l, d381, s_q1l * d376)),
-                ); // N(M col 8l) at 3.z
-                let d385 = A::mul_add(-p.L5, d382, d380); // N(M col 8l) at 3.x
-                let d386 = A::mul_add(
-                    p.L6,
-                    d382,
-                    A::mul_add(-s_q1l, d381, c_q1l * d376),
-                ); // N(M col 8l) at 3.y
-                m[(4, 9)] = d386;
-                m[(9, 4)] = m[(4, 9)];
-                let d387 = A::mul_add(s_q_torso, d382, c_q_torso * d378); // F(M col 8l) at 2.x
-                let d388 = A::mul_add(-c_q_torso, d382, s_q_torso * d378); // F(M col 8l) at 2.z
-                let d389 = A::mul_add(
-                    p.L4,
-                    d383,
-                    A::mul_add(p.L3, d388, A::mul_add(s_q_torso, d384, c_q_torso * d385)),
-                ); // N(M col 8l) at 2.x
-                m[(3, 9)] = -d389;
-                m[(9, 3)] = m[(3, 9)];
-                let d390 = A::mul_add(
-                    -p.L3,
-                    d387,
-                    A::mul_add(-c_q_torso, d384, s_q_torso * d385),
-                ); // N(M col 8l) at 2.z
-                let d391 = A::mul_add(-p.L4, d387, d386); // N(M col 8l) at 2.y
-                let d392 = A::mul_add(c_q_w, d388, s_q_w * d383); // F(M col 8l) at 1.z
-                let d393 = A::mul_add(-s_q_w, d388, c_q_w * d383); // F(M col 8l) at 1.y
-                let d394 = A::mul_add(-p.L2, d393, A::mul_add(p.L1, d392, d389)); // N(M col 8l) at 1.x
-                m[(2, 9)] = -d394;
-                m[(9, 2)] = m[(2, 9)];
-                let d395 = A::mul_add(
-                    -p.L1,
-                    d387,
-                    A::mul_add(c_q_w, d390, s_q_w * d391),
-                ); // N(M col 8l) at 1.z
-                let d396 = A::mul_add(
-                    p.L2,
-                    d387,
-                    A::mul_add(-s_q_w, d390, c_q_w * d391),
-                ); // N(M col 8l) at 1.y
-                let d397 = A::mul_add(c_q_imu, d392, s_q_imu * d393); // F(M col 8l) at 0.x
-                m[(0, 9)] = -d397;
-                m[(9, 0)] = m[(0, 9)];
-                let d398 = A::mul_add(-s_q_imu, d395, c_q_imu * d396); // N(M col 8l) at 0.z
-                m[(1, 9)] = -d398;
-                m[(9, 1)] = m[(1, 9)];
-                let d399 = p.MX7l - d367; // MSC7l.x
-                let d400 = p.MZ7l + d366; // MSC7l.z
-                let k28 = s_q5l * s_q5l; // sin² q5l
-                let k29 = s_q5l * c_q5l; // sin q5l cos q5l
-                let k30 = A::mul_add(2.0, k28, -1.0); // cos 2q5l
-                let d401 = d360 - d364; // JC8l: Jzz − Jxx
-                let d402 = A::mul_add(2.0, d362 * k29, k28 * d401); // JC8l rotated about y: Jzz − J'zz
-                let t57 = p.L8 * d356; // common subexpression
-                let d403 = p.XY7l + t51 - t52 - t55; // JC7l.xy
-                let d404 = A::mul_add(-k29, d401, A::mul_add(d362, k30, p.XZ7l)); // JC7l.xz
-                let d405 = p.YY7l + d365; // JC7l.yy
-                let d406 = p.YZ7l - t53 - t54 + t56; // JC7l.yz
-                let d407 = pc.pc36 - d356; // MSC7l.y
-                let d408 = A::mul_add(2.0, t57, d360 - d402) + pc.pc37; // JC7l.xx
-                m[(8, 8)] = d408;
-                let d409 = A::mul_add(2.0, t57, d364 + d402) + pc.pc38; // JC7l.zz
-                let d410 = A::mul_add(s_q4l, d400, c_q4l * d407); // MSC7l in 6l.y
-                let d411 = A::mul_add(-c_q4l, d400, s_q4l * d407); // MSC7l in 6l.z
-                let t58 = c_q4l * d403; // common subexpression
-                let t59 = s_q4l * d404; // common subexpression
-                let d412 = t58 + t59; // N(M col 7l) at 6l.y
-                m[(7, 8)] = -d412;
-                m[(8, 7)] = m[(7, 8)];
-                let t60 = s_q4l * d403; // common subexpression
-                let t61 = c_q4l * d404; // common subexpression
-                let d413 = t60 - t61; // N(M col 7l) at 6l.z
-                let d414 = s_q3l * d410; // F(M col 7l) at 5l.x
-                let d415 = c_q3l * d410; // F(M col 7l) at 5l.z
-                let d416 = A::mul_add(
-                    -p.L7,
-                    d414,
-                    A::mul_add(c_q3l, d413, s_q3l * d408),
-                ); // N(M col 7l) at 5l.z
-                let d417 = A::mul_add(
-                    -p.L7,
-                    d415,
-                    A::mul_add(-s_q3l, d413, c_q3l * d408),
-                ); // N(M col 7l) at 5l.x
-                m[(6, 8)] = d417;
-                m[(8, 6)] = m[(6, 8)];
-                let d418 = A::mul_add(s_q2l, d415, c_q2l * d411); // F(M col 7l) at 4l.y
-                let d419 = A::mul_add(-c_q2l, d415, s_q2l * d411); // F(M col 7l) at 4l.z
-                let d420 = A::mul_add(-s_q2l, d416, c_q2l * d412); // N(M col 7l) at 4l.y
-                m[(5, 8)] = -d420;
-                m[(8, 5)] = m[(5, 8)];
-                let d421 = A::mul_add(c_q2l, d416, s_q2l * d412); // N(M col 7l) at 4l.z
-                let d422 = A::mul_add(-s_q1l, d419, c_q1l * d414); // F(M col 7l) at 3.y
-                let d423 = A::mul_add(c_q1l, d419, s_q1l * d414); // F(M col 7l) at 3.z
-                let d424 = A::mul_add(-p.L5, d423, d420); // N(M col 7l) at 3.x
-                let d425 = A::mul_add(
-                    p.L6,
-                    d423,
-                    A::mul_add(-s_q1l, d421, c_q1l * d417),
-                ); // N(M col 7l) at 3.y
-                m[(4, 8)] = -d425;
-                m[(8, 4)] = m[(4, 8)];
-                let d426 = A::mul_add(
-                    p.L5,
-                    d418,
-                    A::mul_add(-p.L6, d422, A::mul_add(c_q1l, d421, s_q1l * d417)),
-                ); // N(M col 7l) at 3.z
-                let d427 = A::mul_add(s_q_torso, d423, c_q_torso * d418); // F(M col 7l) at 2.x
-                let d428 = A::mul_add(-c_q_torso, d423, s_q_torso * d418); // F(M col 7l) at 2.z
-                let d429 = A::mul_add(-p.L4, d427, d425); // N(M col 7l) at 2.y
-                let d430 = A::mul_add(
-                    p.L4,
-                    d422,
-                    A::mul_add(p.L3, d428, A::mul_add(s_q_torso, d426, c_q_torso * d424)),
-                ); // N(M col 7l) at 2.x
-                m[(3, 8)] = d430;
-                m[(8, 3)] = m[(3, 8)];
-                let d431 = A::mul_add(
-                    -p.L3,
-                    d427,
-                    A::mul_add(-c_q_torso, d426, s_q_torso * d424),
-                ); // N(M col 7l) at 2.z
-                let d432 = A::mul_add(-s_q_w, d428, c_q_w * d422); // F(M col 7l) at 1.y
-                let d433 = A::mul_add(c_q_w, d428, s_q_w * d422); // F(M col 7l) at 1.z
-                let d434 = A::mul_add(
-                    p.L2,
-                    d427,
-                    A::mul_add(-s_q_w, d431, c_q_w * d429),
-                ); // N(M col 7l) at 1.y
-                let d435 = A::mul_add(-p.L2, d432, A::mul_add(p.L1, d433, d430)); // N(M col 7l) at 1.x
-                m[(2, 8)] = d435;
-                m[(8, 2)] = m[(2, 8)];
-                let d436 = A::mul_add(
-                    -p.L1,
-                    d427,
-                    A::mul_add(c_q_w, d431, s_q_w * d429),
-                ); // N(M col 7l) at 1.z
-                let d437 = A::mul_add(c_q_imu, d433, s_q_imu * d432); // F(M col 7l) at 0.x
-                m[(0, 8)] = d437;
-                m[(8, 0)] = m[(0, 8)];
-                let d438 = A::mul_add(-s_q_imu, d436, c_q_imu * d434); // N(M col 7l) at 0.z
-                m[(1, 8)] = d438;
-                m[(8, 1)] = m[(1, 8)];
-                let d439 = p.MX6l - d399; // MSC6l.x
-                let d440 = p.MY6l - d410; // MSC6l.y
-                let d441 = p.MZ6l - d411; // MSC6l.z
-                let k31 = s_q4l * s_q4l; // sin² q4l
-                let k32 = s_q4l * c_q4l; // sin q4l cos q4l
-                let k33 = A::mul_add(2.0, k31, -1.0); // cos 2q4l
-                let d442 = d405 - d409; // JC7l: Jyy − Jzz
-                let d443 = A::mul_add(-2.0, d406 * k32, k31 * d442); // JC7l rotated about x: Jyy − J'yy
-                let d444 = p.XX6l + d408; // JC6l.xx
-                let d445 = p.XY6l + t58 + t59; // JC6l.xy
-                let d446 = p.XZ6l + t60 - t61; // JC6l.xz
-                let d447 = p.YY6l + d405 - d443; // JC6l.yy
-                m[(7, 7)] = d447;
-                let d448 = A::mul_add(k32, d442, A::mul_add(d406, k33, p.YZ6l)); // JC6l.yz
-                let d449 = p.ZZ6l + d409 + d443; // JC6l.zz
-                let d450 = A::mul_add(c_q3l, d441, s_q3l * d439); // MSC6l in 5l.z
-                let d451 = A::mul_add(-s_q3l, d441, c_q3l * d439); // MSC6l in 5l.x
-                let t62 = c_q3l * d445; // common subexpression
-                let t63 = s_q3l * d448; // common subexpression
-                let t64 = s_q3l * d445; // common subexpression
-                let t65 = c_q3l * d448; // common subexpression
-                let t66 = p.L7 * d451; // common subexpression
-                let t67 = p.L7 * d450; // common subexpression
-                let d452 = t62 - t63 - t66; // N(M col 6l) at 5l.x
-                m[(6, 7)] = -d452;
-                m[(7, 6)] = m[(6, 7)];
-                let d453 = t64 + t65 - t67; // N(M col 6l) at 5l.z
-                let d454 = s_q2l * d451; // F(M col 6l) at 4l.y
-                let d455 = c_q2l * d451; // F(M col 6l) at 4l.z
-                let d456 = A::mul_add(-s_q2l, d453, c_q2l * d447); // N(M col 6l) at 4l.y
-                m[(5, 7)] = d456;
-                m[(7, 5)] = m[(5, 7)];
-                let d457 = A::mul_add(c_q2l, d453, s_q2l * d447); // N(M col 6l) at 4l.z
-                let d458 = A::mul_add(-c_q1l, d455, s_q1l * d450); // F(M col 6l) at 3.z
-                let d459 = A::mul_add(s_q1l, d455, c_q1l * d450); // F(M col 6l) at 3.y
-                let d460 = A::mul_add(
-                    p.L5,
-                    d454,
-                    A::mul_add(-p.L6, d459, A::mul_add(c_q1l, d457, s_q1l * d452)),
-                ); // N(M col 6l) at 3.z
-                let d461 = A::mul_add(-p.L5, d458, d456); // N(M col 6l) at 3.x
-                let d462 = A::mul_add(
-                    p.L6,
-                    d458,
-                    A::mul_add(-s_q1l, d457, c_q1l * d452),
-                ); // N(M col 6l) at 3.y
-                m[(4, 7)] = d462;
-                m[(7, 4)] = m[(4, 7)];
-                let d463 = A::mul_add(s_q_torso, d458, c_q_torso * d454); // F(M col 6l) at 2.x
-                let d464 = A::mul_add(-c_q_torso, d458, s_q_torso * d454); // F(M col 6l) at 2.z
-                let d465 = A::mul_add(
-                    p.L4,
-                    d459,
-                    A::mul_add(p.L3, d464, A::mul_add(s_q_torso, d460, c_q_torso * d461)),
-                ); // N(M col 6l) at 2.x
-                m[(3, 7)] = -d465;
-                m[(7, 3)] = m[(3, 7)];
-                let d466 = A::mul_add(
-                    -p.L3,
-                    d463,
-                    A::mul_add(-c_q_torso, d460, s_q_torso * d461),
-                ); // N(M col 6l) at 2.z
-                let d467 = A::mul_add(-p.L4, d463, d462); // N(M col 6l) at 2.y
-                let d468 = A::mul_add(c_q_w, d464, s_q_w * d459); // F(M col 6l) at 1.z
-                let d469 = A::mul_add(-s_q_w, d464, c_q_w * d459); // F(M col 6l) at 1.y
-                let d470 = A::mul_add(-p.L2, d469, A::mul_add(p.L1, d468, d465)); // N(M col 6l) at 1.x
-                m[(2, 7)] = -d470;
-                m[(7, 2)] = m[(2, 7)];
-                let d471 = A::mul_add(
-                    -p.L1,
-                    d463,
-                    A::mul_add(c_q_w, d466, s_q_w * d467),
-                ); // N(M col 6l) at 1.z
-                let d472 = A::mul_add(
-                    p.L2,
-                    d463,
-                    A::mul_add(-s_q_w, d466, c_q_w * d467),
-                ); // N(M col 6l) at 1.y
-                let d473 = A::mul_add(c_q_imu, d468, s_q_imu * d469); // F(M col 6l) at 0.x
-                m[(0, 7)] = -d473;
-                m[(7, 0)] = m[(0, 7)];
-                let d474 = A::mul_add(-s_q_imu, d471, c_q_imu * d472); // N(M col 6l) at 0.z
-                m[(1, 7)] = -d474;
-                m[(7, 1)] = m[(1, 7)];
-                let d475 = p.MX5l - d451; // MSC5l.x
-                let d476 = p.MZ5l + d450; // MSC5l.z
-                let k34 = s_q3l * s_q3l; // sin² q3l
-                let k35 = s_q3l * c_q3l; // sin q3l cos q3l
-                let k36 = A::mul_add(2.0, k34, -1.0); // cos 2q3l
-                let d477 = d444 - d449; // JC6l: Jzz − Jxx
-                let d478 = A::mul_add(2.0, d446 * k35, k34 * d477); // JC6l rotated about y: Jzz − J'zz
-                let t68 = p.L7 * d440; // common subexpression
-                let d479 = p.XY5l + t62 - t63 - t66; // JC5l.xy
-                let d480 = A::mul_add(-k35, d477, A::mul_add(d446, k36, p.XZ5l)); // JC5l.xz
-                let d481 = p.YY5l + d447; // JC5l.yy
-                let d482 = p.YZ5l - t64 - t65 + t67; // JC5l.yz
-                let d483 = pc.pc42 - d440; // MSC5l.y
-                let d484 = A::mul_add(2.0, t68, d444 - d478) + pc.pc43; // JC5l.xx
-                m[(6, 6)] = d484;
-                let d485 = A::mul_add(2.0, t68, d449 + d478) + pc.pc44; // JC5l.zz
-                let d486 = A::mul_add(s_q2l, d476, c_q2l * d483); // MSC5l in 4l.y
-                let d487 = A::mul_add(-c_q2l, d476, s_q2l * d483); // MSC5l in 4l.z
-                let t69 = c_q2l * d479; // common subexpression
-                let t70 = s_q2l * d480; // common subexpression
-                let d488 = t69 + t70; // N(M col 5l) at 4l.y
-                m[(5, 6)] = -d488;
-                m[(6, 5)] = m[(5, 6)];
-                let t71 = s_q2l * d479; // common subexpression
-                let t72 = c_q2l * d480; // common subexpression
-                let d489 = t71 - t72; // N(M col 5l) at 4l.z
-                let d490 = s_q1l * d486; // F(M col 5l) at 3.y
-                let d491 = c_q1l * d486; // F(M col 5l) at 3.z
-                let d492 = A::mul_add(p.L5, d491, d488); // N(M col 5l) at 3.x
-                let d493 = A::mul_add(
-                    -p.L6,
-                    d491,
-                    A::mul_add(-s_q1l, d489, c_q1l * d484),
-                ); // N(M col 5l) at 3.y
-                m[(4, 6)] = -d493;
-                m[(6, 4)] = m[(4, 6)];
-                let d494 = A::mul_add(
-                    p.L5,
-                    d487,
-                    A::mul_add(-p.L6, d490, A::mul_add(c_q1l, d489, s_q1l * d484)),
-                ); // N(M col 5l) at 3.z
-                let d495 = A::mul_add(-s_q_torso, d491, c_q_torso * d487); // F(M col 5l) at 2.x
-                let d496 = A::mul_add(c_q_torso, d491, s_q_torso * d487); // F(M col 5l) at 2.z
-                let d497 = A::mul_add(-p.L4, d495, d493); // N(M col 5l) at 2.y
-                let d498 = A::mul_add(
-                    p.L4,
-                    d490,
-                    A::mul_add(p.L3, d496, A::mul_add(s_q_torso, d494, c_q_torso * d492)),
-                ); // N(M col 5l) at 2.x
-                m[(3, 6)] = d498;
-                m[(6, 3)] = m[(3, 6)];
-                let d499 = A::mul_add(
-                    -p.L3,
-                    d495,
-                    A::mul_add(-c_q_torso, d494, s_q_torso * d492),
-                ); // N(M col 5l) at 2.z
-                let d500 = A::mul_add(-s_q_w, d496, c_q_w * d490); // F(M col 5l) at 1.y
-                let d501 = A::mul_add(c_q_w, d496, s_q_w * d490); // F(M col 5l) at 1.z
-                let d502 = A::mul_add(
-                    p.L2,
-                    d495,
-                    A::mul_add(-s_q_w, d499, c_q_w * d497),
-                ); // N(M col 5l) at 1.y
-                let d503 = A::mul_add(-p.L2, d500, A::mul_add(p.L1, d501, d498)); // N(M col 5l) at 1.x
-                m[(2, 6)] = d503;
-                m[(6, 2)] = m[(2, 6)];
-                let d504 = A::mul_add(
-                    -p.L1,
-                    d495,
-                    A::mul_add(c_q_w, d499, s_q_w * d497),
-                ); // N(M col 5l) at 1.z
-                let d505 = A::mul_add(c_q_imu, d501, s_q_imu * d500); // F(M col 5l) at 0.x
-                m[(0, 6)] = d505;
-                m[(6, 0)] = m[(0, 6)];
-                let d506 = A::mul_add(-s_q_imu, d504, c_q_imu * d502); // N(M col 5l) at 0.z
-                m[(1, 6)] = d506;
-                m[(6, 1)] = m[(1, 6)];
-                let d507 = p.MX4l - d475; // MSC4l.x
-                let d508 = p.MY4l - d486; // MSC4l.y
-                let d509 = p.MZ4l - d487; // MSC4l.z
-                let k37 = s_q2l * s_q2l; // sin² q2l
-                let k38 = s_q2l * c_q2l; // sin q2l cos q2l
-                let k39 = A::mul_add(2.0, k37, -1.0); // cos 2q2l
-                let d510 = d481 - d485; // JC5l: Jyy − Jzz
-                let d511 = A::mul_add(-2.0, d482 * k38, k37 * d510); // JC5l rotated about x: Jyy − J'yy
-                let d512 = p.XX4l + d484; // JC4l.xx
-                let d513 = p.XY4l + t69 + t70; // JC4l.xy
-                let d514 = p.XZ4l + t71 - t72; // JC4l.xz
-                let d515 = p.YY4l + d481 - d511; // JC4l.yy
-                m[(5, 5)] = d515;
-                let d516 = A::mul_add(k38, d510, A::mul_add(d482, k39, p.YZ4l)); // JC4l.yz
-                let d517 = p.ZZ4l + d485 + d511; // JC4l.zz
-                let d518 = A::mul_add(-s_q1l, d509, c_q1l * d507); // MSC4l in 3.y
-                let d519 = A::mul_add(c_q1l, d509, s_q1l * d507); // MSC4l in 3.z
-                let t73 = c_q1l * d513; // common subexpression
-                let t74 = s_q1l * d516; // common subexpression
-                let t75 = s_q1l * d513; // common subexpression
-                let t76 = c_q1l * d516; // common subexpression
-                let t77 = p.L5 * d518; // common subexpression
-                let t78 = p.L6 * d518; // common subexpression
-                let t79 = p.L6 * d519; // common subexpression
-                let d520 = t75 + t76 - t79; // N(M col 4l) at 3.z
-                let d521 = d515 + t77; // N(M col 4l) at 3.x
-                let d522 = t73 - t74 - t78; // N(M col 4l) at 3.y
-                m[(4, 5)] = d522;
-                m[(5, 4)] = m[(4, 5)];
-                let d523 = s_q_torso * d518; // F(M col 4l) at 2.x
-                let d524 = c_q_torso * d518; // F(M col 4l) at 2.z
-                let d525 = A::mul_add(
-                    p.L4,
-                    d519,
-                    A::mul_add(p.L3, d524, A::mul_add(s_q_torso, d520, c_q_torso * d521)),
-                ); // N(M col 4l) at 2.x
-                m[(3, 5)] = -d525;
-                m[(5, 3)] = m[(3, 5)];
-                let d526 = A::mul_add(
-                    p.L3,
-                    d523,
-                    A::mul_add(-c_q_torso, d520, s_q_torso * d521),
-                ); // N(M col 4l) at 2.z
-                let d527 = A::mul_add(p.L4, d523, d522); // N(M col 4l) at 2.y
-                let d528 = A::mul_add(c_q_w, d524, s_q_w * d519); // F(M col 4l) at 1.z
-                let d529 = A::mul_add(-s_q_w, d524, c_q_w * d519); // F(M col 4l) at 1.y
-                let d530 = A::mul_add(-p.L2, d529, A::mul_add(p.L1, d528, d525)); // N(M col 4l) at 1.x
-                m[(2, 5)] = -d530;
-                m[(5, 2)] = m[(2, 5)];
-                let d531 = A::mul_add(p.L1, d523, A::mul_add(c_q_w, d526, s_q_w * d527)); // N(M col 4l) at 1.z
-                let d532 = A::mul_add(
-                    -p.L2,
-                    d523,
-                    A::mul_add(-s_q_w, d526, c_q_w * d527),
-                ); // N(M col 4l) at 1.y
-                let d533 = A::mul_add(c_q_imu, d528, s_q_imu * d529); // F(M col 4l) at 0.x
-                m[(0, 5)] = -d533;
-                m[(5, 0)] = m[(0, 5)];
-                let d534 = A::mul_add(-s_q_imu, d531, c_q_imu * d532); // N(M col 4l) at 0.z
-                m[(1, 5)] = -d534;
-                m[(5, 1)] = m[(1, 5)];
-                let d535 = p.MZ3 + d251 - d519; // MSC3.z
-                let k40 = s_q1l * s_q1l; // sin² q1l
-                let k41 = s_q1l * c_q1l; // sin q1l cos q1l
-                let k42 = A::mul_add(2.0, k40, -1.0); // cos 2q1l
-                let d536 = d512 - d517; // JC4l: Jzz − Jxx
-                let d537 = A::mul_add(2.0, d514 * k41, k40 * d536); // JC4l rotated about y: Jzz − J'zz
-                let t80 = p.L6 * d508; // common subexpression
-                let d538 = p.XZ3 - t35 - t36 + t39 - t75 - t76 + t79; // JC3.xz
-                let d539 = A::mul_add(
-                    p.L5,
-                    d519,
+            m[(0, 0)] = pc.pc69;
+            m[(11, 11)] = p.ZZ10l;
+            m[(18, 18)] = p.ZZ10r;
+            m[(12, 5)] = 0.0;
+            m[(13, 5)] = 0.0;
+            m[(14, 5)] = 0.0;
+            m[(15, 5)] = 0.0;
+            m[(16, 5)] = 0.0;
+            m[(17, 5)] = 0.0;
+            m[(18, 5)] = 0.0;
+            m[(12, 6)] = 0.0;
+            m[(13, 6)] = 0.0;
+            m[(14, 6)] = 0.0;
+            m[(15, 6)] = 0.0;
+            m[(16, 6)] = 0.0;
+            m[(17, 6)] = 0.0;
+            m[(18, 6)] = 0.0;
+            m[(12, 7)] = 0.0;
+            m[(13, 7)] = 0.0;
+            m[(14, 7)] = 0.0;
+            m[(15, 7)] = 0.0;
+            m[(16, 7)] = 0.0;
+            m[(17, 7)] = 0.0;
+            m[(18, 7)] = 0.0;
+            m[(12, 8)] = 0.0;
+            m[(13, 8)] = 0.0;
+            m[(14, 8)] = 0.0;
+            m[(15, 8)] = 0.0;
+            m[(16, 8)] = 0.0;
+            m[(17, 8)] = 0.0;
+            m[(18, 8)] = 0.0;
+            m[(12, 9)] = 0.0;
+            m[(13, 9)] = 0.0;
+            m[(14, 9)] = 0.0;
+            m[(15, 9)] = 0.0;
+            m[(16, 9)] = 0.0;
+            m[(17, 9)] = 0.0;
+            m[(18, 9)] = 0.0;
+            m[(12, 10)] = 0.0;
+            m[(13, 10)] = 0.0;
+            m[(14, 10)] = 0.0;
+            m[(15, 10)] = 0.0;
+            m[(16, 10)] = 0.0;
+            m[(17, 10)] = 0.0;
+            m[(18, 10)] = 0.0;
+            m[(12, 11)] = 0.0;
+            m[(13, 11)] = 0.0;
+            m[(14, 11)] = 0.0;
+            m[(15, 11)] = 0.0;
+            m[(16, 11)] = 0.0;
+            m[(17, 11)] = 0.0;
+            m[(18, 11)] = 0.0;
+            m[(5, 12)] = 0.0;
+            m[(6, 12)] = 0.0;
+            m[(7, 12)] = 0.0;
+            m[(8, 12)] = 0.0;
+            m[(9, 12)] = 0.0;
+            m[(10, 12)] = 0.0;
+            m[(11, 12)] = 0.0;
+            m[(5, 13)] = 0.0;
+            m[(6, 13)] = 0.0;
+            m[(7, 13)] = 0.0;
+            m[(8, 13)] = 0.0;
+            m[(9, 13)] = 0.0;
+            m[(10, 13)] = 0.0;
+            m[(11, 13)] = 0.0;
+            m[(5, 14)] = 0.0;
+            m[(6, 14)] = 0.0;
+            m[(7, 14)] = 0.0;
+            m[(8, 14)] = 0.0;
+            m[(9, 14)] = 0.0;
+            m[(10, 14)] = 0.0;
+            m[(11, 14)] = 0.0;
+            m[(5, 15)] = 0.0;
+            m[(6, 15)] = 0.0;
+            m[(7, 15)] = 0.0;
+            m[(8, 15)] = 0.0;
+            m[(9, 15)] = 0.0;
+            m[(10, 15)] = 0.0;
+            m[(11, 15)] = 0.0;
+            m[(5, 16)] = 0.0;
+            m[(6, 16)] = 0.0;
+            m[(7, 16)] = 0.0;
+            m[(8, 16)] = 0.0;
+            m[(9, 16)] = 0.0;
+            m[(10, 16)] = 0.0;
+            m[(11, 16)] = 0.0;
+            m[(5, 17)] = 0.0;
+            m[(6, 17)] = 0.0;
+            m[(7, 17)] = 0.0;
+            m[(8, 17)] = 0.0;
+            m[(9, 17)] = 0.0;
+            m[(10, 17)] = 0.0;
+            m[(11, 17)] = 0.0;
+            m[(5, 18)] = 0.0;
+            m[(6, 18)] = 0.0;
+            m[(7, 18)] = 0.0;
+            m[(8, 18)] = 0.0;
+            m[(9, 18)] = 0.0;
+            m[(10, 18)] = 0.0;
+            m[(11, 18)] = 0.0;
+            let d1 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
+            let d2 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
+            let t1 = p.XZ10r * c_q7r; // common subexpression
+            let t2 = p.YZ10r * s_q7r; // common subexpression
+            let t3 = p.XZ10r * s_q7r; // common subexpression
+            let t4 = p.YZ10r * c_q7r; // common subexpression
+            let t5 = p.L9 * d2; // common subexpression
+            let t6 = p.L9 * d1; // common subexpression
+            let d3 = t1 + t2 - t5; // N(M col 10r) at 9r.x
+            m[(17, 18)] = -d3;
+            m[(18, 17)] = m[(17, 18)];
+            let d4 = t3 - t4 - t6; // N(M col 10r) at 9r.z
+            let d5 = d2 * s_q6r; // F(M col 10r) at 8r.y
+            let d6 = d2 * c_q6r; // F(M col 10r) at 8r.z
+            let d7 = A::mul_add(-d4, s_q6r, p.ZZ10r * c_q6r); // N(M col 10r) at 8r.y
+            m[(16, 18)] = d7;
+            m[(18, 16)] = m[(16, 18)];
+            let d8 = A::mul_add(d4, c_q6r, p.ZZ10r * s_q6r); // N(M col 10r) at 8r.z
+            let d9 = A::mul_add(d6, s_q5r, d1 * c_q5r); // F(M col 10r) at 7r.x
+            let d10 = A::mul_add(-d6, c_q5r, d1 * s_q5r); // F(M col 10r) at 7r.z
+            let d11 = A::mul_add(p.L8, d10, A::mul_add(-d8, s_q5r, d3 * c_q5r)); // N(M col 10r) at 7r.x
+            m[(15, 18)] = -d11;
+            m[(18, 15)] = m[(15, 18)];
+            let d12 = A::mul_add(-p.L8, d9, A::mul_add(d8, c_q5r, d3 * s_q5r)); // N(M col 10r) at 7r.z
+            let d13 = A::mul_add(-d10, s_q4r, d5 * c_q4r); // F(M col 10r) at 6r.y
+            let d14 = A::mul_add(d10, c_q4r, d5 * s_q4r); // F(M col 10r) at 6r.z
+            let d15 = A::mul_add(-d12, s_q4r, d7 * c_q4r); // N(M col 10r) at 6r.y
+            m[(14, 18)] = d15;
+            m[(18, 14)] = m[(14, 18)];
+            let d16 = A::mul_add(d12, c_q4r, d7 * s_q4r); // N(M col 10r) at 6r.z
+            let d17 = A::mul_add(-d14, s_q3r, d9 * c_q3r); // F(M col 10r) at 5r.x
+            let d18 = A::mul_add(d14, c_q3r, d9 * s_q3r); // F(M col 10r) at 5r.z
+            let d19 = A::mul_add(p.L7, d18, A::mul_add(-d16, s_q3r, d11 * c_q3r)); // N(M col 10r) at 5r.x
+            m[(13, 18)] = -d19;
+            m[(18, 13)] = m[(13, 18)];
+            let d20 = A::mul_add(-p.L7, d17, A::mul_add(d16, c_q3r, d11 * s_q3r)); // N(M col 10r) at 5r.z
+            let d21 = A::mul_add(-d18, s_q2r, d13 * c_q2r); // F(M col 10r) at 4r.y
+            let d22 = A::mul_add(d18, c_q2r, d13 * s_q2r); // F(M col 10r) at 4r.z
+            let d23 = A::mul_add(-d20, s_q2r, d15 * c_q2r); // N(M col 10r) at 4r.y
+            m[(12, 18)] = d23;
+            m[(18, 12)] = m[(12, 18)];
+            let d24 = A::mul_add(d20, c_q2r, d15 * s_q2r); // N(M col 10r) at 4r.z
+            let d25 = A::mul_add(-d22, s_q1r, d17 * c_q1r); // F(M col 10r) at 3.y
+            let d26 = A::mul_add(d22, c_q1r, d17 * s_q1r); // F(M col 10r) at 3.z
+            let d27 = A::mul_add(-p.L5, d26, d23); // N(M col 10r) at 3.x
+            let d28 = A::mul_add(p.L6, d26, A::mul_add(-d24, s_q1r, d19 * c_q1r)); // N(M col 10r) at 3.y
+            m[(4, 18)] = d28;
+            m[(18, 4)] = m[(4, 18)];
+            let d29 = A::mul_add(
+                d21,
+                p.L5,
+                A::mul_add(-p.L6, d25, A::mul_add(d24, c_q1r, d19 * s_q1r)),
+            ); // N(M col 10r) at 3.z
+            let d30 = A::mul_add(d26, s_q_torso, d21 * c_q_torso); // F(M col 10r) at 2.x
+            let d31 = A::mul_add(-d26, c_q_torso, d21 * s_q_torso); // F(M col 10r) at 2.z
+            let d32 = A::mul_add(
+                -d25,
+                p.L4,
+                A::mul_add(p.L3, d31, A::mul_add(d29, s_q_torso, d27 * c_q_torso)),
+            ); // N(M col 10r) at 2.x
+            m[(3, 18)] = d32;
+            m[(18, 3)] = m[(3, 18)];
+            let d33 = A::mul_add(p.L4, d30, d28); // N(M col 10r) at 2.y
+            let d34 = A::mul_add(
+                -p.L3,
+                d30,
+                A::mul_add(-d29, c_q_torso, d27 * s_q_torso),
+            ); // N(M col 10r) at 2.z
+            let d35 = A::mul_add(-d31, c_q_w, d25 * s_q_w); // F(M col 10r) at 1.z
+            let d36 = A::mul_add(d31, s_q_w, d25 * c_q_w); // F(M col 10r) at 1.y
+            let d37 = A::mul_add(d30, p.L1, A::mul_add(-d34, c_q_w, d33 * s_q_w)); // N(M col 10r) at 1.z
+            let d38 = A::mul_add(p.L2, d36, A::mul_add(-p.L1, d35, d32)); // N(M col 10r) at 1.x
+            m[(2, 18)] = d38;
+            m[(18, 2)] = m[(2, 18)];
+            let d39 = A::mul_add(-d30, p.L2, A::mul_add(d34, s_q_w, d33 * c_q_w)); // N(M col 10r) at 1.y
+            let d40 = A::mul_add(d35, c_q_imu, d36 * s_q_imu); // F(M col 10r) at 0.x
+            m[(0, 18)] = -d40;
+            m[(18, 0)] = m[(0, 18)];
+            let d41 = A::mul_add(-d37, s_q_imu, d39 * c_q_imu); // N(M col 10r) at 0.z
+            m[(1, 18)] = -d41;
+            m[(18, 1)] = m[(1, 18)];
+            let d42 = p.MX9r - d2; // MSC9r.x
+            let d43 = p.MZ9r + d1; // MSC9r.z
+            let k1 = s_q7r * s_q7r; // sin² q7r
+            let k2 = s_q7r * c_q7r; // sin q7r cos q7r
+            let k3 = A::mul_add(2.0, k1, -1.0); // cos 2q7r
+            let d44 = A::mul_add(-2.0, p.XY10r * k2, k1 * pc.pc3); // JC10r rotated about z: Jxx − J'xx
+            let d45 = p.XY9r + t1 + t2 - t5; // JC9r.xy
+            let d46 = A::mul_add(-k2, pc.pc3, A::mul_add(-p.XY10r, k3, p.XZ9r)); // JC9r.xz
+            let d47 = p.YZ9r - t3 + t4 + t6; // JC9r.yz
+            let d48 = pc.pc7 - d44; // JC9r.xx
+            m[(17, 17)] = d48;
+            let d49 = d44 + pc.pc8; // JC9r.zz
+            let d50 = A::mul_add(s_q6r, d43, c_q6r * pc.pc2); // MSC9r in 8r.y
+            let d51 = A::mul_add(-c_q6r, d43, s_q6r * pc.pc2); // MSC9r in 8r.z
+            let t7 = c_q6r * d45; // common subexpression
+            let t8 = s_q6r * d46; // common subexpression
+            let d52 = t7 + t8; // N(M col 9r) at 8r.y
+            m[(16, 17)] = -d52;
+            m[(17, 16)] = m[(16, 17)];
+            let t9 = s_q6r * d45; // common subexpression
+            let t10 = c_q6r * d46; // common subexpression
+            let d53 = t9 - t10; // N(M col 9r) at 8r.z
+            let d54 = s_q5r * d50; // F(M col 9r) at 7r.x
+            let d55 = c_q5r * d50; // F(M col 9r) at 7r.z
+            let d56 = A::mul_add(-p.L8, d54, A::mul_add(c_q5r, d53, s_q5r * d48)); // N(M col 9r) at 7r.z
+            let d57 = A::mul_add(-p.L8, d55, A::mul_add(-s_q5r, d53, c_q5r * d48)); // N(M col 9r) at 7r.x
+            m[(15, 17)] = d57;
+            m[(17, 15)] = m[(15, 17)];
+            let d58 = A::mul_add(s_q4r, d55, c_q4r * d51); // F(M col 9r) at 6r.y
+            let d59 = A::mul_add(-c_q4r, d55, s_q4r * d51); // F(M col 9r) at 6r.z
+            let d60 = A::mul_add(-s_q4r, d56, c_q4r * d52); // N(M col 9r) at 6r.y
+            m[(14, 17)] = -d60;
+            m[(17, 14)] = m[(14, 17)];
+            let d61 = A::mul_add(c_q4r, d56, s_q4r * d52); // N(M col 9r) at 6r.z
+            let d62 = A::mul_add(c_q3r, d59, s_q3r * d54); // F(M col 9r) at 5r.z
+            let d63 = A::mul_add(-s_q3r, d59, c_q3r * d54); // F(M col 9r) at 5r.x
+            let d64 = A::mul_add(-p.L7, d63, A::mul_add(c_q3r, d61, s_q3r * d57)); // N(M col 9r) at 5r.z
+            let d65 = A::mul_add(p.L7, d62, A::mul_add(-s_q3r, d61, c_q3r * d57)); // N(M col 9r) at 5r.x
+            m[(13, 17)] = d65;
+            m[(17, 13)] = m[(13, 17)];
+            let d66 = A::mul_add(-s_q2r, d62, c_q2r * d58); // F(M col 9r) at 4r.y
+            let d67 = A::mul_add(c_q2r, d62, s_q2r * d58); // F(M col 9r) at 4r.z
+            let d68 = A::mul_add(-s_q2r, d64, c_q2r * d60); // N(M col 9r) at 4r.y
+            m[(12, 17)] = -d68;
+            m[(17, 12)] = m[(12, 17)];
+            let d69 = A::mul_add(c_q2r, d64, s_q2r * d60); // N(M col 9r) at 4r.z
+            let d70 = A::mul_add(-s_q1r, d67, c_q1r * d63); // F(M col 9r) at 3.y
+            let d71 = A::mul_add(c_q1r, d67, s_q1r * d63); // F(M col 9r) at 3.z
+            let d72 = A::mul_add(p.L6, d71, A::mul_add(-s_q1r, d69, c_q1r * d65)); // N(M col 9r) at 3.y
+            m[(4, 17)] = -d72;
+            m[(17, 4)] = m[(4, 17)];
+            let d73 = A::mul_add(
+                p.L5,
+                d66,
+                A::mul_add(-p.L6, d70, A::mul_add(c_q1r, d69, s_q1r * d65)),
+            ); // N(M col 9r) at 3.z
+            let d74 = A::mul_add(-p.L5, d71, d68); // N(M col 9r) at 3.x
+            let d75 = A::mul_add(s_q_torso, d71, c_q_torso * d66); // F(M col 9r) at 2.x
+            let d76 = A::mul_add(-c_q_torso, d71, s_q_torso * d66); // F(M col 9r) at 2.z
+            let d77 = A::mul_add(
+                -p.L4,
+                d70,
+                A::mul_add(p.L3, d76, A::mul_add(s_q_torso, d73, c_q_torso * d74)),
+            ); // N(M col 9r) at 2.x
+            m[(3, 17)] = -d77;
+            m[(17, 3)] = m[(3, 17)];
+            let d78 = A::mul_add(p.L4, d75, d72); // N(M col 9r) at 2.y
+            let d79 = A::mul_add(
+                -p.L3,
+                d75,
+                A::mul_add(-c_q_torso, d73, s_q_torso * d74),
+            ); // N(M col 9r) at 2.z
+            let d80 = A::mul_add(s_q_w, d76, c_q_w * d70); // F(M col 9r) at 1.y
+            let d81 = A::mul_add(-c_q_w, d76, s_q_w * d70); // F(M col 9r) at 1.z
+            let d82 = A::mul_add(p.L2, d80, A::mul_add(-p.L1, d81, d77)); // N(M col 9r) at 1.x
+            m[(2, 17)] = -d82;
+            m[(17, 2)] = m[(2, 17)];
+            let d83 = A::mul_add(-p.L2, d75, A::mul_add(s_q_w, d79, c_q_w * d78)); // N(M col 9r) at 1.y
+            let d84 = A::mul_add(p.L1, d75, A::mul_add(-c_q_w, d79, s_q_w * d78)); // N(M col 9r) at 1.z
+            let d85 = A::mul_add(c_q_imu, d81, s_q_imu * d80); // F(M col 9r) at 0.x
+            m[(0, 17)] = d85;
+            m[(17, 0)] = m[(0, 17)];
+            let d86 = A::mul_add(-s_q_imu, d84, c_q_imu * d83); // N(M col 9r) at 0.z
+            m[(1, 17)] = d86;
+            m[(17, 1)] = m[(1, 17)];
+            let d87 = p.MX8r - d42; // MSC8r.x
+            let d88 = p.MY8r - d50; // MSC8r.y
+            let d89 = p.MZ8r - d51; // MSC8r.z
+            let k4 = s_q6r * s_q6r; // sin² q6r
+            let k5 = s_q6r * c_q6r; // sin q6r cos q6r
+            let k6 = A::mul_add(2.0, k4, -1.0); // cos 2q6r
+            let d90 = pc.pc6 - d49; // JC9r: Jyy − Jzz
+            let d91 = A::mul_add(-2.0, d47 * k5, k4 * d90); // JC9r rotated about x: Jyy − J'yy
+            let d92 = p.XX8r + d48; // JC8r.xx
+            let d93 = p.XY8r + t7 + t8; // JC8r.xy
+            let d94 = p.XZ8r + t9 - t10; // JC8r.xz
+            let d95 = A::mul_add(k5, d90, A::mul_add(d47, k6, p.YZ8r)); // JC8r.yz
+            let d96 = p.ZZ8r + d49 + d91; // JC8r.zz
+            let d97 = pc.pc10 - d91; // JC8r.yy
+            m[(16, 16)] = d97;
+            let d98 = A::mul_add(c_q5r, d89, s_q5r * d87); // MSC8r in 7r.z
+            let d99 = A::mul_add(-s_q5r, d89, c_q5r * d87); // MSC8r in 7r.x
+            let t11 = c_q5r * d93; // common subexpression
+            let t12 = s_q5r * d95; // common subexpression
+            let t13 = s_q5r * d93; // common subexpression
+            let t14 = c_q5r * d95; // common subexpression
+            let t15 = p.L8 * d99; // common subexpression
+            let t16 = p.L8 * d98; // common subexpression
+            let d100 = t11 - t12 - t15; // N(M col 8r) at 7r.x
+            m[(15, 16)] = -d100;
+            m[(16, 15)] = m[(15, 16)];
+            let d101 = t13 + t14 - t16; // N(M col 8r) at 7r.z
+            let d102 = s_q4r * d99; // F(M col 8r) at 6r.y
+            let d103 = c_q4r * d99; // F(M col 8r) at 6r.z
+            let d104 = A::mul_add(-s_q4r, d101, c_q4r * d97); // N(M col 8r) at 6r.y
+            m[(14, 16)] = d104;
+            m[(16, 14)] = m[(14, 16)];
+            let d105 = A::mul_add(c_q4r, d101, s_q4r * d97); // N(M col 8r) at 6r.z
+            let d106 = A::mul_add(s_q3r, d103, c_q3r * d98); // F(M col 8r) at 5r.x
+            let d107 = A::mul_add(-c_q3r, d103, s_q3r * d98); // F(M col 8r) at 5r.z
+            let d108 = A::mul_add(p.L7, d107, A::mul_add(-s_q3r, d105, c_q3r * d100)); // N(M col 8r) at 5r.x
+            m[(13, 16)] = -d108;
+            m[(16, 13)] = m[(13, 16)];
+            let d109 = A::mul_add(-p.L7, d106, A::mul_add(c_q3r, d105, s_q3r * d100)); // N(M col 8r) at 5r.z
+            let d110 = A::mul_add(-s_q2r, d107, c_q2r * d102); // F(M col 8r) at 4r.y
+            let d111 = A::mul_add(c_q2r, d107, s_q2r * d102); // F(M col 8r) at 4r.z
+            let d112 = A::mul_add(-s_q2r, d109, c_q2r * d104); // N(M col 8r) at 4r.y
+            m[(12, 16)] = d112;
+            m[(16, 12)] = m[(12, 16)];
+            let d113 = A::mul_add(c_q2r, d109, s_q2r * d104); // N(M col 8r) at 4r.z
+            let d114 = A::mul_add(-s_q1r, d111, c_q1r * d106); // F(M col 8r) at 3.y
+            let d115 = A::mul_add(c_q1r, d111, s_q1r * d106); // F(M col 8r) at 3.z
+            let d116 = A::mul_add(-p.L5, d115, d112); // N(M col 8r) at 3.x
+            let d117 = A::mul_add(p.L6, d115, A::mul_add(-s_q1r, d113, c_q1r * d108)); // N(M col 8r) at 3.y
+            m[(4, 16)] = d117;
+            m[(16, 4)] = m[(4, 16)];
+            let d118 = A::mul_add(
+                p.L5,
+                d110,
+                A::mul_add(-p.L6, d114, A::mul_add(c_q1r, d113, s_q1r * d108)),
+            ); // N(M col 8r) at 3.z
+            let d119 = A::mul_add(s_q_torso, d115, c_q_torso * d110); // F(M col 8r) at 2.x
+            let d120 = A::mul_add(-c_q_torso, d115, s_q_torso * d110); // F(M col 8r) at 2.z
+            let d121 = A::mul_add(
+                -p.L4,
+                d114,
+                A::mul_add(p.L3, d120, A::mul_add(s_q_torso, d118, c_q_torso * d116)),
+            ); // N(M col 8r) at 2.x
+            m[(3, 16)] = d121;
+            m[(16, 3)] = m[(3, 16)];
+            let d122 = A::mul_add(p.L4, d119, d117); // N(M col 8r) at 2.y
+            let d123 = A::mul_add(
+                -p.L3,
+                d119,
+                A::mul_add(-c_q_torso, d118, s_q_torso * d116),
+            ); // N(M col 8r) at 2.z
+            let d124 = A::mul_add(-c_q_w, d120, s_q_w * d114); // F(M col 8r) at 1.z
+            let d125 = A::mul_add(s_q_w, d120, c_q_w * d114); // F(M col 8r) at 1.y
+            let d126 = A::mul_add(p.L1, d119, A::mul_add(-c_q_w, d123, s_q_w * d122)); // N(M col 8r) at 1.z
+            let d127 = A::mul_add(p.L2, d125, A::mul_add(-p.L1, d124, d121)); // N(M col 8r) at 1.x
+            m[(2, 16)] = d127;
+            m[(16, 2)] = m[(2, 16)];
+            let d128 = A::mul_add(-p.L2, d119, A::mul_add(s_q_w, d123, c_q_w * d122)); // N(M col 8r) at 1.y
+            let d129 = A::mul_add(c_q_imu, d124, s_q_imu * d125); // F(M col 8r) at 0.x
+            m[(0, 16)] = -d129;
+            m[(16, 0)] = m[(0, 16)];
+            let d130 = A::mul_add(-s_q_imu, d126, c_q_imu * d128); // N(M col 8r) at 0.z
+            m[(1, 16)] = -d130;
+            m[(16, 1)] = m[(1, 16)];
+            let d131 = p.MX7r - d99; // MSC7r.x
+            let d132 = p.MZ7r + d98; // MSC7r.z
+            let k7 = s_q5r * s_q5r; // sin² q5r
+            let k8 = s_q5r * c_q5r; // sin q5r cos q5r
+            let k9 = A::mul_add(2.0, k7, -1.0); // cos 2q5r
+            let d133 = d92 - d96; // JC8r: Jzz − Jxx
+            let d134 = A::mul_add(2.0, d94 * k8, k7 * d133); // JC8r rotated about y: Jzz − J'zz
+            let t17 = p.L8 * d88; // common subexpression
+            let d135 = p.XY7r + t11 - t12 - t15; // JC7r.xy
+            let d136 = A::mul_add(-k8, d133, A::mul_add(d94, k9, p.XZ7r)); // JC7r.xz
+            let d137 = p.YY7r + d97; // JC7r.yy
+            let d138 = p.YZ7r - t13 - t14 + t16; // JC7r.yz
+            let d139 = pc.pc13 - d88; // MSC7r.y
+            let d140 = A::mul_add(2.0, t17, d92 - d134) + pc.pc14; // JC7r.xx
+            m[(15, 15)] = d140;
+            let d141 = A::mul_add(2.0, t17, d96 + d134) + pc.pc15; // JC7r.zz
+            let d142 = A::mul_add(s_q4r, d132, c_q4r * d139); // MSC7r in 6r.y
+            let d143 = A::mul_add(-c_q4r, d132, s_q4r * d139); // MSC7r in 6r.z
+            let t18 = c_q4r * d135; // common subexpression
+            let t19 = s_q4r * d136; // common subexpression
+            let d144 = t18 + t19; // N(M col 7r) at 6r.y
+            m[(14, 15)] = -d144;
+            m[(15, 14)] = m[(14, 15)];
+            let t20 = s_q4r * d135; // common subexpression
+            let t21 = c_q4r * d136; // common subexpression
+            let d145 = t20 - t21; // N(M col 7r) at 6r.z
+            let d146 = s_q3r * d142; // F(M col 7r) at 5r.x
+            let d147 = c_q3r * d142; // F(M col 7r) at 5r.z
+            let d148 = A::mul_add(-p.L7, d146, A::mul_add(c_q3r, d145, s_q3r * d140)); // N(M col 7r) at 5r.z
+            let d149 = A::mul_add(-p.L7, d147, A::mul_add(-s_q3r, d145, c_q3r * d140)); // N(M col 7r) at 5r.x
+            m[(13, 15)] = d149;
+            m[(15, 13)] = m[(13, 15)];
+            let d150 = A::mul_add(s_q2r, d147, c_q2r * d143); // F(M col 7r) at 4r.y
+            let d151 = A::mul_add(-c_q2r, d147, s_q2r * d143); // F(M col 7r) at 4r.z
+            let d152 = A::mul_add(-s_q2r, d148, c_q2r * d144); // N(M col 7r) at 4r.y
+            m[(12, 15)] = -d152;
+            m[(15, 12)] = m[(12, 15)];
+            let d153 = A::mul_add(c_q2r, d148, s_q2r * d144); // N(M col 7r) at 4r.z
+            let d154 = A::mul_add(-s_q1r, d151, c_q1r * d146); // F(M col 7r) at 3.y
+            let d155 = A::mul_add(c_q1r, d151, s_q1r * d146); // F(M col 7r) at 3.z
+            let d156 = A::mul_add(p.L6, d155, A::mul_add(-s_q1r, d153, c_q1r * d149)); // N(M col 7r) at 3.y
+            m[(4, 15)] = -d156;
+            m[(15, 4)] = m[(4, 15)];
+            let d157 = A::mul_add(
+                p.L5,
+                d150,
+                A::mul_add(-p.L6, d154, A::mul_add(c_q1r, d153, s_q1r * d149)),
+            ); // N(M col 7r) at 3.z
+            let d158 = A::mul_add(-p.L5, d155, d152); // N(M col 7r) at 3.x
+            let d159 = A::mul_add(s_q_torso, d155, c_q_torso * d150); // F(M col 7r) at 2.x
+            let d160 = A::mul_add(-c_q_torso, d155, s_q_torso * d150); // F(M col 7r) at 2.z
+            let d161 = A::mul_add(
+                -p.L4,
+                d154,
+                A::mul_add(p.L3, d160, A::mul_add(s_q_torso, d157, c_q_torso * d158)),
+            ); // N(M col 7r) at 2.x
+            m[(3, 15)] = -d161;
+            m[(15, 3)] = m[(3, 15)];
+            let d162 = A::mul_add(p.L4, d159, d156); // N(M col 7r) at 2.y
+            let d163 = A::mul_add(
+                -p.L3,
+                d159,
+                A::mul_add(-c_q_torso, d157, s_q_torso * d158),
+            ); // N(M col 7r) at 2.z
+            let d164 = A::mul_add(s_q_w, d160, c_q_w * d154); // F(M col 7r) at 1.y
+            let d165 = A::mul_add(-c_q_w, d160, s_q_w * d154); // F(M col 7r) at 1.z
+            let d166 = A::mul_add(p.L2, d164, A::mul_add(-p.L1, d165, d161)); // N(M col 7r) at 1.x
+            m[(2, 15)] = -d166;
+            m[(15, 2)] = m[(2, 15)];
+            let d167 = A::mul_add(-p.L2, d159, A::mul_add(s_q_w, d163, c_q_w * d162)); // N(M col 7r) at 1.y
+            let d168 = A::mul_add(p.L1, d159, A::mul_add(-c_q_w, d163, s_q_w * d162)); // N(M col 7r) at 1.z
+            let d169 = A::mul_add(c_q_imu, d165, s_q_imu * d164); // F(M col 7r) at 0.x
+            m[(0, 15)] = d169;
+            m[(15, 0)] = m[(0, 15)];
+            let d170 = A::mul_add(-s_q_imu, d168, c_q_imu * d167); // N(M col 7r) at 0.z
+            m[(1, 15)] = d170;
+            m[(15, 1)] = m[(1, 15)];
+            let d171 = p.MX6r - d131; // MSC6r.x
+            let d172 = p.MY6r - d142; // MSC6r.y
+            let d173 = p.MZ6r - d143; // MSC6r.z
+            let k10 = s_q4r * s_q4r; // sin² q4r
+            let k11 = s_q4r * c_q4r; // sin q4r cos q4r
+            let k12 = A::mul_add(2.0, k10, -1.0); // cos 2q4r
+            let d174 = d137 - d141; // JC7r: Jyy − Jzz
+            let d175 = A::mul_add(-2.0, d138 * k11, k10 * d174); // JC7r rotated about x: Jyy − J'yy
+            let d176 = p.XX6r + d140; // JC6r.xx
+            let d177 = p.XY6r + t18 + t19; // JC6r.xy
+            let d178 = p.XZ6r + t20 - t21; // JC6r.xz
+            let d179 = p.YY6r + d137 - d175; // JC6r.yy
+            m[(14, 14)] = d179;
+            let d180 = A::mul_add(k11, d174, A::mul_add(d138, k12, p.YZ6r)); // JC6r.yz
+            let d181 = p.ZZ6r + d141 + d175; // JC6r.zz
+            let d182 = A::mul_add(c_q3r, d173, s_q3r * d171); // MSC6r in 5r.z
+            let d183 = A::mul_add(-s_q3r, d173, c_q3r * d171); // MSC6r in 5r.x
+            let t22 = c_q3r * d177; // common subexpression
+            let t23 = s_q3r * d180; // common subexpression
+            let t24 = s_q3r * d177; // common subexpression
+            let t25 = c_q3r * d180; // common subexpression
+            let t26 = p.L7 * d183; // common subexpression
+            let t27 = p.L7 * d182; // common subexpression
+            let d184 = t22 - t23 - t26; // N(M col 6r) at 5r.x
+            m[(13, 14)] = -d184;
+            m[(14, 13)] = m[(13, 14)];
+            let d185 = t24 + t25 - t27; // N(M col 6r) at 5r.z
+            let d186 = s_q2r * d183; // F(M col 6r) at 4r.y
+            let d187 = c_q2r * d183; // F(M col 6r) at 4r.z
+            let d188 = A::mul_add(-s_q2r, d185, c_q2r * d179); // N(M col 6r) at 4r.y
+            m[(12, 14)] = d188;
+            m[(14, 12)] = m[(12, 14)];
+            let d189 = A::mul_add(c_q2r, d185, s_q2r * d179); // N(M col 6r) at 4r.z
+            let d190 = A::mul_add(s_q1r, d187, c_q1r * d182); // F(M col 6r) at 3.y
+            let d191 = A::mul_add(-c_q1r, d187, s_q1r * d182); // F(M col 6r) at 3.z
+            let d192 = A::mul_add(-p.L5, d191, d188); // N(M col 6r) at 3.x
+            let d193 = A::mul_add(p.L6, d191, A::mul_add(-s_q1r, d189, c_q1r * d184)); // N(M col 6r) at 3.y
+            m[(4, 14)] = d193;
+            m[(14, 4)] = m[(4, 14)];
+            let d194 = A::mul_add(
+                p.L5,
+                d186,
+                A::mul_add(-p.L6, d190, A::mul_add(c_q1r, d189, s_q1r * d184)),
+            ); // N(M col 6r) at 3.z
+            let d195 = A::mul_add(s_q_torso, d191, c_q_torso * d186); // F(M col 6r) at 2.x
+            let d196 = A::mul_add(-c_q_torso, d191, s_q_torso * d186); // F(M col 6r) at 2.z
+            let d197 = A::mul_add(
+                -p.L4,
+                d190,
+                A::mul_add(p.L3, d196, A::mul_add(s_q_torso, d194, c_q_torso * d192)),
+            ); // N(M col 6r) at 2.x
+            m[(3, 14)] = d197;
+            m[(14, 3)] = m[(3, 14)];
+            let d198 = A::mul_add(p.L4, d195, d193); // N(M col 6r) at 2.y
+            let d199 = A::mul_add(
+                -p.L3,
+                d195,
+                A::mul_add(-c_q_torso, d194, s_q_torso * d192),
+            ); // N(M col 6r) at 2.z
+            let d200 = A::mul_add(-c_q_w, d196, s_q_w * d190); // F(M col 6r) at 1.z
+            let d201 = A::mul_add(s_q_w, d196, c_q_w * d190); // F(M col 6r) at 1.y
+            let d202 = A::mul_add(p.L1, d195, A::mul_add(-c_q_w, d199, s_q_w * d198)); // N(M col 6r) at 1.z
+            let d203 = A::mul_add(p.L2, d201, A::mul_add(-p.L1, d200, d197)); // N(M col 6r) at 1.x
+            m[(2, 14)] = d203;
+            m[(14, 2)] = m[(2, 14)];
+            let d204 = A::mul_add(-p.L2, d195, A::mul_add(s_q_w, d199, c_q_w * d198)); // N(M col 6r) at 1.y
+            let d205 = A::mul_add(c_q_imu, d200, s_q_imu * d201); // F(M col 6r) at 0.x
+            m[(0, 14)] = -d205;
+            m[(14, 0)] = m[(0, 14)];
+            let d206 = A::mul_add(-s_q_imu, d202, c_q_imu * d204); // N(M col 6r) at 0.z
+            m[(1, 14)] = -d206;
+            m[(14, 1)] = m[(1, 14)];
+            let d207 = p.MX5r - d183; // MSC5r.x
+            let d208 = p.MZ5r + d182; // MSC5r.z
+            let k13 = s_q3r * s_q3r; // sin² q3r
+            let k14 = s_q3r * c_q3r; // sin q3r cos q3r
+            let k15 = A::mul_add(2.0, k13, -1.0); // cos 2q3r
+            let d209 = d176 - d181; // JC6r: Jzz − Jxx
+            let d210 = A::mul_add(2.0, d178 * k14, k13 * d209); // JC6r rotated about y: Jzz − J'zz
+            let t28 = p.L7 * d172; // common subexpression
+            let d211 = p.XY5r + t22 - t23 - t26; // JC5r.xy
+            let d212 = A::mul_add(-k14, d209, A::mul_add(d178, k15, p.XZ5r)); // JC5r.xz
+            let d213 = p.YY5r + d179; // JC5r.yy
+            let d214 = p.YZ5r - t24 - t25 + t27; // JC5r.yz
+            let d215 = pc.pc19 - d172; // MSC5r.y
+            let d216 = A::mul_add(2.0, t28, d176 - d210) + pc.pc20; // JC5r.xx
+            m[(13, 13)] = d216;
+            let d217 = A::mul_add(2.0, t28, d181 + d210) + pc.pc21; // JC5r.zz
+            let d218 = A::mul_add(s_q2r, d208, c_q2r * d215); // MSC5r in 4r.y
+            let d219 = A::mul_add(-c_q2r, d208, s_q2r * d215); // MSC5r in 4r.z
+            let t29 = c_q2r * d211; // common subexpression
+            let t30 = s_q2r * d212; // common subexpression
+            let d220 = t29 + t30; // N(M col 5r) at 4r.y
+            m[(12, 13)] = -d220;
+            m[(13, 12)] = m[(12, 13)];
+            let t31 = s_q2r * d211; // common subexpression
+            let t32 = c_q2r * d212; // common subexpression
+            let d221 = t31 - t32; // N(M col 5r) at 4r.z
+            let d222 = s_q1r * d218; // F(M col 5r) at 3.y
+            let d223 = c_q1r * d218; // F(M col 5r) at 3.z
+            let d224 = A::mul_add(-p.L6, d223, A::mul_add(-s_q1r, d221, c_q1r * d216)); // N(M col 5r) at 3.y
+            m[(4, 13)] = -d224;
+            m[(13, 4)] = m[(4, 13)];
+            let d225 = A::mul_add(
+                p.L5,
+                d219,
+                A::mul_add(-p.L6, d222, A::mul_add(c_q1r, d221, s_q1r * d216)),
+            ); // N(M col 5r) at 3.z
+            let d226 = A::mul_add(p.L5, d223, d220); // N(M col 5r) at 3.x
+            let d227 = A::mul_add(-s_q_torso, d223, c_q_torso * d219); // F(M col 5r) at 2.x
+            let d228 = A::mul_add(c_q_torso, d223, s_q_torso * d219); // F(M col 5r) at 2.z
+            let d229 = A::mul_add(
+                -p.L4,
+                d222,
+                A::mul_add(p.L3, d228, A::mul_add(s_q_torso, d225, c_q_torso * d226)),
+            ); // N(M col 5r) at 2.x
+            m[(3, 13)] = -d229;
+            m[(13, 3)] = m[(3, 13)];
+            let d230 = A::mul_add(p.L4, d227, d224); // N(M col 5r) at 2.y
+            let d231 = A::mul_add(
+                -p.L3,
+                d227,
+                A::mul_add(-c_q_torso, d225, s_q_torso * d226),
+            ); // N(M col 5r) at 2.z
+            let d232 = A::mul_add(s_q_w, d228, c_q_w * d222); // F(M col 5r) at 1.y
+            let d233 = A::mul_add(-c_q_w, d228, s_q_w * d222); // F(M col 5r) at 1.z
+            let d234 = A::mul_add(p.L2, d232, A::mul_add(-p.L1, d233, d229)); // N(M col 5r) at 1.x
+            m[(2, 13)] = -d234;
+            m[(13, 2)] = m[(2, 13)];
+            let d235 = A::mul_add(-p.L2, d227, A::mul_add(s_q_w, d231, c_q_w * d230)); // N(M col 5r) at 1.y
+            let d236 = A::mul_add(p.L1, d227, A::mul_add(-c_q_w, d231, s_q_w * d230)); // N(M col 5r) at 1.z
+            let d237 = A::mul_add(c_q_imu, d233, s_q_imu * d232); // F(M col 5r) at 0.x
+            m[(0, 13)] = d237;
+            m[(13, 0)] = m[(0, 13)];
+            let d238 = A::mul_add(-s_q_imu, d236, c_q_imu * d235); // N(M col 5r) at 0.z
+            m[(1, 13)] = d238;
+            m[(13, 1)] = m[(1, 13)];
+            let d239 = p.MX4r - d207; // MSC4r.x
+            let d240 = p.MY4r - d218; // MSC4r.y
+            let d241 = p.MZ4r - d219; // MSC4r.z
+            let k16 = s_q2r * s_q2r; // sin² q2r
+            let k17 = s_q2r * c_q2r; // sin q2r cos q2r
+            let k18 = A::mul_add(2.0, k16, -1.0); // cos 2q2r
+            let d242 = d213 - d217; // JC5r: Jyy − Jzz
+            let d243 = A::mul_add(-2.0, d214 * k17, k16 * d242); // JC5r rotated about x: Jyy − J'yy
+            let d244 = p.XX4r + d216; // JC4r.xx
+            let d245 = p.XY4r + t29 + t30; // JC4r.xy
+            let d246 = p.XZ4r + t31 - t32; // JC4r.xz
+            let d247 = p.YY4r + d213 - d243; // JC4r.yy
+            m[(12, 12)] = d247;
+            let d248 = A::mul_add(k17, d242, A::mul_add(d214, k18, p.YZ4r)); // JC4r.yz
+            let d249 = p.ZZ4r + d217 + d243; // JC4r.zz
+            let d250 = A::mul_add(-s_q1r, d241, c_q1r * d239); // MSC4r in 3.y
+            let d251 = A::mul_add(c_q1r, d241, s_q1r * d239); // MSC4r in 3.z
+            let t33 = c_q1r * d245; // common subexpression
+            let t34 = s_q1r * d248; // common subexpression
+            let t35 = s_q1r * d245; // common subexpression
+            let t36 = c_q1r * d248; // common subexpression
+            let t37 = p.L5 * d250; // common subexpression
+            let t38 = p.L6 * d250; // common subexpression
+            let t39 = p.L6 * d251; // common subexpression
+            let d252 = d247 + t37; // N(M col 4r) at 3.x
+            let d253 = t33 - t34 - t38; // N(M col 4r) at 3.y
+            m[(4, 12)] = d253;
+            m[(12, 4)] = m[(4, 12)];
+            let d254 = t35 + t36 - t39; // N(M col 4r) at 3.z
+            let d255 = s_q_torso * d250; // F(M col 4r) at 2.x
+            let d256 = c_q_torso * d250; // F(M col 4r) at 2.z
+            let d257 = A::mul_add(
+                -p.L4,
+                d251,
+                A::mul_add(p.L3, d256, A::mul_add(s_q_torso, d254, c_q_torso * d252)),
+            ); // N(M col 4r) at 2.x
+            m[(3, 12)] = d257;
+            m[(12, 3)] = m[(3, 12)];
+            let d258 = A::mul_add(-p.L4, d255, d253); // N(M col 4r) at 2.y
+            let d259 = A::mul_add(
+                p.L3,
+                d255,
+                A::mul_add(-c_q_torso, d254, s_q_torso * d252),
+            ); // N(M col 4r) at 2.z
+            let d260 = A::mul_add(-c_q_w, d256, s_q_w * d251); // F(M col 4r) at 1.z
+            let d261 = A::mul_add(s_q_w, d256, c_q_w * d251); // F(M col 4r) at 1.y
+            let d262 = A::mul_add(-p.L1, d255, A::mul_add(-c_q_w, d259, s_q_w * d258)); // N(M col 4r) at 1.z
+            let d263 = A::mul_add(p.L2, d261, A::mul_add(-p.L1, d260, d257)); // N(M col 4r) at 1.x
+            m[(2, 12)] = d263;
+            m[(12, 2)] = m[(2, 12)];
+            let d264 = A::mul_add(p.L2, d255, A::mul_add(s_q_w, d259, c_q_w * d258)); // N(M col 4r) at 1.y
+            let d265 = A::mul_add(c_q_imu, d260, s_q_imu * d261); // F(M col 4r) at 0.x
+            m[(0, 12)] = -d265;
+            m[(12, 0)] = m[(0, 12)];
+            let d266 = A::mul_add(-s_q_imu, d262, c_q_imu * d264); // N(M col 4r) at 0.z
+            m[(1, 12)] = -d266;
+            m[(12, 1)] = m[(1, 12)];
+            let k19 = s_q1r * s_q1r; // sin² q1r
+            let k20 = s_q1r * c_q1r; // sin q1r cos q1r
+            let k21 = A::mul_add(2.0, k19, -1.0); // cos 2q1r
+            let d267 = d244 - d249; // JC4r: Jzz − Jxx
+            let d268 = A::mul_add(2.0, d246 * k20, k19 * d267); // JC4r rotated about y: Jzz − J'zz
+            let t40 = p.L6 * d240; // common subexpression
+            let d269 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
+            let d270 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
+            let t41 = p.XZ10l * c_q7l; // common subexpression
+            let t42 = p.YZ10l * s_q7l; // common subexpression
+            let t43 = p.XZ10l * s_q7l; // common subexpression
+            let t44 = p.YZ10l * c_q7l; // common subexpression
+            let t45 = p.L9 * d270; // common subexpression
+            let t46 = p.L9 * d269; // common subexpression
+            let d271 = t41 + t42 - t45; // N(M col 10l) at 9l.x
+            m[(10, 11)] = -d271;
+            m[(11, 10)] = m[(10, 11)];
+            let d272 = t43 - t44 - t46; // N(M col 10l) at 9l.z
+            let d273 = d270 * s_q6l; // F(M col 10l) at 8l.y
+            let d274 = d270 * c_q6l; // F(M col 10l) at 8l.z
+            let d275 = A::mul_add(-d272, s_q6l, p.ZZ10l * c_q6l); // N(M col 10l) at 8l.y
+            m[(9, 11)] = d275;
+            m[(11, 9)] = m[(9, 11)];
+            let d276 = A::mul_add(d272, c_q6l, p.ZZ10l * s_q6l); // N(M col 10l) at 8l.z
+            let d277 = A::mul_add(d274, s_q5l, d269 * c_q5l); // F(M col 10l) at 7l.x
+            let d278 = A::mul_add(-d274, c_q5l, d269 * s_q5l); // F(M col 10l) at 7l.z
+            let d279 = A::mul_add(p.L8, d278, A::mul_add(-d276, s_q5l, d271 * c_q5l)); // N(M col 10l) at 7l.x
+            m[(8, 11)] = -d279;
+            m[(11, 8)] = m[(8, 11)];
+            let d280 = A::mul_add(-p.L8, d277, A::mul_add(d276, c_q5l, d271 * s_q5l)); // N(M col 10l) at 7l.z
+            let d281 = A::mul_add(-d278, s_q4l, d273 * c_q4l); // F(M col 10l) at 6l.y
+            let d282 = A::mul_add(d278, c_q4l, d273 * s_q4l); // F(M col 10l) at 6l.z
+            let d283 = A::mul_add(-d280, s_q4l, d275 * c_q4l); // N(M col 10l) at 6l.y
+            m[(7, 11)] = d283;
+            m[(11, 7)] = m[(7, 11)];
+            let d284 = A::mul_add(d280, c_q4l, d275 * s_q4l); // N(M col 10l) at 6l.z
+            let d285 = A::mul_add(-d282, s_q3l, d277 * c_q3l); // F(M col 10l) at 5l.x
+            let d286 = A::mul_add(d282, c_q3l, d277 * s_q3l); // F(M col 10l) at 5l.z
+            let d287 = A::mul_add(p.L7, d286, A::mul_add(-d284, s_q3l, d279 * c_q3l)); // N(M col 10l) at 5l.x
+            m[(6, 11)] = -d287;
+            m[(11, 6)] = m[(6, 11)];
+            let d288 = A::mul_add(-p.L7, d285, A::mul_add(d284, c_q3l, d279 * s_q3l)); // N(M col 10l) at 5l.z
+            let d289 = A::mul_add(-d286, s_q2l, d281 * c_q2l); // F(M col 10l) at 4l.y
+            let d290 = A::mul_add(d286, c_q2l, d281 * s_q2l); // F(M col 10l) at 4l.z
+            let d291 = A::mul_add(-d288, s_q2l, d283 * c_q2l); // N(M col 10l) at 4l.y
+            m[(5, 11)] = d291;
+            m[(11, 5)] = m[(5, 11)];
+            let d292 = A::mul_add(d288, c_q2l, d283 * s_q2l); // N(M col 10l) at 4l.z
+            let d293 = A::mul_add(d290, c_q1l, d285 * s_q1l); // F(M col 10l) at 3.z
+            let d294 = A::mul_add(-d290, s_q1l, d285 * c_q1l); // F(M col 10l) at 3.y
+            let d295 = A::mul_add(
+                p.L5,
+                d289,
+                A::mul_add(-p.L6, d294, A::mul_add(d292, c_q1l, d287 * s_q1l)),
+            ); // N(M col 10l) at 3.z
+            let d296 = A::mul_add(-p.L5, d293, d291); // N(M col 10l) at 3.x
+            let d297 = A::mul_add(p.L6, d293, A::mul_add(-d292, s_q1l, d287 * c_q1l)); // N(M col 10l) at 3.y
+            m[(4, 11)] = d297;
+            m[(11, 4)] = m[(4, 11)];
+            let d298 = A::mul_add(s_q_torso, d293, c_q_torso * d289); // F(M col 10l) at 2.x
+            let d299 = A::mul_add(-c_q_torso, d293, s_q_torso * d289); // F(M col 10l) at 2.z
+            let d300 = A::mul_add(
+                p.L4,
+                d294,
+                A::mul_add(p.L3, d299, A::mul_add(s_q_torso, d295, c_q_torso * d296)),
+            ); // N(M col 10l) at 2.x
+            m[(3, 11)] = -d300;
+            m[(11, 3)] = m[(3, 11)];
+            let d301 = A::mul_add(
+                -p.L3,
+                d298,
+                A::mul_add(-c_q_torso, d295, s_q_torso * d296),
+            ); // N(M col 10l) at 2.z
+            let d302 = A::mul_add(-p.L4, d298, d297); // N(M col 10l) at 2.y
+            let d303 = A::mul_add(c_q_w, d299, s_q_w * d294); // F(M col 10l) at 1.z
+            let d304 = A::mul_add(-s_q_w, d299, c_q_w * d294); // F(M col 10l) at 1.y
+            let d305 = A::mul_add(-p.L2, d304, A::mul_add(p.L1, d303, d300)); // N(M col 10l) at 1.x
+            m[(2, 11)] = -d305;
+            m[(11, 2)] = m[(2, 11)];
+            let d306 = A::mul_add(-p.L1, d298, A::mul_add(c_q_w, d301, s_q_w * d302)); // N(M col 10l) at 1.z
+            let d307 = A::mul_add(p.L2, d298, A::mul_add(-s_q_w, d301, c_q_w * d302)); // N(M col 10l) at 1.y
+            let d308 = A::mul_add(c_q_imu, d303, s_q_imu * d304); // F(M col 10l) at 0.x
+            m[(0, 11)] = -d308;
+            m[(11, 0)] = m[(0, 11)];
+            let d309 = A::mul_add(-s_q_imu, d306, c_q_imu * d307); // N(M col 10l) at 0.z
+            m[(1, 11)] = -d309;
+            m[(11, 1)] = m[(1, 11)];
+            let d310 = p.MX9l - d270; // MSC9l.x
+            let d311 = p.MZ9l + d269; // MSC9l.z
+            let k22 = s_q7l * s_q7l; // sin² q7l
+            let k23 = s_q7l * c_q7l; // sin q7l cos q7l
+            let k24 = A::mul_add(2.0, k22, -1.0); // cos 2q7l
+            let d312 = A::mul_add(-2.0, p.XY10l * k23, k22 * pc.pc26); // JC10l rotated about z: Jxx − J'xx
+            let d313 = p.XY9l + t41 + t42 - t45; // JC9l.xy
+            let d314 = A::mul_add(-k23, pc.pc26, A::mul_add(-p.XY10l, k24, p.XZ9l)); // JC9l.xz
+            let d315 = p.YZ9l - t43 + t44 + t46; // JC9l.yz
+            let d316 = pc.pc30 - d312; // JC9l.xx
+            m[(10, 10)] = d316;
+            let d317 = d312 + pc.pc31; // JC9l.zz
+            let d318 = A::mul_add(s_q6l, d311, c_q6l * pc.pc25); // MSC9l in 8l.y
+            let d319 = A::mul_add(-c_q6l, d311, s_q6l * pc.pc25); // MSC9l in 8l.z
+            let t47 = c_q6l * d313; // common subexpression
+            let t48 = s_q6l * d314; // common subexpression
+            let d320 = t47 + t48; // N(M col 9l) at 8l.y
+            m[(9, 10)] = -d320;
+            m[(10, 9)] = m[(9, 10)];
+            let t49 = s_q6l * d313; // common subexpression
+            let t50 = c_q6l * d314; // common subexpression
+            let d321 = t49 - t50; // N(M col 9l) at 8l.z
+            let d322 = s_q5l * d318; // F(M col 9l) at 7l.x
+            let d323 = c_q5l * d318; // F(M col 9l) at 7l.z
+            let d324 = A::mul_add(-p.L8, d322, A::mul_add(c_q5l, d321, s_q5l * d316)); // N(M col 9l) at 7l.z
+            let d325 = A::mul_add(-p.L8, d323, A::mul_add(-s_q5l, d321, c_q5l * d316)); // N(M col 9l) at 7l.x
+            m[(8, 10)] = d325;
+            m[(10, 8)] = m[(8, 10)];
+            let d326 = A::mul_add(s_q4l, d323, c_q4l * d319); // F(M col 9l) at 6l.y
+            let d327 = A::mul_add(-c_q4l, d323, s_q4l * d319); // F(M col 9l) at 6l.z
+            let d328 = A::mul_add(-s_q4l, d324, c_q4l * d320); // N(M col 9l) at 6l.y
+            m[(7, 10)] = -d328;
+            m[(10, 7)] = m[(7, 10)];
+            let d329 = A::mul_add(c_q4l, d324, s_q4l * d320); // N(M col 9l) at 6l.z
+            let d330 = A::mul_add(c_q3l, d327, s_q3l * d322); // F(M col 9l) at 5l.z
+            let d331 = A::mul_add(-s_q3l, d327, c_q3l * d322); // F(M col 9l) at 5l.x
+            let d332 = A::mul_add(-p.L7, d331, A::mul_add(c_q3l, d329, s_q3l * d325)); // N(M col 9l) at 5l.z
+            let d333 = A::mul_add(p.L7, d330, A::mul_add(-s_q3l, d329, c_q3l * d325)); // N(M col 9l) at 5l.x
+            m[(6, 10)] = d333;
+            m[(10, 6)] = m[(6, 10)];
+            let d334 = A::mul_add(-s_q2l, d330, c_q2l * d326); // F(M col 9l) at 4l.y
+            let d335 = A::mul_add(c_q2l, d330, s_q2l * d326); // F(M col 9l) at 4l.z
+            let d336 = A::mul_add(-s_q2l, d332, c_q2l * d328); // N(M col 9l) at 4l.y
+            m[(5, 10)] = -d336;
+            m[(10, 5)] = m[(5, 10)];
+            let d337 = A::mul_add(c_q2l, d332, s_q2l * d328); // N(M col 9l) at 4l.z
+            let d338 = A::mul_add(-s_q1l, d335, c_q1l * d331); // F(M col 9l) at 3.y
+            let d339 = A::mul_add(c_q1l, d335, s_q1l * d331); // F(M col 9l) at 3.z
+            let d340 = A::mul_add(-p.L5, d339, d336); // N(M col 9l) at 3.x
+            let d341 = A::mul_add(p.L6, d339, A::mul_add(-s_q1l, d337, c_q1l * d333)); // N(M col 9l) at 3.y
+            m[(4, 10)] = -d341;
+            m[(10, 4)] = m[(4, 10)];
+            let d342 = A::mul_add(
+                p.L5,
+                d334,
+                A::mul_add(-p.L6, d338, A::mul_add(c_q1l, d337, s_q1l * d333)),
+            ); // N(M col 9l) at 3.z
+            let d343 = A::mul_add(s_q_torso, d339, c_q_torso * d334); // F(M col 9l) at 2.x
+            let d344 = A::mul_add(-c_q_torso, d339, s_q_torso * d334); // F(M col 9l) at 2.z
+            let d345 = A::mul_add(-p.L4, d343, d341); // N(M col 9l) at 2.y
+            let d346 = A::mul_add(
+                p.L4,
+                d338,
+                A::mul_add(p.L3, d344, A::mul_add(s_q_torso, d342, c_q_torso * d340)),
+            ); // N(M col 9l) at 2.x
+            m[(3, 10)] = d346;
+            m[(10, 3)] = m[(3, 10)];
+            let d347 = A::mul_add(
+                -p.L3,
+                d343,
+                A::mul_add(-c_q_torso, d342, s_q_torso * d340),
+            ); // N(M col 9l) at 2.z
+            let d348 = A::mul_add(-s_q_w, d344, c_q_w * d338); // F(M col 9l) at 1.y
+            let d349 = A::mul_add(c_q_w, d344, s_q_w * d338); // F(M col 9l) at 1.z
+            let d350 = A::mul_add(p.L2, d343, A::mul_add(-s_q_w, d347, c_q_w * d345)); // N(M col 9l) at 1.y
+            let d351 = A::mul_add(-p.L2, d348, A::mul_add(p.L1, d349, d346)); // N(M col 9l) at 1.x
+            m[(2, 10)] = d351;
+            m[(10, 2)] = m[(2, 10)];
+            let d352 = A::mul_add(-p.L1, d343, A::mul_add(c_q_w, d347, s_q_w * d345)); // N(M col 9l) at 1.z
+            let d353 = A::mul_add(c_q_imu, d349, s_q_imu * d348); // F(M col 9l) at 0.x
+            m[(0, 10)] = d353;
+            m[(10, 0)] = m[(0, 10)];
+            let d354 = A::mul_add(-s_q_imu, d352, c_q_imu * d350); // N(M col 9l) at 0.z
+            m[(1, 10)] = d354;
+            m[(10, 1)] = m[(1, 10)];
+            let d355 = p.MX8l - d310; // MSC8l.x
+            let d356 = p.MY8l - d318; // MSC8l.y
+            let d357 = p.MZ8l - d319; // MSC8l.z
+            let k25 = s_q6l * s_q6l; // sin² q6l
+            let k26 = s_q6l * c_q6l; // sin q6l cos q6l
+            let k27 = A::mul_add(2.0, k25, -1.0); // cos 2q6l
+            let d358 = pc.pc29 - d317; // JC9l: Jyy − Jzz
+            let d359 = A::mul_add(-2.0, d315 * k26, k25 * d358); // JC9l rotated about x: Jyy − J'yy
+            let d360 = p.XX8l + d316; // JC8l.xx
+            let d361 = p.XY8l + t47 + t48; // JC8l.xy
+            let d362 = p.XZ8l + t49 - t50; // JC8l.xz
+            let d363 = A::mul_add(k26, d358, A::mul_add(d315, k27, p.YZ8l)); // JC8l.yz
+            let d364 = p.ZZ8l + d317 + d359; // JC8l.zz
+            let d365 = pc.pc33 - d359; // JC8l.yy
+            m[(9, 9)] = d365;
+            let d366 = A::mul_add(c_q5l, d357, s_q5l * d355); // MSC8l in 7l.z
+            let d367 = A::mul_add(-s_q5l, d357, c_q5l * d355); // MSC8l in 7l.x
+            let t51 = c_q5l * d361; // common subexpression
+            let t52 = s_q5l * d363; // common subexpression
+            let t53 = s_q5l * d361; // common subexpression
+            let t54 = c_q5l * d363; // common subexpression
+            let t55 = p.L8 * d367; // common subexpression
+            let t56 = p.L8 * d366; // common subexpression
+            let d368 = t51 - t52 - t55; // N(M col 8l) at 7l.x
+            m[(8, 9)] = -d368;
+            m[(9, 8)] = m[(8, 9)];
+            let d369 = t53 + t54 - t56; // N(M col 8l) at 7l.z
+            let d370 = s_q4l * d367; // F(M col 8l) at 6l.y
+            let d371 = c_q4l * d367; // F(M col 8l) at 6l.z
+            let d372 = A::mul_add(-s_q4l, d369, c_q4l * d365); // N(M col 8l) at 6l.y
+            m[(7, 9)] = d372;
+            m[(9, 7)] = m[(7, 9)];
+            let d373 = A::mul_add(c_q4l, d369, s_q4l * d365); // N(M col 8l) at 6l.z
+            let d374 = A::mul_add(s_q3l, d371, c_q3l * d366); // F(M col 8l) at 5l.x
+            let d375 = A::mul_add(-c_q3l, d371, s_q3l * d366); // F(M col 8l) at 5l.z
+            let d376 = A::mul_add(p.L7, d375, A::mul_add(-s_q3l, d373, c_q3l * d368)); // N(M col 8l) at 5l.x
+            m[(6, 9)] = -d376;
+            m[(9, 6)] = m[(6, 9)];
+            let d377 = A::mul_add(-p.L7, d374, A::mul_add(c_q3l, d373, s_q3l * d368)); // N(M col 8l) at 5l.z
+            let d378 = A::mul_add(-s_q2l, d375, c_q2l * d370); // F(M col 8l) at 4l.y
+            let d379 = A::mul_add(c_q2l, d375, s_q2l * d370); // F(M col 8l) at 4l.z
+            let d380 = A::mul_add(-s_q2l, d377, c_q2l * d372); // N(M col 8l) at 4l.y
+            m[(5, 9)] = d380;
+            m[(9, 5)] = m[(5, 9)];
+            let d381 = A::mul_add(c_q2l, d377, s_q2l * d372); // N(M col 8l) at 4l.z
+            let d382 = A::mul_add(c_q1l, d379, s_q1l * d374); // F(M col 8l) at 3.z
+            let d383 = A::mul_add(-s_q1l, d379, c_q1l * d374); // F(M col 8l) at 3.y
+            let d384 = A::mul_add(
+                p.L5,
+                d378,
+                A::mul_add(-p.L6, d383, A::mul_add(c_q1l, d381, s_q1l * d376)),
+            ); // N(M col 8l) at 3.z
+            let d385 = A::mul_add(-p.L5, d382, d380); // N(M col 8l) at 3.x
+            let d386 = A::mul_add(p.L6, d382, A::mul_add(-s_q1l, d381, c_q1l * d376)); // N(M col 8l) at 3.y
+            m[(4, 9)] = d386;
+            m[(9, 4)] = m[(4, 9)];
+            let d387 = A::mul_add(s_q_torso, d382, c_q_torso * d378); // F(M col 8l) at 2.x
+            let d388 = A::mul_add(-c_q_torso, d382, s_q_torso * d378); // F(M col 8l) at 2.z
+            let d389 = A::mul_add(
+                p.L4,
+                d383,
+                A::mul_add(p.L3, d388, A::mul_add(s_q_torso, d384, c_q_torso * d385)),
+            ); // N(M col 8l) at 2.x
+            m[(3, 9)] = -d389;
+            m[(9, 3)] = m[(3, 9)];
+            let d390 = A::mul_add(
+                -p.L3,
+                d387,
+                A::mul_add(-c_q_torso, d384, s_q_torso * d385),
+            ); // N(M col 8l) at 2.z
+            let d391 = A::mul_add(-p.L4, d387, d386); // N(M col 8l) at 2.y
+            let d392 = A::mul_add(c_q_w, d388, s_q_w * d383); // F(M col 8l) at 1.z
+            let d393 = A::mul_add(-s_q_w, d388, c_q_w * d383); // F(M col 8l) at 1.y
+            let d394 = A::mul_add(-p.L2, d393, A::mul_add(p.L1, d392, d389)); // N(M col 8l) at 1.x
+            m[(2, 9)] = -d394;
+            m[(9, 2)] = m[(2, 9)];
+            let d395 = A::mul_add(-p.L1, d387, A::mul_add(c_q_w, d390, s_q_w * d391)); // N(M col 8l) at 1.z
+            let d396 = A::mul_add(p.L2, d387, A::mul_add(-s_q_w, d390, c_q_w * d391)); // N(M col 8l) at 1.y
+            let d397 = A::mul_add(c_q_imu, d392, s_q_imu * d393); // F(M col 8l) at 0.x
+            m[(0, 9)] = -d397;
+            m[(9, 0)] = m[(0, 9)];
+            let d398 = A::mul_add(-s_q_imu, d395, c_q_imu * d396); // N(M col 8l) at 0.z
+            m[(1, 9)] = -d398;
+            m[(9, 1)] = m[(1, 9)];
+            let d399 = p.MX7l - d367; // MSC7l.x
+            let d400 = p.MZ7l + d366; // MSC7l.z
+            let k28 = s_q5l * s_q5l; // sin² q5l
+            let k29 = s_q5l * c_q5l; // sin q5l cos q5l
+            let k30 = A::mul_add(2.0, k28, -1.0); // cos 2q5l
+            let d401 = d360 - d364; // JC8l: Jzz − Jxx
+            let d402 = A::mul_add(2.0, d362 * k29, k28 * d401); // JC8l rotated about y: Jzz − J'zz
+            let t57 = p.L8 * d356; // common subexpression
+            let d403 = p.XY7l + t51 - t52 - t55; // JC7l.xy
+            let d404 = A::mul_add(-k29, d401, A::mul_add(d362, k30, p.XZ7l)); // JC7l.xz
+            let d405 = p.YY7l + d365; // JC7l.yy
+            let d406 = p.YZ7l - t53 - t54 + t56; // JC7l.yz
+            let d407 = pc.pc36 - d356; // MSC7l.y
+            let d408 = A::mul_add(2.0, t57, d360 - d402) + pc.pc37; // JC7l.xx
+            m[(8, 8)] = d408;
+            let d409 = A::mul_add(2.0, t57, d364 + d402) + pc.pc38; // JC7l.zz
+            let d410 = A::mul_add(s_q4l, d400, c_q4l * d407); // MSC7l in 6l.y
+            let d411 = A::mul_add(-c_q4l, d400, s_q4l * d407); // MSC7l in 6l.z
+            let t58 = c_q4l * d403; // common subexpression
+            let t59 = s_q4l * d404; // common subexpression
+            let d412 = t58 + t59; // N(M col 7l) at 6l.y
+            m[(7, 8)] = -d412;
+            m[(8, 7)] = m[(7, 8)];
+            let t60 = s_q4l * d403; // common subexpression
+            let t61 = c_q4l * d404; // common subexpression
+            let d413 = t60 - t61; // N(M col 7l) at 6l.z
+            let d414 = s_q3l * d410; // F(M col 7l) at 5l.x
+            let d415 = c_q3l * d410; // F(M col 7l) at 5l.z
+            let d416 = A::mul_add(-p.L7, d414, A::mul_add(c_q3l, d413, s_q3l * d408)); // N(M col 7l) at 5l.z
+            let d417 = A::mul_add(-p.L7, d415, A::mul_add(-s_q3l, d413, c_q3l * d408)); // N(M col 7l) at 5l.x
+            m[(6, 8)] = d417;
+            m[(8, 6)] = m[(6, 8)];
+            let d418 = A::mul_add(s_q2l, d415, c_q2l * d411); // F(M col 7l) at 4l.y
+            let d419 = A::mul_add(-c_q2l, d415, s_q2l * d411); // F(M col 7l) at 4l.z
+            let d420 = A::mul_add(-s_q2l, d416, c_q2l * d412); // N(M col 7l) at 4l.y
+            m[(5, 8)] = -d420;
+            m[(8, 5)] = m[(5, 8)];
+            let d421 = A::mul_add(c_q2l, d416, s_q2l * d412); // N(M col 7l) at 4l.z
+            let d422 = A::mul_add(-s_q1l, d419, c_q1l * d414); // F(M col 7l) at 3.y
+            let d423 = A::mul_add(c_q1l, d419, s_q1l * d414); // F(M col 7l) at 3.z
+            let d424 = A::mul_add(-p.L5, d423, d420); // N(M col 7l) at 3.x
+            let d425 = A::mul_add(p.L6, d423, A::mul_add(-s_q1l, d421, c_q1l * d417)); // N(M col 7l) at 3.y
+            m[(4, 8)] = -d425;
+            m[(8, 4)] = m[(4, 8)];
+            let d426 = A::mul_add(
+                p.L5,
+                d418,
+                A::mul_add(-p.L6, d422, A::mul_add(c_q1l, d421, s_q1l * d417)),
+            ); // N(M col 7l) at 3.z
+            let d427 = A::mul_add(s_q_torso, d423, c_q_torso * d418); // F(M col 7l) at 2.x
+            let d428 = A::mul_add(-c_q_torso, d423, s_q_torso * d418); // F(M col 7l) at 2.z
+            let d429 = A::mul_add(-p.L4, d427, d425); // N(M col 7l) at 2.y
+            let d430 = A::mul_add(
+                p.L4,
+                d422,
+                A::mul_add(p.L3, d428, A::mul_add(s_q_torso, d426, c_q_torso * d424)),
+            ); // N(M col 7l) at 2.x
+            m[(3, 8)] = d430;
+            m[(8, 3)] = m[(3, 8)];
+            let d431 = A::mul_add(
+                -p.L3,
+                d427,
+                A::mul_add(-c_q_torso, d426, s_q_torso * d424),
+            ); // N(M col 7l) at 2.z
+            let d432 = A::mul_add(-s_q_w, d428, c_q_w * d422); // F(M col 7l) at 1.y
+            let d433 = A::mul_add(c_q_w, d428, s_q_w * d422); // F(M col 7l) at 1.z
+            let d434 = A::mul_add(p.L2, d427, A::mul_add(-s_q_w, d431, c_q_w * d429)); // N(M col 7l) at 1.y
+            let d435 = A::mul_add(-p.L2, d432, A::mul_add(p.L1, d433, d430)); // N(M col 7l) at 1.x
+            m[(2, 8)] = d435;
+            m[(8, 2)] = m[(2, 8)];
+            let d436 = A::mul_add(-p.L1, d427, A::mul_add(c_q_w, d431, s_q_w * d429)); // N(M col 7l) at 1.z
+            let d437 = A::mul_add(c_q_imu, d433, s_q_imu * d432); // F(M col 7l) at 0.x
+            m[(0, 8)] = d437;
+            m[(8, 0)] = m[(0, 8)];
+            let d438 = A::mul_add(-s_q_imu, d436, c_q_imu * d434); // N(M col 7l) at 0.z
+            m[(1, 8)] = d438;
+            m[(8, 1)] = m[(1, 8)];
+            let d439 = p.MX6l - d399; // MSC6l.x
+            let d440 = p.MY6l - d410; // MSC6l.y
+            let d441 = p.MZ6l - d411; // MSC6l.z
+            let k31 = s_q4l * s_q4l; // sin² q4l
+            let k32 = s_q4l * c_q4l; // sin q4l cos q4l
+            let k33 = A::mul_add(2.0, k31, -1.0); // cos 2q4l
+            let d442 = d405 - d409; // JC7l: Jyy − Jzz
+            let d443 = A::mul_add(-2.0, d406 * k32, k31 * d442); // JC7l rotated about x: Jyy − J'yy
+            let d444 = p.XX6l + d408; // JC6l.xx
+            let d445 = p.XY6l + t58 + t59; // JC6l.xy
+            let d446 = p.XZ6l + t60 - t61; // JC6l.xz
+            let d447 = p.YY6l + d405 - d443; // JC6l.yy
+            m[(7, 7)] = d447;
+            let d448 = A::mul_add(k32, d442, A::mul_add(d406, k33, p.YZ6l)); // JC6l.yz
+            let d449 = p.ZZ6l + d409 + d443; // JC6l.zz
+            let d450 = A::mul_add(c_q3l, d441, s_q3l * d439); // MSC6l in 5l.z
+            let d451 = A::mul_add(-s_q3l, d441, c_q3l * d439); // MSC6l in 5l.x
+            let t62 = c_q3l * d445; // common subexpression
+            let t63 = s_q3l * d448; // common subexpression
+            let t64 = s_q3l * d445; // common subexpression
+            let t65 = c_q3l * d448; // common subexpression
+            let t66 = p.L7 * d451; // common subexpression
+            let t67 = p.L7 * d450; // common subexpression
+            let d452 = t62 - t63 - t66; // N(M col 6l) at 5l.x
+            m[(6, 7)] = -d452;
+            m[(7, 6)] = m[(6, 7)];
+            let d453 = t64 + t65 - t67; // N(M col 6l) at 5l.z
+            let d454 = s_q2l * d451; // F(M col 6l) at 4l.y
+            let d455 = c_q2l * d451; // F(M col 6l) at 4l.z
+            let d456 = A::mul_add(-s_q2l, d453, c_q2l * d447); // N(M col 6l) at 4l.y
+            m[(5, 7)] = d456;
+            m[(7, 5)] = m[(5, 7)];
+            let d457 = A::mul_add(c_q2l, d453, s_q2l * d447); // N(M col 6l) at 4l.z
+            let d458 = A::mul_add(-c_q1l, d455, s_q1l * d450); // F(M col 6l) at 3.z
+            let d459 = A::mul_add(s_q1l, d455, c_q1l * d450); // F(M col 6l) at 3.y
+            let d460 = A::mul_add(
+                p.L5,
+                d454,
+                A::mul_add(-p.L6, d459, A::mul_add(c_q1l, d457, s_q1l * d452)),
+            ); // N(M col 6l) at 3.z
+            let d461 = A::mul_add(-p.L5, d458, d456); // N(M col 6l) at 3.x
+            let d462 = A::mul_add(p.L6, d458, A::mul_add(-s_q1l, d457, c_q1l * d452)); // N(M col 6l) at 3.y
+            m[(4, 7)] = d462;
+            m[(7, 4)] = m[(4, 7)];
+            let d463 = A::mul_add(s_q_torso, d458, c_q_torso * d454); // F(M col 6l) at 2.x
+            let d464 = A::mul_add(-c_q_torso, d458, s_q_torso * d454); // F(M col 6l) at 2.z
+            let d465 = A::mul_add(
+                p.L4,
+                d459,
+                A::mul_add(p.L3, d464, A::mul_add(s_q_torso, d460, c_q_torso * d461)),
+            ); // N(M col 6l) at 2.x
+            m[(3, 7)] = -d465;
+            m[(7, 3)] = m[(3, 7)];
+            let d466 = A::mul_add(
+                -p.L3,
+                d463,
+                A::mul_add(-c_q_torso, d460, s_q_torso * d461),
+            ); // N(M col 6l) at 2.z
+            let d467 = A::mul_add(-p.L4, d463, d462); // N(M col 6l) at 2.y
+            let d468 = A::mul_add(c_q_w, d464, s_q_w * d459); // F(M col 6l) at 1.z
+            let d469 = A::mul_add(-s_q_w, d464, c_q_w * d459); // F(M col 6l) at 1.y
+            let d470 = A::mul_add(-p.L2, d469, A::mul_add(p.L1, d468, d465)); // N(M col 6l) at 1.x
+            m[(2, 7)] = -d470;
+            m[(7, 2)] = m[(2, 7)];
+            let d471 = A::mul_add(-p.L1, d463, A::mul_add(c_q_w, d466, s_q_w * d467)); // N(M col 6l) at 1.z
+            let d472 = A::mul_add(p.L2, d463, A::mul_add(-s_q_w, d466, c_q_w * d467)); // N(M col 6l) at 1.y
+            let d473 = A::mul_add(c_q_imu, d468, s_q_imu * d469); // F(M col 6l) at 0.x
+            m[(0, 7)] = -d473;
+            m[(7, 0)] = m[(0, 7)];
+            let d474 = A::mul_add(-s_q_imu, d471, c_q_imu * d472); // N(M col 6l) at 0.z
+            m[(1, 7)] = -d474;
+            m[(7, 1)] = m[(1, 7)];
+            let d475 = p.MX5l - d451; // MSC5l.x
+            let d476 = p.MZ5l + d450; // MSC5l.z
+            let k34 = s_q3l * s_q3l; // sin² q3l
+            let k35 = s_q3l * c_q3l; // sin q3l cos q3l
+            let k36 = A::mul_add(2.0, k34, -1.0); // cos 2q3l
+            let d477 = d444 - d449; // JC6l: Jzz − Jxx
+            let d478 = A::mul_add(2.0, d446 * k35, k34 * d477); // JC6l rotated about y: Jzz − J'zz
+            let t68 = p.L7 * d440; // common subexpression
+            let d479 = p.XY5l + t62 - t63 - t66; // JC5l.xy
+            let d480 = A::mul_add(-k35, d477, A::mul_add(d446, k36, p.XZ5l)); // JC5l.xz
+            let d481 = p.YY5l + d447; // JC5l.yy
+            let d482 = p.YZ5l - t64 - t65 + t67; // JC5l.yz
+            let d483 = pc.pc42 - d440; // MSC5l.y
+            let d484 = A::mul_add(2.0, t68, d444 - d478) + pc.pc43; // JC5l.xx
+            m[(6, 6)] = d484;
+            let d485 = A::mul_add(2.0, t68, d449 + d478) + pc.pc44; // JC5l.zz
+            let d486 = A::mul_add(s_q2l, d476, c_q2l * d483); // MSC5l in 4l.y
+            let d487 = A::mul_add(-c_q2l, d476, s_q2l * d483); // MSC5l in 4l.z
+            let t69 = c_q2l * d479; // common subexpression
+            let t70 = s_q2l * d480; // common subexpression
+            let d488 = t69 + t70; // N(M col 5l) at 4l.y
+            m[(5, 6)] = -d488;
+            m[(6, 5)] = m[(5, 6)];
+            let t71 = s_q2l * d479; // common subexpression
+            let t72 = c_q2l * d480; // common subexpression
+            let d489 = t71 - t72; // N(M col 5l) at 4l.z
+            let d490 = s_q1l * d486; // F(M col 5l) at 3.y
+            let d491 = c_q1l * d486; // F(M col 5l) at 3.z
+            let d492 = A::mul_add(p.L5, d491, d488); // N(M col 5l) at 3.x
+            let d493 = A::mul_add(-p.L6, d491, A::mul_add(-s_q1l, d489, c_q1l * d484)); // N(M col 5l) at 3.y
+            m[(4, 6)] = -d493;
+            m[(6, 4)] = m[(4, 6)];
+            let d494 = A::mul_add(
+                p.L5,
+                d487,
+                A::mul_add(-p.L6, d490, A::mul_add(c_q1l, d489, s_q1l * d484)),
+            ); // N(M col 5l) at 3.z
+            let d495 = A::mul_add(-s_q_torso, d491, c_q_torso * d487); // F(M col 5l) at 2.x
+            let d496 = A::mul_add(c_q_torso, d491, s_q_torso * d487); // F(M col 5l) at 2.z
+            let d497 = A::mul_add(-p.L4, d495, d493); // N(M col 5l) at 2.y
+            let d498 = A::mul_add(
+                p.L4,
+                d490,
+                A::mul_add(p.L3, d496, A::mul_add(s_q_torso, d494, c_q_torso * d492)),
+            ); // N(M col 5l) at 2.x
+            m[(3, 6)] = d498;
+            m[(6, 3)] = m[(3, 6)];
+            let d499 = A::mul_add(
+                -p.L3,
+                d495,
+                A::mul_add(-c_q_torso, d494, s_q_torso * d492),
+            ); // N(M col 5l) at 2.z
+            let d500 = A::mul_add(-s_q_w, d496, c_q_w * d490); // F(M col 5l) at 1.y
+            let d501 = A::mul_add(c_q_w, d496, s_q_w * d490); // F(M col 5l) at 1.z
+            let d502 = A::mul_add(p.L2, d495, A::mul_add(-s_q_w, d499, c_q_w * d497)); // N(M col 5l) at 1.y
+            let d503 = A::mul_add(-p.L2, d500, A::mul_add(p.L1, d501, d498)); // N(M col 5l) at 1.x
+            m[(2, 6)] = d503;
+            m[(6, 2)] = m[(2, 6)];
+            let d504 = A::mul_add(-p.L1, d495, A::mul_add(c_q_w, d499, s_q_w * d497)); // N(M col 5l) at 1.z
+            let d505 = A::mul_add(c_q_imu, d501, s_q_imu * d500); // F(M col 5l) at 0.x
+            m[(0, 6)] = d505;
+            m[(6, 0)] = m[(0, 6)];
+            let d506 = A::mul_add(-s_q_imu, d504, c_q_imu * d502); // N(M col 5l) at 0.z
+            m[(1, 6)] = d506;
+            m[(6, 1)] = m[(1, 6)];
+            let d507 = p.MX4l - d475; // MSC4l.x
+            let d508 = p.MY4l - d486; // MSC4l.y
+            let d509 = p.MZ4l - d487; // MSC4l.z
+            let k37 = s_q2l * s_q2l; // sin² q2l
+            let k38 = s_q2l * c_q2l; // sin q2l cos q2l
+            let k39 = A::mul_add(2.0, k37, -1.0); // cos 2q2l
+            let d510 = d481 - d485; // JC5l: Jyy − Jzz
+            let d511 = A::mul_add(-2.0, d482 * k38, k37 * d510); // JC5l rotated about x: Jyy − J'yy
+            let d512 = p.XX4l + d484; // JC4l.xx
+            let d513 = p.XY4l + t69 + t70; // JC4l.xy
+            let d514 = p.XZ4l + t71 - t72; // JC4l.xz
+            let d515 = p.YY4l + d481 - d511; // JC4l.yy
+            m[(5, 5)] = d515;
+            let d516 = A::mul_add(k38, d510, A::mul_add(d482, k39, p.YZ4l)); // JC4l.yz
+            let d517 = p.ZZ4l + d485 + d511; // JC4l.zz
+            let d518 = A::mul_add(-s_q1l, d509, c_q1l * d507); // MSC4l in 3.y
+            let d519 = A::mul_add(c_q1l, d509, s_q1l * d507); // MSC4l in 3.z
+            let t73 = c_q1l * d513; // common subexpression
+            let t74 = s_q1l * d516; // common subexpression
+            let t75 = s_q1l * d513; // common subexpression
+            let t76 = c_q1l * d516; // common subexpression
+            let t77 = p.L5 * d518; // common subexpression
+            let t78 = p.L6 * d518; // common subexpression
+            let t79 = p.L6 * d519; // common subexpression
+            let d520 = t75 + t76 - t79; // N(M col 4l) at 3.z
+            let d521 = d515 + t77; // N(M col 4l) at 3.x
+            let d522 = t73 - t74 - t78; // N(M col 4l) at 3.y
+            m[(4, 5)] = d522;
+            m[(5, 4)] = m[(4, 5)];
+            let d523 = s_q_torso * d518; // F(M col 4l) at 2.x
+            let d524 = c_q_torso * d518; // F(M col 4l) at 2.z
+            let d525 = A::mul_add(
+                p.L4,
+                d519,
+                A::mul_add(p.L3, d524, A::mul_add(s_q_torso, d520, c_q_torso * d521)),
+            ); // N(M col 4l) at 2.x
+            m[(3, 5)] = -d525;
+            m[(5, 3)] = m[(3, 5)];
+            let d526 = A::mul_add(
+                p.L3,
+                d523,
+                A::mul_add(-c_q_torso, d520, s_q_torso * d521),
+            ); // N(M col 4l) at 2.z
+            let d527 = A::mul_add(p.L4, d523, d522); // N(M col 4l) at 2.y
+            let d528 = A::mul_add(c_q_w, d524, s_q_w * d519); // F(M col 4l) at 1.z
+            let d529 = A::mul_add(-s_q_w, d524, c_q_w * d519); // F(M col 4l) at 1.y
+            let d530 = A::mul_add(-p.L2, d529, A::mul_add(p.L1, d528, d525)); // N(M col 4l) at 1.x
+            m[(2, 5)] = -d530;
+            m[(5, 2)] = m[(2, 5)];
+            let d531 = A::mul_add(p.L1, d523, A::mul_add(c_q_w, d526, s_q_w * d527)); // N(M col 4l) at 1.z
+            let d532 = A::mul_add(-p.L2, d523, A::mul_add(-s_q_w, d526, c_q_w * d527)); // N(M col 4l) at 1.y
+            let d533 = A::mul_add(c_q_imu, d528, s_q_imu * d529); // F(M col 4l) at 0.x
+            m[(0, 5)] = -d533;
+            m[(5, 0)] = m[(0, 5)];
+            let d534 = A::mul_add(-s_q_imu, d531, c_q_imu * d532); // N(M col 4l) at 0.z
+            m[(1, 5)] = -d534;
+            m[(5, 1)] = m[(1, 5)];
+            let d535 = p.MZ3 + d251 - d519; // MSC3.z
+            let k40 = s_q1l * s_q1l; // sin² q1l
+            let k41 = s_q1l * c_q1l; // sin q1l cos q1l
+            let k42 = A::mul_add(2.0, k40, -1.0); // cos 2q1l
+            let d536 = d512 - d517; // JC4l: Jzz − Jxx
+            let d537 = A::mul_add(2.0, d514 * k41, k40 * d536); // JC4l rotated about y: Jzz − J'zz
+            let t80 = p.L6 * d508; // common subexpression
+            let d538 = p.XZ3 - t35 - t36 + t39 - t75 - t76 + t79; // JC3.xz
+            let d539 = A::mul_add(
+                p.L5,
+                d519,
+                A::mul_add(
+                    -k41,
+                    d536,
                     A::mul_add(
-                        -k41,
-                        d536,
+                        d514,
+                        k42,
                         A::mul_add(
-                            d514,
-                            k42,
-                            A::mul_add(
-                                -p.L5,
-                                d251,
-                                A::mul_add(k20, d267, A::mul_add(-d246, k21, p.YZ3)),
-                            ),
+                            -p.L5,
+                            d251,
+                            A::mul_add(k20, d267, A::mul_add(-d246, k21, p.YZ3)),
                         ),
                     ),
-                ); // JC3.yz
-                let d540 = d508 - d240 + pc.pc47; // MSC3.x
-                let d541 = d250 + d518 + pc.pc48; // MSC3.y
-                let d542 = A::mul_add(2.0, t77, A::mul_add(2.0, t37, d247) + d515)
-                    + pc.pc49; // JC3.xx
-                let d543 = A::mul_add(
-                    -p.L5,
-                    d508,
-                    A::mul_add(p.L5, d240, t34 - t33 + t38) + t73 - t74 - t78,
-                ) + pc.pc50; // JC3.xy
-                let d544 = A::mul_add(
+                ),
+            ); // JC3.yz
+            let d540 = d508 - d240 + pc.pc47; // MSC3.x
+            let d541 = d250 + d518 + pc.pc48; // MSC3.y
+            let d542 = A::mul_add(2.0, t77, A::mul_add(2.0, t37, d247) + d515) + pc.pc49; // JC3.xx
+            let d543 = A::mul_add(
+                -p.L5,
+                d508,
+                A::mul_add(p.L5, d240, t34 - t33 + t38) + t73 - t74 - t78,
+            ) + pc.pc50; // JC3.xy
+            let d544 = A::mul_add(
+                2.0,
+                t80,
+                A::mul_add(2.0, t40, d244 - d268) + d512 - d537,
+            ) + pc.pc51; // JC3.yy
+            m[(4, 4)] = d544;
+            let d545 = A::mul_add(
+                2.0,
+                t80,
+                A::mul_add(
                     2.0,
-                    t80,
-                    A::mul_add(2.0, t40, d244 - d268) + d512 - d537,
-                ) + pc.pc51; // JC3.yy
-                m[(4, 4)] = d544;
-                let d545 = A::mul_add(
-                    2.0,
-                    t80,
-                    A::mul_add(
-                        2.0,
-                        t77,
-                        A::mul_add(2.0, t40, A::mul_add(2.0, t37, d249) + d268) + d517,
-                    ) + d537,
-                ) + pc.pc52; // JC3.zz
-                let d546 = A::mul_add(-s_q_torso, d535, c_q_torso * d540); // MSC3 in 2.x
-                let d547 = A::mul_add(c_q_torso, d535, s_q_torso * d540); // MSC3 in 2.z
-                let t81 = c_q_torso * d543; // common subexpression
-                let t82 = s_q_torso * d539; // common subexpression
-                let t83 = s_q_torso * d543; // common subexpression
-                let t84 = c_q_torso * d539; // common subexpression
-                let t85 = p.L3 * d546; // common subexpression
-                let t86 = p.L4 * d547; // common subexpression
-                let t87 = p.L3 * d547; // common subexpression
-                let d548 = t81 - t82 - t85; // N(M col 3) at 2.x
-                m[(3, 4)] = -d548;
-                m[(4, 3)] = m[(3, 4)];
-                let d549 = t83 + t84 - t87; // N(M col 3) at 2.z
-                let d550 = d544 - t86; // N(M col 3) at 2.y
-                let d551 = s_q_w * d546; // F(M col 3) at 1.y
-                let d552 = c_q_w * d546; // F(M col 3) at 1.z
-                let d553 = A::mul_add(-p.L2, d551, A::mul_add(-p.L1, d552, d548)); // N(M col 3) at 1.x
-                m[(2, 4)] = -d553;
-                m[(4, 2)] = m[(2, 4)];
-                let d554 = A::mul_add(
-                    -p.L1,
-                    d547,
-                    A::mul_add(c_q_w, d549, s_q_w * d550),
-                ); // N(M col 3) at 1.z
-                let d555 = A::mul_add(
-                    p.L2,
-                    d547,
-                    A::mul_add(-s_q_w, d549, c_q_w * d550),
-                ); // N(M col 3) at 1.y
-                let d556 = A::mul_add(-c_q_imu, d552, s_q_imu * d551); // F(M col 3) at 0.x
-                m[(0, 4)] = -d556;
-                m[(4, 0)] = m[(0, 4)];
-                let d557 = A::mul_add(-s_q_imu, d554, c_q_imu * d555); // N(M col 3) at 0.z
-                m[(1, 4)] = -d557;
-                m[(4, 1)] = m[(1, 4)];
-                let d558 = p.MX2 - d546; // MSC2.x
-                let k43 = s_q_torso * s_q_torso; // sin² q_torso
-                let k44 = s_q_torso * c_q_torso; // sin q_torso cos q_torso
-                let k45 = A::mul_add(2.0, k43, -1.0); // cos 2q_torso
-                let d559 = d542 - d545; // JC3: Jzz − Jxx
-                let d560 = A::mul_add(2.0, d538 * k44, k43 * d559); // JC3 rotated about y: Jzz − J'zz
-                let t88 = p.L3 * d541; // common subexpression
-                let d561 = p.XY2 - t81 + t82 + t85; // JC2.xy
-                let d562 = A::mul_add(
-                    p.L4,
-                    d546,
-                    A::mul_add(k44, d559, A::mul_add(-d538, k45, p.XZ2)),
-                ); // JC2.xz
-                let d563 = d541 + pc.pc54; // MSC2.y
-                let d564 = pc.pc55 - d547; // MSC2.z
-                let d565 = A::mul_add(2.0, t88, A::mul_add(-2.0, t86, d542) - d560)
-                    + pc.pc56; // JC2.xx
-                m[(3, 3)] = d565;
-                let d566 = A::mul_add(-2.0, t86, d544) + pc.pc57; // JC2.yy
-                let d567 = A::mul_add(-p.L4, d541, t87 - t83 - t84) + pc.pc58; // JC2.yz
-                let d568 = A::mul_add(2.0, t88, d545 + d560) + pc.pc59; // JC2.zz
-                let d569 = A::mul_add(s_q_w, d564, c_q_w * d563); // MSC2 in 1.y
-                let d570 = A::mul_add(-c_q_w, d564, s_q_w * d563); // MSC2 in 1.z
-                let t89 = c_q_w * d561; // common subexpression
-                let t90 = s_q_w * d562; // common subexpression
-                let t91 = s_q_w * d561; // common subexpression
-                let t92 = c_q_w * d562; // common subexpression
-                let d571 = t91 - t92; // N(M col 2) at 1.z
-                let t93 = p.L1 * d569; // common subexpression
-                let t94 = p.L2 * d570; // common subexpression
-                let d572 = d565 + t93 + t94; // N(M col 2) at 1.x
-                m[(2, 3)] = d572;
-                m[(3, 2)] = m[(2, 3)];
-                let d573 = t89 + t90; // N(M col 2) at 1.y
-                let d574 = A::mul_add(-c_q_imu, d569, s_q_imu * d570); // F(M col 2) at 0.x
-                m[(0, 3)] = -d574;
-                m[(3, 0)] = m[(0, 3)];
-                let d575 = A::mul_add(-s_q_imu, d571, c_q_imu * d573); // N(M col 2) at 0.z
-                m[(1, 3)] = -d575;
-                m[(3, 1)] = m[(1, 3)];
-                let d576 = p.MX1 + d558; // MSC1.x
-                m[(0, 1)] = d576;
-                m[(1, 0)] = m[(0, 1)];
-                let k46 = s_q_w * s_q_w; // sin² q_w
-                let k47 = s_q_w * c_q_w; // sin q_w cos q_w
-                let k48 = A::mul_add(2.0, k46, -1.0); // cos 2q_w
-                let d577 = d566 - d568; // JC2: Jyy − Jzz
-                let d578 = A::mul_add(-2.0, d567 * k47, k46 * d577); // JC2 rotated about x: Jyy − J'yy
-                let d579 = A::mul_add(-p.L1, d558, p.XY1 + t89 + t90); // JC1.xy
-                let d580 = A::mul_add(p.L2, d558, p.XZ1 - t91 + t92); // JC1.xz
-                let d581 = d569 + pc.pc61; // MSC1.y
-                let d582 = pc.pc62 - d570; // MSC1.z
-                let d583 = A::mul_add(2.0, t94, A::mul_add(2.0, t93, d565)) + pc.pc63; // JC1.xx
-                m[(2, 2)] = d583;
-                let d584 = A::mul_add(2.0, t94, d566) - d578 + pc.pc64; // JC1.yy
-                let d585 = A::mul_add(
-                    p.L1,
-                    d570,
-                    A::mul_add(-k47, d577, A::mul_add(-d567, k48, p.L2 * d569)),
-                ) + pc.pc65; // JC1.yz
-                let d586 = A::mul_add(2.0, t93, d568) + d578 + pc.pc66; // JC1.zz
-                let d587 = A::mul_add(s_q_imu, d582, c_q_imu * d581); // MSC1 in 0.z
-                m[(0, 2)] = d587;
-                m[(2, 0)] = m[(0, 2)];
-                let d588 = A::mul_add(s_q_imu, d580, c_q_imu * d579); // N(M col 1) at 0.z
-                m[(1, 2)] = -d588;
-                m[(2, 1)] = m[(1, 2)];
-                let k49 = s_q_imu * s_q_imu; // sin² q_imu
-                let k50 = s_q_imu * c_q_imu; // sin q_imu cos q_imu
-                let d589 = d584 - d586; // JC1: Jyy − Jzz
-                let d590 = A::mul_add(-2.0, d585 * k50, k49 * d589); // JC1 rotated about x: Jyy − J'yy
-                let d591 = d584 - d590; // JC0
-                m[(1, 1)] = d591 + pc.pc68;
-            }
-            m
+                    t77,
+                    A::mul_add(2.0, t40, A::mul_add(2.0, t37, d249) + d268) + d517,
+                ) + d537,
+            ) + pc.pc52; // JC3.zz
+            let d546 = A::mul_add(-s_q_torso, d535, c_q_torso * d540); // MSC3 in 2.x
+            let d547 = A::mul_add(c_q_torso, d535, s_q_torso * d540); // MSC3 in 2.z
+            let t81 = c_q_torso * d543; // common subexpression
+            let t82 = s_q_torso * d539; // common subexpression
+            let t83 = s_q_torso * d543; // common subexpression
+            let t84 = c_q_torso * d539; // common subexpression
+            let t85 = p.L3 * d546; // common subexpression
+            let t86 = p.L4 * d547; // common subexpression
+            let t87 = p.L3 * d547; // common subexpression
+            let d548 = t81 - t82 - t85; // N(M col 3) at 2.x
+            m[(3, 4)] = -d548;
+            m[(4, 3)] = m[(3, 4)];
+            let d549 = t83 + t84 - t87; // N(M col 3) at 2.z
+            let d550 = d544 - t86; // N(M col 3) at 2.y
+            let d551 = s_q_w * d546; // F(M col 3) at 1.y
+            let d552 = c_q_w * d546; // F(M col 3) at 1.z
+            let d553 = A::mul_add(-p.L2, d551, A::mul_add(-p.L1, d552, d548)); // N(M col 3) at 1.x
+            m[(2, 4)] = -d553;
+            m[(4, 2)] = m[(2, 4)];
+            let d554 = A::mul_add(-p.L1, d547, A::mul_add(c_q_w, d549, s_q_w * d550)); // N(M col 3) at 1.z
+            let d555 = A::mul_add(p.L2, d547, A::mul_add(-s_q_w, d549, c_q_w * d550)); // N(M col 3) at 1.y
+            let d556 = A::mul_add(-c_q_imu, d552, s_q_imu * d551); // F(M col 3) at 0.x
+            m[(0, 4)] = -d556;
+            m[(4, 0)] = m[(0, 4)];
+            let d557 = A::mul_add(-s_q_imu, d554, c_q_imu * d555); // N(M col 3) at 0.z
+            m[(1, 4)] = -d557;
+            m[(4, 1)] = m[(1, 4)];
+            let d558 = p.MX2 - d546; // MSC2.x
+            let k43 = s_q_torso * s_q_torso; // sin² q_torso
+            let k44 = s_q_torso * c_q_torso; // sin q_torso cos q_torso
+            let k45 = A::mul_add(2.0, k43, -1.0); // cos 2q_torso
+            let d559 = d542 - d545; // JC3: Jzz − Jxx
+            let d560 = A::mul_add(2.0, d538 * k44, k43 * d559); // JC3 rotated about y: Jzz − J'zz
+            let t88 = p.L3 * d541; // common subexpression
+            let d561 = p.XY2 - t81 + t82 + t85; // JC2.xy
+            let d562 = A::mul_add(
+                p.L4,
+                d546,
+                A::mul_add(k44, d559, A::mul_add(-d538, k45, p.XZ2)),
+            ); // JC2.xz
+            let d563 = d541 + pc.pc54; // MSC2.y
+            let d564 = pc.pc55 - d547; // MSC2.z
+            let d565 = A::mul_add(2.0, t88, A::mul_add(-2.0, t86, d542) - d560)
+                + pc.pc56; // JC2.xx
+            m[(3, 3)] = d565;
+            let d566 = A::mul_add(-2.0, t86, d544) + pc.pc57; // JC2.yy
+            let d567 = A::mul_add(-p.L4, d541, t87 - t83 - t84) + pc.pc58; // JC2.yz
+            let d568 = A::mul_add(2.0, t88, d545 + d560) + pc.pc59; // JC2.zz
+            let d569 = A::mul_add(s_q_w, d564, c_q_w * d563); // MSC2 in 1.y
+            let d570 = A::mul_add(-c_q_w, d564, s_q_w * d563); // MSC2 in 1.z
+            let t89 = c_q_w * d561; // common subexpression
+            let t90 = s_q_w * d562; // common subexpression
+            let t91 = s_q_w * d561; // common subexpression
+            let t92 = c_q_w * d562; // common subexpression
+            let d571 = t91 - t92; // N(M col 2) at 1.z
+            let t93 = p.L1 * d569; // common subexpression
+            let t94 = p.L2 * d570; // common subexpression
+            let d572 = d565 + t93 + t94; // N(M col 2) at 1.x
+            m[(2, 3)] = d572;
+            m[(3, 2)] = m[(2, 3)];
+            let d573 = t89 + t90; // N(M col 2) at 1.y
+            let d574 = A::mul_add(-c_q_imu, d569, s_q_imu * d570); // F(M col 2) at 0.x
+            m[(0, 3)] = -d574;
+            m[(3, 0)] = m[(0, 3)];
+            let d575 = A::mul_add(-s_q_imu, d571, c_q_imu * d573); // N(M col 2) at 0.z
+            m[(1, 3)] = -d575;
+            m[(3, 1)] = m[(1, 3)];
+            let d576 = p.MX1 + d558; // MSC1.x
+            m[(0, 1)] = d576;
+            m[(1, 0)] = m[(0, 1)];
+            let k46 = s_q_w * s_q_w; // sin² q_w
+            let k47 = s_q_w * c_q_w; // sin q_w cos q_w
+            let k48 = A::mul_add(2.0, k46, -1.0); // cos 2q_w
+            let d577 = d566 - d568; // JC2: Jyy − Jzz
+            let d578 = A::mul_add(-2.0, d567 * k47, k46 * d577); // JC2 rotated about x: Jyy − J'yy
+            let d579 = A::mul_add(-p.L1, d558, p.XY1 + t89 + t90); // JC1.xy
+            let d580 = A::mul_add(p.L2, d558, p.XZ1 - t91 + t92); // JC1.xz
+            let d581 = d569 + pc.pc61; // MSC1.y
+            let d582 = pc.pc62 - d570; // MSC1.z
+            let d583 = A::mul_add(2.0, t94, A::mul_add(2.0, t93, d565)) + pc.pc63; // JC1.xx
+            m[(2, 2)] = d583;
+            let d584 = A::mul_add(2.0, t94, d566) - d578 + pc.pc64; // JC1.yy
+            let d585 = A::mul_add(
+                p.L1,
+                d570,
+                A::mul_add(-k47, d577, A::mul_add(-d567, k48, p.L2 * d569)),
+            ) + pc.pc65; // JC1.yz
+            let d586 = A::mul_add(2.0, t93, d568) + d578 + pc.pc66; // JC1.zz
+            let d587 = A::mul_add(s_q_imu, d582, c_q_imu * d581); // MSC1 in 0.z
+            m[(0, 2)] = d587;
+            m[(2, 0)] = m[(0, 2)];
+            let d588 = A::mul_add(s_q_imu, d580, c_q_imu * d579); // N(M col 1) at 0.z
+            m[(1, 2)] = -d588;
+            m[(2, 1)] = m[(1, 2)];
+            let k49 = s_q_imu * s_q_imu; // sin² q_imu
+            let k50 = s_q_imu * c_q_imu; // sin q_imu cos q_imu
+            let d589 = d584 - d586; // JC1: Jyy − Jzz
+            let d590 = A::mul_add(-2.0, d585 * k50, k49 * d589); // JC1 rotated about x: Jyy − J'yy
+            let d591 = d584 - d590; // JC0
+            m[(1, 1)] = d591 + pc.pc68;
         }
-        kanegen_runtime::isa::dispatch_fused(
+        kanegen_runtime::isa::dispatch_fused_with(
+            out,
             #[inline(always)]
-            || body::<kanegen_runtime::isa::Plain>(p, pc, q),
+            |m| body::<kanegen_runtime::isa::Plain>(p, pc, q, m),
             #[inline(always)]
-            || body::<kanegen_runtime::isa::Fused>(p, pc, q),
+            |m| body::<kanegen_runtime::isa::Fused>(p, pc, q, m),
         )
     }
     /// Coriolis and centrifugal vector c(q, u) (velocity-product terms).
@@ -10534,6 +10444,15 @@ mod generated {
         #[inline]
         pub fn mass_matrix(&self, q: &SVector<f64, 19>) -> SMatrix<f64, 19, 19> {
             mass_matrix(&self.params, &self.pre, q)
+        }
+        /// [`mass_matrix`](Self::mass_matrix) written into `out` (every entry), without returning the matrix by value.
+        #[inline]
+        pub fn mass_matrix_into(
+            &self,
+            q: &SVector<f64, 19>,
+            out: &mut SMatrix<f64, 19, 19>,
+        ) {
+            mass_matrix_into(&self.params, &self.pre, q, out)
         }
         /// Coriolis and centrifugal vector c(q, u) (velocity-product terms).
         #[inline]

@@ -14,7 +14,8 @@
 //! inlines the closure and the body: that copy of the body is compiled for AVX2 with the
 //! three-operand VEX encodings and 256-bit vectors where LLVM vectorizes. Calling a
 //! `#[target_feature]` function needs `unsafe` (the CPU must have the features); this module
-//! holds that call (the same in [`dispatch`] and [`dispatch_fused`]), right after the check that
+//! holds that call (the same in [`dispatch`] and [`dispatch_fused_with`], through which
+//! [`dispatch_fused`] runs), right after the check that
 //! the features are present; the crate's only other `unsafe` block is the same kind of call in
 //! [`crate::derivative_steps::run`] (its AVX2 kernel, after [`active`] reported x86-64-v3).
 //!
@@ -204,16 +205,37 @@ if_dispatching! {
     /// the module docs.
     #[inline(always)]
     pub fn dispatch_fused<R>(plain: impl FnOnce() -> R, fused: impl FnOnce() -> R) -> R {
+        dispatch_fused_with(
+            (),
+            #[inline(always)]
+            |()| plain(),
+            #[inline(always)]
+            |()| fused(),
+        )
+    }
+
+    /// [`dispatch_fused`] passing `arg` to the copy that runs: for an argument both closures
+    /// would otherwise capture, such as the `&mut` result array of a batched function
+    /// (`mass_matrix_batch_into`), which two closures cannot borrow at once.
+    #[inline(always)]
+    pub fn dispatch_fused_with<T, R>(
+        arg: T,
+        plain: impl FnOnce(T) -> R,
+        fused: impl FnOnce(T) -> R,
+    ) -> R {
         if active_code() == V3 {
             // SAFETY: `ACTIVE` holds `V3` only after `v3_present()` found every feature
             // `run_v3` is compiled with (`detect` and `select` check it before storing), so the
             // CPU executes its instructions. The same call as in `dispatch` above.
             #[allow(unsafe_code)]
             unsafe {
-                return run_v3(fused);
+                return run_v3(
+                    #[inline(always)]
+                    || fused(arg),
+                );
             }
         }
-        plain()
+        plain(arg)
     }
 }
 
@@ -233,13 +255,30 @@ if_not_dispatching! {
     /// otherwise: this build has one copy of every function (see the module docs).
     #[inline(always)]
     pub fn dispatch_fused<R>(plain: impl FnOnce() -> R, fused: impl FnOnce() -> R) -> R {
+        dispatch_fused_with(
+            (),
+            #[inline(always)]
+            |()| plain(),
+            #[inline(always)]
+            |()| fused(),
+        )
+    }
+
+    /// [`dispatch_fused`] passing `arg` to the copy that runs (for an argument both closures
+    /// would otherwise capture, such as a `&mut` result array).
+    #[inline(always)]
+    pub fn dispatch_fused_with<T, R>(
+        arg: T,
+        plain: impl FnOnce(T) -> R,
+        fused: impl FnOnce(T) -> R,
+    ) -> R {
         #[cfg(all(
             feature = "std",
             any(target_feature = "fma", target_arch = "aarch64")
         ))]
         {
             let _ = plain;
-            fused()
+            fused(arg)
         }
         #[cfg(not(all(
             feature = "std",
@@ -247,7 +286,7 @@ if_not_dispatching! {
         )))]
         {
             let _ = fused;
-            plain()
+            plain(arg)
         }
     }
 }

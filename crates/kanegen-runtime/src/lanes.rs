@@ -118,6 +118,19 @@ pub fn sin_cos<const L: usize>(x: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
     (Lanes(s), Lanes(c))
 }
 
+/// `(sin x, cos x)` of every angle `k` in every lane `l` (`x[k][l]`), in one call of
+/// [`crate::trig::sin_cos_slice`]: bit for bit the values of [`crate::trig::sin_cos_n`], which
+/// the single-state functions call. The batched functions pass all joint angles of all their
+/// states at once (`[q[2].0, q[3].0, …]`).
+#[inline(always)]
+pub fn sin_cos_n<const N: usize, const L: usize>(
+    x: [[f64; L]; N],
+) -> ([[f64; L]; N], [[f64; L]; N]) {
+    let (mut s, mut c) = ([[0.0; L]; N], [[0.0; L]; N]);
+    crate::trig::sin_cos_slice(x.as_flattened(), s.as_flattened_mut(), c.as_flattened_mut());
+    (s, c)
+}
+
 /// The inputs of a batched function in lane-major order: entry `i` holds coordinate (speed,
 /// acceleration) `i` of every state. Written to memory behind an optimisation barrier
 /// (`core::hint::black_box`), so that the statements read whole lane vectors from consecutive
@@ -126,7 +139,14 @@ pub fn sin_cos<const L: usize>(x: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
 /// state, slower than a single-state call).
 #[inline(always)]
 pub fn inputs<const L: usize, const N: usize>(x: &[SVector<f64, N>; L]) -> [Lanes<L>; N] {
-    let mut t: [Lanes<L>; N] = core::array::from_fn(|i| Lanes::gather(x, i));
+    // Plain loops, not `core::array::from_fn`: at L = 8 LLVM left that one out of line
+    // (`try_from_fn`: 7 % of Krang's batched c).
+    let mut t = [Lanes::splat(0.0); N];
+    for (l, x) in x.iter().enumerate() {
+        for (t, x) in t.iter_mut().zip(x.iter()) {
+            t.0[l] = *x;
+        }
+    }
     core::hint::black_box(&mut t);
     t
 }

@@ -133,24 +133,32 @@ fn lane_values(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
     ts
 }
 
-/// The result stores of the loop body as text lines, by position (see
-/// [`Printer::statement_block`]): every nonzero entry right after the last statement it reads
-/// (with multiply-add chains); and the stores for a loop of their own after it: the lower
-/// entries of a symmetric matrix copied from the upper ones, and `0.0` into every entry no
-/// statement writes. Each entry of the caller's result is written exactly once, so nothing is
-/// zeroed first. Both kinds stay out of the vectorized loop: LLVM merges adjacent zero stores
-/// into `memset` calls, and a loop with a call is not vectorized; with the mirrored stores in
-/// it (as a copy or as the value again) Krang's M was not vectorized either ("runtime pointer
-/// checks needed").
-fn stores(
-    cx: &Context<'_>,
-    printer: &Printer<'_>,
-    p: &Program,
-    shape: Shape,
-) -> (Stores, TokenStream) {
-    let mut stores: Stores = vec![Vec::new(); p.stmts.len() + 1];
+/// The stores of the loop body (text lines by position, see [`Printer::statement_block`]) and
+/// of a loop of their own after it.
+struct ResultStores {
+    in_loop: Stores,
+    after: TokenStream,
+}
+
+/// The result stores: every nonzero entry right after the last statement it reads (with
+/// multiply-add chains), into the caller's result `m`; after the loop, the lower entries of a
+/// symmetric matrix (copied from the upper ones) and `0.0` into every entry no statement
+/// writes. Each entry of the caller's result is written exactly once, so nothing is zeroed
+/// first. The mirrored entries and the zeros stay out of the vectorized loop: LLVM merges
+/// adjacent zero stores into `memset` calls, and a loop with a call is not vectorized; with the
+/// mirrored stores in it (as a copy or as the value again) Krang's M was not vectorized either
+/// ("loop not vectorized: runtime pointer checks needed").
+fn stores(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) -> ResultStores {
+    let mut in_loop: Stores = vec![Vec::new(); p.stmts.len() + 1];
     let (rows, cols) = shape.size_in(&cx.low.sizes);
     let vector = cols == 1;
+    let entry_text = |r: usize, c: usize| {
+        if vector {
+            format!("m[{r}]")
+        } else {
+            format!("m[({r}, {c})]")
+        }
+    };
     let entry = |r: usize, c: usize| {
         let (ri, ci) = (idx(r), idx(c));
         if vector {
@@ -165,12 +173,11 @@ fn stores(
     for (r, c, e) in nonzero_outputs(p) {
         let (r, c) = (*r, *c);
         let v = text(cx, printer, e);
-        let at = entry(r, c);
-        store_text_after(&mut stores, e, format!("{at} = {v};"));
+        store_text_after(&mut in_loop, e, format!("{} = {v};", entry_text(r, c)));
         written[c * rows + r] = true;
         if mirror && r != c {
-            let to = entry(c, r);
-            after.extend(quote!(#to = #at;));
+            let (to, from) = (entry(c, r), entry(r, c));
+            after.extend(quote!(#to = #from;));
             written[r * rows + c] = true;
         }
     }
@@ -180,7 +187,7 @@ fn stores(
             after.extend(quote!(#to = 0.0;));
         }
     }
-    (stores, after)
+    ResultStores { in_loop, after }
 }
 
 /// The batched free functions of `f` (`NAME_batch_into` and `NAME_batch`), or nothing if it
@@ -225,13 +232,16 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     let out = out_arg(cx, spec);
     let lane_inputs = lane_inputs(cx, p, &reads);
     let lane_values = lane_values(cx, p, &reads);
+    let ty = return_type(cx, spec);
+    let ResultStores {
+        in_loop: stores,
+        after,
+    } = stores(cx, &printer, p, spec.shape);
     let lane_loop = if lane_values.is_empty() {
         quote!(for m in out.iter_mut())
     } else {
         quote!(for (l, m) in out.iter_mut().enumerate())
     };
-    let ty = return_type(cx, spec);
-    let (stores, after) = stores(cx, &printer, p, spec.shape);
     let after_loop = if after.is_empty() {
         TokenStream::new()
     } else {

@@ -88,17 +88,10 @@ fn sin_cos_n_slow<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
 /// What the batched functions call (through [`crate::lanes::sin_cos_n`]) for all joint angles
 /// of all states at once: one dispatched call instead of one per angle (measured on Krang's
 /// batched c at 4 states: the 17 per-angle calls took 39 % of its time). Compiled for the
-/// baseline and for x86-64-v3 like [`sin_cos_n`].
-///
-/// # Panics
-/// If the three slices differ in length (a caller's bug: the batched functions pass arrays of
-/// one type).
+/// baseline and for x86-64-v3 like [`sin_cos_n`]. Slices of different lengths: the first
+/// `min` of the three lengths are computed, the rest of `s` and `c` is left as it is.
 #[inline(never)]
 pub fn sin_cos_slice(x: &[f64], s: &mut [f64], c: &mut [f64]) {
-    assert!(
-        x.len() == s.len() && x.len() == c.len(),
-        "sin_cos_slice: x, s and c must have the same length"
-    );
     crate::isa::dispatch(
         #[inline(always)]
         || {

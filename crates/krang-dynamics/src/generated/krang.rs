@@ -8088,9 +8088,9 @@ mod generated {
                 let c_q6r = cos_q[15][l];
                 let s_q7r = sin_q[16][l];
                 let c_q7r = cos_q[16][l];
-                m [(0 , 0)] = pc.pc69;
-                m [(11 , 11)] = p.ZZ10l;
-                m [(18 , 18)] = p.ZZ10r;
+                m[(0, 0)] = pc.pc69;
+                m[(11, 11)] = p.ZZ10l;
+                m[(18, 18)] = p.ZZ10r;
                 let d1 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
                 let d2 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
                 let t1 = p.XZ10r * c_q7r; // common subexpression
@@ -8100,38 +8100,38 @@ mod generated {
                 let t5 = p.L9 * d2; // common subexpression
                 let t6 = p.L9 * d1; // common subexpression
                 let d3 = t1 + t2 - t5; // N(M col 10r) at 9r.x
-                m [(17 , 18)] = -d3;
+                m[(17, 18)] = -d3;
                 let d4 = t3 - t4 - t6; // N(M col 10r) at 9r.z
                 let d5 = d2 * s_q6r; // F(M col 10r) at 8r.y
                 let d6 = d2 * c_q6r; // F(M col 10r) at 8r.z
                 let d7 = A::mul_add(-d4, s_q6r, p.ZZ10r * c_q6r); // N(M col 10r) at 8r.y
-                m [(16 , 18)] = d7;
+                m[(16, 18)] = d7;
                 let d8 = A::mul_add(d4, c_q6r, p.ZZ10r * s_q6r); // N(M col 10r) at 8r.z
                 let d9 = A::mul_add(d6, s_q5r, d1 * c_q5r); // F(M col 10r) at 7r.x
                 let d10 = A::mul_add(-d6, c_q5r, d1 * s_q5r); // F(M col 10r) at 7r.z
                 let d11 = A::mul_add(p.L8, d10, A::mul_add(-d8, s_q5r, d3 * c_q5r)); // N(M col 10r) at 7r.x
-                m [(15 , 18)] = -d11;
+                m[(15, 18)] = -d11;
                 let d12 = A::mul_add(-p.L8, d9, A::mul_add(d8, c_q5r, d3 * s_q5r)); // N(M col 10r) at 7r.z
                 let d13 = A::mul_add(-d10, s_q4r, d5 * c_q4r); // F(M col 10r) at 6r.y
                 let d14 = A::mul_add(d10, c_q4r, d5 * s_q4r); // F(M col 10r) at 6r.z
                 let d15 = A::mul_add(-d12, s_q4r, d7 * c_q4r); // N(M col 10r) at 6r.y
-                m [(14 , 18)] = d15;
+                m[(14, 18)] = d15;
                 let d16 = A::mul_add(d12, c_q4r, d7 * s_q4r); // N(M col 10r) at 6r.z
                 let d17 = A::mul_add(-d14, s_q3r, d9 * c_q3r); // F(M col 10r) at 5r.x
                 let d18 = A::mul_add(d14, c_q3r, d9 * s_q3r); // F(M col 10r) at 5r.z
                 let d19 = A::mul_add(p.L7, d18, A::mul_add(-d16, s_q3r, d11 * c_q3r)); // N(M col 10r) at 5r.x
-                m [(13 , 18)] = -d19;
+                m[(13, 18)] = -d19;
                 let d20 = A::mul_add(-p.L7, d17, A::mul_add(d16, c_q3r, d11 * s_q3r)); // N(M col 10r) at 5r.z
                 let d21 = A::mul_add(-d18, s_q2r, d13 * c_q2r); // F(M col 10r) at 4r.y
                 let d22 = A::mul_add(d18, c_q2r, d13 * s_q2r); // F(M col 10r) at 4r.z
                 let d23 = A::mul_add(-d20, s_q2r, d15 * c_q2r); // N(M col 10r) at 4r.y
-                m [(12 , 18)] = d23;
+                m[(12, 18)] = d23;
                 let d24 = A::mul_add(d20, c_q2r, d15 * s_q2r); // N(M col 10r) at 4r.z
                 let d25 = A::mul_add(-d22, s_q1r, d17 * c_q1r); // F(M col 10r) at 3.y
                 let d26 = A::mul_add(d22, c_q1r, d17 * s_q1r); // F(M col 10r) at 3.z
                 let d27 = A::mul_add(-p.L5, d26, d23); // N(M col 10r) at 3.x
                 let d28 = A::mul_add(p.L6, d26, A::mul_add(-d24, s_q1r, d19 * c_q1r)); // N(M col 10r) at 3.y
-                m [(4 , 18)] = d28;
+                m[(4, 18)] = d28;
                 let d29 = A::mul_add(
                     d21,
                     p.L5,
@@ -8144,7 +8144,7 @@ mod generated {
                     p.L4,
                     A::mul_add(p.L3, d31, A::mul_add(d29, s_q_torso, d27 * c_q_torso)),
                 ); // N(M col 10r) at 2.x
-                m [(3 , 18)] = d32;
+                m[(3, 18)] = d32;
                 let d33 = A::mul_add(p.L4, d30, d28); // N(M col 10r) at 2.y
                 let d34 = A::mul_add(
                     -p.L3,
@@ -8155,12 +8155,12 @@ mod generated {
                 let d36 = A::mul_add(d31, s_q_w, d25 * c_q_w); // F(M col 10r) at 1.y
                 let d37 = A::mul_add(d30, p.L1, A::mul_add(-d34, c_q_w, d33 * s_q_w)); // N(M col 10r) at 1.z
                 let d38 = A::mul_add(p.L2, d36, A::mul_add(-p.L1, d35, d32)); // N(M col 10r) at 1.x
-                m [(2 , 18)] = d38;
+                m[(2, 18)] = d38;
                 let d39 = A::mul_add(-d30, p.L2, A::mul_add(d34, s_q_w, d33 * c_q_w)); // N(M col 10r) at 1.y
                 let d40 = A::mul_add(d35, c_q_imu, d36 * s_q_imu); // F(M col 10r) at 0.x
-                m [(0 , 18)] = -d40;
+                m[(0, 18)] = -d40;
                 let d41 = A::mul_add(-d37, s_q_imu, d39 * c_q_imu); // N(M col 10r) at 0.z
-                m [(1 , 18)] = -d41;
+                m[(1, 18)] = -d41;
                 let d42 = p.MX9r - d2; // MSC9r.x
                 let d43 = p.MZ9r + d1; // MSC9r.z
                 let k1 = s_q7r * s_q7r; // sin² q7r
@@ -8171,14 +8171,14 @@ mod generated {
                 let d46 = A::mul_add(-k2, pc.pc3, A::mul_add(-p.XY10r, k3, p.XZ9r)); // JC9r.xz
                 let d47 = p.YZ9r - t3 + t4 + t6; // JC9r.yz
                 let d48 = pc.pc7 - d44; // JC9r.xx
-                m [(17 , 17)] = d48;
+                m[(17, 17)] = d48;
                 let d49 = d44 + pc.pc8; // JC9r.zz
                 let d50 = A::mul_add(s_q6r, d43, c_q6r * pc.pc2); // MSC9r in 8r.y
                 let d51 = A::mul_add(-c_q6r, d43, s_q6r * pc.pc2); // MSC9r in 8r.z
                 let t7 = c_q6r * d45; // common subexpression
                 let t8 = s_q6r * d46; // common subexpression
                 let d52 = t7 + t8; // N(M col 9r) at 8r.y
-                m [(16 , 17)] = -d52;
+                m[(16, 17)] = -d52;
                 let t9 = s_q6r * d45; // common subexpression
                 let t10 = c_q6r * d46; // common subexpression
                 let d53 = t9 - t10; // N(M col 9r) at 8r.z
@@ -8186,26 +8186,26 @@ mod generated {
                 let d55 = c_q5r * d50; // F(M col 9r) at 7r.z
                 let d56 = A::mul_add(-p.L8, d54, A::mul_add(c_q5r, d53, s_q5r * d48)); // N(M col 9r) at 7r.z
                 let d57 = A::mul_add(-p.L8, d55, A::mul_add(-s_q5r, d53, c_q5r * d48)); // N(M col 9r) at 7r.x
-                m [(15 , 17)] = d57;
+                m[(15, 17)] = d57;
                 let d58 = A::mul_add(s_q4r, d55, c_q4r * d51); // F(M col 9r) at 6r.y
                 let d59 = A::mul_add(-c_q4r, d55, s_q4r * d51); // F(M col 9r) at 6r.z
                 let d60 = A::mul_add(-s_q4r, d56, c_q4r * d52); // N(M col 9r) at 6r.y
-                m [(14 , 17)] = -d60;
+                m[(14, 17)] = -d60;
                 let d61 = A::mul_add(c_q4r, d56, s_q4r * d52); // N(M col 9r) at 6r.z
                 let d62 = A::mul_add(c_q3r, d59, s_q3r * d54); // F(M col 9r) at 5r.z
                 let d63 = A::mul_add(-s_q3r, d59, c_q3r * d54); // F(M col 9r) at 5r.x
                 let d64 = A::mul_add(-p.L7, d63, A::mul_add(c_q3r, d61, s_q3r * d57)); // N(M col 9r) at 5r.z
                 let d65 = A::mul_add(p.L7, d62, A::mul_add(-s_q3r, d61, c_q3r * d57)); // N(M col 9r) at 5r.x
-                m [(13 , 17)] = d65;
+                m[(13, 17)] = d65;
                 let d66 = A::mul_add(-s_q2r, d62, c_q2r * d58); // F(M col 9r) at 4r.y
                 let d67 = A::mul_add(c_q2r, d62, s_q2r * d58); // F(M col 9r) at 4r.z
                 let d68 = A::mul_add(-s_q2r, d64, c_q2r * d60); // N(M col 9r) at 4r.y
-                m [(12 , 17)] = -d68;
+                m[(12, 17)] = -d68;
                 let d69 = A::mul_add(c_q2r, d64, s_q2r * d60); // N(M col 9r) at 4r.z
                 let d70 = A::mul_add(-s_q1r, d67, c_q1r * d63); // F(M col 9r) at 3.y
                 let d71 = A::mul_add(c_q1r, d67, s_q1r * d63); // F(M col 9r) at 3.z
                 let d72 = A::mul_add(p.L6, d71, A::mul_add(-s_q1r, d69, c_q1r * d65)); // N(M col 9r) at 3.y
-                m [(4 , 17)] = -d72;
+                m[(4, 17)] = -d72;
                 let d73 = A::mul_add(
                     p.L5,
                     d66,
@@ -8219,7 +8219,7 @@ mod generated {
                     d70,
                     A::mul_add(p.L3, d76, A::mul_add(s_q_torso, d73, c_q_torso * d74)),
                 ); // N(M col 9r) at 2.x
-                m [(3 , 17)] = -d77;
+                m[(3, 17)] = -d77;
                 let d78 = A::mul_add(p.L4, d75, d72); // N(M col 9r) at 2.y
                 let d79 = A::mul_add(
                     -p.L3,
@@ -8229,13 +8229,13 @@ mod generated {
                 let d80 = A::mul_add(s_q_w, d76, c_q_w * d70); // F(M col 9r) at 1.y
                 let d81 = A::mul_add(-c_q_w, d76, s_q_w * d70); // F(M col 9r) at 1.z
                 let d82 = A::mul_add(p.L2, d80, A::mul_add(-p.L1, d81, d77)); // N(M col 9r) at 1.x
-                m [(2 , 17)] = -d82;
+                m[(2, 17)] = -d82;
                 let d83 = A::mul_add(-p.L2, d75, A::mul_add(s_q_w, d79, c_q_w * d78)); // N(M col 9r) at 1.y
                 let d84 = A::mul_add(p.L1, d75, A::mul_add(-c_q_w, d79, s_q_w * d78)); // N(M col 9r) at 1.z
                 let d85 = A::mul_add(c_q_imu, d81, s_q_imu * d80); // F(M col 9r) at 0.x
-                m [(0 , 17)] = d85;
+                m[(0, 17)] = d85;
                 let d86 = A::mul_add(-s_q_imu, d84, c_q_imu * d83); // N(M col 9r) at 0.z
-                m [(1 , 17)] = d86;
+                m[(1, 17)] = d86;
                 let d87 = p.MX8r - d42; // MSC8r.x
                 let d88 = p.MY8r - d50; // MSC8r.y
                 let d89 = p.MZ8r - d51; // MSC8r.z
@@ -8250,7 +8250,7 @@ mod generated {
                 let d95 = A::mul_add(k5, d90, A::mul_add(d47, k6, p.YZ8r)); // JC8r.yz
                 let d96 = p.ZZ8r + d49 + d91; // JC8r.zz
                 let d97 = pc.pc10 - d91; // JC8r.yy
-                m [(16 , 16)] = d97;
+                m[(16, 16)] = d97;
                 let d98 = A::mul_add(c_q5r, d89, s_q5r * d87); // MSC8r in 7r.z
                 let d99 = A::mul_add(-s_q5r, d89, c_q5r * d87); // MSC8r in 7r.x
                 let t11 = c_q5r * d93; // common subexpression
@@ -8260,12 +8260,12 @@ mod generated {
                 let t15 = p.L8 * d99; // common subexpression
                 let t16 = p.L8 * d98; // common subexpression
                 let d100 = t11 - t12 - t15; // N(M col 8r) at 7r.x
-                m [(15 , 16)] = -d100;
+                m[(15, 16)] = -d100;
                 let d101 = t13 + t14 - t16; // N(M col 8r) at 7r.z
                 let d102 = s_q4r * d99; // F(M col 8r) at 6r.y
                 let d103 = c_q4r * d99; // F(M col 8r) at 6r.z
                 let d104 = A::mul_add(-s_q4r, d101, c_q4r * d97); // N(M col 8r) at 6r.y
-                m [(14 , 16)] = d104;
+                m[(14, 16)] = d104;
                 let d105 = A::mul_add(c_q4r, d101, s_q4r * d97); // N(M col 8r) at 6r.z
                 let d106 = A::mul_add(s_q3r, d103, c_q3r * d98); // F(M col 8r) at 5r.x
                 let d107 = A::mul_add(-c_q3r, d103, s_q3r * d98); // F(M col 8r) at 5r.z
@@ -8274,7 +8274,7 @@ mod generated {
                     d107,
                     A::mul_add(-s_q3r, d105, c_q3r * d100),
                 ); // N(M col 8r) at 5r.x
-                m [(13 , 16)] = -d108;
+                m[(13, 16)] = -d108;
                 let d109 = A::mul_add(
                     -p.L7,
                     d106,
@@ -8283,7 +8283,7 @@ mod generated {
                 let d110 = A::mul_add(-s_q2r, d107, c_q2r * d102); // F(M col 8r) at 4r.y
                 let d111 = A::mul_add(c_q2r, d107, s_q2r * d102); // F(M col 8r) at 4r.z
                 let d112 = A::mul_add(-s_q2r, d109, c_q2r * d104); // N(M col 8r) at 4r.y
-                m [(12 , 16)] = d112;
+                m[(12, 16)] = d112;
                 let d113 = A::mul_add(c_q2r, d109, s_q2r * d104); // N(M col 8r) at 4r.z
                 let d114 = A::mul_add(-s_q1r, d111, c_q1r * d106); // F(M col 8r) at 3.y
                 let d115 = A::mul_add(c_q1r, d111, s_q1r * d106); // F(M col 8r) at 3.z
@@ -8293,7 +8293,7 @@ mod generated {
                     d115,
                     A::mul_add(-s_q1r, d113, c_q1r * d108),
                 ); // N(M col 8r) at 3.y
-                m [(4 , 16)] = d117;
+                m[(4, 16)] = d117;
                 let d118 = A::mul_add(
                     p.L5,
                     d110,
@@ -8306,7 +8306,7 @@ mod generated {
                     d114,
                     A::mul_add(p.L3, d120, A::mul_add(s_q_torso, d118, c_q_torso * d116)),
                 ); // N(M col 8r) at 2.x
-                m [(3 , 16)] = d121;
+                m[(3, 16)] = d121;
                 let d122 = A::mul_add(p.L4, d119, d117); // N(M col 8r) at 2.y
                 let d123 = A::mul_add(
                     -p.L3,
@@ -8321,16 +8321,16 @@ mod generated {
                     A::mul_add(-c_q_w, d123, s_q_w * d122),
                 ); // N(M col 8r) at 1.z
                 let d127 = A::mul_add(p.L2, d125, A::mul_add(-p.L1, d124, d121)); // N(M col 8r) at 1.x
-                m [(2 , 16)] = d127;
+                m[(2, 16)] = d127;
                 let d128 = A::mul_add(
                     -p.L2,
                     d119,
                     A::mul_add(s_q_w, d123, c_q_w * d122),
                 ); // N(M col 8r) at 1.y
                 let d129 = A::mul_add(c_q_imu, d124, s_q_imu * d125); // F(M col 8r) at 0.x
-                m [(0 , 16)] = -d129;
+                m[(0, 16)] = -d129;
                 let d130 = A::mul_add(-s_q_imu, d126, c_q_imu * d128); // N(M col 8r) at 0.z
-                m [(1 , 16)] = -d130;
+                m[(1, 16)] = -d130;
                 let d131 = p.MX7r - d99; // MSC7r.x
                 let d132 = p.MZ7r + d98; // MSC7r.z
                 let k7 = s_q5r * s_q5r; // sin² q5r
@@ -8345,14 +8345,14 @@ mod generated {
                 let d138 = p.YZ7r - t13 - t14 + t16; // JC7r.yz
                 let d139 = pc.pc13 - d88; // MSC7r.y
                 let d140 = A::mul_add(2.0, t17, d92 - d134) + pc.pc14; // JC7r.xx
-                m [(15 , 15)] = d140;
+                m[(15, 15)] = d140;
                 let d141 = A::mul_add(2.0, t17, d96 + d134) + pc.pc15; // JC7r.zz
                 let d142 = A::mul_add(s_q4r, d132, c_q4r * d139); // MSC7r in 6r.y
                 let d143 = A::mul_add(-c_q4r, d132, s_q4r * d139); // MSC7r in 6r.z
                 let t18 = c_q4r * d135; // common subexpression
                 let t19 = s_q4r * d136; // common subexpression
                 let d144 = t18 + t19; // N(M col 7r) at 6r.y
-                m [(14 , 15)] = -d144;
+                m[(14, 15)] = -d144;
                 let t20 = s_q4r * d135; // common subexpression
                 let t21 = c_q4r * d136; // common subexpression
                 let d145 = t20 - t21; // N(M col 7r) at 6r.z
@@ -8368,11 +8368,11 @@ mod generated {
                     d147,
                     A::mul_add(-s_q3r, d145, c_q3r * d140),
                 ); // N(M col 7r) at 5r.x
-                m [(13 , 15)] = d149;
+                m[(13, 15)] = d149;
                 let d150 = A::mul_add(s_q2r, d147, c_q2r * d143); // F(M col 7r) at 4r.y
                 let d151 = A::mul_add(-c_q2r, d147, s_q2r * d143); // F(M col 7r) at 4r.z
                 let d152 = A::mul_add(-s_q2r, d148, c_q2r * d144); // N(M col 7r) at 4r.y
-                m [(12 , 15)] = -d152;
+                m[(12, 15)] = -d152;
                 let d153 = A::mul_add(c_q2r, d148, s_q2r * d144); // N(M col 7r) at 4r.z
                 let d154 = A::mul_add(-s_q1r, d151, c_q1r * d146); // F(M col 7r) at 3.y
                 let d155 = A::mul_add(c_q1r, d151, s_q1r * d146); // F(M col 7r) at 3.z
@@ -8381,7 +8381,7 @@ mod generated {
                     d155,
                     A::mul_add(-s_q1r, d153, c_q1r * d149),
                 ); // N(M col 7r) at 3.y
-                m [(4 , 15)] = -d156;
+                m[(4, 15)] = -d156;
                 let d157 = A::mul_add(
                     p.L5,
                     d150,
@@ -8395,7 +8395,7 @@ mod generated {
                     d154,
                     A::mul_add(p.L3, d160, A::mul_add(s_q_torso, d157, c_q_torso * d158)),
                 ); // N(M col 7r) at 2.x
-                m [(3 , 15)] = -d161;
+                m[(3, 15)] = -d161;
                 let d162 = A::mul_add(p.L4, d159, d156); // N(M col 7r) at 2.y
                 let d163 = A::mul_add(
                     -p.L3,
@@ -8405,7 +8405,7 @@ mod generated {
                 let d164 = A::mul_add(s_q_w, d160, c_q_w * d154); // F(M col 7r) at 1.y
                 let d165 = A::mul_add(-c_q_w, d160, s_q_w * d154); // F(M col 7r) at 1.z
                 let d166 = A::mul_add(p.L2, d164, A::mul_add(-p.L1, d165, d161)); // N(M col 7r) at 1.x
-                m [(2 , 15)] = -d166;
+                m[(2, 15)] = -d166;
                 let d167 = A::mul_add(
                     -p.L2,
                     d159,
@@ -8417,9 +8417,9 @@ mod generated {
                     A::mul_add(-c_q_w, d163, s_q_w * d162),
                 ); // N(M col 7r) at 1.z
                 let d169 = A::mul_add(c_q_imu, d165, s_q_imu * d164); // F(M col 7r) at 0.x
-                m [(0 , 15)] = d169;
+                m[(0, 15)] = d169;
                 let d170 = A::mul_add(-s_q_imu, d168, c_q_imu * d167); // N(M col 7r) at 0.z
-                m [(1 , 15)] = d170;
+                m[(1, 15)] = d170;
                 let d171 = p.MX6r - d131; // MSC6r.x
                 let d172 = p.MY6r - d142; // MSC6r.y
                 let d173 = p.MZ6r - d143; // MSC6r.z
@@ -8432,7 +8432,7 @@ mod generated {
                 let d177 = p.XY6r + t18 + t19; // JC6r.xy
                 let d178 = p.XZ6r + t20 - t21; // JC6r.xz
                 let d179 = p.YY6r + d137 - d175; // JC6r.yy
-                m [(14 , 14)] = d179;
+                m[(14, 14)] = d179;
                 let d180 = A::mul_add(k11, d174, A::mul_add(d138, k12, p.YZ6r)); // JC6r.yz
                 let d181 = p.ZZ6r + d141 + d175; // JC6r.zz
                 let d182 = A::mul_add(c_q3r, d173, s_q3r * d171); // MSC6r in 5r.z
@@ -8444,12 +8444,12 @@ mod generated {
                 let t26 = p.L7 * d183; // common subexpression
                 let t27 = p.L7 * d182; // common subexpression
                 let d184 = t22 - t23 - t26; // N(M col 6r) at 5r.x
-                m [(13 , 14)] = -d184;
+                m[(13, 14)] = -d184;
                 let d185 = t24 + t25 - t27; // N(M col 6r) at 5r.z
                 let d186 = s_q2r * d183; // F(M col 6r) at 4r.y
                 let d187 = c_q2r * d183; // F(M col 6r) at 4r.z
                 let d188 = A::mul_add(-s_q2r, d185, c_q2r * d179); // N(M col 6r) at 4r.y
-                m [(12 , 14)] = d188;
+                m[(12, 14)] = d188;
                 let d189 = A::mul_add(c_q2r, d185, s_q2r * d179); // N(M col 6r) at 4r.z
                 let d190 = A::mul_add(s_q1r, d187, c_q1r * d182); // F(M col 6r) at 3.y
                 let d191 = A::mul_add(-c_q1r, d187, s_q1r * d182); // F(M col 6r) at 3.z
@@ -8459,7 +8459,7 @@ mod generated {
                     d191,
                     A::mul_add(-s_q1r, d189, c_q1r * d184),
                 ); // N(M col 6r) at 3.y
-                m [(4 , 14)] = d193;
+                m[(4, 14)] = d193;
                 let d194 = A::mul_add(
                     p.L5,
                     d186,
@@ -8472,7 +8472,7 @@ mod generated {
                     d190,
                     A::mul_add(p.L3, d196, A::mul_add(s_q_torso, d194, c_q_torso * d192)),
                 ); // N(M col 6r) at 2.x
-                m [(3 , 14)] = d197;
+                m[(3, 14)] = d197;
                 let d198 = A::mul_add(p.L4, d195, d193); // N(M col 6r) at 2.y
                 let d199 = A::mul_add(
                     -p.L3,
@@ -8487,16 +8487,16 @@ mod generated {
                     A::mul_add(-c_q_w, d199, s_q_w * d198),
                 ); // N(M col 6r) at 1.z
                 let d203 = A::mul_add(p.L2, d201, A::mul_add(-p.L1, d200, d197)); // N(M col 6r) at 1.x
-                m [(2 , 14)] = d203;
+                m[(2, 14)] = d203;
                 let d204 = A::mul_add(
                     -p.L2,
                     d195,
                     A::mul_add(s_q_w, d199, c_q_w * d198),
                 ); // N(M col 6r) at 1.y
                 let d205 = A::mul_add(c_q_imu, d200, s_q_imu * d201); // F(M col 6r) at 0.x
-                m [(0 , 14)] = -d205;
+                m[(0, 14)] = -d205;
                 let d206 = A::mul_add(-s_q_imu, d202, c_q_imu * d204); // N(M col 6r) at 0.z
-                m [(1 , 14)] = -d206;
+                m[(1, 14)] = -d206;
                 let d207 = p.MX5r - d183; // MSC5r.x
                 let d208 = p.MZ5r + d182; // MSC5r.z
                 let k13 = s_q3r * s_q3r; // sin² q3r
@@ -8511,14 +8511,14 @@ mod generated {
                 let d214 = p.YZ5r - t24 - t25 + t27; // JC5r.yz
                 let d215 = pc.pc19 - d172; // MSC5r.y
                 let d216 = A::mul_add(2.0, t28, d176 - d210) + pc.pc20; // JC5r.xx
-                m [(13 , 13)] = d216;
+                m[(13, 13)] = d216;
                 let d217 = A::mul_add(2.0, t28, d181 + d210) + pc.pc21; // JC5r.zz
                 let d218 = A::mul_add(s_q2r, d208, c_q2r * d215); // MSC5r in 4r.y
                 let d219 = A::mul_add(-c_q2r, d208, s_q2r * d215); // MSC5r in 4r.z
                 let t29 = c_q2r * d211; // common subexpression
                 let t30 = s_q2r * d212; // common subexpression
                 let d220 = t29 + t30; // N(M col 5r) at 4r.y
-                m [(12 , 13)] = -d220;
+                m[(12, 13)] = -d220;
                 let t31 = s_q2r * d211; // common subexpression
                 let t32 = c_q2r * d212; // common subexpression
                 let d221 = t31 - t32; // N(M col 5r) at 4r.z
@@ -8529,7 +8529,7 @@ mod generated {
                     d223,
                     A::mul_add(-s_q1r, d221, c_q1r * d216),
                 ); // N(M col 5r) at 3.y
-                m [(4 , 13)] = -d224;
+                m[(4, 13)] = -d224;
                 let d225 = A::mul_add(
                     p.L5,
                     d219,
@@ -8543,7 +8543,7 @@ mod generated {
                     d222,
                     A::mul_add(p.L3, d228, A::mul_add(s_q_torso, d225, c_q_torso * d226)),
                 ); // N(M col 5r) at 2.x
-                m [(3 , 13)] = -d229;
+                m[(3, 13)] = -d229;
                 let d230 = A::mul_add(p.L4, d227, d224); // N(M col 5r) at 2.y
                 let d231 = A::mul_add(
                     -p.L3,
@@ -8553,7 +8553,7 @@ mod generated {
                 let d232 = A::mul_add(s_q_w, d228, c_q_w * d222); // F(M col 5r) at 1.y
                 let d233 = A::mul_add(-c_q_w, d228, s_q_w * d222); // F(M col 5r) at 1.z
                 let d234 = A::mul_add(p.L2, d232, A::mul_add(-p.L1, d233, d229)); // N(M col 5r) at 1.x
-                m [(2 , 13)] = -d234;
+                m[(2, 13)] = -d234;
                 let d235 = A::mul_add(
                     -p.L2,
                     d227,
@@ -8565,9 +8565,9 @@ mod generated {
                     A::mul_add(-c_q_w, d231, s_q_w * d230),
                 ); // N(M col 5r) at 1.z
                 let d237 = A::mul_add(c_q_imu, d233, s_q_imu * d232); // F(M col 5r) at 0.x
-                m [(0 , 13)] = d237;
+                m[(0, 13)] = d237;
                 let d238 = A::mul_add(-s_q_imu, d236, c_q_imu * d235); // N(M col 5r) at 0.z
-                m [(1 , 13)] = d238;
+                m[(1, 13)] = d238;
                 let d239 = p.MX4r - d207; // MSC4r.x
                 let d240 = p.MY4r - d218; // MSC4r.y
                 let d241 = p.MZ4r - d219; // MSC4r.z
@@ -8580,7 +8580,7 @@ mod generated {
                 let d245 = p.XY4r + t29 + t30; // JC4r.xy
                 let d246 = p.XZ4r + t31 - t32; // JC4r.xz
                 let d247 = p.YY4r + d213 - d243; // JC4r.yy
-                m [(12 , 12)] = d247;
+                m[(12, 12)] = d247;
                 let d248 = A::mul_add(k17, d242, A::mul_add(d214, k18, p.YZ4r)); // JC4r.yz
                 let d249 = p.ZZ4r + d217 + d243; // JC4r.zz
                 let d250 = A::mul_add(-s_q1r, d241, c_q1r * d239); // MSC4r in 3.y
@@ -8594,7 +8594,7 @@ mod generated {
                 let t39 = p.L6 * d251; // common subexpression
                 let d252 = d247 + t37; // N(M col 4r) at 3.x
                 let d253 = t33 - t34 - t38; // N(M col 4r) at 3.y
-                m [(4 , 12)] = d253;
+                m[(4, 12)] = d253;
                 let d254 = t35 + t36 - t39; // N(M col 4r) at 3.z
                 let d255 = s_q_torso * d250; // F(M col 4r) at 2.x
                 let d256 = c_q_torso * d250; // F(M col 4r) at 2.z
@@ -8603,7 +8603,7 @@ mod generated {
                     d251,
                     A::mul_add(p.L3, d256, A::mul_add(s_q_torso, d254, c_q_torso * d252)),
                 ); // N(M col 4r) at 2.x
-                m [(3 , 12)] = d257;
+                m[(3, 12)] = d257;
                 let d258 = A::mul_add(-p.L4, d255, d253); // N(M col 4r) at 2.y
                 let d259 = A::mul_add(
                     p.L3,
@@ -8618,12 +8618,12 @@ mod generated {
                     A::mul_add(-c_q_w, d259, s_q_w * d258),
                 ); // N(M col 4r) at 1.z
                 let d263 = A::mul_add(p.L2, d261, A::mul_add(-p.L1, d260, d257)); // N(M col 4r) at 1.x
-                m [(2 , 12)] = d263;
+                m[(2, 12)] = d263;
                 let d264 = A::mul_add(p.L2, d255, A::mul_add(s_q_w, d259, c_q_w * d258)); // N(M col 4r) at 1.y
                 let d265 = A::mul_add(c_q_imu, d260, s_q_imu * d261); // F(M col 4r) at 0.x
-                m [(0 , 12)] = -d265;
+                m[(0, 12)] = -d265;
                 let d266 = A::mul_add(-s_q_imu, d262, c_q_imu * d264); // N(M col 4r) at 0.z
-                m [(1 , 12)] = -d266;
+                m[(1, 12)] = -d266;
                 let k19 = s_q1r * s_q1r; // sin² q1r
                 let k20 = s_q1r * c_q1r; // sin q1r cos q1r
                 let k21 = A::mul_add(2.0, k19, -1.0); // cos 2q1r
@@ -8639,12 +8639,12 @@ mod generated {
                 let t45 = p.L9 * d270; // common subexpression
                 let t46 = p.L9 * d269; // common subexpression
                 let d271 = t41 + t42 - t45; // N(M col 10l) at 9l.x
-                m [(10 , 11)] = -d271;
+                m[(10, 11)] = -d271;
                 let d272 = t43 - t44 - t46; // N(M col 10l) at 9l.z
                 let d273 = d270 * s_q6l; // F(M col 10l) at 8l.y
                 let d274 = d270 * c_q6l; // F(M col 10l) at 8l.z
                 let d275 = A::mul_add(-d272, s_q6l, p.ZZ10l * c_q6l); // N(M col 10l) at 8l.y
-                m [(9 , 11)] = d275;
+                m[(9, 11)] = d275;
                 let d276 = A::mul_add(d272, c_q6l, p.ZZ10l * s_q6l); // N(M col 10l) at 8l.z
                 let d277 = A::mul_add(d274, s_q5l, d269 * c_q5l); // F(M col 10l) at 7l.x
                 let d278 = A::mul_add(-d274, c_q5l, d269 * s_q5l); // F(M col 10l) at 7l.z
@@ -8653,7 +8653,7 @@ mod generated {
                     d278,
                     A::mul_add(-d276, s_q5l, d271 * c_q5l),
                 ); // N(M col 10l) at 7l.x
-                m [(8 , 11)] = -d279;
+                m[(8, 11)] = -d279;
                 let d280 = A::mul_add(
                     -p.L8,
                     d277,
@@ -8662,7 +8662,7 @@ mod generated {
                 let d281 = A::mul_add(-d278, s_q4l, d273 * c_q4l); // F(M col 10l) at 6l.y
                 let d282 = A::mul_add(d278, c_q4l, d273 * s_q4l); // F(M col 10l) at 6l.z
                 let d283 = A::mul_add(-d280, s_q4l, d275 * c_q4l); // N(M col 10l) at 6l.y
-                m [(7 , 11)] = d283;
+                m[(7, 11)] = d283;
                 let d284 = A::mul_add(d280, c_q4l, d275 * s_q4l); // N(M col 10l) at 6l.z
                 let d285 = A::mul_add(-d282, s_q3l, d277 * c_q3l); // F(M col 10l) at 5l.x
                 let d286 = A::mul_add(d282, c_q3l, d277 * s_q3l); // F(M col 10l) at 5l.z
@@ -8671,7 +8671,7 @@ mod generated {
                     d286,
                     A::mul_add(-d284, s_q3l, d279 * c_q3l),
                 ); // N(M col 10l) at 5l.x
-                m [(6 , 11)] = -d287;
+                m[(6, 11)] = -d287;
                 let d288 = A::mul_add(
                     -p.L7,
                     d285,
@@ -8680,7 +8680,7 @@ mod generated {
                 let d289 = A::mul_add(-d286, s_q2l, d281 * c_q2l); // F(M col 10l) at 4l.y
                 let d290 = A::mul_add(d286, c_q2l, d281 * s_q2l); // F(M col 10l) at 4l.z
                 let d291 = A::mul_add(-d288, s_q2l, d283 * c_q2l); // N(M col 10l) at 4l.y
-                m [(5 , 11)] = d291;
+                m[(5, 11)] = d291;
                 let d292 = A::mul_add(d288, c_q2l, d283 * s_q2l); // N(M col 10l) at 4l.z
                 let d293 = A::mul_add(d290, c_q1l, d285 * s_q1l); // F(M col 10l) at 3.z
                 let d294 = A::mul_add(-d290, s_q1l, d285 * c_q1l); // F(M col 10l) at 3.y
@@ -8695,7 +8695,7 @@ mod generated {
                     d293,
                     A::mul_add(-d292, s_q1l, d287 * c_q1l),
                 ); // N(M col 10l) at 3.y
-                m [(4 , 11)] = d297;
+                m[(4, 11)] = d297;
                 let d298 = A::mul_add(s_q_torso, d293, c_q_torso * d289); // F(M col 10l) at 2.x
                 let d299 = A::mul_add(-c_q_torso, d293, s_q_torso * d289); // F(M col 10l) at 2.z
                 let d300 = A::mul_add(
@@ -8703,7 +8703,7 @@ mod generated {
                     d294,
                     A::mul_add(p.L3, d299, A::mul_add(s_q_torso, d295, c_q_torso * d296)),
                 ); // N(M col 10l) at 2.x
-                m [(3 , 11)] = -d300;
+                m[(3, 11)] = -d300;
                 let d301 = A::mul_add(
                     -p.L3,
                     d298,
@@ -8713,7 +8713,7 @@ mod generated {
                 let d303 = A::mul_add(c_q_w, d299, s_q_w * d294); // F(M col 10l) at 1.z
                 let d304 = A::mul_add(-s_q_w, d299, c_q_w * d294); // F(M col 10l) at 1.y
                 let d305 = A::mul_add(-p.L2, d304, A::mul_add(p.L1, d303, d300)); // N(M col 10l) at 1.x
-                m [(2 , 11)] = -d305;
+                m[(2, 11)] = -d305;
                 let d306 = A::mul_add(
                     -p.L1,
                     d298,
@@ -8725,9 +8725,9 @@ mod generated {
                     A::mul_add(-s_q_w, d301, c_q_w * d302),
                 ); // N(M col 10l) at 1.y
                 let d308 = A::mul_add(c_q_imu, d303, s_q_imu * d304); // F(M col 10l) at 0.x
-                m [(0 , 11)] = -d308;
+                m[(0, 11)] = -d308;
                 let d309 = A::mul_add(-s_q_imu, d306, c_q_imu * d307); // N(M col 10l) at 0.z
-                m [(1 , 11)] = -d309;
+                m[(1, 11)] = -d309;
                 let d310 = p.MX9l - d270; // MSC9l.x
                 let d311 = p.MZ9l + d269; // MSC9l.z
                 let k22 = s_q7l * s_q7l; // sin² q7l
@@ -8738,14 +8738,14 @@ mod generated {
                 let d314 = A::mul_add(-k23, pc.pc26, A::mul_add(-p.XY10l, k24, p.XZ9l)); // JC9l.xz
                 let d315 = p.YZ9l - t43 + t44 + t46; // JC9l.yz
                 let d316 = pc.pc30 - d312; // JC9l.xx
-                m [(10 , 10)] = d316;
+                m[(10, 10)] = d316;
                 let d317 = d312 + pc.pc31; // JC9l.zz
                 let d318 = A::mul_add(s_q6l, d311, c_q6l * pc.pc25); // MSC9l in 8l.y
                 let d319 = A::mul_add(-c_q6l, d311, s_q6l * pc.pc25); // MSC9l in 8l.z
                 let t47 = c_q6l * d313; // common subexpression
                 let t48 = s_q6l * d314; // common subexpression
                 let d320 = t47 + t48; // N(M col 9l) at 8l.y
-                m [(9 , 10)] = -d320;
+                m[(9, 10)] = -d320;
                 let t49 = s_q6l * d313; // common subexpression
                 let t50 = c_q6l * d314; // common subexpression
                 let d321 = t49 - t50; // N(M col 9l) at 8l.z
@@ -8761,11 +8761,11 @@ mod generated {
                     d323,
                     A::mul_add(-s_q5l, d321, c_q5l * d316),
                 ); // N(M col 9l) at 7l.x
-                m [(8 , 10)] = d325;
+                m[(8, 10)] = d325;
                 let d326 = A::mul_add(s_q4l, d323, c_q4l * d319); // F(M col 9l) at 6l.y
                 let d327 = A::mul_add(-c_q4l, d323, s_q4l * d319); // F(M col 9l) at 6l.z
                 let d328 = A::mul_add(-s_q4l, d324, c_q4l * d320); // N(M col 9l) at 6l.y
-                m [(7 , 10)] = -d328;
+                m[(7, 10)] = -d328;
                 let d329 = A::mul_add(c_q4l, d324, s_q4l * d320); // N(M col 9l) at 6l.z
                 let d330 = A::mul_add(c_q3l, d327, s_q3l * d322); // F(M col 9l) at 5l.z
                 let d331 = A::mul_add(-s_q3l, d327, c_q3l * d322); // F(M col 9l) at 5l.x
@@ -8779,11 +8779,11 @@ mod generated {
                     d330,
                     A::mul_add(-s_q3l, d329, c_q3l * d325),
                 ); // N(M col 9l) at 5l.x
-                m [(6 , 10)] = d333;
+                m[(6, 10)] = d333;
                 let d334 = A::mul_add(-s_q2l, d330, c_q2l * d326); // F(M col 9l) at 4l.y
                 let d335 = A::mul_add(c_q2l, d330, s_q2l * d326); // F(M col 9l) at 4l.z
                 let d336 = A::mul_add(-s_q2l, d332, c_q2l * d328); // N(M col 9l) at 4l.y
-                m [(5 , 10)] = -d336;
+                m[(5, 10)] = -d336;
                 let d337 = A::mul_add(c_q2l, d332, s_q2l * d328); // N(M col 9l) at 4l.z
                 let d338 = A::mul_add(-s_q1l, d335, c_q1l * d331); // F(M col 9l) at 3.y
                 let d339 = A::mul_add(c_q1l, d335, s_q1l * d331); // F(M col 9l) at 3.z
@@ -8793,7 +8793,7 @@ mod generated {
                     d339,
                     A::mul_add(-s_q1l, d337, c_q1l * d333),
                 ); // N(M col 9l) at 3.y
-                m [(4 , 10)] = -d341;
+                m[(4, 10)] = -d341;
                 let d342 = A::mul_add(
                     p.L5,
                     d334,
@@ -8807,7 +8807,7 @@ mod generated {
                     d338,
                     A::mul_add(p.L3, d344, A::mul_add(s_q_torso, d342, c_q_torso * d340)),
                 ); // N(M col 9l) at 2.x
-                m [(3 , 10)] = d346;
+                m[(3, 10)] = d346;
                 let d347 = A::mul_add(
                     -p.L3,
                     d343,
@@ -8821,16 +8821,16 @@ mod generated {
                     A::mul_add(-s_q_w, d347, c_q_w * d345),
                 ); // N(M col 9l) at 1.y
                 let d351 = A::mul_add(-p.L2, d348, A::mul_add(p.L1, d349, d346)); // N(M col 9l) at 1.x
-                m [(2 , 10)] = d351;
+                m[(2, 10)] = d351;
                 let d352 = A::mul_add(
                     -p.L1,
                     d343,
                     A::mul_add(c_q_w, d347, s_q_w * d345),
                 ); // N(M col 9l) at 1.z
                 let d353 = A::mul_add(c_q_imu, d349, s_q_imu * d348); // F(M col 9l) at 0.x
-                m [(0 , 10)] = d353;
+                m[(0, 10)] = d353;
                 let d354 = A::mul_add(-s_q_imu, d352, c_q_imu * d350); // N(M col 9l) at 0.z
-                m [(1 , 10)] = d354;
+                m[(1, 10)] = d354;
                 let d355 = p.MX8l - d310; // MSC8l.x
                 let d356 = p.MY8l - d318; // MSC8l.y
                 let d357 = p.MZ8l - d319; // MSC8l.z
@@ -8845,7 +8845,7 @@ mod generated {
                 let d363 = A::mul_add(k26, d358, A::mul_add(d315, k27, p.YZ8l)); // JC8l.yz
                 let d364 = p.ZZ8l + d317 + d359; // JC8l.zz
                 let d365 = pc.pc33 - d359; // JC8l.yy
-                m [(9 , 9)] = d365;
+                m[(9, 9)] = d365;
                 let d366 = A::mul_add(c_q5l, d357, s_q5l * d355); // MSC8l in 7l.z
                 let d367 = A::mul_add(-s_q5l, d357, c_q5l * d355); // MSC8l in 7l.x
                 let t51 = c_q5l * d361; // common subexpression
@@ -8855,12 +8855,12 @@ mod generated {
                 let t55 = p.L8 * d367; // common subexpression
                 let t56 = p.L8 * d366; // common subexpression
                 let d368 = t51 - t52 - t55; // N(M col 8l) at 7l.x
-                m [(8 , 9)] = -d368;
+                m[(8, 9)] = -d368;
                 let d369 = t53 + t54 - t56; // N(M col 8l) at 7l.z
                 let d370 = s_q4l * d367; // F(M col 8l) at 6l.y
                 let d371 = c_q4l * d367; // F(M col 8l) at 6l.z
                 let d372 = A::mul_add(-s_q4l, d369, c_q4l * d365); // N(M col 8l) at 6l.y
-                m [(7 , 9)] = d372;
+                m[(7, 9)] = d372;
                 let d373 = A::mul_add(c_q4l, d369, s_q4l * d365); // N(M col 8l) at 6l.z
                 let d374 = A::mul_add(s_q3l, d371, c_q3l * d366); // F(M col 8l) at 5l.x
                 let d375 = A::mul_add(-c_q3l, d371, s_q3l * d366); // F(M col 8l) at 5l.z
@@ -8869,7 +8869,7 @@ mod generated {
                     d375,
                     A::mul_add(-s_q3l, d373, c_q3l * d368),
                 ); // N(M col 8l) at 5l.x
-                m [(6 , 9)] = -d376;
+                m[(6, 9)] = -d376;
                 let d377 = A::mul_add(
                     -p.L7,
                     d374,
@@ -8878,7 +8878,7 @@ mod generated {
                 let d378 = A::mul_add(-s_q2l, d375, c_q2l * d370); // F(M col 8l) at 4l.y
                 let d379 = A::mul_add(c_q2l, d375, s_q2l * d370); // F(M col 8l) at 4l.z
                 let d380 = A::mul_add(-s_q2l, d377, c_q2l * d372); // N(M col 8l) at 4l.y
-                m [(5 , 9)] = d380;
+                m[(5, 9)] = d380;
                 let d381 = A::mul_add(c_q2l, d377, s_q2l * d372); // N(M col 8l) at 4l.z
                 let d382 = A::mul_add(c_q1l, d379, s_q1l * d374); // F(M col 8l) at 3.z
                 let d383 = A::mul_add(-s_q1l, d379, c_q1l * d374); // F(M col 8l) at 3.y
@@ -8893,7 +8893,7 @@ mod generated {
                     d382,
                     A::mul_add(-s_q1l, d381, c_q1l * d376),
                 ); // N(M col 8l) at 3.y
-                m [(4 , 9)] = d386;
+                m[(4, 9)] = d386;
                 let d387 = A::mul_add(s_q_torso, d382, c_q_torso * d378); // F(M col 8l) at 2.x
                 let d388 = A::mul_add(-c_q_torso, d382, s_q_torso * d378); // F(M col 8l) at 2.z
                 let d389 = A::mul_add(
@@ -8901,7 +8901,7 @@ mod generated {
                     d383,
                     A::mul_add(p.L3, d388, A::mul_add(s_q_torso, d384, c_q_torso * d385)),
                 ); // N(M col 8l) at 2.x
-                m [(3 , 9)] = -d389;
+                m[(3, 9)] = -d389;
                 let d390 = A::mul_add(
                     -p.L3,
                     d387,
@@ -8911,7 +8911,7 @@ mod generated {
                 let d392 = A::mul_add(c_q_w, d388, s_q_w * d383); // F(M col 8l) at 1.z
                 let d393 = A::mul_add(-s_q_w, d388, c_q_w * d383); // F(M col 8l) at 1.y
                 let d394 = A::mul_add(-p.L2, d393, A::mul_add(p.L1, d392, d389)); // N(M col 8l) at 1.x
-                m [(2 , 9)] = -d394;
+                m[(2, 9)] = -d394;
                 let d395 = A::mul_add(
                     -p.L1,
                     d387,
@@ -8923,9 +8923,9 @@ mod generated {
                     A::mul_add(-s_q_w, d390, c_q_w * d391),
                 ); // N(M col 8l) at 1.y
                 let d397 = A::mul_add(c_q_imu, d392, s_q_imu * d393); // F(M col 8l) at 0.x
-                m [(0 , 9)] = -d397;
+                m[(0, 9)] = -d397;
                 let d398 = A::mul_add(-s_q_imu, d395, c_q_imu * d396); // N(M col 8l) at 0.z
-                m [(1 , 9)] = -d398;
+                m[(1, 9)] = -d398;
                 let d399 = p.MX7l - d367; // MSC7l.x
                 let d400 = p.MZ7l + d366; // MSC7l.z
                 let k28 = s_q5l * s_q5l; // sin² q5l
@@ -8940,14 +8940,14 @@ mod generated {
                 let d406 = p.YZ7l - t53 - t54 + t56; // JC7l.yz
                 let d407 = pc.pc36 - d356; // MSC7l.y
                 let d408 = A::mul_add(2.0, t57, d360 - d402) + pc.pc37; // JC7l.xx
-                m [(8 , 8)] = d408;
+                m[(8, 8)] = d408;
                 let d409 = A::mul_add(2.0, t57, d364 + d402) + pc.pc38; // JC7l.zz
                 let d410 = A::mul_add(s_q4l, d400, c_q4l * d407); // MSC7l in 6l.y
                 let d411 = A::mul_add(-c_q4l, d400, s_q4l * d407); // MSC7l in 6l.z
                 let t58 = c_q4l * d403; // common subexpression
                 let t59 = s_q4l * d404; // common subexpression
                 let d412 = t58 + t59; // N(M col 7l) at 6l.y
-                m [(7 , 8)] = -d412;
+                m[(7, 8)] = -d412;
                 let t60 = s_q4l * d403; // common subexpression
                 let t61 = c_q4l * d404; // common subexpression
                 let d413 = t60 - t61; // N(M col 7l) at 6l.z
@@ -8963,11 +8963,11 @@ mod generated {
                     d415,
                     A::mul_add(-s_q3l, d413, c_q3l * d408),
                 ); // N(M col 7l) at 5l.x
-                m [(6 , 8)] = d417;
+                m[(6, 8)] = d417;
                 let d418 = A::mul_add(s_q2l, d415, c_q2l * d411); // F(M col 7l) at 4l.y
                 let d419 = A::mul_add(-c_q2l, d415, s_q2l * d411); // F(M col 7l) at 4l.z
                 let d420 = A::mul_add(-s_q2l, d416, c_q2l * d412); // N(M col 7l) at 4l.y
-                m [(5 , 8)] = -d420;
+                m[(5, 8)] = -d420;
                 let d421 = A::mul_add(c_q2l, d416, s_q2l * d412); // N(M col 7l) at 4l.z
                 let d422 = A::mul_add(-s_q1l, d419, c_q1l * d414); // F(M col 7l) at 3.y
                 let d423 = A::mul_add(c_q1l, d419, s_q1l * d414); // F(M col 7l) at 3.z
@@ -8977,7 +8977,7 @@ mod generated {
                     d423,
                     A::mul_add(-s_q1l, d421, c_q1l * d417),
                 ); // N(M col 7l) at 3.y
-                m [(4 , 8)] = -d425;
+                m[(4, 8)] = -d425;
                 let d426 = A::mul_add(
                     p.L5,
                     d418,
@@ -8991,7 +8991,7 @@ mod generated {
                     d422,
                     A::mul_add(p.L3, d428, A::mul_add(s_q_torso, d426, c_q_torso * d424)),
                 ); // N(M col 7l) at 2.x
-                m [(3 , 8)] = d430;
+                m[(3, 8)] = d430;
                 let d431 = A::mul_add(
                     -p.L3,
                     d427,
@@ -9005,16 +9005,16 @@ mod generated {
                     A::mul_add(-s_q_w, d431, c_q_w * d429),
                 ); // N(M col 7l) at 1.y
                 let d435 = A::mul_add(-p.L2, d432, A::mul_add(p.L1, d433, d430)); // N(M col 7l) at 1.x
-                m [(2 , 8)] = d435;
+                m[(2, 8)] = d435;
                 let d436 = A::mul_add(
                     -p.L1,
                     d427,
                     A::mul_add(c_q_w, d431, s_q_w * d429),
                 ); // N(M col 7l) at 1.z
                 let d437 = A::mul_add(c_q_imu, d433, s_q_imu * d432); // F(M col 7l) at 0.x
-                m [(0 , 8)] = d437;
+                m[(0, 8)] = d437;
                 let d438 = A::mul_add(-s_q_imu, d436, c_q_imu * d434); // N(M col 7l) at 0.z
-                m [(1 , 8)] = d438;
+                m[(1, 8)] = d438;
                 let d439 = p.MX6l - d399; // MSC6l.x
                 let d440 = p.MY6l - d410; // MSC6l.y
                 let d441 = p.MZ6l - d411; // MSC6l.z
@@ -9027,7 +9027,7 @@ mod generated {
                 let d445 = p.XY6l + t58 + t59; // JC6l.xy
                 let d446 = p.XZ6l + t60 - t61; // JC6l.xz
                 let d447 = p.YY6l + d405 - d443; // JC6l.yy
-                m [(7 , 7)] = d447;
+                m[(7, 7)] = d447;
                 let d448 = A::mul_add(k32, d442, A::mul_add(d406, k33, p.YZ6l)); // JC6l.yz
                 let d449 = p.ZZ6l + d409 + d443; // JC6l.zz
                 let d450 = A::mul_add(c_q3l, d441, s_q3l * d439); // MSC6l in 5l.z
@@ -9039,12 +9039,12 @@ mod generated {
                 let t66 = p.L7 * d451; // common subexpression
                 let t67 = p.L7 * d450; // common subexpression
                 let d452 = t62 - t63 - t66; // N(M col 6l) at 5l.x
-                m [(6 , 7)] = -d452;
+                m[(6, 7)] = -d452;
                 let d453 = t64 + t65 - t67; // N(M col 6l) at 5l.z
                 let d454 = s_q2l * d451; // F(M col 6l) at 4l.y
                 let d455 = c_q2l * d451; // F(M col 6l) at 4l.z
                 let d456 = A::mul_add(-s_q2l, d453, c_q2l * d447); // N(M col 6l) at 4l.y
-                m [(5 , 7)] = d456;
+                m[(5, 7)] = d456;
                 let d457 = A::mul_add(c_q2l, d453, s_q2l * d447); // N(M col 6l) at 4l.z
                 let d458 = A::mul_add(-c_q1l, d455, s_q1l * d450); // F(M col 6l) at 3.z
                 let d459 = A::mul_add(s_q1l, d455, c_q1l * d450); // F(M col 6l) at 3.y
@@ -9059,7 +9059,7 @@ mod generated {
                     d458,
                     A::mul_add(-s_q1l, d457, c_q1l * d452),
                 ); // N(M col 6l) at 3.y
-                m [(4 , 7)] = d462;
+                m[(4, 7)] = d462;
                 let d463 = A::mul_add(s_q_torso, d458, c_q_torso * d454); // F(M col 6l) at 2.x
                 let d464 = A::mul_add(-c_q_torso, d458, s_q_torso * d454); // F(M col 6l) at 2.z
                 let d465 = A::mul_add(
@@ -9067,7 +9067,7 @@ mod generated {
                     d459,
                     A::mul_add(p.L3, d464, A::mul_add(s_q_torso, d460, c_q_torso * d461)),
                 ); // N(M col 6l) at 2.x
-                m [(3 , 7)] = -d465;
+                m[(3, 7)] = -d465;
                 let d466 = A::mul_add(
                     -p.L3,
                     d463,
@@ -9077,7 +9077,7 @@ mod generated {
                 let d468 = A::mul_add(c_q_w, d464, s_q_w * d459); // F(M col 6l) at 1.z
                 let d469 = A::mul_add(-s_q_w, d464, c_q_w * d459); // F(M col 6l) at 1.y
                 let d470 = A::mul_add(-p.L2, d469, A::mul_add(p.L1, d468, d465)); // N(M col 6l) at 1.x
-                m [(2 , 7)] = -d470;
+                m[(2, 7)] = -d470;
                 let d471 = A::mul_add(
                     -p.L1,
                     d463,
@@ -9089,9 +9089,9 @@ mod generated {
                     A::mul_add(-s_q_w, d466, c_q_w * d467),
                 ); // N(M col 6l) at 1.y
                 let d473 = A::mul_add(c_q_imu, d468, s_q_imu * d469); // F(M col 6l) at 0.x
-                m [(0 , 7)] = -d473;
+                m[(0, 7)] = -d473;
                 let d474 = A::mul_add(-s_q_imu, d471, c_q_imu * d472); // N(M col 6l) at 0.z
-                m [(1 , 7)] = -d474;
+                m[(1, 7)] = -d474;
                 let d475 = p.MX5l - d451; // MSC5l.x
                 let d476 = p.MZ5l + d450; // MSC5l.z
                 let k34 = s_q3l * s_q3l; // sin² q3l
@@ -9106,14 +9106,14 @@ mod generated {
                 let d482 = p.YZ5l - t64 - t65 + t67; // JC5l.yz
                 let d483 = pc.pc42 - d440; // MSC5l.y
                 let d484 = A::mul_add(2.0, t68, d444 - d478) + pc.pc43; // JC5l.xx
-                m [(6 , 6)] = d484;
+                m[(6, 6)] = d484;
                 let d485 = A::mul_add(2.0, t68, d449 + d478) + pc.pc44; // JC5l.zz
                 let d486 = A::mul_add(s_q2l, d476, c_q2l * d483); // MSC5l in 4l.y
                 let d487 = A::mul_add(-c_q2l, d476, s_q2l * d483); // MSC5l in 4l.z
                 let t69 = c_q2l * d479; // common subexpression
                 let t70 = s_q2l * d480; // common subexpression
                 let d488 = t69 + t70; // N(M col 5l) at 4l.y
-                m [(5 , 6)] = -d488;
+                m[(5, 6)] = -d488;
                 let t71 = s_q2l * d479; // common subexpression
                 let t72 = c_q2l * d480; // common subexpression
                 let d489 = t71 - t72; // N(M col 5l) at 4l.z
@@ -9125,7 +9125,7 @@ mod generated {
                     d491,
                     A::mul_add(-s_q1l, d489, c_q1l * d484),
                 ); // N(M col 5l) at 3.y
-                m [(4 , 6)] = -d493;
+                m[(4, 6)] = -d493;
                 let d494 = A::mul_add(
                     p.L5,
                     d487,
@@ -9139,7 +9139,7 @@ mod generated {
                     d490,
                     A::mul_add(p.L3, d496, A::mul_add(s_q_torso, d494, c_q_torso * d492)),
                 ); // N(M col 5l) at 2.x
-                m [(3 , 6)] = d498;
+                m[(3, 6)] = d498;
                 let d499 = A::mul_add(
                     -p.L3,
                     d495,
@@ -9153,16 +9153,16 @@ mod generated {
                     A::mul_add(-s_q_w, d499, c_q_w * d497),
                 ); // N(M col 5l) at 1.y
                 let d503 = A::mul_add(-p.L2, d500, A::mul_add(p.L1, d501, d498)); // N(M col 5l) at 1.x
-                m [(2 , 6)] = d503;
+                m[(2, 6)] = d503;
                 let d504 = A::mul_add(
                     -p.L1,
                     d495,
                     A::mul_add(c_q_w, d499, s_q_w * d497),
                 ); // N(M col 5l) at 1.z
                 let d505 = A::mul_add(c_q_imu, d501, s_q_imu * d500); // F(M col 5l) at 0.x
-                m [(0 , 6)] = d505;
+                m[(0, 6)] = d505;
                 let d506 = A::mul_add(-s_q_imu, d504, c_q_imu * d502); // N(M col 5l) at 0.z
-                m [(1 , 6)] = d506;
+                m[(1, 6)] = d506;
                 let d507 = p.MX4l - d475; // MSC4l.x
                 let d508 = p.MY4l - d486; // MSC4l.y
                 let d509 = p.MZ4l - d487; // MSC4l.z
@@ -9175,7 +9175,7 @@ mod generated {
                 let d513 = p.XY4l + t69 + t70; // JC4l.xy
                 let d514 = p.XZ4l + t71 - t72; // JC4l.xz
                 let d515 = p.YY4l + d481 - d511; // JC4l.yy
-                m [(5 , 5)] = d515;
+                m[(5, 5)] = d515;
                 let d516 = A::mul_add(k38, d510, A::mul_add(d482, k39, p.YZ4l)); // JC4l.yz
                 let d517 = p.ZZ4l + d485 + d511; // JC4l.zz
                 let d518 = A::mul_add(-s_q1l, d509, c_q1l * d507); // MSC4l in 3.y
@@ -9190,7 +9190,7 @@ mod generated {
                 let d520 = t75 + t76 - t79; // N(M col 4l) at 3.z
                 let d521 = d515 + t77; // N(M col 4l) at 3.x
                 let d522 = t73 - t74 - t78; // N(M col 4l) at 3.y
-                m [(4 , 5)] = d522;
+                m[(4, 5)] = d522;
                 let d523 = s_q_torso * d518; // F(M col 4l) at 2.x
                 let d524 = c_q_torso * d518; // F(M col 4l) at 2.z
                 let d525 = A::mul_add(
@@ -9198,7 +9198,7 @@ mod generated {
                     d519,
                     A::mul_add(p.L3, d524, A::mul_add(s_q_torso, d520, c_q_torso * d521)),
                 ); // N(M col 4l) at 2.x
-                m [(3 , 5)] = -d525;
+                m[(3, 5)] = -d525;
                 let d526 = A::mul_add(
                     p.L3,
                     d523,
@@ -9208,7 +9208,7 @@ mod generated {
                 let d528 = A::mul_add(c_q_w, d524, s_q_w * d519); // F(M col 4l) at 1.z
                 let d529 = A::mul_add(-s_q_w, d524, c_q_w * d519); // F(M col 4l) at 1.y
                 let d530 = A::mul_add(-p.L2, d529, A::mul_add(p.L1, d528, d525)); // N(M col 4l) at 1.x
-                m [(2 , 5)] = -d530;
+                m[(2, 5)] = -d530;
                 let d531 = A::mul_add(p.L1, d523, A::mul_add(c_q_w, d526, s_q_w * d527)); // N(M col 4l) at 1.z
                 let d532 = A::mul_add(
                     -p.L2,
@@ -9216,9 +9216,9 @@ mod generated {
                     A::mul_add(-s_q_w, d526, c_q_w * d527),
                 ); // N(M col 4l) at 1.y
                 let d533 = A::mul_add(c_q_imu, d528, s_q_imu * d529); // F(M col 4l) at 0.x
-                m [(0 , 5)] = -d533;
+                m[(0, 5)] = -d533;
                 let d534 = A::mul_add(-s_q_imu, d531, c_q_imu * d532); // N(M col 4l) at 0.z
-                m [(1 , 5)] = -d534;
+                m[(1, 5)] = -d534;
                 let d535 = p.MZ3 + d251 - d519; // MSC3.z
                 let k40 = s_q1l * s_q1l; // sin² q1l
                 let k41 = s_q1l * c_q1l; // sin q1l cos q1l
@@ -9258,7 +9258,7 @@ mod generated {
                     t80,
                     A::mul_add(2.0, t40, d244 - d268) + d512 - d537,
                 ) + pc.pc51; // JC3.yy
-                m [(4 , 4)] = d544;
+                m[(4, 4)] = d544;
                 let d545 = A::mul_add(
                     2.0,
                     t80,
@@ -9278,13 +9278,13 @@ mod generated {
                 let t86 = p.L4 * d547; // common subexpression
                 let t87 = p.L3 * d547; // common subexpression
                 let d548 = t81 - t82 - t85; // N(M col 3) at 2.x
-                m [(3 , 4)] = -d548;
+                m[(3, 4)] = -d548;
                 let d549 = t83 + t84 - t87; // N(M col 3) at 2.z
                 let d550 = d544 - t86; // N(M col 3) at 2.y
                 let d551 = s_q_w * d546; // F(M col 3) at 1.y
                 let d552 = c_q_w * d546; // F(M col 3) at 1.z
                 let d553 = A::mul_add(-p.L2, d551, A::mul_add(-p.L1, d552, d548)); // N(M col 3) at 1.x
-                m [(2 , 4)] = -d553;
+                m[(2, 4)] = -d553;
                 let d554 = A::mul_add(
                     -p.L1,
                     d547,
@@ -9296,9 +9296,9 @@ mod generated {
                     A::mul_add(-s_q_w, d549, c_q_w * d550),
                 ); // N(M col 3) at 1.y
                 let d556 = A::mul_add(-c_q_imu, d552, s_q_imu * d551); // F(M col 3) at 0.x
-                m [(0 , 4)] = -d556;
+                m[(0, 4)] = -d556;
                 let d557 = A::mul_add(-s_q_imu, d554, c_q_imu * d555); // N(M col 3) at 0.z
-                m [(1 , 4)] = -d557;
+                m[(1, 4)] = -d557;
                 let d558 = p.MX2 - d546; // MSC2.x
                 let k43 = s_q_torso * s_q_torso; // sin² q_torso
                 let k44 = s_q_torso * c_q_torso; // sin q_torso cos q_torso
@@ -9316,7 +9316,7 @@ mod generated {
                 let d564 = pc.pc55 - d547; // MSC2.z
                 let d565 = A::mul_add(2.0, t88, A::mul_add(-2.0, t86, d542) - d560)
                     + pc.pc56; // JC2.xx
-                m [(3 , 3)] = d565;
+                m[(3, 3)] = d565;
                 let d566 = A::mul_add(-2.0, t86, d544) + pc.pc57; // JC2.yy
                 let d567 = A::mul_add(-p.L4, d541, t87 - t83 - t84) + pc.pc58; // JC2.yz
                 let d568 = A::mul_add(2.0, t88, d545 + d560) + pc.pc59; // JC2.zz
@@ -9330,14 +9330,14 @@ mod generated {
                 let t93 = p.L1 * d569; // common subexpression
                 let t94 = p.L2 * d570; // common subexpression
                 let d572 = d565 + t93 + t94; // N(M col 2) at 1.x
-                m [(2 , 3)] = d572;
+                m[(2, 3)] = d572;
                 let d573 = t89 + t90; // N(M col 2) at 1.y
                 let d574 = A::mul_add(-c_q_imu, d569, s_q_imu * d570); // F(M col 2) at 0.x
-                m [(0 , 3)] = -d574;
+                m[(0, 3)] = -d574;
                 let d575 = A::mul_add(-s_q_imu, d571, c_q_imu * d573); // N(M col 2) at 0.z
-                m [(1 , 3)] = -d575;
+                m[(1, 3)] = -d575;
                 let d576 = p.MX1 + d558; // MSC1.x
-                m [(0 , 1)] = d576;
+                m[(0, 1)] = d576;
                 let k46 = s_q_w * s_q_w; // sin² q_w
                 let k47 = s_q_w * c_q_w; // sin q_w cos q_w
                 let k48 = A::mul_add(2.0, k46, -1.0); // cos 2q_w
@@ -9348,7 +9348,7 @@ mod generated {
                 let d581 = d569 + pc.pc61; // MSC1.y
                 let d582 = pc.pc62 - d570; // MSC1.z
                 let d583 = A::mul_add(2.0, t94, A::mul_add(2.0, t93, d565)) + pc.pc63; // JC1.xx
-                m [(2 , 2)] = d583;
+                m[(2, 2)] = d583;
                 let d584 = A::mul_add(2.0, t94, d566) - d578 + pc.pc64; // JC1.yy
                 let d585 = A::mul_add(
                     p.L1,
@@ -9357,15 +9357,15 @@ mod generated {
                 ) + pc.pc65; // JC1.yz
                 let d586 = A::mul_add(2.0, t93, d568) + d578 + pc.pc66; // JC1.zz
                 let d587 = A::mul_add(s_q_imu, d582, c_q_imu * d581); // MSC1 in 0.z
-                m [(0 , 2)] = d587;
+                m[(0, 2)] = d587;
                 let d588 = A::mul_add(s_q_imu, d580, c_q_imu * d579); // N(M col 1) at 0.z
-                m [(1 , 2)] = -d588;
+                m[(1, 2)] = -d588;
                 let k49 = s_q_imu * s_q_imu; // sin² q_imu
                 let k50 = s_q_imu * c_q_imu; // sin q_imu cos q_imu
                 let d589 = d584 - d586; // JC1: Jyy − Jzz
                 let d590 = A::mul_add(-2.0, d585 * k50, k49 * d589); // JC1 rotated about x: Jyy − J'yy
                 let d591 = d584 - d590; // JC0
-                m [(1 , 1)] = d591 + pc.pc68;
+                m[(1, 1)] = d591 + pc.pc68;
             }
             for m in out.iter_mut() {
                 m[(1, 0)] = m[(0, 1)];
@@ -10740,7 +10740,7 @@ mod generated {
                         ),
                     ),
                 ); // N10l|ud=0,g=0.z
-                m [11] = d119;
+                m[11] = d119;
                 let k102 = A::mul_add(-s_q1r, k20, c_q1r * k21); // w3 in 4r|ud=0,g=0.x
                 let k103 = A::mul_add(c_q1r, k20, s_q1r * k21); // w3 in 4r|ud=0,g=0.z
                 let k104 = A::mul_add(-k102, qd1r, A::mul_add(c_q1r, k23, s_q1r * k9)); // wd4r|ud=0,g=0.z
@@ -11625,7 +11625,7 @@ mod generated {
                         ),
                     ),
                 ); // N10r|ud=0,g=0.z
-                m [18] = d203;
+                m[18] = d203;
                 let d204 = A::mul_add(s_q7r, d196, c_q7r * d195); // f10r in 9r|ud=0,g=0.x
                 let d205 = A::mul_add(-c_q7r, d196, s_q7r * d195); // f10r in 9r|ud=0,g=0.z
                 let d206 = d183 + d204; // f9r|ud=0,g=0.x
@@ -11637,7 +11637,7 @@ mod generated {
                     d205,
                     A::mul_add(s_q7r, d202, A::mul_add(c_q7r, d201, d189)),
                 ); // n9r|ud=0,g=0.x
-                m [17] = -d210;
+                m[17] = -d210;
                 let d211 = A::mul_add(
                     p.L9,
                     d204,
@@ -11650,7 +11650,7 @@ mod generated {
                 let d216 = d173 + d212; // f8r|ud=0,g=0.y
                 let d217 = d177 + d210; // n8r|ud=0,g=0.x
                 let d218 = A::mul_add(s_q6r, d211, A::mul_add(c_q6r, d209, d178)); // n8r|ud=0,g=0.y
-                m [16] = d218;
+                m[16] = d218;
                 let d219 = A::mul_add(-c_q6r, d211, A::mul_add(s_q6r, d209, d179)); // n8r|ud=0,g=0.z
                 let d220 = A::mul_add(s_q5r, d214, c_q5r * d215); // f8r in 7r|ud=0,g=0.x
                 let d221 = A::mul_add(-c_q5r, d214, s_q5r * d215); // f8r in 7r|ud=0,g=0.z
@@ -11663,7 +11663,7 @@ mod generated {
                     d221,
                     A::mul_add(-s_q5r, d219, A::mul_add(c_q5r, d217, d165)),
                 ); // n7r|ud=0,g=0.x
-                m [15] = -d226;
+                m[15] = -d226;
                 let d227 = A::mul_add(
                     p.L8,
                     d220,
@@ -11676,7 +11676,7 @@ mod generated {
                 let d232 = d149 + d228; // f6r|ud=0,g=0.y
                 let d233 = d153 + d226; // n6r|ud=0,g=0.x
                 let d234 = A::mul_add(s_q4r, d227, A::mul_add(c_q4r, d225, d154)); // n6r|ud=0,g=0.y
-                m [14] = d234;
+                m[14] = d234;
                 let d235 = A::mul_add(-c_q4r, d227, A::mul_add(s_q4r, d225, d155)); // n6r|ud=0,g=0.z
                 let d236 = A::mul_add(s_q3r, d230, c_q3r * d231); // f6r in 5r|ud=0,g=0.x
                 let d237 = A::mul_add(-c_q3r, d230, s_q3r * d231); // f6r in 5r|ud=0,g=0.z
@@ -11689,7 +11689,7 @@ mod generated {
                     d237,
                     A::mul_add(-s_q3r, d235, A::mul_add(c_q3r, d233, d141)),
                 ); // n5r|ud=0,g=0.x
-                m [13] = -d242;
+                m[13] = -d242;
                 let d243 = A::mul_add(
                     p.L7,
                     d236,
@@ -11702,7 +11702,7 @@ mod generated {
                 let d248 = d125 + d244; // f4r|ud=0,g=0.y
                 let d249 = d129 + d242; // n4r|ud=0,g=0.x
                 let d250 = A::mul_add(s_q2r, d243, A::mul_add(c_q2r, d241, d130)); // n4r|ud=0,g=0.y
-                m [12] = d250;
+                m[12] = d250;
                 let d251 = A::mul_add(-c_q2r, d243, A::mul_add(s_q2r, d241, d131)); // n4r|ud=0,g=0.z
                 let d252 = A::mul_add(s_q1r, d246, c_q1r * d247); // f4r in 3|ud=0,g=0.y
                 let d253 = A::mul_add(-c_q1r, d246, s_q1r * d247); // f4r in 3|ud=0,g=0.z
@@ -11733,7 +11733,7 @@ mod generated {
                     d261,
                     A::mul_add(s_q7l, d118, A::mul_add(c_q7l, d117, d105)),
                 ); // n9l|ud=0,g=0.x
-                m [10] = -d264;
+                m[10] = -d264;
                 let d265 = A::mul_add(
                     p.L9,
                     d260,
@@ -11748,7 +11748,7 @@ mod generated {
                 let d272 = d89 + d262; // f8l|ud=0,g=0.x
                 let d273 = d93 + d264; // n8l|ud=0,g=0.x
                 let d274 = A::mul_add(s_q6l, d265, A::mul_add(c_q6l, d263, d94)); // n8l|ud=0,g=0.y
-                m [9] = d274;
+                m[9] = d274;
                 let d275 = A::mul_add(-c_q6l, d265, A::mul_add(s_q6l, d263, d95)); // n8l|ud=0,g=0.z
                 let d276 = A::mul_add(s_q5l, d271, c_q5l * d272); // f8l in 7l|ud=0,g=0.x
                 let d277 = A::mul_add(-c_q5l, d271, s_q5l * d272); // f8l in 7l|ud=0,g=0.z
@@ -11759,7 +11759,7 @@ mod generated {
                     d277,
                     A::mul_add(-s_q5l, d275, A::mul_add(c_q5l, d273, d81)),
                 ); // n7l|ud=0,g=0.x
-                m [8] = -d280;
+                m[8] = -d280;
                 let d281 = A::mul_add(
                     p.L8,
                     d276,
@@ -11774,7 +11774,7 @@ mod generated {
                 let d288 = d65 + d278; // f6l|ud=0,g=0.x
                 let d289 = d69 + d280; // n6l|ud=0,g=0.x
                 let d290 = A::mul_add(s_q4l, d281, A::mul_add(c_q4l, d279, d70)); // n6l|ud=0,g=0.y
-                m [7] = d290;
+                m[7] = d290;
                 let d291 = A::mul_add(-c_q4l, d281, A::mul_add(s_q4l, d279, d71)); // n6l|ud=0,g=0.z
                 let d292 = A::mul_add(s_q3l, d287, c_q3l * d288); // f6l in 5l|ud=0,g=0.x
                 let d293 = A::mul_add(-c_q3l, d287, s_q3l * d288); // f6l in 5l|ud=0,g=0.z
@@ -11785,7 +11785,7 @@ mod generated {
                     d293,
                     A::mul_add(-s_q3l, d291, A::mul_add(c_q3l, d289, d57)),
                 ); // n5l|ud=0,g=0.x
-                m [6] = -d296;
+                m[6] = -d296;
                 let d297 = A::mul_add(
                     p.L7,
                     d292,
@@ -11800,7 +11800,7 @@ mod generated {
                 let d304 = d41 + d294; // f4l|ud=0,g=0.x
                 let d305 = d45 + d296; // n4l|ud=0,g=0.x
                 let d306 = A::mul_add(s_q2l, d297, A::mul_add(c_q2l, d295, d46)); // n4l|ud=0,g=0.y
-                m [5] = d306;
+                m[5] = d306;
                 let d307 = A::mul_add(-c_q2l, d297, A::mul_add(s_q2l, d295, d47)); // n4l|ud=0,g=0.z
                 let d308 = A::mul_add(-c_q1l, d303, s_q1l * d304); // f4l in 3|ud=0,g=0.z
                 let d309 = A::mul_add(s_q1l, d303, c_q1l * d304); // f4l in 3|ud=0,g=0.y
@@ -11811,7 +11811,7 @@ mod generated {
                     d308,
                     A::mul_add(s_q1l, d307, A::mul_add(-c_q1l, d305, d256)),
                 ); // n3|ud=0,g=0.y
-                m [4] = -d312;
+                m[4] = -d312;
                 let d313 = A::mul_add(
                     -p.L5,
                     d302,
@@ -11837,7 +11837,7 @@ mod generated {
                         A::mul_add(-s_q_torso, d313, A::mul_add(c_q_torso, d311, d21)),
                     ),
                 ); // n2|ud=0,g=0.x
-                m [3] = d321;
+                m[3] = d321;
                 let d322 = A::mul_add(p.L4, d316, d22 - d312); // n2|ud=0,g=0.y
                 let d323 = A::mul_add(
                     -p.L3,
@@ -11849,7 +11849,7 @@ mod generated {
                 let d326 = d4 - d325; // f1|ud=0,g=0.y
                 let d327 = d5 + d324; // f1|ud=0,g=0.z
                 let d328 = A::mul_add(p.L2, d325, A::mul_add(-p.L1, d324, d9 + d321)); // n1|ud=0,g=0.x
-                m [2] = d328;
+                m[2] = d328;
                 let d329 = A::mul_add(
                     -p.L2,
                     d318,
@@ -11861,9 +11861,9 @@ mod generated {
                     A::mul_add(c_q_w, d323, A::mul_add(-s_q_w, d322, d11)),
                 ); // n1|ud=0,g=0.z
                 let d331 = A::mul_add(-c_q_imu, d327, s_q_imu * d326); // f1 in 0|ud=0,g=0.x
-                m [0] = d331;
+                m[0] = d331;
                 let d332 = A::mul_add(s_q_imu, d330, c_q_imu * d329); // n0|ud=0,g=0.z
-                m [1] = -d332;
+                m[1] = -d332;
             }
         }
         kanegen_runtime::isa::dispatch_fused_with(
@@ -11978,7 +11978,7 @@ mod generated {
                 let d18 = A::mul_add(-c_q6l, d16, s_q6l * d13); // gravity acceleration in 9l.z
                 let d19 = A::mul_add(s_q7l, d18, c_q7l * d15); // gravity acceleration in 10l.x
                 let d20 = A::mul_add(-c_q7l, d18, s_q7l * d15); // gravity acceleration in 10l.y
-                m [11] = A::mul_add(-p.MX10l, d20, p.MY10l * d19);
+                m[11] = A::mul_add(-p.MX10l, d20, p.MY10l * d19);
                 let d21 = A::mul_add(-s_q1r, d6, c_q1r * d3); // gravity acceleration in 4r.x
                 let d22 = A::mul_add(c_q1r, d6, s_q1r * d3); // gravity acceleration in 4r.z
                 let d23 = A::mul_add(-s_q2r, d22, c_q2r * d5); // gravity acceleration in 5r.y
@@ -11993,94 +11993,94 @@ mod generated {
                 let d32 = A::mul_add(c_q6r, d30, s_q6r * d27); // gravity acceleration in 9r.z
                 let d33 = A::mul_add(-s_q7r, d32, c_q7r * d29); // gravity acceleration in 10r.x
                 let d34 = A::mul_add(c_q7r, d32, s_q7r * d29); // gravity acceleration in 10r.y
-                m [18] = A::mul_add(-p.MX10r, d34, p.MY10r * d33);
+                m[18] = A::mul_add(-p.MX10r, d34, p.MY10r * d33);
                 let d35 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
                 let d36 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
                 let d37 = p.MX9r - d36; // MSC9r.x
                 let d38 = p.MZ9r + d35; // MSC9r.z
-                m [17] = A::mul_add(-d38, d31, pc.pc2 * d32);
+                m[17] = A::mul_add(-d38, d31, pc.pc2 * d32);
                 let d39 = A::mul_add(s_q6r, d38, c_q6r * pc.pc2); // MSC9r in 8r.y
                 let d40 = A::mul_add(-c_q6r, d38, s_q6r * pc.pc2); // MSC9r in 8r.z
                 let d41 = p.MX8r - d37; // MSC8r.x
                 let d42 = p.MY8r - d39; // MSC8r.y
                 let d43 = p.MZ8r - d40; // MSC8r.z
-                m [16] = A::mul_add(-d41, d30, -d43 * d29);
+                m[16] = A::mul_add(-d41, d30, -d43 * d29);
                 let d44 = A::mul_add(c_q5r, d43, s_q5r * d41); // MSC8r in 7r.z
                 let d45 = A::mul_add(-s_q5r, d43, c_q5r * d41); // MSC8r in 7r.x
                 let d46 = p.MX7r - d45; // MSC7r.x
                 let d47 = p.MZ7r + d44; // MSC7r.z
                 let d48 = pc.pc13 - d42; // MSC7r.y
-                m [15] = A::mul_add(-d47, d27, d48 * d28);
+                m[15] = A::mul_add(-d47, d27, d48 * d28);
                 let d49 = A::mul_add(s_q4r, d47, c_q4r * d48); // MSC7r in 6r.y
                 let d50 = A::mul_add(-c_q4r, d47, s_q4r * d48); // MSC7r in 6r.z
                 let d51 = p.MX6r - d46; // MSC6r.x
                 let d52 = p.MY6r - d49; // MSC6r.y
                 let d53 = p.MZ6r - d50; // MSC6r.z
-                m [14] = A::mul_add(-d51, d26, -d53 * d25);
+                m[14] = A::mul_add(-d51, d26, -d53 * d25);
                 let d54 = A::mul_add(c_q3r, d53, s_q3r * d51); // MSC6r in 5r.z
                 let d55 = A::mul_add(-s_q3r, d53, c_q3r * d51); // MSC6r in 5r.x
                 let d56 = p.MX5r - d55; // MSC5r.x
                 let d57 = p.MZ5r + d54; // MSC5r.z
                 let d58 = pc.pc19 - d52; // MSC5r.y
-                m [13] = A::mul_add(-d57, d23, d58 * d24);
+                m[13] = A::mul_add(-d57, d23, d58 * d24);
                 let d59 = A::mul_add(s_q2r, d57, c_q2r * d58); // MSC5r in 4r.y
                 let d60 = A::mul_add(-c_q2r, d57, s_q2r * d58); // MSC5r in 4r.z
                 let d61 = p.MX4r - d56; // MSC4r.x
                 let d62 = p.MY4r - d59; // MSC4r.y
                 let d63 = p.MZ4r - d60; // MSC4r.z
-                m [12] = A::mul_add(-d61, d22, -d63 * d21);
+                m[12] = A::mul_add(-d61, d22, -d63 * d21);
                 let d64 = A::mul_add(-s_q1r, d63, c_q1r * d61); // MSC4r in 3.y
                 let d65 = A::mul_add(c_q1r, d63, s_q1r * d61); // MSC4r in 3.z
                 let d66 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
                 let d67 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
                 let d68 = p.MX9l - d67; // MSC9l.x
                 let d69 = p.MZ9l + d66; // MSC9l.z
-                m [10] = A::mul_add(-pc.pc25, d18, d69 * d17);
+                m[10] = A::mul_add(-pc.pc25, d18, d69 * d17);
                 let d70 = A::mul_add(s_q6l, d69, c_q6l * pc.pc25); // MSC9l in 8l.y
                 let d71 = A::mul_add(-c_q6l, d69, s_q6l * pc.pc25); // MSC9l in 8l.z
                 let d72 = p.MX8l - d68; // MSC8l.x
                 let d73 = p.MY8l - d70; // MSC8l.y
                 let d74 = p.MZ8l - d71; // MSC8l.z
-                m [9] = A::mul_add(-d72, d16, -d74 * d15);
+                m[9] = A::mul_add(-d72, d16, -d74 * d15);
                 let d75 = A::mul_add(c_q5l, d74, s_q5l * d72); // MSC8l in 7l.z
                 let d76 = A::mul_add(-s_q5l, d74, c_q5l * d72); // MSC8l in 7l.x
                 let d77 = p.MX7l - d76; // MSC7l.x
                 let d78 = p.MZ7l + d75; // MSC7l.z
                 let d79 = pc.pc36 - d73; // MSC7l.y
-                m [8] = A::mul_add(-d79, d14, d78 * d13);
+                m[8] = A::mul_add(-d79, d14, d78 * d13);
                 let d80 = A::mul_add(s_q4l, d78, c_q4l * d79); // MSC7l in 6l.y
                 let d81 = A::mul_add(-c_q4l, d78, s_q4l * d79); // MSC7l in 6l.z
                 let d82 = p.MX6l - d77; // MSC6l.x
                 let d83 = p.MY6l - d80; // MSC6l.y
                 let d84 = p.MZ6l - d81; // MSC6l.z
-                m [7] = A::mul_add(-d82, d12, -d84 * d11);
+                m[7] = A::mul_add(-d82, d12, -d84 * d11);
                 let d85 = A::mul_add(c_q3l, d84, s_q3l * d82); // MSC6l in 5l.z
                 let d86 = A::mul_add(-s_q3l, d84, c_q3l * d82); // MSC6l in 5l.x
                 let d87 = p.MX5l - d86; // MSC5l.x
                 let d88 = p.MZ5l + d85; // MSC5l.z
                 let d89 = pc.pc42 - d83; // MSC5l.y
-                m [6] = A::mul_add(-d89, d10, d88 * d9);
+                m[6] = A::mul_add(-d89, d10, d88 * d9);
                 let d90 = A::mul_add(s_q2l, d88, c_q2l * d89); // MSC5l in 4l.y
                 let d91 = A::mul_add(-c_q2l, d88, s_q2l * d89); // MSC5l in 4l.z
                 let d92 = p.MX4l - d87; // MSC4l.x
                 let d93 = p.MY4l - d90; // MSC4l.y
                 let d94 = p.MZ4l - d91; // MSC4l.z
-                m [5] = A::mul_add(-d92, d8, -d94 * d7);
+                m[5] = A::mul_add(-d92, d8, -d94 * d7);
                 let d95 = A::mul_add(-s_q1l, d94, c_q1l * d92); // MSC4l in 3.y
                 let d96 = A::mul_add(c_q1l, d94, s_q1l * d92); // MSC4l in 3.z
                 let d97 = p.MZ3 + d65 - d96; // MSC3.z
                 let d98 = d93 - d62 + pc.pc47; // MSC3.x
-                m [4] = A::mul_add(-d98, d6, d97 * d5);
+                m[4] = A::mul_add(-d98, d6, d97 * d5);
                 let d99 = d64 + d95 + pc.pc48; // MSC3.y
                 let d100 = A::mul_add(c_q_torso, d97, s_q_torso * d98); // MSC3 in 2.z
                 let d101 = d99 + pc.pc54; // MSC2.y
                 let d102 = pc.pc55 - d100; // MSC2.z
-                m [3] = A::mul_add(-d101, d4, d102 * d3);
+                m[3] = A::mul_add(-d101, d4, d102 * d3);
                 let d103 = A::mul_add(s_q_w, d102, c_q_w * d101); // MSC2 in 1.y
                 let d104 = A::mul_add(-c_q_w, d102, s_q_w * d101); // MSC2 in 1.z
                 let d105 = d103 + pc.pc61; // MSC1.y
                 let d106 = pc.pc62 - d104; // MSC1.z
-                m [2] = A::mul_add(-d105, d2, d106 * d1);
+                m[2] = A::mul_add(-d105, d2, d106 * d1);
             }
             for m in out.iter_mut() {
                 m[0] = 0.0;
@@ -13283,7 +13283,7 @@ mod generated {
                         ),
                     ),
                 ); // N10l.z
-                m [11] = -d155;
+                m[11] = -d155;
                 let k77 = A::mul_add(-s_q1r, k17, c_q1r * k18); // w3 in 4r|ud=0,g=0.x
                 let k78 = A::mul_add(c_q1r, k17, s_q1r * k18); // w3 in 4r|ud=0,g=0.z
                 let k79 = k19 - qdd1r; // wd4r.y
@@ -14078,7 +14078,7 @@ mod generated {
                         ),
                     ),
                 ); // N10r.z
-                m [18] = -d264;
+                m[18] = -d264;
                 let d265 = A::mul_add(
                     -p.MX10r,
                     d250,
@@ -14115,7 +14115,7 @@ mod generated {
                     d266,
                     A::mul_add(-s_q7r, d265, A::mul_add(c_q7r, d263, d247)),
                 ); // n9r.x
-                m [17] = d272;
+                m[17] = d272;
                 let d273 = d248 + d264; // n9r.y
                 let d274 = A::mul_add(-s_q6r, d271, c_q6r * d268); // f9r in 8r.y
                 let d275 = A::mul_add(c_q6r, d271, s_q6r * d268); // f9r in 8r.z
@@ -14125,7 +14125,7 @@ mod generated {
                 let d279 = d228 + d275; // f8r.z
                 let d280 = d233 - d272; // n8r.x
                 let d281 = A::mul_add(s_q6r, d269, A::mul_add(-c_q6r, d273, d234)); // n8r.y
-                m [16] = d281;
+                m[16] = d281;
                 let d282 = A::mul_add(-s_q5r, d279, c_q5r * d278); // f8r in 7r.x
                 let d283 = A::mul_add(c_q5r, d279, s_q5r * d278); // f8r in 7r.z
                 let d284 = d209 - d276; // f7r.y
@@ -14141,7 +14141,7 @@ mod generated {
                     d283,
                     A::mul_add(-s_q5r, d277, A::mul_add(-c_q5r, d280, d216)),
                 ); // n7r.x
-                m [15] = d288;
+                m[15] = d288;
                 let d289 = d217 - d281; // n7r.y
                 let d290 = A::mul_add(-s_q4r, d287, c_q4r * d284); // f7r in 6r.y
                 let d291 = A::mul_add(c_q4r, d287, s_q4r * d284); // f7r in 6r.z
@@ -14151,7 +14151,7 @@ mod generated {
                 let d295 = d197 + d291; // f6r.z
                 let d296 = d202 - d288; // n6r.x
                 let d297 = A::mul_add(s_q4r, d285, A::mul_add(-c_q4r, d289, d203)); // n6r.y
-                m [14] = d297;
+                m[14] = d297;
                 let d298 = A::mul_add(-s_q3r, d295, c_q3r * d294); // f6r in 5r.x
                 let d299 = A::mul_add(c_q3r, d295, s_q3r * d294); // f6r in 5r.z
                 let d300 = d178 - d292; // f5r.y
@@ -14167,7 +14167,7 @@ mod generated {
                     d299,
                     A::mul_add(-s_q3r, d293, A::mul_add(-c_q3r, d296, d185)),
                 ); // n5r.x
-                m [13] = d304;
+                m[13] = d304;
                 let d305 = d186 - d297; // n5r.y
                 let d306 = A::mul_add(-s_q2r, d303, c_q2r * d300); // f5r in 4r.y
                 let d307 = A::mul_add(c_q2r, d303, s_q2r * d300); // f5r in 4r.z
@@ -14177,7 +14177,7 @@ mod generated {
                 let d311 = d166 + d307; // f4r.z
                 let d312 = d171 - d304; // n4r.x
                 let d313 = A::mul_add(s_q2r, d301, A::mul_add(-c_q2r, d305, d172)); // n4r.y
-                m [12] = d313;
+                m[12] = d313;
                 let d314 = A::mul_add(-s_q1r, d311, c_q1r * d310); // f4r in 3.y
                 let d315 = A::mul_add(c_q1r, d311, s_q1r * d310); // f4r in 3.z
                 let d316 = d37 - d308; // f3.x
@@ -14209,7 +14209,7 @@ mod generated {
                     d322,
                     A::mul_add(-s_q7l, d154, A::mul_add(-c_q7l, d153, d136)),
                 ); // n9l.x
-                m [10] = -d328;
+                m[10] = -d328;
                 let d329 = A::mul_add(
                     -p.L9,
                     d323,
@@ -14223,7 +14223,7 @@ mod generated {
                 let d335 = d117 + d330; // f8l.y
                 let d336 = d118 + d331; // f8l.z
                 let d337 = A::mul_add(s_q6l, d329, A::mul_add(c_q6l, d327, d124)); // n8l.y
-                m [9] = d337;
+                m[9] = d337;
                 let d338 = A::mul_add(-c_q5l, d336, s_q5l * d332); // f8l in 7l.z
                 let d339 = A::mul_add(s_q5l, d336, c_q5l * d332); // f8l in 7l.x
                 let d340 = d99 - d339; // f7l.x
@@ -14235,7 +14235,7 @@ mod generated {
                     d338,
                     A::mul_add(s_q5l, d334, A::mul_add(-c_q5l, d333, d105)),
                 ); // n7l.x
-                m [8] = -d344;
+                m[8] = -d344;
                 let d345 = A::mul_add(
                     -p.L8,
                     d339,
@@ -14249,7 +14249,7 @@ mod generated {
                 let d351 = d86 + d346; // f6l.y
                 let d352 = d87 + d347; // f6l.z
                 let d353 = A::mul_add(s_q4l, d345, A::mul_add(c_q4l, d343, d93)); // n6l.y
-                m [7] = d353;
+                m[7] = d353;
                 let d354 = A::mul_add(-c_q3l, d352, s_q3l * d348); // f6l in 5l.z
                 let d355 = A::mul_add(s_q3l, d352, c_q3l * d348); // f6l in 5l.x
                 let d356 = d68 - d355; // f5l.x
@@ -14261,7 +14261,7 @@ mod generated {
                     d354,
                     A::mul_add(s_q3l, d350, A::mul_add(-c_q3l, d349, d74)),
                 ); // n5l.x
-                m [6] = -d360;
+                m[6] = -d360;
                 let d361 = A::mul_add(
                     -p.L7,
                     d355,
@@ -14275,7 +14275,7 @@ mod generated {
                 let d367 = d55 + d362; // f4l.y
                 let d368 = d56 + d363; // f4l.z
                 let d369 = A::mul_add(s_q2l, d361, A::mul_add(c_q2l, d359, d62)); // n4l.y
-                m [5] = d369;
+                m[5] = d369;
                 let d370 = A::mul_add(s_q1l, d368, c_q1l * d364); // f4l in 3.y
                 let d371 = A::mul_add(-c_q1l, d368, s_q1l * d364); // f4l in 3.z
                 let d372 = d316 - d367; // f3.x
@@ -14296,7 +14296,7 @@ mod generated {
                     d371,
                     A::mul_add(s_q1l, d366, A::mul_add(-c_q1l, d365, d321)),
                 ); // n3.y
-                m [4] = d377;
+                m[4] = d377;
                 let d378 = A::mul_add(s_q_torso, d376, c_q_torso * d372); // f3 in 2.x
                 let d379 = A::mul_add(-c_q_torso, d376, s_q_torso * d372); // f3 in 2.z
                 let d380 = d21 - d375; // f2.y
@@ -14316,7 +14316,7 @@ mod generated {
                         A::mul_add(-s_q_torso, d374, A::mul_add(c_q_torso, d373, d28)),
                     ),
                 ); // n2.x
-                m [3] = d384;
+                m[3] = d384;
                 let d385 = A::mul_add(p.L4, d378, d29 + d377); // n2.y
                 let d386 = A::mul_add(-s_q_w, d383, c_q_w * d380); // f2 in 1.y
                 let d387 = A::mul_add(c_q_w, d383, s_q_w * d380); // f2 in 1.z
@@ -14328,16 +14328,16 @@ mod generated {
                 ); // n1.z
                 let d390 = d7 + d387; // f1.z
                 let d391 = A::mul_add(-p.L2, d386, A::mul_add(p.L1, d387, d12 + d384)); // n1.x
-                m [2] = d391;
+                m[2] = d391;
                 let d392 = A::mul_add(
                     -p.L2,
                     d382,
                     A::mul_add(-s_q_w, d381, A::mul_add(c_q_w, d385, d13)),
                 ); // n1.y
                 let d393 = A::mul_add(c_q_imu, d390, s_q_imu * d388); // f1 in 0.x
-                m [0] = A::mul_add(pc.pc67, xdd, d393);
+                m[0] = A::mul_add(pc.pc67, xdd, d393);
                 let d394 = A::mul_add(-s_q_imu, d389, c_q_imu * d392); // n0.z
-                m [1] = A::mul_add(pc.pc68, psidd, -d394);
+                m[1] = A::mul_add(pc.pc68, psidd, -d394);
             }
         }
         kanegen_runtime::isa::dispatch_fused_with(

@@ -6,8 +6,9 @@
 //! ```
 //!
 //! Ids: `simd/<function>/<isa>` (one state per call) and `simd/<function>/<isa>/batch<L>` (one
-//! call of `<function>_batch` with `L` states: divide by `L` for the time per state). The
-//! states cycle through 64 random ones.
+//! call of `<function>_batch_into` with `L` states: divide by `L` for the time per state;
+//! `batch<L>_by_value`: `mass_matrix_batch`, which returns the results). The states cycle
+//! through 64 random ones.
 
 use std::hint::black_box;
 use std::time::Duration;
@@ -50,7 +51,18 @@ fn bench_batch<const L: usize>(c: &mut Criterion, k: &Krang, s: &[(V, V, V)], ta
     let batches: Vec<_> = (0..64).step_by(L).map(|i| batch::<L>(s, i)).collect();
     let n = batches.len();
     let mut i = 0;
+    // The `_into` forms, into arrays kept across calls (no zeroed array, no copy of the
+    // results), and the by-value form of M for comparison.
+    let mut m = [nalgebra::SMatrix::<f64, 19, 19>::zeros(); L];
+    let mut v = [V::zeros(); L];
     c.bench_function(&format!("simd/mass_matrix/{tag}/batch{L}"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            black_box(k).mass_matrix_batch_into(black_box(&batches[i].0), &mut m);
+            black_box(&m);
+        })
+    });
+    c.bench_function(&format!("simd/mass_matrix/{tag}/batch{L}_by_value"), |b| {
         b.iter(|| {
             i = (i + 1) % n;
             black_box(k).mass_matrix_batch(black_box(&batches[i].0))
@@ -60,20 +72,36 @@ fn bench_batch<const L: usize>(c: &mut Criterion, k: &Krang, s: &[(V, V, V)], ta
         b.iter(|| {
             i = (i + 1) % n;
             let (q, u, _) = &batches[i];
-            black_box(k).coriolis_batch(black_box(q), black_box(u))
+            black_box(k).coriolis_batch_into(black_box(q), black_box(u), &mut v);
+            black_box(&v);
         })
     });
     c.bench_function(&format!("simd/gravity/{tag}/batch{L}"), |b| {
         b.iter(|| {
             i = (i + 1) % n;
-            black_box(k).gravity_batch(black_box(&batches[i].0))
+            black_box(k).gravity_batch_into(black_box(&batches[i].0), &mut v);
+            black_box(&v);
         })
     });
     c.bench_function(&format!("simd/inverse_dynamics/{tag}/batch{L}"), |b| {
         b.iter(|| {
             i = (i + 1) % n;
             let (q, u, ud) = &batches[i];
-            black_box(k).inverse_dynamics_batch(black_box(q), black_box(u), black_box(ud))
+            black_box(k).inverse_dynamics_batch_into(
+                black_box(q),
+                black_box(u),
+                black_box(ud),
+                &mut v,
+            );
+            black_box(&v);
+        })
+    });
+    c.bench_function(&format!("simd/coriolis_matrix/{tag}/batch{L}"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            let (q, u, _) = &batches[i];
+            black_box(k).coriolis_matrix_batch_into(black_box(q), black_box(u), &mut m);
+            black_box(&m);
         })
     });
 }

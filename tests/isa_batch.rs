@@ -1,9 +1,11 @@
 //! Run-time instruction-set dispatch and batched evaluation (issue 14): the x86-64-v3 copy of
 //! every generated function (which fuses multiply-adds) agrees with the baseline copy to
-//! rounding, and every batched function gives the single-state function's baseline bits in
-//! every lane (the batched functions fuse nothing), for batch sizes 1, 3 (odd), 4 and 8, with
-//! both instruction sets, on random parameter sets and states (angles of all sizes, including
-//! a huge one that takes the slow sin/cos path in one lane).
+//! rounding, and every batched function gives, in every lane, the bits of the single-state
+//! function *with the same instruction set* (the same statements, multiply-add chains included,
+//! in a loop over the states): for batch sizes 1, 3 (odd), 4 and 8, with both instruction sets,
+//! on random parameter sets and states (angles of all sizes, including a huge one that takes
+//! the slow sin/cos path in one lane). The `_into` forms write every entry of the caller's
+//! results (filled with NaN before the call) and give the by-value forms' bits.
 
 mod common;
 
@@ -46,7 +48,8 @@ fn isa_lock() -> std::sync::MutexGuard<'static, ()> {
 }
 
 /// Every batched function of `k` at `L` states (with the active instruction set) equals its
-/// single-state function's baseline copy in each lane.
+/// single-state function with the same instruction set in each lane, and its `_into` form
+/// writes the same bits over a result array filled with NaN.
 fn check_batch<const L: usize>(k: &kd::Krang, q: &[V; L], u: &[V; L], ud: &[V; L]) {
     let m = k.mass_matrix_batch(q);
     let c = k.coriolis_batch(q, u);
@@ -55,8 +58,6 @@ fn check_batch<const L: usize>(k: &kd::Krang, q: &[V; L], u: &[V; L], ud: &[V; L
     let cm = k.coriolis_matrix_batch(q, u);
     let mb = kd::baked::mass_matrix_batch(q);
     let tb = kd::baked::inverse_dynamics_batch(q, u, ud);
-    let active = isa::active();
-    isa::select(Isa::Baseline).unwrap();
     for l in 0..L {
         let (ql, ul, udl) = (&q[l], &u[l], &ud[l]);
         assert!(
@@ -86,27 +87,35 @@ fn check_batch<const L: usize>(k: &kd::Krang, q: &[V; L], u: &[V; L], ud: &[V; L
             "baked τ lane {l}"
         );
     }
-    isa::select(active).unwrap();
-}
-
-/// Runs `f` on a thread with a large stack: unoptimised (debug) builds keep every statement's
-/// `Lanes<L>` value in its own stack slot (Krang's batched M at L = 8: thousands of 64-byte
-/// locals), more than a test thread's default 2 MB. Optimised builds need a few KB.
-fn with_big_stack(f: impl FnOnce() + Send + 'static) {
-    std::thread::Builder::new()
-        .stack_size(512 << 20)
-        .spawn(f)
-        .unwrap()
-        .join()
-        .unwrap();
+    // The `_into` forms: every entry written (NaN before), the by-value forms' bits.
+    let flat = |a: &[nalgebra::SMatrix<f64, 19, 19>]| -> Vec<f64> {
+        a.iter().flat_map(|m| m.iter().copied()).collect()
+    };
+    let flat_v = |a: &[V]| -> Vec<f64> { a.iter().flat_map(|v| v.iter().copied()).collect() };
+    let mut mi = [nalgebra::SMatrix::<f64, 19, 19>::from_element(f64::NAN); L];
+    k.mass_matrix_batch_into(q, &mut mi);
+    assert!(same_bits(&flat(&mi), &flat(&m)), "M into, {L} states");
+    let mut cmi = [nalgebra::SMatrix::<f64, 19, 19>::from_element(f64::NAN); L];
+    k.coriolis_matrix_batch_into(q, u, &mut cmi);
+    assert!(same_bits(&flat(&cmi), &flat(&cm)), "C into");
+    kd::baked::mass_matrix_batch_into(q, &mut mi);
+    assert!(same_bits(&flat(&mi), &flat(&mb)), "baked M into");
+    let mut vi = [V::from_element(f64::NAN); L];
+    k.coriolis_batch_into(q, u, &mut vi);
+    assert!(same_bits(&flat_v(&vi), &flat_v(&c)), "c into");
+    let mut vi = [V::from_element(f64::NAN); L];
+    k.gravity_batch_into(q, &mut vi);
+    assert!(same_bits(&flat_v(&vi), &flat_v(&g)), "g into");
+    let mut vi = [V::from_element(f64::NAN); L];
+    k.inverse_dynamics_batch_into(q, u, ud, &mut vi);
+    assert!(same_bits(&flat_v(&vi), &flat_v(&t)), "τ into");
+    let mut vi = [V::from_element(f64::NAN); L];
+    kd::baked::inverse_dynamics_batch_into(q, u, ud, &mut vi);
+    assert!(same_bits(&flat_v(&vi), &flat_v(&tb)), "baked τ into");
 }
 
 #[test]
 fn batched_functions_equal_the_single_state_functions_bit_for_bit() {
-    with_big_stack(batched_equal_single);
-}
-
-fn batched_equal_single() {
     let _one_at_a_time = isa_lock();
     let model = model("krang.toml");
     let mut uniform = rng(14);

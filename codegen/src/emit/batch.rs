@@ -1,20 +1,23 @@
 //! Batched functions: the statements of one generated function evaluated at `L` states per
-//! call (`mass_matrix_batch(p, pc, &[q; L]) -> [SMatrix; L]`), every state-dependent value a
-//! `kanegen_runtime::lanes::Lanes<L>`.
+//! call (`mass_matrix_batch_into(p, pc, &[q; L], &mut [SMatrix; L])`, and the by-value
+//! `mass_matrix_batch(p, pc, &[q; L]) -> [SMatrix; L]`).
 //!
-//! The statements are printed exactly as for the single-state function: parameters and
-//! literals stay `f64` and `Lanes` implements the operators with `f64` on either side, so lane
-//! `l` of every value is the single-state value at state `l`, bit for bit. Only the bindings of
-//! the inputs (transposed to lane-major order, sines and cosines lane by lane) and the result
-//! stores (into a lane-major buffer, transposed at the end) differ. `L` is a const generic: one emitted body for every batch size.
+//! The body is a loop over the states around the single-state function's statements, printed
+//! exactly as there (the same multiply-add chains, generic over `A: Arith<f64>` and dispatched
+//! like the single-state function), so lane `l` is the single-state value at state `l`, bit
+//! for bit with the same instruction set. LLVM's loop vectorizer runs the loop body on vectors
+//! across the states. Only the bindings of the inputs (transposed to lane-major order, sines
+//! and cosines lane by lane, before the loop) and the result stores (straight into the
+//! caller's `L` results) differ. `L` is a const generic: one emitted body for every batch size.
+//! README "Instruction sets at run time and batched evaluation" has the measurements.
 
 use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::Context;
-use super::function::{Reads, last_local, nonzero_outputs, unused_inputs};
+use super::function::{Reads, Stores, nonzero_outputs, store_text_after, text, unused_inputs};
 use super::items::{arg_names, return_type};
-use super::print::{ident, idx};
+use super::print::{Printer, ident, idx};
 use crate::lower::{FunctionProgram, LExpr, Program};
 use crate::naming;
 use crate::registry::{FunctionSpec, Inputs, Shape};
@@ -49,10 +52,16 @@ fn args(cx: &Context<'_>, inputs: Inputs) -> TokenStream {
     }
 }
 
-/// The input bindings: per joint angle one lane-wise `sin_cos`, then coordinates, speeds and
-/// accelerations gathered from the `L` states.
-fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
-    let speeds = &cx.model.speeds;
+/// The output argument of the `_into` form: `&mut [SMatrix<f64, R, C>; L]`.
+fn out_arg(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
+    let ty = return_type(cx, spec);
+    quote!(out: &mut [#ty; L])
+}
+
+/// The lane-major bindings before the loop: the inputs the program reads transposed
+/// (`let q = kanegen_runtime::lanes::inputs(q);`, `[Lanes<L>; N]`) and per joint angle one
+/// lane-wise `sin_cos`.
+fn lane_inputs(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
     let mut ts = TokenStream::new();
     let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
     if reads_q {
@@ -64,41 +73,134 @@ fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
     if reads.accel.contains(&true) {
         ts.extend(quote!(let ud = kanegen_runtime::lanes::inputs(ud);));
     }
-    for &s in &p.sincos {
-        let sl = idx(s);
-        let sn = if reads.sin[s] {
-            let id = ident(&naming::sin(&speeds[s].coordinate));
-            quote!(#id)
-        } else {
-            quote!(_)
+    if !p.sincos.is_empty() {
+        // All angles of all states in one call (a dependent joint's from its master's).
+        let angles = p.sincos.iter().map(|&s| {
+            let a = super::function::joint_angle(cx, s, &quote!(q));
+            if cx.low.mimic_angles.iter().any(|(d, _)| *d == s) {
+                quote!((#a).0)
+            } else {
+                quote!(#a.0)
+            }
+        });
+        let name = |read: &[bool], n: TokenStream| {
+            if p.sincos.iter().any(|&s| read[s]) {
+                n
+            } else {
+                quote!(_)
+            }
         };
-        let cn = if reads.cos[s] {
-            let id = ident(&naming::cos(&speeds[s].coordinate));
-            quote!(#id)
-        } else {
-            quote!(_)
-        };
-        ts.extend(quote!(let (#sn, #cn) = kanegen_runtime::lanes::sin_cos(q[#sl]);));
+        let (sn, cn) = (
+            name(&reads.sin, quote!(sin_q)),
+            name(&reads.cos, quote!(cos_q)),
+        );
+        ts.extend(quote!(let (#sn, #cn) = kanegen_runtime::lanes::sin_cos_n([#(#angles),*]);));
     }
-    for (s, speed) in speeds.iter().enumerate() {
+    ts
+}
+
+/// The scalar bindings at the top of the loop body: lane `l` of every sine, cosine,
+/// coordinate, speed and acceleration the program reads.
+fn lane_values(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
+    let mut ts = TokenStream::new();
+    for (k, &s) in p.sincos.iter().enumerate() {
+        let speed = &cx.model.speeds[s];
+        let kl = idx(k);
+        if reads.sin[s] {
+            let id = ident(&naming::sin(&speed.coordinate));
+            ts.extend(quote!(let #id = sin_q[#kl][l];));
+        }
+        if reads.cos[s] {
+            let id = ident(&naming::cos(&speed.coordinate));
+            ts.extend(quote!(let #id = cos_q[#kl][l];));
+        }
+    }
+    for (s, speed) in cx.model.speeds.iter().enumerate() {
         let sl = idx(s);
         if reads.coord[s] {
             let id = ident(&speed.coordinate);
-            ts.extend(quote!(let #id = q[#sl];));
+            ts.extend(quote!(let #id = q[#sl].0[l];));
         }
         if reads.speed[s] {
             let id = ident(&speed.name);
-            ts.extend(quote!(let #id = u[#sl];));
+            ts.extend(quote!(let #id = u[#sl].0[l];));
         }
         if reads.accel[s] {
             let id = ident(&naming::accel(&speed.name));
-            ts.extend(quote!(let #id = ud[#sl];));
+            ts.extend(quote!(let #id = ud[#sl].0[l];));
         }
     }
     ts
 }
 
-/// The batched free function of `f`, or nothing if it has none.
+/// The stores of the loop body (text lines by position, see [`Printer::statement_block`]) and
+/// of a loop of their own after it.
+struct ResultStores {
+    in_loop: Stores,
+    after: TokenStream,
+}
+
+/// The result stores: every nonzero entry right after the last statement it reads (with
+/// multiply-add chains), into the caller's result `m`; after the loop, the lower entries of a
+/// symmetric matrix (copied from the upper ones) and `0.0` into every entry no statement
+/// writes. Each entry of the caller's result is written exactly once, so nothing is zeroed
+/// first. The mirrored entries and the zeros stay out of the vectorized loop: LLVM merges
+/// adjacent zero stores into `memset` calls, and a loop with a call is not vectorized; with the
+/// mirrored stores in it (as a copy or as the value again) Krang's M was not vectorized either
+/// ("loop not vectorized: runtime pointer checks needed").
+fn stores(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) -> ResultStores {
+    let mut in_loop: Stores = vec![Vec::new(); p.stmts.len() + 1];
+    let (rows, cols) = shape.size_in(&cx.low.sizes);
+    let vector = cols == 1;
+    let entry_text = |r: usize, c: usize| {
+        if vector {
+            format!("m[{r}]")
+        } else {
+            format!("m[({r}, {c})]")
+        }
+    };
+    let entry = |r: usize, c: usize| {
+        let (ri, ci) = (idx(r), idx(c));
+        if vector {
+            quote!(m[#ri])
+        } else {
+            quote!(m[(#ri, #ci)])
+        }
+    };
+    let mirror = shape == Shape::SymmetricMatrix;
+    let mut written = vec![false; rows * cols];
+    let mut after = TokenStream::new();
+    for (r, c, e) in nonzero_outputs(p) {
+        let (r, c) = (*r, *c);
+        let v = text(cx, printer, e);
+        store_text_after(&mut in_loop, e, format!("{} = {v};", entry_text(r, c)));
+        written[c * rows + r] = true;
+        if mirror && r != c {
+            let (to, from) = (entry(c, r), entry(r, c));
+            after.extend(quote!(#to = #from;));
+            written[r * rows + c] = true;
+        }
+    }
+    for (r, c) in (0..cols).flat_map(|c| (0..rows).map(move |r| (r, c))) {
+        if !written[c * rows + r] {
+            let to = entry(r, c);
+            after.extend(quote!(#to = 0.0;));
+        }
+    }
+    ResultStores { in_loop, after }
+}
+
+/// The batched free functions of `f` (`NAME_batch_into` and `NAME_batch`), or nothing if it
+/// has none.
+///
+/// The body is one loop over the lanes, `for (l, m) in out.iter_mut().enumerate()`, around the
+/// single-state function's statements, printed as they are (multiply-add chains over
+/// `A: Arith<f64>` included) and storing into the caller's result `m`: LLVM's loop vectorizer
+/// then runs the whole body on vectors across the states (four lanes per AVX2 register, two
+/// per SSE2 register). Before the loop: the inputs in lane-major order, the lane-wise sines
+/// and cosines, and copies of the parameter structs (`let p = &{ *p };`) — without those the
+/// vectorizer needs run-time checks that the result stores do not overwrite parameters it
+/// reads, and gives up ("loop not vectorized: runtime pointer checks needed").
 pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     if !batched(f) {
         return TokenStream::new();
@@ -108,54 +210,101 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     let printer = cx.printer(&p.stmts);
     let reads = Reads::of(p, cx.low.dof);
     let name = batch_name(spec);
+    let name_into = ident(&format!("{}_batch_into", spec.name));
     let single = spec.name;
     let doc = format!(
         " [`{single}`] at `L` states per call: entry `l` of the result is `{single}` at \
-         entry `l` of the inputs, bit for bit (the same statements over \
-         [`kanegen_runtime::lanes::Lanes`], vectorized across the states)."
+         entry `l` of the inputs, bit for bit with the same instruction set (the same \
+         statements in a loop over the states, vectorized across them). Returns the results \
+         by value; [`{single}_batch_into`] writes them into the caller's array instead (no \
+         zeroed array, no copy)."
+    );
+    let doc_into = format!(
+        " [`{single}`] at `L` states per call, into `out`: entry `l` of `out` becomes \
+         `{single}` at entry `l` of the inputs, bit for bit with the same instruction set \
+         (the same statements in a loop over the states, vectorized across them). Every \
+         entry of `out` is written."
     );
     let param_args = super::function::param_args(cx, &reads);
+    let (outer_params, pass_params) = super::function::outer_params(cx);
     let state = args(cx, spec.inputs);
-    let prologue = prologue(cx, p, &reads);
+    let names = arg_names(spec.inputs);
+    let out = out_arg(cx, spec);
+    let lane_inputs = lane_inputs(cx, p, &reads);
+    let lane_values = lane_values(cx, p, &reads);
     let ty = return_type(cx, spec);
-    let mut stores: Vec<TokenStream> = vec![TokenStream::new(); p.stmts.len() + 1];
-    let store_after = |stores: &mut [TokenStream], e: &LExpr, store: TokenStream| {
-        stores[last_local(e).map_or(0, |i| i + 1)].extend(store);
-    };
-    for (r, c, e) in nonzero_outputs(p) {
-        let v = printer.expr(e, false);
-        let (r, c) = (idx(*r), idx(*c));
-        let store = quote!(buf[#c][#r] = kanegen_runtime::lanes::lanes(#v););
-        store_after(&mut stores, e, store);
-    }
-    let statements = printer.statements(&stores);
-    let symmetric = spec.shape == Shape::SymmetricMatrix;
-    let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
-    let (rows, cols) = (idx(rows), idx(cols));
-    let unused = unused_inputs(spec.inputs, p, &reads);
-    let body = quote! {
-        #unused
-        #prologue
-        #[allow(unused_mut)]
-        let mut buf = kanegen_runtime::lanes::buffer::<L, #rows, #cols>();
-        #statements
-        kanegen_runtime::lanes::results(&mut buf, #symmetric)
-    };
-    let body = if cx.isa_dispatch {
-        quote!(kanegen_runtime::isa::dispatch(#[inline(always)] || { #body }))
+    let ResultStores {
+        in_loop: stores,
+        after,
+    } = stores(cx, &printer, p, spec.shape);
+    let lane_loop = if lane_values.is_empty() {
+        quote!(for m in out.iter_mut())
     } else {
-        body
+        quote!(for (l, m) in out.iter_mut().enumerate())
+    };
+    let after_loop = if after.is_empty() {
+        TokenStream::new()
+    } else {
+        quote!(for m in out.iter_mut() { #after })
+    };
+    let stored: Vec<&LExpr> = nonzero_outputs(p).map(|(_, _, e)| e).collect();
+    let block =
+        printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true);
+    let statements = cx.blocks.placeholder(block);
+    let unused = unused_inputs(spec.inputs, p, &reads);
+    // Local copies of the parameters: the result stores cannot alias them (see above).
+    let mut copies = TokenStream::new();
+    if cx.low.params.is_runtime() {
+        if reads.param {
+            copies.extend(quote!(let p = &{ *p };));
+        }
+        if reads.pre {
+            copies.extend(quote!(let pc = &{ *pc };));
+        }
+    }
+    let call = if cx.isa_dispatch {
+        // `out` goes to the copy that runs (two closures cannot both borrow it).
+        quote!(kanegen_runtime::isa::dispatch_fused_with(
+            out,
+            #[inline(always)]
+            |out| body::<kanegen_runtime::isa::Plain, L>(#pass_params #names, out),
+            #[inline(always)]
+            |out| body::<kanegen_runtime::isa::Fused, L>(#pass_params #names, out),
+        ))
+    } else {
+        quote!(body::<kanegen_runtime::isa::Native, L>(#pass_params #names, out))
     };
     quote! {
-        #[doc = #doc]
+        #[doc = #doc_into]
         #[inline(never)]
-        pub fn #name<const L: usize>(#param_args #state) -> [#ty; L] {
-            #body
+        pub fn #name_into<const L: usize>(#outer_params #state, #out) {
+            #[inline(always)]
+            fn body<A: kanegen_runtime::isa::Arith<f64>, const L: usize>(
+                #param_args #state, #out
+            ) {
+                #unused
+                #copies
+                #lane_inputs
+                #lane_loop {
+                    #lane_values
+                    #statements
+                }
+                #after_loop
+            }
+            #call
+        }
+
+        #[doc = #doc]
+        #[inline]
+        pub fn #name<const L: usize>(#outer_params #state) -> [#ty; L] {
+            let mut out = [<#ty>::zeros(); L];
+            #name_into(#pass_params #names, &mut out);
+            out
         }
     }
 }
 
-/// The wrapper's methods for the batched functions.
+/// The wrapper's methods for the batched functions (by value and `_into`).
 pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
     cx.low
         .functions
@@ -164,24 +313,40 @@ pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
         .map(|f| {
             let spec = f.id.spec();
             let name = batch_name(spec);
+            let name_into = ident(&format!("{}_batch_into", spec.name));
             let doc = format!(
                 " [`Self::{}`] at `L` states per call (entry `l` of the result at entry `l` of \
-                 the inputs, bit for bit; vectorized across the states).",
+                 the inputs, bit for bit with the same instruction set; vectorized across the \
+                 states). [`Self::{}_batch_into`] writes into the caller's array instead.",
+                spec.name, spec.name
+            );
+            let doc_into = format!(
+                " [`Self::{}`] at `L` states per call, written into `out` (every entry; entry \
+                 `l` at entry `l` of the inputs, bit for bit with the same instruction set).",
                 spec.name
             );
             let state = args(cx, spec.inputs);
+            let out = out_arg(cx, spec);
             let ty = return_type(cx, spec);
             let names = arg_names(spec.inputs);
-            let call = if cx.low.params.is_runtime() {
-                quote!(#name(&self.params, &self.pre, #names))
+            let (call, call_into) = if cx.low.params.is_runtime() {
+                (
+                    quote!(#name(&self.params, &self.pre, #names)),
+                    quote!(#name_into(&self.params, &self.pre, #names, out)),
+                )
             } else {
-                quote!(#name(#names))
+                (quote!(#name(#names)), quote!(#name_into(#names, out)))
             };
             quote! {
                 #[doc = #doc]
                 #[inline]
                 pub fn #name<const L: usize>(&self, #state) -> [#ty; L] {
                     #call
+                }
+                #[doc = #doc_into]
+                #[inline]
+                pub fn #name_into<const L: usize>(&self, #state, #out) {
+                    #call_into
                 }
             }
         })

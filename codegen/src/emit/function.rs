@@ -115,32 +115,7 @@ pub(super) fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStr
         // right below, which come before every other binding, and the sine/cosine names all
         // start with `s_`/`c_`.
         // A dependent (mimic) joint's angle is formed from its master's coordinate.
-        let angles =
-            p.sincos.iter().map(
-                |&s| match cx.low.mimic_angles.iter().find(|(d, _)| *d == s) {
-                    Some((_, m)) => {
-                        let ml = idx(m.master as usize);
-                        let aq = match m.multiplier {
-                            1.0 => quote!(q[#ml]),
-                            -1.0 => quote!(-q[#ml]),
-                            a => {
-                                let a = signed_lit(a, cx.precision);
-                                quote!(#a * q[#ml])
-                            }
-                        };
-                        let b = lit(m.offset.abs(), cx.precision);
-                        match m.offset {
-                            0.0 => aq,
-                            o if o < 0.0 => quote!(#aq - #b),
-                            _ => quote!(#aq + #b),
-                        }
-                    }
-                    None => {
-                        let sl = idx(s);
-                        quote!(q[#sl])
-                    }
-                },
-            );
+        let angles = p.sincos.iter().map(|&s| joint_angle(cx, s, &quote!(q)));
         ts.extend(quote!(let (sin_q, cos_q) = sin_cos_n([#(#angles),*]);));
         for (k, &s) in p.sincos.iter().enumerate() {
             let sn = ident(&naming::sin(&speeds[s].coordinate));
@@ -170,6 +145,36 @@ pub(super) fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStr
         }
     }
     ts
+}
+
+/// The angle whose sine and cosine speed `s`'s joint needs, read from the coordinates `q`
+/// (`q[5]`): a dependent (mimic) joint's angle is formed from its master's coordinate
+/// (`-q[3]`, `2.0 * q[3] + 0.1`). The single-state prologue indexes `f64`s, the batched one
+/// `kanegen_runtime::lanes::Lanes` (whose operators take `f64` on either side).
+pub(super) fn joint_angle(cx: &Context<'_>, s: usize, q: &TokenStream) -> TokenStream {
+    match cx.low.mimic_angles.iter().find(|(d, _)| *d == s) {
+        Some((_, m)) => {
+            let ml = idx(m.master as usize);
+            let aq = match m.multiplier {
+                1.0 => quote!(#q[#ml]),
+                -1.0 => quote!(-#q[#ml]),
+                a => {
+                    let a = signed_lit(a, cx.precision);
+                    quote!(#a * #q[#ml])
+                }
+            };
+            let b = lit(m.offset.abs(), cx.precision);
+            match m.offset {
+                0.0 => aq,
+                o if o < 0.0 => quote!(#aq - #b),
+                _ => quote!(#aq + #b),
+            }
+        }
+        None => {
+            let sl = idx(s);
+            quote!(#q[#sl])
+        }
+    }
 }
 
 /// The result: its type, its initialisation, the stores placed after the statements they read

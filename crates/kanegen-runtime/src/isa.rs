@@ -14,7 +14,8 @@
 //! inlines the closure and the body: that copy of the body is compiled for AVX2 with the
 //! three-operand VEX encodings and 256-bit vectors where LLVM vectorizes. Calling a
 //! `#[target_feature]` function needs `unsafe` (the CPU must have the features); this module
-//! holds that call (the same in [`dispatch`], [`dispatch_fused`] and `dispatch_fused_with`), right after the check that
+//! holds that call (the same in [`dispatch`] and [`dispatch_fused_with`], through which
+//! [`dispatch_fused`] runs), right after the check that
 //! the features are present; the crate's only other `unsafe` block is the same kind of call in
 //! [`crate::derivative_steps::run`] (its AVX2 kernel, after [`active`] reported x86-64-v3).
 //!
@@ -204,20 +205,18 @@ if_dispatching! {
     /// the module docs.
     #[inline(always)]
     pub fn dispatch_fused<R>(plain: impl FnOnce() -> R, fused: impl FnOnce() -> R) -> R {
-        if active_code() == V3 {
-            // SAFETY: `ACTIVE` holds `V3` only after `v3_present()` found every feature
-            // `run_v3` is compiled with (`detect` and `select` check it before storing), so the
-            // CPU executes its instructions. The same call as in `dispatch` above.
-            #[allow(unsafe_code)]
-            unsafe {
-                return run_v3(fused);
-            }
-        }
-        plain()
+        dispatch_fused_with(
+            (),
+            #[inline(always)]
+            |()| plain(),
+            #[inline(always)]
+            |()| fused(),
+        )
     }
 
-    /// [`dispatch_fused`] for bodies that take an argument, such as the `&mut` result matrix
-    /// of a generated `_into` function (two closures cannot both hold it).
+    /// [`dispatch_fused`] passing `arg` to the copy that runs: for an argument both closures
+    /// would otherwise capture, such as the `&mut` result array of a batched function
+    /// (`mass_matrix_batch_into`), which two closures cannot borrow at once.
     #[inline(always)]
     pub fn dispatch_fused_with<T, R>(
         arg: T,
@@ -225,12 +224,14 @@ if_dispatching! {
         fused: impl FnOnce(T) -> R,
     ) -> R {
         if active_code() == V3 {
-            // SAFETY: as in `dispatch_fused` above (the same check before the same call).
+            // SAFETY: `ACTIVE` holds `V3` only after `v3_present()` found every feature
+            // `run_v3` is compiled with (`detect` and `select` check it before storing), so the
+            // CPU executes its instructions. The same call as in `dispatch` above.
             #[allow(unsafe_code)]
             unsafe {
                 return run_v3(
                     #[inline(always)]
-                    move || fused(arg),
+                    || fused(arg),
                 );
             }
         }
@@ -254,26 +255,17 @@ if_not_dispatching! {
     /// otherwise: this build has one copy of every function (see the module docs).
     #[inline(always)]
     pub fn dispatch_fused<R>(plain: impl FnOnce() -> R, fused: impl FnOnce() -> R) -> R {
-        #[cfg(all(
-            feature = "std",
-            any(target_feature = "fma", target_arch = "aarch64")
-        ))]
-        {
-            let _ = plain;
-            fused()
-        }
-        #[cfg(not(all(
-            feature = "std",
-            any(target_feature = "fma", target_arch = "aarch64")
-        )))]
-        {
-            let _ = fused;
-            plain()
-        }
+        dispatch_fused_with(
+            (),
+            #[inline(always)]
+            |()| plain(),
+            #[inline(always)]
+            |()| fused(),
+        )
     }
 
-    /// [`dispatch_fused`] for bodies that take an argument, such as the `&mut` result matrix
-    /// of a generated `_into` function (two closures cannot both hold it).
+    /// [`dispatch_fused`] passing `arg` to the copy that runs (for an argument both closures
+    /// would otherwise capture, such as a `&mut` result array).
     #[inline(always)]
     pub fn dispatch_fused_with<T, R>(
         arg: T,

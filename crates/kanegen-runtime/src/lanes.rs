@@ -1,14 +1,17 @@
-//! Lane types for batched evaluation: one generated function evaluated at `L` states per call.
+//! Lane types and helpers for batched evaluation: one generated function evaluated at `L`
+//! states per call.
 //!
-//! A generated module's `*_batch` functions (e.g. `mass_matrix_batch(p, pc, &[q; L])`, or the
-//! wrapper's `Krang::mass_matrix_batch`) run the *same* straight-line statements as the
-//! single-state function, with every state-dependent value a [`Lanes<L>`]: `L` `f64`s, one per
-//! state, combined lane by lane. The operators are plain element-wise IEEE operations, and
-//! parameters and literals stay `f64` (an `f64` operand is applied to every lane), so lane `l`
-//! of every value is computed by exactly the operations, in exactly the order, of the
-//! single-state function at state `l`: **the results are the single-state results bit for
-//! bit**. The compiler turns the lane loops into vector instructions (two lanes per SSE2
-//! instruction, four per AVX2 instruction; the x86-64-v3 copy is chosen by [`crate::isa`]).
+//! A generated module's `*_batch_into` functions (e.g. `mass_matrix_batch_into(p, pc, &[q; L],
+//! &mut [SMatrix; L])`, or the wrapper's `Krang::mass_matrix_batch_into`; `*_batch` returns the
+//! results by value) run the *same* straight-line statements as the single-state function in
+//! a loop over the states, which LLVM's loop vectorizer turns into vector instructions across
+//! the states (two per SSE2 register, four per AVX2 register; the x86-64-v3 copy is chosen by
+//! [`crate::isa`]). Lane `l` is therefore the single-state result at state `l` **bit for bit**,
+//! with the same instruction set. Before the loop the inputs are transposed to lane-major
+//! order ([`inputs`]) and the sines and cosines of all joint angles of all states are computed
+//! in one call ([`sin_cos_n`]). [`Lanes<L>`] (`L` `f64`s with lane-wise operators, `f64`
+//! operands applied to every lane) holds the transposed inputs and forms a dependent (mimic)
+//! joint's angle from its master's.
 //!
 //! `L` is a const generic of the batch functions: any `L ≥ 1` works; 4 (one AVX2 register) and
 //! 8 are the sizes the benchmarks measure.
@@ -23,7 +26,7 @@
 
 use core::ops::{Add, Div, Mul, Neg, Sub};
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SVector;
 
 /// `L` values of one quantity, one per state of a batch (see the [module docs](self)).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -89,121 +92,38 @@ impl<const L: usize> Neg for Lanes<L> {
     }
 }
 
-/// A value of a batched function: [`Lanes`], or an `f64` that is the same in every lane (a
-/// result entry that depends on parameters only).
-pub trait LaneValue<const L: usize>: Copy {
-    /// The value in lane `l`.
-    fn lane(self, l: usize) -> f64;
-}
-
-impl<const L: usize> LaneValue<L> for Lanes<L> {
-    #[inline(always)]
-    fn lane(self, l: usize) -> f64 {
-        self.0[l]
-    }
-}
-
-impl<const L: usize> LaneValue<L> for f64 {
-    #[inline(always)]
-    fn lane(self, _l: usize) -> f64 {
-        self
-    }
-}
-
-/// `(sin x, cos x)` lane by lane: [`crate::trig::sin_cos_n`] on the lanes, so bit for bit the
-/// values of the single-state functions.
+/// `(sin x, cos x)` of every angle `k` in every lane `l` (`x[k][l]`), in one call of
+/// [`crate::trig::sin_cos_slice`]: bit for bit the values of [`crate::trig::sin_cos_n`], which
+/// the single-state functions call. The batched functions pass all joint angles of all their
+/// states at once (`[q[2].0, q[3].0, …]`).
 #[inline(always)]
-pub fn sin_cos<const L: usize>(x: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
-    let (s, c) = crate::trig::sin_cos_n(x.0);
-    (Lanes(s), Lanes(c))
+pub fn sin_cos_n<const N: usize, const L: usize>(
+    x: [[f64; L]; N],
+) -> ([[f64; L]; N], [[f64; L]; N]) {
+    let (mut s, mut c) = ([[0.0; L]; N], [[0.0; L]; N]);
+    crate::trig::sin_cos_slice(x.as_flattened(), s.as_flattened_mut(), c.as_flattened_mut());
+    (s, c)
 }
 
 /// The inputs of a batched function in lane-major order: entry `i` holds coordinate (speed,
 /// acceleration) `i` of every state. Written to memory behind an optimisation barrier
-/// (`core::hint::black_box`), so that the statements read whole lane vectors from consecutive
-/// addresses: without it LLVM reads every lane from the states' own (strided) storage and
-/// keeps the whole function scalar (measured: Krang's batched M at 4 states ran 645 ns per
-/// state, slower than a single-state call).
+/// (`core::hint::black_box`), so that the batched function's loop over the states reads whole
+/// lane vectors from consecutive addresses: without it LLVM reads every lane from the states'
+/// own (strided) storage and Krang's batched c and τ were not vectorized (1.2 µs instead of
+/// 0.6 µs at 4 states). Returned by value, i.e. copied out of the array that passed the
+/// barrier (a `memcpy`, 608 bytes for 19 speeds at 4 states): measured, reading the lanes from
+/// the array that passed the barrier (which LLVM must then assume the result stores may
+/// overwrite) kept the loop from being vectorized (twice the time of c, τ and M at 4 states).
 #[inline(always)]
 pub fn inputs<const L: usize, const N: usize>(x: &[SVector<f64, N>; L]) -> [Lanes<L>; N] {
-    let mut t: [Lanes<L>; N] = core::array::from_fn(|i| Lanes::gather(x, i));
+    // Plain loops, not `core::array::from_fn`: at L = 8 LLVM left that one out of line
+    // (`try_from_fn`: 7 % of Krang's batched c).
+    let mut t = [Lanes::splat(0.0); N];
+    for (l, x) in x.iter().enumerate() {
+        for (t, x) in t.iter_mut().zip(x.iter()) {
+            t.0[l] = *x;
+        }
+    }
     core::hint::black_box(&mut t);
     t
-}
-
-/// The result buffer of a batched function: column `c`, row `r`, all lanes together (see
-/// [`inputs`] for why lane-major).
-pub type Buffer<const L: usize, const R: usize, const C: usize> = [[Lanes<L>; R]; C];
-
-/// An all-zero [`Buffer`].
-#[inline(always)]
-pub fn buffer<const L: usize, const R: usize, const C: usize>() -> Buffer<L, R, C> {
-    [[Lanes::splat(0.0); R]; C]
-}
-
-/// `v` in every lane (an `f64` result entry) or `v` itself.
-#[inline(always)]
-pub fn lanes<const L: usize>(v: impl LaneValue<L>) -> Lanes<L> {
-    Lanes::from_fn(|l| v.lane(l))
-}
-
-/// The results of the `L` states from a filled [`Buffer`] (read behind an optimisation
-/// barrier, so that the stores into the buffer stay whole vectors); `symmetric`: the upper
-/// triangle is copied into the lower one.
-#[inline(always)]
-pub fn results<const L: usize, const R: usize, const C: usize>(
-    buf: &mut Buffer<L, R, C>,
-    symmetric: bool,
-) -> [SMatrix<f64, R, C>; L] {
-    core::hint::black_box(&mut *buf);
-    let mut out = [SMatrix::<f64, R, C>::zeros(); L];
-    for (l, m) in out.iter_mut().enumerate() {
-        for c in 0..C {
-            for r in 0..R {
-                m[(r, c)] = if symmetric && r > c {
-                    buf[r][c].0[l]
-                } else {
-                    buf[c][r].0[l]
-                };
-            }
-        }
-    }
-    out
-}
-/// Stores `v`'s lane `l` into entry `(r, c)` of `m[l]`.
-#[inline(always)]
-pub fn set_matrix<const L: usize, const R: usize, const C: usize>(
-    m: &mut [SMatrix<f64, R, C>; L],
-    r: usize,
-    c: usize,
-    v: impl LaneValue<L>,
-) {
-    for (l, m) in m.iter_mut().enumerate() {
-        m[(r, c)] = v.lane(l);
-    }
-}
-
-/// Stores `v`'s lane `l` into entry `r` of `out[l]`.
-#[inline(always)]
-pub fn set_vector<const L: usize, const N: usize>(
-    out: &mut [SVector<f64, N>; L],
-    r: usize,
-    v: impl LaneValue<L>,
-) {
-    for (l, out) in out.iter_mut().enumerate() {
-        out[r] = v.lane(l);
-    }
-}
-
-/// Copies the upper triangle of every `m[l]` into its lower triangle (symmetric results).
-#[inline(always)]
-pub fn mirror_upper<const L: usize, const N: usize>(m: &mut [SMatrix<f64, N, N>; L]) {
-    for m in m.iter_mut() {
-        let s = m.as_mut_slice();
-        for c in 1..N {
-            for r in 0..c {
-                s[r * N + c] = s[c * N + r];
-            }
-        }
-    }
 }

@@ -1,10 +1,10 @@
 //! Accuracy of the `trig` routines: within an ulp of `std` on robot angles, a few ulp on huge
 //! ones, NaN for non-finite ones; the batched routine bit for bit the scalar one in every lane
-//! (whichever path the batch takes); the `f32` kernel within an ulp of the correctly rounded
+//! (whichever path the batch takes), the slice routine of the batched functions too; the `f32` kernel within an ulp of the correctly rounded
 //! result, measured against the `f64` routine.
 
 use kanegen_runtime::trig::{
-    SIN_COS_F32_FAST_BOUND, SIN_COS_FAST_BOUND, sin_cos, sin_cos_n, sin_cos_n_f32,
+    SIN_COS_F32_FAST_BOUND, SIN_COS_FAST_BOUND, sin_cos, sin_cos_n, sin_cos_n_f32, sin_cos_slice,
 };
 
 fn check(x: f64, tol: f64) {
@@ -167,6 +167,53 @@ fn both_sides_of_the_fast_bound() {
     check_batch([SIN_COS_FAST_BOUND, -SIN_COS_FAST_BOUND, 1.0], 1e-15);
     check(SIN_COS_FAST_BOUND, 1e-15);
     check(below, 1e-15);
+}
+
+/// `sin_cos_slice` (all angles of all states of a batched function in one call) gives the
+/// scalar routine's bits for every value, at every length (every remainder of 2-, 4- and
+/// 8-lane vectors), with and without a huge or non-finite value somewhere in the slice; the
+/// lanes form (`lanes::sin_cos_n`, `[[f64; L]; N]`) the same.
+#[test]
+fn slice_routine_gives_the_scalar_bits_at_every_length_and_path() {
+    let mut xs = robot_angles();
+    xs.truncate(200);
+    let odd = [f64::NAN, f64::INFINITY, -823_549.0, 1e22];
+    for n in 0..70 {
+        for poison in [None, Some(n / 2)] {
+            let mut x: Vec<f64> = xs.iter().cycle().skip(n).take(n).copied().collect();
+            if let Some(k) = poison.filter(|&k| k < n) {
+                x[k] = odd[n % odd.len()];
+            }
+            let (mut s, mut c) = (vec![0.0; n], vec![0.0; n]);
+            sin_cos_slice(&x, &mut s, &mut c);
+            for k in 0..n {
+                let (s1, c1) = sin_cos(x[k]);
+                assert!(
+                    same(s[k], s1) && same(c[k], c1),
+                    "value {k} of {n}, x = {:e}: slice ({}, {}) vs scalar ({s1}, {c1})",
+                    x[k],
+                    s[k],
+                    c[k]
+                );
+            }
+        }
+    }
+    // Slices of different lengths: the common length, the rest left alone.
+    let (mut s, mut c) = ([7.0; 3], [7.0; 2]);
+    sin_cos_slice(&[0.5, 1.0, 1.5, 2.0], &mut s, &mut c);
+    assert_eq!((s[2], s[0], c[1]), (7.0, sin_cos(0.5).0, sin_cos(1.0).1));
+    // The lanes form: x[k][l].
+    let x: [[f64; 4]; 3] = core::array::from_fn(|k| core::array::from_fn(|l| xs[4 * k + l]));
+    let (s, c) = kanegen_runtime::lanes::sin_cos_n(x);
+    for k in 0..3 {
+        for l in 0..4 {
+            let (s1, c1) = sin_cos(x[k][l]);
+            assert!(
+                same(s[k][l], s1) && same(c[k][l], c1),
+                "angle {k}, lane {l}"
+            );
+        }
+    }
 }
 
 /// Distance in units in the last place between two finite `f32` of any sign.

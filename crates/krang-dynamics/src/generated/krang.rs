@@ -7926,1771 +7926,6340 @@ mod generated {
             || body::<kanegen_runtime::isa::Fused>(p, pc, q, u, ud),
         )
     }
-    /// [`mass_matrix`] at `L` states per call: entry `l` of the result is `mass_matrix` at entry `l` of the inputs, bit for bit (the same statements over [`kanegen_runtime::lanes::Lanes`], vectorized across the states).
+    /// [`mass_matrix`] at `L` states per call, into `out`: entry `l` of `out` becomes `mass_matrix` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
     #[inline(never)]
+    pub fn mass_matrix_batch_into<const L: usize>(
+        p: &Params,
+        pc: &Precomputed,
+        q: &[SVector<f64, 19>; L],
+        out: &mut [SMatrix<f64, 19, 19>; L],
+    ) {
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>, const L: usize>(
+            p: &Params,
+            pc: &Precomputed,
+            q: &[SVector<f64, 19>; L],
+            out: &mut [SMatrix<f64, 19, 19>; L],
+        ) {
+            let p = &{ *p };
+            let pc = &{ *pc };
+            let q = kanegen_runtime::lanes::inputs(q);
+            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n([
+                q[2].0,
+                q[3].0,
+                q[4].0,
+                q[5].0,
+                q[6].0,
+                q[7].0,
+                q[8].0,
+                q[9].0,
+                q[10].0,
+                q[11].0,
+                q[12].0,
+                q[13].0,
+                q[14].0,
+                q[15].0,
+                q[16].0,
+                q[17].0,
+                q[18].0,
+            ]);
+            for (l, m) in out.iter_mut().enumerate() {
+                let s_q_imu = sin_q[0][l];
+                let c_q_imu = cos_q[0][l];
+                let s_q_w = sin_q[1][l];
+                let c_q_w = cos_q[1][l];
+                let s_q_torso = sin_q[2][l];
+                let c_q_torso = cos_q[2][l];
+                let s_q1l = sin_q[3][l];
+                let c_q1l = cos_q[3][l];
+                let s_q2l = sin_q[4][l];
+                let c_q2l = cos_q[4][l];
+                let s_q3l = sin_q[5][l];
+                let c_q3l = cos_q[5][l];
+                let s_q4l = sin_q[6][l];
+                let c_q4l = cos_q[6][l];
+                let s_q5l = sin_q[7][l];
+                let c_q5l = cos_q[7][l];
+                let s_q6l = sin_q[8][l];
+                let c_q6l = cos_q[8][l];
+                let s_q7l = sin_q[9][l];
+                let c_q7l = cos_q[9][l];
+                let s_q1r = sin_q[10][l];
+                let c_q1r = cos_q[10][l];
+                let s_q2r = sin_q[11][l];
+                let c_q2r = cos_q[11][l];
+                let s_q3r = sin_q[12][l];
+                let c_q3r = cos_q[12][l];
+                let s_q4r = sin_q[13][l];
+                let c_q4r = cos_q[13][l];
+                let s_q5r = sin_q[14][l];
+                let c_q5r = cos_q[14][l];
+                let s_q6r = sin_q[15][l];
+                let c_q6r = cos_q[15][l];
+                let s_q7r = sin_q[16][l];
+                let c_q7r = cos_q[16][l];
+                m[(0, 0)] = pc.pc69;
+                m[(11, 11)] = p.ZZ10l;
+                m[(18, 18)] = p.ZZ10r;
+                let d1 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
+                let d2 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
+                let t1 = p.XZ10r * c_q7r; // common subexpression
+                let t2 = p.YZ10r * s_q7r; // common subexpression
+                let t3 = p.XZ10r * s_q7r; // common subexpression
+                let t4 = p.YZ10r * c_q7r; // common subexpression
+                let t5 = p.L9 * d2; // common subexpression
+                let t6 = p.L9 * d1; // common subexpression
+                let d3 = t1 + t2 - t5; // N(M col 10r) at 9r.x
+                m[(17, 18)] = -d3;
+                let d4 = t3 - t4 - t6; // N(M col 10r) at 9r.z
+                let d5 = d2 * s_q6r; // F(M col 10r) at 8r.y
+                let d6 = d2 * c_q6r; // F(M col 10r) at 8r.z
+                let d7 = A::mul_add(-d4, s_q6r, p.ZZ10r * c_q6r); // N(M col 10r) at 8r.y
+                m[(16, 18)] = d7;
+                let d8 = A::mul_add(d4, c_q6r, p.ZZ10r * s_q6r); // N(M col 10r) at 8r.z
+                let d9 = A::mul_add(d6, s_q5r, d1 * c_q5r); // F(M col 10r) at 7r.x
+                let d10 = A::mul_add(-d6, c_q5r, d1 * s_q5r); // F(M col 10r) at 7r.z
+                let d11 = A::mul_add(p.L8, d10, A::mul_add(-d8, s_q5r, d3 * c_q5r)); // N(M col 10r) at 7r.x
+                m[(15, 18)] = -d11;
+                let d12 = A::mul_add(-p.L8, d9, A::mul_add(d8, c_q5r, d3 * s_q5r)); // N(M col 10r) at 7r.z
+                let d13 = A::mul_add(-d10, s_q4r, d5 * c_q4r); // F(M col 10r) at 6r.y
+                let d14 = A::mul_add(d10, c_q4r, d5 * s_q4r); // F(M col 10r) at 6r.z
+                let d15 = A::mul_add(-d12, s_q4r, d7 * c_q4r); // N(M col 10r) at 6r.y
+                m[(14, 18)] = d15;
+                let d16 = A::mul_add(d12, c_q4r, d7 * s_q4r); // N(M col 10r) at 6r.z
+                let d17 = A::mul_add(-d14, s_q3r, d9 * c_q3r); // F(M col 10r) at 5r.x
+                let d18 = A::mul_add(d14, c_q3r, d9 * s_q3r); // F(M col 10r) at 5r.z
+                let d19 = A::mul_add(p.L7, d18, A::mul_add(-d16, s_q3r, d11 * c_q3r)); // N(M col 10r) at 5r.x
+                m[(13, 18)] = -d19;
+                let d20 = A::mul_add(-p.L7, d17, A::mul_add(d16, c_q3r, d11 * s_q3r)); // N(M col 10r) at 5r.z
+                let d21 = A::mul_add(-d18, s_q2r, d13 * c_q2r); // F(M col 10r) at 4r.y
+                let d22 = A::mul_add(d18, c_q2r, d13 * s_q2r); // F(M col 10r) at 4r.z
+                let d23 = A::mul_add(-d20, s_q2r, d15 * c_q2r); // N(M col 10r) at 4r.y
+                m[(12, 18)] = d23;
+                let d24 = A::mul_add(d20, c_q2r, d15 * s_q2r); // N(M col 10r) at 4r.z
+                let d25 = A::mul_add(-d22, s_q1r, d17 * c_q1r); // F(M col 10r) at 3.y
+                let d26 = A::mul_add(d22, c_q1r, d17 * s_q1r); // F(M col 10r) at 3.z
+                let d27 = A::mul_add(-p.L5, d26, d23); // N(M col 10r) at 3.x
+                let d28 = A::mul_add(p.L6, d26, A::mul_add(-d24, s_q1r, d19 * c_q1r)); // N(M col 10r) at 3.y
+                m[(4, 18)] = d28;
+                let d29 = A::mul_add(
+                    d21,
+                    p.L5,
+                    A::mul_add(-p.L6, d25, A::mul_add(d24, c_q1r, d19 * s_q1r)),
+                ); // N(M col 10r) at 3.z
+                let d30 = A::mul_add(d26, s_q_torso, d21 * c_q_torso); // F(M col 10r) at 2.x
+                let d31 = A::mul_add(-d26, c_q_torso, d21 * s_q_torso); // F(M col 10r) at 2.z
+                let d32 = A::mul_add(
+                    -d25,
+                    p.L4,
+                    A::mul_add(p.L3, d31, A::mul_add(d29, s_q_torso, d27 * c_q_torso)),
+                ); // N(M col 10r) at 2.x
+                m[(3, 18)] = d32;
+                let d33 = A::mul_add(p.L4, d30, d28); // N(M col 10r) at 2.y
+                let d34 = A::mul_add(
+                    -p.L3,
+                    d30,
+                    A::mul_add(-d29, c_q_torso, d27 * s_q_torso),
+                ); // N(M col 10r) at 2.z
+                let d35 = A::mul_add(-d31, c_q_w, d25 * s_q_w); // F(M col 10r) at 1.z
+                let d36 = A::mul_add(d31, s_q_w, d25 * c_q_w); // F(M col 10r) at 1.y
+                let d37 = A::mul_add(d30, p.L1, A::mul_add(-d34, c_q_w, d33 * s_q_w)); // N(M col 10r) at 1.z
+                let d38 = A::mul_add(p.L2, d36, A::mul_add(-p.L1, d35, d32)); // N(M col 10r) at 1.x
+                m[(2, 18)] = d38;
+                let d39 = A::mul_add(-d30, p.L2, A::mul_add(d34, s_q_w, d33 * c_q_w)); // N(M col 10r) at 1.y
+                let d40 = A::mul_add(d35, c_q_imu, d36 * s_q_imu); // F(M col 10r) at 0.x
+                m[(0, 18)] = -d40;
+                let d41 = A::mul_add(-d37, s_q_imu, d39 * c_q_imu); // N(M col 10r) at 0.z
+                m[(1, 18)] = -d41;
+                let d42 = p.MX9r - d2; // MSC9r.x
+                let d43 = p.MZ9r + d1; // MSC9r.z
+                let k1 = s_q7r * s_q7r; // sin² q7r
+                let k2 = s_q7r * c_q7r; // sin q7r cos q7r
+                let k3 = A::mul_add(2.0, k1, -1.0); // cos 2q7r
+                let d44 = A::mul_add(-2.0, p.XY10r * k2, k1 * pc.pc3); // JC10r rotated about z: Jxx − J'xx
+                let d45 = p.XY9r + t1 + t2 - t5; // JC9r.xy
+                let d46 = A::mul_add(-k2, pc.pc3, A::mul_add(-p.XY10r, k3, p.XZ9r)); // JC9r.xz
+                let d47 = p.YZ9r - t3 + t4 + t6; // JC9r.yz
+                let d48 = pc.pc7 - d44; // JC9r.xx
+                m[(17, 17)] = d48;
+                let d49 = d44 + pc.pc8; // JC9r.zz
+                let d50 = A::mul_add(s_q6r, d43, c_q6r * pc.pc2); // MSC9r in 8r.y
+                let d51 = A::mul_add(-c_q6r, d43, s_q6r * pc.pc2); // MSC9r in 8r.z
+                let t7 = c_q6r * d45; // common subexpression
+                let t8 = s_q6r * d46; // common subexpression
+                let d52 = t7 + t8; // N(M col 9r) at 8r.y
+                m[(16, 17)] = -d52;
+                let t9 = s_q6r * d45; // common subexpression
+                let t10 = c_q6r * d46; // common subexpression
+                let d53 = t9 - t10; // N(M col 9r) at 8r.z
+                let d54 = s_q5r * d50; // F(M col 9r) at 7r.x
+                let d55 = c_q5r * d50; // F(M col 9r) at 7r.z
+                let d56 = A::mul_add(-p.L8, d54, A::mul_add(c_q5r, d53, s_q5r * d48)); // N(M col 9r) at 7r.z
+                let d57 = A::mul_add(-p.L8, d55, A::mul_add(-s_q5r, d53, c_q5r * d48)); // N(M col 9r) at 7r.x
+                m[(15, 17)] = d57;
+                let d58 = A::mul_add(s_q4r, d55, c_q4r * d51); // F(M col 9r) at 6r.y
+                let d59 = A::mul_add(-c_q4r, d55, s_q4r * d51); // F(M col 9r) at 6r.z
+                let d60 = A::mul_add(-s_q4r, d56, c_q4r * d52); // N(M col 9r) at 6r.y
+                m[(14, 17)] = -d60;
+                let d61 = A::mul_add(c_q4r, d56, s_q4r * d52); // N(M col 9r) at 6r.z
+                let d62 = A::mul_add(c_q3r, d59, s_q3r * d54); // F(M col 9r) at 5r.z
+                let d63 = A::mul_add(-s_q3r, d59, c_q3r * d54); // F(M col 9r) at 5r.x
+                let d64 = A::mul_add(-p.L7, d63, A::mul_add(c_q3r, d61, s_q3r * d57)); // N(M col 9r) at 5r.z
+                let d65 = A::mul_add(p.L7, d62, A::mul_add(-s_q3r, d61, c_q3r * d57)); // N(M col 9r) at 5r.x
+                m[(13, 17)] = d65;
+                let d66 = A::mul_add(-s_q2r, d62, c_q2r * d58); // F(M col 9r) at 4r.y
+                let d67 = A::mul_add(c_q2r, d62, s_q2r * d58); // F(M col 9r) at 4r.z
+                let d68 = A::mul_add(-s_q2r, d64, c_q2r * d60); // N(M col 9r) at 4r.y
+                m[(12, 17)] = -d68;
+                let d69 = A::mul_add(c_q2r, d64, s_q2r * d60); // N(M col 9r) at 4r.z
+                let d70 = A::mul_add(-s_q1r, d67, c_q1r * d63); // F(M col 9r) at 3.y
+                let d71 = A::mul_add(c_q1r, d67, s_q1r * d63); // F(M col 9r) at 3.z
+                let d72 = A::mul_add(p.L6, d71, A::mul_add(-s_q1r, d69, c_q1r * d65)); // N(M col 9r) at 3.y
+                m[(4, 17)] = -d72;
+                let d73 = A::mul_add(
+                    p.L5,
+                    d66,
+                    A::mul_add(-p.L6, d70, A::mul_add(c_q1r, d69, s_q1r * d65)),
+                ); // N(M col 9r) at 3.z
+                let d74 = A::mul_add(-p.L5, d71, d68); // N(M col 9r) at 3.x
+                let d75 = A::mul_add(s_q_torso, d71, c_q_torso * d66); // F(M col 9r) at 2.x
+                let d76 = A::mul_add(-c_q_torso, d71, s_q_torso * d66); // F(M col 9r) at 2.z
+                let d77 = A::mul_add(
+                    -p.L4,
+                    d70,
+                    A::mul_add(p.L3, d76, A::mul_add(s_q_torso, d73, c_q_torso * d74)),
+                ); // N(M col 9r) at 2.x
+                m[(3, 17)] = -d77;
+                let d78 = A::mul_add(p.L4, d75, d72); // N(M col 9r) at 2.y
+                let d79 = A::mul_add(
+                    -p.L3,
+                    d75,
+                    A::mul_add(-c_q_torso, d73, s_q_torso * d74),
+                ); // N(M col 9r) at 2.z
+                let d80 = A::mul_add(s_q_w, d76, c_q_w * d70); // F(M col 9r) at 1.y
+                let d81 = A::mul_add(-c_q_w, d76, s_q_w * d70); // F(M col 9r) at 1.z
+                let d82 = A::mul_add(p.L2, d80, A::mul_add(-p.L1, d81, d77)); // N(M col 9r) at 1.x
+                m[(2, 17)] = -d82;
+                let d83 = A::mul_add(-p.L2, d75, A::mul_add(s_q_w, d79, c_q_w * d78)); // N(M col 9r) at 1.y
+                let d84 = A::mul_add(p.L1, d75, A::mul_add(-c_q_w, d79, s_q_w * d78)); // N(M col 9r) at 1.z
+                let d85 = A::mul_add(c_q_imu, d81, s_q_imu * d80); // F(M col 9r) at 0.x
+                m[(0, 17)] = d85;
+                let d86 = A::mul_add(-s_q_imu, d84, c_q_imu * d83); // N(M col 9r) at 0.z
+                m[(1, 17)] = d86;
+                let d87 = p.MX8r - d42; // MSC8r.x
+                let d88 = p.MY8r - d50; // MSC8r.y
+                let d89 = p.MZ8r - d51; // MSC8r.z
+                let k4 = s_q6r * s_q6r; // sin² q6r
+                let k5 = s_q6r * c_q6r; // sin q6r cos q6r
+                let k6 = A::mul_add(2.0, k4, -1.0); // cos 2q6r
+                let d90 = pc.pc6 - d49; // JC9r: Jyy − Jzz
+                let d91 = A::mul_add(-2.0, d47 * k5, k4 * d90); // JC9r rotated about x: Jyy − J'yy
+                let d92 = p.XX8r + d48; // JC8r.xx
+                let d93 = p.XY8r + t7 + t8; // JC8r.xy
+                let d94 = p.XZ8r + t9 - t10; // JC8r.xz
+                let d95 = A::mul_add(k5, d90, A::mul_add(d47, k6, p.YZ8r)); // JC8r.yz
+                let d96 = p.ZZ8r + d49 + d91; // JC8r.zz
+                let d97 = pc.pc10 - d91; // JC8r.yy
+                m[(16, 16)] = d97;
+                let d98 = A::mul_add(c_q5r, d89, s_q5r * d87); // MSC8r in 7r.z
+                let d99 = A::mul_add(-s_q5r, d89, c_q5r * d87); // MSC8r in 7r.x
+                let t11 = c_q5r * d93; // common subexpression
+                let t12 = s_q5r * d95; // common subexpression
+                let t13 = s_q5r * d93; // common subexpression
+                let t14 = c_q5r * d95; // common subexpression
+                let t15 = p.L8 * d99; // common subexpression
+                let t16 = p.L8 * d98; // common subexpression
+                let d100 = t11 - t12 - t15; // N(M col 8r) at 7r.x
+                m[(15, 16)] = -d100;
+                let d101 = t13 + t14 - t16; // N(M col 8r) at 7r.z
+                let d102 = s_q4r * d99; // F(M col 8r) at 6r.y
+                let d103 = c_q4r * d99; // F(M col 8r) at 6r.z
+                let d104 = A::mul_add(-s_q4r, d101, c_q4r * d97); // N(M col 8r) at 6r.y
+                m[(14, 16)] = d104;
+                let d105 = A::mul_add(c_q4r, d101, s_q4r * d97); // N(M col 8r) at 6r.z
+                let d106 = A::mul_add(s_q3r, d103, c_q3r * d98); // F(M col 8r) at 5r.x
+                let d107 = A::mul_add(-c_q3r, d103, s_q3r * d98); // F(M col 8r) at 5r.z
+                let d108 = A::mul_add(
+                    p.L7,
+                    d107,
+                    A::mul_add(-s_q3r, d105, c_q3r * d100),
+                ); // N(M col 8r) at 5r.x
+                m[(13, 16)] = -d108;
+                let d109 = A::mul_add(
+                    -p.L7,
+                    d106,
+                    A::mul_add(c_q3r, d105, s_q3r * d100),
+                ); // N(M col 8r) at 5r.z
+                let d110 = A::mul_add(-s_q2r, d107, c_q2r * d102); // F(M col 8r) at 4r.y
+                let d111 = A::mul_add(c_q2r, d107, s_q2r * d102); // F(M col 8r) at 4r.z
+                let d112 = A::mul_add(-s_q2r, d109, c_q2r * d104); // N(M col 8r) at 4r.y
+                m[(12, 16)] = d112;
+                let d113 = A::mul_add(c_q2r, d109, s_q2r * d104); // N(M col 8r) at 4r.z
+                let d114 = A::mul_add(-s_q1r, d111, c_q1r * d106); // F(M col 8r) at 3.y
+                let d115 = A::mul_add(c_q1r, d111, s_q1r * d106); // F(M col 8r) at 3.z
+                let d116 = A::mul_add(-p.L5, d115, d112); // N(M col 8r) at 3.x
+                let d117 = A::mul_add(
+                    p.L6,
+                    d115,
+                    A::mul_add(-s_q1r, d113, c_q1r * d108),
+                ); // N(M col 8r) at 3.y
+                m[(4, 16)] = d117;
+                let d118 = A::mul_add(
+                    p.L5,
+                    d110,
+                    A::mul_add(-p.L6, d114, A::mul_add(c_q1r, d113, s_q1r * d108)),
+                ); // N(M col 8r) at 3.z
+                let d119 = A::mul_add(s_q_torso, d115, c_q_torso * d110); // F(M col 8r) at 2.x
+                let d120 = A::mul_add(-c_q_torso, d115, s_q_torso * d110); // F(M col 8r) at 2.z
+                let d121 = A::mul_add(
+                    -p.L4,
+                    d114,
+                    A::mul_add(p.L3, d120, A::mul_add(s_q_torso, d118, c_q_torso * d116)),
+                ); // N(M col 8r) at 2.x
+                m[(3, 16)] = d121;
+                let d122 = A::mul_add(p.L4, d119, d117); // N(M col 8r) at 2.y
+                let d123 = A::mul_add(
+                    -p.L3,
+                    d119,
+                    A::mul_add(-c_q_torso, d118, s_q_torso * d116),
+                ); // N(M col 8r) at 2.z
+                let d124 = A::mul_add(-c_q_w, d120, s_q_w * d114); // F(M col 8r) at 1.z
+                let d125 = A::mul_add(s_q_w, d120, c_q_w * d114); // F(M col 8r) at 1.y
+                let d126 = A::mul_add(
+                    p.L1,
+                    d119,
+                    A::mul_add(-c_q_w, d123, s_q_w * d122),
+                ); // N(M col 8r) at 1.z
+                let d127 = A::mul_add(p.L2, d125, A::mul_add(-p.L1, d124, d121)); // N(M col 8r) at 1.x
+                m[(2, 16)] = d127;
+                let d128 = A::mul_add(
+                    -p.L2,
+                    d119,
+                    A::mul_add(s_q_w, d123, c_q_w * d122),
+                ); // N(M col 8r) at 1.y
+                let d129 = A::mul_add(c_q_imu, d124, s_q_imu * d125); // F(M col 8r) at 0.x
+                m[(0, 16)] = -d129;
+                let d130 = A::mul_add(-s_q_imu, d126, c_q_imu * d128); // N(M col 8r) at 0.z
+                m[(1, 16)] = -d130;
+                let d131 = p.MX7r - d99; // MSC7r.x
+                let d132 = p.MZ7r + d98; // MSC7r.z
+                let k7 = s_q5r * s_q5r; // sin² q5r
+                let k8 = s_q5r * c_q5r; // sin q5r cos q5r
+                let k9 = A::mul_add(2.0, k7, -1.0); // cos 2q5r
+                let d133 = d92 - d96; // JC8r: Jzz − Jxx
+                let d134 = A::mul_add(2.0, d94 * k8, k7 * d133); // JC8r rotated about y: Jzz − J'zz
+                let t17 = p.L8 * d88; // common subexpression
+                let d135 = p.XY7r + t11 - t12 - t15; // JC7r.xy
+                let d136 = A::mul_add(-k8, d133, A::mul_add(d94, k9, p.XZ7r)); // JC7r.xz
+                let d137 = p.YY7r + d97; // JC7r.yy
+                let d138 = p.YZ7r - t13 - t14 + t16; // JC7r.yz
+                let d139 = pc.pc13 - d88; // MSC7r.y
+                let d140 = A::mul_add(2.0, t17, d92 - d134) + pc.pc14; // JC7r.xx
+                m[(15, 15)] = d140;
+                let d141 = A::mul_add(2.0, t17, d96 + d134) + pc.pc15; // JC7r.zz
+                let d142 = A::mul_add(s_q4r, d132, c_q4r * d139); // MSC7r in 6r.y
+                let d143 = A::mul_add(-c_q4r, d132, s_q4r * d139); // MSC7r in 6r.z
+                let t18 = c_q4r * d135; // common subexpression
+                let t19 = s_q4r * d136; // common subexpression
+                let d144 = t18 + t19; // N(M col 7r) at 6r.y
+                m[(14, 15)] = -d144;
+                let t20 = s_q4r * d135; // common subexpression
+                let t21 = c_q4r * d136; // common subexpression
+                let d145 = t20 - t21; // N(M col 7r) at 6r.z
+                let d146 = s_q3r * d142; // F(M col 7r) at 5r.x
+                let d147 = c_q3r * d142; // F(M col 7r) at 5r.z
+                let d148 = A::mul_add(
+                    -p.L7,
+                    d146,
+                    A::mul_add(c_q3r, d145, s_q3r * d140),
+                ); // N(M col 7r) at 5r.z
+                let d149 = A::mul_add(
+                    -p.L7,
+                    d147,
+                    A::mul_add(-s_q3r, d145, c_q3r * d140),
+                ); // N(M col 7r) at 5r.x
+                m[(13, 15)] = d149;
+                let d150 = A::mul_add(s_q2r, d147, c_q2r * d143); // F(M col 7r) at 4r.y
+                let d151 = A::mul_add(-c_q2r, d147, s_q2r * d143); // F(M col 7r) at 4r.z
+                let d152 = A::mul_add(-s_q2r, d148, c_q2r * d144); // N(M col 7r) at 4r.y
+                m[(12, 15)] = -d152;
+                let d153 = A::mul_add(c_q2r, d148, s_q2r * d144); // N(M col 7r) at 4r.z
+                let d154 = A::mul_add(-s_q1r, d151, c_q1r * d146); // F(M col 7r) at 3.y
+                let d155 = A::mul_add(c_q1r, d151, s_q1r * d146); // F(M col 7r) at 3.z
+                let d156 = A::mul_add(
+                    p.L6,
+                    d155,
+                    A::mul_add(-s_q1r, d153, c_q1r * d149),
+                ); // N(M col 7r) at 3.y
+                m[(4, 15)] = -d156;
+                let d157 = A::mul_add(
+                    p.L5,
+                    d150,
+                    A::mul_add(-p.L6, d154, A::mul_add(c_q1r, d153, s_q1r * d149)),
+                ); // N(M col 7r) at 3.z
+                let d158 = A::mul_add(-p.L5, d155, d152); // N(M col 7r) at 3.x
+                let d159 = A::mul_add(s_q_torso, d155, c_q_torso * d150); // F(M col 7r) at 2.x
+                let d160 = A::mul_add(-c_q_torso, d155, s_q_torso * d150); // F(M col 7r) at 2.z
+                let d161 = A::mul_add(
+                    -p.L4,
+                    d154,
+                    A::mul_add(p.L3, d160, A::mul_add(s_q_torso, d157, c_q_torso * d158)),
+                ); // N(M col 7r) at 2.x
+                m[(3, 15)] = -d161;
+                let d162 = A::mul_add(p.L4, d159, d156); // N(M col 7r) at 2.y
+                let d163 = A::mul_add(
+                    -p.L3,
+                    d159,
+                    A::mul_add(-c_q_torso, d157, s_q_torso * d158),
+                ); // N(M col 7r) at 2.z
+                let d164 = A::mul_add(s_q_w, d160, c_q_w * d154); // F(M col 7r) at 1.y
+                let d165 = A::mul_add(-c_q_w, d160, s_q_w * d154); // F(M col 7r) at 1.z
+                let d166 = A::mul_add(p.L2, d164, A::mul_add(-p.L1, d165, d161)); // N(M col 7r) at 1.x
+                m[(2, 15)] = -d166;
+                let d167 = A::mul_add(
+                    -p.L2,
+                    d159,
+                    A::mul_add(s_q_w, d163, c_q_w * d162),
+                ); // N(M col 7r) at 1.y
+                let d168 = A::mul_add(
+                    p.L1,
+                    d159,
+                    A::mul_add(-c_q_w, d163, s_q_w * d162),
+                ); // N(M col 7r) at 1.z
+                let d169 = A::mul_add(c_q_imu, d165, s_q_imu * d164); // F(M col 7r) at 0.x
+                m[(0, 15)] = d169;
+                let d170 = A::mul_add(-s_q_imu, d168, c_q_imu * d167); // N(M col 7r) at 0.z
+                m[(1, 15)] = d170;
+                let d171 = p.MX6r - d131; // MSC6r.x
+                let d172 = p.MY6r - d142; // MSC6r.y
+                let d173 = p.MZ6r - d143; // MSC6r.z
+                let k10 = s_q4r * s_q4r; // sin² q4r
+                let k11 = s_q4r * c_q4r; // sin q4r cos q4r
+                let k12 = A::mul_add(2.0, k10, -1.0); // cos 2q4r
+                let d174 = d137 - d141; // JC7r: Jyy − Jzz
+                let d175 = A::mul_add(-2.0, d138 * k11, k10 * d174); // JC7r rotated about x: Jyy − J'yy
+                let d176 = p.XX6r + d140; // JC6r.xx
+                let d177 = p.XY6r + t18 + t19; // JC6r.xy
+                let d178 = p.XZ6r + t20 - t21; // JC6r.xz
+                let d179 = p.YY6r + d137 - d175; // JC6r.yy
+                m[(14, 14)] = d179;
+                let d180 = A::mul_add(k11, d174, A::mul_add(d138, k12, p.YZ6r)); // JC6r.yz
+                let d181 = p.ZZ6r + d141 + d175; // JC6r.zz
+                let d182 = A::mul_add(c_q3r, d173, s_q3r * d171); // MSC6r in 5r.z
+                let d183 = A::mul_add(-s_q3r, d173, c_q3r * d171); // MSC6r in 5r.x
+                let t22 = c_q3r * d177; // common subexpression
+                let t23 = s_q3r * d180; // common subexpression
+                let t24 = s_q3r * d177; // common subexpression
+                let t25 = c_q3r * d180; // common subexpression
+                let t26 = p.L7 * d183; // common subexpression
+                let t27 = p.L7 * d182; // common subexpression
+                let d184 = t22 - t23 - t26; // N(M col 6r) at 5r.x
+                m[(13, 14)] = -d184;
+                let d185 = t24 + t25 - t27; // N(M col 6r) at 5r.z
+                let d186 = s_q2r * d183; // F(M col 6r) at 4r.y
+                let d187 = c_q2r * d183; // F(M col 6r) at 4r.z
+                let d188 = A::mul_add(-s_q2r, d185, c_q2r * d179); // N(M col 6r) at 4r.y
+                m[(12, 14)] = d188;
+                let d189 = A::mul_add(c_q2r, d185, s_q2r * d179); // N(M col 6r) at 4r.z
+                let d190 = A::mul_add(s_q1r, d187, c_q1r * d182); // F(M col 6r) at 3.y
+                let d191 = A::mul_add(-c_q1r, d187, s_q1r * d182); // F(M col 6r) at 3.z
+                let d192 = A::mul_add(-p.L5, d191, d188); // N(M col 6r) at 3.x
+                let d193 = A::mul_add(
+                    p.L6,
+                    d191,
+                    A::mul_add(-s_q1r, d189, c_q1r * d184),
+                ); // N(M col 6r) at 3.y
+                m[(4, 14)] = d193;
+                let d194 = A::mul_add(
+                    p.L5,
+                    d186,
+                    A::mul_add(-p.L6, d190, A::mul_add(c_q1r, d189, s_q1r * d184)),
+                ); // N(M col 6r) at 3.z
+                let d195 = A::mul_add(s_q_torso, d191, c_q_torso * d186); // F(M col 6r) at 2.x
+                let d196 = A::mul_add(-c_q_torso, d191, s_q_torso * d186); // F(M col 6r) at 2.z
+                let d197 = A::mul_add(
+                    -p.L4,
+                    d190,
+                    A::mul_add(p.L3, d196, A::mul_add(s_q_torso, d194, c_q_torso * d192)),
+                ); // N(M col 6r) at 2.x
+                m[(3, 14)] = d197;
+                let d198 = A::mul_add(p.L4, d195, d193); // N(M col 6r) at 2.y
+                let d199 = A::mul_add(
+                    -p.L3,
+                    d195,
+                    A::mul_add(-c_q_torso, d194, s_q_torso * d192),
+                ); // N(M col 6r) at 2.z
+                let d200 = A::mul_add(-c_q_w, d196, s_q_w * d190); // F(M col 6r) at 1.z
+                let d201 = A::mul_add(s_q_w, d196, c_q_w * d190); // F(M col 6r) at 1.y
+                let d202 = A::mul_add(
+                    p.L1,
+                    d195,
+                    A::mul_add(-c_q_w, d199, s_q_w * d198),
+                ); // N(M col 6r) at 1.z
+                let d203 = A::mul_add(p.L2, d201, A::mul_add(-p.L1, d200, d197)); // N(M col 6r) at 1.x
+                m[(2, 14)] = d203;
+                let d204 = A::mul_add(
+                    -p.L2,
+                    d195,
+                    A::mul_add(s_q_w, d199, c_q_w * d198),
+                ); // N(M col 6r) at 1.y
+                let d205 = A::mul_add(c_q_imu, d200, s_q_imu * d201); // F(M col 6r) at 0.x
+                m[(0, 14)] = -d205;
+                let d206 = A::mul_add(-s_q_imu, d202, c_q_imu * d204); // N(M col 6r) at 0.z
+                m[(1, 14)] = -d206;
+                let d207 = p.MX5r - d183; // MSC5r.x
+                let d208 = p.MZ5r + d182; // MSC5r.z
+                let k13 = s_q3r * s_q3r; // sin² q3r
+                let k14 = s_q3r * c_q3r; // sin q3r cos q3r
+                let k15 = A::mul_add(2.0, k13, -1.0); // cos 2q3r
+                let d209 = d176 - d181; // JC6r: Jzz − Jxx
+                let d210 = A::mul_add(2.0, d178 * k14, k13 * d209); // JC6r rotated about y: Jzz − J'zz
+                let t28 = p.L7 * d172; // common subexpression
+                let d211 = p.XY5r + t22 - t23 - t26; // JC5r.xy
+                let d212 = A::mul_add(-k14, d209, A::mul_add(d178, k15, p.XZ5r)); // JC5r.xz
+                let d213 = p.YY5r + d179; // JC5r.yy
+                let d214 = p.YZ5r - t24 - t25 + t27; // JC5r.yz
+                let d215 = pc.pc19 - d172; // MSC5r.y
+                let d216 = A::mul_add(2.0, t28, d176 - d210) + pc.pc20; // JC5r.xx
+                m[(13, 13)] = d216;
+                let d217 = A::mul_add(2.0, t28, d181 + d210) + pc.pc21; // JC5r.zz
+                let d218 = A::mul_add(s_q2r, d208, c_q2r * d215); // MSC5r in 4r.y
+                let d219 = A::mul_add(-c_q2r, d208, s_q2r * d215); // MSC5r in 4r.z
+                let t29 = c_q2r * d211; // common subexpression
+                let t30 = s_q2r * d212; // common subexpression
+                let d220 = t29 + t30; // N(M col 5r) at 4r.y
+                m[(12, 13)] = -d220;
+                let t31 = s_q2r * d211; // common subexpression
+                let t32 = c_q2r * d212; // common subexpression
+                let d221 = t31 - t32; // N(M col 5r) at 4r.z
+                let d222 = s_q1r * d218; // F(M col 5r) at 3.y
+                let d223 = c_q1r * d218; // F(M col 5r) at 3.z
+                let d224 = A::mul_add(
+                    -p.L6,
+                    d223,
+                    A::mul_add(-s_q1r, d221, c_q1r * d216),
+                ); // N(M col 5r) at 3.y
+                m[(4, 13)] = -d224;
+                let d225 = A::mul_add(
+                    p.L5,
+                    d219,
+                    A::mul_add(-p.L6, d222, A::mul_add(c_q1r, d221, s_q1r * d216)),
+                ); // N(M col 5r) at 3.z
+                let d226 = A::mul_add(p.L5, d223, d220); // N(M col 5r) at 3.x
+                let d227 = A::mul_add(-s_q_torso, d223, c_q_torso * d219); // F(M col 5r) at 2.x
+                let d228 = A::mul_add(c_q_torso, d223, s_q_torso * d219); // F(M col 5r) at 2.z
+                let d229 = A::mul_add(
+                    -p.L4,
+                    d222,
+                    A::mul_add(p.L3, d228, A::mul_add(s_q_torso, d225, c_q_torso * d226)),
+                ); // N(M col 5r) at 2.x
+                m[(3, 13)] = -d229;
+                let d230 = A::mul_add(p.L4, d227, d224); // N(M col 5r) at 2.y
+                let d231 = A::mul_add(
+                    -p.L3,
+                    d227,
+                    A::mul_add(-c_q_torso, d225, s_q_torso * d226),
+                ); // N(M col 5r) at 2.z
+                let d232 = A::mul_add(s_q_w, d228, c_q_w * d222); // F(M col 5r) at 1.y
+                let d233 = A::mul_add(-c_q_w, d228, s_q_w * d222); // F(M col 5r) at 1.z
+                let d234 = A::mul_add(p.L2, d232, A::mul_add(-p.L1, d233, d229)); // N(M col 5r) at 1.x
+                m[(2, 13)] = -d234;
+                let d235 = A::mul_add(
+                    -p.L2,
+                    d227,
+                    A::mul_add(s_q_w, d231, c_q_w * d230),
+                ); // N(M col 5r) at 1.y
+                let d236 = A::mul_add(
+                    p.L1,
+                    d227,
+                    A::mul_add(-c_q_w, d231, s_q_w * d230),
+                ); // N(M col 5r) at 1.z
+                let d237 = A::mul_add(c_q_imu, d233, s_q_imu * d232); // F(M col 5r) at 0.x
+                m[(0, 13)] = d237;
+                let d238 = A::mul_add(-s_q_imu, d236, c_q_imu * d235); // N(M col 5r) at 0.z
+                m[(1, 13)] = d238;
+                let d239 = p.MX4r - d207; // MSC4r.x
+                let d240 = p.MY4r - d218; // MSC4r.y
+                let d241 = p.MZ4r - d219; // MSC4r.z
+                let k16 = s_q2r * s_q2r; // sin² q2r
+                let k17 = s_q2r * c_q2r; // sin q2r cos q2r
+                let k18 = A::mul_add(2.0, k16, -1.0); // cos 2q2r
+                let d242 = d213 - d217; // JC5r: Jyy − Jzz
+                let d243 = A::mul_add(-2.0, d214 * k17, k16 * d242); // JC5r rotated about x: Jyy − J'yy
+                let d244 = p.XX4r + d216; // JC4r.xx
+                let d245 = p.XY4r + t29 + t30; // JC4r.xy
+                let d246 = p.XZ4r + t31 - t32; // JC4r.xz
+                let d247 = p.YY4r + d213 - d243; // JC4r.yy
+                m[(12, 12)] = d247;
+                let d248 = A::mul_add(k17, d242, A::mul_add(d214, k18, p.YZ4r)); // JC4r.yz
+                let d249 = p.ZZ4r + d217 + d243; // JC4r.zz
+                let d250 = A::mul_add(-s_q1r, d241, c_q1r * d239); // MSC4r in 3.y
+                let d251 = A::mul_add(c_q1r, d241, s_q1r * d239); // MSC4r in 3.z
+                let t33 = c_q1r * d245; // common subexpression
+                let t34 = s_q1r * d248; // common subexpression
+                let t35 = s_q1r * d245; // common subexpression
+                let t36 = c_q1r * d248; // common subexpression
+                let t37 = p.L5 * d250; // common subexpression
+                let t38 = p.L6 * d250; // common subexpression
+                let t39 = p.L6 * d251; // common subexpression
+                let d252 = d247 + t37; // N(M col 4r) at 3.x
+                let d253 = t33 - t34 - t38; // N(M col 4r) at 3.y
+                m[(4, 12)] = d253;
+                let d254 = t35 + t36 - t39; // N(M col 4r) at 3.z
+                let d255 = s_q_torso * d250; // F(M col 4r) at 2.x
+                let d256 = c_q_torso * d250; // F(M col 4r) at 2.z
+                let d257 = A::mul_add(
+                    -p.L4,
+                    d251,
+                    A::mul_add(p.L3, d256, A::mul_add(s_q_torso, d254, c_q_torso * d252)),
+                ); // N(M col 4r) at 2.x
+                m[(3, 12)] = d257;
+                let d258 = A::mul_add(-p.L4, d255, d253); // N(M col 4r) at 2.y
+                let d259 = A::mul_add(
+                    p.L3,
+                    d255,
+                    A::mul_add(-c_q_torso, d254, s_q_torso * d252),
+                ); // N(M col 4r) at 2.z
+                let d260 = A::mul_add(-c_q_w, d256, s_q_w * d251); // F(M col 4r) at 1.z
+                let d261 = A::mul_add(s_q_w, d256, c_q_w * d251); // F(M col 4r) at 1.y
+                let d262 = A::mul_add(
+                    -p.L1,
+                    d255,
+                    A::mul_add(-c_q_w, d259, s_q_w * d258),
+                ); // N(M col 4r) at 1.z
+                let d263 = A::mul_add(p.L2, d261, A::mul_add(-p.L1, d260, d257)); // N(M col 4r) at 1.x
+                m[(2, 12)] = d263;
+                let d264 = A::mul_add(p.L2, d255, A::mul_add(s_q_w, d259, c_q_w * d258)); // N(M col 4r) at 1.y
+                let d265 = A::mul_add(c_q_imu, d260, s_q_imu * d261); // F(M col 4r) at 0.x
+                m[(0, 12)] = -d265;
+                let d266 = A::mul_add(-s_q_imu, d262, c_q_imu * d264); // N(M col 4r) at 0.z
+                m[(1, 12)] = -d266;
+                let k19 = s_q1r * s_q1r; // sin² q1r
+                let k20 = s_q1r * c_q1r; // sin q1r cos q1r
+                let k21 = A::mul_add(2.0, k19, -1.0); // cos 2q1r
+                let d267 = d244 - d249; // JC4r: Jzz − Jxx
+                let d268 = A::mul_add(2.0, d246 * k20, k19 * d267); // JC4r rotated about y: Jzz − J'zz
+                let t40 = p.L6 * d240; // common subexpression
+                let d269 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
+                let d270 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
+                let t41 = p.XZ10l * c_q7l; // common subexpression
+                let t42 = p.YZ10l * s_q7l; // common subexpression
+                let t43 = p.XZ10l * s_q7l; // common subexpression
+                let t44 = p.YZ10l * c_q7l; // common subexpression
+                let t45 = p.L9 * d270; // common subexpression
+                let t46 = p.L9 * d269; // common subexpression
+                let d271 = t41 + t42 - t45; // N(M col 10l) at 9l.x
+                m[(10, 11)] = -d271;
+                let d272 = t43 - t44 - t46; // N(M col 10l) at 9l.z
+                let d273 = d270 * s_q6l; // F(M col 10l) at 8l.y
+                let d274 = d270 * c_q6l; // F(M col 10l) at 8l.z
+                let d275 = A::mul_add(-d272, s_q6l, p.ZZ10l * c_q6l); // N(M col 10l) at 8l.y
+                m[(9, 11)] = d275;
+                let d276 = A::mul_add(d272, c_q6l, p.ZZ10l * s_q6l); // N(M col 10l) at 8l.z
+                let d277 = A::mul_add(d274, s_q5l, d269 * c_q5l); // F(M col 10l) at 7l.x
+                let d278 = A::mul_add(-d274, c_q5l, d269 * s_q5l); // F(M col 10l) at 7l.z
+                let d279 = A::mul_add(
+                    p.L8,
+                    d278,
+                    A::mul_add(-d276, s_q5l, d271 * c_q5l),
+                ); // N(M col 10l) at 7l.x
+                m[(8, 11)] = -d279;
+                let d280 = A::mul_add(
+                    -p.L8,
+                    d277,
+                    A::mul_add(d276, c_q5l, d271 * s_q5l),
+                ); // N(M col 10l) at 7l.z
+                let d281 = A::mul_add(-d278, s_q4l, d273 * c_q4l); // F(M col 10l) at 6l.y
+                let d282 = A::mul_add(d278, c_q4l, d273 * s_q4l); // F(M col 10l) at 6l.z
+                let d283 = A::mul_add(-d280, s_q4l, d275 * c_q4l); // N(M col 10l) at 6l.y
+                m[(7, 11)] = d283;
+                let d284 = A::mul_add(d280, c_q4l, d275 * s_q4l); // N(M col 10l) at 6l.z
+                let d285 = A::mul_add(-d282, s_q3l, d277 * c_q3l); // F(M col 10l) at 5l.x
+                let d286 = A::mul_add(d282, c_q3l, d277 * s_q3l); // F(M col 10l) at 5l.z
+                let d287 = A::mul_add(
+                    p.L7,
+                    d286,
+                    A::mul_add(-d284, s_q3l, d279 * c_q3l),
+                ); // N(M col 10l) at 5l.x
+                m[(6, 11)] = -d287;
+                let d288 = A::mul_add(
+                    -p.L7,
+                    d285,
+                    A::mul_add(d284, c_q3l, d279 * s_q3l),
+                ); // N(M col 10l) at 5l.z
+                let d289 = A::mul_add(-d286, s_q2l, d281 * c_q2l); // F(M col 10l) at 4l.y
+                let d290 = A::mul_add(d286, c_q2l, d281 * s_q2l); // F(M col 10l) at 4l.z
+                let d291 = A::mul_add(-d288, s_q2l, d283 * c_q2l); // N(M col 10l) at 4l.y
+                m[(5, 11)] = d291;
+                let d292 = A::mul_add(d288, c_q2l, d283 * s_q2l); // N(M col 10l) at 4l.z
+                let d293 = A::mul_add(d290, c_q1l, d285 * s_q1l); // F(M col 10l) at 3.z
+                let d294 = A::mul_add(-d290, s_q1l, d285 * c_q1l); // F(M col 10l) at 3.y
+                let d295 = A::mul_add(
+                    p.L5,
+                    d289,
+                    A::mul_add(-p.L6, d294, A::mul_add(d292, c_q1l, d287 * s_q1l)),
+                ); // N(M col 10l) at 3.z
+                let d296 = A::mul_add(-p.L5, d293, d291); // N(M col 10l) at 3.x
+                let d297 = A::mul_add(
+                    p.L6,
+                    d293,
+                    A::mul_add(-d292, s_q1l, d287 * c_q1l),
+                ); // N(M col 10l) at 3.y
+                m[(4, 11)] = d297;
+                let d298 = A::mul_add(s_q_torso, d293, c_q_torso * d289); // F(M col 10l) at 2.x
+                let d299 = A::mul_add(-c_q_torso, d293, s_q_torso * d289); // F(M col 10l) at 2.z
+                let d300 = A::mul_add(
+                    p.L4,
+                    d294,
+                    A::mul_add(p.L3, d299, A::mul_add(s_q_torso, d295, c_q_torso * d296)),
+                ); // N(M col 10l) at 2.x
+                m[(3, 11)] = -d300;
+                let d301 = A::mul_add(
+                    -p.L3,
+                    d298,
+                    A::mul_add(-c_q_torso, d295, s_q_torso * d296),
+                ); // N(M col 10l) at 2.z
+                let d302 = A::mul_add(-p.L4, d298, d297); // N(M col 10l) at 2.y
+                let d303 = A::mul_add(c_q_w, d299, s_q_w * d294); // F(M col 10l) at 1.z
+                let d304 = A::mul_add(-s_q_w, d299, c_q_w * d294); // F(M col 10l) at 1.y
+                let d305 = A::mul_add(-p.L2, d304, A::mul_add(p.L1, d303, d300)); // N(M col 10l) at 1.x
+                m[(2, 11)] = -d305;
+                let d306 = A::mul_add(
+                    -p.L1,
+                    d298,
+                    A::mul_add(c_q_w, d301, s_q_w * d302),
+                ); // N(M col 10l) at 1.z
+                let d307 = A::mul_add(
+                    p.L2,
+                    d298,
+                    A::mul_add(-s_q_w, d301, c_q_w * d302),
+                ); // N(M col 10l) at 1.y
+                let d308 = A::mul_add(c_q_imu, d303, s_q_imu * d304); // F(M col 10l) at 0.x
+                m[(0, 11)] = -d308;
+                let d309 = A::mul_add(-s_q_imu, d306, c_q_imu * d307); // N(M col 10l) at 0.z
+                m[(1, 11)] = -d309;
+                let d310 = p.MX9l - d270; // MSC9l.x
+                let d311 = p.MZ9l + d269; // MSC9l.z
+                let k22 = s_q7l * s_q7l; // sin² q7l
+                let k23 = s_q7l * c_q7l; // sin q7l cos q7l
+                let k24 = A::mul_add(2.0, k22, -1.0); // cos 2q7l
+                let d312 = A::mul_add(-2.0, p.XY10l * k23, k22 * pc.pc26); // JC10l rotated about z: Jxx − J'xx
+                let d313 = p.XY9l + t41 + t42 - t45; // JC9l.xy
+                let d314 = A::mul_add(-k23, pc.pc26, A::mul_add(-p.XY10l, k24, p.XZ9l)); // JC9l.xz
+                let d315 = p.YZ9l - t43 + t44 + t46; // JC9l.yz
+                let d316 = pc.pc30 - d312; // JC9l.xx
+                m[(10, 10)] = d316;
+                let d317 = d312 + pc.pc31; // JC9l.zz
+                let d318 = A::mul_add(s_q6l, d311, c_q6l * pc.pc25); // MSC9l in 8l.y
+                let d319 = A::mul_add(-c_q6l, d311, s_q6l * pc.pc25); // MSC9l in 8l.z
+                let t47 = c_q6l * d313; // common subexpression
+                let t48 = s_q6l * d314; // common subexpression
+                let d320 = t47 + t48; // N(M col 9l) at 8l.y
+                m[(9, 10)] = -d320;
+                let t49 = s_q6l * d313; // common subexpression
+                let t50 = c_q6l * d314; // common subexpression
+                let d321 = t49 - t50; // N(M col 9l) at 8l.z
+                let d322 = s_q5l * d318; // F(M col 9l) at 7l.x
+                let d323 = c_q5l * d318; // F(M col 9l) at 7l.z
+                let d324 = A::mul_add(
+                    -p.L8,
+                    d322,
+                    A::mul_add(c_q5l, d321, s_q5l * d316),
+                ); // N(M col 9l) at 7l.z
+                let d325 = A::mul_add(
+                    -p.L8,
+                    d323,
+                    A::mul_add(-s_q5l, d321, c_q5l * d316),
+                ); // N(M col 9l) at 7l.x
+                m[(8, 10)] = d325;
+                let d326 = A::mul_add(s_q4l, d323, c_q4l * d319); // F(M col 9l) at 6l.y
+                let d327 = A::mul_add(-c_q4l, d323, s_q4l * d319); // F(M col 9l) at 6l.z
+                let d328 = A::mul_add(-s_q4l, d324, c_q4l * d320); // N(M col 9l) at 6l.y
+                m[(7, 10)] = -d328;
+                let d329 = A::mul_add(c_q4l, d324, s_q4l * d320); // N(M col 9l) at 6l.z
+                let d330 = A::mul_add(c_q3l, d327, s_q3l * d322); // F(M col 9l) at 5l.z
+                let d331 = A::mul_add(-s_q3l, d327, c_q3l * d322); // F(M col 9l) at 5l.x
+                let d332 = A::mul_add(
+                    -p.L7,
+                    d331,
+                    A::mul_add(c_q3l, d329, s_q3l * d325),
+                ); // N(M col 9l) at 5l.z
+                let d333 = A::mul_add(
+                    p.L7,
+                    d330,
+                    A::mul_add(-s_q3l, d329, c_q3l * d325),
+                ); // N(M col 9l) at 5l.x
+                m[(6, 10)] = d333;
+                let d334 = A::mul_add(-s_q2l, d330, c_q2l * d326); // F(M col 9l) at 4l.y
+                let d335 = A::mul_add(c_q2l, d330, s_q2l * d326); // F(M col 9l) at 4l.z
+                let d336 = A::mul_add(-s_q2l, d332, c_q2l * d328); // N(M col 9l) at 4l.y
+                m[(5, 10)] = -d336;
+                let d337 = A::mul_add(c_q2l, d332, s_q2l * d328); // N(M col 9l) at 4l.z
+                let d338 = A::mul_add(-s_q1l, d335, c_q1l * d331); // F(M col 9l) at 3.y
+                let d339 = A::mul_add(c_q1l, d335, s_q1l * d331); // F(M col 9l) at 3.z
+                let d340 = A::mul_add(-p.L5, d339, d336); // N(M col 9l) at 3.x
+                let d341 = A::mul_add(
+                    p.L6,
+                    d339,
+                    A::mul_add(-s_q1l, d337, c_q1l * d333),
+                ); // N(M col 9l) at 3.y
+                m[(4, 10)] = -d341;
+                let d342 = A::mul_add(
+                    p.L5,
+                    d334,
+                    A::mul_add(-p.L6, d338, A::mul_add(c_q1l, d337, s_q1l * d333)),
+                ); // N(M col 9l) at 3.z
+                let d343 = A::mul_add(s_q_torso, d339, c_q_torso * d334); // F(M col 9l) at 2.x
+                let d344 = A::mul_add(-c_q_torso, d339, s_q_torso * d334); // F(M col 9l) at 2.z
+                let d345 = A::mul_add(-p.L4, d343, d341); // N(M col 9l) at 2.y
+                let d346 = A::mul_add(
+                    p.L4,
+                    d338,
+                    A::mul_add(p.L3, d344, A::mul_add(s_q_torso, d342, c_q_torso * d340)),
+                ); // N(M col 9l) at 2.x
+                m[(3, 10)] = d346;
+                let d347 = A::mul_add(
+                    -p.L3,
+                    d343,
+                    A::mul_add(-c_q_torso, d342, s_q_torso * d340),
+                ); // N(M col 9l) at 2.z
+                let d348 = A::mul_add(-s_q_w, d344, c_q_w * d338); // F(M col 9l) at 1.y
+                let d349 = A::mul_add(c_q_w, d344, s_q_w * d338); // F(M col 9l) at 1.z
+                let d350 = A::mul_add(
+                    p.L2,
+                    d343,
+                    A::mul_add(-s_q_w, d347, c_q_w * d345),
+                ); // N(M col 9l) at 1.y
+                let d351 = A::mul_add(-p.L2, d348, A::mul_add(p.L1, d349, d346)); // N(M col 9l) at 1.x
+                m[(2, 10)] = d351;
+                let d352 = A::mul_add(
+                    -p.L1,
+                    d343,
+                    A::mul_add(c_q_w, d347, s_q_w * d345),
+                ); // N(M col 9l) at 1.z
+                let d353 = A::mul_add(c_q_imu, d349, s_q_imu * d348); // F(M col 9l) at 0.x
+                m[(0, 10)] = d353;
+                let d354 = A::mul_add(-s_q_imu, d352, c_q_imu * d350); // N(M col 9l) at 0.z
+                m[(1, 10)] = d354;
+                let d355 = p.MX8l - d310; // MSC8l.x
+                let d356 = p.MY8l - d318; // MSC8l.y
+                let d357 = p.MZ8l - d319; // MSC8l.z
+                let k25 = s_q6l * s_q6l; // sin² q6l
+                let k26 = s_q6l * c_q6l; // sin q6l cos q6l
+                let k27 = A::mul_add(2.0, k25, -1.0); // cos 2q6l
+                let d358 = pc.pc29 - d317; // JC9l: Jyy − Jzz
+                let d359 = A::mul_add(-2.0, d315 * k26, k25 * d358); // JC9l rotated about x: Jyy − J'yy
+                let d360 = p.XX8l + d316; // JC8l.xx
+                let d361 = p.XY8l + t47 + t48; // JC8l.xy
+                let d362 = p.XZ8l + t49 - t50; // JC8l.xz
+                let d363 = A::mul_add(k26, d358, A::mul_add(d315, k27, p.YZ8l)); // JC8l.yz
+                let d364 = p.ZZ8l + d317 + d359; // JC8l.zz
+                let d365 = pc.pc33 - d359; // JC8l.yy
+                m[(9, 9)] = d365;
+                let d366 = A::mul_add(c_q5l, d357, s_q5l * d355); // MSC8l in 7l.z
+                let d367 = A::mul_add(-s_q5l, d357, c_q5l * d355); // MSC8l in 7l.x
+                let t51 = c_q5l * d361; // common subexpression
+                let t52 = s_q5l * d363; // common subexpression
+                let t53 = s_q5l * d361; // common subexpression
+                let t54 = c_q5l * d363; // common subexpression
+                let t55 = p.L8 * d367; // common subexpression
+                let t56 = p.L8 * d366; // common subexpression
+                let d368 = t51 - t52 - t55; // N(M col 8l) at 7l.x
+                m[(8, 9)] = -d368;
+                let d369 = t53 + t54 - t56; // N(M col 8l) at 7l.z
+                let d370 = s_q4l * d367; // F(M col 8l) at 6l.y
+                let d371 = c_q4l * d367; // F(M col 8l) at 6l.z
+                let d372 = A::mul_add(-s_q4l, d369, c_q4l * d365); // N(M col 8l) at 6l.y
+                m[(7, 9)] = d372;
+                let d373 = A::mul_add(c_q4l, d369, s_q4l * d365); // N(M col 8l) at 6l.z
+                let d374 = A::mul_add(s_q3l, d371, c_q3l * d366); // F(M col 8l) at 5l.x
+                let d375 = A::mul_add(-c_q3l, d371, s_q3l * d366); // F(M col 8l) at 5l.z
+                let d376 = A::mul_add(
+                    p.L7,
+                    d375,
+                    A::mul_add(-s_q3l, d373, c_q3l * d368),
+                ); // N(M col 8l) at 5l.x
+                m[(6, 9)] = -d376;
+                let d377 = A::mul_add(
+                    -p.L7,
+                    d374,
+                    A::mul_add(c_q3l, d373, s_q3l * d368),
+                ); // N(M col 8l) at 5l.z
+                let d378 = A::mul_add(-s_q2l, d375, c_q2l * d370); // F(M col 8l) at 4l.y
+                let d379 = A::mul_add(c_q2l, d375, s_q2l * d370); // F(M col 8l) at 4l.z
+                let d380 = A::mul_add(-s_q2l, d377, c_q2l * d372); // N(M col 8l) at 4l.y
+                m[(5, 9)] = d380;
+                let d381 = A::mul_add(c_q2l, d377, s_q2l * d372); // N(M col 8l) at 4l.z
+                let d382 = A::mul_add(c_q1l, d379, s_q1l * d374); // F(M col 8l) at 3.z
+                let d383 = A::mul_add(-s_q1l, d379, c_q1l * d374); // F(M col 8l) at 3.y
+                let d384 = A::mul_add(
+                    p.L5,
+                    d378,
+                    A::mul_add(-p.L6, d383, A::mul_add(c_q1l, d381, s_q1l * d376)),
+                ); // N(M col 8l) at 3.z
+                let d385 = A::mul_add(-p.L5, d382, d380); // N(M col 8l) at 3.x
+                let d386 = A::mul_add(
+                    p.L6,
+                    d382,
+                    A::mul_add(-s_q1l, d381, c_q1l * d376),
+                ); // N(M col 8l) at 3.y
+                m[(4, 9)] = d386;
+                let d387 = A::mul_add(s_q_torso, d382, c_q_torso * d378); // F(M col 8l) at 2.x
+                let d388 = A::mul_add(-c_q_torso, d382, s_q_torso * d378); // F(M col 8l) at 2.z
+                let d389 = A::mul_add(
+                    p.L4,
+                    d383,
+                    A::mul_add(p.L3, d388, A::mul_add(s_q_torso, d384, c_q_torso * d385)),
+                ); // N(M col 8l) at 2.x
+                m[(3, 9)] = -d389;
+                let d390 = A::mul_add(
+                    -p.L3,
+                    d387,
+                    A::mul_add(-c_q_torso, d384, s_q_torso * d385),
+                ); // N(M col 8l) at 2.z
+                let d391 = A::mul_add(-p.L4, d387, d386); // N(M col 8l) at 2.y
+                let d392 = A::mul_add(c_q_w, d388, s_q_w * d383); // F(M col 8l) at 1.z
+                let d393 = A::mul_add(-s_q_w, d388, c_q_w * d383); // F(M col 8l) at 1.y
+                let d394 = A::mul_add(-p.L2, d393, A::mul_add(p.L1, d392, d389)); // N(M col 8l) at 1.x
+                m[(2, 9)] = -d394;
+                let d395 = A::mul_add(
+                    -p.L1,
+                    d387,
+                    A::mul_add(c_q_w, d390, s_q_w * d391),
+                ); // N(M col 8l) at 1.z
+                let d396 = A::mul_add(
+                    p.L2,
+                    d387,
+                    A::mul_add(-s_q_w, d390, c_q_w * d391),
+                ); // N(M col 8l) at 1.y
+                let d397 = A::mul_add(c_q_imu, d392, s_q_imu * d393); // F(M col 8l) at 0.x
+                m[(0, 9)] = -d397;
+                let d398 = A::mul_add(-s_q_imu, d395, c_q_imu * d396); // N(M col 8l) at 0.z
+                m[(1, 9)] = -d398;
+                let d399 = p.MX7l - d367; // MSC7l.x
+                let d400 = p.MZ7l + d366; // MSC7l.z
+                let k28 = s_q5l * s_q5l; // sin² q5l
+                let k29 = s_q5l * c_q5l; // sin q5l cos q5l
+                let k30 = A::mul_add(2.0, k28, -1.0); // cos 2q5l
+                let d401 = d360 - d364; // JC8l: Jzz − Jxx
+                let d402 = A::mul_add(2.0, d362 * k29, k28 * d401); // JC8l rotated about y: Jzz − J'zz
+                let t57 = p.L8 * d356; // common subexpression
+                let d403 = p.XY7l + t51 - t52 - t55; // JC7l.xy
+                let d404 = A::mul_add(-k29, d401, A::mul_add(d362, k30, p.XZ7l)); // JC7l.xz
+                let d405 = p.YY7l + d365; // JC7l.yy
+                let d406 = p.YZ7l - t53 - t54 + t56; // JC7l.yz
+                let d407 = pc.pc36 - d356; // MSC7l.y
+                let d408 = A::mul_add(2.0, t57, d360 - d402) + pc.pc37; // JC7l.xx
+                m[(8, 8)] = d408;
+                let d409 = A::mul_add(2.0, t57, d364 + d402) + pc.pc38; // JC7l.zz
+                let d410 = A::mul_add(s_q4l, d400, c_q4l * d407); // MSC7l in 6l.y
+                let d411 = A::mul_add(-c_q4l, d400, s_q4l * d407); // MSC7l in 6l.z
+                let t58 = c_q4l * d403; // common subexpression
+                let t59 = s_q4l * d404; // common subexpression
+                let d412 = t58 + t59; // N(M col 7l) at 6l.y
+                m[(7, 8)] = -d412;
+                let t60 = s_q4l * d403; // common subexpression
+                let t61 = c_q4l * d404; // common subexpression
+                let d413 = t60 - t61; // N(M col 7l) at 6l.z
+                let d414 = s_q3l * d410; // F(M col 7l) at 5l.x
+                let d415 = c_q3l * d410; // F(M col 7l) at 5l.z
+                let d416 = A::mul_add(
+                    -p.L7,
+                    d414,
+                    A::mul_add(c_q3l, d413, s_q3l * d408),
+                ); // N(M col 7l) at 5l.z
+                let d417 = A::mul_add(
+                    -p.L7,
+                    d415,
+                    A::mul_add(-s_q3l, d413, c_q3l * d408),
+                ); // N(M col 7l) at 5l.x
+                m[(6, 8)] = d417;
+                let d418 = A::mul_add(s_q2l, d415, c_q2l * d411); // F(M col 7l) at 4l.y
+                let d419 = A::mul_add(-c_q2l, d415, s_q2l * d411); // F(M col 7l) at 4l.z
+                let d420 = A::mul_add(-s_q2l, d416, c_q2l * d412); // N(M col 7l) at 4l.y
+                m[(5, 8)] = -d420;
+                let d421 = A::mul_add(c_q2l, d416, s_q2l * d412); // N(M col 7l) at 4l.z
+                let d422 = A::mul_add(-s_q1l, d419, c_q1l * d414); // F(M col 7l) at 3.y
+                let d423 = A::mul_add(c_q1l, d419, s_q1l * d414); // F(M col 7l) at 3.z
+                let d424 = A::mul_add(-p.L5, d423, d420); // N(M col 7l) at 3.x
+                let d425 = A::mul_add(
+                    p.L6,
+                    d423,
+                    A::mul_add(-s_q1l, d421, c_q1l * d417),
+                ); // N(M col 7l) at 3.y
+                m[(4, 8)] = -d425;
+                let d426 = A::mul_add(
+                    p.L5,
+                    d418,
+                    A::mul_add(-p.L6, d422, A::mul_add(c_q1l, d421, s_q1l * d417)),
+                ); // N(M col 7l) at 3.z
+                let d427 = A::mul_add(s_q_torso, d423, c_q_torso * d418); // F(M col 7l) at 2.x
+                let d428 = A::mul_add(-c_q_torso, d423, s_q_torso * d418); // F(M col 7l) at 2.z
+                let d429 = A::mul_add(-p.L4, d427, d425); // N(M col 7l) at 2.y
+                let d430 = A::mul_add(
+                    p.L4,
+                    d422,
+                    A::mul_add(p.L3, d428, A::mul_add(s_q_torso, d426, c_q_torso * d424)),
+                ); // N(M col 7l) at 2.x
+                m[(3, 8)] = d430;
+                let d431 = A::mul_add(
+                    -p.L3,
+                    d427,
+                    A::mul_add(-c_q_torso, d426, s_q_torso * d424),
+                ); // N(M col 7l) at 2.z
+                let d432 = A::mul_add(-s_q_w, d428, c_q_w * d422); // F(M col 7l) at 1.y
+                let d433 = A::mul_add(c_q_w, d428, s_q_w * d422); // F(M col 7l) at 1.z
+                let d434 = A::mul_add(
+                    p.L2,
+                    d427,
+                    A::mul_add(-s_q_w, d431, c_q_w * d429),
+                ); // N(M col 7l) at 1.y
+                let d435 = A::mul_add(-p.L2, d432, A::mul_add(p.L1, d433, d430)); // N(M col 7l) at 1.x
+                m[(2, 8)] = d435;
+                let d436 = A::mul_add(
+                    -p.L1,
+                    d427,
+                    A::mul_add(c_q_w, d431, s_q_w * d429),
+                ); // N(M col 7l) at 1.z
+                let d437 = A::mul_add(c_q_imu, d433, s_q_imu * d432); // F(M col 7l) at 0.x
+                m[(0, 8)] = d437;
+                let d438 = A::mul_add(-s_q_imu, d436, c_q_imu * d434); // N(M col 7l) at 0.z
+                m[(1, 8)] = d438;
+                let d439 = p.MX6l - d399; // MSC6l.x
+                let d440 = p.MY6l - d410; // MSC6l.y
+                let d441 = p.MZ6l - d411; // MSC6l.z
+                let k31 = s_q4l * s_q4l; // sin² q4l
+                let k32 = s_q4l * c_q4l; // sin q4l cos q4l
+                let k33 = A::mul_add(2.0, k31, -1.0); // cos 2q4l
+                let d442 = d405 - d409; // JC7l: Jyy − Jzz
+                let d443 = A::mul_add(-2.0, d406 * k32, k31 * d442); // JC7l rotated about x: Jyy − J'yy
+                let d444 = p.XX6l + d408; // JC6l.xx
+                let d445 = p.XY6l + t58 + t59; // JC6l.xy
+                let d446 = p.XZ6l + t60 - t61; // JC6l.xz
+                let d447 = p.YY6l + d405 - d443; // JC6l.yy
+                m[(7, 7)] = d447;
+                let d448 = A::mul_add(k32, d442, A::mul_add(d406, k33, p.YZ6l)); // JC6l.yz
+                let d449 = p.ZZ6l + d409 + d443; // JC6l.zz
+                let d450 = A::mul_add(c_q3l, d441, s_q3l * d439); // MSC6l in 5l.z
+                let d451 = A::mul_add(-s_q3l, d441, c_q3l * d439); // MSC6l in 5l.x
+                let t62 = c_q3l * d445; // common subexpression
+                let t63 = s_q3l * d448; // common subexpression
+                let t64 = s_q3l * d445; // common subexpression
+                let t65 = c_q3l * d448; // common subexpression
+                let t66 = p.L7 * d451; // common subexpression
+                let t67 = p.L7 * d450; // common subexpression
+                let d452 = t62 - t63 - t66; // N(M col 6l) at 5l.x
+                m[(6, 7)] = -d452;
+                let d453 = t64 + t65 - t67; // N(M col 6l) at 5l.z
+                let d454 = s_q2l * d451; // F(M col 6l) at 4l.y
+                let d455 = c_q2l * d451; // F(M col 6l) at 4l.z
+                let d456 = A::mul_add(-s_q2l, d453, c_q2l * d447); // N(M col 6l) at 4l.y
+                m[(5, 7)] = d456;
+                let d457 = A::mul_add(c_q2l, d453, s_q2l * d447); // N(M col 6l) at 4l.z
+                let d458 = A::mul_add(-c_q1l, d455, s_q1l * d450); // F(M col 6l) at 3.z
+                let d459 = A::mul_add(s_q1l, d455, c_q1l * d450); // F(M col 6l) at 3.y
+                let d460 = A::mul_add(
+                    p.L5,
+                    d454,
+                    A::mul_add(-p.L6, d459, A::mul_add(c_q1l, d457, s_q1l * d452)),
+                ); // N(M col 6l) at 3.z
+                let d461 = A::mul_add(-p.L5, d458, d456); // N(M col 6l) at 3.x
+                let d462 = A::mul_add(
+                    p.L6,
+                    d458,
+                    A::mul_add(-s_q1l, d457, c_q1l * d452),
+                ); // N(M col 6l) at 3.y
+                m[(4, 7)] = d462;
+                let d463 = A::mul_add(s_q_torso, d458, c_q_torso * d454); // F(M col 6l) at 2.x
+                let d464 = A::mul_add(-c_q_torso, d458, s_q_torso * d454); // F(M col 6l) at 2.z
+                let d465 = A::mul_add(
+                    p.L4,
+                    d459,
+                    A::mul_add(p.L3, d464, A::mul_add(s_q_torso, d460, c_q_torso * d461)),
+                ); // N(M col 6l) at 2.x
+                m[(3, 7)] = -d465;
+                let d466 = A::mul_add(
+                    -p.L3,
+                    d463,
+                    A::mul_add(-c_q_torso, d460, s_q_torso * d461),
+                ); // N(M col 6l) at 2.z
+                let d467 = A::mul_add(-p.L4, d463, d462); // N(M col 6l) at 2.y
+                let d468 = A::mul_add(c_q_w, d464, s_q_w * d459); // F(M col 6l) at 1.z
+                let d469 = A::mul_add(-s_q_w, d464, c_q_w * d459); // F(M col 6l) at 1.y
+                let d470 = A::mul_add(-p.L2, d469, A::mul_add(p.L1, d468, d465)); // N(M col 6l) at 1.x
+                m[(2, 7)] = -d470;
+                let d471 = A::mul_add(
+                    -p.L1,
+                    d463,
+                    A::mul_add(c_q_w, d466, s_q_w * d467),
+                ); // N(M col 6l) at 1.z
+                let d472 = A::mul_add(
+                    p.L2,
+                    d463,
+                    A::mul_add(-s_q_w, d466, c_q_w * d467),
+                ); // N(M col 6l) at 1.y
+                let d473 = A::mul_add(c_q_imu, d468, s_q_imu * d469); // F(M col 6l) at 0.x
+                m[(0, 7)] = -d473;
+                let d474 = A::mul_add(-s_q_imu, d471, c_q_imu * d472); // N(M col 6l) at 0.z
+                m[(1, 7)] = -d474;
+                let d475 = p.MX5l - d451; // MSC5l.x
+                let d476 = p.MZ5l + d450; // MSC5l.z
+                let k34 = s_q3l * s_q3l; // sin² q3l
+                let k35 = s_q3l * c_q3l; // sin q3l cos q3l
+                let k36 = A::mul_add(2.0, k34, -1.0); // cos 2q3l
+                let d477 = d444 - d449; // JC6l: Jzz − Jxx
+                let d478 = A::mul_add(2.0, d446 * k35, k34 * d477); // JC6l rotated about y: Jzz − J'zz
+                let t68 = p.L7 * d440; // common subexpression
+                let d479 = p.XY5l + t62 - t63 - t66; // JC5l.xy
+                let d480 = A::mul_add(-k35, d477, A::mul_add(d446, k36, p.XZ5l)); // JC5l.xz
+                let d481 = p.YY5l + d447; // JC5l.yy
+                let d482 = p.YZ5l - t64 - t65 + t67; // JC5l.yz
+                let d483 = pc.pc42 - d440; // MSC5l.y
+                let d484 = A::mul_add(2.0, t68, d444 - d478) + pc.pc43; // JC5l.xx
+                m[(6, 6)] = d484;
+                let d485 = A::mul_add(2.0, t68, d449 + d478) + pc.pc44; // JC5l.zz
+                let d486 = A::mul_add(s_q2l, d476, c_q2l * d483); // MSC5l in 4l.y
+                let d487 = A::mul_add(-c_q2l, d476, s_q2l * d483); // MSC5l in 4l.z
+                let t69 = c_q2l * d479; // common subexpression
+                let t70 = s_q2l * d480; // common subexpression
+                let d488 = t69 + t70; // N(M col 5l) at 4l.y
+                m[(5, 6)] = -d488;
+                let t71 = s_q2l * d479; // common subexpression
+                let t72 = c_q2l * d480; // common subexpression
+                let d489 = t71 - t72; // N(M col 5l) at 4l.z
+                let d490 = s_q1l * d486; // F(M col 5l) at 3.y
+                let d491 = c_q1l * d486; // F(M col 5l) at 3.z
+                let d492 = A::mul_add(p.L5, d491, d488); // N(M col 5l) at 3.x
+                let d493 = A::mul_add(
+                    -p.L6,
+                    d491,
+                    A::mul_add(-s_q1l, d489, c_q1l * d484),
+                ); // N(M col 5l) at 3.y
+                m[(4, 6)] = -d493;
+                let d494 = A::mul_add(
+                    p.L5,
+                    d487,
+                    A::mul_add(-p.L6, d490, A::mul_add(c_q1l, d489, s_q1l * d484)),
+                ); // N(M col 5l) at 3.z
+                let d495 = A::mul_add(-s_q_torso, d491, c_q_torso * d487); // F(M col 5l) at 2.x
+                let d496 = A::mul_add(c_q_torso, d491, s_q_torso * d487); // F(M col 5l) at 2.z
+                let d497 = A::mul_add(-p.L4, d495, d493); // N(M col 5l) at 2.y
+                let d498 = A::mul_add(
+                    p.L4,
+                    d490,
+                    A::mul_add(p.L3, d496, A::mul_add(s_q_torso, d494, c_q_torso * d492)),
+                ); // N(M col 5l) at 2.x
+                m[(3, 6)] = d498;
+                let d499 = A::mul_add(
+                    -p.L3,
+                    d495,
+                    A::mul_add(-c_q_torso, d494, s_q_torso * d492),
+                ); // N(M col 5l) at 2.z
+                let d500 = A::mul_add(-s_q_w, d496, c_q_w * d490); // F(M col 5l) at 1.y
+                let d501 = A::mul_add(c_q_w, d496, s_q_w * d490); // F(M col 5l) at 1.z
+                let d502 = A::mul_add(
+                    p.L2,
+                    d495,
+                    A::mul_add(-s_q_w, d499, c_q_w * d497),
+                ); // N(M col 5l) at 1.y
+                let d503 = A::mul_add(-p.L2, d500, A::mul_add(p.L1, d501, d498)); // N(M col 5l) at 1.x
+                m[(2, 6)] = d503;
+                let d504 = A::mul_add(
+                    -p.L1,
+                    d495,
+                    A::mul_add(c_q_w, d499, s_q_w * d497),
+                ); // N(M col 5l) at 1.z
+                let d505 = A::mul_add(c_q_imu, d501, s_q_imu * d500); // F(M col 5l) at 0.x
+                m[(0, 6)] = d505;
+                let d506 = A::mul_add(-s_q_imu, d504, c_q_imu * d502); // N(M col 5l) at 0.z
+                m[(1, 6)] = d506;
+                let d507 = p.MX4l - d475; // MSC4l.x
+                let d508 = p.MY4l - d486; // MSC4l.y
+                let d509 = p.MZ4l - d487; // MSC4l.z
+                let k37 = s_q2l * s_q2l; // sin² q2l
+                let k38 = s_q2l * c_q2l; // sin q2l cos q2l
+                let k39 = A::mul_add(2.0, k37, -1.0); // cos 2q2l
+                let d510 = d481 - d485; // JC5l: Jyy − Jzz
+                let d511 = A::mul_add(-2.0, d482 * k38, k37 * d510); // JC5l rotated about x: Jyy − J'yy
+                let d512 = p.XX4l + d484; // JC4l.xx
+                let d513 = p.XY4l + t69 + t70; // JC4l.xy
+                let d514 = p.XZ4l + t71 - t72; // JC4l.xz
+                let d515 = p.YY4l + d481 - d511; // JC4l.yy
+                m[(5, 5)] = d515;
+                let d516 = A::mul_add(k38, d510, A::mul_add(d482, k39, p.YZ4l)); // JC4l.yz
+                let d517 = p.ZZ4l + d485 + d511; // JC4l.zz
+                let d518 = A::mul_add(-s_q1l, d509, c_q1l * d507); // MSC4l in 3.y
+                let d519 = A::mul_add(c_q1l, d509, s_q1l * d507); // MSC4l in 3.z
+                let t73 = c_q1l * d513; // common subexpression
+                let t74 = s_q1l * d516; // common subexpression
+                let t75 = s_q1l * d513; // common subexpression
+                let t76 = c_q1l * d516; // common subexpression
+                let t77 = p.L5 * d518; // common subexpression
+                let t78 = p.L6 * d518; // common subexpression
+                let t79 = p.L6 * d519; // common subexpression
+                let d520 = t75 + t76 - t79; // N(M col 4l) at 3.z
+                let d521 = d515 + t77; // N(M col 4l) at 3.x
+                let d522 = t73 - t74 - t78; // N(M col 4l) at 3.y
+                m[(4, 5)] = d522;
+                let d523 = s_q_torso * d518; // F(M col 4l) at 2.x
+                let d524 = c_q_torso * d518; // F(M col 4l) at 2.z
+                let d525 = A::mul_add(
+                    p.L4,
+                    d519,
+                    A::mul_add(p.L3, d524, A::mul_add(s_q_torso, d520, c_q_torso * d521)),
+                ); // N(M col 4l) at 2.x
+                m[(3, 5)] = -d525;
+                let d526 = A::mul_add(
+                    p.L3,
+                    d523,
+                    A::mul_add(-c_q_torso, d520, s_q_torso * d521),
+                ); // N(M col 4l) at 2.z
+                let d527 = A::mul_add(p.L4, d523, d522); // N(M col 4l) at 2.y
+                let d528 = A::mul_add(c_q_w, d524, s_q_w * d519); // F(M col 4l) at 1.z
+                let d529 = A::mul_add(-s_q_w, d524, c_q_w * d519); // F(M col 4l) at 1.y
+                let d530 = A::mul_add(-p.L2, d529, A::mul_add(p.L1, d528, d525)); // N(M col 4l) at 1.x
+                m[(2, 5)] = -d530;
+                let d531 = A::mul_add(p.L1, d523, A::mul_add(c_q_w, d526, s_q_w * d527)); // N(M col 4l) at 1.z
+                let d532 = A::mul_add(
+                    -p.L2,
+                    d523,
+                    A::mul_add(-s_q_w, d526, c_q_w * d527),
+                ); // N(M col 4l) at 1.y
+                let d533 = A::mul_add(c_q_imu, d528, s_q_imu * d529); // F(M col 4l) at 0.x
+                m[(0, 5)] = -d533;
+                let d534 = A::mul_add(-s_q_imu, d531, c_q_imu * d532); // N(M col 4l) at 0.z
+                m[(1, 5)] = -d534;
+                let d535 = p.MZ3 + d251 - d519; // MSC3.z
+                let k40 = s_q1l * s_q1l; // sin² q1l
+                let k41 = s_q1l * c_q1l; // sin q1l cos q1l
+                let k42 = A::mul_add(2.0, k40, -1.0); // cos 2q1l
+                let d536 = d512 - d517; // JC4l: Jzz − Jxx
+                let d537 = A::mul_add(2.0, d514 * k41, k40 * d536); // JC4l rotated about y: Jzz − J'zz
+                let t80 = p.L6 * d508; // common subexpression
+                let d538 = p.XZ3 - t35 - t36 + t39 - t75 - t76 + t79; // JC3.xz
+                let d539 = A::mul_add(
+                    p.L5,
+                    d519,
+                    A::mul_add(
+                        -k41,
+                        d536,
+                        A::mul_add(
+                            d514,
+                            k42,
+                            A::mul_add(
+                                -p.L5,
+                                d251,
+                                A::mul_add(k20, d267, A::mul_add(-d246, k21, p.YZ3)),
+                            ),
+                        ),
+                    ),
+                ); // JC3.yz
+                let d540 = d508 - d240 + pc.pc47; // MSC3.x
+                let d541 = d250 + d518 + pc.pc48; // MSC3.y
+                let d542 = A::mul_add(2.0, t77, A::mul_add(2.0, t37, d247) + d515)
+                    + pc.pc49; // JC3.xx
+                let d543 = A::mul_add(
+                    -p.L5,
+                    d508,
+                    A::mul_add(p.L5, d240, t34 - t33 + t38) + t73 - t74 - t78,
+                ) + pc.pc50; // JC3.xy
+                let d544 = A::mul_add(
+                    2.0,
+                    t80,
+                    A::mul_add(2.0, t40, d244 - d268) + d512 - d537,
+                ) + pc.pc51; // JC3.yy
+                m[(4, 4)] = d544;
+                let d545 = A::mul_add(
+                    2.0,
+                    t80,
+                    A::mul_add(
+                        2.0,
+                        t77,
+                        A::mul_add(2.0, t40, A::mul_add(2.0, t37, d249) + d268) + d517,
+                    ) + d537,
+                ) + pc.pc52; // JC3.zz
+                let d546 = A::mul_add(-s_q_torso, d535, c_q_torso * d540); // MSC3 in 2.x
+                let d547 = A::mul_add(c_q_torso, d535, s_q_torso * d540); // MSC3 in 2.z
+                let t81 = c_q_torso * d543; // common subexpression
+                let t82 = s_q_torso * d539; // common subexpression
+                let t83 = s_q_torso * d543; // common subexpression
+                let t84 = c_q_torso * d539; // common subexpression
+                let t85 = p.L3 * d546; // common subexpression
+                let t86 = p.L4 * d547; // common subexpression
+                let t87 = p.L3 * d547; // common subexpression
+                let d548 = t81 - t82 - t85; // N(M col 3) at 2.x
+                m[(3, 4)] = -d548;
+                let d549 = t83 + t84 - t87; // N(M col 3) at 2.z
+                let d550 = d544 - t86; // N(M col 3) at 2.y
+                let d551 = s_q_w * d546; // F(M col 3) at 1.y
+                let d552 = c_q_w * d546; // F(M col 3) at 1.z
+                let d553 = A::mul_add(-p.L2, d551, A::mul_add(-p.L1, d552, d548)); // N(M col 3) at 1.x
+                m[(2, 4)] = -d553;
+                let d554 = A::mul_add(
+                    -p.L1,
+                    d547,
+                    A::mul_add(c_q_w, d549, s_q_w * d550),
+                ); // N(M col 3) at 1.z
+                let d555 = A::mul_add(
+                    p.L2,
+                    d547,
+                    A::mul_add(-s_q_w, d549, c_q_w * d550),
+                ); // N(M col 3) at 1.y
+                let d556 = A::mul_add(-c_q_imu, d552, s_q_imu * d551); // F(M col 3) at 0.x
+                m[(0, 4)] = -d556;
+                let d557 = A::mul_add(-s_q_imu, d554, c_q_imu * d555); // N(M col 3) at 0.z
+                m[(1, 4)] = -d557;
+                let d558 = p.MX2 - d546; // MSC2.x
+                let k43 = s_q_torso * s_q_torso; // sin² q_torso
+                let k44 = s_q_torso * c_q_torso; // sin q_torso cos q_torso
+                let k45 = A::mul_add(2.0, k43, -1.0); // cos 2q_torso
+                let d559 = d542 - d545; // JC3: Jzz − Jxx
+                let d560 = A::mul_add(2.0, d538 * k44, k43 * d559); // JC3 rotated about y: Jzz − J'zz
+                let t88 = p.L3 * d541; // common subexpression
+                let d561 = p.XY2 - t81 + t82 + t85; // JC2.xy
+                let d562 = A::mul_add(
+                    p.L4,
+                    d546,
+                    A::mul_add(k44, d559, A::mul_add(-d538, k45, p.XZ2)),
+                ); // JC2.xz
+                let d563 = d541 + pc.pc54; // MSC2.y
+                let d564 = pc.pc55 - d547; // MSC2.z
+                let d565 = A::mul_add(2.0, t88, A::mul_add(-2.0, t86, d542) - d560)
+                    + pc.pc56; // JC2.xx
+                m[(3, 3)] = d565;
+                let d566 = A::mul_add(-2.0, t86, d544) + pc.pc57; // JC2.yy
+                let d567 = A::mul_add(-p.L4, d541, t87 - t83 - t84) + pc.pc58; // JC2.yz
+                let d568 = A::mul_add(2.0, t88, d545 + d560) + pc.pc59; // JC2.zz
+                let d569 = A::mul_add(s_q_w, d564, c_q_w * d563); // MSC2 in 1.y
+                let d570 = A::mul_add(-c_q_w, d564, s_q_w * d563); // MSC2 in 1.z
+                let t89 = c_q_w * d561; // common subexpression
+                let t90 = s_q_w * d562; // common subexpression
+                let t91 = s_q_w * d561; // common subexpression
+                let t92 = c_q_w * d562; // common subexpression
+                let d571 = t91 - t92; // N(M col 2) at 1.z
+                let t93 = p.L1 * d569; // common subexpression
+                let t94 = p.L2 * d570; // common subexpression
+                let d572 = d565 + t93 + t94; // N(M col 2) at 1.x
+                m[(2, 3)] = d572;
+                let d573 = t89 + t90; // N(M col 2) at 1.y
+                let d574 = A::mul_add(-c_q_imu, d569, s_q_imu * d570); // F(M col 2) at 0.x
+                m[(0, 3)] = -d574;
+                let d575 = A::mul_add(-s_q_imu, d571, c_q_imu * d573); // N(M col 2) at 0.z
+                m[(1, 3)] = -d575;
+                let d576 = p.MX1 + d558; // MSC1.x
+                m[(0, 1)] = d576;
+                let k46 = s_q_w * s_q_w; // sin² q_w
+                let k47 = s_q_w * c_q_w; // sin q_w cos q_w
+                let k48 = A::mul_add(2.0, k46, -1.0); // cos 2q_w
+                let d577 = d566 - d568; // JC2: Jyy − Jzz
+                let d578 = A::mul_add(-2.0, d567 * k47, k46 * d577); // JC2 rotated about x: Jyy − J'yy
+                let d579 = A::mul_add(-p.L1, d558, p.XY1 + t89 + t90); // JC1.xy
+                let d580 = A::mul_add(p.L2, d558, p.XZ1 - t91 + t92); // JC1.xz
+                let d581 = d569 + pc.pc61; // MSC1.y
+                let d582 = pc.pc62 - d570; // MSC1.z
+                let d583 = A::mul_add(2.0, t94, A::mul_add(2.0, t93, d565)) + pc.pc63; // JC1.xx
+                m[(2, 2)] = d583;
+                let d584 = A::mul_add(2.0, t94, d566) - d578 + pc.pc64; // JC1.yy
+                let d585 = A::mul_add(
+                    p.L1,
+                    d570,
+                    A::mul_add(-k47, d577, A::mul_add(-d567, k48, p.L2 * d569)),
+                ) + pc.pc65; // JC1.yz
+                let d586 = A::mul_add(2.0, t93, d568) + d578 + pc.pc66; // JC1.zz
+                let d587 = A::mul_add(s_q_imu, d582, c_q_imu * d581); // MSC1 in 0.z
+                m[(0, 2)] = d587;
+                let d588 = A::mul_add(s_q_imu, d580, c_q_imu * d579); // N(M col 1) at 0.z
+                m[(1, 2)] = -d588;
+                let k49 = s_q_imu * s_q_imu; // sin² q_imu
+                let k50 = s_q_imu * c_q_imu; // sin q_imu cos q_imu
+                let d589 = d584 - d586; // JC1: Jyy − Jzz
+                let d590 = A::mul_add(-2.0, d585 * k50, k49 * d589); // JC1 rotated about x: Jyy − J'yy
+                let d591 = d584 - d590; // JC0
+                m[(1, 1)] = d591 + pc.pc68;
+            }
+            for m in out.iter_mut() {
+                m[(1, 0)] = m[(0, 1)];
+                m[(2, 0)] = m[(0, 2)];
+                m[(3, 0)] = m[(0, 3)];
+                m[(4, 0)] = m[(0, 4)];
+                m[(5, 0)] = m[(0, 5)];
+                m[(6, 0)] = m[(0, 6)];
+                m[(7, 0)] = m[(0, 7)];
+                m[(8, 0)] = m[(0, 8)];
+                m[(9, 0)] = m[(0, 9)];
+                m[(10, 0)] = m[(0, 10)];
+                m[(11, 0)] = m[(0, 11)];
+                m[(12, 0)] = m[(0, 12)];
+                m[(13, 0)] = m[(0, 13)];
+                m[(14, 0)] = m[(0, 14)];
+                m[(15, 0)] = m[(0, 15)];
+                m[(16, 0)] = m[(0, 16)];
+                m[(17, 0)] = m[(0, 17)];
+                m[(18, 0)] = m[(0, 18)];
+                m[(2, 1)] = m[(1, 2)];
+                m[(3, 1)] = m[(1, 3)];
+                m[(4, 1)] = m[(1, 4)];
+                m[(5, 1)] = m[(1, 5)];
+                m[(6, 1)] = m[(1, 6)];
+                m[(7, 1)] = m[(1, 7)];
+                m[(8, 1)] = m[(1, 8)];
+                m[(9, 1)] = m[(1, 9)];
+                m[(10, 1)] = m[(1, 10)];
+                m[(11, 1)] = m[(1, 11)];
+                m[(12, 1)] = m[(1, 12)];
+                m[(13, 1)] = m[(1, 13)];
+                m[(14, 1)] = m[(1, 14)];
+                m[(15, 1)] = m[(1, 15)];
+                m[(16, 1)] = m[(1, 16)];
+                m[(17, 1)] = m[(1, 17)];
+                m[(18, 1)] = m[(1, 18)];
+                m[(3, 2)] = m[(2, 3)];
+                m[(4, 2)] = m[(2, 4)];
+                m[(5, 2)] = m[(2, 5)];
+                m[(6, 2)] = m[(2, 6)];
+                m[(7, 2)] = m[(2, 7)];
+                m[(8, 2)] = m[(2, 8)];
+                m[(9, 2)] = m[(2, 9)];
+                m[(10, 2)] = m[(2, 10)];
+                m[(11, 2)] = m[(2, 11)];
+                m[(12, 2)] = m[(2, 12)];
+                m[(13, 2)] = m[(2, 13)];
+                m[(14, 2)] = m[(2, 14)];
+                m[(15, 2)] = m[(2, 15)];
+                m[(16, 2)] = m[(2, 16)];
+                m[(17, 2)] = m[(2, 17)];
+                m[(18, 2)] = m[(2, 18)];
+                m[(4, 3)] = m[(3, 4)];
+                m[(5, 3)] = m[(3, 5)];
+                m[(6, 3)] = m[(3, 6)];
+                m[(7, 3)] = m[(3, 7)];
+                m[(8, 3)] = m[(3, 8)];
+                m[(9, 3)] = m[(3, 9)];
+                m[(10, 3)] = m[(3, 10)];
+                m[(11, 3)] = m[(3, 11)];
+                m[(12, 3)] = m[(3, 12)];
+                m[(13, 3)] = m[(3, 13)];
+                m[(14, 3)] = m[(3, 14)];
+                m[(15, 3)] = m[(3, 15)];
+                m[(16, 3)] = m[(3, 16)];
+                m[(17, 3)] = m[(3, 17)];
+                m[(18, 3)] = m[(3, 18)];
+                m[(5, 4)] = m[(4, 5)];
+                m[(6, 4)] = m[(4, 6)];
+                m[(7, 4)] = m[(4, 7)];
+                m[(8, 4)] = m[(4, 8)];
+                m[(9, 4)] = m[(4, 9)];
+                m[(10, 4)] = m[(4, 10)];
+                m[(11, 4)] = m[(4, 11)];
+                m[(12, 4)] = m[(4, 12)];
+                m[(13, 4)] = m[(4, 13)];
+                m[(14, 4)] = m[(4, 14)];
+                m[(15, 4)] = m[(4, 15)];
+                m[(16, 4)] = m[(4, 16)];
+                m[(17, 4)] = m[(4, 17)];
+                m[(18, 4)] = m[(4, 18)];
+                m[(6, 5)] = m[(5, 6)];
+                m[(7, 5)] = m[(5, 7)];
+                m[(8, 5)] = m[(5, 8)];
+                m[(9, 5)] = m[(5, 9)];
+                m[(10, 5)] = m[(5, 10)];
+                m[(11, 5)] = m[(5, 11)];
+                m[(7, 6)] = m[(6, 7)];
+                m[(8, 6)] = m[(6, 8)];
+                m[(9, 6)] = m[(6, 9)];
+                m[(10, 6)] = m[(6, 10)];
+                m[(11, 6)] = m[(6, 11)];
+                m[(8, 7)] = m[(7, 8)];
+                m[(9, 7)] = m[(7, 9)];
+                m[(10, 7)] = m[(7, 10)];
+                m[(11, 7)] = m[(7, 11)];
+                m[(9, 8)] = m[(8, 9)];
+                m[(10, 8)] = m[(8, 10)];
+                m[(11, 8)] = m[(8, 11)];
+                m[(10, 9)] = m[(9, 10)];
+                m[(11, 9)] = m[(9, 11)];
+                m[(11, 10)] = m[(10, 11)];
+                m[(13, 12)] = m[(12, 13)];
+                m[(14, 12)] = m[(12, 14)];
+                m[(15, 12)] = m[(12, 15)];
+                m[(16, 12)] = m[(12, 16)];
+                m[(17, 12)] = m[(12, 17)];
+                m[(18, 12)] = m[(12, 18)];
+                m[(14, 13)] = m[(13, 14)];
+                m[(15, 13)] = m[(13, 15)];
+                m[(16, 13)] = m[(13, 16)];
+                m[(17, 13)] = m[(13, 17)];
+                m[(18, 13)] = m[(13, 18)];
+                m[(15, 14)] = m[(14, 15)];
+                m[(16, 14)] = m[(14, 16)];
+                m[(17, 14)] = m[(14, 17)];
+                m[(18, 14)] = m[(14, 18)];
+                m[(16, 15)] = m[(15, 16)];
+                m[(17, 15)] = m[(15, 17)];
+                m[(18, 15)] = m[(15, 18)];
+                m[(17, 16)] = m[(16, 17)];
+                m[(18, 16)] = m[(16, 18)];
+                m[(18, 17)] = m[(17, 18)];
+                m[(12, 5)] = 0.0;
+                m[(13, 5)] = 0.0;
+                m[(14, 5)] = 0.0;
+                m[(15, 5)] = 0.0;
+                m[(16, 5)] = 0.0;
+                m[(17, 5)] = 0.0;
+                m[(18, 5)] = 0.0;
+                m[(12, 6)] = 0.0;
+                m[(13, 6)] = 0.0;
+                m[(14, 6)] = 0.0;
+                m[(15, 6)] = 0.0;
+                m[(16, 6)] = 0.0;
+                m[(17, 6)] = 0.0;
+                m[(18, 6)] = 0.0;
+                m[(12, 7)] = 0.0;
+                m[(13, 7)] = 0.0;
+                m[(14, 7)] = 0.0;
+                m[(15, 7)] = 0.0;
+                m[(16, 7)] = 0.0;
+                m[(17, 7)] = 0.0;
+                m[(18, 7)] = 0.0;
+                m[(12, 8)] = 0.0;
+                m[(13, 8)] = 0.0;
+                m[(14, 8)] = 0.0;
+                m[(15, 8)] = 0.0;
+                m[(16, 8)] = 0.0;
+                m[(17, 8)] = 0.0;
+                m[(18, 8)] = 0.0;
+                m[(12, 9)] = 0.0;
+                m[(13, 9)] = 0.0;
+                m[(14, 9)] = 0.0;
+                m[(15, 9)] = 0.0;
+                m[(16, 9)] = 0.0;
+                m[(17, 9)] = 0.0;
+                m[(18, 9)] = 0.0;
+                m[(12, 10)] = 0.0;
+                m[(13, 10)] = 0.0;
+                m[(14, 10)] = 0.0;
+                m[(15, 10)] = 0.0;
+                m[(16, 10)] = 0.0;
+                m[(17, 10)] = 0.0;
+                m[(18, 10)] = 0.0;
+                m[(12, 11)] = 0.0;
+                m[(13, 11)] = 0.0;
+                m[(14, 11)] = 0.0;
+                m[(15, 11)] = 0.0;
+                m[(16, 11)] = 0.0;
+                m[(17, 11)] = 0.0;
+                m[(18, 11)] = 0.0;
+                m[(5, 12)] = 0.0;
+                m[(6, 12)] = 0.0;
+                m[(7, 12)] = 0.0;
+                m[(8, 12)] = 0.0;
+                m[(9, 12)] = 0.0;
+                m[(10, 12)] = 0.0;
+                m[(11, 12)] = 0.0;
+                m[(5, 13)] = 0.0;
+                m[(6, 13)] = 0.0;
+                m[(7, 13)] = 0.0;
+                m[(8, 13)] = 0.0;
+                m[(9, 13)] = 0.0;
+                m[(10, 13)] = 0.0;
+                m[(11, 13)] = 0.0;
+                m[(5, 14)] = 0.0;
+                m[(6, 14)] = 0.0;
+                m[(7, 14)] = 0.0;
+                m[(8, 14)] = 0.0;
+                m[(9, 14)] = 0.0;
+                m[(10, 14)] = 0.0;
+                m[(11, 14)] = 0.0;
+                m[(5, 15)] = 0.0;
+                m[(6, 15)] = 0.0;
+                m[(7, 15)] = 0.0;
+                m[(8, 15)] = 0.0;
+                m[(9, 15)] = 0.0;
+                m[(10, 15)] = 0.0;
+                m[(11, 15)] = 0.0;
+                m[(5, 16)] = 0.0;
+                m[(6, 16)] = 0.0;
+                m[(7, 16)] = 0.0;
+                m[(8, 16)] = 0.0;
+                m[(9, 16)] = 0.0;
+                m[(10, 16)] = 0.0;
+                m[(11, 16)] = 0.0;
+                m[(5, 17)] = 0.0;
+                m[(6, 17)] = 0.0;
+                m[(7, 17)] = 0.0;
+                m[(8, 17)] = 0.0;
+                m[(9, 17)] = 0.0;
+                m[(10, 17)] = 0.0;
+                m[(11, 17)] = 0.0;
+                m[(5, 18)] = 0.0;
+                m[(6, 18)] = 0.0;
+                m[(7, 18)] = 0.0;
+                m[(8, 18)] = 0.0;
+                m[(9, 18)] = 0.0;
+                m[(10, 18)] = 0.0;
+                m[(11, 18)] = 0.0;
+            }
+        }
+        kanegen_runtime::isa::dispatch_fused_with(
+            out,
+            #[inline(always)]
+            |out| body::<kanegen_runtime::isa::Plain, L>(p, pc, q, out),
+            #[inline(always)]
+            |out| body::<kanegen_runtime::isa::Fused, L>(p, pc, q, out),
+        )
+    }
+    /// [`mass_matrix`] at `L` states per call: entry `l` of the result is `mass_matrix` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Returns the results by value; [`mass_matrix_batch_into`] writes them into the caller's array instead (no zeroed array, no copy).
+    #[inline]
     pub fn mass_matrix_batch<const L: usize>(
         p: &Params,
         pc: &Precomputed,
         q: &[SVector<f64, 19>; L],
     ) -> [SMatrix<f64, 19, 19>; L] {
-        kanegen_runtime::isa::dispatch(
+        let mut out = [<SMatrix<f64, 19, 19>>::zeros(); L];
+        mass_matrix_batch_into(p, pc, q, &mut out);
+        out
+    }
+    /// [`coriolis`] at `L` states per call, into `out`: entry `l` of `out` becomes `coriolis` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
+    #[inline(never)]
+    pub fn coriolis_batch_into<const L: usize>(
+        p: &Params,
+        pc: &Precomputed,
+        q: &[SVector<f64, 19>; L],
+        u: &[SVector<f64, 19>; L],
+        out: &mut [SVector<f64, 19>; L],
+    ) {
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>, const L: usize>(
+            p: &Params,
+            _pc: &Precomputed,
+            q: &[SVector<f64, 19>; L],
+            u: &[SVector<f64, 19>; L],
+            out: &mut [SVector<f64, 19>; L],
+        ) {
+            let p = &{ *p };
+            let q = kanegen_runtime::lanes::inputs(q);
+            let u = kanegen_runtime::lanes::inputs(u);
+            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n([
+                q[2].0,
+                q[3].0,
+                q[4].0,
+                q[5].0,
+                q[6].0,
+                q[7].0,
+                q[8].0,
+                q[9].0,
+                q[10].0,
+                q[11].0,
+                q[12].0,
+                q[13].0,
+                q[14].0,
+                q[15].0,
+                q[16].0,
+                q[17].0,
+                q[18].0,
+            ]);
+            for (l, m) in out.iter_mut().enumerate() {
+                let s_q_imu = sin_q[0][l];
+                let c_q_imu = cos_q[0][l];
+                let s_q_w = sin_q[1][l];
+                let c_q_w = cos_q[1][l];
+                let s_q_torso = sin_q[2][l];
+                let c_q_torso = cos_q[2][l];
+                let s_q1l = sin_q[3][l];
+                let c_q1l = cos_q[3][l];
+                let s_q2l = sin_q[4][l];
+                let c_q2l = cos_q[4][l];
+                let s_q3l = sin_q[5][l];
+                let c_q3l = cos_q[5][l];
+                let s_q4l = sin_q[6][l];
+                let c_q4l = cos_q[6][l];
+                let s_q5l = sin_q[7][l];
+                let c_q5l = cos_q[7][l];
+                let s_q6l = sin_q[8][l];
+                let c_q6l = cos_q[8][l];
+                let s_q7l = sin_q[9][l];
+                let c_q7l = cos_q[9][l];
+                let s_q1r = sin_q[10][l];
+                let c_q1r = cos_q[10][l];
+                let s_q2r = sin_q[11][l];
+                let c_q2r = cos_q[11][l];
+                let s_q3r = sin_q[12][l];
+                let c_q3r = cos_q[12][l];
+                let s_q4r = sin_q[13][l];
+                let c_q4r = cos_q[13][l];
+                let s_q5r = sin_q[14][l];
+                let c_q5r = cos_q[14][l];
+                let s_q6r = sin_q[15][l];
+                let c_q6r = cos_q[15][l];
+                let s_q7r = sin_q[16][l];
+                let c_q7r = cos_q[16][l];
+                let xd = u[0].0[l];
+                let psid = u[1].0[l];
+                let qd_imu = u[2].0[l];
+                let qd_w = u[3].0[l];
+                let qd_torso = u[4].0[l];
+                let qd1l = u[5].0[l];
+                let qd2l = u[6].0[l];
+                let qd3l = u[7].0[l];
+                let qd4l = u[8].0[l];
+                let qd5l = u[9].0[l];
+                let qd6l = u[10].0[l];
+                let qd7l = u[11].0[l];
+                let qd1r = u[12].0[l];
+                let qd2r = u[13].0[l];
+                let qd3r = u[14].0[l];
+                let qd4r = u[15].0[l];
+                let qd5r = u[16].0[l];
+                let qd6r = u[17].0[l];
+                let qd7r = u[18].0[l];
+                let k1 = xd * psid; // a0|ud=0,g=0.y
+                let k2 = c_q_imu * psid; // w0 in 1|ud=0,g=0.y
+                let k3 = s_q_imu * psid; // w0 in 1|ud=0,g=0.z
+                let k4 = k3 * qd_imu; // wd1|ud=0,g=0.y
+                let k5 = k2 * qd_imu; // wd1|ud=0,g=0.z
+                let d1 = A::mul_add(-p.MY1, k3, p.MZ1 * k2); // w1xMS1|ud=0,g=0.x
+                let d2 = A::mul_add(p.MZ1, qd_imu, p.MX1 * k3); // w1xMS1|ud=0,g=0.y
+                let d3 = A::mul_add(p.MX1, k2, p.MY1 * qd_imu); // w1xMS1|ud=0,g=0.z
+                let d4 = A::mul_add(-qd_imu, d3, A::mul_add(k3, d1, p.MX1 * k5)); // F1|ud=0,g=0.y
+                let d5 = A::mul_add(-k2, d1, A::mul_add(-qd_imu, d2, p.MX1 * k4)); // F1|ud=0,g=0.z
+                let d6 = A::mul_add(-p.XZ1, k3, A::mul_add(-p.XY1, k2, p.XX1 * qd_imu)); // J1w1|ud=0,g=0.x
+                let d7 = A::mul_add(-p.YZ1, k3, A::mul_add(-p.YY1, k2, p.XY1 * qd_imu)); // J1w1|ud=0,g=0.y
+                let d8 = A::mul_add(-p.ZZ1, k3, A::mul_add(-p.YZ1, k2, p.XZ1 * qd_imu)); // J1w1|ud=0,g=0.z
+                let d9 = A::mul_add(
+                    -k3,
+                    d7,
+                    A::mul_add(k2, d8, A::mul_add(-p.XZ1, k5, p.XY1 * k4)),
+                ); // N1|ud=0,g=0.x
+                let d10 = A::mul_add(
+                    p.MZ1,
+                    k1,
+                    A::mul_add(
+                        qd_imu,
+                        d8,
+                        A::mul_add(k3, d6, A::mul_add(-p.YZ1, k5, p.YY1 * k4)),
+                    ),
+                ); // N1|ud=0,g=0.y
+                let d11 = A::mul_add(
+                    -p.MY1,
+                    k1,
+                    A::mul_add(
+                        -k2,
+                        d6,
+                        A::mul_add(-qd_imu, d7, A::mul_add(-p.ZZ1, k5, p.YZ1 * k4)),
+                    ),
+                ); // N1|ud=0,g=0.z
+                let k6 = A::mul_add(-s_q_w, k3, c_q_w * k2); // w1 in 2|ud=0,g=0.y
+                let k7 = A::mul_add(c_q_w, k3, s_q_w * k2); // w1 in 2|ud=0,g=0.z
+                let k8 = qd_imu + qd_w; // w2|ud=0,g=0.x
+                let k9 = A::mul_add(k7, qd_w, A::mul_add(s_q_w, k5, c_q_w * k4)); // wd2|ud=0,g=0.y
+                let k10 = A::mul_add(-k6, qd_w, A::mul_add(-c_q_w, k5, s_q_w * k4)); // wd2|ud=0,g=0.z
+                let k11 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+                let k12 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+                let k13 = A::mul_add(p.L1, k3, p.L2 * k2); // w1xP2|ud=0,g=0.x
+                let k14 = A::mul_add(k2, k13, qd_imu * k11); // a2 in 1|ud=0,g=0.z
+                let k15 = A::mul_add(
+                    -k3,
+                    k11,
+                    A::mul_add(k2, k12, A::mul_add(p.L1, k5, A::mul_add(-p.L2, k4, k1))),
+                ); // a2 in 1|ud=0,g=0.x
+                let k16 = A::mul_add(qd_imu, k12, k3 * k13); // a2 in 1|ud=0,g=0.y
+                let k17 = A::mul_add(s_q_w, k14, c_q_w * k16); // a2|ud=0,g=0.y
+                let k18 = A::mul_add(-c_q_w, k14, s_q_w * k16); // a2|ud=0,g=0.z
+                let d12 = A::mul_add(-p.MY2, k7, p.MZ2 * k6); // w2xMS2|ud=0,g=0.x
+                let d13 = A::mul_add(p.MZ2, k8, p.MX2 * k7); // w2xMS2|ud=0,g=0.y
+                let d14 = A::mul_add(p.MX2, k6, p.MY2 * k8); // w2xMS2|ud=0,g=0.z
+                let d15 = A::mul_add(
+                    k7,
+                    d13,
+                    A::mul_add(
+                        k6,
+                        d14,
+                        A::mul_add(-p.MY2, k10, A::mul_add(p.MZ2, k9, p.m2 * k15)),
+                    ),
+                ); // F2|ud=0,g=0.x
+                let d16 = A::mul_add(
+                    k8,
+                    d14,
+                    A::mul_add(-k7, d12, A::mul_add(p.MX2, k10, p.m2 * k17)),
+                ); // F2|ud=0,g=0.y
+                let d17 = A::mul_add(
+                    k6,
+                    d12,
+                    A::mul_add(k8, d13, A::mul_add(-p.MX2, k9, p.m2 * k18)),
+                ); // F2|ud=0,g=0.z
+                let d18 = A::mul_add(-p.XZ2, k7, A::mul_add(-p.XY2, k6, p.XX2 * k8)); // J2w2|ud=0,g=0.x
+                let d19 = A::mul_add(-p.YZ2, k7, A::mul_add(-p.YY2, k6, p.XY2 * k8)); // J2w2|ud=0,g=0.y
+                let d20 = A::mul_add(-p.ZZ2, k7, A::mul_add(-p.YZ2, k6, p.XZ2 * k8)); // J2w2|ud=0,g=0.z
+                let d21 = A::mul_add(
+                    -p.MZ2,
+                    k17,
+                    A::mul_add(
+                        p.MY2,
+                        k18,
+                        A::mul_add(
+                            -k7,
+                            d19,
+                            A::mul_add(k6, d20, A::mul_add(p.XZ2, k10, p.XY2 * k9)),
+                        ),
+                    ),
+                ); // N2|ud=0,g=0.x
+                let d22 = A::mul_add(
+                    -p.MX2,
+                    k18,
+                    A::mul_add(
+                        p.MZ2,
+                        k15,
+                        A::mul_add(
+                            k8,
+                            d20,
+                            A::mul_add(k7, d18, A::mul_add(p.YZ2, k10, p.YY2 * k9)),
+                        ),
+                    ),
+                ); // N2|ud=0,g=0.y
+                let d23 = A::mul_add(
+                    -p.MY2,
+                    k15,
+                    A::mul_add(
+                        p.MX2,
+                        k17,
+                        A::mul_add(
+                            -k6,
+                            d18,
+                            A::mul_add(-k8, d19, A::mul_add(p.ZZ2, k10, p.YZ2 * k9)),
+                        ),
+                    ),
+                ); // N2|ud=0,g=0.z
+                let k19 = A::mul_add(-s_q_torso, k7, c_q_torso * k8); // w2 in 3|ud=0,g=0.x
+                let k20 = A::mul_add(c_q_torso, k7, s_q_torso * k8); // w2 in 3|ud=0,g=0.z
+                let k21 = k6 - qd_torso; // w3|ud=0,g=0.y
+                let k22 = A::mul_add(-k20, qd_torso, s_q_torso * k10); // wd3|ud=0,g=0.x
+                let k23 = A::mul_add(-k19, qd_torso, c_q_torso * k10); // wd3|ud=0,g=0.z
+                let k24 = A::mul_add(-p.L3, k7, p.L4 * k6); // w2xP3|ud=0,g=0.x
+                let k25 = p.L4 * k8; // w2xP3|ud=0,g=0.y
+                let k26 = p.L3 * k8; // w2xP3|ud=0,g=0.z
+                let k27 = A::mul_add(
+                    k7,
+                    k25,
+                    A::mul_add(
+                        k6,
+                        k26,
+                        A::mul_add(-p.L3, k10, A::mul_add(p.L4, k9, k15)),
+                    ),
+                ); // a3 in 2|ud=0,g=0.x
+                let k28 = A::mul_add(k8, k26, A::mul_add(-k7, k24, k17)); // a3 in 2|ud=0,g=0.y
+                let k29 = A::mul_add(k6, k24, A::mul_add(k8, k25, k18)); // a3 in 2|ud=0,g=0.z
+                let k30 = A::mul_add(s_q_torso, k29, c_q_torso * k27); // a3|ud=0,g=0.x
+                let k31 = A::mul_add(-c_q_torso, k29, s_q_torso * k27); // a3|ud=0,g=0.z
+                let d24 = A::mul_add(p.MY3, k20, p.MZ3 * k21); // w3xMS3|ud=0,g=0.x
+                let d25 = A::mul_add(-p.MX3, k21, p.MY3 * k19); // w3xMS3|ud=0,g=0.z
+                let d26 = A::mul_add(p.MZ3, k19, p.MX3 * k20); // w3xMS3|ud=0,g=0.y
+                let d27 = A::mul_add(
+                    -k20,
+                    d26,
+                    A::mul_add(
+                        k21,
+                        d25,
+                        A::mul_add(-p.MY3, k23, A::mul_add(-p.MZ3, k9, p.m3 * k30)),
+                    ),
+                ); // F3|ud=0,g=0.x
+                let d28 = A::mul_add(
+                    k19,
+                    d25,
+                    A::mul_add(
+                        k20,
+                        d24,
+                        A::mul_add(p.MZ3, k22, A::mul_add(-p.MX3, k23, p.m3 * k28)),
+                    ),
+                ); // F3|ud=0,g=0.y
+                let d29 = A::mul_add(
+                    k21,
+                    d24,
+                    A::mul_add(
+                        k19,
+                        d26,
+                        A::mul_add(-p.MX3, k9, A::mul_add(-p.MY3, k22, p.m3 * k31)),
+                    ),
+                ); // F3|ud=0,g=0.z
+                let d30 = A::mul_add(-p.XZ3, k20, A::mul_add(p.XY3, k21, p.XX3 * k19)); // J3w3|ud=0,g=0.x
+                let d31 = A::mul_add(-p.YZ3, k20, A::mul_add(p.YY3, k21, p.XY3 * k19)); // J3w3|ud=0,g=0.y
+                let d32 = A::mul_add(-p.ZZ3, k20, A::mul_add(p.YZ3, k21, p.XZ3 * k19)); // J3w3|ud=0,g=0.z
+                let d33 = A::mul_add(
+                    p.MZ3,
+                    k28,
+                    A::mul_add(
+                        -p.MY3,
+                        k31,
+                        A::mul_add(
+                            k20,
+                            d31,
+                            A::mul_add(
+                                k21,
+                                d32,
+                                A::mul_add(p.XZ3, k23, A::mul_add(-p.XY3, k9, p.XX3 * k22)),
+                            ),
+                        ),
+                    ),
+                ); // N3|ud=0,g=0.x
+                let d34 = A::mul_add(
+                    p.MX3,
+                    k31,
+                    A::mul_add(
+                        p.MZ3,
+                        k30,
+                        A::mul_add(
+                            -k19,
+                            d32,
+                            A::mul_add(
+                                -k20,
+                                d30,
+                                A::mul_add(p.YZ3, k23, A::mul_add(-p.YY3, k9, p.XY3 * k22)),
+                            ),
+                        ),
+                    ),
+                ); // N3|ud=0,g=0.y
+                let d35 = A::mul_add(
+                    -p.MY3,
+                    k30,
+                    A::mul_add(
+                        -p.MX3,
+                        k28,
+                        A::mul_add(
+                            -k21,
+                            d30,
+                            A::mul_add(
+                                k19,
+                                d31,
+                                A::mul_add(p.ZZ3, k23, A::mul_add(-p.YZ3, k9, p.XZ3 * k22)),
+                            ),
+                        ),
+                    ),
+                ); // N3|ud=0,g=0.z
+                let k32 = A::mul_add(s_q1l, k20, c_q1l * k21); // w3 in 4l|ud=0,g=0.x
+                let k33 = A::mul_add(-c_q1l, k20, s_q1l * k21); // w3 in 4l|ud=0,g=0.z
+                let k34 = k19 - qd1l; // w4l|ud=0,g=0.y
+                let k35 = A::mul_add(-k32, qd1l, A::mul_add(-c_q1l, k23, s_q1l * k9)); // wd4l|ud=0,g=0.z
+                let k36 = A::mul_add(k33, qd1l, A::mul_add(s_q1l, k23, c_q1l * k9)); // wd4l|ud=0,g=0.x
+                let k37 = p.L5 * k20; // w3xP4l|ud=0,g=0.x
+                let k38 = p.L6 * k20; // w3xP4l|ud=0,g=0.y
+                let t1 = p.L5 * k19; // common subexpression
+                let t2 = p.L6 * k21; // common subexpression
+                let k39 = t1 - t2; // w3xP4l|ud=0,g=0.z
+                let t3 = p.L5 * k23; // common subexpression
+                let t4 = p.L6 * k23; // common subexpression
+                let t5 = p.L5 * k22; // common subexpression
+                let t6 = p.L6 * k9; // common subexpression
+                let t7 = k20 * k38; // common subexpression
+                let t8 = k20 * k37; // common subexpression
+                let t9 = k19 * k38; // common subexpression
+                let t10 = k21 * k37; // common subexpression
+                let k40 = A::mul_add(k21, k39, k30 - t3) - t7; // a4l in 3|ud=0,g=0.x
+                let k41 = A::mul_add(k19, k39, k28 - t4 + t8); // a4l in 3|ud=0,g=0.y
+                let k42 = k31 - t5 - t6 + t9 + t10; // a4l in 3|ud=0,g=0.z
+                let k43 = A::mul_add(c_q1l, k42, s_q1l * k41); // a4l|ud=0,g=0.z
+                let k44 = A::mul_add(-s_q1l, k42, c_q1l * k41); // a4l|ud=0,g=0.x
+                let d36 = A::mul_add(p.MY4l, k33, p.MZ4l * k34); // w4lxMS4l|ud=0,g=0.x
+                let d37 = A::mul_add(-p.MX4l, k34, p.MY4l * k32); // w4lxMS4l|ud=0,g=0.z
+                let d38 = A::mul_add(p.MZ4l, k32, p.MX4l * k33); // w4lxMS4l|ud=0,g=0.y
+                let d39 = A::mul_add(
+                    -k32,
+                    d37,
+                    A::mul_add(
+                        -k33,
+                        d36,
+                        A::mul_add(p.MZ4l, k36, A::mul_add(p.MX4l, k35, p.m4l * k40)),
+                    ),
+                ); // F4l|ud=0,g=0.y
+                let d40 = A::mul_add(
+                    -k34,
+                    d36,
+                    A::mul_add(
+                        -k32,
+                        d38,
+                        A::mul_add(-p.MX4l, k22, A::mul_add(-p.MY4l, k36, p.m4l * k43)),
+                    ),
+                ); // F4l|ud=0,g=0.z
+                let d41 = A::mul_add(
+                    k33,
+                    d38,
+                    A::mul_add(
+                        -k34,
+                        d37,
+                        A::mul_add(p.MY4l, k35, A::mul_add(-p.MZ4l, k22, p.m4l * k44)),
+                    ),
+                ); // F4l|ud=0,g=0.x
+                let d42 = A::mul_add(
+                    -p.XZ4l,
+                    k33,
+                    A::mul_add(p.XY4l, k34, p.XX4l * k32),
+                ); // J4lw4l|ud=0,g=0.x
+                let d43 = A::mul_add(
+                    -p.YZ4l,
+                    k33,
+                    A::mul_add(p.YY4l, k34, p.XY4l * k32),
+                ); // J4lw4l|ud=0,g=0.y
+                let d44 = A::mul_add(
+                    -p.ZZ4l,
+                    k33,
+                    A::mul_add(p.YZ4l, k34, p.XZ4l * k32),
+                ); // J4lw4l|ud=0,g=0.z
+                let d45 = A::mul_add(
+                    p.MZ4l,
+                    k40,
+                    A::mul_add(
+                        -p.MY4l,
+                        k43,
+                        A::mul_add(
+                            -k33,
+                            d43,
+                            A::mul_add(
+                                -k34,
+                                d44,
+                                A::mul_add(
+                                    -p.XZ4l,
+                                    k35,
+                                    A::mul_add(-p.XY4l, k22, p.XX4l * k36),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N4l|ud=0,g=0.x
+                let d46 = A::mul_add(
+                    p.MX4l,
+                    k43,
+                    A::mul_add(
+                        p.MZ4l,
+                        k44,
+                        A::mul_add(
+                            k32,
+                            d44,
+                            A::mul_add(
+                                k33,
+                                d42,
+                                A::mul_add(
+                                    -p.YZ4l,
+                                    k35,
+                                    A::mul_add(-p.YY4l, k22, p.XY4l * k36),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N4l|ud=0,g=0.y
+                let d47 = A::mul_add(
+                    -p.MY4l,
+                    k44,
+                    A::mul_add(
+                        -p.MX4l,
+                        k40,
+                        A::mul_add(
+                            k34,
+                            d42,
+                            A::mul_add(
+                                -k32,
+                                d43,
+                                A::mul_add(
+                                    -p.ZZ4l,
+                                    k35,
+                                    A::mul_add(-p.YZ4l, k22, p.XZ4l * k36),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N4l|ud=0,g=0.z
+                let k45 = A::mul_add(-s_q2l, k33, c_q2l * k34); // w4l in 5l|ud=0,g=0.y
+                let k46 = A::mul_add(c_q2l, k33, s_q2l * k34); // w4l in 5l|ud=0,g=0.z
+                let k47 = k32 + qd2l; // w5l|ud=0,g=0.x
+                let k48 = A::mul_add(-k46, qd2l, A::mul_add(s_q2l, k35, c_q2l * k22)); // wd5l|ud=0,g=0.y
+                let k49 = A::mul_add(k45, qd2l, A::mul_add(-c_q2l, k35, s_q2l * k22)); // wd5l|ud=0,g=0.z
+                let k50 = A::mul_add(s_q2l, k43, c_q2l * k40); // a5l|ud=0,g=0.y
+                let k51 = A::mul_add(-c_q2l, k43, s_q2l * k40); // a5l|ud=0,g=0.z
+                let d48 = A::mul_add(-p.MY5l, k46, p.MZ5l * k45); // w5lxMS5l|ud=0,g=0.x
+                let d49 = A::mul_add(-p.MZ5l, k47, p.MX5l * k46); // w5lxMS5l|ud=0,g=0.y
+                let d50 = A::mul_add(-p.MX5l, k45, p.MY5l * k47); // w5lxMS5l|ud=0,g=0.z
+                let d51 = A::mul_add(
+                    -k46,
+                    d49,
+                    A::mul_add(
+                        k45,
+                        d50,
+                        A::mul_add(p.MY5l, k49, A::mul_add(-p.MZ5l, k48, p.m5l * k44)),
+                    ),
+                ); // F5l|ud=0,g=0.x
+                let d52 = A::mul_add(
+                    k47,
+                    d50,
+                    A::mul_add(
+                        -k46,
+                        d48,
+                        A::mul_add(p.MZ5l, k36, A::mul_add(p.MX5l, k49, p.m5l * k50)),
+                    ),
+                ); // F5l|ud=0,g=0.y
+                let d53 = A::mul_add(
+                    k45,
+                    d48,
+                    A::mul_add(
+                        -k47,
+                        d49,
+                        A::mul_add(-p.MX5l, k48, A::mul_add(-p.MY5l, k36, p.m5l * k51)),
+                    ),
+                ); // F5l|ud=0,g=0.z
+                let d54 = A::mul_add(p.XZ5l, k46, A::mul_add(p.XY5l, k45, p.XX5l * k47)); // J5lw5l|ud=0,g=0.x
+                let d55 = A::mul_add(p.YZ5l, k46, A::mul_add(p.YY5l, k45, p.XY5l * k47)); // J5lw5l|ud=0,g=0.y
+                let d56 = A::mul_add(p.ZZ5l, k46, A::mul_add(p.YZ5l, k45, p.XZ5l * k47)); // J5lw5l|ud=0,g=0.z
+                let d57 = A::mul_add(
+                    p.MZ5l,
+                    k50,
+                    A::mul_add(
+                        -p.MY5l,
+                        k51,
+                        A::mul_add(
+                            -k46,
+                            d55,
+                            A::mul_add(
+                                k45,
+                                d56,
+                                A::mul_add(
+                                    -p.XZ5l,
+                                    k49,
+                                    A::mul_add(-p.XY5l, k48, p.XX5l * k36),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N5l|ud=0,g=0.x
+                let d58 = A::mul_add(
+                    p.MX5l,
+                    k51,
+                    A::mul_add(
+                        p.MZ5l,
+                        k44,
+                        A::mul_add(
+                            -k47,
+                            d56,
+                            A::mul_add(
+                                k46,
+                                d54,
+                                A::mul_add(
+                                    -p.YZ5l,
+                                    k49,
+                                    A::mul_add(-p.YY5l, k48, p.XY5l * k36),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N5l|ud=0,g=0.y
+                let d59 = A::mul_add(
+                    -p.MY5l,
+                    k44,
+                    A::mul_add(
+                        -p.MX5l,
+                        k50,
+                        A::mul_add(
+                            -k45,
+                            d54,
+                            A::mul_add(
+                                k47,
+                                d55,
+                                A::mul_add(
+                                    -p.ZZ5l,
+                                    k49,
+                                    A::mul_add(-p.YZ5l, k48, p.XZ5l * k36),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N5l|ud=0,g=0.z
+                let k52 = A::mul_add(-s_q3l, k46, c_q3l * k47); // w5l in 6l|ud=0,g=0.x
+                let k53 = A::mul_add(c_q3l, k46, s_q3l * k47); // w5l in 6l|ud=0,g=0.z
+                let k54 = k45 - qd3l; // w6l|ud=0,g=0.y
+                let k55 = A::mul_add(-k52, qd3l, A::mul_add(-c_q3l, k49, s_q3l * k36)); // wd6l|ud=0,g=0.z
+                let k56 = A::mul_add(k53, qd3l, A::mul_add(s_q3l, k49, c_q3l * k36)); // wd6l|ud=0,g=0.x
+                let k57 = p.L7 * k46; // w5lxP6l|ud=0,g=0.x
+                let k58 = p.L7 * k47; // w5lxP6l|ud=0,g=0.z
+                let k59 = A::mul_add(-k45, k58, A::mul_add(-p.L7, k49, k44)); // a6l in 5l|ud=0,g=0.x
+                let k60 = A::mul_add(-k47, k58, A::mul_add(-k46, k57, k50)); // a6l in 5l|ud=0,g=0.y
+                let k61 = A::mul_add(k45, k57, A::mul_add(p.L7, k36, k51)); // a6l in 5l|ud=0,g=0.z
+                let k62 = A::mul_add(-c_q3l, k61, s_q3l * k59); // a6l|ud=0,g=0.z
+                let k63 = A::mul_add(s_q3l, k61, c_q3l * k59); // a6l|ud=0,g=0.x
+                let d60 = A::mul_add(p.MY6l, k53, p.MZ6l * k54); // w6lxMS6l|ud=0,g=0.x
+                let d61 = A::mul_add(-p.MX6l, k54, p.MY6l * k52); // w6lxMS6l|ud=0,g=0.z
+                let d62 = A::mul_add(p.MZ6l, k52, p.MX6l * k53); // w6lxMS6l|ud=0,g=0.y
+                let d63 = A::mul_add(
+                    -k52,
+                    d61,
+                    A::mul_add(
+                        -k53,
+                        d60,
+                        A::mul_add(p.MZ6l, k56, A::mul_add(p.MX6l, k55, p.m6l * k60)),
+                    ),
+                ); // F6l|ud=0,g=0.y
+                let d64 = A::mul_add(
+                    -k54,
+                    d60,
+                    A::mul_add(
+                        -k52,
+                        d62,
+                        A::mul_add(-p.MX6l, k48, A::mul_add(-p.MY6l, k56, p.m6l * k62)),
+                    ),
+                ); // F6l|ud=0,g=0.z
+                let d65 = A::mul_add(
+                    k53,
+                    d62,
+                    A::mul_add(
+                        -k54,
+                        d61,
+                        A::mul_add(p.MY6l, k55, A::mul_add(-p.MZ6l, k48, p.m6l * k63)),
+                    ),
+                ); // F6l|ud=0,g=0.x
+                let d66 = A::mul_add(
+                    -p.XZ6l,
+                    k53,
+                    A::mul_add(p.XY6l, k54, p.XX6l * k52),
+                ); // J6lw6l|ud=0,g=0.x
+                let d67 = A::mul_add(
+                    -p.YZ6l,
+                    k53,
+                    A::mul_add(p.YY6l, k54, p.XY6l * k52),
+                ); // J6lw6l|ud=0,g=0.y
+                let d68 = A::mul_add(
+                    -p.ZZ6l,
+                    k53,
+                    A::mul_add(p.YZ6l, k54, p.XZ6l * k52),
+                ); // J6lw6l|ud=0,g=0.z
+                let d69 = A::mul_add(
+                    p.MZ6l,
+                    k60,
+                    A::mul_add(
+                        -p.MY6l,
+                        k62,
+                        A::mul_add(
+                            -k53,
+                            d67,
+                            A::mul_add(
+                                -k54,
+                                d68,
+                                A::mul_add(
+                                    -p.XZ6l,
+                                    k55,
+                                    A::mul_add(-p.XY6l, k48, p.XX6l * k56),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N6l|ud=0,g=0.x
+                let d70 = A::mul_add(
+                    p.MX6l,
+                    k62,
+                    A::mul_add(
+                        p.MZ6l,
+                        k63,
+                        A::mul_add(
+                            k52,
+                            d68,
+                            A::mul_add(
+                                k53,
+                                d66,
+                                A::mul_add(
+                                    -p.YZ6l,
+                                    k55,
+                                    A::mul_add(-p.YY6l, k48, p.XY6l * k56),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N6l|ud=0,g=0.y
+                let d71 = A::mul_add(
+                    -p.MY6l,
+                    k63,
+                    A::mul_add(
+                        -p.MX6l,
+                        k60,
+                        A::mul_add(
+                            k54,
+                            d66,
+                            A::mul_add(
+                                -k52,
+                                d67,
+                                A::mul_add(
+                                    -p.ZZ6l,
+                                    k55,
+                                    A::mul_add(-p.YZ6l, k48, p.XZ6l * k56),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N6l|ud=0,g=0.z
+                let k64 = A::mul_add(-s_q4l, k53, c_q4l * k54); // w6l in 7l|ud=0,g=0.y
+                let k65 = A::mul_add(c_q4l, k53, s_q4l * k54); // w6l in 7l|ud=0,g=0.z
+                let k66 = k52 + qd4l; // w7l|ud=0,g=0.x
+                let k67 = A::mul_add(-k65, qd4l, A::mul_add(s_q4l, k55, c_q4l * k48)); // wd7l|ud=0,g=0.y
+                let k68 = A::mul_add(k64, qd4l, A::mul_add(-c_q4l, k55, s_q4l * k48)); // wd7l|ud=0,g=0.z
+                let k69 = A::mul_add(s_q4l, k62, c_q4l * k60); // a7l|ud=0,g=0.y
+                let k70 = A::mul_add(-c_q4l, k62, s_q4l * k60); // a7l|ud=0,g=0.z
+                let d72 = A::mul_add(-p.MY7l, k65, p.MZ7l * k64); // w7lxMS7l|ud=0,g=0.x
+                let d73 = A::mul_add(-p.MZ7l, k66, p.MX7l * k65); // w7lxMS7l|ud=0,g=0.y
+                let d74 = A::mul_add(-p.MX7l, k64, p.MY7l * k66); // w7lxMS7l|ud=0,g=0.z
+                let d75 = A::mul_add(
+                    -k65,
+                    d73,
+                    A::mul_add(
+                        k64,
+                        d74,
+                        A::mul_add(p.MY7l, k68, A::mul_add(-p.MZ7l, k67, p.m7l * k63)),
+                    ),
+                ); // F7l|ud=0,g=0.x
+                let d76 = A::mul_add(
+                    k66,
+                    d74,
+                    A::mul_add(
+                        -k65,
+                        d72,
+                        A::mul_add(p.MZ7l, k56, A::mul_add(p.MX7l, k68, p.m7l * k69)),
+                    ),
+                ); // F7l|ud=0,g=0.y
+                let d77 = A::mul_add(
+                    k64,
+                    d72,
+                    A::mul_add(
+                        -k66,
+                        d73,
+                        A::mul_add(-p.MX7l, k67, A::mul_add(-p.MY7l, k56, p.m7l * k70)),
+                    ),
+                ); // F7l|ud=0,g=0.z
+                let d78 = A::mul_add(p.XZ7l, k65, A::mul_add(p.XY7l, k64, p.XX7l * k66)); // J7lw7l|ud=0,g=0.x
+                let d79 = A::mul_add(p.YZ7l, k65, A::mul_add(p.YY7l, k64, p.XY7l * k66)); // J7lw7l|ud=0,g=0.y
+                let d80 = A::mul_add(p.ZZ7l, k65, A::mul_add(p.YZ7l, k64, p.XZ7l * k66)); // J7lw7l|ud=0,g=0.z
+                let d81 = A::mul_add(
+                    p.MZ7l,
+                    k69,
+                    A::mul_add(
+                        -p.MY7l,
+                        k70,
+                        A::mul_add(
+                            -k65,
+                            d79,
+                            A::mul_add(
+                                k64,
+                                d80,
+                                A::mul_add(
+                                    -p.XZ7l,
+                                    k68,
+                                    A::mul_add(-p.XY7l, k67, p.XX7l * k56),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N7l|ud=0,g=0.x
+                let d82 = A::mul_add(
+                    p.MX7l,
+                    k70,
+                    A::mul_add(
+                        p.MZ7l,
+                        k63,
+                        A::mul_add(
+                            -k66,
+                            d80,
+                            A::mul_add(
+                                k65,
+                                d78,
+                                A::mul_add(
+                                    -p.YZ7l,
+                                    k68,
+                                    A::mul_add(-p.YY7l, k67, p.XY7l * k56),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N7l|ud=0,g=0.y
+                let d83 = A::mul_add(
+                    -p.MY7l,
+                    k63,
+                    A::mul_add(
+                        -p.MX7l,
+                        k69,
+                        A::mul_add(
+                            -k64,
+                            d78,
+                            A::mul_add(
+                                k66,
+                                d79,
+                                A::mul_add(
+                                    -p.ZZ7l,
+                                    k68,
+                                    A::mul_add(-p.YZ7l, k67, p.XZ7l * k56),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N7l|ud=0,g=0.z
+                let k71 = A::mul_add(-s_q5l, k65, c_q5l * k66); // w7l in 8l|ud=0,g=0.x
+                let k72 = A::mul_add(c_q5l, k65, s_q5l * k66); // w7l in 8l|ud=0,g=0.z
+                let k73 = k64 - qd5l; // w8l|ud=0,g=0.y
+                let k74 = A::mul_add(-k71, qd5l, A::mul_add(-c_q5l, k68, s_q5l * k56)); // wd8l|ud=0,g=0.z
+                let k75 = A::mul_add(k72, qd5l, A::mul_add(s_q5l, k68, c_q5l * k56)); // wd8l|ud=0,g=0.x
+                let k76 = p.L8 * k65; // w7lxP8l|ud=0,g=0.x
+                let k77 = p.L8 * k66; // w7lxP8l|ud=0,g=0.z
+                let k78 = A::mul_add(-k64, k77, A::mul_add(-p.L8, k68, k63)); // a8l in 7l|ud=0,g=0.x
+                let k79 = A::mul_add(-k66, k77, A::mul_add(-k65, k76, k69)); // a8l in 7l|ud=0,g=0.y
+                let k80 = A::mul_add(k64, k76, A::mul_add(p.L8, k56, k70)); // a8l in 7l|ud=0,g=0.z
+                let k81 = A::mul_add(-c_q5l, k80, s_q5l * k78); // a8l|ud=0,g=0.z
+                let k82 = A::mul_add(s_q5l, k80, c_q5l * k78); // a8l|ud=0,g=0.x
+                let d84 = A::mul_add(p.MY8l, k72, p.MZ8l * k73); // w8lxMS8l|ud=0,g=0.x
+                let d85 = A::mul_add(-p.MX8l, k73, p.MY8l * k71); // w8lxMS8l|ud=0,g=0.z
+                let d86 = A::mul_add(p.MZ8l, k71, p.MX8l * k72); // w8lxMS8l|ud=0,g=0.y
+                let d87 = A::mul_add(
+                    -k71,
+                    d85,
+                    A::mul_add(
+                        -k72,
+                        d84,
+                        A::mul_add(p.MZ8l, k75, A::mul_add(p.MX8l, k74, p.m8l * k79)),
+                    ),
+                ); // F8l|ud=0,g=0.y
+                let d88 = A::mul_add(
+                    -k73,
+                    d84,
+                    A::mul_add(
+                        -k71,
+                        d86,
+                        A::mul_add(-p.MX8l, k67, A::mul_add(-p.MY8l, k75, p.m8l * k81)),
+                    ),
+                ); // F8l|ud=0,g=0.z
+                let d89 = A::mul_add(
+                    k72,
+                    d86,
+                    A::mul_add(
+                        -k73,
+                        d85,
+                        A::mul_add(p.MY8l, k74, A::mul_add(-p.MZ8l, k67, p.m8l * k82)),
+                    ),
+                ); // F8l|ud=0,g=0.x
+                let d90 = A::mul_add(
+                    -p.XZ8l,
+                    k72,
+                    A::mul_add(p.XY8l, k73, p.XX8l * k71),
+                ); // J8lw8l|ud=0,g=0.x
+                let d91 = A::mul_add(
+                    -p.YZ8l,
+                    k72,
+                    A::mul_add(p.YY8l, k73, p.XY8l * k71),
+                ); // J8lw8l|ud=0,g=0.y
+                let d92 = A::mul_add(
+                    -p.ZZ8l,
+                    k72,
+                    A::mul_add(p.YZ8l, k73, p.XZ8l * k71),
+                ); // J8lw8l|ud=0,g=0.z
+                let d93 = A::mul_add(
+                    p.MZ8l,
+                    k79,
+                    A::mul_add(
+                        -p.MY8l,
+                        k81,
+                        A::mul_add(
+                            -k72,
+                            d91,
+                            A::mul_add(
+                                -k73,
+                                d92,
+                                A::mul_add(
+                                    -p.XZ8l,
+                                    k74,
+                                    A::mul_add(-p.XY8l, k67, p.XX8l * k75),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8l|ud=0,g=0.x
+                let d94 = A::mul_add(
+                    p.MX8l,
+                    k81,
+                    A::mul_add(
+                        p.MZ8l,
+                        k82,
+                        A::mul_add(
+                            k71,
+                            d92,
+                            A::mul_add(
+                                k72,
+                                d90,
+                                A::mul_add(
+                                    -p.YZ8l,
+                                    k74,
+                                    A::mul_add(-p.YY8l, k67, p.XY8l * k75),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8l|ud=0,g=0.y
+                let d95 = A::mul_add(
+                    -p.MY8l,
+                    k82,
+                    A::mul_add(
+                        -p.MX8l,
+                        k79,
+                        A::mul_add(
+                            k73,
+                            d90,
+                            A::mul_add(
+                                -k71,
+                                d91,
+                                A::mul_add(
+                                    -p.ZZ8l,
+                                    k74,
+                                    A::mul_add(-p.YZ8l, k67, p.XZ8l * k75),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8l|ud=0,g=0.z
+                let k83 = A::mul_add(-s_q6l, k72, c_q6l * k73); // w8l in 9l|ud=0,g=0.y
+                let k84 = A::mul_add(c_q6l, k72, s_q6l * k73); // w8l in 9l|ud=0,g=0.z
+                let k85 = k71 + qd6l; // w9l|ud=0,g=0.x
+                let k86 = A::mul_add(-k84, qd6l, A::mul_add(s_q6l, k74, c_q6l * k67)); // wd9l|ud=0,g=0.y
+                let k87 = A::mul_add(k83, qd6l, A::mul_add(-c_q6l, k74, s_q6l * k67)); // wd9l|ud=0,g=0.z
+                let k88 = A::mul_add(s_q6l, k81, c_q6l * k79); // a9l|ud=0,g=0.y
+                let k89 = A::mul_add(-c_q6l, k81, s_q6l * k79); // a9l|ud=0,g=0.z
+                let d96 = A::mul_add(-p.MY9l, k84, p.MZ9l * k83); // w9lxMS9l|ud=0,g=0.x
+                let d97 = A::mul_add(-p.MZ9l, k85, p.MX9l * k84); // w9lxMS9l|ud=0,g=0.y
+                let d98 = A::mul_add(-p.MX9l, k83, p.MY9l * k85); // w9lxMS9l|ud=0,g=0.z
+                let d99 = A::mul_add(
+                    -k84,
+                    d97,
+                    A::mul_add(
+                        k83,
+                        d98,
+                        A::mul_add(p.MY9l, k87, A::mul_add(-p.MZ9l, k86, p.m9l * k82)),
+                    ),
+                ); // F9l|ud=0,g=0.x
+                let d100 = A::mul_add(
+                    k85,
+                    d98,
+                    A::mul_add(
+                        -k84,
+                        d96,
+                        A::mul_add(p.MZ9l, k75, A::mul_add(p.MX9l, k87, p.m9l * k88)),
+                    ),
+                ); // F9l|ud=0,g=0.y
+                let d101 = A::mul_add(
+                    k83,
+                    d96,
+                    A::mul_add(
+                        -k85,
+                        d97,
+                        A::mul_add(-p.MX9l, k86, A::mul_add(-p.MY9l, k75, p.m9l * k89)),
+                    ),
+                ); // F9l|ud=0,g=0.z
+                let d102 = A::mul_add(
+                    p.XZ9l,
+                    k84,
+                    A::mul_add(p.XY9l, k83, p.XX9l * k85),
+                ); // J9lw9l|ud=0,g=0.x
+                let d103 = A::mul_add(
+                    p.YZ9l,
+                    k84,
+                    A::mul_add(p.YY9l, k83, p.XY9l * k85),
+                ); // J9lw9l|ud=0,g=0.y
+                let d104 = A::mul_add(
+                    p.ZZ9l,
+                    k84,
+                    A::mul_add(p.YZ9l, k83, p.XZ9l * k85),
+                ); // J9lw9l|ud=0,g=0.z
+                let d105 = A::mul_add(
+                    p.MZ9l,
+                    k88,
+                    A::mul_add(
+                        -p.MY9l,
+                        k89,
+                        A::mul_add(
+                            -k84,
+                            d103,
+                            A::mul_add(
+                                k83,
+                                d104,
+                                A::mul_add(
+                                    -p.XZ9l,
+                                    k87,
+                                    A::mul_add(-p.XY9l, k86, p.XX9l * k75),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9l|ud=0,g=0.x
+                let d106 = A::mul_add(
+                    p.MX9l,
+                    k89,
+                    A::mul_add(
+                        p.MZ9l,
+                        k82,
+                        A::mul_add(
+                            -k85,
+                            d104,
+                            A::mul_add(
+                                k84,
+                                d102,
+                                A::mul_add(
+                                    -p.YZ9l,
+                                    k87,
+                                    A::mul_add(-p.YY9l, k86, p.XY9l * k75),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9l|ud=0,g=0.y
+                let d107 = A::mul_add(
+                    -p.MY9l,
+                    k82,
+                    A::mul_add(
+                        -p.MX9l,
+                        k88,
+                        A::mul_add(
+                            -k83,
+                            d102,
+                            A::mul_add(
+                                k85,
+                                d103,
+                                A::mul_add(
+                                    -p.ZZ9l,
+                                    k87,
+                                    A::mul_add(-p.YZ9l, k86, p.XZ9l * k75),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9l|ud=0,g=0.z
+                let k90 = A::mul_add(-s_q7l, k84, c_q7l * k85); // w9l in 10l|ud=0,g=0.x
+                let k91 = A::mul_add(c_q7l, k84, s_q7l * k85); // w9l in 10l|ud=0,g=0.y
+                let k92 = k83 - qd7l; // w10l|ud=0,g=0.z
+                let k93 = A::mul_add(k91, qd7l, A::mul_add(s_q7l, k87, c_q7l * k75)); // wd10l|ud=0,g=0.x
+                let k94 = A::mul_add(-k90, qd7l, A::mul_add(-c_q7l, k87, s_q7l * k75)); // wd10l|ud=0,g=0.y
+                let k95 = p.L9 * k84; // w9lxP10l|ud=0,g=0.x
+                let k96 = p.L9 * k85; // w9lxP10l|ud=0,g=0.z
+                let k97 = A::mul_add(-k83, k96, A::mul_add(-p.L9, k87, k82)); // a10l in 9l|ud=0,g=0.x
+                let k98 = A::mul_add(-k85, k96, A::mul_add(-k84, k95, k88)); // a10l in 9l|ud=0,g=0.y
+                let k99 = A::mul_add(k83, k95, A::mul_add(p.L9, k75, k89)); // a10l in 9l|ud=0,g=0.z
+                let k100 = A::mul_add(s_q7l, k99, c_q7l * k97); // a10l|ud=0,g=0.x
+                let k101 = A::mul_add(-c_q7l, k99, s_q7l * k97); // a10l|ud=0,g=0.y
+                let d108 = A::mul_add(-p.MY10l, k92, p.MZ10l * k91); // w10lxMS10l|ud=0,g=0.x
+                let d109 = A::mul_add(-p.MZ10l, k90, p.MX10l * k92); // w10lxMS10l|ud=0,g=0.y
+                let d110 = A::mul_add(-p.MX10l, k91, p.MY10l * k90); // w10lxMS10l|ud=0,g=0.z
+                let d111 = A::mul_add(
+                    -k91,
+                    d108,
+                    A::mul_add(
+                        k90,
+                        d109,
+                        A::mul_add(p.MX10l, k94, A::mul_add(-p.MY10l, k93, p.m10l * k98)),
+                    ),
+                ); // F10l|ud=0,g=0.z
+                let d112 = A::mul_add(
+                    k92,
+                    d109,
+                    A::mul_add(
+                        -k91,
+                        d110,
+                        A::mul_add(p.MY10l, k86, A::mul_add(p.MZ10l, k94, p.m10l * k100)),
+                    ),
+                ); // F10l|ud=0,g=0.x
+                let d113 = A::mul_add(
+                    k90,
+                    d110,
+                    A::mul_add(
+                        -k92,
+                        d108,
+                        A::mul_add(
+                            -p.MZ10l,
+                            k93,
+                            A::mul_add(-p.MX10l, k86, p.m10l * k101),
+                        ),
+                    ),
+                ); // F10l|ud=0,g=0.y
+                let d114 = A::mul_add(
+                    p.XZ10l,
+                    k92,
+                    A::mul_add(p.XY10l, k91, p.XX10l * k90),
+                ); // J10lw10l|ud=0,g=0.x
+                let d115 = A::mul_add(
+                    p.YZ10l,
+                    k92,
+                    A::mul_add(p.YY10l, k91, p.XY10l * k90),
+                ); // J10lw10l|ud=0,g=0.y
+                let d116 = A::mul_add(
+                    p.ZZ10l,
+                    k92,
+                    A::mul_add(p.YZ10l, k91, p.XZ10l * k90),
+                ); // J10lw10l|ud=0,g=0.z
+                let d117 = A::mul_add(
+                    -p.MZ10l,
+                    k101,
+                    A::mul_add(
+                        -p.MY10l,
+                        k98,
+                        A::mul_add(
+                            k92,
+                            d115,
+                            A::mul_add(
+                                -k91,
+                                d116,
+                                A::mul_add(
+                                    -p.XZ10l,
+                                    k86,
+                                    A::mul_add(p.XY10l, k94, p.XX10l * k93),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10l|ud=0,g=0.x
+                let d118 = A::mul_add(
+                    p.MX10l,
+                    k98,
+                    A::mul_add(
+                        p.MZ10l,
+                        k100,
+                        A::mul_add(
+                            k90,
+                            d116,
+                            A::mul_add(
+                                -k92,
+                                d114,
+                                A::mul_add(
+                                    -p.YZ10l,
+                                    k86,
+                                    A::mul_add(p.YY10l, k94, p.XY10l * k93),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10l|ud=0,g=0.y
+                let d119 = A::mul_add(
+                    -p.MY10l,
+                    k100,
+                    A::mul_add(
+                        p.MX10l,
+                        k101,
+                        A::mul_add(
+                            k91,
+                            d114,
+                            A::mul_add(
+                                -k90,
+                                d115,
+                                A::mul_add(
+                                    -p.ZZ10l,
+                                    k86,
+                                    A::mul_add(p.YZ10l, k94, p.XZ10l * k93),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10l|ud=0,g=0.z
+                m[11] = d119;
+                let k102 = A::mul_add(-s_q1r, k20, c_q1r * k21); // w3 in 4r|ud=0,g=0.x
+                let k103 = A::mul_add(c_q1r, k20, s_q1r * k21); // w3 in 4r|ud=0,g=0.z
+                let k104 = A::mul_add(-k102, qd1r, A::mul_add(c_q1r, k23, s_q1r * k9)); // wd4r|ud=0,g=0.z
+                let k105 = k19 + qd1r; // w4r|ud=0,g=0.y
+                let k106 = A::mul_add(k103, qd1r, A::mul_add(-s_q1r, k23, c_q1r * k9)); // wd4r|ud=0,g=0.x
+                let k107 = t1 + t2; // w3xP4r|ud=0,g=0.z
+                let k108 = A::mul_add(k21, k107, k30 - t3 + t7); // a4r in 3|ud=0,g=0.x
+                let k109 = A::mul_add(k19, k107, k28 + t4 + t8); // a4r in 3|ud=0,g=0.y
+                let k110 = k31 - t5 + t6 - t9 + t10; // a4r in 3|ud=0,g=0.z
+                let k111 = A::mul_add(-c_q1r, k110, s_q1r * k109); // a4r|ud=0,g=0.z
+                let k112 = A::mul_add(s_q1r, k110, c_q1r * k109); // a4r|ud=0,g=0.x
+                let d120 = A::mul_add(p.MX4r, k105, p.MY4r * k102); // w4rxMS4r|ud=0,g=0.z
+                let d121 = A::mul_add(-p.MY4r, k103, p.MZ4r * k105); // w4rxMS4r|ud=0,g=0.x
+                let d122 = A::mul_add(p.MZ4r, k102, p.MX4r * k103); // w4rxMS4r|ud=0,g=0.y
+                let d123 = A::mul_add(
+                    -k105,
+                    d121,
+                    A::mul_add(
+                        -k102,
+                        d122,
+                        A::mul_add(p.MX4r, k22, A::mul_add(-p.MY4r, k106, p.m4r * k111)),
+                    ),
+                ); // F4r|ud=0,g=0.z
+                let d124 = A::mul_add(
+                    k103,
+                    d122,
+                    A::mul_add(
+                        k105,
+                        d120,
+                        A::mul_add(p.MY4r, k104, A::mul_add(p.MZ4r, k22, p.m4r * k112)),
+                    ),
+                ); // F4r|ud=0,g=0.x
+                let d125 = A::mul_add(
+                    k102,
+                    d120,
+                    A::mul_add(
+                        -k103,
+                        d121,
+                        A::mul_add(
+                            -p.MZ4r,
+                            k106,
+                            A::mul_add(-p.MX4r, k104, p.m4r * k108),
+                        ),
+                    ),
+                ); // F4r|ud=0,g=0.y
+                let d126 = A::mul_add(
+                    -p.XZ4r,
+                    k103,
+                    A::mul_add(-p.XY4r, k105, p.XX4r * k102),
+                ); // J4rw4r|ud=0,g=0.x
+                let d127 = A::mul_add(
+                    -p.YZ4r,
+                    k103,
+                    A::mul_add(-p.YY4r, k105, p.XY4r * k102),
+                ); // J4rw4r|ud=0,g=0.y
+                let d128 = A::mul_add(
+                    -p.ZZ4r,
+                    k103,
+                    A::mul_add(-p.YZ4r, k105, p.XZ4r * k102),
+                ); // J4rw4r|ud=0,g=0.z
+                let d129 = A::mul_add(
+                    -p.MZ4r,
+                    k108,
+                    A::mul_add(
+                        -p.MY4r,
+                        k111,
+                        A::mul_add(
+                            -k103,
+                            d127,
+                            A::mul_add(
+                                k105,
+                                d128,
+                                A::mul_add(
+                                    -p.XZ4r,
+                                    k104,
+                                    A::mul_add(p.XY4r, k22, p.XX4r * k106),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N4r|ud=0,g=0.x
+                let d130 = A::mul_add(
+                    p.MX4r,
+                    k111,
+                    A::mul_add(
+                        p.MZ4r,
+                        k112,
+                        A::mul_add(
+                            k102,
+                            d128,
+                            A::mul_add(
+                                k103,
+                                d126,
+                                A::mul_add(
+                                    -p.YZ4r,
+                                    k104,
+                                    A::mul_add(p.YY4r, k22, p.XY4r * k106),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N4r|ud=0,g=0.y
+                let d131 = A::mul_add(
+                    -p.MY4r,
+                    k112,
+                    A::mul_add(
+                        p.MX4r,
+                        k108,
+                        A::mul_add(
+                            -k105,
+                            d126,
+                            A::mul_add(
+                                -k102,
+                                d127,
+                                A::mul_add(
+                                    -p.ZZ4r,
+                                    k104,
+                                    A::mul_add(p.YZ4r, k22, p.XZ4r * k106),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N4r|ud=0,g=0.z
+                let k113 = A::mul_add(s_q2r, k103, c_q2r * k105); // w4r in 5r|ud=0,g=0.y
+                let k114 = A::mul_add(-c_q2r, k103, s_q2r * k105); // w4r in 5r|ud=0,g=0.z
+                let k115 = A::mul_add(
+                    -k114,
+                    qd2r,
+                    A::mul_add(-s_q2r, k104, c_q2r * k22),
+                ); // wd5r|ud=0,g=0.y
+                let k116 = A::mul_add(k113, qd2r, A::mul_add(c_q2r, k104, s_q2r * k22)); // wd5r|ud=0,g=0.z
+                let k117 = k102 + qd2r; // w5r|ud=0,g=0.x
+                let k118 = A::mul_add(-s_q2r, k111, c_q2r * k108); // a5r|ud=0,g=0.y
+                let k119 = A::mul_add(c_q2r, k111, s_q2r * k108); // a5r|ud=0,g=0.z
+                let d132 = A::mul_add(-p.MY5r, k114, p.MZ5r * k113); // w5rxMS5r|ud=0,g=0.x
+                let d133 = A::mul_add(p.MZ5r, k117, p.MX5r * k114); // w5rxMS5r|ud=0,g=0.y
+                let d134 = A::mul_add(p.MX5r, k113, p.MY5r * k117); // w5rxMS5r|ud=0,g=0.z
+                let d135 = A::mul_add(
+                    -k114,
+                    d133,
+                    A::mul_add(
+                        -k113,
+                        d134,
+                        A::mul_add(-p.MY5r, k116, A::mul_add(p.MZ5r, k115, p.m5r * k112)),
+                    ),
+                ); // F5r|ud=0,g=0.x
+                let d136 = A::mul_add(
+                    -k117,
+                    d134,
+                    A::mul_add(
+                        k114,
+                        d132,
+                        A::mul_add(-p.MZ5r, k106, A::mul_add(p.MX5r, k116, p.m5r * k118)),
+                    ),
+                ); // F5r|ud=0,g=0.y
+                let d137 = A::mul_add(
+                    -k113,
+                    d132,
+                    A::mul_add(
+                        -k117,
+                        d133,
+                        A::mul_add(-p.MX5r, k115, A::mul_add(p.MY5r, k106, p.m5r * k119)),
+                    ),
+                ); // F5r|ud=0,g=0.z
+                let d138 = A::mul_add(
+                    -p.XZ5r,
+                    k114,
+                    A::mul_add(-p.XY5r, k113, p.XX5r * k117),
+                ); // J5rw5r|ud=0,g=0.x
+                let d139 = A::mul_add(
+                    -p.YZ5r,
+                    k114,
+                    A::mul_add(-p.YY5r, k113, p.XY5r * k117),
+                ); // J5rw5r|ud=0,g=0.y
+                let d140 = A::mul_add(
+                    -p.ZZ5r,
+                    k114,
+                    A::mul_add(-p.YZ5r, k113, p.XZ5r * k117),
+                ); // J5rw5r|ud=0,g=0.z
+                let d141 = A::mul_add(
+                    -p.MZ5r,
+                    k118,
+                    A::mul_add(
+                        p.MY5r,
+                        k119,
+                        A::mul_add(
+                            k114,
+                            d139,
+                            A::mul_add(
+                                -k113,
+                                d140,
+                                A::mul_add(
+                                    p.XZ5r,
+                                    k116,
+                                    A::mul_add(p.XY5r, k115, p.XX5r * k106),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N5r|ud=0,g=0.x
+                let d142 = A::mul_add(
+                    -p.MX5r,
+                    k119,
+                    A::mul_add(
+                        p.MZ5r,
+                        k112,
+                        A::mul_add(
+                            -k117,
+                            d140,
+                            A::mul_add(
+                                -k114,
+                                d138,
+                                A::mul_add(
+                                    p.YZ5r,
+                                    k116,
+                                    A::mul_add(p.YY5r, k115, p.XY5r * k106),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N5r|ud=0,g=0.y
+                let d143 = A::mul_add(
+                    -p.MY5r,
+                    k112,
+                    A::mul_add(
+                        p.MX5r,
+                        k118,
+                        A::mul_add(
+                            k113,
+                            d138,
+                            A::mul_add(
+                                k117,
+                                d139,
+                                A::mul_add(
+                                    p.ZZ5r,
+                                    k116,
+                                    A::mul_add(p.YZ5r, k115, p.XZ5r * k106),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N5r|ud=0,g=0.z
+                let k120 = A::mul_add(s_q3r, k114, c_q3r * k117); // w5r in 6r|ud=0,g=0.x
+                let k121 = A::mul_add(-c_q3r, k114, s_q3r * k117); // w5r in 6r|ud=0,g=0.z
+                let k122 = A::mul_add(
+                    -k120,
+                    qd3r,
+                    A::mul_add(c_q3r, k116, s_q3r * k106),
+                ); // wd6r|ud=0,g=0.z
+                let k123 = k113 + qd3r; // w6r|ud=0,g=0.y
+                let k124 = A::mul_add(
+                    k121,
+                    qd3r,
+                    A::mul_add(-s_q3r, k116, c_q3r * k106),
+                ); // wd6r|ud=0,g=0.x
+                let k125 = p.L7 * k114; // w5rxP6r|ud=0,g=0.x
+                let k126 = p.L7 * k117; // w5rxP6r|ud=0,g=0.z
+                let k127 = A::mul_add(k113, k126, A::mul_add(p.L7, k116, k112)); // a6r in 5r|ud=0,g=0.x
+                let k128 = A::mul_add(k117, k126, A::mul_add(k114, k125, k118)); // a6r in 5r|ud=0,g=0.y
+                let k129 = A::mul_add(-k113, k125, A::mul_add(-p.L7, k106, k119)); // a6r in 5r|ud=0,g=0.z
+                let k130 = A::mul_add(c_q3r, k129, s_q3r * k127); // a6r|ud=0,g=0.z
+                let k131 = A::mul_add(-s_q3r, k129, c_q3r * k127); // a6r|ud=0,g=0.x
+                let d144 = A::mul_add(p.MX6r, k123, p.MY6r * k120); // w6rxMS6r|ud=0,g=0.z
+                let d145 = A::mul_add(-p.MY6r, k121, p.MZ6r * k123); // w6rxMS6r|ud=0,g=0.x
+                let d146 = A::mul_add(p.MZ6r, k120, p.MX6r * k121); // w6rxMS6r|ud=0,g=0.y
+                let d147 = A::mul_add(
+                    -k123,
+                    d145,
+                    A::mul_add(
+                        -k120,
+                        d146,
+                        A::mul_add(p.MX6r, k115, A::mul_add(-p.MY6r, k124, p.m6r * k130)),
+                    ),
+                ); // F6r|ud=0,g=0.z
+                let d148 = A::mul_add(
+                    k121,
+                    d146,
+                    A::mul_add(
+                        k123,
+                        d144,
+                        A::mul_add(p.MY6r, k122, A::mul_add(p.MZ6r, k115, p.m6r * k131)),
+                    ),
+                ); // F6r|ud=0,g=0.x
+                let d149 = A::mul_add(
+                    k120,
+                    d144,
+                    A::mul_add(
+                        -k121,
+                        d145,
+                        A::mul_add(
+                            -p.MZ6r,
+                            k124,
+                            A::mul_add(-p.MX6r, k122, p.m6r * k128),
+                        ),
+                    ),
+                ); // F6r|ud=0,g=0.y
+                let d150 = A::mul_add(
+                    -p.XZ6r,
+                    k121,
+                    A::mul_add(-p.XY6r, k123, p.XX6r * k120),
+                ); // J6rw6r|ud=0,g=0.x
+                let d151 = A::mul_add(
+                    -p.YZ6r,
+                    k121,
+                    A::mul_add(-p.YY6r, k123, p.XY6r * k120),
+                ); // J6rw6r|ud=0,g=0.y
+                let d152 = A::mul_add(
+                    -p.ZZ6r,
+                    k121,
+                    A::mul_add(-p.YZ6r, k123, p.XZ6r * k120),
+                ); // J6rw6r|ud=0,g=0.z
+                let d153 = A::mul_add(
+                    -p.MZ6r,
+                    k128,
+                    A::mul_add(
+                        -p.MY6r,
+                        k130,
+                        A::mul_add(
+                            -k121,
+                            d151,
+                            A::mul_add(
+                                k123,
+                                d152,
+                                A::mul_add(
+                                    -p.XZ6r,
+                                    k122,
+                                    A::mul_add(p.XY6r, k115, p.XX6r * k124),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N6r|ud=0,g=0.x
+                let d154 = A::mul_add(
+                    p.MX6r,
+                    k130,
+                    A::mul_add(
+                        p.MZ6r,
+                        k131,
+                        A::mul_add(
+                            k120,
+                            d152,
+                            A::mul_add(
+                                k121,
+                                d150,
+                                A::mul_add(
+                                    -p.YZ6r,
+                                    k122,
+                                    A::mul_add(p.YY6r, k115, p.XY6r * k124),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N6r|ud=0,g=0.y
+                let d155 = A::mul_add(
+                    -p.MY6r,
+                    k131,
+                    A::mul_add(
+                        p.MX6r,
+                        k128,
+                        A::mul_add(
+                            -k123,
+                            d150,
+                            A::mul_add(
+                                -k120,
+                                d151,
+                                A::mul_add(
+                                    -p.ZZ6r,
+                                    k122,
+                                    A::mul_add(p.YZ6r, k115, p.XZ6r * k124),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N6r|ud=0,g=0.z
+                let k132 = A::mul_add(s_q4r, k121, c_q4r * k123); // w6r in 7r|ud=0,g=0.y
+                let k133 = A::mul_add(-c_q4r, k121, s_q4r * k123); // w6r in 7r|ud=0,g=0.z
+                let k134 = A::mul_add(
+                    -k133,
+                    qd4r,
+                    A::mul_add(-s_q4r, k122, c_q4r * k115),
+                ); // wd7r|ud=0,g=0.y
+                let k135 = A::mul_add(k132, qd4r, A::mul_add(c_q4r, k122, s_q4r * k115)); // wd7r|ud=0,g=0.z
+                let k136 = k120 + qd4r; // w7r|ud=0,g=0.x
+                let k137 = A::mul_add(-s_q4r, k130, c_q4r * k128); // a7r|ud=0,g=0.y
+                let k138 = A::mul_add(c_q4r, k130, s_q4r * k128); // a7r|ud=0,g=0.z
+                let d156 = A::mul_add(-p.MY7r, k133, p.MZ7r * k132); // w7rxMS7r|ud=0,g=0.x
+                let d157 = A::mul_add(p.MZ7r, k136, p.MX7r * k133); // w7rxMS7r|ud=0,g=0.y
+                let d158 = A::mul_add(p.MX7r, k132, p.MY7r * k136); // w7rxMS7r|ud=0,g=0.z
+                let d159 = A::mul_add(
+                    -k133,
+                    d157,
+                    A::mul_add(
+                        -k132,
+                        d158,
+                        A::mul_add(-p.MY7r, k135, A::mul_add(p.MZ7r, k134, p.m7r * k131)),
+                    ),
+                ); // F7r|ud=0,g=0.x
+                let d160 = A::mul_add(
+                    -k136,
+                    d158,
+                    A::mul_add(
+                        k133,
+                        d156,
+                        A::mul_add(-p.MZ7r, k124, A::mul_add(p.MX7r, k135, p.m7r * k137)),
+                    ),
+                ); // F7r|ud=0,g=0.y
+                let d161 = A::mul_add(
+                    -k132,
+                    d156,
+                    A::mul_add(
+                        -k136,
+                        d157,
+                        A::mul_add(-p.MX7r, k134, A::mul_add(p.MY7r, k124, p.m7r * k138)),
+                    ),
+                ); // F7r|ud=0,g=0.z
+                let d162 = A::mul_add(
+                    -p.XZ7r,
+                    k133,
+                    A::mul_add(-p.XY7r, k132, p.XX7r * k136),
+                ); // J7rw7r|ud=0,g=0.x
+                let d163 = A::mul_add(
+                    -p.YZ7r,
+                    k133,
+                    A::mul_add(-p.YY7r, k132, p.XY7r * k136),
+                ); // J7rw7r|ud=0,g=0.y
+                let d164 = A::mul_add(
+                    -p.ZZ7r,
+                    k133,
+                    A::mul_add(-p.YZ7r, k132, p.XZ7r * k136),
+                ); // J7rw7r|ud=0,g=0.z
+                let d165 = A::mul_add(
+                    -p.MZ7r,
+                    k137,
+                    A::mul_add(
+                        p.MY7r,
+                        k138,
+                        A::mul_add(
+                            k133,
+                            d163,
+                            A::mul_add(
+                                -k132,
+                                d164,
+                                A::mul_add(
+                                    p.XZ7r,
+                                    k135,
+                                    A::mul_add(p.XY7r, k134, p.XX7r * k124),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N7r|ud=0,g=0.x
+                let d166 = A::mul_add(
+                    -p.MX7r,
+                    k138,
+                    A::mul_add(
+                        p.MZ7r,
+                        k131,
+                        A::mul_add(
+                            -k136,
+                            d164,
+                            A::mul_add(
+                                -k133,
+                                d162,
+                                A::mul_add(
+                                    p.YZ7r,
+                                    k135,
+                                    A::mul_add(p.YY7r, k134, p.XY7r * k124),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N7r|ud=0,g=0.y
+                let d167 = A::mul_add(
+                    -p.MY7r,
+                    k131,
+                    A::mul_add(
+                        p.MX7r,
+                        k137,
+                        A::mul_add(
+                            k132,
+                            d162,
+                            A::mul_add(
+                                k136,
+                                d163,
+                                A::mul_add(
+                                    p.ZZ7r,
+                                    k135,
+                                    A::mul_add(p.YZ7r, k134, p.XZ7r * k124),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N7r|ud=0,g=0.z
+                let k139 = A::mul_add(s_q5r, k133, c_q5r * k136); // w7r in 8r|ud=0,g=0.x
+                let k140 = A::mul_add(-c_q5r, k133, s_q5r * k136); // w7r in 8r|ud=0,g=0.z
+                let k141 = A::mul_add(
+                    -k139,
+                    qd5r,
+                    A::mul_add(c_q5r, k135, s_q5r * k124),
+                ); // wd8r|ud=0,g=0.z
+                let k142 = k132 + qd5r; // w8r|ud=0,g=0.y
+                let k143 = A::mul_add(
+                    k140,
+                    qd5r,
+                    A::mul_add(-s_q5r, k135, c_q5r * k124),
+                ); // wd8r|ud=0,g=0.x
+                let k144 = p.L8 * k133; // w7rxP8r|ud=0,g=0.x
+                let k145 = p.L8 * k136; // w7rxP8r|ud=0,g=0.z
+                let k146 = A::mul_add(k132, k145, A::mul_add(p.L8, k135, k131)); // a8r in 7r|ud=0,g=0.x
+                let k147 = A::mul_add(k136, k145, A::mul_add(k133, k144, k137)); // a8r in 7r|ud=0,g=0.y
+                let k148 = A::mul_add(-k132, k144, A::mul_add(-p.L8, k124, k138)); // a8r in 7r|ud=0,g=0.z
+                let k149 = A::mul_add(c_q5r, k148, s_q5r * k146); // a8r|ud=0,g=0.z
+                let k150 = A::mul_add(-s_q5r, k148, c_q5r * k146); // a8r|ud=0,g=0.x
+                let d168 = A::mul_add(p.MX8r, k142, p.MY8r * k139); // w8rxMS8r|ud=0,g=0.z
+                let d169 = A::mul_add(-p.MY8r, k140, p.MZ8r * k142); // w8rxMS8r|ud=0,g=0.x
+                let d170 = A::mul_add(p.MZ8r, k139, p.MX8r * k140); // w8rxMS8r|ud=0,g=0.y
+                let d171 = A::mul_add(
+                    -k142,
+                    d169,
+                    A::mul_add(
+                        -k139,
+                        d170,
+                        A::mul_add(p.MX8r, k134, A::mul_add(-p.MY8r, k143, p.m8r * k149)),
+                    ),
+                ); // F8r|ud=0,g=0.z
+                let d172 = A::mul_add(
+                    k140,
+                    d170,
+                    A::mul_add(
+                        k142,
+                        d168,
+                        A::mul_add(p.MY8r, k141, A::mul_add(p.MZ8r, k134, p.m8r * k150)),
+                    ),
+                ); // F8r|ud=0,g=0.x
+                let d173 = A::mul_add(
+                    k139,
+                    d168,
+                    A::mul_add(
+                        -k140,
+                        d169,
+                        A::mul_add(
+                            -p.MZ8r,
+                            k143,
+                            A::mul_add(-p.MX8r, k141, p.m8r * k147),
+                        ),
+                    ),
+                ); // F8r|ud=0,g=0.y
+                let d174 = A::mul_add(
+                    -p.XZ8r,
+                    k140,
+                    A::mul_add(-p.XY8r, k142, p.XX8r * k139),
+                ); // J8rw8r|ud=0,g=0.x
+                let d175 = A::mul_add(
+                    -p.YZ8r,
+                    k140,
+                    A::mul_add(-p.YY8r, k142, p.XY8r * k139),
+                ); // J8rw8r|ud=0,g=0.y
+                let d176 = A::mul_add(
+                    -p.ZZ8r,
+                    k140,
+                    A::mul_add(-p.YZ8r, k142, p.XZ8r * k139),
+                ); // J8rw8r|ud=0,g=0.z
+                let d177 = A::mul_add(
+                    -p.MZ8r,
+                    k147,
+                    A::mul_add(
+                        -p.MY8r,
+                        k149,
+                        A::mul_add(
+                            -k140,
+                            d175,
+                            A::mul_add(
+                                k142,
+                                d176,
+                                A::mul_add(
+                                    -p.XZ8r,
+                                    k141,
+                                    A::mul_add(p.XY8r, k134, p.XX8r * k143),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8r|ud=0,g=0.x
+                let d178 = A::mul_add(
+                    p.MX8r,
+                    k149,
+                    A::mul_add(
+                        p.MZ8r,
+                        k150,
+                        A::mul_add(
+                            k139,
+                            d176,
+                            A::mul_add(
+                                k140,
+                                d174,
+                                A::mul_add(
+                                    -p.YZ8r,
+                                    k141,
+                                    A::mul_add(p.YY8r, k134, p.XY8r * k143),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8r|ud=0,g=0.y
+                let d179 = A::mul_add(
+                    -p.MY8r,
+                    k150,
+                    A::mul_add(
+                        p.MX8r,
+                        k147,
+                        A::mul_add(
+                            -k142,
+                            d174,
+                            A::mul_add(
+                                -k139,
+                                d175,
+                                A::mul_add(
+                                    -p.ZZ8r,
+                                    k141,
+                                    A::mul_add(p.YZ8r, k134, p.XZ8r * k143),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8r|ud=0,g=0.z
+                let k151 = A::mul_add(s_q6r, k140, c_q6r * k142); // w8r in 9r|ud=0,g=0.y
+                let k152 = A::mul_add(-c_q6r, k140, s_q6r * k142); // w8r in 9r|ud=0,g=0.z
+                let k153 = A::mul_add(
+                    -k152,
+                    qd6r,
+                    A::mul_add(-s_q6r, k141, c_q6r * k134),
+                ); // wd9r|ud=0,g=0.y
+                let k154 = A::mul_add(k151, qd6r, A::mul_add(c_q6r, k141, s_q6r * k134)); // wd9r|ud=0,g=0.z
+                let k155 = k139 + qd6r; // w9r|ud=0,g=0.x
+                let k156 = A::mul_add(-s_q6r, k149, c_q6r * k147); // a9r|ud=0,g=0.y
+                let k157 = A::mul_add(c_q6r, k149, s_q6r * k147); // a9r|ud=0,g=0.z
+                let d180 = A::mul_add(-p.MY9r, k152, p.MZ9r * k151); // w9rxMS9r|ud=0,g=0.x
+                let d181 = A::mul_add(p.MZ9r, k155, p.MX9r * k152); // w9rxMS9r|ud=0,g=0.y
+                let d182 = A::mul_add(p.MX9r, k151, p.MY9r * k155); // w9rxMS9r|ud=0,g=0.z
+                let d183 = A::mul_add(
+                    -k152,
+                    d181,
+                    A::mul_add(
+                        -k151,
+                        d182,
+                        A::mul_add(-p.MY9r, k154, A::mul_add(p.MZ9r, k153, p.m9r * k150)),
+                    ),
+                ); // F9r|ud=0,g=0.x
+                let d184 = A::mul_add(
+                    -k155,
+                    d182,
+                    A::mul_add(
+                        k152,
+                        d180,
+                        A::mul_add(-p.MZ9r, k143, A::mul_add(p.MX9r, k154, p.m9r * k156)),
+                    ),
+                ); // F9r|ud=0,g=0.y
+                let d185 = A::mul_add(
+                    -k151,
+                    d180,
+                    A::mul_add(
+                        -k155,
+                        d181,
+                        A::mul_add(-p.MX9r, k153, A::mul_add(p.MY9r, k143, p.m9r * k157)),
+                    ),
+                ); // F9r|ud=0,g=0.z
+                let d186 = A::mul_add(
+                    -p.XZ9r,
+                    k152,
+                    A::mul_add(-p.XY9r, k151, p.XX9r * k155),
+                ); // J9rw9r|ud=0,g=0.x
+                let d187 = A::mul_add(
+                    -p.YZ9r,
+                    k152,
+                    A::mul_add(-p.YY9r, k151, p.XY9r * k155),
+                ); // J9rw9r|ud=0,g=0.y
+                let d188 = A::mul_add(
+                    -p.ZZ9r,
+                    k152,
+                    A::mul_add(-p.YZ9r, k151, p.XZ9r * k155),
+                ); // J9rw9r|ud=0,g=0.z
+                let d189 = A::mul_add(
+                    -p.MZ9r,
+                    k156,
+                    A::mul_add(
+                        p.MY9r,
+                        k157,
+                        A::mul_add(
+                            k152,
+                            d187,
+                            A::mul_add(
+                                -k151,
+                                d188,
+                                A::mul_add(
+                                    p.XZ9r,
+                                    k154,
+                                    A::mul_add(p.XY9r, k153, p.XX9r * k143),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9r|ud=0,g=0.x
+                let d190 = A::mul_add(
+                    -p.MX9r,
+                    k157,
+                    A::mul_add(
+                        p.MZ9r,
+                        k150,
+                        A::mul_add(
+                            -k155,
+                            d188,
+                            A::mul_add(
+                                -k152,
+                                d186,
+                                A::mul_add(
+                                    p.YZ9r,
+                                    k154,
+                                    A::mul_add(p.YY9r, k153, p.XY9r * k143),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9r|ud=0,g=0.y
+                let d191 = A::mul_add(
+                    -p.MY9r,
+                    k150,
+                    A::mul_add(
+                        p.MX9r,
+                        k156,
+                        A::mul_add(
+                            k151,
+                            d186,
+                            A::mul_add(
+                                k155,
+                                d187,
+                                A::mul_add(
+                                    p.ZZ9r,
+                                    k154,
+                                    A::mul_add(p.YZ9r, k153, p.XZ9r * k143),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9r|ud=0,g=0.z
+                let k158 = A::mul_add(s_q7r, k152, c_q7r * k155); // w9r in 10r|ud=0,g=0.x
+                let k159 = A::mul_add(-c_q7r, k152, s_q7r * k155); // w9r in 10r|ud=0,g=0.y
+                let k160 = k151 + qd7r; // w10r|ud=0,g=0.z
+                let k161 = A::mul_add(
+                    k159,
+                    qd7r,
+                    A::mul_add(-s_q7r, k154, c_q7r * k143),
+                ); // wd10r|ud=0,g=0.x
+                let k162 = A::mul_add(
+                    -k158,
+                    qd7r,
+                    A::mul_add(c_q7r, k154, s_q7r * k143),
+                ); // wd10r|ud=0,g=0.y
+                let k163 = p.L9 * k152; // w9rxP10r|ud=0,g=0.x
+                let k164 = p.L9 * k155; // w9rxP10r|ud=0,g=0.z
+                let k165 = A::mul_add(k151, k164, A::mul_add(p.L9, k154, k150)); // a10r in 9r|ud=0,g=0.x
+                let k166 = A::mul_add(k155, k164, A::mul_add(k152, k163, k156)); // a10r in 9r|ud=0,g=0.y
+                let k167 = A::mul_add(-k151, k163, A::mul_add(-p.L9, k143, k157)); // a10r in 9r|ud=0,g=0.z
+                let k168 = A::mul_add(-s_q7r, k167, c_q7r * k165); // a10r|ud=0,g=0.x
+                let k169 = A::mul_add(c_q7r, k167, s_q7r * k165); // a10r|ud=0,g=0.y
+                let d192 = A::mul_add(p.MY10r, k160, p.MZ10r * k159); // w10rxMS10r|ud=0,g=0.x
+                let d193 = A::mul_add(-p.MX10r, k159, p.MY10r * k158); // w10rxMS10r|ud=0,g=0.z
+                let d194 = A::mul_add(p.MZ10r, k158, p.MX10r * k160); // w10rxMS10r|ud=0,g=0.y
+                let d195 = A::mul_add(
+                    k160,
+                    d194,
+                    A::mul_add(
+                        -k159,
+                        d193,
+                        A::mul_add(
+                            -p.MY10r,
+                            k153,
+                            A::mul_add(p.MZ10r, k162, p.m10r * k168),
+                        ),
+                    ),
+                ); // F10r|ud=0,g=0.x
+                let d196 = A::mul_add(
+                    k158,
+                    d193,
+                    A::mul_add(
+                        k160,
+                        d192,
+                        A::mul_add(
+                            -p.MZ10r,
+                            k161,
+                            A::mul_add(p.MX10r, k153, p.m10r * k169),
+                        ),
+                    ),
+                ); // F10r|ud=0,g=0.y
+                let d197 = A::mul_add(
+                    k159,
+                    d192,
+                    A::mul_add(
+                        k158,
+                        d194,
+                        A::mul_add(
+                            -p.MX10r,
+                            k162,
+                            A::mul_add(p.MY10r, k161, p.m10r * k166),
+                        ),
+                    ),
+                ); // F10r|ud=0,g=0.z
+                let d198 = A::mul_add(
+                    -p.XZ10r,
+                    k160,
+                    A::mul_add(p.XY10r, k159, p.XX10r * k158),
+                ); // J10rw10r|ud=0,g=0.x
+                let d199 = A::mul_add(
+                    -p.YZ10r,
+                    k160,
+                    A::mul_add(p.YY10r, k159, p.XY10r * k158),
+                ); // J10rw10r|ud=0,g=0.y
+                let d200 = A::mul_add(
+                    -p.ZZ10r,
+                    k160,
+                    A::mul_add(p.YZ10r, k159, p.XZ10r * k158),
+                ); // J10rw10r|ud=0,g=0.z
+                let d201 = A::mul_add(
+                    -p.MZ10r,
+                    k169,
+                    A::mul_add(
+                        p.MY10r,
+                        k166,
+                        A::mul_add(
+                            -k160,
+                            d199,
+                            A::mul_add(
+                                -k159,
+                                d200,
+                                A::mul_add(
+                                    p.XZ10r,
+                                    k153,
+                                    A::mul_add(p.XY10r, k162, p.XX10r * k161),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10r|ud=0,g=0.x
+                let d202 = A::mul_add(
+                    -p.MX10r,
+                    k166,
+                    A::mul_add(
+                        p.MZ10r,
+                        k168,
+                        A::mul_add(
+                            k158,
+                            d200,
+                            A::mul_add(
+                                k160,
+                                d198,
+                                A::mul_add(
+                                    p.YZ10r,
+                                    k153,
+                                    A::mul_add(p.YY10r, k162, p.XY10r * k161),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10r|ud=0,g=0.y
+                let d203 = A::mul_add(
+                    -p.MY10r,
+                    k168,
+                    A::mul_add(
+                        p.MX10r,
+                        k169,
+                        A::mul_add(
+                            k159,
+                            d198,
+                            A::mul_add(
+                                -k158,
+                                d199,
+                                A::mul_add(
+                                    p.ZZ10r,
+                                    k153,
+                                    A::mul_add(p.YZ10r, k162, p.XZ10r * k161),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10r|ud=0,g=0.z
+                m[18] = d203;
+                let d204 = A::mul_add(s_q7r, d196, c_q7r * d195); // f10r in 9r|ud=0,g=0.x
+                let d205 = A::mul_add(-c_q7r, d196, s_q7r * d195); // f10r in 9r|ud=0,g=0.z
+                let d206 = d183 + d204; // f9r|ud=0,g=0.x
+                let d207 = d184 + d197; // f9r|ud=0,g=0.y
+                let d208 = d185 - d205; // f9r|ud=0,g=0.z
+                let d209 = d190 + d203; // n9r|ud=0,g=0.y
+                let d210 = A::mul_add(
+                    p.L9,
+                    d205,
+                    A::mul_add(s_q7r, d202, A::mul_add(c_q7r, d201, d189)),
+                ); // n9r|ud=0,g=0.x
+                m[17] = -d210;
+                let d211 = A::mul_add(
+                    p.L9,
+                    d204,
+                    A::mul_add(c_q7r, d202, A::mul_add(-s_q7r, d201, d191)),
+                ); // n9r|ud=0,g=0.z
+                let d212 = A::mul_add(s_q6r, d208, c_q6r * d207); // f9r in 8r|ud=0,g=0.y
+                let d213 = A::mul_add(-c_q6r, d208, s_q6r * d207); // f9r in 8r|ud=0,g=0.z
+                let d214 = d171 - d213; // f8r|ud=0,g=0.z
+                let d215 = d172 + d206; // f8r|ud=0,g=0.x
+                let d216 = d173 + d212; // f8r|ud=0,g=0.y
+                let d217 = d177 + d210; // n8r|ud=0,g=0.x
+                let d218 = A::mul_add(s_q6r, d211, A::mul_add(c_q6r, d209, d178)); // n8r|ud=0,g=0.y
+                m[16] = d218;
+                let d219 = A::mul_add(-c_q6r, d211, A::mul_add(s_q6r, d209, d179)); // n8r|ud=0,g=0.z
+                let d220 = A::mul_add(s_q5r, d214, c_q5r * d215); // f8r in 7r|ud=0,g=0.x
+                let d221 = A::mul_add(-c_q5r, d214, s_q5r * d215); // f8r in 7r|ud=0,g=0.z
+                let d222 = d159 + d220; // f7r|ud=0,g=0.x
+                let d223 = d160 + d216; // f7r|ud=0,g=0.y
+                let d224 = d161 - d221; // f7r|ud=0,g=0.z
+                let d225 = d166 + d218; // n7r|ud=0,g=0.y
+                let d226 = A::mul_add(
+                    p.L8,
+                    d221,
+                    A::mul_add(-s_q5r, d219, A::mul_add(c_q5r, d217, d165)),
+                ); // n7r|ud=0,g=0.x
+                m[15] = -d226;
+                let d227 = A::mul_add(
+                    p.L8,
+                    d220,
+                    A::mul_add(-c_q5r, d219, A::mul_add(-s_q5r, d217, d167)),
+                ); // n7r|ud=0,g=0.z
+                let d228 = A::mul_add(s_q4r, d224, c_q4r * d223); // f7r in 6r|ud=0,g=0.y
+                let d229 = A::mul_add(-c_q4r, d224, s_q4r * d223); // f7r in 6r|ud=0,g=0.z
+                let d230 = d147 - d229; // f6r|ud=0,g=0.z
+                let d231 = d148 + d222; // f6r|ud=0,g=0.x
+                let d232 = d149 + d228; // f6r|ud=0,g=0.y
+                let d233 = d153 + d226; // n6r|ud=0,g=0.x
+                let d234 = A::mul_add(s_q4r, d227, A::mul_add(c_q4r, d225, d154)); // n6r|ud=0,g=0.y
+                m[14] = d234;
+                let d235 = A::mul_add(-c_q4r, d227, A::mul_add(s_q4r, d225, d155)); // n6r|ud=0,g=0.z
+                let d236 = A::mul_add(s_q3r, d230, c_q3r * d231); // f6r in 5r|ud=0,g=0.x
+                let d237 = A::mul_add(-c_q3r, d230, s_q3r * d231); // f6r in 5r|ud=0,g=0.z
+                let d238 = d135 + d236; // f5r|ud=0,g=0.x
+                let d239 = d136 + d232; // f5r|ud=0,g=0.y
+                let d240 = d137 - d237; // f5r|ud=0,g=0.z
+                let d241 = d142 + d234; // n5r|ud=0,g=0.y
+                let d242 = A::mul_add(
+                    p.L7,
+                    d237,
+                    A::mul_add(-s_q3r, d235, A::mul_add(c_q3r, d233, d141)),
+                ); // n5r|ud=0,g=0.x
+                m[13] = -d242;
+                let d243 = A::mul_add(
+                    p.L7,
+                    d236,
+                    A::mul_add(-c_q3r, d235, A::mul_add(-s_q3r, d233, d143)),
+                ); // n5r|ud=0,g=0.z
+                let d244 = A::mul_add(s_q2r, d240, c_q2r * d239); // f5r in 4r|ud=0,g=0.y
+                let d245 = A::mul_add(-c_q2r, d240, s_q2r * d239); // f5r in 4r|ud=0,g=0.z
+                let d246 = d123 - d245; // f4r|ud=0,g=0.z
+                let d247 = d124 + d238; // f4r|ud=0,g=0.x
+                let d248 = d125 + d244; // f4r|ud=0,g=0.y
+                let d249 = d129 + d242; // n4r|ud=0,g=0.x
+                let d250 = A::mul_add(s_q2r, d243, A::mul_add(c_q2r, d241, d130)); // n4r|ud=0,g=0.y
+                m[12] = d250;
+                let d251 = A::mul_add(-c_q2r, d243, A::mul_add(s_q2r, d241, d131)); // n4r|ud=0,g=0.z
+                let d252 = A::mul_add(s_q1r, d246, c_q1r * d247); // f4r in 3|ud=0,g=0.y
+                let d253 = A::mul_add(-c_q1r, d246, s_q1r * d247); // f4r in 3|ud=0,g=0.z
+                let d254 = d27 + d248; // f3|ud=0,g=0.x
+                let d255 = A::mul_add(-p.L5, d253, d33 + d250); // n3|ud=0,g=0.x
+                let d256 = A::mul_add(
+                    -p.L6,
+                    d253,
+                    A::mul_add(s_q1r, d251, A::mul_add(-c_q1r, d249, d34)),
+                ); // n3|ud=0,g=0.y
+                let d257 = A::mul_add(
+                    -p.L5,
+                    d248,
+                    A::mul_add(
+                        p.L6,
+                        d252,
+                        A::mul_add(-c_q1r, d251, A::mul_add(-s_q1r, d249, d35)),
+                    ),
+                ); // n3|ud=0,g=0.z
+                let d258 = d28 + d252; // f3|ud=0,g=0.y
+                let d259 = d29 + d253; // f3|ud=0,g=0.z
+                let d260 = A::mul_add(s_q7l, d113, c_q7l * d112); // f10l in 9l|ud=0,g=0.x
+                let d261 = A::mul_add(-c_q7l, d113, s_q7l * d112); // f10l in 9l|ud=0,g=0.z
+                let d262 = d99 + d260; // f9l|ud=0,g=0.x
+                let d263 = d106 + d119; // n9l|ud=0,g=0.y
+                let d264 = A::mul_add(
+                    p.L9,
+                    d261,
+                    A::mul_add(s_q7l, d118, A::mul_add(c_q7l, d117, d105)),
+                ); // n9l|ud=0,g=0.x
+                m[10] = -d264;
+                let d265 = A::mul_add(
+                    p.L9,
+                    d260,
+                    A::mul_add(c_q7l, d118, A::mul_add(-s_q7l, d117, d107)),
+                ); // n9l|ud=0,g=0.z
+                let d266 = d100 + d111; // f9l|ud=0,g=0.y
+                let d267 = d101 + d261; // f9l|ud=0,g=0.z
+                let d268 = A::mul_add(s_q6l, d267, c_q6l * d266); // f9l in 8l|ud=0,g=0.y
+                let d269 = A::mul_add(-c_q6l, d267, s_q6l * d266); // f9l in 8l|ud=0,g=0.z
+                let d270 = d87 + d268; // f8l|ud=0,g=0.y
+                let d271 = d88 + d269; // f8l|ud=0,g=0.z
+                let d272 = d89 + d262; // f8l|ud=0,g=0.x
+                let d273 = d93 + d264; // n8l|ud=0,g=0.x
+                let d274 = A::mul_add(s_q6l, d265, A::mul_add(c_q6l, d263, d94)); // n8l|ud=0,g=0.y
+                m[9] = d274;
+                let d275 = A::mul_add(-c_q6l, d265, A::mul_add(s_q6l, d263, d95)); // n8l|ud=0,g=0.z
+                let d276 = A::mul_add(s_q5l, d271, c_q5l * d272); // f8l in 7l|ud=0,g=0.x
+                let d277 = A::mul_add(-c_q5l, d271, s_q5l * d272); // f8l in 7l|ud=0,g=0.z
+                let d278 = d75 + d276; // f7l|ud=0,g=0.x
+                let d279 = d82 + d274; // n7l|ud=0,g=0.y
+                let d280 = A::mul_add(
+                    p.L8,
+                    d277,
+                    A::mul_add(-s_q5l, d275, A::mul_add(c_q5l, d273, d81)),
+                ); // n7l|ud=0,g=0.x
+                m[8] = -d280;
+                let d281 = A::mul_add(
+                    p.L8,
+                    d276,
+                    A::mul_add(-c_q5l, d275, A::mul_add(-s_q5l, d273, d83)),
+                ); // n7l|ud=0,g=0.z
+                let d282 = d76 + d270; // f7l|ud=0,g=0.y
+                let d283 = d77 + d277; // f7l|ud=0,g=0.z
+                let d284 = A::mul_add(s_q4l, d283, c_q4l * d282); // f7l in 6l|ud=0,g=0.y
+                let d285 = A::mul_add(-c_q4l, d283, s_q4l * d282); // f7l in 6l|ud=0,g=0.z
+                let d286 = d63 + d284; // f6l|ud=0,g=0.y
+                let d287 = d64 + d285; // f6l|ud=0,g=0.z
+                let d288 = d65 + d278; // f6l|ud=0,g=0.x
+                let d289 = d69 + d280; // n6l|ud=0,g=0.x
+                let d290 = A::mul_add(s_q4l, d281, A::mul_add(c_q4l, d279, d70)); // n6l|ud=0,g=0.y
+                m[7] = d290;
+                let d291 = A::mul_add(-c_q4l, d281, A::mul_add(s_q4l, d279, d71)); // n6l|ud=0,g=0.z
+                let d292 = A::mul_add(s_q3l, d287, c_q3l * d288); // f6l in 5l|ud=0,g=0.x
+                let d293 = A::mul_add(-c_q3l, d287, s_q3l * d288); // f6l in 5l|ud=0,g=0.z
+                let d294 = d51 + d292; // f5l|ud=0,g=0.x
+                let d295 = d58 + d290; // n5l|ud=0,g=0.y
+                let d296 = A::mul_add(
+                    p.L7,
+                    d293,
+                    A::mul_add(-s_q3l, d291, A::mul_add(c_q3l, d289, d57)),
+                ); // n5l|ud=0,g=0.x
+                m[6] = -d296;
+                let d297 = A::mul_add(
+                    p.L7,
+                    d292,
+                    A::mul_add(-c_q3l, d291, A::mul_add(-s_q3l, d289, d59)),
+                ); // n5l|ud=0,g=0.z
+                let d298 = d52 + d286; // f5l|ud=0,g=0.y
+                let d299 = d53 + d293; // f5l|ud=0,g=0.z
+                let d300 = A::mul_add(s_q2l, d299, c_q2l * d298); // f5l in 4l|ud=0,g=0.y
+                let d301 = A::mul_add(-c_q2l, d299, s_q2l * d298); // f5l in 4l|ud=0,g=0.z
+                let d302 = d39 + d300; // f4l|ud=0,g=0.y
+                let d303 = d40 + d301; // f4l|ud=0,g=0.z
+                let d304 = d41 + d294; // f4l|ud=0,g=0.x
+                let d305 = d45 + d296; // n4l|ud=0,g=0.x
+                let d306 = A::mul_add(s_q2l, d297, A::mul_add(c_q2l, d295, d46)); // n4l|ud=0,g=0.y
+                m[5] = d306;
+                let d307 = A::mul_add(-c_q2l, d297, A::mul_add(s_q2l, d295, d47)); // n4l|ud=0,g=0.z
+                let d308 = A::mul_add(-c_q1l, d303, s_q1l * d304); // f4l in 3|ud=0,g=0.z
+                let d309 = A::mul_add(s_q1l, d303, c_q1l * d304); // f4l in 3|ud=0,g=0.y
+                let d310 = d254 + d302; // f3|ud=0,g=0.x
+                let d311 = A::mul_add(p.L5, d308, d255 - d306); // n3|ud=0,g=0.x
+                let d312 = A::mul_add(
+                    -p.L6,
+                    d308,
+                    A::mul_add(s_q1l, d307, A::mul_add(-c_q1l, d305, d256)),
+                ); // n3|ud=0,g=0.y
+                m[4] = -d312;
+                let d313 = A::mul_add(
+                    -p.L5,
+                    d302,
+                    A::mul_add(
+                        -p.L6,
+                        d309,
+                        A::mul_add(c_q1l, d307, A::mul_add(s_q1l, d305, d257)),
+                    ),
+                ); // n3|ud=0,g=0.z
+                let d314 = d258 + d309; // f3|ud=0,g=0.y
+                let d315 = d259 - d308; // f3|ud=0,g=0.z
+                let d316 = A::mul_add(s_q_torso, d315, c_q_torso * d310); // f3 in 2|ud=0,g=0.x
+                let d317 = A::mul_add(-c_q_torso, d315, s_q_torso * d310); // f3 in 2|ud=0,g=0.z
+                let d318 = d15 + d316; // f2|ud=0,g=0.x
+                let d319 = d16 + d314; // f2|ud=0,g=0.y
+                let d320 = d17 + d317; // f2|ud=0,g=0.z
+                let d321 = A::mul_add(
+                    -p.L4,
+                    d314,
+                    A::mul_add(
+                        p.L3,
+                        d317,
+                        A::mul_add(-s_q_torso, d313, A::mul_add(c_q_torso, d311, d21)),
+                    ),
+                ); // n2|ud=0,g=0.x
+                m[3] = d321;
+                let d322 = A::mul_add(p.L4, d316, d22 - d312); // n2|ud=0,g=0.y
+                let d323 = A::mul_add(
+                    -p.L3,
+                    d316,
+                    A::mul_add(c_q_torso, d313, A::mul_add(s_q_torso, d311, d23)),
+                ); // n2|ud=0,g=0.z
+                let d324 = A::mul_add(-c_q_w, d320, s_q_w * d319); // f2 in 1|ud=0,g=0.z
+                let d325 = A::mul_add(s_q_w, d320, c_q_w * d319); // f2 in 1|ud=0,g=0.y
+                let d326 = d4 - d325; // f1|ud=0,g=0.y
+                let d327 = d5 + d324; // f1|ud=0,g=0.z
+                let d328 = A::mul_add(p.L2, d325, A::mul_add(-p.L1, d324, d9 + d321)); // n1|ud=0,g=0.x
+                m[2] = d328;
+                let d329 = A::mul_add(
+                    -p.L2,
+                    d318,
+                    A::mul_add(s_q_w, d323, A::mul_add(c_q_w, d322, d10)),
+                ); // n1|ud=0,g=0.y
+                let d330 = A::mul_add(
+                    -p.L1,
+                    d318,
+                    A::mul_add(c_q_w, d323, A::mul_add(-s_q_w, d322, d11)),
+                ); // n1|ud=0,g=0.z
+                let d331 = A::mul_add(-c_q_imu, d327, s_q_imu * d326); // f1 in 0|ud=0,g=0.x
+                m[0] = d331;
+                let d332 = A::mul_add(s_q_imu, d330, c_q_imu * d329); // n0|ud=0,g=0.z
+                m[1] = -d332;
+            }
+        }
+        kanegen_runtime::isa::dispatch_fused_with(
+            out,
             #[inline(always)]
-            || {
-                let q = kanegen_runtime::lanes::inputs(q);
-                let (s_q_imu, c_q_imu) = kanegen_runtime::lanes::sin_cos(q[2]);
-                let (s_q_w, c_q_w) = kanegen_runtime::lanes::sin_cos(q[3]);
-                let (s_q_torso, c_q_torso) = kanegen_runtime::lanes::sin_cos(q[4]);
-                let (s_q1l, c_q1l) = kanegen_runtime::lanes::sin_cos(q[5]);
-                let (s_q2l, c_q2l) = kanegen_runtime::lanes::sin_cos(q[6]);
-                let (s_q3l, c_q3l) = kanegen_runtime::lanes::sin_cos(q[7]);
-                let (s_q4l, c_q4l) = kanegen_runtime::lanes::sin_cos(q[8]);
-                let (s_q5l, c_q5l) = kanegen_runtime::lanes::sin_cos(q[9]);
-                let (s_q6l, c_q6l) = kanegen_runtime::lanes::sin_cos(q[10]);
-                let (s_q7l, c_q7l) = kanegen_runtime::lanes::sin_cos(q[11]);
-                let (s_q1r, c_q1r) = kanegen_runtime::lanes::sin_cos(q[12]);
-                let (s_q2r, c_q2r) = kanegen_runtime::lanes::sin_cos(q[13]);
-                let (s_q3r, c_q3r) = kanegen_runtime::lanes::sin_cos(q[14]);
-                let (s_q4r, c_q4r) = kanegen_runtime::lanes::sin_cos(q[15]);
-                let (s_q5r, c_q5r) = kanegen_runtime::lanes::sin_cos(q[16]);
-                let (s_q6r, c_q6r) = kanegen_runtime::lanes::sin_cos(q[17]);
-                let (s_q7r, c_q7r) = kanegen_runtime::lanes::sin_cos(q[18]);
-                #[allow(unused_mut)]
-                let mut buf = kanegen_runtime::lanes::buffer::<L, 19, 19>();
-                buf[0][0] = kanegen_runtime::lanes::lanes(pc.pc69);
-                buf[11][11] = kanegen_runtime::lanes::lanes(p.ZZ10l);
-                buf[18][18] = kanegen_runtime::lanes::lanes(p.ZZ10r);
-                let d1 = p.MX10r * s_q7r - p.MY10r * c_q7r;
-                let d2 = p.MX10r * c_q7r + p.MY10r * s_q7r;
-                let t1 = p.XZ10r * c_q7r;
-                let t2 = p.YZ10r * s_q7r;
-                let t3 = p.XZ10r * s_q7r;
-                let t4 = p.YZ10r * c_q7r;
-                let t5 = p.L9 * d2;
-                let t6 = p.L9 * d1;
-                let d3 = t1 + t2 - t5;
-                buf[18][17] = kanegen_runtime::lanes::lanes(-d3);
-                let d4 = t3 - t4 - t6;
-                let d5 = d2 * s_q6r;
-                let d6 = d2 * c_q6r;
-                let d7 = p.ZZ10r * c_q6r - d4 * s_q6r;
-                buf[18][16] = kanegen_runtime::lanes::lanes(d7);
-                let d8 = p.ZZ10r * s_q6r + d4 * c_q6r;
-                let d9 = d1 * c_q5r + d6 * s_q5r;
-                let d10 = d1 * s_q5r - d6 * c_q5r;
-                let d11 = d3 * c_q5r - d8 * s_q5r + p.L8 * d10;
-                buf[18][15] = kanegen_runtime::lanes::lanes(-d11);
-                let d12 = d3 * s_q5r + d8 * c_q5r - p.L8 * d9;
-                let d13 = d5 * c_q4r - d10 * s_q4r;
-                let d14 = d5 * s_q4r + d10 * c_q4r;
-                let d15 = d7 * c_q4r - d12 * s_q4r;
-                buf[18][14] = kanegen_runtime::lanes::lanes(d15);
-                let d16 = d7 * s_q4r + d12 * c_q4r;
-                let d17 = d9 * c_q3r - d14 * s_q3r;
-                let d18 = d9 * s_q3r + d14 * c_q3r;
-                let d19 = d11 * c_q3r - d16 * s_q3r + p.L7 * d18;
-                buf[18][13] = kanegen_runtime::lanes::lanes(-d19);
-                let d20 = d11 * s_q3r + d16 * c_q3r - p.L7 * d17;
-                let d21 = d13 * c_q2r - d18 * s_q2r;
-                let d22 = d13 * s_q2r + d18 * c_q2r;
-                let d23 = d15 * c_q2r - d20 * s_q2r;
-                buf[18][12] = kanegen_runtime::lanes::lanes(d23);
-                let d24 = d15 * s_q2r + d20 * c_q2r;
-                let d25 = d17 * c_q1r - d22 * s_q1r;
-                let d26 = d17 * s_q1r + d22 * c_q1r;
-                let d27 = d23 - p.L5 * d26;
-                let d28 = d19 * c_q1r - d24 * s_q1r + p.L6 * d26;
-                buf[18][4] = kanegen_runtime::lanes::lanes(d28);
-                let d29 = d19 * s_q1r + d24 * c_q1r - p.L6 * d25 + d21 * p.L5;
-                let d30 = d21 * c_q_torso + d26 * s_q_torso;
-                let d31 = d21 * s_q_torso - d26 * c_q_torso;
-                let d32 = d27 * c_q_torso + d29 * s_q_torso + p.L3 * d31 - d25 * p.L4;
-                buf[18][3] = kanegen_runtime::lanes::lanes(d32);
-                let d33 = d28 + p.L4 * d30;
-                let d34 = d27 * s_q_torso - d29 * c_q_torso - p.L3 * d30;
-                let d35 = d25 * s_q_w - d31 * c_q_w;
-                let d36 = d25 * c_q_w + d31 * s_q_w;
-                let d37 = d33 * s_q_w - d34 * c_q_w + d30 * p.L1;
-                let d38 = d32 - p.L1 * d35 + p.L2 * d36;
-                buf[18][2] = kanegen_runtime::lanes::lanes(d38);
-                let d39 = d33 * c_q_w + d34 * s_q_w - d30 * p.L2;
-                let d40 = d36 * s_q_imu + d35 * c_q_imu;
-                buf[18][0] = kanegen_runtime::lanes::lanes(-d40);
-                let d41 = d39 * c_q_imu - d37 * s_q_imu;
-                buf[18][1] = kanegen_runtime::lanes::lanes(-d41);
-                let d42 = p.MX9r - d2;
-                let d43 = p.MZ9r + d1;
-                let k1 = s_q7r * s_q7r;
-                let k2 = s_q7r * c_q7r;
-                let k3 = 2.0 * k1 - 1.0;
-                let d44 = k1 * pc.pc3 - 2.0 * (p.XY10r * k2);
-                let d45 = p.XY9r + t1 + t2 - t5;
-                let d46 = p.XZ9r - p.XY10r * k3 - k2 * pc.pc3;
-                let d47 = p.YZ9r - t3 + t4 + t6;
-                let d48 = pc.pc7 - d44;
-                buf[17][17] = kanegen_runtime::lanes::lanes(d48);
-                let d49 = d44 + pc.pc8;
-                let d50 = c_q6r * pc.pc2 + s_q6r * d43;
-                let d51 = s_q6r * pc.pc2 - c_q6r * d43;
-                let t7 = c_q6r * d45;
-                let t8 = s_q6r * d46;
-                let d52 = t7 + t8;
-                buf[17][16] = kanegen_runtime::lanes::lanes(-d52);
-                let t9 = s_q6r * d45;
-                let t10 = c_q6r * d46;
-                let d53 = t9 - t10;
-                let d54 = s_q5r * d50;
-                let d55 = c_q5r * d50;
-                let d56 = s_q5r * d48 + c_q5r * d53 - p.L8 * d54;
-                let d57 = c_q5r * d48 - s_q5r * d53 - p.L8 * d55;
-                buf[17][15] = kanegen_runtime::lanes::lanes(d57);
-                let d58 = c_q4r * d51 + s_q4r * d55;
-                let d59 = s_q4r * d51 - c_q4r * d55;
-                let d60 = c_q4r * d52 - s_q4r * d56;
-                buf[17][14] = kanegen_runtime::lanes::lanes(-d60);
-                let d61 = s_q4r * d52 + c_q4r * d56;
-                let d62 = s_q3r * d54 + c_q3r * d59;
-                let d63 = c_q3r * d54 - s_q3r * d59;
-                let d64 = s_q3r * d57 + c_q3r * d61 - p.L7 * d63;
-                let d65 = c_q3r * d57 - s_q3r * d61 + p.L7 * d62;
-                buf[17][13] = kanegen_runtime::lanes::lanes(d65);
-                let d66 = c_q2r * d58 - s_q2r * d62;
-                let d67 = s_q2r * d58 + c_q2r * d62;
-                let d68 = c_q2r * d60 - s_q2r * d64;
-                buf[17][12] = kanegen_runtime::lanes::lanes(-d68);
-                let d69 = s_q2r * d60 + c_q2r * d64;
-                let d70 = c_q1r * d63 - s_q1r * d67;
-                let d71 = s_q1r * d63 + c_q1r * d67;
-                let d72 = c_q1r * d65 - s_q1r * d69 + p.L6 * d71;
-                buf[17][4] = kanegen_runtime::lanes::lanes(-d72);
-                let d73 = s_q1r * d65 + c_q1r * d69 - p.L6 * d70 + p.L5 * d66;
-                let d74 = d68 - p.L5 * d71;
-                let d75 = c_q_torso * d66 + s_q_torso * d71;
-                let d76 = s_q_torso * d66 - c_q_torso * d71;
-                let d77 = c_q_torso * d74 + s_q_torso * d73 + p.L3 * d76 - p.L4 * d70;
-                buf[17][3] = kanegen_runtime::lanes::lanes(-d77);
-                let d78 = d72 + p.L4 * d75;
-                let d79 = s_q_torso * d74 - c_q_torso * d73 - p.L3 * d75;
-                let d80 = c_q_w * d70 + s_q_w * d76;
-                let d81 = s_q_w * d70 - c_q_w * d76;
-                let d82 = d77 - p.L1 * d81 + p.L2 * d80;
-                buf[17][2] = kanegen_runtime::lanes::lanes(-d82);
-                let d83 = c_q_w * d78 + s_q_w * d79 - p.L2 * d75;
-                let d84 = s_q_w * d78 - c_q_w * d79 + p.L1 * d75;
-                let d85 = s_q_imu * d80 + c_q_imu * d81;
-                buf[17][0] = kanegen_runtime::lanes::lanes(d85);
-                let d86 = c_q_imu * d83 - s_q_imu * d84;
-                buf[17][1] = kanegen_runtime::lanes::lanes(d86);
-                let d87 = p.MX8r - d42;
-                let d88 = p.MY8r - d50;
-                let d89 = p.MZ8r - d51;
-                let k4 = s_q6r * s_q6r;
-                let k5 = s_q6r * c_q6r;
-                let k6 = 2.0 * k4 - 1.0;
-                let d90 = pc.pc6 - d49;
-                let d91 = k4 * d90 - 2.0 * (d47 * k5);
-                let d92 = p.XX8r + d48;
-                let d93 = p.XY8r + t7 + t8;
-                let d94 = p.XZ8r + t9 - t10;
-                let d95 = p.YZ8r + d47 * k6 + k5 * d90;
-                let d96 = p.ZZ8r + d49 + d91;
-                let d97 = pc.pc10 - d91;
-                buf[16][16] = kanegen_runtime::lanes::lanes(d97);
-                let d98 = s_q5r * d87 + c_q5r * d89;
-                let d99 = c_q5r * d87 - s_q5r * d89;
-                let t11 = c_q5r * d93;
-                let t12 = s_q5r * d95;
-                let t13 = s_q5r * d93;
-                let t14 = c_q5r * d95;
-                let t15 = p.L8 * d99;
-                let t16 = p.L8 * d98;
-                let d100 = t11 - t12 - t15;
-                buf[16][15] = kanegen_runtime::lanes::lanes(-d100);
-                let d101 = t13 + t14 - t16;
-                let d102 = s_q4r * d99;
-                let d103 = c_q4r * d99;
-                let d104 = c_q4r * d97 - s_q4r * d101;
-                buf[16][14] = kanegen_runtime::lanes::lanes(d104);
-                let d105 = s_q4r * d97 + c_q4r * d101;
-                let d106 = c_q3r * d98 + s_q3r * d103;
-                let d107 = s_q3r * d98 - c_q3r * d103;
-                let d108 = c_q3r * d100 - s_q3r * d105 + p.L7 * d107;
-                buf[16][13] = kanegen_runtime::lanes::lanes(-d108);
-                let d109 = s_q3r * d100 + c_q3r * d105 - p.L7 * d106;
-                let d110 = c_q2r * d102 - s_q2r * d107;
-                let d111 = s_q2r * d102 + c_q2r * d107;
-                let d112 = c_q2r * d104 - s_q2r * d109;
-                buf[16][12] = kanegen_runtime::lanes::lanes(d112);
-                let d113 = s_q2r * d104 + c_q2r * d109;
-                let d114 = c_q1r * d106 - s_q1r * d111;
-                let d115 = s_q1r * d106 + c_q1r * d111;
-                let d116 = d112 - p.L5 * d115;
-                let d117 = c_q1r * d108 - s_q1r * d113 + p.L6 * d115;
-                buf[16][4] = kanegen_runtime::lanes::lanes(d117);
-                let d118 = s_q1r * d108 + c_q1r * d113 - p.L6 * d114 + p.L5 * d110;
-                let d119 = c_q_torso * d110 + s_q_torso * d115;
-                let d120 = s_q_torso * d110 - c_q_torso * d115;
-                let d121 = c_q_torso * d116 + s_q_torso * d118 + p.L3 * d120
-                    - p.L4 * d114;
-                buf[16][3] = kanegen_runtime::lanes::lanes(d121);
-                let d122 = d117 + p.L4 * d119;
-                let d123 = s_q_torso * d116 - c_q_torso * d118 - p.L3 * d119;
-                let d124 = s_q_w * d114 - c_q_w * d120;
-                let d125 = c_q_w * d114 + s_q_w * d120;
-                let d126 = s_q_w * d122 - c_q_w * d123 + p.L1 * d119;
-                let d127 = d121 - p.L1 * d124 + p.L2 * d125;
-                buf[16][2] = kanegen_runtime::lanes::lanes(d127);
-                let d128 = c_q_w * d122 + s_q_w * d123 - p.L2 * d119;
-                let d129 = s_q_imu * d125 + c_q_imu * d124;
-                buf[16][0] = kanegen_runtime::lanes::lanes(-d129);
-                let d130 = c_q_imu * d128 - s_q_imu * d126;
-                buf[16][1] = kanegen_runtime::lanes::lanes(-d130);
-                let d131 = p.MX7r - d99;
-                let d132 = p.MZ7r + d98;
-                let k7 = s_q5r * s_q5r;
-                let k8 = s_q5r * c_q5r;
-                let k9 = 2.0 * k7 - 1.0;
-                let d133 = d92 - d96;
-                let d134 = k7 * d133 + 2.0 * (d94 * k8);
-                let t17 = p.L8 * d88;
-                let d135 = p.XY7r + t11 - t12 - t15;
-                let d136 = p.XZ7r + d94 * k9 - k8 * d133;
-                let d137 = p.YY7r + d97;
-                let d138 = p.YZ7r - t13 - t14 + t16;
-                let d139 = pc.pc13 - d88;
-                let d140 = d92 - d134 + 2.0 * t17 + pc.pc14;
-                buf[15][15] = kanegen_runtime::lanes::lanes(d140);
-                let d141 = d96 + d134 + 2.0 * t17 + pc.pc15;
-                let d142 = c_q4r * d139 + s_q4r * d132;
-                let d143 = s_q4r * d139 - c_q4r * d132;
-                let t18 = c_q4r * d135;
-                let t19 = s_q4r * d136;
-                let d144 = t18 + t19;
-                buf[15][14] = kanegen_runtime::lanes::lanes(-d144);
-                let t20 = s_q4r * d135;
-                let t21 = c_q4r * d136;
-                let d145 = t20 - t21;
-                let d146 = s_q3r * d142;
-                let d147 = c_q3r * d142;
-                let d148 = s_q3r * d140 + c_q3r * d145 - p.L7 * d146;
-                let d149 = c_q3r * d140 - s_q3r * d145 - p.L7 * d147;
-                buf[15][13] = kanegen_runtime::lanes::lanes(d149);
-                let d150 = c_q2r * d143 + s_q2r * d147;
-                let d151 = s_q2r * d143 - c_q2r * d147;
-                let d152 = c_q2r * d144 - s_q2r * d148;
-                buf[15][12] = kanegen_runtime::lanes::lanes(-d152);
-                let d153 = s_q2r * d144 + c_q2r * d148;
-                let d154 = c_q1r * d146 - s_q1r * d151;
-                let d155 = s_q1r * d146 + c_q1r * d151;
-                let d156 = c_q1r * d149 - s_q1r * d153 + p.L6 * d155;
-                buf[15][4] = kanegen_runtime::lanes::lanes(-d156);
-                let d157 = s_q1r * d149 + c_q1r * d153 - p.L6 * d154 + p.L5 * d150;
-                let d158 = d152 - p.L5 * d155;
-                let d159 = c_q_torso * d150 + s_q_torso * d155;
-                let d160 = s_q_torso * d150 - c_q_torso * d155;
-                let d161 = c_q_torso * d158 + s_q_torso * d157 + p.L3 * d160
-                    - p.L4 * d154;
-                buf[15][3] = kanegen_runtime::lanes::lanes(-d161);
-                let d162 = d156 + p.L4 * d159;
-                let d163 = s_q_torso * d158 - c_q_torso * d157 - p.L3 * d159;
-                let d164 = c_q_w * d154 + s_q_w * d160;
-                let d165 = s_q_w * d154 - c_q_w * d160;
-                let d166 = d161 - p.L1 * d165 + p.L2 * d164;
-                buf[15][2] = kanegen_runtime::lanes::lanes(-d166);
-                let d167 = c_q_w * d162 + s_q_w * d163 - p.L2 * d159;
-                let d168 = s_q_w * d162 - c_q_w * d163 + p.L1 * d159;
-                let d169 = s_q_imu * d164 + c_q_imu * d165;
-                buf[15][0] = kanegen_runtime::lanes::lanes(d169);
-                let d170 = c_q_imu * d167 - s_q_imu * d168;
-                buf[15][1] = kanegen_runtime::lanes::lanes(d170);
-                let d171 = p.MX6r - d131;
-                let d172 = p.MY6r - d142;
-                let d173 = p.MZ6r - d143;
-                let k10 = s_q4r * s_q4r;
-                let k11 = s_q4r * c_q4r;
-                let k12 = 2.0 * k10 - 1.0;
-                let d174 = d137 - d141;
-                let d175 = k10 * d174 - 2.0 * (d138 * k11);
-                let d176 = p.XX6r + d140;
-                let d177 = p.XY6r + t18 + t19;
-                let d178 = p.XZ6r + t20 - t21;
-                let d179 = p.YY6r + d137 - d175;
-                buf[14][14] = kanegen_runtime::lanes::lanes(d179);
-                let d180 = p.YZ6r + d138 * k12 + k11 * d174;
-                let d181 = p.ZZ6r + d141 + d175;
-                let d182 = s_q3r * d171 + c_q3r * d173;
-                let d183 = c_q3r * d171 - s_q3r * d173;
-                let t22 = c_q3r * d177;
-                let t23 = s_q3r * d180;
-                let t24 = s_q3r * d177;
-                let t25 = c_q3r * d180;
-                let t26 = p.L7 * d183;
-                let t27 = p.L7 * d182;
-                let d184 = t22 - t23 - t26;
-                buf[14][13] = kanegen_runtime::lanes::lanes(-d184);
-                let d185 = t24 + t25 - t27;
-                let d186 = s_q2r * d183;
-                let d187 = c_q2r * d183;
-                let d188 = c_q2r * d179 - s_q2r * d185;
-                buf[14][12] = kanegen_runtime::lanes::lanes(d188);
-                let d189 = s_q2r * d179 + c_q2r * d185;
-                let d190 = c_q1r * d182 + s_q1r * d187;
-                let d191 = s_q1r * d182 - c_q1r * d187;
-                let d192 = d188 - p.L5 * d191;
-                let d193 = c_q1r * d184 - s_q1r * d189 + p.L6 * d191;
-                buf[14][4] = kanegen_runtime::lanes::lanes(d193);
-                let d194 = s_q1r * d184 + c_q1r * d189 - p.L6 * d190 + p.L5 * d186;
-                let d195 = c_q_torso * d186 + s_q_torso * d191;
-                let d196 = s_q_torso * d186 - c_q_torso * d191;
-                let d197 = c_q_torso * d192 + s_q_torso * d194 + p.L3 * d196
-                    - p.L4 * d190;
-                buf[14][3] = kanegen_runtime::lanes::lanes(d197);
-                let d198 = d193 + p.L4 * d195;
-                let d199 = s_q_torso * d192 - c_q_torso * d194 - p.L3 * d195;
-                let d200 = s_q_w * d190 - c_q_w * d196;
-                let d201 = c_q_w * d190 + s_q_w * d196;
-                let d202 = s_q_w * d198 - c_q_w * d199 + p.L1 * d195;
-                let d203 = d197 - p.L1 * d200 + p.L2 * d201;
-                buf[14][2] = kanegen_runtime::lanes::lanes(d203);
-                let d204 = c_q_w * d198 + s_q_w * d199 - p.L2 * d195;
-                let d205 = s_q_imu * d201 + c_q_imu * d200;
-                buf[14][0] = kanegen_runtime::lanes::lanes(-d205);
-                let d206 = c_q_imu * d204 - s_q_imu * d202;
-                buf[14][1] = kanegen_runtime::lanes::lanes(-d206);
-                let d207 = p.MX5r - d183;
-                let d208 = p.MZ5r + d182;
-                let k13 = s_q3r * s_q3r;
-                let k14 = s_q3r * c_q3r;
-                let k15 = 2.0 * k13 - 1.0;
-                let d209 = d176 - d181;
-                let d210 = k13 * d209 + 2.0 * (d178 * k14);
-                let t28 = p.L7 * d172;
-                let d211 = p.XY5r + t22 - t23 - t26;
-                let d212 = p.XZ5r + d178 * k15 - k14 * d209;
-                let d213 = p.YY5r + d179;
-                let d214 = p.YZ5r - t24 - t25 + t27;
-                let d215 = pc.pc19 - d172;
-                let d216 = d176 - d210 + 2.0 * t28 + pc.pc20;
-                buf[13][13] = kanegen_runtime::lanes::lanes(d216);
-                let d217 = d181 + d210 + 2.0 * t28 + pc.pc21;
-                let d218 = c_q2r * d215 + s_q2r * d208;
-                let d219 = s_q2r * d215 - c_q2r * d208;
-                let t29 = c_q2r * d211;
-                let t30 = s_q2r * d212;
-                let d220 = t29 + t30;
-                buf[13][12] = kanegen_runtime::lanes::lanes(-d220);
-                let t31 = s_q2r * d211;
-                let t32 = c_q2r * d212;
-                let d221 = t31 - t32;
-                let d222 = s_q1r * d218;
-                let d223 = c_q1r * d218;
-                let d224 = c_q1r * d216 - s_q1r * d221 - p.L6 * d223;
-                buf[13][4] = kanegen_runtime::lanes::lanes(-d224);
-                let d225 = s_q1r * d216 + c_q1r * d221 - p.L6 * d222 + p.L5 * d219;
-                let d226 = d220 + p.L5 * d223;
-                let d227 = c_q_torso * d219 - s_q_torso * d223;
-                let d228 = s_q_torso * d219 + c_q_torso * d223;
-                let d229 = c_q_torso * d226 + s_q_torso * d225 + p.L3 * d228
-                    - p.L4 * d222;
-                buf[13][3] = kanegen_runtime::lanes::lanes(-d229);
-                let d230 = d224 + p.L4 * d227;
-                let d231 = s_q_torso * d226 - c_q_torso * d225 - p.L3 * d227;
-                let d232 = c_q_w * d222 + s_q_w * d228;
-                let d233 = s_q_w * d222 - c_q_w * d228;
-                let d234 = d229 - p.L1 * d233 + p.L2 * d232;
-                buf[13][2] = kanegen_runtime::lanes::lanes(-d234);
-                let d235 = c_q_w * d230 + s_q_w * d231 - p.L2 * d227;
-                let d236 = s_q_w * d230 - c_q_w * d231 + p.L1 * d227;
-                let d237 = s_q_imu * d232 + c_q_imu * d233;
-                buf[13][0] = kanegen_runtime::lanes::lanes(d237);
-                let d238 = c_q_imu * d235 - s_q_imu * d236;
-                buf[13][1] = kanegen_runtime::lanes::lanes(d238);
-                let d239 = p.MX4r - d207;
-                let d240 = p.MY4r - d218;
-                let d241 = p.MZ4r - d219;
-                let k16 = s_q2r * s_q2r;
-                let k17 = s_q2r * c_q2r;
-                let k18 = 2.0 * k16 - 1.0;
-                let d242 = d213 - d217;
-                let d243 = k16 * d242 - 2.0 * (d214 * k17);
-                let d244 = p.XX4r + d216;
-                let d245 = p.XY4r + t29 + t30;
-                let d246 = p.XZ4r + t31 - t32;
-                let d247 = p.YY4r + d213 - d243;
-                buf[12][12] = kanegen_runtime::lanes::lanes(d247);
-                let d248 = p.YZ4r + d214 * k18 + k17 * d242;
-                let d249 = p.ZZ4r + d217 + d243;
-                let d250 = c_q1r * d239 - s_q1r * d241;
-                let d251 = s_q1r * d239 + c_q1r * d241;
-                let t33 = c_q1r * d245;
-                let t34 = s_q1r * d248;
-                let t35 = s_q1r * d245;
-                let t36 = c_q1r * d248;
-                let t37 = p.L5 * d250;
-                let t38 = p.L6 * d250;
-                let t39 = p.L6 * d251;
-                let d252 = d247 + t37;
-                let d253 = t33 - t34 - t38;
-                buf[12][4] = kanegen_runtime::lanes::lanes(d253);
-                let d254 = t35 + t36 - t39;
-                let d255 = s_q_torso * d250;
-                let d256 = c_q_torso * d250;
-                let d257 = c_q_torso * d252 + s_q_torso * d254 + p.L3 * d256
-                    - p.L4 * d251;
-                buf[12][3] = kanegen_runtime::lanes::lanes(d257);
-                let d258 = d253 - p.L4 * d255;
-                let d259 = s_q_torso * d252 - c_q_torso * d254 + p.L3 * d255;
-                let d260 = s_q_w * d251 - c_q_w * d256;
-                let d261 = c_q_w * d251 + s_q_w * d256;
-                let d262 = s_q_w * d258 - c_q_w * d259 - p.L1 * d255;
-                let d263 = d257 - p.L1 * d260 + p.L2 * d261;
-                buf[12][2] = kanegen_runtime::lanes::lanes(d263);
-                let d264 = c_q_w * d258 + s_q_w * d259 + p.L2 * d255;
-                let d265 = s_q_imu * d261 + c_q_imu * d260;
-                buf[12][0] = kanegen_runtime::lanes::lanes(-d265);
-                let d266 = c_q_imu * d264 - s_q_imu * d262;
-                buf[12][1] = kanegen_runtime::lanes::lanes(-d266);
-                let k19 = s_q1r * s_q1r;
-                let k20 = s_q1r * c_q1r;
-                let k21 = 2.0 * k19 - 1.0;
-                let d267 = d244 - d249;
-                let d268 = k19 * d267 + 2.0 * (d246 * k20);
-                let t40 = p.L6 * d240;
-                let d269 = p.MX10l * s_q7l - p.MY10l * c_q7l;
-                let d270 = p.MX10l * c_q7l + p.MY10l * s_q7l;
-                let t41 = p.XZ10l * c_q7l;
-                let t42 = p.YZ10l * s_q7l;
-                let t43 = p.XZ10l * s_q7l;
-                let t44 = p.YZ10l * c_q7l;
-                let t45 = p.L9 * d270;
-                let t46 = p.L9 * d269;
-                let d271 = t41 + t42 - t45;
-                buf[11][10] = kanegen_runtime::lanes::lanes(-d271);
-                let d272 = t43 - t44 - t46;
-                let d273 = d270 * s_q6l;
-                let d274 = d270 * c_q6l;
-                let d275 = p.ZZ10l * c_q6l - d272 * s_q6l;
-                buf[11][9] = kanegen_runtime::lanes::lanes(d275);
-                let d276 = p.ZZ10l * s_q6l + d272 * c_q6l;
-                let d277 = d269 * c_q5l + d274 * s_q5l;
-                let d278 = d269 * s_q5l - d274 * c_q5l;
-                let d279 = d271 * c_q5l - d276 * s_q5l + p.L8 * d278;
-                buf[11][8] = kanegen_runtime::lanes::lanes(-d279);
-                let d280 = d271 * s_q5l + d276 * c_q5l - p.L8 * d277;
-                let d281 = d273 * c_q4l - d278 * s_q4l;
-                let d282 = d273 * s_q4l + d278 * c_q4l;
-                let d283 = d275 * c_q4l - d280 * s_q4l;
-                buf[11][7] = kanegen_runtime::lanes::lanes(d283);
-                let d284 = d275 * s_q4l + d280 * c_q4l;
-                let d285 = d277 * c_q3l - d282 * s_q3l;
-                let d286 = d277 * s_q3l + d282 * c_q3l;
-                let d287 = d279 * c_q3l - d284 * s_q3l + p.L7 * d286;
-                buf[11][6] = kanegen_runtime::lanes::lanes(-d287);
-                let d288 = d279 * s_q3l + d284 * c_q3l - p.L7 * d285;
-                let d289 = d281 * c_q2l - d286 * s_q2l;
-                let d290 = d281 * s_q2l + d286 * c_q2l;
-                let d291 = d283 * c_q2l - d288 * s_q2l;
-                buf[11][5] = kanegen_runtime::lanes::lanes(d291);
-                let d292 = d283 * s_q2l + d288 * c_q2l;
-                let d293 = d285 * s_q1l + d290 * c_q1l;
-                let d294 = d285 * c_q1l - d290 * s_q1l;
-                let d295 = d287 * s_q1l + d292 * c_q1l - p.L6 * d294 + p.L5 * d289;
-                let d296 = d291 - p.L5 * d293;
-                let d297 = d287 * c_q1l - d292 * s_q1l + p.L6 * d293;
-                buf[11][4] = kanegen_runtime::lanes::lanes(d297);
-                let d298 = c_q_torso * d289 + s_q_torso * d293;
-                let d299 = s_q_torso * d289 - c_q_torso * d293;
-                let d300 = c_q_torso * d296 + s_q_torso * d295 + p.L3 * d299
-                    + p.L4 * d294;
-                buf[11][3] = kanegen_runtime::lanes::lanes(-d300);
-                let d301 = s_q_torso * d296 - c_q_torso * d295 - p.L3 * d298;
-                let d302 = d297 - p.L4 * d298;
-                let d303 = s_q_w * d294 + c_q_w * d299;
-                let d304 = c_q_w * d294 - s_q_w * d299;
-                let d305 = d300 + p.L1 * d303 - p.L2 * d304;
-                buf[11][2] = kanegen_runtime::lanes::lanes(-d305);
-                let d306 = s_q_w * d302 + c_q_w * d301 - p.L1 * d298;
-                let d307 = c_q_w * d302 - s_q_w * d301 + p.L2 * d298;
-                let d308 = s_q_imu * d304 + c_q_imu * d303;
-                buf[11][0] = kanegen_runtime::lanes::lanes(-d308);
-                let d309 = c_q_imu * d307 - s_q_imu * d306;
-                buf[11][1] = kanegen_runtime::lanes::lanes(-d309);
-                let d310 = p.MX9l - d270;
-                let d311 = p.MZ9l + d269;
-                let k22 = s_q7l * s_q7l;
-                let k23 = s_q7l * c_q7l;
-                let k24 = 2.0 * k22 - 1.0;
-                let d312 = k22 * pc.pc26 - 2.0 * (p.XY10l * k23);
-                let d313 = p.XY9l + t41 + t42 - t45;
-                let d314 = p.XZ9l - p.XY10l * k24 - k23 * pc.pc26;
-                let d315 = p.YZ9l - t43 + t44 + t46;
-                let d316 = pc.pc30 - d312;
-                buf[10][10] = kanegen_runtime::lanes::lanes(d316);
-                let d317 = d312 + pc.pc31;
-                let d318 = c_q6l * pc.pc25 + s_q6l * d311;
-                let d319 = s_q6l * pc.pc25 - c_q6l * d311;
-                let t47 = c_q6l * d313;
-                let t48 = s_q6l * d314;
-                let d320 = t47 + t48;
-                buf[10][9] = kanegen_runtime::lanes::lanes(-d320);
-                let t49 = s_q6l * d313;
-                let t50 = c_q6l * d314;
-                let d321 = t49 - t50;
-                let d322 = s_q5l * d318;
-                let d323 = c_q5l * d318;
-                let d324 = s_q5l * d316 + c_q5l * d321 - p.L8 * d322;
-                let d325 = c_q5l * d316 - s_q5l * d321 - p.L8 * d323;
-                buf[10][8] = kanegen_runtime::lanes::lanes(d325);
-                let d326 = c_q4l * d319 + s_q4l * d323;
-                let d327 = s_q4l * d319 - c_q4l * d323;
-                let d328 = c_q4l * d320 - s_q4l * d324;
-                buf[10][7] = kanegen_runtime::lanes::lanes(-d328);
-                let d329 = s_q4l * d320 + c_q4l * d324;
-                let d330 = s_q3l * d322 + c_q3l * d327;
-                let d331 = c_q3l * d322 - s_q3l * d327;
-                let d332 = s_q3l * d325 + c_q3l * d329 - p.L7 * d331;
-                let d333 = c_q3l * d325 - s_q3l * d329 + p.L7 * d330;
-                buf[10][6] = kanegen_runtime::lanes::lanes(d333);
-                let d334 = c_q2l * d326 - s_q2l * d330;
-                let d335 = s_q2l * d326 + c_q2l * d330;
-                let d336 = c_q2l * d328 - s_q2l * d332;
-                buf[10][5] = kanegen_runtime::lanes::lanes(-d336);
-                let d337 = s_q2l * d328 + c_q2l * d332;
-                let d338 = c_q1l * d331 - s_q1l * d335;
-                let d339 = s_q1l * d331 + c_q1l * d335;
-                let d340 = d336 - p.L5 * d339;
-                let d341 = c_q1l * d333 - s_q1l * d337 + p.L6 * d339;
-                buf[10][4] = kanegen_runtime::lanes::lanes(-d341);
-                let d342 = s_q1l * d333 + c_q1l * d337 - p.L6 * d338 + p.L5 * d334;
-                let d343 = c_q_torso * d334 + s_q_torso * d339;
-                let d344 = s_q_torso * d334 - c_q_torso * d339;
-                let d345 = d341 - p.L4 * d343;
-                let d346 = c_q_torso * d340 + s_q_torso * d342 + p.L3 * d344
-                    + p.L4 * d338;
-                buf[10][3] = kanegen_runtime::lanes::lanes(d346);
-                let d347 = s_q_torso * d340 - c_q_torso * d342 - p.L3 * d343;
-                let d348 = c_q_w * d338 - s_q_w * d344;
-                let d349 = s_q_w * d338 + c_q_w * d344;
-                let d350 = c_q_w * d345 - s_q_w * d347 + p.L2 * d343;
-                let d351 = d346 + p.L1 * d349 - p.L2 * d348;
-                buf[10][2] = kanegen_runtime::lanes::lanes(d351);
-                let d352 = s_q_w * d345 + c_q_w * d347 - p.L1 * d343;
-                let d353 = s_q_imu * d348 + c_q_imu * d349;
-                buf[10][0] = kanegen_runtime::lanes::lanes(d353);
-                let d354 = c_q_imu * d350 - s_q_imu * d352;
-                buf[10][1] = kanegen_runtime::lanes::lanes(d354);
-                let d355 = p.MX8l - d310;
-                let d356 = p.MY8l - d318;
-                let d357 = p.MZ8l - d319;
-                let k25 = s_q6l * s_q6l;
-                let k26 = s_q6l * c_q6l;
-                let k27 = 2.0 * k25 - 1.0;
-                let d358 = pc.pc29 - d317;
-                let d359 = k25 * d358 - 2.0 * (d315 * k26);
-                let d360 = p.XX8l + d316;
-                let d361 = p.XY8l + t47 + t48;
-                let d362 = p.XZ8l + t49 - t50;
-                let d363 = p.YZ8l + d315 * k27 + k26 * d358;
-                let d364 = p.ZZ8l + d317 + d359;
-                let d365 = pc.pc33 - d359;
-                buf[9][9] = kanegen_runtime::lanes::lanes(d365);
-                let d366 = s_q5l * d355 + c_q5l * d357;
-                let d367 = c_q5l * d355 - s_q5l * d357;
-                let t51 = c_q5l * d361;
-                let t52 = s_q5l * d363;
-                let t53 = s_q5l * d361;
-                let t54 = c_q5l * d363;
-                let t55 = p.L8 * d367;
-                let t56 = p.L8 * d366;
-                let d368 = t51 - t52 - t55;
-                buf[9][8] = kanegen_runtime::lanes::lanes(-d368);
-                let d369 = t53 + t54 - t56;
-                let d370 = s_q4l * d367;
-                let d371 = c_q4l * d367;
-                let d372 = c_q4l * d365 - s_q4l * d369;
-                buf[9][7] = kanegen_runtime::lanes::lanes(d372);
-                let d373 = s_q4l * d365 + c_q4l * d369;
-                let d374 = c_q3l * d366 + s_q3l * d371;
-                let d375 = s_q3l * d366 - c_q3l * d371;
-                let d376 = c_q3l * d368 - s_q3l * d373 + p.L7 * d375;
-                buf[9][6] = kanegen_runtime::lanes::lanes(-d376);
-                let d377 = s_q3l * d368 + c_q3l * d373 - p.L7 * d374;
-                let d378 = c_q2l * d370 - s_q2l * d375;
-                let d379 = s_q2l * d370 + c_q2l * d375;
-                let d380 = c_q2l * d372 - s_q2l * d377;
-                buf[9][5] = kanegen_runtime::lanes::lanes(d380);
-                let d381 = s_q2l * d372 + c_q2l * d377;
-                let d382 = s_q1l * d374 + c_q1l * d379;
-                let d383 = c_q1l * d374 - s_q1l * d379;
-                let d384 = s_q1l * d376 + c_q1l * d381 - p.L6 * d383 + p.L5 * d378;
-                let d385 = d380 - p.L5 * d382;
-                let d386 = c_q1l * d376 - s_q1l * d381 + p.L6 * d382;
-                buf[9][4] = kanegen_runtime::lanes::lanes(d386);
-                let d387 = c_q_torso * d378 + s_q_torso * d382;
-                let d388 = s_q_torso * d378 - c_q_torso * d382;
-                let d389 = c_q_torso * d385 + s_q_torso * d384 + p.L3 * d388
-                    + p.L4 * d383;
-                buf[9][3] = kanegen_runtime::lanes::lanes(-d389);
-                let d390 = s_q_torso * d385 - c_q_torso * d384 - p.L3 * d387;
-                let d391 = d386 - p.L4 * d387;
-                let d392 = s_q_w * d383 + c_q_w * d388;
-                let d393 = c_q_w * d383 - s_q_w * d388;
-                let d394 = d389 + p.L1 * d392 - p.L2 * d393;
-                buf[9][2] = kanegen_runtime::lanes::lanes(-d394);
-                let d395 = s_q_w * d391 + c_q_w * d390 - p.L1 * d387;
-                let d396 = c_q_w * d391 - s_q_w * d390 + p.L2 * d387;
-                let d397 = s_q_imu * d393 + c_q_imu * d392;
-                buf[9][0] = kanegen_runtime::lanes::lanes(-d397);
-                let d398 = c_q_imu * d396 - s_q_imu * d395;
-                buf[9][1] = kanegen_runtime::lanes::lanes(-d398);
-                let d399 = p.MX7l - d367;
-                let d400 = p.MZ7l + d366;
-                let k28 = s_q5l * s_q5l;
-                let k29 = s_q5l * c_q5l;
-                let k30 = 2.0 * k28 - 1.0;
-                let d401 = d360 - d364;
-                let d402 = k28 * d401 + 2.0 * (d362 * k29);
-                let t57 = p.L8 * d356;
-                let d403 = p.XY7l + t51 - t52 - t55;
-                let d404 = p.XZ7l + d362 * k30 - k29 * d401;
-                let d405 = p.YY7l + d365;
-                let d406 = p.YZ7l - t53 - t54 + t56;
-                let d407 = pc.pc36 - d356;
-                let d408 = d360 - d402 + 2.0 * t57 + pc.pc37;
-                buf[8][8] = kanegen_runtime::lanes::lanes(d408);
-                let d409 = d364 + d402 + 2.0 * t57 + pc.pc38;
-                let d410 = c_q4l * d407 + s_q4l * d400;
-                let d411 = s_q4l * d407 - c_q4l * d400;
-                let t58 = c_q4l * d403;
-                let t59 = s_q4l * d404;
-                let d412 = t58 + t59;
-                buf[8][7] = kanegen_runtime::lanes::lanes(-d412);
-                let t60 = s_q4l * d403;
-                let t61 = c_q4l * d404;
-                let d413 = t60 - t61;
-                let d414 = s_q3l * d410;
-                let d415 = c_q3l * d410;
-                let d416 = s_q3l * d408 + c_q3l * d413 - p.L7 * d414;
-                let d417 = c_q3l * d408 - s_q3l * d413 - p.L7 * d415;
-                buf[8][6] = kanegen_runtime::lanes::lanes(d417);
-                let d418 = c_q2l * d411 + s_q2l * d415;
-                let d419 = s_q2l * d411 - c_q2l * d415;
-                let d420 = c_q2l * d412 - s_q2l * d416;
-                buf[8][5] = kanegen_runtime::lanes::lanes(-d420);
-                let d421 = s_q2l * d412 + c_q2l * d416;
-                let d422 = c_q1l * d414 - s_q1l * d419;
-                let d423 = s_q1l * d414 + c_q1l * d419;
-                let d424 = d420 - p.L5 * d423;
-                let d425 = c_q1l * d417 - s_q1l * d421 + p.L6 * d423;
-                buf[8][4] = kanegen_runtime::lanes::lanes(-d425);
-                let d426 = s_q1l * d417 + c_q1l * d421 - p.L6 * d422 + p.L5 * d418;
-                let d427 = c_q_torso * d418 + s_q_torso * d423;
-                let d428 = s_q_torso * d418 - c_q_torso * d423;
-                let d429 = d425 - p.L4 * d427;
-                let d430 = c_q_torso * d424 + s_q_torso * d426 + p.L3 * d428
-                    + p.L4 * d422;
-                buf[8][3] = kanegen_runtime::lanes::lanes(d430);
-                let d431 = s_q_torso * d424 - c_q_torso * d426 - p.L3 * d427;
-                let d432 = c_q_w * d422 - s_q_w * d428;
-                let d433 = s_q_w * d422 + c_q_w * d428;
-                let d434 = c_q_w * d429 - s_q_w * d431 + p.L2 * d427;
-                let d435 = d430 + p.L1 * d433 - p.L2 * d432;
-                buf[8][2] = kanegen_runtime::lanes::lanes(d435);
-                let d436 = s_q_w * d429 + c_q_w * d431 - p.L1 * d427;
-                let d437 = s_q_imu * d432 + c_q_imu * d433;
-                buf[8][0] = kanegen_runtime::lanes::lanes(d437);
-                let d438 = c_q_imu * d434 - s_q_imu * d436;
-                buf[8][1] = kanegen_runtime::lanes::lanes(d438);
-                let d439 = p.MX6l - d399;
-                let d440 = p.MY6l - d410;
-                let d441 = p.MZ6l - d411;
-                let k31 = s_q4l * s_q4l;
-                let k32 = s_q4l * c_q4l;
-                let k33 = 2.0 * k31 - 1.0;
-                let d442 = d405 - d409;
-                let d443 = k31 * d442 - 2.0 * (d406 * k32);
-                let d444 = p.XX6l + d408;
-                let d445 = p.XY6l + t58 + t59;
-                let d446 = p.XZ6l + t60 - t61;
-                let d447 = p.YY6l + d405 - d443;
-                buf[7][7] = kanegen_runtime::lanes::lanes(d447);
-                let d448 = p.YZ6l + d406 * k33 + k32 * d442;
-                let d449 = p.ZZ6l + d409 + d443;
-                let d450 = s_q3l * d439 + c_q3l * d441;
-                let d451 = c_q3l * d439 - s_q3l * d441;
-                let t62 = c_q3l * d445;
-                let t63 = s_q3l * d448;
-                let t64 = s_q3l * d445;
-                let t65 = c_q3l * d448;
-                let t66 = p.L7 * d451;
-                let t67 = p.L7 * d450;
-                let d452 = t62 - t63 - t66;
-                buf[7][6] = kanegen_runtime::lanes::lanes(-d452);
-                let d453 = t64 + t65 - t67;
-                let d454 = s_q2l * d451;
-                let d455 = c_q2l * d451;
-                let d456 = c_q2l * d447 - s_q2l * d453;
-                buf[7][5] = kanegen_runtime::lanes::lanes(d456);
-                let d457 = s_q2l * d447 + c_q2l * d453;
-                let d458 = s_q1l * d450 - c_q1l * d455;
-                let d459 = c_q1l * d450 + s_q1l * d455;
-                let d460 = s_q1l * d452 + c_q1l * d457 - p.L6 * d459 + p.L5 * d454;
-                let d461 = d456 - p.L5 * d458;
-                let d462 = c_q1l * d452 - s_q1l * d457 + p.L6 * d458;
-                buf[7][4] = kanegen_runtime::lanes::lanes(d462);
-                let d463 = c_q_torso * d454 + s_q_torso * d458;
-                let d464 = s_q_torso * d454 - c_q_torso * d458;
-                let d465 = c_q_torso * d461 + s_q_torso * d460 + p.L3 * d464
-                    + p.L4 * d459;
-                buf[7][3] = kanegen_runtime::lanes::lanes(-d465);
-                let d466 = s_q_torso * d461 - c_q_torso * d460 - p.L3 * d463;
-                let d467 = d462 - p.L4 * d463;
-                let d468 = s_q_w * d459 + c_q_w * d464;
-                let d469 = c_q_w * d459 - s_q_w * d464;
-                let d470 = d465 + p.L1 * d468 - p.L2 * d469;
-                buf[7][2] = kanegen_runtime::lanes::lanes(-d470);
-                let d471 = s_q_w * d467 + c_q_w * d466 - p.L1 * d463;
-                let d472 = c_q_w * d467 - s_q_w * d466 + p.L2 * d463;
-                let d473 = s_q_imu * d469 + c_q_imu * d468;
-                buf[7][0] = kanegen_runtime::lanes::lanes(-d473);
-                let d474 = c_q_imu * d472 - s_q_imu * d471;
-                buf[7][1] = kanegen_runtime::lanes::lanes(-d474);
-                let d475 = p.MX5l - d451;
-                let d476 = p.MZ5l + d450;
-                let k34 = s_q3l * s_q3l;
-                let k35 = s_q3l * c_q3l;
-                let k36 = 2.0 * k34 - 1.0;
-                let d477 = d444 - d449;
-                let d478 = k34 * d477 + 2.0 * (d446 * k35);
-                let t68 = p.L7 * d440;
-                let d479 = p.XY5l + t62 - t63 - t66;
-                let d480 = p.XZ5l + d446 * k36 - k35 * d477;
-                let d481 = p.YY5l + d447;
-                let d482 = p.YZ5l - t64 - t65 + t67;
-                let d483 = pc.pc42 - d440;
-                let d484 = d444 - d478 + 2.0 * t68 + pc.pc43;
-                buf[6][6] = kanegen_runtime::lanes::lanes(d484);
-                let d485 = d449 + d478 + 2.0 * t68 + pc.pc44;
-                let d486 = c_q2l * d483 + s_q2l * d476;
-                let d487 = s_q2l * d483 - c_q2l * d476;
-                let t69 = c_q2l * d479;
-                let t70 = s_q2l * d480;
-                let d488 = t69 + t70;
-                buf[6][5] = kanegen_runtime::lanes::lanes(-d488);
-                let t71 = s_q2l * d479;
-                let t72 = c_q2l * d480;
-                let d489 = t71 - t72;
-                let d490 = s_q1l * d486;
-                let d491 = c_q1l * d486;
-                let d492 = d488 + p.L5 * d491;
-                let d493 = c_q1l * d484 - s_q1l * d489 - p.L6 * d491;
-                buf[6][4] = kanegen_runtime::lanes::lanes(-d493);
-                let d494 = s_q1l * d484 + c_q1l * d489 - p.L6 * d490 + p.L5 * d487;
-                let d495 = c_q_torso * d487 - s_q_torso * d491;
-                let d496 = s_q_torso * d487 + c_q_torso * d491;
-                let d497 = d493 - p.L4 * d495;
-                let d498 = c_q_torso * d492 + s_q_torso * d494 + p.L3 * d496
-                    + p.L4 * d490;
-                buf[6][3] = kanegen_runtime::lanes::lanes(d498);
-                let d499 = s_q_torso * d492 - c_q_torso * d494 - p.L3 * d495;
-                let d500 = c_q_w * d490 - s_q_w * d496;
-                let d501 = s_q_w * d490 + c_q_w * d496;
-                let d502 = c_q_w * d497 - s_q_w * d499 + p.L2 * d495;
-                let d503 = d498 + p.L1 * d501 - p.L2 * d500;
-                buf[6][2] = kanegen_runtime::lanes::lanes(d503);
-                let d504 = s_q_w * d497 + c_q_w * d499 - p.L1 * d495;
-                let d505 = s_q_imu * d500 + c_q_imu * d501;
-                buf[6][0] = kanegen_runtime::lanes::lanes(d505);
-                let d506 = c_q_imu * d502 - s_q_imu * d504;
-                buf[6][1] = kanegen_runtime::lanes::lanes(d506);
-                let d507 = p.MX4l - d475;
-                let d508 = p.MY4l - d486;
-                let d509 = p.MZ4l - d487;
-                let k37 = s_q2l * s_q2l;
-                let k38 = s_q2l * c_q2l;
-                let k39 = 2.0 * k37 - 1.0;
-                let d510 = d481 - d485;
-                let d511 = k37 * d510 - 2.0 * (d482 * k38);
-                let d512 = p.XX4l + d484;
-                let d513 = p.XY4l + t69 + t70;
-                let d514 = p.XZ4l + t71 - t72;
-                let d515 = p.YY4l + d481 - d511;
-                buf[5][5] = kanegen_runtime::lanes::lanes(d515);
-                let d516 = p.YZ4l + d482 * k39 + k38 * d510;
-                let d517 = p.ZZ4l + d485 + d511;
-                let d518 = c_q1l * d507 - s_q1l * d509;
-                let d519 = s_q1l * d507 + c_q1l * d509;
-                let t73 = c_q1l * d513;
-                let t74 = s_q1l * d516;
-                let t75 = s_q1l * d513;
-                let t76 = c_q1l * d516;
-                let t77 = p.L5 * d518;
-                let t78 = p.L6 * d518;
-                let t79 = p.L6 * d519;
-                let d520 = t75 + t76 - t79;
-                let d521 = d515 + t77;
-                let d522 = t73 - t74 - t78;
-                buf[5][4] = kanegen_runtime::lanes::lanes(d522);
-                let d523 = s_q_torso * d518;
-                let d524 = c_q_torso * d518;
-                let d525 = c_q_torso * d521 + s_q_torso * d520 + p.L3 * d524
-                    + p.L4 * d519;
-                buf[5][3] = kanegen_runtime::lanes::lanes(-d525);
-                let d526 = s_q_torso * d521 - c_q_torso * d520 + p.L3 * d523;
-                let d527 = d522 + p.L4 * d523;
-                let d528 = s_q_w * d519 + c_q_w * d524;
-                let d529 = c_q_w * d519 - s_q_w * d524;
-                let d530 = d525 + p.L1 * d528 - p.L2 * d529;
-                buf[5][2] = kanegen_runtime::lanes::lanes(-d530);
-                let d531 = s_q_w * d527 + c_q_w * d526 + p.L1 * d523;
-                let d532 = c_q_w * d527 - s_q_w * d526 - p.L2 * d523;
-                let d533 = s_q_imu * d529 + c_q_imu * d528;
-                buf[5][0] = kanegen_runtime::lanes::lanes(-d533);
-                let d534 = c_q_imu * d532 - s_q_imu * d531;
-                buf[5][1] = kanegen_runtime::lanes::lanes(-d534);
-                let d535 = p.MZ3 + d251 - d519;
-                let k40 = s_q1l * s_q1l;
-                let k41 = s_q1l * c_q1l;
-                let k42 = 2.0 * k40 - 1.0;
-                let d536 = d512 - d517;
-                let d537 = k40 * d536 + 2.0 * (d514 * k41);
-                let t80 = p.L6 * d508;
-                let d538 = p.XZ3 - t35 - t36 + t39 - t75 - t76 + t79;
-                let d539 = p.YZ3 - d246 * k21 + k20 * d267 - p.L5 * d251 + d514 * k42
-                    - k41 * d536 + p.L5 * d519;
-                let d540 = d508 - d240 + pc.pc47;
-                let d541 = d250 + d518 + pc.pc48;
-                let d542 = d247 + 2.0 * t37 + d515 + 2.0 * t77 + pc.pc49;
-                let d543 = t34 - t33 + t38 + p.L5 * d240 + t73 - t74 - t78 - p.L5 * d508
-                    + pc.pc50;
-                let d544 = d244 - d268 + 2.0 * t40 + d512 - d537 + 2.0 * t80 + pc.pc51;
-                buf[4][4] = kanegen_runtime::lanes::lanes(d544);
-                let d545 = d249 + 2.0 * t37 + d268 + 2.0 * t40 + d517 + 2.0 * t77 + d537
-                    + 2.0 * t80 + pc.pc52;
-                let d546 = c_q_torso * d540 - s_q_torso * d535;
-                let d547 = s_q_torso * d540 + c_q_torso * d535;
-                let t81 = c_q_torso * d543;
-                let t82 = s_q_torso * d539;
-                let t83 = s_q_torso * d543;
-                let t84 = c_q_torso * d539;
-                let t85 = p.L3 * d546;
-                let t86 = p.L4 * d547;
-                let t87 = p.L3 * d547;
-                let d548 = t81 - t82 - t85;
-                buf[4][3] = kanegen_runtime::lanes::lanes(-d548);
-                let d549 = t83 + t84 - t87;
-                let d550 = d544 - t86;
-                let d551 = s_q_w * d546;
-                let d552 = c_q_w * d546;
-                let d553 = d548 - p.L1 * d552 - p.L2 * d551;
-                buf[4][2] = kanegen_runtime::lanes::lanes(-d553);
-                let d554 = s_q_w * d550 + c_q_w * d549 - p.L1 * d547;
-                let d555 = c_q_w * d550 - s_q_w * d549 + p.L2 * d547;
-                let d556 = s_q_imu * d551 - c_q_imu * d552;
-                buf[4][0] = kanegen_runtime::lanes::lanes(-d556);
-                let d557 = c_q_imu * d555 - s_q_imu * d554;
-                buf[4][1] = kanegen_runtime::lanes::lanes(-d557);
-                let d558 = p.MX2 - d546;
-                let k43 = s_q_torso * s_q_torso;
-                let k44 = s_q_torso * c_q_torso;
-                let k45 = 2.0 * k43 - 1.0;
-                let d559 = d542 - d545;
-                let d560 = k43 * d559 + 2.0 * (d538 * k44);
-                let t88 = p.L3 * d541;
-                let d561 = p.XY2 - t81 + t82 + t85;
-                let d562 = p.XZ2 - d538 * k45 + k44 * d559 + p.L4 * d546;
-                let d563 = d541 + pc.pc54;
-                let d564 = pc.pc55 - d547;
-                let d565 = d542 - 2.0 * t86 - d560 + 2.0 * t88 + pc.pc56;
-                buf[3][3] = kanegen_runtime::lanes::lanes(d565);
-                let d566 = d544 - 2.0 * t86 + pc.pc57;
-                let d567 = t87 - t83 - t84 - p.L4 * d541 + pc.pc58;
-                let d568 = d545 + d560 + 2.0 * t88 + pc.pc59;
-                let d569 = c_q_w * d563 + s_q_w * d564;
-                let d570 = s_q_w * d563 - c_q_w * d564;
-                let t89 = c_q_w * d561;
-                let t90 = s_q_w * d562;
-                let t91 = s_q_w * d561;
-                let t92 = c_q_w * d562;
-                let d571 = t91 - t92;
-                let t93 = p.L1 * d569;
-                let t94 = p.L2 * d570;
-                let d572 = d565 + t93 + t94;
-                buf[3][2] = kanegen_runtime::lanes::lanes(d572);
-                let d573 = t89 + t90;
-                let d574 = s_q_imu * d570 - c_q_imu * d569;
-                buf[3][0] = kanegen_runtime::lanes::lanes(-d574);
-                let d575 = c_q_imu * d573 - s_q_imu * d571;
-                buf[3][1] = kanegen_runtime::lanes::lanes(-d575);
-                let d576 = p.MX1 + d558;
-                buf[1][0] = kanegen_runtime::lanes::lanes(d576);
-                let k46 = s_q_w * s_q_w;
-                let k47 = s_q_w * c_q_w;
-                let k48 = 2.0 * k46 - 1.0;
-                let d577 = d566 - d568;
-                let d578 = k46 * d577 - 2.0 * (d567 * k47);
-                let d579 = p.XY1 + t89 + t90 - p.L1 * d558;
-                let d580 = p.XZ1 - t91 + t92 + p.L2 * d558;
-                let d581 = d569 + pc.pc61;
-                let d582 = pc.pc62 - d570;
-                let d583 = d565 + 2.0 * t93 + 2.0 * t94 + pc.pc63;
-                buf[2][2] = kanegen_runtime::lanes::lanes(d583);
-                let d584 = d566 + 2.0 * t94 - d578 + pc.pc64;
-                let d585 = p.L2 * d569 - d567 * k48 - k47 * d577 + p.L1 * d570 + pc.pc65;
-                let d586 = d568 + 2.0 * t93 + d578 + pc.pc66;
-                let d587 = c_q_imu * d581 + s_q_imu * d582;
-                buf[2][0] = kanegen_runtime::lanes::lanes(d587);
-                let d588 = c_q_imu * d579 + s_q_imu * d580;
-                buf[2][1] = kanegen_runtime::lanes::lanes(-d588);
-                let k49 = s_q_imu * s_q_imu;
-                let k50 = s_q_imu * c_q_imu;
-                let d589 = d584 - d586;
-                let d590 = k49 * d589 - 2.0 * (d585 * k50);
-                let d591 = d584 - d590;
-                buf[1][1] = kanegen_runtime::lanes::lanes(d591 + pc.pc68);
-                kanegen_runtime::lanes::results(&mut buf, true)
-            },
+            |out| body::<kanegen_runtime::isa::Plain, L>(p, pc, q, u, out),
+            #[inline(always)]
+            |out| body::<kanegen_runtime::isa::Fused, L>(p, pc, q, u, out),
         )
     }
-    /// [`coriolis`] at `L` states per call: entry `l` of the result is `coriolis` at entry `l` of the inputs, bit for bit (the same statements over [`kanegen_runtime::lanes::Lanes`], vectorized across the states).
-    #[inline(never)]
+    /// [`coriolis`] at `L` states per call: entry `l` of the result is `coriolis` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Returns the results by value; [`coriolis_batch_into`] writes them into the caller's array instead (no zeroed array, no copy).
+    #[inline]
     pub fn coriolis_batch<const L: usize>(
         p: &Params,
-        _pc: &Precomputed,
+        pc: &Precomputed,
         q: &[SVector<f64, 19>; L],
         u: &[SVector<f64, 19>; L],
     ) -> [SVector<f64, 19>; L] {
-        kanegen_runtime::isa::dispatch(
+        let mut out = [<SVector<f64, 19>>::zeros(); L];
+        coriolis_batch_into(p, pc, q, u, &mut out);
+        out
+    }
+    /// [`gravity`] at `L` states per call, into `out`: entry `l` of `out` becomes `gravity` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
+    #[inline(never)]
+    pub fn gravity_batch_into<const L: usize>(
+        p: &Params,
+        pc: &Precomputed,
+        q: &[SVector<f64, 19>; L],
+        out: &mut [SVector<f64, 19>; L],
+    ) {
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>, const L: usize>(
+            p: &Params,
+            pc: &Precomputed,
+            q: &[SVector<f64, 19>; L],
+            out: &mut [SVector<f64, 19>; L],
+        ) {
+            let p = &{ *p };
+            let pc = &{ *pc };
+            let q = kanegen_runtime::lanes::inputs(q);
+            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n([
+                q[2].0,
+                q[3].0,
+                q[4].0,
+                q[5].0,
+                q[6].0,
+                q[7].0,
+                q[8].0,
+                q[9].0,
+                q[10].0,
+                q[11].0,
+                q[12].0,
+                q[13].0,
+                q[14].0,
+                q[15].0,
+                q[16].0,
+                q[17].0,
+                q[18].0,
+            ]);
+            for (l, m) in out.iter_mut().enumerate() {
+                let s_q_imu = sin_q[0][l];
+                let c_q_imu = cos_q[0][l];
+                let s_q_w = sin_q[1][l];
+                let c_q_w = cos_q[1][l];
+                let s_q_torso = sin_q[2][l];
+                let c_q_torso = cos_q[2][l];
+                let s_q1l = sin_q[3][l];
+                let c_q1l = cos_q[3][l];
+                let s_q2l = sin_q[4][l];
+                let c_q2l = cos_q[4][l];
+                let s_q3l = sin_q[5][l];
+                let c_q3l = cos_q[5][l];
+                let s_q4l = sin_q[6][l];
+                let c_q4l = cos_q[6][l];
+                let s_q5l = sin_q[7][l];
+                let c_q5l = cos_q[7][l];
+                let s_q6l = sin_q[8][l];
+                let c_q6l = cos_q[8][l];
+                let s_q7l = sin_q[9][l];
+                let c_q7l = cos_q[9][l];
+                let s_q1r = sin_q[10][l];
+                let c_q1r = cos_q[10][l];
+                let s_q2r = sin_q[11][l];
+                let c_q2r = cos_q[11][l];
+                let s_q3r = sin_q[12][l];
+                let c_q3r = cos_q[12][l];
+                let s_q4r = sin_q[13][l];
+                let c_q4r = cos_q[13][l];
+                let s_q5r = sin_q[14][l];
+                let c_q5r = cos_q[14][l];
+                let s_q6r = sin_q[15][l];
+                let c_q6r = cos_q[15][l];
+                let s_q7r = sin_q[16][l];
+                let c_q7r = cos_q[16][l];
+                let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
+                let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
+                let d3 = A::mul_add(-s_q_w, d2, c_q_w * d1); // gravity acceleration in 2.y
+                let d4 = A::mul_add(c_q_w, d2, s_q_w * d1); // gravity acceleration in 2.z
+                let d5 = s_q_torso * d4; // gravity acceleration in 3.x
+                let d6 = c_q_torso * d4; // gravity acceleration in 3.z
+                let d7 = A::mul_add(s_q1l, d6, c_q1l * d3); // gravity acceleration in 4l.x
+                let d8 = A::mul_add(-c_q1l, d6, s_q1l * d3); // gravity acceleration in 4l.z
+                let d9 = A::mul_add(s_q2l, d8, c_q2l * d5); // gravity acceleration in 5l.y
+                let d10 = A::mul_add(-c_q2l, d8, s_q2l * d5); // gravity acceleration in 5l.z
+                let d11 = A::mul_add(s_q3l, d10, c_q3l * d7); // gravity acceleration in 6l.x
+                let d12 = A::mul_add(-c_q3l, d10, s_q3l * d7); // gravity acceleration in 6l.z
+                let d13 = A::mul_add(s_q4l, d12, c_q4l * d9); // gravity acceleration in 7l.y
+                let d14 = A::mul_add(-c_q4l, d12, s_q4l * d9); // gravity acceleration in 7l.z
+                let d15 = A::mul_add(s_q5l, d14, c_q5l * d11); // gravity acceleration in 8l.x
+                let d16 = A::mul_add(-c_q5l, d14, s_q5l * d11); // gravity acceleration in 8l.z
+                let d17 = A::mul_add(s_q6l, d16, c_q6l * d13); // gravity acceleration in 9l.y
+                let d18 = A::mul_add(-c_q6l, d16, s_q6l * d13); // gravity acceleration in 9l.z
+                let d19 = A::mul_add(s_q7l, d18, c_q7l * d15); // gravity acceleration in 10l.x
+                let d20 = A::mul_add(-c_q7l, d18, s_q7l * d15); // gravity acceleration in 10l.y
+                m[11] = A::mul_add(-p.MX10l, d20, p.MY10l * d19);
+                let d21 = A::mul_add(-s_q1r, d6, c_q1r * d3); // gravity acceleration in 4r.x
+                let d22 = A::mul_add(c_q1r, d6, s_q1r * d3); // gravity acceleration in 4r.z
+                let d23 = A::mul_add(-s_q2r, d22, c_q2r * d5); // gravity acceleration in 5r.y
+                let d24 = A::mul_add(c_q2r, d22, s_q2r * d5); // gravity acceleration in 5r.z
+                let d25 = A::mul_add(-s_q3r, d24, c_q3r * d21); // gravity acceleration in 6r.x
+                let d26 = A::mul_add(c_q3r, d24, s_q3r * d21); // gravity acceleration in 6r.z
+                let d27 = A::mul_add(-s_q4r, d26, c_q4r * d23); // gravity acceleration in 7r.y
+                let d28 = A::mul_add(c_q4r, d26, s_q4r * d23); // gravity acceleration in 7r.z
+                let d29 = A::mul_add(-s_q5r, d28, c_q5r * d25); // gravity acceleration in 8r.x
+                let d30 = A::mul_add(c_q5r, d28, s_q5r * d25); // gravity acceleration in 8r.z
+                let d31 = A::mul_add(-s_q6r, d30, c_q6r * d27); // gravity acceleration in 9r.y
+                let d32 = A::mul_add(c_q6r, d30, s_q6r * d27); // gravity acceleration in 9r.z
+                let d33 = A::mul_add(-s_q7r, d32, c_q7r * d29); // gravity acceleration in 10r.x
+                let d34 = A::mul_add(c_q7r, d32, s_q7r * d29); // gravity acceleration in 10r.y
+                m[18] = A::mul_add(-p.MX10r, d34, p.MY10r * d33);
+                let d35 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
+                let d36 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
+                let d37 = p.MX9r - d36; // MSC9r.x
+                let d38 = p.MZ9r + d35; // MSC9r.z
+                m[17] = A::mul_add(-d38, d31, pc.pc2 * d32);
+                let d39 = A::mul_add(s_q6r, d38, c_q6r * pc.pc2); // MSC9r in 8r.y
+                let d40 = A::mul_add(-c_q6r, d38, s_q6r * pc.pc2); // MSC9r in 8r.z
+                let d41 = p.MX8r - d37; // MSC8r.x
+                let d42 = p.MY8r - d39; // MSC8r.y
+                let d43 = p.MZ8r - d40; // MSC8r.z
+                m[16] = A::mul_add(-d41, d30, -d43 * d29);
+                let d44 = A::mul_add(c_q5r, d43, s_q5r * d41); // MSC8r in 7r.z
+                let d45 = A::mul_add(-s_q5r, d43, c_q5r * d41); // MSC8r in 7r.x
+                let d46 = p.MX7r - d45; // MSC7r.x
+                let d47 = p.MZ7r + d44; // MSC7r.z
+                let d48 = pc.pc13 - d42; // MSC7r.y
+                m[15] = A::mul_add(-d47, d27, d48 * d28);
+                let d49 = A::mul_add(s_q4r, d47, c_q4r * d48); // MSC7r in 6r.y
+                let d50 = A::mul_add(-c_q4r, d47, s_q4r * d48); // MSC7r in 6r.z
+                let d51 = p.MX6r - d46; // MSC6r.x
+                let d52 = p.MY6r - d49; // MSC6r.y
+                let d53 = p.MZ6r - d50; // MSC6r.z
+                m[14] = A::mul_add(-d51, d26, -d53 * d25);
+                let d54 = A::mul_add(c_q3r, d53, s_q3r * d51); // MSC6r in 5r.z
+                let d55 = A::mul_add(-s_q3r, d53, c_q3r * d51); // MSC6r in 5r.x
+                let d56 = p.MX5r - d55; // MSC5r.x
+                let d57 = p.MZ5r + d54; // MSC5r.z
+                let d58 = pc.pc19 - d52; // MSC5r.y
+                m[13] = A::mul_add(-d57, d23, d58 * d24);
+                let d59 = A::mul_add(s_q2r, d57, c_q2r * d58); // MSC5r in 4r.y
+                let d60 = A::mul_add(-c_q2r, d57, s_q2r * d58); // MSC5r in 4r.z
+                let d61 = p.MX4r - d56; // MSC4r.x
+                let d62 = p.MY4r - d59; // MSC4r.y
+                let d63 = p.MZ4r - d60; // MSC4r.z
+                m[12] = A::mul_add(-d61, d22, -d63 * d21);
+                let d64 = A::mul_add(-s_q1r, d63, c_q1r * d61); // MSC4r in 3.y
+                let d65 = A::mul_add(c_q1r, d63, s_q1r * d61); // MSC4r in 3.z
+                let d66 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
+                let d67 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
+                let d68 = p.MX9l - d67; // MSC9l.x
+                let d69 = p.MZ9l + d66; // MSC9l.z
+                m[10] = A::mul_add(-pc.pc25, d18, d69 * d17);
+                let d70 = A::mul_add(s_q6l, d69, c_q6l * pc.pc25); // MSC9l in 8l.y
+                let d71 = A::mul_add(-c_q6l, d69, s_q6l * pc.pc25); // MSC9l in 8l.z
+                let d72 = p.MX8l - d68; // MSC8l.x
+                let d73 = p.MY8l - d70; // MSC8l.y
+                let d74 = p.MZ8l - d71; // MSC8l.z
+                m[9] = A::mul_add(-d72, d16, -d74 * d15);
+                let d75 = A::mul_add(c_q5l, d74, s_q5l * d72); // MSC8l in 7l.z
+                let d76 = A::mul_add(-s_q5l, d74, c_q5l * d72); // MSC8l in 7l.x
+                let d77 = p.MX7l - d76; // MSC7l.x
+                let d78 = p.MZ7l + d75; // MSC7l.z
+                let d79 = pc.pc36 - d73; // MSC7l.y
+                m[8] = A::mul_add(-d79, d14, d78 * d13);
+                let d80 = A::mul_add(s_q4l, d78, c_q4l * d79); // MSC7l in 6l.y
+                let d81 = A::mul_add(-c_q4l, d78, s_q4l * d79); // MSC7l in 6l.z
+                let d82 = p.MX6l - d77; // MSC6l.x
+                let d83 = p.MY6l - d80; // MSC6l.y
+                let d84 = p.MZ6l - d81; // MSC6l.z
+                m[7] = A::mul_add(-d82, d12, -d84 * d11);
+                let d85 = A::mul_add(c_q3l, d84, s_q3l * d82); // MSC6l in 5l.z
+                let d86 = A::mul_add(-s_q3l, d84, c_q3l * d82); // MSC6l in 5l.x
+                let d87 = p.MX5l - d86; // MSC5l.x
+                let d88 = p.MZ5l + d85; // MSC5l.z
+                let d89 = pc.pc42 - d83; // MSC5l.y
+                m[6] = A::mul_add(-d89, d10, d88 * d9);
+                let d90 = A::mul_add(s_q2l, d88, c_q2l * d89); // MSC5l in 4l.y
+                let d91 = A::mul_add(-c_q2l, d88, s_q2l * d89); // MSC5l in 4l.z
+                let d92 = p.MX4l - d87; // MSC4l.x
+                let d93 = p.MY4l - d90; // MSC4l.y
+                let d94 = p.MZ4l - d91; // MSC4l.z
+                m[5] = A::mul_add(-d92, d8, -d94 * d7);
+                let d95 = A::mul_add(-s_q1l, d94, c_q1l * d92); // MSC4l in 3.y
+                let d96 = A::mul_add(c_q1l, d94, s_q1l * d92); // MSC4l in 3.z
+                let d97 = p.MZ3 + d65 - d96; // MSC3.z
+                let d98 = d93 - d62 + pc.pc47; // MSC3.x
+                m[4] = A::mul_add(-d98, d6, d97 * d5);
+                let d99 = d64 + d95 + pc.pc48; // MSC3.y
+                let d100 = A::mul_add(c_q_torso, d97, s_q_torso * d98); // MSC3 in 2.z
+                let d101 = d99 + pc.pc54; // MSC2.y
+                let d102 = pc.pc55 - d100; // MSC2.z
+                m[3] = A::mul_add(-d101, d4, d102 * d3);
+                let d103 = A::mul_add(s_q_w, d102, c_q_w * d101); // MSC2 in 1.y
+                let d104 = A::mul_add(-c_q_w, d102, s_q_w * d101); // MSC2 in 1.z
+                let d105 = d103 + pc.pc61; // MSC1.y
+                let d106 = pc.pc62 - d104; // MSC1.z
+                m[2] = A::mul_add(-d105, d2, d106 * d1);
+            }
+            for m in out.iter_mut() {
+                m[0] = 0.0;
+                m[1] = 0.0;
+            }
+        }
+        kanegen_runtime::isa::dispatch_fused_with(
+            out,
             #[inline(always)]
-            || {
-                let q = kanegen_runtime::lanes::inputs(q);
-                let u = kanegen_runtime::lanes::inputs(u);
-                let (s_q_imu, c_q_imu) = kanegen_runtime::lanes::sin_cos(q[2]);
-                let (s_q_w, c_q_w) = kanegen_runtime::lanes::sin_cos(q[3]);
-                let (s_q_torso, c_q_torso) = kanegen_runtime::lanes::sin_cos(q[4]);
-                let (s_q1l, c_q1l) = kanegen_runtime::lanes::sin_cos(q[5]);
-                let (s_q2l, c_q2l) = kanegen_runtime::lanes::sin_cos(q[6]);
-                let (s_q3l, c_q3l) = kanegen_runtime::lanes::sin_cos(q[7]);
-                let (s_q4l, c_q4l) = kanegen_runtime::lanes::sin_cos(q[8]);
-                let (s_q5l, c_q5l) = kanegen_runtime::lanes::sin_cos(q[9]);
-                let (s_q6l, c_q6l) = kanegen_runtime::lanes::sin_cos(q[10]);
-                let (s_q7l, c_q7l) = kanegen_runtime::lanes::sin_cos(q[11]);
-                let (s_q1r, c_q1r) = kanegen_runtime::lanes::sin_cos(q[12]);
-                let (s_q2r, c_q2r) = kanegen_runtime::lanes::sin_cos(q[13]);
-                let (s_q3r, c_q3r) = kanegen_runtime::lanes::sin_cos(q[14]);
-                let (s_q4r, c_q4r) = kanegen_runtime::lanes::sin_cos(q[15]);
-                let (s_q5r, c_q5r) = kanegen_runtime::lanes::sin_cos(q[16]);
-                let (s_q6r, c_q6r) = kanegen_runtime::lanes::sin_cos(q[17]);
-                let (s_q7r, c_q7r) = kanegen_runtime::lanes::sin_cos(q[18]);
-                let xd = u[0];
-                let psid = u[1];
-                let qd_imu = u[2];
-                let qd_w = u[3];
-                let qd_torso = u[4];
-                let qd1l = u[5];
-                let qd2l = u[6];
-                let qd3l = u[7];
-                let qd4l = u[8];
-                let qd5l = u[9];
-                let qd6l = u[10];
-                let qd7l = u[11];
-                let qd1r = u[12];
-                let qd2r = u[13];
-                let qd3r = u[14];
-                let qd4r = u[15];
-                let qd5r = u[16];
-                let qd6r = u[17];
-                let qd7r = u[18];
-                #[allow(unused_mut)]
-                let mut buf = kanegen_runtime::lanes::buffer::<L, 19, 1>();
-                let k1 = xd * psid;
-                let k2 = c_q_imu * psid;
-                let k3 = s_q_imu * psid;
-                let k4 = k3 * qd_imu;
-                let k5 = k2 * qd_imu;
-                let d1 = p.MZ1 * k2 - p.MY1 * k3;
-                let d2 = p.MX1 * k3 + p.MZ1 * qd_imu;
-                let d3 = p.MY1 * qd_imu + p.MX1 * k2;
-                let d4 = p.MX1 * k5 + k3 * d1 - qd_imu * d3;
-                let d5 = p.MX1 * k4 - qd_imu * d2 - k2 * d1;
-                let d6 = p.XX1 * qd_imu - p.XY1 * k2 - p.XZ1 * k3;
-                let d7 = p.XY1 * qd_imu - p.YY1 * k2 - p.YZ1 * k3;
-                let d8 = p.XZ1 * qd_imu - p.YZ1 * k2 - p.ZZ1 * k3;
-                let d9 = p.XY1 * k4 - p.XZ1 * k5 + k2 * d8 - k3 * d7;
-                let d10 = p.YY1 * k4 - p.YZ1 * k5 + k3 * d6 + qd_imu * d8 + p.MZ1 * k1;
-                let d11 = p.YZ1 * k4 - p.ZZ1 * k5 - qd_imu * d7 - k2 * d6 - p.MY1 * k1;
-                let k6 = c_q_w * k2 - s_q_w * k3;
-                let k7 = s_q_w * k2 + c_q_w * k3;
-                let k8 = qd_imu + qd_w;
-                let k9 = c_q_w * k4 + s_q_w * k5 + k7 * qd_w;
-                let k10 = s_q_w * k4 - c_q_w * k5 - k6 * qd_w;
-                let k11 = p.L2 * qd_imu;
-                let k12 = p.L1 * qd_imu;
-                let k13 = p.L2 * k2 + p.L1 * k3;
-                let k14 = qd_imu * k11 + k2 * k13;
-                let k15 = k1 - p.L2 * k4 + p.L1 * k5 + k2 * k12 - k3 * k11;
-                let k16 = k3 * k13 + qd_imu * k12;
-                let k17 = c_q_w * k16 + s_q_w * k14;
-                let k18 = s_q_w * k16 - c_q_w * k14;
-                let d12 = p.MZ2 * k6 - p.MY2 * k7;
-                let d13 = p.MX2 * k7 + p.MZ2 * k8;
-                let d14 = p.MY2 * k8 + p.MX2 * k6;
-                let d15 = p.m2 * k15 + p.MZ2 * k9 - p.MY2 * k10 + k6 * d14 + k7 * d13;
-                let d16 = p.m2 * k17 + p.MX2 * k10 - k7 * d12 + k8 * d14;
-                let d17 = p.m2 * k18 - p.MX2 * k9 + k8 * d13 + k6 * d12;
-                let d18 = p.XX2 * k8 - p.XY2 * k6 - p.XZ2 * k7;
-                let d19 = p.XY2 * k8 - p.YY2 * k6 - p.YZ2 * k7;
-                let d20 = p.XZ2 * k8 - p.YZ2 * k6 - p.ZZ2 * k7;
-                let d21 = p.XY2 * k9 + p.XZ2 * k10 + k6 * d20 - k7 * d19 + p.MY2 * k18
-                    - p.MZ2 * k17;
-                let d22 = p.YY2 * k9 + p.YZ2 * k10 + k7 * d18 + k8 * d20 + p.MZ2 * k15
-                    - p.MX2 * k18;
-                let d23 = p.YZ2 * k9 + p.ZZ2 * k10 - k8 * d19 - k6 * d18 + p.MX2 * k17
-                    - p.MY2 * k15;
-                let k19 = c_q_torso * k8 - s_q_torso * k7;
-                let k20 = s_q_torso * k8 + c_q_torso * k7;
-                let k21 = k6 - qd_torso;
-                let k22 = s_q_torso * k10 - k20 * qd_torso;
-                let k23 = c_q_torso * k10 - k19 * qd_torso;
-                let k24 = p.L4 * k6 - p.L3 * k7;
-                let k25 = p.L4 * k8;
-                let k26 = p.L3 * k8;
-                let k27 = k15 + p.L4 * k9 - p.L3 * k10 + k6 * k26 + k7 * k25;
-                let k28 = k17 - k7 * k24 + k8 * k26;
-                let k29 = k18 + k8 * k25 + k6 * k24;
-                let k30 = c_q_torso * k27 + s_q_torso * k29;
-                let k31 = s_q_torso * k27 - c_q_torso * k29;
-                let d24 = p.MZ3 * k21 + p.MY3 * k20;
-                let d25 = p.MY3 * k19 - p.MX3 * k21;
-                let d26 = p.MX3 * k20 + p.MZ3 * k19;
-                let d27 = p.m3 * k30 - p.MZ3 * k9 - p.MY3 * k23 + k21 * d25 - k20 * d26;
-                let d28 = p.m3 * k28 - p.MX3 * k23 + p.MZ3 * k22 + k20 * d24 + k19 * d25;
-                let d29 = p.m3 * k31 - p.MY3 * k22 - p.MX3 * k9 + k19 * d26 + k21 * d24;
-                let d30 = p.XX3 * k19 + p.XY3 * k21 - p.XZ3 * k20;
-                let d31 = p.XY3 * k19 + p.YY3 * k21 - p.YZ3 * k20;
-                let d32 = p.XZ3 * k19 + p.YZ3 * k21 - p.ZZ3 * k20;
-                let d33 = p.XX3 * k22 - p.XY3 * k9 + p.XZ3 * k23 + k21 * d32 + k20 * d31
-                    - p.MY3 * k31 + p.MZ3 * k28;
-                let d34 = p.XY3 * k22 - p.YY3 * k9 + p.YZ3 * k23 - k20 * d30 - k19 * d32
-                    + p.MZ3 * k30 + p.MX3 * k31;
-                let d35 = p.XZ3 * k22 - p.YZ3 * k9 + p.ZZ3 * k23 + k19 * d31 - k21 * d30
-                    - p.MX3 * k28 - p.MY3 * k30;
-                let k32 = c_q1l * k21 + s_q1l * k20;
-                let k33 = s_q1l * k21 - c_q1l * k20;
-                let k34 = k19 - qd1l;
-                let k35 = s_q1l * k9 - c_q1l * k23 - k32 * qd1l;
-                let k36 = c_q1l * k9 + s_q1l * k23 + k33 * qd1l;
-                let k37 = p.L5 * k20;
-                let k38 = p.L6 * k20;
-                let t1 = p.L5 * k19;
-                let t2 = p.L6 * k21;
-                let k39 = t1 - t2;
-                let t3 = p.L5 * k23;
-                let t4 = p.L6 * k23;
-                let t5 = p.L5 * k22;
-                let t6 = p.L6 * k9;
-                let t7 = k20 * k38;
-                let t8 = k20 * k37;
-                let t9 = k19 * k38;
-                let t10 = k21 * k37;
-                let k40 = k30 - t3 + k21 * k39 - t7;
-                let k41 = k28 - t4 + t8 + k19 * k39;
-                let k42 = k31 - t5 - t6 + t9 + t10;
-                let k43 = s_q1l * k41 + c_q1l * k42;
-                let k44 = c_q1l * k41 - s_q1l * k42;
-                let d36 = p.MZ4l * k34 + p.MY4l * k33;
-                let d37 = p.MY4l * k32 - p.MX4l * k34;
-                let d38 = p.MX4l * k33 + p.MZ4l * k32;
-                let d39 = p.m4l * k40 + p.MX4l * k35 + p.MZ4l * k36 - k33 * d36
-                    - k32 * d37;
-                let d40 = p.m4l * k43 - p.MY4l * k36 - p.MX4l * k22 - k32 * d38
-                    - k34 * d36;
-                let d41 = p.m4l * k44 - p.MZ4l * k22 + p.MY4l * k35 - k34 * d37
-                    + k33 * d38;
-                let d42 = p.XX4l * k32 + p.XY4l * k34 - p.XZ4l * k33;
-                let d43 = p.XY4l * k32 + p.YY4l * k34 - p.YZ4l * k33;
-                let d44 = p.XZ4l * k32 + p.YZ4l * k34 - p.ZZ4l * k33;
-                let d45 = p.XX4l * k36 - p.XY4l * k22 - p.XZ4l * k35 - k34 * d44
-                    - k33 * d43 - p.MY4l * k43 + p.MZ4l * k40;
-                let d46 = p.XY4l * k36 - p.YY4l * k22 - p.YZ4l * k35 + k33 * d42
-                    + k32 * d44 + p.MZ4l * k44 + p.MX4l * k43;
-                let d47 = p.XZ4l * k36 - p.YZ4l * k22 - p.ZZ4l * k35 - k32 * d43
-                    + k34 * d42 - p.MX4l * k40 - p.MY4l * k44;
-                let k45 = c_q2l * k34 - s_q2l * k33;
-                let k46 = s_q2l * k34 + c_q2l * k33;
-                let k47 = k32 + qd2l;
-                let k48 = c_q2l * k22 + s_q2l * k35 - k46 * qd2l;
-                let k49 = s_q2l * k22 - c_q2l * k35 + k45 * qd2l;
-                let k50 = c_q2l * k40 + s_q2l * k43;
-                let k51 = s_q2l * k40 - c_q2l * k43;
-                let d48 = p.MZ5l * k45 - p.MY5l * k46;
-                let d49 = p.MX5l * k46 - p.MZ5l * k47;
-                let d50 = p.MY5l * k47 - p.MX5l * k45;
-                let d51 = p.m5l * k44 - p.MZ5l * k48 + p.MY5l * k49 + k45 * d50
-                    - k46 * d49;
-                let d52 = p.m5l * k50 + p.MX5l * k49 + p.MZ5l * k36 - k46 * d48
-                    + k47 * d50;
-                let d53 = p.m5l * k51 - p.MY5l * k36 - p.MX5l * k48 - k47 * d49
-                    + k45 * d48;
-                let d54 = p.XX5l * k47 + p.XY5l * k45 + p.XZ5l * k46;
-                let d55 = p.XY5l * k47 + p.YY5l * k45 + p.YZ5l * k46;
-                let d56 = p.XZ5l * k47 + p.YZ5l * k45 + p.ZZ5l * k46;
-                let d57 = p.XX5l * k36 - p.XY5l * k48 - p.XZ5l * k49 + k45 * d56
-                    - k46 * d55 - p.MY5l * k51 + p.MZ5l * k50;
-                let d58 = p.XY5l * k36 - p.YY5l * k48 - p.YZ5l * k49 + k46 * d54
-                    - k47 * d56 + p.MZ5l * k44 + p.MX5l * k51;
-                let d59 = p.XZ5l * k36 - p.YZ5l * k48 - p.ZZ5l * k49 + k47 * d55
-                    - k45 * d54 - p.MX5l * k50 - p.MY5l * k44;
-                let k52 = c_q3l * k47 - s_q3l * k46;
-                let k53 = s_q3l * k47 + c_q3l * k46;
-                let k54 = k45 - qd3l;
-                let k55 = s_q3l * k36 - c_q3l * k49 - k52 * qd3l;
-                let k56 = c_q3l * k36 + s_q3l * k49 + k53 * qd3l;
-                let k57 = p.L7 * k46;
-                let k58 = p.L7 * k47;
-                let k59 = k44 - p.L7 * k49 - k45 * k58;
-                let k60 = k50 - k46 * k57 - k47 * k58;
-                let k61 = k51 + p.L7 * k36 + k45 * k57;
-                let k62 = s_q3l * k59 - c_q3l * k61;
-                let k63 = c_q3l * k59 + s_q3l * k61;
-                let d60 = p.MZ6l * k54 + p.MY6l * k53;
-                let d61 = p.MY6l * k52 - p.MX6l * k54;
-                let d62 = p.MX6l * k53 + p.MZ6l * k52;
-                let d63 = p.m6l * k60 + p.MX6l * k55 + p.MZ6l * k56 - k53 * d60
-                    - k52 * d61;
-                let d64 = p.m6l * k62 - p.MY6l * k56 - p.MX6l * k48 - k52 * d62
-                    - k54 * d60;
-                let d65 = p.m6l * k63 - p.MZ6l * k48 + p.MY6l * k55 - k54 * d61
-                    + k53 * d62;
-                let d66 = p.XX6l * k52 + p.XY6l * k54 - p.XZ6l * k53;
-                let d67 = p.XY6l * k52 + p.YY6l * k54 - p.YZ6l * k53;
-                let d68 = p.XZ6l * k52 + p.YZ6l * k54 - p.ZZ6l * k53;
-                let d69 = p.XX6l * k56 - p.XY6l * k48 - p.XZ6l * k55 - k54 * d68
-                    - k53 * d67 - p.MY6l * k62 + p.MZ6l * k60;
-                let d70 = p.XY6l * k56 - p.YY6l * k48 - p.YZ6l * k55 + k53 * d66
-                    + k52 * d68 + p.MZ6l * k63 + p.MX6l * k62;
-                let d71 = p.XZ6l * k56 - p.YZ6l * k48 - p.ZZ6l * k55 - k52 * d67
-                    + k54 * d66 - p.MX6l * k60 - p.MY6l * k63;
-                let k64 = c_q4l * k54 - s_q4l * k53;
-                let k65 = s_q4l * k54 + c_q4l * k53;
-                let k66 = k52 + qd4l;
-                let k67 = c_q4l * k48 + s_q4l * k55 - k65 * qd4l;
-                let k68 = s_q4l * k48 - c_q4l * k55 + k64 * qd4l;
-                let k69 = c_q4l * k60 + s_q4l * k62;
-                let k70 = s_q4l * k60 - c_q4l * k62;
-                let d72 = p.MZ7l * k64 - p.MY7l * k65;
-                let d73 = p.MX7l * k65 - p.MZ7l * k66;
-                let d74 = p.MY7l * k66 - p.MX7l * k64;
-                let d75 = p.m7l * k63 - p.MZ7l * k67 + p.MY7l * k68 + k64 * d74
-                    - k65 * d73;
-                let d76 = p.m7l * k69 + p.MX7l * k68 + p.MZ7l * k56 - k65 * d72
-                    + k66 * d74;
-                let d77 = p.m7l * k70 - p.MY7l * k56 - p.MX7l * k67 - k66 * d73
-                    + k64 * d72;
-                let d78 = p.XX7l * k66 + p.XY7l * k64 + p.XZ7l * k65;
-                let d79 = p.XY7l * k66 + p.YY7l * k64 + p.YZ7l * k65;
-                let d80 = p.XZ7l * k66 + p.YZ7l * k64 + p.ZZ7l * k65;
-                let d81 = p.XX7l * k56 - p.XY7l * k67 - p.XZ7l * k68 + k64 * d80
-                    - k65 * d79 - p.MY7l * k70 + p.MZ7l * k69;
-                let d82 = p.XY7l * k56 - p.YY7l * k67 - p.YZ7l * k68 + k65 * d78
-                    - k66 * d80 + p.MZ7l * k63 + p.MX7l * k70;
-                let d83 = p.XZ7l * k56 - p.YZ7l * k67 - p.ZZ7l * k68 + k66 * d79
-                    - k64 * d78 - p.MX7l * k69 - p.MY7l * k63;
-                let k71 = c_q5l * k66 - s_q5l * k65;
-                let k72 = s_q5l * k66 + c_q5l * k65;
-                let k73 = k64 - qd5l;
-                let k74 = s_q5l * k56 - c_q5l * k68 - k71 * qd5l;
-                let k75 = c_q5l * k56 + s_q5l * k68 + k72 * qd5l;
-                let k76 = p.L8 * k65;
-                let k77 = p.L8 * k66;
-                let k78 = k63 - p.L8 * k68 - k64 * k77;
-                let k79 = k69 - k65 * k76 - k66 * k77;
-                let k80 = k70 + p.L8 * k56 + k64 * k76;
-                let k81 = s_q5l * k78 - c_q5l * k80;
-                let k82 = c_q5l * k78 + s_q5l * k80;
-                let d84 = p.MZ8l * k73 + p.MY8l * k72;
-                let d85 = p.MY8l * k71 - p.MX8l * k73;
-                let d86 = p.MX8l * k72 + p.MZ8l * k71;
-                let d87 = p.m8l * k79 + p.MX8l * k74 + p.MZ8l * k75 - k72 * d84
-                    - k71 * d85;
-                let d88 = p.m8l * k81 - p.MY8l * k75 - p.MX8l * k67 - k71 * d86
-                    - k73 * d84;
-                let d89 = p.m8l * k82 - p.MZ8l * k67 + p.MY8l * k74 - k73 * d85
-                    + k72 * d86;
-                let d90 = p.XX8l * k71 + p.XY8l * k73 - p.XZ8l * k72;
-                let d91 = p.XY8l * k71 + p.YY8l * k73 - p.YZ8l * k72;
-                let d92 = p.XZ8l * k71 + p.YZ8l * k73 - p.ZZ8l * k72;
-                let d93 = p.XX8l * k75 - p.XY8l * k67 - p.XZ8l * k74 - k73 * d92
-                    - k72 * d91 - p.MY8l * k81 + p.MZ8l * k79;
-                let d94 = p.XY8l * k75 - p.YY8l * k67 - p.YZ8l * k74 + k72 * d90
-                    + k71 * d92 + p.MZ8l * k82 + p.MX8l * k81;
-                let d95 = p.XZ8l * k75 - p.YZ8l * k67 - p.ZZ8l * k74 - k71 * d91
-                    + k73 * d90 - p.MX8l * k79 - p.MY8l * k82;
-                let k83 = c_q6l * k73 - s_q6l * k72;
-                let k84 = s_q6l * k73 + c_q6l * k72;
-                let k85 = k71 + qd6l;
-                let k86 = c_q6l * k67 + s_q6l * k74 - k84 * qd6l;
-                let k87 = s_q6l * k67 - c_q6l * k74 + k83 * qd6l;
-                let k88 = c_q6l * k79 + s_q6l * k81;
-                let k89 = s_q6l * k79 - c_q6l * k81;
-                let d96 = p.MZ9l * k83 - p.MY9l * k84;
-                let d97 = p.MX9l * k84 - p.MZ9l * k85;
-                let d98 = p.MY9l * k85 - p.MX9l * k83;
-                let d99 = p.m9l * k82 - p.MZ9l * k86 + p.MY9l * k87 + k83 * d98
-                    - k84 * d97;
-                let d100 = p.m9l * k88 + p.MX9l * k87 + p.MZ9l * k75 - k84 * d96
-                    + k85 * d98;
-                let d101 = p.m9l * k89 - p.MY9l * k75 - p.MX9l * k86 - k85 * d97
-                    + k83 * d96;
-                let d102 = p.XX9l * k85 + p.XY9l * k83 + p.XZ9l * k84;
-                let d103 = p.XY9l * k85 + p.YY9l * k83 + p.YZ9l * k84;
-                let d104 = p.XZ9l * k85 + p.YZ9l * k83 + p.ZZ9l * k84;
-                let d105 = p.XX9l * k75 - p.XY9l * k86 - p.XZ9l * k87 + k83 * d104
-                    - k84 * d103 - p.MY9l * k89 + p.MZ9l * k88;
-                let d106 = p.XY9l * k75 - p.YY9l * k86 - p.YZ9l * k87 + k84 * d102
-                    - k85 * d104 + p.MZ9l * k82 + p.MX9l * k89;
-                let d107 = p.XZ9l * k75 - p.YZ9l * k86 - p.ZZ9l * k87 + k85 * d103
-                    - k83 * d102 - p.MX9l * k88 - p.MY9l * k82;
-                let k90 = c_q7l * k85 - s_q7l * k84;
-                let k91 = s_q7l * k85 + c_q7l * k84;
-                let k92 = k83 - qd7l;
-                let k93 = c_q7l * k75 + s_q7l * k87 + k91 * qd7l;
-                let k94 = s_q7l * k75 - c_q7l * k87 - k90 * qd7l;
-                let k95 = p.L9 * k84;
-                let k96 = p.L9 * k85;
-                let k97 = k82 - p.L9 * k87 - k83 * k96;
-                let k98 = k88 - k84 * k95 - k85 * k96;
-                let k99 = k89 + p.L9 * k75 + k83 * k95;
-                let k100 = c_q7l * k97 + s_q7l * k99;
-                let k101 = s_q7l * k97 - c_q7l * k99;
-                let d108 = p.MZ10l * k91 - p.MY10l * k92;
-                let d109 = p.MX10l * k92 - p.MZ10l * k90;
-                let d110 = p.MY10l * k90 - p.MX10l * k91;
-                let d111 = p.m10l * k98 - p.MY10l * k93 + p.MX10l * k94 + k90 * d109
-                    - k91 * d108;
-                let d112 = p.m10l * k100 + p.MZ10l * k94 + p.MY10l * k86 - k91 * d110
-                    + k92 * d109;
-                let d113 = p.m10l * k101 - p.MX10l * k86 - p.MZ10l * k93 - k92 * d108
-                    + k90 * d110;
-                let d114 = p.XX10l * k90 + p.XY10l * k91 + p.XZ10l * k92;
-                let d115 = p.XY10l * k90 + p.YY10l * k91 + p.YZ10l * k92;
-                let d116 = p.XZ10l * k90 + p.YZ10l * k91 + p.ZZ10l * k92;
-                let d117 = p.XX10l * k93 + p.XY10l * k94 - p.XZ10l * k86 - k91 * d116
-                    + k92 * d115 - p.MY10l * k98 - p.MZ10l * k101;
-                let d118 = p.XY10l * k93 + p.YY10l * k94 - p.YZ10l * k86 - k92 * d114
-                    + k90 * d116 + p.MZ10l * k100 + p.MX10l * k98;
-                let d119 = p.XZ10l * k93 + p.YZ10l * k94 - p.ZZ10l * k86 - k90 * d115
-                    + k91 * d114 + p.MX10l * k101 - p.MY10l * k100;
-                buf[0][11] = kanegen_runtime::lanes::lanes(d119);
-                let k102 = c_q1r * k21 - s_q1r * k20;
-                let k103 = s_q1r * k21 + c_q1r * k20;
-                let k104 = s_q1r * k9 + c_q1r * k23 - k102 * qd1r;
-                let k105 = k19 + qd1r;
-                let k106 = c_q1r * k9 - s_q1r * k23 + k103 * qd1r;
-                let k107 = t1 + t2;
-                let k108 = k30 - t3 + t7 + k21 * k107;
-                let k109 = k28 + t4 + t8 + k19 * k107;
-                let k110 = k31 - t5 + t6 - t9 + t10;
-                let k111 = s_q1r * k109 - c_q1r * k110;
-                let k112 = c_q1r * k109 + s_q1r * k110;
-                let d120 = p.MY4r * k102 + p.MX4r * k105;
-                let d121 = p.MZ4r * k105 - p.MY4r * k103;
-                let d122 = p.MX4r * k103 + p.MZ4r * k102;
-                let d123 = p.m4r * k111 - p.MY4r * k106 + p.MX4r * k22 - k102 * d122
-                    - k105 * d121;
-                let d124 = p.m4r * k112 + p.MZ4r * k22 + p.MY4r * k104 + k105 * d120
-                    + k103 * d122;
-                let d125 = p.m4r * k108 - p.MX4r * k104 - p.MZ4r * k106 - k103 * d121
-                    + k102 * d120;
-                let d126 = p.XX4r * k102 - p.XY4r * k105 - p.XZ4r * k103;
-                let d127 = p.XY4r * k102 - p.YY4r * k105 - p.YZ4r * k103;
-                let d128 = p.XZ4r * k102 - p.YZ4r * k105 - p.ZZ4r * k103;
-                let d129 = p.XX4r * k106 + p.XY4r * k22 - p.XZ4r * k104 + k105 * d128
-                    - k103 * d127 - p.MY4r * k111 - p.MZ4r * k108;
-                let d130 = p.XY4r * k106 + p.YY4r * k22 - p.YZ4r * k104 + k103 * d126
-                    + k102 * d128 + p.MZ4r * k112 + p.MX4r * k111;
-                let d131 = p.XZ4r * k106 + p.YZ4r * k22 - p.ZZ4r * k104 - k102 * d127
-                    - k105 * d126 + p.MX4r * k108 - p.MY4r * k112;
-                let k113 = c_q2r * k105 + s_q2r * k103;
-                let k114 = s_q2r * k105 - c_q2r * k103;
-                let k115 = c_q2r * k22 - s_q2r * k104 - k114 * qd2r;
-                let k116 = s_q2r * k22 + c_q2r * k104 + k113 * qd2r;
-                let k117 = k102 + qd2r;
-                let k118 = c_q2r * k108 - s_q2r * k111;
-                let k119 = s_q2r * k108 + c_q2r * k111;
-                let d132 = p.MZ5r * k113 - p.MY5r * k114;
-                let d133 = p.MX5r * k114 + p.MZ5r * k117;
-                let d134 = p.MY5r * k117 + p.MX5r * k113;
-                let d135 = p.m5r * k112 + p.MZ5r * k115 - p.MY5r * k116 - k113 * d134
-                    - k114 * d133;
-                let d136 = p.m5r * k118 + p.MX5r * k116 - p.MZ5r * k106 + k114 * d132
-                    - k117 * d134;
-                let d137 = p.m5r * k119 + p.MY5r * k106 - p.MX5r * k115 - k117 * d133
-                    - k113 * d132;
-                let d138 = p.XX5r * k117 - p.XY5r * k113 - p.XZ5r * k114;
-                let d139 = p.XY5r * k117 - p.YY5r * k113 - p.YZ5r * k114;
-                let d140 = p.XZ5r * k117 - p.YZ5r * k113 - p.ZZ5r * k114;
-                let d141 = p.XX5r * k106 + p.XY5r * k115 + p.XZ5r * k116 - k113 * d140
-                    + k114 * d139 + p.MY5r * k119 - p.MZ5r * k118;
-                let d142 = p.XY5r * k106 + p.YY5r * k115 + p.YZ5r * k116 - k114 * d138
-                    - k117 * d140 + p.MZ5r * k112 - p.MX5r * k119;
-                let d143 = p.XZ5r * k106 + p.YZ5r * k115 + p.ZZ5r * k116 + k117 * d139
-                    + k113 * d138 + p.MX5r * k118 - p.MY5r * k112;
-                let k120 = c_q3r * k117 + s_q3r * k114;
-                let k121 = s_q3r * k117 - c_q3r * k114;
-                let k122 = s_q3r * k106 + c_q3r * k116 - k120 * qd3r;
-                let k123 = k113 + qd3r;
-                let k124 = c_q3r * k106 - s_q3r * k116 + k121 * qd3r;
-                let k125 = p.L7 * k114;
-                let k126 = p.L7 * k117;
-                let k127 = k112 + p.L7 * k116 + k113 * k126;
-                let k128 = k118 + k114 * k125 + k117 * k126;
-                let k129 = k119 - p.L7 * k106 - k113 * k125;
-                let k130 = s_q3r * k127 + c_q3r * k129;
-                let k131 = c_q3r * k127 - s_q3r * k129;
-                let d144 = p.MY6r * k120 + p.MX6r * k123;
-                let d145 = p.MZ6r * k123 - p.MY6r * k121;
-                let d146 = p.MX6r * k121 + p.MZ6r * k120;
-                let d147 = p.m6r * k130 - p.MY6r * k124 + p.MX6r * k115 - k120 * d146
-                    - k123 * d145;
-                let d148 = p.m6r * k131 + p.MZ6r * k115 + p.MY6r * k122 + k123 * d144
-                    + k121 * d146;
-                let d149 = p.m6r * k128 - p.MX6r * k122 - p.MZ6r * k124 - k121 * d145
-                    + k120 * d144;
-                let d150 = p.XX6r * k120 - p.XY6r * k123 - p.XZ6r * k121;
-                let d151 = p.XY6r * k120 - p.YY6r * k123 - p.YZ6r * k121;
-                let d152 = p.XZ6r * k120 - p.YZ6r * k123 - p.ZZ6r * k121;
-                let d153 = p.XX6r * k124 + p.XY6r * k115 - p.XZ6r * k122 + k123 * d152
-                    - k121 * d151 - p.MY6r * k130 - p.MZ6r * k128;
-                let d154 = p.XY6r * k124 + p.YY6r * k115 - p.YZ6r * k122 + k121 * d150
-                    + k120 * d152 + p.MZ6r * k131 + p.MX6r * k130;
-                let d155 = p.XZ6r * k124 + p.YZ6r * k115 - p.ZZ6r * k122 - k120 * d151
-                    - k123 * d150 + p.MX6r * k128 - p.MY6r * k131;
-                let k132 = c_q4r * k123 + s_q4r * k121;
-                let k133 = s_q4r * k123 - c_q4r * k121;
-                let k134 = c_q4r * k115 - s_q4r * k122 - k133 * qd4r;
-                let k135 = s_q4r * k115 + c_q4r * k122 + k132 * qd4r;
-                let k136 = k120 + qd4r;
-                let k137 = c_q4r * k128 - s_q4r * k130;
-                let k138 = s_q4r * k128 + c_q4r * k130;
-                let d156 = p.MZ7r * k132 - p.MY7r * k133;
-                let d157 = p.MX7r * k133 + p.MZ7r * k136;
-                let d158 = p.MY7r * k136 + p.MX7r * k132;
-                let d159 = p.m7r * k131 + p.MZ7r * k134 - p.MY7r * k135 - k132 * d158
-                    - k133 * d157;
-                let d160 = p.m7r * k137 + p.MX7r * k135 - p.MZ7r * k124 + k133 * d156
-                    - k136 * d158;
-                let d161 = p.m7r * k138 + p.MY7r * k124 - p.MX7r * k134 - k136 * d157
-                    - k132 * d156;
-                let d162 = p.XX7r * k136 - p.XY7r * k132 - p.XZ7r * k133;
-                let d163 = p.XY7r * k136 - p.YY7r * k132 - p.YZ7r * k133;
-                let d164 = p.XZ7r * k136 - p.YZ7r * k132 - p.ZZ7r * k133;
-                let d165 = p.XX7r * k124 + p.XY7r * k134 + p.XZ7r * k135 - k132 * d164
-                    + k133 * d163 + p.MY7r * k138 - p.MZ7r * k137;
-                let d166 = p.XY7r * k124 + p.YY7r * k134 + p.YZ7r * k135 - k133 * d162
-                    - k136 * d164 + p.MZ7r * k131 - p.MX7r * k138;
-                let d167 = p.XZ7r * k124 + p.YZ7r * k134 + p.ZZ7r * k135 + k136 * d163
-                    + k132 * d162 + p.MX7r * k137 - p.MY7r * k131;
-                let k139 = c_q5r * k136 + s_q5r * k133;
-                let k140 = s_q5r * k136 - c_q5r * k133;
-                let k141 = s_q5r * k124 + c_q5r * k135 - k139 * qd5r;
-                let k142 = k132 + qd5r;
-                let k143 = c_q5r * k124 - s_q5r * k135 + k140 * qd5r;
-                let k144 = p.L8 * k133;
-                let k145 = p.L8 * k136;
-                let k146 = k131 + p.L8 * k135 + k132 * k145;
-                let k147 = k137 + k133 * k144 + k136 * k145;
-                let k148 = k138 - p.L8 * k124 - k132 * k144;
-                let k149 = s_q5r * k146 + c_q5r * k148;
-                let k150 = c_q5r * k146 - s_q5r * k148;
-                let d168 = p.MY8r * k139 + p.MX8r * k142;
-                let d169 = p.MZ8r * k142 - p.MY8r * k140;
-                let d170 = p.MX8r * k140 + p.MZ8r * k139;
-                let d171 = p.m8r * k149 - p.MY8r * k143 + p.MX8r * k134 - k139 * d170
-                    - k142 * d169;
-                let d172 = p.m8r * k150 + p.MZ8r * k134 + p.MY8r * k141 + k142 * d168
-                    + k140 * d170;
-                let d173 = p.m8r * k147 - p.MX8r * k141 - p.MZ8r * k143 - k140 * d169
-                    + k139 * d168;
-                let d174 = p.XX8r * k139 - p.XY8r * k142 - p.XZ8r * k140;
-                let d175 = p.XY8r * k139 - p.YY8r * k142 - p.YZ8r * k140;
-                let d176 = p.XZ8r * k139 - p.YZ8r * k142 - p.ZZ8r * k140;
-                let d177 = p.XX8r * k143 + p.XY8r * k134 - p.XZ8r * k141 + k142 * d176
-                    - k140 * d175 - p.MY8r * k149 - p.MZ8r * k147;
-                let d178 = p.XY8r * k143 + p.YY8r * k134 - p.YZ8r * k141 + k140 * d174
-                    + k139 * d176 + p.MZ8r * k150 + p.MX8r * k149;
-                let d179 = p.XZ8r * k143 + p.YZ8r * k134 - p.ZZ8r * k141 - k139 * d175
-                    - k142 * d174 + p.MX8r * k147 - p.MY8r * k150;
-                let k151 = c_q6r * k142 + s_q6r * k140;
-                let k152 = s_q6r * k142 - c_q6r * k140;
-                let k153 = c_q6r * k134 - s_q6r * k141 - k152 * qd6r;
-                let k154 = s_q6r * k134 + c_q6r * k141 + k151 * qd6r;
-                let k155 = k139 + qd6r;
-                let k156 = c_q6r * k147 - s_q6r * k149;
-                let k157 = s_q6r * k147 + c_q6r * k149;
-                let d180 = p.MZ9r * k151 - p.MY9r * k152;
-                let d181 = p.MX9r * k152 + p.MZ9r * k155;
-                let d182 = p.MY9r * k155 + p.MX9r * k151;
-                let d183 = p.m9r * k150 + p.MZ9r * k153 - p.MY9r * k154 - k151 * d182
-                    - k152 * d181;
-                let d184 = p.m9r * k156 + p.MX9r * k154 - p.MZ9r * k143 + k152 * d180
-                    - k155 * d182;
-                let d185 = p.m9r * k157 + p.MY9r * k143 - p.MX9r * k153 - k155 * d181
-                    - k151 * d180;
-                let d186 = p.XX9r * k155 - p.XY9r * k151 - p.XZ9r * k152;
-                let d187 = p.XY9r * k155 - p.YY9r * k151 - p.YZ9r * k152;
-                let d188 = p.XZ9r * k155 - p.YZ9r * k151 - p.ZZ9r * k152;
-                let d189 = p.XX9r * k143 + p.XY9r * k153 + p.XZ9r * k154 - k151 * d188
-                    + k152 * d187 + p.MY9r * k157 - p.MZ9r * k156;
-                let d190 = p.XY9r * k143 + p.YY9r * k153 + p.YZ9r * k154 - k152 * d186
-                    - k155 * d188 + p.MZ9r * k150 - p.MX9r * k157;
-                let d191 = p.XZ9r * k143 + p.YZ9r * k153 + p.ZZ9r * k154 + k155 * d187
-                    + k151 * d186 + p.MX9r * k156 - p.MY9r * k150;
-                let k158 = c_q7r * k155 + s_q7r * k152;
-                let k159 = s_q7r * k155 - c_q7r * k152;
-                let k160 = k151 + qd7r;
-                let k161 = c_q7r * k143 - s_q7r * k154 + k159 * qd7r;
-                let k162 = s_q7r * k143 + c_q7r * k154 - k158 * qd7r;
-                let k163 = p.L9 * k152;
-                let k164 = p.L9 * k155;
-                let k165 = k150 + p.L9 * k154 + k151 * k164;
-                let k166 = k156 + k152 * k163 + k155 * k164;
-                let k167 = k157 - p.L9 * k143 - k151 * k163;
-                let k168 = c_q7r * k165 - s_q7r * k167;
-                let k169 = s_q7r * k165 + c_q7r * k167;
-                let d192 = p.MZ10r * k159 + p.MY10r * k160;
-                let d193 = p.MY10r * k158 - p.MX10r * k159;
-                let d194 = p.MX10r * k160 + p.MZ10r * k158;
-                let d195 = p.m10r * k168 + p.MZ10r * k162 - p.MY10r * k153 - k159 * d193
-                    + k160 * d194;
-                let d196 = p.m10r * k169 + p.MX10r * k153 - p.MZ10r * k161 + k160 * d192
-                    + k158 * d193;
-                let d197 = p.m10r * k166 + p.MY10r * k161 - p.MX10r * k162 + k158 * d194
-                    + k159 * d192;
-                let d198 = p.XX10r * k158 + p.XY10r * k159 - p.XZ10r * k160;
-                let d199 = p.XY10r * k158 + p.YY10r * k159 - p.YZ10r * k160;
-                let d200 = p.XZ10r * k158 + p.YZ10r * k159 - p.ZZ10r * k160;
-                let d201 = p.XX10r * k161 + p.XY10r * k162 + p.XZ10r * k153 - k159 * d200
-                    - k160 * d199 + p.MY10r * k166 - p.MZ10r * k169;
-                let d202 = p.XY10r * k161 + p.YY10r * k162 + p.YZ10r * k153 + k160 * d198
-                    + k158 * d200 + p.MZ10r * k168 - p.MX10r * k166;
-                let d203 = p.XZ10r * k161 + p.YZ10r * k162 + p.ZZ10r * k153 - k158 * d199
-                    + k159 * d198 + p.MX10r * k169 - p.MY10r * k168;
-                buf[0][18] = kanegen_runtime::lanes::lanes(d203);
-                let d204 = c_q7r * d195 + s_q7r * d196;
-                let d205 = s_q7r * d195 - c_q7r * d196;
-                let d206 = d183 + d204;
-                let d207 = d184 + d197;
-                let d208 = d185 - d205;
-                let d209 = d190 + d203;
-                let d210 = d189 + c_q7r * d201 + s_q7r * d202 + p.L9 * d205;
-                buf[0][17] = kanegen_runtime::lanes::lanes(-d210);
-                let d211 = d191 - s_q7r * d201 + c_q7r * d202 + p.L9 * d204;
-                let d212 = c_q6r * d207 + s_q6r * d208;
-                let d213 = s_q6r * d207 - c_q6r * d208;
-                let d214 = d171 - d213;
-                let d215 = d172 + d206;
-                let d216 = d173 + d212;
-                let d217 = d177 + d210;
-                let d218 = d178 + c_q6r * d209 + s_q6r * d211;
-                buf[0][16] = kanegen_runtime::lanes::lanes(d218);
-                let d219 = d179 + s_q6r * d209 - c_q6r * d211;
-                let d220 = c_q5r * d215 + s_q5r * d214;
-                let d221 = s_q5r * d215 - c_q5r * d214;
-                let d222 = d159 + d220;
-                let d223 = d160 + d216;
-                let d224 = d161 - d221;
-                let d225 = d166 + d218;
-                let d226 = d165 + c_q5r * d217 - s_q5r * d219 + p.L8 * d221;
-                buf[0][15] = kanegen_runtime::lanes::lanes(-d226);
-                let d227 = d167 - s_q5r * d217 - c_q5r * d219 + p.L8 * d220;
-                let d228 = c_q4r * d223 + s_q4r * d224;
-                let d229 = s_q4r * d223 - c_q4r * d224;
-                let d230 = d147 - d229;
-                let d231 = d148 + d222;
-                let d232 = d149 + d228;
-                let d233 = d153 + d226;
-                let d234 = d154 + c_q4r * d225 + s_q4r * d227;
-                buf[0][14] = kanegen_runtime::lanes::lanes(d234);
-                let d235 = d155 + s_q4r * d225 - c_q4r * d227;
-                let d236 = c_q3r * d231 + s_q3r * d230;
-                let d237 = s_q3r * d231 - c_q3r * d230;
-                let d238 = d135 + d236;
-                let d239 = d136 + d232;
-                let d240 = d137 - d237;
-                let d241 = d142 + d234;
-                let d242 = d141 + c_q3r * d233 - s_q3r * d235 + p.L7 * d237;
-                buf[0][13] = kanegen_runtime::lanes::lanes(-d242);
-                let d243 = d143 - s_q3r * d233 - c_q3r * d235 + p.L7 * d236;
-                let d244 = c_q2r * d239 + s_q2r * d240;
-                let d245 = s_q2r * d239 - c_q2r * d240;
-                let d246 = d123 - d245;
-                let d247 = d124 + d238;
-                let d248 = d125 + d244;
-                let d249 = d129 + d242;
-                let d250 = d130 + c_q2r * d241 + s_q2r * d243;
-                buf[0][12] = kanegen_runtime::lanes::lanes(d250);
-                let d251 = d131 + s_q2r * d241 - c_q2r * d243;
-                let d252 = c_q1r * d247 + s_q1r * d246;
-                let d253 = s_q1r * d247 - c_q1r * d246;
-                let d254 = d27 + d248;
-                let d255 = d33 + d250 - p.L5 * d253;
-                let d256 = d34 - c_q1r * d249 + s_q1r * d251 - p.L6 * d253;
-                let d257 = d35 - s_q1r * d249 - c_q1r * d251 + p.L6 * d252 - p.L5 * d248;
-                let d258 = d28 + d252;
-                let d259 = d29 + d253;
-                let d260 = c_q7l * d112 + s_q7l * d113;
-                let d261 = s_q7l * d112 - c_q7l * d113;
-                let d262 = d99 + d260;
-                let d263 = d106 + d119;
-                let d264 = d105 + c_q7l * d117 + s_q7l * d118 + p.L9 * d261;
-                buf[0][10] = kanegen_runtime::lanes::lanes(-d264);
-                let d265 = d107 - s_q7l * d117 + c_q7l * d118 + p.L9 * d260;
-                let d266 = d100 + d111;
-                let d267 = d101 + d261;
-                let d268 = c_q6l * d266 + s_q6l * d267;
-                let d269 = s_q6l * d266 - c_q6l * d267;
-                let d270 = d87 + d268;
-                let d271 = d88 + d269;
-                let d272 = d89 + d262;
-                let d273 = d93 + d264;
-                let d274 = d94 + c_q6l * d263 + s_q6l * d265;
-                buf[0][9] = kanegen_runtime::lanes::lanes(d274);
-                let d275 = d95 + s_q6l * d263 - c_q6l * d265;
-                let d276 = c_q5l * d272 + s_q5l * d271;
-                let d277 = s_q5l * d272 - c_q5l * d271;
-                let d278 = d75 + d276;
-                let d279 = d82 + d274;
-                let d280 = d81 + c_q5l * d273 - s_q5l * d275 + p.L8 * d277;
-                buf[0][8] = kanegen_runtime::lanes::lanes(-d280);
-                let d281 = d83 - s_q5l * d273 - c_q5l * d275 + p.L8 * d276;
-                let d282 = d76 + d270;
-                let d283 = d77 + d277;
-                let d284 = c_q4l * d282 + s_q4l * d283;
-                let d285 = s_q4l * d282 - c_q4l * d283;
-                let d286 = d63 + d284;
-                let d287 = d64 + d285;
-                let d288 = d65 + d278;
-                let d289 = d69 + d280;
-                let d290 = d70 + c_q4l * d279 + s_q4l * d281;
-                buf[0][7] = kanegen_runtime::lanes::lanes(d290);
-                let d291 = d71 + s_q4l * d279 - c_q4l * d281;
-                let d292 = c_q3l * d288 + s_q3l * d287;
-                let d293 = s_q3l * d288 - c_q3l * d287;
-                let d294 = d51 + d292;
-                let d295 = d58 + d290;
-                let d296 = d57 + c_q3l * d289 - s_q3l * d291 + p.L7 * d293;
-                buf[0][6] = kanegen_runtime::lanes::lanes(-d296);
-                let d297 = d59 - s_q3l * d289 - c_q3l * d291 + p.L7 * d292;
-                let d298 = d52 + d286;
-                let d299 = d53 + d293;
-                let d300 = c_q2l * d298 + s_q2l * d299;
-                let d301 = s_q2l * d298 - c_q2l * d299;
-                let d302 = d39 + d300;
-                let d303 = d40 + d301;
-                let d304 = d41 + d294;
-                let d305 = d45 + d296;
-                let d306 = d46 + c_q2l * d295 + s_q2l * d297;
-                buf[0][5] = kanegen_runtime::lanes::lanes(d306);
-                let d307 = d47 + s_q2l * d295 - c_q2l * d297;
-                let d308 = s_q1l * d304 - c_q1l * d303;
-                let d309 = c_q1l * d304 + s_q1l * d303;
-                let d310 = d254 + d302;
-                let d311 = d255 - d306 + p.L5 * d308;
-                let d312 = d256 - c_q1l * d305 + s_q1l * d307 - p.L6 * d308;
-                buf[0][4] = kanegen_runtime::lanes::lanes(-d312);
-                let d313 = d257 + s_q1l * d305 + c_q1l * d307 - p.L6 * d309
-                    - p.L5 * d302;
-                let d314 = d258 + d309;
-                let d315 = d259 - d308;
-                let d316 = c_q_torso * d310 + s_q_torso * d315;
-                let d317 = s_q_torso * d310 - c_q_torso * d315;
-                let d318 = d15 + d316;
-                let d319 = d16 + d314;
-                let d320 = d17 + d317;
-                let d321 = d21 + c_q_torso * d311 - s_q_torso * d313 + p.L3 * d317
-                    - p.L4 * d314;
-                buf[0][3] = kanegen_runtime::lanes::lanes(d321);
-                let d322 = d22 - d312 + p.L4 * d316;
-                let d323 = d23 + s_q_torso * d311 + c_q_torso * d313 - p.L3 * d316;
-                let d324 = s_q_w * d319 - c_q_w * d320;
-                let d325 = c_q_w * d319 + s_q_w * d320;
-                let d326 = d4 - d325;
-                let d327 = d5 + d324;
-                let d328 = d9 + d321 - p.L1 * d324 + p.L2 * d325;
-                buf[0][2] = kanegen_runtime::lanes::lanes(d328);
-                let d329 = d10 + c_q_w * d322 + s_q_w * d323 - p.L2 * d318;
-                let d330 = d11 - s_q_w * d322 + c_q_w * d323 - p.L1 * d318;
-                let d331 = s_q_imu * d326 - c_q_imu * d327;
-                buf[0][0] = kanegen_runtime::lanes::lanes(d331);
-                let d332 = c_q_imu * d329 + s_q_imu * d330;
-                buf[0][1] = kanegen_runtime::lanes::lanes(-d332);
-                kanegen_runtime::lanes::results(&mut buf, false)
-            },
+            |out| body::<kanegen_runtime::isa::Plain, L>(p, pc, q, out),
+            #[inline(always)]
+            |out| body::<kanegen_runtime::isa::Fused, L>(p, pc, q, out),
         )
     }
-    /// [`gravity`] at `L` states per call: entry `l` of the result is `gravity` at entry `l` of the inputs, bit for bit (the same statements over [`kanegen_runtime::lanes::Lanes`], vectorized across the states).
-    #[inline(never)]
+    /// [`gravity`] at `L` states per call: entry `l` of the result is `gravity` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Returns the results by value; [`gravity_batch_into`] writes them into the caller's array instead (no zeroed array, no copy).
+    #[inline]
     pub fn gravity_batch<const L: usize>(
         p: &Params,
         pc: &Precomputed,
         q: &[SVector<f64, 19>; L],
     ) -> [SVector<f64, 19>; L] {
-        kanegen_runtime::isa::dispatch(
+        let mut out = [<SVector<f64, 19>>::zeros(); L];
+        gravity_batch_into(p, pc, q, &mut out);
+        out
+    }
+    /// [`inverse_dynamics`] at `L` states per call, into `out`: entry `l` of `out` becomes `inverse_dynamics` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
+    #[inline(never)]
+    pub fn inverse_dynamics_batch_into<const L: usize>(
+        p: &Params,
+        pc: &Precomputed,
+        q: &[SVector<f64, 19>; L],
+        u: &[SVector<f64, 19>; L],
+        ud: &[SVector<f64, 19>; L],
+        out: &mut [SVector<f64, 19>; L],
+    ) {
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>, const L: usize>(
+            p: &Params,
+            pc: &Precomputed,
+            q: &[SVector<f64, 19>; L],
+            u: &[SVector<f64, 19>; L],
+            ud: &[SVector<f64, 19>; L],
+            out: &mut [SVector<f64, 19>; L],
+        ) {
+            let p = &{ *p };
+            let pc = &{ *pc };
+            let q = kanegen_runtime::lanes::inputs(q);
+            let u = kanegen_runtime::lanes::inputs(u);
+            let ud = kanegen_runtime::lanes::inputs(ud);
+            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n([
+                q[2].0,
+                q[3].0,
+                q[4].0,
+                q[5].0,
+                q[6].0,
+                q[7].0,
+                q[8].0,
+                q[9].0,
+                q[10].0,
+                q[11].0,
+                q[12].0,
+                q[13].0,
+                q[14].0,
+                q[15].0,
+                q[16].0,
+                q[17].0,
+                q[18].0,
+            ]);
+            for (l, m) in out.iter_mut().enumerate() {
+                let s_q_imu = sin_q[0][l];
+                let c_q_imu = cos_q[0][l];
+                let s_q_w = sin_q[1][l];
+                let c_q_w = cos_q[1][l];
+                let s_q_torso = sin_q[2][l];
+                let c_q_torso = cos_q[2][l];
+                let s_q1l = sin_q[3][l];
+                let c_q1l = cos_q[3][l];
+                let s_q2l = sin_q[4][l];
+                let c_q2l = cos_q[4][l];
+                let s_q3l = sin_q[5][l];
+                let c_q3l = cos_q[5][l];
+                let s_q4l = sin_q[6][l];
+                let c_q4l = cos_q[6][l];
+                let s_q5l = sin_q[7][l];
+                let c_q5l = cos_q[7][l];
+                let s_q6l = sin_q[8][l];
+                let c_q6l = cos_q[8][l];
+                let s_q7l = sin_q[9][l];
+                let c_q7l = cos_q[9][l];
+                let s_q1r = sin_q[10][l];
+                let c_q1r = cos_q[10][l];
+                let s_q2r = sin_q[11][l];
+                let c_q2r = cos_q[11][l];
+                let s_q3r = sin_q[12][l];
+                let c_q3r = cos_q[12][l];
+                let s_q4r = sin_q[13][l];
+                let c_q4r = cos_q[13][l];
+                let s_q5r = sin_q[14][l];
+                let c_q5r = cos_q[14][l];
+                let s_q6r = sin_q[15][l];
+                let c_q6r = cos_q[15][l];
+                let s_q7r = sin_q[16][l];
+                let c_q7r = cos_q[16][l];
+                let xd = u[0].0[l];
+                let xdd = ud[0].0[l];
+                let psid = u[1].0[l];
+                let psidd = ud[1].0[l];
+                let qd_imu = u[2].0[l];
+                let qdd_imu = ud[2].0[l];
+                let qd_w = u[3].0[l];
+                let qdd_w = ud[3].0[l];
+                let qd_torso = u[4].0[l];
+                let qdd_torso = ud[4].0[l];
+                let qd1l = u[5].0[l];
+                let qdd1l = ud[5].0[l];
+                let qd2l = u[6].0[l];
+                let qdd2l = ud[6].0[l];
+                let qd3l = u[7].0[l];
+                let qdd3l = ud[7].0[l];
+                let qd4l = u[8].0[l];
+                let qdd4l = ud[8].0[l];
+                let qd5l = u[9].0[l];
+                let qdd5l = ud[9].0[l];
+                let qd6l = u[10].0[l];
+                let qdd6l = ud[10].0[l];
+                let qd7l = u[11].0[l];
+                let qdd7l = ud[11].0[l];
+                let qd1r = u[12].0[l];
+                let qdd1r = ud[12].0[l];
+                let qd2r = u[13].0[l];
+                let qdd2r = ud[13].0[l];
+                let qd3r = u[14].0[l];
+                let qdd3r = ud[14].0[l];
+                let qd4r = u[15].0[l];
+                let qdd4r = ud[15].0[l];
+                let qd5r = u[16].0[l];
+                let qdd5r = ud[16].0[l];
+                let qd6r = u[17].0[l];
+                let qdd6r = ud[17].0[l];
+                let qd7r = u[18].0[l];
+                let qdd7r = ud[18].0[l];
+                let k1 = xd * psid; // a0|ud=0,g=0.y
+                let k2 = c_q_imu * psid; // w0 in 1|ud=0,g=0.y
+                let k3 = s_q_imu * psid; // w0 in 1|ud=0,g=0.z
+                let k4 = A::mul_add(s_q_imu, psidd, k2 * qd_imu); // wd1.z
+                let k5 = A::mul_add(-c_q_imu, psidd, k3 * qd_imu); // wd1.y
+                let d1 = A::mul_add(s_q_imu, xdd, c_q_imu * p.g); // a1.y
+                let d2 = A::mul_add(-c_q_imu, xdd, s_q_imu * p.g); // a1.z
+                let d3 = A::mul_add(-p.MY1, k3, p.MZ1 * k2); // w1xMS1|ud=0,g=0.x
+                let d4 = A::mul_add(p.MZ1, qd_imu, p.MX1 * k3); // w1xMS1|ud=0,g=0.y
+                let d5 = A::mul_add(p.MX1, k2, p.MY1 * qd_imu); // w1xMS1|ud=0,g=0.z
+                let d6 = A::mul_add(
+                    p.MZ1,
+                    qdd_imu,
+                    A::mul_add(
+                        p.MX1,
+                        k4,
+                        A::mul_add(p.m1, d1, A::mul_add(-qd_imu, d5, k3 * d3)),
+                    ),
+                ); // F1.y
+                let d7 = A::mul_add(
+                    -p.MX1,
+                    k5,
+                    A::mul_add(
+                        p.MY1,
+                        qdd_imu,
+                        A::mul_add(-p.m1, d2, A::mul_add(k2, d3, qd_imu * d4)),
+                    ),
+                ); // F1.z
+                let d8 = A::mul_add(-p.XZ1, k3, A::mul_add(-p.XY1, k2, p.XX1 * qd_imu)); // J1w1|ud=0,g=0.x
+                let d9 = A::mul_add(-p.YZ1, k3, A::mul_add(-p.YY1, k2, p.XY1 * qd_imu)); // J1w1|ud=0,g=0.y
+                let d10 = A::mul_add(-p.ZZ1, k3, A::mul_add(-p.YZ1, k2, p.XZ1 * qd_imu)); // J1w1|ud=0,g=0.z
+                let d11 = A::mul_add(
+                    p.MX1,
+                    d1,
+                    A::mul_add(
+                        p.ZZ1,
+                        k4,
+                        A::mul_add(
+                            -p.YZ1,
+                            k5,
+                            A::mul_add(
+                                -p.XZ1,
+                                qdd_imu,
+                                A::mul_add(p.MY1, k1, A::mul_add(k2, d8, qd_imu * d9)),
+                            ),
+                        ),
+                    ),
+                ); // N1.z
+                let d12 = A::mul_add(
+                    p.MZ1,
+                    d1,
+                    A::mul_add(
+                        -p.MY1,
+                        d2,
+                        A::mul_add(
+                            -p.XZ1,
+                            k4,
+                            A::mul_add(
+                                p.XY1,
+                                k5,
+                                A::mul_add(p.XX1, qdd_imu, A::mul_add(-k3, d9, k2 * d10)),
+                            ),
+                        ),
+                    ),
+                ); // N1.x
+                let d13 = A::mul_add(
+                    p.MX1,
+                    d2,
+                    A::mul_add(
+                        -p.YZ1,
+                        k4,
+                        A::mul_add(
+                            p.YY1,
+                            k5,
+                            A::mul_add(
+                                p.XY1,
+                                qdd_imu,
+                                A::mul_add(p.MZ1, k1, A::mul_add(qd_imu, d10, k3 * d8)),
+                            ),
+                        ),
+                    ),
+                ); // N1.y
+                let k6 = A::mul_add(-s_q_w, k3, c_q_w * k2); // w1 in 2|ud=0,g=0.y
+                let k7 = A::mul_add(c_q_w, k3, s_q_w * k2); // w1 in 2|ud=0,g=0.z
+                let k8 = A::mul_add(c_q_w, k4, A::mul_add(-s_q_w, k5, k6 * qd_w)); // wd2.z
+                let k9 = qd_imu + qd_w; // w2|ud=0,g=0.x
+                let k10 = qdd_imu + qdd_w; // wd2.x
+                let k11 = A::mul_add(s_q_w, k4, A::mul_add(c_q_w, k5, k7 * qd_w)); // wd2.y
+                let k12 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+                let k13 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+                let k14 = A::mul_add(p.L1, k3, p.L2 * k2); // w1xP2|ud=0,g=0.x
+                let d14 = A::mul_add(
+                    -p.L1,
+                    qdd_imu,
+                    A::mul_add(k2, k14, qd_imu * k12) + d2,
+                ); // a2 in 1.z
+                let k15 = A::mul_add(
+                    p.L1,
+                    k4,
+                    A::mul_add(-p.L2, k5, A::mul_add(-k3, k12, A::mul_add(k2, k13, k1))),
+                ); // a2 in 1.x
+                let d15 = A::mul_add(
+                    p.L2,
+                    qdd_imu,
+                    A::mul_add(qd_imu, k13, k3 * k14) - d1,
+                ); // a2 in 1.y
+                let d16 = A::mul_add(s_q_w, d14, c_q_w * d15); // a2.y
+                let d17 = A::mul_add(-c_q_w, d14, s_q_w * d15); // a2.z
+                let d18 = A::mul_add(-p.MY2, k7, p.MZ2 * k6); // w2xMS2|ud=0,g=0.x
+                let d19 = A::mul_add(p.MZ2, k9, p.MX2 * k7); // w2xMS2|ud=0,g=0.y
+                let d20 = A::mul_add(p.MX2, k6, p.MY2 * k9); // w2xMS2|ud=0,g=0.z
+                let d21 = A::mul_add(
+                    p.MZ2,
+                    k10,
+                    A::mul_add(
+                        p.MX2,
+                        k8,
+                        A::mul_add(-p.m2, d16, A::mul_add(-k9, d20, k7 * d18)),
+                    ),
+                ); // F2.y
+                let d22 = A::mul_add(
+                    p.MY2,
+                    k8,
+                    A::mul_add(
+                        p.MZ2,
+                        k11,
+                        A::mul_add(p.m2, k15, A::mul_add(k7, d19, k6 * d20)),
+                    ),
+                ); // F2.x
+                let d23 = A::mul_add(
+                    -p.MX2,
+                    k11,
+                    A::mul_add(
+                        p.MY2,
+                        k10,
+                        A::mul_add(p.m2, d17, A::mul_add(k6, d18, k9 * d19)),
+                    ),
+                ); // F2.z
+                let d24 = A::mul_add(-p.XZ2, k7, A::mul_add(-p.XY2, k6, p.XX2 * k9)); // J2w2|ud=0,g=0.x
+                let d25 = A::mul_add(-p.YZ2, k7, A::mul_add(-p.YY2, k6, p.XY2 * k9)); // J2w2|ud=0,g=0.y
+                let d26 = A::mul_add(-p.ZZ2, k7, A::mul_add(-p.YZ2, k6, p.XZ2 * k9)); // J2w2|ud=0,g=0.z
+                let d27 = A::mul_add(
+                    p.MY2,
+                    k15,
+                    A::mul_add(
+                        -p.MX2,
+                        d16,
+                        A::mul_add(
+                            p.ZZ2,
+                            k8,
+                            A::mul_add(
+                                -p.YZ2,
+                                k11,
+                                A::mul_add(-p.XZ2, k10, A::mul_add(k6, d24, k9 * d25)),
+                            ),
+                        ),
+                    ),
+                ); // N2.z
+                let d28 = A::mul_add(
+                    -p.MZ2,
+                    d16,
+                    A::mul_add(
+                        p.MY2,
+                        d17,
+                        A::mul_add(
+                            -p.XZ2,
+                            k8,
+                            A::mul_add(
+                                p.XY2,
+                                k11,
+                                A::mul_add(p.XX2, k10, A::mul_add(-k7, d25, k6 * d26)),
+                            ),
+                        ),
+                    ),
+                ); // N2.x
+                let d29 = A::mul_add(
+                    -p.MX2,
+                    d17,
+                    A::mul_add(
+                        p.MZ2,
+                        k15,
+                        A::mul_add(
+                            -p.YZ2,
+                            k8,
+                            A::mul_add(
+                                p.YY2,
+                                k11,
+                                A::mul_add(p.XY2, k10, A::mul_add(k9, d26, k7 * d24)),
+                            ),
+                        ),
+                    ),
+                ); // N2.y
+                let k16 = A::mul_add(-s_q_torso, k7, c_q_torso * k9); // w2 in 3|ud=0,g=0.x
+                let k17 = A::mul_add(c_q_torso, k7, s_q_torso * k9); // w2 in 3|ud=0,g=0.z
+                let k18 = k6 - qd_torso; // w3|ud=0,g=0.y
+                let k19 = A::mul_add(
+                    s_q_torso,
+                    k8,
+                    A::mul_add(-c_q_torso, k10, k17 * qd_torso),
+                ); // wd3.x
+                let k20 = k11 + qdd_torso; // wd3.y
+                let k21 = A::mul_add(
+                    c_q_torso,
+                    k8,
+                    A::mul_add(s_q_torso, k10, k16 * qd_torso),
+                ); // wd3.z
+                let k22 = A::mul_add(-p.L3, k7, p.L4 * k6); // w2xP3|ud=0,g=0.x
+                let k23 = p.L4 * k9; // w2xP3|ud=0,g=0.y
+                let k24 = p.L3 * k9; // w2xP3|ud=0,g=0.z
+                let d30 = A::mul_add(p.L4, k10, A::mul_add(-k9, k24, k7 * k22) - d16); // a3 in 2.y
+                let k25 = A::mul_add(
+                    p.L3,
+                    k8,
+                    A::mul_add(p.L4, k11, A::mul_add(k7, k23, k6 * k24) + k15),
+                ); // a3 in 2.x
+                let d31 = A::mul_add(p.L3, k10, A::mul_add(k6, k22, k9 * k23) + d17); // a3 in 2.z
+                let d32 = A::mul_add(s_q_torso, d31, c_q_torso * k25); // a3.x
+                let d33 = A::mul_add(-c_q_torso, d31, s_q_torso * k25); // a3.z
+                let d34 = A::mul_add(p.MY3, k17, p.MZ3 * k18); // w3xMS3|ud=0,g=0.x
+                let d35 = A::mul_add(-p.MX3, k18, p.MY3 * k16); // w3xMS3|ud=0,g=0.z
+                let d36 = A::mul_add(p.MZ3, k16, p.MX3 * k17); // w3xMS3|ud=0,g=0.y
+                let d37 = A::mul_add(
+                    p.MY3,
+                    k21,
+                    A::mul_add(
+                        -p.MZ3,
+                        k20,
+                        A::mul_add(p.m3, d32, A::mul_add(-k17, d36, k18 * d35)),
+                    ),
+                ); // F3.x
+                let d38 = A::mul_add(
+                    -p.MZ3,
+                    k19,
+                    A::mul_add(
+                        p.MX3,
+                        k21,
+                        A::mul_add(-p.m3, d30, A::mul_add(k16, d35, k17 * d34)),
+                    ),
+                ); // F3.y
+                let d39 = A::mul_add(
+                    -p.MX3,
+                    k20,
+                    A::mul_add(
+                        p.MY3,
+                        k19,
+                        A::mul_add(p.m3, d33, A::mul_add(k18, d34, k16 * d36)),
+                    ),
+                ); // F3.z
+                let d40 = A::mul_add(-p.XZ3, k17, A::mul_add(p.XY3, k18, p.XX3 * k16)); // J3w3|ud=0,g=0.x
+                let d41 = A::mul_add(-p.YZ3, k17, A::mul_add(p.YY3, k18, p.XY3 * k16)); // J3w3|ud=0,g=0.y
+                let d42 = A::mul_add(-p.ZZ3, k17, A::mul_add(p.YZ3, k18, p.XZ3 * k16)); // J3w3|ud=0,g=0.z
+                let d43 = A::mul_add(
+                    -p.MZ3,
+                    d30,
+                    A::mul_add(
+                        -p.MY3,
+                        d33,
+                        A::mul_add(
+                            -p.XZ3,
+                            k21,
+                            A::mul_add(
+                                -p.XY3,
+                                k20,
+                                A::mul_add(-p.XX3, k19, A::mul_add(k17, d41, k18 * d42)),
+                            ),
+                        ),
+                    ),
+                ); // N3.x
+                let d44 = A::mul_add(
+                    -p.MY3,
+                    d32,
+                    A::mul_add(
+                        p.MX3,
+                        d30,
+                        A::mul_add(
+                            -p.ZZ3,
+                            k21,
+                            A::mul_add(
+                                -p.YZ3,
+                                k20,
+                                A::mul_add(-p.XZ3, k19, A::mul_add(-k18, d40, k16 * d41)),
+                            ),
+                        ),
+                    ),
+                ); // N3.z
+                let d45 = A::mul_add(
+                    -p.MX3,
+                    d33,
+                    A::mul_add(
+                        -p.MZ3,
+                        d32,
+                        A::mul_add(
+                            p.YZ3,
+                            k21,
+                            A::mul_add(
+                                p.YY3,
+                                k20,
+                                A::mul_add(p.XY3, k19, A::mul_add(k16, d42, k17 * d40)),
+                            ),
+                        ),
+                    ),
+                ); // N3.y
+                let k26 = A::mul_add(s_q1l, k17, c_q1l * k18); // w3 in 4l|ud=0,g=0.x
+                let k27 = A::mul_add(-c_q1l, k17, s_q1l * k18); // w3 in 4l|ud=0,g=0.z
+                let k28 = k16 - qd1l; // w4l|ud=0,g=0.y
+                let k29 = A::mul_add(-s_q1l, k21, A::mul_add(c_q1l, k20, k27 * qd1l)); // wd4l.x
+                let k30 = k19 + qdd1l; // wd4l.y
+                let k31 = A::mul_add(-c_q1l, k21, A::mul_add(-s_q1l, k20, k26 * qd1l)); // wd4l.z
+                let k32 = p.L5 * k17; // w3xP4l|ud=0,g=0.x
+                let k33 = p.L6 * k17; // w3xP4l|ud=0,g=0.y
+                let t1 = p.L5 * k16; // common subexpression
+                let t2 = p.L6 * k18; // common subexpression
+                let k34 = t1 - t2; // w3xP4l|ud=0,g=0.z
+                let t3 = p.L5 * k21; // common subexpression
+                let t4 = p.L6 * k21; // common subexpression
+                let t5 = p.L5 * k19; // common subexpression
+                let t6 = p.L6 * k20; // common subexpression
+                let t7 = k17 * k33; // common subexpression
+                let t8 = k17 * k32; // common subexpression
+                let t9 = k16 * k33; // common subexpression
+                let t10 = k18 * k32; // common subexpression
+                let d46 = A::mul_add(k18, k34, -t7) + d32 + t3; // a4l in 3.x
+                let d47 = A::mul_add(k16, k34, t8) - d30 + t4; // a4l in 3.y
+                let d48 = t9 + t10 + d33 + t5 - t6; // a4l in 3.z
+                let d49 = A::mul_add(c_q1l, d48, s_q1l * d47); // a4l.z
+                let d50 = A::mul_add(-s_q1l, d48, c_q1l * d47); // a4l.x
+                let d51 = A::mul_add(p.MY4l, k27, p.MZ4l * k28); // w4lxMS4l|ud=0,g=0.x
+                let d52 = A::mul_add(-p.MX4l, k28, p.MY4l * k26); // w4lxMS4l|ud=0,g=0.z
+                let d53 = A::mul_add(p.MZ4l, k26, p.MX4l * k27); // w4lxMS4l|ud=0,g=0.y
+                let d54 = A::mul_add(
+                    p.MY4l,
+                    k31,
+                    A::mul_add(
+                        -p.MZ4l,
+                        k30,
+                        A::mul_add(-p.m4l, d50, A::mul_add(-k27, d53, k28 * d52)),
+                    ),
+                ); // F4l.x
+                let d55 = A::mul_add(
+                    -p.MZ4l,
+                    k29,
+                    A::mul_add(
+                        p.MX4l,
+                        k31,
+                        A::mul_add(-p.m4l, d46, A::mul_add(k26, d52, k27 * d51)),
+                    ),
+                ); // F4l.y
+                let d56 = A::mul_add(
+                    -p.MX4l,
+                    k30,
+                    A::mul_add(
+                        p.MY4l,
+                        k29,
+                        A::mul_add(-p.m4l, d49, A::mul_add(k28, d51, k26 * d53)),
+                    ),
+                ); // F4l.z
+                let d57 = A::mul_add(
+                    -p.XZ4l,
+                    k27,
+                    A::mul_add(p.XY4l, k28, p.XX4l * k26),
+                ); // J4lw4l|ud=0,g=0.x
+                let d58 = A::mul_add(
+                    -p.YZ4l,
+                    k27,
+                    A::mul_add(p.YY4l, k28, p.XY4l * k26),
+                ); // J4lw4l|ud=0,g=0.y
+                let d59 = A::mul_add(
+                    -p.ZZ4l,
+                    k27,
+                    A::mul_add(p.YZ4l, k28, p.XZ4l * k26),
+                ); // J4lw4l|ud=0,g=0.z
+                let d60 = A::mul_add(
+                    -p.MZ4l,
+                    d46,
+                    A::mul_add(
+                        p.MY4l,
+                        d49,
+                        A::mul_add(
+                            -p.XZ4l,
+                            k31,
+                            A::mul_add(
+                                -p.XY4l,
+                                k30,
+                                A::mul_add(-p.XX4l, k29, A::mul_add(k27, d58, k28 * d59)),
+                            ),
+                        ),
+                    ),
+                ); // N4l.x
+                let d61 = A::mul_add(
+                    p.MY4l,
+                    d50,
+                    A::mul_add(
+                        p.MX4l,
+                        d46,
+                        A::mul_add(
+                            -p.ZZ4l,
+                            k31,
+                            A::mul_add(
+                                -p.YZ4l,
+                                k30,
+                                A::mul_add(-p.XZ4l, k29, A::mul_add(-k28, d57, k26 * d58)),
+                            ),
+                        ),
+                    ),
+                ); // N4l.z
+                let d62 = A::mul_add(
+                    p.MX4l,
+                    d49,
+                    A::mul_add(
+                        p.MZ4l,
+                        d50,
+                        A::mul_add(
+                            p.YZ4l,
+                            k31,
+                            A::mul_add(
+                                p.YY4l,
+                                k30,
+                                A::mul_add(p.XY4l, k29, A::mul_add(k26, d59, k27 * d57)),
+                            ),
+                        ),
+                    ),
+                ); // N4l.y
+                let k35 = A::mul_add(-s_q2l, k27, c_q2l * k28); // w4l in 5l|ud=0,g=0.y
+                let k36 = A::mul_add(c_q2l, k27, s_q2l * k28); // w4l in 5l|ud=0,g=0.z
+                let k37 = k29 - qdd2l; // wd5l.x
+                let k38 = A::mul_add(s_q2l, k31, A::mul_add(c_q2l, k30, k36 * qd2l)); // wd5l.y
+                let k39 = k26 + qd2l; // w5l|ud=0,g=0.x
+                let k40 = A::mul_add(c_q2l, k31, A::mul_add(-s_q2l, k30, k35 * qd2l)); // wd5l.z
+                let d63 = A::mul_add(s_q2l, d49, c_q2l * d46); // a5l.y
+                let d64 = A::mul_add(-c_q2l, d49, s_q2l * d46); // a5l.z
+                let d65 = A::mul_add(-p.MY5l, k36, p.MZ5l * k35); // w5lxMS5l|ud=0,g=0.x
+                let d66 = A::mul_add(-p.MZ5l, k39, p.MX5l * k36); // w5lxMS5l|ud=0,g=0.y
+                let d67 = A::mul_add(-p.MX5l, k35, p.MY5l * k39); // w5lxMS5l|ud=0,g=0.z
+                let d68 = A::mul_add(
+                    p.MY5l,
+                    k40,
+                    A::mul_add(
+                        p.MZ5l,
+                        k38,
+                        A::mul_add(p.m5l, d50, A::mul_add(-k36, d66, k35 * d67)),
+                    ),
+                ); // F5l.x
+                let d69 = A::mul_add(
+                    -p.MZ5l,
+                    k37,
+                    A::mul_add(
+                        -p.MX5l,
+                        k40,
+                        A::mul_add(-p.m5l, d63, A::mul_add(-k39, d67, k36 * d65)),
+                    ),
+                ); // F5l.y
+                let d70 = A::mul_add(
+                    -p.MX5l,
+                    k38,
+                    A::mul_add(
+                        p.MY5l,
+                        k37,
+                        A::mul_add(-p.m5l, d64, A::mul_add(-k35, d65, k39 * d66)),
+                    ),
+                ); // F5l.z
+                let d71 = A::mul_add(p.XZ5l, k36, A::mul_add(p.XY5l, k35, p.XX5l * k39)); // J5lw5l|ud=0,g=0.x
+                let d72 = A::mul_add(p.YZ5l, k36, A::mul_add(p.YY5l, k35, p.XY5l * k39)); // J5lw5l|ud=0,g=0.y
+                let d73 = A::mul_add(p.ZZ5l, k36, A::mul_add(p.YZ5l, k35, p.XZ5l * k39)); // J5lw5l|ud=0,g=0.z
+                let d74 = A::mul_add(
+                    p.MZ5l,
+                    d63,
+                    A::mul_add(
+                        -p.MY5l,
+                        d64,
+                        A::mul_add(
+                            -p.XZ5l,
+                            k40,
+                            A::mul_add(
+                                p.XY5l,
+                                k38,
+                                A::mul_add(p.XX5l, k37, A::mul_add(-k36, d72, k35 * d73)),
+                            ),
+                        ),
+                    ),
+                ); // N5l.x
+                let d75 = A::mul_add(
+                    p.MX5l,
+                    d64,
+                    A::mul_add(
+                        p.MZ5l,
+                        d50,
+                        A::mul_add(
+                            -p.YZ5l,
+                            k40,
+                            A::mul_add(
+                                p.YY5l,
+                                k38,
+                                A::mul_add(p.XY5l, k37, A::mul_add(-k39, d73, k36 * d71)),
+                            ),
+                        ),
+                    ),
+                ); // N5l.y
+                let d76 = A::mul_add(
+                    -p.MY5l,
+                    d50,
+                    A::mul_add(
+                        -p.MX5l,
+                        d63,
+                        A::mul_add(
+                            -p.ZZ5l,
+                            k40,
+                            A::mul_add(
+                                p.YZ5l,
+                                k38,
+                                A::mul_add(p.XZ5l, k37, A::mul_add(-k35, d71, k39 * d72)),
+                            ),
+                        ),
+                    ),
+                ); // N5l.z
+                let k41 = A::mul_add(-s_q3l, k36, c_q3l * k39); // w5l in 6l|ud=0,g=0.x
+                let k42 = A::mul_add(c_q3l, k36, s_q3l * k39); // w5l in 6l|ud=0,g=0.z
+                let k43 = k35 - qd3l; // w6l|ud=0,g=0.y
+                let k44 = A::mul_add(s_q3l, k40, A::mul_add(c_q3l, k37, k42 * qd3l)); // wd6l.x
+                let k45 = k38 + qdd3l; // wd6l.y
+                let k46 = A::mul_add(c_q3l, k40, A::mul_add(-s_q3l, k37, k41 * qd3l)); // wd6l.z
+                let k47 = p.L7 * k36; // w5lxP6l|ud=0,g=0.x
+                let k48 = p.L7 * k39; // w5lxP6l|ud=0,g=0.z
+                let d77 = A::mul_add(k39, k48, k36 * k47) - d63; // a6l in 5l.y
+                let d78 = A::mul_add(p.L7, k40, A::mul_add(k35, k48, -d50)); // a6l in 5l.x
+                let d79 = A::mul_add(p.L7, k37, A::mul_add(k35, k47, d64)); // a6l in 5l.z
+                let d80 = A::mul_add(-s_q3l, d79, c_q3l * d78); // a6l.x
+                let d81 = A::mul_add(c_q3l, d79, s_q3l * d78); // a6l.z
+                let d82 = A::mul_add(p.MY6l, k42, p.MZ6l * k43); // w6lxMS6l|ud=0,g=0.x
+                let d83 = A::mul_add(-p.MX6l, k43, p.MY6l * k41); // w6lxMS6l|ud=0,g=0.z
+                let d84 = A::mul_add(p.MZ6l, k41, p.MX6l * k42); // w6lxMS6l|ud=0,g=0.y
+                let d85 = A::mul_add(
+                    p.MY6l,
+                    k46,
+                    A::mul_add(
+                        -p.MZ6l,
+                        k45,
+                        A::mul_add(p.m6l, d80, A::mul_add(-k42, d84, k43 * d83)),
+                    ),
+                ); // F6l.x
+                let d86 = A::mul_add(
+                    -p.MZ6l,
+                    k44,
+                    A::mul_add(
+                        p.MX6l,
+                        k46,
+                        A::mul_add(p.m6l, d77, A::mul_add(k41, d83, k42 * d82)),
+                    ),
+                ); // F6l.y
+                let d87 = A::mul_add(
+                    -p.MX6l,
+                    k45,
+                    A::mul_add(
+                        p.MY6l,
+                        k44,
+                        A::mul_add(p.m6l, d81, A::mul_add(k43, d82, k41 * d84)),
+                    ),
+                ); // F6l.z
+                let d88 = A::mul_add(
+                    -p.XZ6l,
+                    k42,
+                    A::mul_add(p.XY6l, k43, p.XX6l * k41),
+                ); // J6lw6l|ud=0,g=0.x
+                let d89 = A::mul_add(
+                    -p.YZ6l,
+                    k42,
+                    A::mul_add(p.YY6l, k43, p.XY6l * k41),
+                ); // J6lw6l|ud=0,g=0.y
+                let d90 = A::mul_add(
+                    -p.ZZ6l,
+                    k42,
+                    A::mul_add(p.YZ6l, k43, p.XZ6l * k41),
+                ); // J6lw6l|ud=0,g=0.z
+                let d91 = A::mul_add(
+                    p.MZ6l,
+                    d77,
+                    A::mul_add(
+                        -p.MY6l,
+                        d81,
+                        A::mul_add(
+                            -p.XZ6l,
+                            k46,
+                            A::mul_add(
+                                -p.XY6l,
+                                k45,
+                                A::mul_add(-p.XX6l, k44, A::mul_add(k42, d89, k43 * d90)),
+                            ),
+                        ),
+                    ),
+                ); // N6l.x
+                let d92 = A::mul_add(
+                    -p.MY6l,
+                    d80,
+                    A::mul_add(
+                        -p.MX6l,
+                        d77,
+                        A::mul_add(
+                            -p.ZZ6l,
+                            k46,
+                            A::mul_add(
+                                -p.YZ6l,
+                                k45,
+                                A::mul_add(-p.XZ6l, k44, A::mul_add(-k43, d88, k41 * d89)),
+                            ),
+                        ),
+                    ),
+                ); // N6l.z
+                let d93 = A::mul_add(
+                    -p.MX6l,
+                    d81,
+                    A::mul_add(
+                        -p.MZ6l,
+                        d80,
+                        A::mul_add(
+                            p.YZ6l,
+                            k46,
+                            A::mul_add(
+                                p.YY6l,
+                                k45,
+                                A::mul_add(p.XY6l, k44, A::mul_add(k41, d90, k42 * d88)),
+                            ),
+                        ),
+                    ),
+                ); // N6l.y
+                let k49 = A::mul_add(-s_q4l, k42, c_q4l * k43); // w6l in 7l|ud=0,g=0.y
+                let k50 = A::mul_add(c_q4l, k42, s_q4l * k43); // w6l in 7l|ud=0,g=0.z
+                let k51 = k44 - qdd4l; // wd7l.x
+                let k52 = A::mul_add(s_q4l, k46, A::mul_add(c_q4l, k45, k50 * qd4l)); // wd7l.y
+                let k53 = k41 + qd4l; // w7l|ud=0,g=0.x
+                let k54 = A::mul_add(c_q4l, k46, A::mul_add(-s_q4l, k45, k49 * qd4l)); // wd7l.z
+                let d94 = A::mul_add(s_q4l, d81, c_q4l * d77); // a7l.y
+                let d95 = A::mul_add(-c_q4l, d81, s_q4l * d77); // a7l.z
+                let d96 = A::mul_add(-p.MY7l, k50, p.MZ7l * k49); // w7lxMS7l|ud=0,g=0.x
+                let d97 = A::mul_add(-p.MZ7l, k53, p.MX7l * k50); // w7lxMS7l|ud=0,g=0.y
+                let d98 = A::mul_add(-p.MX7l, k49, p.MY7l * k53); // w7lxMS7l|ud=0,g=0.z
+                let d99 = A::mul_add(
+                    p.MY7l,
+                    k54,
+                    A::mul_add(
+                        p.MZ7l,
+                        k52,
+                        A::mul_add(-p.m7l, d80, A::mul_add(-k50, d97, k49 * d98)),
+                    ),
+                ); // F7l.x
+                let d100 = A::mul_add(
+                    -p.MZ7l,
+                    k51,
+                    A::mul_add(
+                        -p.MX7l,
+                        k54,
+                        A::mul_add(p.m7l, d94, A::mul_add(-k53, d98, k50 * d96)),
+                    ),
+                ); // F7l.y
+                let d101 = A::mul_add(
+                    -p.MX7l,
+                    k52,
+                    A::mul_add(
+                        p.MY7l,
+                        k51,
+                        A::mul_add(p.m7l, d95, A::mul_add(-k49, d96, k53 * d97)),
+                    ),
+                ); // F7l.z
+                let d102 = A::mul_add(
+                    p.XZ7l,
+                    k50,
+                    A::mul_add(p.XY7l, k49, p.XX7l * k53),
+                ); // J7lw7l|ud=0,g=0.x
+                let d103 = A::mul_add(
+                    p.YZ7l,
+                    k50,
+                    A::mul_add(p.YY7l, k49, p.XY7l * k53),
+                ); // J7lw7l|ud=0,g=0.y
+                let d104 = A::mul_add(
+                    p.ZZ7l,
+                    k50,
+                    A::mul_add(p.YZ7l, k49, p.XZ7l * k53),
+                ); // J7lw7l|ud=0,g=0.z
+                let d105 = A::mul_add(
+                    -p.MZ7l,
+                    d94,
+                    A::mul_add(
+                        p.MY7l,
+                        d95,
+                        A::mul_add(
+                            -p.XZ7l,
+                            k54,
+                            A::mul_add(
+                                p.XY7l,
+                                k52,
+                                A::mul_add(p.XX7l, k51, A::mul_add(-k50, d103, k49 * d104)),
+                            ),
+                        ),
+                    ),
+                ); // N7l.x
+                let d106 = A::mul_add(
+                    -p.MX7l,
+                    d95,
+                    A::mul_add(
+                        -p.MZ7l,
+                        d80,
+                        A::mul_add(
+                            -p.YZ7l,
+                            k54,
+                            A::mul_add(
+                                p.YY7l,
+                                k52,
+                                A::mul_add(p.XY7l, k51, A::mul_add(-k53, d104, k50 * d102)),
+                            ),
+                        ),
+                    ),
+                ); // N7l.y
+                let d107 = A::mul_add(
+                    p.MY7l,
+                    d80,
+                    A::mul_add(
+                        p.MX7l,
+                        d94,
+                        A::mul_add(
+                            -p.ZZ7l,
+                            k54,
+                            A::mul_add(
+                                p.YZ7l,
+                                k52,
+                                A::mul_add(p.XZ7l, k51, A::mul_add(-k49, d102, k53 * d103)),
+                            ),
+                        ),
+                    ),
+                ); // N7l.z
+                let k55 = A::mul_add(-s_q5l, k50, c_q5l * k53); // w7l in 8l|ud=0,g=0.x
+                let k56 = A::mul_add(c_q5l, k50, s_q5l * k53); // w7l in 8l|ud=0,g=0.z
+                let k57 = k49 - qd5l; // w8l|ud=0,g=0.y
+                let k58 = A::mul_add(s_q5l, k54, A::mul_add(c_q5l, k51, k56 * qd5l)); // wd8l.x
+                let k59 = k52 + qdd5l; // wd8l.y
+                let k60 = A::mul_add(c_q5l, k54, A::mul_add(-s_q5l, k51, k55 * qd5l)); // wd8l.z
+                let k61 = p.L8 * k50; // w7lxP8l|ud=0,g=0.x
+                let k62 = p.L8 * k53; // w7lxP8l|ud=0,g=0.z
+                let d108 = A::mul_add(k53, k62, k50 * k61) + d94; // a8l in 7l.y
+                let d109 = A::mul_add(p.L8, k54, A::mul_add(k49, k62, d80)); // a8l in 7l.x
+                let d110 = A::mul_add(p.L8, k51, A::mul_add(k49, k61, -d95)); // a8l in 7l.z
+                let d111 = A::mul_add(-s_q5l, d110, c_q5l * d109); // a8l.x
+                let d112 = A::mul_add(c_q5l, d110, s_q5l * d109); // a8l.z
+                let d113 = A::mul_add(p.MY8l, k56, p.MZ8l * k57); // w8lxMS8l|ud=0,g=0.x
+                let d114 = A::mul_add(-p.MX8l, k57, p.MY8l * k55); // w8lxMS8l|ud=0,g=0.z
+                let d115 = A::mul_add(p.MZ8l, k55, p.MX8l * k56); // w8lxMS8l|ud=0,g=0.y
+                let d116 = A::mul_add(
+                    p.MY8l,
+                    k60,
+                    A::mul_add(
+                        -p.MZ8l,
+                        k59,
+                        A::mul_add(p.m8l, d111, A::mul_add(-k56, d115, k57 * d114)),
+                    ),
+                ); // F8l.x
+                let d117 = A::mul_add(
+                    -p.MZ8l,
+                    k58,
+                    A::mul_add(
+                        p.MX8l,
+                        k60,
+                        A::mul_add(p.m8l, d108, A::mul_add(k55, d114, k56 * d113)),
+                    ),
+                ); // F8l.y
+                let d118 = A::mul_add(
+                    -p.MX8l,
+                    k59,
+                    A::mul_add(
+                        p.MY8l,
+                        k58,
+                        A::mul_add(p.m8l, d112, A::mul_add(k57, d113, k55 * d115)),
+                    ),
+                ); // F8l.z
+                let d119 = A::mul_add(
+                    -p.XZ8l,
+                    k56,
+                    A::mul_add(p.XY8l, k57, p.XX8l * k55),
+                ); // J8lw8l|ud=0,g=0.x
+                let d120 = A::mul_add(
+                    -p.YZ8l,
+                    k56,
+                    A::mul_add(p.YY8l, k57, p.XY8l * k55),
+                ); // J8lw8l|ud=0,g=0.y
+                let d121 = A::mul_add(
+                    -p.ZZ8l,
+                    k56,
+                    A::mul_add(p.YZ8l, k57, p.XZ8l * k55),
+                ); // J8lw8l|ud=0,g=0.z
+                let d122 = A::mul_add(
+                    p.MZ8l,
+                    d108,
+                    A::mul_add(
+                        -p.MY8l,
+                        d112,
+                        A::mul_add(
+                            -p.XZ8l,
+                            k60,
+                            A::mul_add(
+                                -p.XY8l,
+                                k59,
+                                A::mul_add(-p.XX8l, k58, A::mul_add(k56, d120, k57 * d121)),
+                            ),
+                        ),
+                    ),
+                ); // N8l.x
+                let d123 = A::mul_add(
+                    -p.MY8l,
+                    d111,
+                    A::mul_add(
+                        -p.MX8l,
+                        d108,
+                        A::mul_add(
+                            -p.ZZ8l,
+                            k60,
+                            A::mul_add(
+                                -p.YZ8l,
+                                k59,
+                                A::mul_add(-p.XZ8l, k58, A::mul_add(-k57, d119, k55 * d120)),
+                            ),
+                        ),
+                    ),
+                ); // N8l.z
+                let d124 = A::mul_add(
+                    -p.MX8l,
+                    d112,
+                    A::mul_add(
+                        -p.MZ8l,
+                        d111,
+                        A::mul_add(
+                            p.YZ8l,
+                            k60,
+                            A::mul_add(
+                                p.YY8l,
+                                k59,
+                                A::mul_add(p.XY8l, k58, A::mul_add(k55, d121, k56 * d119)),
+                            ),
+                        ),
+                    ),
+                ); // N8l.y
+                let k63 = A::mul_add(-s_q6l, k56, c_q6l * k57); // w8l in 9l|ud=0,g=0.y
+                let k64 = A::mul_add(c_q6l, k56, s_q6l * k57); // w8l in 9l|ud=0,g=0.z
+                let k65 = k58 - qdd6l; // wd9l.x
+                let k66 = A::mul_add(s_q6l, k60, A::mul_add(c_q6l, k59, k64 * qd6l)); // wd9l.y
+                let k67 = k55 + qd6l; // w9l|ud=0,g=0.x
+                let k68 = A::mul_add(c_q6l, k60, A::mul_add(-s_q6l, k59, k63 * qd6l)); // wd9l.z
+                let d125 = A::mul_add(s_q6l, d112, c_q6l * d108); // a9l.y
+                let d126 = A::mul_add(-c_q6l, d112, s_q6l * d108); // a9l.z
+                let d127 = A::mul_add(-p.MY9l, k64, p.MZ9l * k63); // w9lxMS9l|ud=0,g=0.x
+                let d128 = A::mul_add(-p.MZ9l, k67, p.MX9l * k64); // w9lxMS9l|ud=0,g=0.y
+                let d129 = A::mul_add(-p.MX9l, k63, p.MY9l * k67); // w9lxMS9l|ud=0,g=0.z
+                let d130 = A::mul_add(
+                    p.MY9l,
+                    k68,
+                    A::mul_add(
+                        p.MZ9l,
+                        k66,
+                        A::mul_add(-p.m9l, d111, A::mul_add(-k64, d128, k63 * d129)),
+                    ),
+                ); // F9l.x
+                let d131 = A::mul_add(
+                    -p.MZ9l,
+                    k65,
+                    A::mul_add(
+                        -p.MX9l,
+                        k68,
+                        A::mul_add(p.m9l, d125, A::mul_add(-k67, d129, k64 * d127)),
+                    ),
+                ); // F9l.y
+                let d132 = A::mul_add(
+                    -p.MX9l,
+                    k66,
+                    A::mul_add(
+                        p.MY9l,
+                        k65,
+                        A::mul_add(p.m9l, d126, A::mul_add(-k63, d127, k67 * d128)),
+                    ),
+                ); // F9l.z
+                let d133 = A::mul_add(
+                    p.XZ9l,
+                    k64,
+                    A::mul_add(p.XY9l, k63, p.XX9l * k67),
+                ); // J9lw9l|ud=0,g=0.x
+                let d134 = A::mul_add(
+                    p.YZ9l,
+                    k64,
+                    A::mul_add(p.YY9l, k63, p.XY9l * k67),
+                ); // J9lw9l|ud=0,g=0.y
+                let d135 = A::mul_add(
+                    p.ZZ9l,
+                    k64,
+                    A::mul_add(p.YZ9l, k63, p.XZ9l * k67),
+                ); // J9lw9l|ud=0,g=0.z
+                let d136 = A::mul_add(
+                    -p.MZ9l,
+                    d125,
+                    A::mul_add(
+                        p.MY9l,
+                        d126,
+                        A::mul_add(
+                            -p.XZ9l,
+                            k68,
+                            A::mul_add(
+                                p.XY9l,
+                                k66,
+                                A::mul_add(p.XX9l, k65, A::mul_add(-k64, d134, k63 * d135)),
+                            ),
+                        ),
+                    ),
+                ); // N9l.x
+                let d137 = A::mul_add(
+                    -p.MX9l,
+                    d126,
+                    A::mul_add(
+                        -p.MZ9l,
+                        d111,
+                        A::mul_add(
+                            -p.YZ9l,
+                            k68,
+                            A::mul_add(
+                                p.YY9l,
+                                k66,
+                                A::mul_add(p.XY9l, k65, A::mul_add(-k67, d135, k64 * d133)),
+                            ),
+                        ),
+                    ),
+                ); // N9l.y
+                let d138 = A::mul_add(
+                    p.MY9l,
+                    d111,
+                    A::mul_add(
+                        p.MX9l,
+                        d125,
+                        A::mul_add(
+                            -p.ZZ9l,
+                            k68,
+                            A::mul_add(
+                                p.YZ9l,
+                                k66,
+                                A::mul_add(p.XZ9l, k65, A::mul_add(-k63, d133, k67 * d134)),
+                            ),
+                        ),
+                    ),
+                ); // N9l.z
+                let k69 = A::mul_add(-s_q7l, k64, c_q7l * k67); // w9l in 10l|ud=0,g=0.x
+                let k70 = A::mul_add(c_q7l, k64, s_q7l * k67); // w9l in 10l|ud=0,g=0.y
+                let k71 = k63 - qd7l; // w10l|ud=0,g=0.z
+                let k72 = A::mul_add(c_q7l, k68, A::mul_add(-s_q7l, k65, k69 * qd7l)); // wd10l.y
+                let k73 = A::mul_add(s_q7l, k68, A::mul_add(c_q7l, k65, k70 * qd7l)); // wd10l.x
+                let k74 = k66 + qdd7l; // wd10l.z
+                let k75 = p.L9 * k64; // w9lxP10l|ud=0,g=0.x
+                let k76 = p.L9 * k67; // w9lxP10l|ud=0,g=0.z
+                let d139 = A::mul_add(k67, k76, k64 * k75) + d125; // a10l in 9l.y
+                let d140 = A::mul_add(p.L9, k68, A::mul_add(k63, k76, d111)); // a10l in 9l.x
+                let d141 = A::mul_add(p.L9, k65, A::mul_add(k63, k75, -d126)); // a10l in 9l.z
+                let d142 = A::mul_add(-s_q7l, d141, c_q7l * d140); // a10l.x
+                let d143 = A::mul_add(c_q7l, d141, s_q7l * d140); // a10l.y
+                let d144 = A::mul_add(-p.MY10l, k71, p.MZ10l * k70); // w10lxMS10l|ud=0,g=0.x
+                let d145 = A::mul_add(-p.MZ10l, k69, p.MX10l * k71); // w10lxMS10l|ud=0,g=0.y
+                let d146 = A::mul_add(-p.MX10l, k70, p.MY10l * k69); // w10lxMS10l|ud=0,g=0.z
+                let d147 = A::mul_add(
+                    p.MY10l,
+                    k74,
+                    A::mul_add(
+                        p.MZ10l,
+                        k72,
+                        A::mul_add(p.m10l, d142, A::mul_add(-k71, d145, k70 * d146)),
+                    ),
+                ); // F10l.x
+                let d148 = A::mul_add(
+                    p.MZ10l,
+                    k73,
+                    A::mul_add(
+                        -p.MX10l,
+                        k74,
+                        A::mul_add(p.m10l, d143, A::mul_add(-k69, d146, k71 * d144)),
+                    ),
+                ); // F10l.y
+                let d149 = A::mul_add(
+                    -p.MX10l,
+                    k72,
+                    A::mul_add(
+                        -p.MY10l,
+                        k73,
+                        A::mul_add(-p.m10l, d139, A::mul_add(-k70, d144, k69 * d145)),
+                    ),
+                ); // F10l.z
+                let d150 = A::mul_add(
+                    p.XZ10l,
+                    k71,
+                    A::mul_add(p.XY10l, k70, p.XX10l * k69),
+                ); // J10lw10l|ud=0,g=0.x
+                let d151 = A::mul_add(
+                    p.YZ10l,
+                    k71,
+                    A::mul_add(p.YY10l, k70, p.XY10l * k69),
+                ); // J10lw10l|ud=0,g=0.y
+                let d152 = A::mul_add(
+                    p.ZZ10l,
+                    k71,
+                    A::mul_add(p.YZ10l, k70, p.XZ10l * k69),
+                ); // J10lw10l|ud=0,g=0.z
+                let d153 = A::mul_add(
+                    -p.MZ10l,
+                    d143,
+                    A::mul_add(
+                        -p.MY10l,
+                        d139,
+                        A::mul_add(
+                            -p.XZ10l,
+                            k74,
+                            A::mul_add(
+                                p.XY10l,
+                                k72,
+                                A::mul_add(
+                                    -p.XX10l,
+                                    k73,
+                                    A::mul_add(-k71, d151, k70 * d152),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10l.x
+                let d154 = A::mul_add(
+                    p.MX10l,
+                    d139,
+                    A::mul_add(
+                        p.MZ10l,
+                        d142,
+                        A::mul_add(
+                            -p.YZ10l,
+                            k74,
+                            A::mul_add(
+                                p.YY10l,
+                                k72,
+                                A::mul_add(
+                                    -p.XY10l,
+                                    k73,
+                                    A::mul_add(-k69, d152, k71 * d150),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10l.y
+                let d155 = A::mul_add(
+                    -p.MY10l,
+                    d142,
+                    A::mul_add(
+                        p.MX10l,
+                        d143,
+                        A::mul_add(
+                            -p.ZZ10l,
+                            k74,
+                            A::mul_add(
+                                p.YZ10l,
+                                k72,
+                                A::mul_add(
+                                    -p.XZ10l,
+                                    k73,
+                                    A::mul_add(-k70, d150, k69 * d151),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10l.z
+                m[11] = -d155;
+                let k77 = A::mul_add(-s_q1r, k17, c_q1r * k18); // w3 in 4r|ud=0,g=0.x
+                let k78 = A::mul_add(c_q1r, k17, s_q1r * k18); // w3 in 4r|ud=0,g=0.z
+                let k79 = k19 - qdd1r; // wd4r.y
+                let k80 = k16 + qd1r; // w4r|ud=0,g=0.y
+                let k81 = A::mul_add(s_q1r, k21, A::mul_add(c_q1r, k20, k78 * qd1r)); // wd4r.x
+                let k82 = A::mul_add(c_q1r, k21, A::mul_add(-s_q1r, k20, k77 * qd1r)); // wd4r.z
+                let k83 = t1 + t2; // w3xP4r|ud=0,g=0.z
+                let d156 = A::mul_add(k18, k83, t7) + d32 + t3; // a4r in 3.x
+                let d157 = t9 - t10 - d33 - t5 - t6; // a4r in 3.z
+                let d158 = A::mul_add(k16, k83, t8) - d30 - t4; // a4r in 3.y
+                let d159 = A::mul_add(c_q1r, d157, s_q1r * d158); // a4r.z
+                let d160 = A::mul_add(-s_q1r, d157, c_q1r * d158); // a4r.x
+                let d161 = A::mul_add(p.MX4r, k80, p.MY4r * k77); // w4rxMS4r|ud=0,g=0.z
+                let d162 = A::mul_add(-p.MY4r, k78, p.MZ4r * k80); // w4rxMS4r|ud=0,g=0.x
+                let d163 = A::mul_add(p.MZ4r, k77, p.MX4r * k78); // w4rxMS4r|ud=0,g=0.y
+                let d164 = A::mul_add(
+                    p.MZ4r,
+                    k81,
+                    A::mul_add(
+                        -p.MX4r,
+                        k82,
+                        A::mul_add(-p.m4r, d156, A::mul_add(-k77, d161, k78 * d162)),
+                    ),
+                ); // F4r.y
+                let d165 = A::mul_add(
+                    -p.MY4r,
+                    k82,
+                    A::mul_add(
+                        -p.MZ4r,
+                        k79,
+                        A::mul_add(p.m4r, d160, A::mul_add(k78, d163, k80 * d161)),
+                    ),
+                ); // F4r.x
+                let d166 = A::mul_add(
+                    p.MX4r,
+                    k79,
+                    A::mul_add(
+                        p.MY4r,
+                        k81,
+                        A::mul_add(-p.m4r, d159, A::mul_add(k80, d162, k77 * d163)),
+                    ),
+                ); // F4r.z
+                let d167 = A::mul_add(
+                    -p.XZ4r,
+                    k78,
+                    A::mul_add(-p.XY4r, k80, p.XX4r * k77),
+                ); // J4rw4r|ud=0,g=0.x
+                let d168 = A::mul_add(
+                    -p.YZ4r,
+                    k78,
+                    A::mul_add(-p.YY4r, k80, p.XY4r * k77),
+                ); // J4rw4r|ud=0,g=0.y
+                let d169 = A::mul_add(
+                    -p.ZZ4r,
+                    k78,
+                    A::mul_add(-p.YZ4r, k80, p.XZ4r * k77),
+                ); // J4rw4r|ud=0,g=0.z
+                let d170 = A::mul_add(
+                    p.MY4r,
+                    d160,
+                    A::mul_add(
+                        -p.MX4r,
+                        d156,
+                        A::mul_add(
+                            -p.ZZ4r,
+                            k82,
+                            A::mul_add(
+                                p.YZ4r,
+                                k79,
+                                A::mul_add(-p.XZ4r, k81, A::mul_add(k80, d167, k77 * d168)),
+                            ),
+                        ),
+                    ),
+                ); // N4r.z
+                let d171 = A::mul_add(
+                    -p.MZ4r,
+                    d156,
+                    A::mul_add(
+                        -p.MY4r,
+                        d159,
+                        A::mul_add(
+                            p.XZ4r,
+                            k82,
+                            A::mul_add(
+                                -p.XY4r,
+                                k79,
+                                A::mul_add(p.XX4r, k81, A::mul_add(-k78, d168, k80 * d169)),
+                            ),
+                        ),
+                    ),
+                ); // N4r.x
+                let d172 = A::mul_add(
+                    p.MX4r,
+                    d159,
+                    A::mul_add(
+                        p.MZ4r,
+                        d160,
+                        A::mul_add(
+                            p.YZ4r,
+                            k82,
+                            A::mul_add(
+                                -p.YY4r,
+                                k79,
+                                A::mul_add(p.XY4r, k81, A::mul_add(k77, d169, k78 * d167)),
+                            ),
+                        ),
+                    ),
+                ); // N4r.y
+                let k84 = A::mul_add(s_q2r, k78, c_q2r * k80); // w4r in 5r|ud=0,g=0.y
+                let k85 = A::mul_add(-c_q2r, k78, s_q2r * k80); // w4r in 5r|ud=0,g=0.z
+                let k86 = k81 - qdd2r; // wd5r.x
+                let k87 = A::mul_add(-c_q2r, k82, A::mul_add(-s_q2r, k79, k84 * qd2r)); // wd5r.z
+                let k88 = k77 + qd2r; // w5r|ud=0,g=0.x
+                let k89 = A::mul_add(-s_q2r, k82, A::mul_add(c_q2r, k79, k85 * qd2r)); // wd5r.y
+                let d173 = A::mul_add(-s_q2r, d159, c_q2r * d156); // a5r.y
+                let d174 = A::mul_add(c_q2r, d159, s_q2r * d156); // a5r.z
+                let d175 = A::mul_add(-p.MY5r, k85, p.MZ5r * k84); // w5rxMS5r|ud=0,g=0.x
+                let d176 = A::mul_add(p.MZ5r, k88, p.MX5r * k85); // w5rxMS5r|ud=0,g=0.y
+                let d177 = A::mul_add(p.MX5r, k84, p.MY5r * k88); // w5rxMS5r|ud=0,g=0.z
+                let d178 = A::mul_add(
+                    -p.MZ5r,
+                    k86,
+                    A::mul_add(
+                        p.MX5r,
+                        k87,
+                        A::mul_add(p.m5r, d173, A::mul_add(-k88, d177, k85 * d175)),
+                    ),
+                ); // F5r.y
+                let d179 = A::mul_add(
+                    p.MY5r,
+                    k87,
+                    A::mul_add(
+                        p.MZ5r,
+                        k89,
+                        A::mul_add(-p.m5r, d160, A::mul_add(k85, d176, k84 * d177)),
+                    ),
+                ); // F5r.x
+                let d180 = A::mul_add(
+                    -p.MX5r,
+                    k89,
+                    A::mul_add(
+                        -p.MY5r,
+                        k86,
+                        A::mul_add(-p.m5r, d174, A::mul_add(k84, d175, k88 * d176)),
+                    ),
+                ); // F5r.z
+                let d181 = A::mul_add(
+                    -p.XZ5r,
+                    k85,
+                    A::mul_add(-p.XY5r, k84, p.XX5r * k88),
+                ); // J5rw5r|ud=0,g=0.x
+                let d182 = A::mul_add(
+                    -p.YZ5r,
+                    k85,
+                    A::mul_add(-p.YY5r, k84, p.XY5r * k88),
+                ); // J5rw5r|ud=0,g=0.y
+                let d183 = A::mul_add(
+                    -p.ZZ5r,
+                    k85,
+                    A::mul_add(-p.YZ5r, k84, p.XZ5r * k88),
+                ); // J5rw5r|ud=0,g=0.z
+                let d184 = A::mul_add(
+                    -p.MY5r,
+                    d160,
+                    A::mul_add(
+                        p.MX5r,
+                        d173,
+                        A::mul_add(
+                            p.ZZ5r,
+                            k87,
+                            A::mul_add(
+                                -p.YZ5r,
+                                k89,
+                                A::mul_add(p.XZ5r, k86, A::mul_add(k84, d181, k88 * d182)),
+                            ),
+                        ),
+                    ),
+                ); // N5r.z
+                let d185 = A::mul_add(
+                    p.MZ5r,
+                    d173,
+                    A::mul_add(
+                        -p.MY5r,
+                        d174,
+                        A::mul_add(
+                            -p.XZ5r,
+                            k87,
+                            A::mul_add(
+                                p.XY5r,
+                                k89,
+                                A::mul_add(-p.XX5r, k86, A::mul_add(-k85, d182, k84 * d183)),
+                            ),
+                        ),
+                    ),
+                ); // N5r.x
+                let d186 = A::mul_add(
+                    p.MX5r,
+                    d174,
+                    A::mul_add(
+                        -p.MZ5r,
+                        d160,
+                        A::mul_add(
+                            -p.YZ5r,
+                            k87,
+                            A::mul_add(
+                                p.YY5r,
+                                k89,
+                                A::mul_add(-p.XY5r, k86, A::mul_add(k88, d183, k85 * d181)),
+                            ),
+                        ),
+                    ),
+                ); // N5r.y
+                let k90 = A::mul_add(s_q3r, k85, c_q3r * k88); // w5r in 6r|ud=0,g=0.x
+                let k91 = A::mul_add(-c_q3r, k85, s_q3r * k88); // w5r in 6r|ud=0,g=0.z
+                let k92 = k89 - qdd3r; // wd6r.y
+                let k93 = k84 + qd3r; // w6r|ud=0,g=0.y
+                let k94 = A::mul_add(-s_q3r, k87, A::mul_add(c_q3r, k86, k91 * qd3r)); // wd6r.x
+                let k95 = A::mul_add(-c_q3r, k87, A::mul_add(-s_q3r, k86, k90 * qd3r)); // wd6r.z
+                let k96 = p.L7 * k85; // w5rxP6r|ud=0,g=0.x
+                let k97 = p.L7 * k88; // w5rxP6r|ud=0,g=0.z
+                let d187 = A::mul_add(p.L7, k87, A::mul_add(k84, k97, d160)); // a6r in 5r.x
+                let d188 = A::mul_add(k88, k97, k85 * k96) + d173; // a6r in 5r.y
+                let d189 = A::mul_add(p.L7, k86, A::mul_add(k84, k96, -d174)); // a6r in 5r.z
+                let d190 = A::mul_add(-c_q3r, d189, s_q3r * d187); // a6r.z
+                let d191 = A::mul_add(s_q3r, d189, c_q3r * d187); // a6r.x
+                let d192 = A::mul_add(p.MX6r, k93, p.MY6r * k90); // w6rxMS6r|ud=0,g=0.z
+                let d193 = A::mul_add(-p.MY6r, k91, p.MZ6r * k93); // w6rxMS6r|ud=0,g=0.x
+                let d194 = A::mul_add(p.MZ6r, k90, p.MX6r * k91); // w6rxMS6r|ud=0,g=0.y
+                let d195 = A::mul_add(
+                    p.MZ6r,
+                    k94,
+                    A::mul_add(
+                        -p.MX6r,
+                        k95,
+                        A::mul_add(-p.m6r, d188, A::mul_add(-k90, d192, k91 * d193)),
+                    ),
+                ); // F6r.y
+                let d196 = A::mul_add(
+                    -p.MY6r,
+                    k95,
+                    A::mul_add(
+                        -p.MZ6r,
+                        k92,
+                        A::mul_add(p.m6r, d191, A::mul_add(k91, d194, k93 * d192)),
+                    ),
+                ); // F6r.x
+                let d197 = A::mul_add(
+                    p.MX6r,
+                    k92,
+                    A::mul_add(
+                        p.MY6r,
+                        k94,
+                        A::mul_add(-p.m6r, d190, A::mul_add(k93, d193, k90 * d194)),
+                    ),
+                ); // F6r.z
+                let d198 = A::mul_add(
+                    -p.XZ6r,
+                    k91,
+                    A::mul_add(-p.XY6r, k93, p.XX6r * k90),
+                ); // J6rw6r|ud=0,g=0.x
+                let d199 = A::mul_add(
+                    -p.YZ6r,
+                    k91,
+                    A::mul_add(-p.YY6r, k93, p.XY6r * k90),
+                ); // J6rw6r|ud=0,g=0.y
+                let d200 = A::mul_add(
+                    -p.ZZ6r,
+                    k91,
+                    A::mul_add(-p.YZ6r, k93, p.XZ6r * k90),
+                ); // J6rw6r|ud=0,g=0.z
+                let d201 = A::mul_add(
+                    p.MY6r,
+                    d191,
+                    A::mul_add(
+                        -p.MX6r,
+                        d188,
+                        A::mul_add(
+                            -p.ZZ6r,
+                            k95,
+                            A::mul_add(
+                                p.YZ6r,
+                                k92,
+                                A::mul_add(-p.XZ6r, k94, A::mul_add(k93, d198, k90 * d199)),
+                            ),
+                        ),
+                    ),
+                ); // N6r.z
+                let d202 = A::mul_add(
+                    -p.MZ6r,
+                    d188,
+                    A::mul_add(
+                        -p.MY6r,
+                        d190,
+                        A::mul_add(
+                            p.XZ6r,
+                            k95,
+                            A::mul_add(
+                                -p.XY6r,
+                                k92,
+                                A::mul_add(p.XX6r, k94, A::mul_add(-k91, d199, k93 * d200)),
+                            ),
+                        ),
+                    ),
+                ); // N6r.x
+                let d203 = A::mul_add(
+                    p.MX6r,
+                    d190,
+                    A::mul_add(
+                        p.MZ6r,
+                        d191,
+                        A::mul_add(
+                            p.YZ6r,
+                            k95,
+                            A::mul_add(
+                                -p.YY6r,
+                                k92,
+                                A::mul_add(p.XY6r, k94, A::mul_add(k90, d200, k91 * d198)),
+                            ),
+                        ),
+                    ),
+                ); // N6r.y
+                let k98 = A::mul_add(s_q4r, k91, c_q4r * k93); // w6r in 7r|ud=0,g=0.y
+                let k99 = A::mul_add(-c_q4r, k91, s_q4r * k93); // w6r in 7r|ud=0,g=0.z
+                let k100 = k94 - qdd4r; // wd7r.x
+                let k101 = A::mul_add(-c_q4r, k95, A::mul_add(-s_q4r, k92, k98 * qd4r)); // wd7r.z
+                let k102 = k90 + qd4r; // w7r|ud=0,g=0.x
+                let k103 = A::mul_add(-s_q4r, k95, A::mul_add(c_q4r, k92, k99 * qd4r)); // wd7r.y
+                let d204 = A::mul_add(-s_q4r, d190, c_q4r * d188); // a7r.y
+                let d205 = A::mul_add(c_q4r, d190, s_q4r * d188); // a7r.z
+                let d206 = A::mul_add(-p.MY7r, k99, p.MZ7r * k98); // w7rxMS7r|ud=0,g=0.x
+                let d207 = A::mul_add(p.MZ7r, k102, p.MX7r * k99); // w7rxMS7r|ud=0,g=0.y
+                let d208 = A::mul_add(p.MX7r, k98, p.MY7r * k102); // w7rxMS7r|ud=0,g=0.z
+                let d209 = A::mul_add(
+                    -p.MZ7r,
+                    k100,
+                    A::mul_add(
+                        p.MX7r,
+                        k101,
+                        A::mul_add(p.m7r, d204, A::mul_add(-k102, d208, k99 * d206)),
+                    ),
+                ); // F7r.y
+                let d210 = A::mul_add(
+                    p.MY7r,
+                    k101,
+                    A::mul_add(
+                        p.MZ7r,
+                        k103,
+                        A::mul_add(-p.m7r, d191, A::mul_add(k99, d207, k98 * d208)),
+                    ),
+                ); // F7r.x
+                let d211 = A::mul_add(
+                    -p.MX7r,
+                    k103,
+                    A::mul_add(
+                        -p.MY7r,
+                        k100,
+                        A::mul_add(-p.m7r, d205, A::mul_add(k98, d206, k102 * d207)),
+                    ),
+                ); // F7r.z
+                let d212 = A::mul_add(
+                    -p.XZ7r,
+                    k99,
+                    A::mul_add(-p.XY7r, k98, p.XX7r * k102),
+                ); // J7rw7r|ud=0,g=0.x
+                let d213 = A::mul_add(
+                    -p.YZ7r,
+                    k99,
+                    A::mul_add(-p.YY7r, k98, p.XY7r * k102),
+                ); // J7rw7r|ud=0,g=0.y
+                let d214 = A::mul_add(
+                    -p.ZZ7r,
+                    k99,
+                    A::mul_add(-p.YZ7r, k98, p.XZ7r * k102),
+                ); // J7rw7r|ud=0,g=0.z
+                let d215 = A::mul_add(
+                    -p.MY7r,
+                    d191,
+                    A::mul_add(
+                        p.MX7r,
+                        d204,
+                        A::mul_add(
+                            p.ZZ7r,
+                            k101,
+                            A::mul_add(
+                                -p.YZ7r,
+                                k103,
+                                A::mul_add(p.XZ7r, k100, A::mul_add(k98, d212, k102 * d213)),
+                            ),
+                        ),
+                    ),
+                ); // N7r.z
+                let d216 = A::mul_add(
+                    p.MZ7r,
+                    d204,
+                    A::mul_add(
+                        -p.MY7r,
+                        d205,
+                        A::mul_add(
+                            -p.XZ7r,
+                            k101,
+                            A::mul_add(
+                                p.XY7r,
+                                k103,
+                                A::mul_add(
+                                    -p.XX7r,
+                                    k100,
+                                    A::mul_add(-k99, d213, k98 * d214),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N7r.x
+                let d217 = A::mul_add(
+                    p.MX7r,
+                    d205,
+                    A::mul_add(
+                        -p.MZ7r,
+                        d191,
+                        A::mul_add(
+                            -p.YZ7r,
+                            k101,
+                            A::mul_add(
+                                p.YY7r,
+                                k103,
+                                A::mul_add(
+                                    -p.XY7r,
+                                    k100,
+                                    A::mul_add(k102, d214, k99 * d212),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N7r.y
+                let k104 = A::mul_add(s_q5r, k99, c_q5r * k102); // w7r in 8r|ud=0,g=0.x
+                let k105 = A::mul_add(-c_q5r, k99, s_q5r * k102); // w7r in 8r|ud=0,g=0.z
+                let k106 = k103 - qdd5r; // wd8r.y
+                let k107 = k98 + qd5r; // w8r|ud=0,g=0.y
+                let k108 = A::mul_add(
+                    -s_q5r,
+                    k101,
+                    A::mul_add(c_q5r, k100, k105 * qd5r),
+                ); // wd8r.x
+                let k109 = A::mul_add(
+                    -c_q5r,
+                    k101,
+                    A::mul_add(-s_q5r, k100, k104 * qd5r),
+                ); // wd8r.z
+                let k110 = p.L8 * k99; // w7rxP8r|ud=0,g=0.x
+                let k111 = p.L8 * k102; // w7rxP8r|ud=0,g=0.z
+                let d218 = A::mul_add(p.L8, k101, A::mul_add(k98, k111, d191)); // a8r in 7r.x
+                let d219 = A::mul_add(k102, k111, k99 * k110) + d204; // a8r in 7r.y
+                let d220 = A::mul_add(p.L8, k100, A::mul_add(k98, k110, -d205)); // a8r in 7r.z
+                let d221 = A::mul_add(-c_q5r, d220, s_q5r * d218); // a8r.z
+                let d222 = A::mul_add(s_q5r, d220, c_q5r * d218); // a8r.x
+                let d223 = A::mul_add(p.MX8r, k107, p.MY8r * k104); // w8rxMS8r|ud=0,g=0.z
+                let d224 = A::mul_add(-p.MY8r, k105, p.MZ8r * k107); // w8rxMS8r|ud=0,g=0.x
+                let d225 = A::mul_add(p.MZ8r, k104, p.MX8r * k105); // w8rxMS8r|ud=0,g=0.y
+                let d226 = A::mul_add(
+                    p.MZ8r,
+                    k108,
+                    A::mul_add(
+                        -p.MX8r,
+                        k109,
+                        A::mul_add(-p.m8r, d219, A::mul_add(-k104, d223, k105 * d224)),
+                    ),
+                ); // F8r.y
+                let d227 = A::mul_add(
+                    -p.MY8r,
+                    k109,
+                    A::mul_add(
+                        -p.MZ8r,
+                        k106,
+                        A::mul_add(p.m8r, d222, A::mul_add(k105, d225, k107 * d223)),
+                    ),
+                ); // F8r.x
+                let d228 = A::mul_add(
+                    p.MX8r,
+                    k106,
+                    A::mul_add(
+                        p.MY8r,
+                        k108,
+                        A::mul_add(-p.m8r, d221, A::mul_add(k107, d224, k104 * d225)),
+                    ),
+                ); // F8r.z
+                let d229 = A::mul_add(
+                    -p.XZ8r,
+                    k105,
+                    A::mul_add(-p.XY8r, k107, p.XX8r * k104),
+                ); // J8rw8r|ud=0,g=0.x
+                let d230 = A::mul_add(
+                    -p.YZ8r,
+                    k105,
+                    A::mul_add(-p.YY8r, k107, p.XY8r * k104),
+                ); // J8rw8r|ud=0,g=0.y
+                let d231 = A::mul_add(
+                    -p.ZZ8r,
+                    k105,
+                    A::mul_add(-p.YZ8r, k107, p.XZ8r * k104),
+                ); // J8rw8r|ud=0,g=0.z
+                let d232 = A::mul_add(
+                    p.MY8r,
+                    d222,
+                    A::mul_add(
+                        -p.MX8r,
+                        d219,
+                        A::mul_add(
+                            -p.ZZ8r,
+                            k109,
+                            A::mul_add(
+                                p.YZ8r,
+                                k106,
+                                A::mul_add(
+                                    -p.XZ8r,
+                                    k108,
+                                    A::mul_add(k107, d229, k104 * d230),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8r.z
+                let d233 = A::mul_add(
+                    -p.MZ8r,
+                    d219,
+                    A::mul_add(
+                        -p.MY8r,
+                        d221,
+                        A::mul_add(
+                            p.XZ8r,
+                            k109,
+                            A::mul_add(
+                                -p.XY8r,
+                                k106,
+                                A::mul_add(
+                                    p.XX8r,
+                                    k108,
+                                    A::mul_add(-k105, d230, k107 * d231),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8r.x
+                let d234 = A::mul_add(
+                    p.MX8r,
+                    d221,
+                    A::mul_add(
+                        p.MZ8r,
+                        d222,
+                        A::mul_add(
+                            p.YZ8r,
+                            k109,
+                            A::mul_add(
+                                -p.YY8r,
+                                k106,
+                                A::mul_add(
+                                    p.XY8r,
+                                    k108,
+                                    A::mul_add(k104, d231, k105 * d229),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8r.y
+                let k112 = A::mul_add(s_q6r, k105, c_q6r * k107); // w8r in 9r|ud=0,g=0.y
+                let k113 = A::mul_add(-c_q6r, k105, s_q6r * k107); // w8r in 9r|ud=0,g=0.z
+                let k114 = k108 - qdd6r; // wd9r.x
+                let k115 = A::mul_add(
+                    -c_q6r,
+                    k109,
+                    A::mul_add(-s_q6r, k106, k112 * qd6r),
+                ); // wd9r.z
+                let k116 = k104 + qd6r; // w9r|ud=0,g=0.x
+                let k117 = A::mul_add(
+                    -s_q6r,
+                    k109,
+                    A::mul_add(c_q6r, k106, k113 * qd6r),
+                ); // wd9r.y
+                let d235 = A::mul_add(-s_q6r, d221, c_q6r * d219); // a9r.y
+                let d236 = A::mul_add(c_q6r, d221, s_q6r * d219); // a9r.z
+                let d237 = A::mul_add(-p.MY9r, k113, p.MZ9r * k112); // w9rxMS9r|ud=0,g=0.x
+                let d238 = A::mul_add(p.MZ9r, k116, p.MX9r * k113); // w9rxMS9r|ud=0,g=0.y
+                let d239 = A::mul_add(p.MX9r, k112, p.MY9r * k116); // w9rxMS9r|ud=0,g=0.z
+                let d240 = A::mul_add(
+                    -p.MZ9r,
+                    k114,
+                    A::mul_add(
+                        p.MX9r,
+                        k115,
+                        A::mul_add(p.m9r, d235, A::mul_add(-k116, d239, k113 * d237)),
+                    ),
+                ); // F9r.y
+                let d241 = A::mul_add(
+                    p.MY9r,
+                    k115,
+                    A::mul_add(
+                        p.MZ9r,
+                        k117,
+                        A::mul_add(-p.m9r, d222, A::mul_add(k113, d238, k112 * d239)),
+                    ),
+                ); // F9r.x
+                let d242 = A::mul_add(
+                    -p.MX9r,
+                    k117,
+                    A::mul_add(
+                        -p.MY9r,
+                        k114,
+                        A::mul_add(-p.m9r, d236, A::mul_add(k112, d237, k116 * d238)),
+                    ),
+                ); // F9r.z
+                let d243 = A::mul_add(
+                    -p.XZ9r,
+                    k113,
+                    A::mul_add(-p.XY9r, k112, p.XX9r * k116),
+                ); // J9rw9r|ud=0,g=0.x
+                let d244 = A::mul_add(
+                    -p.YZ9r,
+                    k113,
+                    A::mul_add(-p.YY9r, k112, p.XY9r * k116),
+                ); // J9rw9r|ud=0,g=0.y
+                let d245 = A::mul_add(
+                    -p.ZZ9r,
+                    k113,
+                    A::mul_add(-p.YZ9r, k112, p.XZ9r * k116),
+                ); // J9rw9r|ud=0,g=0.z
+                let d246 = A::mul_add(
+                    -p.MY9r,
+                    d222,
+                    A::mul_add(
+                        p.MX9r,
+                        d235,
+                        A::mul_add(
+                            p.ZZ9r,
+                            k115,
+                            A::mul_add(
+                                -p.YZ9r,
+                                k117,
+                                A::mul_add(
+                                    p.XZ9r,
+                                    k114,
+                                    A::mul_add(k112, d243, k116 * d244),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9r.z
+                let d247 = A::mul_add(
+                    p.MZ9r,
+                    d235,
+                    A::mul_add(
+                        -p.MY9r,
+                        d236,
+                        A::mul_add(
+                            -p.XZ9r,
+                            k115,
+                            A::mul_add(
+                                p.XY9r,
+                                k117,
+                                A::mul_add(
+                                    -p.XX9r,
+                                    k114,
+                                    A::mul_add(-k113, d244, k112 * d245),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9r.x
+                let d248 = A::mul_add(
+                    p.MX9r,
+                    d236,
+                    A::mul_add(
+                        -p.MZ9r,
+                        d222,
+                        A::mul_add(
+                            -p.YZ9r,
+                            k115,
+                            A::mul_add(
+                                p.YY9r,
+                                k117,
+                                A::mul_add(
+                                    -p.XY9r,
+                                    k114,
+                                    A::mul_add(k116, d245, k113 * d243),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9r.y
+                let k118 = A::mul_add(s_q7r, k113, c_q7r * k116); // w9r in 10r|ud=0,g=0.x
+                let k119 = A::mul_add(-c_q7r, k113, s_q7r * k116); // w9r in 10r|ud=0,g=0.y
+                let k120 = k117 - qdd7r; // wd10r.z
+                let k121 = A::mul_add(
+                    -c_q7r,
+                    k115,
+                    A::mul_add(-s_q7r, k114, k118 * qd7r),
+                ); // wd10r.y
+                let k122 = k112 + qd7r; // w10r|ud=0,g=0.z
+                let k123 = A::mul_add(
+                    -s_q7r,
+                    k115,
+                    A::mul_add(c_q7r, k114, k119 * qd7r),
+                ); // wd10r.x
+                let k124 = p.L9 * k113; // w9rxP10r|ud=0,g=0.x
+                let k125 = p.L9 * k116; // w9rxP10r|ud=0,g=0.z
+                let d249 = A::mul_add(p.L9, k115, A::mul_add(k112, k125, d222)); // a10r in 9r.x
+                let d250 = A::mul_add(k116, k125, k113 * k124) + d235; // a10r in 9r.y
+                let d251 = A::mul_add(p.L9, k114, A::mul_add(k112, k124, -d236)); // a10r in 9r.z
+                let d252 = A::mul_add(s_q7r, d251, c_q7r * d249); // a10r.x
+                let d253 = A::mul_add(-c_q7r, d251, s_q7r * d249); // a10r.y
+                let d254 = A::mul_add(p.MY10r, k122, p.MZ10r * k119); // w10rxMS10r|ud=0,g=0.x
+                let d255 = A::mul_add(-p.MX10r, k119, p.MY10r * k118); // w10rxMS10r|ud=0,g=0.z
+                let d256 = A::mul_add(p.MZ10r, k118, p.MX10r * k122); // w10rxMS10r|ud=0,g=0.y
+                let d257 = A::mul_add(
+                    -p.MY10r,
+                    k120,
+                    A::mul_add(
+                        p.MZ10r,
+                        k121,
+                        A::mul_add(-p.m10r, d252, A::mul_add(-k122, d256, k119 * d255)),
+                    ),
+                ); // F10r.x
+                let d258 = A::mul_add(
+                    -p.MZ10r,
+                    k123,
+                    A::mul_add(
+                        -p.MX10r,
+                        k120,
+                        A::mul_add(p.m10r, d253, A::mul_add(k118, d255, k122 * d254)),
+                    ),
+                ); // F10r.y
+                let d259 = A::mul_add(
+                    p.MX10r,
+                    k121,
+                    A::mul_add(
+                        p.MY10r,
+                        k123,
+                        A::mul_add(p.m10r, d250, A::mul_add(k119, d254, k118 * d256)),
+                    ),
+                ); // F10r.z
+                let d260 = A::mul_add(
+                    -p.XZ10r,
+                    k122,
+                    A::mul_add(p.XY10r, k119, p.XX10r * k118),
+                ); // J10rw10r|ud=0,g=0.x
+                let d261 = A::mul_add(
+                    -p.YZ10r,
+                    k122,
+                    A::mul_add(p.YY10r, k119, p.XY10r * k118),
+                ); // J10rw10r|ud=0,g=0.y
+                let d262 = A::mul_add(
+                    -p.ZZ10r,
+                    k122,
+                    A::mul_add(p.YZ10r, k119, p.XZ10r * k118),
+                ); // J10rw10r|ud=0,g=0.z
+                let d263 = A::mul_add(
+                    p.MZ10r,
+                    d253,
+                    A::mul_add(
+                        -p.MY10r,
+                        d250,
+                        A::mul_add(
+                            p.XZ10r,
+                            k120,
+                            A::mul_add(
+                                p.XY10r,
+                                k121,
+                                A::mul_add(
+                                    -p.XX10r,
+                                    k123,
+                                    A::mul_add(k122, d261, k119 * d262),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10r.x
+                let d264 = A::mul_add(
+                    p.MY10r,
+                    d252,
+                    A::mul_add(
+                        -p.MX10r,
+                        d253,
+                        A::mul_add(
+                            p.ZZ10r,
+                            k120,
+                            A::mul_add(
+                                p.YZ10r,
+                                k121,
+                                A::mul_add(
+                                    -p.XZ10r,
+                                    k123,
+                                    A::mul_add(-k119, d260, k118 * d261),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10r.z
+                m[18] = -d264;
+                let d265 = A::mul_add(
+                    -p.MX10r,
+                    d250,
+                    A::mul_add(
+                        p.MZ10r,
+                        d252,
+                        A::mul_add(
+                            -p.YZ10r,
+                            k120,
+                            A::mul_add(
+                                -p.YY10r,
+                                k121,
+                                A::mul_add(
+                                    p.XY10r,
+                                    k123,
+                                    A::mul_add(k118, d262, k122 * d260),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10r.y
+                let d266 = A::mul_add(c_q7r, d258, s_q7r * d257); // f10r in 9r.z
+                let d267 = A::mul_add(-s_q7r, d258, c_q7r * d257); // f10r in 9r.x
+                let d268 = d240 + d259; // f9r.y
+                let d269 = A::mul_add(
+                    -p.L9,
+                    d267,
+                    A::mul_add(c_q7r, d265, A::mul_add(s_q7r, d263, d246)),
+                ); // n9r.z
+                let d270 = d241 + d267; // f9r.x
+                let d271 = d242 - d266; // f9r.z
+                let d272 = A::mul_add(
+                    p.L9,
+                    d266,
+                    A::mul_add(-s_q7r, d265, A::mul_add(c_q7r, d263, d247)),
+                ); // n9r.x
+                m[17] = d272;
+                let d273 = d248 + d264; // n9r.y
+                let d274 = A::mul_add(-s_q6r, d271, c_q6r * d268); // f9r in 8r.y
+                let d275 = A::mul_add(c_q6r, d271, s_q6r * d268); // f9r in 8r.z
+                let d276 = d226 - d274; // f8r.y
+                let d277 = A::mul_add(c_q6r, d269, A::mul_add(s_q6r, d273, d232)); // n8r.z
+                let d278 = d227 - d270; // f8r.x
+                let d279 = d228 + d275; // f8r.z
+                let d280 = d233 - d272; // n8r.x
+                let d281 = A::mul_add(s_q6r, d269, A::mul_add(-c_q6r, d273, d234)); // n8r.y
+                m[16] = d281;
+                let d282 = A::mul_add(-s_q5r, d279, c_q5r * d278); // f8r in 7r.x
+                let d283 = A::mul_add(c_q5r, d279, s_q5r * d278); // f8r in 7r.z
+                let d284 = d209 - d276; // f7r.y
+                let d285 = A::mul_add(
+                    p.L8,
+                    d282,
+                    A::mul_add(c_q5r, d277, A::mul_add(-s_q5r, d280, d215)),
+                ); // n7r.z
+                let d286 = d210 - d282; // f7r.x
+                let d287 = d211 + d283; // f7r.z
+                let d288 = A::mul_add(
+                    -p.L8,
+                    d283,
+                    A::mul_add(-s_q5r, d277, A::mul_add(-c_q5r, d280, d216)),
+                ); // n7r.x
+                m[15] = d288;
+                let d289 = d217 - d281; // n7r.y
+                let d290 = A::mul_add(-s_q4r, d287, c_q4r * d284); // f7r in 6r.y
+                let d291 = A::mul_add(c_q4r, d287, s_q4r * d284); // f7r in 6r.z
+                let d292 = d195 - d290; // f6r.y
+                let d293 = A::mul_add(c_q4r, d285, A::mul_add(s_q4r, d289, d201)); // n6r.z
+                let d294 = d196 - d286; // f6r.x
+                let d295 = d197 + d291; // f6r.z
+                let d296 = d202 - d288; // n6r.x
+                let d297 = A::mul_add(s_q4r, d285, A::mul_add(-c_q4r, d289, d203)); // n6r.y
+                m[14] = d297;
+                let d298 = A::mul_add(-s_q3r, d295, c_q3r * d294); // f6r in 5r.x
+                let d299 = A::mul_add(c_q3r, d295, s_q3r * d294); // f6r in 5r.z
+                let d300 = d178 - d292; // f5r.y
+                let d301 = A::mul_add(
+                    p.L7,
+                    d298,
+                    A::mul_add(c_q3r, d293, A::mul_add(-s_q3r, d296, d184)),
+                ); // n5r.z
+                let d302 = d179 - d298; // f5r.x
+                let d303 = d180 + d299; // f5r.z
+                let d304 = A::mul_add(
+                    -p.L7,
+                    d299,
+                    A::mul_add(-s_q3r, d293, A::mul_add(-c_q3r, d296, d185)),
+                ); // n5r.x
+                m[13] = d304;
+                let d305 = d186 - d297; // n5r.y
+                let d306 = A::mul_add(-s_q2r, d303, c_q2r * d300); // f5r in 4r.y
+                let d307 = A::mul_add(c_q2r, d303, s_q2r * d300); // f5r in 4r.z
+                let d308 = d164 - d306; // f4r.y
+                let d309 = A::mul_add(c_q2r, d301, A::mul_add(s_q2r, d305, d170)); // n4r.z
+                let d310 = d165 - d302; // f4r.x
+                let d311 = d166 + d307; // f4r.z
+                let d312 = d171 - d304; // n4r.x
+                let d313 = A::mul_add(s_q2r, d301, A::mul_add(-c_q2r, d305, d172)); // n4r.y
+                m[12] = d313;
+                let d314 = A::mul_add(-s_q1r, d311, c_q1r * d310); // f4r in 3.y
+                let d315 = A::mul_add(c_q1r, d311, s_q1r * d310); // f4r in 3.z
+                let d316 = d37 - d308; // f3.x
+                let d317 = A::mul_add(-p.L5, d315, d43 + d313); // n3.x
+                let d318 = A::mul_add(
+                    p.L5,
+                    d308,
+                    A::mul_add(
+                        p.L6,
+                        d314,
+                        A::mul_add(c_q1r, d309, A::mul_add(-s_q1r, d312, d44)),
+                    ),
+                ); // n3.z
+                let d319 = d38 + d314; // f3.y
+                let d320 = d39 + d315; // f3.z
+                let d321 = A::mul_add(
+                    p.L6,
+                    d315,
+                    A::mul_add(s_q1r, d309, A::mul_add(c_q1r, d312, d45)),
+                ); // n3.y
+                let d322 = A::mul_add(-c_q7l, d148, s_q7l * d147); // f10l in 9l.z
+                let d323 = A::mul_add(s_q7l, d148, c_q7l * d147); // f10l in 9l.x
+                let d324 = d130 - d323; // f9l.x
+                let d325 = d131 - d149; // f9l.y
+                let d326 = d132 + d322; // f9l.z
+                let d327 = d137 - d155; // n9l.y
+                let d328 = A::mul_add(
+                    -p.L9,
+                    d322,
+                    A::mul_add(-s_q7l, d154, A::mul_add(-c_q7l, d153, d136)),
+                ); // n9l.x
+                m[10] = -d328;
+                let d329 = A::mul_add(
+                    -p.L9,
+                    d323,
+                    A::mul_add(-c_q7l, d154, A::mul_add(s_q7l, d153, d138)),
+                ); // n9l.z
+                let d330 = A::mul_add(s_q6l, d326, c_q6l * d325); // f9l in 8l.y
+                let d331 = A::mul_add(-c_q6l, d326, s_q6l * d325); // f9l in 8l.z
+                let d332 = d116 - d324; // f8l.x
+                let d333 = d122 - d328; // n8l.x
+                let d334 = A::mul_add(c_q6l, d329, A::mul_add(-s_q6l, d327, d123)); // n8l.z
+                let d335 = d117 + d330; // f8l.y
+                let d336 = d118 + d331; // f8l.z
+                let d337 = A::mul_add(s_q6l, d329, A::mul_add(c_q6l, d327, d124)); // n8l.y
+                m[9] = d337;
+                let d338 = A::mul_add(-c_q5l, d336, s_q5l * d332); // f8l in 7l.z
+                let d339 = A::mul_add(s_q5l, d336, c_q5l * d332); // f8l in 7l.x
+                let d340 = d99 - d339; // f7l.x
+                let d341 = d100 + d335; // f7l.y
+                let d342 = d101 + d338; // f7l.z
+                let d343 = d106 + d337; // n7l.y
+                let d344 = A::mul_add(
+                    -p.L8,
+                    d338,
+                    A::mul_add(s_q5l, d334, A::mul_add(-c_q5l, d333, d105)),
+                ); // n7l.x
+                m[8] = -d344;
+                let d345 = A::mul_add(
+                    -p.L8,
+                    d339,
+                    A::mul_add(c_q5l, d334, A::mul_add(s_q5l, d333, d107)),
+                ); // n7l.z
+                let d346 = A::mul_add(s_q4l, d342, c_q4l * d341); // f7l in 6l.y
+                let d347 = A::mul_add(-c_q4l, d342, s_q4l * d341); // f7l in 6l.z
+                let d348 = d85 - d340; // f6l.x
+                let d349 = d91 - d344; // n6l.x
+                let d350 = A::mul_add(c_q4l, d345, A::mul_add(-s_q4l, d343, d92)); // n6l.z
+                let d351 = d86 + d346; // f6l.y
+                let d352 = d87 + d347; // f6l.z
+                let d353 = A::mul_add(s_q4l, d345, A::mul_add(c_q4l, d343, d93)); // n6l.y
+                m[7] = d353;
+                let d354 = A::mul_add(-c_q3l, d352, s_q3l * d348); // f6l in 5l.z
+                let d355 = A::mul_add(s_q3l, d352, c_q3l * d348); // f6l in 5l.x
+                let d356 = d68 - d355; // f5l.x
+                let d357 = d69 + d351; // f5l.y
+                let d358 = d70 + d354; // f5l.z
+                let d359 = d75 + d353; // n5l.y
+                let d360 = A::mul_add(
+                    -p.L7,
+                    d354,
+                    A::mul_add(s_q3l, d350, A::mul_add(-c_q3l, d349, d74)),
+                ); // n5l.x
+                m[6] = -d360;
+                let d361 = A::mul_add(
+                    -p.L7,
+                    d355,
+                    A::mul_add(c_q3l, d350, A::mul_add(s_q3l, d349, d76)),
+                ); // n5l.z
+                let d362 = A::mul_add(s_q2l, d358, c_q2l * d357); // f5l in 4l.y
+                let d363 = A::mul_add(-c_q2l, d358, s_q2l * d357); // f5l in 4l.z
+                let d364 = d54 - d356; // f4l.x
+                let d365 = d60 - d360; // n4l.x
+                let d366 = A::mul_add(c_q2l, d361, A::mul_add(-s_q2l, d359, d61)); // n4l.z
+                let d367 = d55 + d362; // f4l.y
+                let d368 = d56 + d363; // f4l.z
+                let d369 = A::mul_add(s_q2l, d361, A::mul_add(c_q2l, d359, d62)); // n4l.y
+                m[5] = d369;
+                let d370 = A::mul_add(s_q1l, d368, c_q1l * d364); // f4l in 3.y
+                let d371 = A::mul_add(-c_q1l, d368, s_q1l * d364); // f4l in 3.z
+                let d372 = d316 - d367; // f3.x
+                let d373 = A::mul_add(-p.L5, d371, d317 - d369); // n3.x
+                let d374 = A::mul_add(
+                    p.L5,
+                    d367,
+                    A::mul_add(
+                        p.L6,
+                        d370,
+                        A::mul_add(-c_q1l, d366, A::mul_add(-s_q1l, d365, d318)),
+                    ),
+                ); // n3.z
+                let d375 = d319 - d370; // f3.y
+                let d376 = d320 + d371; // f3.z
+                let d377 = A::mul_add(
+                    -p.L6,
+                    d371,
+                    A::mul_add(s_q1l, d366, A::mul_add(-c_q1l, d365, d321)),
+                ); // n3.y
+                m[4] = d377;
+                let d378 = A::mul_add(s_q_torso, d376, c_q_torso * d372); // f3 in 2.x
+                let d379 = A::mul_add(-c_q_torso, d376, s_q_torso * d372); // f3 in 2.z
+                let d380 = d21 - d375; // f2.y
+                let d381 = A::mul_add(
+                    p.L3,
+                    d378,
+                    A::mul_add(-c_q_torso, d374, A::mul_add(-s_q_torso, d373, d27)),
+                ); // n2.z
+                let d382 = d22 + d378; // f2.x
+                let d383 = d23 + d379; // f2.z
+                let d384 = A::mul_add(
+                    -p.L4,
+                    d375,
+                    A::mul_add(
+                        p.L3,
+                        d379,
+                        A::mul_add(-s_q_torso, d374, A::mul_add(c_q_torso, d373, d28)),
+                    ),
+                ); // n2.x
+                m[3] = d384;
+                let d385 = A::mul_add(p.L4, d378, d29 + d377); // n2.y
+                let d386 = A::mul_add(-s_q_w, d383, c_q_w * d380); // f2 in 1.y
+                let d387 = A::mul_add(c_q_w, d383, s_q_w * d380); // f2 in 1.z
+                let d388 = d6 + d386; // f1.y
+                let d389 = A::mul_add(
+                    p.L1,
+                    d382,
+                    A::mul_add(c_q_w, d381, A::mul_add(s_q_w, d385, d11)),
+                ); // n1.z
+                let d390 = d7 + d387; // f1.z
+                let d391 = A::mul_add(-p.L2, d386, A::mul_add(p.L1, d387, d12 + d384)); // n1.x
+                m[2] = d391;
+                let d392 = A::mul_add(
+                    -p.L2,
+                    d382,
+                    A::mul_add(-s_q_w, d381, A::mul_add(c_q_w, d385, d13)),
+                ); // n1.y
+                let d393 = A::mul_add(c_q_imu, d390, s_q_imu * d388); // f1 in 0.x
+                m[0] = A::mul_add(pc.pc67, xdd, d393);
+                let d394 = A::mul_add(-s_q_imu, d389, c_q_imu * d392); // n0.z
+                m[1] = A::mul_add(pc.pc68, psidd, -d394);
+            }
+        }
+        kanegen_runtime::isa::dispatch_fused_with(
+            out,
             #[inline(always)]
-            || {
-                let q = kanegen_runtime::lanes::inputs(q);
-                let (s_q_imu, c_q_imu) = kanegen_runtime::lanes::sin_cos(q[2]);
-                let (s_q_w, c_q_w) = kanegen_runtime::lanes::sin_cos(q[3]);
-                let (s_q_torso, c_q_torso) = kanegen_runtime::lanes::sin_cos(q[4]);
-                let (s_q1l, c_q1l) = kanegen_runtime::lanes::sin_cos(q[5]);
-                let (s_q2l, c_q2l) = kanegen_runtime::lanes::sin_cos(q[6]);
-                let (s_q3l, c_q3l) = kanegen_runtime::lanes::sin_cos(q[7]);
-                let (s_q4l, c_q4l) = kanegen_runtime::lanes::sin_cos(q[8]);
-                let (s_q5l, c_q5l) = kanegen_runtime::lanes::sin_cos(q[9]);
-                let (s_q6l, c_q6l) = kanegen_runtime::lanes::sin_cos(q[10]);
-                let (s_q7l, c_q7l) = kanegen_runtime::lanes::sin_cos(q[11]);
-                let (s_q1r, c_q1r) = kanegen_runtime::lanes::sin_cos(q[12]);
-                let (s_q2r, c_q2r) = kanegen_runtime::lanes::sin_cos(q[13]);
-                let (s_q3r, c_q3r) = kanegen_runtime::lanes::sin_cos(q[14]);
-                let (s_q4r, c_q4r) = kanegen_runtime::lanes::sin_cos(q[15]);
-                let (s_q5r, c_q5r) = kanegen_runtime::lanes::sin_cos(q[16]);
-                let (s_q6r, c_q6r) = kanegen_runtime::lanes::sin_cos(q[17]);
-                let (s_q7r, c_q7r) = kanegen_runtime::lanes::sin_cos(q[18]);
-                #[allow(unused_mut)]
-                let mut buf = kanegen_runtime::lanes::buffer::<L, 19, 1>();
-                let d1 = c_q_imu * p.g;
-                let d2 = s_q_imu * p.g;
-                let d3 = c_q_w * d1 - s_q_w * d2;
-                let d4 = s_q_w * d1 + c_q_w * d2;
-                let d5 = s_q_torso * d4;
-                let d6 = c_q_torso * d4;
-                let d7 = c_q1l * d3 + s_q1l * d6;
-                let d8 = s_q1l * d3 - c_q1l * d6;
-                let d9 = c_q2l * d5 + s_q2l * d8;
-                let d10 = s_q2l * d5 - c_q2l * d8;
-                let d11 = c_q3l * d7 + s_q3l * d10;
-                let d12 = s_q3l * d7 - c_q3l * d10;
-                let d13 = c_q4l * d9 + s_q4l * d12;
-                let d14 = s_q4l * d9 - c_q4l * d12;
-                let d15 = c_q5l * d11 + s_q5l * d14;
-                let d16 = s_q5l * d11 - c_q5l * d14;
-                let d17 = c_q6l * d13 + s_q6l * d16;
-                let d18 = s_q6l * d13 - c_q6l * d16;
-                let d19 = c_q7l * d15 + s_q7l * d18;
-                let d20 = s_q7l * d15 - c_q7l * d18;
-                buf[0][11] = kanegen_runtime::lanes::lanes(
-                    p.MY10l * d19 - p.MX10l * d20,
-                );
-                let d21 = c_q1r * d3 - s_q1r * d6;
-                let d22 = s_q1r * d3 + c_q1r * d6;
-                let d23 = c_q2r * d5 - s_q2r * d22;
-                let d24 = s_q2r * d5 + c_q2r * d22;
-                let d25 = c_q3r * d21 - s_q3r * d24;
-                let d26 = s_q3r * d21 + c_q3r * d24;
-                let d27 = c_q4r * d23 - s_q4r * d26;
-                let d28 = s_q4r * d23 + c_q4r * d26;
-                let d29 = c_q5r * d25 - s_q5r * d28;
-                let d30 = s_q5r * d25 + c_q5r * d28;
-                let d31 = c_q6r * d27 - s_q6r * d30;
-                let d32 = s_q6r * d27 + c_q6r * d30;
-                let d33 = c_q7r * d29 - s_q7r * d32;
-                let d34 = s_q7r * d29 + c_q7r * d32;
-                buf[0][18] = kanegen_runtime::lanes::lanes(
-                    p.MY10r * d33 - p.MX10r * d34,
-                );
-                let d35 = p.MX10r * s_q7r - p.MY10r * c_q7r;
-                let d36 = p.MX10r * c_q7r + p.MY10r * s_q7r;
-                let d37 = p.MX9r - d36;
-                let d38 = p.MZ9r + d35;
-                buf[0][17] = kanegen_runtime::lanes::lanes(pc.pc2 * d32 - d38 * d31);
-                let d39 = c_q6r * pc.pc2 + s_q6r * d38;
-                let d40 = s_q6r * pc.pc2 - c_q6r * d38;
-                let d41 = p.MX8r - d37;
-                let d42 = p.MY8r - d39;
-                let d43 = p.MZ8r - d40;
-                buf[0][16] = kanegen_runtime::lanes::lanes(-d43 * d29 - d41 * d30);
-                let d44 = s_q5r * d41 + c_q5r * d43;
-                let d45 = c_q5r * d41 - s_q5r * d43;
-                let d46 = p.MX7r - d45;
-                let d47 = p.MZ7r + d44;
-                let d48 = pc.pc13 - d42;
-                buf[0][15] = kanegen_runtime::lanes::lanes(d48 * d28 - d47 * d27);
-                let d49 = c_q4r * d48 + s_q4r * d47;
-                let d50 = s_q4r * d48 - c_q4r * d47;
-                let d51 = p.MX6r - d46;
-                let d52 = p.MY6r - d49;
-                let d53 = p.MZ6r - d50;
-                buf[0][14] = kanegen_runtime::lanes::lanes(-d53 * d25 - d51 * d26);
-                let d54 = s_q3r * d51 + c_q3r * d53;
-                let d55 = c_q3r * d51 - s_q3r * d53;
-                let d56 = p.MX5r - d55;
-                let d57 = p.MZ5r + d54;
-                let d58 = pc.pc19 - d52;
-                buf[0][13] = kanegen_runtime::lanes::lanes(d58 * d24 - d57 * d23);
-                let d59 = c_q2r * d58 + s_q2r * d57;
-                let d60 = s_q2r * d58 - c_q2r * d57;
-                let d61 = p.MX4r - d56;
-                let d62 = p.MY4r - d59;
-                let d63 = p.MZ4r - d60;
-                buf[0][12] = kanegen_runtime::lanes::lanes(-d63 * d21 - d61 * d22);
-                let d64 = c_q1r * d61 - s_q1r * d63;
-                let d65 = s_q1r * d61 + c_q1r * d63;
-                let d66 = p.MX10l * s_q7l - p.MY10l * c_q7l;
-                let d67 = p.MX10l * c_q7l + p.MY10l * s_q7l;
-                let d68 = p.MX9l - d67;
-                let d69 = p.MZ9l + d66;
-                buf[0][10] = kanegen_runtime::lanes::lanes(d69 * d17 - pc.pc25 * d18);
-                let d70 = c_q6l * pc.pc25 + s_q6l * d69;
-                let d71 = s_q6l * pc.pc25 - c_q6l * d69;
-                let d72 = p.MX8l - d68;
-                let d73 = p.MY8l - d70;
-                let d74 = p.MZ8l - d71;
-                buf[0][9] = kanegen_runtime::lanes::lanes(-d74 * d15 - d72 * d16);
-                let d75 = s_q5l * d72 + c_q5l * d74;
-                let d76 = c_q5l * d72 - s_q5l * d74;
-                let d77 = p.MX7l - d76;
-                let d78 = p.MZ7l + d75;
-                let d79 = pc.pc36 - d73;
-                buf[0][8] = kanegen_runtime::lanes::lanes(d78 * d13 - d79 * d14);
-                let d80 = c_q4l * d79 + s_q4l * d78;
-                let d81 = s_q4l * d79 - c_q4l * d78;
-                let d82 = p.MX6l - d77;
-                let d83 = p.MY6l - d80;
-                let d84 = p.MZ6l - d81;
-                buf[0][7] = kanegen_runtime::lanes::lanes(-d84 * d11 - d82 * d12);
-                let d85 = s_q3l * d82 + c_q3l * d84;
-                let d86 = c_q3l * d82 - s_q3l * d84;
-                let d87 = p.MX5l - d86;
-                let d88 = p.MZ5l + d85;
-                let d89 = pc.pc42 - d83;
-                buf[0][6] = kanegen_runtime::lanes::lanes(d88 * d9 - d89 * d10);
-                let d90 = c_q2l * d89 + s_q2l * d88;
-                let d91 = s_q2l * d89 - c_q2l * d88;
-                let d92 = p.MX4l - d87;
-                let d93 = p.MY4l - d90;
-                let d94 = p.MZ4l - d91;
-                buf[0][5] = kanegen_runtime::lanes::lanes(-d94 * d7 - d92 * d8);
-                let d95 = c_q1l * d92 - s_q1l * d94;
-                let d96 = s_q1l * d92 + c_q1l * d94;
-                let d97 = p.MZ3 + d65 - d96;
-                let d98 = d93 - d62 + pc.pc47;
-                buf[0][4] = kanegen_runtime::lanes::lanes(d97 * d5 - d98 * d6);
-                let d99 = d64 + d95 + pc.pc48;
-                let d100 = s_q_torso * d98 + c_q_torso * d97;
-                let d101 = d99 + pc.pc54;
-                let d102 = pc.pc55 - d100;
-                buf[0][3] = kanegen_runtime::lanes::lanes(d102 * d3 - d101 * d4);
-                let d103 = c_q_w * d101 + s_q_w * d102;
-                let d104 = s_q_w * d101 - c_q_w * d102;
-                let d105 = d103 + pc.pc61;
-                let d106 = pc.pc62 - d104;
-                buf[0][2] = kanegen_runtime::lanes::lanes(d106 * d1 - d105 * d2);
-                kanegen_runtime::lanes::results(&mut buf, false)
-            },
+            |out| body::<kanegen_runtime::isa::Plain, L>(p, pc, q, u, ud, out),
+            #[inline(always)]
+            |out| body::<kanegen_runtime::isa::Fused, L>(p, pc, q, u, ud, out),
         )
     }
-    /// [`inverse_dynamics`] at `L` states per call: entry `l` of the result is `inverse_dynamics` at entry `l` of the inputs, bit for bit (the same statements over [`kanegen_runtime::lanes::Lanes`], vectorized across the states).
-    #[inline(never)]
+    /// [`inverse_dynamics`] at `L` states per call: entry `l` of the result is `inverse_dynamics` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Returns the results by value; [`inverse_dynamics_batch_into`] writes them into the caller's array instead (no zeroed array, no copy).
+    #[inline]
     pub fn inverse_dynamics_batch<const L: usize>(
         p: &Params,
         pc: &Precomputed,
@@ -9698,717 +14267,9 @@ mod generated {
         u: &[SVector<f64, 19>; L],
         ud: &[SVector<f64, 19>; L],
     ) -> [SVector<f64, 19>; L] {
-        kanegen_runtime::isa::dispatch(
-            #[inline(always)]
-            || {
-                let q = kanegen_runtime::lanes::inputs(q);
-                let u = kanegen_runtime::lanes::inputs(u);
-                let ud = kanegen_runtime::lanes::inputs(ud);
-                let (s_q_imu, c_q_imu) = kanegen_runtime::lanes::sin_cos(q[2]);
-                let (s_q_w, c_q_w) = kanegen_runtime::lanes::sin_cos(q[3]);
-                let (s_q_torso, c_q_torso) = kanegen_runtime::lanes::sin_cos(q[4]);
-                let (s_q1l, c_q1l) = kanegen_runtime::lanes::sin_cos(q[5]);
-                let (s_q2l, c_q2l) = kanegen_runtime::lanes::sin_cos(q[6]);
-                let (s_q3l, c_q3l) = kanegen_runtime::lanes::sin_cos(q[7]);
-                let (s_q4l, c_q4l) = kanegen_runtime::lanes::sin_cos(q[8]);
-                let (s_q5l, c_q5l) = kanegen_runtime::lanes::sin_cos(q[9]);
-                let (s_q6l, c_q6l) = kanegen_runtime::lanes::sin_cos(q[10]);
-                let (s_q7l, c_q7l) = kanegen_runtime::lanes::sin_cos(q[11]);
-                let (s_q1r, c_q1r) = kanegen_runtime::lanes::sin_cos(q[12]);
-                let (s_q2r, c_q2r) = kanegen_runtime::lanes::sin_cos(q[13]);
-                let (s_q3r, c_q3r) = kanegen_runtime::lanes::sin_cos(q[14]);
-                let (s_q4r, c_q4r) = kanegen_runtime::lanes::sin_cos(q[15]);
-                let (s_q5r, c_q5r) = kanegen_runtime::lanes::sin_cos(q[16]);
-                let (s_q6r, c_q6r) = kanegen_runtime::lanes::sin_cos(q[17]);
-                let (s_q7r, c_q7r) = kanegen_runtime::lanes::sin_cos(q[18]);
-                let xd = u[0];
-                let xdd = ud[0];
-                let psid = u[1];
-                let psidd = ud[1];
-                let qd_imu = u[2];
-                let qdd_imu = ud[2];
-                let qd_w = u[3];
-                let qdd_w = ud[3];
-                let qd_torso = u[4];
-                let qdd_torso = ud[4];
-                let qd1l = u[5];
-                let qdd1l = ud[5];
-                let qd2l = u[6];
-                let qdd2l = ud[6];
-                let qd3l = u[7];
-                let qdd3l = ud[7];
-                let qd4l = u[8];
-                let qdd4l = ud[8];
-                let qd5l = u[9];
-                let qdd5l = ud[9];
-                let qd6l = u[10];
-                let qdd6l = ud[10];
-                let qd7l = u[11];
-                let qdd7l = ud[11];
-                let qd1r = u[12];
-                let qdd1r = ud[12];
-                let qd2r = u[13];
-                let qdd2r = ud[13];
-                let qd3r = u[14];
-                let qdd3r = ud[14];
-                let qd4r = u[15];
-                let qdd4r = ud[15];
-                let qd5r = u[16];
-                let qdd5r = ud[16];
-                let qd6r = u[17];
-                let qdd6r = ud[17];
-                let qd7r = u[18];
-                let qdd7r = ud[18];
-                #[allow(unused_mut)]
-                let mut buf = kanegen_runtime::lanes::buffer::<L, 19, 1>();
-                let k1 = xd * psid;
-                let k2 = c_q_imu * psid;
-                let k3 = s_q_imu * psid;
-                let k4 = k2 * qd_imu + s_q_imu * psidd;
-                let k5 = k3 * qd_imu - c_q_imu * psidd;
-                let d1 = c_q_imu * p.g + s_q_imu * xdd;
-                let d2 = s_q_imu * p.g - c_q_imu * xdd;
-                let d3 = p.MZ1 * k2 - p.MY1 * k3;
-                let d4 = p.MX1 * k3 + p.MZ1 * qd_imu;
-                let d5 = p.MY1 * qd_imu + p.MX1 * k2;
-                let d6 = k3 * d3 - qd_imu * d5 + p.m1 * d1 + p.MX1 * k4
-                    + p.MZ1 * qdd_imu;
-                let d7 = qd_imu * d4 + k2 * d3 - p.m1 * d2 + p.MY1 * qdd_imu
-                    - p.MX1 * k5;
-                let d8 = p.XX1 * qd_imu - p.XY1 * k2 - p.XZ1 * k3;
-                let d9 = p.XY1 * qd_imu - p.YY1 * k2 - p.YZ1 * k3;
-                let d10 = p.XZ1 * qd_imu - p.YZ1 * k2 - p.ZZ1 * k3;
-                let d11 = qd_imu * d9 + k2 * d8 + p.MY1 * k1 - p.XZ1 * qdd_imu
-                    - p.YZ1 * k5 + p.ZZ1 * k4 + p.MX1 * d1;
-                let d12 = k2 * d10 - k3 * d9 + p.XX1 * qdd_imu + p.XY1 * k5 - p.XZ1 * k4
-                    - p.MY1 * d2 + p.MZ1 * d1;
-                let d13 = k3 * d8 + qd_imu * d10 + p.MZ1 * k1 + p.XY1 * qdd_imu
-                    + p.YY1 * k5 - p.YZ1 * k4 + p.MX1 * d2;
-                let k6 = c_q_w * k2 - s_q_w * k3;
-                let k7 = s_q_w * k2 + c_q_w * k3;
-                let k8 = k6 * qd_w - s_q_w * k5 + c_q_w * k4;
-                let k9 = qd_imu + qd_w;
-                let k10 = qdd_imu + qdd_w;
-                let k11 = k7 * qd_w + c_q_w * k5 + s_q_w * k4;
-                let k12 = p.L2 * qd_imu;
-                let k13 = p.L1 * qd_imu;
-                let k14 = p.L2 * k2 + p.L1 * k3;
-                let d14 = qd_imu * k12 + k2 * k14 + d2 - p.L1 * qdd_imu;
-                let k15 = k1 + k2 * k13 - k3 * k12 - p.L2 * k5 + p.L1 * k4;
-                let d15 = k3 * k14 + qd_imu * k13 - d1 + p.L2 * qdd_imu;
-                let d16 = c_q_w * d15 + s_q_w * d14;
-                let d17 = s_q_w * d15 - c_q_w * d14;
-                let d18 = p.MZ2 * k6 - p.MY2 * k7;
-                let d19 = p.MX2 * k7 + p.MZ2 * k9;
-                let d20 = p.MY2 * k9 + p.MX2 * k6;
-                let d21 = k7 * d18 - k9 * d20 - p.m2 * d16 + p.MX2 * k8 + p.MZ2 * k10;
-                let d22 = k6 * d20 + k7 * d19 + p.m2 * k15 + p.MZ2 * k11 + p.MY2 * k8;
-                let d23 = k9 * d19 + k6 * d18 + p.m2 * d17 + p.MY2 * k10 - p.MX2 * k11;
-                let d24 = p.XX2 * k9 - p.XY2 * k6 - p.XZ2 * k7;
-                let d25 = p.XY2 * k9 - p.YY2 * k6 - p.YZ2 * k7;
-                let d26 = p.XZ2 * k9 - p.YZ2 * k6 - p.ZZ2 * k7;
-                let d27 = k9 * d25 + k6 * d24 - p.XZ2 * k10 - p.YZ2 * k11 + p.ZZ2 * k8
-                    - p.MX2 * d16 + p.MY2 * k15;
-                let d28 = k6 * d26 - k7 * d25 + p.XX2 * k10 + p.XY2 * k11 - p.XZ2 * k8
-                    + p.MY2 * d17 - p.MZ2 * d16;
-                let d29 = k7 * d24 + k9 * d26 + p.XY2 * k10 + p.YY2 * k11 - p.YZ2 * k8
-                    + p.MZ2 * k15 - p.MX2 * d17;
-                let k16 = c_q_torso * k9 - s_q_torso * k7;
-                let k17 = s_q_torso * k9 + c_q_torso * k7;
-                let k18 = k6 - qd_torso;
-                let k19 = k17 * qd_torso - c_q_torso * k10 + s_q_torso * k8;
-                let k20 = k11 + qdd_torso;
-                let k21 = k16 * qd_torso + s_q_torso * k10 + c_q_torso * k8;
-                let k22 = p.L4 * k6 - p.L3 * k7;
-                let k23 = p.L4 * k9;
-                let k24 = p.L3 * k9;
-                let d30 = k7 * k22 - k9 * k24 - d16 + p.L4 * k10;
-                let k25 = k6 * k24 + k7 * k23 + k15 + p.L4 * k11 + p.L3 * k8;
-                let d31 = k9 * k23 + k6 * k22 + d17 + p.L3 * k10;
-                let d32 = c_q_torso * k25 + s_q_torso * d31;
-                let d33 = s_q_torso * k25 - c_q_torso * d31;
-                let d34 = p.MZ3 * k18 + p.MY3 * k17;
-                let d35 = p.MY3 * k16 - p.MX3 * k18;
-                let d36 = p.MX3 * k17 + p.MZ3 * k16;
-                let d37 = k18 * d35 - k17 * d36 + p.m3 * d32 - p.MZ3 * k20 + p.MY3 * k21;
-                let d38 = k17 * d34 + k16 * d35 - p.m3 * d30 + p.MX3 * k21 - p.MZ3 * k19;
-                let d39 = k16 * d36 + k18 * d34 + p.m3 * d33 + p.MY3 * k19 - p.MX3 * k20;
-                let d40 = p.XX3 * k16 + p.XY3 * k18 - p.XZ3 * k17;
-                let d41 = p.XY3 * k16 + p.YY3 * k18 - p.YZ3 * k17;
-                let d42 = p.XZ3 * k16 + p.YZ3 * k18 - p.ZZ3 * k17;
-                let d43 = k18 * d42 + k17 * d41 - p.XX3 * k19 - p.XY3 * k20 - p.XZ3 * k21
-                    - p.MY3 * d33 - p.MZ3 * d30;
-                let d44 = k16 * d41 - k18 * d40 - p.XZ3 * k19 - p.YZ3 * k20 - p.ZZ3 * k21
-                    + p.MX3 * d30 - p.MY3 * d32;
-                let d45 = k17 * d40 + k16 * d42 + p.XY3 * k19 + p.YY3 * k20 + p.YZ3 * k21
-                    - p.MZ3 * d32 - p.MX3 * d33;
-                let k26 = c_q1l * k18 + s_q1l * k17;
-                let k27 = s_q1l * k18 - c_q1l * k17;
-                let k28 = k16 - qd1l;
-                let k29 = k27 * qd1l + c_q1l * k20 - s_q1l * k21;
-                let k30 = k19 + qdd1l;
-                let k31 = k26 * qd1l - s_q1l * k20 - c_q1l * k21;
-                let k32 = p.L5 * k17;
-                let k33 = p.L6 * k17;
-                let t1 = p.L5 * k16;
-                let t2 = p.L6 * k18;
-                let k34 = t1 - t2;
-                let t3 = p.L5 * k21;
-                let t4 = p.L6 * k21;
-                let t5 = p.L5 * k19;
-                let t6 = p.L6 * k20;
-                let t7 = k17 * k33;
-                let t8 = k17 * k32;
-                let t9 = k16 * k33;
-                let t10 = k18 * k32;
-                let d46 = k18 * k34 - t7 + d32 + t3;
-                let d47 = t8 + k16 * k34 - d30 + t4;
-                let d48 = t9 + t10 + d33 + t5 - t6;
-                let d49 = s_q1l * d47 + c_q1l * d48;
-                let d50 = c_q1l * d47 - s_q1l * d48;
-                let d51 = p.MZ4l * k28 + p.MY4l * k27;
-                let d52 = p.MY4l * k26 - p.MX4l * k28;
-                let d53 = p.MX4l * k27 + p.MZ4l * k26;
-                let d54 = k28 * d52 - k27 * d53 - p.m4l * d50 - p.MZ4l * k30
-                    + p.MY4l * k31;
-                let d55 = k27 * d51 + k26 * d52 - p.m4l * d46 + p.MX4l * k31
-                    - p.MZ4l * k29;
-                let d56 = k26 * d53 + k28 * d51 - p.m4l * d49 + p.MY4l * k29
-                    - p.MX4l * k30;
-                let d57 = p.XX4l * k26 + p.XY4l * k28 - p.XZ4l * k27;
-                let d58 = p.XY4l * k26 + p.YY4l * k28 - p.YZ4l * k27;
-                let d59 = p.XZ4l * k26 + p.YZ4l * k28 - p.ZZ4l * k27;
-                let d60 = k28 * d59 + k27 * d58 - p.XX4l * k29 - p.XY4l * k30
-                    - p.XZ4l * k31 + p.MY4l * d49 - p.MZ4l * d46;
-                let d61 = k26 * d58 - k28 * d57 - p.XZ4l * k29 - p.YZ4l * k30
-                    - p.ZZ4l * k31 + p.MX4l * d46 + p.MY4l * d50;
-                let d62 = k27 * d57 + k26 * d59 + p.XY4l * k29 + p.YY4l * k30
-                    + p.YZ4l * k31 + p.MZ4l * d50 + p.MX4l * d49;
-                let k35 = c_q2l * k28 - s_q2l * k27;
-                let k36 = s_q2l * k28 + c_q2l * k27;
-                let k37 = k29 - qdd2l;
-                let k38 = k36 * qd2l + c_q2l * k30 + s_q2l * k31;
-                let k39 = k26 + qd2l;
-                let k40 = k35 * qd2l - s_q2l * k30 + c_q2l * k31;
-                let d63 = c_q2l * d46 + s_q2l * d49;
-                let d64 = s_q2l * d46 - c_q2l * d49;
-                let d65 = p.MZ5l * k35 - p.MY5l * k36;
-                let d66 = p.MX5l * k36 - p.MZ5l * k39;
-                let d67 = p.MY5l * k39 - p.MX5l * k35;
-                let d68 = k35 * d67 - k36 * d66 + p.m5l * d50 + p.MZ5l * k38
-                    + p.MY5l * k40;
-                let d69 = k36 * d65 - k39 * d67 - p.m5l * d63 - p.MX5l * k40
-                    - p.MZ5l * k37;
-                let d70 = k39 * d66 - k35 * d65 - p.m5l * d64 + p.MY5l * k37
-                    - p.MX5l * k38;
-                let d71 = p.XX5l * k39 + p.XY5l * k35 + p.XZ5l * k36;
-                let d72 = p.XY5l * k39 + p.YY5l * k35 + p.YZ5l * k36;
-                let d73 = p.XZ5l * k39 + p.YZ5l * k35 + p.ZZ5l * k36;
-                let d74 = k35 * d73 - k36 * d72 + p.XX5l * k37 + p.XY5l * k38
-                    - p.XZ5l * k40 - p.MY5l * d64 + p.MZ5l * d63;
-                let d75 = k36 * d71 - k39 * d73 + p.XY5l * k37 + p.YY5l * k38
-                    - p.YZ5l * k40 + p.MZ5l * d50 + p.MX5l * d64;
-                let d76 = k39 * d72 - k35 * d71 + p.XZ5l * k37 + p.YZ5l * k38
-                    - p.ZZ5l * k40 - p.MX5l * d63 - p.MY5l * d50;
-                let k41 = c_q3l * k39 - s_q3l * k36;
-                let k42 = s_q3l * k39 + c_q3l * k36;
-                let k43 = k35 - qd3l;
-                let k44 = k42 * qd3l + c_q3l * k37 + s_q3l * k40;
-                let k45 = k38 + qdd3l;
-                let k46 = k41 * qd3l - s_q3l * k37 + c_q3l * k40;
-                let k47 = p.L7 * k36;
-                let k48 = p.L7 * k39;
-                let d77 = k36 * k47 + k39 * k48 - d63;
-                let d78 = k35 * k48 - d50 + p.L7 * k40;
-                let d79 = k35 * k47 + d64 + p.L7 * k37;
-                let d80 = c_q3l * d78 - s_q3l * d79;
-                let d81 = s_q3l * d78 + c_q3l * d79;
-                let d82 = p.MZ6l * k43 + p.MY6l * k42;
-                let d83 = p.MY6l * k41 - p.MX6l * k43;
-                let d84 = p.MX6l * k42 + p.MZ6l * k41;
-                let d85 = k43 * d83 - k42 * d84 + p.m6l * d80 - p.MZ6l * k45
-                    + p.MY6l * k46;
-                let d86 = k42 * d82 + k41 * d83 + p.m6l * d77 + p.MX6l * k46
-                    - p.MZ6l * k44;
-                let d87 = k41 * d84 + k43 * d82 + p.m6l * d81 + p.MY6l * k44
-                    - p.MX6l * k45;
-                let d88 = p.XX6l * k41 + p.XY6l * k43 - p.XZ6l * k42;
-                let d89 = p.XY6l * k41 + p.YY6l * k43 - p.YZ6l * k42;
-                let d90 = p.XZ6l * k41 + p.YZ6l * k43 - p.ZZ6l * k42;
-                let d91 = k43 * d90 + k42 * d89 - p.XX6l * k44 - p.XY6l * k45
-                    - p.XZ6l * k46 - p.MY6l * d81 + p.MZ6l * d77;
-                let d92 = k41 * d89 - k43 * d88 - p.XZ6l * k44 - p.YZ6l * k45
-                    - p.ZZ6l * k46 - p.MX6l * d77 - p.MY6l * d80;
-                let d93 = k42 * d88 + k41 * d90 + p.XY6l * k44 + p.YY6l * k45
-                    + p.YZ6l * k46 - p.MZ6l * d80 - p.MX6l * d81;
-                let k49 = c_q4l * k43 - s_q4l * k42;
-                let k50 = s_q4l * k43 + c_q4l * k42;
-                let k51 = k44 - qdd4l;
-                let k52 = k50 * qd4l + c_q4l * k45 + s_q4l * k46;
-                let k53 = k41 + qd4l;
-                let k54 = k49 * qd4l - s_q4l * k45 + c_q4l * k46;
-                let d94 = c_q4l * d77 + s_q4l * d81;
-                let d95 = s_q4l * d77 - c_q4l * d81;
-                let d96 = p.MZ7l * k49 - p.MY7l * k50;
-                let d97 = p.MX7l * k50 - p.MZ7l * k53;
-                let d98 = p.MY7l * k53 - p.MX7l * k49;
-                let d99 = k49 * d98 - k50 * d97 - p.m7l * d80 + p.MZ7l * k52
-                    + p.MY7l * k54;
-                let d100 = k50 * d96 - k53 * d98 + p.m7l * d94 - p.MX7l * k54
-                    - p.MZ7l * k51;
-                let d101 = k53 * d97 - k49 * d96 + p.m7l * d95 + p.MY7l * k51
-                    - p.MX7l * k52;
-                let d102 = p.XX7l * k53 + p.XY7l * k49 + p.XZ7l * k50;
-                let d103 = p.XY7l * k53 + p.YY7l * k49 + p.YZ7l * k50;
-                let d104 = p.XZ7l * k53 + p.YZ7l * k49 + p.ZZ7l * k50;
-                let d105 = k49 * d104 - k50 * d103 + p.XX7l * k51 + p.XY7l * k52
-                    - p.XZ7l * k54 + p.MY7l * d95 - p.MZ7l * d94;
-                let d106 = k50 * d102 - k53 * d104 + p.XY7l * k51 + p.YY7l * k52
-                    - p.YZ7l * k54 - p.MZ7l * d80 - p.MX7l * d95;
-                let d107 = k53 * d103 - k49 * d102 + p.XZ7l * k51 + p.YZ7l * k52
-                    - p.ZZ7l * k54 + p.MX7l * d94 + p.MY7l * d80;
-                let k55 = c_q5l * k53 - s_q5l * k50;
-                let k56 = s_q5l * k53 + c_q5l * k50;
-                let k57 = k49 - qd5l;
-                let k58 = k56 * qd5l + c_q5l * k51 + s_q5l * k54;
-                let k59 = k52 + qdd5l;
-                let k60 = k55 * qd5l - s_q5l * k51 + c_q5l * k54;
-                let k61 = p.L8 * k50;
-                let k62 = p.L8 * k53;
-                let d108 = k50 * k61 + k53 * k62 + d94;
-                let d109 = k49 * k62 + d80 + p.L8 * k54;
-                let d110 = k49 * k61 - d95 + p.L8 * k51;
-                let d111 = c_q5l * d109 - s_q5l * d110;
-                let d112 = s_q5l * d109 + c_q5l * d110;
-                let d113 = p.MZ8l * k57 + p.MY8l * k56;
-                let d114 = p.MY8l * k55 - p.MX8l * k57;
-                let d115 = p.MX8l * k56 + p.MZ8l * k55;
-                let d116 = k57 * d114 - k56 * d115 + p.m8l * d111 - p.MZ8l * k59
-                    + p.MY8l * k60;
-                let d117 = k56 * d113 + k55 * d114 + p.m8l * d108 + p.MX8l * k60
-                    - p.MZ8l * k58;
-                let d118 = k55 * d115 + k57 * d113 + p.m8l * d112 + p.MY8l * k58
-                    - p.MX8l * k59;
-                let d119 = p.XX8l * k55 + p.XY8l * k57 - p.XZ8l * k56;
-                let d120 = p.XY8l * k55 + p.YY8l * k57 - p.YZ8l * k56;
-                let d121 = p.XZ8l * k55 + p.YZ8l * k57 - p.ZZ8l * k56;
-                let d122 = k57 * d121 + k56 * d120 - p.XX8l * k58 - p.XY8l * k59
-                    - p.XZ8l * k60 - p.MY8l * d112 + p.MZ8l * d108;
-                let d123 = k55 * d120 - k57 * d119 - p.XZ8l * k58 - p.YZ8l * k59
-                    - p.ZZ8l * k60 - p.MX8l * d108 - p.MY8l * d111;
-                let d124 = k56 * d119 + k55 * d121 + p.XY8l * k58 + p.YY8l * k59
-                    + p.YZ8l * k60 - p.MZ8l * d111 - p.MX8l * d112;
-                let k63 = c_q6l * k57 - s_q6l * k56;
-                let k64 = s_q6l * k57 + c_q6l * k56;
-                let k65 = k58 - qdd6l;
-                let k66 = k64 * qd6l + c_q6l * k59 + s_q6l * k60;
-                let k67 = k55 + qd6l;
-                let k68 = k63 * qd6l - s_q6l * k59 + c_q6l * k60;
-                let d125 = c_q6l * d108 + s_q6l * d112;
-                let d126 = s_q6l * d108 - c_q6l * d112;
-                let d127 = p.MZ9l * k63 - p.MY9l * k64;
-                let d128 = p.MX9l * k64 - p.MZ9l * k67;
-                let d129 = p.MY9l * k67 - p.MX9l * k63;
-                let d130 = k63 * d129 - k64 * d128 - p.m9l * d111 + p.MZ9l * k66
-                    + p.MY9l * k68;
-                let d131 = k64 * d127 - k67 * d129 + p.m9l * d125 - p.MX9l * k68
-                    - p.MZ9l * k65;
-                let d132 = k67 * d128 - k63 * d127 + p.m9l * d126 + p.MY9l * k65
-                    - p.MX9l * k66;
-                let d133 = p.XX9l * k67 + p.XY9l * k63 + p.XZ9l * k64;
-                let d134 = p.XY9l * k67 + p.YY9l * k63 + p.YZ9l * k64;
-                let d135 = p.XZ9l * k67 + p.YZ9l * k63 + p.ZZ9l * k64;
-                let d136 = k63 * d135 - k64 * d134 + p.XX9l * k65 + p.XY9l * k66
-                    - p.XZ9l * k68 + p.MY9l * d126 - p.MZ9l * d125;
-                let d137 = k64 * d133 - k67 * d135 + p.XY9l * k65 + p.YY9l * k66
-                    - p.YZ9l * k68 - p.MZ9l * d111 - p.MX9l * d126;
-                let d138 = k67 * d134 - k63 * d133 + p.XZ9l * k65 + p.YZ9l * k66
-                    - p.ZZ9l * k68 + p.MX9l * d125 + p.MY9l * d111;
-                let k69 = c_q7l * k67 - s_q7l * k64;
-                let k70 = s_q7l * k67 + c_q7l * k64;
-                let k71 = k63 - qd7l;
-                let k72 = k69 * qd7l - s_q7l * k65 + c_q7l * k68;
-                let k73 = k70 * qd7l + c_q7l * k65 + s_q7l * k68;
-                let k74 = k66 + qdd7l;
-                let k75 = p.L9 * k64;
-                let k76 = p.L9 * k67;
-                let d139 = k64 * k75 + k67 * k76 + d125;
-                let d140 = k63 * k76 + d111 + p.L9 * k68;
-                let d141 = k63 * k75 - d126 + p.L9 * k65;
-                let d142 = c_q7l * d140 - s_q7l * d141;
-                let d143 = s_q7l * d140 + c_q7l * d141;
-                let d144 = p.MZ10l * k70 - p.MY10l * k71;
-                let d145 = p.MX10l * k71 - p.MZ10l * k69;
-                let d146 = p.MY10l * k69 - p.MX10l * k70;
-                let d147 = k70 * d146 - k71 * d145 + p.m10l * d142 + p.MZ10l * k72
-                    + p.MY10l * k74;
-                let d148 = k71 * d144 - k69 * d146 + p.m10l * d143 - p.MX10l * k74
-                    + p.MZ10l * k73;
-                let d149 = k69 * d145 - k70 * d144 - p.m10l * d139 - p.MY10l * k73
-                    - p.MX10l * k72;
-                let d150 = p.XX10l * k69 + p.XY10l * k70 + p.XZ10l * k71;
-                let d151 = p.XY10l * k69 + p.YY10l * k70 + p.YZ10l * k71;
-                let d152 = p.XZ10l * k69 + p.YZ10l * k70 + p.ZZ10l * k71;
-                let d153 = k70 * d152 - k71 * d151 - p.XX10l * k73 + p.XY10l * k72
-                    - p.XZ10l * k74 - p.MY10l * d139 - p.MZ10l * d143;
-                let d154 = k71 * d150 - k69 * d152 - p.XY10l * k73 + p.YY10l * k72
-                    - p.YZ10l * k74 + p.MZ10l * d142 + p.MX10l * d139;
-                let d155 = k69 * d151 - k70 * d150 - p.XZ10l * k73 + p.YZ10l * k72
-                    - p.ZZ10l * k74 + p.MX10l * d143 - p.MY10l * d142;
-                buf[0][11] = kanegen_runtime::lanes::lanes(-d155);
-                let k77 = c_q1r * k18 - s_q1r * k17;
-                let k78 = s_q1r * k18 + c_q1r * k17;
-                let k79 = k19 - qdd1r;
-                let k80 = k16 + qd1r;
-                let k81 = k78 * qd1r + c_q1r * k20 + s_q1r * k21;
-                let k82 = k77 * qd1r - s_q1r * k20 + c_q1r * k21;
-                let k83 = t1 + t2;
-                let d156 = t7 + k18 * k83 + d32 + t3;
-                let d157 = t9 - t10 - d33 - t5 - t6;
-                let d158 = t8 + k16 * k83 - d30 - t4;
-                let d159 = s_q1r * d158 + c_q1r * d157;
-                let d160 = c_q1r * d158 - s_q1r * d157;
-                let d161 = p.MY4r * k77 + p.MX4r * k80;
-                let d162 = p.MZ4r * k80 - p.MY4r * k78;
-                let d163 = p.MX4r * k78 + p.MZ4r * k77;
-                let d164 = k78 * d162 - k77 * d161 - p.m4r * d156 - p.MX4r * k82
-                    + p.MZ4r * k81;
-                let d165 = k80 * d161 + k78 * d163 + p.m4r * d160 - p.MZ4r * k79
-                    - p.MY4r * k82;
-                let d166 = k77 * d163 + k80 * d162 - p.m4r * d159 + p.MY4r * k81
-                    + p.MX4r * k79;
-                let d167 = p.XX4r * k77 - p.XY4r * k80 - p.XZ4r * k78;
-                let d168 = p.XY4r * k77 - p.YY4r * k80 - p.YZ4r * k78;
-                let d169 = p.XZ4r * k77 - p.YZ4r * k80 - p.ZZ4r * k78;
-                let d170 = k77 * d168 + k80 * d167 - p.XZ4r * k81 + p.YZ4r * k79
-                    - p.ZZ4r * k82 - p.MX4r * d156 + p.MY4r * d160;
-                let d171 = k80 * d169 - k78 * d168 + p.XX4r * k81 - p.XY4r * k79
-                    + p.XZ4r * k82 - p.MY4r * d159 - p.MZ4r * d156;
-                let d172 = k78 * d167 + k77 * d169 + p.XY4r * k81 - p.YY4r * k79
-                    + p.YZ4r * k82 + p.MZ4r * d160 + p.MX4r * d159;
-                let k84 = c_q2r * k80 + s_q2r * k78;
-                let k85 = s_q2r * k80 - c_q2r * k78;
-                let k86 = k81 - qdd2r;
-                let k87 = k84 * qd2r - s_q2r * k79 - c_q2r * k82;
-                let k88 = k77 + qd2r;
-                let k89 = k85 * qd2r + c_q2r * k79 - s_q2r * k82;
-                let d173 = c_q2r * d156 - s_q2r * d159;
-                let d174 = s_q2r * d156 + c_q2r * d159;
-                let d175 = p.MZ5r * k84 - p.MY5r * k85;
-                let d176 = p.MX5r * k85 + p.MZ5r * k88;
-                let d177 = p.MY5r * k88 + p.MX5r * k84;
-                let d178 = k85 * d175 - k88 * d177 + p.m5r * d173 + p.MX5r * k87
-                    - p.MZ5r * k86;
-                let d179 = k84 * d177 + k85 * d176 - p.m5r * d160 + p.MZ5r * k89
-                    + p.MY5r * k87;
-                let d180 = k88 * d176 + k84 * d175 - p.m5r * d174 - p.MY5r * k86
-                    - p.MX5r * k89;
-                let d181 = p.XX5r * k88 - p.XY5r * k84 - p.XZ5r * k85;
-                let d182 = p.XY5r * k88 - p.YY5r * k84 - p.YZ5r * k85;
-                let d183 = p.XZ5r * k88 - p.YZ5r * k84 - p.ZZ5r * k85;
-                let d184 = k88 * d182 + k84 * d181 + p.XZ5r * k86 - p.YZ5r * k89
-                    + p.ZZ5r * k87 + p.MX5r * d173 - p.MY5r * d160;
-                let d185 = k84 * d183 - k85 * d182 - p.XX5r * k86 + p.XY5r * k89
-                    - p.XZ5r * k87 - p.MY5r * d174 + p.MZ5r * d173;
-                let d186 = k85 * d181 + k88 * d183 - p.XY5r * k86 + p.YY5r * k89
-                    - p.YZ5r * k87 - p.MZ5r * d160 + p.MX5r * d174;
-                let k90 = c_q3r * k88 + s_q3r * k85;
-                let k91 = s_q3r * k88 - c_q3r * k85;
-                let k92 = k89 - qdd3r;
-                let k93 = k84 + qd3r;
-                let k94 = k91 * qd3r + c_q3r * k86 - s_q3r * k87;
-                let k95 = k90 * qd3r - s_q3r * k86 - c_q3r * k87;
-                let k96 = p.L7 * k85;
-                let k97 = p.L7 * k88;
-                let d187 = k84 * k97 + d160 + p.L7 * k87;
-                let d188 = k85 * k96 + k88 * k97 + d173;
-                let d189 = k84 * k96 - d174 + p.L7 * k86;
-                let d190 = s_q3r * d187 - c_q3r * d189;
-                let d191 = c_q3r * d187 + s_q3r * d189;
-                let d192 = p.MY6r * k90 + p.MX6r * k93;
-                let d193 = p.MZ6r * k93 - p.MY6r * k91;
-                let d194 = p.MX6r * k91 + p.MZ6r * k90;
-                let d195 = k91 * d193 - k90 * d192 - p.m6r * d188 - p.MX6r * k95
-                    + p.MZ6r * k94;
-                let d196 = k93 * d192 + k91 * d194 + p.m6r * d191 - p.MZ6r * k92
-                    - p.MY6r * k95;
-                let d197 = k90 * d194 + k93 * d193 - p.m6r * d190 + p.MY6r * k94
-                    + p.MX6r * k92;
-                let d198 = p.XX6r * k90 - p.XY6r * k93 - p.XZ6r * k91;
-                let d199 = p.XY6r * k90 - p.YY6r * k93 - p.YZ6r * k91;
-                let d200 = p.XZ6r * k90 - p.YZ6r * k93 - p.ZZ6r * k91;
-                let d201 = k90 * d199 + k93 * d198 - p.XZ6r * k94 + p.YZ6r * k92
-                    - p.ZZ6r * k95 - p.MX6r * d188 + p.MY6r * d191;
-                let d202 = k93 * d200 - k91 * d199 + p.XX6r * k94 - p.XY6r * k92
-                    + p.XZ6r * k95 - p.MY6r * d190 - p.MZ6r * d188;
-                let d203 = k91 * d198 + k90 * d200 + p.XY6r * k94 - p.YY6r * k92
-                    + p.YZ6r * k95 + p.MZ6r * d191 + p.MX6r * d190;
-                let k98 = c_q4r * k93 + s_q4r * k91;
-                let k99 = s_q4r * k93 - c_q4r * k91;
-                let k100 = k94 - qdd4r;
-                let k101 = k98 * qd4r - s_q4r * k92 - c_q4r * k95;
-                let k102 = k90 + qd4r;
-                let k103 = k99 * qd4r + c_q4r * k92 - s_q4r * k95;
-                let d204 = c_q4r * d188 - s_q4r * d190;
-                let d205 = s_q4r * d188 + c_q4r * d190;
-                let d206 = p.MZ7r * k98 - p.MY7r * k99;
-                let d207 = p.MX7r * k99 + p.MZ7r * k102;
-                let d208 = p.MY7r * k102 + p.MX7r * k98;
-                let d209 = k99 * d206 - k102 * d208 + p.m7r * d204 + p.MX7r * k101
-                    - p.MZ7r * k100;
-                let d210 = k98 * d208 + k99 * d207 - p.m7r * d191 + p.MZ7r * k103
-                    + p.MY7r * k101;
-                let d211 = k102 * d207 + k98 * d206 - p.m7r * d205 - p.MY7r * k100
-                    - p.MX7r * k103;
-                let d212 = p.XX7r * k102 - p.XY7r * k98 - p.XZ7r * k99;
-                let d213 = p.XY7r * k102 - p.YY7r * k98 - p.YZ7r * k99;
-                let d214 = p.XZ7r * k102 - p.YZ7r * k98 - p.ZZ7r * k99;
-                let d215 = k102 * d213 + k98 * d212 + p.XZ7r * k100 - p.YZ7r * k103
-                    + p.ZZ7r * k101 + p.MX7r * d204 - p.MY7r * d191;
-                let d216 = k98 * d214 - k99 * d213 - p.XX7r * k100 + p.XY7r * k103
-                    - p.XZ7r * k101 - p.MY7r * d205 + p.MZ7r * d204;
-                let d217 = k99 * d212 + k102 * d214 - p.XY7r * k100 + p.YY7r * k103
-                    - p.YZ7r * k101 - p.MZ7r * d191 + p.MX7r * d205;
-                let k104 = c_q5r * k102 + s_q5r * k99;
-                let k105 = s_q5r * k102 - c_q5r * k99;
-                let k106 = k103 - qdd5r;
-                let k107 = k98 + qd5r;
-                let k108 = k105 * qd5r + c_q5r * k100 - s_q5r * k101;
-                let k109 = k104 * qd5r - s_q5r * k100 - c_q5r * k101;
-                let k110 = p.L8 * k99;
-                let k111 = p.L8 * k102;
-                let d218 = k98 * k111 + d191 + p.L8 * k101;
-                let d219 = k99 * k110 + k102 * k111 + d204;
-                let d220 = k98 * k110 - d205 + p.L8 * k100;
-                let d221 = s_q5r * d218 - c_q5r * d220;
-                let d222 = c_q5r * d218 + s_q5r * d220;
-                let d223 = p.MY8r * k104 + p.MX8r * k107;
-                let d224 = p.MZ8r * k107 - p.MY8r * k105;
-                let d225 = p.MX8r * k105 + p.MZ8r * k104;
-                let d226 = k105 * d224 - k104 * d223 - p.m8r * d219 - p.MX8r * k109
-                    + p.MZ8r * k108;
-                let d227 = k107 * d223 + k105 * d225 + p.m8r * d222 - p.MZ8r * k106
-                    - p.MY8r * k109;
-                let d228 = k104 * d225 + k107 * d224 - p.m8r * d221 + p.MY8r * k108
-                    + p.MX8r * k106;
-                let d229 = p.XX8r * k104 - p.XY8r * k107 - p.XZ8r * k105;
-                let d230 = p.XY8r * k104 - p.YY8r * k107 - p.YZ8r * k105;
-                let d231 = p.XZ8r * k104 - p.YZ8r * k107 - p.ZZ8r * k105;
-                let d232 = k104 * d230 + k107 * d229 - p.XZ8r * k108 + p.YZ8r * k106
-                    - p.ZZ8r * k109 - p.MX8r * d219 + p.MY8r * d222;
-                let d233 = k107 * d231 - k105 * d230 + p.XX8r * k108 - p.XY8r * k106
-                    + p.XZ8r * k109 - p.MY8r * d221 - p.MZ8r * d219;
-                let d234 = k105 * d229 + k104 * d231 + p.XY8r * k108 - p.YY8r * k106
-                    + p.YZ8r * k109 + p.MZ8r * d222 + p.MX8r * d221;
-                let k112 = c_q6r * k107 + s_q6r * k105;
-                let k113 = s_q6r * k107 - c_q6r * k105;
-                let k114 = k108 - qdd6r;
-                let k115 = k112 * qd6r - s_q6r * k106 - c_q6r * k109;
-                let k116 = k104 + qd6r;
-                let k117 = k113 * qd6r + c_q6r * k106 - s_q6r * k109;
-                let d235 = c_q6r * d219 - s_q6r * d221;
-                let d236 = s_q6r * d219 + c_q6r * d221;
-                let d237 = p.MZ9r * k112 - p.MY9r * k113;
-                let d238 = p.MX9r * k113 + p.MZ9r * k116;
-                let d239 = p.MY9r * k116 + p.MX9r * k112;
-                let d240 = k113 * d237 - k116 * d239 + p.m9r * d235 + p.MX9r * k115
-                    - p.MZ9r * k114;
-                let d241 = k112 * d239 + k113 * d238 - p.m9r * d222 + p.MZ9r * k117
-                    + p.MY9r * k115;
-                let d242 = k116 * d238 + k112 * d237 - p.m9r * d236 - p.MY9r * k114
-                    - p.MX9r * k117;
-                let d243 = p.XX9r * k116 - p.XY9r * k112 - p.XZ9r * k113;
-                let d244 = p.XY9r * k116 - p.YY9r * k112 - p.YZ9r * k113;
-                let d245 = p.XZ9r * k116 - p.YZ9r * k112 - p.ZZ9r * k113;
-                let d246 = k116 * d244 + k112 * d243 + p.XZ9r * k114 - p.YZ9r * k117
-                    + p.ZZ9r * k115 + p.MX9r * d235 - p.MY9r * d222;
-                let d247 = k112 * d245 - k113 * d244 - p.XX9r * k114 + p.XY9r * k117
-                    - p.XZ9r * k115 - p.MY9r * d236 + p.MZ9r * d235;
-                let d248 = k113 * d243 + k116 * d245 - p.XY9r * k114 + p.YY9r * k117
-                    - p.YZ9r * k115 - p.MZ9r * d222 + p.MX9r * d236;
-                let k118 = c_q7r * k116 + s_q7r * k113;
-                let k119 = s_q7r * k116 - c_q7r * k113;
-                let k120 = k117 - qdd7r;
-                let k121 = k118 * qd7r - s_q7r * k114 - c_q7r * k115;
-                let k122 = k112 + qd7r;
-                let k123 = k119 * qd7r + c_q7r * k114 - s_q7r * k115;
-                let k124 = p.L9 * k113;
-                let k125 = p.L9 * k116;
-                let d249 = k112 * k125 + d222 + p.L9 * k115;
-                let d250 = k113 * k124 + k116 * k125 + d235;
-                let d251 = k112 * k124 - d236 + p.L9 * k114;
-                let d252 = c_q7r * d249 + s_q7r * d251;
-                let d253 = s_q7r * d249 - c_q7r * d251;
-                let d254 = p.MZ10r * k119 + p.MY10r * k122;
-                let d255 = p.MY10r * k118 - p.MX10r * k119;
-                let d256 = p.MX10r * k122 + p.MZ10r * k118;
-                let d257 = k119 * d255 - k122 * d256 - p.m10r * d252 + p.MZ10r * k121
-                    - p.MY10r * k120;
-                let d258 = k122 * d254 + k118 * d255 + p.m10r * d253 - p.MX10r * k120
-                    - p.MZ10r * k123;
-                let d259 = k118 * d256 + k119 * d254 + p.m10r * d250 + p.MY10r * k123
-                    + p.MX10r * k121;
-                let d260 = p.XX10r * k118 + p.XY10r * k119 - p.XZ10r * k122;
-                let d261 = p.XY10r * k118 + p.YY10r * k119 - p.YZ10r * k122;
-                let d262 = p.XZ10r * k118 + p.YZ10r * k119 - p.ZZ10r * k122;
-                let d263 = k119 * d262 + k122 * d261 - p.XX10r * k123 + p.XY10r * k121
-                    + p.XZ10r * k120 - p.MY10r * d250 + p.MZ10r * d253;
-                let d264 = k118 * d261 - k119 * d260 - p.XZ10r * k123 + p.YZ10r * k121
-                    + p.ZZ10r * k120 - p.MX10r * d253 + p.MY10r * d252;
-                buf[0][18] = kanegen_runtime::lanes::lanes(-d264);
-                let d265 = k122 * d260 + k118 * d262 + p.XY10r * k123 - p.YY10r * k121
-                    - p.YZ10r * k120 + p.MZ10r * d252 - p.MX10r * d250;
-                let d266 = s_q7r * d257 + c_q7r * d258;
-                let d267 = c_q7r * d257 - s_q7r * d258;
-                let d268 = d240 + d259;
-                let d269 = d246 + s_q7r * d263 + c_q7r * d265 - p.L9 * d267;
-                let d270 = d241 + d267;
-                let d271 = d242 - d266;
-                let d272 = d247 + c_q7r * d263 - s_q7r * d265 + p.L9 * d266;
-                buf[0][17] = kanegen_runtime::lanes::lanes(d272);
-                let d273 = d248 + d264;
-                let d274 = c_q6r * d268 - s_q6r * d271;
-                let d275 = s_q6r * d268 + c_q6r * d271;
-                let d276 = d226 - d274;
-                let d277 = d232 + s_q6r * d273 + c_q6r * d269;
-                let d278 = d227 - d270;
-                let d279 = d228 + d275;
-                let d280 = d233 - d272;
-                let d281 = d234 - c_q6r * d273 + s_q6r * d269;
-                buf[0][16] = kanegen_runtime::lanes::lanes(d281);
-                let d282 = c_q5r * d278 - s_q5r * d279;
-                let d283 = s_q5r * d278 + c_q5r * d279;
-                let d284 = d209 - d276;
-                let d285 = d215 - s_q5r * d280 + c_q5r * d277 + p.L8 * d282;
-                let d286 = d210 - d282;
-                let d287 = d211 + d283;
-                let d288 = d216 - c_q5r * d280 - s_q5r * d277 - p.L8 * d283;
-                buf[0][15] = kanegen_runtime::lanes::lanes(d288);
-                let d289 = d217 - d281;
-                let d290 = c_q4r * d284 - s_q4r * d287;
-                let d291 = s_q4r * d284 + c_q4r * d287;
-                let d292 = d195 - d290;
-                let d293 = d201 + s_q4r * d289 + c_q4r * d285;
-                let d294 = d196 - d286;
-                let d295 = d197 + d291;
-                let d296 = d202 - d288;
-                let d297 = d203 - c_q4r * d289 + s_q4r * d285;
-                buf[0][14] = kanegen_runtime::lanes::lanes(d297);
-                let d298 = c_q3r * d294 - s_q3r * d295;
-                let d299 = s_q3r * d294 + c_q3r * d295;
-                let d300 = d178 - d292;
-                let d301 = d184 - s_q3r * d296 + c_q3r * d293 + p.L7 * d298;
-                let d302 = d179 - d298;
-                let d303 = d180 + d299;
-                let d304 = d185 - c_q3r * d296 - s_q3r * d293 - p.L7 * d299;
-                buf[0][13] = kanegen_runtime::lanes::lanes(d304);
-                let d305 = d186 - d297;
-                let d306 = c_q2r * d300 - s_q2r * d303;
-                let d307 = s_q2r * d300 + c_q2r * d303;
-                let d308 = d164 - d306;
-                let d309 = d170 + s_q2r * d305 + c_q2r * d301;
-                let d310 = d165 - d302;
-                let d311 = d166 + d307;
-                let d312 = d171 - d304;
-                let d313 = d172 - c_q2r * d305 + s_q2r * d301;
-                buf[0][12] = kanegen_runtime::lanes::lanes(d313);
-                let d314 = c_q1r * d310 - s_q1r * d311;
-                let d315 = s_q1r * d310 + c_q1r * d311;
-                let d316 = d37 - d308;
-                let d317 = d43 + d313 - p.L5 * d315;
-                let d318 = d44 - s_q1r * d312 + c_q1r * d309 + p.L6 * d314 + p.L5 * d308;
-                let d319 = d38 + d314;
-                let d320 = d39 + d315;
-                let d321 = d45 + c_q1r * d312 + s_q1r * d309 + p.L6 * d315;
-                let d322 = s_q7l * d147 - c_q7l * d148;
-                let d323 = c_q7l * d147 + s_q7l * d148;
-                let d324 = d130 - d323;
-                let d325 = d131 - d149;
-                let d326 = d132 + d322;
-                let d327 = d137 - d155;
-                let d328 = d136 - c_q7l * d153 - s_q7l * d154 - p.L9 * d322;
-                buf[0][10] = kanegen_runtime::lanes::lanes(-d328);
-                let d329 = d138 + s_q7l * d153 - c_q7l * d154 - p.L9 * d323;
-                let d330 = c_q6l * d325 + s_q6l * d326;
-                let d331 = s_q6l * d325 - c_q6l * d326;
-                let d332 = d116 - d324;
-                let d333 = d122 - d328;
-                let d334 = d123 - s_q6l * d327 + c_q6l * d329;
-                let d335 = d117 + d330;
-                let d336 = d118 + d331;
-                let d337 = d124 + c_q6l * d327 + s_q6l * d329;
-                buf[0][9] = kanegen_runtime::lanes::lanes(d337);
-                let d338 = s_q5l * d332 - c_q5l * d336;
-                let d339 = c_q5l * d332 + s_q5l * d336;
-                let d340 = d99 - d339;
-                let d341 = d100 + d335;
-                let d342 = d101 + d338;
-                let d343 = d106 + d337;
-                let d344 = d105 - c_q5l * d333 + s_q5l * d334 - p.L8 * d338;
-                buf[0][8] = kanegen_runtime::lanes::lanes(-d344);
-                let d345 = d107 + s_q5l * d333 + c_q5l * d334 - p.L8 * d339;
-                let d346 = c_q4l * d341 + s_q4l * d342;
-                let d347 = s_q4l * d341 - c_q4l * d342;
-                let d348 = d85 - d340;
-                let d349 = d91 - d344;
-                let d350 = d92 - s_q4l * d343 + c_q4l * d345;
-                let d351 = d86 + d346;
-                let d352 = d87 + d347;
-                let d353 = d93 + c_q4l * d343 + s_q4l * d345;
-                buf[0][7] = kanegen_runtime::lanes::lanes(d353);
-                let d354 = s_q3l * d348 - c_q3l * d352;
-                let d355 = c_q3l * d348 + s_q3l * d352;
-                let d356 = d68 - d355;
-                let d357 = d69 + d351;
-                let d358 = d70 + d354;
-                let d359 = d75 + d353;
-                let d360 = d74 - c_q3l * d349 + s_q3l * d350 - p.L7 * d354;
-                buf[0][6] = kanegen_runtime::lanes::lanes(-d360);
-                let d361 = d76 + s_q3l * d349 + c_q3l * d350 - p.L7 * d355;
-                let d362 = c_q2l * d357 + s_q2l * d358;
-                let d363 = s_q2l * d357 - c_q2l * d358;
-                let d364 = d54 - d356;
-                let d365 = d60 - d360;
-                let d366 = d61 - s_q2l * d359 + c_q2l * d361;
-                let d367 = d55 + d362;
-                let d368 = d56 + d363;
-                let d369 = d62 + c_q2l * d359 + s_q2l * d361;
-                buf[0][5] = kanegen_runtime::lanes::lanes(d369);
-                let d370 = c_q1l * d364 + s_q1l * d368;
-                let d371 = s_q1l * d364 - c_q1l * d368;
-                let d372 = d316 - d367;
-                let d373 = d317 - d369 - p.L5 * d371;
-                let d374 = d318 - s_q1l * d365 - c_q1l * d366 + p.L6 * d370
-                    + p.L5 * d367;
-                let d375 = d319 - d370;
-                let d376 = d320 + d371;
-                let d377 = d321 - c_q1l * d365 + s_q1l * d366 - p.L6 * d371;
-                buf[0][4] = kanegen_runtime::lanes::lanes(d377);
-                let d378 = c_q_torso * d372 + s_q_torso * d376;
-                let d379 = s_q_torso * d372 - c_q_torso * d376;
-                let d380 = d21 - d375;
-                let d381 = d27 - s_q_torso * d373 - c_q_torso * d374 + p.L3 * d378;
-                let d382 = d22 + d378;
-                let d383 = d23 + d379;
-                let d384 = d28 + c_q_torso * d373 - s_q_torso * d374 + p.L3 * d379
-                    - p.L4 * d375;
-                buf[0][3] = kanegen_runtime::lanes::lanes(d384);
-                let d385 = d29 + d377 + p.L4 * d378;
-                let d386 = c_q_w * d380 - s_q_w * d383;
-                let d387 = s_q_w * d380 + c_q_w * d383;
-                let d388 = d6 + d386;
-                let d389 = d11 + s_q_w * d385 + c_q_w * d381 + p.L1 * d382;
-                let d390 = d7 + d387;
-                let d391 = d12 + d384 + p.L1 * d387 - p.L2 * d386;
-                buf[0][2] = kanegen_runtime::lanes::lanes(d391);
-                let d392 = d13 + c_q_w * d385 - s_q_w * d381 - p.L2 * d382;
-                let d393 = s_q_imu * d388 + c_q_imu * d390;
-                buf[0][0] = kanegen_runtime::lanes::lanes(d393 + pc.pc67 * xdd);
-                let d394 = c_q_imu * d392 - s_q_imu * d389;
-                buf[0][1] = kanegen_runtime::lanes::lanes(pc.pc68 * psidd - d394);
-                kanegen_runtime::lanes::results(&mut buf, false)
-            },
-        )
+        let mut out = [<SVector<f64, 19>>::zeros(); L];
+        inverse_dynamics_batch_into(p, pc, q, u, ud, &mut out);
+        out
     }
     /// The dynamics of `krang` with one parameter set: `τ = M(q) u̇ + c(q, u) + g(q)`.
     ///
@@ -10478,7 +14339,7 @@ mod generated {
         ) -> SVector<f64, 19> {
             inverse_dynamics(&self.params, &self.pre, q, u, ud)
         }
-        /// [`Self::mass_matrix`] at `L` states per call (entry `l` of the result at entry `l` of the inputs, bit for bit; vectorized across the states).
+        /// [`Self::mass_matrix`] at `L` states per call (entry `l` of the result at entry `l` of the inputs, bit for bit with the same instruction set; vectorized across the states). [`Self::mass_matrix_batch_into`] writes into the caller's array instead.
         #[inline]
         pub fn mass_matrix_batch<const L: usize>(
             &self,
@@ -10486,7 +14347,16 @@ mod generated {
         ) -> [SMatrix<f64, 19, 19>; L] {
             mass_matrix_batch(&self.params, &self.pre, q)
         }
-        /// [`Self::coriolis`] at `L` states per call (entry `l` of the result at entry `l` of the inputs, bit for bit; vectorized across the states).
+        /// [`Self::mass_matrix`] at `L` states per call, written into `out` (every entry; entry `l` at entry `l` of the inputs, bit for bit with the same instruction set).
+        #[inline]
+        pub fn mass_matrix_batch_into<const L: usize>(
+            &self,
+            q: &[SVector<f64, 19>; L],
+            out: &mut [SMatrix<f64, 19, 19>; L],
+        ) {
+            mass_matrix_batch_into(&self.params, &self.pre, q, out)
+        }
+        /// [`Self::coriolis`] at `L` states per call (entry `l` of the result at entry `l` of the inputs, bit for bit with the same instruction set; vectorized across the states). [`Self::coriolis_batch_into`] writes into the caller's array instead.
         #[inline]
         pub fn coriolis_batch<const L: usize>(
             &self,
@@ -10495,7 +14365,17 @@ mod generated {
         ) -> [SVector<f64, 19>; L] {
             coriolis_batch(&self.params, &self.pre, q, u)
         }
-        /// [`Self::gravity`] at `L` states per call (entry `l` of the result at entry `l` of the inputs, bit for bit; vectorized across the states).
+        /// [`Self::coriolis`] at `L` states per call, written into `out` (every entry; entry `l` at entry `l` of the inputs, bit for bit with the same instruction set).
+        #[inline]
+        pub fn coriolis_batch_into<const L: usize>(
+            &self,
+            q: &[SVector<f64, 19>; L],
+            u: &[SVector<f64, 19>; L],
+            out: &mut [SVector<f64, 19>; L],
+        ) {
+            coriolis_batch_into(&self.params, &self.pre, q, u, out)
+        }
+        /// [`Self::gravity`] at `L` states per call (entry `l` of the result at entry `l` of the inputs, bit for bit with the same instruction set; vectorized across the states). [`Self::gravity_batch_into`] writes into the caller's array instead.
         #[inline]
         pub fn gravity_batch<const L: usize>(
             &self,
@@ -10503,7 +14383,16 @@ mod generated {
         ) -> [SVector<f64, 19>; L] {
             gravity_batch(&self.params, &self.pre, q)
         }
-        /// [`Self::inverse_dynamics`] at `L` states per call (entry `l` of the result at entry `l` of the inputs, bit for bit; vectorized across the states).
+        /// [`Self::gravity`] at `L` states per call, written into `out` (every entry; entry `l` at entry `l` of the inputs, bit for bit with the same instruction set).
+        #[inline]
+        pub fn gravity_batch_into<const L: usize>(
+            &self,
+            q: &[SVector<f64, 19>; L],
+            out: &mut [SVector<f64, 19>; L],
+        ) {
+            gravity_batch_into(&self.params, &self.pre, q, out)
+        }
+        /// [`Self::inverse_dynamics`] at `L` states per call (entry `l` of the result at entry `l` of the inputs, bit for bit with the same instruction set; vectorized across the states). [`Self::inverse_dynamics_batch_into`] writes into the caller's array instead.
         #[inline]
         pub fn inverse_dynamics_batch<const L: usize>(
             &self,
@@ -10512,6 +14401,17 @@ mod generated {
             ud: &[SVector<f64, 19>; L],
         ) -> [SVector<f64, 19>; L] {
             inverse_dynamics_batch(&self.params, &self.pre, q, u, ud)
+        }
+        /// [`Self::inverse_dynamics`] at `L` states per call, written into `out` (every entry; entry `l` at entry `l` of the inputs, bit for bit with the same instruction set).
+        #[inline]
+        pub fn inverse_dynamics_batch_into<const L: usize>(
+            &self,
+            q: &[SVector<f64, 19>; L],
+            u: &[SVector<f64, 19>; L],
+            ud: &[SVector<f64, 19>; L],
+            out: &mut [SVector<f64, 19>; L],
+        ) {
+            inverse_dynamics_batch_into(&self.params, &self.pre, q, u, ud, out)
         }
     }
     impl kanegen_runtime::RobotDynamics<DOF> for Krang {

@@ -43,7 +43,14 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
     });
     let speeds = plan.speeds.iter().map(|s| {
         let (i, m, j) = (u16_of(s.index), u16_of(s.motion), s.joint);
-        quote!(kanegen_runtime::derivative_steps::Speed { index: #i, motion: #m, joint: #j })
+        let axis = match s.axis {
+            Some(k) => {
+                let k = proc_macro2::Literal::u8_unsuffixed(k);
+                quote!(#k)
+            }
+            None => quote!(kanegen_runtime::derivative_steps::DENSE),
+        };
+        quote!(kanegen_runtime::derivative_steps::Speed { index: #i, motion: #m, joint: #j, axis: #axis })
     });
     let columns = plan.columns.iter().map(|c| {
         let (l, s, f) = (u16_of(c.link), u16_of(c.speed), u16_of(c.forces));

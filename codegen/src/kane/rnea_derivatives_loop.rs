@@ -72,11 +72,13 @@ pub enum Offset {
 pub struct LoopSpeed {
     /// Result row (and column) index.
     pub index: usize,
-    /// Workspace offset of the motion lanes (36 entries: per component k, `(Ψ̈, Ψ̇, S, S)_k`,
-    /// then per component `(c Ψ̇, S)_k`, c = 2 for a joint and 1 for the wheeled base).
+    /// Workspace offset of `S`, `Ψ̇`, `Ψ̈` (6 each).
     pub motion: usize,
     /// A joint's speed (`true`) or one of the wheeled base's.
     pub joint: bool,
+    /// `Some(k)` when `S = ±(e_k; 0)` (a rotation about a coordinate axis of the link's frame,
+    /// `k < 3`): `Ψ̇ = V_λ × S` vanishes in components `k` and `3 + k`.
+    pub axis: Option<u8>,
 }
 
 /// One column of a [`DerivativeLoop`].
@@ -130,7 +132,7 @@ impl DerivativeLoop {
 
     /// Floating-point operations of the loop per call, as `derivative_steps::run` performs
     /// them (a multiply-add counting 2; the transforms by the links' [`DerivativeLink::rotation`]
-    /// and [`DerivativeLink::offset`], the motion lanes dense).
+    /// and [`DerivativeLink::offset`], the dot products dense).
     pub fn flops(&self) -> usize {
         // A step, per force (4 lanes): R f and R n (2 × 15 dense, 2 × 6 for a shaped rotation:
         // two components of 2 multiply(-add)s each, the third a copy or a negation), then
@@ -144,16 +146,18 @@ impl DerivativeLoop {
             };
             4 * (rot + off)
         };
-        // The lanes `(Ψ̈, Ψ̇, S, S)` against `(Φ, Ξ, H, G)`: 4 × 11 (the rows of the column's
-        // own link: these only); `(c Ψ̇, S)` against `(Φ, Ξ)`: 2 × 11; the two sums.
-        let rows = 44;
-        let reads = 44 + 22 + 2;
+        // A dot product of a motion with the four forces: 4 × 11.
+        let dots = 44;
         let mut total = 0;
         for c in &self.columns {
-            total += self.links[c.link].speeds.len() * rows;
+            total += self.links[c.link].speeds.len() * dots;
             let mut l = c.link;
             while let Some(p) = self.links[l].parent {
-                total += step(&self.links[l]) + self.links[p].speeds.len() * reads;
+                total += step(&self.links[l]);
+                for s in &self.speeds[self.links[p].speeds.clone()] {
+                    // S, Ψ̇ (and Ψ̈) dots, then the sums of the two column entries.
+                    total += if s.joint { 3 * dots + 3 } else { 2 * dots + 1 };
+                }
                 l = p;
             }
         }
@@ -168,6 +172,20 @@ impl DerivativeLoop {
 }
 
 impl Ctx<'_> {
+    /// `Some(k)` when `s` is `±(e_k; 0)` exactly (constants), else `None`.
+    fn rotation_axis(&self, s: &[ExprId; 6]) -> Option<u8> {
+        let value = |e: ExprId| self.ar.as_const(e);
+        let mut axis = None;
+        for (k, &e) in s.iter().enumerate() {
+            match value(e) {
+                Some(0.0) => {}
+                Some(v) if k < 3 && v.abs() == 1.0 && axis.is_none() => axis = Some(k as u8),
+                _ => return None,
+            }
+        }
+        axis
+    }
+
     /// The structure of a transform `R` (by rows), `P`: see [`DerivativeLink::rotation`] and
     /// [`DerivativeLink::offset`].
     fn transform_shape(
@@ -251,23 +269,15 @@ impl Ctx<'_> {
             };
             let first = plan.speeds.len();
             for col in &columns[l] {
-                // Lanes against the carried forces `(Φ, Ξ, H, G)` of each component k:
-                // `(Ψ̈, Ψ̇, S, S)_k`, then `(k Ψ̇, S)_k` against `(Φ, Ξ)_k` (k = 2 for a joint,
-                // 1 for the wheeled base's quasi-velocities).
-                let psidd = col.psidd.unwrap_or([zero; 6]);
-                let factor = if col.psidd.is_some() { 2.0 } else { 1.0 };
-                let mut m: Vec<ExprId> = (0..6)
-                    .flat_map(|k| [psidd[k], col.psid[k], col.s[k], col.s[k]])
-                    .collect();
-                for k in 0..6 {
-                    let psid = self.ar.scale(col.psid[k], factor);
-                    m.extend_from_slice(&[psid, col.s[k]]);
-                }
+                let mut m = col.s.to_vec();
+                m.extend_from_slice(&col.psid);
+                m.extend_from_slice(&col.psidd.unwrap_or([zero; 6]));
                 let motion = push(&mut ws, &m);
                 plan.speeds.push(LoopSpeed {
                     index: col.speed,
                     motion,
                     joint: col.psidd.is_some(),
+                    axis: self.rotation_axis(&col.s),
                 });
             }
             plan.links.push(DerivativeLink {
@@ -356,6 +366,7 @@ mod tests {
                 index: u16_of(s.index),
                 motion: u16_of(s.motion),
                 joint: s.joint,
+                axis: s.axis.unwrap_or(kanegen_runtime::derivative_steps::DENSE),
             })
             .collect();
         let columns: Vec<Column> = plan

@@ -63,22 +63,19 @@ pub const ZERO_OFFSET: u8 = 3;
 pub struct Speed {
     /// Its index in the result (row `index`; columns `index` and `N + index`).
     pub index: u16,
-    /// Offset in the workspace of its motion lanes ([`MOTION`] entries, in the link's frame):
-    /// for each component `k` (`ω.x, ω.y, ω.z, v.x, v.y, v.z`) the four lanes
-    /// `(Ψ̈_k, Ψ̇_k, S_k, S_k)`, read against the carried forces `(Φ_k, Ξ_k, H_k, G_k)`; then
-    /// for each `k` the two lanes `(c Ψ̇_k, S_k)` against `(Φ_k, Ξ_k)`, `c = 2` for a joint and
-    /// 1 for the wheeled base's quasi-velocities. One sum of six lane products gives
-    /// `(Φ·Ψ̈, Ξ·Ψ̇, H·S, G·S)`, the other `(c Φ·Ψ̇, Ξ·S)`: every entry the speed reads from a
-    /// column, as dense multiply-adds (no broadcasts, no per-axis branches).
+    /// Offset in the workspace of `S`, `Ψ̇`, `Ψ̈` (6 entries each, in the link's frame).
     pub motion: u16,
     /// A joint speed (`true`) or one of the wheeled base's quasi-velocities (`false`: no
     /// coordinate of its own enters τ, so it has no `Ψ̈` and no q-column).
     pub joint: bool,
+    /// `k` when `S` is the unit rotation about axis `k` of the link's frame, times ±1
+    /// (`S = ±(e_k; 0)`, `k` in 0..3: then `Ψ̇ = V_λ × S` vanishes in components `k` and
+    /// `3 + k` and the x86-64-v3 copy reads `S` as one component and `Ψ̇` as four);
+    /// [`DENSE`] otherwise.
+    pub axis: u8,
 }
 
-/// Number of workspace entries of a [`Speed`]'s motion lanes.
-pub const MOTION: usize = 36;
-
+/// [`Speed::axis`] of a speed whose `S` is not a rotation about a coordinate axis;
 /// [`Link::rotation`] and [`Link::offset`] of a dense `R` or `P`.
 pub const DENSE: u8 = u8::MAX;
 
@@ -133,13 +130,6 @@ where
         L4([a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]])
     }
 
-    /// Lane-wise product.
-    #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        let (a, b) = (self.0, o.0);
-        L4([a[0] * b[0], a[1] * b[1], a[2] * b[2], a[3] * b[3]])
-    }
-
     #[inline(always)]
     fn sub(self, o: Self) -> Self {
         let (a, b) = (self.0, o.0);
@@ -160,42 +150,17 @@ where
 /// `Φ`, `Ξ`, `H`, `G`.
 type Forces<T> = [L4<T>; 6];
 
-/// `Σ_k m_k ⊙ f_k` over the first 24 motion lanes: `(Φ·Ψ̈, Ξ·Ψ̇, H·S, G·S)`.
+/// `Σ_k x[k] f[k]`: the four dot products of a motion `x` with the four forces.
 #[inline(always)]
-fn rows<T>(m: &[T; MOTION], f: &Forces<T>) -> L4<T>
+fn dots<T>(x: &[T], f: &Forces<T>) -> L4<T>
 where
     T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
 {
-    let lane = |k: usize| L4::load(&m[4 * k..4 * k + 4]);
-    let a = f[0].mul(lane(0)).add(f[1].mul(lane(1)));
-    let b = f[2].mul(lane(2)).add(f[3].mul(lane(3)));
-    let c = f[4].mul(lane(4)).add(f[5].mul(lane(5)));
+    let x = [x[0], x[1], x[2], x[3], x[4], x[5]];
+    let a = f[0].scale(x[0]).add(f[1].scale(x[1]));
+    let b = f[2].scale(x[2]).add(f[3].scale(x[3]));
+    let c = f[4].scale(x[4]).add(f[5].scale(x[5]));
     a.add(b).add(c)
-}
-
-/// The reads of an ancestor speed: [`rows`] and `(c Φ·Ψ̇, Ξ·S)` from the last 12 lanes.
-#[inline(always)]
-fn reads<T>(m: &[T; MOTION], f: &Forces<T>) -> (L4<T>, [T; 2])
-where
-    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
-{
-    let pair = |i: usize| {
-        let (phi, xi) = (f[i].0[0], f[i].0[1]);
-        (phi * m[24 + 2 * i], xi * m[25 + 2 * i])
-    };
-    let sum = |a: (T, T), b: (T, T)| (a.0 + b.0, a.1 + b.1);
-    let x = sum(
-        sum(pair(0), pair(1)),
-        sum(sum(pair(2), pair(3)), sum(pair(4), pair(5))),
-    );
-    (rows(m, f), [x.0, x.1])
-}
-
-/// The motion lanes of the speed at workspace offset `at`.
-#[inline(always)]
-fn motion<T>(w: &[T], at: u16) -> &[T; MOTION] {
-    let at = usize::from(at);
-    w[at..at + MOTION].try_into().expect("MOTION entries")
 }
 
 /// The other two of the three axes, `(k + 1) % 3` and `(k + 2) % 3`.
@@ -370,12 +335,13 @@ where
         let mut l = usize::from(col.link);
         let link = plan.links[l];
         for a in &plan.speeds[usize::from(link.first)..usize::from(link.end)] {
-            let r = rows(motion(w, a.motion), &f).0;
+            let m = usize::from(a.motion);
+            let ds = dots(&w[m..m + 6], &f);
             let ai = usize::from(a.index);
             if this.joint {
-                out[ai + n * ci] = r[3];
+                out[ai + n * ci] = ds.0[3];
             }
-            out[ai + n * (n + ci)] = r[2];
+            out[ai + n * (n + ci)] = ds.0[2];
         }
         // Up to the root: every ancestor speed reads the four forces in its frame.
         loop {
@@ -389,17 +355,21 @@ where
             l = usize::from(link.parent);
             let parent = plan.links[l];
             for a in &plan.speeds[usize::from(parent.first)..usize::from(parent.end)] {
-                let (r, c) = reads(motion(w, a.motion), &f);
-                let r = r.0;
+                let m = usize::from(a.motion);
+                let ds = dots(&w[m..m + 6], &f);
+                let dpd = dots(&w[m + 6..m + 12], &f);
                 let ai = usize::from(a.index);
                 if this.joint {
-                    out[ai + n * ci] = r[3];
+                    out[ai + n * ci] = ds.0[3];
                 }
-                out[ai + n * (n + ci)] = r[2];
+                out[ai + n * (n + ci)] = ds.0[2];
                 if a.joint {
-                    out[ci + n * ai] = r[0] + r[1];
+                    let dpdd = dots(&w[m + 12..m + 18], &f);
+                    out[ci + n * ai] = dpdd.0[0] + dpd.0[1];
+                    out[ci + n * (n + ai)] = (dpd.0[0] + dpd.0[0]) + ds.0[1];
+                } else {
+                    out[ci + n * (n + ai)] = dpd.0[0] + ds.0[1];
                 }
-                out[ci + n * (n + ai)] = c[0] + c[1];
             }
         }
     }
@@ -417,46 +387,51 @@ where
 ))]
 mod avx2 {
     use core::arch::x86_64::{
-        __m128d, __m256d, _mm_add_pd, _mm_cvtsd_f64, _mm_fmadd_pd, _mm_hadd_pd, _mm_mul_pd,
-        _mm_setr_pd, _mm_unpackhi_pd, _mm256_add_pd, _mm256_castpd256_pd128, _mm256_extractf128_pd,
-        _mm256_fmadd_pd, _mm256_fnmadd_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_setr_pd,
-        _mm256_setzero_pd, _mm256_sub_pd,
+        __m256d, _mm_cvtsd_f64, _mm_unpackhi_pd, _mm256_add_pd, _mm256_castpd256_pd128,
+        _mm256_extractf128_pd, _mm256_fmadd_pd, _mm256_fnmadd_pd, _mm256_mul_pd, _mm256_set_pd,
+        _mm256_set1_pd, _mm256_setzero_pd, _mm256_sub_pd,
     };
 
-    use super::{Link, MOTION, NO_PARENT, Plan, ZERO_OFFSET};
+    use super::{Link, NO_PARENT, Plan, Speed, ZERO_OFFSET};
 
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
     fn load(x: &[f64]) -> __m256d {
-        _mm256_setr_pd(x[0], x[1], x[2], x[3])
+        _mm256_set_pd(x[3], x[2], x[1], x[0])
     }
 
-    /// `Σ_k m_k ⊙ f_k` over the first 24 motion lanes (see [`super::rows`]), as a chain of
-    /// fused multiply-adds with the lanes as memory operands.
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
-    fn rows(m: &[f64; MOTION], f: &[__m256d; 6]) -> __m256d {
-        let a = _mm256_fmadd_pd(f[1], load(&m[4..8]), _mm256_mul_pd(f[0], load(&m[0..4])));
-        let b = _mm256_fmadd_pd(f[3], load(&m[12..16]), _mm256_mul_pd(f[2], load(&m[8..12])));
+    fn lanes(v: __m256d) -> [f64; 4] {
+        let lo = _mm256_castpd256_pd128(v);
+        let hi = _mm256_extractf128_pd::<1>(v);
+        [
+            _mm_cvtsd_f64(lo),
+            _mm_cvtsd_f64(_mm_unpackhi_pd(lo, lo)),
+            _mm_cvtsd_f64(hi),
+            _mm_cvtsd_f64(_mm_unpackhi_pd(hi, hi)),
+        ]
+    }
+
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn dots(x: &[f64], f: &[__m256d; 6]) -> [f64; 4] {
+        let a = _mm256_fmadd_pd(
+            f[1],
+            _mm256_set1_pd(x[1]),
+            _mm256_mul_pd(f[0], _mm256_set1_pd(x[0])),
+        );
+        let b = _mm256_fmadd_pd(
+            f[3],
+            _mm256_set1_pd(x[3]),
+            _mm256_mul_pd(f[2], _mm256_set1_pd(x[2])),
+        );
         let c = _mm256_fmadd_pd(
             f[5],
-            load(&m[20..24]),
-            _mm256_mul_pd(f[4], load(&m[16..20])),
+            _mm256_set1_pd(x[5]),
+            _mm256_mul_pd(f[4], _mm256_set1_pd(x[4])),
         );
-        _mm256_add_pd(_mm256_add_pd(a, b), c)
-    }
-
-    /// `(c Φ·Ψ̇, Ξ·S)` from the last 12 motion lanes (see [`super::reads`]), on the low halves
-    /// of the force registers.
-    #[target_feature(enable = "avx,avx2,fma")]
-    #[inline]
-    fn pairs(m: &[f64; MOTION], f: &[__m256d; 6]) -> __m128d {
-        let lo = |k: usize| _mm256_castpd256_pd128(f[k]);
-        let ld = |k: usize| _mm_setr_pd(m[24 + 2 * k], m[25 + 2 * k]);
-        let a = _mm_fmadd_pd(lo(1), ld(1), _mm_mul_pd(lo(0), ld(0)));
-        let b = _mm_fmadd_pd(lo(3), ld(3), _mm_mul_pd(lo(2), ld(2)));
-        let c = _mm_fmadd_pd(lo(5), ld(5), _mm_mul_pd(lo(4), ld(4)));
-        _mm_add_pd(_mm_add_pd(a, b), c)
+        lanes(_mm256_add_pd(_mm256_add_pd(a, b), c))
     }
 
     /// `R x` for a shaped rotation (see [`super::rot_axis`]), `t` = `R` by rows.
@@ -565,6 +540,54 @@ mod avx2 {
         [n[0], n[1], n[2], g[0], g[1], g[2]]
     }
 
+    /// `Σ_j x[j] f[j]` over the four components `j` other than `k` and `3 + k`.
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn dots4<const K: usize>(x: &[f64], f: &[__m256d; 6]) -> [f64; 4] {
+        let (a, b) = ((K + 1) % 3, (K + 2) % 3);
+        let p = _mm256_fmadd_pd(
+            f[b],
+            _mm256_set1_pd(x[b]),
+            _mm256_mul_pd(f[a], _mm256_set1_pd(x[a])),
+        );
+        let q = _mm256_fmadd_pd(
+            f[3 + b],
+            _mm256_set1_pd(x[3 + b]),
+            _mm256_mul_pd(f[3 + a], _mm256_set1_pd(x[3 + a])),
+        );
+        lanes(_mm256_add_pd(p, q))
+    }
+
+    /// The dot products a speed `a` reads: `S·F`, `Ψ̇·F` and (joints) `Ψ̈·F`, from the motions
+    /// at `m` (`S = ±e_k` read as one component and `Ψ̇` as four when `a.axis` is `k`).
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn reads<const K: usize>(w: &[f64], m: usize, a: &Speed, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
+        let ds = lanes(_mm256_mul_pd(f[K], _mm256_set1_pd(w[m + K])));
+        let dpd = dots4::<K>(&w[m + 6..m + 12], f);
+        // Ψ̈ = A_λ × S + V_λ × Ψ̇ has all six components in general.
+        let dpdd = if a.joint {
+            dots(&w[m + 12..m + 18], f)
+        } else {
+            [0.0; 4]
+        };
+        [ds, dpd, dpdd]
+    }
+
+    /// [`reads`] for any `S`.
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    fn reads_dense(w: &[f64], m: usize, a: &Speed, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
+        let ds = dots(&w[m..m + 6], f);
+        let dpd = dots(&w[m + 6..m + 12], f);
+        let dpdd = if a.joint {
+            dots(&w[m + 12..m + 18], f)
+        } else {
+            [0.0; 4]
+        };
+        [ds, dpd, dpdd]
+    }
+
     /// See [`super::steps`].
     #[target_feature(enable = "avx,avx2,fma")]
     pub(super) fn steps(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
@@ -585,12 +608,13 @@ mod avx2 {
             let mut l = usize::from(col.link);
             let link = plan.links[l];
             for a in &plan.speeds[usize::from(link.first)..usize::from(link.end)] {
-                let hi = _mm256_extractf128_pd::<1>(rows(super::motion(w, a.motion), &f));
+                let m = usize::from(a.motion);
+                let ds = dots(&w[m..m + 6], &f);
                 let ai = usize::from(a.index);
                 if this.joint {
-                    out[ai + n * ci] = _mm_cvtsd_f64(_mm_unpackhi_pd(hi, hi));
+                    out[ai + n * ci] = ds[3];
                 }
-                out[ai + n * (n + ci)] = _mm_cvtsd_f64(hi);
+                out[ai + n * (n + ci)] = ds[2];
             }
             loop {
                 let link = plan.links[l];
@@ -603,20 +627,24 @@ mod avx2 {
                 l = usize::from(link.parent);
                 let parent = plan.links[l];
                 for a in &plan.speeds[usize::from(parent.first)..usize::from(parent.end)] {
-                    let m = super::motion(w, a.motion);
-                    let r = rows(m, &f);
-                    let hi = _mm256_extractf128_pd::<1>(r);
-                    // (Φ·Ψ̈ + Ξ·Ψ̇, c Φ·Ψ̇ + Ξ·S)
-                    let cols = _mm_hadd_pd(_mm256_castpd256_pd128(r), pairs(m, &f));
+                    let m = usize::from(a.motion);
+                    let [ds, dpd, dpdd] = match a.axis {
+                        0 => reads::<0>(w, m, a, &f),
+                        1 => reads::<1>(w, m, a, &f),
+                        2 => reads::<2>(w, m, a, &f),
+                        _ => reads_dense(w, m, a, &f),
+                    };
                     let ai = usize::from(a.index);
                     if this.joint {
-                        out[ai + n * ci] = _mm_cvtsd_f64(_mm_unpackhi_pd(hi, hi));
+                        out[ai + n * ci] = ds[3];
                     }
-                    out[ai + n * (n + ci)] = _mm_cvtsd_f64(hi);
+                    out[ai + n * (n + ci)] = ds[2];
                     if a.joint {
-                        out[ci + n * ai] = _mm_cvtsd_f64(cols);
+                        out[ci + n * ai] = dpdd[0] + dpd[1];
+                        out[ci + n * (n + ai)] = (dpd[0] + dpd[0]) + ds[1];
+                    } else {
+                        out[ci + n * (n + ai)] = dpd[0] + ds[1];
                     }
-                    out[ci + n * (n + ai)] = _mm_cvtsd_f64(_mm_unpackhi_pd(cols, cols));
                 }
             }
         }
@@ -665,13 +693,14 @@ mod tests {
         let mut columns = Vec::new();
         let motion = |w: &mut Vec<f64>, rng: &mut Lcg| {
             let at = w.len();
-            w.extend((0..MOTION).map(|_| rng.next()));
+            w.extend((0..18).map(|_| rng.next()));
             at as u16
         };
         speeds.push(Speed {
             index: 0,
             motion: motion(&mut w, &mut rng),
             joint: true,
+            axis: DENSE,
         });
         for i in 0..children {
             let rotation = if i % 19 == 18 { DENSE } else { (i % 19) as u8 };
@@ -704,6 +733,7 @@ mod tests {
                 index: s,
                 motion: motion(&mut w, &mut rng),
                 joint: i % 2 == 0,
+                axis: DENSE,
             });
             links.push(Link {
                 parent: 0,

@@ -37,9 +37,7 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
             u16_of(l.speeds.start),
             u16_of(l.speeds.end),
         );
-        let code = |c: u8| proc_macro2::Literal::u8_unsuffixed(c);
-        let (r, o) = (code(l.rotation_code()), code(l.offset_code()));
-        quote!(kanegen_runtime::derivative_steps::Link { parent: #parent, transform: #t, first: #a, end: #b, rotation: #r, offset: #o })
+        quote!(kanegen_runtime::derivative_steps::Link { parent: #parent, transform: #t, first: #a, end: #b })
     });
     let speeds = plan.speeds.iter().map(|s| {
         let (i, m, j) = (u16_of(s.index), u16_of(s.motion), s.joint);

@@ -82,7 +82,7 @@ pub use regressor_loop::{
     CarryFrom, JointShape, KIN, LANES, LOOP_MIN_PAIRS, LoopLink, LoopPlan, LoopStep, PlanStep,
     RegressorLoop, first_row,
 };
-pub use rnea_derivatives_loop::{DerivativeLink, DerivativeLoop, LoopColumn, LoopSpeed, Offset};
+pub use rnea_derivatives_loop::{DerivativeLink, DerivativeLoop, LoopColumn, LoopSpeed};
 
 /// One derived registry function: its output entries as expressions in the arena (its name,
 /// inputs and result shape are in the registry).

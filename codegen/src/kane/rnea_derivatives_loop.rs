@@ -46,25 +46,6 @@ pub struct DerivativeLink {
     pub transform: usize,
     /// The link's speeds, a range of [`DerivativeLoop::speeds`].
     pub speeds: std::ops::Range<usize>,
-    /// The structure of `R`: `Some((row, column, negative))` when entry `(row, column)` is the
-    /// constant ±1 (−1 when `negative`) and the rest of its row and column are constant zeros
-    /// (a rotation about a coordinate axis after a constant signed permutation: Krang's joints);
-    /// `None` when dense. The loop then rotates a 3-vector with 4 multiply(-add)s instead of 9.
-    pub rotation: Option<(usize, usize, bool)>,
-    /// The structure of `P`.
-    pub offset: Offset,
-}
-
-/// Which components of a link's origin `P` in its parent can be non-zero (the loop skips the
-/// `P ×` terms of the others).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Offset {
-    /// `P = 0`: no `P × R f` term.
-    Zero,
-    /// `P = p e_k`: two multiply-adds per force.
-    Axis(usize),
-    /// Any `P`.
-    Dense,
 }
 
 /// One speed of a [`DerivativeLoop`].
@@ -92,27 +73,6 @@ pub struct LoopColumn {
     pub forces: usize,
 }
 
-impl DerivativeLink {
-    /// [`DerivativeLink::rotation`] as `kanegen_runtime::derivative_steps::Link::rotation`:
-    /// `3 row + column`, plus 9 for −1; `DENSE` (255) when dense.
-    pub fn rotation_code(&self) -> u8 {
-        match self.rotation {
-            Some((row, col, negative)) => (3 * row + col + if negative { 9 } else { 0 }) as u8,
-            None => u8::MAX,
-        }
-    }
-
-    /// [`DerivativeLink::offset`] as `kanegen_runtime::derivative_steps::Link::offset`: the
-    /// axis `k`, 3 for `P = 0`, `DENSE` (255) when dense.
-    pub fn offset_code(&self) -> u8 {
-        match self.offset {
-            Offset::Axis(k) => k as u8,
-            Offset::Zero => 3,
-            Offset::Dense => u8::MAX,
-        }
-    }
-}
-
 impl DerivativeLoop {
     /// Number of steps up (one force transform of the four forces each).
     pub fn steps(&self) -> usize {
@@ -131,21 +91,10 @@ impl DerivativeLoop {
     }
 
     /// Floating-point operations of the loop per call, as `derivative_steps::run` performs
-    /// them (a multiply-add counting 2; the transforms by the links' [`DerivativeLink::rotation`]
-    /// and [`DerivativeLink::offset`], the dot products dense).
+    /// them (dense: the loop does not skip the zeros of axis-aligned joints).
     pub fn flops(&self) -> usize {
-        // A step, per force (4 lanes): R f and R n (2 × 15 dense, 2 × 6 for a shaped rotation:
-        // two components of 2 multiply(-add)s each, the third a copy or a negation), then
-        // P × R f (12 dense, 4 on one axis, none for P = 0).
-        let step = |link: &DerivativeLink| {
-            let rot = if link.rotation.is_some() { 12 } else { 30 };
-            let off = match link.offset {
-                Offset::Zero => 0,
-                Offset::Axis(_) => 4,
-                Offset::Dense => 12,
-            };
-            4 * (rot + off)
-        };
+        // A step: 4 forces × (R f, R n: 2 × 15; P × f: 9; the sum: 3).
+        let step = 4 * 42;
         // A dot product of a motion with the four forces: 4 × 11.
         let dots = 44;
         let mut total = 0;
@@ -153,7 +102,7 @@ impl DerivativeLoop {
             total += self.links[c.link].speeds.len() * dots;
             let mut l = c.link;
             while let Some(p) = self.links[l].parent {
-                total += step(&self.links[l]);
+                total += step;
                 for s in &self.speeds[self.links[p].speeds.clone()] {
                     // S, Ψ̇ (and Ψ̈) dots, then the sums of the two column entries.
                     total += if s.joint { 3 * dots + 3 } else { 2 * dots + 1 };
@@ -184,30 +133,6 @@ impl Ctx<'_> {
             }
         }
         axis
-    }
-
-    /// The structure of a transform `R` (by rows), `P`: see [`DerivativeLink::rotation`] and
-    /// [`DerivativeLink::offset`].
-    fn transform_shape(
-        &self,
-        r: &[[ExprId; 3]; 3],
-        p: &[ExprId; 3],
-    ) -> (Option<(usize, usize, bool)>, Offset) {
-        let is = |e: ExprId, v: f64| self.ar.as_const(e) == Some(v);
-        let rotation = (0..9).map(|i| (i / 3, i % 3)).find_map(|(row, col)| {
-            let e = r[row][col];
-            let sign = (is(e, 1.0) || is(e, -1.0))
-                && (0..3)
-                    .all(|k| (k == col || is(r[row][k], 0.0)) && (k == row || is(r[k][col], 0.0)));
-            sign.then(|| (row, col, is(e, -1.0)))
-        });
-        let free: Vec<usize> = (0..3).filter(|&k| !is(p[k], 0.0)).collect();
-        let offset = match free.as_slice() {
-            [] => Offset::Zero,
-            [k] => Offset::Axis(*k),
-            _ => Offset::Dense,
-        };
-        (rotation, offset)
     }
 
     /// The workspace entries `(offset, 0, expr)` and the tables of the looped derivatives (see
@@ -252,20 +177,15 @@ impl Ctx<'_> {
         // Transforms and motions.
         for l in 0..links {
             let mount = model.links[l].mount.as_ref();
-            let (transform, rotation, offset) = match mount {
+            let transform = match mount {
                 Some(m) if stepped[l] => {
                     let r = self.rotation(l, &m.joint);
                     let p = self.position(l, &m.joint);
-                    let (rotation, offset) = self.transform_shape(&r, &p);
                     let mut t = r.concat().to_vec();
                     t.extend_from_slice(&p);
-                    // The constant ±1 of a shaped rotation is in the table, not read.
-                    if let Some((row, col, _)) = rotation {
-                        t[3 * row + col] = zero;
-                    }
-                    (push(&mut ws, &t), rotation, offset)
+                    push(&mut ws, &t)
                 }
-                _ => (0, None, Offset::Dense),
+                _ => 0,
             };
             let first = plan.speeds.len();
             for col in &columns[l] {
@@ -284,8 +204,6 @@ impl Ctx<'_> {
                 parent: mount.map(|m| m.parent),
                 transform,
                 speeds: first..plan.speeds.len(),
-                rotation,
-                offset,
             });
         }
         // The columns' forces, leaves first (the straight-line form's order).
@@ -355,8 +273,6 @@ mod tests {
                 transform: u16_of(l.transform),
                 first: u16_of(l.speeds.start),
                 end: u16_of(l.speeds.end),
-                rotation: l.rotation_code(),
-                offset: l.offset_code(),
             })
             .collect();
         let speeds: Vec<Speed> = plan

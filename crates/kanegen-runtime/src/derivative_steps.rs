@@ -26,7 +26,7 @@
 //! Allocation-free and infallible; the tables are generated together with the code that fills
 //! the workspace, so every offset is in range.
 
-use core::ops::{Add, Mul, Neg, Sub};
+use core::ops::{Add, Mul, Sub};
 
 /// Marker of a link without a parent (the root) in [`Link::parent`].
 pub const NO_PARENT: u16 = u16::MAX;
@@ -44,19 +44,7 @@ pub struct Link {
     pub first: u16,
     /// End of the link's range of [`Plan::speeds`].
     pub end: u16,
-    /// The structure of `R`, known at generation time: `3 row + column` of its constant ±1
-    /// entry (plus 9 when the entry is −1) whose row and column are otherwise zero — a
-    /// rotation about a coordinate axis after a constant signed permutation — or [`DENSE`].
-    /// A shaped rotation moves a 3-vector with 4 multiply(-add)s instead of 9 and does not
-    /// read the ±1 entry.
-    pub rotation: u8,
-    /// The structure of `P`: `k` when only component `k` can be non-zero (`P × f` is then two
-    /// multiply-adds), [`ZERO_OFFSET`] when `P = 0` (no `P ×` term), or [`DENSE`].
-    pub offset: u8,
 }
-
-/// [`Link::offset`] of a link whose origin is that of its parent.
-pub const ZERO_OFFSET: u8 = 3;
 
 /// One speed of the tree (a row and a column of the result).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -75,8 +63,7 @@ pub struct Speed {
     pub axis: u8,
 }
 
-/// [`Speed::axis`] of a speed whose `S` is not a rotation about a coordinate axis;
-/// [`Link::rotation`] and [`Link::offset`] of a dense `R` or `P`.
+/// [`Speed::axis`] of a speed whose `S` is not a rotation about a coordinate axis.
 pub const DENSE: u8 = u8::MAX;
 
 /// One column of the recursion: a speed and its four forces.
@@ -135,15 +122,6 @@ where
         let (a, b) = (self.0, o.0);
         L4([a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3]])
     }
-
-    #[inline(always)]
-    fn neg(self) -> Self
-    where
-        T: Neg<Output = T>,
-    {
-        let a = self.0;
-        L4([-a[0], -a[1], -a[2], -a[3]])
-    }
 }
 
 /// Component-major forces: `f[k]` holds component `k` (`n.x, n.y, n.z, f.x, f.y, f.z`) of
@@ -163,106 +141,27 @@ where
     a.add(b).add(c)
 }
 
-/// The other two of the three axes, `(k + 1) % 3` and `(k + 2) % 3`.
+/// The four forces moved from a link to its parent: `(R n + P × R f; R f)`, `t` = `R` by rows
+/// then `P`.
 #[inline(always)]
-const fn others(k: usize) -> (usize, usize) {
-    ((k + 1) % 3, (k + 2) % 3)
-}
-
-/// `R x` for a rotation whose entry `(RR, RC)` is the constant `±1` (`−1` when `NEG`) and whose
-/// other entries in row `RR` and column `RC` are zero (`t` = `R` by rows): component `RR` is
-/// `±x[RC]`, the other two take two products each.
-#[inline(always)]
-fn rot_axis<T, const RR: usize, const RC: usize, const NEG: bool>(
-    t: &[T; 12],
-    x: [L4<T>; 3],
-) -> [L4<T>; 3]
+fn up<T>(t: &[T], f: &Forces<T>) -> Forces<T>
 where
-    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T> + Neg<Output = T>,
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
 {
-    let (i1, i2) = others(RR);
-    let (c1, c2) = others(RC);
-    let mut o = x;
-    o[RR] = if NEG { x[RC].neg() } else { x[RC] };
-    o[i1] = x[c1].scale(t[3 * i1 + c1]).add(x[c2].scale(t[3 * i1 + c2]));
-    o[i2] = x[c1].scale(t[3 * i2 + c1]).add(x[c2].scale(t[3 * i2 + c2]));
-    o
-}
-
-/// `R x` for a dense rotation (`t` = `R` by rows).
-#[inline(always)]
-fn rot_dense<T>(t: &[T; 12], x: [L4<T>; 3]) -> [L4<T>; 3]
-where
-    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T> + Neg<Output = T>,
-{
-    let row = |i: usize| {
+    let t: [T; 12] = [
+        t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8], t[9], t[10], t[11],
+    ];
+    let rot = |x: &[L4<T>], i: usize| {
         x[0].scale(t[3 * i])
             .add(x[1].scale(t[3 * i + 1]))
             .add(x[2].scale(t[3 * i + 2]))
     };
-    [row(0), row(1), row(2)]
-}
-
-/// `n + P × g` for `P = p e_A` (`p = t[9 + A]`): components `A + 1` and `A + 2` only.
-#[inline(always)]
-fn cross_axis<T, const A: usize>(t: &[T; 12], g: &[L4<T>; 3], mut n: [L4<T>; 3]) -> [L4<T>; 3]
-where
-    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
-{
-    let (b, c) = others(A);
-    let p = t[9 + A];
-    n[b] = n[b].sub(g[c].scale(p));
-    n[c] = n[c].add(g[b].scale(p));
-    n
-}
-
-/// `n + P × g` for any `P`.
-#[inline(always)]
-fn cross_dense<T>(t: &[T; 12], g: &[L4<T>; 3], n: [L4<T>; 3]) -> [L4<T>; 3]
-where
-    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
-{
     let (p0, p1, p2) = (t[9], t[10], t[11]);
-    [
-        n[0].add(g[2].scale(p1).sub(g[1].scale(p2))),
-        n[1].add(g[0].scale(p2).sub(g[2].scale(p0))),
-        n[2].add(g[1].scale(p0).sub(g[0].scale(p1))),
-    ]
-}
-
-/// The four forces moved from `link` to its parent, `(R n + P × R f; R f)`, by the link's
-/// [`Link::rotation`] and [`Link::offset`] (`t` = `R` by rows then `P`).
-#[inline(always)]
-fn up_shaped<T>(link: &Link, t: &[T; 12], f: &Forces<T>) -> Forces<T>
-where
-    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T> + Neg<Output = T>,
-{
-    let fv = [f[3], f[4], f[5]];
-    let nv = [f[0], f[1], f[2]];
-    macro_rules! rot {
-        ($($code:literal => $rr:literal, $rc:literal, $neg:literal;)*) => {
-            match link.rotation {
-                $($code => (rot_axis::<T, $rr, $rc, $neg>(t, fv), rot_axis::<T, $rr, $rc, $neg>(t, nv)),)*
-                _ => (rot_dense(t, fv), rot_dense(t, nv)),
-            }
-        };
-    }
-    let (g, n) = rot! {
-        0 => 0, 0, false; 1 => 0, 1, false; 2 => 0, 2, false;
-        3 => 1, 0, false; 4 => 1, 1, false; 5 => 1, 2, false;
-        6 => 2, 0, false; 7 => 2, 1, false; 8 => 2, 2, false;
-        9 => 0, 0, true; 10 => 0, 1, true; 11 => 0, 2, true;
-        12 => 1, 0, true; 13 => 1, 1, true; 14 => 1, 2, true;
-        15 => 2, 0, true; 16 => 2, 1, true; 17 => 2, 2, true;
-    };
-    let n = match link.offset {
-        0 => cross_axis::<T, 0>(t, &g, n),
-        1 => cross_axis::<T, 1>(t, &g, n),
-        2 => cross_axis::<T, 2>(t, &g, n),
-        ZERO_OFFSET => n,
-        _ => cross_dense(t, &g, n),
-    };
-    [n[0], n[1], n[2], g[0], g[1], g[2]]
+    let (f0, f1, f2) = (rot(&f[3..6], 0), rot(&f[3..6], 1), rot(&f[3..6], 2));
+    let n0 = rot(&f[0..3], 0).add(f2.scale(p1).sub(f1.scale(p2)));
+    let n1 = rot(&f[0..3], 1).add(f0.scale(p2).sub(f2.scale(p0)));
+    let n2 = rot(&f[0..3], 2).add(f1.scale(p0).sub(f0.scale(p1)));
+    [n0, n1, n2, f0, f1, f2]
 }
 
 /// Runs the steps of `plan` on the workspace `w` and writes the entries of
@@ -313,7 +212,7 @@ pub fn run(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
 #[inline(never)]
 pub fn run_generic<T>(plan: &Plan<'_>, w: &[T], out: &mut [T])
 where
-    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T> + Neg<Output = T>,
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
 {
     steps(plan, w, out)
 }
@@ -322,7 +221,7 @@ where
 #[inline(always)]
 fn steps<T>(plan: &Plan<'_>, w: &[T], out: &mut [T])
 where
-    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T> + Neg<Output = T>,
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
 {
     let n = plan.dof;
     for col in plan.columns {
@@ -350,8 +249,7 @@ where
                 break;
             }
             let t = usize::from(link.transform);
-            let t: &[T; 12] = w[t..t + 12].try_into().expect("12 entries");
-            f = up_shaped(&link, t, &f);
+            f = up(&w[t..t + 12], &f);
             l = usize::from(link.parent);
             let parent = plan.links[l];
             for a in &plan.speeds[usize::from(parent.first)..usize::from(parent.end)] {
@@ -389,10 +287,10 @@ mod avx2 {
     use core::arch::x86_64::{
         __m256d, _mm_cvtsd_f64, _mm_unpackhi_pd, _mm256_add_pd, _mm256_castpd256_pd128,
         _mm256_extractf128_pd, _mm256_fmadd_pd, _mm256_fnmadd_pd, _mm256_mul_pd, _mm256_set_pd,
-        _mm256_set1_pd, _mm256_setzero_pd, _mm256_sub_pd,
+        _mm256_set1_pd,
     };
 
-    use super::{Link, NO_PARENT, Plan, Speed, ZERO_OFFSET};
+    use super::{NO_PARENT, Plan, Speed};
 
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
@@ -434,110 +332,34 @@ mod avx2 {
         lanes(_mm256_add_pd(_mm256_add_pd(a, b), c))
     }
 
-    /// `R x` for a shaped rotation (see [`super::rot_axis`]), `t` = `R` by rows.
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
-    fn rot_axis<const RR: usize, const RC: usize, const NEG: bool>(
-        t: &[f64; 12],
-        x: [__m256d; 3],
-    ) -> [__m256d; 3] {
-        let (i1, i2) = super::others(RR);
-        let (c1, c2) = super::others(RC);
-        let mut o = x;
-        o[RR] = if NEG {
-            _mm256_sub_pd(_mm256_setzero_pd(), x[RC])
-        } else {
-            x[RC]
-        };
-        o[i1] = _mm256_fmadd_pd(
-            x[c2],
-            _mm256_set1_pd(t[3 * i1 + c2]),
-            _mm256_mul_pd(x[c1], _mm256_set1_pd(t[3 * i1 + c1])),
-        );
-        o[i2] = _mm256_fmadd_pd(
-            x[c2],
-            _mm256_set1_pd(t[3 * i2 + c2]),
-            _mm256_mul_pd(x[c1], _mm256_set1_pd(t[3 * i2 + c1])),
-        );
-        o
-    }
-
-    /// `R x` for a dense rotation.
-    #[target_feature(enable = "avx,avx2,fma")]
-    #[inline]
-    fn rot_dense(t: &[f64; 12], x: [__m256d; 3]) -> [__m256d; 3] {
-        let row = |i: usize| {
-            let a = _mm256_fmadd_pd(
-                x[1],
-                _mm256_set1_pd(t[3 * i + 1]),
-                _mm256_mul_pd(x[0], _mm256_set1_pd(t[3 * i])),
-            );
-            _mm256_fmadd_pd(x[2], _mm256_set1_pd(t[3 * i + 2]), a)
-        };
-        [row(0), row(1), row(2)]
-    }
-
-    /// `n + P × g` for `P = p e_A`.
-    #[target_feature(enable = "avx,avx2,fma")]
-    #[inline]
-    fn cross_axis<const A: usize>(
-        t: &[f64; 12],
-        g: &[__m256d; 3],
-        mut n: [__m256d; 3],
-    ) -> [__m256d; 3] {
-        let (b, c) = super::others(A);
-        let p = _mm256_set1_pd(t[9 + A]);
-        n[b] = _mm256_fnmadd_pd(g[c], p, n[b]);
-        n[c] = _mm256_fmadd_pd(g[b], p, n[c]);
-        n
-    }
-
-    /// `n + P × g` for any `P`: two fused operations per component.
-    #[target_feature(enable = "avx,avx2,fma")]
-    #[inline]
-    fn cross_dense(t: &[f64; 12], g: &[__m256d; 3], n: [__m256d; 3]) -> [__m256d; 3] {
+    fn up(t: &[f64], f: &[__m256d; 6]) -> [__m256d; 6] {
+        let t = &t[..12];
+        // Row i of R times (x0, x1, x2).
+        macro_rules! rot {
+            ($i:expr, $x0:expr, $x1:expr, $x2:expr) => {{
+                let a = _mm256_fmadd_pd(
+                    $x1,
+                    _mm256_set1_pd(t[3 * $i + 1]),
+                    _mm256_mul_pd($x0, _mm256_set1_pd(t[3 * $i])),
+                );
+                _mm256_fmadd_pd($x2, _mm256_set1_pd(t[3 * $i + 2]), a)
+            }};
+        }
         let (p0, p1, p2) = (
             _mm256_set1_pd(t[9]),
             _mm256_set1_pd(t[10]),
             _mm256_set1_pd(t[11]),
         );
-        [
-            _mm256_fmadd_pd(g[2], p1, _mm256_fnmadd_pd(g[1], p2, n[0])),
-            _mm256_fmadd_pd(g[0], p2, _mm256_fnmadd_pd(g[2], p0, n[1])),
-            _mm256_fmadd_pd(g[1], p0, _mm256_fnmadd_pd(g[0], p1, n[2])),
-        ]
-    }
-
-    /// See [`super::up_shaped`].
-    #[target_feature(enable = "avx,avx2,fma")]
-    #[inline]
-    fn up_shaped(link: &Link, t: &[f64; 12], f: &[__m256d; 6]) -> [__m256d; 6] {
-        let fv = [f[3], f[4], f[5]];
-        let nv = [f[0], f[1], f[2]];
-        macro_rules! rot {
-            ($($code:literal => $rr:literal, $rc:literal, $neg:literal;)*) => {
-                match link.rotation {
-                    $($code => (rot_axis::<$rr, $rc, $neg>(t, fv), rot_axis::<$rr, $rc, $neg>(t, nv)),)*
-                    _ => (rot_dense(t, fv), rot_dense(t, nv)),
-                }
-            };
-        }
-        let (g, n) = rot! {
-            0 => 0, 0, false; 1 => 0, 1, false; 2 => 0, 2, false;
-            3 => 1, 0, false; 4 => 1, 1, false; 5 => 1, 2, false;
-            6 => 2, 0, false; 7 => 2, 1, false; 8 => 2, 2, false;
-            9 => 0, 0, true; 10 => 0, 1, true; 11 => 0, 2, true;
-            12 => 1, 0, true; 13 => 1, 1, true; 14 => 1, 2, true;
-            15 => 2, 0, true; 16 => 2, 1, true; 17 => 2, 2, true;
-        };
-        let n = match link.offset {
-            0 => cross_axis::<0>(t, &g, n),
-            1 => cross_axis::<1>(t, &g, n),
-            2 => cross_axis::<2>(t, &g, n),
-            ZERO_OFFSET => n,
-            _ => cross_dense(t, &g, n),
-        };
-        [n[0], n[1], n[2], g[0], g[1], g[2]]
+        let f0 = rot!(0, f[3], f[4], f[5]);
+        let f1 = rot!(1, f[3], f[4], f[5]);
+        let f2 = rot!(2, f[3], f[4], f[5]);
+        // R n + P × R f: two fused operations per component.
+        let n0 = _mm256_fmadd_pd(f2, p1, _mm256_fnmadd_pd(f1, p2, rot!(0, f[0], f[1], f[2])));
+        let n1 = _mm256_fmadd_pd(f0, p2, _mm256_fnmadd_pd(f2, p0, rot!(1, f[0], f[1], f[2])));
+        let n2 = _mm256_fmadd_pd(f1, p0, _mm256_fnmadd_pd(f0, p1, rot!(2, f[0], f[1], f[2])));
+        [n0, n1, n2, f0, f1, f2]
     }
 
     /// `Σ_j x[j] f[j]` over the four components `j` other than `k` and `3 + k`.
@@ -622,8 +444,7 @@ mod avx2 {
                     break;
                 }
                 let t = usize::from(link.transform);
-                let t: &[f64; 12] = w[t..t + 12].try_into().expect("12 entries");
-                f = up_shaped(&link, t, &f);
+                f = up(&w[t..t + 12], &f);
                 l = usize::from(link.parent);
                 let parent = plan.links[l];
                 for a in &plan.speeds[usize::from(parent.first)..usize::from(parent.end)] {
@@ -647,144 +468,6 @@ mod avx2 {
                     }
                 }
             }
-        }
-    }
-}
-
-#[cfg(all(test, feature = "std"))]
-mod tests {
-    use super::*;
-    use std::vec;
-    use std::vec::Vec;
-
-    /// Uniform in [−1, 1) from a 64-bit LCG.
-    struct Lcg(u64);
-
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        }
-    }
-
-    /// Every rotation shape (18 codes and dense) with every offset shape (three axes, zero,
-    /// dense): a root with one speed and 95 children, each with one speed and a column, so
-    /// that each child's forces take one step up through its own shape. The shaped tables
-    /// against the same workspace run with every link marked dense (the workspace holds the
-    /// full `R`, its ±1 entry included, and the zeros).
-    #[test]
-    fn shaped_transforms_equal_the_dense_transform_for_every_rotation_and_offset_shape() {
-        let mut rng = Lcg(7);
-        let offsets = [0, 1, 2, ZERO_OFFSET, DENSE];
-        let children = 95;
-        let mut w = Vec::new();
-        let mut links = vec![Link {
-            parent: NO_PARENT,
-            transform: 0,
-            first: 0,
-            end: 1,
-            rotation: DENSE,
-            offset: DENSE,
-        }];
-        let mut speeds = Vec::new();
-        let mut columns = Vec::new();
-        let motion = |w: &mut Vec<f64>, rng: &mut Lcg| {
-            let at = w.len();
-            w.extend((0..18).map(|_| rng.next()));
-            at as u16
-        };
-        speeds.push(Speed {
-            index: 0,
-            motion: motion(&mut w, &mut rng),
-            joint: true,
-            axis: DENSE,
-        });
-        for i in 0..children {
-            let rotation = if i % 19 == 18 { DENSE } else { (i % 19) as u8 };
-            let offset = offsets[i % 5];
-            let mut t: Vec<f64> = (0..12).map(|_| rng.next()).collect();
-            if rotation != DENSE {
-                let (code, negative) = (usize::from(rotation % 9), rotation >= 9);
-                let (rr, rc) = (code / 3, code % 3);
-                for k in 0..3 {
-                    t[3 * rr + k] = 0.0;
-                    t[3 * k + rc] = 0.0;
-                }
-                t[3 * rr + rc] = if negative { -1.0 } else { 1.0 };
-            }
-            match offset {
-                ZERO_OFFSET => t[9..12].fill(0.0),
-                k if k < 3 => {
-                    for j in 0..3 {
-                        if j != usize::from(k) {
-                            t[9 + j] = 0.0;
-                        }
-                    }
-                }
-                _ => {}
-            }
-            let transform = w.len() as u16;
-            w.extend_from_slice(&t);
-            let s = speeds.len() as u16;
-            speeds.push(Speed {
-                index: s,
-                motion: motion(&mut w, &mut rng),
-                joint: i % 2 == 0,
-                axis: DENSE,
-            });
-            links.push(Link {
-                parent: 0,
-                transform,
-                first: s,
-                end: s + 1,
-                rotation,
-                offset,
-            });
-            let forces = w.len() as u16;
-            w.extend((0..24).map(|_| rng.next()));
-            columns.push(Column {
-                link: (i + 1) as u16,
-                speed: s,
-                forces,
-            });
-        }
-        let dense_links: Vec<Link> = links
-            .iter()
-            .map(|l| Link {
-                rotation: DENSE,
-                offset: DENSE,
-                ..*l
-            })
-            .collect();
-        let n = speeds.len();
-        let plan = |links| Plan {
-            dof: n,
-            links,
-            speeds: &speeds,
-            columns: &columns,
-        };
-        let result = |plan: &Plan<'_>, kernel: fn(&Plan<'_>, &[f64], &mut [f64])| {
-            let mut out = vec![0.0; 2 * n * n];
-            kernel(plan, &w, &mut out);
-            out
-        };
-        let dense = result(&plan(&dense_links), run_generic::<f64>);
-        let shaped = result(&plan(&links), run_generic::<f64>);
-        let dispatched = result(&plan(&links), run);
-        let scale = dense.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-        for (k, d) in dense.iter().enumerate() {
-            let (s, r) = (shaped[k], dispatched[k]);
-            assert!(
-                (s - d).abs() <= 1e-14 * scale,
-                "entry {k}: shaped {s} vs dense {d} (portable kernel)"
-            );
-            assert!(
-                (r - d).abs() <= 1e-13 * scale,
-                "entry {k}: shaped {r} vs dense {d} (dispatched kernel)"
-            );
         }
     }
 }

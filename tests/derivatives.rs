@@ -155,6 +155,40 @@ fn krang_position_and_heading_columns_are_exactly_zero() {
 }
 
 #[test]
+fn derivatives_into_a_kept_matrix_equal_the_by_value_result_bit_for_bit() {
+    // `inverse_dynamics_derivatives_into` writes every entry (structural zeros included) of a
+    // matrix that holds anything before: Krang (looped form) and the two-link model
+    // (straight-line form), on random parameters and states.
+    let mut r = rng(1211);
+    let mut m = SMatrix::<f64, 19, 38>::from_element(f64::NAN);
+    for draw in 0..20 {
+        let k = if draw == 0 {
+            kd::Krang::default()
+        } else {
+            random_krang(&mut r)
+        };
+        let (q, u, ud) = random_state(&mut r, 19);
+        let (q, u, ud) = (sv::<19>(&q), sv::<19>(&u), sv::<19>(&ud));
+        k.inverse_dynamics_derivatives_into(&q, &u, &ud, &mut m);
+        let by_value = k.inverse_dynamics_derivatives(&q, &u, &ud);
+        assert!(
+            m.iter()
+                .zip(by_value.iter())
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        );
+        m.fill(f64::NAN);
+    }
+    let two = kd::two_link::TwoLink::default();
+    let mut m = SMatrix::<f64, 2, 4>::from_element(f64::NAN);
+    for _ in 0..20 {
+        let (q, u, ud) = random_state(&mut r, 2);
+        let (q, u, ud) = (sv::<2>(&q), sv::<2>(&u), sv::<2>(&ud));
+        two.inverse_dynamics_derivatives_into(&q, &u, &ud, &mut m);
+        assert_eq!(m, two.inverse_dynamics_derivatives(&q, &u, &ud));
+    }
+}
+
+#[test]
 fn dual_number_baseline_equals_the_generated_derivatives() {
     // kanegen-rbd's recursion in num-dual's Dual64 (2N passes): an independent derivation of
     // the same two matrices, on random parameters and states.

@@ -7,8 +7,8 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::function::{
-    Reads, Stores, generic_body, nonzero_outputs, param_args, prologue, result_type, state_args,
-    store_text_after, text, unused_inputs,
+    Reads, Stores, nonzero_outputs, param_args, prologue, state_args, store_text_after, text,
+    unused_inputs,
 };
 use super::print::{ident, idx, lit};
 use super::{Context, scalar_type};
@@ -111,7 +111,6 @@ pub(super) fn function(
     let t = scalar_type(cx.precision);
     let zero = lit(0.0, cx.precision);
     let len = idx(looped.plan.workspace);
-    let ty = result_type(cx, spec.shape);
     let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
     let (rows, cols) = (idx(rows), idx(cols));
     let tables_name = ident(TABLES);
@@ -125,14 +124,46 @@ pub(super) fn function(
         #prologue
         let mut w: [#t; #len] = [#zero; #len];
         #body
-        let mut m = SMatrix::<#t, #rows, #cols>::zeros();
         #run(&#tables_name, &w, m.as_mut_slice());
-        m
     };
-    // Multiply-add chains in the straight-line part: fused in the x86-64-v3 copy, like every
-    // single-state function (`generic_body`).
-    let (outer_params, generic) = generic_body(cx, spec.inputs, param_args, &ty, body);
+    let mat = quote!(SMatrix<#t, #rows, #cols>);
+    // The body generic over the multiply-add (fused in the x86-64-v3 copy, like every
+    // single-state function's), writing into `m`; with dispatch both closures name `m`, passed
+    // through a `Cell` that the one closure run takes it from.
+    let (outer_params, pass_params) = super::function::outer_params(cx);
+    let state = super::items::arg_names(spec.inputs);
+    let call = if cx.isa_dispatch {
+        quote! {
+            let m = core::cell::Cell::new(Some(m));
+            kanegen_runtime::isa::dispatch_fused(
+                #[inline(always)]
+                || {
+                    if let Some(m) = m.take() {
+                        body::<kanegen_runtime::isa::Plain>(#pass_params #state, m)
+                    }
+                },
+                #[inline(always)]
+                || {
+                    if let Some(m) = m.take() {
+                        body::<kanegen_runtime::isa::Fused>(#pass_params #state, m)
+                    }
+                },
+            );
+        }
+    } else {
+        quote!(body::<kanegen_runtime::isa::Native>(#pass_params #state, m);)
+    };
     let tables = tables(&looped.plan);
+    let into = ident(&format!("{}_into", spec.name));
+    let onto = ident(&format!("{}_onto", spec.name));
+    let into_doc = format!(
+        " [`{}`] written into `m` (every entry; no copy of the result: the form for a caller that keeps its matrix).",
+        spec.name
+    );
+    let onto_doc = format!(
+        " The entries of [`{}`] written into `m`, whose other entries are zero (the structural zeros are not written): the by-value function passes a new zero matrix, so that the result is built where the caller keeps it rather than copied out.",
+        spec.name
+    );
     quote! {
         #tables
 
@@ -140,9 +171,93 @@ pub(super) fn function(
         #[doc = ""]
         #[doc = #arg_doc]
         #[doc = #ops]
+        #[inline]
+        pub fn #fname(#outer_params #args) -> #mat {
+            let mut m = <#mat>::zeros();
+            #onto(#pass_params #state, &mut m);
+            m
+        }
+
+        #[doc = #into_doc]
+        #[doc = ""]
+        #[doc = #arg_doc]
+        #[inline]
+        pub fn #into(#outer_params #args, m: &mut #mat) {
+            m.fill(#zero);
+            #onto(#pass_params #state, m);
+        }
+
+        #[doc = #onto_doc]
         #[inline(never)]
-        pub fn #fname(#outer_params #args) -> #ty {
-            #generic
+        fn #onto(#outer_params #args, m: &mut #mat) {
+            #[inline(always)]
+            fn body<A: kanegen_runtime::isa::Arith<#t>>(#param_args #args, m: &mut #mat) {
+                #body
+            }
+            #call
+        }
+    }
+}
+
+/// The in-place `inverse_dynamics_derivatives_into` of the straight-line form (the looped form's
+/// [`function`] emits its own): the same API whichever form a model gets.
+pub(super) fn straight_into(cx: &Context<'_>, f: &FunctionProgram, looped: bool) -> TokenStream {
+    if f.id != crate::registry::FunctionId::InverseDynamicsDerivatives || looped {
+        return quote!();
+    }
+    let spec = f.id.spec();
+    let fname = ident(spec.name);
+    let into = ident(&format!("{}_into", spec.name));
+    let t = scalar_type(cx.precision);
+    let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
+    let (rows, cols) = (idx(rows), idx(cols));
+    let (args, arg_doc) = state_args(cx, spec.inputs);
+    let state = super::items::arg_names(spec.inputs);
+    let (outer_params, pass_params) = super::function::outer_params(cx);
+    let doc = format!(" [`{}`] written into `m`.", spec.name);
+    quote! {
+        #[doc = #doc]
+        #[doc = ""]
+        #[doc = #arg_doc]
+        #[inline]
+        pub fn #into(#outer_params #args, m: &mut SMatrix<#t, #rows, #cols>) {
+            *m = #fname(#pass_params #state);
+        }
+    }
+}
+
+/// The wrapper's method `inverse_dynamics_derivatives_into(&self, …, m)` when the module has
+/// the derivatives.
+pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
+    let Some(f) = cx
+        .low
+        .functions
+        .iter()
+        .find(|f| f.id == crate::registry::FunctionId::InverseDynamicsDerivatives)
+    else {
+        return quote!();
+    };
+    let spec = f.id.spec();
+    let into = ident(&format!("{}_into", spec.name));
+    let doc = format!(
+        " [`Self::{}`] written into `m` (no result copy; for a caller that keeps its matrix, e.g. along an MPC horizon).",
+        spec.name
+    );
+    let (args, _) = state_args(cx, spec.inputs);
+    let t = scalar_type(cx.precision);
+    let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
+    let (rows, cols) = (idx(rows), idx(cols));
+    let state = super::items::arg_names(spec.inputs);
+    let call = if cx.low.params.is_runtime() {
+        quote!(#into(&self.params, &self.pre, #state, m))
+    } else {
+        quote!(#into(#state, m))
+    };
+    quote! {
+        #[doc = #doc]
+        #[inline]
+        pub fn #into(&self, #args, m: &mut SMatrix<#t, #rows, #cols>) {
+            #call
         }
     }
 }

@@ -197,6 +197,11 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
             _ => items.extend(function::function(&cx, f)),
         }
         items.extend(regressor_loop::straight_into(&cx, f));
+        items.extend(derivative_loop::straight_into(
+            &cx,
+            f,
+            low.derivative_loop.is_some(),
+        ));
         // After a per-frame function's last frame, its dispatcher.
         let last = low.functions.get(i + 1).is_none_or(|next| next.id != f.id);
         if f.frame.is_some() && last {

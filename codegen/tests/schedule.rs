@@ -7,6 +7,17 @@ use kanegen::lower::lower;
 use kanegen::model::Model;
 use kanegen::{FunctionId, Options, ParamMode};
 
+/// Krang derived with `mode` parameters and lowered.
+fn lowered(mode: ParamMode) -> kanegen::lower::Lowered {
+    lower(&derive(
+        &krang(),
+        Options {
+            params: mode,
+            ..Options::default()
+        },
+    ))
+}
+
 fn krang() -> Model {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     Model::from_toml_file(root.join("models/krang.toml")).expect("krang.toml loads")
@@ -26,14 +37,7 @@ const MAX_LIVE: [(FunctionId, usize); 5] = [
 #[test]
 fn krang_programs_keep_few_values_live() {
     for mode in [ParamMode::Runtime, ParamMode::Baked] {
-        let d = derive(
-            &krang(),
-            Options {
-                params: mode,
-                ..Options::default()
-            },
-        );
-        let low = lower(&d);
+        let low = lowered(mode);
         for (name, bound) in MAX_LIVE {
             let live = low.function(name).expect("function exists").max_live();
             assert!(
@@ -83,14 +87,7 @@ fn subtree_order_keeps_the_values_and_lowers_the_values_live() {
     let u: Vec<f64> = (0..19).map(|i| 0.4 - 0.07 * i as f64).collect();
     let ud: Vec<f64> = (0..19).map(|i| (i as f64 * 0.53).cos()).collect();
     for mode in [ParamMode::Runtime, ParamMode::Baked] {
-        let d = derive(
-            &krang(),
-            Options {
-                params: mode,
-                ..Options::default()
-            },
-        );
-        let low = lower(&d);
+        let low = lowered(mode);
         for id in [
             FunctionId::Coriolis,
             FunctionId::InverseDynamics,

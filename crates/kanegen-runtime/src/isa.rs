@@ -199,21 +199,6 @@ if_dispatching! {
         f()
     }
 
-    /// Calls `plain` (compiled for the baseline) or `fused` (compiled for x86-64-v3), by the
-    /// [`active`] instruction set: a generated function passes its body instantiated with
-    /// [`Plain`] and with [`Fused`], so that only the x86-64-v3 copy fuses multiply-adds. See
-    /// the module docs.
-    #[inline(always)]
-    pub fn dispatch_fused<R>(plain: impl FnOnce() -> R, fused: impl FnOnce() -> R) -> R {
-        dispatch_fused_with(
-            (),
-            #[inline(always)]
-            |()| plain(),
-            #[inline(always)]
-            |()| fused(),
-        )
-    }
-
     /// [`dispatch_fused`] passing `arg` to the copy that runs: for an argument both closures
     /// would otherwise capture, such as the `&mut` result array of a batched function
     /// (`mass_matrix_batch_into`), which two closures cannot borrow at once.
@@ -251,19 +236,6 @@ if_not_dispatching! {
         f()
     }
 
-    /// Calls `fused` when the compilation target has FMA ([`Native`] is [`Fused`]), `plain`
-    /// otherwise: this build has one copy of every function (see the module docs).
-    #[inline(always)]
-    pub fn dispatch_fused<R>(plain: impl FnOnce() -> R, fused: impl FnOnce() -> R) -> R {
-        dispatch_fused_with(
-            (),
-            #[inline(always)]
-            |()| plain(),
-            #[inline(always)]
-            |()| fused(),
-        )
-    }
-
     /// [`dispatch_fused`] passing `arg` to the copy that runs (for an argument both closures
     /// would otherwise capture, such as a `&mut` result array).
     #[inline(always)]
@@ -289,6 +261,22 @@ if_not_dispatching! {
             plain(arg)
         }
     }
+}
+
+/// Calls `plain` (compiled for the baseline) or `fused` (compiled for x86-64-v3), by the
+/// [`active`] instruction set: a generated function passes its body instantiated with [`Plain`]
+/// and with [`Fused`], so that only the x86-64-v3 copy fuses multiply-adds. Without dispatch
+/// (see the module docs) there is one copy: `fused` when the compilation target has FMA
+/// ([`Native`] is [`Fused`]), `plain` otherwise. [`dispatch_fused_with`] without an argument.
+#[inline(always)]
+pub fn dispatch_fused<R>(plain: impl FnOnce() -> R, fused: impl FnOnce() -> R) -> R {
+    dispatch_fused_with(
+        (),
+        #[inline(always)]
+        |()| plain(),
+        #[inline(always)]
+        |()| fused(),
+    )
 }
 
 /// The best instruction set this CPU and this build can dispatch to.

@@ -26,8 +26,9 @@ impl Scalar for f64 {
 
     /// [`kanegen_runtime::trig::sin_cos_n`], the batch of generated code: a branch-free
     /// polynomial kernel the compiler vectorizes across the batch (SSE2: two angles per
-    /// instruction), with a cold lane-by-lane path for a batch holding `|x| ≥ 2¹⁹·π/2` or a
-    /// non-finite angle.
+    /// instruction; the x86-64-v3 copy fuses its multiply-adds, within 2 ulp of
+    /// [`Self::sin_cos_joint`]), with a cold lane-by-lane path for a batch holding
+    /// `|x| ≥ 2¹⁹·π/2` or a non-finite angle.
     #[inline(always)]
     fn sin_cos_batch<const N: usize>(x: &[Self; N], s: &mut [Self; N], c: &mut [Self; N]) {
         (*s, *c) = kanegen_runtime::trig::sin_cos_n(*x);

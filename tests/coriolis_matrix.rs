@@ -222,9 +222,7 @@ fn into_forms_write_every_entry_with_the_by_value_bits() {
     let mut r = rng(106);
     let mut out = nalgebra::SMatrix::<f64, 19, 19>::zeros();
     let same = |a: &nalgebra::SMatrix<f64, 19, 19>, b: &nalgebra::SMatrix<f64, 19, 19>| {
-        a.iter()
-            .zip(b.iter())
-            .all(|(x, y)| x.to_bits() == y.to_bits())
+        same_bits(a.as_slice(), b.as_slice())
     };
     for set in [Isa::Baseline, Isa::X86_64V3] {
         if !isa::available(set) {

@@ -171,11 +171,7 @@ fn derivatives_into_a_kept_matrix_equal_the_by_value_result_bit_for_bit() {
         let (q, u, ud) = (sv::<19>(&q), sv::<19>(&u), sv::<19>(&ud));
         k.inverse_dynamics_derivatives_into(&q, &u, &ud, &mut m);
         let by_value = k.inverse_dynamics_derivatives(&q, &u, &ud);
-        assert!(
-            m.iter()
-                .zip(by_value.iter())
-                .all(|(a, b)| a.to_bits() == b.to_bits())
-        );
+        assert!(same_bits(m.as_slice(), by_value.as_slice()));
         m.fill(f64::NAN);
     }
     let two = kd::two_link::TwoLink::default();

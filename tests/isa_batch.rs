@@ -34,11 +34,6 @@ fn states<const L: usize>(uniform: &mut impl FnMut() -> f64) -> ([V; L], [V; L],
     (q, u, ud)
 }
 
-/// Bitwise equality (`==` would accept `0.0 == -0.0` and reject equal NaNs).
-fn same_bits(a: &[f64], b: &[f64]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
-}
-
 /// The instruction set is global ([`isa::select`]) and the tests of this file select it: one
 /// at a time.
 static ISA: std::sync::Mutex<()> = std::sync::Mutex::new(());

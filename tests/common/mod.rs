@@ -7,6 +7,11 @@ use kanegen_model::Model;
 use kanegen_reference::random::{SplitMix64, uniform_vec};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
+/// Bitwise equality (`==` would accept `0.0 == -0.0` and reject equal NaNs).
+pub fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
 /// The repository root.
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

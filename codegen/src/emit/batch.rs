@@ -262,18 +262,8 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
             copies.extend(quote!(let pc = &{ *pc };));
         }
     }
-    let call = if cx.isa_dispatch {
-        // `out` goes to the copy that runs (two closures cannot both borrow it).
-        quote!(kanegen_runtime::isa::dispatch_fused_with(
-            out,
-            #[inline(always)]
-            |out| body::<kanegen_runtime::isa::Plain, L>(#pass_params #names, out),
-            #[inline(always)]
-            |out| body::<kanegen_runtime::isa::Fused, L>(#pass_params #names, out),
-        ))
-    } else {
-        quote!(body::<kanegen_runtime::isa::Native, L>(#pass_params #names, out))
-    };
+    let call =
+        super::function::call_body_into(cx, quote!(, L), quote!(#pass_params #names,), quote!(out));
     quote! {
         #[doc = #doc_into]
         #[inline(never)]

@@ -128,31 +128,12 @@ pub(super) fn function(
     };
     let mat = quote!(SMatrix<#t, #rows, #cols>);
     // The body generic over the multiply-add (fused in the x86-64-v3 copy, like every
-    // single-state function's), writing into `m`; with dispatch both closures name `m`, passed
-    // through a `Cell` that the one closure run takes it from.
+    // single-state function's), writing into `m`.
     let (outer_params, pass_params) = super::function::outer_params(cx);
     let state = super::items::arg_names(spec.inputs);
-    let call = if cx.isa_dispatch {
-        quote! {
-            let m = core::cell::Cell::new(Some(m));
-            kanegen_runtime::isa::dispatch_fused(
-                #[inline(always)]
-                || {
-                    if let Some(m) = m.take() {
-                        body::<kanegen_runtime::isa::Plain>(#pass_params #state, m)
-                    }
-                },
-                #[inline(always)]
-                || {
-                    if let Some(m) = m.take() {
-                        body::<kanegen_runtime::isa::Fused>(#pass_params #state, m)
-                    }
-                },
-            );
-        }
-    } else {
-        quote!(body::<kanegen_runtime::isa::Native>(#pass_params #state, m);)
-    };
+    let call =
+        super::function::call_body_into(cx, quote!(), quote!(#pass_params #state,), quote!(m));
+    let call = quote!(#call;);
     let tables = tables(&looped.plan);
     let into = ident(&format!("{}_into", spec.name));
     let onto = ident(&format!("{}_onto", spec.name));

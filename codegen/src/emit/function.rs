@@ -494,6 +494,31 @@ fn zero_stores(p: &Program, n: usize, mirror: bool) -> Vec<String> {
         .collect()
 }
 
+/// The call of a generated function's inner `body::<A, …>(…, out)`, generic over the
+/// multiply-add (`A: isa::Arith`), that writes into the caller's result `out` (an `_into`
+/// form): with dispatch `isa::dispatch_fused_with`, which hands `out` to the one copy that runs
+/// (`Plain` for the baseline, `Fused` for x86-64-v3; two closures cannot both borrow it),
+/// without it `isa::Native`. `generics` follows `A` (`, L` for a batch); `args` are the
+/// arguments before `out`, each followed by a comma.
+pub(super) fn call_body_into(
+    cx: &Context<'_>,
+    generics: TokenStream,
+    args: TokenStream,
+    out: TokenStream,
+) -> TokenStream {
+    if cx.isa_dispatch {
+        quote!(kanegen_runtime::isa::dispatch_fused_with(
+            #out,
+            #[inline(always)]
+            |out| body::<kanegen_runtime::isa::Plain #generics>(#args out),
+            #[inline(always)]
+            |out| body::<kanegen_runtime::isa::Fused #generics>(#args out),
+        ))
+    } else {
+        quote!(body::<kanegen_runtime::isa::Native #generics>(#args #out))
+    }
+}
+
 /// The two functions of an n×n result: `NAME_into(…, out: &mut SMatrix)`, whose body (the
 /// statements and stores of [`result`], every entry written once) writes into the caller's
 /// matrix, and `NAME(…) -> SMatrix`, which zeroes a matrix and calls it.
@@ -518,17 +543,7 @@ fn into_pair(
     let (args, _) = state_args(cx, spec.inputs);
     let names = super::items::arg_names(spec.inputs);
     let (outer_params, pass_params) = outer_params(cx);
-    let call = if cx.isa_dispatch {
-        quote!(kanegen_runtime::isa::dispatch_fused_with(
-            out,
-            #[inline(always)]
-            |m| body::<kanegen_runtime::isa::Plain>(#pass_params #names, m),
-            #[inline(always)]
-            |m| body::<kanegen_runtime::isa::Fused>(#pass_params #names, m),
-        ))
-    } else {
-        quote!(body::<kanegen_runtime::isa::Native>(#pass_params #names, out))
-    };
+    let call = call_body_into(cx, quote!(), quote!(#pass_params #names,), quote!(out));
     let into_doc = format!(
         " [`{}`] written into `out` (every entry), without returning the matrix by value: \
          for a caller that keeps its matrix (a controller's workspace), and a little faster.",

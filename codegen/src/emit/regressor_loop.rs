@@ -168,29 +168,10 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
     let (outer_params, pass_params) = super::function::outer_params(cx);
     let state = super::items::arg_names(spec.inputs);
     // The body generic over the multiply-add, compiled twice with dispatch (`Plain` for the
-    // baseline, `Fused` for x86-64-v3). Both closures name `y`: it is passed through a `Cell`
-    // that the one closure run takes it from.
-    let call = if cx.isa_dispatch {
-        quote! {
-            let y = core::cell::Cell::new(Some(y));
-            kanegen_runtime::isa::dispatch_fused(
-                #[inline(always)]
-                || {
-                    if let Some(y) = y.take() {
-                        body::<kanegen_runtime::isa::Plain>(#pass_params #state, y)
-                    }
-                },
-                #[inline(always)]
-                || {
-                    if let Some(y) = y.take() {
-                        body::<kanegen_runtime::isa::Fused>(#pass_params #state, y)
-                    }
-                },
-            );
-        }
-    } else {
-        quote!(body::<kanegen_runtime::isa::Native>(#pass_params #state, y);)
-    };
+    // baseline, `Fused` for x86-64-v3), writing into `y`.
+    let call =
+        super::function::call_body_into(cx, quote!(), quote!(#pass_params #state,), quote!(y));
+    let call = quote!(#call;);
     let into_doc = format!(
         " [`{name}`] written into `y` (every entry; nothing to allocate, zero or copy: the fast form for a caller that keeps its result matrix)."
     );

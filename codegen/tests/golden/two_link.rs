@@ -388,9 +388,9 @@ mod generated {
         kanegen_runtime::isa::dispatch_fused_with(
             out,
             #[inline(always)]
-            |m| body::<kanegen_runtime::isa::Plain>(p, pc, q, m),
+            |out| body::<kanegen_runtime::isa::Plain>(p, pc, q, out),
             #[inline(always)]
-            |m| body::<kanegen_runtime::isa::Fused>(p, pc, q, m),
+            |out| body::<kanegen_runtime::isa::Fused>(p, pc, q, out),
         )
     }
     /// Coriolis and centrifugal vector c(q, u) (velocity-product terms).
@@ -617,9 +617,9 @@ mod generated {
         kanegen_runtime::isa::dispatch_fused_with(
             out,
             #[inline(always)]
-            |m| body::<kanegen_runtime::isa::Plain>(p, pc, q, u, m),
+            |out| body::<kanegen_runtime::isa::Plain>(p, pc, q, u, out),
             #[inline(always)]
-            |m| body::<kanegen_runtime::isa::Fused>(p, pc, q, u, m),
+            |out| body::<kanegen_runtime::isa::Fused>(p, pc, q, u, out),
         )
     }
     /// The dynamics of `two-link` with one parameter set: `τ = M(q) u̇ + c(q, u) + g(q)`.

@@ -262,8 +262,13 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
             copies.extend(quote!(let pc = &{ *pc };));
         }
     }
-    let call =
-        super::function::call_body_into(cx, quote!(, L), quote!(#pass_params #names,), quote!(out));
+    let call = super::function::call_body_into(
+        cx,
+        super::function::Copies::WithV4,
+        quote!(, L),
+        quote!(#pass_params #names,),
+        quote!(out),
+    );
     quote! {
         #[doc = #doc_into]
         #[inline(never)]

@@ -131,8 +131,13 @@ pub(super) fn function(
     // single-state function's), writing into `m`.
     let (outer_params, pass_params) = super::function::outer_params(cx);
     let state = super::items::arg_names(spec.inputs);
-    let call =
-        super::function::call_body_into(cx, quote!(), quote!(#pass_params #state,), quote!(m));
+    let call = super::function::call_body_into(
+        cx,
+        super::function::Copies::BaselineAndV3,
+        quote!(),
+        quote!(#pass_params #state,),
+        quote!(m),
+    );
     let call = quote!(#call;);
     let tables = tables(&looped.plan);
     let into = ident(&format!("{}_into", spec.name));

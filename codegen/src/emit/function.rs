@@ -494,20 +494,38 @@ fn zero_stores(p: &Program, n: usize, mirror: bool) -> Vec<String> {
         .collect()
 }
 
+/// Which instruction-set copies a dispatched function is compiled in.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Copies {
+    /// The baseline and x86-64-v3 (`isa::dispatch_fused_with`): single-state functions. An
+    /// x86-64-v4 copy was measured no faster for them (Krang's M, c, g, τ, C within 5 %) and
+    /// costs a third more compile time.
+    BaselineAndV3,
+    /// Also x86-64-v4 (`isa::dispatch_fused_wide_with`): the batched functions, whose loop
+    /// over the states LLVM vectorizes 8 lanes wide with AVX-512.
+    WithV4,
+}
+
 /// The call of a generated function's inner `body::<A, …>(…, out)`, generic over the
 /// multiply-add (`A: isa::Arith`), that writes into the caller's result `out` (an `_into`
-/// form): with dispatch `isa::dispatch_fused_with`, which hands `out` to the one copy that runs
-/// (`Plain` for the baseline, `Fused` for x86-64-v3; two closures cannot both borrow it),
-/// without it `isa::Native`. `generics` follows `A` (`, L` for a batch); `args` are the
-/// arguments before `out`, each followed by a comma.
+/// form): with dispatch `isa::dispatch_fused_with` (or `dispatch_fused_wide_with`, by
+/// `copies`), which hands `out` to the one copy that runs (`Plain` for the baseline, `Fused`
+/// for x86-64-v3 and v4; two closures cannot both borrow it), without it `isa::Native`.
+/// `generics` follows `A` (`, L` for a batch); `args` are the arguments before `out`, each
+/// followed by a comma.
 pub(super) fn call_body_into(
     cx: &Context<'_>,
+    copies: Copies,
     generics: TokenStream,
     args: TokenStream,
     out: TokenStream,
 ) -> TokenStream {
     if cx.isa_dispatch {
-        quote!(kanegen_runtime::isa::dispatch_fused_with(
+        let dispatch = match copies {
+            Copies::BaselineAndV3 => quote!(dispatch_fused_with),
+            Copies::WithV4 => quote!(dispatch_fused_wide_with),
+        };
+        quote!(kanegen_runtime::isa::#dispatch(
             #out,
             #[inline(always)]
             |out| body::<kanegen_runtime::isa::Plain #generics>(#args out),
@@ -543,7 +561,13 @@ fn into_pair(
     let (args, _) = state_args(cx, spec.inputs);
     let names = super::items::arg_names(spec.inputs);
     let (outer_params, pass_params) = outer_params(cx);
-    let call = call_body_into(cx, quote!(), quote!(#pass_params #names,), quote!(out));
+    let call = call_body_into(
+        cx,
+        Copies::BaselineAndV3,
+        quote!(),
+        quote!(#pass_params #names,),
+        quote!(out),
+    );
     let into_doc = format!(
         " [`{}`] written into `out` (every entry), without returning the matrix by value: \
          for a caller that keeps its matrix (a controller's workspace), and a little faster.",

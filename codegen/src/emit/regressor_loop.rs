@@ -169,8 +169,13 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
     let state = super::items::arg_names(spec.inputs);
     // The body generic over the multiply-add, compiled twice with dispatch (`Plain` for the
     // baseline, `Fused` for x86-64-v3), writing into `y`.
-    let call =
-        super::function::call_body_into(cx, quote!(), quote!(#pass_params #state,), quote!(y));
+    let call = super::function::call_body_into(
+        cx,
+        super::function::Copies::BaselineAndV3,
+        quote!(),
+        quote!(#pass_params #state,),
+        quote!(y),
+    );
     let call = quote!(#call;);
     let into_doc = format!(
         " [`{name}`] written into `y` (every entry; nothing to allocate, zero or copy: the fast form for a caller that keeps its result matrix)."

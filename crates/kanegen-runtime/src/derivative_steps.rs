@@ -185,7 +185,7 @@ pub fn run(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
         target_arch = "x86_64",
         not(all(target_feature = "avx2", target_feature = "fma"))
     ))]
-    if crate::isa::active() == crate::isa::Isa::X86_64V3 {
+    if crate::isa::active() != crate::isa::Isa::Baseline {
         // SAFETY: `isa::active` is x86-64-v3 only when the CPU has AVX and AVX2 (it checks
         // every feature of x86-64-v3 before selecting it), the features `avx2::steps` is
         // compiled with.

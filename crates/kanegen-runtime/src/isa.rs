@@ -75,17 +75,21 @@ pub enum Isa {
     /// x86-64-v3: AVX, AVX2, FMA, BMI1, BMI2, LZCNT, F16C, POPCNT (Intel Haswell, AMD Excavator
     /// and later).
     X86_64V3,
+    /// x86-64-v4: x86-64-v3 and AVX-512 F, BW, CD, DQ, VL (Intel Skylake-SP, AMD Zen 4 and
+    /// later): 32 vector registers, 8 `f64` lanes per register.
+    X86_64V4,
 }
 
 impl Isa {
     /// Every instruction set, from the most widely available.
-    pub const ALL: [Isa; 2] = [Isa::Baseline, Isa::X86_64V3];
+    pub const ALL: [Isa; 3] = [Isa::Baseline, Isa::X86_64V3, Isa::X86_64V4];
 
-    /// `"baseline"`, `"x86-64-v3"`.
+    /// `"baseline"`, `"x86-64-v3"`, `"x86-64-v4"`.
     pub fn name(self) -> &'static str {
         match self {
             Isa::Baseline => "baseline",
             Isa::X86_64V3 => "x86-64-v3",
+            Isa::X86_64V4 => "x86-64-v4",
         }
     }
 
@@ -93,6 +97,7 @@ impl Isa {
         match self {
             Isa::Baseline => BASELINE,
             Isa::X86_64V3 => V3,
+            Isa::X86_64V4 => V4,
         }
     }
 }
@@ -128,6 +133,7 @@ impl core::error::Error for IsaUnavailable {}
 const UNKNOWN: u8 = 0;
 const BASELINE: u8 = 1;
 const V3: u8 = 2;
+const V4: u8 = 3;
 
 /// The instruction set [`dispatch`] uses: [`UNKNOWN`] until the first call detects it.
 static ACTIVE: AtomicU8 = AtomicU8::new(UNKNOWN);
@@ -169,12 +175,29 @@ if_dispatching! {
             && std::arch::is_x86_feature_detected!("popcnt")
     }
 
+    fn v4_present() -> bool {
+        v3_present()
+            && std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512bw")
+            && std::arch::is_x86_feature_detected!("avx512cd")
+            && std::arch::is_x86_feature_detected!("avx512dq")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+    }
+
     /// Whether this CPU can run `isa`'s copy.
     pub fn available(isa: Isa) -> bool {
         match isa {
             Isa::Baseline => true,
             Isa::X86_64V3 => v3_present(),
+            Isa::X86_64V4 => v4_present(),
         }
+    }
+
+    /// `f()` compiled with x86-64-v4's features.
+    #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,f16c,popcnt,avx512f,avx512bw,avx512cd,avx512dq,avx512vl")]
+    #[inline]
+    fn run_v4<R, F: FnOnce() -> R>(f: F) -> R {
+        f()
     }
 
     /// `f()` compiled with x86-64-v3's features (LLVM inlines `f` here when it is
@@ -189,8 +212,8 @@ if_dispatching! {
     /// for x86-64-v3, when `f` (and what it calls) is `#[inline(always)]`. See the module docs.
     #[inline(always)]
     pub fn dispatch<R, F: FnOnce() -> R>(f: F) -> R {
-        if active_code() == V3 {
-            // SAFETY: as in `dispatch_fused` below (the same check before the same call).
+        if active_code() >= V3 {
+            // SAFETY: as in `dispatch_fused_with` below (the same check before the same call).
             #[allow(unsafe_code)]
             unsafe {
                 return run_v3(f);
@@ -208,10 +231,11 @@ if_dispatching! {
         plain: impl FnOnce(T) -> R,
         fused: impl FnOnce(T) -> R,
     ) -> R {
-        if active_code() == V3 {
-            // SAFETY: `ACTIVE` holds `V3` only after `v3_present()` found every feature
-            // `run_v3` is compiled with (`detect` and `select` check it before storing), so the
-            // CPU executes its instructions. The same call as in `dispatch` above.
+        if active_code() >= V3 {
+            // SAFETY: `ACTIVE` holds `V3` or `V4` only after `v3_present()` found every feature
+            // `run_v3` is compiled with (`detect` and `select` check it before storing; `V4`
+            // needs `v3_present()` too), so the CPU executes its instructions. The same call as
+            // in `dispatch` above.
             #[allow(unsafe_code)]
             unsafe {
                 return run_v3(
@@ -221,6 +245,39 @@ if_dispatching! {
             }
         }
         plain(arg)
+    }
+
+    /// [`dispatch_fused_with`] with a third copy, compiled for x86-64-v4 (AVX-512: 8 `f64`
+    /// lanes per register, 32 registers), run when [`active`] is [`Isa::X86_64V4`]: what the
+    /// batched functions and [`crate::trig::sin_cos_slice`] use, whose loops over the states
+    /// LLVM vectorizes 8 lanes wide there. The copies for x86-64-v3 and x86-64-v4 both run
+    /// `fused` (the same IEEE operations: their results are equal bit for bit).
+    #[inline(always)]
+    pub fn dispatch_fused_wide_with<T, R>(
+        arg: T,
+        plain: impl FnOnce(T) -> R,
+        fused: impl FnOnce(T) -> R,
+    ) -> R {
+        match active_code() {
+            // SAFETY: `ACTIVE` holds `V4` only after `v4_present()` found every feature
+            // `run_v4` is compiled with (`detect` and `select` check it before storing).
+            #[allow(unsafe_code)]
+            V4 => unsafe {
+                run_v4(
+                    #[inline(always)]
+                    || fused(arg),
+                )
+            },
+            // SAFETY: as in `dispatch_fused_with`.
+            #[allow(unsafe_code)]
+            V3 => unsafe {
+                run_v3(
+                    #[inline(always)]
+                    || fused(arg),
+                )
+            },
+            _ => plain(arg),
+        }
     }
 }
 
@@ -261,6 +318,16 @@ if_not_dispatching! {
             plain(arg)
         }
     }
+
+    /// [`dispatch_fused_with`]: this build has one copy of every function.
+    #[inline(always)]
+    pub fn dispatch_fused_wide_with<T, R>(
+        arg: T,
+        plain: impl FnOnce(T) -> R,
+        fused: impl FnOnce(T) -> R,
+    ) -> R {
+        dispatch_fused_with(arg, plain, fused)
+    }
 }
 
 /// Calls `plain` (compiled for the baseline) or `fused` (compiled for x86-64-v3), by the
@@ -281,7 +348,9 @@ pub fn dispatch_fused<R>(plain: impl FnOnce() -> R, fused: impl FnOnce() -> R) -
 
 /// The best instruction set this CPU and this build can dispatch to.
 pub fn detected() -> Isa {
-    if available(Isa::X86_64V3) {
+    if available(Isa::X86_64V4) {
+        Isa::X86_64V4
+    } else if available(Isa::X86_64V3) {
         Isa::X86_64V3
     } else {
         Isa::Baseline
@@ -311,6 +380,7 @@ fn detect() -> u8 {
 pub fn active() -> Isa {
     match active_code() {
         V3 => Isa::X86_64V3,
+        V4 => Isa::X86_64V4,
         _ => Isa::Baseline,
     }
 }

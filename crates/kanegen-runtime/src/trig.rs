@@ -108,11 +108,12 @@ fn sin_cos_n_slow<A: Arith<f64>, const N: usize>(x: [f64; N]) -> ([f64; N], [f64
 /// What the batched functions call (through [`crate::lanes::sin_cos_n`]) for all joint angles
 /// of all states at once: one dispatched call instead of one per angle (measured on Krang's
 /// batched c at 4 states: the 17 per-angle calls took 39 % of its time). Compiled for the
-/// baseline and for x86-64-v3 like [`sin_cos_n`]. Slices of different lengths: the first
+/// baseline and for x86-64-v3 like [`sin_cos_n`], and for x86-64-v4 (8 lanes per AVX-512
+/// instruction, the same fused kernels: the x86-64-v3 copy's bits) like the batched functions. Slices of different lengths: the first
 /// `min` of the three lengths are computed, the rest of `s` and `c` is left as it is.
 #[inline(never)]
 pub fn sin_cos_slice(x: &[f64], s: &mut [f64], c: &mut [f64]) {
-    crate::isa::dispatch_fused_with(
+    crate::isa::dispatch_fused_wide_with(
         (s, c),
         #[inline(always)]
         |(s, c)| sin_cos_slice_lanes::<Plain>(x, s, c),

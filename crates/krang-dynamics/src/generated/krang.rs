@@ -9500,7 +9500,7 @@ mod generated {
                 m[(11, 18)] = 0.0;
             }
         }
-        kanegen_runtime::isa::dispatch_fused_with(
+        kanegen_runtime::isa::dispatch_fused_wide_with(
             out,
             #[inline(always)]
             |out| body::<kanegen_runtime::isa::Plain, L>(p, pc, q, out),
@@ -11776,7 +11776,7 @@ mod generated {
                 m[1] = -d332;
             }
         }
-        kanegen_runtime::isa::dispatch_fused_with(
+        kanegen_runtime::isa::dispatch_fused_wide_with(
             out,
             #[inline(always)]
             |out| body::<kanegen_runtime::isa::Plain, L>(p, pc, q, u, out),
@@ -11997,7 +11997,7 @@ mod generated {
                 m[1] = 0.0;
             }
         }
-        kanegen_runtime::isa::dispatch_fused_with(
+        kanegen_runtime::isa::dispatch_fused_wide_with(
             out,
             #[inline(always)]
             |out| body::<kanegen_runtime::isa::Plain, L>(p, pc, q, out),
@@ -14250,7 +14250,7 @@ mod generated {
                 m[1] = A::mul_add(pc.pc68, psidd, -d394);
             }
         }
-        kanegen_runtime::isa::dispatch_fused_with(
+        kanegen_runtime::isa::dispatch_fused_wide_with(
             out,
             #[inline(always)]
             |out| body::<kanegen_runtime::isa::Plain, L>(p, pc, q, u, ud, out),

@@ -1,5 +1,6 @@
 //! Issue 14: the generated Krang functions with each instruction set of the run-time dispatch
-//! (`baseline`, `x86-64-v3`: AVX2 + FMA) and batched at 4 and 8 states per call.
+//! (`baseline`, `x86-64-v3`: AVX2 + FMA, `x86-64-v4`: AVX-512, which only the batched functions
+//! have a copy for) and batched at 4 and 8 states per call.
 //!
 //! ```sh
 //! cargo bench --bench simd                 # ≈ 2 minutes

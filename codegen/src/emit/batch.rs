@@ -4,11 +4,12 @@
 //!
 //! The body is a loop over the states around the single-state function's statements, printed
 //! exactly as there (the same multiply-add chains, generic over `A: Arith<f64>` and dispatched
-//! like the single-state function), so lane `l` is the single-state value at state `l`, bit
-//! for bit with the same instruction set. LLVM's loop vectorizer runs the loop body on vectors
-//! across the states. Only the bindings of the inputs (transposed to lane-major order, sines
-//! and cosines lane by lane, before the loop) and the result stores (straight into the
-//! caller's `L` results) differ. `L` is a const generic: one emitted body for every batch size.
+//! like the single-state function, with an x86-64-v4 copy more: `isa::dispatch_fused_wide_with`),
+//! so lane `l` is the single-state value at state `l`, bit for bit with the same instruction
+//! set (the x86-64-v4 copy gives the x86-64-v3 copy's bits). LLVM's loop vectorizer runs the
+//! loop body on vectors across the states. Only the bindings of the inputs (transposed to
+//! lane-major order, sines and cosines lane by lane, before the loop) and the result stores
+//! (straight into the caller's `L` results) differ. `L` is a const generic: one emitted body for every batch size.
 //! README "Instruction sets at run time and batched evaluation" has the measurements.
 
 use proc_macro2::TokenStream;

@@ -53,7 +53,8 @@ pub struct EmitError {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct EmitOptions {
     /// Run-time instruction-set dispatch (default `true`): every generated function is compiled
-    /// for the baseline target and for x86-64-v3 (AVX2 + FMA), and
+    /// for the baseline target and for x86-64-v3 (AVX2 + FMA), the batched ones also for
+    /// x86-64-v4 (AVX-512), and
     /// `kanegen_runtime::isa::dispatch` runs the best copy the CPU supports (a plain call in
     /// builds without the runtime's `dispatch` feature, on other architectures and when the
     /// crate is compiled with `-C target-cpu` that has AVX2 and FMA). Off: one copy.

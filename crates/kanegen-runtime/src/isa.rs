@@ -6,7 +6,11 @@
 //! generated function (and [`crate::trig::sin_cos_n`]) is therefore compiled twice, for the
 //! baseline and for x86-64-v3, and [`dispatch`] chooses between the two copies at every call
 //! by one relaxed atomic load of the instruction set detected once, at the first call
-//! ([`active`]).
+//! ([`active`]). The batched functions (and [`crate::trig::sin_cos_slice`]) have a third copy,
+//! for x86-64-v4 (AVX-512), chosen by [`dispatch_fused_wide_with`]: their loop over the states
+//! runs 8 lanes per instruction there. On an AVX-512 CPU [`active`] is [`Isa::X86_64V4`] and
+//! the single-state functions run their x86-64-v3 copy (an AVX-512 copy of them was measured no
+//! faster on Krang, and costs a third more compile time).
 //!
 //! How: the generated function's body is `#[inline(always)]` and is passed to [`dispatch`] as
 //! an `#[inline(always)]` closure. [`dispatch`] calls it directly (the baseline copy) or through
@@ -14,8 +18,9 @@
 //! inlines the closure and the body: that copy of the body is compiled for AVX2 with the
 //! three-operand VEX encodings and 256-bit vectors where LLVM vectorizes. Calling a
 //! `#[target_feature]` function needs `unsafe` (the CPU must have the features); this module
-//! holds that call (the same in [`dispatch`] and [`dispatch_fused_with`], through which
-//! [`dispatch_fused`] runs), right after the check that
+//! holds that call (the same in [`dispatch`], [`dispatch_fused_with`], through which
+//! [`dispatch_fused`] runs, and [`dispatch_fused_wide_with`], which also calls the x86-64-v4
+//! copy), right after the check that
 //! the features are present; the crate's only other `unsafe` block is the same kind of call in
 //! [`crate::derivative_steps::run`] (its AVX2 kernel, after [`active`] reported x86-64-v3).
 //!
@@ -193,8 +198,10 @@ if_dispatching! {
         }
     }
 
-    /// `f()` compiled with x86-64-v4's features.
-    #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,f16c,popcnt,avx512f,avx512bw,avx512cd,avx512dq,avx512vl")]
+    /// `f()` compiled with x86-64-v4's features (x86-64-v3's and AVX-512 F, BW, CD, DQ, VL).
+    #[target_feature(
+        enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,f16c,popcnt,avx512f,avx512bw,avx512cd,avx512dq,avx512vl"
+    )]
     #[inline]
     fn run_v4<R, F: FnOnce() -> R>(f: F) -> R {
         f()

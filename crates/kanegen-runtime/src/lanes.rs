@@ -5,8 +5,8 @@
 //! &mut [SMatrix; L])`, or the wrapper's `Krang::mass_matrix_batch_into`; `*_batch` returns the
 //! results by value) run the *same* straight-line statements as the single-state function in
 //! a loop over the states, which LLVM's loop vectorizer turns into vector instructions across
-//! the states (two per SSE2 register, four per AVX2 register; the x86-64-v3 copy is chosen by
-//! [`crate::isa`]). Lane `l` is therefore the single-state result at state `l` **bit for bit**,
+//! the states (two per SSE2 register, four per AVX2 register, eight per AVX-512 register; the
+//! x86-64-v3 or x86-64-v4 copy is chosen by [`crate::isa`]). Lane `l` is therefore the single-state result at state `l` **bit for bit**,
 //! with the same instruction set. Before the loop the inputs are transposed to lane-major
 //! order ([`inputs`]) and the sines and cosines of all joint angles of all states are computed
 //! in one call ([`sin_cos_n`]). [`Lanes<L>`] (`L` `f64`s with lane-wise operators, `f64`

@@ -16,7 +16,8 @@
 //!   matrix): the trait every generated robot type implements, so that a controller can be
 //!   written once for any generated robot.
 //!
-//! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA), the
+//! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA; the
+//!   batched functions also x86-64-v4, AVX-512), the
 //!   crate's `unsafe` calls (see below), and [`isa::Arith`], the multiply-add the copies
 //!   differ in; [`lanes`]: the lane type of the batched functions.
 //! - [`regressor`]: the loop of a loop-form inverse-dynamics regressor (per link and four rows
@@ -25,8 +26,9 @@
 //!   (column, ancestor) steps of the analytic recursion over generated tables); its AVX2 copy
 //!   is called from the crate's second `unsafe` block.
 //!
-//! `#![no_std]`, `unsafe` only to call code compiled for x86-64-v3 after the CPU was checked
-//! ([`isa::dispatch`], [`isa::dispatch_fused`], [`derivative_steps::run`]), no dependency but [`nalgebra`] (re-exported: its vector and
+//! `#![no_std]`, `unsafe` only to call code compiled for x86-64-v3 or v4 after the CPU was
+//! checked ([`isa::dispatch`], [`isa::dispatch_fused_with`], [`isa::dispatch_fused_wide_with`],
+//! [`derivative_steps::run`]), no dependency but [`nalgebra`] (re-exported: its vector and
 //! matrix types are the trait's argument types) and, behind features, `serde` and `toml`.
 //!
 //! # How generated code uses it
@@ -134,12 +136,14 @@
 //! - `serde`: `Serialize`/`Deserialize` for every generated `Params` (`no_std`-compatible);
 //!   re-exports `serde`.
 //! - `dispatch` (default; needs `std` for feature detection): every generated function is
-//!   compiled for the baseline and for x86-64-v3 and the best copy runs ([`isa`]).
+//!   compiled for the baseline and for x86-64-v3 (the batched ones also for x86-64-v4) and
+//!   the best copy runs ([`isa`]).
 //! - `toml` (implies `serde` and `std`): `params_from_model_toml`, the `[parameters]` table
 //!   of a model description file as a generated `Params`, at run time.
 
 #![no_std]
-// One `unsafe` call, in `isa::dispatch` and `isa::dispatch_fused` (calling the x86-64-v3 copy after feature detection).
+// `unsafe` only to call a copy compiled for x86-64-v3 or v4 after feature detection (`isa`,
+// `derivative_steps::run`).
 #![deny(unsafe_code)]
 
 #[cfg(feature = "std")]

@@ -9,7 +9,7 @@
 //! Ids: `simd/<function>/<isa>` (one state per call) and `simd/<function>/<isa>/batch<L>` (one
 //! call of `<function>_batch_into` with `L` states: divide by `L` for the time per state;
 //! `batch<L>_by_value`: `mass_matrix_batch`, which returns the results). The states cycle
-//! through 64 random ones.
+//! through the profile driver's 64 random ones.
 
 use std::hint::black_box;
 use std::time::Duration;
@@ -17,27 +17,12 @@ use std::time::Duration;
 use criterion::{Criterion, criterion_group, criterion_main};
 use krang_dynamics::Krang;
 use krang_dynamics::isa::{self, Isa};
-use nalgebra::SVector;
 
-type V = SVector<f64, 19>;
-
-fn states() -> Vec<(V, V, V)> {
-    let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
-    let mut next = move || {
-        x = x
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (x >> 11) as f64 / (1u64 << 53) as f64
-    };
-    (0..64)
-        .map(|_| {
-            let q = V::from_fn(|_, _| (2.0 * next() - 1.0) * std::f64::consts::PI);
-            let u = V::from_fn(|_, _| 4.0 * next() - 2.0);
-            let ud = V::from_fn(|_, _| 10.0 * next() - 5.0);
-            (q, u, ud)
-        })
-        .collect()
-}
+/// The 64 states the profile driver (`crates/krang-dynamics/examples/profile.rs`) cycles
+/// through, so that its figures and this bench's measure the same inputs.
+#[path = "../crates/krang-dynamics/examples/profile_states/mod.rs"]
+mod profile_states;
+use profile_states::{V, states};
 
 /// `L` consecutive states from state `i`, as the batched functions take them.
 fn batch<const L: usize>(s: &[(V, V, V)], i: usize) -> ([V; L], [V; L], [V; L]) {

@@ -1,5 +1,6 @@
 //! The 64 fixed pseudo-random Krang states the profiling examples (`profile`,
-//! `profile_regressors`) cycle through: a small LCG, deterministic and dependency-free.
+//! `profile_regressors`) and the workspace's `benches/simd.rs` cycle through: a small LCG,
+//! deterministic and dependency-free.
 
 use nalgebra::SVector;
 

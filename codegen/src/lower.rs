@@ -188,6 +188,66 @@ fn locals(e: &LExpr, out: &mut Vec<usize>) {
     }
 }
 
+/// The program `p` restricted to the result entries `keep(row, col)` selects: those entries
+/// and the statements they read, directly or not, in `p`'s order and with `p`'s names, so
+/// every value is the same expression as in `p` (the same bits). Its operation counts are its
+/// own; its `sincos` is `p`'s (the angles a caller computed for `p`, in `p`'s order). What the
+/// batched functions use to split a program with more result entries than one vectorized loop
+/// can store into several loops (`emit::batch`).
+pub fn restrict(p: &Program, keep: impl Fn(usize, usize) -> bool) -> Program {
+    let outputs: Vec<(usize, usize, LExpr)> = p
+        .outputs
+        .iter()
+        .filter(|(r, c, _)| keep(*r, *c))
+        .cloned()
+        .collect();
+    let mut needed = vec![false; p.stmts.len()];
+    let mut stack = Vec::new();
+    for (_, _, e) in &outputs {
+        locals(e, &mut stack);
+    }
+    while let Some(i) = stack.pop() {
+        if !needed[i] {
+            needed[i] = true;
+            locals(&p.stmts[i].expr, &mut stack);
+        }
+    }
+    let mut index = vec![usize::MAX; p.stmts.len()];
+    let mut stmts = Vec::new();
+    for (i, s) in p.stmts.iter().enumerate() {
+        if needed[i] {
+            index[i] = stmts.len();
+            stmts.push(s.clone());
+        }
+    }
+    fn renumber(e: &mut LExpr, index: &[usize]) {
+        match e {
+            LExpr::Leaf(Leaf::Local(i)) => *i = index[*i],
+            LExpr::Leaf(_) => {}
+            LExpr::Sum { terms, .. } => terms.iter_mut().for_each(|(_, t)| renumber(t, index)),
+            LExpr::Prod(f) => f.iter_mut().for_each(|(b, _)| renumber(b, index)),
+        }
+    }
+    let mut q = Program {
+        name: p.name.clone(),
+        sincos: Vec::new(),
+        stmts,
+        outputs,
+        ops: OpCount::default(),
+        k_vars: p.k_vars,
+        d_vars: p.d_vars,
+    };
+    q.stmts
+        .iter_mut()
+        .for_each(|s| renumber(&mut s.expr, &index));
+    q.outputs
+        .iter_mut()
+        .for_each(|(_, _, e)| renumber(e, &index));
+    finish(&mut q);
+    q.sincos = p.sincos.clone();
+    q
+}
+
 /// Reorders the statements of a program whose result entries are indexed by speed (their row:
 /// c, τ, the Coriolis matrix) per subtree: one arm's forward and backward passes before the
 /// other arm's, instead of the forward pass of all frames before the backward pass of all

@@ -123,3 +123,47 @@ fn subtree_order_keeps_the_values_and_lowers_the_values_live() {
 fn f_live(low: &kanegen::lower::Lowered, id: FunctionId) -> usize {
     low.function(id).expect("function exists").max_live()
 }
+
+/// `restrict` (how a batched function with more result entries than one vectorized loop can
+/// store is split into several loops): each part of Krang's Coriolis matrix, split by rows as
+/// its batched function is (rows 0–7: 128 entries, 8–18: 132), gives its entries the whole program's bits and nothing else, and
+/// holds only the statements its entries read (fewer than the whole; together more: the
+/// statements both read are in both).
+#[test]
+fn restricted_programs_give_their_entries_bits_and_hold_only_what_they_read() {
+    use kanegen::lower::restrict;
+    let params: Vec<f64> = krang().params.iter().map(|p| p.value).collect();
+    let q: Vec<f64> = (0..19).map(|i| 0.13 * i as f64 - 0.9).collect();
+    let u: Vec<f64> = (0..19).map(|i| 0.4 - 0.07 * i as f64).collect();
+    let low = lowered(ParamMode::Runtime);
+    let id = FunctionId::CoriolisMatrix;
+    let whole = low.evaluate(id, &params, &q, &u, &[0.0; 19]);
+    let full = low.function(id).expect("function exists");
+    let mut statements = 0;
+    for rows in [0..8, 8..19] {
+        let mut part = low.clone();
+        let f = part
+            .functions
+            .iter_mut()
+            .find(|f| f.id == id)
+            .expect("function exists");
+        f.program = restrict(&f.program, |r, _| rows.contains(&r));
+        assert!(f.program.stmts.len() < full.stmts.len());
+        assert_eq!(f.program.sincos, full.sincos);
+        statements += f.program.stmts.len();
+        eprintln!(
+            "rows {rows:?}: {} statements, {} flops (whole: {}, {})",
+            f.program.stmts.len(),
+            f.program.ops.flops(),
+            full.stmts.len(),
+            full.ops.flops()
+        );
+        let values = part.evaluate(id, &params, &q, &u, &[0.0; 19]);
+        for (i, (a, b)) in whole.iter().zip(&values).enumerate() {
+            let (r, c) = (i / 19, i % 19);
+            let expected = if rows.contains(&r) { *a } else { 0.0 };
+            assert_eq!(b.to_bits(), expected.to_bits(), "C[({r}, {c})]");
+        }
+    }
+    assert!(statements > full.stmts.len());
+}

@@ -12,6 +12,8 @@
 //! (straight into the caller's `L` results) differ. `L` is a const generic: one emitted body for every batch size.
 //! README "Instruction sets at run time and batched evaluation" has the measurements.
 
+use std::borrow::Cow;
+
 use proc_macro2::TokenStream;
 use quote::quote;
 
@@ -19,7 +21,7 @@ use super::Context;
 use super::function::{Reads, Stores, nonzero_outputs, store_text_after, text, unused_inputs};
 use super::items::{arg_names, return_type};
 use super::print::{Printer, ident, idx};
-use crate::lower::{FunctionProgram, LExpr, Program};
+use crate::lower::{self, FunctionProgram, LExpr, Program};
 use crate::naming;
 use crate::registry::{FunctionSpec, Inputs, Shape};
 
@@ -134,32 +136,65 @@ fn lane_values(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
     ts
 }
 
-/// The stores of the loop body (text lines by position, see [`Printer::statement_block`]) and
-/// of a loop of their own after it.
-struct ResultStores {
-    in_loop: Stores,
-    after: TokenStream,
+/// Most result entries one loop over the states stores. LLVM's loop vectorizer needs to know
+/// that the loop's stores do not overwrite what it reads; its alias-set tracker gives up
+/// beyond 250 distinct memory locations per loop (`-alias-set-saturation-threshold`), and
+/// then the loop stays scalar ("runtime pointer checks needed"). Krang's M (141 entries)
+/// stays below it with its inputs; the Coriolis matrix (260 entries) did not, so a function
+/// with more entries is emitted as several loops ([`loop_parts`]).
+const LOOP_ENTRIES: usize = 150;
+
+/// The programs of the loops over the states: `p` itself, or, when it has more than
+/// [`LOOP_ENTRIES`] nonzero result entries, `p` restricted to consecutive ranges of result
+/// rows with about equal numbers of entries ([`lower::restrict`]: each part recomputes the
+/// statements it reads, with the same expressions, so every entry keeps its bits).
+fn loop_parts(p: &Program) -> Vec<Cow<'_, Program>> {
+    let mut rows: Vec<usize> = nonzero_outputs(p).map(|(r, _, _)| *r).collect();
+    if rows.len() <= LOOP_ENTRIES {
+        return vec![Cow::Borrowed(p)];
+    }
+    rows.sort_unstable();
+    let parts = rows.len().div_ceil(LOOP_ENTRIES);
+    // Part k takes the rows from the one holding entry k·n/parts (in row order) on.
+    let mut first_rows: Vec<usize> = (0..parts).map(|k| rows[k * rows.len() / parts]).collect();
+    first_rows.dedup();
+    first_rows
+        .iter()
+        .enumerate()
+        .map(|(k, &from)| {
+            let to = first_rows.get(k + 1).copied().unwrap_or(usize::MAX);
+            Cow::Owned(lower::restrict(p, |r, _| (from..to).contains(&r)))
+        })
+        .collect()
 }
 
-/// The result stores: every nonzero entry right after the last statement it reads (with
-/// multiply-add chains), into the caller's result `m`; after the loop, the lower entries of a
-/// symmetric matrix (copied from the upper ones) and `0.0` into every entry no statement
-/// writes. Each entry of the caller's result is written exactly once, so nothing is zeroed
-/// first. The mirrored entries and the zeros stay out of the vectorized loop: LLVM merges
-/// adjacent zero stores into `memset` calls, and a loop with a call is not vectorized; with the
-/// mirrored stores in it (as a copy or as the value again) Krang's M was not vectorized either
-/// ("loop not vectorized: runtime pointer checks needed").
-fn stores(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) -> ResultStores {
-    let mut in_loop: Stores = vec![Vec::new(); p.stmts.len() + 1];
-    let (rows, cols) = shape.size_in(&cx.low.sizes);
-    let vector = cols == 1;
-    let entry_text = |r: usize, c: usize| {
-        if vector {
+/// The result stores inside the loop: every nonzero entry of `p` right after the last
+/// statement it reads (with multiply-add chains), into the caller's result `m` (text lines by
+/// position, see [`Printer::statement_block`]).
+fn loop_stores(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, vector: bool) -> Stores {
+    let mut stores: Stores = vec![Vec::new(); p.stmts.len() + 1];
+    for (r, c, e) in nonzero_outputs(p) {
+        let v = text(cx, printer, e);
+        let entry = if vector {
             format!("m[{r}]")
         } else {
             format!("m[({r}, {c})]")
-        }
-    };
+        };
+        store_text_after(&mut stores, e, format!("{entry} = {v};"));
+    }
+    stores
+}
+
+/// The stores of a loop of their own after the loops that compute: the lower entries of a
+/// symmetric matrix (copied from the upper ones) and `0.0` into every entry no statement
+/// writes. With the loops' stores, each entry of the caller's result is written exactly once,
+/// so nothing is zeroed first. The mirrored entries and the zeros stay out of the vectorized
+/// loop: LLVM merges adjacent zero stores into `memset` calls, and a loop with a call is not
+/// vectorized; with the mirrored stores in it (as a copy or as the value again) Krang's M was
+/// not vectorized either ("loop not vectorized: runtime pointer checks needed").
+fn after_stores(cx: &Context<'_>, p: &Program, shape: Shape) -> TokenStream {
+    let (rows, cols) = shape.size_in(&cx.low.sizes);
+    let vector = cols == 1;
     let entry = |r: usize, c: usize| {
         let (ri, ci) = (idx(r), idx(c));
         if vector {
@@ -171,10 +206,8 @@ fn stores(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
     let mirror = shape == Shape::SymmetricMatrix;
     let mut written = vec![false; rows * cols];
     let mut after = TokenStream::new();
-    for (r, c, e) in nonzero_outputs(p) {
+    for (r, c, _) in nonzero_outputs(p) {
         let (r, c) = (*r, *c);
-        let v = text(cx, printer, e);
-        store_text_after(&mut in_loop, e, format!("{} = {v};", entry_text(r, c)));
         written[c * rows + r] = true;
         if mirror && r != c {
             let (to, from) = (entry(c, r), entry(r, c));
@@ -188,13 +221,14 @@ fn stores(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
             after.extend(quote!(#to = 0.0;));
         }
     }
-    ResultStores { in_loop, after }
+    after
 }
 
 /// The batched free functions of `f` (`NAME_batch_into` and `NAME_batch`), or nothing if it
 /// has none.
 ///
-/// The body is one loop over the lanes, `for (l, m) in out.iter_mut().enumerate()`, around the
+/// The body is one loop over the lanes, `for (l, m) in out.iter_mut().enumerate()` (several
+/// for a result with more than [`LOOP_ENTRIES`] entries: [`loop_parts`]), around the
 /// single-state function's statements, printed as they are (multiply-add chains over
 /// `A: Arith<f64>` included) and storing into the caller's result `m`: LLVM's loop vectorizer
 /// then runs the whole body on vectors across the states (four lanes per AVX2 register, two
@@ -208,7 +242,6 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     }
     let spec = f.id.spec();
     let p = &f.program;
-    let printer = cx.printer(&p.stmts);
     let reads = Reads::of(p, cx.low.dof);
     let name = batch_name(spec);
     let name_into = ident(&format!("{}_batch_into", spec.name));
@@ -232,26 +265,33 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     let names = arg_names(spec.inputs);
     let out = out_arg(cx, spec);
     let lane_inputs = lane_inputs(cx, p, &reads);
-    let lane_values = lane_values(cx, p, &reads);
     let ty = return_type(cx, spec);
-    let ResultStores {
-        in_loop: stores,
-        after,
-    } = stores(cx, &printer, p, spec.shape);
-    let lane_loop = if lane_values.is_empty() {
-        quote!(for m in out.iter_mut())
-    } else {
-        quote!(for (l, m) in out.iter_mut().enumerate())
-    };
+    let vector = spec.shape.size_in(&cx.low.sizes).1 == 1;
+    // One loop per part (one part unless the result has more entries than a vectorized loop
+    // can store).
+    let mut loops = TokenStream::new();
+    for part in loop_parts(p) {
+        let printer = cx.printer(&part.stmts);
+        let reads = Reads::of(&part, cx.low.dof);
+        let lane_values = lane_values(cx, &part, &reads);
+        let stores = loop_stores(cx, &printer, &part, vector);
+        let stored: Vec<&LExpr> = nonzero_outputs(&part).map(|(_, _, e)| e).collect();
+        let block =
+            printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true);
+        let statements = cx.blocks.placeholder(block);
+        let lane_loop = if lane_values.is_empty() {
+            quote!(for m in out.iter_mut())
+        } else {
+            quote!(for (l, m) in out.iter_mut().enumerate())
+        };
+        loops.extend(quote!(#lane_loop { #lane_values #statements }));
+    }
+    let after = after_stores(cx, p, spec.shape);
     let after_loop = if after.is_empty() {
         TokenStream::new()
     } else {
         quote!(for m in out.iter_mut() { #after })
     };
-    let stored: Vec<&LExpr> = nonzero_outputs(p).map(|(_, _, e)| e).collect();
-    let block =
-        printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true);
-    let statements = cx.blocks.placeholder(block);
     let unused = unused_inputs(spec.inputs, p, &reads);
     // Local copies of the parameters: the result stores cannot alias them (see above).
     let mut copies = TokenStream::new();
@@ -281,10 +321,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
                 #unused
                 #copies
                 #lane_inputs
-                #lane_loop {
-                    #lane_values
-                    #statements
-                }
+                #loops
                 #after_loop
             }
             #call

@@ -13,6 +13,7 @@
 //! README "Instruction sets at run time and batched evaluation" has the measurements.
 
 use std::borrow::Cow;
+use std::collections::BTreeMap;
 
 use proc_macro2::TokenStream;
 use quote::quote;
@@ -136,35 +137,62 @@ fn lane_values(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
     ts
 }
 
-/// Most result entries one loop over the states stores. LLVM's loop vectorizer needs to know
-/// that the loop's stores do not overwrite what it reads; its alias-set tracker gives up
-/// beyond 250 distinct memory locations per loop (`-alias-set-saturation-threshold`), and
-/// then the loop stays scalar ("runtime pointer checks needed"). Krang's M (141 entries)
-/// stays below it with its inputs; the Coriolis matrix (260 entries) did not, so a function
-/// with more entries is emitted as several loops ([`loop_parts`]).
-const LOOP_ENTRIES: usize = 150;
+/// Most memory locations one loop over the states may touch: result entries stored plus
+/// lane inputs read (sines, cosines, coordinates, speeds, accelerations). LLVM's loop
+/// vectorizer needs to know that the loop's stores do not overwrite what it reads; its
+/// alias-set tracker gives up beyond 250 distinct locations per loop
+/// (`-alias-set-saturation-threshold`), and then the loop stays scalar ("runtime pointer checks
+/// needed"). Krang's M (141 entries, 34 sines and cosines read) stays below it; its Coriolis
+/// matrix (260 entries, 53 inputs) did not, so it is emitted as two loops ([`loop_parts`]).
+const LOOP_LOCATIONS: usize = 240;
 
-/// The programs of the loops over the states: `p` itself, or, when it has more than
-/// [`LOOP_ENTRIES`] nonzero result entries, `p` restricted to consecutive ranges of result
-/// rows with about equal numbers of entries ([`lower::restrict`]: each part recomputes the
-/// statements it reads, with the same expressions, so every entry keeps its bits).
-fn loop_parts(p: &Program) -> Vec<Cow<'_, Program>> {
-    let mut rows: Vec<usize> = nonzero_outputs(p).map(|(r, _, _)| *r).collect();
-    if rows.len() <= LOOP_ENTRIES {
+/// The programs of the loops over the states: `p` itself, or, when its nonzero result entries
+/// and the lane inputs it reads exceed [`LOOP_LOCATIONS`], `p` restricted to consecutive
+/// ranges of result rows ([`lower::restrict`]: each part computes the statements its entries
+/// read, with the same expressions, so every entry keeps its bits). Each range is as long as
+/// the budget allows (the entries it stores plus the inputs the whole program reads): the
+/// fewest loops, and for a tree numbered one subtree after the other the last parts are whole
+/// subtrees, which read little of the others. Krang's Coriolis matrix: rows 0–11 (trunk and
+/// left arm, 176 entries) and 12–18 (right arm, 84): 9,531 flops per state in all, the fewest
+/// of its two-part splits by rows (equal halves, rows 0–7 and 8–18: 10,347; one loop: 7,893).
+/// A row with more entries than the budget gets a loop of its own (which may stay scalar).
+fn loop_parts<'p>(p: &'p Program, reads: &Reads) -> Vec<Cow<'p, Program>> {
+    let inputs = [
+        &reads.sin,
+        &reads.cos,
+        &reads.coord,
+        &reads.speed,
+        &reads.accel,
+    ]
+    .iter()
+    .map(|read| read.iter().filter(|&&r| r).count())
+    .sum::<usize>();
+    let mut per_row: BTreeMap<usize, usize> = BTreeMap::new();
+    for (r, _, _) in nonzero_outputs(p) {
+        *per_row.entry(*r).or_default() += 1;
+    }
+    let budget = LOOP_LOCATIONS.saturating_sub(inputs);
+    if per_row.values().sum::<usize>() <= budget {
         return vec![Cow::Borrowed(p)];
     }
-    rows.sort_unstable();
-    let parts = rows.len().div_ceil(LOOP_ENTRIES);
-    // Part k takes the rows from the one holding entry k·n/parts (in row order) on.
-    let mut first_rows: Vec<usize> = (0..parts).map(|k| rows[k * rows.len() / parts]).collect();
-    first_rows.dedup();
-    first_rows
-        .iter()
-        .enumerate()
-        .map(|(k, &from)| {
-            let to = first_rows.get(k + 1).copied().unwrap_or(usize::MAX);
-            Cow::Owned(lower::restrict(p, |r, _| (from..to).contains(&r)))
-        })
+    // Greedy: each range of rows takes rows while its entries fit the budget.
+    let mut ranges: Vec<(usize, usize)> = Vec::new();
+    let mut entries = 0;
+    for (&row, &n) in &per_row {
+        match ranges.last_mut() {
+            Some(range) if entries + n <= budget => {
+                range.1 = row + 1;
+                entries += n;
+            }
+            _ => {
+                ranges.push((row, row + 1));
+                entries = n;
+            }
+        }
+    }
+    ranges
+        .into_iter()
+        .map(|(from, to)| Cow::Owned(lower::restrict(p, |r, _| (from..to).contains(&r))))
         .collect()
 }
 
@@ -228,7 +256,7 @@ fn after_stores(cx: &Context<'_>, p: &Program, shape: Shape) -> TokenStream {
 /// has none.
 ///
 /// The body is one loop over the lanes, `for (l, m) in out.iter_mut().enumerate()` (several
-/// for a result with more than [`LOOP_ENTRIES`] entries: [`loop_parts`]), around the
+/// for a result with more entries than one vectorized loop can store: [`loop_parts`]), around the
 /// single-state function's statements, printed as they are (multiply-add chains over
 /// `A: Arith<f64>` included) and storing into the caller's result `m`: LLVM's loop vectorizer
 /// then runs the whole body on vectors across the states (four lanes per AVX2 register, two
@@ -270,7 +298,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     // One loop per part (one part unless the result has more entries than a vectorized loop
     // can store).
     let mut loops = TokenStream::new();
-    for part in loop_parts(p) {
+    for part in loop_parts(p, &reads) {
         let printer = cx.printer(&part.stmts);
         let reads = Reads::of(&part, cx.low.dof);
         let lane_values = lane_values(cx, &part, &reads);

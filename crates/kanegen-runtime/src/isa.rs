@@ -265,26 +265,19 @@ if_dispatching! {
         plain: impl FnOnce(T) -> R,
         fused: impl FnOnce(T) -> R,
     ) -> R {
-        match active_code() {
+        if active_code() == V4 {
             // SAFETY: `ACTIVE` holds `V4` only after `v4_present()` found every feature
-            // `run_v4` is compiled with (`detect` and `select` check it before storing).
+            // `run_v4` is compiled with (`detect` and `select` check it before storing), so
+            // the CPU executes its instructions.
             #[allow(unsafe_code)]
-            V4 => unsafe {
-                run_v4(
+            unsafe {
+                return run_v4(
                     #[inline(always)]
                     || fused(arg),
-                )
-            },
-            // SAFETY: as in `dispatch_fused_with`.
-            #[allow(unsafe_code)]
-            V3 => unsafe {
-                run_v3(
-                    #[inline(always)]
-                    || fused(arg),
-                )
-            },
-            _ => plain(arg),
+                );
+            }
         }
+        dispatch_fused_with(arg, plain, fused)
     }
 }
 

@@ -191,7 +191,8 @@ fn locals(e: &LExpr, out: &mut Vec<usize>) {
 /// The program `p` restricted to the result entries `keep(row, col)` selects: those entries
 /// and the statements they read, directly or not, in `p`'s order and with `p`'s names, so
 /// every value is the same expression as in `p` (the same bits). Its operation counts are its
-/// own; its `sincos` is `p`'s (the angles a caller computed for `p`, in `p`'s order). What the
+/// own; its `sincos` is `p`'s (the angles a caller computed for `p`, in `p`'s order), and so
+/// are its K and D variable counts (the derivation's, for reports). What the
 /// batched functions use to split a program with more result entries than one vectorized loop
 /// can store into several loops (`emit::batch`).
 pub fn restrict(p: &Program, keep: impl Fn(usize, usize) -> bool) -> Program {

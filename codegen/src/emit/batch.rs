@@ -9,7 +9,9 @@
 //! set (the x86-64-v4 copy gives the x86-64-v3 copy's bits). LLVM's loop vectorizer runs the
 //! loop body on vectors across the states. Only the bindings of the inputs (transposed to
 //! lane-major order, sines and cosines lane by lane, before the loop) and the result stores
-//! (straight into the caller's `L` results) differ. `L` is a const generic: one emitted body for every batch size.
+//! (straight into the caller's `L` results) differ; a result with more entries than one
+//! vectorized loop can store is computed in several loops ([`loop_parts`]). `L` is a const
+//! generic: one emitted body for every batch size.
 //! README "Instruction sets at run time and batched evaluation" has the measurements.
 
 use std::borrow::Cow;
@@ -256,8 +258,8 @@ fn after_stores(cx: &Context<'_>, p: &Program, shape: Shape) -> TokenStream {
 /// has none.
 ///
 /// The body is one loop over the lanes, `for (l, m) in out.iter_mut().enumerate()` (several
-/// for a result with more entries than one vectorized loop can store: [`loop_parts`]), around the
-/// single-state function's statements, printed as they are (multiply-add chains over
+/// for a result with more entries than one vectorized loop can store: [`loop_parts`]), around
+/// the single-state function's statements, printed as they are (multiply-add chains over
 /// `A: Arith<f64>` included) and storing into the caller's result `m`: LLVM's loop vectorizer
 /// then runs the whole body on vectors across the states (four lanes per AVX2 register, two
 /// per SSE2 register). Before the loop: the inputs in lane-major order, the lane-wise sines

@@ -499,7 +499,7 @@ fn zero_stores(p: &Program, n: usize, mirror: bool) -> Vec<String> {
 pub(super) enum Copies {
     /// The baseline and x86-64-v3 (`isa::dispatch_fused_with`): single-state functions. An
     /// x86-64-v4 copy was measured no faster for them (Krang's M, c, g, τ, C within 5 %) and
-    /// costs a third more compile time.
+    /// cost 43 % more compile time (README, "x86-64-v4 copy of the batched functions").
     BaselineAndV3,
     /// Also x86-64-v4 (`isa::dispatch_fused_wide_with`): the batched functions, whose loop
     /// over the states LLVM vectorizes 8 lanes wide with AVX-512.

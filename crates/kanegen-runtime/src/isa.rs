@@ -10,7 +10,7 @@
 //! for x86-64-v4 (AVX-512), chosen by [`dispatch_fused_wide_with`]: their loop over the states
 //! runs 8 lanes per instruction there. On an AVX-512 CPU [`active`] is [`Isa::X86_64V4`] and
 //! the single-state functions run their x86-64-v3 copy (an AVX-512 copy of them was measured no
-//! faster on Krang, and costs a third more compile time).
+//! faster on Krang, and cost 43 % more compile time).
 //!
 //! How: the generated function's body is `#[inline(always)]` and is passed to [`dispatch`] as
 //! an `#[inline(always)]` closure. [`dispatch`] calls it directly (the baseline copy) or through

@@ -100,7 +100,7 @@ fn lane_inputs(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
             name(&reads.sin, quote!(sin_q)),
             name(&reads.cos, quote!(cos_q)),
         );
-        ts.extend(quote!(let (#sn, #cn) = kanegen_runtime::lanes::sin_cos_n([#(#angles),*]);));
+        ts.extend(quote!(let (#sn, #cn) = kanegen_runtime::lanes::sin_cos_n_inline::<A, _, L>([#(#angles),*]);));
     }
     ts
 }

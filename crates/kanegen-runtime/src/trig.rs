@@ -103,14 +103,15 @@ fn sin_cos_n_slow<A: Arith<f64>, const N: usize>(x: [f64; N]) -> ([f64; N], [f64
 }
 
 /// [`sin_cos_n`] over a slice: `(s[k], c[k]) = (sin x[k], cos x[k])` for every `k`, bit for
-/// bit the values of [`sin_cos_n`] with the same instruction set, in one branch-free loop the compiler
-/// vectorizes, with the same flag and cold per-value fallback for a huge or non-finite value.
-/// What the batched functions call (through [`crate::lanes::sin_cos_n`]) for all joint angles
-/// of all states at once: one dispatched call instead of one per angle (measured on Krang's
-/// batched c at 4 states: the 17 per-angle calls took 39 % of its time). Compiled for the
+/// bit the values of [`sin_cos_n`] with the same instruction set, in one branch-free loop the
+/// compiler vectorizes, with the same flag and cold per-value fallback for a huge or
+/// non-finite value. The batched functions run this loop inline
+/// ([`crate::lanes::sin_cos_n_inline`]) for all joint angles of all their states at once (one
+/// call per angle instead took 39 % of Krang's batched c at 4 states). Compiled for the
 /// baseline and for x86-64-v3 like [`sin_cos_n`], and for x86-64-v4 (8 lanes per AVX-512
-/// instruction, the same fused kernels: the x86-64-v3 copy's bits) like the batched functions. Slices of different lengths: the first
-/// `min` of the three lengths are computed, the rest of `s` and `c` is left as it is.
+/// instruction, the same fused kernels: the x86-64-v3 copy's bits) like the batched functions.
+/// Slices of different lengths: the first `min` of the three lengths are computed, the rest of
+/// `s` and `c` is left as it is.
 #[inline(never)]
 pub fn sin_cos_slice(x: &[f64], s: &mut [f64], c: &mut [f64]) {
     crate::isa::dispatch_fused_wide_with(
@@ -124,7 +125,7 @@ pub fn sin_cos_slice(x: &[f64], s: &mut [f64], c: &mut [f64]) {
 
 /// The loop of [`sin_cos_slice`], inlined into each instruction set's copy.
 #[inline(always)]
-fn sin_cos_slice_lanes<A: Arith<f64>>(x: &[f64], s: &mut [f64], c: &mut [f64]) {
+pub(crate) fn sin_cos_slice_lanes<A: Arith<f64>>(x: &[f64], s: &mut [f64], c: &mut [f64]) {
     let mut fast = true;
     for ((x, s), c) in x.iter().zip(s.iter_mut()).zip(c.iter_mut()) {
         let (r, quadrant) = sin_cos_reduce(*x);

@@ -226,6 +226,40 @@ fn slice_routine_gives_the_scalar_bits_at_every_length_and_path() {
     }
 }
 
+/// The inline lanes form the batched functions use (`lanes::sin_cos_n_inline`): with `Plain`
+/// the scalar routine's bits, with `Fused` within 2 ulp of them (the fused kernels), on robot
+/// angles and with a huge value in one lane (the per-value fallback).
+#[test]
+fn inline_lanes_form_gives_the_plain_bits_and_fuses_within_two_ulp() {
+    use kanegen_runtime::isa::{Fused, Plain};
+    use kanegen_runtime::lanes::sin_cos_n_inline;
+    let xs = robot_angles();
+    let mut x: [[f64; 4]; 5] = core::array::from_fn(|k| core::array::from_fn(|l| xs[4 * k + l]));
+    for huge in [false, true] {
+        if huge {
+            x[3][1] = 1e22;
+        }
+        let (sp, cp) = sin_cos_n_inline::<Plain, 5, 4>(x);
+        let (sf, cf) = sin_cos_n_inline::<Fused, 5, 4>(x);
+        for k in 0..5 {
+            for l in 0..4 {
+                let (s1, c1) = sin_cos(x[k][l]);
+                assert!(
+                    same(sp[k][l], s1) && same(cp[k][l], c1),
+                    "plain, angle {k} lane {l}"
+                );
+                for (f, p) in [(sf[k][l], s1), (cf[k][l], c1)] {
+                    let tol = 2.0 * f64::EPSILON * p.abs().max(f64::MIN_POSITIVE);
+                    assert!(
+                        (f - p).abs() <= tol,
+                        "fused, angle {k} lane {l}: {f:e} vs {p:e}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 /// Distance in units in the last place between two finite `f32` of any sign.
 fn ulps(a: f32, b: f32) -> u32 {
     fn key(x: f32) -> i64 {

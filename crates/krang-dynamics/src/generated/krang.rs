@@ -7944,7 +7944,11 @@ mod generated {
             let p = &{ *p };
             let pc = &{ *pc };
             let q = kanegen_runtime::lanes::inputs(q);
-            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n([
+            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
+                A,
+                _,
+                L,
+            >([
                 q[2].0,
                 q[3].0,
                 q[4].0,
@@ -9539,7 +9543,11 @@ mod generated {
             let p = &{ *p };
             let q = kanegen_runtime::lanes::inputs(q);
             let u = kanegen_runtime::lanes::inputs(u);
-            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n([
+            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
+                A,
+                _,
+                L,
+            >([
                 q[2].0,
                 q[3].0,
                 q[4].0,
@@ -11814,7 +11822,11 @@ mod generated {
             let p = &{ *p };
             let pc = &{ *pc };
             let q = kanegen_runtime::lanes::inputs(q);
-            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n([
+            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
+                A,
+                _,
+                L,
+            >([
                 q[2].0,
                 q[3].0,
                 q[4].0,
@@ -12040,7 +12052,11 @@ mod generated {
             let q = kanegen_runtime::lanes::inputs(q);
             let u = kanegen_runtime::lanes::inputs(u);
             let ud = kanegen_runtime::lanes::inputs(ud);
-            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n([
+            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
+                A,
+                _,
+                L,
+            >([
                 q[2].0,
                 q[3].0,
                 q[4].0,

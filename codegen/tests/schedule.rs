@@ -167,3 +167,60 @@ fn restricted_programs_give_their_entries_bits_and_hold_only_what_they_read() {
     }
     assert!(statements > full.stmts.len());
 }
+
+/// The emitted batched functions of Krang: the Coriolis matrix (260 entries, 53 lane inputs:
+/// over the 240 locations one vectorized loop may touch) in two loops over the states, rows
+/// 0–11 and 12–18, each storing only its own rows; M, c, g and τ in one loop each.
+#[test]
+fn batched_coriolis_matrix_is_split_into_two_loops_by_rows_and_the_others_are_not() {
+    let emit = kanegen::EmitOptions {
+        batch: true,
+        ..kanegen::EmitOptions::default()
+    };
+    let g = kanegen::generate_with(krang(), kanegen::Options::default(), &emit).expect("generates");
+    // The body of `NAME_batch_into`: from its signature to the next public item.
+    let body = |name: &str| {
+        let from = g
+            .source
+            .find(&format!("pub fn {name}_batch_into<"))
+            .unwrap_or_else(|| panic!("{name}_batch_into is emitted"));
+        let rest = &g.source[from + 1..];
+        let to = rest.find("\n    pub fn ").unwrap_or(rest.len());
+        rest[..to].to_owned()
+    };
+    let loops = |text: &str| {
+        text.matches("for (l, m) in out.iter_mut().enumerate()")
+            .count()
+    };
+    for name in ["mass_matrix", "coriolis", "gravity", "inverse_dynamics"] {
+        assert_eq!(loops(&body(name)), 1, "{name}");
+    }
+    let c = body("coriolis_matrix");
+    assert_eq!(loops(&c), 2);
+    let second = c
+        .rfind("for (l, m) in out.iter_mut().enumerate()")
+        .expect("two loops");
+    let rows = |text: &str| -> Vec<usize> {
+        let mut rows: Vec<usize> = text
+            .match_indices("m[(")
+            .filter_map(|(i, _)| {
+                let rest = &text[i + 3..];
+                let r = &rest[..rest.find(',')?];
+                // Stores only: `m[(r, c)] = …`.
+                rest.find(")] =").filter(|&e| e < 12)?;
+                r.parse().ok()
+            })
+            .collect();
+        rows.sort_unstable();
+        rows.dedup();
+        rows
+    };
+    assert_eq!(rows(&c[..second]), (0..12).collect::<Vec<_>>());
+    let after = c[second..]
+        .find("for m in out.iter_mut()")
+        .unwrap_or(c.len() - second);
+    assert_eq!(
+        rows(&c[second..second + after]),
+        (12..19).collect::<Vec<_>>()
+    );
+}

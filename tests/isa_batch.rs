@@ -4,8 +4,9 @@
 //! function *with the same instruction set* (the same statements, multiply-add chains included,
 //! in a loop over the states): for batch sizes 1, 3 (odd), 4 and 8, with every instruction set
 //! the CPU has (on an AVX-512 CPU also x86-64-v4, where the batched functions run their AVX-512
-//! copy and the single-state ones their x86-64-v3 copy: the same fused operations), on random parameter sets and states (angles of all sizes, including a huge one that takes
-//! the slow sin/cos path in one lane). The `_into` forms write every entry of the caller's
+//! copy and the single-state ones their x86-64-v3 copy: the same fused operations), on random
+//! parameter sets and states (angles of all sizes, including a huge one that takes the slow
+//! sin/cos path in one lane). The `_into` forms write every entry of the caller's
 //! results (filled with NaN before the call) and give the by-value forms' bits.
 
 mod common;

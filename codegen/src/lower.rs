@@ -192,9 +192,9 @@ fn locals(e: &LExpr, out: &mut Vec<usize>) {
 /// and the statements they read, directly or not, in `p`'s order and with `p`'s names, so
 /// every value is the same expression as in `p` (the same bits). Its operation counts are its
 /// own; its `sincos` is `p`'s (the angles a caller computed for `p`, in `p`'s order), and so
-/// are its K and D variable counts (the derivation's, for reports). What the
-/// batched functions use to split a program with more result entries than one vectorized loop
-/// can store into several loops (`emit::batch`).
+/// are its K and D variable counts (the derivation's, for reports). What the batched functions
+/// use to split a program with more result entries than one vectorized loop can store into
+/// several loops (`emit::batch`).
 pub fn restrict(p: &Program, keep: impl Fn(usize, usize) -> bool) -> Program {
     let outputs: Vec<(usize, usize, LExpr)> = p
         .outputs
@@ -219,14 +219,6 @@ pub fn restrict(p: &Program, keep: impl Fn(usize, usize) -> bool) -> Program {
         if needed[i] {
             index[i] = stmts.len();
             stmts.push(s.clone());
-        }
-    }
-    fn renumber(e: &mut LExpr, index: &[usize]) {
-        match e {
-            LExpr::Leaf(Leaf::Local(i)) => *i = index[*i],
-            LExpr::Leaf(_) => {}
-            LExpr::Sum { terms, .. } => terms.iter_mut().for_each(|(_, t)| renumber(t, index)),
-            LExpr::Prod(f) => f.iter_mut().for_each(|(b, _)| renumber(b, index)),
         }
     }
     let mut q = Program {

@@ -126,9 +126,9 @@ fn f_live(low: &kanegen::lower::Lowered, id: FunctionId) -> usize {
 
 /// `restrict` (how a batched function with more result entries than one vectorized loop can
 /// store is split into several loops): each part of Krang's Coriolis matrix, split by rows as
-/// its batched function is (rows 0–11: 176 entries, 12–18: 84), gives its entries the whole program's bits and nothing else, and
-/// holds only the statements its entries read (fewer than the whole; together more: the
-/// statements both read are in both).
+/// its batched function is (rows 0–11: 176 entries, 12–18: 84), gives its entries the whole
+/// program's bits and nothing else, and holds only the statements its entries read (fewer than
+/// the whole; together more: the statements both read are in both).
 #[test]
 fn restricted_programs_give_their_entries_bits_and_hold_only_what_they_read() {
     use kanegen::lower::restrict;

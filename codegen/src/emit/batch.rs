@@ -302,8 +302,8 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     let mut loops = TokenStream::new();
     for part in loop_parts(p, &reads) {
         let printer = cx.printer(&part.stmts);
-        let reads = Reads::of(&part, cx.low.dof);
-        let lane_values = lane_values(cx, &part, &reads);
+        let part_reads = Reads::of(&part, cx.low.dof);
+        let lane_values = lane_values(cx, &part, &part_reads);
         let stores = loop_stores(cx, &printer, &part, vector);
         let stored: Vec<&LExpr> = nonzero_outputs(&part).map(|(_, _, e)| e).collect();
         let block =

@@ -495,7 +495,7 @@ fn zero_stores(p: &Program, n: usize, mirror: bool) -> Vec<String> {
 }
 
 /// Which instruction-set copies a dispatched function is compiled in.
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy)]
 pub(super) enum Copies {
     /// The baseline and x86-64-v3 (`isa::dispatch_fused_with`): single-state functions. An
     /// x86-64-v4 copy was measured no faster for them (Krang's M, c, g, τ, C within 5 %) and

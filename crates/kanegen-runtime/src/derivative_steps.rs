@@ -171,8 +171,8 @@ where
 ///
 /// A function of its own, not inlined into the generated function (whose straight-line part
 /// is long). On x86-64 it runs a copy written with AVX2 and FMA intrinsics when
-/// [`crate::isa::active`] is x86-64-v3 (or the crate is compiled for AVX2 and FMA): the four
-/// lanes in one register. LLVM does not vectorize the portable form (it splits the lanes into
+/// [`crate::isa::active`] is x86-64-v3 or x86-64-v4 (or the crate is compiled for AVX2 and
+/// FMA): the four lanes in one register. LLVM does not vectorize the portable form (it splits the lanes into
 /// scalars): Krang's 104 steps take 46,000 instructions in it even in the x86-64-v3 copy,
 /// 21,200 with AVX2 intrinsics and 18,600 with AVX2 and FMA (callgrind). Elsewhere the
 /// portable form runs. The two copies differ in the last bits (the fused multiply-adds round
@@ -186,9 +186,9 @@ pub fn run(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
         not(all(target_feature = "avx2", target_feature = "fma"))
     ))]
     if crate::isa::active() != crate::isa::Isa::Baseline {
-        // SAFETY: `isa::active` is x86-64-v3 only when the CPU has AVX and AVX2 (it checks
-        // every feature of x86-64-v3 before selecting it), the features `avx2::steps` is
-        // compiled with.
+        // SAFETY: `isa::active` is x86-64-v3 or x86-64-v4 only when the CPU has AVX and AVX2
+        // (it checks every feature of x86-64-v3 before selecting either), the features
+        // `avx2::steps` is compiled with.
         #[allow(unsafe_code)]
         unsafe {
             return avx2::steps(plan, w, out);

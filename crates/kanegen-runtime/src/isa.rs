@@ -22,7 +22,8 @@
 //! [`dispatch_fused`] runs, and [`dispatch_fused_wide_with`], which also calls the x86-64-v4
 //! copy), right after the check that
 //! the features are present; the crate's only other `unsafe` block is the same kind of call in
-//! [`crate::derivative_steps::run`] (its AVX2 kernel, after [`active`] reported x86-64-v3).
+//! [`crate::derivative_steps::run`] (its AVX2 kernel, after [`active`] reported x86-64-v3 or
+//! x86-64-v4).
 //!
 //! Results: Rust never fuses `a * b + c` into a fused multiply-add on its own. Generated
 //! functions therefore print their sums of products as [`Arith::mul_add`] chains in a body

@@ -7,10 +7,10 @@
 //! a loop over the states, which LLVM's loop vectorizer turns into vector instructions across
 //! the states (two per SSE2 register, four per AVX2 register, eight per AVX-512 register; the
 //! x86-64-v3 or x86-64-v4 copy is chosen by [`crate::isa`]). Lane `l` is therefore the
-//! single-state result at state `l` **bit for bit**, with the same instruction set. Before the loop the inputs are transposed to lane-major
-//! order ([`inputs`]) and the sines and cosines of all joint angles of all states are computed
-//! in one loop, inline in the batched function's copy ([`sin_cos_n_inline`]; [`sin_cos_n`] is
-//! the same as a dispatched call). [`Lanes<L>`] (`L` `f64`s with lane-wise operators, `f64`
+//! single-state result at state `l` **bit for bit**, with the same instruction set. Before the
+//! loop the inputs are transposed to lane-major order ([`inputs`]) and the sines and cosines of
+//! all joint angles of all states are computed in one loop, inline in the batched function's
+//! copy ([`sin_cos_n_inline`]; [`sin_cos_n`] is the same as a dispatched call). [`Lanes<L>`] (`L` `f64`s with lane-wise operators, `f64`
 //! operands applied to every lane) holds the transposed inputs and forms a dependent (mimic)
 //! joint's angle from its master's.
 //!

@@ -122,7 +122,10 @@ pub fn generate_combined(
         derivation.arena.len(),
         derivation.arena.vars().len()
     ));
-    let lowered = lower::lower_with(&derivation, emit.derivatives_form);
+    let mut lowered = lower::lower_with(&derivation, emit.derivatives_form);
+    if emit.mirrored_lanes && emit.precision == Precision::F64 {
+        lower::lanes::apply(&mut lowered, &derivation);
+    }
     progress.stage("lowered to straight-line programs");
     let source = emit::emit(&model, &lowered, emit)?;
     progress.stage(&format!("emitted ({} bytes of Rust)", source.len()));
@@ -244,6 +247,7 @@ pub struct Builder {
     combined: Vec<combined::Combined>,
     isa_dispatch: bool,
     batch: bool,
+    mirrored_lanes: bool,
     split_above: usize,
     regressor_form: RegressorForm,
     derivatives_form: DerivativesForm,
@@ -267,6 +271,7 @@ impl Builder {
             combined: Vec::new(),
             isa_dispatch: true,
             batch: false,
+            mirrored_lanes: false,
             split_above: emit::SPLIT_ABOVE,
             regressor_form: RegressorForm::Auto,
             derivatives_form: DerivativesForm::Auto,
@@ -406,6 +411,24 @@ impl Builder {
         self
     }
 
+    /// Mirrored subtrees in two SIMD lanes ("arms in lanes", default `false`; `f64` modules):
+    /// where the model has two sibling subtrees of the same shape (Krang's arms: the same
+    /// joints, axes and geometry below their first joint, each with its own inertial
+    /// parameters), the single-state M, c, g, τ, C and nonlinear effects compute each pair of
+    /// mirrored statements once, the first subtree in the low lane of a
+    /// `kanegen_runtime::pair::F64x2` and the second in the high lane. Every result entry is
+    /// computed with the same operations as the scalar statements, in the same order (tested
+    /// bit for bit); the right subtree's sums are printed in the left's order. Models without
+    /// mirrored subtrees are unaffected. See README, "Arms in lanes".
+    ///
+    /// ```no_run
+    /// kanegen::Builder::new("krang.toml").mirrored_lanes(true).run();
+    /// ```
+    pub fn mirrored_lanes(mut self, on: bool) -> Self {
+        self.mirrored_lanes = on;
+        self
+    }
+
     /// Split generated functions of more than `statements` statements into blocks of 500
     /// (default [`emit::SPLIT_ABOVE`], 2,600): rustc's debug info nests a scope per `let` and
     /// overflowed its stack on longer functions (`rustc unexpectedly overflowed its stack` in a
@@ -443,6 +466,7 @@ impl Builder {
             precision: self.precision,
             isa_dispatch: self.isa_dispatch,
             batch: self.batch,
+            mirrored_lanes: self.mirrored_lanes,
             split_above: self.split_above,
             regressor_form: self.regressor_form,
             ..EmitOptions::default()

@@ -55,6 +55,7 @@ mod modules {
             kanegen::Builder::new(model)
                 .coriolis_matrix(coriolis_matrix)
                 .derivatives_form(form)
+                .mirrored_lanes(true)
         };
         if coriolis_matrix || kinematics || derivatives || regressors {
             // The main module, with the Coriolis matrix and/or the kinematics and energies (centre
@@ -78,6 +79,7 @@ mod modules {
                 .functions(functions)
                 .regressor_form(regressor_form())
                 .derivatives_form(form)
+                .mirrored_lanes(true)
                 .batch(true);
             if kinematics {
                 main = main.combined(whole_body_terms());

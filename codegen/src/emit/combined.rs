@@ -129,7 +129,8 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
     };
     let param_args = super::function::param_args(cx, &reads);
     // Generic over the multiply-add, as the separate functions (whose bits it gives).
-    let (param_args, body) = generic_body(cx, c.spec.inputs, param_args, &quote!(#ty), body);
+    let (param_args, body) =
+        generic_body(cx, c.spec.inputs, (param_args, false), &quote!(#ty), body);
     let (args, arg_doc) = state_args(cx, c.spec.inputs);
     let doc = format!(
         " Combined function: {} in one straight-line program (every sine, cosine and shared intermediate value computed once); each field equals the separate function's value (bit for bit in the baseline copy; in the x86-64-v3 copy, which fuses multiply-adds, to rounding where a product is shared here and inline there).",

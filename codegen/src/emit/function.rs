@@ -6,6 +6,7 @@ use quote::quote;
 
 use super::print::{Printer, ident, idx, lit, signed_lit};
 use super::{Context, scalar_type};
+use crate::lower::lanes::{LaneLeaves, LanePlan};
 use crate::lower::{FunctionProgram, LExpr, Leaf, Program};
 use crate::naming;
 use crate::registry::{Inputs, Shape};
@@ -419,21 +420,28 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     } else {
         (outputs, Vec::new())
     };
-    let block = printer.statement_block(
-        &cx.leaf_names,
-        stores,
-        (&stored, &read_at_end),
-        cx.split_above,
-        true,
-    );
+    let lanes = lanes_of(cx, f);
+    let block = match lanes {
+        Some((leaves, plan)) => {
+            super::lanes::lane_block(&printer, &cx.leaf_names, leaves, p, plan, stores)
+        }
+        None => printer.statement_block(
+            &cx.leaf_names,
+            stores,
+            (&stored, &read_at_end),
+            cx.split_above,
+            true,
+        ),
+    };
     let body = cx.blocks.placeholder(block);
     let unused = unused_inputs(spec.inputs, p, &reads);
+    let lanes = lanes.is_some();
     if into {
         return into_pair(
             cx,
             f,
             (&doc, arg_doc, &ops),
-            param_args,
+            (param_args, lanes),
             &ty,
             quote! {
                 #unused
@@ -457,7 +465,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         #body
         #value
     };
-    let (outer_params, generic) = generic_body(cx, spec.inputs, param_args, &ty, body);
+    let (outer_params, generic) = generic_body(cx, spec.inputs, (param_args, lanes), &ty, body);
     quote! {
         #[doc = #doc]
         #[doc = ""]
@@ -474,6 +482,18 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
 /// matrix and a by-value function that calls it: the n×n results (M, the Coriolis matrix).
 pub(super) fn has_into(f: &FunctionProgram) -> bool {
     f.frame.is_none() && matches!(f.id.spec().shape, Shape::SymmetricMatrix | Shape::Matrix)
+}
+
+/// The lane plan `f` is emitted with, if any: the lowering paired its statements (see
+/// [`crate::lower::lanes`]), the module is `f64` and the function is not split into blocks.
+pub(super) fn lanes_of<'a>(
+    cx: &'a Context<'_>,
+    f: &'a FunctionProgram,
+) -> Option<(&'a LaneLeaves, &'a LanePlan)> {
+    let leaves = cx.low.lane_leaves.as_ref()?;
+    let plan = f.lanes.as_ref()?;
+    (cx.precision == crate::Precision::F64 && f.program.stmts.len() <= cx.split_above)
+        .then_some((leaves, plan))
 }
 
 /// `m[(r, c)] = 0.0;` for every entry of an n×n result that no store of [`result`] writes (the
@@ -504,6 +524,10 @@ pub(super) enum Copies {
     /// Also x86-64-v4 (`isa::dispatch_fused_wide_with`): the batched functions, whose loop
     /// over the states LLVM vectorizes 8 lanes wide with AVX-512.
     WithV4,
+    /// The baseline and x86-64-v3 for a body with paired statements
+    /// (`isa::dispatch_pair_with`): the body's first argument is the copy's two-lane
+    /// multiply-add (`lanes`).
+    Lanes,
 }
 
 /// The call of a generated function's inner `body::<A, …>(…, out)`, generic over the
@@ -520,17 +544,33 @@ pub(super) fn call_body_into(
     args: TokenStream,
     out: TokenStream,
 ) -> TokenStream {
+    let lanes = matches!(copies, Copies::Lanes);
     if cx.isa_dispatch {
         let dispatch = match copies {
             Copies::BaselineAndV3 => quote!(dispatch_fused_with),
             Copies::WithV4 => quote!(dispatch_fused_wide_with),
+            Copies::Lanes => quote!(dispatch_pair_with),
         };
+        if lanes {
+            return quote!(kanegen_runtime::isa::#dispatch(
+                #out,
+                #[inline(always)]
+                |out, lanes| body::<kanegen_runtime::isa::Plain, _ #generics>(lanes, #args out),
+                #[inline(always)]
+                |out, lanes| body::<kanegen_runtime::isa::Fused, _ #generics>(lanes, #args out),
+            ));
+        }
         quote!(kanegen_runtime::isa::#dispatch(
             #out,
             #[inline(always)]
             |out| body::<kanegen_runtime::isa::Plain #generics>(#args out),
             #[inline(always)]
             |out| body::<kanegen_runtime::isa::Fused #generics>(#args out),
+        ))
+    } else if lanes {
+        quote!(body::<kanegen_runtime::isa::Native, _ #generics>(
+            kanegen_runtime::isa::native_pair(),
+            #args #out
         ))
     } else {
         quote!(body::<kanegen_runtime::isa::Native #generics>(#args #out))
@@ -550,12 +590,11 @@ fn into_pair(
     cx: &Context<'_>,
     f: &FunctionProgram,
     (doc, arg_doc, ops): (&str, &str, &str),
-    param_args: TokenStream,
+    (param_args, lanes): (TokenStream, bool),
     ty: &TokenStream,
     body: TokenStream,
 ) -> TokenStream {
     let spec = f.id.spec();
-    let t = scalar_type(cx.precision);
     let fname = ident(spec.name);
     let into = ident(&format!("{}_into", spec.name));
     let (args, _) = state_args(cx, spec.inputs);
@@ -563,11 +602,16 @@ fn into_pair(
     let (outer_params, pass_params) = outer_params(cx);
     let call = call_body_into(
         cx,
-        Copies::BaselineAndV3,
+        if lanes {
+            Copies::Lanes
+        } else {
+            Copies::BaselineAndV3
+        },
         quote!(),
         quote!(#pass_params #names,),
         quote!(out),
     );
+    let (generics, lanes_arg) = body_generics(cx, lanes);
     let into_doc = format!(
         " [`{}`] written into `out` (every entry), without returning the matrix by value: \
          for a caller that keeps its matrix (a controller's workspace), and a little faster.",
@@ -596,7 +640,7 @@ fn into_pair(
         #[inline(never)]
         pub fn #into(#outer_params #args, out: &mut #ty) {
             #[inline(always)]
-            fn body<A: kanegen_runtime::isa::Arith<#t>>(#param_args #args, m: &mut #ty) {
+            fn body<#generics>(#lanes_arg #param_args #args, m: &mut #ty) {
                 #body
             }
             #call
@@ -636,15 +680,28 @@ pub(super) fn outer_params(cx: &Context<'_>) -> (TokenStream, TokenStream) {
 pub(super) fn generic_body(
     cx: &Context<'_>,
     inputs: Inputs,
-    param_args: TokenStream,
+    (param_args, lanes): (TokenStream, bool),
     ty: &TokenStream,
     body: TokenStream,
 ) -> (TokenStream, TokenStream) {
-    let t = scalar_type(cx.precision);
     let (args, _) = state_args(cx, inputs);
     let names = super::items::arg_names(inputs);
     let (outer_params, pass_params) = outer_params(cx);
-    let call = if cx.isa_dispatch {
+    let (generics, lanes_arg) = body_generics(cx, lanes);
+    let call = if lanes && cx.isa_dispatch {
+        quote!(kanegen_runtime::isa::dispatch_pair_with(
+            (),
+            #[inline(always)]
+            |(), lanes| body::<kanegen_runtime::isa::Plain, _>(lanes, #pass_params #names),
+            #[inline(always)]
+            |(), lanes| body::<kanegen_runtime::isa::Fused, _>(lanes, #pass_params #names),
+        ))
+    } else if lanes {
+        quote!(body::<kanegen_runtime::isa::Native, _>(
+            kanegen_runtime::isa::native_pair(),
+            #pass_params #names
+        ))
+    } else if cx.isa_dispatch {
         quote!(kanegen_runtime::isa::dispatch_fused(
             #[inline(always)]
             || body::<kanegen_runtime::isa::Plain>(#pass_params #names),
@@ -656,12 +713,26 @@ pub(super) fn generic_body(
     };
     let generic = quote! {
         #[inline(always)]
-        fn body<A: kanegen_runtime::isa::Arith<#t>>(#param_args #args) -> #ty {
+        fn body<#generics>(#lanes_arg #param_args #args) -> #ty {
             #body
         }
         #call
     };
     (outer_params, generic)
+}
+
+/// The generic parameters of a function body (`A: Arith<f64>`, and with `lanes` the two-lane
+/// multiply-add `P: PairArith`) and, with `lanes`, its first argument `lanes: P,`.
+fn body_generics(cx: &Context<'_>, lanes: bool) -> (TokenStream, TokenStream) {
+    let t = scalar_type(cx.precision);
+    if lanes {
+        (
+            quote!(A: kanegen_runtime::isa::Arith<#t>, P: kanegen_runtime::isa::PairArith),
+            quote!(lanes: P,),
+        )
+    } else {
+        (quote!(A: kanegen_runtime::isa::Arith<#t>), quote!())
+    }
 }
 
 /// `let _ = q;` (and `u`, `ud`) for the inputs a function's program never reads, so that the

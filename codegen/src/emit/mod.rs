@@ -21,6 +21,7 @@ mod derivative_loop;
 mod frames;
 mod function;
 mod items;
+mod lanes;
 mod print;
 mod regressor_loop;
 mod regressors;
@@ -63,6 +64,10 @@ pub struct EmitOptions {
     /// states per call (`f64` modules; every function whose result is a vector or matrix and
     /// that takes no frame), the single-state statements over `kanegen_runtime::lanes::Lanes`.
     pub batch: bool,
+    /// Mirrored subtrees in two SIMD lanes (default `false`): see
+    /// [`crate::Builder::mirrored_lanes`]. Read by [`crate::generate_combined`], which pairs
+    /// the lowered programs ([`crate::lower::lanes::apply`]).
+    pub mirrored_lanes: bool,
     /// The floating-point type of the module.
     pub precision: Precision,
     /// Lines written as comments after the header (e.g. URDF import notes: snapped angles,
@@ -92,6 +97,7 @@ impl Default for EmitOptions {
         Self {
             isa_dispatch: true,
             batch: false,
+            mirrored_lanes: false,
             precision: Precision::default(),
             notes: Vec::new(),
             notes_title: String::new(),
@@ -127,6 +133,7 @@ impl Context<'_> {
             stmts,
             pre: &self.pre,
             precision: self.precision,
+            lane: None,
         }
     }
 }
@@ -177,6 +184,11 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
                 use kanegen_runtime::trig::sin_cos_n_f32 as sin_cos_n;
             ),
         });
+    }
+    if low.lane_leaves.is_some() {
+        items.extend(quote!(
+            use kanegen_runtime::pair::F64x2;
+        ));
     }
     items.extend(items::names(&cx));
     let mut labels = annotate::Labels::default();

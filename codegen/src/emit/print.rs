@@ -36,7 +36,11 @@ pub(super) fn signed_lit(v: f64, precision: Precision) -> TokenStream {
     if v < 0.0 { quote!(-#l) } else { quote!(#l) }
 }
 
+/// The two-lane text of a leaf (see [`Printer::lane`]).
+pub(super) type LaneLeaf<'a> = dyn Fn(&Leaf) -> Option<String> + 'a;
+
 /// Prints the expressions of one program: leaves by their names in the model.
+#[derive(Clone, Copy)]
 pub(super) struct Printer<'a> {
     pub model: &'a Model,
     /// The program's statements (for the names of locals).
@@ -44,6 +48,10 @@ pub(super) struct Printer<'a> {
     /// Field names of the precomputed values.
     pub pre: &'a [String],
     pub precision: Precision,
+    /// For a paired statement (arms in lanes): the two-lane text of the leaves that differ
+    /// between the two subtrees (`None` for a shared leaf, printed as usual); its
+    /// multiply-adds are then `lanes.mul_add(…)` (see `text::lane_block`).
+    pub lane: Option<&'a LaneLeaf<'a>>,
 }
 
 impl Printer<'_> {

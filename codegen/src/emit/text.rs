@@ -400,7 +400,12 @@ impl Printer<'_> {
             }
             (x, y)
         };
-        let call = |x: &str, y: &str, acc: &str| format!("A::mul_add({x}, {y}, {acc})");
+        let mul_add = if self.lane.is_some() {
+            "lanes.mul_add("
+        } else {
+            "A::mul_add("
+        };
+        let call = |x: &str, y: &str, acc: &str| format!("{mul_add}{x}, {y}, {acc})");
         let order: Vec<usize> = sum_order(terms).collect();
         let (k0, t0) = (terms[order[0]].0, &terms[order[0]].1);
         let mut plain_after = false;
@@ -441,10 +446,14 @@ impl Printer<'_> {
             plain_after = true;
         }
         out.push_str(&acc);
-        plain_after || !acc.starts_with("A::mul_add(")
+        plain_after || !acc.starts_with(mul_add)
     }
 
-    fn leaf_text(&self, names: &LeafNames, l: &Leaf, out: &mut String) {
+    pub(super) fn leaf_text(&self, names: &LeafNames, l: &Leaf, out: &mut String) {
+        if let Some(text) = self.lane.and_then(|lane| lane(l)) {
+            out.push_str(&text);
+            return;
+        }
         let name: &str = match *l {
             Leaf::Const(c) => {
                 if c < 0.0 {
@@ -548,7 +557,7 @@ impl Printer<'_> {
 }
 
 /// The statements `e` reads.
-fn locals_of(e: &LExpr, out: &mut Vec<usize>) {
+pub(super) fn locals_of(e: &LExpr, out: &mut Vec<usize>) {
     match e {
         LExpr::Leaf(Leaf::Local(i)) => out.push(*i),
         LExpr::Leaf(_) => {}
@@ -704,6 +713,7 @@ mod tests {
                     stmts: &p.stmts,
                     pre: &pre,
                     precision,
+                    lane: None,
                 };
                 // Statements, and result entries as `let`, matrix and vector stores.
                 let mut cases: Vec<(String, TokenStream)> = Vec::new();
@@ -931,6 +941,7 @@ mod tests {
                     stmts: &p.stmts,
                     pre: &pre,
                     precision: Precision::F64,
+                    lane: None,
                 };
                 // Leaves and statement values (each statement's plain value: every expression
                 // is evaluated three ways on the same inputs).

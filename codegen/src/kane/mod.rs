@@ -61,6 +61,7 @@ mod grouping;
 mod kinematics;
 mod mass_matrix;
 mod mimic;
+mod mirror;
 mod regressor;
 mod regressor_loop;
 mod rnea;
@@ -77,6 +78,7 @@ use crate::registry::{FunctionId, Sizes};
 use algebra::{M3, V3};
 use composite::Composite;
 pub use grouping::{Coefficient, Exactness, SymbolicGroup, symbolic_group_text};
+pub use mirror::Mirror;
 pub use regressor::{BaseParameters, Regressors, group_text};
 pub use regressor_loop::{
     CarryFrom, JointShape, KIN, LANES, LOOP_MIN_PAIRS, LoopLink, LoopPlan, LoopStep, PlanStep,
@@ -131,6 +133,9 @@ pub struct Derivation {
     /// The looped form of `inverse_dynamics_derivatives` (its own arena phase, after every
     /// other): derived when the module has the derivatives and the model has no mimic joints.
     pub derivative_loop: Option<LoopedDerivatives>,
+    /// The model's mirrored subtrees, if it has any (see [`Mirror`]): what the lowering pairs
+    /// into two-lane statements.
+    pub mirror: Option<Mirror>,
 }
 
 /// The looped form of `inverse_dynamics_derivatives` (`kane/rnea_derivatives_loop.rs`): the
@@ -346,6 +351,7 @@ pub fn derive_shaped(
         sizes,
         combined: combined_out,
         derivative_loop,
+        mirror: Mirror::of(model),
     }
 }
 

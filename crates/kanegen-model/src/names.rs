@@ -46,6 +46,7 @@ use crate::ir::{JointKind, Model};
 /// `_pc` when unused), results (`m`, `out`), the symmetric copy loop (`s`, `c`, `r`), the
 /// batched trigonometry (`sin_q`, `cos_q`, `sin_cos_n`), and `Params::from_array`'s argument `v`.
 pub const RESERVED_LOCALS: &[&str] = &[
+    "lanes",
     "p",
     "_p",
     "pc",
@@ -70,6 +71,7 @@ pub const RESERVED_LOCALS: &[&str] = &[
 /// Items of a generated module, and the prelude names its code uses: a model name equal to one
 /// of them would shadow it or be read as a pattern (`let None = …`).
 pub const RESERVED_ITEMS: &[&str] = &[
+    "F64x2",
     "DOF",
     "SPEED_NAMES",
     "COORDINATE_NAMES",
@@ -145,12 +147,19 @@ pub fn type_name(model: &str) -> String {
 }
 
 /// Whether `name` has the shape of a statement local of generated code: one of
-/// [`LOCAL_PREFIXES`] followed by digits only (`k12`, `d3`, `t4`, `pc7`).
+/// [`LOCAL_PREFIXES`] followed by digits only (`k12`, `d3`, `t4`, `pc7`), or two of them
+/// joined by `_` (`d5_d90`: a pair of statements computed in two lanes).
 pub fn is_generated_local(name: &str) -> bool {
-    LOCAL_PREFIXES.iter().any(|p| {
-        name.strip_prefix(p)
-            .is_some_and(|rest| !rest.is_empty() && rest.bytes().all(|b| b.is_ascii_digit()))
-    })
+    let single = |name: &str| {
+        LOCAL_PREFIXES.iter().any(|p| {
+            name.strip_prefix(p)
+                .is_some_and(|rest| !rest.is_empty() && rest.bytes().all(|b| b.is_ascii_digit()))
+        })
+    };
+    single(name)
+        || name
+            .split_once('_')
+            .is_some_and(|(a, b)| single(a) && single(b))
 }
 
 /// Whether generated code binds or uses `name` itself, whatever the model

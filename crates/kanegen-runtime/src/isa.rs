@@ -71,6 +71,7 @@
 use core::sync::atomic::{AtomicU8, Ordering};
 
 pub use crate::arith::{Arith, Fused, Native, Plain};
+pub use crate::pair::{FusedPair, PairArith};
 
 /// An instruction set a generated function can run with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -255,6 +256,30 @@ if_dispatching! {
         plain(arg)
     }
 
+    /// [`dispatch_fused_with`] for a body with paired statements (see [`crate::pair`]): the
+    /// copy that runs also gets the two-lane multiply-add of its instruction set,
+    /// [`Plain`] for the baseline copy and a [`FusedPair`] for the x86-64-v3 copy, which
+    /// is made here, after the check that the CPU has FMA.
+    #[inline(always)]
+    pub fn dispatch_pair_with<T, R>(
+        arg: T,
+        plain: impl FnOnce(T, Plain) -> R,
+        fused: impl FnOnce(T, FusedPair) -> R,
+    ) -> R {
+        if active_code() >= V3 {
+            // SAFETY: as in `dispatch_fused_with` above (the same check before the same call);
+            // the `FusedPair` is made after that check, where the CPU has FMA.
+            #[allow(unsafe_code)]
+            unsafe {
+                return run_v3(
+                    #[inline(always)]
+                    || fused(arg, FusedPair::new_unchecked()),
+                );
+            }
+        }
+        plain(arg, Plain)
+    }
+
     /// [`dispatch_fused_with`] with a third copy, compiled for x86-64-v4 (AVX-512: 8 `f64`
     /// lanes per register, 32 registers), run when [`active`] is [`Isa::X86_64V4`]: what the
     /// batched functions and [`crate::trig::sin_cos_slice`] use, whose loops over the states
@@ -320,6 +345,32 @@ if_not_dispatching! {
         }
     }
 
+    /// [`dispatch_fused_with`] for a body with paired statements: one copy, with the
+    /// two-lane multiply-add of [`native_pair`].
+    #[inline(always)]
+    pub fn dispatch_pair_with<T, R>(
+        arg: T,
+        plain: impl FnOnce(T, Plain) -> R,
+        fused: impl FnOnce(T, FusedPair) -> R,
+    ) -> R {
+        #[cfg(all(
+            feature = "std",
+            any(target_feature = "fma", target_arch = "aarch64")
+        ))]
+        {
+            let _ = plain;
+            fused(arg, native_pair())
+        }
+        #[cfg(not(all(
+            feature = "std",
+            any(target_feature = "fma", target_arch = "aarch64")
+        )))]
+        {
+            let _ = fused;
+            plain(arg, native_pair())
+        }
+    }
+
     /// [`dispatch_fused_with`]: this build has one copy of every function.
     #[inline(always)]
     pub fn dispatch_fused_wide_with<T, R>(
@@ -346,6 +397,33 @@ pub fn dispatch_fused<R>(plain: impl FnOnce() -> R, fused: impl FnOnce() -> R) -
         |()| fused(),
     )
 }
+
+/// The two-lane multiply-add that goes with [`Native`] (for a module generated without
+/// dispatch, `kanegen::Builder::isa_dispatch(false)`): a [`FusedPair`] when the build enables
+/// FMA (and `std` is on; aarch64), [`Plain`] otherwise.
+#[cfg(all(feature = "std", any(target_feature = "fma", target_arch = "aarch64")))]
+#[inline(always)]
+pub fn native_pair() -> NativePair {
+    // The build enables FMA (x86-64) or the lanes are portable (aarch64): see `FusedPair`.
+    FusedPair::new_unchecked()
+}
+
+/// The two-lane multiply-add that goes with [`Native`] (for a module generated without
+/// dispatch, `kanegen::Builder::isa_dispatch(false)`): a [`FusedPair`] when the build enables
+/// FMA (and `std` is on; aarch64), [`Plain`] otherwise.
+#[cfg(not(all(feature = "std", any(target_feature = "fma", target_arch = "aarch64"))))]
+#[inline(always)]
+pub fn native_pair() -> NativePair {
+    Plain
+}
+
+/// What [`native_pair`] returns.
+#[cfg(all(feature = "std", any(target_feature = "fma", target_arch = "aarch64")))]
+pub type NativePair = FusedPair;
+
+/// What [`native_pair`] returns.
+#[cfg(not(all(feature = "std", any(target_feature = "fma", target_arch = "aarch64"))))]
+pub type NativePair = Plain;
 
 /// The best instruction set this CPU and this build can dispatch to.
 pub fn detected() -> Isa {

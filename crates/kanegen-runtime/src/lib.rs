@@ -155,6 +155,7 @@ mod dynamics;
 mod invalid_parameter;
 pub mod isa;
 pub mod lanes;
+pub mod pair;
 pub mod regressor;
 #[doc(hidden)]
 pub mod serde_support;

@@ -12,6 +12,7 @@ fn committed_default_module_is_what_the_generator_makes_of_krang_toml() {
     let generated = kanegen::Builder::new(dir.join("krang.toml"))
         .coriolis_matrix(false)
         .batch(true)
+        .mirrored_lanes(true)
         .generate()
         .unwrap()
         .source;

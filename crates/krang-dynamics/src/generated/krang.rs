@@ -12,6 +12,7 @@ pub use self::generated::*;
 mod generated {
     use nalgebra::{SMatrix, SVector};
     use kanegen_runtime::trig::sin_cos_n;
+    use kanegen_runtime::pair::F64x2;
     /// Number of generalized speeds (and coordinates).
     pub const DOF: usize = 19;
     /// Generalized speed names, in the order of `u`.
@@ -2168,7 +2169,8 @@ mod generated {
         out: &mut SMatrix<f64, 19, 19>,
     ) {
         #[inline(always)]
-        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+        fn body<A: kanegen_runtime::isa::Arith<f64>, P: kanegen_runtime::isa::PairArith>(
+            lanes: P,
             p: &Params,
             pc: &Precomputed,
             q: &SVector<f64, 19>,
@@ -2328,588 +2330,260 @@ mod generated {
             m[(9, 18)] = 0.0;
             m[(10, 18)] = 0.0;
             m[(11, 18)] = 0.0;
-            let d1 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
-            let d2 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
-            let t1 = p.XZ10r * c_q7r; // common subexpression
-            let t2 = p.YZ10r * s_q7r; // common subexpression
-            let t3 = p.XZ10r * s_q7r; // common subexpression
-            let t4 = p.YZ10r * c_q7r; // common subexpression
-            let t5 = p.L9 * d2; // common subexpression
-            let t6 = p.L9 * d1; // common subexpression
-            let d3 = t1 + t2 - t5; // N(M col 10r) at 9r.x
-            m[(17, 18)] = -d3;
-            m[(18, 17)] = m[(17, 18)];
-            let d4 = t3 - t4 - t6; // N(M col 10r) at 9r.z
-            let d5 = d2 * s_q6r; // F(M col 10r) at 8r.y
-            let d6 = d2 * c_q6r; // F(M col 10r) at 8r.z
-            let d7 = A::mul_add(-d4, s_q6r, p.ZZ10r * c_q6r); // N(M col 10r) at 8r.y
-            m[(16, 18)] = d7;
-            m[(18, 16)] = m[(16, 18)];
-            let d8 = A::mul_add(d4, c_q6r, p.ZZ10r * s_q6r); // N(M col 10r) at 8r.z
-            let d9 = A::mul_add(d6, s_q5r, d1 * c_q5r); // F(M col 10r) at 7r.x
-            let d10 = A::mul_add(-d6, c_q5r, d1 * s_q5r); // F(M col 10r) at 7r.z
-            let d11 = A::mul_add(p.L8, d10, A::mul_add(-d8, s_q5r, d3 * c_q5r)); // N(M col 10r) at 7r.x
-            m[(15, 18)] = -d11;
-            m[(18, 15)] = m[(15, 18)];
-            let d12 = A::mul_add(-p.L8, d9, A::mul_add(d8, c_q5r, d3 * s_q5r)); // N(M col 10r) at 7r.z
-            let d13 = A::mul_add(-d10, s_q4r, d5 * c_q4r); // F(M col 10r) at 6r.y
-            let d14 = A::mul_add(d10, c_q4r, d5 * s_q4r); // F(M col 10r) at 6r.z
-            let d15 = A::mul_add(-d12, s_q4r, d7 * c_q4r); // N(M col 10r) at 6r.y
-            m[(14, 18)] = d15;
-            m[(18, 14)] = m[(14, 18)];
-            let d16 = A::mul_add(d12, c_q4r, d7 * s_q4r); // N(M col 10r) at 6r.z
-            let d17 = A::mul_add(-d14, s_q3r, d9 * c_q3r); // F(M col 10r) at 5r.x
-            let d18 = A::mul_add(d14, c_q3r, d9 * s_q3r); // F(M col 10r) at 5r.z
-            let d19 = A::mul_add(p.L7, d18, A::mul_add(-d16, s_q3r, d11 * c_q3r)); // N(M col 10r) at 5r.x
-            m[(13, 18)] = -d19;
-            m[(18, 13)] = m[(13, 18)];
-            let d20 = A::mul_add(-p.L7, d17, A::mul_add(d16, c_q3r, d11 * s_q3r)); // N(M col 10r) at 5r.z
-            let d21 = A::mul_add(-d18, s_q2r, d13 * c_q2r); // F(M col 10r) at 4r.y
-            let d22 = A::mul_add(d18, c_q2r, d13 * s_q2r); // F(M col 10r) at 4r.z
-            let d23 = A::mul_add(-d20, s_q2r, d15 * c_q2r); // N(M col 10r) at 4r.y
-            m[(12, 18)] = d23;
-            m[(18, 12)] = m[(12, 18)];
-            let d24 = A::mul_add(d20, c_q2r, d15 * s_q2r); // N(M col 10r) at 4r.z
-            let d25 = A::mul_add(-d22, s_q1r, d17 * c_q1r); // F(M col 10r) at 3.y
-            let d26 = A::mul_add(d22, c_q1r, d17 * s_q1r); // F(M col 10r) at 3.z
-            let d27 = A::mul_add(-p.L5, d26, d23); // N(M col 10r) at 3.x
-            let d28 = A::mul_add(p.L6, d26, A::mul_add(-d24, s_q1r, d19 * c_q1r)); // N(M col 10r) at 3.y
-            m[(4, 18)] = d28;
-            m[(18, 4)] = m[(4, 18)];
-            let d29 = A::mul_add(
-                d21,
-                p.L5,
-                A::mul_add(-p.L6, d25, A::mul_add(d24, c_q1r, d19 * s_q1r)),
-            ); // N(M col 10r) at 3.z
-            let d30 = A::mul_add(d26, s_q_torso, d21 * c_q_torso); // F(M col 10r) at 2.x
-            let d31 = A::mul_add(-d26, c_q_torso, d21 * s_q_torso); // F(M col 10r) at 2.z
-            let d32 = A::mul_add(
-                -d25,
-                p.L4,
-                A::mul_add(p.L3, d31, A::mul_add(d29, s_q_torso, d27 * c_q_torso)),
-            ); // N(M col 10r) at 2.x
-            m[(3, 18)] = d32;
-            m[(18, 3)] = m[(3, 18)];
-            let d33 = A::mul_add(p.L4, d30, d28); // N(M col 10r) at 2.y
-            let d34 = A::mul_add(
-                -p.L3,
-                d30,
-                A::mul_add(-d29, c_q_torso, d27 * s_q_torso),
-            ); // N(M col 10r) at 2.z
-            let d35 = A::mul_add(-d31, c_q_w, d25 * s_q_w); // F(M col 10r) at 1.z
-            let d36 = A::mul_add(d31, s_q_w, d25 * c_q_w); // F(M col 10r) at 1.y
-            let d37 = A::mul_add(d30, p.L1, A::mul_add(-d34, c_q_w, d33 * s_q_w)); // N(M col 10r) at 1.z
-            let d38 = A::mul_add(p.L2, d36, A::mul_add(-p.L1, d35, d32)); // N(M col 10r) at 1.x
-            m[(2, 18)] = d38;
-            m[(18, 2)] = m[(2, 18)];
-            let d39 = A::mul_add(-d30, p.L2, A::mul_add(d34, s_q_w, d33 * c_q_w)); // N(M col 10r) at 1.y
-            let d40 = A::mul_add(d35, c_q_imu, d36 * s_q_imu); // F(M col 10r) at 0.x
-            m[(0, 18)] = -d40;
-            m[(18, 0)] = m[(0, 18)];
-            let d41 = A::mul_add(-d37, s_q_imu, d39 * c_q_imu); // N(M col 10r) at 0.z
-            m[(1, 18)] = -d41;
-            m[(18, 1)] = m[(1, 18)];
-            let d42 = p.MX9r - d2; // MSC9r.x
-            let d43 = p.MZ9r + d1; // MSC9r.z
-            let k1 = s_q7r * s_q7r; // sin² q7r
-            let k2 = s_q7r * c_q7r; // sin q7r cos q7r
-            let k3 = A::mul_add(2.0, k1, -1.0); // cos 2q7r
-            let d44 = A::mul_add(-2.0, p.XY10r * k2, k1 * pc.pc3); // JC10r rotated about z: Jxx − J'xx
-            let d45 = p.XY9r + t1 + t2 - t5; // JC9r.xy
-            let d46 = A::mul_add(-k2, pc.pc3, A::mul_add(-p.XY10r, k3, p.XZ9r)); // JC9r.xz
-            let d47 = p.YZ9r - t3 + t4 + t6; // JC9r.yz
-            let d48 = pc.pc7 - d44; // JC9r.xx
-            m[(17, 17)] = d48;
-            let d49 = d44 + pc.pc8; // JC9r.zz
-            let d50 = A::mul_add(s_q6r, d43, c_q6r * pc.pc2); // MSC9r in 8r.y
-            let d51 = A::mul_add(-c_q6r, d43, s_q6r * pc.pc2); // MSC9r in 8r.z
-            let t7 = c_q6r * d45; // common subexpression
-            let t8 = s_q6r * d46; // common subexpression
-            let d52 = t7 + t8; // N(M col 9r) at 8r.y
-            m[(16, 17)] = -d52;
-            m[(17, 16)] = m[(16, 17)];
-            let t9 = s_q6r * d45; // common subexpression
-            let t10 = c_q6r * d46; // common subexpression
-            let d53 = t9 - t10; // N(M col 9r) at 8r.z
-            let d54 = s_q5r * d50; // F(M col 9r) at 7r.x
-            let d55 = c_q5r * d50; // F(M col 9r) at 7r.z
-            let d56 = A::mul_add(-p.L8, d54, A::mul_add(c_q5r, d53, s_q5r * d48)); // N(M col 9r) at 7r.z
-            let d57 = A::mul_add(-p.L8, d55, A::mul_add(-s_q5r, d53, c_q5r * d48)); // N(M col 9r) at 7r.x
-            m[(15, 17)] = d57;
-            m[(17, 15)] = m[(15, 17)];
-            let d58 = A::mul_add(s_q4r, d55, c_q4r * d51); // F(M col 9r) at 6r.y
-            let d59 = A::mul_add(-c_q4r, d55, s_q4r * d51); // F(M col 9r) at 6r.z
-            let d60 = A::mul_add(-s_q4r, d56, c_q4r * d52); // N(M col 9r) at 6r.y
-            m[(14, 17)] = -d60;
-            m[(17, 14)] = m[(14, 17)];
-            let d61 = A::mul_add(c_q4r, d56, s_q4r * d52); // N(M col 9r) at 6r.z
-            let d62 = A::mul_add(c_q3r, d59, s_q3r * d54); // F(M col 9r) at 5r.z
-            let d63 = A::mul_add(-s_q3r, d59, c_q3r * d54); // F(M col 9r) at 5r.x
-            let d64 = A::mul_add(-p.L7, d63, A::mul_add(c_q3r, d61, s_q3r * d57)); // N(M col 9r) at 5r.z
-            let d65 = A::mul_add(p.L7, d62, A::mul_add(-s_q3r, d61, c_q3r * d57)); // N(M col 9r) at 5r.x
-            m[(13, 17)] = d65;
-            m[(17, 13)] = m[(13, 17)];
-            let d66 = A::mul_add(-s_q2r, d62, c_q2r * d58); // F(M col 9r) at 4r.y
-            let d67 = A::mul_add(c_q2r, d62, s_q2r * d58); // F(M col 9r) at 4r.z
-            let d68 = A::mul_add(-s_q2r, d64, c_q2r * d60); // N(M col 9r) at 4r.y
-            m[(12, 17)] = -d68;
-            m[(17, 12)] = m[(12, 17)];
-            let d69 = A::mul_add(c_q2r, d64, s_q2r * d60); // N(M col 9r) at 4r.z
-            let d70 = A::mul_add(-s_q1r, d67, c_q1r * d63); // F(M col 9r) at 3.y
-            let d71 = A::mul_add(c_q1r, d67, s_q1r * d63); // F(M col 9r) at 3.z
-            let d72 = A::mul_add(p.L6, d71, A::mul_add(-s_q1r, d69, c_q1r * d65)); // N(M col 9r) at 3.y
-            m[(4, 17)] = -d72;
-            m[(17, 4)] = m[(4, 17)];
-            let d73 = A::mul_add(
-                p.L5,
-                d66,
-                A::mul_add(-p.L6, d70, A::mul_add(c_q1r, d69, s_q1r * d65)),
-            ); // N(M col 9r) at 3.z
-            let d74 = A::mul_add(-p.L5, d71, d68); // N(M col 9r) at 3.x
-            let d75 = A::mul_add(s_q_torso, d71, c_q_torso * d66); // F(M col 9r) at 2.x
-            let d76 = A::mul_add(-c_q_torso, d71, s_q_torso * d66); // F(M col 9r) at 2.z
-            let d77 = A::mul_add(
-                -p.L4,
-                d70,
-                A::mul_add(p.L3, d76, A::mul_add(s_q_torso, d73, c_q_torso * d74)),
-            ); // N(M col 9r) at 2.x
-            m[(3, 17)] = -d77;
-            m[(17, 3)] = m[(3, 17)];
-            let d78 = A::mul_add(p.L4, d75, d72); // N(M col 9r) at 2.y
-            let d79 = A::mul_add(
-                -p.L3,
-                d75,
-                A::mul_add(-c_q_torso, d73, s_q_torso * d74),
-            ); // N(M col 9r) at 2.z
-            let d80 = A::mul_add(s_q_w, d76, c_q_w * d70); // F(M col 9r) at 1.y
-            let d81 = A::mul_add(-c_q_w, d76, s_q_w * d70); // F(M col 9r) at 1.z
-            let d82 = A::mul_add(p.L2, d80, A::mul_add(-p.L1, d81, d77)); // N(M col 9r) at 1.x
-            m[(2, 17)] = -d82;
-            m[(17, 2)] = m[(2, 17)];
-            let d83 = A::mul_add(-p.L2, d75, A::mul_add(s_q_w, d79, c_q_w * d78)); // N(M col 9r) at 1.y
-            let d84 = A::mul_add(p.L1, d75, A::mul_add(-c_q_w, d79, s_q_w * d78)); // N(M col 9r) at 1.z
-            let d85 = A::mul_add(c_q_imu, d81, s_q_imu * d80); // F(M col 9r) at 0.x
-            m[(0, 17)] = d85;
-            m[(17, 0)] = m[(0, 17)];
-            let d86 = A::mul_add(-s_q_imu, d84, c_q_imu * d83); // N(M col 9r) at 0.z
-            m[(1, 17)] = d86;
-            m[(17, 1)] = m[(1, 17)];
-            let d87 = p.MX8r - d42; // MSC8r.x
-            let d88 = p.MY8r - d50; // MSC8r.y
-            let d89 = p.MZ8r - d51; // MSC8r.z
-            let k4 = s_q6r * s_q6r; // sin² q6r
-            let k5 = s_q6r * c_q6r; // sin q6r cos q6r
-            let k6 = A::mul_add(2.0, k4, -1.0); // cos 2q6r
-            let d90 = pc.pc6 - d49; // JC9r: Jyy − Jzz
-            let d91 = A::mul_add(-2.0, d47 * k5, k4 * d90); // JC9r rotated about x: Jyy − J'yy
-            let d92 = p.XX8r + d48; // JC8r.xx
-            let d93 = p.XY8r + t7 + t8; // JC8r.xy
-            let d94 = p.XZ8r + t9 - t10; // JC8r.xz
-            let d95 = A::mul_add(k5, d90, A::mul_add(d47, k6, p.YZ8r)); // JC8r.yz
-            let d96 = p.ZZ8r + d49 + d91; // JC8r.zz
-            let d97 = pc.pc10 - d91; // JC8r.yy
-            m[(16, 16)] = d97;
-            let d98 = A::mul_add(c_q5r, d89, s_q5r * d87); // MSC8r in 7r.z
-            let d99 = A::mul_add(-s_q5r, d89, c_q5r * d87); // MSC8r in 7r.x
-            let t11 = c_q5r * d93; // common subexpression
-            let t12 = s_q5r * d95; // common subexpression
-            let t13 = s_q5r * d93; // common subexpression
-            let t14 = c_q5r * d95; // common subexpression
-            let t15 = p.L8 * d99; // common subexpression
-            let t16 = p.L8 * d98; // common subexpression
-            let d100 = t11 - t12 - t15; // N(M col 8r) at 7r.x
-            m[(15, 16)] = -d100;
-            m[(16, 15)] = m[(15, 16)];
-            let d101 = t13 + t14 - t16; // N(M col 8r) at 7r.z
-            let d102 = s_q4r * d99; // F(M col 8r) at 6r.y
-            let d103 = c_q4r * d99; // F(M col 8r) at 6r.z
-            let d104 = A::mul_add(-s_q4r, d101, c_q4r * d97); // N(M col 8r) at 6r.y
-            m[(14, 16)] = d104;
-            m[(16, 14)] = m[(14, 16)];
-            let d105 = A::mul_add(c_q4r, d101, s_q4r * d97); // N(M col 8r) at 6r.z
-            let d106 = A::mul_add(s_q3r, d103, c_q3r * d98); // F(M col 8r) at 5r.x
-            let d107 = A::mul_add(-c_q3r, d103, s_q3r * d98); // F(M col 8r) at 5r.z
-            let d108 = A::mul_add(p.L7, d107, A::mul_add(-s_q3r, d105, c_q3r * d100)); // N(M col 8r) at 5r.x
-            m[(13, 16)] = -d108;
-            m[(16, 13)] = m[(13, 16)];
-            let d109 = A::mul_add(-p.L7, d106, A::mul_add(c_q3r, d105, s_q3r * d100)); // N(M col 8r) at 5r.z
-            let d110 = A::mul_add(-s_q2r, d107, c_q2r * d102); // F(M col 8r) at 4r.y
-            let d111 = A::mul_add(c_q2r, d107, s_q2r * d102); // F(M col 8r) at 4r.z
-            let d112 = A::mul_add(-s_q2r, d109, c_q2r * d104); // N(M col 8r) at 4r.y
-            m[(12, 16)] = d112;
-            m[(16, 12)] = m[(12, 16)];
-            let d113 = A::mul_add(c_q2r, d109, s_q2r * d104); // N(M col 8r) at 4r.z
-            let d114 = A::mul_add(-s_q1r, d111, c_q1r * d106); // F(M col 8r) at 3.y
-            let d115 = A::mul_add(c_q1r, d111, s_q1r * d106); // F(M col 8r) at 3.z
-            let d116 = A::mul_add(-p.L5, d115, d112); // N(M col 8r) at 3.x
-            let d117 = A::mul_add(p.L6, d115, A::mul_add(-s_q1r, d113, c_q1r * d108)); // N(M col 8r) at 3.y
-            m[(4, 16)] = d117;
-            m[(16, 4)] = m[(4, 16)];
-            let d118 = A::mul_add(
-                p.L5,
-                d110,
-                A::mul_add(-p.L6, d114, A::mul_add(c_q1r, d113, s_q1r * d108)),
-            ); // N(M col 8r) at 3.z
-            let d119 = A::mul_add(s_q_torso, d115, c_q_torso * d110); // F(M col 8r) at 2.x
-            let d120 = A::mul_add(-c_q_torso, d115, s_q_torso * d110); // F(M col 8r) at 2.z
-            let d121 = A::mul_add(
-                -p.L4,
-                d114,
-                A::mul_add(p.L3, d120, A::mul_add(s_q_torso, d118, c_q_torso * d116)),
-            ); // N(M col 8r) at 2.x
-            m[(3, 16)] = d121;
-            m[(16, 3)] = m[(3, 16)];
-            let d122 = A::mul_add(p.L4, d119, d117); // N(M col 8r) at 2.y
-            let d123 = A::mul_add(
-                -p.L3,
-                d119,
-                A::mul_add(-c_q_torso, d118, s_q_torso * d116),
-            ); // N(M col 8r) at 2.z
-            let d124 = A::mul_add(-c_q_w, d120, s_q_w * d114); // F(M col 8r) at 1.z
-            let d125 = A::mul_add(s_q_w, d120, c_q_w * d114); // F(M col 8r) at 1.y
-            let d126 = A::mul_add(p.L1, d119, A::mul_add(-c_q_w, d123, s_q_w * d122)); // N(M col 8r) at 1.z
-            let d127 = A::mul_add(p.L2, d125, A::mul_add(-p.L1, d124, d121)); // N(M col 8r) at 1.x
-            m[(2, 16)] = d127;
-            m[(16, 2)] = m[(2, 16)];
-            let d128 = A::mul_add(-p.L2, d119, A::mul_add(s_q_w, d123, c_q_w * d122)); // N(M col 8r) at 1.y
-            let d129 = A::mul_add(c_q_imu, d124, s_q_imu * d125); // F(M col 8r) at 0.x
-            m[(0, 16)] = -d129;
-            m[(16, 0)] = m[(0, 16)];
-            let d130 = A::mul_add(-s_q_imu, d126, c_q_imu * d128); // N(M col 8r) at 0.z
-            m[(1, 16)] = -d130;
-            m[(16, 1)] = m[(1, 16)];
-            let d131 = p.MX7r - d99; // MSC7r.x
-            let d132 = p.MZ7r + d98; // MSC7r.z
-            let k7 = s_q5r * s_q5r; // sin² q5r
-            let k8 = s_q5r * c_q5r; // sin q5r cos q5r
-            let k9 = A::mul_add(2.0, k7, -1.0); // cos 2q5r
-            let d133 = d92 - d96; // JC8r: Jzz − Jxx
-            let d134 = A::mul_add(2.0, d94 * k8, k7 * d133); // JC8r rotated about y: Jzz − J'zz
-            let t17 = p.L8 * d88; // common subexpression
-            let d135 = p.XY7r + t11 - t12 - t15; // JC7r.xy
-            let d136 = A::mul_add(-k8, d133, A::mul_add(d94, k9, p.XZ7r)); // JC7r.xz
-            let d137 = p.YY7r + d97; // JC7r.yy
-            let d138 = p.YZ7r - t13 - t14 + t16; // JC7r.yz
-            let d139 = pc.pc13 - d88; // MSC7r.y
-            let d140 = A::mul_add(2.0, t17, d92 - d134) + pc.pc14; // JC7r.xx
-            m[(15, 15)] = d140;
-            let d141 = A::mul_add(2.0, t17, d96 + d134) + pc.pc15; // JC7r.zz
-            let d142 = A::mul_add(s_q4r, d132, c_q4r * d139); // MSC7r in 6r.y
-            let d143 = A::mul_add(-c_q4r, d132, s_q4r * d139); // MSC7r in 6r.z
-            let t18 = c_q4r * d135; // common subexpression
-            let t19 = s_q4r * d136; // common subexpression
-            let d144 = t18 + t19; // N(M col 7r) at 6r.y
-            m[(14, 15)] = -d144;
-            m[(15, 14)] = m[(14, 15)];
-            let t20 = s_q4r * d135; // common subexpression
-            let t21 = c_q4r * d136; // common subexpression
-            let d145 = t20 - t21; // N(M col 7r) at 6r.z
-            let d146 = s_q3r * d142; // F(M col 7r) at 5r.x
-            let d147 = c_q3r * d142; // F(M col 7r) at 5r.z
-            let d148 = A::mul_add(-p.L7, d146, A::mul_add(c_q3r, d145, s_q3r * d140)); // N(M col 7r) at 5r.z
-            let d149 = A::mul_add(-p.L7, d147, A::mul_add(-s_q3r, d145, c_q3r * d140)); // N(M col 7r) at 5r.x
-            m[(13, 15)] = d149;
-            m[(15, 13)] = m[(13, 15)];
-            let d150 = A::mul_add(s_q2r, d147, c_q2r * d143); // F(M col 7r) at 4r.y
-            let d151 = A::mul_add(-c_q2r, d147, s_q2r * d143); // F(M col 7r) at 4r.z
-            let d152 = A::mul_add(-s_q2r, d148, c_q2r * d144); // N(M col 7r) at 4r.y
-            m[(12, 15)] = -d152;
-            m[(15, 12)] = m[(12, 15)];
-            let d153 = A::mul_add(c_q2r, d148, s_q2r * d144); // N(M col 7r) at 4r.z
-            let d154 = A::mul_add(-s_q1r, d151, c_q1r * d146); // F(M col 7r) at 3.y
-            let d155 = A::mul_add(c_q1r, d151, s_q1r * d146); // F(M col 7r) at 3.z
-            let d156 = A::mul_add(p.L6, d155, A::mul_add(-s_q1r, d153, c_q1r * d149)); // N(M col 7r) at 3.y
-            m[(4, 15)] = -d156;
-            m[(15, 4)] = m[(4, 15)];
-            let d157 = A::mul_add(
-                p.L5,
-                d150,
-                A::mul_add(-p.L6, d154, A::mul_add(c_q1r, d153, s_q1r * d149)),
-            ); // N(M col 7r) at 3.z
-            let d158 = A::mul_add(-p.L5, d155, d152); // N(M col 7r) at 3.x
-            let d159 = A::mul_add(s_q_torso, d155, c_q_torso * d150); // F(M col 7r) at 2.x
-            let d160 = A::mul_add(-c_q_torso, d155, s_q_torso * d150); // F(M col 7r) at 2.z
-            let d161 = A::mul_add(
-                -p.L4,
-                d154,
-                A::mul_add(p.L3, d160, A::mul_add(s_q_torso, d157, c_q_torso * d158)),
-            ); // N(M col 7r) at 2.x
-            m[(3, 15)] = -d161;
-            m[(15, 3)] = m[(3, 15)];
-            let d162 = A::mul_add(p.L4, d159, d156); // N(M col 7r) at 2.y
-            let d163 = A::mul_add(
-                -p.L3,
-                d159,
-                A::mul_add(-c_q_torso, d157, s_q_torso * d158),
-            ); // N(M col 7r) at 2.z
-            let d164 = A::mul_add(s_q_w, d160, c_q_w * d154); // F(M col 7r) at 1.y
-            let d165 = A::mul_add(-c_q_w, d160, s_q_w * d154); // F(M col 7r) at 1.z
-            let d166 = A::mul_add(p.L2, d164, A::mul_add(-p.L1, d165, d161)); // N(M col 7r) at 1.x
-            m[(2, 15)] = -d166;
-            m[(15, 2)] = m[(2, 15)];
-            let d167 = A::mul_add(-p.L2, d159, A::mul_add(s_q_w, d163, c_q_w * d162)); // N(M col 7r) at 1.y
-            let d168 = A::mul_add(p.L1, d159, A::mul_add(-c_q_w, d163, s_q_w * d162)); // N(M col 7r) at 1.z
-            let d169 = A::mul_add(c_q_imu, d165, s_q_imu * d164); // F(M col 7r) at 0.x
-            m[(0, 15)] = d169;
-            m[(15, 0)] = m[(0, 15)];
-            let d170 = A::mul_add(-s_q_imu, d168, c_q_imu * d167); // N(M col 7r) at 0.z
-            m[(1, 15)] = d170;
-            m[(15, 1)] = m[(1, 15)];
-            let d171 = p.MX6r - d131; // MSC6r.x
-            let d172 = p.MY6r - d142; // MSC6r.y
-            let d173 = p.MZ6r - d143; // MSC6r.z
-            let k10 = s_q4r * s_q4r; // sin² q4r
-            let k11 = s_q4r * c_q4r; // sin q4r cos q4r
-            let k12 = A::mul_add(2.0, k10, -1.0); // cos 2q4r
-            let d174 = d137 - d141; // JC7r: Jyy − Jzz
-            let d175 = A::mul_add(-2.0, d138 * k11, k10 * d174); // JC7r rotated about x: Jyy − J'yy
-            let d176 = p.XX6r + d140; // JC6r.xx
-            let d177 = p.XY6r + t18 + t19; // JC6r.xy
-            let d178 = p.XZ6r + t20 - t21; // JC6r.xz
-            let d179 = p.YY6r + d137 - d175; // JC6r.yy
-            m[(14, 14)] = d179;
-            let d180 = A::mul_add(k11, d174, A::mul_add(d138, k12, p.YZ6r)); // JC6r.yz
-            let d181 = p.ZZ6r + d141 + d175; // JC6r.zz
-            let d182 = A::mul_add(c_q3r, d173, s_q3r * d171); // MSC6r in 5r.z
-            let d183 = A::mul_add(-s_q3r, d173, c_q3r * d171); // MSC6r in 5r.x
-            let t22 = c_q3r * d177; // common subexpression
-            let t23 = s_q3r * d180; // common subexpression
-            let t24 = s_q3r * d177; // common subexpression
-            let t25 = c_q3r * d180; // common subexpression
-            let t26 = p.L7 * d183; // common subexpression
-            let t27 = p.L7 * d182; // common subexpression
-            let d184 = t22 - t23 - t26; // N(M col 6r) at 5r.x
-            m[(13, 14)] = -d184;
-            m[(14, 13)] = m[(13, 14)];
-            let d185 = t24 + t25 - t27; // N(M col 6r) at 5r.z
-            let d186 = s_q2r * d183; // F(M col 6r) at 4r.y
-            let d187 = c_q2r * d183; // F(M col 6r) at 4r.z
-            let d188 = A::mul_add(-s_q2r, d185, c_q2r * d179); // N(M col 6r) at 4r.y
-            m[(12, 14)] = d188;
-            m[(14, 12)] = m[(12, 14)];
-            let d189 = A::mul_add(c_q2r, d185, s_q2r * d179); // N(M col 6r) at 4r.z
-            let d190 = A::mul_add(s_q1r, d187, c_q1r * d182); // F(M col 6r) at 3.y
-            let d191 = A::mul_add(-c_q1r, d187, s_q1r * d182); // F(M col 6r) at 3.z
-            let d192 = A::mul_add(-p.L5, d191, d188); // N(M col 6r) at 3.x
-            let d193 = A::mul_add(p.L6, d191, A::mul_add(-s_q1r, d189, c_q1r * d184)); // N(M col 6r) at 3.y
-            m[(4, 14)] = d193;
-            m[(14, 4)] = m[(4, 14)];
-            let d194 = A::mul_add(
-                p.L5,
-                d186,
-                A::mul_add(-p.L6, d190, A::mul_add(c_q1r, d189, s_q1r * d184)),
-            ); // N(M col 6r) at 3.z
-            let d195 = A::mul_add(s_q_torso, d191, c_q_torso * d186); // F(M col 6r) at 2.x
-            let d196 = A::mul_add(-c_q_torso, d191, s_q_torso * d186); // F(M col 6r) at 2.z
-            let d197 = A::mul_add(
-                -p.L4,
-                d190,
-                A::mul_add(p.L3, d196, A::mul_add(s_q_torso, d194, c_q_torso * d192)),
-            ); // N(M col 6r) at 2.x
-            m[(3, 14)] = d197;
-            m[(14, 3)] = m[(3, 14)];
-            let d198 = A::mul_add(p.L4, d195, d193); // N(M col 6r) at 2.y
-            let d199 = A::mul_add(
-                -p.L3,
-                d195,
-                A::mul_add(-c_q_torso, d194, s_q_torso * d192),
-            ); // N(M col 6r) at 2.z
-            let d200 = A::mul_add(-c_q_w, d196, s_q_w * d190); // F(M col 6r) at 1.z
-            let d201 = A::mul_add(s_q_w, d196, c_q_w * d190); // F(M col 6r) at 1.y
-            let d202 = A::mul_add(p.L1, d195, A::mul_add(-c_q_w, d199, s_q_w * d198)); // N(M col 6r) at 1.z
-            let d203 = A::mul_add(p.L2, d201, A::mul_add(-p.L1, d200, d197)); // N(M col 6r) at 1.x
-            m[(2, 14)] = d203;
-            m[(14, 2)] = m[(2, 14)];
-            let d204 = A::mul_add(-p.L2, d195, A::mul_add(s_q_w, d199, c_q_w * d198)); // N(M col 6r) at 1.y
-            let d205 = A::mul_add(c_q_imu, d200, s_q_imu * d201); // F(M col 6r) at 0.x
-            m[(0, 14)] = -d205;
-            m[(14, 0)] = m[(0, 14)];
-            let d206 = A::mul_add(-s_q_imu, d202, c_q_imu * d204); // N(M col 6r) at 0.z
-            m[(1, 14)] = -d206;
-            m[(14, 1)] = m[(1, 14)];
-            let d207 = p.MX5r - d183; // MSC5r.x
-            let d208 = p.MZ5r + d182; // MSC5r.z
-            let k13 = s_q3r * s_q3r; // sin² q3r
-            let k14 = s_q3r * c_q3r; // sin q3r cos q3r
-            let k15 = A::mul_add(2.0, k13, -1.0); // cos 2q3r
-            let d209 = d176 - d181; // JC6r: Jzz − Jxx
-            let d210 = A::mul_add(2.0, d178 * k14, k13 * d209); // JC6r rotated about y: Jzz − J'zz
-            let t28 = p.L7 * d172; // common subexpression
-            let d211 = p.XY5r + t22 - t23 - t26; // JC5r.xy
-            let d212 = A::mul_add(-k14, d209, A::mul_add(d178, k15, p.XZ5r)); // JC5r.xz
-            let d213 = p.YY5r + d179; // JC5r.yy
-            let d214 = p.YZ5r - t24 - t25 + t27; // JC5r.yz
-            let d215 = pc.pc19 - d172; // MSC5r.y
-            let d216 = A::mul_add(2.0, t28, d176 - d210) + pc.pc20; // JC5r.xx
-            m[(13, 13)] = d216;
-            let d217 = A::mul_add(2.0, t28, d181 + d210) + pc.pc21; // JC5r.zz
-            let d218 = A::mul_add(s_q2r, d208, c_q2r * d215); // MSC5r in 4r.y
-            let d219 = A::mul_add(-c_q2r, d208, s_q2r * d215); // MSC5r in 4r.z
-            let t29 = c_q2r * d211; // common subexpression
-            let t30 = s_q2r * d212; // common subexpression
-            let d220 = t29 + t30; // N(M col 5r) at 4r.y
-            m[(12, 13)] = -d220;
-            m[(13, 12)] = m[(12, 13)];
-            let t31 = s_q2r * d211; // common subexpression
-            let t32 = c_q2r * d212; // common subexpression
-            let d221 = t31 - t32; // N(M col 5r) at 4r.z
-            let d222 = s_q1r * d218; // F(M col 5r) at 3.y
-            let d223 = c_q1r * d218; // F(M col 5r) at 3.z
-            let d224 = A::mul_add(-p.L6, d223, A::mul_add(-s_q1r, d221, c_q1r * d216)); // N(M col 5r) at 3.y
-            m[(4, 13)] = -d224;
-            m[(13, 4)] = m[(4, 13)];
-            let d225 = A::mul_add(
-                p.L5,
-                d219,
-                A::mul_add(-p.L6, d222, A::mul_add(c_q1r, d221, s_q1r * d216)),
-            ); // N(M col 5r) at 3.z
-            let d226 = A::mul_add(p.L5, d223, d220); // N(M col 5r) at 3.x
-            let d227 = A::mul_add(-s_q_torso, d223, c_q_torso * d219); // F(M col 5r) at 2.x
-            let d228 = A::mul_add(c_q_torso, d223, s_q_torso * d219); // F(M col 5r) at 2.z
-            let d229 = A::mul_add(
-                -p.L4,
-                d222,
-                A::mul_add(p.L3, d228, A::mul_add(s_q_torso, d225, c_q_torso * d226)),
-            ); // N(M col 5r) at 2.x
-            m[(3, 13)] = -d229;
-            m[(13, 3)] = m[(3, 13)];
-            let d230 = A::mul_add(p.L4, d227, d224); // N(M col 5r) at 2.y
-            let d231 = A::mul_add(
-                -p.L3,
-                d227,
-                A::mul_add(-c_q_torso, d225, s_q_torso * d226),
-            ); // N(M col 5r) at 2.z
-            let d232 = A::mul_add(s_q_w, d228, c_q_w * d222); // F(M col 5r) at 1.y
-            let d233 = A::mul_add(-c_q_w, d228, s_q_w * d222); // F(M col 5r) at 1.z
-            let d234 = A::mul_add(p.L2, d232, A::mul_add(-p.L1, d233, d229)); // N(M col 5r) at 1.x
-            m[(2, 13)] = -d234;
-            m[(13, 2)] = m[(2, 13)];
-            let d235 = A::mul_add(-p.L2, d227, A::mul_add(s_q_w, d231, c_q_w * d230)); // N(M col 5r) at 1.y
-            let d236 = A::mul_add(p.L1, d227, A::mul_add(-c_q_w, d231, s_q_w * d230)); // N(M col 5r) at 1.z
-            let d237 = A::mul_add(c_q_imu, d233, s_q_imu * d232); // F(M col 5r) at 0.x
-            m[(0, 13)] = d237;
-            m[(13, 0)] = m[(0, 13)];
-            let d238 = A::mul_add(-s_q_imu, d236, c_q_imu * d235); // N(M col 5r) at 0.z
-            m[(1, 13)] = d238;
-            m[(13, 1)] = m[(1, 13)];
-            let d239 = p.MX4r - d207; // MSC4r.x
-            let d240 = p.MY4r - d218; // MSC4r.y
-            let d241 = p.MZ4r - d219; // MSC4r.z
-            let k16 = s_q2r * s_q2r; // sin² q2r
-            let k17 = s_q2r * c_q2r; // sin q2r cos q2r
-            let k18 = A::mul_add(2.0, k16, -1.0); // cos 2q2r
-            let d242 = d213 - d217; // JC5r: Jyy − Jzz
-            let d243 = A::mul_add(-2.0, d214 * k17, k16 * d242); // JC5r rotated about x: Jyy − J'yy
-            let d244 = p.XX4r + d216; // JC4r.xx
-            let d245 = p.XY4r + t29 + t30; // JC4r.xy
-            let d246 = p.XZ4r + t31 - t32; // JC4r.xz
-            let d247 = p.YY4r + d213 - d243; // JC4r.yy
-            m[(12, 12)] = d247;
-            let d248 = A::mul_add(k17, d242, A::mul_add(d214, k18, p.YZ4r)); // JC4r.yz
-            let d249 = p.ZZ4r + d217 + d243; // JC4r.zz
-            let d250 = A::mul_add(-s_q1r, d241, c_q1r * d239); // MSC4r in 3.y
-            let d251 = A::mul_add(c_q1r, d241, s_q1r * d239); // MSC4r in 3.z
-            let t33 = c_q1r * d245; // common subexpression
-            let t34 = s_q1r * d248; // common subexpression
-            let t35 = s_q1r * d245; // common subexpression
-            let t36 = c_q1r * d248; // common subexpression
-            let t37 = p.L5 * d250; // common subexpression
-            let t38 = p.L6 * d250; // common subexpression
-            let t39 = p.L6 * d251; // common subexpression
-            let d252 = d247 + t37; // N(M col 4r) at 3.x
-            let d253 = t33 - t34 - t38; // N(M col 4r) at 3.y
-            m[(4, 12)] = d253;
-            m[(12, 4)] = m[(4, 12)];
-            let d254 = t35 + t36 - t39; // N(M col 4r) at 3.z
-            let d255 = s_q_torso * d250; // F(M col 4r) at 2.x
-            let d256 = c_q_torso * d250; // F(M col 4r) at 2.z
-            let d257 = A::mul_add(
-                -p.L4,
-                d251,
-                A::mul_add(p.L3, d256, A::mul_add(s_q_torso, d254, c_q_torso * d252)),
-            ); // N(M col 4r) at 2.x
-            m[(3, 12)] = d257;
-            m[(12, 3)] = m[(3, 12)];
-            let d258 = A::mul_add(-p.L4, d255, d253); // N(M col 4r) at 2.y
-            let d259 = A::mul_add(
-                p.L3,
-                d255,
-                A::mul_add(-c_q_torso, d254, s_q_torso * d252),
-            ); // N(M col 4r) at 2.z
-            let d260 = A::mul_add(-c_q_w, d256, s_q_w * d251); // F(M col 4r) at 1.z
-            let d261 = A::mul_add(s_q_w, d256, c_q_w * d251); // F(M col 4r) at 1.y
-            let d262 = A::mul_add(-p.L1, d255, A::mul_add(-c_q_w, d259, s_q_w * d258)); // N(M col 4r) at 1.z
-            let d263 = A::mul_add(p.L2, d261, A::mul_add(-p.L1, d260, d257)); // N(M col 4r) at 1.x
-            m[(2, 12)] = d263;
-            m[(12, 2)] = m[(2, 12)];
-            let d264 = A::mul_add(p.L2, d255, A::mul_add(s_q_w, d259, c_q_w * d258)); // N(M col 4r) at 1.y
-            let d265 = A::mul_add(c_q_imu, d260, s_q_imu * d261); // F(M col 4r) at 0.x
-            m[(0, 12)] = -d265;
-            m[(12, 0)] = m[(0, 12)];
-            let d266 = A::mul_add(-s_q_imu, d262, c_q_imu * d264); // N(M col 4r) at 0.z
-            m[(1, 12)] = -d266;
-            m[(12, 1)] = m[(1, 12)];
-            let k19 = s_q1r * s_q1r; // sin² q1r
-            let k20 = s_q1r * c_q1r; // sin q1r cos q1r
-            let k21 = A::mul_add(2.0, k19, -1.0); // cos 2q1r
-            let d267 = d244 - d249; // JC4r: Jzz − Jxx
-            let d268 = A::mul_add(2.0, d246 * k20, k19 * d267); // JC4r rotated about y: Jzz − J'zz
-            let t40 = p.L6 * d240; // common subexpression
-            let d269 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
-            let d270 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
-            let t41 = p.XZ10l * c_q7l; // common subexpression
-            let t42 = p.YZ10l * s_q7l; // common subexpression
-            let t43 = p.XZ10l * s_q7l; // common subexpression
-            let t44 = p.YZ10l * c_q7l; // common subexpression
-            let t45 = p.L9 * d270; // common subexpression
-            let t46 = p.L9 * d269; // common subexpression
-            let d271 = t41 + t42 - t45; // N(M col 10l) at 9l.x
+            let d269_d1 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY10l, p.MY10r),
+                    F64x2::new(c_q7l, c_q7r),
+                    F64x2::new(p.MX10l, p.MX10r) * F64x2::new(s_q7l, s_q7r),
+                ); // MSC10l in 9l.z | MSC10r in 9r.z
+            let d270_d2 = lanes
+                .mul_add(
+                    F64x2::new(p.MY10l, p.MY10r),
+                    F64x2::new(s_q7l, s_q7r),
+                    F64x2::new(p.MX10l, p.MX10r) * F64x2::new(c_q7l, c_q7r),
+                ); // MSC10l in 9l.x | MSC10r in 9r.x
+            let t41_t1 = F64x2::new(p.XZ10l, p.XZ10r) * F64x2::new(c_q7l, c_q7r); // common subexpression | common subexpression
+            let t42_t2 = F64x2::new(p.YZ10l, p.YZ10r) * F64x2::new(s_q7l, s_q7r); // common subexpression | common subexpression
+            let t43_t3 = F64x2::new(p.XZ10l, p.XZ10r) * F64x2::new(s_q7l, s_q7r); // common subexpression | common subexpression
+            let t44_t4 = F64x2::new(p.YZ10l, p.YZ10r) * F64x2::new(c_q7l, c_q7r); // common subexpression | common subexpression
+            let t45_t5 = p.L9 * d270_d2; // common subexpression | common subexpression
+            let t46_t6 = p.L9 * d269_d1; // common subexpression | common subexpression
+            let d271_d3 = t41_t1 + t42_t2 - t45_t5; // N(M col 10l) at 9l.x | N(M col 10r) at 9r.x
+            let d271 = d271_d3.lo();
+            let d3 = d271_d3.hi();
             m[(10, 11)] = -d271;
             m[(11, 10)] = m[(10, 11)];
-            let d272 = t43 - t44 - t46; // N(M col 10l) at 9l.z
-            let d273 = d270 * s_q6l; // F(M col 10l) at 8l.y
-            let d274 = d270 * c_q6l; // F(M col 10l) at 8l.z
-            let d275 = A::mul_add(-d272, s_q6l, p.ZZ10l * c_q6l); // N(M col 10l) at 8l.y
+            m[(17, 18)] = -d3;
+            m[(18, 17)] = m[(17, 18)];
+            let d272_d4 = t43_t3 - t44_t4 - t46_t6; // N(M col 10l) at 9l.z | N(M col 10r) at 9r.z
+            let d273_d5 = d270_d2 * F64x2::new(s_q6l, s_q6r); // F(M col 10l) at 8l.y | F(M col 10r) at 8r.y
+            let d274_d6 = d270_d2 * F64x2::new(c_q6l, c_q6r); // F(M col 10l) at 8l.z | F(M col 10r) at 8r.z
+            let d275_d7 = lanes
+                .mul_add(
+                    -d272_d4,
+                    F64x2::new(s_q6l, s_q6r),
+                    F64x2::new(p.ZZ10l, p.ZZ10r) * F64x2::new(c_q6l, c_q6r),
+                ); // N(M col 10l) at 8l.y | N(M col 10r) at 8r.y
+            let d275 = d275_d7.lo();
+            let d7 = d275_d7.hi();
             m[(9, 11)] = d275;
             m[(11, 9)] = m[(9, 11)];
-            let d276 = A::mul_add(d272, c_q6l, p.ZZ10l * s_q6l); // N(M col 10l) at 8l.z
-            let d277 = A::mul_add(d274, s_q5l, d269 * c_q5l); // F(M col 10l) at 7l.x
-            let d278 = A::mul_add(-d274, c_q5l, d269 * s_q5l); // F(M col 10l) at 7l.z
-            let d279 = A::mul_add(p.L8, d278, A::mul_add(-d276, s_q5l, d271 * c_q5l)); // N(M col 10l) at 7l.x
+            m[(16, 18)] = d7;
+            m[(18, 16)] = m[(16, 18)];
+            let d276_d8 = lanes
+                .mul_add(
+                    d272_d4,
+                    F64x2::new(c_q6l, c_q6r),
+                    F64x2::new(p.ZZ10l, p.ZZ10r) * F64x2::new(s_q6l, s_q6r),
+                ); // N(M col 10l) at 8l.z | N(M col 10r) at 8r.z
+            let d277_d9 = lanes
+                .mul_add(
+                    d274_d6,
+                    F64x2::new(s_q5l, s_q5r),
+                    d269_d1 * F64x2::new(c_q5l, c_q5r),
+                ); // F(M col 10l) at 7l.x | F(M col 10r) at 7r.x
+            let d278_d10 = lanes
+                .mul_add(
+                    -d274_d6,
+                    F64x2::new(c_q5l, c_q5r),
+                    d269_d1 * F64x2::new(s_q5l, s_q5r),
+                ); // F(M col 10l) at 7l.z | F(M col 10r) at 7r.z
+            let d279_d11 = lanes
+                .mul_add(
+                    p.L8,
+                    d278_d10,
+                    lanes
+                        .mul_add(
+                            -d276_d8,
+                            F64x2::new(s_q5l, s_q5r),
+                            d271_d3 * F64x2::new(c_q5l, c_q5r),
+                        ),
+                ); // N(M col 10l) at 7l.x | N(M col 10r) at 7r.x
+            let d279 = d279_d11.lo();
+            let d11 = d279_d11.hi();
             m[(8, 11)] = -d279;
             m[(11, 8)] = m[(8, 11)];
-            let d280 = A::mul_add(-p.L8, d277, A::mul_add(d276, c_q5l, d271 * s_q5l)); // N(M col 10l) at 7l.z
-            let d281 = A::mul_add(-d278, s_q4l, d273 * c_q4l); // F(M col 10l) at 6l.y
-            let d282 = A::mul_add(d278, c_q4l, d273 * s_q4l); // F(M col 10l) at 6l.z
-            let d283 = A::mul_add(-d280, s_q4l, d275 * c_q4l); // N(M col 10l) at 6l.y
+            m[(15, 18)] = -d11;
+            m[(18, 15)] = m[(15, 18)];
+            let d280_d12 = lanes
+                .mul_add(
+                    -p.L8,
+                    d277_d9,
+                    lanes
+                        .mul_add(
+                            d276_d8,
+                            F64x2::new(c_q5l, c_q5r),
+                            d271_d3 * F64x2::new(s_q5l, s_q5r),
+                        ),
+                ); // N(M col 10l) at 7l.z | N(M col 10r) at 7r.z
+            let d281_d13 = lanes
+                .mul_add(
+                    -d278_d10,
+                    F64x2::new(s_q4l, s_q4r),
+                    d273_d5 * F64x2::new(c_q4l, c_q4r),
+                ); // F(M col 10l) at 6l.y | F(M col 10r) at 6r.y
+            let d282_d14 = lanes
+                .mul_add(
+                    d278_d10,
+                    F64x2::new(c_q4l, c_q4r),
+                    d273_d5 * F64x2::new(s_q4l, s_q4r),
+                ); // F(M col 10l) at 6l.z | F(M col 10r) at 6r.z
+            let d283_d15 = lanes
+                .mul_add(
+                    -d280_d12,
+                    F64x2::new(s_q4l, s_q4r),
+                    d275_d7 * F64x2::new(c_q4l, c_q4r),
+                ); // N(M col 10l) at 6l.y | N(M col 10r) at 6r.y
+            let d283 = d283_d15.lo();
+            let d15 = d283_d15.hi();
             m[(7, 11)] = d283;
             m[(11, 7)] = m[(7, 11)];
-            let d284 = A::mul_add(d280, c_q4l, d275 * s_q4l); // N(M col 10l) at 6l.z
-            let d285 = A::mul_add(-d282, s_q3l, d277 * c_q3l); // F(M col 10l) at 5l.x
-            let d286 = A::mul_add(d282, c_q3l, d277 * s_q3l); // F(M col 10l) at 5l.z
-            let d287 = A::mul_add(p.L7, d286, A::mul_add(-d284, s_q3l, d279 * c_q3l)); // N(M col 10l) at 5l.x
+            m[(14, 18)] = d15;
+            m[(18, 14)] = m[(14, 18)];
+            let d284_d16 = lanes
+                .mul_add(
+                    d280_d12,
+                    F64x2::new(c_q4l, c_q4r),
+                    d275_d7 * F64x2::new(s_q4l, s_q4r),
+                ); // N(M col 10l) at 6l.z | N(M col 10r) at 6r.z
+            let d285_d17 = lanes
+                .mul_add(
+                    -d282_d14,
+                    F64x2::new(s_q3l, s_q3r),
+                    d277_d9 * F64x2::new(c_q3l, c_q3r),
+                ); // F(M col 10l) at 5l.x | F(M col 10r) at 5r.x
+            let d286_d18 = lanes
+                .mul_add(
+                    d282_d14,
+                    F64x2::new(c_q3l, c_q3r),
+                    d277_d9 * F64x2::new(s_q3l, s_q3r),
+                ); // F(M col 10l) at 5l.z | F(M col 10r) at 5r.z
+            let d287_d19 = lanes
+                .mul_add(
+                    p.L7,
+                    d286_d18,
+                    lanes
+                        .mul_add(
+                            -d284_d16,
+                            F64x2::new(s_q3l, s_q3r),
+                            d279_d11 * F64x2::new(c_q3l, c_q3r),
+                        ),
+                ); // N(M col 10l) at 5l.x | N(M col 10r) at 5r.x
+            let d287 = d287_d19.lo();
+            let d19 = d287_d19.hi();
             m[(6, 11)] = -d287;
             m[(11, 6)] = m[(6, 11)];
-            let d288 = A::mul_add(-p.L7, d285, A::mul_add(d284, c_q3l, d279 * s_q3l)); // N(M col 10l) at 5l.z
-            let d289 = A::mul_add(-d286, s_q2l, d281 * c_q2l); // F(M col 10l) at 4l.y
-            let d290 = A::mul_add(d286, c_q2l, d281 * s_q2l); // F(M col 10l) at 4l.z
-            let d291 = A::mul_add(-d288, s_q2l, d283 * c_q2l); // N(M col 10l) at 4l.y
+            m[(13, 18)] = -d19;
+            m[(18, 13)] = m[(13, 18)];
+            let d288_d20 = lanes
+                .mul_add(
+                    -p.L7,
+                    d285_d17,
+                    lanes
+                        .mul_add(
+                            d284_d16,
+                            F64x2::new(c_q3l, c_q3r),
+                            d279_d11 * F64x2::new(s_q3l, s_q3r),
+                        ),
+                ); // N(M col 10l) at 5l.z | N(M col 10r) at 5r.z
+            let d289_d21 = lanes
+                .mul_add(
+                    -d286_d18,
+                    F64x2::new(s_q2l, s_q2r),
+                    d281_d13 * F64x2::new(c_q2l, c_q2r),
+                ); // F(M col 10l) at 4l.y | F(M col 10r) at 4r.y
+            let d290_d22 = lanes
+                .mul_add(
+                    d286_d18,
+                    F64x2::new(c_q2l, c_q2r),
+                    d281_d13 * F64x2::new(s_q2l, s_q2r),
+                ); // F(M col 10l) at 4l.z | F(M col 10r) at 4r.z
+            let d291_d23 = lanes
+                .mul_add(
+                    -d288_d20,
+                    F64x2::new(s_q2l, s_q2r),
+                    d283_d15 * F64x2::new(c_q2l, c_q2r),
+                ); // N(M col 10l) at 4l.y | N(M col 10r) at 4r.y
+            let d291 = d291_d23.lo();
+            let d23 = d291_d23.hi();
             m[(5, 11)] = d291;
             m[(11, 5)] = m[(5, 11)];
-            let d292 = A::mul_add(d288, c_q2l, d283 * s_q2l); // N(M col 10l) at 4l.z
-            let d293 = A::mul_add(d290, c_q1l, d285 * s_q1l); // F(M col 10l) at 3.z
-            let d294 = A::mul_add(-d290, s_q1l, d285 * c_q1l); // F(M col 10l) at 3.y
-            let d295 = A::mul_add(
-                p.L5,
-                d289,
-                A::mul_add(-p.L6, d294, A::mul_add(d292, c_q1l, d287 * s_q1l)),
-            ); // N(M col 10l) at 3.z
-            let d296 = A::mul_add(-p.L5, d293, d291); // N(M col 10l) at 3.x
-            let d297 = A::mul_add(p.L6, d293, A::mul_add(-d292, s_q1l, d287 * c_q1l)); // N(M col 10l) at 3.y
+            m[(12, 18)] = d23;
+            m[(18, 12)] = m[(12, 18)];
+            let d292_d24 = lanes
+                .mul_add(
+                    d288_d20,
+                    F64x2::new(c_q2l, c_q2r),
+                    d283_d15 * F64x2::new(s_q2l, s_q2r),
+                ); // N(M col 10l) at 4l.z | N(M col 10r) at 4r.z
+            let d293_d26 = lanes
+                .mul_add(
+                    d290_d22,
+                    F64x2::new(c_q1l, c_q1r),
+                    d285_d17 * F64x2::new(s_q1l, s_q1r),
+                ); // F(M col 10l) at 3.z | F(M col 10r) at 3.z
+            let d294_d25 = lanes
+                .mul_add(
+                    -d290_d22,
+                    F64x2::new(s_q1l, s_q1r),
+                    d285_d17 * F64x2::new(c_q1l, c_q1r),
+                ); // F(M col 10l) at 3.y | F(M col 10r) at 3.y
+            let d294 = d294_d25.lo();
+            let d25 = d294_d25.hi();
+            let d295_d29 = lanes
+                .mul_add(
+                    p.L5,
+                    d289_d21,
+                    lanes
+                        .mul_add(
+                            -p.L6,
+                            d294_d25,
+                            lanes
+                                .mul_add(
+                                    d292_d24,
+                                    F64x2::new(c_q1l, c_q1r),
+                                    d287_d19 * F64x2::new(s_q1l, s_q1r),
+                                ),
+                        ),
+                ); // N(M col 10l) at 3.z | N(M col 10r) at 3.z
+            let d295 = d295_d29.lo();
+            let d29 = d295_d29.hi();
+            let d296_d27 = lanes.mul_add(-p.L5, d293_d26, d291_d23); // N(M col 10l) at 3.x | N(M col 10r) at 3.x
+            let d296 = d296_d27.lo();
+            let d27 = d296_d27.hi();
+            let d297_d28 = lanes
+                .mul_add(
+                    p.L6,
+                    d293_d26,
+                    lanes
+                        .mul_add(
+                            -d292_d24,
+                            F64x2::new(s_q1l, s_q1r),
+                            d287_d19 * F64x2::new(c_q1l, c_q1r),
+                        ),
+                ); // N(M col 10l) at 3.y | N(M col 10r) at 3.y
+            let d297 = d297_d28.lo();
+            let d28 = d297_d28.hi();
             m[(4, 11)] = d297;
             m[(11, 4)] = m[(4, 11)];
-            let d298 = A::mul_add(s_q_torso, d293, c_q_torso * d289); // F(M col 10l) at 2.x
-            let d299 = A::mul_add(-c_q_torso, d293, s_q_torso * d289); // F(M col 10l) at 2.z
+            m[(4, 18)] = d28;
+            m[(18, 4)] = m[(4, 18)];
+            let d298_d30 = lanes.mul_add(s_q_torso, d293_d26, c_q_torso * d289_d21); // F(M col 10l) at 2.x | F(M col 10r) at 2.x
+            let d298 = d298_d30.lo();
+            let d30 = d298_d30.hi();
+            let d33 = A::mul_add(-p.L4, d30, -d28); // N(M col 10r) at 2.y
+            let d299_d31 = lanes.mul_add(-c_q_torso, d293_d26, s_q_torso * d289_d21); // F(M col 10l) at 2.z | F(M col 10r) at 2.z
+            let d299 = d299_d31.lo();
+            let d31 = d299_d31.hi();
+            let d32 = A::mul_add(
+                -p.L3,
+                d31,
+                A::mul_add(-d29, s_q_torso, A::mul_add(-d27, c_q_torso, d25 * p.L4)),
+            ); // N(M col 10r) at 2.x
+            m[(3, 18)] = -d32;
+            m[(18, 3)] = m[(3, 18)];
+            let d35 = A::mul_add(-d31, c_q_w, d25 * s_q_w); // F(M col 10r) at 1.z
+            let d36 = A::mul_add(d31, s_q_w, d25 * c_q_w); // F(M col 10r) at 1.y
             let d300 = A::mul_add(
                 p.L4,
                 d294,
@@ -2917,85 +2591,307 @@ mod generated {
             ); // N(M col 10l) at 2.x
             m[(3, 11)] = -d300;
             m[(11, 3)] = m[(3, 11)];
-            let d301 = A::mul_add(
-                -p.L3,
-                d298,
-                A::mul_add(-c_q_torso, d295, s_q_torso * d296),
-            ); // N(M col 10l) at 2.z
+            let d300_d32 = F64x2::new(d300, d32);
+            let d301_d34 = lanes
+                .mul_add(
+                    -p.L3,
+                    d298_d30,
+                    lanes.mul_add(-c_q_torso, d295_d29, s_q_torso * d296_d27),
+                ); // N(M col 10l) at 2.z | N(M col 10r) at 2.z
             let d302 = A::mul_add(-p.L4, d298, d297); // N(M col 10l) at 2.y
+            let d302_d33 = F64x2::new(d302, d33);
             let d303 = A::mul_add(c_q_w, d299, s_q_w * d294); // F(M col 10l) at 1.z
+            let d303_d35 = F64x2::new(d303, d35);
             let d304 = A::mul_add(-s_q_w, d299, c_q_w * d294); // F(M col 10l) at 1.y
-            let d305 = A::mul_add(-p.L2, d304, A::mul_add(p.L1, d303, d300)); // N(M col 10l) at 1.x
+            let d304_d36 = F64x2::new(d304, d36);
+            let d305_d38 = lanes
+                .mul_add(-p.L2, d304_d36, lanes.mul_add(p.L1, d303_d35, d300_d32)); // N(M col 10l) at 1.x | N(M col 10r) at 1.x
+            let d305 = d305_d38.lo();
+            let d38 = d305_d38.hi();
             m[(2, 11)] = -d305;
             m[(11, 2)] = m[(2, 11)];
-            let d306 = A::mul_add(-p.L1, d298, A::mul_add(c_q_w, d301, s_q_w * d302)); // N(M col 10l) at 1.z
-            let d307 = A::mul_add(p.L2, d298, A::mul_add(-s_q_w, d301, c_q_w * d302)); // N(M col 10l) at 1.y
-            let d308 = A::mul_add(c_q_imu, d303, s_q_imu * d304); // F(M col 10l) at 0.x
+            m[(2, 18)] = -d38;
+            m[(18, 2)] = m[(2, 18)];
+            let d306_d37 = lanes
+                .mul_add(
+                    -p.L1,
+                    d298_d30,
+                    lanes.mul_add(c_q_w, d301_d34, s_q_w * d302_d33),
+                ); // N(M col 10l) at 1.z | N(M col 10r) at 1.z
+            let d307_d39 = lanes
+                .mul_add(
+                    p.L2,
+                    d298_d30,
+                    lanes.mul_add(-s_q_w, d301_d34, c_q_w * d302_d33),
+                ); // N(M col 10l) at 1.y | N(M col 10r) at 1.y
+            let d308_d40 = lanes.mul_add(c_q_imu, d303_d35, s_q_imu * d304_d36); // F(M col 10l) at 0.x | F(M col 10r) at 0.x
+            let d308 = d308_d40.lo();
+            let d40 = d308_d40.hi();
             m[(0, 11)] = -d308;
             m[(11, 0)] = m[(0, 11)];
-            let d309 = A::mul_add(-s_q_imu, d306, c_q_imu * d307); // N(M col 10l) at 0.z
+            m[(0, 18)] = -d40;
+            m[(18, 0)] = m[(0, 18)];
+            let d309_d41 = lanes.mul_add(-s_q_imu, d306_d37, c_q_imu * d307_d39); // N(M col 10l) at 0.z | N(M col 10r) at 0.z
+            let d309 = d309_d41.lo();
+            let d41 = d309_d41.hi();
             m[(1, 11)] = -d309;
             m[(11, 1)] = m[(1, 11)];
-            let d310 = p.MX9l - d270; // MSC9l.x
-            let d311 = p.MZ9l + d269; // MSC9l.z
-            let k22 = s_q7l * s_q7l; // sin² q7l
-            let k23 = s_q7l * c_q7l; // sin q7l cos q7l
-            let k24 = A::mul_add(2.0, k22, -1.0); // cos 2q7l
-            let d312 = A::mul_add(-2.0, p.XY10l * k23, k22 * pc.pc26); // JC10l rotated about z: Jxx − J'xx
-            let d313 = p.XY9l + t41 + t42 - t45; // JC9l.xy
-            let d314 = A::mul_add(-k23, pc.pc26, A::mul_add(-p.XY10l, k24, p.XZ9l)); // JC9l.xz
-            let d315 = p.YZ9l - t43 + t44 + t46; // JC9l.yz
-            let d316 = pc.pc30 - d312; // JC9l.xx
+            m[(1, 18)] = d41;
+            m[(18, 1)] = m[(1, 18)];
+            let d310_d42 = F64x2::new(p.MX9l, p.MX9r) - d270_d2; // MSC9l.x | MSC9r.x
+            let d311_d43 = F64x2::new(p.MZ9l, p.MZ9r) + d269_d1; // MSC9l.z | MSC9r.z
+            let k22_k1 = F64x2::new(s_q7l, s_q7r) * F64x2::new(s_q7l, s_q7r); // sin² q7l | sin² q7r
+            let k23_k2 = F64x2::new(s_q7l, s_q7r) * F64x2::new(c_q7l, c_q7r); // sin q7l cos q7l | sin q7r cos q7r
+            let k24_k3 = lanes.mul_add(2.0, k22_k1, -1.0); // cos 2q7l | cos 2q7r
+            let d312_d44 = lanes
+                .mul_add(
+                    -2.0,
+                    F64x2::new(p.XY10l, p.XY10r) * k23_k2,
+                    k22_k1 * F64x2::new(pc.pc26, pc.pc3),
+                ); // JC10l rotated about z: Jxx − J'xx | JC10r rotated about z: Jxx − J'xx
+            let d313_d45 = F64x2::new(p.XY9l, p.XY9r) + t41_t1 + t42_t2 - t45_t5; // JC9l.xy | JC9r.xy
+            let d314_d46 = lanes
+                .mul_add(
+                    -k23_k2,
+                    F64x2::new(pc.pc26, pc.pc3),
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.XY10l, p.XY10r),
+                            k24_k3,
+                            F64x2::new(p.XZ9l, p.XZ9r),
+                        ),
+                ); // JC9l.xz | JC9r.xz
+            let d315_d47 = F64x2::new(p.YZ9l, p.YZ9r) - t43_t3 + t44_t4 + t46_t6; // JC9l.yz | JC9r.yz
+            let d316_d48 = F64x2::new(pc.pc30, pc.pc7) - d312_d44; // JC9l.xx | JC9r.xx
+            let d316 = d316_d48.lo();
+            let d48 = d316_d48.hi();
             m[(10, 10)] = d316;
-            let d317 = d312 + pc.pc31; // JC9l.zz
-            let d318 = A::mul_add(s_q6l, d311, c_q6l * pc.pc25); // MSC9l in 8l.y
-            let d319 = A::mul_add(-c_q6l, d311, s_q6l * pc.pc25); // MSC9l in 8l.z
-            let t47 = c_q6l * d313; // common subexpression
-            let t48 = s_q6l * d314; // common subexpression
-            let d320 = t47 + t48; // N(M col 9l) at 8l.y
+            m[(17, 17)] = d48;
+            let d317_d49 = d312_d44 + F64x2::new(pc.pc31, pc.pc8); // JC9l.zz | JC9r.zz
+            let d318_d50 = lanes
+                .mul_add(
+                    F64x2::new(s_q6l, s_q6r),
+                    d311_d43,
+                    F64x2::new(c_q6l, c_q6r) * F64x2::new(pc.pc25, pc.pc2),
+                ); // MSC9l in 8l.y | MSC9r in 8r.y
+            let d319_d51 = lanes
+                .mul_add(
+                    -F64x2::new(c_q6l, c_q6r),
+                    d311_d43,
+                    F64x2::new(s_q6l, s_q6r) * F64x2::new(pc.pc25, pc.pc2),
+                ); // MSC9l in 8l.z | MSC9r in 8r.z
+            let t47_t7 = F64x2::new(c_q6l, c_q6r) * d313_d45; // common subexpression | common subexpression
+            let t48_t8 = F64x2::new(s_q6l, s_q6r) * d314_d46; // common subexpression | common subexpression
+            let d320_d52 = t47_t7 + t48_t8; // N(M col 9l) at 8l.y | N(M col 9r) at 8r.y
+            let d320 = d320_d52.lo();
+            let d52 = d320_d52.hi();
             m[(9, 10)] = -d320;
             m[(10, 9)] = m[(9, 10)];
-            let t49 = s_q6l * d313; // common subexpression
-            let t50 = c_q6l * d314; // common subexpression
-            let d321 = t49 - t50; // N(M col 9l) at 8l.z
-            let d322 = s_q5l * d318; // F(M col 9l) at 7l.x
-            let d323 = c_q5l * d318; // F(M col 9l) at 7l.z
-            let d324 = A::mul_add(-p.L8, d322, A::mul_add(c_q5l, d321, s_q5l * d316)); // N(M col 9l) at 7l.z
-            let d325 = A::mul_add(-p.L8, d323, A::mul_add(-s_q5l, d321, c_q5l * d316)); // N(M col 9l) at 7l.x
+            m[(16, 17)] = -d52;
+            m[(17, 16)] = m[(16, 17)];
+            let t49_t9 = F64x2::new(s_q6l, s_q6r) * d313_d45; // common subexpression | common subexpression
+            let t50_t10 = F64x2::new(c_q6l, c_q6r) * d314_d46; // common subexpression | common subexpression
+            let d321_d53 = t49_t9 - t50_t10; // N(M col 9l) at 8l.z | N(M col 9r) at 8r.z
+            let d322_d54 = F64x2::new(s_q5l, s_q5r) * d318_d50; // F(M col 9l) at 7l.x | F(M col 9r) at 7r.x
+            let d323_d55 = F64x2::new(c_q5l, c_q5r) * d318_d50; // F(M col 9l) at 7l.z | F(M col 9r) at 7r.z
+            let d324_d56 = lanes
+                .mul_add(
+                    -p.L8,
+                    d322_d54,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q5l, c_q5r),
+                            d321_d53,
+                            F64x2::new(s_q5l, s_q5r) * d316_d48,
+                        ),
+                ); // N(M col 9l) at 7l.z | N(M col 9r) at 7r.z
+            let d325_d57 = lanes
+                .mul_add(
+                    -p.L8,
+                    d323_d55,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q5l, s_q5r),
+                            d321_d53,
+                            F64x2::new(c_q5l, c_q5r) * d316_d48,
+                        ),
+                ); // N(M col 9l) at 7l.x | N(M col 9r) at 7r.x
+            let d325 = d325_d57.lo();
+            let d57 = d325_d57.hi();
             m[(8, 10)] = d325;
             m[(10, 8)] = m[(8, 10)];
-            let d326 = A::mul_add(s_q4l, d323, c_q4l * d319); // F(M col 9l) at 6l.y
-            let d327 = A::mul_add(-c_q4l, d323, s_q4l * d319); // F(M col 9l) at 6l.z
-            let d328 = A::mul_add(-s_q4l, d324, c_q4l * d320); // N(M col 9l) at 6l.y
+            m[(15, 17)] = d57;
+            m[(17, 15)] = m[(15, 17)];
+            let d326_d58 = lanes
+                .mul_add(
+                    F64x2::new(s_q4l, s_q4r),
+                    d323_d55,
+                    F64x2::new(c_q4l, c_q4r) * d319_d51,
+                ); // F(M col 9l) at 6l.y | F(M col 9r) at 6r.y
+            let d327_d59 = lanes
+                .mul_add(
+                    -F64x2::new(c_q4l, c_q4r),
+                    d323_d55,
+                    F64x2::new(s_q4l, s_q4r) * d319_d51,
+                ); // F(M col 9l) at 6l.z | F(M col 9r) at 6r.z
+            let d328_d60 = lanes
+                .mul_add(
+                    -F64x2::new(s_q4l, s_q4r),
+                    d324_d56,
+                    F64x2::new(c_q4l, c_q4r) * d320_d52,
+                ); // N(M col 9l) at 6l.y | N(M col 9r) at 6r.y
+            let d328 = d328_d60.lo();
+            let d60 = d328_d60.hi();
             m[(7, 10)] = -d328;
             m[(10, 7)] = m[(7, 10)];
-            let d329 = A::mul_add(c_q4l, d324, s_q4l * d320); // N(M col 9l) at 6l.z
-            let d330 = A::mul_add(c_q3l, d327, s_q3l * d322); // F(M col 9l) at 5l.z
-            let d331 = A::mul_add(-s_q3l, d327, c_q3l * d322); // F(M col 9l) at 5l.x
-            let d332 = A::mul_add(-p.L7, d331, A::mul_add(c_q3l, d329, s_q3l * d325)); // N(M col 9l) at 5l.z
-            let d333 = A::mul_add(p.L7, d330, A::mul_add(-s_q3l, d329, c_q3l * d325)); // N(M col 9l) at 5l.x
+            m[(14, 17)] = -d60;
+            m[(17, 14)] = m[(14, 17)];
+            let d329_d61 = lanes
+                .mul_add(
+                    F64x2::new(c_q4l, c_q4r),
+                    d324_d56,
+                    F64x2::new(s_q4l, s_q4r) * d320_d52,
+                ); // N(M col 9l) at 6l.z | N(M col 9r) at 6r.z
+            let d330_d62 = lanes
+                .mul_add(
+                    F64x2::new(c_q3l, c_q3r),
+                    d327_d59,
+                    F64x2::new(s_q3l, s_q3r) * d322_d54,
+                ); // F(M col 9l) at 5l.z | F(M col 9r) at 5r.z
+            let d331_d63 = lanes
+                .mul_add(
+                    -F64x2::new(s_q3l, s_q3r),
+                    d327_d59,
+                    F64x2::new(c_q3l, c_q3r) * d322_d54,
+                ); // F(M col 9l) at 5l.x | F(M col 9r) at 5r.x
+            let d332_d64 = lanes
+                .mul_add(
+                    -p.L7,
+                    d331_d63,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q3l, c_q3r),
+                            d329_d61,
+                            F64x2::new(s_q3l, s_q3r) * d325_d57,
+                        ),
+                ); // N(M col 9l) at 5l.z | N(M col 9r) at 5r.z
+            let d333_d65 = lanes
+                .mul_add(
+                    p.L7,
+                    d330_d62,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q3l, s_q3r),
+                            d329_d61,
+                            F64x2::new(c_q3l, c_q3r) * d325_d57,
+                        ),
+                ); // N(M col 9l) at 5l.x | N(M col 9r) at 5r.x
+            let d333 = d333_d65.lo();
+            let d65 = d333_d65.hi();
             m[(6, 10)] = d333;
             m[(10, 6)] = m[(6, 10)];
-            let d334 = A::mul_add(-s_q2l, d330, c_q2l * d326); // F(M col 9l) at 4l.y
-            let d335 = A::mul_add(c_q2l, d330, s_q2l * d326); // F(M col 9l) at 4l.z
-            let d336 = A::mul_add(-s_q2l, d332, c_q2l * d328); // N(M col 9l) at 4l.y
+            m[(13, 17)] = d65;
+            m[(17, 13)] = m[(13, 17)];
+            let d334_d66 = lanes
+                .mul_add(
+                    -F64x2::new(s_q2l, s_q2r),
+                    d330_d62,
+                    F64x2::new(c_q2l, c_q2r) * d326_d58,
+                ); // F(M col 9l) at 4l.y | F(M col 9r) at 4r.y
+            let d335_d67 = lanes
+                .mul_add(
+                    F64x2::new(c_q2l, c_q2r),
+                    d330_d62,
+                    F64x2::new(s_q2l, s_q2r) * d326_d58,
+                ); // F(M col 9l) at 4l.z | F(M col 9r) at 4r.z
+            let d336_d68 = lanes
+                .mul_add(
+                    -F64x2::new(s_q2l, s_q2r),
+                    d332_d64,
+                    F64x2::new(c_q2l, c_q2r) * d328_d60,
+                ); // N(M col 9l) at 4l.y | N(M col 9r) at 4r.y
+            let d336 = d336_d68.lo();
+            let d68 = d336_d68.hi();
             m[(5, 10)] = -d336;
             m[(10, 5)] = m[(5, 10)];
-            let d337 = A::mul_add(c_q2l, d332, s_q2l * d328); // N(M col 9l) at 4l.z
-            let d338 = A::mul_add(-s_q1l, d335, c_q1l * d331); // F(M col 9l) at 3.y
-            let d339 = A::mul_add(c_q1l, d335, s_q1l * d331); // F(M col 9l) at 3.z
-            let d340 = A::mul_add(-p.L5, d339, d336); // N(M col 9l) at 3.x
-            let d341 = A::mul_add(p.L6, d339, A::mul_add(-s_q1l, d337, c_q1l * d333)); // N(M col 9l) at 3.y
+            m[(12, 17)] = -d68;
+            m[(17, 12)] = m[(12, 17)];
+            let d337_d69 = lanes
+                .mul_add(
+                    F64x2::new(c_q2l, c_q2r),
+                    d332_d64,
+                    F64x2::new(s_q2l, s_q2r) * d328_d60,
+                ); // N(M col 9l) at 4l.z | N(M col 9r) at 4r.z
+            let d338_d70 = lanes
+                .mul_add(
+                    -F64x2::new(s_q1l, s_q1r),
+                    d335_d67,
+                    F64x2::new(c_q1l, c_q1r) * d331_d63,
+                ); // F(M col 9l) at 3.y | F(M col 9r) at 3.y
+            let d338 = d338_d70.lo();
+            let d70 = d338_d70.hi();
+            let d339_d71 = lanes
+                .mul_add(
+                    F64x2::new(c_q1l, c_q1r),
+                    d335_d67,
+                    F64x2::new(s_q1l, s_q1r) * d331_d63,
+                ); // F(M col 9l) at 3.z | F(M col 9r) at 3.z
+            let d340_d74 = lanes.mul_add(-p.L5, d339_d71, d336_d68); // N(M col 9l) at 3.x | N(M col 9r) at 3.x
+            let d340 = d340_d74.lo();
+            let d74 = d340_d74.hi();
+            let d341_d72 = lanes
+                .mul_add(
+                    p.L6,
+                    d339_d71,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q1l, s_q1r),
+                            d337_d69,
+                            F64x2::new(c_q1l, c_q1r) * d333_d65,
+                        ),
+                ); // N(M col 9l) at 3.y | N(M col 9r) at 3.y
+            let d341 = d341_d72.lo();
+            let d72 = d341_d72.hi();
             m[(4, 10)] = -d341;
             m[(10, 4)] = m[(4, 10)];
-            let d342 = A::mul_add(
-                p.L5,
-                d334,
-                A::mul_add(-p.L6, d338, A::mul_add(c_q1l, d337, s_q1l * d333)),
-            ); // N(M col 9l) at 3.z
-            let d343 = A::mul_add(s_q_torso, d339, c_q_torso * d334); // F(M col 9l) at 2.x
-            let d344 = A::mul_add(-c_q_torso, d339, s_q_torso * d334); // F(M col 9l) at 2.z
+            m[(4, 17)] = -d72;
+            m[(17, 4)] = m[(4, 17)];
+            let d342_d73 = lanes
+                .mul_add(
+                    p.L5,
+                    d334_d66,
+                    lanes
+                        .mul_add(
+                            -p.L6,
+                            d338_d70,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(c_q1l, c_q1r),
+                                    d337_d69,
+                                    F64x2::new(s_q1l, s_q1r) * d333_d65,
+                                ),
+                        ),
+                ); // N(M col 9l) at 3.z | N(M col 9r) at 3.z
+            let d342 = d342_d73.lo();
+            let d73 = d342_d73.hi();
+            let d343_d75 = lanes.mul_add(s_q_torso, d339_d71, c_q_torso * d334_d66); // F(M col 9l) at 2.x | F(M col 9r) at 2.x
+            let d343 = d343_d75.lo();
+            let d75 = d343_d75.hi();
+            let d78 = A::mul_add(-p.L4, d75, -d72); // N(M col 9r) at 2.y
+            let d344_d76 = lanes.mul_add(-c_q_torso, d339_d71, s_q_torso * d334_d66); // F(M col 9l) at 2.z | F(M col 9r) at 2.z
+            let d344 = d344_d76.lo();
+            let d76 = d344_d76.hi();
+            let d77 = A::mul_add(
+                -p.L3,
+                d76,
+                A::mul_add(-s_q_torso, d73, A::mul_add(-c_q_torso, d74, p.L4 * d70)),
+            ); // N(M col 9r) at 2.x
+            m[(3, 17)] = d77;
+            m[(17, 3)] = m[(3, 17)];
+            let d80 = A::mul_add(s_q_w, d76, c_q_w * d70); // F(M col 9r) at 1.y
+            let d81 = A::mul_add(-c_q_w, d76, s_q_w * d70); // F(M col 9r) at 1.z
             let d345 = A::mul_add(-p.L4, d343, d341); // N(M col 9l) at 2.y
+            let d345_d78 = F64x2::new(d345, d78);
             let d346 = A::mul_add(
                 p.L4,
                 d338,
@@ -3003,82 +2899,259 @@ mod generated {
             ); // N(M col 9l) at 2.x
             m[(3, 10)] = d346;
             m[(10, 3)] = m[(3, 10)];
-            let d347 = A::mul_add(
-                -p.L3,
-                d343,
-                A::mul_add(-c_q_torso, d342, s_q_torso * d340),
-            ); // N(M col 9l) at 2.z
+            let d346_d77 = F64x2::new(d346, d77);
+            let d347_d79 = lanes
+                .mul_add(
+                    -p.L3,
+                    d343_d75,
+                    lanes.mul_add(-c_q_torso, d342_d73, s_q_torso * d340_d74),
+                ); // N(M col 9l) at 2.z | N(M col 9r) at 2.z
             let d348 = A::mul_add(-s_q_w, d344, c_q_w * d338); // F(M col 9l) at 1.y
+            let d348_d80 = F64x2::new(d348, d80);
             let d349 = A::mul_add(c_q_w, d344, s_q_w * d338); // F(M col 9l) at 1.z
-            let d350 = A::mul_add(p.L2, d343, A::mul_add(-s_q_w, d347, c_q_w * d345)); // N(M col 9l) at 1.y
-            let d351 = A::mul_add(-p.L2, d348, A::mul_add(p.L1, d349, d346)); // N(M col 9l) at 1.x
+            let d349_d81 = F64x2::new(d349, d81);
+            let d350_d83 = lanes
+                .mul_add(
+                    p.L2,
+                    d343_d75,
+                    lanes.mul_add(-s_q_w, d347_d79, c_q_w * d345_d78),
+                ); // N(M col 9l) at 1.y | N(M col 9r) at 1.y
+            let d351_d82 = lanes
+                .mul_add(-p.L2, d348_d80, lanes.mul_add(p.L1, d349_d81, d346_d77)); // N(M col 9l) at 1.x | N(M col 9r) at 1.x
+            let d351 = d351_d82.lo();
+            let d82 = d351_d82.hi();
             m[(2, 10)] = d351;
             m[(10, 2)] = m[(2, 10)];
-            let d352 = A::mul_add(-p.L1, d343, A::mul_add(c_q_w, d347, s_q_w * d345)); // N(M col 9l) at 1.z
-            let d353 = A::mul_add(c_q_imu, d349, s_q_imu * d348); // F(M col 9l) at 0.x
+            m[(2, 17)] = d82;
+            m[(17, 2)] = m[(2, 17)];
+            let d352_d84 = lanes
+                .mul_add(
+                    -p.L1,
+                    d343_d75,
+                    lanes.mul_add(c_q_w, d347_d79, s_q_w * d345_d78),
+                ); // N(M col 9l) at 1.z | N(M col 9r) at 1.z
+            let d353_d85 = lanes.mul_add(c_q_imu, d349_d81, s_q_imu * d348_d80); // F(M col 9l) at 0.x | F(M col 9r) at 0.x
+            let d353 = d353_d85.lo();
+            let d85 = d353_d85.hi();
             m[(0, 10)] = d353;
             m[(10, 0)] = m[(0, 10)];
-            let d354 = A::mul_add(-s_q_imu, d352, c_q_imu * d350); // N(M col 9l) at 0.z
+            m[(0, 17)] = d85;
+            m[(17, 0)] = m[(0, 17)];
+            let d354_d86 = lanes.mul_add(-s_q_imu, d352_d84, c_q_imu * d350_d83); // N(M col 9l) at 0.z | N(M col 9r) at 0.z
+            let d354 = d354_d86.lo();
+            let d86 = d354_d86.hi();
             m[(1, 10)] = d354;
             m[(10, 1)] = m[(1, 10)];
-            let d355 = p.MX8l - d310; // MSC8l.x
-            let d356 = p.MY8l - d318; // MSC8l.y
-            let d357 = p.MZ8l - d319; // MSC8l.z
-            let k25 = s_q6l * s_q6l; // sin² q6l
-            let k26 = s_q6l * c_q6l; // sin q6l cos q6l
-            let k27 = A::mul_add(2.0, k25, -1.0); // cos 2q6l
-            let d358 = pc.pc29 - d317; // JC9l: Jyy − Jzz
-            let d359 = A::mul_add(-2.0, d315 * k26, k25 * d358); // JC9l rotated about x: Jyy − J'yy
-            let d360 = p.XX8l + d316; // JC8l.xx
-            let d361 = p.XY8l + t47 + t48; // JC8l.xy
-            let d362 = p.XZ8l + t49 - t50; // JC8l.xz
-            let d363 = A::mul_add(k26, d358, A::mul_add(d315, k27, p.YZ8l)); // JC8l.yz
-            let d364 = p.ZZ8l + d317 + d359; // JC8l.zz
-            let d365 = pc.pc33 - d359; // JC8l.yy
+            m[(1, 17)] = -d86;
+            m[(17, 1)] = m[(1, 17)];
+            let d355_d87 = F64x2::new(p.MX8l, p.MX8r) - d310_d42; // MSC8l.x | MSC8r.x
+            let d356_d88 = F64x2::new(p.MY8l, p.MY8r) - d318_d50; // MSC8l.y | MSC8r.y
+            let d357_d89 = F64x2::new(p.MZ8l, p.MZ8r) - d319_d51; // MSC8l.z | MSC8r.z
+            let k25_k4 = F64x2::new(s_q6l, s_q6r) * F64x2::new(s_q6l, s_q6r); // sin² q6l | sin² q6r
+            let k26_k5 = F64x2::new(s_q6l, s_q6r) * F64x2::new(c_q6l, c_q6r); // sin q6l cos q6l | sin q6r cos q6r
+            let k27_k6 = lanes.mul_add(2.0, k25_k4, -1.0); // cos 2q6l | cos 2q6r
+            let d90_d358 = F64x2::new(pc.pc6, pc.pc29) - d317_d49.swap(); // JC9r: Jyy − Jzz | JC9l: Jyy − Jzz
+            let d359_d91 = lanes
+                .mul_add(-2.0, d315_d47 * k26_k5, k25_k4 * d90_d358.swap()); // JC9l rotated about x: Jyy − J'yy | JC9r rotated about x: Jyy − J'yy
+            let d360_d92 = F64x2::new(p.XX8l, p.XX8r) + d316_d48; // JC8l.xx | JC8r.xx
+            let d361_d93 = F64x2::new(p.XY8l, p.XY8r) + t47_t7 + t48_t8; // JC8l.xy | JC8r.xy
+            let d362_d94 = F64x2::new(p.XZ8l, p.XZ8r) + t49_t9 - t50_t10; // JC8l.xz | JC8r.xz
+            let d363_d95 = lanes
+                .mul_add(
+                    k26_k5,
+                    d90_d358.swap(),
+                    lanes.mul_add(d315_d47, k27_k6, F64x2::new(p.YZ8l, p.YZ8r)),
+                ); // JC8l.yz | JC8r.yz
+            let d364_d96 = F64x2::new(p.ZZ8l, p.ZZ8r) + d317_d49 + d359_d91; // JC8l.zz | JC8r.zz
+            let d365_d97 = F64x2::new(pc.pc33, pc.pc10) - d359_d91; // JC8l.yy | JC8r.yy
+            let d365 = d365_d97.lo();
+            let d97 = d365_d97.hi();
             m[(9, 9)] = d365;
-            let d366 = A::mul_add(c_q5l, d357, s_q5l * d355); // MSC8l in 7l.z
-            let d367 = A::mul_add(-s_q5l, d357, c_q5l * d355); // MSC8l in 7l.x
-            let t51 = c_q5l * d361; // common subexpression
-            let t52 = s_q5l * d363; // common subexpression
-            let t53 = s_q5l * d361; // common subexpression
-            let t54 = c_q5l * d363; // common subexpression
-            let t55 = p.L8 * d367; // common subexpression
-            let t56 = p.L8 * d366; // common subexpression
-            let d368 = t51 - t52 - t55; // N(M col 8l) at 7l.x
+            m[(16, 16)] = d97;
+            let d366_d98 = lanes
+                .mul_add(
+                    F64x2::new(c_q5l, c_q5r),
+                    d357_d89,
+                    F64x2::new(s_q5l, s_q5r) * d355_d87,
+                ); // MSC8l in 7l.z | MSC8r in 7r.z
+            let d367_d99 = lanes
+                .mul_add(
+                    -F64x2::new(s_q5l, s_q5r),
+                    d357_d89,
+                    F64x2::new(c_q5l, c_q5r) * d355_d87,
+                ); // MSC8l in 7l.x | MSC8r in 7r.x
+            let t51_t11 = F64x2::new(c_q5l, c_q5r) * d361_d93; // common subexpression | common subexpression
+            let t52_t12 = F64x2::new(s_q5l, s_q5r) * d363_d95; // common subexpression | common subexpression
+            let t53_t13 = F64x2::new(s_q5l, s_q5r) * d361_d93; // common subexpression | common subexpression
+            let t54_t14 = F64x2::new(c_q5l, c_q5r) * d363_d95; // common subexpression | common subexpression
+            let t55_t15 = p.L8 * d367_d99; // common subexpression | common subexpression
+            let t56_t16 = p.L8 * d366_d98; // common subexpression | common subexpression
+            let d368_d100 = t51_t11 - t52_t12 - t55_t15; // N(M col 8l) at 7l.x | N(M col 8r) at 7r.x
+            let d368 = d368_d100.lo();
+            let d100 = d368_d100.hi();
             m[(8, 9)] = -d368;
             m[(9, 8)] = m[(8, 9)];
-            let d369 = t53 + t54 - t56; // N(M col 8l) at 7l.z
-            let d370 = s_q4l * d367; // F(M col 8l) at 6l.y
-            let d371 = c_q4l * d367; // F(M col 8l) at 6l.z
-            let d372 = A::mul_add(-s_q4l, d369, c_q4l * d365); // N(M col 8l) at 6l.y
+            m[(15, 16)] = -d100;
+            m[(16, 15)] = m[(15, 16)];
+            let d369_d101 = t53_t13 + t54_t14 - t56_t16; // N(M col 8l) at 7l.z | N(M col 8r) at 7r.z
+            let d370_d102 = F64x2::new(s_q4l, s_q4r) * d367_d99; // F(M col 8l) at 6l.y | F(M col 8r) at 6r.y
+            let d371_d103 = F64x2::new(c_q4l, c_q4r) * d367_d99; // F(M col 8l) at 6l.z | F(M col 8r) at 6r.z
+            let d372_d104 = lanes
+                .mul_add(
+                    -F64x2::new(s_q4l, s_q4r),
+                    d369_d101,
+                    F64x2::new(c_q4l, c_q4r) * d365_d97,
+                ); // N(M col 8l) at 6l.y | N(M col 8r) at 6r.y
+            let d372 = d372_d104.lo();
+            let d104 = d372_d104.hi();
             m[(7, 9)] = d372;
             m[(9, 7)] = m[(7, 9)];
-            let d373 = A::mul_add(c_q4l, d369, s_q4l * d365); // N(M col 8l) at 6l.z
-            let d374 = A::mul_add(s_q3l, d371, c_q3l * d366); // F(M col 8l) at 5l.x
-            let d375 = A::mul_add(-c_q3l, d371, s_q3l * d366); // F(M col 8l) at 5l.z
-            let d376 = A::mul_add(p.L7, d375, A::mul_add(-s_q3l, d373, c_q3l * d368)); // N(M col 8l) at 5l.x
+            m[(14, 16)] = d104;
+            m[(16, 14)] = m[(14, 16)];
+            let d373_d105 = lanes
+                .mul_add(
+                    F64x2::new(c_q4l, c_q4r),
+                    d369_d101,
+                    F64x2::new(s_q4l, s_q4r) * d365_d97,
+                ); // N(M col 8l) at 6l.z | N(M col 8r) at 6r.z
+            let d374_d106 = lanes
+                .mul_add(
+                    F64x2::new(s_q3l, s_q3r),
+                    d371_d103,
+                    F64x2::new(c_q3l, c_q3r) * d366_d98,
+                ); // F(M col 8l) at 5l.x | F(M col 8r) at 5r.x
+            let d375_d107 = lanes
+                .mul_add(
+                    -F64x2::new(c_q3l, c_q3r),
+                    d371_d103,
+                    F64x2::new(s_q3l, s_q3r) * d366_d98,
+                ); // F(M col 8l) at 5l.z | F(M col 8r) at 5r.z
+            let d376_d108 = lanes
+                .mul_add(
+                    p.L7,
+                    d375_d107,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q3l, s_q3r),
+                            d373_d105,
+                            F64x2::new(c_q3l, c_q3r) * d368_d100,
+                        ),
+                ); // N(M col 8l) at 5l.x | N(M col 8r) at 5r.x
+            let d376 = d376_d108.lo();
+            let d108 = d376_d108.hi();
             m[(6, 9)] = -d376;
             m[(9, 6)] = m[(6, 9)];
-            let d377 = A::mul_add(-p.L7, d374, A::mul_add(c_q3l, d373, s_q3l * d368)); // N(M col 8l) at 5l.z
-            let d378 = A::mul_add(-s_q2l, d375, c_q2l * d370); // F(M col 8l) at 4l.y
-            let d379 = A::mul_add(c_q2l, d375, s_q2l * d370); // F(M col 8l) at 4l.z
-            let d380 = A::mul_add(-s_q2l, d377, c_q2l * d372); // N(M col 8l) at 4l.y
+            m[(13, 16)] = -d108;
+            m[(16, 13)] = m[(13, 16)];
+            let d377_d109 = lanes
+                .mul_add(
+                    -p.L7,
+                    d374_d106,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q3l, c_q3r),
+                            d373_d105,
+                            F64x2::new(s_q3l, s_q3r) * d368_d100,
+                        ),
+                ); // N(M col 8l) at 5l.z | N(M col 8r) at 5r.z
+            let d378_d110 = lanes
+                .mul_add(
+                    -F64x2::new(s_q2l, s_q2r),
+                    d375_d107,
+                    F64x2::new(c_q2l, c_q2r) * d370_d102,
+                ); // F(M col 8l) at 4l.y | F(M col 8r) at 4r.y
+            let d379_d111 = lanes
+                .mul_add(
+                    F64x2::new(c_q2l, c_q2r),
+                    d375_d107,
+                    F64x2::new(s_q2l, s_q2r) * d370_d102,
+                ); // F(M col 8l) at 4l.z | F(M col 8r) at 4r.z
+            let d380_d112 = lanes
+                .mul_add(
+                    -F64x2::new(s_q2l, s_q2r),
+                    d377_d109,
+                    F64x2::new(c_q2l, c_q2r) * d372_d104,
+                ); // N(M col 8l) at 4l.y | N(M col 8r) at 4r.y
+            let d380 = d380_d112.lo();
+            let d112 = d380_d112.hi();
             m[(5, 9)] = d380;
             m[(9, 5)] = m[(5, 9)];
-            let d381 = A::mul_add(c_q2l, d377, s_q2l * d372); // N(M col 8l) at 4l.z
-            let d382 = A::mul_add(c_q1l, d379, s_q1l * d374); // F(M col 8l) at 3.z
-            let d383 = A::mul_add(-s_q1l, d379, c_q1l * d374); // F(M col 8l) at 3.y
-            let d384 = A::mul_add(
-                p.L5,
-                d378,
-                A::mul_add(-p.L6, d383, A::mul_add(c_q1l, d381, s_q1l * d376)),
-            ); // N(M col 8l) at 3.z
-            let d385 = A::mul_add(-p.L5, d382, d380); // N(M col 8l) at 3.x
-            let d386 = A::mul_add(p.L6, d382, A::mul_add(-s_q1l, d381, c_q1l * d376)); // N(M col 8l) at 3.y
+            m[(12, 16)] = d112;
+            m[(16, 12)] = m[(12, 16)];
+            let d381_d113 = lanes
+                .mul_add(
+                    F64x2::new(c_q2l, c_q2r),
+                    d377_d109,
+                    F64x2::new(s_q2l, s_q2r) * d372_d104,
+                ); // N(M col 8l) at 4l.z | N(M col 8r) at 4r.z
+            let d382_d115 = lanes
+                .mul_add(
+                    F64x2::new(c_q1l, c_q1r),
+                    d379_d111,
+                    F64x2::new(s_q1l, s_q1r) * d374_d106,
+                ); // F(M col 8l) at 3.z | F(M col 8r) at 3.z
+            let d383_d114 = lanes
+                .mul_add(
+                    -F64x2::new(s_q1l, s_q1r),
+                    d379_d111,
+                    F64x2::new(c_q1l, c_q1r) * d374_d106,
+                ); // F(M col 8l) at 3.y | F(M col 8r) at 3.y
+            let d383 = d383_d114.lo();
+            let d114 = d383_d114.hi();
+            let d384_d118 = lanes
+                .mul_add(
+                    p.L5,
+                    d378_d110,
+                    lanes
+                        .mul_add(
+                            -p.L6,
+                            d383_d114,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(c_q1l, c_q1r),
+                                    d381_d113,
+                                    F64x2::new(s_q1l, s_q1r) * d376_d108,
+                                ),
+                        ),
+                ); // N(M col 8l) at 3.z | N(M col 8r) at 3.z
+            let d384 = d384_d118.lo();
+            let d118 = d384_d118.hi();
+            let d385_d116 = lanes.mul_add(-p.L5, d382_d115, d380_d112); // N(M col 8l) at 3.x | N(M col 8r) at 3.x
+            let d385 = d385_d116.lo();
+            let d116 = d385_d116.hi();
+            let d386_d117 = lanes
+                .mul_add(
+                    p.L6,
+                    d382_d115,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q1l, s_q1r),
+                            d381_d113,
+                            F64x2::new(c_q1l, c_q1r) * d376_d108,
+                        ),
+                ); // N(M col 8l) at 3.y | N(M col 8r) at 3.y
+            let d386 = d386_d117.lo();
+            let d117 = d386_d117.hi();
             m[(4, 9)] = d386;
             m[(9, 4)] = m[(4, 9)];
-            let d387 = A::mul_add(s_q_torso, d382, c_q_torso * d378); // F(M col 8l) at 2.x
-            let d388 = A::mul_add(-c_q_torso, d382, s_q_torso * d378); // F(M col 8l) at 2.z
+            m[(4, 16)] = d117;
+            m[(16, 4)] = m[(4, 16)];
+            let d387_d119 = lanes.mul_add(s_q_torso, d382_d115, c_q_torso * d378_d110); // F(M col 8l) at 2.x | F(M col 8r) at 2.x
+            let d387 = d387_d119.lo();
+            let d119 = d387_d119.hi();
+            let d122 = A::mul_add(-p.L4, d119, -d117); // N(M col 8r) at 2.y
+            let d388_d120 = lanes.mul_add(-c_q_torso, d382_d115, s_q_torso * d378_d110); // F(M col 8l) at 2.z | F(M col 8r) at 2.z
+            let d388 = d388_d120.lo();
+            let d120 = d388_d120.hi();
+            let d121 = A::mul_add(
+                -p.L3,
+                d120,
+                A::mul_add(-s_q_torso, d118, A::mul_add(-c_q_torso, d116, p.L4 * d114)),
+            ); // N(M col 8r) at 2.x
+            m[(3, 16)] = -d121;
+            m[(16, 3)] = m[(3, 16)];
+            let d124 = A::mul_add(-c_q_w, d120, s_q_w * d114); // F(M col 8r) at 1.z
+            let d125 = A::mul_add(s_q_w, d120, c_q_w * d114); // F(M col 8r) at 1.y
             let d389 = A::mul_add(
                 p.L4,
                 d383,
@@ -3086,77 +3159,233 @@ mod generated {
             ); // N(M col 8l) at 2.x
             m[(3, 9)] = -d389;
             m[(9, 3)] = m[(3, 9)];
-            let d390 = A::mul_add(
-                -p.L3,
-                d387,
-                A::mul_add(-c_q_torso, d384, s_q_torso * d385),
-            ); // N(M col 8l) at 2.z
+            let d389_d121 = F64x2::new(d389, d121);
+            let d390_d123 = lanes
+                .mul_add(
+                    -p.L3,
+                    d387_d119,
+                    lanes.mul_add(-c_q_torso, d384_d118, s_q_torso * d385_d116),
+                ); // N(M col 8l) at 2.z | N(M col 8r) at 2.z
             let d391 = A::mul_add(-p.L4, d387, d386); // N(M col 8l) at 2.y
+            let d391_d122 = F64x2::new(d391, d122);
             let d392 = A::mul_add(c_q_w, d388, s_q_w * d383); // F(M col 8l) at 1.z
+            let d392_d124 = F64x2::new(d392, d124);
             let d393 = A::mul_add(-s_q_w, d388, c_q_w * d383); // F(M col 8l) at 1.y
-            let d394 = A::mul_add(-p.L2, d393, A::mul_add(p.L1, d392, d389)); // N(M col 8l) at 1.x
+            let d393_d125 = F64x2::new(d393, d125);
+            let d394_d127 = lanes
+                .mul_add(-p.L2, d393_d125, lanes.mul_add(p.L1, d392_d124, d389_d121)); // N(M col 8l) at 1.x | N(M col 8r) at 1.x
+            let d394 = d394_d127.lo();
+            let d127 = d394_d127.hi();
             m[(2, 9)] = -d394;
             m[(9, 2)] = m[(2, 9)];
-            let d395 = A::mul_add(-p.L1, d387, A::mul_add(c_q_w, d390, s_q_w * d391)); // N(M col 8l) at 1.z
-            let d396 = A::mul_add(p.L2, d387, A::mul_add(-s_q_w, d390, c_q_w * d391)); // N(M col 8l) at 1.y
-            let d397 = A::mul_add(c_q_imu, d392, s_q_imu * d393); // F(M col 8l) at 0.x
+            m[(2, 16)] = -d127;
+            m[(16, 2)] = m[(2, 16)];
+            let d395_d126 = lanes
+                .mul_add(
+                    -p.L1,
+                    d387_d119,
+                    lanes.mul_add(c_q_w, d390_d123, s_q_w * d391_d122),
+                ); // N(M col 8l) at 1.z | N(M col 8r) at 1.z
+            let d396_d128 = lanes
+                .mul_add(
+                    p.L2,
+                    d387_d119,
+                    lanes.mul_add(-s_q_w, d390_d123, c_q_w * d391_d122),
+                ); // N(M col 8l) at 1.y | N(M col 8r) at 1.y
+            let d397_d129 = lanes.mul_add(c_q_imu, d392_d124, s_q_imu * d393_d125); // F(M col 8l) at 0.x | F(M col 8r) at 0.x
+            let d397 = d397_d129.lo();
+            let d129 = d397_d129.hi();
             m[(0, 9)] = -d397;
             m[(9, 0)] = m[(0, 9)];
-            let d398 = A::mul_add(-s_q_imu, d395, c_q_imu * d396); // N(M col 8l) at 0.z
+            m[(0, 16)] = -d129;
+            m[(16, 0)] = m[(0, 16)];
+            let d398_d130 = lanes.mul_add(-s_q_imu, d395_d126, c_q_imu * d396_d128); // N(M col 8l) at 0.z | N(M col 8r) at 0.z
+            let d398 = d398_d130.lo();
+            let d130 = d398_d130.hi();
             m[(1, 9)] = -d398;
             m[(9, 1)] = m[(1, 9)];
-            let d399 = p.MX7l - d367; // MSC7l.x
-            let d400 = p.MZ7l + d366; // MSC7l.z
-            let k28 = s_q5l * s_q5l; // sin² q5l
-            let k29 = s_q5l * c_q5l; // sin q5l cos q5l
-            let k30 = A::mul_add(2.0, k28, -1.0); // cos 2q5l
-            let d401 = d360 - d364; // JC8l: Jzz − Jxx
-            let d402 = A::mul_add(2.0, d362 * k29, k28 * d401); // JC8l rotated about y: Jzz − J'zz
-            let t57 = p.L8 * d356; // common subexpression
-            let d403 = p.XY7l + t51 - t52 - t55; // JC7l.xy
-            let d404 = A::mul_add(-k29, d401, A::mul_add(d362, k30, p.XZ7l)); // JC7l.xz
-            let d405 = p.YY7l + d365; // JC7l.yy
-            let d406 = p.YZ7l - t53 - t54 + t56; // JC7l.yz
-            let d407 = pc.pc36 - d356; // MSC7l.y
-            let d408 = A::mul_add(2.0, t57, d360 - d402) + pc.pc37; // JC7l.xx
+            m[(1, 16)] = d130;
+            m[(16, 1)] = m[(1, 16)];
+            let d399_d131 = F64x2::new(p.MX7l, p.MX7r) - d367_d99; // MSC7l.x | MSC7r.x
+            let d400_d132 = F64x2::new(p.MZ7l, p.MZ7r) + d366_d98; // MSC7l.z | MSC7r.z
+            let k28_k7 = F64x2::new(s_q5l, s_q5r) * F64x2::new(s_q5l, s_q5r); // sin² q5l | sin² q5r
+            let k29_k8 = F64x2::new(s_q5l, s_q5r) * F64x2::new(c_q5l, c_q5r); // sin q5l cos q5l | sin q5r cos q5r
+            let k30_k9 = lanes.mul_add(2.0, k28_k7, -1.0); // cos 2q5l | cos 2q5r
+            let d401_d133 = d360_d92 - d364_d96; // JC8l: Jzz − Jxx | JC8r: Jzz − Jxx
+            let d402_d134 = lanes.mul_add(2.0, d362_d94 * k29_k8, k28_k7 * d401_d133); // JC8l rotated about y: Jzz − J'zz | JC8r rotated about y: Jzz − J'zz
+            let t57_t17 = p.L8 * d356_d88; // common subexpression | common subexpression
+            let d403_d135 = F64x2::new(p.XY7l, p.XY7r) + t51_t11 - t52_t12 - t55_t15; // JC7l.xy | JC7r.xy
+            let d404_d136 = lanes
+                .mul_add(
+                    -k29_k8,
+                    d401_d133,
+                    lanes.mul_add(d362_d94, k30_k9, F64x2::new(p.XZ7l, p.XZ7r)),
+                ); // JC7l.xz | JC7r.xz
+            let d405_d137 = F64x2::new(p.YY7l, p.YY7r) + d365_d97; // JC7l.yy | JC7r.yy
+            let d406_d138 = F64x2::new(p.YZ7l, p.YZ7r) - t53_t13 - t54_t14 + t56_t16; // JC7l.yz | JC7r.yz
+            let d407_d139 = F64x2::new(pc.pc36, pc.pc13) - d356_d88; // MSC7l.y | MSC7r.y
+            let d408_d140 = lanes.mul_add(2.0, t57_t17, d360_d92 - d402_d134)
+                + F64x2::new(pc.pc37, pc.pc14); // JC7l.xx | JC7r.xx
+            let d408 = d408_d140.lo();
+            let d140 = d408_d140.hi();
             m[(8, 8)] = d408;
-            let d409 = A::mul_add(2.0, t57, d364 + d402) + pc.pc38; // JC7l.zz
-            let d410 = A::mul_add(s_q4l, d400, c_q4l * d407); // MSC7l in 6l.y
-            let d411 = A::mul_add(-c_q4l, d400, s_q4l * d407); // MSC7l in 6l.z
-            let t58 = c_q4l * d403; // common subexpression
-            let t59 = s_q4l * d404; // common subexpression
-            let d412 = t58 + t59; // N(M col 7l) at 6l.y
+            m[(15, 15)] = d140;
+            let d409_d141 = lanes.mul_add(2.0, t57_t17, d364_d96 + d402_d134)
+                + F64x2::new(pc.pc38, pc.pc15); // JC7l.zz | JC7r.zz
+            let d410_d142 = lanes
+                .mul_add(
+                    F64x2::new(s_q4l, s_q4r),
+                    d400_d132,
+                    F64x2::new(c_q4l, c_q4r) * d407_d139,
+                ); // MSC7l in 6l.y | MSC7r in 6r.y
+            let d411_d143 = lanes
+                .mul_add(
+                    -F64x2::new(c_q4l, c_q4r),
+                    d400_d132,
+                    F64x2::new(s_q4l, s_q4r) * d407_d139,
+                ); // MSC7l in 6l.z | MSC7r in 6r.z
+            let t58_t18 = F64x2::new(c_q4l, c_q4r) * d403_d135; // common subexpression | common subexpression
+            let t59_t19 = F64x2::new(s_q4l, s_q4r) * d404_d136; // common subexpression | common subexpression
+            let d412_d144 = t58_t18 + t59_t19; // N(M col 7l) at 6l.y | N(M col 7r) at 6r.y
+            let d412 = d412_d144.lo();
+            let d144 = d412_d144.hi();
             m[(7, 8)] = -d412;
             m[(8, 7)] = m[(7, 8)];
-            let t60 = s_q4l * d403; // common subexpression
-            let t61 = c_q4l * d404; // common subexpression
-            let d413 = t60 - t61; // N(M col 7l) at 6l.z
-            let d414 = s_q3l * d410; // F(M col 7l) at 5l.x
-            let d415 = c_q3l * d410; // F(M col 7l) at 5l.z
-            let d416 = A::mul_add(-p.L7, d414, A::mul_add(c_q3l, d413, s_q3l * d408)); // N(M col 7l) at 5l.z
-            let d417 = A::mul_add(-p.L7, d415, A::mul_add(-s_q3l, d413, c_q3l * d408)); // N(M col 7l) at 5l.x
+            m[(14, 15)] = -d144;
+            m[(15, 14)] = m[(14, 15)];
+            let t60_t20 = F64x2::new(s_q4l, s_q4r) * d403_d135; // common subexpression | common subexpression
+            let t61_t21 = F64x2::new(c_q4l, c_q4r) * d404_d136; // common subexpression | common subexpression
+            let d413_d145 = t60_t20 - t61_t21; // N(M col 7l) at 6l.z | N(M col 7r) at 6r.z
+            let d414_d146 = F64x2::new(s_q3l, s_q3r) * d410_d142; // F(M col 7l) at 5l.x | F(M col 7r) at 5r.x
+            let d415_d147 = F64x2::new(c_q3l, c_q3r) * d410_d142; // F(M col 7l) at 5l.z | F(M col 7r) at 5r.z
+            let d416_d148 = lanes
+                .mul_add(
+                    -p.L7,
+                    d414_d146,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q3l, c_q3r),
+                            d413_d145,
+                            F64x2::new(s_q3l, s_q3r) * d408_d140,
+                        ),
+                ); // N(M col 7l) at 5l.z | N(M col 7r) at 5r.z
+            let d417_d149 = lanes
+                .mul_add(
+                    -p.L7,
+                    d415_d147,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q3l, s_q3r),
+                            d413_d145,
+                            F64x2::new(c_q3l, c_q3r) * d408_d140,
+                        ),
+                ); // N(M col 7l) at 5l.x | N(M col 7r) at 5r.x
+            let d417 = d417_d149.lo();
+            let d149 = d417_d149.hi();
             m[(6, 8)] = d417;
             m[(8, 6)] = m[(6, 8)];
-            let d418 = A::mul_add(s_q2l, d415, c_q2l * d411); // F(M col 7l) at 4l.y
-            let d419 = A::mul_add(-c_q2l, d415, s_q2l * d411); // F(M col 7l) at 4l.z
-            let d420 = A::mul_add(-s_q2l, d416, c_q2l * d412); // N(M col 7l) at 4l.y
+            m[(13, 15)] = d149;
+            m[(15, 13)] = m[(13, 15)];
+            let d418_d150 = lanes
+                .mul_add(
+                    F64x2::new(s_q2l, s_q2r),
+                    d415_d147,
+                    F64x2::new(c_q2l, c_q2r) * d411_d143,
+                ); // F(M col 7l) at 4l.y | F(M col 7r) at 4r.y
+            let d419_d151 = lanes
+                .mul_add(
+                    -F64x2::new(c_q2l, c_q2r),
+                    d415_d147,
+                    F64x2::new(s_q2l, s_q2r) * d411_d143,
+                ); // F(M col 7l) at 4l.z | F(M col 7r) at 4r.z
+            let d420_d152 = lanes
+                .mul_add(
+                    -F64x2::new(s_q2l, s_q2r),
+                    d416_d148,
+                    F64x2::new(c_q2l, c_q2r) * d412_d144,
+                ); // N(M col 7l) at 4l.y | N(M col 7r) at 4r.y
+            let d420 = d420_d152.lo();
+            let d152 = d420_d152.hi();
             m[(5, 8)] = -d420;
             m[(8, 5)] = m[(5, 8)];
-            let d421 = A::mul_add(c_q2l, d416, s_q2l * d412); // N(M col 7l) at 4l.z
-            let d422 = A::mul_add(-s_q1l, d419, c_q1l * d414); // F(M col 7l) at 3.y
-            let d423 = A::mul_add(c_q1l, d419, s_q1l * d414); // F(M col 7l) at 3.z
-            let d424 = A::mul_add(-p.L5, d423, d420); // N(M col 7l) at 3.x
-            let d425 = A::mul_add(p.L6, d423, A::mul_add(-s_q1l, d421, c_q1l * d417)); // N(M col 7l) at 3.y
+            m[(12, 15)] = -d152;
+            m[(15, 12)] = m[(12, 15)];
+            let d421_d153 = lanes
+                .mul_add(
+                    F64x2::new(c_q2l, c_q2r),
+                    d416_d148,
+                    F64x2::new(s_q2l, s_q2r) * d412_d144,
+                ); // N(M col 7l) at 4l.z | N(M col 7r) at 4r.z
+            let d422_d154 = lanes
+                .mul_add(
+                    -F64x2::new(s_q1l, s_q1r),
+                    d419_d151,
+                    F64x2::new(c_q1l, c_q1r) * d414_d146,
+                ); // F(M col 7l) at 3.y | F(M col 7r) at 3.y
+            let d422 = d422_d154.lo();
+            let d154 = d422_d154.hi();
+            let d423_d155 = lanes
+                .mul_add(
+                    F64x2::new(c_q1l, c_q1r),
+                    d419_d151,
+                    F64x2::new(s_q1l, s_q1r) * d414_d146,
+                ); // F(M col 7l) at 3.z | F(M col 7r) at 3.z
+            let d424_d158 = lanes.mul_add(-p.L5, d423_d155, d420_d152); // N(M col 7l) at 3.x | N(M col 7r) at 3.x
+            let d424 = d424_d158.lo();
+            let d158 = d424_d158.hi();
+            let d425_d156 = lanes
+                .mul_add(
+                    p.L6,
+                    d423_d155,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q1l, s_q1r),
+                            d421_d153,
+                            F64x2::new(c_q1l, c_q1r) * d417_d149,
+                        ),
+                ); // N(M col 7l) at 3.y | N(M col 7r) at 3.y
+            let d425 = d425_d156.lo();
+            let d156 = d425_d156.hi();
             m[(4, 8)] = -d425;
             m[(8, 4)] = m[(4, 8)];
-            let d426 = A::mul_add(
-                p.L5,
-                d418,
-                A::mul_add(-p.L6, d422, A::mul_add(c_q1l, d421, s_q1l * d417)),
-            ); // N(M col 7l) at 3.z
-            let d427 = A::mul_add(s_q_torso, d423, c_q_torso * d418); // F(M col 7l) at 2.x
-            let d428 = A::mul_add(-c_q_torso, d423, s_q_torso * d418); // F(M col 7l) at 2.z
+            m[(4, 15)] = -d156;
+            m[(15, 4)] = m[(4, 15)];
+            let d426_d157 = lanes
+                .mul_add(
+                    p.L5,
+                    d418_d150,
+                    lanes
+                        .mul_add(
+                            -p.L6,
+                            d422_d154,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(c_q1l, c_q1r),
+                                    d421_d153,
+                                    F64x2::new(s_q1l, s_q1r) * d417_d149,
+                                ),
+                        ),
+                ); // N(M col 7l) at 3.z | N(M col 7r) at 3.z
+            let d426 = d426_d157.lo();
+            let d157 = d426_d157.hi();
+            let d427_d159 = lanes.mul_add(s_q_torso, d423_d155, c_q_torso * d418_d150); // F(M col 7l) at 2.x | F(M col 7r) at 2.x
+            let d427 = d427_d159.lo();
+            let d159 = d427_d159.hi();
+            let d162 = A::mul_add(-p.L4, d159, -d156); // N(M col 7r) at 2.y
+            let d428_d160 = lanes.mul_add(-c_q_torso, d423_d155, s_q_torso * d418_d150); // F(M col 7l) at 2.z | F(M col 7r) at 2.z
+            let d428 = d428_d160.lo();
+            let d160 = d428_d160.hi();
+            let d161 = A::mul_add(
+                -p.L3,
+                d160,
+                A::mul_add(-s_q_torso, d157, A::mul_add(-c_q_torso, d158, p.L4 * d154)),
+            ); // N(M col 7r) at 2.x
+            m[(3, 15)] = d161;
+            m[(15, 3)] = m[(3, 15)];
+            let d164 = A::mul_add(s_q_w, d160, c_q_w * d154); // F(M col 7r) at 1.y
+            let d165 = A::mul_add(-c_q_w, d160, s_q_w * d154); // F(M col 7r) at 1.z
             let d429 = A::mul_add(-p.L4, d427, d425); // N(M col 7l) at 2.y
+            let d429_d162 = F64x2::new(d429, d162);
             let d430 = A::mul_add(
                 p.L4,
                 d422,
@@ -3164,70 +3393,189 @@ mod generated {
             ); // N(M col 7l) at 2.x
             m[(3, 8)] = d430;
             m[(8, 3)] = m[(3, 8)];
-            let d431 = A::mul_add(
-                -p.L3,
-                d427,
-                A::mul_add(-c_q_torso, d426, s_q_torso * d424),
-            ); // N(M col 7l) at 2.z
+            let d430_d161 = F64x2::new(d430, d161);
+            let d431_d163 = lanes
+                .mul_add(
+                    -p.L3,
+                    d427_d159,
+                    lanes.mul_add(-c_q_torso, d426_d157, s_q_torso * d424_d158),
+                ); // N(M col 7l) at 2.z | N(M col 7r) at 2.z
             let d432 = A::mul_add(-s_q_w, d428, c_q_w * d422); // F(M col 7l) at 1.y
+            let d432_d164 = F64x2::new(d432, d164);
             let d433 = A::mul_add(c_q_w, d428, s_q_w * d422); // F(M col 7l) at 1.z
-            let d434 = A::mul_add(p.L2, d427, A::mul_add(-s_q_w, d431, c_q_w * d429)); // N(M col 7l) at 1.y
-            let d435 = A::mul_add(-p.L2, d432, A::mul_add(p.L1, d433, d430)); // N(M col 7l) at 1.x
+            let d433_d165 = F64x2::new(d433, d165);
+            let d434_d167 = lanes
+                .mul_add(
+                    p.L2,
+                    d427_d159,
+                    lanes.mul_add(-s_q_w, d431_d163, c_q_w * d429_d162),
+                ); // N(M col 7l) at 1.y | N(M col 7r) at 1.y
+            let d435_d166 = lanes
+                .mul_add(-p.L2, d432_d164, lanes.mul_add(p.L1, d433_d165, d430_d161)); // N(M col 7l) at 1.x | N(M col 7r) at 1.x
+            let d435 = d435_d166.lo();
+            let d166 = d435_d166.hi();
             m[(2, 8)] = d435;
             m[(8, 2)] = m[(2, 8)];
-            let d436 = A::mul_add(-p.L1, d427, A::mul_add(c_q_w, d431, s_q_w * d429)); // N(M col 7l) at 1.z
-            let d437 = A::mul_add(c_q_imu, d433, s_q_imu * d432); // F(M col 7l) at 0.x
+            m[(2, 15)] = d166;
+            m[(15, 2)] = m[(2, 15)];
+            let d436_d168 = lanes
+                .mul_add(
+                    -p.L1,
+                    d427_d159,
+                    lanes.mul_add(c_q_w, d431_d163, s_q_w * d429_d162),
+                ); // N(M col 7l) at 1.z | N(M col 7r) at 1.z
+            let d437_d169 = lanes.mul_add(c_q_imu, d433_d165, s_q_imu * d432_d164); // F(M col 7l) at 0.x | F(M col 7r) at 0.x
+            let d437 = d437_d169.lo();
+            let d169 = d437_d169.hi();
             m[(0, 8)] = d437;
             m[(8, 0)] = m[(0, 8)];
-            let d438 = A::mul_add(-s_q_imu, d436, c_q_imu * d434); // N(M col 7l) at 0.z
+            m[(0, 15)] = d169;
+            m[(15, 0)] = m[(0, 15)];
+            let d438_d170 = lanes.mul_add(-s_q_imu, d436_d168, c_q_imu * d434_d167); // N(M col 7l) at 0.z | N(M col 7r) at 0.z
+            let d438 = d438_d170.lo();
+            let d170 = d438_d170.hi();
             m[(1, 8)] = d438;
             m[(8, 1)] = m[(1, 8)];
-            let d439 = p.MX6l - d399; // MSC6l.x
-            let d440 = p.MY6l - d410; // MSC6l.y
-            let d441 = p.MZ6l - d411; // MSC6l.z
-            let k31 = s_q4l * s_q4l; // sin² q4l
-            let k32 = s_q4l * c_q4l; // sin q4l cos q4l
-            let k33 = A::mul_add(2.0, k31, -1.0); // cos 2q4l
-            let d442 = d405 - d409; // JC7l: Jyy − Jzz
-            let d443 = A::mul_add(-2.0, d406 * k32, k31 * d442); // JC7l rotated about x: Jyy − J'yy
-            let d444 = p.XX6l + d408; // JC6l.xx
-            let d445 = p.XY6l + t58 + t59; // JC6l.xy
-            let d446 = p.XZ6l + t60 - t61; // JC6l.xz
-            let d447 = p.YY6l + d405 - d443; // JC6l.yy
+            m[(1, 15)] = -d170;
+            m[(15, 1)] = m[(1, 15)];
+            let d439_d171 = F64x2::new(p.MX6l, p.MX6r) - d399_d131; // MSC6l.x | MSC6r.x
+            let d440_d172 = F64x2::new(p.MY6l, p.MY6r) - d410_d142; // MSC6l.y | MSC6r.y
+            let d441_d173 = F64x2::new(p.MZ6l, p.MZ6r) - d411_d143; // MSC6l.z | MSC6r.z
+            let k31_k10 = F64x2::new(s_q4l, s_q4r) * F64x2::new(s_q4l, s_q4r); // sin² q4l | sin² q4r
+            let k32_k11 = F64x2::new(s_q4l, s_q4r) * F64x2::new(c_q4l, c_q4r); // sin q4l cos q4l | sin q4r cos q4r
+            let k33_k12 = lanes.mul_add(2.0, k31_k10, -1.0); // cos 2q4l | cos 2q4r
+            let d442_d174 = d405_d137 - d409_d141; // JC7l: Jyy − Jzz | JC7r: Jyy − Jzz
+            let d443_d175 = lanes
+                .mul_add(-2.0, d406_d138 * k32_k11, k31_k10 * d442_d174); // JC7l rotated about x: Jyy − J'yy | JC7r rotated about x: Jyy − J'yy
+            let d444_d176 = F64x2::new(p.XX6l, p.XX6r) + d408_d140; // JC6l.xx | JC6r.xx
+            let d445_d177 = F64x2::new(p.XY6l, p.XY6r) + t58_t18 + t59_t19; // JC6l.xy | JC6r.xy
+            let d446_d178 = F64x2::new(p.XZ6l, p.XZ6r) + t60_t20 - t61_t21; // JC6l.xz | JC6r.xz
+            let d447_d179 = F64x2::new(p.YY6l, p.YY6r) + d405_d137 - d443_d175; // JC6l.yy | JC6r.yy
+            let d447 = d447_d179.lo();
+            let d179 = d447_d179.hi();
             m[(7, 7)] = d447;
-            let d448 = A::mul_add(k32, d442, A::mul_add(d406, k33, p.YZ6l)); // JC6l.yz
-            let d449 = p.ZZ6l + d409 + d443; // JC6l.zz
-            let d450 = A::mul_add(c_q3l, d441, s_q3l * d439); // MSC6l in 5l.z
-            let d451 = A::mul_add(-s_q3l, d441, c_q3l * d439); // MSC6l in 5l.x
-            let t62 = c_q3l * d445; // common subexpression
-            let t63 = s_q3l * d448; // common subexpression
-            let t64 = s_q3l * d445; // common subexpression
-            let t65 = c_q3l * d448; // common subexpression
-            let t66 = p.L7 * d451; // common subexpression
-            let t67 = p.L7 * d450; // common subexpression
-            let d452 = t62 - t63 - t66; // N(M col 6l) at 5l.x
+            m[(14, 14)] = d179;
+            let d448_d180 = lanes
+                .mul_add(
+                    k32_k11,
+                    d442_d174,
+                    lanes.mul_add(d406_d138, k33_k12, F64x2::new(p.YZ6l, p.YZ6r)),
+                ); // JC6l.yz | JC6r.yz
+            let d449_d181 = F64x2::new(p.ZZ6l, p.ZZ6r) + d409_d141 + d443_d175; // JC6l.zz | JC6r.zz
+            let d450_d182 = lanes
+                .mul_add(
+                    F64x2::new(c_q3l, c_q3r),
+                    d441_d173,
+                    F64x2::new(s_q3l, s_q3r) * d439_d171,
+                ); // MSC6l in 5l.z | MSC6r in 5r.z
+            let d451_d183 = lanes
+                .mul_add(
+                    -F64x2::new(s_q3l, s_q3r),
+                    d441_d173,
+                    F64x2::new(c_q3l, c_q3r) * d439_d171,
+                ); // MSC6l in 5l.x | MSC6r in 5r.x
+            let t62_t22 = F64x2::new(c_q3l, c_q3r) * d445_d177; // common subexpression | common subexpression
+            let t63_t23 = F64x2::new(s_q3l, s_q3r) * d448_d180; // common subexpression | common subexpression
+            let t64_t24 = F64x2::new(s_q3l, s_q3r) * d445_d177; // common subexpression | common subexpression
+            let t65_t25 = F64x2::new(c_q3l, c_q3r) * d448_d180; // common subexpression | common subexpression
+            let t66_t26 = p.L7 * d451_d183; // common subexpression | common subexpression
+            let t67_t27 = p.L7 * d450_d182; // common subexpression | common subexpression
+            let d452_d184 = t62_t22 - t63_t23 - t66_t26; // N(M col 6l) at 5l.x | N(M col 6r) at 5r.x
+            let d452 = d452_d184.lo();
+            let d184 = d452_d184.hi();
             m[(6, 7)] = -d452;
             m[(7, 6)] = m[(6, 7)];
-            let d453 = t64 + t65 - t67; // N(M col 6l) at 5l.z
-            let d454 = s_q2l * d451; // F(M col 6l) at 4l.y
-            let d455 = c_q2l * d451; // F(M col 6l) at 4l.z
-            let d456 = A::mul_add(-s_q2l, d453, c_q2l * d447); // N(M col 6l) at 4l.y
+            m[(13, 14)] = -d184;
+            m[(14, 13)] = m[(13, 14)];
+            let d453_d185 = t64_t24 + t65_t25 - t67_t27; // N(M col 6l) at 5l.z | N(M col 6r) at 5r.z
+            let d454_d186 = F64x2::new(s_q2l, s_q2r) * d451_d183; // F(M col 6l) at 4l.y | F(M col 6r) at 4r.y
+            let d455_d187 = F64x2::new(c_q2l, c_q2r) * d451_d183; // F(M col 6l) at 4l.z | F(M col 6r) at 4r.z
+            let d456_d188 = lanes
+                .mul_add(
+                    -F64x2::new(s_q2l, s_q2r),
+                    d453_d185,
+                    F64x2::new(c_q2l, c_q2r) * d447_d179,
+                ); // N(M col 6l) at 4l.y | N(M col 6r) at 4r.y
+            let d456 = d456_d188.lo();
+            let d188 = d456_d188.hi();
             m[(5, 7)] = d456;
             m[(7, 5)] = m[(5, 7)];
-            let d457 = A::mul_add(c_q2l, d453, s_q2l * d447); // N(M col 6l) at 4l.z
-            let d458 = A::mul_add(-c_q1l, d455, s_q1l * d450); // F(M col 6l) at 3.z
-            let d459 = A::mul_add(s_q1l, d455, c_q1l * d450); // F(M col 6l) at 3.y
-            let d460 = A::mul_add(
-                p.L5,
-                d454,
-                A::mul_add(-p.L6, d459, A::mul_add(c_q1l, d457, s_q1l * d452)),
-            ); // N(M col 6l) at 3.z
-            let d461 = A::mul_add(-p.L5, d458, d456); // N(M col 6l) at 3.x
-            let d462 = A::mul_add(p.L6, d458, A::mul_add(-s_q1l, d457, c_q1l * d452)); // N(M col 6l) at 3.y
+            m[(12, 14)] = d188;
+            m[(14, 12)] = m[(12, 14)];
+            let d457_d189 = lanes
+                .mul_add(
+                    F64x2::new(c_q2l, c_q2r),
+                    d453_d185,
+                    F64x2::new(s_q2l, s_q2r) * d447_d179,
+                ); // N(M col 6l) at 4l.z | N(M col 6r) at 4r.z
+            let d458_d191 = lanes
+                .mul_add(
+                    -F64x2::new(c_q1l, c_q1r),
+                    d455_d187,
+                    F64x2::new(s_q1l, s_q1r) * d450_d182,
+                ); // F(M col 6l) at 3.z | F(M col 6r) at 3.z
+            let d459_d190 = lanes
+                .mul_add(
+                    F64x2::new(s_q1l, s_q1r),
+                    d455_d187,
+                    F64x2::new(c_q1l, c_q1r) * d450_d182,
+                ); // F(M col 6l) at 3.y | F(M col 6r) at 3.y
+            let d459 = d459_d190.lo();
+            let d190 = d459_d190.hi();
+            let d460_d194 = lanes
+                .mul_add(
+                    p.L5,
+                    d454_d186,
+                    lanes
+                        .mul_add(
+                            -p.L6,
+                            d459_d190,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(c_q1l, c_q1r),
+                                    d457_d189,
+                                    F64x2::new(s_q1l, s_q1r) * d452_d184,
+                                ),
+                        ),
+                ); // N(M col 6l) at 3.z | N(M col 6r) at 3.z
+            let d460 = d460_d194.lo();
+            let d194 = d460_d194.hi();
+            let d461_d192 = lanes.mul_add(-p.L5, d458_d191, d456_d188); // N(M col 6l) at 3.x | N(M col 6r) at 3.x
+            let d461 = d461_d192.lo();
+            let d192 = d461_d192.hi();
+            let d462_d193 = lanes
+                .mul_add(
+                    p.L6,
+                    d458_d191,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q1l, s_q1r),
+                            d457_d189,
+                            F64x2::new(c_q1l, c_q1r) * d452_d184,
+                        ),
+                ); // N(M col 6l) at 3.y | N(M col 6r) at 3.y
+            let d462 = d462_d193.lo();
+            let d193 = d462_d193.hi();
             m[(4, 7)] = d462;
             m[(7, 4)] = m[(4, 7)];
-            let d463 = A::mul_add(s_q_torso, d458, c_q_torso * d454); // F(M col 6l) at 2.x
-            let d464 = A::mul_add(-c_q_torso, d458, s_q_torso * d454); // F(M col 6l) at 2.z
+            m[(4, 14)] = d193;
+            m[(14, 4)] = m[(4, 14)];
+            let d463_d195 = lanes.mul_add(s_q_torso, d458_d191, c_q_torso * d454_d186); // F(M col 6l) at 2.x | F(M col 6r) at 2.x
+            let d463 = d463_d195.lo();
+            let d195 = d463_d195.hi();
+            let d198 = A::mul_add(-p.L4, d195, -d193); // N(M col 6r) at 2.y
+            let d464_d196 = lanes.mul_add(-c_q_torso, d458_d191, s_q_torso * d454_d186); // F(M col 6l) at 2.z | F(M col 6r) at 2.z
+            let d464 = d464_d196.lo();
+            let d196 = d464_d196.hi();
+            let d197 = A::mul_add(
+                -p.L3,
+                d196,
+                A::mul_add(-s_q_torso, d194, A::mul_add(-c_q_torso, d192, p.L4 * d190)),
+            ); // N(M col 6r) at 2.x
+            m[(3, 14)] = -d197;
+            m[(14, 3)] = m[(3, 14)];
+            let d200 = A::mul_add(-c_q_w, d196, s_q_w * d190); // F(M col 6r) at 1.z
+            let d201 = A::mul_add(s_q_w, d196, c_q_w * d190); // F(M col 6r) at 1.y
             let d465 = A::mul_add(
                 p.L4,
                 d459,
@@ -3235,65 +3583,163 @@ mod generated {
             ); // N(M col 6l) at 2.x
             m[(3, 7)] = -d465;
             m[(7, 3)] = m[(3, 7)];
-            let d466 = A::mul_add(
-                -p.L3,
-                d463,
-                A::mul_add(-c_q_torso, d460, s_q_torso * d461),
-            ); // N(M col 6l) at 2.z
+            let d465_d197 = F64x2::new(d465, d197);
+            let d466_d199 = lanes
+                .mul_add(
+                    -p.L3,
+                    d463_d195,
+                    lanes.mul_add(-c_q_torso, d460_d194, s_q_torso * d461_d192),
+                ); // N(M col 6l) at 2.z | N(M col 6r) at 2.z
             let d467 = A::mul_add(-p.L4, d463, d462); // N(M col 6l) at 2.y
+            let d467_d198 = F64x2::new(d467, d198);
             let d468 = A::mul_add(c_q_w, d464, s_q_w * d459); // F(M col 6l) at 1.z
+            let d468_d200 = F64x2::new(d468, d200);
             let d469 = A::mul_add(-s_q_w, d464, c_q_w * d459); // F(M col 6l) at 1.y
-            let d470 = A::mul_add(-p.L2, d469, A::mul_add(p.L1, d468, d465)); // N(M col 6l) at 1.x
+            let d469_d201 = F64x2::new(d469, d201);
+            let d470_d203 = lanes
+                .mul_add(-p.L2, d469_d201, lanes.mul_add(p.L1, d468_d200, d465_d197)); // N(M col 6l) at 1.x | N(M col 6r) at 1.x
+            let d470 = d470_d203.lo();
+            let d203 = d470_d203.hi();
             m[(2, 7)] = -d470;
             m[(7, 2)] = m[(2, 7)];
-            let d471 = A::mul_add(-p.L1, d463, A::mul_add(c_q_w, d466, s_q_w * d467)); // N(M col 6l) at 1.z
-            let d472 = A::mul_add(p.L2, d463, A::mul_add(-s_q_w, d466, c_q_w * d467)); // N(M col 6l) at 1.y
-            let d473 = A::mul_add(c_q_imu, d468, s_q_imu * d469); // F(M col 6l) at 0.x
+            m[(2, 14)] = -d203;
+            m[(14, 2)] = m[(2, 14)];
+            let d471_d202 = lanes
+                .mul_add(
+                    -p.L1,
+                    d463_d195,
+                    lanes.mul_add(c_q_w, d466_d199, s_q_w * d467_d198),
+                ); // N(M col 6l) at 1.z | N(M col 6r) at 1.z
+            let d472_d204 = lanes
+                .mul_add(
+                    p.L2,
+                    d463_d195,
+                    lanes.mul_add(-s_q_w, d466_d199, c_q_w * d467_d198),
+                ); // N(M col 6l) at 1.y | N(M col 6r) at 1.y
+            let d473_d205 = lanes.mul_add(c_q_imu, d468_d200, s_q_imu * d469_d201); // F(M col 6l) at 0.x | F(M col 6r) at 0.x
+            let d473 = d473_d205.lo();
+            let d205 = d473_d205.hi();
             m[(0, 7)] = -d473;
             m[(7, 0)] = m[(0, 7)];
-            let d474 = A::mul_add(-s_q_imu, d471, c_q_imu * d472); // N(M col 6l) at 0.z
+            m[(0, 14)] = -d205;
+            m[(14, 0)] = m[(0, 14)];
+            let d474_d206 = lanes.mul_add(-s_q_imu, d471_d202, c_q_imu * d472_d204); // N(M col 6l) at 0.z | N(M col 6r) at 0.z
+            let d474 = d474_d206.lo();
+            let d206 = d474_d206.hi();
             m[(1, 7)] = -d474;
             m[(7, 1)] = m[(1, 7)];
-            let d475 = p.MX5l - d451; // MSC5l.x
-            let d476 = p.MZ5l + d450; // MSC5l.z
-            let k34 = s_q3l * s_q3l; // sin² q3l
-            let k35 = s_q3l * c_q3l; // sin q3l cos q3l
-            let k36 = A::mul_add(2.0, k34, -1.0); // cos 2q3l
-            let d477 = d444 - d449; // JC6l: Jzz − Jxx
-            let d478 = A::mul_add(2.0, d446 * k35, k34 * d477); // JC6l rotated about y: Jzz − J'zz
-            let t68 = p.L7 * d440; // common subexpression
-            let d479 = p.XY5l + t62 - t63 - t66; // JC5l.xy
-            let d480 = A::mul_add(-k35, d477, A::mul_add(d446, k36, p.XZ5l)); // JC5l.xz
-            let d481 = p.YY5l + d447; // JC5l.yy
-            let d482 = p.YZ5l - t64 - t65 + t67; // JC5l.yz
-            let d483 = pc.pc42 - d440; // MSC5l.y
-            let d484 = A::mul_add(2.0, t68, d444 - d478) + pc.pc43; // JC5l.xx
+            m[(1, 14)] = d206;
+            m[(14, 1)] = m[(1, 14)];
+            let d475_d207 = F64x2::new(p.MX5l, p.MX5r) - d451_d183; // MSC5l.x | MSC5r.x
+            let d476_d208 = F64x2::new(p.MZ5l, p.MZ5r) + d450_d182; // MSC5l.z | MSC5r.z
+            let k34_k13 = F64x2::new(s_q3l, s_q3r) * F64x2::new(s_q3l, s_q3r); // sin² q3l | sin² q3r
+            let k35_k14 = F64x2::new(s_q3l, s_q3r) * F64x2::new(c_q3l, c_q3r); // sin q3l cos q3l | sin q3r cos q3r
+            let k36_k15 = lanes.mul_add(2.0, k34_k13, -1.0); // cos 2q3l | cos 2q3r
+            let d477_d209 = d444_d176 - d449_d181; // JC6l: Jzz − Jxx | JC6r: Jzz − Jxx
+            let d478_d210 = lanes.mul_add(2.0, d446_d178 * k35_k14, k34_k13 * d477_d209); // JC6l rotated about y: Jzz − J'zz | JC6r rotated about y: Jzz − J'zz
+            let t68_t28 = p.L7 * d440_d172; // common subexpression | common subexpression
+            let d479_d211 = F64x2::new(p.XY5l, p.XY5r) + t62_t22 - t63_t23 - t66_t26; // JC5l.xy | JC5r.xy
+            let d480_d212 = lanes
+                .mul_add(
+                    -k35_k14,
+                    d477_d209,
+                    lanes.mul_add(d446_d178, k36_k15, F64x2::new(p.XZ5l, p.XZ5r)),
+                ); // JC5l.xz | JC5r.xz
+            let d481_d213 = F64x2::new(p.YY5l, p.YY5r) + d447_d179; // JC5l.yy | JC5r.yy
+            let d482_d214 = F64x2::new(p.YZ5l, p.YZ5r) - t64_t24 - t65_t25 + t67_t27; // JC5l.yz | JC5r.yz
+            let d483_d215 = F64x2::new(pc.pc42, pc.pc19) - d440_d172; // MSC5l.y | MSC5r.y
+            let d484_d216 = lanes.mul_add(2.0, t68_t28, d444_d176 - d478_d210)
+                + F64x2::new(pc.pc43, pc.pc20); // JC5l.xx | JC5r.xx
+            let d484 = d484_d216.lo();
+            let d216 = d484_d216.hi();
             m[(6, 6)] = d484;
-            let d485 = A::mul_add(2.0, t68, d449 + d478) + pc.pc44; // JC5l.zz
-            let d486 = A::mul_add(s_q2l, d476, c_q2l * d483); // MSC5l in 4l.y
-            let d487 = A::mul_add(-c_q2l, d476, s_q2l * d483); // MSC5l in 4l.z
-            let t69 = c_q2l * d479; // common subexpression
-            let t70 = s_q2l * d480; // common subexpression
-            let d488 = t69 + t70; // N(M col 5l) at 4l.y
+            m[(13, 13)] = d216;
+            let d485_d217 = lanes.mul_add(2.0, t68_t28, d449_d181 + d478_d210)
+                + F64x2::new(pc.pc44, pc.pc21); // JC5l.zz | JC5r.zz
+            let d486_d218 = lanes
+                .mul_add(
+                    F64x2::new(s_q2l, s_q2r),
+                    d476_d208,
+                    F64x2::new(c_q2l, c_q2r) * d483_d215,
+                ); // MSC5l in 4l.y | MSC5r in 4r.y
+            let d487_d219 = lanes
+                .mul_add(
+                    -F64x2::new(c_q2l, c_q2r),
+                    d476_d208,
+                    F64x2::new(s_q2l, s_q2r) * d483_d215,
+                ); // MSC5l in 4l.z | MSC5r in 4r.z
+            let t69_t29 = F64x2::new(c_q2l, c_q2r) * d479_d211; // common subexpression | common subexpression
+            let t70_t30 = F64x2::new(s_q2l, s_q2r) * d480_d212; // common subexpression | common subexpression
+            let d488_d220 = t69_t29 + t70_t30; // N(M col 5l) at 4l.y | N(M col 5r) at 4r.y
+            let d488 = d488_d220.lo();
+            let d220 = d488_d220.hi();
             m[(5, 6)] = -d488;
             m[(6, 5)] = m[(5, 6)];
-            let t71 = s_q2l * d479; // common subexpression
-            let t72 = c_q2l * d480; // common subexpression
-            let d489 = t71 - t72; // N(M col 5l) at 4l.z
-            let d490 = s_q1l * d486; // F(M col 5l) at 3.y
-            let d491 = c_q1l * d486; // F(M col 5l) at 3.z
-            let d492 = A::mul_add(p.L5, d491, d488); // N(M col 5l) at 3.x
-            let d493 = A::mul_add(-p.L6, d491, A::mul_add(-s_q1l, d489, c_q1l * d484)); // N(M col 5l) at 3.y
+            m[(12, 13)] = -d220;
+            m[(13, 12)] = m[(12, 13)];
+            let t71_t31 = F64x2::new(s_q2l, s_q2r) * d479_d211; // common subexpression | common subexpression
+            let t72_t32 = F64x2::new(c_q2l, c_q2r) * d480_d212; // common subexpression | common subexpression
+            let d489_d221 = t71_t31 - t72_t32; // N(M col 5l) at 4l.z | N(M col 5r) at 4r.z
+            let d490_d222 = F64x2::new(s_q1l, s_q1r) * d486_d218; // F(M col 5l) at 3.y | F(M col 5r) at 3.y
+            let d490 = d490_d222.lo();
+            let d222 = d490_d222.hi();
+            let d491_d223 = F64x2::new(c_q1l, c_q1r) * d486_d218; // F(M col 5l) at 3.z | F(M col 5r) at 3.z
+            let d492_d226 = lanes.mul_add(p.L5, d491_d223, d488_d220); // N(M col 5l) at 3.x | N(M col 5r) at 3.x
+            let d492 = d492_d226.lo();
+            let d226 = d492_d226.hi();
+            let d493_d224 = lanes
+                .mul_add(
+                    -p.L6,
+                    d491_d223,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q1l, s_q1r),
+                            d489_d221,
+                            F64x2::new(c_q1l, c_q1r) * d484_d216,
+                        ),
+                ); // N(M col 5l) at 3.y | N(M col 5r) at 3.y
+            let d493 = d493_d224.lo();
+            let d224 = d493_d224.hi();
             m[(4, 6)] = -d493;
             m[(6, 4)] = m[(4, 6)];
-            let d494 = A::mul_add(
-                p.L5,
-                d487,
-                A::mul_add(-p.L6, d490, A::mul_add(c_q1l, d489, s_q1l * d484)),
-            ); // N(M col 5l) at 3.z
-            let d495 = A::mul_add(-s_q_torso, d491, c_q_torso * d487); // F(M col 5l) at 2.x
-            let d496 = A::mul_add(c_q_torso, d491, s_q_torso * d487); // F(M col 5l) at 2.z
+            m[(4, 13)] = -d224;
+            m[(13, 4)] = m[(4, 13)];
+            let d494_d225 = lanes
+                .mul_add(
+                    p.L5,
+                    d487_d219,
+                    lanes
+                        .mul_add(
+                            -p.L6,
+                            d490_d222,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(c_q1l, c_q1r),
+                                    d489_d221,
+                                    F64x2::new(s_q1l, s_q1r) * d484_d216,
+                                ),
+                        ),
+                ); // N(M col 5l) at 3.z | N(M col 5r) at 3.z
+            let d494 = d494_d225.lo();
+            let d225 = d494_d225.hi();
+            let d495_d227 = lanes.mul_add(-s_q_torso, d491_d223, c_q_torso * d487_d219); // F(M col 5l) at 2.x | F(M col 5r) at 2.x
+            let d495 = d495_d227.lo();
+            let d227 = d495_d227.hi();
+            let d230 = A::mul_add(-p.L4, d227, -d224); // N(M col 5r) at 2.y
+            let d496_d228 = lanes.mul_add(c_q_torso, d491_d223, s_q_torso * d487_d219); // F(M col 5l) at 2.z | F(M col 5r) at 2.z
+            let d496 = d496_d228.lo();
+            let d228 = d496_d228.hi();
+            let d229 = A::mul_add(
+                -p.L3,
+                d228,
+                A::mul_add(-s_q_torso, d225, A::mul_add(-c_q_torso, d226, p.L4 * d222)),
+            ); // N(M col 5r) at 2.x
+            m[(3, 13)] = d229;
+            m[(13, 3)] = m[(3, 13)];
+            let d232 = A::mul_add(s_q_w, d228, c_q_w * d222); // F(M col 5r) at 1.y
+            let d233 = A::mul_add(-c_q_w, d228, s_q_w * d222); // F(M col 5r) at 1.z
             let d497 = A::mul_add(-p.L4, d495, d493); // N(M col 5l) at 2.y
+            let d497_d230 = F64x2::new(d497, d230);
             let d498 = A::mul_add(
                 p.L4,
                 d490,
@@ -3301,55 +3747,149 @@ mod generated {
             ); // N(M col 5l) at 2.x
             m[(3, 6)] = d498;
             m[(6, 3)] = m[(3, 6)];
-            let d499 = A::mul_add(
-                -p.L3,
-                d495,
-                A::mul_add(-c_q_torso, d494, s_q_torso * d492),
-            ); // N(M col 5l) at 2.z
+            let d498_d229 = F64x2::new(d498, d229);
+            let d499_d231 = lanes
+                .mul_add(
+                    -p.L3,
+                    d495_d227,
+                    lanes.mul_add(-c_q_torso, d494_d225, s_q_torso * d492_d226),
+                ); // N(M col 5l) at 2.z | N(M col 5r) at 2.z
             let d500 = A::mul_add(-s_q_w, d496, c_q_w * d490); // F(M col 5l) at 1.y
+            let d500_d232 = F64x2::new(d500, d232);
             let d501 = A::mul_add(c_q_w, d496, s_q_w * d490); // F(M col 5l) at 1.z
-            let d502 = A::mul_add(p.L2, d495, A::mul_add(-s_q_w, d499, c_q_w * d497)); // N(M col 5l) at 1.y
-            let d503 = A::mul_add(-p.L2, d500, A::mul_add(p.L1, d501, d498)); // N(M col 5l) at 1.x
+            let d501_d233 = F64x2::new(d501, d233);
+            let d502_d235 = lanes
+                .mul_add(
+                    p.L2,
+                    d495_d227,
+                    lanes.mul_add(-s_q_w, d499_d231, c_q_w * d497_d230),
+                ); // N(M col 5l) at 1.y | N(M col 5r) at 1.y
+            let d503_d234 = lanes
+                .mul_add(-p.L2, d500_d232, lanes.mul_add(p.L1, d501_d233, d498_d229)); // N(M col 5l) at 1.x | N(M col 5r) at 1.x
+            let d503 = d503_d234.lo();
+            let d234 = d503_d234.hi();
             m[(2, 6)] = d503;
             m[(6, 2)] = m[(2, 6)];
-            let d504 = A::mul_add(-p.L1, d495, A::mul_add(c_q_w, d499, s_q_w * d497)); // N(M col 5l) at 1.z
-            let d505 = A::mul_add(c_q_imu, d501, s_q_imu * d500); // F(M col 5l) at 0.x
+            m[(2, 13)] = d234;
+            m[(13, 2)] = m[(2, 13)];
+            let d504_d236 = lanes
+                .mul_add(
+                    -p.L1,
+                    d495_d227,
+                    lanes.mul_add(c_q_w, d499_d231, s_q_w * d497_d230),
+                ); // N(M col 5l) at 1.z | N(M col 5r) at 1.z
+            let d505_d237 = lanes.mul_add(c_q_imu, d501_d233, s_q_imu * d500_d232); // F(M col 5l) at 0.x | F(M col 5r) at 0.x
+            let d505 = d505_d237.lo();
+            let d237 = d505_d237.hi();
             m[(0, 6)] = d505;
             m[(6, 0)] = m[(0, 6)];
-            let d506 = A::mul_add(-s_q_imu, d504, c_q_imu * d502); // N(M col 5l) at 0.z
+            m[(0, 13)] = d237;
+            m[(13, 0)] = m[(0, 13)];
+            let d506_d238 = lanes.mul_add(-s_q_imu, d504_d236, c_q_imu * d502_d235); // N(M col 5l) at 0.z | N(M col 5r) at 0.z
+            let d506 = d506_d238.lo();
+            let d238 = d506_d238.hi();
             m[(1, 6)] = d506;
             m[(6, 1)] = m[(1, 6)];
-            let d507 = p.MX4l - d475; // MSC4l.x
-            let d508 = p.MY4l - d486; // MSC4l.y
-            let d509 = p.MZ4l - d487; // MSC4l.z
-            let k37 = s_q2l * s_q2l; // sin² q2l
-            let k38 = s_q2l * c_q2l; // sin q2l cos q2l
-            let k39 = A::mul_add(2.0, k37, -1.0); // cos 2q2l
-            let d510 = d481 - d485; // JC5l: Jyy − Jzz
-            let d511 = A::mul_add(-2.0, d482 * k38, k37 * d510); // JC5l rotated about x: Jyy − J'yy
-            let d512 = p.XX4l + d484; // JC4l.xx
-            let d513 = p.XY4l + t69 + t70; // JC4l.xy
-            let d514 = p.XZ4l + t71 - t72; // JC4l.xz
-            let d515 = p.YY4l + d481 - d511; // JC4l.yy
+            m[(1, 13)] = -d238;
+            m[(13, 1)] = m[(1, 13)];
+            let d507_d239 = F64x2::new(p.MX4l, p.MX4r) - d475_d207; // MSC4l.x | MSC4r.x
+            let d508_d240 = F64x2::new(p.MY4l, p.MY4r) - d486_d218; // MSC4l.y | MSC4r.y
+            let d508 = d508_d240.lo();
+            let d240 = d508_d240.hi();
+            let d509_d241 = F64x2::new(p.MZ4l, p.MZ4r) - d487_d219; // MSC4l.z | MSC4r.z
+            let k37_k16 = F64x2::new(s_q2l, s_q2r) * F64x2::new(s_q2l, s_q2r); // sin² q2l | sin² q2r
+            let k38_k17 = F64x2::new(s_q2l, s_q2r) * F64x2::new(c_q2l, c_q2r); // sin q2l cos q2l | sin q2r cos q2r
+            let k39_k18 = lanes.mul_add(2.0, k37_k16, -1.0); // cos 2q2l | cos 2q2r
+            let d510_d242 = d481_d213 - d485_d217; // JC5l: Jyy − Jzz | JC5r: Jyy − Jzz
+            let d511_d243 = lanes
+                .mul_add(-2.0, d482_d214 * k38_k17, k37_k16 * d510_d242); // JC5l rotated about x: Jyy − J'yy | JC5r rotated about x: Jyy − J'yy
+            let d512_d244 = F64x2::new(p.XX4l, p.XX4r) + d484_d216; // JC4l.xx | JC4r.xx
+            let d512 = d512_d244.lo();
+            let d244 = d512_d244.hi();
+            let d513_d245 = F64x2::new(p.XY4l, p.XY4r) + t69_t29 + t70_t30; // JC4l.xy | JC4r.xy
+            let d514_d246 = F64x2::new(p.XZ4l, p.XZ4r) + t71_t31 - t72_t32; // JC4l.xz | JC4r.xz
+            let d514 = d514_d246.lo();
+            let d246 = d514_d246.hi();
+            let d515_d247 = F64x2::new(p.YY4l, p.YY4r) + d481_d213 - d511_d243; // JC4l.yy | JC4r.yy
+            let d515 = d515_d247.lo();
+            let d247 = d515_d247.hi();
             m[(5, 5)] = d515;
-            let d516 = A::mul_add(k38, d510, A::mul_add(d482, k39, p.YZ4l)); // JC4l.yz
-            let d517 = p.ZZ4l + d485 + d511; // JC4l.zz
-            let d518 = A::mul_add(-s_q1l, d509, c_q1l * d507); // MSC4l in 3.y
-            let d519 = A::mul_add(c_q1l, d509, s_q1l * d507); // MSC4l in 3.z
-            let t73 = c_q1l * d513; // common subexpression
-            let t74 = s_q1l * d516; // common subexpression
-            let t75 = s_q1l * d513; // common subexpression
-            let t76 = c_q1l * d516; // common subexpression
-            let t77 = p.L5 * d518; // common subexpression
-            let t78 = p.L6 * d518; // common subexpression
-            let t79 = p.L6 * d519; // common subexpression
-            let d520 = t75 + t76 - t79; // N(M col 4l) at 3.z
-            let d521 = d515 + t77; // N(M col 4l) at 3.x
-            let d522 = t73 - t74 - t78; // N(M col 4l) at 3.y
+            m[(12, 12)] = d247;
+            let d516_d248 = lanes
+                .mul_add(
+                    k38_k17,
+                    d510_d242,
+                    lanes.mul_add(d482_d214, k39_k18, F64x2::new(p.YZ4l, p.YZ4r)),
+                ); // JC4l.yz | JC4r.yz
+            let d517_d249 = F64x2::new(p.ZZ4l, p.ZZ4r) + d485_d217 + d511_d243; // JC4l.zz | JC4r.zz
+            let d517 = d517_d249.lo();
+            let d249 = d517_d249.hi();
+            let d518_d250 = lanes
+                .mul_add(
+                    -F64x2::new(s_q1l, s_q1r),
+                    d509_d241,
+                    F64x2::new(c_q1l, c_q1r) * d507_d239,
+                ); // MSC4l in 3.y | MSC4r in 3.y
+            let d518 = d518_d250.lo();
+            let d250 = d518_d250.hi();
+            let d519_d251 = lanes
+                .mul_add(
+                    F64x2::new(c_q1l, c_q1r),
+                    d509_d241,
+                    F64x2::new(s_q1l, s_q1r) * d507_d239,
+                ); // MSC4l in 3.z | MSC4r in 3.z
+            let d519 = d519_d251.lo();
+            let d251 = d519_d251.hi();
+            let t73_t33 = F64x2::new(c_q1l, c_q1r) * d513_d245; // common subexpression | common subexpression
+            let t73 = t73_t33.lo();
+            let t33 = t73_t33.hi();
+            let t74_t34 = F64x2::new(s_q1l, s_q1r) * d516_d248; // common subexpression | common subexpression
+            let t74 = t74_t34.lo();
+            let t34 = t74_t34.hi();
+            let t75_t35 = F64x2::new(s_q1l, s_q1r) * d513_d245; // common subexpression | common subexpression
+            let t75 = t75_t35.lo();
+            let t35 = t75_t35.hi();
+            let t76_t36 = F64x2::new(c_q1l, c_q1r) * d516_d248; // common subexpression | common subexpression
+            let t76 = t76_t36.lo();
+            let t36 = t76_t36.hi();
+            let t77_t37 = p.L5 * d518_d250; // common subexpression | common subexpression
+            let t77 = t77_t37.lo();
+            let t37 = t77_t37.hi();
+            let t78_t38 = p.L6 * d518_d250; // common subexpression | common subexpression
+            let t78 = t78_t38.lo();
+            let t38 = t78_t38.hi();
+            let t79_t39 = p.L6 * d519_d251; // common subexpression | common subexpression
+            let t79 = t79_t39.lo();
+            let t39 = t79_t39.hi();
+            let d520_d254 = t75_t35 + t76_t36 - t79_t39; // N(M col 4l) at 3.z | N(M col 4r) at 3.z
+            let d520 = d520_d254.lo();
+            let d254 = d520_d254.hi();
+            let d521_d252 = d515_d247 + t77_t37; // N(M col 4l) at 3.x | N(M col 4r) at 3.x
+            let d521 = d521_d252.lo();
+            let d252 = d521_d252.hi();
+            let d522_d253 = t73_t33 - t74_t34 - t78_t38; // N(M col 4l) at 3.y | N(M col 4r) at 3.y
+            let d522 = d522_d253.lo();
+            let d253 = d522_d253.hi();
             m[(4, 5)] = d522;
             m[(5, 4)] = m[(4, 5)];
-            let d523 = s_q_torso * d518; // F(M col 4l) at 2.x
-            let d524 = c_q_torso * d518; // F(M col 4l) at 2.z
+            m[(4, 12)] = d253;
+            m[(12, 4)] = m[(4, 12)];
+            let d523_d255 = s_q_torso * d518_d250; // F(M col 4l) at 2.x | F(M col 4r) at 2.x
+            let d523 = d523_d255.lo();
+            let d255 = d523_d255.hi();
+            let d258 = A::mul_add(p.L4, d255, -d253); // N(M col 4r) at 2.y
+            let d524_d256 = c_q_torso * d518_d250; // F(M col 4l) at 2.z | F(M col 4r) at 2.z
+            let d524 = d524_d256.lo();
+            let d256 = d524_d256.hi();
+            let d257 = A::mul_add(
+                -p.L3,
+                d256,
+                A::mul_add(-s_q_torso, d254, A::mul_add(-c_q_torso, d252, p.L4 * d251)),
+            ); // N(M col 4r) at 2.x
+            m[(3, 12)] = -d257;
+            m[(12, 3)] = m[(3, 12)];
+            let d260 = A::mul_add(-c_q_w, d256, s_q_w * d251); // F(M col 4r) at 1.z
+            let d261 = A::mul_add(s_q_w, d256, c_q_w * d251); // F(M col 4r) at 1.y
             let d525 = A::mul_add(
                 p.L4,
                 d519,
@@ -3357,32 +3897,70 @@ mod generated {
             ); // N(M col 4l) at 2.x
             m[(3, 5)] = -d525;
             m[(5, 3)] = m[(3, 5)];
-            let d526 = A::mul_add(
-                p.L3,
-                d523,
-                A::mul_add(-c_q_torso, d520, s_q_torso * d521),
-            ); // N(M col 4l) at 2.z
+            let d525_d257 = F64x2::new(d525, d257);
+            let d526_d259 = lanes
+                .mul_add(
+                    p.L3,
+                    d523_d255,
+                    lanes.mul_add(-c_q_torso, d520_d254, s_q_torso * d521_d252),
+                ); // N(M col 4l) at 2.z | N(M col 4r) at 2.z
             let d527 = A::mul_add(p.L4, d523, d522); // N(M col 4l) at 2.y
+            let d527_d258 = F64x2::new(d527, d258);
             let d528 = A::mul_add(c_q_w, d524, s_q_w * d519); // F(M col 4l) at 1.z
+            let d528_d260 = F64x2::new(d528, d260);
             let d529 = A::mul_add(-s_q_w, d524, c_q_w * d519); // F(M col 4l) at 1.y
-            let d530 = A::mul_add(-p.L2, d529, A::mul_add(p.L1, d528, d525)); // N(M col 4l) at 1.x
+            let d529_d261 = F64x2::new(d529, d261);
+            let d530_d263 = lanes
+                .mul_add(-p.L2, d529_d261, lanes.mul_add(p.L1, d528_d260, d525_d257)); // N(M col 4l) at 1.x | N(M col 4r) at 1.x
+            let d530 = d530_d263.lo();
+            let d263 = d530_d263.hi();
             m[(2, 5)] = -d530;
             m[(5, 2)] = m[(2, 5)];
-            let d531 = A::mul_add(p.L1, d523, A::mul_add(c_q_w, d526, s_q_w * d527)); // N(M col 4l) at 1.z
-            let d532 = A::mul_add(-p.L2, d523, A::mul_add(-s_q_w, d526, c_q_w * d527)); // N(M col 4l) at 1.y
-            let d533 = A::mul_add(c_q_imu, d528, s_q_imu * d529); // F(M col 4l) at 0.x
+            m[(2, 12)] = -d263;
+            m[(12, 2)] = m[(2, 12)];
+            let d531_d262 = lanes
+                .mul_add(
+                    p.L1,
+                    d523_d255,
+                    lanes.mul_add(c_q_w, d526_d259, s_q_w * d527_d258),
+                ); // N(M col 4l) at 1.z | N(M col 4r) at 1.z
+            let d532_d264 = lanes
+                .mul_add(
+                    -p.L2,
+                    d523_d255,
+                    lanes.mul_add(-s_q_w, d526_d259, c_q_w * d527_d258),
+                ); // N(M col 4l) at 1.y | N(M col 4r) at 1.y
+            let d533_d265 = lanes.mul_add(c_q_imu, d528_d260, s_q_imu * d529_d261); // F(M col 4l) at 0.x | F(M col 4r) at 0.x
+            let d533 = d533_d265.lo();
+            let d265 = d533_d265.hi();
             m[(0, 5)] = -d533;
             m[(5, 0)] = m[(0, 5)];
-            let d534 = A::mul_add(-s_q_imu, d531, c_q_imu * d532); // N(M col 4l) at 0.z
+            m[(0, 12)] = -d265;
+            m[(12, 0)] = m[(0, 12)];
+            let d534_d266 = lanes.mul_add(-s_q_imu, d531_d262, c_q_imu * d532_d264); // N(M col 4l) at 0.z | N(M col 4r) at 0.z
+            let d534 = d534_d266.lo();
+            let d266 = d534_d266.hi();
             m[(1, 5)] = -d534;
             m[(5, 1)] = m[(1, 5)];
+            m[(1, 12)] = d266;
+            m[(12, 1)] = m[(1, 12)];
             let d535 = p.MZ3 + d251 - d519; // MSC3.z
-            let k40 = s_q1l * s_q1l; // sin² q1l
-            let k41 = s_q1l * c_q1l; // sin q1l cos q1l
-            let k42 = A::mul_add(2.0, k40, -1.0); // cos 2q1l
-            let d536 = d512 - d517; // JC4l: Jzz − Jxx
-            let d537 = A::mul_add(2.0, d514 * k41, k40 * d536); // JC4l rotated about y: Jzz − J'zz
-            let t80 = p.L6 * d508; // common subexpression
+            let k40_k19 = F64x2::new(s_q1l, s_q1r) * F64x2::new(s_q1l, s_q1r); // sin² q1l | sin² q1r
+            let k41_k20 = F64x2::new(s_q1l, s_q1r) * F64x2::new(c_q1l, c_q1r); // sin q1l cos q1l | sin q1r cos q1r
+            let k41 = k41_k20.lo();
+            let k20 = k41_k20.hi();
+            let k42_k21 = lanes.mul_add(2.0, k40_k19, -1.0); // cos 2q1l | cos 2q1r
+            let k42 = k42_k21.lo();
+            let k21 = k42_k21.hi();
+            let d536_d267 = d512_d244 - d517_d249; // JC4l: Jzz − Jxx | JC4r: Jzz − Jxx
+            let d536 = d536_d267.lo();
+            let d267 = d536_d267.hi();
+            let d537_d268 = lanes.mul_add(2.0, d514_d246 * k41_k20, k40_k19 * d536_d267); // JC4l rotated about y: Jzz − J'zz | JC4r rotated about y: Jzz − J'zz
+            let d537 = d537_d268.lo();
+            let d268 = d537_d268.hi();
+            let t80_t40 = p.L6 * d508_d240; // common subexpression | common subexpression
+            let t80 = t80_t40.lo();
+            let t40 = t80_t40.hi();
             let d538 = p.XZ3 - t35 - t36 + t39 - t75 - t76 + t79; // JC3.xz
             let d539 = A::mul_add(
                 p.L5,
@@ -3525,12 +4103,12 @@ mod generated {
             let d591 = d584 - d590; // JC0
             m[(1, 1)] = d591 + pc.pc68;
         }
-        kanegen_runtime::isa::dispatch_fused_with(
+        kanegen_runtime::isa::dispatch_pair_with(
             out,
             #[inline(always)]
-            |out| body::<kanegen_runtime::isa::Plain>(p, pc, q, out),
+            |out, lanes| body::<kanegen_runtime::isa::Plain, _>(lanes, p, pc, q, out),
             #[inline(always)]
-            |out| body::<kanegen_runtime::isa::Fused>(p, pc, q, out),
+            |out, lanes| body::<kanegen_runtime::isa::Fused, _>(lanes, p, pc, q, out),
         )
     }
     /// Coriolis and centrifugal vector c(q, u) (velocity-product terms).
@@ -3545,7 +4123,8 @@ mod generated {
         u: &SVector<f64, 19>,
     ) -> SVector<f64, 19> {
         #[inline(always)]
-        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+        fn body<A: kanegen_runtime::isa::Arith<f64>, P: kanegen_runtime::isa::PairArith>(
+            lanes: P,
             p: &Params,
             _pc: &Precomputed,
             q: &SVector<f64, 19>,
@@ -3865,9 +4444,40 @@ mod generated {
             let k42 = k31 - t5 - t6 + t9 + t10; // a4l in 3|ud=0,g=0.z
             let k43 = A::mul_add(c_q1l, k42, s_q1l * k41); // a4l|ud=0,g=0.z
             let k44 = A::mul_add(-s_q1l, k42, c_q1l * k41); // a4l|ud=0,g=0.x
-            let d36 = A::mul_add(p.MY4l, k33, p.MZ4l * k34); // w4lxMS4l|ud=0,g=0.x
-            let d37 = A::mul_add(-p.MX4l, k34, p.MY4l * k32); // w4lxMS4l|ud=0,g=0.z
-            let d38 = A::mul_add(p.MZ4l, k32, p.MX4l * k33); // w4lxMS4l|ud=0,g=0.y
+            let k50 = A::mul_add(s_q2l, k43, c_q2l * k40); // a5l|ud=0,g=0.y
+            let k51 = A::mul_add(-c_q2l, k43, s_q2l * k40); // a5l|ud=0,g=0.z
+            let k102 = A::mul_add(-s_q1r, k20, c_q1r * k21); // w3 in 4r|ud=0,g=0.x
+            let k32_k102 = F64x2::new(k32, k102);
+            let k103 = A::mul_add(c_q1r, k20, s_q1r * k21); // w3 in 4r|ud=0,g=0.z
+            let k33_k103 = F64x2::new(k33, k103);
+            let k104 = A::mul_add(-k102, qd1r, A::mul_add(c_q1r, k23, s_q1r * k9)); // wd4r|ud=0,g=0.z
+            let k105 = -k19 - qd1r; // w4r|ud=0,g=0.y
+            let k34_k105 = F64x2::new(k34, k105);
+            let k106 = A::mul_add(k103, qd1r, A::mul_add(-s_q1r, k23, c_q1r * k9)); // wd4r|ud=0,g=0.x
+            let k36_k106 = F64x2::new(k36, k106);
+            let k107 = t1 + t2; // w3xP4r|ud=0,g=0.z
+            let k108 = A::mul_add(k21, k107, k30 - t3 + t7); // a4r in 3|ud=0,g=0.x
+            let k109 = A::mul_add(k19, k107, k28 + t4 + t8); // a4r in 3|ud=0,g=0.y
+            let k110 = k31 - t5 + t6 - t9 + t10; // a4r in 3|ud=0,g=0.z
+            let k111 = A::mul_add(-c_q1r, k110, s_q1r * k109); // a4r|ud=0,g=0.z
+            let k112 = A::mul_add(s_q1r, k110, c_q1r * k109); // a4r|ud=0,g=0.x
+            let k44_k112 = F64x2::new(k44, k112);
+            let d37_d120 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX4l, p.MX4r),
+                    k34_k105,
+                    F64x2::new(p.MY4l, p.MY4r) * k32_k102,
+                ); // w4lxMS4l|ud=0,g=0.z | w4rxMS4r|ud=0,g=0.z
+            let d37 = d37_d120.lo();
+            let d120 = d37_d120.hi();
+            let d36_d121 = lanes
+                .mul_add(
+                    F64x2::new(p.MY4l, p.MY4r),
+                    k33_k103,
+                    F64x2::new(p.MZ4l, p.MZ4r) * k34_k105,
+                ); // w4lxMS4l|ud=0,g=0.x | w4rxMS4r|ud=0,g=0.x
+            let d36 = d36_d121.lo();
+            let d121 = d36_d121.hi();
             let d39 = A::mul_add(
                 -k32,
                 d37,
@@ -3877,6 +4487,14 @@ mod generated {
                     A::mul_add(p.MZ4l, k36, A::mul_add(p.MX4l, k35, p.m4l * k40)),
                 ),
             ); // F4l|ud=0,g=0.y
+            let d38_d122 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ4l, p.MZ4r),
+                    k32_k102,
+                    F64x2::new(p.MX4l, p.MX4r) * k33_k103,
+                ); // w4lxMS4l|ud=0,g=0.y | w4rxMS4r|ud=0,g=0.y
+            let d38 = d38_d122.lo();
+            let d122 = d38_d122.hi();
             let d40 = A::mul_add(
                 -k34,
                 d36,
@@ -3895,9 +4513,96 @@ mod generated {
                     A::mul_add(p.MY4l, k35, A::mul_add(-p.MZ4l, k22, p.m4l * k44)),
                 ),
             ); // F4l|ud=0,g=0.x
-            let d42 = A::mul_add(-p.XZ4l, k33, A::mul_add(p.XY4l, k34, p.XX4l * k32)); // J4lw4l|ud=0,g=0.x
-            let d43 = A::mul_add(-p.YZ4l, k33, A::mul_add(p.YY4l, k34, p.XY4l * k32)); // J4lw4l|ud=0,g=0.y
-            let d44 = A::mul_add(-p.ZZ4l, k33, A::mul_add(p.YZ4l, k34, p.XZ4l * k32)); // J4lw4l|ud=0,g=0.z
+            let d123 = A::mul_add(
+                -k105,
+                d121,
+                A::mul_add(
+                    -k102,
+                    d122,
+                    A::mul_add(p.MX4r, k22, A::mul_add(-p.MY4r, k106, p.m4r * k111)),
+                ),
+            ); // F4r|ud=0,g=0.z
+            let d40_d123 = F64x2::new(d40, d123);
+            let d124 = A::mul_add(
+                k103,
+                d122,
+                A::mul_add(
+                    -k105,
+                    d120,
+                    A::mul_add(p.MY4r, k104, A::mul_add(p.MZ4r, k22, p.m4r * k112)),
+                ),
+            ); // F4r|ud=0,g=0.x
+            let d41_d124 = F64x2::new(d41, d124);
+            let d125 = A::mul_add(
+                -k102,
+                d120,
+                A::mul_add(
+                    -k103,
+                    d121,
+                    A::mul_add(p.MZ4r, k106, A::mul_add(-p.m4r, k108, p.MX4r * k104)),
+                ),
+            ); // F4r|ud=0,g=0.y
+            let d39_d125 = F64x2::new(d39, d125);
+            let d42_d126 = lanes
+                .mul_add(
+                    -F64x2::new(p.XZ4l, p.XZ4r),
+                    k33_k103,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY4l, p.XY4r),
+                            k34_k105,
+                            F64x2::new(p.XX4l, p.XX4r) * k32_k102,
+                        ),
+                ); // J4lw4l|ud=0,g=0.x | J4rw4r|ud=0,g=0.x
+            let d42 = d42_d126.lo();
+            let d126 = d42_d126.hi();
+            let d43_d127 = lanes
+                .mul_add(
+                    -F64x2::new(p.YZ4l, p.YZ4r),
+                    k33_k103,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY4l, p.YY4r),
+                            k34_k105,
+                            F64x2::new(p.XY4l, p.XY4r) * k32_k102,
+                        ),
+                ); // J4lw4l|ud=0,g=0.y | J4rw4r|ud=0,g=0.y
+            let d43 = d43_d127.lo();
+            let d127 = d43_d127.hi();
+            let d47 = A::mul_add(
+                -p.MY4l,
+                k44,
+                A::mul_add(
+                    -p.MX4l,
+                    k40,
+                    A::mul_add(
+                        k34,
+                        d42,
+                        A::mul_add(
+                            -k32,
+                            d43,
+                            A::mul_add(
+                                -p.ZZ4l,
+                                k35,
+                                A::mul_add(-p.YZ4l, k22, p.XZ4l * k36),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N4l|ud=0,g=0.z
+            let d44_d128 = lanes
+                .mul_add(
+                    -F64x2::new(p.ZZ4l, p.ZZ4r),
+                    k33_k103,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ4l, p.YZ4r),
+                            k34_k105,
+                            F64x2::new(p.XZ4l, p.XZ4r) * k32_k102,
+                        ),
+                ); // J4lw4l|ud=0,g=0.z | J4rw4r|ud=0,g=0.z
+            let d44 = d44_d128.lo();
+            let d128 = d44_d128.hi();
             let d45 = A::mul_add(
                 p.MZ4l,
                 k40,
@@ -3940,717 +4645,6 @@ mod generated {
                     ),
                 ),
             ); // N4l|ud=0,g=0.y
-            let d47 = A::mul_add(
-                -p.MY4l,
-                k44,
-                A::mul_add(
-                    -p.MX4l,
-                    k40,
-                    A::mul_add(
-                        k34,
-                        d42,
-                        A::mul_add(
-                            -k32,
-                            d43,
-                            A::mul_add(
-                                -p.ZZ4l,
-                                k35,
-                                A::mul_add(-p.YZ4l, k22, p.XZ4l * k36),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N4l|ud=0,g=0.z
-            let k45 = A::mul_add(-s_q2l, k33, c_q2l * k34); // w4l in 5l|ud=0,g=0.y
-            let k46 = A::mul_add(c_q2l, k33, s_q2l * k34); // w4l in 5l|ud=0,g=0.z
-            let k47 = k32 + qd2l; // w5l|ud=0,g=0.x
-            let k48 = A::mul_add(-k46, qd2l, A::mul_add(s_q2l, k35, c_q2l * k22)); // wd5l|ud=0,g=0.y
-            let k49 = A::mul_add(k45, qd2l, A::mul_add(-c_q2l, k35, s_q2l * k22)); // wd5l|ud=0,g=0.z
-            let k50 = A::mul_add(s_q2l, k43, c_q2l * k40); // a5l|ud=0,g=0.y
-            let k51 = A::mul_add(-c_q2l, k43, s_q2l * k40); // a5l|ud=0,g=0.z
-            let d48 = A::mul_add(-p.MY5l, k46, p.MZ5l * k45); // w5lxMS5l|ud=0,g=0.x
-            let d49 = A::mul_add(-p.MZ5l, k47, p.MX5l * k46); // w5lxMS5l|ud=0,g=0.y
-            let d50 = A::mul_add(-p.MX5l, k45, p.MY5l * k47); // w5lxMS5l|ud=0,g=0.z
-            let d51 = A::mul_add(
-                -k46,
-                d49,
-                A::mul_add(
-                    k45,
-                    d50,
-                    A::mul_add(p.MY5l, k49, A::mul_add(-p.MZ5l, k48, p.m5l * k44)),
-                ),
-            ); // F5l|ud=0,g=0.x
-            let d52 = A::mul_add(
-                k47,
-                d50,
-                A::mul_add(
-                    -k46,
-                    d48,
-                    A::mul_add(p.MZ5l, k36, A::mul_add(p.MX5l, k49, p.m5l * k50)),
-                ),
-            ); // F5l|ud=0,g=0.y
-            let d53 = A::mul_add(
-                k45,
-                d48,
-                A::mul_add(
-                    -k47,
-                    d49,
-                    A::mul_add(-p.MX5l, k48, A::mul_add(-p.MY5l, k36, p.m5l * k51)),
-                ),
-            ); // F5l|ud=0,g=0.z
-            let d54 = A::mul_add(p.XZ5l, k46, A::mul_add(p.XY5l, k45, p.XX5l * k47)); // J5lw5l|ud=0,g=0.x
-            let d55 = A::mul_add(p.YZ5l, k46, A::mul_add(p.YY5l, k45, p.XY5l * k47)); // J5lw5l|ud=0,g=0.y
-            let d56 = A::mul_add(p.ZZ5l, k46, A::mul_add(p.YZ5l, k45, p.XZ5l * k47)); // J5lw5l|ud=0,g=0.z
-            let d57 = A::mul_add(
-                p.MZ5l,
-                k50,
-                A::mul_add(
-                    -p.MY5l,
-                    k51,
-                    A::mul_add(
-                        -k46,
-                        d55,
-                        A::mul_add(
-                            k45,
-                            d56,
-                            A::mul_add(
-                                -p.XZ5l,
-                                k49,
-                                A::mul_add(-p.XY5l, k48, p.XX5l * k36),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N5l|ud=0,g=0.x
-            let d58 = A::mul_add(
-                p.MX5l,
-                k51,
-                A::mul_add(
-                    p.MZ5l,
-                    k44,
-                    A::mul_add(
-                        -k47,
-                        d56,
-                        A::mul_add(
-                            k46,
-                            d54,
-                            A::mul_add(
-                                -p.YZ5l,
-                                k49,
-                                A::mul_add(-p.YY5l, k48, p.XY5l * k36),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N5l|ud=0,g=0.y
-            let d59 = A::mul_add(
-                -p.MY5l,
-                k44,
-                A::mul_add(
-                    -p.MX5l,
-                    k50,
-                    A::mul_add(
-                        -k45,
-                        d54,
-                        A::mul_add(
-                            k47,
-                            d55,
-                            A::mul_add(
-                                -p.ZZ5l,
-                                k49,
-                                A::mul_add(-p.YZ5l, k48, p.XZ5l * k36),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N5l|ud=0,g=0.z
-            let k52 = A::mul_add(-s_q3l, k46, c_q3l * k47); // w5l in 6l|ud=0,g=0.x
-            let k53 = A::mul_add(c_q3l, k46, s_q3l * k47); // w5l in 6l|ud=0,g=0.z
-            let k54 = k45 - qd3l; // w6l|ud=0,g=0.y
-            let k55 = A::mul_add(-k52, qd3l, A::mul_add(-c_q3l, k49, s_q3l * k36)); // wd6l|ud=0,g=0.z
-            let k56 = A::mul_add(k53, qd3l, A::mul_add(s_q3l, k49, c_q3l * k36)); // wd6l|ud=0,g=0.x
-            let k57 = p.L7 * k46; // w5lxP6l|ud=0,g=0.x
-            let k58 = p.L7 * k47; // w5lxP6l|ud=0,g=0.z
-            let k59 = A::mul_add(-k45, k58, A::mul_add(-p.L7, k49, k44)); // a6l in 5l|ud=0,g=0.x
-            let k60 = A::mul_add(-k47, k58, A::mul_add(-k46, k57, k50)); // a6l in 5l|ud=0,g=0.y
-            let k61 = A::mul_add(k45, k57, A::mul_add(p.L7, k36, k51)); // a6l in 5l|ud=0,g=0.z
-            let k62 = A::mul_add(-c_q3l, k61, s_q3l * k59); // a6l|ud=0,g=0.z
-            let k63 = A::mul_add(s_q3l, k61, c_q3l * k59); // a6l|ud=0,g=0.x
-            let d60 = A::mul_add(p.MY6l, k53, p.MZ6l * k54); // w6lxMS6l|ud=0,g=0.x
-            let d61 = A::mul_add(-p.MX6l, k54, p.MY6l * k52); // w6lxMS6l|ud=0,g=0.z
-            let d62 = A::mul_add(p.MZ6l, k52, p.MX6l * k53); // w6lxMS6l|ud=0,g=0.y
-            let d63 = A::mul_add(
-                -k52,
-                d61,
-                A::mul_add(
-                    -k53,
-                    d60,
-                    A::mul_add(p.MZ6l, k56, A::mul_add(p.MX6l, k55, p.m6l * k60)),
-                ),
-            ); // F6l|ud=0,g=0.y
-            let d64 = A::mul_add(
-                -k54,
-                d60,
-                A::mul_add(
-                    -k52,
-                    d62,
-                    A::mul_add(-p.MX6l, k48, A::mul_add(-p.MY6l, k56, p.m6l * k62)),
-                ),
-            ); // F6l|ud=0,g=0.z
-            let d65 = A::mul_add(
-                k53,
-                d62,
-                A::mul_add(
-                    -k54,
-                    d61,
-                    A::mul_add(p.MY6l, k55, A::mul_add(-p.MZ6l, k48, p.m6l * k63)),
-                ),
-            ); // F6l|ud=0,g=0.x
-            let d66 = A::mul_add(-p.XZ6l, k53, A::mul_add(p.XY6l, k54, p.XX6l * k52)); // J6lw6l|ud=0,g=0.x
-            let d67 = A::mul_add(-p.YZ6l, k53, A::mul_add(p.YY6l, k54, p.XY6l * k52)); // J6lw6l|ud=0,g=0.y
-            let d68 = A::mul_add(-p.ZZ6l, k53, A::mul_add(p.YZ6l, k54, p.XZ6l * k52)); // J6lw6l|ud=0,g=0.z
-            let d69 = A::mul_add(
-                p.MZ6l,
-                k60,
-                A::mul_add(
-                    -p.MY6l,
-                    k62,
-                    A::mul_add(
-                        -k53,
-                        d67,
-                        A::mul_add(
-                            -k54,
-                            d68,
-                            A::mul_add(
-                                -p.XZ6l,
-                                k55,
-                                A::mul_add(-p.XY6l, k48, p.XX6l * k56),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N6l|ud=0,g=0.x
-            let d70 = A::mul_add(
-                p.MX6l,
-                k62,
-                A::mul_add(
-                    p.MZ6l,
-                    k63,
-                    A::mul_add(
-                        k52,
-                        d68,
-                        A::mul_add(
-                            k53,
-                            d66,
-                            A::mul_add(
-                                -p.YZ6l,
-                                k55,
-                                A::mul_add(-p.YY6l, k48, p.XY6l * k56),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N6l|ud=0,g=0.y
-            let d71 = A::mul_add(
-                -p.MY6l,
-                k63,
-                A::mul_add(
-                    -p.MX6l,
-                    k60,
-                    A::mul_add(
-                        k54,
-                        d66,
-                        A::mul_add(
-                            -k52,
-                            d67,
-                            A::mul_add(
-                                -p.ZZ6l,
-                                k55,
-                                A::mul_add(-p.YZ6l, k48, p.XZ6l * k56),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N6l|ud=0,g=0.z
-            let k64 = A::mul_add(-s_q4l, k53, c_q4l * k54); // w6l in 7l|ud=0,g=0.y
-            let k65 = A::mul_add(c_q4l, k53, s_q4l * k54); // w6l in 7l|ud=0,g=0.z
-            let k66 = k52 + qd4l; // w7l|ud=0,g=0.x
-            let k67 = A::mul_add(-k65, qd4l, A::mul_add(s_q4l, k55, c_q4l * k48)); // wd7l|ud=0,g=0.y
-            let k68 = A::mul_add(k64, qd4l, A::mul_add(-c_q4l, k55, s_q4l * k48)); // wd7l|ud=0,g=0.z
-            let k69 = A::mul_add(s_q4l, k62, c_q4l * k60); // a7l|ud=0,g=0.y
-            let k70 = A::mul_add(-c_q4l, k62, s_q4l * k60); // a7l|ud=0,g=0.z
-            let d72 = A::mul_add(-p.MY7l, k65, p.MZ7l * k64); // w7lxMS7l|ud=0,g=0.x
-            let d73 = A::mul_add(-p.MZ7l, k66, p.MX7l * k65); // w7lxMS7l|ud=0,g=0.y
-            let d74 = A::mul_add(-p.MX7l, k64, p.MY7l * k66); // w7lxMS7l|ud=0,g=0.z
-            let d75 = A::mul_add(
-                -k65,
-                d73,
-                A::mul_add(
-                    k64,
-                    d74,
-                    A::mul_add(p.MY7l, k68, A::mul_add(-p.MZ7l, k67, p.m7l * k63)),
-                ),
-            ); // F7l|ud=0,g=0.x
-            let d76 = A::mul_add(
-                k66,
-                d74,
-                A::mul_add(
-                    -k65,
-                    d72,
-                    A::mul_add(p.MZ7l, k56, A::mul_add(p.MX7l, k68, p.m7l * k69)),
-                ),
-            ); // F7l|ud=0,g=0.y
-            let d77 = A::mul_add(
-                k64,
-                d72,
-                A::mul_add(
-                    -k66,
-                    d73,
-                    A::mul_add(-p.MX7l, k67, A::mul_add(-p.MY7l, k56, p.m7l * k70)),
-                ),
-            ); // F7l|ud=0,g=0.z
-            let d78 = A::mul_add(p.XZ7l, k65, A::mul_add(p.XY7l, k64, p.XX7l * k66)); // J7lw7l|ud=0,g=0.x
-            let d79 = A::mul_add(p.YZ7l, k65, A::mul_add(p.YY7l, k64, p.XY7l * k66)); // J7lw7l|ud=0,g=0.y
-            let d80 = A::mul_add(p.ZZ7l, k65, A::mul_add(p.YZ7l, k64, p.XZ7l * k66)); // J7lw7l|ud=0,g=0.z
-            let d81 = A::mul_add(
-                p.MZ7l,
-                k69,
-                A::mul_add(
-                    -p.MY7l,
-                    k70,
-                    A::mul_add(
-                        -k65,
-                        d79,
-                        A::mul_add(
-                            k64,
-                            d80,
-                            A::mul_add(
-                                -p.XZ7l,
-                                k68,
-                                A::mul_add(-p.XY7l, k67, p.XX7l * k56),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N7l|ud=0,g=0.x
-            let d82 = A::mul_add(
-                p.MX7l,
-                k70,
-                A::mul_add(
-                    p.MZ7l,
-                    k63,
-                    A::mul_add(
-                        -k66,
-                        d80,
-                        A::mul_add(
-                            k65,
-                            d78,
-                            A::mul_add(
-                                -p.YZ7l,
-                                k68,
-                                A::mul_add(-p.YY7l, k67, p.XY7l * k56),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N7l|ud=0,g=0.y
-            let d83 = A::mul_add(
-                -p.MY7l,
-                k63,
-                A::mul_add(
-                    -p.MX7l,
-                    k69,
-                    A::mul_add(
-                        -k64,
-                        d78,
-                        A::mul_add(
-                            k66,
-                            d79,
-                            A::mul_add(
-                                -p.ZZ7l,
-                                k68,
-                                A::mul_add(-p.YZ7l, k67, p.XZ7l * k56),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N7l|ud=0,g=0.z
-            let k71 = A::mul_add(-s_q5l, k65, c_q5l * k66); // w7l in 8l|ud=0,g=0.x
-            let k72 = A::mul_add(c_q5l, k65, s_q5l * k66); // w7l in 8l|ud=0,g=0.z
-            let k73 = k64 - qd5l; // w8l|ud=0,g=0.y
-            let k74 = A::mul_add(-k71, qd5l, A::mul_add(-c_q5l, k68, s_q5l * k56)); // wd8l|ud=0,g=0.z
-            let k75 = A::mul_add(k72, qd5l, A::mul_add(s_q5l, k68, c_q5l * k56)); // wd8l|ud=0,g=0.x
-            let k76 = p.L8 * k65; // w7lxP8l|ud=0,g=0.x
-            let k77 = p.L8 * k66; // w7lxP8l|ud=0,g=0.z
-            let k78 = A::mul_add(-k64, k77, A::mul_add(-p.L8, k68, k63)); // a8l in 7l|ud=0,g=0.x
-            let k79 = A::mul_add(-k66, k77, A::mul_add(-k65, k76, k69)); // a8l in 7l|ud=0,g=0.y
-            let k80 = A::mul_add(k64, k76, A::mul_add(p.L8, k56, k70)); // a8l in 7l|ud=0,g=0.z
-            let k81 = A::mul_add(-c_q5l, k80, s_q5l * k78); // a8l|ud=0,g=0.z
-            let k82 = A::mul_add(s_q5l, k80, c_q5l * k78); // a8l|ud=0,g=0.x
-            let d84 = A::mul_add(p.MY8l, k72, p.MZ8l * k73); // w8lxMS8l|ud=0,g=0.x
-            let d85 = A::mul_add(-p.MX8l, k73, p.MY8l * k71); // w8lxMS8l|ud=0,g=0.z
-            let d86 = A::mul_add(p.MZ8l, k71, p.MX8l * k72); // w8lxMS8l|ud=0,g=0.y
-            let d87 = A::mul_add(
-                -k71,
-                d85,
-                A::mul_add(
-                    -k72,
-                    d84,
-                    A::mul_add(p.MZ8l, k75, A::mul_add(p.MX8l, k74, p.m8l * k79)),
-                ),
-            ); // F8l|ud=0,g=0.y
-            let d88 = A::mul_add(
-                -k73,
-                d84,
-                A::mul_add(
-                    -k71,
-                    d86,
-                    A::mul_add(-p.MX8l, k67, A::mul_add(-p.MY8l, k75, p.m8l * k81)),
-                ),
-            ); // F8l|ud=0,g=0.z
-            let d89 = A::mul_add(
-                k72,
-                d86,
-                A::mul_add(
-                    -k73,
-                    d85,
-                    A::mul_add(p.MY8l, k74, A::mul_add(-p.MZ8l, k67, p.m8l * k82)),
-                ),
-            ); // F8l|ud=0,g=0.x
-            let d90 = A::mul_add(-p.XZ8l, k72, A::mul_add(p.XY8l, k73, p.XX8l * k71)); // J8lw8l|ud=0,g=0.x
-            let d91 = A::mul_add(-p.YZ8l, k72, A::mul_add(p.YY8l, k73, p.XY8l * k71)); // J8lw8l|ud=0,g=0.y
-            let d92 = A::mul_add(-p.ZZ8l, k72, A::mul_add(p.YZ8l, k73, p.XZ8l * k71)); // J8lw8l|ud=0,g=0.z
-            let d93 = A::mul_add(
-                p.MZ8l,
-                k79,
-                A::mul_add(
-                    -p.MY8l,
-                    k81,
-                    A::mul_add(
-                        -k72,
-                        d91,
-                        A::mul_add(
-                            -k73,
-                            d92,
-                            A::mul_add(
-                                -p.XZ8l,
-                                k74,
-                                A::mul_add(-p.XY8l, k67, p.XX8l * k75),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N8l|ud=0,g=0.x
-            let d94 = A::mul_add(
-                p.MX8l,
-                k81,
-                A::mul_add(
-                    p.MZ8l,
-                    k82,
-                    A::mul_add(
-                        k71,
-                        d92,
-                        A::mul_add(
-                            k72,
-                            d90,
-                            A::mul_add(
-                                -p.YZ8l,
-                                k74,
-                                A::mul_add(-p.YY8l, k67, p.XY8l * k75),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N8l|ud=0,g=0.y
-            let d95 = A::mul_add(
-                -p.MY8l,
-                k82,
-                A::mul_add(
-                    -p.MX8l,
-                    k79,
-                    A::mul_add(
-                        k73,
-                        d90,
-                        A::mul_add(
-                            -k71,
-                            d91,
-                            A::mul_add(
-                                -p.ZZ8l,
-                                k74,
-                                A::mul_add(-p.YZ8l, k67, p.XZ8l * k75),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N8l|ud=0,g=0.z
-            let k83 = A::mul_add(-s_q6l, k72, c_q6l * k73); // w8l in 9l|ud=0,g=0.y
-            let k84 = A::mul_add(c_q6l, k72, s_q6l * k73); // w8l in 9l|ud=0,g=0.z
-            let k85 = k71 + qd6l; // w9l|ud=0,g=0.x
-            let k86 = A::mul_add(-k84, qd6l, A::mul_add(s_q6l, k74, c_q6l * k67)); // wd9l|ud=0,g=0.y
-            let k87 = A::mul_add(k83, qd6l, A::mul_add(-c_q6l, k74, s_q6l * k67)); // wd9l|ud=0,g=0.z
-            let k88 = A::mul_add(s_q6l, k81, c_q6l * k79); // a9l|ud=0,g=0.y
-            let k89 = A::mul_add(-c_q6l, k81, s_q6l * k79); // a9l|ud=0,g=0.z
-            let d96 = A::mul_add(-p.MY9l, k84, p.MZ9l * k83); // w9lxMS9l|ud=0,g=0.x
-            let d97 = A::mul_add(-p.MZ9l, k85, p.MX9l * k84); // w9lxMS9l|ud=0,g=0.y
-            let d98 = A::mul_add(-p.MX9l, k83, p.MY9l * k85); // w9lxMS9l|ud=0,g=0.z
-            let d99 = A::mul_add(
-                -k84,
-                d97,
-                A::mul_add(
-                    k83,
-                    d98,
-                    A::mul_add(p.MY9l, k87, A::mul_add(-p.MZ9l, k86, p.m9l * k82)),
-                ),
-            ); // F9l|ud=0,g=0.x
-            let d100 = A::mul_add(
-                k85,
-                d98,
-                A::mul_add(
-                    -k84,
-                    d96,
-                    A::mul_add(p.MZ9l, k75, A::mul_add(p.MX9l, k87, p.m9l * k88)),
-                ),
-            ); // F9l|ud=0,g=0.y
-            let d101 = A::mul_add(
-                k83,
-                d96,
-                A::mul_add(
-                    -k85,
-                    d97,
-                    A::mul_add(-p.MX9l, k86, A::mul_add(-p.MY9l, k75, p.m9l * k89)),
-                ),
-            ); // F9l|ud=0,g=0.z
-            let d102 = A::mul_add(p.XZ9l, k84, A::mul_add(p.XY9l, k83, p.XX9l * k85)); // J9lw9l|ud=0,g=0.x
-            let d103 = A::mul_add(p.YZ9l, k84, A::mul_add(p.YY9l, k83, p.XY9l * k85)); // J9lw9l|ud=0,g=0.y
-            let d104 = A::mul_add(p.ZZ9l, k84, A::mul_add(p.YZ9l, k83, p.XZ9l * k85)); // J9lw9l|ud=0,g=0.z
-            let d105 = A::mul_add(
-                p.MZ9l,
-                k88,
-                A::mul_add(
-                    -p.MY9l,
-                    k89,
-                    A::mul_add(
-                        -k84,
-                        d103,
-                        A::mul_add(
-                            k83,
-                            d104,
-                            A::mul_add(
-                                -p.XZ9l,
-                                k87,
-                                A::mul_add(-p.XY9l, k86, p.XX9l * k75),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N9l|ud=0,g=0.x
-            let d106 = A::mul_add(
-                p.MX9l,
-                k89,
-                A::mul_add(
-                    p.MZ9l,
-                    k82,
-                    A::mul_add(
-                        -k85,
-                        d104,
-                        A::mul_add(
-                            k84,
-                            d102,
-                            A::mul_add(
-                                -p.YZ9l,
-                                k87,
-                                A::mul_add(-p.YY9l, k86, p.XY9l * k75),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N9l|ud=0,g=0.y
-            let d107 = A::mul_add(
-                -p.MY9l,
-                k82,
-                A::mul_add(
-                    -p.MX9l,
-                    k88,
-                    A::mul_add(
-                        -k83,
-                        d102,
-                        A::mul_add(
-                            k85,
-                            d103,
-                            A::mul_add(
-                                -p.ZZ9l,
-                                k87,
-                                A::mul_add(-p.YZ9l, k86, p.XZ9l * k75),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N9l|ud=0,g=0.z
-            let k90 = A::mul_add(-s_q7l, k84, c_q7l * k85); // w9l in 10l|ud=0,g=0.x
-            let k91 = A::mul_add(c_q7l, k84, s_q7l * k85); // w9l in 10l|ud=0,g=0.y
-            let k92 = k83 - qd7l; // w10l|ud=0,g=0.z
-            let k93 = A::mul_add(k91, qd7l, A::mul_add(s_q7l, k87, c_q7l * k75)); // wd10l|ud=0,g=0.x
-            let k94 = A::mul_add(-k90, qd7l, A::mul_add(-c_q7l, k87, s_q7l * k75)); // wd10l|ud=0,g=0.y
-            let k95 = p.L9 * k84; // w9lxP10l|ud=0,g=0.x
-            let k96 = p.L9 * k85; // w9lxP10l|ud=0,g=0.z
-            let k97 = A::mul_add(-k83, k96, A::mul_add(-p.L9, k87, k82)); // a10l in 9l|ud=0,g=0.x
-            let k98 = A::mul_add(-k85, k96, A::mul_add(-k84, k95, k88)); // a10l in 9l|ud=0,g=0.y
-            let k99 = A::mul_add(k83, k95, A::mul_add(p.L9, k75, k89)); // a10l in 9l|ud=0,g=0.z
-            let k100 = A::mul_add(s_q7l, k99, c_q7l * k97); // a10l|ud=0,g=0.x
-            let k101 = A::mul_add(-c_q7l, k99, s_q7l * k97); // a10l|ud=0,g=0.y
-            let d108 = A::mul_add(-p.MY10l, k92, p.MZ10l * k91); // w10lxMS10l|ud=0,g=0.x
-            let d109 = A::mul_add(-p.MZ10l, k90, p.MX10l * k92); // w10lxMS10l|ud=0,g=0.y
-            let d110 = A::mul_add(-p.MX10l, k91, p.MY10l * k90); // w10lxMS10l|ud=0,g=0.z
-            let d111 = A::mul_add(
-                -k91,
-                d108,
-                A::mul_add(
-                    k90,
-                    d109,
-                    A::mul_add(p.MX10l, k94, A::mul_add(-p.MY10l, k93, p.m10l * k98)),
-                ),
-            ); // F10l|ud=0,g=0.z
-            let d112 = A::mul_add(
-                k92,
-                d109,
-                A::mul_add(
-                    -k91,
-                    d110,
-                    A::mul_add(p.MY10l, k86, A::mul_add(p.MZ10l, k94, p.m10l * k100)),
-                ),
-            ); // F10l|ud=0,g=0.x
-            let d113 = A::mul_add(
-                k90,
-                d110,
-                A::mul_add(
-                    -k92,
-                    d108,
-                    A::mul_add(-p.MZ10l, k93, A::mul_add(-p.MX10l, k86, p.m10l * k101)),
-                ),
-            ); // F10l|ud=0,g=0.y
-            let d114 = A::mul_add(p.XZ10l, k92, A::mul_add(p.XY10l, k91, p.XX10l * k90)); // J10lw10l|ud=0,g=0.x
-            let d115 = A::mul_add(p.YZ10l, k92, A::mul_add(p.YY10l, k91, p.XY10l * k90)); // J10lw10l|ud=0,g=0.y
-            let d116 = A::mul_add(p.ZZ10l, k92, A::mul_add(p.YZ10l, k91, p.XZ10l * k90)); // J10lw10l|ud=0,g=0.z
-            let d117 = A::mul_add(
-                -p.MZ10l,
-                k101,
-                A::mul_add(
-                    -p.MY10l,
-                    k98,
-                    A::mul_add(
-                        k92,
-                        d115,
-                        A::mul_add(
-                            -k91,
-                            d116,
-                            A::mul_add(
-                                -p.XZ10l,
-                                k86,
-                                A::mul_add(p.XY10l, k94, p.XX10l * k93),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N10l|ud=0,g=0.x
-            let d118 = A::mul_add(
-                p.MX10l,
-                k98,
-                A::mul_add(
-                    p.MZ10l,
-                    k100,
-                    A::mul_add(
-                        k90,
-                        d116,
-                        A::mul_add(
-                            -k92,
-                            d114,
-                            A::mul_add(
-                                -p.YZ10l,
-                                k86,
-                                A::mul_add(p.YY10l, k94, p.XY10l * k93),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N10l|ud=0,g=0.y
-            let d119 = A::mul_add(
-                -p.MY10l,
-                k100,
-                A::mul_add(
-                    p.MX10l,
-                    k101,
-                    A::mul_add(
-                        k91,
-                        d114,
-                        A::mul_add(
-                            -k90,
-                            d115,
-                            A::mul_add(
-                                -p.ZZ10l,
-                                k86,
-                                A::mul_add(p.YZ10l, k94, p.XZ10l * k93),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N10l|ud=0,g=0.z
-            out[11] = core::hint::black_box(d119);
-            let k102 = A::mul_add(-s_q1r, k20, c_q1r * k21); // w3 in 4r|ud=0,g=0.x
-            let k103 = A::mul_add(c_q1r, k20, s_q1r * k21); // w3 in 4r|ud=0,g=0.z
-            let k104 = A::mul_add(-k102, qd1r, A::mul_add(c_q1r, k23, s_q1r * k9)); // wd4r|ud=0,g=0.z
-            let k105 = k19 + qd1r; // w4r|ud=0,g=0.y
-            let k106 = A::mul_add(k103, qd1r, A::mul_add(-s_q1r, k23, c_q1r * k9)); // wd4r|ud=0,g=0.x
-            let k107 = t1 + t2; // w3xP4r|ud=0,g=0.z
-            let k108 = A::mul_add(k21, k107, k30 - t3 + t7); // a4r in 3|ud=0,g=0.x
-            let k109 = A::mul_add(k19, k107, k28 + t4 + t8); // a4r in 3|ud=0,g=0.y
-            let k110 = k31 - t5 + t6 - t9 + t10; // a4r in 3|ud=0,g=0.z
-            let k111 = A::mul_add(-c_q1r, k110, s_q1r * k109); // a4r|ud=0,g=0.z
-            let k112 = A::mul_add(s_q1r, k110, c_q1r * k109); // a4r|ud=0,g=0.x
-            let d120 = A::mul_add(p.MX4r, k105, p.MY4r * k102); // w4rxMS4r|ud=0,g=0.z
-            let d121 = A::mul_add(-p.MY4r, k103, p.MZ4r * k105); // w4rxMS4r|ud=0,g=0.x
-            let d122 = A::mul_add(p.MZ4r, k102, p.MX4r * k103); // w4rxMS4r|ud=0,g=0.y
-            let d123 = A::mul_add(
-                -k105,
-                d121,
-                A::mul_add(
-                    -k102,
-                    d122,
-                    A::mul_add(p.MX4r, k22, A::mul_add(-p.MY4r, k106, p.m4r * k111)),
-                ),
-            ); // F4r|ud=0,g=0.z
-            let d124 = A::mul_add(
-                k103,
-                d122,
-                A::mul_add(
-                    k105,
-                    d120,
-                    A::mul_add(p.MY4r, k104, A::mul_add(p.MZ4r, k22, p.m4r * k112)),
-                ),
-            ); // F4r|ud=0,g=0.x
-            let d125 = A::mul_add(
-                k102,
-                d120,
-                A::mul_add(
-                    -k103,
-                    d121,
-                    A::mul_add(-p.MZ4r, k106, A::mul_add(-p.MX4r, k104, p.m4r * k108)),
-                ),
-            ); // F4r|ud=0,g=0.y
-            let d126 = A::mul_add(
-                -p.XZ4r,
-                k103,
-                A::mul_add(-p.XY4r, k105, p.XX4r * k102),
-            ); // J4rw4r|ud=0,g=0.x
-            let d127 = A::mul_add(
-                -p.YZ4r,
-                k103,
-                A::mul_add(-p.YY4r, k105, p.XY4r * k102),
-            ); // J4rw4r|ud=0,g=0.y
-            let d128 = A::mul_add(
-                -p.ZZ4r,
-                k103,
-                A::mul_add(-p.YZ4r, k105, p.XZ4r * k102),
-            ); // J4rw4r|ud=0,g=0.z
             let d129 = A::mul_add(
                 -p.MZ4r,
                 k108,
@@ -4661,7 +4655,7 @@ mod generated {
                         -k103,
                         d127,
                         A::mul_add(
-                            k105,
+                            -k105,
                             d128,
                             A::mul_add(
                                 -p.XZ4r,
@@ -4672,6 +4666,7 @@ mod generated {
                     ),
                 ),
             ); // N4r|ud=0,g=0.x
+            let d45_d129 = F64x2::new(d45, d129);
             let d130 = A::mul_add(
                 p.MX4r,
                 k111,
@@ -4693,6 +4688,7 @@ mod generated {
                     ),
                 ),
             ); // N4r|ud=0,g=0.y
+            let d46_d130 = F64x2::new(d46, d130);
             let d131 = A::mul_add(
                 -p.MY4r,
                 k112,
@@ -4700,7 +4696,7 @@ mod generated {
                     p.MX4r,
                     k108,
                     A::mul_add(
-                        -k105,
+                        k105,
                         d126,
                         A::mul_add(
                             -k102,
@@ -4714,801 +4710,1806 @@ mod generated {
                     ),
                 ),
             ); // N4r|ud=0,g=0.z
-            let k113 = A::mul_add(s_q2r, k103, c_q2r * k105); // w4r in 5r|ud=0,g=0.y
-            let k114 = A::mul_add(-c_q2r, k103, s_q2r * k105); // w4r in 5r|ud=0,g=0.z
-            let k115 = A::mul_add(-k114, qd2r, A::mul_add(-s_q2r, k104, c_q2r * k22)); // wd5r|ud=0,g=0.y
-            let k116 = A::mul_add(k113, qd2r, A::mul_add(c_q2r, k104, s_q2r * k22)); // wd5r|ud=0,g=0.z
-            let k117 = k102 + qd2r; // w5r|ud=0,g=0.x
-            let k118 = A::mul_add(-s_q2r, k111, c_q2r * k108); // a5r|ud=0,g=0.y
-            let k119 = A::mul_add(c_q2r, k111, s_q2r * k108); // a5r|ud=0,g=0.z
-            let d132 = A::mul_add(-p.MY5r, k114, p.MZ5r * k113); // w5rxMS5r|ud=0,g=0.x
-            let d133 = A::mul_add(p.MZ5r, k117, p.MX5r * k114); // w5rxMS5r|ud=0,g=0.y
-            let d134 = A::mul_add(p.MX5r, k113, p.MY5r * k117); // w5rxMS5r|ud=0,g=0.z
-            let d135 = A::mul_add(
-                -k114,
-                d133,
-                A::mul_add(
-                    -k113,
-                    d134,
-                    A::mul_add(-p.MY5r, k116, A::mul_add(p.MZ5r, k115, p.m5r * k112)),
-                ),
-            ); // F5r|ud=0,g=0.x
-            let d136 = A::mul_add(
-                -k117,
-                d134,
-                A::mul_add(
-                    k114,
-                    d132,
-                    A::mul_add(-p.MZ5r, k106, A::mul_add(p.MX5r, k116, p.m5r * k118)),
-                ),
-            ); // F5r|ud=0,g=0.y
-            let d137 = A::mul_add(
-                -k113,
-                d132,
-                A::mul_add(
-                    -k117,
-                    d133,
-                    A::mul_add(-p.MX5r, k115, A::mul_add(p.MY5r, k106, p.m5r * k119)),
-                ),
-            ); // F5r|ud=0,g=0.z
-            let d138 = A::mul_add(
-                -p.XZ5r,
-                k114,
-                A::mul_add(-p.XY5r, k113, p.XX5r * k117),
-            ); // J5rw5r|ud=0,g=0.x
-            let d139 = A::mul_add(
-                -p.YZ5r,
-                k114,
-                A::mul_add(-p.YY5r, k113, p.XY5r * k117),
-            ); // J5rw5r|ud=0,g=0.y
-            let d140 = A::mul_add(
-                -p.ZZ5r,
-                k114,
-                A::mul_add(-p.YZ5r, k113, p.XZ5r * k117),
-            ); // J5rw5r|ud=0,g=0.z
-            let d141 = A::mul_add(
-                -p.MZ5r,
-                k118,
-                A::mul_add(
-                    p.MY5r,
-                    k119,
-                    A::mul_add(
-                        k114,
-                        d139,
-                        A::mul_add(
-                            -k113,
-                            d140,
-                            A::mul_add(
-                                p.XZ5r,
-                                k116,
-                                A::mul_add(p.XY5r, k115, p.XX5r * k106),
-                            ),
+            let d47_d131 = F64x2::new(d47, d131);
+            let k45_k113 = lanes
+                .mul_add(
+                    -F64x2::new(s_q2l, s_q2r),
+                    k33_k103,
+                    F64x2::new(c_q2l, c_q2r) * k34_k105,
+                ); // w4l in 5l|ud=0,g=0.y | w4r in 5r|ud=0,g=0.y
+            let k45 = k45_k113.lo();
+            let k113 = k45_k113.hi();
+            let k49 = A::mul_add(k45, qd2l, A::mul_add(-c_q2l, k35, s_q2l * k22)); // wd5l|ud=0,g=0.z
+            let k46_k114 = lanes
+                .mul_add(
+                    F64x2::new(c_q2l, c_q2r),
+                    k33_k103,
+                    F64x2::new(s_q2l, s_q2r) * k34_k105,
+                ); // w4l in 5l|ud=0,g=0.z | w4r in 5r|ud=0,g=0.z
+            let k46 = k46_k114.lo();
+            let k114 = k46_k114.hi();
+            let k48 = A::mul_add(-k46, qd2l, A::mul_add(s_q2l, k35, c_q2l * k22)); // wd5l|ud=0,g=0.y
+            let k115 = A::mul_add(-k114, qd2r, A::mul_add(-c_q2r, k22, s_q2r * k104)); // wd5r|ud=0,g=0.y
+            let k48_k115 = F64x2::new(k48, k115);
+            let k116 = A::mul_add(-c_q2r, k104, A::mul_add(-s_q2r, k22, k113 * qd2r)); // wd5r|ud=0,g=0.z
+            let k49_k116 = F64x2::new(k49, k116);
+            let k47_k117 = k32_k102 + F64x2::new(qd2l, qd2r); // w5l|ud=0,g=0.x | w5r|ud=0,g=0.x
+            let k118 = A::mul_add(-c_q2r, k108, s_q2r * k111); // a5r|ud=0,g=0.y
+            let k50_k118 = F64x2::new(k50, k118);
+            let k119 = A::mul_add(-c_q2r, k111, -s_q2r * k108); // a5r|ud=0,g=0.z
+            let k51_k119 = F64x2::new(k51, k119);
+            let d48_d132 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY5l, p.MY5r),
+                    k46_k114,
+                    F64x2::new(p.MZ5l, p.MZ5r) * k45_k113,
+                ); // w5lxMS5l|ud=0,g=0.x | w5rxMS5r|ud=0,g=0.x
+            let d49_d133 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ5l, p.MZ5r),
+                    k47_k117,
+                    F64x2::new(p.MX5l, p.MX5r) * k46_k114,
+                ); // w5lxMS5l|ud=0,g=0.y | w5rxMS5r|ud=0,g=0.y
+            let d50_d134 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX5l, p.MX5r),
+                    k45_k113,
+                    F64x2::new(p.MY5l, p.MY5r) * k47_k117,
+                ); // w5lxMS5l|ud=0,g=0.z | w5rxMS5r|ud=0,g=0.z
+            let d51_d135 = lanes
+                .mul_add(
+                    -k46_k114,
+                    d49_d133,
+                    lanes
+                        .mul_add(
+                            k45_k113,
+                            d50_d134,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.MY5l, p.MY5r),
+                                    k49_k116,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.MZ5l, p.MZ5r),
+                                            k48_k115,
+                                            F64x2::new(p.m5l, p.m5r) * k44_k112,
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N5r|ud=0,g=0.x
-            let d142 = A::mul_add(
-                -p.MX5r,
-                k119,
-                A::mul_add(
-                    p.MZ5r,
-                    k112,
-                    A::mul_add(
-                        -k117,
-                        d140,
-                        A::mul_add(
-                            -k114,
-                            d138,
-                            A::mul_add(
-                                p.YZ5r,
-                                k116,
-                                A::mul_add(p.YY5r, k115, p.XY5r * k106),
-                            ),
+                ); // F5l|ud=0,g=0.x | F5r|ud=0,g=0.x
+            let d52_d136 = lanes
+                .mul_add(
+                    k47_k117,
+                    d50_d134,
+                    lanes
+                        .mul_add(
+                            -k46_k114,
+                            d48_d132,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.MZ5l, p.MZ5r),
+                                    k36_k106,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.MX5l, p.MX5r),
+                                            k49_k116,
+                                            F64x2::new(p.m5l, p.m5r) * k50_k118,
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N5r|ud=0,g=0.y
-            let d143 = A::mul_add(
-                -p.MY5r,
-                k112,
-                A::mul_add(
-                    p.MX5r,
-                    k118,
-                    A::mul_add(
-                        k113,
-                        d138,
-                        A::mul_add(
-                            k117,
-                            d139,
-                            A::mul_add(
-                                p.ZZ5r,
-                                k116,
-                                A::mul_add(p.YZ5r, k115, p.XZ5r * k106),
-                            ),
+                ); // F5l|ud=0,g=0.y | F5r|ud=0,g=0.y
+            let d53_d137 = lanes
+                .mul_add(
+                    k45_k113,
+                    d48_d132,
+                    lanes
+                        .mul_add(
+                            -k47_k117,
+                            d49_d133,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.MX5l, p.MX5r),
+                                    k48_k115,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.MY5l, p.MY5r),
+                                            k36_k106,
+                                            F64x2::new(p.m5l, p.m5r) * k51_k119,
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N5r|ud=0,g=0.z
-            let k120 = A::mul_add(s_q3r, k114, c_q3r * k117); // w5r in 6r|ud=0,g=0.x
-            let k121 = A::mul_add(-c_q3r, k114, s_q3r * k117); // w5r in 6r|ud=0,g=0.z
-            let k122 = A::mul_add(-k120, qd3r, A::mul_add(c_q3r, k116, s_q3r * k106)); // wd6r|ud=0,g=0.z
-            let k123 = k113 + qd3r; // w6r|ud=0,g=0.y
-            let k124 = A::mul_add(k121, qd3r, A::mul_add(-s_q3r, k116, c_q3r * k106)); // wd6r|ud=0,g=0.x
-            let k125 = p.L7 * k114; // w5rxP6r|ud=0,g=0.x
-            let k126 = p.L7 * k117; // w5rxP6r|ud=0,g=0.z
-            let k127 = A::mul_add(k113, k126, A::mul_add(p.L7, k116, k112)); // a6r in 5r|ud=0,g=0.x
-            let k128 = A::mul_add(k117, k126, A::mul_add(k114, k125, k118)); // a6r in 5r|ud=0,g=0.y
-            let k129 = A::mul_add(-k113, k125, A::mul_add(-p.L7, k106, k119)); // a6r in 5r|ud=0,g=0.z
-            let k130 = A::mul_add(c_q3r, k129, s_q3r * k127); // a6r|ud=0,g=0.z
-            let k131 = A::mul_add(-s_q3r, k129, c_q3r * k127); // a6r|ud=0,g=0.x
-            let d144 = A::mul_add(p.MX6r, k123, p.MY6r * k120); // w6rxMS6r|ud=0,g=0.z
-            let d145 = A::mul_add(-p.MY6r, k121, p.MZ6r * k123); // w6rxMS6r|ud=0,g=0.x
-            let d146 = A::mul_add(p.MZ6r, k120, p.MX6r * k121); // w6rxMS6r|ud=0,g=0.y
-            let d147 = A::mul_add(
-                -k123,
-                d145,
-                A::mul_add(
-                    -k120,
-                    d146,
-                    A::mul_add(p.MX6r, k115, A::mul_add(-p.MY6r, k124, p.m6r * k130)),
-                ),
-            ); // F6r|ud=0,g=0.z
-            let d148 = A::mul_add(
-                k121,
-                d146,
-                A::mul_add(
-                    k123,
-                    d144,
-                    A::mul_add(p.MY6r, k122, A::mul_add(p.MZ6r, k115, p.m6r * k131)),
-                ),
-            ); // F6r|ud=0,g=0.x
-            let d149 = A::mul_add(
-                k120,
-                d144,
-                A::mul_add(
-                    -k121,
-                    d145,
-                    A::mul_add(-p.MZ6r, k124, A::mul_add(-p.MX6r, k122, p.m6r * k128)),
-                ),
-            ); // F6r|ud=0,g=0.y
-            let d150 = A::mul_add(
-                -p.XZ6r,
-                k121,
-                A::mul_add(-p.XY6r, k123, p.XX6r * k120),
-            ); // J6rw6r|ud=0,g=0.x
-            let d151 = A::mul_add(
-                -p.YZ6r,
-                k121,
-                A::mul_add(-p.YY6r, k123, p.XY6r * k120),
-            ); // J6rw6r|ud=0,g=0.y
-            let d152 = A::mul_add(
-                -p.ZZ6r,
-                k121,
-                A::mul_add(-p.YZ6r, k123, p.XZ6r * k120),
-            ); // J6rw6r|ud=0,g=0.z
-            let d153 = A::mul_add(
-                -p.MZ6r,
-                k128,
-                A::mul_add(
-                    -p.MY6r,
-                    k130,
-                    A::mul_add(
-                        -k121,
-                        d151,
-                        A::mul_add(
-                            k123,
-                            d152,
-                            A::mul_add(
-                                -p.XZ6r,
-                                k122,
-                                A::mul_add(p.XY6r, k115, p.XX6r * k124),
-                            ),
+                ); // F5l|ud=0,g=0.z | F5r|ud=0,g=0.z
+            let d54_d138 = lanes
+                .mul_add(
+                    F64x2::new(p.XZ5l, p.XZ5r),
+                    k46_k114,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY5l, p.XY5r),
+                            k45_k113,
+                            F64x2::new(p.XX5l, p.XX5r) * k47_k117,
                         ),
-                    ),
-                ),
-            ); // N6r|ud=0,g=0.x
-            let d154 = A::mul_add(
-                p.MX6r,
-                k130,
-                A::mul_add(
-                    p.MZ6r,
-                    k131,
-                    A::mul_add(
-                        k120,
-                        d152,
-                        A::mul_add(
-                            k121,
-                            d150,
-                            A::mul_add(
-                                -p.YZ6r,
-                                k122,
-                                A::mul_add(p.YY6r, k115, p.XY6r * k124),
-                            ),
+                ); // J5lw5l|ud=0,g=0.x | J5rw5r|ud=0,g=0.x
+            let d55_d139 = lanes
+                .mul_add(
+                    F64x2::new(p.YZ5l, p.YZ5r),
+                    k46_k114,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY5l, p.YY5r),
+                            k45_k113,
+                            F64x2::new(p.XY5l, p.XY5r) * k47_k117,
                         ),
-                    ),
-                ),
-            ); // N6r|ud=0,g=0.y
-            let d155 = A::mul_add(
-                -p.MY6r,
-                k131,
-                A::mul_add(
-                    p.MX6r,
-                    k128,
-                    A::mul_add(
-                        -k123,
-                        d150,
-                        A::mul_add(
-                            -k120,
-                            d151,
-                            A::mul_add(
-                                -p.ZZ6r,
-                                k122,
-                                A::mul_add(p.YZ6r, k115, p.XZ6r * k124),
-                            ),
+                ); // J5lw5l|ud=0,g=0.y | J5rw5r|ud=0,g=0.y
+            let d56_d140 = lanes
+                .mul_add(
+                    F64x2::new(p.ZZ5l, p.ZZ5r),
+                    k46_k114,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ5l, p.YZ5r),
+                            k45_k113,
+                            F64x2::new(p.XZ5l, p.XZ5r) * k47_k117,
                         ),
-                    ),
-                ),
-            ); // N6r|ud=0,g=0.z
-            let k132 = A::mul_add(s_q4r, k121, c_q4r * k123); // w6r in 7r|ud=0,g=0.y
-            let k133 = A::mul_add(-c_q4r, k121, s_q4r * k123); // w6r in 7r|ud=0,g=0.z
-            let k134 = A::mul_add(-k133, qd4r, A::mul_add(-s_q4r, k122, c_q4r * k115)); // wd7r|ud=0,g=0.y
-            let k135 = A::mul_add(k132, qd4r, A::mul_add(c_q4r, k122, s_q4r * k115)); // wd7r|ud=0,g=0.z
-            let k136 = k120 + qd4r; // w7r|ud=0,g=0.x
-            let k137 = A::mul_add(-s_q4r, k130, c_q4r * k128); // a7r|ud=0,g=0.y
-            let k138 = A::mul_add(c_q4r, k130, s_q4r * k128); // a7r|ud=0,g=0.z
-            let d156 = A::mul_add(-p.MY7r, k133, p.MZ7r * k132); // w7rxMS7r|ud=0,g=0.x
-            let d157 = A::mul_add(p.MZ7r, k136, p.MX7r * k133); // w7rxMS7r|ud=0,g=0.y
-            let d158 = A::mul_add(p.MX7r, k132, p.MY7r * k136); // w7rxMS7r|ud=0,g=0.z
-            let d159 = A::mul_add(
-                -k133,
-                d157,
-                A::mul_add(
-                    -k132,
-                    d158,
-                    A::mul_add(-p.MY7r, k135, A::mul_add(p.MZ7r, k134, p.m7r * k131)),
-                ),
-            ); // F7r|ud=0,g=0.x
-            let d160 = A::mul_add(
-                -k136,
-                d158,
-                A::mul_add(
-                    k133,
-                    d156,
-                    A::mul_add(-p.MZ7r, k124, A::mul_add(p.MX7r, k135, p.m7r * k137)),
-                ),
-            ); // F7r|ud=0,g=0.y
-            let d161 = A::mul_add(
-                -k132,
-                d156,
-                A::mul_add(
-                    -k136,
-                    d157,
-                    A::mul_add(-p.MX7r, k134, A::mul_add(p.MY7r, k124, p.m7r * k138)),
-                ),
-            ); // F7r|ud=0,g=0.z
-            let d162 = A::mul_add(
-                -p.XZ7r,
-                k133,
-                A::mul_add(-p.XY7r, k132, p.XX7r * k136),
-            ); // J7rw7r|ud=0,g=0.x
-            let d163 = A::mul_add(
-                -p.YZ7r,
-                k133,
-                A::mul_add(-p.YY7r, k132, p.XY7r * k136),
-            ); // J7rw7r|ud=0,g=0.y
-            let d164 = A::mul_add(
-                -p.ZZ7r,
-                k133,
-                A::mul_add(-p.YZ7r, k132, p.XZ7r * k136),
-            ); // J7rw7r|ud=0,g=0.z
-            let d165 = A::mul_add(
-                -p.MZ7r,
-                k137,
-                A::mul_add(
-                    p.MY7r,
-                    k138,
-                    A::mul_add(
-                        k133,
-                        d163,
-                        A::mul_add(
-                            -k132,
-                            d164,
-                            A::mul_add(
-                                p.XZ7r,
-                                k135,
-                                A::mul_add(p.XY7r, k134, p.XX7r * k124),
-                            ),
+                ); // J5lw5l|ud=0,g=0.z | J5rw5r|ud=0,g=0.z
+            let d57_d141 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ5l, p.MZ5r),
+                    k50_k118,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MY5l, p.MY5r),
+                            k51_k119,
+                            lanes
+                                .mul_add(
+                                    -k46_k114,
+                                    d55_d139,
+                                    lanes
+                                        .mul_add(
+                                            k45_k113,
+                                            d56_d140,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XZ5l, p.XZ5r),
+                                                    k49_k116,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.XY5l, p.XY5r),
+                                                            k48_k115,
+                                                            F64x2::new(p.XX5l, p.XX5r) * k36_k106,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N7r|ud=0,g=0.x
-            let d166 = A::mul_add(
-                -p.MX7r,
-                k138,
-                A::mul_add(
-                    p.MZ7r,
-                    k131,
-                    A::mul_add(
-                        -k136,
-                        d164,
-                        A::mul_add(
-                            -k133,
-                            d162,
-                            A::mul_add(
-                                p.YZ7r,
-                                k135,
-                                A::mul_add(p.YY7r, k134, p.XY7r * k124),
-                            ),
+                ); // N5l|ud=0,g=0.x | N5r|ud=0,g=0.x
+            let d58_d142 = lanes
+                .mul_add(
+                    F64x2::new(p.MX5l, p.MX5r),
+                    k51_k119,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ5l, p.MZ5r),
+                            k44_k112,
+                            lanes
+                                .mul_add(
+                                    -k47_k117,
+                                    d56_d140,
+                                    lanes
+                                        .mul_add(
+                                            k46_k114,
+                                            d54_d138,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.YZ5l, p.YZ5r),
+                                                    k49_k116,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.YY5l, p.YY5r),
+                                                            k48_k115,
+                                                            F64x2::new(p.XY5l, p.XY5r) * k36_k106,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N7r|ud=0,g=0.y
-            let d167 = A::mul_add(
-                -p.MY7r,
-                k131,
-                A::mul_add(
-                    p.MX7r,
-                    k137,
-                    A::mul_add(
-                        k132,
-                        d162,
-                        A::mul_add(
-                            k136,
-                            d163,
-                            A::mul_add(
-                                p.ZZ7r,
-                                k135,
-                                A::mul_add(p.YZ7r, k134, p.XZ7r * k124),
-                            ),
+                ); // N5l|ud=0,g=0.y | N5r|ud=0,g=0.y
+            let d59_d143 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY5l, p.MY5r),
+                    k44_k112,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MX5l, p.MX5r),
+                            k50_k118,
+                            lanes
+                                .mul_add(
+                                    -k45_k113,
+                                    d54_d138,
+                                    lanes
+                                        .mul_add(
+                                            k47_k117,
+                                            d55_d139,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.ZZ5l, p.ZZ5r),
+                                                    k49_k116,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.YZ5l, p.YZ5r),
+                                                            k48_k115,
+                                                            F64x2::new(p.XZ5l, p.XZ5r) * k36_k106,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N7r|ud=0,g=0.z
-            let k139 = A::mul_add(s_q5r, k133, c_q5r * k136); // w7r in 8r|ud=0,g=0.x
-            let k140 = A::mul_add(-c_q5r, k133, s_q5r * k136); // w7r in 8r|ud=0,g=0.z
-            let k141 = A::mul_add(-k139, qd5r, A::mul_add(c_q5r, k135, s_q5r * k124)); // wd8r|ud=0,g=0.z
-            let k142 = k132 + qd5r; // w8r|ud=0,g=0.y
-            let k143 = A::mul_add(k140, qd5r, A::mul_add(-s_q5r, k135, c_q5r * k124)); // wd8r|ud=0,g=0.x
-            let k144 = p.L8 * k133; // w7rxP8r|ud=0,g=0.x
-            let k145 = p.L8 * k136; // w7rxP8r|ud=0,g=0.z
-            let k146 = A::mul_add(k132, k145, A::mul_add(p.L8, k135, k131)); // a8r in 7r|ud=0,g=0.x
-            let k147 = A::mul_add(k136, k145, A::mul_add(k133, k144, k137)); // a8r in 7r|ud=0,g=0.y
-            let k148 = A::mul_add(-k132, k144, A::mul_add(-p.L8, k124, k138)); // a8r in 7r|ud=0,g=0.z
-            let k149 = A::mul_add(c_q5r, k148, s_q5r * k146); // a8r|ud=0,g=0.z
-            let k150 = A::mul_add(-s_q5r, k148, c_q5r * k146); // a8r|ud=0,g=0.x
-            let d168 = A::mul_add(p.MX8r, k142, p.MY8r * k139); // w8rxMS8r|ud=0,g=0.z
-            let d169 = A::mul_add(-p.MY8r, k140, p.MZ8r * k142); // w8rxMS8r|ud=0,g=0.x
-            let d170 = A::mul_add(p.MZ8r, k139, p.MX8r * k140); // w8rxMS8r|ud=0,g=0.y
-            let d171 = A::mul_add(
-                -k142,
-                d169,
-                A::mul_add(
-                    -k139,
-                    d170,
-                    A::mul_add(p.MX8r, k134, A::mul_add(-p.MY8r, k143, p.m8r * k149)),
-                ),
-            ); // F8r|ud=0,g=0.z
-            let d172 = A::mul_add(
-                k140,
-                d170,
-                A::mul_add(
-                    k142,
-                    d168,
-                    A::mul_add(p.MY8r, k141, A::mul_add(p.MZ8r, k134, p.m8r * k150)),
-                ),
-            ); // F8r|ud=0,g=0.x
-            let d173 = A::mul_add(
-                k139,
-                d168,
-                A::mul_add(
-                    -k140,
-                    d169,
-                    A::mul_add(-p.MZ8r, k143, A::mul_add(-p.MX8r, k141, p.m8r * k147)),
-                ),
-            ); // F8r|ud=0,g=0.y
-            let d174 = A::mul_add(
-                -p.XZ8r,
-                k140,
-                A::mul_add(-p.XY8r, k142, p.XX8r * k139),
-            ); // J8rw8r|ud=0,g=0.x
-            let d175 = A::mul_add(
-                -p.YZ8r,
-                k140,
-                A::mul_add(-p.YY8r, k142, p.XY8r * k139),
-            ); // J8rw8r|ud=0,g=0.y
-            let d176 = A::mul_add(
-                -p.ZZ8r,
-                k140,
-                A::mul_add(-p.YZ8r, k142, p.XZ8r * k139),
-            ); // J8rw8r|ud=0,g=0.z
-            let d177 = A::mul_add(
-                -p.MZ8r,
-                k147,
-                A::mul_add(
-                    -p.MY8r,
-                    k149,
-                    A::mul_add(
-                        -k140,
-                        d175,
-                        A::mul_add(
-                            k142,
-                            d176,
-                            A::mul_add(
-                                -p.XZ8r,
-                                k141,
-                                A::mul_add(p.XY8r, k134, p.XX8r * k143),
-                            ),
+                ); // N5l|ud=0,g=0.z | N5r|ud=0,g=0.z
+            let k52_k120 = lanes
+                .mul_add(
+                    -F64x2::new(s_q3l, s_q3r),
+                    k46_k114,
+                    F64x2::new(c_q3l, c_q3r) * k47_k117,
+                ); // w5l in 6l|ud=0,g=0.x | w5r in 6r|ud=0,g=0.x
+            let k53_k121 = lanes
+                .mul_add(
+                    F64x2::new(c_q3l, c_q3r),
+                    k46_k114,
+                    F64x2::new(s_q3l, s_q3r) * k47_k117,
+                ); // w5l in 6l|ud=0,g=0.z | w5r in 6r|ud=0,g=0.z
+            let k55_k122 = lanes
+                .mul_add(
+                    -k52_k120,
+                    F64x2::new(qd3l, qd3r),
+                    lanes
+                        .mul_add(
+                            -F64x2::new(c_q3l, c_q3r),
+                            k49_k116,
+                            F64x2::new(s_q3l, s_q3r) * k36_k106,
                         ),
-                    ),
-                ),
-            ); // N8r|ud=0,g=0.x
-            let d178 = A::mul_add(
-                p.MX8r,
-                k149,
-                A::mul_add(
-                    p.MZ8r,
-                    k150,
-                    A::mul_add(
-                        k139,
-                        d176,
-                        A::mul_add(
-                            k140,
-                            d174,
-                            A::mul_add(
-                                -p.YZ8r,
-                                k141,
-                                A::mul_add(p.YY8r, k134, p.XY8r * k143),
-                            ),
+                ); // wd6l|ud=0,g=0.z | wd6r|ud=0,g=0.z
+            let k54_k123 = k45_k113 - F64x2::new(qd3l, qd3r); // w6l|ud=0,g=0.y | w6r|ud=0,g=0.y
+            let k56_k124 = lanes
+                .mul_add(
+                    k53_k121,
+                    F64x2::new(qd3l, qd3r),
+                    lanes
+                        .mul_add(
+                            F64x2::new(s_q3l, s_q3r),
+                            k49_k116,
+                            F64x2::new(c_q3l, c_q3r) * k36_k106,
                         ),
-                    ),
-                ),
-            ); // N8r|ud=0,g=0.y
-            let d179 = A::mul_add(
-                -p.MY8r,
-                k150,
-                A::mul_add(
-                    p.MX8r,
-                    k147,
-                    A::mul_add(
-                        -k142,
-                        d174,
-                        A::mul_add(
-                            -k139,
-                            d175,
-                            A::mul_add(
-                                -p.ZZ8r,
-                                k141,
-                                A::mul_add(p.YZ8r, k134, p.XZ8r * k143),
-                            ),
+                ); // wd6l|ud=0,g=0.x | wd6r|ud=0,g=0.x
+            let k57_k125 = p.L7 * k46_k114; // w5lxP6l|ud=0,g=0.x | w5rxP6r|ud=0,g=0.x
+            let k58_k126 = p.L7 * k47_k117; // w5lxP6l|ud=0,g=0.z | w5rxP6r|ud=0,g=0.z
+            let k59_k127 = lanes
+                .mul_add(-k45_k113, k58_k126, lanes.mul_add(-p.L7, k49_k116, k44_k112)); // a6l in 5l|ud=0,g=0.x | a6r in 5r|ud=0,g=0.x
+            let k60_k128 = lanes
+                .mul_add(
+                    -k47_k117,
+                    k58_k126,
+                    lanes.mul_add(-k46_k114, k57_k125, k50_k118),
+                ); // a6l in 5l|ud=0,g=0.y | a6r in 5r|ud=0,g=0.y
+            let k61_k129 = lanes
+                .mul_add(k45_k113, k57_k125, lanes.mul_add(p.L7, k36_k106, k51_k119)); // a6l in 5l|ud=0,g=0.z | a6r in 5r|ud=0,g=0.z
+            let k62_k130 = lanes
+                .mul_add(
+                    -F64x2::new(c_q3l, c_q3r),
+                    k61_k129,
+                    F64x2::new(s_q3l, s_q3r) * k59_k127,
+                ); // a6l|ud=0,g=0.z | a6r|ud=0,g=0.z
+            let k63_k131 = lanes
+                .mul_add(
+                    F64x2::new(s_q3l, s_q3r),
+                    k61_k129,
+                    F64x2::new(c_q3l, c_q3r) * k59_k127,
+                ); // a6l|ud=0,g=0.x | a6r|ud=0,g=0.x
+            let d61_d144 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX6l, p.MX6r),
+                    k54_k123,
+                    F64x2::new(p.MY6l, p.MY6r) * k52_k120,
+                ); // w6lxMS6l|ud=0,g=0.z | w6rxMS6r|ud=0,g=0.z
+            let d60_d145 = lanes
+                .mul_add(
+                    F64x2::new(p.MY6l, p.MY6r),
+                    k53_k121,
+                    F64x2::new(p.MZ6l, p.MZ6r) * k54_k123,
+                ); // w6lxMS6l|ud=0,g=0.x | w6rxMS6r|ud=0,g=0.x
+            let d62_d146 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ6l, p.MZ6r),
+                    k52_k120,
+                    F64x2::new(p.MX6l, p.MX6r) * k53_k121,
+                ); // w6lxMS6l|ud=0,g=0.y | w6rxMS6r|ud=0,g=0.y
+            let d64_d147 = lanes
+                .mul_add(
+                    -k54_k123,
+                    d60_d145,
+                    lanes
+                        .mul_add(
+                            -k52_k120,
+                            d62_d146,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.MX6l, p.MX6r),
+                                    k48_k115,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.MY6l, p.MY6r),
+                                            k56_k124,
+                                            F64x2::new(p.m6l, p.m6r) * k62_k130,
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N8r|ud=0,g=0.z
-            let k151 = A::mul_add(s_q6r, k140, c_q6r * k142); // w8r in 9r|ud=0,g=0.y
-            let k152 = A::mul_add(-c_q6r, k140, s_q6r * k142); // w8r in 9r|ud=0,g=0.z
-            let k153 = A::mul_add(-k152, qd6r, A::mul_add(-s_q6r, k141, c_q6r * k134)); // wd9r|ud=0,g=0.y
-            let k154 = A::mul_add(k151, qd6r, A::mul_add(c_q6r, k141, s_q6r * k134)); // wd9r|ud=0,g=0.z
-            let k155 = k139 + qd6r; // w9r|ud=0,g=0.x
-            let k156 = A::mul_add(-s_q6r, k149, c_q6r * k147); // a9r|ud=0,g=0.y
-            let k157 = A::mul_add(c_q6r, k149, s_q6r * k147); // a9r|ud=0,g=0.z
-            let d180 = A::mul_add(-p.MY9r, k152, p.MZ9r * k151); // w9rxMS9r|ud=0,g=0.x
-            let d181 = A::mul_add(p.MZ9r, k155, p.MX9r * k152); // w9rxMS9r|ud=0,g=0.y
-            let d182 = A::mul_add(p.MX9r, k151, p.MY9r * k155); // w9rxMS9r|ud=0,g=0.z
-            let d183 = A::mul_add(
-                -k152,
-                d181,
-                A::mul_add(
-                    -k151,
-                    d182,
-                    A::mul_add(-p.MY9r, k154, A::mul_add(p.MZ9r, k153, p.m9r * k150)),
-                ),
-            ); // F9r|ud=0,g=0.x
-            let d184 = A::mul_add(
-                -k155,
-                d182,
-                A::mul_add(
-                    k152,
-                    d180,
-                    A::mul_add(-p.MZ9r, k143, A::mul_add(p.MX9r, k154, p.m9r * k156)),
-                ),
-            ); // F9r|ud=0,g=0.y
-            let d185 = A::mul_add(
-                -k151,
-                d180,
-                A::mul_add(
-                    -k155,
-                    d181,
-                    A::mul_add(-p.MX9r, k153, A::mul_add(p.MY9r, k143, p.m9r * k157)),
-                ),
-            ); // F9r|ud=0,g=0.z
-            let d186 = A::mul_add(
-                -p.XZ9r,
-                k152,
-                A::mul_add(-p.XY9r, k151, p.XX9r * k155),
-            ); // J9rw9r|ud=0,g=0.x
-            let d187 = A::mul_add(
-                -p.YZ9r,
-                k152,
-                A::mul_add(-p.YY9r, k151, p.XY9r * k155),
-            ); // J9rw9r|ud=0,g=0.y
-            let d188 = A::mul_add(
-                -p.ZZ9r,
-                k152,
-                A::mul_add(-p.YZ9r, k151, p.XZ9r * k155),
-            ); // J9rw9r|ud=0,g=0.z
-            let d189 = A::mul_add(
-                -p.MZ9r,
-                k156,
-                A::mul_add(
-                    p.MY9r,
-                    k157,
-                    A::mul_add(
-                        k152,
-                        d187,
-                        A::mul_add(
-                            -k151,
-                            d188,
-                            A::mul_add(
-                                p.XZ9r,
-                                k154,
-                                A::mul_add(p.XY9r, k153, p.XX9r * k143),
-                            ),
+                ); // F6l|ud=0,g=0.z | F6r|ud=0,g=0.z
+            let d65_d148 = lanes
+                .mul_add(
+                    k53_k121,
+                    d62_d146,
+                    lanes
+                        .mul_add(
+                            -k54_k123,
+                            d61_d144,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.MY6l, p.MY6r),
+                                    k55_k122,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.MZ6l, p.MZ6r),
+                                            k48_k115,
+                                            F64x2::new(p.m6l, p.m6r) * k63_k131,
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N9r|ud=0,g=0.x
-            let d190 = A::mul_add(
-                -p.MX9r,
-                k157,
-                A::mul_add(
-                    p.MZ9r,
-                    k150,
-                    A::mul_add(
-                        -k155,
-                        d188,
-                        A::mul_add(
-                            -k152,
-                            d186,
-                            A::mul_add(
-                                p.YZ9r,
-                                k154,
-                                A::mul_add(p.YY9r, k153, p.XY9r * k143),
-                            ),
+                ); // F6l|ud=0,g=0.x | F6r|ud=0,g=0.x
+            let d63_d149 = lanes
+                .mul_add(
+                    -k52_k120,
+                    d61_d144,
+                    lanes
+                        .mul_add(
+                            -k53_k121,
+                            d60_d145,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.MZ6l, p.MZ6r),
+                                    k56_k124,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.MX6l, p.MX6r),
+                                            k55_k122,
+                                            F64x2::new(p.m6l, p.m6r) * k60_k128,
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N9r|ud=0,g=0.y
-            let d191 = A::mul_add(
-                -p.MY9r,
-                k150,
-                A::mul_add(
-                    p.MX9r,
-                    k156,
-                    A::mul_add(
-                        k151,
-                        d186,
-                        A::mul_add(
-                            k155,
-                            d187,
-                            A::mul_add(
-                                p.ZZ9r,
-                                k154,
-                                A::mul_add(p.YZ9r, k153, p.XZ9r * k143),
-                            ),
+                ); // F6l|ud=0,g=0.y | F6r|ud=0,g=0.y
+            let d66_d150 = lanes
+                .mul_add(
+                    -F64x2::new(p.XZ6l, p.XZ6r),
+                    k53_k121,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY6l, p.XY6r),
+                            k54_k123,
+                            F64x2::new(p.XX6l, p.XX6r) * k52_k120,
                         ),
-                    ),
-                ),
-            ); // N9r|ud=0,g=0.z
-            let k158 = A::mul_add(s_q7r, k152, c_q7r * k155); // w9r in 10r|ud=0,g=0.x
-            let k159 = A::mul_add(-c_q7r, k152, s_q7r * k155); // w9r in 10r|ud=0,g=0.y
-            let k160 = k151 + qd7r; // w10r|ud=0,g=0.z
-            let k161 = A::mul_add(k159, qd7r, A::mul_add(-s_q7r, k154, c_q7r * k143)); // wd10r|ud=0,g=0.x
-            let k162 = A::mul_add(-k158, qd7r, A::mul_add(c_q7r, k154, s_q7r * k143)); // wd10r|ud=0,g=0.y
-            let k163 = p.L9 * k152; // w9rxP10r|ud=0,g=0.x
-            let k164 = p.L9 * k155; // w9rxP10r|ud=0,g=0.z
-            let k165 = A::mul_add(k151, k164, A::mul_add(p.L9, k154, k150)); // a10r in 9r|ud=0,g=0.x
-            let k166 = A::mul_add(k155, k164, A::mul_add(k152, k163, k156)); // a10r in 9r|ud=0,g=0.y
-            let k167 = A::mul_add(-k151, k163, A::mul_add(-p.L9, k143, k157)); // a10r in 9r|ud=0,g=0.z
-            let k168 = A::mul_add(-s_q7r, k167, c_q7r * k165); // a10r|ud=0,g=0.x
-            let k169 = A::mul_add(c_q7r, k167, s_q7r * k165); // a10r|ud=0,g=0.y
-            let d192 = A::mul_add(p.MY10r, k160, p.MZ10r * k159); // w10rxMS10r|ud=0,g=0.x
-            let d193 = A::mul_add(-p.MX10r, k159, p.MY10r * k158); // w10rxMS10r|ud=0,g=0.z
-            let d194 = A::mul_add(p.MZ10r, k158, p.MX10r * k160); // w10rxMS10r|ud=0,g=0.y
-            let d195 = A::mul_add(
-                k160,
-                d194,
-                A::mul_add(
-                    -k159,
-                    d193,
-                    A::mul_add(-p.MY10r, k153, A::mul_add(p.MZ10r, k162, p.m10r * k168)),
-                ),
-            ); // F10r|ud=0,g=0.x
-            let d196 = A::mul_add(
-                k158,
-                d193,
-                A::mul_add(
-                    k160,
-                    d192,
-                    A::mul_add(-p.MZ10r, k161, A::mul_add(p.MX10r, k153, p.m10r * k169)),
-                ),
-            ); // F10r|ud=0,g=0.y
-            let d197 = A::mul_add(
-                k159,
-                d192,
-                A::mul_add(
-                    k158,
-                    d194,
-                    A::mul_add(-p.MX10r, k162, A::mul_add(p.MY10r, k161, p.m10r * k166)),
-                ),
-            ); // F10r|ud=0,g=0.z
-            let d198 = A::mul_add(
-                -p.XZ10r,
-                k160,
-                A::mul_add(p.XY10r, k159, p.XX10r * k158),
-            ); // J10rw10r|ud=0,g=0.x
-            let d199 = A::mul_add(
-                -p.YZ10r,
-                k160,
-                A::mul_add(p.YY10r, k159, p.XY10r * k158),
-            ); // J10rw10r|ud=0,g=0.y
-            let d200 = A::mul_add(
-                -p.ZZ10r,
-                k160,
-                A::mul_add(p.YZ10r, k159, p.XZ10r * k158),
-            ); // J10rw10r|ud=0,g=0.z
-            let d201 = A::mul_add(
-                -p.MZ10r,
-                k169,
-                A::mul_add(
-                    p.MY10r,
-                    k166,
-                    A::mul_add(
-                        -k160,
-                        d199,
-                        A::mul_add(
-                            -k159,
-                            d200,
-                            A::mul_add(
-                                p.XZ10r,
-                                k153,
-                                A::mul_add(p.XY10r, k162, p.XX10r * k161),
-                            ),
+                ); // J6lw6l|ud=0,g=0.x | J6rw6r|ud=0,g=0.x
+            let d67_d151 = lanes
+                .mul_add(
+                    -F64x2::new(p.YZ6l, p.YZ6r),
+                    k53_k121,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY6l, p.YY6r),
+                            k54_k123,
+                            F64x2::new(p.XY6l, p.XY6r) * k52_k120,
                         ),
-                    ),
-                ),
-            ); // N10r|ud=0,g=0.x
-            let d202 = A::mul_add(
-                -p.MX10r,
-                k166,
-                A::mul_add(
-                    p.MZ10r,
-                    k168,
-                    A::mul_add(
-                        k158,
-                        d200,
-                        A::mul_add(
-                            k160,
-                            d198,
-                            A::mul_add(
-                                p.YZ10r,
-                                k153,
-                                A::mul_add(p.YY10r, k162, p.XY10r * k161),
-                            ),
+                ); // J6lw6l|ud=0,g=0.y | J6rw6r|ud=0,g=0.y
+            let d68_d152 = lanes
+                .mul_add(
+                    -F64x2::new(p.ZZ6l, p.ZZ6r),
+                    k53_k121,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ6l, p.YZ6r),
+                            k54_k123,
+                            F64x2::new(p.XZ6l, p.XZ6r) * k52_k120,
                         ),
-                    ),
-                ),
-            ); // N10r|ud=0,g=0.y
-            let d203 = A::mul_add(
-                -p.MY10r,
-                k168,
-                A::mul_add(
-                    p.MX10r,
-                    k169,
-                    A::mul_add(
-                        k159,
-                        d198,
-                        A::mul_add(
-                            -k158,
-                            d199,
-                            A::mul_add(
-                                p.ZZ10r,
-                                k153,
-                                A::mul_add(p.YZ10r, k162, p.XZ10r * k161),
-                            ),
+                ); // J6lw6l|ud=0,g=0.z | J6rw6r|ud=0,g=0.z
+            let d69_d153 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ6l, p.MZ6r),
+                    k60_k128,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MY6l, p.MY6r),
+                            k62_k130,
+                            lanes
+                                .mul_add(
+                                    -k53_k121,
+                                    d67_d151,
+                                    lanes
+                                        .mul_add(
+                                            -k54_k123,
+                                            d68_d152,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XZ6l, p.XZ6r),
+                                                    k55_k122,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.XY6l, p.XY6r),
+                                                            k48_k115,
+                                                            F64x2::new(p.XX6l, p.XX6r) * k56_k124,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N10r|ud=0,g=0.z
+                ); // N6l|ud=0,g=0.x | N6r|ud=0,g=0.x
+            let d70_d154 = lanes
+                .mul_add(
+                    F64x2::new(p.MX6l, p.MX6r),
+                    k62_k130,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ6l, p.MZ6r),
+                            k63_k131,
+                            lanes
+                                .mul_add(
+                                    k52_k120,
+                                    d68_d152,
+                                    lanes
+                                        .mul_add(
+                                            k53_k121,
+                                            d66_d150,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.YZ6l, p.YZ6r),
+                                                    k55_k122,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.YY6l, p.YY6r),
+                                                            k48_k115,
+                                                            F64x2::new(p.XY6l, p.XY6r) * k56_k124,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N6l|ud=0,g=0.y | N6r|ud=0,g=0.y
+            let d71_d155 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY6l, p.MY6r),
+                    k63_k131,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MX6l, p.MX6r),
+                            k60_k128,
+                            lanes
+                                .mul_add(
+                                    k54_k123,
+                                    d66_d150,
+                                    lanes
+                                        .mul_add(
+                                            -k52_k120,
+                                            d67_d151,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.ZZ6l, p.ZZ6r),
+                                                    k55_k122,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.YZ6l, p.YZ6r),
+                                                            k48_k115,
+                                                            F64x2::new(p.XZ6l, p.XZ6r) * k56_k124,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N6l|ud=0,g=0.z | N6r|ud=0,g=0.z
+            let k64_k132 = lanes
+                .mul_add(
+                    -F64x2::new(s_q4l, s_q4r),
+                    k53_k121,
+                    F64x2::new(c_q4l, c_q4r) * k54_k123,
+                ); // w6l in 7l|ud=0,g=0.y | w6r in 7r|ud=0,g=0.y
+            let k65_k133 = lanes
+                .mul_add(
+                    F64x2::new(c_q4l, c_q4r),
+                    k53_k121,
+                    F64x2::new(s_q4l, s_q4r) * k54_k123,
+                ); // w6l in 7l|ud=0,g=0.z | w6r in 7r|ud=0,g=0.z
+            let k67_k134 = lanes
+                .mul_add(
+                    -k65_k133,
+                    F64x2::new(qd4l, qd4r),
+                    lanes
+                        .mul_add(
+                            F64x2::new(s_q4l, s_q4r),
+                            k55_k122,
+                            F64x2::new(c_q4l, c_q4r) * k48_k115,
+                        ),
+                ); // wd7l|ud=0,g=0.y | wd7r|ud=0,g=0.y
+            let k68_k135 = lanes
+                .mul_add(
+                    k64_k132,
+                    F64x2::new(qd4l, qd4r),
+                    lanes
+                        .mul_add(
+                            -F64x2::new(c_q4l, c_q4r),
+                            k55_k122,
+                            F64x2::new(s_q4l, s_q4r) * k48_k115,
+                        ),
+                ); // wd7l|ud=0,g=0.z | wd7r|ud=0,g=0.z
+            let k66_k136 = k52_k120 + F64x2::new(qd4l, qd4r); // w7l|ud=0,g=0.x | w7r|ud=0,g=0.x
+            let k69_k137 = lanes
+                .mul_add(
+                    F64x2::new(s_q4l, s_q4r),
+                    k62_k130,
+                    F64x2::new(c_q4l, c_q4r) * k60_k128,
+                ); // a7l|ud=0,g=0.y | a7r|ud=0,g=0.y
+            let k70_k138 = lanes
+                .mul_add(
+                    -F64x2::new(c_q4l, c_q4r),
+                    k62_k130,
+                    F64x2::new(s_q4l, s_q4r) * k60_k128,
+                ); // a7l|ud=0,g=0.z | a7r|ud=0,g=0.z
+            let d72_d156 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY7l, p.MY7r),
+                    k65_k133,
+                    F64x2::new(p.MZ7l, p.MZ7r) * k64_k132,
+                ); // w7lxMS7l|ud=0,g=0.x | w7rxMS7r|ud=0,g=0.x
+            let d73_d157 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ7l, p.MZ7r),
+                    k66_k136,
+                    F64x2::new(p.MX7l, p.MX7r) * k65_k133,
+                ); // w7lxMS7l|ud=0,g=0.y | w7rxMS7r|ud=0,g=0.y
+            let d74_d158 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX7l, p.MX7r),
+                    k64_k132,
+                    F64x2::new(p.MY7l, p.MY7r) * k66_k136,
+                ); // w7lxMS7l|ud=0,g=0.z | w7rxMS7r|ud=0,g=0.z
+            let d75_d159 = lanes
+                .mul_add(
+                    -k65_k133,
+                    d73_d157,
+                    lanes
+                        .mul_add(
+                            k64_k132,
+                            d74_d158,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.MY7l, p.MY7r),
+                                    k68_k135,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.MZ7l, p.MZ7r),
+                                            k67_k134,
+                                            F64x2::new(p.m7l, p.m7r) * k63_k131,
+                                        ),
+                                ),
+                        ),
+                ); // F7l|ud=0,g=0.x | F7r|ud=0,g=0.x
+            let d76_d160 = lanes
+                .mul_add(
+                    k66_k136,
+                    d74_d158,
+                    lanes
+                        .mul_add(
+                            -k65_k133,
+                            d72_d156,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.MZ7l, p.MZ7r),
+                                    k56_k124,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.MX7l, p.MX7r),
+                                            k68_k135,
+                                            F64x2::new(p.m7l, p.m7r) * k69_k137,
+                                        ),
+                                ),
+                        ),
+                ); // F7l|ud=0,g=0.y | F7r|ud=0,g=0.y
+            let d77_d161 = lanes
+                .mul_add(
+                    k64_k132,
+                    d72_d156,
+                    lanes
+                        .mul_add(
+                            -k66_k136,
+                            d73_d157,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.MX7l, p.MX7r),
+                                    k67_k134,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.MY7l, p.MY7r),
+                                            k56_k124,
+                                            F64x2::new(p.m7l, p.m7r) * k70_k138,
+                                        ),
+                                ),
+                        ),
+                ); // F7l|ud=0,g=0.z | F7r|ud=0,g=0.z
+            let d78_d162 = lanes
+                .mul_add(
+                    F64x2::new(p.XZ7l, p.XZ7r),
+                    k65_k133,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY7l, p.XY7r),
+                            k64_k132,
+                            F64x2::new(p.XX7l, p.XX7r) * k66_k136,
+                        ),
+                ); // J7lw7l|ud=0,g=0.x | J7rw7r|ud=0,g=0.x
+            let d79_d163 = lanes
+                .mul_add(
+                    F64x2::new(p.YZ7l, p.YZ7r),
+                    k65_k133,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY7l, p.YY7r),
+                            k64_k132,
+                            F64x2::new(p.XY7l, p.XY7r) * k66_k136,
+                        ),
+                ); // J7lw7l|ud=0,g=0.y | J7rw7r|ud=0,g=0.y
+            let d80_d164 = lanes
+                .mul_add(
+                    F64x2::new(p.ZZ7l, p.ZZ7r),
+                    k65_k133,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ7l, p.YZ7r),
+                            k64_k132,
+                            F64x2::new(p.XZ7l, p.XZ7r) * k66_k136,
+                        ),
+                ); // J7lw7l|ud=0,g=0.z | J7rw7r|ud=0,g=0.z
+            let d81_d165 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ7l, p.MZ7r),
+                    k69_k137,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MY7l, p.MY7r),
+                            k70_k138,
+                            lanes
+                                .mul_add(
+                                    -k65_k133,
+                                    d79_d163,
+                                    lanes
+                                        .mul_add(
+                                            k64_k132,
+                                            d80_d164,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XZ7l, p.XZ7r),
+                                                    k68_k135,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.XY7l, p.XY7r),
+                                                            k67_k134,
+                                                            F64x2::new(p.XX7l, p.XX7r) * k56_k124,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N7l|ud=0,g=0.x | N7r|ud=0,g=0.x
+            let d82_d166 = lanes
+                .mul_add(
+                    F64x2::new(p.MX7l, p.MX7r),
+                    k70_k138,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ7l, p.MZ7r),
+                            k63_k131,
+                            lanes
+                                .mul_add(
+                                    -k66_k136,
+                                    d80_d164,
+                                    lanes
+                                        .mul_add(
+                                            k65_k133,
+                                            d78_d162,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.YZ7l, p.YZ7r),
+                                                    k68_k135,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.YY7l, p.YY7r),
+                                                            k67_k134,
+                                                            F64x2::new(p.XY7l, p.XY7r) * k56_k124,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N7l|ud=0,g=0.y | N7r|ud=0,g=0.y
+            let d83_d167 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY7l, p.MY7r),
+                    k63_k131,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MX7l, p.MX7r),
+                            k69_k137,
+                            lanes
+                                .mul_add(
+                                    -k64_k132,
+                                    d78_d162,
+                                    lanes
+                                        .mul_add(
+                                            k66_k136,
+                                            d79_d163,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.ZZ7l, p.ZZ7r),
+                                                    k68_k135,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.YZ7l, p.YZ7r),
+                                                            k67_k134,
+                                                            F64x2::new(p.XZ7l, p.XZ7r) * k56_k124,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N7l|ud=0,g=0.z | N7r|ud=0,g=0.z
+            let k71_k139 = lanes
+                .mul_add(
+                    -F64x2::new(s_q5l, s_q5r),
+                    k65_k133,
+                    F64x2::new(c_q5l, c_q5r) * k66_k136,
+                ); // w7l in 8l|ud=0,g=0.x | w7r in 8r|ud=0,g=0.x
+            let k72_k140 = lanes
+                .mul_add(
+                    F64x2::new(c_q5l, c_q5r),
+                    k65_k133,
+                    F64x2::new(s_q5l, s_q5r) * k66_k136,
+                ); // w7l in 8l|ud=0,g=0.z | w7r in 8r|ud=0,g=0.z
+            let k74_k141 = lanes
+                .mul_add(
+                    -k71_k139,
+                    F64x2::new(qd5l, qd5r),
+                    lanes
+                        .mul_add(
+                            -F64x2::new(c_q5l, c_q5r),
+                            k68_k135,
+                            F64x2::new(s_q5l, s_q5r) * k56_k124,
+                        ),
+                ); // wd8l|ud=0,g=0.z | wd8r|ud=0,g=0.z
+            let k73_k142 = k64_k132 - F64x2::new(qd5l, qd5r); // w8l|ud=0,g=0.y | w8r|ud=0,g=0.y
+            let k75_k143 = lanes
+                .mul_add(
+                    k72_k140,
+                    F64x2::new(qd5l, qd5r),
+                    lanes
+                        .mul_add(
+                            F64x2::new(s_q5l, s_q5r),
+                            k68_k135,
+                            F64x2::new(c_q5l, c_q5r) * k56_k124,
+                        ),
+                ); // wd8l|ud=0,g=0.x | wd8r|ud=0,g=0.x
+            let k76_k144 = p.L8 * k65_k133; // w7lxP8l|ud=0,g=0.x | w7rxP8r|ud=0,g=0.x
+            let k77_k145 = p.L8 * k66_k136; // w7lxP8l|ud=0,g=0.z | w7rxP8r|ud=0,g=0.z
+            let k78_k146 = lanes
+                .mul_add(-k64_k132, k77_k145, lanes.mul_add(-p.L8, k68_k135, k63_k131)); // a8l in 7l|ud=0,g=0.x | a8r in 7r|ud=0,g=0.x
+            let k79_k147 = lanes
+                .mul_add(
+                    -k66_k136,
+                    k77_k145,
+                    lanes.mul_add(-k65_k133, k76_k144, k69_k137),
+                ); // a8l in 7l|ud=0,g=0.y | a8r in 7r|ud=0,g=0.y
+            let k80_k148 = lanes
+                .mul_add(k64_k132, k76_k144, lanes.mul_add(p.L8, k56_k124, k70_k138)); // a8l in 7l|ud=0,g=0.z | a8r in 7r|ud=0,g=0.z
+            let k81_k149 = lanes
+                .mul_add(
+                    -F64x2::new(c_q5l, c_q5r),
+                    k80_k148,
+                    F64x2::new(s_q5l, s_q5r) * k78_k146,
+                ); // a8l|ud=0,g=0.z | a8r|ud=0,g=0.z
+            let k82_k150 = lanes
+                .mul_add(
+                    F64x2::new(s_q5l, s_q5r),
+                    k80_k148,
+                    F64x2::new(c_q5l, c_q5r) * k78_k146,
+                ); // a8l|ud=0,g=0.x | a8r|ud=0,g=0.x
+            let d85_d168 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX8l, p.MX8r),
+                    k73_k142,
+                    F64x2::new(p.MY8l, p.MY8r) * k71_k139,
+                ); // w8lxMS8l|ud=0,g=0.z | w8rxMS8r|ud=0,g=0.z
+            let d84_d169 = lanes
+                .mul_add(
+                    F64x2::new(p.MY8l, p.MY8r),
+                    k72_k140,
+                    F64x2::new(p.MZ8l, p.MZ8r) * k73_k142,
+                ); // w8lxMS8l|ud=0,g=0.x | w8rxMS8r|ud=0,g=0.x
+            let d86_d170 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ8l, p.MZ8r),
+                    k71_k139,
+                    F64x2::new(p.MX8l, p.MX8r) * k72_k140,
+                ); // w8lxMS8l|ud=0,g=0.y | w8rxMS8r|ud=0,g=0.y
+            let d88_d171 = lanes
+                .mul_add(
+                    -k73_k142,
+                    d84_d169,
+                    lanes
+                        .mul_add(
+                            -k71_k139,
+                            d86_d170,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.MX8l, p.MX8r),
+                                    k67_k134,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.MY8l, p.MY8r),
+                                            k75_k143,
+                                            F64x2::new(p.m8l, p.m8r) * k81_k149,
+                                        ),
+                                ),
+                        ),
+                ); // F8l|ud=0,g=0.z | F8r|ud=0,g=0.z
+            let d89_d172 = lanes
+                .mul_add(
+                    k72_k140,
+                    d86_d170,
+                    lanes
+                        .mul_add(
+                            -k73_k142,
+                            d85_d168,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.MY8l, p.MY8r),
+                                    k74_k141,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.MZ8l, p.MZ8r),
+                                            k67_k134,
+                                            F64x2::new(p.m8l, p.m8r) * k82_k150,
+                                        ),
+                                ),
+                        ),
+                ); // F8l|ud=0,g=0.x | F8r|ud=0,g=0.x
+            let d87_d173 = lanes
+                .mul_add(
+                    -k71_k139,
+                    d85_d168,
+                    lanes
+                        .mul_add(
+                            -k72_k140,
+                            d84_d169,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.MZ8l, p.MZ8r),
+                                    k75_k143,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.MX8l, p.MX8r),
+                                            k74_k141,
+                                            F64x2::new(p.m8l, p.m8r) * k79_k147,
+                                        ),
+                                ),
+                        ),
+                ); // F8l|ud=0,g=0.y | F8r|ud=0,g=0.y
+            let d90_d174 = lanes
+                .mul_add(
+                    -F64x2::new(p.XZ8l, p.XZ8r),
+                    k72_k140,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY8l, p.XY8r),
+                            k73_k142,
+                            F64x2::new(p.XX8l, p.XX8r) * k71_k139,
+                        ),
+                ); // J8lw8l|ud=0,g=0.x | J8rw8r|ud=0,g=0.x
+            let d91_d175 = lanes
+                .mul_add(
+                    -F64x2::new(p.YZ8l, p.YZ8r),
+                    k72_k140,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY8l, p.YY8r),
+                            k73_k142,
+                            F64x2::new(p.XY8l, p.XY8r) * k71_k139,
+                        ),
+                ); // J8lw8l|ud=0,g=0.y | J8rw8r|ud=0,g=0.y
+            let d92_d176 = lanes
+                .mul_add(
+                    -F64x2::new(p.ZZ8l, p.ZZ8r),
+                    k72_k140,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ8l, p.YZ8r),
+                            k73_k142,
+                            F64x2::new(p.XZ8l, p.XZ8r) * k71_k139,
+                        ),
+                ); // J8lw8l|ud=0,g=0.z | J8rw8r|ud=0,g=0.z
+            let d93_d177 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ8l, p.MZ8r),
+                    k79_k147,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MY8l, p.MY8r),
+                            k81_k149,
+                            lanes
+                                .mul_add(
+                                    -k72_k140,
+                                    d91_d175,
+                                    lanes
+                                        .mul_add(
+                                            -k73_k142,
+                                            d92_d176,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XZ8l, p.XZ8r),
+                                                    k74_k141,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.XY8l, p.XY8r),
+                                                            k67_k134,
+                                                            F64x2::new(p.XX8l, p.XX8r) * k75_k143,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N8l|ud=0,g=0.x | N8r|ud=0,g=0.x
+            let d94_d178 = lanes
+                .mul_add(
+                    F64x2::new(p.MX8l, p.MX8r),
+                    k81_k149,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ8l, p.MZ8r),
+                            k82_k150,
+                            lanes
+                                .mul_add(
+                                    k71_k139,
+                                    d92_d176,
+                                    lanes
+                                        .mul_add(
+                                            k72_k140,
+                                            d90_d174,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.YZ8l, p.YZ8r),
+                                                    k74_k141,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.YY8l, p.YY8r),
+                                                            k67_k134,
+                                                            F64x2::new(p.XY8l, p.XY8r) * k75_k143,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N8l|ud=0,g=0.y | N8r|ud=0,g=0.y
+            let d95_d179 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY8l, p.MY8r),
+                    k82_k150,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MX8l, p.MX8r),
+                            k79_k147,
+                            lanes
+                                .mul_add(
+                                    k73_k142,
+                                    d90_d174,
+                                    lanes
+                                        .mul_add(
+                                            -k71_k139,
+                                            d91_d175,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.ZZ8l, p.ZZ8r),
+                                                    k74_k141,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.YZ8l, p.YZ8r),
+                                                            k67_k134,
+                                                            F64x2::new(p.XZ8l, p.XZ8r) * k75_k143,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N8l|ud=0,g=0.z | N8r|ud=0,g=0.z
+            let k83_k151 = lanes
+                .mul_add(
+                    -F64x2::new(s_q6l, s_q6r),
+                    k72_k140,
+                    F64x2::new(c_q6l, c_q6r) * k73_k142,
+                ); // w8l in 9l|ud=0,g=0.y | w8r in 9r|ud=0,g=0.y
+            let k84_k152 = lanes
+                .mul_add(
+                    F64x2::new(c_q6l, c_q6r),
+                    k72_k140,
+                    F64x2::new(s_q6l, s_q6r) * k73_k142,
+                ); // w8l in 9l|ud=0,g=0.z | w8r in 9r|ud=0,g=0.z
+            let k86_k153 = lanes
+                .mul_add(
+                    -k84_k152,
+                    F64x2::new(qd6l, qd6r),
+                    lanes
+                        .mul_add(
+                            F64x2::new(s_q6l, s_q6r),
+                            k74_k141,
+                            F64x2::new(c_q6l, c_q6r) * k67_k134,
+                        ),
+                ); // wd9l|ud=0,g=0.y | wd9r|ud=0,g=0.y
+            let k87_k154 = lanes
+                .mul_add(
+                    k83_k151,
+                    F64x2::new(qd6l, qd6r),
+                    lanes
+                        .mul_add(
+                            -F64x2::new(c_q6l, c_q6r),
+                            k74_k141,
+                            F64x2::new(s_q6l, s_q6r) * k67_k134,
+                        ),
+                ); // wd9l|ud=0,g=0.z | wd9r|ud=0,g=0.z
+            let k85_k155 = k71_k139 + F64x2::new(qd6l, qd6r); // w9l|ud=0,g=0.x | w9r|ud=0,g=0.x
+            let k88_k156 = lanes
+                .mul_add(
+                    F64x2::new(s_q6l, s_q6r),
+                    k81_k149,
+                    F64x2::new(c_q6l, c_q6r) * k79_k147,
+                ); // a9l|ud=0,g=0.y | a9r|ud=0,g=0.y
+            let k89_k157 = lanes
+                .mul_add(
+                    -F64x2::new(c_q6l, c_q6r),
+                    k81_k149,
+                    F64x2::new(s_q6l, s_q6r) * k79_k147,
+                ); // a9l|ud=0,g=0.z | a9r|ud=0,g=0.z
+            let d96_d180 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY9l, p.MY9r),
+                    k84_k152,
+                    F64x2::new(p.MZ9l, p.MZ9r) * k83_k151,
+                ); // w9lxMS9l|ud=0,g=0.x | w9rxMS9r|ud=0,g=0.x
+            let d97_d181 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ9l, p.MZ9r),
+                    k85_k155,
+                    F64x2::new(p.MX9l, p.MX9r) * k84_k152,
+                ); // w9lxMS9l|ud=0,g=0.y | w9rxMS9r|ud=0,g=0.y
+            let d98_d182 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX9l, p.MX9r),
+                    k83_k151,
+                    F64x2::new(p.MY9l, p.MY9r) * k85_k155,
+                ); // w9lxMS9l|ud=0,g=0.z | w9rxMS9r|ud=0,g=0.z
+            let d99_d183 = lanes
+                .mul_add(
+                    -k84_k152,
+                    d97_d181,
+                    lanes
+                        .mul_add(
+                            k83_k151,
+                            d98_d182,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.MY9l, p.MY9r),
+                                    k87_k154,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.MZ9l, p.MZ9r),
+                                            k86_k153,
+                                            F64x2::new(p.m9l, p.m9r) * k82_k150,
+                                        ),
+                                ),
+                        ),
+                ); // F9l|ud=0,g=0.x | F9r|ud=0,g=0.x
+            let d100_d184 = lanes
+                .mul_add(
+                    k85_k155,
+                    d98_d182,
+                    lanes
+                        .mul_add(
+                            -k84_k152,
+                            d96_d180,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.MZ9l, p.MZ9r),
+                                    k75_k143,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.MX9l, p.MX9r),
+                                            k87_k154,
+                                            F64x2::new(p.m9l, p.m9r) * k88_k156,
+                                        ),
+                                ),
+                        ),
+                ); // F9l|ud=0,g=0.y | F9r|ud=0,g=0.y
+            let d101_d185 = lanes
+                .mul_add(
+                    k83_k151,
+                    d96_d180,
+                    lanes
+                        .mul_add(
+                            -k85_k155,
+                            d97_d181,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.MX9l, p.MX9r),
+                                    k86_k153,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.MY9l, p.MY9r),
+                                            k75_k143,
+                                            F64x2::new(p.m9l, p.m9r) * k89_k157,
+                                        ),
+                                ),
+                        ),
+                ); // F9l|ud=0,g=0.z | F9r|ud=0,g=0.z
+            let d102_d186 = lanes
+                .mul_add(
+                    F64x2::new(p.XZ9l, p.XZ9r),
+                    k84_k152,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY9l, p.XY9r),
+                            k83_k151,
+                            F64x2::new(p.XX9l, p.XX9r) * k85_k155,
+                        ),
+                ); // J9lw9l|ud=0,g=0.x | J9rw9r|ud=0,g=0.x
+            let d103_d187 = lanes
+                .mul_add(
+                    F64x2::new(p.YZ9l, p.YZ9r),
+                    k84_k152,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY9l, p.YY9r),
+                            k83_k151,
+                            F64x2::new(p.XY9l, p.XY9r) * k85_k155,
+                        ),
+                ); // J9lw9l|ud=0,g=0.y | J9rw9r|ud=0,g=0.y
+            let d104_d188 = lanes
+                .mul_add(
+                    F64x2::new(p.ZZ9l, p.ZZ9r),
+                    k84_k152,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ9l, p.YZ9r),
+                            k83_k151,
+                            F64x2::new(p.XZ9l, p.XZ9r) * k85_k155,
+                        ),
+                ); // J9lw9l|ud=0,g=0.z | J9rw9r|ud=0,g=0.z
+            let d105_d189 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ9l, p.MZ9r),
+                    k88_k156,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MY9l, p.MY9r),
+                            k89_k157,
+                            lanes
+                                .mul_add(
+                                    -k84_k152,
+                                    d103_d187,
+                                    lanes
+                                        .mul_add(
+                                            k83_k151,
+                                            d104_d188,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XZ9l, p.XZ9r),
+                                                    k87_k154,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.XY9l, p.XY9r),
+                                                            k86_k153,
+                                                            F64x2::new(p.XX9l, p.XX9r) * k75_k143,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N9l|ud=0,g=0.x | N9r|ud=0,g=0.x
+            let d106_d190 = lanes
+                .mul_add(
+                    F64x2::new(p.MX9l, p.MX9r),
+                    k89_k157,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ9l, p.MZ9r),
+                            k82_k150,
+                            lanes
+                                .mul_add(
+                                    -k85_k155,
+                                    d104_d188,
+                                    lanes
+                                        .mul_add(
+                                            k84_k152,
+                                            d102_d186,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.YZ9l, p.YZ9r),
+                                                    k87_k154,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.YY9l, p.YY9r),
+                                                            k86_k153,
+                                                            F64x2::new(p.XY9l, p.XY9r) * k75_k143,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N9l|ud=0,g=0.y | N9r|ud=0,g=0.y
+            let d107_d191 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY9l, p.MY9r),
+                    k82_k150,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MX9l, p.MX9r),
+                            k88_k156,
+                            lanes
+                                .mul_add(
+                                    -k83_k151,
+                                    d102_d186,
+                                    lanes
+                                        .mul_add(
+                                            k85_k155,
+                                            d103_d187,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.ZZ9l, p.ZZ9r),
+                                                    k87_k154,
+                                                    lanes
+                                                        .mul_add(
+                                                            -F64x2::new(p.YZ9l, p.YZ9r),
+                                                            k86_k153,
+                                                            F64x2::new(p.XZ9l, p.XZ9r) * k75_k143,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N9l|ud=0,g=0.z | N9r|ud=0,g=0.z
+            let k90_k158 = lanes
+                .mul_add(
+                    -F64x2::new(s_q7l, s_q7r),
+                    k84_k152,
+                    F64x2::new(c_q7l, c_q7r) * k85_k155,
+                ); // w9l in 10l|ud=0,g=0.x | w9r in 10r|ud=0,g=0.x
+            let k91_k159 = lanes
+                .mul_add(
+                    F64x2::new(c_q7l, c_q7r),
+                    k84_k152,
+                    F64x2::new(s_q7l, s_q7r) * k85_k155,
+                ); // w9l in 10l|ud=0,g=0.y | w9r in 10r|ud=0,g=0.y
+            let k92_k160 = k83_k151 - F64x2::new(qd7l, qd7r); // w10l|ud=0,g=0.z | w10r|ud=0,g=0.z
+            let k93_k161 = lanes
+                .mul_add(
+                    k91_k159,
+                    F64x2::new(qd7l, qd7r),
+                    lanes
+                        .mul_add(
+                            F64x2::new(s_q7l, s_q7r),
+                            k87_k154,
+                            F64x2::new(c_q7l, c_q7r) * k75_k143,
+                        ),
+                ); // wd10l|ud=0,g=0.x | wd10r|ud=0,g=0.x
+            let k94_k162 = lanes
+                .mul_add(
+                    -k90_k158,
+                    F64x2::new(qd7l, qd7r),
+                    lanes
+                        .mul_add(
+                            -F64x2::new(c_q7l, c_q7r),
+                            k87_k154,
+                            F64x2::new(s_q7l, s_q7r) * k75_k143,
+                        ),
+                ); // wd10l|ud=0,g=0.y | wd10r|ud=0,g=0.y
+            let k95_k163 = p.L9 * k84_k152; // w9lxP10l|ud=0,g=0.x | w9rxP10r|ud=0,g=0.x
+            let k96_k164 = p.L9 * k85_k155; // w9lxP10l|ud=0,g=0.z | w9rxP10r|ud=0,g=0.z
+            let k97_k165 = lanes
+                .mul_add(-k83_k151, k96_k164, lanes.mul_add(-p.L9, k87_k154, k82_k150)); // a10l in 9l|ud=0,g=0.x | a10r in 9r|ud=0,g=0.x
+            let k98_k166 = lanes
+                .mul_add(
+                    -k85_k155,
+                    k96_k164,
+                    lanes.mul_add(-k84_k152, k95_k163, k88_k156),
+                ); // a10l in 9l|ud=0,g=0.y | a10r in 9r|ud=0,g=0.y
+            let k99_k167 = lanes
+                .mul_add(k83_k151, k95_k163, lanes.mul_add(p.L9, k75_k143, k89_k157)); // a10l in 9l|ud=0,g=0.z | a10r in 9r|ud=0,g=0.z
+            let k100_k168 = lanes
+                .mul_add(
+                    F64x2::new(s_q7l, s_q7r),
+                    k99_k167,
+                    F64x2::new(c_q7l, c_q7r) * k97_k165,
+                ); // a10l|ud=0,g=0.x | a10r|ud=0,g=0.x
+            let k101_k169 = lanes
+                .mul_add(
+                    -F64x2::new(c_q7l, c_q7r),
+                    k99_k167,
+                    F64x2::new(s_q7l, s_q7r) * k97_k165,
+                ); // a10l|ud=0,g=0.y | a10r|ud=0,g=0.y
+            let d108_d192 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY10l, p.MY10r),
+                    k92_k160,
+                    F64x2::new(p.MZ10l, p.MZ10r) * k91_k159,
+                ); // w10lxMS10l|ud=0,g=0.x | w10rxMS10r|ud=0,g=0.x
+            let d110_d193 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX10l, p.MX10r),
+                    k91_k159,
+                    F64x2::new(p.MY10l, p.MY10r) * k90_k158,
+                ); // w10lxMS10l|ud=0,g=0.z | w10rxMS10r|ud=0,g=0.z
+            let d109_d194 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ10l, p.MZ10r),
+                    k90_k158,
+                    F64x2::new(p.MX10l, p.MX10r) * k92_k160,
+                ); // w10lxMS10l|ud=0,g=0.y | w10rxMS10r|ud=0,g=0.y
+            let d112_d195 = lanes
+                .mul_add(
+                    k92_k160,
+                    d109_d194,
+                    lanes
+                        .mul_add(
+                            -k91_k159,
+                            d110_d193,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.MY10l, p.MY10r),
+                                    k86_k153,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.MZ10l, p.MZ10r),
+                                            k94_k162,
+                                            F64x2::new(p.m10l, p.m10r) * k100_k168,
+                                        ),
+                                ),
+                        ),
+                ); // F10l|ud=0,g=0.x | F10r|ud=0,g=0.x
+            let d113_d196 = lanes
+                .mul_add(
+                    k90_k158,
+                    d110_d193,
+                    lanes
+                        .mul_add(
+                            -k92_k160,
+                            d108_d192,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.MZ10l, p.MZ10r),
+                                    k93_k161,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.MX10l, p.MX10r),
+                                            k86_k153,
+                                            F64x2::new(p.m10l, p.m10r) * k101_k169,
+                                        ),
+                                ),
+                        ),
+                ); // F10l|ud=0,g=0.y | F10r|ud=0,g=0.y
+            let d111_d197 = lanes
+                .mul_add(
+                    -k91_k159,
+                    d108_d192,
+                    lanes
+                        .mul_add(
+                            k90_k158,
+                            d109_d194,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.MX10l, p.MX10r),
+                                    k94_k162,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.MY10l, p.MY10r),
+                                            k93_k161,
+                                            F64x2::new(p.m10l, p.m10r) * k98_k166,
+                                        ),
+                                ),
+                        ),
+                ); // F10l|ud=0,g=0.z | F10r|ud=0,g=0.z
+            let d114_d198 = lanes
+                .mul_add(
+                    F64x2::new(p.XZ10l, p.XZ10r),
+                    k92_k160,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY10l, p.XY10r),
+                            k91_k159,
+                            F64x2::new(p.XX10l, p.XX10r) * k90_k158,
+                        ),
+                ); // J10lw10l|ud=0,g=0.x | J10rw10r|ud=0,g=0.x
+            let d115_d199 = lanes
+                .mul_add(
+                    F64x2::new(p.YZ10l, p.YZ10r),
+                    k92_k160,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY10l, p.YY10r),
+                            k91_k159,
+                            F64x2::new(p.XY10l, p.XY10r) * k90_k158,
+                        ),
+                ); // J10lw10l|ud=0,g=0.y | J10rw10r|ud=0,g=0.y
+            let d116_d200 = lanes
+                .mul_add(
+                    F64x2::new(p.ZZ10l, p.ZZ10r),
+                    k92_k160,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ10l, p.YZ10r),
+                            k91_k159,
+                            F64x2::new(p.XZ10l, p.XZ10r) * k90_k158,
+                        ),
+                ); // J10lw10l|ud=0,g=0.z | J10rw10r|ud=0,g=0.z
+            let d117_d201 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ10l, p.MZ10r),
+                    k101_k169,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MY10l, p.MY10r),
+                            k98_k166,
+                            lanes
+                                .mul_add(
+                                    k92_k160,
+                                    d115_d199,
+                                    lanes
+                                        .mul_add(
+                                            -k91_k159,
+                                            d116_d200,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XZ10l, p.XZ10r),
+                                                    k86_k153,
+                                                    lanes
+                                                        .mul_add(
+                                                            F64x2::new(p.XY10l, p.XY10r),
+                                                            k94_k162,
+                                                            F64x2::new(p.XX10l, p.XX10r) * k93_k161,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N10l|ud=0,g=0.x | N10r|ud=0,g=0.x
+            let d118_d202 = lanes
+                .mul_add(
+                    F64x2::new(p.MX10l, p.MX10r),
+                    k98_k166,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ10l, p.MZ10r),
+                            k100_k168,
+                            lanes
+                                .mul_add(
+                                    k90_k158,
+                                    d116_d200,
+                                    lanes
+                                        .mul_add(
+                                            -k92_k160,
+                                            d114_d198,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.YZ10l, p.YZ10r),
+                                                    k86_k153,
+                                                    lanes
+                                                        .mul_add(
+                                                            F64x2::new(p.YY10l, p.YY10r),
+                                                            k94_k162,
+                                                            F64x2::new(p.XY10l, p.XY10r) * k93_k161,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N10l|ud=0,g=0.y | N10r|ud=0,g=0.y
+            let d119_d203 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY10l, p.MY10r),
+                    k100_k168,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MX10l, p.MX10r),
+                            k101_k169,
+                            lanes
+                                .mul_add(
+                                    k91_k159,
+                                    d114_d198,
+                                    lanes
+                                        .mul_add(
+                                            -k90_k158,
+                                            d115_d199,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.ZZ10l, p.ZZ10r),
+                                                    k86_k153,
+                                                    lanes
+                                                        .mul_add(
+                                                            F64x2::new(p.YZ10l, p.YZ10r),
+                                                            k94_k162,
+                                                            F64x2::new(p.XZ10l, p.XZ10r) * k93_k161,
+                                                        ),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N10l|ud=0,g=0.z | N10r|ud=0,g=0.z
+            let d119 = d119_d203.lo();
+            let d203 = d119_d203.hi();
+            out[11] = core::hint::black_box(d119);
             out[18] = core::hint::black_box(d203);
-            let d204 = A::mul_add(s_q7r, d196, c_q7r * d195); // f10r in 9r|ud=0,g=0.x
-            let d205 = A::mul_add(-c_q7r, d196, s_q7r * d195); // f10r in 9r|ud=0,g=0.z
-            let d206 = d183 + d204; // f9r|ud=0,g=0.x
-            let d207 = d184 + d197; // f9r|ud=0,g=0.y
-            let d208 = d185 - d205; // f9r|ud=0,g=0.z
-            let d209 = d190 + d203; // n9r|ud=0,g=0.y
-            let d210 = A::mul_add(
-                p.L9,
-                d205,
-                A::mul_add(s_q7r, d202, A::mul_add(c_q7r, d201, d189)),
-            ); // n9r|ud=0,g=0.x
+            let d260_d204 = lanes
+                .mul_add(
+                    F64x2::new(s_q7l, s_q7r),
+                    d113_d196,
+                    F64x2::new(c_q7l, c_q7r) * d112_d195,
+                ); // f10l in 9l|ud=0,g=0.x | f10r in 9r|ud=0,g=0.x
+            let d261_d205 = lanes
+                .mul_add(
+                    -F64x2::new(c_q7l, c_q7r),
+                    d113_d196,
+                    F64x2::new(s_q7l, s_q7r) * d112_d195,
+                ); // f10l in 9l|ud=0,g=0.z | f10r in 9r|ud=0,g=0.z
+            let d262_d206 = d99_d183 + d260_d204; // f9l|ud=0,g=0.x | f9r|ud=0,g=0.x
+            let d263_d209 = d106_d190 + d119_d203; // n9l|ud=0,g=0.y | n9r|ud=0,g=0.y
+            let d264_d210 = lanes
+                .mul_add(
+                    p.L9,
+                    d261_d205,
+                    lanes
+                        .mul_add(
+                            F64x2::new(s_q7l, s_q7r),
+                            d118_d202,
+                            lanes.mul_add(F64x2::new(c_q7l, c_q7r), d117_d201, d105_d189),
+                        ),
+                ); // n9l|ud=0,g=0.x | n9r|ud=0,g=0.x
+            let d264 = d264_d210.lo();
+            let d210 = d264_d210.hi();
+            out[10] = core::hint::black_box(-d264);
             out[17] = core::hint::black_box(-d210);
-            let d211 = A::mul_add(
-                p.L9,
-                d204,
-                A::mul_add(c_q7r, d202, A::mul_add(-s_q7r, d201, d191)),
-            ); // n9r|ud=0,g=0.z
-            let d212 = A::mul_add(s_q6r, d208, c_q6r * d207); // f9r in 8r|ud=0,g=0.y
-            let d213 = A::mul_add(-c_q6r, d208, s_q6r * d207); // f9r in 8r|ud=0,g=0.z
-            let d214 = d171 - d213; // f8r|ud=0,g=0.z
-            let d215 = d172 + d206; // f8r|ud=0,g=0.x
-            let d216 = d173 + d212; // f8r|ud=0,g=0.y
-            let d217 = d177 + d210; // n8r|ud=0,g=0.x
-            let d218 = A::mul_add(s_q6r, d211, A::mul_add(c_q6r, d209, d178)); // n8r|ud=0,g=0.y
+            let d265_d211 = lanes
+                .mul_add(
+                    p.L9,
+                    d260_d204,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q7l, c_q7r),
+                            d118_d202,
+                            lanes
+                                .mul_add(-F64x2::new(s_q7l, s_q7r), d117_d201, d107_d191),
+                        ),
+                ); // n9l|ud=0,g=0.z | n9r|ud=0,g=0.z
+            let d266_d207 = d100_d184 + d111_d197; // f9l|ud=0,g=0.y | f9r|ud=0,g=0.y
+            let d267_d208 = d101_d185 + d261_d205; // f9l|ud=0,g=0.z | f9r|ud=0,g=0.z
+            let d268_d212 = lanes
+                .mul_add(
+                    F64x2::new(s_q6l, s_q6r),
+                    d267_d208,
+                    F64x2::new(c_q6l, c_q6r) * d266_d207,
+                ); // f9l in 8l|ud=0,g=0.y | f9r in 8r|ud=0,g=0.y
+            let d269_d213 = lanes
+                .mul_add(
+                    -F64x2::new(c_q6l, c_q6r),
+                    d267_d208,
+                    F64x2::new(s_q6l, s_q6r) * d266_d207,
+                ); // f9l in 8l|ud=0,g=0.z | f9r in 8r|ud=0,g=0.z
+            let d270_d216 = d87_d173 + d268_d212; // f8l|ud=0,g=0.y | f8r|ud=0,g=0.y
+            let d271_d214 = d88_d171 + d269_d213; // f8l|ud=0,g=0.z | f8r|ud=0,g=0.z
+            let d272_d215 = d89_d172 + d262_d206; // f8l|ud=0,g=0.x | f8r|ud=0,g=0.x
+            let d273_d217 = d93_d177 + d264_d210; // n8l|ud=0,g=0.x | n8r|ud=0,g=0.x
+            let d274_d218 = lanes
+                .mul_add(
+                    F64x2::new(s_q6l, s_q6r),
+                    d265_d211,
+                    lanes.mul_add(F64x2::new(c_q6l, c_q6r), d263_d209, d94_d178),
+                ); // n8l|ud=0,g=0.y | n8r|ud=0,g=0.y
+            let d274 = d274_d218.lo();
+            let d218 = d274_d218.hi();
+            out[9] = core::hint::black_box(d274);
             out[16] = core::hint::black_box(d218);
-            let d219 = A::mul_add(-c_q6r, d211, A::mul_add(s_q6r, d209, d179)); // n8r|ud=0,g=0.z
-            let d220 = A::mul_add(s_q5r, d214, c_q5r * d215); // f8r in 7r|ud=0,g=0.x
-            let d221 = A::mul_add(-c_q5r, d214, s_q5r * d215); // f8r in 7r|ud=0,g=0.z
-            let d222 = d159 + d220; // f7r|ud=0,g=0.x
-            let d223 = d160 + d216; // f7r|ud=0,g=0.y
-            let d224 = d161 - d221; // f7r|ud=0,g=0.z
-            let d225 = d166 + d218; // n7r|ud=0,g=0.y
-            let d226 = A::mul_add(
-                p.L8,
-                d221,
-                A::mul_add(-s_q5r, d219, A::mul_add(c_q5r, d217, d165)),
-            ); // n7r|ud=0,g=0.x
+            let d275_d219 = lanes
+                .mul_add(
+                    -F64x2::new(c_q6l, c_q6r),
+                    d265_d211,
+                    lanes.mul_add(F64x2::new(s_q6l, s_q6r), d263_d209, d95_d179),
+                ); // n8l|ud=0,g=0.z | n8r|ud=0,g=0.z
+            let d276_d220 = lanes
+                .mul_add(
+                    F64x2::new(s_q5l, s_q5r),
+                    d271_d214,
+                    F64x2::new(c_q5l, c_q5r) * d272_d215,
+                ); // f8l in 7l|ud=0,g=0.x | f8r in 7r|ud=0,g=0.x
+            let d277_d221 = lanes
+                .mul_add(
+                    -F64x2::new(c_q5l, c_q5r),
+                    d271_d214,
+                    F64x2::new(s_q5l, s_q5r) * d272_d215,
+                ); // f8l in 7l|ud=0,g=0.z | f8r in 7r|ud=0,g=0.z
+            let d278_d222 = d75_d159 + d276_d220; // f7l|ud=0,g=0.x | f7r|ud=0,g=0.x
+            let d279_d225 = d82_d166 + d274_d218; // n7l|ud=0,g=0.y | n7r|ud=0,g=0.y
+            let d280_d226 = lanes
+                .mul_add(
+                    p.L8,
+                    d277_d221,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q5l, s_q5r),
+                            d275_d219,
+                            lanes.mul_add(F64x2::new(c_q5l, c_q5r), d273_d217, d81_d165),
+                        ),
+                ); // n7l|ud=0,g=0.x | n7r|ud=0,g=0.x
+            let d280 = d280_d226.lo();
+            let d226 = d280_d226.hi();
+            out[8] = core::hint::black_box(-d280);
             out[15] = core::hint::black_box(-d226);
-            let d227 = A::mul_add(
-                p.L8,
-                d220,
-                A::mul_add(-c_q5r, d219, A::mul_add(-s_q5r, d217, d167)),
-            ); // n7r|ud=0,g=0.z
-            let d228 = A::mul_add(s_q4r, d224, c_q4r * d223); // f7r in 6r|ud=0,g=0.y
-            let d229 = A::mul_add(-c_q4r, d224, s_q4r * d223); // f7r in 6r|ud=0,g=0.z
-            let d230 = d147 - d229; // f6r|ud=0,g=0.z
-            let d231 = d148 + d222; // f6r|ud=0,g=0.x
-            let d232 = d149 + d228; // f6r|ud=0,g=0.y
-            let d233 = d153 + d226; // n6r|ud=0,g=0.x
-            let d234 = A::mul_add(s_q4r, d227, A::mul_add(c_q4r, d225, d154)); // n6r|ud=0,g=0.y
+            let d281_d227 = lanes
+                .mul_add(
+                    p.L8,
+                    d276_d220,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(c_q5l, c_q5r),
+                            d275_d219,
+                            lanes.mul_add(-F64x2::new(s_q5l, s_q5r), d273_d217, d83_d167),
+                        ),
+                ); // n7l|ud=0,g=0.z | n7r|ud=0,g=0.z
+            let d282_d223 = d76_d160 + d270_d216; // f7l|ud=0,g=0.y | f7r|ud=0,g=0.y
+            let d283_d224 = d77_d161 + d277_d221; // f7l|ud=0,g=0.z | f7r|ud=0,g=0.z
+            let d284_d228 = lanes
+                .mul_add(
+                    F64x2::new(s_q4l, s_q4r),
+                    d283_d224,
+                    F64x2::new(c_q4l, c_q4r) * d282_d223,
+                ); // f7l in 6l|ud=0,g=0.y | f7r in 6r|ud=0,g=0.y
+            let d285_d229 = lanes
+                .mul_add(
+                    -F64x2::new(c_q4l, c_q4r),
+                    d283_d224,
+                    F64x2::new(s_q4l, s_q4r) * d282_d223,
+                ); // f7l in 6l|ud=0,g=0.z | f7r in 6r|ud=0,g=0.z
+            let d286_d232 = d63_d149 + d284_d228; // f6l|ud=0,g=0.y | f6r|ud=0,g=0.y
+            let d287_d230 = d64_d147 + d285_d229; // f6l|ud=0,g=0.z | f6r|ud=0,g=0.z
+            let d288_d231 = d65_d148 + d278_d222; // f6l|ud=0,g=0.x | f6r|ud=0,g=0.x
+            let d289_d233 = d69_d153 + d280_d226; // n6l|ud=0,g=0.x | n6r|ud=0,g=0.x
+            let d290_d234 = lanes
+                .mul_add(
+                    F64x2::new(s_q4l, s_q4r),
+                    d281_d227,
+                    lanes.mul_add(F64x2::new(c_q4l, c_q4r), d279_d225, d70_d154),
+                ); // n6l|ud=0,g=0.y | n6r|ud=0,g=0.y
+            let d290 = d290_d234.lo();
+            let d234 = d290_d234.hi();
+            out[7] = core::hint::black_box(d290);
             out[14] = core::hint::black_box(d234);
-            let d235 = A::mul_add(-c_q4r, d227, A::mul_add(s_q4r, d225, d155)); // n6r|ud=0,g=0.z
-            let d236 = A::mul_add(s_q3r, d230, c_q3r * d231); // f6r in 5r|ud=0,g=0.x
-            let d237 = A::mul_add(-c_q3r, d230, s_q3r * d231); // f6r in 5r|ud=0,g=0.z
-            let d238 = d135 + d236; // f5r|ud=0,g=0.x
-            let d239 = d136 + d232; // f5r|ud=0,g=0.y
-            let d240 = d137 - d237; // f5r|ud=0,g=0.z
-            let d241 = d142 + d234; // n5r|ud=0,g=0.y
-            let d242 = A::mul_add(
-                p.L7,
-                d237,
-                A::mul_add(-s_q3r, d235, A::mul_add(c_q3r, d233, d141)),
-            ); // n5r|ud=0,g=0.x
+            let d291_d235 = lanes
+                .mul_add(
+                    -F64x2::new(c_q4l, c_q4r),
+                    d281_d227,
+                    lanes.mul_add(F64x2::new(s_q4l, s_q4r), d279_d225, d71_d155),
+                ); // n6l|ud=0,g=0.z | n6r|ud=0,g=0.z
+            let d292_d236 = lanes
+                .mul_add(
+                    F64x2::new(s_q3l, s_q3r),
+                    d287_d230,
+                    F64x2::new(c_q3l, c_q3r) * d288_d231,
+                ); // f6l in 5l|ud=0,g=0.x | f6r in 5r|ud=0,g=0.x
+            let d293_d237 = lanes
+                .mul_add(
+                    -F64x2::new(c_q3l, c_q3r),
+                    d287_d230,
+                    F64x2::new(s_q3l, s_q3r) * d288_d231,
+                ); // f6l in 5l|ud=0,g=0.z | f6r in 5r|ud=0,g=0.z
+            let d294_d238 = d51_d135 + d292_d236; // f5l|ud=0,g=0.x | f5r|ud=0,g=0.x
+            let d295_d241 = d58_d142 + d290_d234; // n5l|ud=0,g=0.y | n5r|ud=0,g=0.y
+            let d296_d242 = lanes
+                .mul_add(
+                    p.L7,
+                    d293_d237,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q3l, s_q3r),
+                            d291_d235,
+                            lanes.mul_add(F64x2::new(c_q3l, c_q3r), d289_d233, d57_d141),
+                        ),
+                ); // n5l|ud=0,g=0.x | n5r|ud=0,g=0.x
+            let d296 = d296_d242.lo();
+            let d242 = d296_d242.hi();
+            out[6] = core::hint::black_box(-d296);
             out[13] = core::hint::black_box(-d242);
-            let d243 = A::mul_add(
-                p.L7,
-                d236,
-                A::mul_add(-c_q3r, d235, A::mul_add(-s_q3r, d233, d143)),
-            ); // n5r|ud=0,g=0.z
-            let d244 = A::mul_add(s_q2r, d240, c_q2r * d239); // f5r in 4r|ud=0,g=0.y
-            let d245 = A::mul_add(-c_q2r, d240, s_q2r * d239); // f5r in 4r|ud=0,g=0.z
-            let d246 = d123 - d245; // f4r|ud=0,g=0.z
-            let d247 = d124 + d238; // f4r|ud=0,g=0.x
-            let d248 = d125 + d244; // f4r|ud=0,g=0.y
-            let d249 = d129 + d242; // n4r|ud=0,g=0.x
-            let d250 = A::mul_add(s_q2r, d243, A::mul_add(c_q2r, d241, d130)); // n4r|ud=0,g=0.y
+            let d297_d243 = lanes
+                .mul_add(
+                    p.L7,
+                    d292_d236,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(c_q3l, c_q3r),
+                            d291_d235,
+                            lanes.mul_add(-F64x2::new(s_q3l, s_q3r), d289_d233, d59_d143),
+                        ),
+                ); // n5l|ud=0,g=0.z | n5r|ud=0,g=0.z
+            let d298_d239 = d52_d136 + d286_d232; // f5l|ud=0,g=0.y | f5r|ud=0,g=0.y
+            let d299_d240 = d53_d137 + d293_d237; // f5l|ud=0,g=0.z | f5r|ud=0,g=0.z
+            let d300_d244 = lanes
+                .mul_add(
+                    F64x2::new(s_q2l, s_q2r),
+                    d299_d240,
+                    F64x2::new(c_q2l, c_q2r) * d298_d239,
+                ); // f5l in 4l|ud=0,g=0.y | f5r in 4r|ud=0,g=0.y
+            let d301_d245 = lanes
+                .mul_add(
+                    -F64x2::new(c_q2l, c_q2r),
+                    d299_d240,
+                    F64x2::new(s_q2l, s_q2r) * d298_d239,
+                ); // f5l in 4l|ud=0,g=0.z | f5r in 4r|ud=0,g=0.z
+            let d302_d248 = d39_d125 + d300_d244; // f4l|ud=0,g=0.y | f4r|ud=0,g=0.y
+            let d302 = d302_d248.lo();
+            let d248 = d302_d248.hi();
+            let d254 = d27 - d248; // f3|ud=0,g=0.x
+            let d303_d246 = d40_d123 + d301_d245; // f4l|ud=0,g=0.z | f4r|ud=0,g=0.z
+            let d304_d247 = d41_d124 + d294_d238; // f4l|ud=0,g=0.x | f4r|ud=0,g=0.x
+            let d305_d249 = d45_d129 + d296_d242; // n4l|ud=0,g=0.x | n4r|ud=0,g=0.x
+            let d305 = d305_d249.lo();
+            let d249 = d305_d249.hi();
+            let d306_d250 = lanes
+                .mul_add(
+                    F64x2::new(s_q2l, s_q2r),
+                    d297_d243,
+                    lanes.mul_add(F64x2::new(c_q2l, c_q2r), d295_d241, d46_d130),
+                ); // n4l|ud=0,g=0.y | n4r|ud=0,g=0.y
+            let d306 = d306_d250.lo();
+            let d250 = d306_d250.hi();
+            out[5] = core::hint::black_box(d306);
             out[12] = core::hint::black_box(d250);
-            let d251 = A::mul_add(-c_q2r, d243, A::mul_add(s_q2r, d241, d131)); // n4r|ud=0,g=0.z
-            let d252 = A::mul_add(s_q1r, d246, c_q1r * d247); // f4r in 3|ud=0,g=0.y
-            let d253 = A::mul_add(-c_q1r, d246, s_q1r * d247); // f4r in 3|ud=0,g=0.z
-            let d254 = d27 + d248; // f3|ud=0,g=0.x
+            let d307_d251 = lanes
+                .mul_add(
+                    -F64x2::new(c_q2l, c_q2r),
+                    d297_d243,
+                    lanes.mul_add(F64x2::new(s_q2l, s_q2r), d295_d241, d47_d131),
+                ); // n4l|ud=0,g=0.z | n4r|ud=0,g=0.z
+            let d307 = d307_d251.lo();
+            let d251 = d307_d251.hi();
+            let d308_d253 = lanes
+                .mul_add(
+                    -F64x2::new(c_q1l, c_q1r),
+                    d303_d246,
+                    F64x2::new(s_q1l, s_q1r) * d304_d247,
+                ); // f4l in 3|ud=0,g=0.z | f4r in 3|ud=0,g=0.z
+            let d308 = d308_d253.lo();
+            let d253 = d308_d253.hi();
             let d255 = A::mul_add(-p.L5, d253, d33 + d250); // n3|ud=0,g=0.x
             let d256 = A::mul_add(
                 -p.L6,
                 d253,
                 A::mul_add(s_q1r, d251, A::mul_add(-c_q1r, d249, d34)),
             ); // n3|ud=0,g=0.y
+            let d259 = d29 + d253; // f3|ud=0,g=0.z
+            let d309_d252 = lanes
+                .mul_add(
+                    F64x2::new(s_q1l, s_q1r),
+                    d303_d246,
+                    F64x2::new(c_q1l, c_q1r) * d304_d247,
+                ); // f4l in 3|ud=0,g=0.y | f4r in 3|ud=0,g=0.y
+            let d309 = d309_d252.lo();
+            let d252 = d309_d252.hi();
             let d257 = A::mul_add(
-                -p.L5,
+                p.L5,
                 d248,
                 A::mul_add(
                     p.L6,
@@ -5517,87 +6518,6 @@ mod generated {
                 ),
             ); // n3|ud=0,g=0.z
             let d258 = d28 + d252; // f3|ud=0,g=0.y
-            let d259 = d29 + d253; // f3|ud=0,g=0.z
-            let d260 = A::mul_add(s_q7l, d113, c_q7l * d112); // f10l in 9l|ud=0,g=0.x
-            let d261 = A::mul_add(-c_q7l, d113, s_q7l * d112); // f10l in 9l|ud=0,g=0.z
-            let d262 = d99 + d260; // f9l|ud=0,g=0.x
-            let d263 = d106 + d119; // n9l|ud=0,g=0.y
-            let d264 = A::mul_add(
-                p.L9,
-                d261,
-                A::mul_add(s_q7l, d118, A::mul_add(c_q7l, d117, d105)),
-            ); // n9l|ud=0,g=0.x
-            out[10] = core::hint::black_box(-d264);
-            let d265 = A::mul_add(
-                p.L9,
-                d260,
-                A::mul_add(c_q7l, d118, A::mul_add(-s_q7l, d117, d107)),
-            ); // n9l|ud=0,g=0.z
-            let d266 = d100 + d111; // f9l|ud=0,g=0.y
-            let d267 = d101 + d261; // f9l|ud=0,g=0.z
-            let d268 = A::mul_add(s_q6l, d267, c_q6l * d266); // f9l in 8l|ud=0,g=0.y
-            let d269 = A::mul_add(-c_q6l, d267, s_q6l * d266); // f9l in 8l|ud=0,g=0.z
-            let d270 = d87 + d268; // f8l|ud=0,g=0.y
-            let d271 = d88 + d269; // f8l|ud=0,g=0.z
-            let d272 = d89 + d262; // f8l|ud=0,g=0.x
-            let d273 = d93 + d264; // n8l|ud=0,g=0.x
-            let d274 = A::mul_add(s_q6l, d265, A::mul_add(c_q6l, d263, d94)); // n8l|ud=0,g=0.y
-            out[9] = core::hint::black_box(d274);
-            let d275 = A::mul_add(-c_q6l, d265, A::mul_add(s_q6l, d263, d95)); // n8l|ud=0,g=0.z
-            let d276 = A::mul_add(s_q5l, d271, c_q5l * d272); // f8l in 7l|ud=0,g=0.x
-            let d277 = A::mul_add(-c_q5l, d271, s_q5l * d272); // f8l in 7l|ud=0,g=0.z
-            let d278 = d75 + d276; // f7l|ud=0,g=0.x
-            let d279 = d82 + d274; // n7l|ud=0,g=0.y
-            let d280 = A::mul_add(
-                p.L8,
-                d277,
-                A::mul_add(-s_q5l, d275, A::mul_add(c_q5l, d273, d81)),
-            ); // n7l|ud=0,g=0.x
-            out[8] = core::hint::black_box(-d280);
-            let d281 = A::mul_add(
-                p.L8,
-                d276,
-                A::mul_add(-c_q5l, d275, A::mul_add(-s_q5l, d273, d83)),
-            ); // n7l|ud=0,g=0.z
-            let d282 = d76 + d270; // f7l|ud=0,g=0.y
-            let d283 = d77 + d277; // f7l|ud=0,g=0.z
-            let d284 = A::mul_add(s_q4l, d283, c_q4l * d282); // f7l in 6l|ud=0,g=0.y
-            let d285 = A::mul_add(-c_q4l, d283, s_q4l * d282); // f7l in 6l|ud=0,g=0.z
-            let d286 = d63 + d284; // f6l|ud=0,g=0.y
-            let d287 = d64 + d285; // f6l|ud=0,g=0.z
-            let d288 = d65 + d278; // f6l|ud=0,g=0.x
-            let d289 = d69 + d280; // n6l|ud=0,g=0.x
-            let d290 = A::mul_add(s_q4l, d281, A::mul_add(c_q4l, d279, d70)); // n6l|ud=0,g=0.y
-            out[7] = core::hint::black_box(d290);
-            let d291 = A::mul_add(-c_q4l, d281, A::mul_add(s_q4l, d279, d71)); // n6l|ud=0,g=0.z
-            let d292 = A::mul_add(s_q3l, d287, c_q3l * d288); // f6l in 5l|ud=0,g=0.x
-            let d293 = A::mul_add(-c_q3l, d287, s_q3l * d288); // f6l in 5l|ud=0,g=0.z
-            let d294 = d51 + d292; // f5l|ud=0,g=0.x
-            let d295 = d58 + d290; // n5l|ud=0,g=0.y
-            let d296 = A::mul_add(
-                p.L7,
-                d293,
-                A::mul_add(-s_q3l, d291, A::mul_add(c_q3l, d289, d57)),
-            ); // n5l|ud=0,g=0.x
-            out[6] = core::hint::black_box(-d296);
-            let d297 = A::mul_add(
-                p.L7,
-                d292,
-                A::mul_add(-c_q3l, d291, A::mul_add(-s_q3l, d289, d59)),
-            ); // n5l|ud=0,g=0.z
-            let d298 = d52 + d286; // f5l|ud=0,g=0.y
-            let d299 = d53 + d293; // f5l|ud=0,g=0.z
-            let d300 = A::mul_add(s_q2l, d299, c_q2l * d298); // f5l in 4l|ud=0,g=0.y
-            let d301 = A::mul_add(-c_q2l, d299, s_q2l * d298); // f5l in 4l|ud=0,g=0.z
-            let d302 = d39 + d300; // f4l|ud=0,g=0.y
-            let d303 = d40 + d301; // f4l|ud=0,g=0.z
-            let d304 = d41 + d294; // f4l|ud=0,g=0.x
-            let d305 = d45 + d296; // n4l|ud=0,g=0.x
-            let d306 = A::mul_add(s_q2l, d297, A::mul_add(c_q2l, d295, d46)); // n4l|ud=0,g=0.y
-            out[5] = core::hint::black_box(d306);
-            let d307 = A::mul_add(-c_q2l, d297, A::mul_add(s_q2l, d295, d47)); // n4l|ud=0,g=0.z
-            let d308 = A::mul_add(-c_q1l, d303, s_q1l * d304); // f4l in 3|ud=0,g=0.z
-            let d309 = A::mul_add(s_q1l, d303, c_q1l * d304); // f4l in 3|ud=0,g=0.y
             let d310 = d254 + d302; // f3|ud=0,g=0.x
             let d311 = A::mul_add(p.L5, d308, d255 - d306); // n3|ud=0,g=0.x
             let d312 = A::mul_add(
@@ -5660,11 +6580,12 @@ mod generated {
             out[1] = core::hint::black_box(-d332);
             out
         }
-        kanegen_runtime::isa::dispatch_fused(
+        kanegen_runtime::isa::dispatch_pair_with(
+            (),
             #[inline(always)]
-            || body::<kanegen_runtime::isa::Plain>(p, pc, q, u),
+            |(), lanes| body::<kanegen_runtime::isa::Plain, _>(lanes, p, pc, q, u),
             #[inline(always)]
-            || body::<kanegen_runtime::isa::Fused>(p, pc, q, u),
+            |(), lanes| body::<kanegen_runtime::isa::Fused, _>(lanes, p, pc, q, u),
         )
     }
     /// Gravity vector g(q).
@@ -5678,7 +6599,8 @@ mod generated {
         q: &SVector<f64, 19>,
     ) -> SVector<f64, 19> {
         #[inline(always)]
-        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+        fn body<A: kanegen_runtime::isa::Arith<f64>, P: kanegen_runtime::isa::PairArith>(
+            lanes: P,
             p: &Params,
             pc: &Precomputed,
             q: &SVector<f64, 19>,
@@ -5745,108 +6667,249 @@ mod generated {
             let d6 = c_q_torso * d4; // gravity acceleration in 3.z
             let d7 = A::mul_add(s_q1l, d6, c_q1l * d3); // gravity acceleration in 4l.x
             let d8 = A::mul_add(-c_q1l, d6, s_q1l * d3); // gravity acceleration in 4l.z
-            let d9 = A::mul_add(s_q2l, d8, c_q2l * d5); // gravity acceleration in 5l.y
-            let d10 = A::mul_add(-c_q2l, d8, s_q2l * d5); // gravity acceleration in 5l.z
-            let d11 = A::mul_add(s_q3l, d10, c_q3l * d7); // gravity acceleration in 6l.x
-            let d12 = A::mul_add(-c_q3l, d10, s_q3l * d7); // gravity acceleration in 6l.z
-            let d13 = A::mul_add(s_q4l, d12, c_q4l * d9); // gravity acceleration in 7l.y
-            let d14 = A::mul_add(-c_q4l, d12, s_q4l * d9); // gravity acceleration in 7l.z
-            let d15 = A::mul_add(s_q5l, d14, c_q5l * d11); // gravity acceleration in 8l.x
-            let d16 = A::mul_add(-c_q5l, d14, s_q5l * d11); // gravity acceleration in 8l.z
-            let d17 = A::mul_add(s_q6l, d16, c_q6l * d13); // gravity acceleration in 9l.y
-            let d18 = A::mul_add(-c_q6l, d16, s_q6l * d13); // gravity acceleration in 9l.z
-            let d19 = A::mul_add(s_q7l, d18, c_q7l * d15); // gravity acceleration in 10l.x
-            let d20 = A::mul_add(-c_q7l, d18, s_q7l * d15); // gravity acceleration in 10l.y
+            let d21 = A::mul_add(-c_q1r, d3, s_q1r * d6); // gravity acceleration in 4r.x
+            let d7_d21 = F64x2::new(d7, d21);
+            let d22 = A::mul_add(-c_q1r, d6, -s_q1r * d3); // gravity acceleration in 4r.z
+            let d8_d22 = F64x2::new(d8, d22);
+            let d9_d23 = lanes
+                .mul_add(
+                    F64x2::new(s_q2l, s_q2r),
+                    d8_d22,
+                    F64x2::new(c_q2l, c_q2r) * d5,
+                ); // gravity acceleration in 5l.y | gravity acceleration in 5r.y
+            let d9 = d9_d23.lo();
+            let d23 = d9_d23.hi();
+            let d10_d24 = lanes
+                .mul_add(
+                    -F64x2::new(c_q2l, c_q2r),
+                    d8_d22,
+                    F64x2::new(s_q2l, s_q2r) * d5,
+                ); // gravity acceleration in 5l.z | gravity acceleration in 5r.z
+            let d10 = d10_d24.lo();
+            let d24 = d10_d24.hi();
+            let d11_d25 = lanes
+                .mul_add(
+                    F64x2::new(s_q3l, s_q3r),
+                    d10_d24,
+                    F64x2::new(c_q3l, c_q3r) * d7_d21,
+                ); // gravity acceleration in 6l.x | gravity acceleration in 6r.x
+            let d11 = d11_d25.lo();
+            let d25 = d11_d25.hi();
+            let d12_d26 = lanes
+                .mul_add(
+                    -F64x2::new(c_q3l, c_q3r),
+                    d10_d24,
+                    F64x2::new(s_q3l, s_q3r) * d7_d21,
+                ); // gravity acceleration in 6l.z | gravity acceleration in 6r.z
+            let d12 = d12_d26.lo();
+            let d26 = d12_d26.hi();
+            let d13_d27 = lanes
+                .mul_add(
+                    F64x2::new(s_q4l, s_q4r),
+                    d12_d26,
+                    F64x2::new(c_q4l, c_q4r) * d9_d23,
+                ); // gravity acceleration in 7l.y | gravity acceleration in 7r.y
+            let d13 = d13_d27.lo();
+            let d27 = d13_d27.hi();
+            let d14_d28 = lanes
+                .mul_add(
+                    -F64x2::new(c_q4l, c_q4r),
+                    d12_d26,
+                    F64x2::new(s_q4l, s_q4r) * d9_d23,
+                ); // gravity acceleration in 7l.z | gravity acceleration in 7r.z
+            let d14 = d14_d28.lo();
+            let d28 = d14_d28.hi();
+            let d15_d29 = lanes
+                .mul_add(
+                    F64x2::new(s_q5l, s_q5r),
+                    d14_d28,
+                    F64x2::new(c_q5l, c_q5r) * d11_d25,
+                ); // gravity acceleration in 8l.x | gravity acceleration in 8r.x
+            let d15 = d15_d29.lo();
+            let d29 = d15_d29.hi();
+            let d16_d30 = lanes
+                .mul_add(
+                    -F64x2::new(c_q5l, c_q5r),
+                    d14_d28,
+                    F64x2::new(s_q5l, s_q5r) * d11_d25,
+                ); // gravity acceleration in 8l.z | gravity acceleration in 8r.z
+            let d16 = d16_d30.lo();
+            let d30 = d16_d30.hi();
+            let d17_d31 = lanes
+                .mul_add(
+                    F64x2::new(s_q6l, s_q6r),
+                    d16_d30,
+                    F64x2::new(c_q6l, c_q6r) * d13_d27,
+                ); // gravity acceleration in 9l.y | gravity acceleration in 9r.y
+            let d17 = d17_d31.lo();
+            let d31 = d17_d31.hi();
+            let d18_d32 = lanes
+                .mul_add(
+                    -F64x2::new(c_q6l, c_q6r),
+                    d16_d30,
+                    F64x2::new(s_q6l, s_q6r) * d13_d27,
+                ); // gravity acceleration in 9l.z | gravity acceleration in 9r.z
+            let d18 = d18_d32.lo();
+            let d32 = d18_d32.hi();
+            let d19_d33 = lanes
+                .mul_add(
+                    F64x2::new(s_q7l, s_q7r),
+                    d18_d32,
+                    F64x2::new(c_q7l, c_q7r) * d15_d29,
+                ); // gravity acceleration in 10l.x | gravity acceleration in 10r.x
+            let d19 = d19_d33.lo();
+            let d33 = d19_d33.hi();
+            let d20_d34 = lanes
+                .mul_add(
+                    -F64x2::new(c_q7l, c_q7r),
+                    d18_d32,
+                    F64x2::new(s_q7l, s_q7r) * d15_d29,
+                ); // gravity acceleration in 10l.y | gravity acceleration in 10r.y
+            let d20 = d20_d34.lo();
+            let d34 = d20_d34.hi();
             out[11] = core::hint::black_box(A::mul_add(-p.MX10l, d20, p.MY10l * d19));
-            let d21 = A::mul_add(-s_q1r, d6, c_q1r * d3); // gravity acceleration in 4r.x
-            let d22 = A::mul_add(c_q1r, d6, s_q1r * d3); // gravity acceleration in 4r.z
-            let d23 = A::mul_add(-s_q2r, d22, c_q2r * d5); // gravity acceleration in 5r.y
-            let d24 = A::mul_add(c_q2r, d22, s_q2r * d5); // gravity acceleration in 5r.z
-            let d25 = A::mul_add(-s_q3r, d24, c_q3r * d21); // gravity acceleration in 6r.x
-            let d26 = A::mul_add(c_q3r, d24, s_q3r * d21); // gravity acceleration in 6r.z
-            let d27 = A::mul_add(-s_q4r, d26, c_q4r * d23); // gravity acceleration in 7r.y
-            let d28 = A::mul_add(c_q4r, d26, s_q4r * d23); // gravity acceleration in 7r.z
-            let d29 = A::mul_add(-s_q5r, d28, c_q5r * d25); // gravity acceleration in 8r.x
-            let d30 = A::mul_add(c_q5r, d28, s_q5r * d25); // gravity acceleration in 8r.z
-            let d31 = A::mul_add(-s_q6r, d30, c_q6r * d27); // gravity acceleration in 9r.y
-            let d32 = A::mul_add(c_q6r, d30, s_q6r * d27); // gravity acceleration in 9r.z
-            let d33 = A::mul_add(-s_q7r, d32, c_q7r * d29); // gravity acceleration in 10r.x
-            let d34 = A::mul_add(c_q7r, d32, s_q7r * d29); // gravity acceleration in 10r.y
-            out[18] = core::hint::black_box(A::mul_add(-p.MX10r, d34, p.MY10r * d33));
-            let d35 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
-            let d36 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
-            let d37 = p.MX9r - d36; // MSC9r.x
-            let d38 = p.MZ9r + d35; // MSC9r.z
-            out[17] = core::hint::black_box(A::mul_add(-d38, d31, pc.pc2 * d32));
-            let d39 = A::mul_add(s_q6r, d38, c_q6r * pc.pc2); // MSC9r in 8r.y
-            let d40 = A::mul_add(-c_q6r, d38, s_q6r * pc.pc2); // MSC9r in 8r.z
-            let d41 = p.MX8r - d37; // MSC8r.x
-            let d42 = p.MY8r - d39; // MSC8r.y
-            let d43 = p.MZ8r - d40; // MSC8r.z
-            out[16] = core::hint::black_box(A::mul_add(-d41, d30, -d43 * d29));
-            let d44 = A::mul_add(c_q5r, d43, s_q5r * d41); // MSC8r in 7r.z
-            let d45 = A::mul_add(-s_q5r, d43, c_q5r * d41); // MSC8r in 7r.x
-            let d46 = p.MX7r - d45; // MSC7r.x
-            let d47 = p.MZ7r + d44; // MSC7r.z
-            let d48 = pc.pc13 - d42; // MSC7r.y
-            out[15] = core::hint::black_box(A::mul_add(-d47, d27, d48 * d28));
-            let d49 = A::mul_add(s_q4r, d47, c_q4r * d48); // MSC7r in 6r.y
-            let d50 = A::mul_add(-c_q4r, d47, s_q4r * d48); // MSC7r in 6r.z
-            let d51 = p.MX6r - d46; // MSC6r.x
-            let d52 = p.MY6r - d49; // MSC6r.y
-            let d53 = p.MZ6r - d50; // MSC6r.z
-            out[14] = core::hint::black_box(A::mul_add(-d51, d26, -d53 * d25));
-            let d54 = A::mul_add(c_q3r, d53, s_q3r * d51); // MSC6r in 5r.z
-            let d55 = A::mul_add(-s_q3r, d53, c_q3r * d51); // MSC6r in 5r.x
-            let d56 = p.MX5r - d55; // MSC5r.x
-            let d57 = p.MZ5r + d54; // MSC5r.z
-            let d58 = pc.pc19 - d52; // MSC5r.y
-            out[13] = core::hint::black_box(A::mul_add(-d57, d23, d58 * d24));
-            let d59 = A::mul_add(s_q2r, d57, c_q2r * d58); // MSC5r in 4r.y
-            let d60 = A::mul_add(-c_q2r, d57, s_q2r * d58); // MSC5r in 4r.z
-            let d61 = p.MX4r - d56; // MSC4r.x
-            let d62 = p.MY4r - d59; // MSC4r.y
-            let d63 = p.MZ4r - d60; // MSC4r.z
-            out[12] = core::hint::black_box(A::mul_add(-d61, d22, -d63 * d21));
-            let d64 = A::mul_add(-s_q1r, d63, c_q1r * d61); // MSC4r in 3.y
-            let d65 = A::mul_add(c_q1r, d63, s_q1r * d61); // MSC4r in 3.z
-            let d66 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
-            let d67 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
-            let d68 = p.MX9l - d67; // MSC9l.x
-            let d69 = p.MZ9l + d66; // MSC9l.z
+            out[18] = core::hint::black_box(A::mul_add(-p.MY10r, d33, p.MX10r * d34));
+            let d66_d35 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY10l, p.MY10r),
+                    F64x2::new(c_q7l, c_q7r),
+                    F64x2::new(p.MX10l, p.MX10r) * F64x2::new(s_q7l, s_q7r),
+                ); // MSC10l in 9l.z | MSC10r in 9r.z
+            let d67_d36 = lanes
+                .mul_add(
+                    F64x2::new(p.MY10l, p.MY10r),
+                    F64x2::new(s_q7l, s_q7r),
+                    F64x2::new(p.MX10l, p.MX10r) * F64x2::new(c_q7l, c_q7r),
+                ); // MSC10l in 9l.x | MSC10r in 9r.x
+            let d68_d37 = F64x2::new(p.MX9l, p.MX9r) - d67_d36; // MSC9l.x | MSC9r.x
+            let d69_d38 = F64x2::new(p.MZ9l, p.MZ9r) + d66_d35; // MSC9l.z | MSC9r.z
+            let d69 = d69_d38.lo();
+            let d38 = d69_d38.hi();
             out[10] = core::hint::black_box(A::mul_add(-pc.pc25, d18, d69 * d17));
-            let d70 = A::mul_add(s_q6l, d69, c_q6l * pc.pc25); // MSC9l in 8l.y
-            let d71 = A::mul_add(-c_q6l, d69, s_q6l * pc.pc25); // MSC9l in 8l.z
-            let d72 = p.MX8l - d68; // MSC8l.x
-            let d73 = p.MY8l - d70; // MSC8l.y
-            let d74 = p.MZ8l - d71; // MSC8l.z
+            out[17] = core::hint::black_box(A::mul_add(-d38, d31, pc.pc2 * d32));
+            let d70_d39 = lanes
+                .mul_add(
+                    F64x2::new(s_q6l, s_q6r),
+                    d69_d38,
+                    F64x2::new(c_q6l, c_q6r) * F64x2::new(pc.pc25, pc.pc2),
+                ); // MSC9l in 8l.y | MSC9r in 8r.y
+            let d71_d40 = lanes
+                .mul_add(
+                    -F64x2::new(c_q6l, c_q6r),
+                    d69_d38,
+                    F64x2::new(s_q6l, s_q6r) * F64x2::new(pc.pc25, pc.pc2),
+                ); // MSC9l in 8l.z | MSC9r in 8r.z
+            let d72_d41 = F64x2::new(p.MX8l, p.MX8r) - d68_d37; // MSC8l.x | MSC8r.x
+            let d72 = d72_d41.lo();
+            let d41 = d72_d41.hi();
+            let d73_d42 = F64x2::new(p.MY8l, p.MY8r) - d70_d39; // MSC8l.y | MSC8r.y
+            let d74_d43 = F64x2::new(p.MZ8l, p.MZ8r) - d71_d40; // MSC8l.z | MSC8r.z
+            let d74 = d74_d43.lo();
+            let d43 = d74_d43.hi();
             out[9] = core::hint::black_box(A::mul_add(-d72, d16, -d74 * d15));
-            let d75 = A::mul_add(c_q5l, d74, s_q5l * d72); // MSC8l in 7l.z
-            let d76 = A::mul_add(-s_q5l, d74, c_q5l * d72); // MSC8l in 7l.x
-            let d77 = p.MX7l - d76; // MSC7l.x
-            let d78 = p.MZ7l + d75; // MSC7l.z
-            let d79 = pc.pc36 - d73; // MSC7l.y
+            out[16] = core::hint::black_box(A::mul_add(d41, d30, d43 * d29));
+            let d75_d44 = lanes
+                .mul_add(
+                    F64x2::new(c_q5l, c_q5r),
+                    d74_d43,
+                    F64x2::new(s_q5l, s_q5r) * d72_d41,
+                ); // MSC8l in 7l.z | MSC8r in 7r.z
+            let d76_d45 = lanes
+                .mul_add(
+                    -F64x2::new(s_q5l, s_q5r),
+                    d74_d43,
+                    F64x2::new(c_q5l, c_q5r) * d72_d41,
+                ); // MSC8l in 7l.x | MSC8r in 7r.x
+            let d77_d46 = F64x2::new(p.MX7l, p.MX7r) - d76_d45; // MSC7l.x | MSC7r.x
+            let d78_d47 = F64x2::new(p.MZ7l, p.MZ7r) + d75_d44; // MSC7l.z | MSC7r.z
+            let d78 = d78_d47.lo();
+            let d47 = d78_d47.hi();
+            let d79_d48 = F64x2::new(pc.pc36, pc.pc13) - d73_d42; // MSC7l.y | MSC7r.y
+            let d79 = d79_d48.lo();
+            let d48 = d79_d48.hi();
             out[8] = core::hint::black_box(A::mul_add(-d79, d14, d78 * d13));
-            let d80 = A::mul_add(s_q4l, d78, c_q4l * d79); // MSC7l in 6l.y
-            let d81 = A::mul_add(-c_q4l, d78, s_q4l * d79); // MSC7l in 6l.z
-            let d82 = p.MX6l - d77; // MSC6l.x
-            let d83 = p.MY6l - d80; // MSC6l.y
-            let d84 = p.MZ6l - d81; // MSC6l.z
+            out[15] = core::hint::black_box(A::mul_add(-d47, d27, d48 * d28));
+            let d80_d49 = lanes
+                .mul_add(
+                    F64x2::new(s_q4l, s_q4r),
+                    d78_d47,
+                    F64x2::new(c_q4l, c_q4r) * d79_d48,
+                ); // MSC7l in 6l.y | MSC7r in 6r.y
+            let d81_d50 = lanes
+                .mul_add(
+                    -F64x2::new(c_q4l, c_q4r),
+                    d78_d47,
+                    F64x2::new(s_q4l, s_q4r) * d79_d48,
+                ); // MSC7l in 6l.z | MSC7r in 6r.z
+            let d82_d51 = F64x2::new(p.MX6l, p.MX6r) - d77_d46; // MSC6l.x | MSC6r.x
+            let d82 = d82_d51.lo();
+            let d51 = d82_d51.hi();
+            let d83_d52 = F64x2::new(p.MY6l, p.MY6r) - d80_d49; // MSC6l.y | MSC6r.y
+            let d84_d53 = F64x2::new(p.MZ6l, p.MZ6r) - d81_d50; // MSC6l.z | MSC6r.z
+            let d84 = d84_d53.lo();
+            let d53 = d84_d53.hi();
             out[7] = core::hint::black_box(A::mul_add(-d82, d12, -d84 * d11));
-            let d85 = A::mul_add(c_q3l, d84, s_q3l * d82); // MSC6l in 5l.z
-            let d86 = A::mul_add(-s_q3l, d84, c_q3l * d82); // MSC6l in 5l.x
-            let d87 = p.MX5l - d86; // MSC5l.x
-            let d88 = p.MZ5l + d85; // MSC5l.z
-            let d89 = pc.pc42 - d83; // MSC5l.y
+            out[14] = core::hint::black_box(A::mul_add(d51, d26, d53 * d25));
+            let d85_d54 = lanes
+                .mul_add(
+                    F64x2::new(c_q3l, c_q3r),
+                    d84_d53,
+                    F64x2::new(s_q3l, s_q3r) * d82_d51,
+                ); // MSC6l in 5l.z | MSC6r in 5r.z
+            let d86_d55 = lanes
+                .mul_add(
+                    -F64x2::new(s_q3l, s_q3r),
+                    d84_d53,
+                    F64x2::new(c_q3l, c_q3r) * d82_d51,
+                ); // MSC6l in 5l.x | MSC6r in 5r.x
+            let d87_d56 = F64x2::new(p.MX5l, p.MX5r) - d86_d55; // MSC5l.x | MSC5r.x
+            let d88_d57 = F64x2::new(p.MZ5l, p.MZ5r) + d85_d54; // MSC5l.z | MSC5r.z
+            let d88 = d88_d57.lo();
+            let d57 = d88_d57.hi();
+            let d89_d58 = F64x2::new(pc.pc42, pc.pc19) - d83_d52; // MSC5l.y | MSC5r.y
+            let d89 = d89_d58.lo();
+            let d58 = d89_d58.hi();
             out[6] = core::hint::black_box(A::mul_add(-d89, d10, d88 * d9));
-            let d90 = A::mul_add(s_q2l, d88, c_q2l * d89); // MSC5l in 4l.y
-            let d91 = A::mul_add(-c_q2l, d88, s_q2l * d89); // MSC5l in 4l.z
-            let d92 = p.MX4l - d87; // MSC4l.x
-            let d93 = p.MY4l - d90; // MSC4l.y
-            let d94 = p.MZ4l - d91; // MSC4l.z
+            out[13] = core::hint::black_box(A::mul_add(-d57, d23, d58 * d24));
+            let d90_d59 = lanes
+                .mul_add(
+                    F64x2::new(s_q2l, s_q2r),
+                    d88_d57,
+                    F64x2::new(c_q2l, c_q2r) * d89_d58,
+                ); // MSC5l in 4l.y | MSC5r in 4r.y
+            let d91_d60 = lanes
+                .mul_add(
+                    -F64x2::new(c_q2l, c_q2r),
+                    d88_d57,
+                    F64x2::new(s_q2l, s_q2r) * d89_d58,
+                ); // MSC5l in 4l.z | MSC5r in 4r.z
+            let d92_d61 = F64x2::new(p.MX4l, p.MX4r) - d87_d56; // MSC4l.x | MSC4r.x
+            let d92 = d92_d61.lo();
+            let d61 = d92_d61.hi();
+            let d93_d62 = F64x2::new(p.MY4l, p.MY4r) - d90_d59; // MSC4l.y | MSC4r.y
+            let d93 = d93_d62.lo();
+            let d62 = d93_d62.hi();
+            let d94_d63 = F64x2::new(p.MZ4l, p.MZ4r) - d91_d60; // MSC4l.z | MSC4r.z
+            let d94 = d94_d63.lo();
+            let d63 = d94_d63.hi();
             out[5] = core::hint::black_box(A::mul_add(-d92, d8, -d94 * d7));
-            let d95 = A::mul_add(-s_q1l, d94, c_q1l * d92); // MSC4l in 3.y
-            let d96 = A::mul_add(c_q1l, d94, s_q1l * d92); // MSC4l in 3.z
+            out[12] = core::hint::black_box(A::mul_add(d61, d22, d63 * d21));
+            let d95_d64 = lanes
+                .mul_add(
+                    -F64x2::new(s_q1l, s_q1r),
+                    d94_d63,
+                    F64x2::new(c_q1l, c_q1r) * d92_d61,
+                ); // MSC4l in 3.y | MSC4r in 3.y
+            let d95 = d95_d64.lo();
+            let d64 = d95_d64.hi();
+            let d96_d65 = lanes
+                .mul_add(
+                    F64x2::new(c_q1l, c_q1r),
+                    d94_d63,
+                    F64x2::new(s_q1l, s_q1r) * d92_d61,
+                ); // MSC4l in 3.z | MSC4r in 3.z
+            let d96 = d96_d65.lo();
+            let d65 = d96_d65.hi();
             let d97 = p.MZ3 + d65 - d96; // MSC3.z
             let d98 = d93 - d62 + pc.pc47; // MSC3.x
             out[4] = core::hint::black_box(A::mul_add(-d98, d6, d97 * d5));
@@ -5862,11 +6925,12 @@ mod generated {
             out[2] = core::hint::black_box(A::mul_add(-d105, d2, d106 * d1));
             out
         }
-        kanegen_runtime::isa::dispatch_fused(
+        kanegen_runtime::isa::dispatch_pair_with(
+            (),
             #[inline(always)]
-            || body::<kanegen_runtime::isa::Plain>(p, pc, q),
+            |(), lanes| body::<kanegen_runtime::isa::Plain, _>(lanes, p, pc, q),
             #[inline(always)]
-            || body::<kanegen_runtime::isa::Fused>(p, pc, q),
+            |(), lanes| body::<kanegen_runtime::isa::Fused, _>(lanes, p, pc, q),
         )
     }
     /// Inverse dynamics τ = M(q) u̇ + c(q, u) + g(q), in one pass.
@@ -5882,7 +6946,8 @@ mod generated {
         ud: &SVector<f64, 19>,
     ) -> SVector<f64, 19> {
         #[inline(always)]
-        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+        fn body<A: kanegen_runtime::isa::Arith<f64>, P: kanegen_runtime::isa::PairArith>(
+            lanes: P,
             p: &Params,
             pc: &Precomputed,
             q: &SVector<f64, 19>,
@@ -6299,18 +7364,44 @@ mod generated {
             let d48 = t9 + t10 + d33 + t5 - t6; // a4l in 3.z
             let d49 = A::mul_add(c_q1l, d48, s_q1l * d47); // a4l.z
             let d50 = A::mul_add(-s_q1l, d48, c_q1l * d47); // a4l.x
-            let d51 = A::mul_add(p.MY4l, k27, p.MZ4l * k28); // w4lxMS4l|ud=0,g=0.x
-            let d52 = A::mul_add(-p.MX4l, k28, p.MY4l * k26); // w4lxMS4l|ud=0,g=0.z
-            let d53 = A::mul_add(p.MZ4l, k26, p.MX4l * k27); // w4lxMS4l|ud=0,g=0.y
-            let d54 = A::mul_add(
-                p.MY4l,
-                k31,
-                A::mul_add(
-                    -p.MZ4l,
-                    k30,
-                    A::mul_add(-p.m4l, d50, A::mul_add(-k27, d53, k28 * d52)),
-                ),
-            ); // F4l.x
+            let d63 = A::mul_add(s_q2l, d49, c_q2l * d46); // a5l.y
+            let d64 = A::mul_add(-c_q2l, d49, s_q2l * d46); // a5l.z
+            let k77 = A::mul_add(-s_q1r, k17, c_q1r * k18); // w3 in 4r|ud=0,g=0.x
+            let k26_k77 = F64x2::new(k26, k77);
+            let k78 = A::mul_add(c_q1r, k17, s_q1r * k18); // w3 in 4r|ud=0,g=0.z
+            let k27_k78 = F64x2::new(k27, k78);
+            let k79 = qdd1r - k19; // wd4r.y
+            let k30_k79 = F64x2::new(k30, k79);
+            let k80 = -k16 - qd1r; // w4r|ud=0,g=0.y
+            let k28_k80 = F64x2::new(k28, k80);
+            let k81 = A::mul_add(s_q1r, k21, A::mul_add(c_q1r, k20, k78 * qd1r)); // wd4r.x
+            let k29_k81 = F64x2::new(k29, k81);
+            let k82 = A::mul_add(c_q1r, k21, A::mul_add(-s_q1r, k20, k77 * qd1r)); // wd4r.z
+            let k31_k82 = F64x2::new(k31, k82);
+            let k83 = t1 + t2; // w3xP4r|ud=0,g=0.z
+            let d156 = A::mul_add(k18, k83, t7) + d32 + t3; // a4r in 3.x
+            let d157 = t9 - t10 - d33 - t5 - t6; // a4r in 3.z
+            let d158 = A::mul_add(k16, k83, t8) - d30 - t4; // a4r in 3.y
+            let d159 = A::mul_add(c_q1r, d157, s_q1r * d158); // a4r.z
+            let d49_d159 = F64x2::new(d49, d159);
+            let d160 = A::mul_add(-s_q1r, d157, c_q1r * d158); // a4r.x
+            let d50_d160 = F64x2::new(d50, d160);
+            let d52_d161 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX4l, p.MX4r),
+                    k28_k80,
+                    F64x2::new(p.MY4l, p.MY4r) * k26_k77,
+                ); // w4lxMS4l|ud=0,g=0.z | w4rxMS4r|ud=0,g=0.z
+            let d52 = d52_d161.lo();
+            let d161 = d52_d161.hi();
+            let d51_d162 = lanes
+                .mul_add(
+                    F64x2::new(p.MY4l, p.MY4r),
+                    k27_k78,
+                    F64x2::new(p.MZ4l, p.MZ4r) * k28_k80,
+                ); // w4lxMS4l|ud=0,g=0.x | w4rxMS4r|ud=0,g=0.x
+            let d51 = d51_d162.lo();
+            let d162 = d51_d162.hi();
             let d55 = A::mul_add(
                 -p.MZ4l,
                 k29,
@@ -6320,35 +7411,80 @@ mod generated {
                     A::mul_add(-p.m4l, d46, A::mul_add(k26, d52, k27 * d51)),
                 ),
             ); // F4l.y
-            let d56 = A::mul_add(
-                -p.MX4l,
-                k30,
+            let d53_d163 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ4l, p.MZ4r),
+                    k26_k77,
+                    F64x2::new(p.MX4l, p.MX4r) * k27_k78,
+                ); // w4lxMS4l|ud=0,g=0.y | w4rxMS4r|ud=0,g=0.y
+            let d164 = A::mul_add(
+                -p.MZ4r,
+                k81,
                 A::mul_add(
-                    p.MY4l,
-                    k29,
-                    A::mul_add(-p.m4l, d49, A::mul_add(k28, d51, k26 * d53)),
+                    p.MX4r,
+                    k82,
+                    A::mul_add(p.m4r, d156, A::mul_add(k77, d161, k78 * d162)),
                 ),
-            ); // F4l.z
-            let d57 = A::mul_add(-p.XZ4l, k27, A::mul_add(p.XY4l, k28, p.XX4l * k26)); // J4lw4l|ud=0,g=0.x
-            let d58 = A::mul_add(-p.YZ4l, k27, A::mul_add(p.YY4l, k28, p.XY4l * k26)); // J4lw4l|ud=0,g=0.y
-            let d59 = A::mul_add(-p.ZZ4l, k27, A::mul_add(p.YZ4l, k28, p.XZ4l * k26)); // J4lw4l|ud=0,g=0.z
-            let d60 = A::mul_add(
-                -p.MZ4l,
-                d46,
-                A::mul_add(
-                    p.MY4l,
-                    d49,
-                    A::mul_add(
-                        -p.XZ4l,
-                        k31,
-                        A::mul_add(
-                            -p.XY4l,
-                            k30,
-                            A::mul_add(-p.XX4l, k29, A::mul_add(k27, d58, k28 * d59)),
+            ); // F4r.y
+            let d55_d164 = F64x2::new(d55, d164);
+            let d54_d165 = lanes
+                .mul_add(
+                    F64x2::new(p.MY4l, p.MY4r),
+                    k31_k82,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MZ4l, p.MZ4r),
+                            k30_k79,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.m4l, p.m4r),
+                                    d50_d160,
+                                    lanes.mul_add(-k27_k78, d53_d163, k28_k80 * d52_d161),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N4l.x
+                ); // F4l.x | F4r.x
+            let d56_d166 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX4l, p.MX4r),
+                    k30_k79,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MY4l, p.MY4r),
+                            k29_k81,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.m4l, p.m4r),
+                                    d49_d159,
+                                    lanes.mul_add(k28_k80, d51_d162, k26_k77 * d53_d163),
+                                ),
+                        ),
+                ); // F4l.z | F4r.z
+            let d57_d167 = lanes
+                .mul_add(
+                    -F64x2::new(p.XZ4l, p.XZ4r),
+                    k27_k78,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY4l, p.XY4r),
+                            k28_k80,
+                            F64x2::new(p.XX4l, p.XX4r) * k26_k77,
+                        ),
+                ); // J4lw4l|ud=0,g=0.x | J4rw4r|ud=0,g=0.x
+            let d57 = d57_d167.lo();
+            let d167 = d57_d167.hi();
+            let d58_d168 = lanes
+                .mul_add(
+                    -F64x2::new(p.YZ4l, p.YZ4r),
+                    k27_k78,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY4l, p.YY4r),
+                            k28_k80,
+                            F64x2::new(p.XY4l, p.XY4r) * k26_k77,
+                        ),
+                ); // J4lw4l|ud=0,g=0.y | J4rw4r|ud=0,g=0.y
+            let d58 = d58_d168.lo();
+            let d168 = d58_d168.hi();
             let d61 = A::mul_add(
                 p.MY4l,
                 d50,
@@ -6366,636 +7502,36 @@ mod generated {
                     ),
                 ),
             ); // N4l.z
-            let d62 = A::mul_add(
-                p.MX4l,
-                d49,
+            let d59_d169 = lanes
+                .mul_add(
+                    -F64x2::new(p.ZZ4l, p.ZZ4r),
+                    k27_k78,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ4l, p.YZ4r),
+                            k28_k80,
+                            F64x2::new(p.XZ4l, p.XZ4r) * k26_k77,
+                        ),
+                ); // J4lw4l|ud=0,g=0.z | J4rw4r|ud=0,g=0.z
+            let d59 = d59_d169.lo();
+            let d169 = d59_d169.hi();
+            let d60 = A::mul_add(
+                -p.MZ4l,
+                d46,
                 A::mul_add(
-                    p.MZ4l,
-                    d50,
+                    p.MY4l,
+                    d49,
                     A::mul_add(
-                        p.YZ4l,
+                        -p.XZ4l,
                         k31,
                         A::mul_add(
-                            p.YY4l,
+                            -p.XY4l,
                             k30,
-                            A::mul_add(p.XY4l, k29, A::mul_add(k26, d59, k27 * d57)),
+                            A::mul_add(-p.XX4l, k29, A::mul_add(k27, d58, k28 * d59)),
                         ),
                     ),
                 ),
-            ); // N4l.y
-            let k35 = A::mul_add(-s_q2l, k27, c_q2l * k28); // w4l in 5l|ud=0,g=0.y
-            let k36 = A::mul_add(c_q2l, k27, s_q2l * k28); // w4l in 5l|ud=0,g=0.z
-            let k37 = k29 - qdd2l; // wd5l.x
-            let k38 = A::mul_add(s_q2l, k31, A::mul_add(c_q2l, k30, k36 * qd2l)); // wd5l.y
-            let k39 = k26 + qd2l; // w5l|ud=0,g=0.x
-            let k40 = A::mul_add(c_q2l, k31, A::mul_add(-s_q2l, k30, k35 * qd2l)); // wd5l.z
-            let d63 = A::mul_add(s_q2l, d49, c_q2l * d46); // a5l.y
-            let d64 = A::mul_add(-c_q2l, d49, s_q2l * d46); // a5l.z
-            let d65 = A::mul_add(-p.MY5l, k36, p.MZ5l * k35); // w5lxMS5l|ud=0,g=0.x
-            let d66 = A::mul_add(-p.MZ5l, k39, p.MX5l * k36); // w5lxMS5l|ud=0,g=0.y
-            let d67 = A::mul_add(-p.MX5l, k35, p.MY5l * k39); // w5lxMS5l|ud=0,g=0.z
-            let d68 = A::mul_add(
-                p.MY5l,
-                k40,
-                A::mul_add(
-                    p.MZ5l,
-                    k38,
-                    A::mul_add(p.m5l, d50, A::mul_add(-k36, d66, k35 * d67)),
-                ),
-            ); // F5l.x
-            let d69 = A::mul_add(
-                -p.MZ5l,
-                k37,
-                A::mul_add(
-                    -p.MX5l,
-                    k40,
-                    A::mul_add(-p.m5l, d63, A::mul_add(-k39, d67, k36 * d65)),
-                ),
-            ); // F5l.y
-            let d70 = A::mul_add(
-                -p.MX5l,
-                k38,
-                A::mul_add(
-                    p.MY5l,
-                    k37,
-                    A::mul_add(-p.m5l, d64, A::mul_add(-k35, d65, k39 * d66)),
-                ),
-            ); // F5l.z
-            let d71 = A::mul_add(p.XZ5l, k36, A::mul_add(p.XY5l, k35, p.XX5l * k39)); // J5lw5l|ud=0,g=0.x
-            let d72 = A::mul_add(p.YZ5l, k36, A::mul_add(p.YY5l, k35, p.XY5l * k39)); // J5lw5l|ud=0,g=0.y
-            let d73 = A::mul_add(p.ZZ5l, k36, A::mul_add(p.YZ5l, k35, p.XZ5l * k39)); // J5lw5l|ud=0,g=0.z
-            let d74 = A::mul_add(
-                p.MZ5l,
-                d63,
-                A::mul_add(
-                    -p.MY5l,
-                    d64,
-                    A::mul_add(
-                        -p.XZ5l,
-                        k40,
-                        A::mul_add(
-                            p.XY5l,
-                            k38,
-                            A::mul_add(p.XX5l, k37, A::mul_add(-k36, d72, k35 * d73)),
-                        ),
-                    ),
-                ),
-            ); // N5l.x
-            let d75 = A::mul_add(
-                p.MX5l,
-                d64,
-                A::mul_add(
-                    p.MZ5l,
-                    d50,
-                    A::mul_add(
-                        -p.YZ5l,
-                        k40,
-                        A::mul_add(
-                            p.YY5l,
-                            k38,
-                            A::mul_add(p.XY5l, k37, A::mul_add(-k39, d73, k36 * d71)),
-                        ),
-                    ),
-                ),
-            ); // N5l.y
-            let d76 = A::mul_add(
-                -p.MY5l,
-                d50,
-                A::mul_add(
-                    -p.MX5l,
-                    d63,
-                    A::mul_add(
-                        -p.ZZ5l,
-                        k40,
-                        A::mul_add(
-                            p.YZ5l,
-                            k38,
-                            A::mul_add(p.XZ5l, k37, A::mul_add(-k35, d71, k39 * d72)),
-                        ),
-                    ),
-                ),
-            ); // N5l.z
-            let k41 = A::mul_add(-s_q3l, k36, c_q3l * k39); // w5l in 6l|ud=0,g=0.x
-            let k42 = A::mul_add(c_q3l, k36, s_q3l * k39); // w5l in 6l|ud=0,g=0.z
-            let k43 = k35 - qd3l; // w6l|ud=0,g=0.y
-            let k44 = A::mul_add(s_q3l, k40, A::mul_add(c_q3l, k37, k42 * qd3l)); // wd6l.x
-            let k45 = k38 + qdd3l; // wd6l.y
-            let k46 = A::mul_add(c_q3l, k40, A::mul_add(-s_q3l, k37, k41 * qd3l)); // wd6l.z
-            let k47 = p.L7 * k36; // w5lxP6l|ud=0,g=0.x
-            let k48 = p.L7 * k39; // w5lxP6l|ud=0,g=0.z
-            let d77 = A::mul_add(k39, k48, k36 * k47) - d63; // a6l in 5l.y
-            let d78 = A::mul_add(p.L7, k40, A::mul_add(k35, k48, -d50)); // a6l in 5l.x
-            let d79 = A::mul_add(p.L7, k37, A::mul_add(k35, k47, d64)); // a6l in 5l.z
-            let d80 = A::mul_add(-s_q3l, d79, c_q3l * d78); // a6l.x
-            let d81 = A::mul_add(c_q3l, d79, s_q3l * d78); // a6l.z
-            let d82 = A::mul_add(p.MY6l, k42, p.MZ6l * k43); // w6lxMS6l|ud=0,g=0.x
-            let d83 = A::mul_add(-p.MX6l, k43, p.MY6l * k41); // w6lxMS6l|ud=0,g=0.z
-            let d84 = A::mul_add(p.MZ6l, k41, p.MX6l * k42); // w6lxMS6l|ud=0,g=0.y
-            let d85 = A::mul_add(
-                p.MY6l,
-                k46,
-                A::mul_add(
-                    -p.MZ6l,
-                    k45,
-                    A::mul_add(p.m6l, d80, A::mul_add(-k42, d84, k43 * d83)),
-                ),
-            ); // F6l.x
-            let d86 = A::mul_add(
-                -p.MZ6l,
-                k44,
-                A::mul_add(
-                    p.MX6l,
-                    k46,
-                    A::mul_add(p.m6l, d77, A::mul_add(k41, d83, k42 * d82)),
-                ),
-            ); // F6l.y
-            let d87 = A::mul_add(
-                -p.MX6l,
-                k45,
-                A::mul_add(
-                    p.MY6l,
-                    k44,
-                    A::mul_add(p.m6l, d81, A::mul_add(k43, d82, k41 * d84)),
-                ),
-            ); // F6l.z
-            let d88 = A::mul_add(-p.XZ6l, k42, A::mul_add(p.XY6l, k43, p.XX6l * k41)); // J6lw6l|ud=0,g=0.x
-            let d89 = A::mul_add(-p.YZ6l, k42, A::mul_add(p.YY6l, k43, p.XY6l * k41)); // J6lw6l|ud=0,g=0.y
-            let d90 = A::mul_add(-p.ZZ6l, k42, A::mul_add(p.YZ6l, k43, p.XZ6l * k41)); // J6lw6l|ud=0,g=0.z
-            let d91 = A::mul_add(
-                p.MZ6l,
-                d77,
-                A::mul_add(
-                    -p.MY6l,
-                    d81,
-                    A::mul_add(
-                        -p.XZ6l,
-                        k46,
-                        A::mul_add(
-                            -p.XY6l,
-                            k45,
-                            A::mul_add(-p.XX6l, k44, A::mul_add(k42, d89, k43 * d90)),
-                        ),
-                    ),
-                ),
-            ); // N6l.x
-            let d92 = A::mul_add(
-                -p.MY6l,
-                d80,
-                A::mul_add(
-                    -p.MX6l,
-                    d77,
-                    A::mul_add(
-                        -p.ZZ6l,
-                        k46,
-                        A::mul_add(
-                            -p.YZ6l,
-                            k45,
-                            A::mul_add(-p.XZ6l, k44, A::mul_add(-k43, d88, k41 * d89)),
-                        ),
-                    ),
-                ),
-            ); // N6l.z
-            let d93 = A::mul_add(
-                -p.MX6l,
-                d81,
-                A::mul_add(
-                    -p.MZ6l,
-                    d80,
-                    A::mul_add(
-                        p.YZ6l,
-                        k46,
-                        A::mul_add(
-                            p.YY6l,
-                            k45,
-                            A::mul_add(p.XY6l, k44, A::mul_add(k41, d90, k42 * d88)),
-                        ),
-                    ),
-                ),
-            ); // N6l.y
-            let k49 = A::mul_add(-s_q4l, k42, c_q4l * k43); // w6l in 7l|ud=0,g=0.y
-            let k50 = A::mul_add(c_q4l, k42, s_q4l * k43); // w6l in 7l|ud=0,g=0.z
-            let k51 = k44 - qdd4l; // wd7l.x
-            let k52 = A::mul_add(s_q4l, k46, A::mul_add(c_q4l, k45, k50 * qd4l)); // wd7l.y
-            let k53 = k41 + qd4l; // w7l|ud=0,g=0.x
-            let k54 = A::mul_add(c_q4l, k46, A::mul_add(-s_q4l, k45, k49 * qd4l)); // wd7l.z
-            let d94 = A::mul_add(s_q4l, d81, c_q4l * d77); // a7l.y
-            let d95 = A::mul_add(-c_q4l, d81, s_q4l * d77); // a7l.z
-            let d96 = A::mul_add(-p.MY7l, k50, p.MZ7l * k49); // w7lxMS7l|ud=0,g=0.x
-            let d97 = A::mul_add(-p.MZ7l, k53, p.MX7l * k50); // w7lxMS7l|ud=0,g=0.y
-            let d98 = A::mul_add(-p.MX7l, k49, p.MY7l * k53); // w7lxMS7l|ud=0,g=0.z
-            let d99 = A::mul_add(
-                p.MY7l,
-                k54,
-                A::mul_add(
-                    p.MZ7l,
-                    k52,
-                    A::mul_add(-p.m7l, d80, A::mul_add(-k50, d97, k49 * d98)),
-                ),
-            ); // F7l.x
-            let d100 = A::mul_add(
-                -p.MZ7l,
-                k51,
-                A::mul_add(
-                    -p.MX7l,
-                    k54,
-                    A::mul_add(p.m7l, d94, A::mul_add(-k53, d98, k50 * d96)),
-                ),
-            ); // F7l.y
-            let d101 = A::mul_add(
-                -p.MX7l,
-                k52,
-                A::mul_add(
-                    p.MY7l,
-                    k51,
-                    A::mul_add(p.m7l, d95, A::mul_add(-k49, d96, k53 * d97)),
-                ),
-            ); // F7l.z
-            let d102 = A::mul_add(p.XZ7l, k50, A::mul_add(p.XY7l, k49, p.XX7l * k53)); // J7lw7l|ud=0,g=0.x
-            let d103 = A::mul_add(p.YZ7l, k50, A::mul_add(p.YY7l, k49, p.XY7l * k53)); // J7lw7l|ud=0,g=0.y
-            let d104 = A::mul_add(p.ZZ7l, k50, A::mul_add(p.YZ7l, k49, p.XZ7l * k53)); // J7lw7l|ud=0,g=0.z
-            let d105 = A::mul_add(
-                -p.MZ7l,
-                d94,
-                A::mul_add(
-                    p.MY7l,
-                    d95,
-                    A::mul_add(
-                        -p.XZ7l,
-                        k54,
-                        A::mul_add(
-                            p.XY7l,
-                            k52,
-                            A::mul_add(p.XX7l, k51, A::mul_add(-k50, d103, k49 * d104)),
-                        ),
-                    ),
-                ),
-            ); // N7l.x
-            let d106 = A::mul_add(
-                -p.MX7l,
-                d95,
-                A::mul_add(
-                    -p.MZ7l,
-                    d80,
-                    A::mul_add(
-                        -p.YZ7l,
-                        k54,
-                        A::mul_add(
-                            p.YY7l,
-                            k52,
-                            A::mul_add(p.XY7l, k51, A::mul_add(-k53, d104, k50 * d102)),
-                        ),
-                    ),
-                ),
-            ); // N7l.y
-            let d107 = A::mul_add(
-                p.MY7l,
-                d80,
-                A::mul_add(
-                    p.MX7l,
-                    d94,
-                    A::mul_add(
-                        -p.ZZ7l,
-                        k54,
-                        A::mul_add(
-                            p.YZ7l,
-                            k52,
-                            A::mul_add(p.XZ7l, k51, A::mul_add(-k49, d102, k53 * d103)),
-                        ),
-                    ),
-                ),
-            ); // N7l.z
-            let k55 = A::mul_add(-s_q5l, k50, c_q5l * k53); // w7l in 8l|ud=0,g=0.x
-            let k56 = A::mul_add(c_q5l, k50, s_q5l * k53); // w7l in 8l|ud=0,g=0.z
-            let k57 = k49 - qd5l; // w8l|ud=0,g=0.y
-            let k58 = A::mul_add(s_q5l, k54, A::mul_add(c_q5l, k51, k56 * qd5l)); // wd8l.x
-            let k59 = k52 + qdd5l; // wd8l.y
-            let k60 = A::mul_add(c_q5l, k54, A::mul_add(-s_q5l, k51, k55 * qd5l)); // wd8l.z
-            let k61 = p.L8 * k50; // w7lxP8l|ud=0,g=0.x
-            let k62 = p.L8 * k53; // w7lxP8l|ud=0,g=0.z
-            let d108 = A::mul_add(k53, k62, k50 * k61) + d94; // a8l in 7l.y
-            let d109 = A::mul_add(p.L8, k54, A::mul_add(k49, k62, d80)); // a8l in 7l.x
-            let d110 = A::mul_add(p.L8, k51, A::mul_add(k49, k61, -d95)); // a8l in 7l.z
-            let d111 = A::mul_add(-s_q5l, d110, c_q5l * d109); // a8l.x
-            let d112 = A::mul_add(c_q5l, d110, s_q5l * d109); // a8l.z
-            let d113 = A::mul_add(p.MY8l, k56, p.MZ8l * k57); // w8lxMS8l|ud=0,g=0.x
-            let d114 = A::mul_add(-p.MX8l, k57, p.MY8l * k55); // w8lxMS8l|ud=0,g=0.z
-            let d115 = A::mul_add(p.MZ8l, k55, p.MX8l * k56); // w8lxMS8l|ud=0,g=0.y
-            let d116 = A::mul_add(
-                p.MY8l,
-                k60,
-                A::mul_add(
-                    -p.MZ8l,
-                    k59,
-                    A::mul_add(p.m8l, d111, A::mul_add(-k56, d115, k57 * d114)),
-                ),
-            ); // F8l.x
-            let d117 = A::mul_add(
-                -p.MZ8l,
-                k58,
-                A::mul_add(
-                    p.MX8l,
-                    k60,
-                    A::mul_add(p.m8l, d108, A::mul_add(k55, d114, k56 * d113)),
-                ),
-            ); // F8l.y
-            let d118 = A::mul_add(
-                -p.MX8l,
-                k59,
-                A::mul_add(
-                    p.MY8l,
-                    k58,
-                    A::mul_add(p.m8l, d112, A::mul_add(k57, d113, k55 * d115)),
-                ),
-            ); // F8l.z
-            let d119 = A::mul_add(-p.XZ8l, k56, A::mul_add(p.XY8l, k57, p.XX8l * k55)); // J8lw8l|ud=0,g=0.x
-            let d120 = A::mul_add(-p.YZ8l, k56, A::mul_add(p.YY8l, k57, p.XY8l * k55)); // J8lw8l|ud=0,g=0.y
-            let d121 = A::mul_add(-p.ZZ8l, k56, A::mul_add(p.YZ8l, k57, p.XZ8l * k55)); // J8lw8l|ud=0,g=0.z
-            let d122 = A::mul_add(
-                p.MZ8l,
-                d108,
-                A::mul_add(
-                    -p.MY8l,
-                    d112,
-                    A::mul_add(
-                        -p.XZ8l,
-                        k60,
-                        A::mul_add(
-                            -p.XY8l,
-                            k59,
-                            A::mul_add(-p.XX8l, k58, A::mul_add(k56, d120, k57 * d121)),
-                        ),
-                    ),
-                ),
-            ); // N8l.x
-            let d123 = A::mul_add(
-                -p.MY8l,
-                d111,
-                A::mul_add(
-                    -p.MX8l,
-                    d108,
-                    A::mul_add(
-                        -p.ZZ8l,
-                        k60,
-                        A::mul_add(
-                            -p.YZ8l,
-                            k59,
-                            A::mul_add(-p.XZ8l, k58, A::mul_add(-k57, d119, k55 * d120)),
-                        ),
-                    ),
-                ),
-            ); // N8l.z
-            let d124 = A::mul_add(
-                -p.MX8l,
-                d112,
-                A::mul_add(
-                    -p.MZ8l,
-                    d111,
-                    A::mul_add(
-                        p.YZ8l,
-                        k60,
-                        A::mul_add(
-                            p.YY8l,
-                            k59,
-                            A::mul_add(p.XY8l, k58, A::mul_add(k55, d121, k56 * d119)),
-                        ),
-                    ),
-                ),
-            ); // N8l.y
-            let k63 = A::mul_add(-s_q6l, k56, c_q6l * k57); // w8l in 9l|ud=0,g=0.y
-            let k64 = A::mul_add(c_q6l, k56, s_q6l * k57); // w8l in 9l|ud=0,g=0.z
-            let k65 = k58 - qdd6l; // wd9l.x
-            let k66 = A::mul_add(s_q6l, k60, A::mul_add(c_q6l, k59, k64 * qd6l)); // wd9l.y
-            let k67 = k55 + qd6l; // w9l|ud=0,g=0.x
-            let k68 = A::mul_add(c_q6l, k60, A::mul_add(-s_q6l, k59, k63 * qd6l)); // wd9l.z
-            let d125 = A::mul_add(s_q6l, d112, c_q6l * d108); // a9l.y
-            let d126 = A::mul_add(-c_q6l, d112, s_q6l * d108); // a9l.z
-            let d127 = A::mul_add(-p.MY9l, k64, p.MZ9l * k63); // w9lxMS9l|ud=0,g=0.x
-            let d128 = A::mul_add(-p.MZ9l, k67, p.MX9l * k64); // w9lxMS9l|ud=0,g=0.y
-            let d129 = A::mul_add(-p.MX9l, k63, p.MY9l * k67); // w9lxMS9l|ud=0,g=0.z
-            let d130 = A::mul_add(
-                p.MY9l,
-                k68,
-                A::mul_add(
-                    p.MZ9l,
-                    k66,
-                    A::mul_add(-p.m9l, d111, A::mul_add(-k64, d128, k63 * d129)),
-                ),
-            ); // F9l.x
-            let d131 = A::mul_add(
-                -p.MZ9l,
-                k65,
-                A::mul_add(
-                    -p.MX9l,
-                    k68,
-                    A::mul_add(p.m9l, d125, A::mul_add(-k67, d129, k64 * d127)),
-                ),
-            ); // F9l.y
-            let d132 = A::mul_add(
-                -p.MX9l,
-                k66,
-                A::mul_add(
-                    p.MY9l,
-                    k65,
-                    A::mul_add(p.m9l, d126, A::mul_add(-k63, d127, k67 * d128)),
-                ),
-            ); // F9l.z
-            let d133 = A::mul_add(p.XZ9l, k64, A::mul_add(p.XY9l, k63, p.XX9l * k67)); // J9lw9l|ud=0,g=0.x
-            let d134 = A::mul_add(p.YZ9l, k64, A::mul_add(p.YY9l, k63, p.XY9l * k67)); // J9lw9l|ud=0,g=0.y
-            let d135 = A::mul_add(p.ZZ9l, k64, A::mul_add(p.YZ9l, k63, p.XZ9l * k67)); // J9lw9l|ud=0,g=0.z
-            let d136 = A::mul_add(
-                -p.MZ9l,
-                d125,
-                A::mul_add(
-                    p.MY9l,
-                    d126,
-                    A::mul_add(
-                        -p.XZ9l,
-                        k68,
-                        A::mul_add(
-                            p.XY9l,
-                            k66,
-                            A::mul_add(p.XX9l, k65, A::mul_add(-k64, d134, k63 * d135)),
-                        ),
-                    ),
-                ),
-            ); // N9l.x
-            let d137 = A::mul_add(
-                -p.MX9l,
-                d126,
-                A::mul_add(
-                    -p.MZ9l,
-                    d111,
-                    A::mul_add(
-                        -p.YZ9l,
-                        k68,
-                        A::mul_add(
-                            p.YY9l,
-                            k66,
-                            A::mul_add(p.XY9l, k65, A::mul_add(-k67, d135, k64 * d133)),
-                        ),
-                    ),
-                ),
-            ); // N9l.y
-            let d138 = A::mul_add(
-                p.MY9l,
-                d111,
-                A::mul_add(
-                    p.MX9l,
-                    d125,
-                    A::mul_add(
-                        -p.ZZ9l,
-                        k68,
-                        A::mul_add(
-                            p.YZ9l,
-                            k66,
-                            A::mul_add(p.XZ9l, k65, A::mul_add(-k63, d133, k67 * d134)),
-                        ),
-                    ),
-                ),
-            ); // N9l.z
-            let k69 = A::mul_add(-s_q7l, k64, c_q7l * k67); // w9l in 10l|ud=0,g=0.x
-            let k70 = A::mul_add(c_q7l, k64, s_q7l * k67); // w9l in 10l|ud=0,g=0.y
-            let k71 = k63 - qd7l; // w10l|ud=0,g=0.z
-            let k72 = A::mul_add(c_q7l, k68, A::mul_add(-s_q7l, k65, k69 * qd7l)); // wd10l.y
-            let k73 = A::mul_add(s_q7l, k68, A::mul_add(c_q7l, k65, k70 * qd7l)); // wd10l.x
-            let k74 = k66 + qdd7l; // wd10l.z
-            let k75 = p.L9 * k64; // w9lxP10l|ud=0,g=0.x
-            let k76 = p.L9 * k67; // w9lxP10l|ud=0,g=0.z
-            let d139 = A::mul_add(k67, k76, k64 * k75) + d125; // a10l in 9l.y
-            let d140 = A::mul_add(p.L9, k68, A::mul_add(k63, k76, d111)); // a10l in 9l.x
-            let d141 = A::mul_add(p.L9, k65, A::mul_add(k63, k75, -d126)); // a10l in 9l.z
-            let d142 = A::mul_add(-s_q7l, d141, c_q7l * d140); // a10l.x
-            let d143 = A::mul_add(c_q7l, d141, s_q7l * d140); // a10l.y
-            let d144 = A::mul_add(-p.MY10l, k71, p.MZ10l * k70); // w10lxMS10l|ud=0,g=0.x
-            let d145 = A::mul_add(-p.MZ10l, k69, p.MX10l * k71); // w10lxMS10l|ud=0,g=0.y
-            let d146 = A::mul_add(-p.MX10l, k70, p.MY10l * k69); // w10lxMS10l|ud=0,g=0.z
-            let d147 = A::mul_add(
-                p.MY10l,
-                k74,
-                A::mul_add(
-                    p.MZ10l,
-                    k72,
-                    A::mul_add(p.m10l, d142, A::mul_add(-k71, d145, k70 * d146)),
-                ),
-            ); // F10l.x
-            let d148 = A::mul_add(
-                p.MZ10l,
-                k73,
-                A::mul_add(
-                    -p.MX10l,
-                    k74,
-                    A::mul_add(p.m10l, d143, A::mul_add(-k69, d146, k71 * d144)),
-                ),
-            ); // F10l.y
-            let d149 = A::mul_add(
-                -p.MX10l,
-                k72,
-                A::mul_add(
-                    -p.MY10l,
-                    k73,
-                    A::mul_add(-p.m10l, d139, A::mul_add(-k70, d144, k69 * d145)),
-                ),
-            ); // F10l.z
-            let d150 = A::mul_add(p.XZ10l, k71, A::mul_add(p.XY10l, k70, p.XX10l * k69)); // J10lw10l|ud=0,g=0.x
-            let d151 = A::mul_add(p.YZ10l, k71, A::mul_add(p.YY10l, k70, p.XY10l * k69)); // J10lw10l|ud=0,g=0.y
-            let d152 = A::mul_add(p.ZZ10l, k71, A::mul_add(p.YZ10l, k70, p.XZ10l * k69)); // J10lw10l|ud=0,g=0.z
-            let d153 = A::mul_add(
-                -p.MZ10l,
-                d143,
-                A::mul_add(
-                    -p.MY10l,
-                    d139,
-                    A::mul_add(
-                        -p.XZ10l,
-                        k74,
-                        A::mul_add(
-                            p.XY10l,
-                            k72,
-                            A::mul_add(-p.XX10l, k73, A::mul_add(-k71, d151, k70 * d152)),
-                        ),
-                    ),
-                ),
-            ); // N10l.x
-            let d154 = A::mul_add(
-                p.MX10l,
-                d139,
-                A::mul_add(
-                    p.MZ10l,
-                    d142,
-                    A::mul_add(
-                        -p.YZ10l,
-                        k74,
-                        A::mul_add(
-                            p.YY10l,
-                            k72,
-                            A::mul_add(-p.XY10l, k73, A::mul_add(-k69, d152, k71 * d150)),
-                        ),
-                    ),
-                ),
-            ); // N10l.y
-            let d155 = A::mul_add(
-                -p.MY10l,
-                d142,
-                A::mul_add(
-                    p.MX10l,
-                    d143,
-                    A::mul_add(
-                        -p.ZZ10l,
-                        k74,
-                        A::mul_add(
-                            p.YZ10l,
-                            k72,
-                            A::mul_add(-p.XZ10l, k73, A::mul_add(-k70, d150, k69 * d151)),
-                        ),
-                    ),
-                ),
-            ); // N10l.z
-            out[11] = core::hint::black_box(-d155);
-            let k77 = A::mul_add(-s_q1r, k17, c_q1r * k18); // w3 in 4r|ud=0,g=0.x
-            let k78 = A::mul_add(c_q1r, k17, s_q1r * k18); // w3 in 4r|ud=0,g=0.z
-            let k79 = k19 - qdd1r; // wd4r.y
-            let k80 = k16 + qd1r; // w4r|ud=0,g=0.y
-            let k81 = A::mul_add(s_q1r, k21, A::mul_add(c_q1r, k20, k78 * qd1r)); // wd4r.x
-            let k82 = A::mul_add(c_q1r, k21, A::mul_add(-s_q1r, k20, k77 * qd1r)); // wd4r.z
-            let k83 = t1 + t2; // w3xP4r|ud=0,g=0.z
-            let d156 = A::mul_add(k18, k83, t7) + d32 + t3; // a4r in 3.x
-            let d157 = t9 - t10 - d33 - t5 - t6; // a4r in 3.z
-            let d158 = A::mul_add(k16, k83, t8) - d30 - t4; // a4r in 3.y
-            let d159 = A::mul_add(c_q1r, d157, s_q1r * d158); // a4r.z
-            let d160 = A::mul_add(-s_q1r, d157, c_q1r * d158); // a4r.x
-            let d161 = A::mul_add(p.MX4r, k80, p.MY4r * k77); // w4rxMS4r|ud=0,g=0.z
-            let d162 = A::mul_add(-p.MY4r, k78, p.MZ4r * k80); // w4rxMS4r|ud=0,g=0.x
-            let d163 = A::mul_add(p.MZ4r, k77, p.MX4r * k78); // w4rxMS4r|ud=0,g=0.y
-            let d164 = A::mul_add(
-                p.MZ4r,
-                k81,
-                A::mul_add(
-                    -p.MX4r,
-                    k82,
-                    A::mul_add(-p.m4r, d156, A::mul_add(-k77, d161, k78 * d162)),
-                ),
-            ); // F4r.y
-            let d165 = A::mul_add(
-                -p.MY4r,
-                k82,
-                A::mul_add(
-                    -p.MZ4r,
-                    k79,
-                    A::mul_add(p.m4r, d160, A::mul_add(k78, d163, k80 * d161)),
-                ),
-            ); // F4r.x
-            let d166 = A::mul_add(
-                p.MX4r,
-                k79,
-                A::mul_add(
-                    p.MY4r,
-                    k81,
-                    A::mul_add(-p.m4r, d159, A::mul_add(k80, d162, k77 * d163)),
-                ),
-            ); // F4r.z
-            let d167 = A::mul_add(-p.XZ4r, k78, A::mul_add(-p.XY4r, k80, p.XX4r * k77)); // J4rw4r|ud=0,g=0.x
-            let d168 = A::mul_add(-p.YZ4r, k78, A::mul_add(-p.YY4r, k80, p.XY4r * k77)); // J4rw4r|ud=0,g=0.y
-            let d169 = A::mul_add(-p.ZZ4r, k78, A::mul_add(-p.YZ4r, k80, p.XZ4r * k77)); // J4rw4r|ud=0,g=0.z
+            ); // N4l.x
             let d170 = A::mul_add(
                 p.MY4r,
                 d160,
@@ -7006,857 +7542,1691 @@ mod generated {
                         -p.ZZ4r,
                         k82,
                         A::mul_add(
-                            p.YZ4r,
+                            -p.YZ4r,
                             k79,
-                            A::mul_add(-p.XZ4r, k81, A::mul_add(k80, d167, k77 * d168)),
+                            A::mul_add(-p.XZ4r, k81, A::mul_add(-k80, d167, k77 * d168)),
                         ),
                     ),
                 ),
             ); // N4r.z
+            let d61_d170 = F64x2::new(d61, d170);
             let d171 = A::mul_add(
-                -p.MZ4r,
+                p.MZ4r,
                 d156,
                 A::mul_add(
-                    -p.MY4r,
+                    p.MY4r,
                     d159,
                     A::mul_add(
-                        p.XZ4r,
+                        -p.XZ4r,
                         k82,
                         A::mul_add(
                             -p.XY4r,
                             k79,
-                            A::mul_add(p.XX4r, k81, A::mul_add(-k78, d168, k80 * d169)),
+                            A::mul_add(-p.XX4r, k81, A::mul_add(k78, d168, k80 * d169)),
                         ),
                     ),
                 ),
             ); // N4r.x
-            let d172 = A::mul_add(
-                p.MX4r,
-                d159,
-                A::mul_add(
-                    p.MZ4r,
-                    d160,
-                    A::mul_add(
-                        p.YZ4r,
-                        k82,
-                        A::mul_add(
-                            -p.YY4r,
-                            k79,
-                            A::mul_add(p.XY4r, k81, A::mul_add(k77, d169, k78 * d167)),
+            let d60_d171 = F64x2::new(d60, d171);
+            let d62_d172 = lanes
+                .mul_add(
+                    F64x2::new(p.MX4l, p.MX4r),
+                    d49_d159,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ4l, p.MZ4r),
+                            d50_d160,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.YZ4l, p.YZ4r),
+                                    k31_k82,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.YY4l, p.YY4r),
+                                            k30_k79,
+                                            lanes
+                                                .mul_add(
+                                                    F64x2::new(p.XY4l, p.XY4r),
+                                                    k29_k81,
+                                                    lanes.mul_add(k26_k77, d59_d169, k27_k78 * d57_d167),
+                                                ),
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N4r.y
-            let k84 = A::mul_add(s_q2r, k78, c_q2r * k80); // w4r in 5r|ud=0,g=0.y
-            let k85 = A::mul_add(-c_q2r, k78, s_q2r * k80); // w4r in 5r|ud=0,g=0.z
-            let k86 = k81 - qdd2r; // wd5r.x
-            let k87 = A::mul_add(-c_q2r, k82, A::mul_add(-s_q2r, k79, k84 * qd2r)); // wd5r.z
-            let k88 = k77 + qd2r; // w5r|ud=0,g=0.x
-            let k89 = A::mul_add(-s_q2r, k82, A::mul_add(c_q2r, k79, k85 * qd2r)); // wd5r.y
-            let d173 = A::mul_add(-s_q2r, d159, c_q2r * d156); // a5r.y
-            let d174 = A::mul_add(c_q2r, d159, s_q2r * d156); // a5r.z
-            let d175 = A::mul_add(-p.MY5r, k85, p.MZ5r * k84); // w5rxMS5r|ud=0,g=0.x
-            let d176 = A::mul_add(p.MZ5r, k88, p.MX5r * k85); // w5rxMS5r|ud=0,g=0.y
-            let d177 = A::mul_add(p.MX5r, k84, p.MY5r * k88); // w5rxMS5r|ud=0,g=0.z
-            let d178 = A::mul_add(
-                -p.MZ5r,
-                k86,
-                A::mul_add(
-                    p.MX5r,
-                    k87,
-                    A::mul_add(p.m5r, d173, A::mul_add(-k88, d177, k85 * d175)),
-                ),
-            ); // F5r.y
-            let d179 = A::mul_add(
-                p.MY5r,
-                k87,
-                A::mul_add(
-                    p.MZ5r,
-                    k89,
-                    A::mul_add(-p.m5r, d160, A::mul_add(k85, d176, k84 * d177)),
-                ),
-            ); // F5r.x
-            let d180 = A::mul_add(
-                -p.MX5r,
-                k89,
-                A::mul_add(
-                    -p.MY5r,
-                    k86,
-                    A::mul_add(-p.m5r, d174, A::mul_add(k84, d175, k88 * d176)),
-                ),
-            ); // F5r.z
-            let d181 = A::mul_add(-p.XZ5r, k85, A::mul_add(-p.XY5r, k84, p.XX5r * k88)); // J5rw5r|ud=0,g=0.x
-            let d182 = A::mul_add(-p.YZ5r, k85, A::mul_add(-p.YY5r, k84, p.XY5r * k88)); // J5rw5r|ud=0,g=0.y
-            let d183 = A::mul_add(-p.ZZ5r, k85, A::mul_add(-p.YZ5r, k84, p.XZ5r * k88)); // J5rw5r|ud=0,g=0.z
-            let d184 = A::mul_add(
-                -p.MY5r,
-                d160,
-                A::mul_add(
-                    p.MX5r,
-                    d173,
-                    A::mul_add(
-                        p.ZZ5r,
-                        k87,
-                        A::mul_add(
-                            -p.YZ5r,
-                            k89,
-                            A::mul_add(p.XZ5r, k86, A::mul_add(k84, d181, k88 * d182)),
+                ); // N4l.y | N4r.y
+            let k35_k84 = lanes
+                .mul_add(
+                    -F64x2::new(s_q2l, s_q2r),
+                    k27_k78,
+                    F64x2::new(c_q2l, c_q2r) * k28_k80,
+                ); // w4l in 5l|ud=0,g=0.y | w4r in 5r|ud=0,g=0.y
+            let k36_k85 = lanes
+                .mul_add(
+                    F64x2::new(c_q2l, c_q2r),
+                    k27_k78,
+                    F64x2::new(s_q2l, s_q2r) * k28_k80,
+                ); // w4l in 5l|ud=0,g=0.z | w4r in 5r|ud=0,g=0.z
+            let k37_k86 = k29_k81 - F64x2::new(qdd2l, qdd2r); // wd5l.x | wd5r.x
+            let k40_k87 = lanes
+                .mul_add(
+                    F64x2::new(c_q2l, c_q2r),
+                    k31_k82,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q2l, s_q2r),
+                            k30_k79,
+                            k35_k84 * F64x2::new(qd2l, qd2r),
                         ),
-                    ),
-                ),
-            ); // N5r.z
-            let d185 = A::mul_add(
-                p.MZ5r,
-                d173,
-                A::mul_add(
-                    -p.MY5r,
-                    d174,
-                    A::mul_add(
-                        -p.XZ5r,
-                        k87,
-                        A::mul_add(
-                            p.XY5r,
-                            k89,
-                            A::mul_add(-p.XX5r, k86, A::mul_add(-k85, d182, k84 * d183)),
+                ); // wd5l.z | wd5r.z
+            let k39_k88 = k26_k77 + F64x2::new(qd2l, qd2r); // w5l|ud=0,g=0.x | w5r|ud=0,g=0.x
+            let k38_k89 = lanes
+                .mul_add(
+                    F64x2::new(s_q2l, s_q2r),
+                    k31_k82,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q2l, c_q2r),
+                            k30_k79,
+                            k36_k85 * F64x2::new(qd2l, qd2r),
                         ),
-                    ),
-                ),
-            ); // N5r.x
-            let d186 = A::mul_add(
-                p.MX5r,
-                d174,
-                A::mul_add(
-                    -p.MZ5r,
-                    d160,
-                    A::mul_add(
-                        -p.YZ5r,
-                        k87,
-                        A::mul_add(
-                            p.YY5r,
-                            k89,
-                            A::mul_add(-p.XY5r, k86, A::mul_add(k88, d183, k85 * d181)),
+                ); // wd5l.y | wd5r.y
+            let d173 = A::mul_add(-c_q2r, d156, s_q2r * d159); // a5r.y
+            let d63_d173 = F64x2::new(d63, d173);
+            let d174 = A::mul_add(-c_q2r, d159, -s_q2r * d156); // a5r.z
+            let d64_d174 = F64x2::new(d64, d174);
+            let d65_d175 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY5l, p.MY5r),
+                    k36_k85,
+                    F64x2::new(p.MZ5l, p.MZ5r) * k35_k84,
+                ); // w5lxMS5l|ud=0,g=0.x | w5rxMS5r|ud=0,g=0.x
+            let d66_d176 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ5l, p.MZ5r),
+                    k39_k88,
+                    F64x2::new(p.MX5l, p.MX5r) * k36_k85,
+                ); // w5lxMS5l|ud=0,g=0.y | w5rxMS5r|ud=0,g=0.y
+            let d67_d177 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX5l, p.MX5r),
+                    k35_k84,
+                    F64x2::new(p.MY5l, p.MY5r) * k39_k88,
+                ); // w5lxMS5l|ud=0,g=0.z | w5rxMS5r|ud=0,g=0.z
+            let d69_d178 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ5l, p.MZ5r),
+                    k37_k86,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MX5l, p.MX5r),
+                            k40_k87,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.m5l, p.m5r),
+                                    d63_d173,
+                                    lanes.mul_add(-k39_k88, d67_d177, k36_k85 * d65_d175),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N5r.y
-            let k90 = A::mul_add(s_q3r, k85, c_q3r * k88); // w5r in 6r|ud=0,g=0.x
-            let k91 = A::mul_add(-c_q3r, k85, s_q3r * k88); // w5r in 6r|ud=0,g=0.z
-            let k92 = k89 - qdd3r; // wd6r.y
-            let k93 = k84 + qd3r; // w6r|ud=0,g=0.y
-            let k94 = A::mul_add(-s_q3r, k87, A::mul_add(c_q3r, k86, k91 * qd3r)); // wd6r.x
-            let k95 = A::mul_add(-c_q3r, k87, A::mul_add(-s_q3r, k86, k90 * qd3r)); // wd6r.z
-            let k96 = p.L7 * k85; // w5rxP6r|ud=0,g=0.x
-            let k97 = p.L7 * k88; // w5rxP6r|ud=0,g=0.z
-            let d187 = A::mul_add(p.L7, k87, A::mul_add(k84, k97, d160)); // a6r in 5r.x
-            let d188 = A::mul_add(k88, k97, k85 * k96) + d173; // a6r in 5r.y
-            let d189 = A::mul_add(p.L7, k86, A::mul_add(k84, k96, -d174)); // a6r in 5r.z
-            let d190 = A::mul_add(-c_q3r, d189, s_q3r * d187); // a6r.z
-            let d191 = A::mul_add(s_q3r, d189, c_q3r * d187); // a6r.x
-            let d192 = A::mul_add(p.MX6r, k93, p.MY6r * k90); // w6rxMS6r|ud=0,g=0.z
-            let d193 = A::mul_add(-p.MY6r, k91, p.MZ6r * k93); // w6rxMS6r|ud=0,g=0.x
-            let d194 = A::mul_add(p.MZ6r, k90, p.MX6r * k91); // w6rxMS6r|ud=0,g=0.y
-            let d195 = A::mul_add(
-                p.MZ6r,
-                k94,
-                A::mul_add(
-                    -p.MX6r,
-                    k95,
-                    A::mul_add(-p.m6r, d188, A::mul_add(-k90, d192, k91 * d193)),
-                ),
-            ); // F6r.y
-            let d196 = A::mul_add(
-                -p.MY6r,
-                k95,
-                A::mul_add(
-                    -p.MZ6r,
-                    k92,
-                    A::mul_add(p.m6r, d191, A::mul_add(k91, d194, k93 * d192)),
-                ),
-            ); // F6r.x
-            let d197 = A::mul_add(
-                p.MX6r,
-                k92,
-                A::mul_add(
-                    p.MY6r,
-                    k94,
-                    A::mul_add(-p.m6r, d190, A::mul_add(k93, d193, k90 * d194)),
-                ),
-            ); // F6r.z
-            let d198 = A::mul_add(-p.XZ6r, k91, A::mul_add(-p.XY6r, k93, p.XX6r * k90)); // J6rw6r|ud=0,g=0.x
-            let d199 = A::mul_add(-p.YZ6r, k91, A::mul_add(-p.YY6r, k93, p.XY6r * k90)); // J6rw6r|ud=0,g=0.y
-            let d200 = A::mul_add(-p.ZZ6r, k91, A::mul_add(-p.YZ6r, k93, p.XZ6r * k90)); // J6rw6r|ud=0,g=0.z
-            let d201 = A::mul_add(
-                p.MY6r,
-                d191,
-                A::mul_add(
-                    -p.MX6r,
-                    d188,
-                    A::mul_add(
-                        -p.ZZ6r,
-                        k95,
-                        A::mul_add(
-                            p.YZ6r,
-                            k92,
-                            A::mul_add(-p.XZ6r, k94, A::mul_add(k93, d198, k90 * d199)),
+                ); // F5l.y | F5r.y
+            let d68_d179 = lanes
+                .mul_add(
+                    F64x2::new(p.MY5l, p.MY5r),
+                    k40_k87,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ5l, p.MZ5r),
+                            k38_k89,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m5l, p.m5r),
+                                    d50_d160,
+                                    lanes.mul_add(-k36_k85, d66_d176, k35_k84 * d67_d177),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N6r.z
-            let d202 = A::mul_add(
-                -p.MZ6r,
-                d188,
-                A::mul_add(
-                    -p.MY6r,
-                    d190,
-                    A::mul_add(
-                        p.XZ6r,
-                        k95,
-                        A::mul_add(
-                            -p.XY6r,
-                            k92,
-                            A::mul_add(p.XX6r, k94, A::mul_add(-k91, d199, k93 * d200)),
+                ); // F5l.x | F5r.x
+            let d70_d180 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX5l, p.MX5r),
+                    k38_k89,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MY5l, p.MY5r),
+                            k37_k86,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.m5l, p.m5r),
+                                    d64_d174,
+                                    lanes.mul_add(-k35_k84, d65_d175, k39_k88 * d66_d176),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N6r.x
-            let d203 = A::mul_add(
-                p.MX6r,
-                d190,
-                A::mul_add(
-                    p.MZ6r,
-                    d191,
-                    A::mul_add(
-                        p.YZ6r,
-                        k95,
-                        A::mul_add(
-                            -p.YY6r,
-                            k92,
-                            A::mul_add(p.XY6r, k94, A::mul_add(k90, d200, k91 * d198)),
+                ); // F5l.z | F5r.z
+            let d71_d181 = lanes
+                .mul_add(
+                    F64x2::new(p.XZ5l, p.XZ5r),
+                    k36_k85,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY5l, p.XY5r),
+                            k35_k84,
+                            F64x2::new(p.XX5l, p.XX5r) * k39_k88,
                         ),
-                    ),
-                ),
-            ); // N6r.y
-            let k98 = A::mul_add(s_q4r, k91, c_q4r * k93); // w6r in 7r|ud=0,g=0.y
-            let k99 = A::mul_add(-c_q4r, k91, s_q4r * k93); // w6r in 7r|ud=0,g=0.z
-            let k100 = k94 - qdd4r; // wd7r.x
-            let k101 = A::mul_add(-c_q4r, k95, A::mul_add(-s_q4r, k92, k98 * qd4r)); // wd7r.z
-            let k102 = k90 + qd4r; // w7r|ud=0,g=0.x
-            let k103 = A::mul_add(-s_q4r, k95, A::mul_add(c_q4r, k92, k99 * qd4r)); // wd7r.y
-            let d204 = A::mul_add(-s_q4r, d190, c_q4r * d188); // a7r.y
-            let d205 = A::mul_add(c_q4r, d190, s_q4r * d188); // a7r.z
-            let d206 = A::mul_add(-p.MY7r, k99, p.MZ7r * k98); // w7rxMS7r|ud=0,g=0.x
-            let d207 = A::mul_add(p.MZ7r, k102, p.MX7r * k99); // w7rxMS7r|ud=0,g=0.y
-            let d208 = A::mul_add(p.MX7r, k98, p.MY7r * k102); // w7rxMS7r|ud=0,g=0.z
-            let d209 = A::mul_add(
-                -p.MZ7r,
-                k100,
-                A::mul_add(
-                    p.MX7r,
-                    k101,
-                    A::mul_add(p.m7r, d204, A::mul_add(-k102, d208, k99 * d206)),
-                ),
-            ); // F7r.y
-            let d210 = A::mul_add(
-                p.MY7r,
-                k101,
-                A::mul_add(
-                    p.MZ7r,
-                    k103,
-                    A::mul_add(-p.m7r, d191, A::mul_add(k99, d207, k98 * d208)),
-                ),
-            ); // F7r.x
-            let d211 = A::mul_add(
-                -p.MX7r,
-                k103,
-                A::mul_add(
-                    -p.MY7r,
-                    k100,
-                    A::mul_add(-p.m7r, d205, A::mul_add(k98, d206, k102 * d207)),
-                ),
-            ); // F7r.z
-            let d212 = A::mul_add(-p.XZ7r, k99, A::mul_add(-p.XY7r, k98, p.XX7r * k102)); // J7rw7r|ud=0,g=0.x
-            let d213 = A::mul_add(-p.YZ7r, k99, A::mul_add(-p.YY7r, k98, p.XY7r * k102)); // J7rw7r|ud=0,g=0.y
-            let d214 = A::mul_add(-p.ZZ7r, k99, A::mul_add(-p.YZ7r, k98, p.XZ7r * k102)); // J7rw7r|ud=0,g=0.z
-            let d215 = A::mul_add(
-                -p.MY7r,
-                d191,
-                A::mul_add(
-                    p.MX7r,
-                    d204,
-                    A::mul_add(
-                        p.ZZ7r,
-                        k101,
-                        A::mul_add(
-                            -p.YZ7r,
-                            k103,
-                            A::mul_add(p.XZ7r, k100, A::mul_add(k98, d212, k102 * d213)),
+                ); // J5lw5l|ud=0,g=0.x | J5rw5r|ud=0,g=0.x
+            let d72_d182 = lanes
+                .mul_add(
+                    F64x2::new(p.YZ5l, p.YZ5r),
+                    k36_k85,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY5l, p.YY5r),
+                            k35_k84,
+                            F64x2::new(p.XY5l, p.XY5r) * k39_k88,
                         ),
-                    ),
-                ),
-            ); // N7r.z
-            let d216 = A::mul_add(
-                p.MZ7r,
-                d204,
-                A::mul_add(
-                    -p.MY7r,
-                    d205,
-                    A::mul_add(
-                        -p.XZ7r,
-                        k101,
-                        A::mul_add(
-                            p.XY7r,
-                            k103,
-                            A::mul_add(-p.XX7r, k100, A::mul_add(-k99, d213, k98 * d214)),
+                ); // J5lw5l|ud=0,g=0.y | J5rw5r|ud=0,g=0.y
+            let d73_d183 = lanes
+                .mul_add(
+                    F64x2::new(p.ZZ5l, p.ZZ5r),
+                    k36_k85,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ5l, p.YZ5r),
+                            k35_k84,
+                            F64x2::new(p.XZ5l, p.XZ5r) * k39_k88,
                         ),
-                    ),
-                ),
-            ); // N7r.x
-            let d217 = A::mul_add(
-                p.MX7r,
-                d205,
-                A::mul_add(
-                    -p.MZ7r,
-                    d191,
-                    A::mul_add(
-                        -p.YZ7r,
-                        k101,
-                        A::mul_add(
-                            p.YY7r,
-                            k103,
-                            A::mul_add(-p.XY7r, k100, A::mul_add(k102, d214, k99 * d212)),
+                ); // J5lw5l|ud=0,g=0.z | J5rw5r|ud=0,g=0.z
+            let d76_d184 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY5l, p.MY5r),
+                    d50_d160,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MX5l, p.MX5r),
+                            d63_d173,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.ZZ5l, p.ZZ5r),
+                                    k40_k87,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.YZ5l, p.YZ5r),
+                                            k38_k89,
+                                            lanes
+                                                .mul_add(
+                                                    F64x2::new(p.XZ5l, p.XZ5r),
+                                                    k37_k86,
+                                                    lanes.mul_add(-k35_k84, d71_d181, k39_k88 * d72_d182),
+                                                ),
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N7r.y
-            let k104 = A::mul_add(s_q5r, k99, c_q5r * k102); // w7r in 8r|ud=0,g=0.x
-            let k105 = A::mul_add(-c_q5r, k99, s_q5r * k102); // w7r in 8r|ud=0,g=0.z
-            let k106 = k103 - qdd5r; // wd8r.y
-            let k107 = k98 + qd5r; // w8r|ud=0,g=0.y
-            let k108 = A::mul_add(-s_q5r, k101, A::mul_add(c_q5r, k100, k105 * qd5r)); // wd8r.x
-            let k109 = A::mul_add(-c_q5r, k101, A::mul_add(-s_q5r, k100, k104 * qd5r)); // wd8r.z
-            let k110 = p.L8 * k99; // w7rxP8r|ud=0,g=0.x
-            let k111 = p.L8 * k102; // w7rxP8r|ud=0,g=0.z
-            let d218 = A::mul_add(p.L8, k101, A::mul_add(k98, k111, d191)); // a8r in 7r.x
-            let d219 = A::mul_add(k102, k111, k99 * k110) + d204; // a8r in 7r.y
-            let d220 = A::mul_add(p.L8, k100, A::mul_add(k98, k110, -d205)); // a8r in 7r.z
-            let d221 = A::mul_add(-c_q5r, d220, s_q5r * d218); // a8r.z
-            let d222 = A::mul_add(s_q5r, d220, c_q5r * d218); // a8r.x
-            let d223 = A::mul_add(p.MX8r, k107, p.MY8r * k104); // w8rxMS8r|ud=0,g=0.z
-            let d224 = A::mul_add(-p.MY8r, k105, p.MZ8r * k107); // w8rxMS8r|ud=0,g=0.x
-            let d225 = A::mul_add(p.MZ8r, k104, p.MX8r * k105); // w8rxMS8r|ud=0,g=0.y
-            let d226 = A::mul_add(
-                p.MZ8r,
-                k108,
-                A::mul_add(
-                    -p.MX8r,
-                    k109,
-                    A::mul_add(-p.m8r, d219, A::mul_add(-k104, d223, k105 * d224)),
-                ),
-            ); // F8r.y
-            let d227 = A::mul_add(
-                -p.MY8r,
-                k109,
-                A::mul_add(
-                    -p.MZ8r,
-                    k106,
-                    A::mul_add(p.m8r, d222, A::mul_add(k105, d225, k107 * d223)),
-                ),
-            ); // F8r.x
-            let d228 = A::mul_add(
-                p.MX8r,
-                k106,
-                A::mul_add(
-                    p.MY8r,
-                    k108,
-                    A::mul_add(-p.m8r, d221, A::mul_add(k107, d224, k104 * d225)),
-                ),
-            ); // F8r.z
-            let d229 = A::mul_add(
-                -p.XZ8r,
-                k105,
-                A::mul_add(-p.XY8r, k107, p.XX8r * k104),
-            ); // J8rw8r|ud=0,g=0.x
-            let d230 = A::mul_add(
-                -p.YZ8r,
-                k105,
-                A::mul_add(-p.YY8r, k107, p.XY8r * k104),
-            ); // J8rw8r|ud=0,g=0.y
-            let d231 = A::mul_add(
-                -p.ZZ8r,
-                k105,
-                A::mul_add(-p.YZ8r, k107, p.XZ8r * k104),
-            ); // J8rw8r|ud=0,g=0.z
-            let d232 = A::mul_add(
-                p.MY8r,
-                d222,
-                A::mul_add(
-                    -p.MX8r,
-                    d219,
-                    A::mul_add(
-                        -p.ZZ8r,
-                        k109,
-                        A::mul_add(
-                            p.YZ8r,
-                            k106,
-                            A::mul_add(
-                                -p.XZ8r,
-                                k108,
-                                A::mul_add(k107, d229, k104 * d230),
-                            ),
+                ); // N5l.z | N5r.z
+            let d74_d185 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ5l, p.MZ5r),
+                    d63_d173,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MY5l, p.MY5r),
+                            d64_d174,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.XZ5l, p.XZ5r),
+                                    k40_k87,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.XY5l, p.XY5r),
+                                            k38_k89,
+                                            lanes
+                                                .mul_add(
+                                                    F64x2::new(p.XX5l, p.XX5r),
+                                                    k37_k86,
+                                                    lanes.mul_add(-k36_k85, d72_d182, k35_k84 * d73_d183),
+                                                ),
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N8r.z
-            let d233 = A::mul_add(
-                -p.MZ8r,
-                d219,
-                A::mul_add(
-                    -p.MY8r,
-                    d221,
-                    A::mul_add(
-                        p.XZ8r,
-                        k109,
-                        A::mul_add(
-                            -p.XY8r,
-                            k106,
-                            A::mul_add(
-                                p.XX8r,
-                                k108,
-                                A::mul_add(-k105, d230, k107 * d231),
-                            ),
+                ); // N5l.x | N5r.x
+            let d75_d186 = lanes
+                .mul_add(
+                    F64x2::new(p.MX5l, p.MX5r),
+                    d64_d174,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ5l, p.MZ5r),
+                            d50_d160,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.YZ5l, p.YZ5r),
+                                    k40_k87,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.YY5l, p.YY5r),
+                                            k38_k89,
+                                            lanes
+                                                .mul_add(
+                                                    F64x2::new(p.XY5l, p.XY5r),
+                                                    k37_k86,
+                                                    lanes.mul_add(-k39_k88, d73_d183, k36_k85 * d71_d181),
+                                                ),
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N8r.x
-            let d234 = A::mul_add(
-                p.MX8r,
-                d221,
-                A::mul_add(
-                    p.MZ8r,
-                    d222,
-                    A::mul_add(
-                        p.YZ8r,
-                        k109,
-                        A::mul_add(
-                            -p.YY8r,
-                            k106,
-                            A::mul_add(p.XY8r, k108, A::mul_add(k104, d231, k105 * d229)),
+                ); // N5l.y | N5r.y
+            let k41_k90 = lanes
+                .mul_add(
+                    -F64x2::new(s_q3l, s_q3r),
+                    k36_k85,
+                    F64x2::new(c_q3l, c_q3r) * k39_k88,
+                ); // w5l in 6l|ud=0,g=0.x | w5r in 6r|ud=0,g=0.x
+            let k42_k91 = lanes
+                .mul_add(
+                    F64x2::new(c_q3l, c_q3r),
+                    k36_k85,
+                    F64x2::new(s_q3l, s_q3r) * k39_k88,
+                ); // w5l in 6l|ud=0,g=0.z | w5r in 6r|ud=0,g=0.z
+            let k45_k92 = k38_k89 + F64x2::new(qdd3l, qdd3r); // wd6l.y | wd6r.y
+            let k43_k93 = k35_k84 - F64x2::new(qd3l, qd3r); // w6l|ud=0,g=0.y | w6r|ud=0,g=0.y
+            let k44_k94 = lanes
+                .mul_add(
+                    F64x2::new(s_q3l, s_q3r),
+                    k40_k87,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q3l, c_q3r),
+                            k37_k86,
+                            k42_k91 * F64x2::new(qd3l, qd3r),
                         ),
-                    ),
-                ),
-            ); // N8r.y
-            let k112 = A::mul_add(s_q6r, k105, c_q6r * k107); // w8r in 9r|ud=0,g=0.y
-            let k113 = A::mul_add(-c_q6r, k105, s_q6r * k107); // w8r in 9r|ud=0,g=0.z
-            let k114 = k108 - qdd6r; // wd9r.x
-            let k115 = A::mul_add(-c_q6r, k109, A::mul_add(-s_q6r, k106, k112 * qd6r)); // wd9r.z
-            let k116 = k104 + qd6r; // w9r|ud=0,g=0.x
-            let k117 = A::mul_add(-s_q6r, k109, A::mul_add(c_q6r, k106, k113 * qd6r)); // wd9r.y
-            let d235 = A::mul_add(-s_q6r, d221, c_q6r * d219); // a9r.y
-            let d236 = A::mul_add(c_q6r, d221, s_q6r * d219); // a9r.z
-            let d237 = A::mul_add(-p.MY9r, k113, p.MZ9r * k112); // w9rxMS9r|ud=0,g=0.x
-            let d238 = A::mul_add(p.MZ9r, k116, p.MX9r * k113); // w9rxMS9r|ud=0,g=0.y
-            let d239 = A::mul_add(p.MX9r, k112, p.MY9r * k116); // w9rxMS9r|ud=0,g=0.z
-            let d240 = A::mul_add(
-                -p.MZ9r,
-                k114,
-                A::mul_add(
-                    p.MX9r,
-                    k115,
-                    A::mul_add(p.m9r, d235, A::mul_add(-k116, d239, k113 * d237)),
-                ),
-            ); // F9r.y
-            let d241 = A::mul_add(
-                p.MY9r,
-                k115,
-                A::mul_add(
-                    p.MZ9r,
-                    k117,
-                    A::mul_add(-p.m9r, d222, A::mul_add(k113, d238, k112 * d239)),
-                ),
-            ); // F9r.x
-            let d242 = A::mul_add(
-                -p.MX9r,
-                k117,
-                A::mul_add(
-                    -p.MY9r,
-                    k114,
-                    A::mul_add(-p.m9r, d236, A::mul_add(k112, d237, k116 * d238)),
-                ),
-            ); // F9r.z
-            let d243 = A::mul_add(
-                -p.XZ9r,
-                k113,
-                A::mul_add(-p.XY9r, k112, p.XX9r * k116),
-            ); // J9rw9r|ud=0,g=0.x
-            let d244 = A::mul_add(
-                -p.YZ9r,
-                k113,
-                A::mul_add(-p.YY9r, k112, p.XY9r * k116),
-            ); // J9rw9r|ud=0,g=0.y
-            let d245 = A::mul_add(
-                -p.ZZ9r,
-                k113,
-                A::mul_add(-p.YZ9r, k112, p.XZ9r * k116),
-            ); // J9rw9r|ud=0,g=0.z
-            let d246 = A::mul_add(
-                -p.MY9r,
-                d222,
-                A::mul_add(
-                    p.MX9r,
-                    d235,
-                    A::mul_add(
-                        p.ZZ9r,
-                        k115,
-                        A::mul_add(
-                            -p.YZ9r,
-                            k117,
-                            A::mul_add(p.XZ9r, k114, A::mul_add(k112, d243, k116 * d244)),
+                ); // wd6l.x | wd6r.x
+            let k46_k95 = lanes
+                .mul_add(
+                    F64x2::new(c_q3l, c_q3r),
+                    k40_k87,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q3l, s_q3r),
+                            k37_k86,
+                            k41_k90 * F64x2::new(qd3l, qd3r),
                         ),
-                    ),
-                ),
-            ); // N9r.z
-            let d247 = A::mul_add(
-                p.MZ9r,
-                d235,
-                A::mul_add(
-                    -p.MY9r,
-                    d236,
-                    A::mul_add(
-                        -p.XZ9r,
-                        k115,
-                        A::mul_add(
-                            p.XY9r,
-                            k117,
-                            A::mul_add(
-                                -p.XX9r,
-                                k114,
-                                A::mul_add(-k113, d244, k112 * d245),
-                            ),
+                ); // wd6l.z | wd6r.z
+            let k47_k96 = p.L7 * k36_k85; // w5lxP6l|ud=0,g=0.x | w5rxP6r|ud=0,g=0.x
+            let k48_k97 = p.L7 * k39_k88; // w5lxP6l|ud=0,g=0.z | w5rxP6r|ud=0,g=0.z
+            let d78_d187 = lanes
+                .mul_add(p.L7, k40_k87, lanes.mul_add(k35_k84, k48_k97, -d50_d160)); // a6l in 5l.x | a6r in 5r.x
+            let d77_d188 = lanes.mul_add(k39_k88, k48_k97, k36_k85 * k47_k96) - d63_d173; // a6l in 5l.y | a6r in 5r.y
+            let d79_d189 = lanes
+                .mul_add(p.L7, k37_k86, lanes.mul_add(k35_k84, k47_k96, d64_d174)); // a6l in 5l.z | a6r in 5r.z
+            let d81_d190 = lanes
+                .mul_add(
+                    F64x2::new(c_q3l, c_q3r),
+                    d79_d189,
+                    F64x2::new(s_q3l, s_q3r) * d78_d187,
+                ); // a6l.z | a6r.z
+            let d80_d191 = lanes
+                .mul_add(
+                    -F64x2::new(s_q3l, s_q3r),
+                    d79_d189,
+                    F64x2::new(c_q3l, c_q3r) * d78_d187,
+                ); // a6l.x | a6r.x
+            let d83_d192 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX6l, p.MX6r),
+                    k43_k93,
+                    F64x2::new(p.MY6l, p.MY6r) * k41_k90,
+                ); // w6lxMS6l|ud=0,g=0.z | w6rxMS6r|ud=0,g=0.z
+            let d82_d193 = lanes
+                .mul_add(
+                    F64x2::new(p.MY6l, p.MY6r),
+                    k42_k91,
+                    F64x2::new(p.MZ6l, p.MZ6r) * k43_k93,
+                ); // w6lxMS6l|ud=0,g=0.x | w6rxMS6r|ud=0,g=0.x
+            let d84_d194 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ6l, p.MZ6r),
+                    k41_k90,
+                    F64x2::new(p.MX6l, p.MX6r) * k42_k91,
+                ); // w6lxMS6l|ud=0,g=0.y | w6rxMS6r|ud=0,g=0.y
+            let d86_d195 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ6l, p.MZ6r),
+                    k44_k94,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MX6l, p.MX6r),
+                            k46_k95,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m6l, p.m6r),
+                                    d77_d188,
+                                    lanes.mul_add(k41_k90, d83_d192, k42_k91 * d82_d193),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N9r.x
-            let d248 = A::mul_add(
-                p.MX9r,
-                d236,
-                A::mul_add(
-                    -p.MZ9r,
-                    d222,
-                    A::mul_add(
-                        -p.YZ9r,
-                        k115,
-                        A::mul_add(
-                            p.YY9r,
-                            k117,
-                            A::mul_add(
-                                -p.XY9r,
-                                k114,
-                                A::mul_add(k116, d245, k113 * d243),
-                            ),
+                ); // F6l.y | F6r.y
+            let d85_d196 = lanes
+                .mul_add(
+                    F64x2::new(p.MY6l, p.MY6r),
+                    k46_k95,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MZ6l, p.MZ6r),
+                            k45_k92,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m6l, p.m6r),
+                                    d80_d191,
+                                    lanes.mul_add(-k42_k91, d84_d194, k43_k93 * d83_d192),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N9r.y
-            let k118 = A::mul_add(s_q7r, k113, c_q7r * k116); // w9r in 10r|ud=0,g=0.x
-            let k119 = A::mul_add(-c_q7r, k113, s_q7r * k116); // w9r in 10r|ud=0,g=0.y
-            let k120 = k117 - qdd7r; // wd10r.z
-            let k121 = A::mul_add(-c_q7r, k115, A::mul_add(-s_q7r, k114, k118 * qd7r)); // wd10r.y
-            let k122 = k112 + qd7r; // w10r|ud=0,g=0.z
-            let k123 = A::mul_add(-s_q7r, k115, A::mul_add(c_q7r, k114, k119 * qd7r)); // wd10r.x
-            let k124 = p.L9 * k113; // w9rxP10r|ud=0,g=0.x
-            let k125 = p.L9 * k116; // w9rxP10r|ud=0,g=0.z
-            let d249 = A::mul_add(p.L9, k115, A::mul_add(k112, k125, d222)); // a10r in 9r.x
-            let d250 = A::mul_add(k116, k125, k113 * k124) + d235; // a10r in 9r.y
-            let d251 = A::mul_add(p.L9, k114, A::mul_add(k112, k124, -d236)); // a10r in 9r.z
-            let d252 = A::mul_add(s_q7r, d251, c_q7r * d249); // a10r.x
-            let d253 = A::mul_add(-c_q7r, d251, s_q7r * d249); // a10r.y
-            let d254 = A::mul_add(p.MY10r, k122, p.MZ10r * k119); // w10rxMS10r|ud=0,g=0.x
-            let d255 = A::mul_add(-p.MX10r, k119, p.MY10r * k118); // w10rxMS10r|ud=0,g=0.z
-            let d256 = A::mul_add(p.MZ10r, k118, p.MX10r * k122); // w10rxMS10r|ud=0,g=0.y
-            let d257 = A::mul_add(
-                -p.MY10r,
-                k120,
-                A::mul_add(
-                    p.MZ10r,
-                    k121,
-                    A::mul_add(-p.m10r, d252, A::mul_add(-k122, d256, k119 * d255)),
-                ),
-            ); // F10r.x
-            let d258 = A::mul_add(
-                -p.MZ10r,
-                k123,
-                A::mul_add(
-                    -p.MX10r,
-                    k120,
-                    A::mul_add(p.m10r, d253, A::mul_add(k118, d255, k122 * d254)),
-                ),
-            ); // F10r.y
-            let d259 = A::mul_add(
-                p.MX10r,
-                k121,
-                A::mul_add(
-                    p.MY10r,
-                    k123,
-                    A::mul_add(p.m10r, d250, A::mul_add(k119, d254, k118 * d256)),
-                ),
-            ); // F10r.z
-            let d260 = A::mul_add(
-                -p.XZ10r,
-                k122,
-                A::mul_add(p.XY10r, k119, p.XX10r * k118),
-            ); // J10rw10r|ud=0,g=0.x
-            let d261 = A::mul_add(
-                -p.YZ10r,
-                k122,
-                A::mul_add(p.YY10r, k119, p.XY10r * k118),
-            ); // J10rw10r|ud=0,g=0.y
-            let d262 = A::mul_add(
-                -p.ZZ10r,
-                k122,
-                A::mul_add(p.YZ10r, k119, p.XZ10r * k118),
-            ); // J10rw10r|ud=0,g=0.z
-            let d263 = A::mul_add(
-                p.MZ10r,
-                d253,
-                A::mul_add(
-                    -p.MY10r,
-                    d250,
-                    A::mul_add(
-                        p.XZ10r,
-                        k120,
-                        A::mul_add(
-                            p.XY10r,
-                            k121,
-                            A::mul_add(
-                                -p.XX10r,
-                                k123,
-                                A::mul_add(k122, d261, k119 * d262),
-                            ),
+                ); // F6l.x | F6r.x
+            let d87_d197 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX6l, p.MX6r),
+                    k45_k92,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MY6l, p.MY6r),
+                            k44_k94,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m6l, p.m6r),
+                                    d81_d190,
+                                    lanes.mul_add(k43_k93, d82_d193, k41_k90 * d84_d194),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N10r.x
-            let d264 = A::mul_add(
-                p.MY10r,
-                d252,
-                A::mul_add(
-                    -p.MX10r,
-                    d253,
-                    A::mul_add(
-                        p.ZZ10r,
-                        k120,
-                        A::mul_add(
-                            p.YZ10r,
-                            k121,
-                            A::mul_add(
-                                -p.XZ10r,
-                                k123,
-                                A::mul_add(-k119, d260, k118 * d261),
-                            ),
+                ); // F6l.z | F6r.z
+            let d88_d198 = lanes
+                .mul_add(
+                    -F64x2::new(p.XZ6l, p.XZ6r),
+                    k42_k91,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY6l, p.XY6r),
+                            k43_k93,
+                            F64x2::new(p.XX6l, p.XX6r) * k41_k90,
                         ),
-                    ),
-                ),
-            ); // N10r.z
+                ); // J6lw6l|ud=0,g=0.x | J6rw6r|ud=0,g=0.x
+            let d89_d199 = lanes
+                .mul_add(
+                    -F64x2::new(p.YZ6l, p.YZ6r),
+                    k42_k91,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY6l, p.YY6r),
+                            k43_k93,
+                            F64x2::new(p.XY6l, p.XY6r) * k41_k90,
+                        ),
+                ); // J6lw6l|ud=0,g=0.y | J6rw6r|ud=0,g=0.y
+            let d90_d200 = lanes
+                .mul_add(
+                    -F64x2::new(p.ZZ6l, p.ZZ6r),
+                    k42_k91,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ6l, p.YZ6r),
+                            k43_k93,
+                            F64x2::new(p.XZ6l, p.XZ6r) * k41_k90,
+                        ),
+                ); // J6lw6l|ud=0,g=0.z | J6rw6r|ud=0,g=0.z
+            let d92_d201 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY6l, p.MY6r),
+                    d80_d191,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MX6l, p.MX6r),
+                            d77_d188,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.ZZ6l, p.ZZ6r),
+                                    k46_k95,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.YZ6l, p.YZ6r),
+                                            k45_k92,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XZ6l, p.XZ6r),
+                                                    k44_k94,
+                                                    lanes.mul_add(-k43_k93, d88_d198, k41_k90 * d89_d199),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N6l.z | N6r.z
+            let d91_d202 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ6l, p.MZ6r),
+                    d77_d188,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MY6l, p.MY6r),
+                            d81_d190,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.XZ6l, p.XZ6r),
+                                    k46_k95,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.XY6l, p.XY6r),
+                                            k45_k92,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XX6l, p.XX6r),
+                                                    k44_k94,
+                                                    lanes.mul_add(k42_k91, d89_d199, k43_k93 * d90_d200),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N6l.x | N6r.x
+            let d93_d203 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX6l, p.MX6r),
+                    d81_d190,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MZ6l, p.MZ6r),
+                            d80_d191,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.YZ6l, p.YZ6r),
+                                    k46_k95,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.YY6l, p.YY6r),
+                                            k45_k92,
+                                            lanes
+                                                .mul_add(
+                                                    F64x2::new(p.XY6l, p.XY6r),
+                                                    k44_k94,
+                                                    lanes.mul_add(k41_k90, d90_d200, k42_k91 * d88_d198),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N6l.y | N6r.y
+            let k49_k98 = lanes
+                .mul_add(
+                    -F64x2::new(s_q4l, s_q4r),
+                    k42_k91,
+                    F64x2::new(c_q4l, c_q4r) * k43_k93,
+                ); // w6l in 7l|ud=0,g=0.y | w6r in 7r|ud=0,g=0.y
+            let k50_k99 = lanes
+                .mul_add(
+                    F64x2::new(c_q4l, c_q4r),
+                    k42_k91,
+                    F64x2::new(s_q4l, s_q4r) * k43_k93,
+                ); // w6l in 7l|ud=0,g=0.z | w6r in 7r|ud=0,g=0.z
+            let k51_k100 = k44_k94 - F64x2::new(qdd4l, qdd4r); // wd7l.x | wd7r.x
+            let k54_k101 = lanes
+                .mul_add(
+                    F64x2::new(c_q4l, c_q4r),
+                    k46_k95,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q4l, s_q4r),
+                            k45_k92,
+                            k49_k98 * F64x2::new(qd4l, qd4r),
+                        ),
+                ); // wd7l.z | wd7r.z
+            let k53_k102 = k41_k90 + F64x2::new(qd4l, qd4r); // w7l|ud=0,g=0.x | w7r|ud=0,g=0.x
+            let k52_k103 = lanes
+                .mul_add(
+                    F64x2::new(s_q4l, s_q4r),
+                    k46_k95,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q4l, c_q4r),
+                            k45_k92,
+                            k50_k99 * F64x2::new(qd4l, qd4r),
+                        ),
+                ); // wd7l.y | wd7r.y
+            let d94_d204 = lanes
+                .mul_add(
+                    F64x2::new(s_q4l, s_q4r),
+                    d81_d190,
+                    F64x2::new(c_q4l, c_q4r) * d77_d188,
+                ); // a7l.y | a7r.y
+            let d95_d205 = lanes
+                .mul_add(
+                    -F64x2::new(c_q4l, c_q4r),
+                    d81_d190,
+                    F64x2::new(s_q4l, s_q4r) * d77_d188,
+                ); // a7l.z | a7r.z
+            let d96_d206 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY7l, p.MY7r),
+                    k50_k99,
+                    F64x2::new(p.MZ7l, p.MZ7r) * k49_k98,
+                ); // w7lxMS7l|ud=0,g=0.x | w7rxMS7r|ud=0,g=0.x
+            let d97_d207 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ7l, p.MZ7r),
+                    k53_k102,
+                    F64x2::new(p.MX7l, p.MX7r) * k50_k99,
+                ); // w7lxMS7l|ud=0,g=0.y | w7rxMS7r|ud=0,g=0.y
+            let d98_d208 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX7l, p.MX7r),
+                    k49_k98,
+                    F64x2::new(p.MY7l, p.MY7r) * k53_k102,
+                ); // w7lxMS7l|ud=0,g=0.z | w7rxMS7r|ud=0,g=0.z
+            let d100_d209 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ7l, p.MZ7r),
+                    k51_k100,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MX7l, p.MX7r),
+                            k54_k101,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m7l, p.m7r),
+                                    d94_d204,
+                                    lanes.mul_add(-k53_k102, d98_d208, k50_k99 * d96_d206),
+                                ),
+                        ),
+                ); // F7l.y | F7r.y
+            let d99_d210 = lanes
+                .mul_add(
+                    F64x2::new(p.MY7l, p.MY7r),
+                    k54_k101,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ7l, p.MZ7r),
+                            k52_k103,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.m7l, p.m7r),
+                                    d80_d191,
+                                    lanes.mul_add(-k50_k99, d97_d207, k49_k98 * d98_d208),
+                                ),
+                        ),
+                ); // F7l.x | F7r.x
+            let d101_d211 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX7l, p.MX7r),
+                    k52_k103,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MY7l, p.MY7r),
+                            k51_k100,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m7l, p.m7r),
+                                    d95_d205,
+                                    lanes.mul_add(-k49_k98, d96_d206, k53_k102 * d97_d207),
+                                ),
+                        ),
+                ); // F7l.z | F7r.z
+            let d102_d212 = lanes
+                .mul_add(
+                    F64x2::new(p.XZ7l, p.XZ7r),
+                    k50_k99,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY7l, p.XY7r),
+                            k49_k98,
+                            F64x2::new(p.XX7l, p.XX7r) * k53_k102,
+                        ),
+                ); // J7lw7l|ud=0,g=0.x | J7rw7r|ud=0,g=0.x
+            let d103_d213 = lanes
+                .mul_add(
+                    F64x2::new(p.YZ7l, p.YZ7r),
+                    k50_k99,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY7l, p.YY7r),
+                            k49_k98,
+                            F64x2::new(p.XY7l, p.XY7r) * k53_k102,
+                        ),
+                ); // J7lw7l|ud=0,g=0.y | J7rw7r|ud=0,g=0.y
+            let d104_d214 = lanes
+                .mul_add(
+                    F64x2::new(p.ZZ7l, p.ZZ7r),
+                    k50_k99,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ7l, p.YZ7r),
+                            k49_k98,
+                            F64x2::new(p.XZ7l, p.XZ7r) * k53_k102,
+                        ),
+                ); // J7lw7l|ud=0,g=0.z | J7rw7r|ud=0,g=0.z
+            let d107_d215 = lanes
+                .mul_add(
+                    F64x2::new(p.MY7l, p.MY7r),
+                    d80_d191,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MX7l, p.MX7r),
+                            d94_d204,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.ZZ7l, p.ZZ7r),
+                                    k54_k101,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.YZ7l, p.YZ7r),
+                                            k52_k103,
+                                            lanes
+                                                .mul_add(
+                                                    F64x2::new(p.XZ7l, p.XZ7r),
+                                                    k51_k100,
+                                                    lanes.mul_add(-k49_k98, d102_d212, k53_k102 * d103_d213),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N7l.z | N7r.z
+            let d105_d216 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ7l, p.MZ7r),
+                    d94_d204,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MY7l, p.MY7r),
+                            d95_d205,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.XZ7l, p.XZ7r),
+                                    k54_k101,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.XY7l, p.XY7r),
+                                            k52_k103,
+                                            lanes
+                                                .mul_add(
+                                                    F64x2::new(p.XX7l, p.XX7r),
+                                                    k51_k100,
+                                                    lanes.mul_add(-k50_k99, d103_d213, k49_k98 * d104_d214),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N7l.x | N7r.x
+            let d106_d217 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX7l, p.MX7r),
+                    d95_d205,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MZ7l, p.MZ7r),
+                            d80_d191,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.YZ7l, p.YZ7r),
+                                    k54_k101,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.YY7l, p.YY7r),
+                                            k52_k103,
+                                            lanes
+                                                .mul_add(
+                                                    F64x2::new(p.XY7l, p.XY7r),
+                                                    k51_k100,
+                                                    lanes.mul_add(-k53_k102, d104_d214, k50_k99 * d102_d212),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N7l.y | N7r.y
+            let k55_k104 = lanes
+                .mul_add(
+                    -F64x2::new(s_q5l, s_q5r),
+                    k50_k99,
+                    F64x2::new(c_q5l, c_q5r) * k53_k102,
+                ); // w7l in 8l|ud=0,g=0.x | w7r in 8r|ud=0,g=0.x
+            let k56_k105 = lanes
+                .mul_add(
+                    F64x2::new(c_q5l, c_q5r),
+                    k50_k99,
+                    F64x2::new(s_q5l, s_q5r) * k53_k102,
+                ); // w7l in 8l|ud=0,g=0.z | w7r in 8r|ud=0,g=0.z
+            let k59_k106 = k52_k103 + F64x2::new(qdd5l, qdd5r); // wd8l.y | wd8r.y
+            let k57_k107 = k49_k98 - F64x2::new(qd5l, qd5r); // w8l|ud=0,g=0.y | w8r|ud=0,g=0.y
+            let k58_k108 = lanes
+                .mul_add(
+                    F64x2::new(s_q5l, s_q5r),
+                    k54_k101,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q5l, c_q5r),
+                            k51_k100,
+                            k56_k105 * F64x2::new(qd5l, qd5r),
+                        ),
+                ); // wd8l.x | wd8r.x
+            let k60_k109 = lanes
+                .mul_add(
+                    F64x2::new(c_q5l, c_q5r),
+                    k54_k101,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q5l, s_q5r),
+                            k51_k100,
+                            k55_k104 * F64x2::new(qd5l, qd5r),
+                        ),
+                ); // wd8l.z | wd8r.z
+            let k61_k110 = p.L8 * k50_k99; // w7lxP8l|ud=0,g=0.x | w7rxP8r|ud=0,g=0.x
+            let k62_k111 = p.L8 * k53_k102; // w7lxP8l|ud=0,g=0.z | w7rxP8r|ud=0,g=0.z
+            let d109_d218 = lanes
+                .mul_add(p.L8, k54_k101, lanes.mul_add(k49_k98, k62_k111, d80_d191)); // a8l in 7l.x | a8r in 7r.x
+            let d108_d219 = lanes.mul_add(k53_k102, k62_k111, k50_k99 * k61_k110)
+                + d94_d204; // a8l in 7l.y | a8r in 7r.y
+            let d110_d220 = lanes
+                .mul_add(p.L8, k51_k100, lanes.mul_add(k49_k98, k61_k110, -d95_d205)); // a8l in 7l.z | a8r in 7r.z
+            let d112_d221 = lanes
+                .mul_add(
+                    F64x2::new(c_q5l, c_q5r),
+                    d110_d220,
+                    F64x2::new(s_q5l, s_q5r) * d109_d218,
+                ); // a8l.z | a8r.z
+            let d111_d222 = lanes
+                .mul_add(
+                    -F64x2::new(s_q5l, s_q5r),
+                    d110_d220,
+                    F64x2::new(c_q5l, c_q5r) * d109_d218,
+                ); // a8l.x | a8r.x
+            let d114_d223 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX8l, p.MX8r),
+                    k57_k107,
+                    F64x2::new(p.MY8l, p.MY8r) * k55_k104,
+                ); // w8lxMS8l|ud=0,g=0.z | w8rxMS8r|ud=0,g=0.z
+            let d113_d224 = lanes
+                .mul_add(
+                    F64x2::new(p.MY8l, p.MY8r),
+                    k56_k105,
+                    F64x2::new(p.MZ8l, p.MZ8r) * k57_k107,
+                ); // w8lxMS8l|ud=0,g=0.x | w8rxMS8r|ud=0,g=0.x
+            let d115_d225 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ8l, p.MZ8r),
+                    k55_k104,
+                    F64x2::new(p.MX8l, p.MX8r) * k56_k105,
+                ); // w8lxMS8l|ud=0,g=0.y | w8rxMS8r|ud=0,g=0.y
+            let d117_d226 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ8l, p.MZ8r),
+                    k58_k108,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MX8l, p.MX8r),
+                            k60_k109,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m8l, p.m8r),
+                                    d108_d219,
+                                    lanes.mul_add(k55_k104, d114_d223, k56_k105 * d113_d224),
+                                ),
+                        ),
+                ); // F8l.y | F8r.y
+            let d116_d227 = lanes
+                .mul_add(
+                    F64x2::new(p.MY8l, p.MY8r),
+                    k60_k109,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MZ8l, p.MZ8r),
+                            k59_k106,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m8l, p.m8r),
+                                    d111_d222,
+                                    lanes.mul_add(-k56_k105, d115_d225, k57_k107 * d114_d223),
+                                ),
+                        ),
+                ); // F8l.x | F8r.x
+            let d118_d228 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX8l, p.MX8r),
+                    k59_k106,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MY8l, p.MY8r),
+                            k58_k108,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m8l, p.m8r),
+                                    d112_d221,
+                                    lanes.mul_add(k57_k107, d113_d224, k55_k104 * d115_d225),
+                                ),
+                        ),
+                ); // F8l.z | F8r.z
+            let d119_d229 = lanes
+                .mul_add(
+                    -F64x2::new(p.XZ8l, p.XZ8r),
+                    k56_k105,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY8l, p.XY8r),
+                            k57_k107,
+                            F64x2::new(p.XX8l, p.XX8r) * k55_k104,
+                        ),
+                ); // J8lw8l|ud=0,g=0.x | J8rw8r|ud=0,g=0.x
+            let d120_d230 = lanes
+                .mul_add(
+                    -F64x2::new(p.YZ8l, p.YZ8r),
+                    k56_k105,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY8l, p.YY8r),
+                            k57_k107,
+                            F64x2::new(p.XY8l, p.XY8r) * k55_k104,
+                        ),
+                ); // J8lw8l|ud=0,g=0.y | J8rw8r|ud=0,g=0.y
+            let d121_d231 = lanes
+                .mul_add(
+                    -F64x2::new(p.ZZ8l, p.ZZ8r),
+                    k56_k105,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ8l, p.YZ8r),
+                            k57_k107,
+                            F64x2::new(p.XZ8l, p.XZ8r) * k55_k104,
+                        ),
+                ); // J8lw8l|ud=0,g=0.z | J8rw8r|ud=0,g=0.z
+            let d123_d232 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY8l, p.MY8r),
+                    d111_d222,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MX8l, p.MX8r),
+                            d108_d219,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.ZZ8l, p.ZZ8r),
+                                    k60_k109,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.YZ8l, p.YZ8r),
+                                            k59_k106,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XZ8l, p.XZ8r),
+                                                    k58_k108,
+                                                    lanes.mul_add(-k57_k107, d119_d229, k55_k104 * d120_d230),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N8l.z | N8r.z
+            let d122_d233 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ8l, p.MZ8r),
+                    d108_d219,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MY8l, p.MY8r),
+                            d112_d221,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.XZ8l, p.XZ8r),
+                                    k60_k109,
+                                    lanes
+                                        .mul_add(
+                                            -F64x2::new(p.XY8l, p.XY8r),
+                                            k59_k106,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XX8l, p.XX8r),
+                                                    k58_k108,
+                                                    lanes.mul_add(k56_k105, d120_d230, k57_k107 * d121_d231),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N8l.x | N8r.x
+            let d124_d234 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX8l, p.MX8r),
+                    d112_d221,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MZ8l, p.MZ8r),
+                            d111_d222,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.YZ8l, p.YZ8r),
+                                    k60_k109,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.YY8l, p.YY8r),
+                                            k59_k106,
+                                            lanes
+                                                .mul_add(
+                                                    F64x2::new(p.XY8l, p.XY8r),
+                                                    k58_k108,
+                                                    lanes.mul_add(k55_k104, d121_d231, k56_k105 * d119_d229),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N8l.y | N8r.y
+            let k63_k112 = lanes
+                .mul_add(
+                    -F64x2::new(s_q6l, s_q6r),
+                    k56_k105,
+                    F64x2::new(c_q6l, c_q6r) * k57_k107,
+                ); // w8l in 9l|ud=0,g=0.y | w8r in 9r|ud=0,g=0.y
+            let k64_k113 = lanes
+                .mul_add(
+                    F64x2::new(c_q6l, c_q6r),
+                    k56_k105,
+                    F64x2::new(s_q6l, s_q6r) * k57_k107,
+                ); // w8l in 9l|ud=0,g=0.z | w8r in 9r|ud=0,g=0.z
+            let k65_k114 = k58_k108 - F64x2::new(qdd6l, qdd6r); // wd9l.x | wd9r.x
+            let k68_k115 = lanes
+                .mul_add(
+                    F64x2::new(c_q6l, c_q6r),
+                    k60_k109,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q6l, s_q6r),
+                            k59_k106,
+                            k63_k112 * F64x2::new(qd6l, qd6r),
+                        ),
+                ); // wd9l.z | wd9r.z
+            let k67_k116 = k55_k104 + F64x2::new(qd6l, qd6r); // w9l|ud=0,g=0.x | w9r|ud=0,g=0.x
+            let k66_k117 = lanes
+                .mul_add(
+                    F64x2::new(s_q6l, s_q6r),
+                    k60_k109,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q6l, c_q6r),
+                            k59_k106,
+                            k64_k113 * F64x2::new(qd6l, qd6r),
+                        ),
+                ); // wd9l.y | wd9r.y
+            let d125_d235 = lanes
+                .mul_add(
+                    F64x2::new(s_q6l, s_q6r),
+                    d112_d221,
+                    F64x2::new(c_q6l, c_q6r) * d108_d219,
+                ); // a9l.y | a9r.y
+            let d126_d236 = lanes
+                .mul_add(
+                    -F64x2::new(c_q6l, c_q6r),
+                    d112_d221,
+                    F64x2::new(s_q6l, s_q6r) * d108_d219,
+                ); // a9l.z | a9r.z
+            let d127_d237 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY9l, p.MY9r),
+                    k64_k113,
+                    F64x2::new(p.MZ9l, p.MZ9r) * k63_k112,
+                ); // w9lxMS9l|ud=0,g=0.x | w9rxMS9r|ud=0,g=0.x
+            let d128_d238 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ9l, p.MZ9r),
+                    k67_k116,
+                    F64x2::new(p.MX9l, p.MX9r) * k64_k113,
+                ); // w9lxMS9l|ud=0,g=0.y | w9rxMS9r|ud=0,g=0.y
+            let d129_d239 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX9l, p.MX9r),
+                    k63_k112,
+                    F64x2::new(p.MY9l, p.MY9r) * k67_k116,
+                ); // w9lxMS9l|ud=0,g=0.z | w9rxMS9r|ud=0,g=0.z
+            let d131_d240 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ9l, p.MZ9r),
+                    k65_k114,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MX9l, p.MX9r),
+                            k68_k115,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m9l, p.m9r),
+                                    d125_d235,
+                                    lanes.mul_add(-k67_k116, d129_d239, k64_k113 * d127_d237),
+                                ),
+                        ),
+                ); // F9l.y | F9r.y
+            let d130_d241 = lanes
+                .mul_add(
+                    F64x2::new(p.MY9l, p.MY9r),
+                    k68_k115,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ9l, p.MZ9r),
+                            k66_k117,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.m9l, p.m9r),
+                                    d111_d222,
+                                    lanes.mul_add(-k64_k113, d128_d238, k63_k112 * d129_d239),
+                                ),
+                        ),
+                ); // F9l.x | F9r.x
+            let d132_d242 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX9l, p.MX9r),
+                    k66_k117,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MY9l, p.MY9r),
+                            k65_k114,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m9l, p.m9r),
+                                    d126_d236,
+                                    lanes.mul_add(-k63_k112, d127_d237, k67_k116 * d128_d238),
+                                ),
+                        ),
+                ); // F9l.z | F9r.z
+            let d133_d243 = lanes
+                .mul_add(
+                    F64x2::new(p.XZ9l, p.XZ9r),
+                    k64_k113,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY9l, p.XY9r),
+                            k63_k112,
+                            F64x2::new(p.XX9l, p.XX9r) * k67_k116,
+                        ),
+                ); // J9lw9l|ud=0,g=0.x | J9rw9r|ud=0,g=0.x
+            let d134_d244 = lanes
+                .mul_add(
+                    F64x2::new(p.YZ9l, p.YZ9r),
+                    k64_k113,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY9l, p.YY9r),
+                            k63_k112,
+                            F64x2::new(p.XY9l, p.XY9r) * k67_k116,
+                        ),
+                ); // J9lw9l|ud=0,g=0.y | J9rw9r|ud=0,g=0.y
+            let d135_d245 = lanes
+                .mul_add(
+                    F64x2::new(p.ZZ9l, p.ZZ9r),
+                    k64_k113,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ9l, p.YZ9r),
+                            k63_k112,
+                            F64x2::new(p.XZ9l, p.XZ9r) * k67_k116,
+                        ),
+                ); // J9lw9l|ud=0,g=0.z | J9rw9r|ud=0,g=0.z
+            let d138_d246 = lanes
+                .mul_add(
+                    F64x2::new(p.MY9l, p.MY9r),
+                    d111_d222,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MX9l, p.MX9r),
+                            d125_d235,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.ZZ9l, p.ZZ9r),
+                                    k68_k115,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.YZ9l, p.YZ9r),
+                                            k66_k117,
+                                            lanes
+                                                .mul_add(
+                                                    F64x2::new(p.XZ9l, p.XZ9r),
+                                                    k65_k114,
+                                                    lanes.mul_add(-k63_k112, d133_d243, k67_k116 * d134_d244),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N9l.z | N9r.z
+            let d136_d247 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ9l, p.MZ9r),
+                    d125_d235,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MY9l, p.MY9r),
+                            d126_d236,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.XZ9l, p.XZ9r),
+                                    k68_k115,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.XY9l, p.XY9r),
+                                            k66_k117,
+                                            lanes
+                                                .mul_add(
+                                                    F64x2::new(p.XX9l, p.XX9r),
+                                                    k65_k114,
+                                                    lanes.mul_add(-k64_k113, d134_d244, k63_k112 * d135_d245),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N9l.x | N9r.x
+            let d137_d248 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX9l, p.MX9r),
+                    d126_d236,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MZ9l, p.MZ9r),
+                            d111_d222,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.YZ9l, p.YZ9r),
+                                    k68_k115,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.YY9l, p.YY9r),
+                                            k66_k117,
+                                            lanes
+                                                .mul_add(
+                                                    F64x2::new(p.XY9l, p.XY9r),
+                                                    k65_k114,
+                                                    lanes.mul_add(-k67_k116, d135_d245, k64_k113 * d133_d243),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N9l.y | N9r.y
+            let k69_k118 = lanes
+                .mul_add(
+                    -F64x2::new(s_q7l, s_q7r),
+                    k64_k113,
+                    F64x2::new(c_q7l, c_q7r) * k67_k116,
+                ); // w9l in 10l|ud=0,g=0.x | w9r in 10r|ud=0,g=0.x
+            let k70_k119 = lanes
+                .mul_add(
+                    F64x2::new(c_q7l, c_q7r),
+                    k64_k113,
+                    F64x2::new(s_q7l, s_q7r) * k67_k116,
+                ); // w9l in 10l|ud=0,g=0.y | w9r in 10r|ud=0,g=0.y
+            let k74_k120 = k66_k117 + F64x2::new(qdd7l, qdd7r); // wd10l.z | wd10r.z
+            let k72_k121 = lanes
+                .mul_add(
+                    F64x2::new(c_q7l, c_q7r),
+                    k68_k115,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q7l, s_q7r),
+                            k65_k114,
+                            k69_k118 * F64x2::new(qd7l, qd7r),
+                        ),
+                ); // wd10l.y | wd10r.y
+            let k71_k122 = k63_k112 - F64x2::new(qd7l, qd7r); // w10l|ud=0,g=0.z | w10r|ud=0,g=0.z
+            let k73_k123 = lanes
+                .mul_add(
+                    F64x2::new(s_q7l, s_q7r),
+                    k68_k115,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q7l, c_q7r),
+                            k65_k114,
+                            k70_k119 * F64x2::new(qd7l, qd7r),
+                        ),
+                ); // wd10l.x | wd10r.x
+            let k75_k124 = p.L9 * k64_k113; // w9lxP10l|ud=0,g=0.x | w9rxP10r|ud=0,g=0.x
+            let k76_k125 = p.L9 * k67_k116; // w9lxP10l|ud=0,g=0.z | w9rxP10r|ud=0,g=0.z
+            let d140_d249 = lanes
+                .mul_add(p.L9, k68_k115, lanes.mul_add(k63_k112, k76_k125, d111_d222)); // a10l in 9l.x | a10r in 9r.x
+            let d139_d250 = lanes.mul_add(k67_k116, k76_k125, k64_k113 * k75_k124)
+                + d125_d235; // a10l in 9l.y | a10r in 9r.y
+            let d141_d251 = lanes
+                .mul_add(p.L9, k65_k114, lanes.mul_add(k63_k112, k75_k124, -d126_d236)); // a10l in 9l.z | a10r in 9r.z
+            let d142_d252 = lanes
+                .mul_add(
+                    -F64x2::new(s_q7l, s_q7r),
+                    d141_d251,
+                    F64x2::new(c_q7l, c_q7r) * d140_d249,
+                ); // a10l.x | a10r.x
+            let d143_d253 = lanes
+                .mul_add(
+                    F64x2::new(c_q7l, c_q7r),
+                    d141_d251,
+                    F64x2::new(s_q7l, s_q7r) * d140_d249,
+                ); // a10l.y | a10r.y
+            let d144_d254 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY10l, p.MY10r),
+                    k71_k122,
+                    F64x2::new(p.MZ10l, p.MZ10r) * k70_k119,
+                ); // w10lxMS10l|ud=0,g=0.x | w10rxMS10r|ud=0,g=0.x
+            let d146_d255 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX10l, p.MX10r),
+                    k70_k119,
+                    F64x2::new(p.MY10l, p.MY10r) * k69_k118,
+                ); // w10lxMS10l|ud=0,g=0.z | w10rxMS10r|ud=0,g=0.z
+            let d145_d256 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ10l, p.MZ10r),
+                    k69_k118,
+                    F64x2::new(p.MX10l, p.MX10r) * k71_k122,
+                ); // w10lxMS10l|ud=0,g=0.y | w10rxMS10r|ud=0,g=0.y
+            let d147_d257 = lanes
+                .mul_add(
+                    F64x2::new(p.MY10l, p.MY10r),
+                    k74_k120,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ10l, p.MZ10r),
+                            k72_k121,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m10l, p.m10r),
+                                    d142_d252,
+                                    lanes.mul_add(-k71_k122, d145_d256, k70_k119 * d146_d255),
+                                ),
+                        ),
+                ); // F10l.x | F10r.x
+            let d148_d258 = lanes
+                .mul_add(
+                    F64x2::new(p.MZ10l, p.MZ10r),
+                    k73_k123,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MX10l, p.MX10r),
+                            k74_k120,
+                            lanes
+                                .mul_add(
+                                    F64x2::new(p.m10l, p.m10r),
+                                    d143_d253,
+                                    lanes.mul_add(-k69_k118, d146_d255, k71_k122 * d144_d254),
+                                ),
+                        ),
+                ); // F10l.y | F10r.y
+            let d149_d259 = lanes
+                .mul_add(
+                    -F64x2::new(p.MX10l, p.MX10r),
+                    k72_k121,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MY10l, p.MY10r),
+                            k73_k123,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.m10l, p.m10r),
+                                    d139_d250,
+                                    lanes.mul_add(-k70_k119, d144_d254, k69_k118 * d145_d256),
+                                ),
+                        ),
+                ); // F10l.z | F10r.z
+            let d150_d260 = lanes
+                .mul_add(
+                    F64x2::new(p.XZ10l, p.XZ10r),
+                    k71_k122,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.XY10l, p.XY10r),
+                            k70_k119,
+                            F64x2::new(p.XX10l, p.XX10r) * k69_k118,
+                        ),
+                ); // J10lw10l|ud=0,g=0.x | J10rw10r|ud=0,g=0.x
+            let d151_d261 = lanes
+                .mul_add(
+                    F64x2::new(p.YZ10l, p.YZ10r),
+                    k71_k122,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YY10l, p.YY10r),
+                            k70_k119,
+                            F64x2::new(p.XY10l, p.XY10r) * k69_k118,
+                        ),
+                ); // J10lw10l|ud=0,g=0.y | J10rw10r|ud=0,g=0.y
+            let d152_d262 = lanes
+                .mul_add(
+                    F64x2::new(p.ZZ10l, p.ZZ10r),
+                    k71_k122,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.YZ10l, p.YZ10r),
+                            k70_k119,
+                            F64x2::new(p.XZ10l, p.XZ10r) * k69_k118,
+                        ),
+                ); // J10lw10l|ud=0,g=0.z | J10rw10r|ud=0,g=0.z
+            let d153_d263 = lanes
+                .mul_add(
+                    -F64x2::new(p.MZ10l, p.MZ10r),
+                    d143_d253,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(p.MY10l, p.MY10r),
+                            d139_d250,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.XZ10l, p.XZ10r),
+                                    k74_k120,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.XY10l, p.XY10r),
+                                            k72_k121,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XX10l, p.XX10r),
+                                                    k73_k123,
+                                                    lanes.mul_add(-k71_k122, d151_d261, k70_k119 * d152_d262),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N10l.x | N10r.x
+            let d155_d264 = lanes
+                .mul_add(
+                    -F64x2::new(p.MY10l, p.MY10r),
+                    d142_d252,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MX10l, p.MX10r),
+                            d143_d253,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.ZZ10l, p.ZZ10r),
+                                    k74_k120,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.YZ10l, p.YZ10r),
+                                            k72_k121,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XZ10l, p.XZ10r),
+                                                    k73_k123,
+                                                    lanes.mul_add(-k70_k119, d150_d260, k69_k118 * d151_d261),
+                                                ),
+                                        ),
+                                ),
+                        ),
+                ); // N10l.z | N10r.z
+            let d155 = d155_d264.lo();
+            let d264 = d155_d264.hi();
+            out[11] = core::hint::black_box(-d155);
             out[18] = core::hint::black_box(-d264);
-            let d265 = A::mul_add(
-                -p.MX10r,
-                d250,
-                A::mul_add(
-                    p.MZ10r,
-                    d252,
-                    A::mul_add(
-                        -p.YZ10r,
-                        k120,
-                        A::mul_add(
-                            -p.YY10r,
-                            k121,
-                            A::mul_add(
-                                p.XY10r,
-                                k123,
-                                A::mul_add(k118, d262, k122 * d260),
-                            ),
+            let d154_d265 = lanes
+                .mul_add(
+                    F64x2::new(p.MX10l, p.MX10r),
+                    d139_d250,
+                    lanes
+                        .mul_add(
+                            F64x2::new(p.MZ10l, p.MZ10r),
+                            d142_d252,
+                            lanes
+                                .mul_add(
+                                    -F64x2::new(p.YZ10l, p.YZ10r),
+                                    k74_k120,
+                                    lanes
+                                        .mul_add(
+                                            F64x2::new(p.YY10l, p.YY10r),
+                                            k72_k121,
+                                            lanes
+                                                .mul_add(
+                                                    -F64x2::new(p.XY10l, p.XY10r),
+                                                    k73_k123,
+                                                    lanes.mul_add(-k69_k118, d152_d262, k71_k122 * d150_d260),
+                                                ),
+                                        ),
+                                ),
                         ),
-                    ),
-                ),
-            ); // N10r.y
-            let d266 = A::mul_add(c_q7r, d258, s_q7r * d257); // f10r in 9r.z
-            let d267 = A::mul_add(-s_q7r, d258, c_q7r * d257); // f10r in 9r.x
-            let d268 = d240 + d259; // f9r.y
-            let d269 = A::mul_add(
-                -p.L9,
-                d267,
-                A::mul_add(c_q7r, d265, A::mul_add(s_q7r, d263, d246)),
-            ); // n9r.z
-            let d270 = d241 + d267; // f9r.x
-            let d271 = d242 - d266; // f9r.z
-            let d272 = A::mul_add(
-                p.L9,
-                d266,
-                A::mul_add(-s_q7r, d265, A::mul_add(c_q7r, d263, d247)),
-            ); // n9r.x
-            out[17] = core::hint::black_box(d272);
-            let d273 = d248 + d264; // n9r.y
-            let d274 = A::mul_add(-s_q6r, d271, c_q6r * d268); // f9r in 8r.y
-            let d275 = A::mul_add(c_q6r, d271, s_q6r * d268); // f9r in 8r.z
-            let d276 = d226 - d274; // f8r.y
-            let d277 = A::mul_add(c_q6r, d269, A::mul_add(s_q6r, d273, d232)); // n8r.z
-            let d278 = d227 - d270; // f8r.x
-            let d279 = d228 + d275; // f8r.z
-            let d280 = d233 - d272; // n8r.x
-            let d281 = A::mul_add(s_q6r, d269, A::mul_add(-c_q6r, d273, d234)); // n8r.y
+                ); // N10l.y | N10r.y
+            let d322_d266 = lanes
+                .mul_add(
+                    -F64x2::new(c_q7l, c_q7r),
+                    d148_d258,
+                    F64x2::new(s_q7l, s_q7r) * d147_d257,
+                ); // f10l in 9l.z | f10r in 9r.z
+            let d323_d267 = lanes
+                .mul_add(
+                    F64x2::new(s_q7l, s_q7r),
+                    d148_d258,
+                    F64x2::new(c_q7l, c_q7r) * d147_d257,
+                ); // f10l in 9l.x | f10r in 9r.x
+            let d324_d270 = d130_d241 - d323_d267; // f9l.x | f9r.x
+            let d325_d268 = d131_d240 - d149_d259; // f9l.y | f9r.y
+            let d326_d271 = d132_d242 + d322_d266; // f9l.z | f9r.z
+            let d327_d273 = d137_d248 - d155_d264; // n9l.y | n9r.y
+            let d328_d272 = lanes
+                .mul_add(
+                    -p.L9,
+                    d322_d266,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(s_q7l, s_q7r),
+                            d154_d265,
+                            lanes
+                                .mul_add(-F64x2::new(c_q7l, c_q7r), d153_d263, d136_d247),
+                        ),
+                ); // n9l.x | n9r.x
+            let d328 = d328_d272.lo();
+            let d272 = d328_d272.hi();
+            out[10] = core::hint::black_box(-d328);
+            out[17] = core::hint::black_box(-d272);
+            let d329_d269 = lanes
+                .mul_add(
+                    -p.L9,
+                    d323_d267,
+                    lanes
+                        .mul_add(
+                            -F64x2::new(c_q7l, c_q7r),
+                            d154_d265,
+                            lanes.mul_add(F64x2::new(s_q7l, s_q7r), d153_d263, d138_d246),
+                        ),
+                ); // n9l.z | n9r.z
+            let d330_d274 = lanes
+                .mul_add(
+                    F64x2::new(s_q6l, s_q6r),
+                    d326_d271,
+                    F64x2::new(c_q6l, c_q6r) * d325_d268,
+                ); // f9l in 8l.y | f9r in 8r.y
+            let d331_d275 = lanes
+                .mul_add(
+                    -F64x2::new(c_q6l, c_q6r),
+                    d326_d271,
+                    F64x2::new(s_q6l, s_q6r) * d325_d268,
+                ); // f9l in 8l.z | f9r in 8r.z
+            let d332_d278 = d116_d227 - d324_d270; // f8l.x | f8r.x
+            let d333_d280 = d122_d233 - d328_d272; // n8l.x | n8r.x
+            let d334_d277 = lanes
+                .mul_add(
+                    F64x2::new(c_q6l, c_q6r),
+                    d329_d269,
+                    lanes.mul_add(-F64x2::new(s_q6l, s_q6r), d327_d273, d123_d232),
+                ); // n8l.z | n8r.z
+            let d335_d276 = d117_d226 + d330_d274; // f8l.y | f8r.y
+            let d336_d279 = d118_d228 + d331_d275; // f8l.z | f8r.z
+            let d337_d281 = lanes
+                .mul_add(
+                    F64x2::new(s_q6l, s_q6r),
+                    d329_d269,
+                    lanes.mul_add(F64x2::new(c_q6l, c_q6r), d327_d273, d124_d234),
+                ); // n8l.y | n8r.y
+            let d337 = d337_d281.lo();
+            let d281 = d337_d281.hi();
+            out[9] = core::hint::black_box(d337);
             out[16] = core::hint::black_box(d281);
-            let d282 = A::mul_add(-s_q5r, d279, c_q5r * d278); // f8r in 7r.x
-            let d283 = A::mul_add(c_q5r, d279, s_q5r * d278); // f8r in 7r.z
-            let d284 = d209 - d276; // f7r.y
-            let d285 = A::mul_add(
-                p.L8,
-                d282,
-                A::mul_add(c_q5r, d277, A::mul_add(-s_q5r, d280, d215)),
-            ); // n7r.z
-            let d286 = d210 - d282; // f7r.x
-            let d287 = d211 + d283; // f7r.z
-            let d288 = A::mul_add(
-                -p.L8,
-                d283,
-                A::mul_add(-s_q5r, d277, A::mul_add(-c_q5r, d280, d216)),
-            ); // n7r.x
-            out[15] = core::hint::black_box(d288);
-            let d289 = d217 - d281; // n7r.y
-            let d290 = A::mul_add(-s_q4r, d287, c_q4r * d284); // f7r in 6r.y
-            let d291 = A::mul_add(c_q4r, d287, s_q4r * d284); // f7r in 6r.z
-            let d292 = d195 - d290; // f6r.y
-            let d293 = A::mul_add(c_q4r, d285, A::mul_add(s_q4r, d289, d201)); // n6r.z
-            let d294 = d196 - d286; // f6r.x
-            let d295 = d197 + d291; // f6r.z
-            let d296 = d202 - d288; // n6r.x
-            let d297 = A::mul_add(s_q4r, d285, A::mul_add(-c_q4r, d289, d203)); // n6r.y
+            let d338_d283 = lanes
+                .mul_add(
+                    -F64x2::new(c_q5l, c_q5r),
+                    d336_d279,
+                    F64x2::new(s_q5l, s_q5r) * d332_d278,
+                ); // f8l in 7l.z | f8r in 7r.z
+            let d339_d282 = lanes
+                .mul_add(
+                    F64x2::new(s_q5l, s_q5r),
+                    d336_d279,
+                    F64x2::new(c_q5l, c_q5r) * d332_d278,
+                ); // f8l in 7l.x | f8r in 7r.x
+            let d340_d286 = d99_d210 - d339_d282; // f7l.x | f7r.x
+            let d341_d284 = d100_d209 + d335_d276; // f7l.y | f7r.y
+            let d342_d287 = d101_d211 + d338_d283; // f7l.z | f7r.z
+            let d343_d289 = d106_d217 + d337_d281; // n7l.y | n7r.y
+            let d344_d288 = lanes
+                .mul_add(
+                    -p.L8,
+                    d338_d283,
+                    lanes
+                        .mul_add(
+                            F64x2::new(s_q5l, s_q5r),
+                            d334_d277,
+                            lanes
+                                .mul_add(-F64x2::new(c_q5l, c_q5r), d333_d280, d105_d216),
+                        ),
+                ); // n7l.x | n7r.x
+            let d344 = d344_d288.lo();
+            let d288 = d344_d288.hi();
+            out[8] = core::hint::black_box(-d344);
+            out[15] = core::hint::black_box(-d288);
+            let d345_d285 = lanes
+                .mul_add(
+                    -p.L8,
+                    d339_d282,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q5l, c_q5r),
+                            d334_d277,
+                            lanes.mul_add(F64x2::new(s_q5l, s_q5r), d333_d280, d107_d215),
+                        ),
+                ); // n7l.z | n7r.z
+            let d346_d290 = lanes
+                .mul_add(
+                    F64x2::new(s_q4l, s_q4r),
+                    d342_d287,
+                    F64x2::new(c_q4l, c_q4r) * d341_d284,
+                ); // f7l in 6l.y | f7r in 6r.y
+            let d347_d291 = lanes
+                .mul_add(
+                    -F64x2::new(c_q4l, c_q4r),
+                    d342_d287,
+                    F64x2::new(s_q4l, s_q4r) * d341_d284,
+                ); // f7l in 6l.z | f7r in 6r.z
+            let d348_d294 = d85_d196 - d340_d286; // f6l.x | f6r.x
+            let d349_d296 = d91_d202 - d344_d288; // n6l.x | n6r.x
+            let d350_d293 = lanes
+                .mul_add(
+                    F64x2::new(c_q4l, c_q4r),
+                    d345_d285,
+                    lanes.mul_add(-F64x2::new(s_q4l, s_q4r), d343_d289, d92_d201),
+                ); // n6l.z | n6r.z
+            let d351_d292 = d86_d195 + d346_d290; // f6l.y | f6r.y
+            let d352_d295 = d87_d197 + d347_d291; // f6l.z | f6r.z
+            let d353_d297 = lanes
+                .mul_add(
+                    F64x2::new(s_q4l, s_q4r),
+                    d345_d285,
+                    lanes.mul_add(F64x2::new(c_q4l, c_q4r), d343_d289, d93_d203),
+                ); // n6l.y | n6r.y
+            let d353 = d353_d297.lo();
+            let d297 = d353_d297.hi();
+            out[7] = core::hint::black_box(d353);
             out[14] = core::hint::black_box(d297);
-            let d298 = A::mul_add(-s_q3r, d295, c_q3r * d294); // f6r in 5r.x
-            let d299 = A::mul_add(c_q3r, d295, s_q3r * d294); // f6r in 5r.z
-            let d300 = d178 - d292; // f5r.y
-            let d301 = A::mul_add(
-                p.L7,
-                d298,
-                A::mul_add(c_q3r, d293, A::mul_add(-s_q3r, d296, d184)),
-            ); // n5r.z
-            let d302 = d179 - d298; // f5r.x
-            let d303 = d180 + d299; // f5r.z
-            let d304 = A::mul_add(
-                -p.L7,
-                d299,
-                A::mul_add(-s_q3r, d293, A::mul_add(-c_q3r, d296, d185)),
-            ); // n5r.x
-            out[13] = core::hint::black_box(d304);
-            let d305 = d186 - d297; // n5r.y
-            let d306 = A::mul_add(-s_q2r, d303, c_q2r * d300); // f5r in 4r.y
-            let d307 = A::mul_add(c_q2r, d303, s_q2r * d300); // f5r in 4r.z
-            let d308 = d164 - d306; // f4r.y
-            let d309 = A::mul_add(c_q2r, d301, A::mul_add(s_q2r, d305, d170)); // n4r.z
-            let d310 = d165 - d302; // f4r.x
-            let d311 = d166 + d307; // f4r.z
-            let d312 = d171 - d304; // n4r.x
-            let d313 = A::mul_add(s_q2r, d301, A::mul_add(-c_q2r, d305, d172)); // n4r.y
+            let d354_d299 = lanes
+                .mul_add(
+                    -F64x2::new(c_q3l, c_q3r),
+                    d352_d295,
+                    F64x2::new(s_q3l, s_q3r) * d348_d294,
+                ); // f6l in 5l.z | f6r in 5r.z
+            let d355_d298 = lanes
+                .mul_add(
+                    F64x2::new(s_q3l, s_q3r),
+                    d352_d295,
+                    F64x2::new(c_q3l, c_q3r) * d348_d294,
+                ); // f6l in 5l.x | f6r in 5r.x
+            let d356_d302 = d68_d179 - d355_d298; // f5l.x | f5r.x
+            let d357_d300 = d69_d178 + d351_d292; // f5l.y | f5r.y
+            let d358_d303 = d70_d180 + d354_d299; // f5l.z | f5r.z
+            let d359_d305 = d75_d186 + d353_d297; // n5l.y | n5r.y
+            let d360_d304 = lanes
+                .mul_add(
+                    -p.L7,
+                    d354_d299,
+                    lanes
+                        .mul_add(
+                            F64x2::new(s_q3l, s_q3r),
+                            d350_d293,
+                            lanes.mul_add(-F64x2::new(c_q3l, c_q3r), d349_d296, d74_d185),
+                        ),
+                ); // n5l.x | n5r.x
+            let d360 = d360_d304.lo();
+            let d304 = d360_d304.hi();
+            out[6] = core::hint::black_box(-d360);
+            out[13] = core::hint::black_box(-d304);
+            let d361_d301 = lanes
+                .mul_add(
+                    -p.L7,
+                    d355_d298,
+                    lanes
+                        .mul_add(
+                            F64x2::new(c_q3l, c_q3r),
+                            d350_d293,
+                            lanes.mul_add(F64x2::new(s_q3l, s_q3r), d349_d296, d76_d184),
+                        ),
+                ); // n5l.z | n5r.z
+            let d362_d306 = lanes
+                .mul_add(
+                    F64x2::new(s_q2l, s_q2r),
+                    d358_d303,
+                    F64x2::new(c_q2l, c_q2r) * d357_d300,
+                ); // f5l in 4l.y | f5r in 4r.y
+            let d363_d307 = lanes
+                .mul_add(
+                    -F64x2::new(c_q2l, c_q2r),
+                    d358_d303,
+                    F64x2::new(s_q2l, s_q2r) * d357_d300,
+                ); // f5l in 4l.z | f5r in 4r.z
+            let d364_d310 = d54_d165 - d356_d302; // f4l.x | f4r.x
+            let d365_d312 = d60_d171 - d360_d304; // n4l.x | n4r.x
+            let d365 = d365_d312.lo();
+            let d312 = d365_d312.hi();
+            let d366_d309 = lanes
+                .mul_add(
+                    F64x2::new(c_q2l, c_q2r),
+                    d361_d301,
+                    lanes.mul_add(-F64x2::new(s_q2l, s_q2r), d359_d305, d61_d170),
+                ); // n4l.z | n4r.z
+            let d366 = d366_d309.lo();
+            let d309 = d366_d309.hi();
+            let d367_d308 = d55_d164 + d362_d306; // f4l.y | f4r.y
+            let d367 = d367_d308.lo();
+            let d308 = d367_d308.hi();
+            let d316 = d37 + d308; // f3.x
+            let d368_d311 = d56_d166 + d363_d307; // f4l.z | f4r.z
+            let d369_d313 = lanes
+                .mul_add(
+                    F64x2::new(s_q2l, s_q2r),
+                    d361_d301,
+                    lanes.mul_add(F64x2::new(c_q2l, c_q2r), d359_d305, d62_d172),
+                ); // n4l.y | n4r.y
+            let d369 = d369_d313.lo();
+            let d313 = d369_d313.hi();
+            out[5] = core::hint::black_box(d369);
             out[12] = core::hint::black_box(d313);
-            let d314 = A::mul_add(-s_q1r, d311, c_q1r * d310); // f4r in 3.y
-            let d315 = A::mul_add(c_q1r, d311, s_q1r * d310); // f4r in 3.z
-            let d316 = d37 - d308; // f3.x
-            let d317 = A::mul_add(-p.L5, d315, d43 + d313); // n3.x
+            let d370_d314 = lanes
+                .mul_add(
+                    F64x2::new(s_q1l, s_q1r),
+                    d368_d311,
+                    F64x2::new(c_q1l, c_q1r) * d364_d310,
+                ); // f4l in 3.y | f4r in 3.y
+            let d370 = d370_d314.lo();
+            let d314 = d370_d314.hi();
             let d318 = A::mul_add(
-                p.L5,
+                -p.L5,
                 d308,
                 A::mul_add(
-                    p.L6,
+                    -p.L6,
                     d314,
-                    A::mul_add(c_q1r, d309, A::mul_add(-s_q1r, d312, d44)),
+                    A::mul_add(c_q1r, d309, A::mul_add(s_q1r, d312, d44)),
                 ),
             ); // n3.z
-            let d319 = d38 + d314; // f3.y
-            let d320 = d39 + d315; // f3.z
+            let d319 = d38 - d314; // f3.y
+            let d371_d315 = lanes
+                .mul_add(
+                    -F64x2::new(c_q1l, c_q1r),
+                    d368_d311,
+                    F64x2::new(s_q1l, s_q1r) * d364_d310,
+                ); // f4l in 3.z | f4r in 3.z
+            let d371 = d371_d315.lo();
+            let d315 = d371_d315.hi();
+            let d317 = A::mul_add(p.L5, d315, d43 + d313); // n3.x
+            let d320 = d39 - d315; // f3.z
             let d321 = A::mul_add(
-                p.L6,
+                -p.L6,
                 d315,
-                A::mul_add(s_q1r, d309, A::mul_add(c_q1r, d312, d45)),
+                A::mul_add(s_q1r, d309, A::mul_add(-c_q1r, d312, d45)),
             ); // n3.y
-            let d322 = A::mul_add(-c_q7l, d148, s_q7l * d147); // f10l in 9l.z
-            let d323 = A::mul_add(s_q7l, d148, c_q7l * d147); // f10l in 9l.x
-            let d324 = d130 - d323; // f9l.x
-            let d325 = d131 - d149; // f9l.y
-            let d326 = d132 + d322; // f9l.z
-            let d327 = d137 - d155; // n9l.y
-            let d328 = A::mul_add(
-                -p.L9,
-                d322,
-                A::mul_add(-s_q7l, d154, A::mul_add(-c_q7l, d153, d136)),
-            ); // n9l.x
-            out[10] = core::hint::black_box(-d328);
-            let d329 = A::mul_add(
-                -p.L9,
-                d323,
-                A::mul_add(-c_q7l, d154, A::mul_add(s_q7l, d153, d138)),
-            ); // n9l.z
-            let d330 = A::mul_add(s_q6l, d326, c_q6l * d325); // f9l in 8l.y
-            let d331 = A::mul_add(-c_q6l, d326, s_q6l * d325); // f9l in 8l.z
-            let d332 = d116 - d324; // f8l.x
-            let d333 = d122 - d328; // n8l.x
-            let d334 = A::mul_add(c_q6l, d329, A::mul_add(-s_q6l, d327, d123)); // n8l.z
-            let d335 = d117 + d330; // f8l.y
-            let d336 = d118 + d331; // f8l.z
-            let d337 = A::mul_add(s_q6l, d329, A::mul_add(c_q6l, d327, d124)); // n8l.y
-            out[9] = core::hint::black_box(d337);
-            let d338 = A::mul_add(-c_q5l, d336, s_q5l * d332); // f8l in 7l.z
-            let d339 = A::mul_add(s_q5l, d336, c_q5l * d332); // f8l in 7l.x
-            let d340 = d99 - d339; // f7l.x
-            let d341 = d100 + d335; // f7l.y
-            let d342 = d101 + d338; // f7l.z
-            let d343 = d106 + d337; // n7l.y
-            let d344 = A::mul_add(
-                -p.L8,
-                d338,
-                A::mul_add(s_q5l, d334, A::mul_add(-c_q5l, d333, d105)),
-            ); // n7l.x
-            out[8] = core::hint::black_box(-d344);
-            let d345 = A::mul_add(
-                -p.L8,
-                d339,
-                A::mul_add(c_q5l, d334, A::mul_add(s_q5l, d333, d107)),
-            ); // n7l.z
-            let d346 = A::mul_add(s_q4l, d342, c_q4l * d341); // f7l in 6l.y
-            let d347 = A::mul_add(-c_q4l, d342, s_q4l * d341); // f7l in 6l.z
-            let d348 = d85 - d340; // f6l.x
-            let d349 = d91 - d344; // n6l.x
-            let d350 = A::mul_add(c_q4l, d345, A::mul_add(-s_q4l, d343, d92)); // n6l.z
-            let d351 = d86 + d346; // f6l.y
-            let d352 = d87 + d347; // f6l.z
-            let d353 = A::mul_add(s_q4l, d345, A::mul_add(c_q4l, d343, d93)); // n6l.y
-            out[7] = core::hint::black_box(d353);
-            let d354 = A::mul_add(-c_q3l, d352, s_q3l * d348); // f6l in 5l.z
-            let d355 = A::mul_add(s_q3l, d352, c_q3l * d348); // f6l in 5l.x
-            let d356 = d68 - d355; // f5l.x
-            let d357 = d69 + d351; // f5l.y
-            let d358 = d70 + d354; // f5l.z
-            let d359 = d75 + d353; // n5l.y
-            let d360 = A::mul_add(
-                -p.L7,
-                d354,
-                A::mul_add(s_q3l, d350, A::mul_add(-c_q3l, d349, d74)),
-            ); // n5l.x
-            out[6] = core::hint::black_box(-d360);
-            let d361 = A::mul_add(
-                -p.L7,
-                d355,
-                A::mul_add(c_q3l, d350, A::mul_add(s_q3l, d349, d76)),
-            ); // n5l.z
-            let d362 = A::mul_add(s_q2l, d358, c_q2l * d357); // f5l in 4l.y
-            let d363 = A::mul_add(-c_q2l, d358, s_q2l * d357); // f5l in 4l.z
-            let d364 = d54 - d356; // f4l.x
-            let d365 = d60 - d360; // n4l.x
-            let d366 = A::mul_add(c_q2l, d361, A::mul_add(-s_q2l, d359, d61)); // n4l.z
-            let d367 = d55 + d362; // f4l.y
-            let d368 = d56 + d363; // f4l.z
-            let d369 = A::mul_add(s_q2l, d361, A::mul_add(c_q2l, d359, d62)); // n4l.y
-            out[5] = core::hint::black_box(d369);
-            let d370 = A::mul_add(s_q1l, d368, c_q1l * d364); // f4l in 3.y
-            let d371 = A::mul_add(-c_q1l, d368, s_q1l * d364); // f4l in 3.z
             let d372 = d316 - d367; // f3.x
             let d373 = A::mul_add(-p.L5, d371, d317 - d369); // n3.x
             let d374 = A::mul_add(
@@ -7919,11 +9289,12 @@ mod generated {
             out[1] = core::hint::black_box(A::mul_add(pc.pc68, psidd, -d394));
             out
         }
-        kanegen_runtime::isa::dispatch_fused(
+        kanegen_runtime::isa::dispatch_pair_with(
+            (),
             #[inline(always)]
-            || body::<kanegen_runtime::isa::Plain>(p, pc, q, u, ud),
+            |(), lanes| body::<kanegen_runtime::isa::Plain, _>(lanes, p, pc, q, u, ud),
             #[inline(always)]
-            || body::<kanegen_runtime::isa::Fused>(p, pc, q, u, ud),
+            |(), lanes| body::<kanegen_runtime::isa::Fused, _>(lanes, p, pc, q, u, ud),
         )
     }
     /// [`mass_matrix`] at `L` states per call, into `out`: entry `l` of `out` becomes `mass_matrix` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
@@ -8005,613 +9376,131 @@ mod generated {
                 m[(0, 0)] = pc.pc69;
                 m[(11, 11)] = p.ZZ10l;
                 m[(18, 18)] = p.ZZ10r;
-                let d1 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
-                let d2 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
-                let t1 = p.XZ10r * c_q7r; // common subexpression
-                let t2 = p.YZ10r * s_q7r; // common subexpression
-                let t3 = p.XZ10r * s_q7r; // common subexpression
-                let t4 = p.YZ10r * c_q7r; // common subexpression
-                let t5 = p.L9 * d2; // common subexpression
-                let t6 = p.L9 * d1; // common subexpression
-                let d3 = t1 + t2 - t5; // N(M col 10r) at 9r.x
-                m[(17, 18)] = -d3;
-                let d4 = t3 - t4 - t6; // N(M col 10r) at 9r.z
-                let d5 = d2 * s_q6r; // F(M col 10r) at 8r.y
-                let d6 = d2 * c_q6r; // F(M col 10r) at 8r.z
-                let d7 = A::mul_add(-d4, s_q6r, p.ZZ10r * c_q6r); // N(M col 10r) at 8r.y
-                m[(16, 18)] = d7;
-                let d8 = A::mul_add(d4, c_q6r, p.ZZ10r * s_q6r); // N(M col 10r) at 8r.z
-                let d9 = A::mul_add(d6, s_q5r, d1 * c_q5r); // F(M col 10r) at 7r.x
-                let d10 = A::mul_add(-d6, c_q5r, d1 * s_q5r); // F(M col 10r) at 7r.z
-                let d11 = A::mul_add(p.L8, d10, A::mul_add(-d8, s_q5r, d3 * c_q5r)); // N(M col 10r) at 7r.x
-                m[(15, 18)] = -d11;
-                let d12 = A::mul_add(-p.L8, d9, A::mul_add(d8, c_q5r, d3 * s_q5r)); // N(M col 10r) at 7r.z
-                let d13 = A::mul_add(-d10, s_q4r, d5 * c_q4r); // F(M col 10r) at 6r.y
-                let d14 = A::mul_add(d10, c_q4r, d5 * s_q4r); // F(M col 10r) at 6r.z
-                let d15 = A::mul_add(-d12, s_q4r, d7 * c_q4r); // N(M col 10r) at 6r.y
-                m[(14, 18)] = d15;
-                let d16 = A::mul_add(d12, c_q4r, d7 * s_q4r); // N(M col 10r) at 6r.z
-                let d17 = A::mul_add(-d14, s_q3r, d9 * c_q3r); // F(M col 10r) at 5r.x
-                let d18 = A::mul_add(d14, c_q3r, d9 * s_q3r); // F(M col 10r) at 5r.z
-                let d19 = A::mul_add(p.L7, d18, A::mul_add(-d16, s_q3r, d11 * c_q3r)); // N(M col 10r) at 5r.x
-                m[(13, 18)] = -d19;
-                let d20 = A::mul_add(-p.L7, d17, A::mul_add(d16, c_q3r, d11 * s_q3r)); // N(M col 10r) at 5r.z
-                let d21 = A::mul_add(-d18, s_q2r, d13 * c_q2r); // F(M col 10r) at 4r.y
-                let d22 = A::mul_add(d18, c_q2r, d13 * s_q2r); // F(M col 10r) at 4r.z
-                let d23 = A::mul_add(-d20, s_q2r, d15 * c_q2r); // N(M col 10r) at 4r.y
-                m[(12, 18)] = d23;
-                let d24 = A::mul_add(d20, c_q2r, d15 * s_q2r); // N(M col 10r) at 4r.z
-                let d25 = A::mul_add(-d22, s_q1r, d17 * c_q1r); // F(M col 10r) at 3.y
-                let d26 = A::mul_add(d22, c_q1r, d17 * s_q1r); // F(M col 10r) at 3.z
-                let d27 = A::mul_add(-p.L5, d26, d23); // N(M col 10r) at 3.x
-                let d28 = A::mul_add(p.L6, d26, A::mul_add(-d24, s_q1r, d19 * c_q1r)); // N(M col 10r) at 3.y
-                m[(4, 18)] = d28;
-                let d29 = A::mul_add(
-                    d21,
-                    p.L5,
-                    A::mul_add(-p.L6, d25, A::mul_add(d24, c_q1r, d19 * s_q1r)),
-                ); // N(M col 10r) at 3.z
-                let d30 = A::mul_add(d26, s_q_torso, d21 * c_q_torso); // F(M col 10r) at 2.x
-                let d31 = A::mul_add(-d26, c_q_torso, d21 * s_q_torso); // F(M col 10r) at 2.z
-                let d32 = A::mul_add(
-                    -d25,
-                    p.L4,
-                    A::mul_add(p.L3, d31, A::mul_add(d29, s_q_torso, d27 * c_q_torso)),
-                ); // N(M col 10r) at 2.x
-                m[(3, 18)] = d32;
-                let d33 = A::mul_add(p.L4, d30, d28); // N(M col 10r) at 2.y
-                let d34 = A::mul_add(
-                    -p.L3,
-                    d30,
-                    A::mul_add(-d29, c_q_torso, d27 * s_q_torso),
-                ); // N(M col 10r) at 2.z
-                let d35 = A::mul_add(-d31, c_q_w, d25 * s_q_w); // F(M col 10r) at 1.z
-                let d36 = A::mul_add(d31, s_q_w, d25 * c_q_w); // F(M col 10r) at 1.y
-                let d37 = A::mul_add(d30, p.L1, A::mul_add(-d34, c_q_w, d33 * s_q_w)); // N(M col 10r) at 1.z
-                let d38 = A::mul_add(p.L2, d36, A::mul_add(-p.L1, d35, d32)); // N(M col 10r) at 1.x
-                m[(2, 18)] = d38;
-                let d39 = A::mul_add(-d30, p.L2, A::mul_add(d34, s_q_w, d33 * c_q_w)); // N(M col 10r) at 1.y
-                let d40 = A::mul_add(d35, c_q_imu, d36 * s_q_imu); // F(M col 10r) at 0.x
-                m[(0, 18)] = -d40;
-                let d41 = A::mul_add(-d37, s_q_imu, d39 * c_q_imu); // N(M col 10r) at 0.z
-                m[(1, 18)] = -d41;
-                let d42 = p.MX9r - d2; // MSC9r.x
-                let d43 = p.MZ9r + d1; // MSC9r.z
-                let k1 = s_q7r * s_q7r; // sin² q7r
-                let k2 = s_q7r * c_q7r; // sin q7r cos q7r
-                let k3 = A::mul_add(2.0, k1, -1.0); // cos 2q7r
-                let d44 = A::mul_add(-2.0, p.XY10r * k2, k1 * pc.pc3); // JC10r rotated about z: Jxx − J'xx
-                let d45 = p.XY9r + t1 + t2 - t5; // JC9r.xy
-                let d46 = A::mul_add(-k2, pc.pc3, A::mul_add(-p.XY10r, k3, p.XZ9r)); // JC9r.xz
-                let d47 = p.YZ9r - t3 + t4 + t6; // JC9r.yz
-                let d48 = pc.pc7 - d44; // JC9r.xx
-                m[(17, 17)] = d48;
-                let d49 = d44 + pc.pc8; // JC9r.zz
-                let d50 = A::mul_add(s_q6r, d43, c_q6r * pc.pc2); // MSC9r in 8r.y
-                let d51 = A::mul_add(-c_q6r, d43, s_q6r * pc.pc2); // MSC9r in 8r.z
-                let t7 = c_q6r * d45; // common subexpression
-                let t8 = s_q6r * d46; // common subexpression
-                let d52 = t7 + t8; // N(M col 9r) at 8r.y
-                m[(16, 17)] = -d52;
-                let t9 = s_q6r * d45; // common subexpression
-                let t10 = c_q6r * d46; // common subexpression
-                let d53 = t9 - t10; // N(M col 9r) at 8r.z
-                let d54 = s_q5r * d50; // F(M col 9r) at 7r.x
-                let d55 = c_q5r * d50; // F(M col 9r) at 7r.z
-                let d56 = A::mul_add(-p.L8, d54, A::mul_add(c_q5r, d53, s_q5r * d48)); // N(M col 9r) at 7r.z
-                let d57 = A::mul_add(-p.L8, d55, A::mul_add(-s_q5r, d53, c_q5r * d48)); // N(M col 9r) at 7r.x
-                m[(15, 17)] = d57;
-                let d58 = A::mul_add(s_q4r, d55, c_q4r * d51); // F(M col 9r) at 6r.y
-                let d59 = A::mul_add(-c_q4r, d55, s_q4r * d51); // F(M col 9r) at 6r.z
-                let d60 = A::mul_add(-s_q4r, d56, c_q4r * d52); // N(M col 9r) at 6r.y
-                m[(14, 17)] = -d60;
-                let d61 = A::mul_add(c_q4r, d56, s_q4r * d52); // N(M col 9r) at 6r.z
-                let d62 = A::mul_add(c_q3r, d59, s_q3r * d54); // F(M col 9r) at 5r.z
-                let d63 = A::mul_add(-s_q3r, d59, c_q3r * d54); // F(M col 9r) at 5r.x
-                let d64 = A::mul_add(-p.L7, d63, A::mul_add(c_q3r, d61, s_q3r * d57)); // N(M col 9r) at 5r.z
-                let d65 = A::mul_add(p.L7, d62, A::mul_add(-s_q3r, d61, c_q3r * d57)); // N(M col 9r) at 5r.x
-                m[(13, 17)] = d65;
-                let d66 = A::mul_add(-s_q2r, d62, c_q2r * d58); // F(M col 9r) at 4r.y
-                let d67 = A::mul_add(c_q2r, d62, s_q2r * d58); // F(M col 9r) at 4r.z
-                let d68 = A::mul_add(-s_q2r, d64, c_q2r * d60); // N(M col 9r) at 4r.y
-                m[(12, 17)] = -d68;
-                let d69 = A::mul_add(c_q2r, d64, s_q2r * d60); // N(M col 9r) at 4r.z
-                let d70 = A::mul_add(-s_q1r, d67, c_q1r * d63); // F(M col 9r) at 3.y
-                let d71 = A::mul_add(c_q1r, d67, s_q1r * d63); // F(M col 9r) at 3.z
-                let d72 = A::mul_add(p.L6, d71, A::mul_add(-s_q1r, d69, c_q1r * d65)); // N(M col 9r) at 3.y
-                m[(4, 17)] = -d72;
-                let d73 = A::mul_add(
-                    p.L5,
-                    d66,
-                    A::mul_add(-p.L6, d70, A::mul_add(c_q1r, d69, s_q1r * d65)),
-                ); // N(M col 9r) at 3.z
-                let d74 = A::mul_add(-p.L5, d71, d68); // N(M col 9r) at 3.x
-                let d75 = A::mul_add(s_q_torso, d71, c_q_torso * d66); // F(M col 9r) at 2.x
-                let d76 = A::mul_add(-c_q_torso, d71, s_q_torso * d66); // F(M col 9r) at 2.z
-                let d77 = A::mul_add(
-                    -p.L4,
-                    d70,
-                    A::mul_add(p.L3, d76, A::mul_add(s_q_torso, d73, c_q_torso * d74)),
-                ); // N(M col 9r) at 2.x
-                m[(3, 17)] = -d77;
-                let d78 = A::mul_add(p.L4, d75, d72); // N(M col 9r) at 2.y
-                let d79 = A::mul_add(
-                    -p.L3,
-                    d75,
-                    A::mul_add(-c_q_torso, d73, s_q_torso * d74),
-                ); // N(M col 9r) at 2.z
-                let d80 = A::mul_add(s_q_w, d76, c_q_w * d70); // F(M col 9r) at 1.y
-                let d81 = A::mul_add(-c_q_w, d76, s_q_w * d70); // F(M col 9r) at 1.z
-                let d82 = A::mul_add(p.L2, d80, A::mul_add(-p.L1, d81, d77)); // N(M col 9r) at 1.x
-                m[(2, 17)] = -d82;
-                let d83 = A::mul_add(-p.L2, d75, A::mul_add(s_q_w, d79, c_q_w * d78)); // N(M col 9r) at 1.y
-                let d84 = A::mul_add(p.L1, d75, A::mul_add(-c_q_w, d79, s_q_w * d78)); // N(M col 9r) at 1.z
-                let d85 = A::mul_add(c_q_imu, d81, s_q_imu * d80); // F(M col 9r) at 0.x
-                m[(0, 17)] = d85;
-                let d86 = A::mul_add(-s_q_imu, d84, c_q_imu * d83); // N(M col 9r) at 0.z
-                m[(1, 17)] = d86;
-                let d87 = p.MX8r - d42; // MSC8r.x
-                let d88 = p.MY8r - d50; // MSC8r.y
-                let d89 = p.MZ8r - d51; // MSC8r.z
-                let k4 = s_q6r * s_q6r; // sin² q6r
-                let k5 = s_q6r * c_q6r; // sin q6r cos q6r
-                let k6 = A::mul_add(2.0, k4, -1.0); // cos 2q6r
-                let d90 = pc.pc6 - d49; // JC9r: Jyy − Jzz
-                let d91 = A::mul_add(-2.0, d47 * k5, k4 * d90); // JC9r rotated about x: Jyy − J'yy
-                let d92 = p.XX8r + d48; // JC8r.xx
-                let d93 = p.XY8r + t7 + t8; // JC8r.xy
-                let d94 = p.XZ8r + t9 - t10; // JC8r.xz
-                let d95 = A::mul_add(k5, d90, A::mul_add(d47, k6, p.YZ8r)); // JC8r.yz
-                let d96 = p.ZZ8r + d49 + d91; // JC8r.zz
-                let d97 = pc.pc10 - d91; // JC8r.yy
-                m[(16, 16)] = d97;
-                let d98 = A::mul_add(c_q5r, d89, s_q5r * d87); // MSC8r in 7r.z
-                let d99 = A::mul_add(-s_q5r, d89, c_q5r * d87); // MSC8r in 7r.x
-                let t11 = c_q5r * d93; // common subexpression
-                let t12 = s_q5r * d95; // common subexpression
-                let t13 = s_q5r * d93; // common subexpression
-                let t14 = c_q5r * d95; // common subexpression
-                let t15 = p.L8 * d99; // common subexpression
-                let t16 = p.L8 * d98; // common subexpression
-                let d100 = t11 - t12 - t15; // N(M col 8r) at 7r.x
-                m[(15, 16)] = -d100;
-                let d101 = t13 + t14 - t16; // N(M col 8r) at 7r.z
-                let d102 = s_q4r * d99; // F(M col 8r) at 6r.y
-                let d103 = c_q4r * d99; // F(M col 8r) at 6r.z
-                let d104 = A::mul_add(-s_q4r, d101, c_q4r * d97); // N(M col 8r) at 6r.y
-                m[(14, 16)] = d104;
-                let d105 = A::mul_add(c_q4r, d101, s_q4r * d97); // N(M col 8r) at 6r.z
-                let d106 = A::mul_add(s_q3r, d103, c_q3r * d98); // F(M col 8r) at 5r.x
-                let d107 = A::mul_add(-c_q3r, d103, s_q3r * d98); // F(M col 8r) at 5r.z
-                let d108 = A::mul_add(
-                    p.L7,
-                    d107,
-                    A::mul_add(-s_q3r, d105, c_q3r * d100),
-                ); // N(M col 8r) at 5r.x
-                m[(13, 16)] = -d108;
-                let d109 = A::mul_add(
-                    -p.L7,
-                    d106,
-                    A::mul_add(c_q3r, d105, s_q3r * d100),
-                ); // N(M col 8r) at 5r.z
-                let d110 = A::mul_add(-s_q2r, d107, c_q2r * d102); // F(M col 8r) at 4r.y
-                let d111 = A::mul_add(c_q2r, d107, s_q2r * d102); // F(M col 8r) at 4r.z
-                let d112 = A::mul_add(-s_q2r, d109, c_q2r * d104); // N(M col 8r) at 4r.y
-                m[(12, 16)] = d112;
-                let d113 = A::mul_add(c_q2r, d109, s_q2r * d104); // N(M col 8r) at 4r.z
-                let d114 = A::mul_add(-s_q1r, d111, c_q1r * d106); // F(M col 8r) at 3.y
-                let d115 = A::mul_add(c_q1r, d111, s_q1r * d106); // F(M col 8r) at 3.z
-                let d116 = A::mul_add(-p.L5, d115, d112); // N(M col 8r) at 3.x
-                let d117 = A::mul_add(
-                    p.L6,
-                    d115,
-                    A::mul_add(-s_q1r, d113, c_q1r * d108),
-                ); // N(M col 8r) at 3.y
-                m[(4, 16)] = d117;
-                let d118 = A::mul_add(
-                    p.L5,
-                    d110,
-                    A::mul_add(-p.L6, d114, A::mul_add(c_q1r, d113, s_q1r * d108)),
-                ); // N(M col 8r) at 3.z
-                let d119 = A::mul_add(s_q_torso, d115, c_q_torso * d110); // F(M col 8r) at 2.x
-                let d120 = A::mul_add(-c_q_torso, d115, s_q_torso * d110); // F(M col 8r) at 2.z
-                let d121 = A::mul_add(
-                    -p.L4,
-                    d114,
-                    A::mul_add(p.L3, d120, A::mul_add(s_q_torso, d118, c_q_torso * d116)),
-                ); // N(M col 8r) at 2.x
-                m[(3, 16)] = d121;
-                let d122 = A::mul_add(p.L4, d119, d117); // N(M col 8r) at 2.y
-                let d123 = A::mul_add(
-                    -p.L3,
-                    d119,
-                    A::mul_add(-c_q_torso, d118, s_q_torso * d116),
-                ); // N(M col 8r) at 2.z
-                let d124 = A::mul_add(-c_q_w, d120, s_q_w * d114); // F(M col 8r) at 1.z
-                let d125 = A::mul_add(s_q_w, d120, c_q_w * d114); // F(M col 8r) at 1.y
-                let d126 = A::mul_add(
-                    p.L1,
-                    d119,
-                    A::mul_add(-c_q_w, d123, s_q_w * d122),
-                ); // N(M col 8r) at 1.z
-                let d127 = A::mul_add(p.L2, d125, A::mul_add(-p.L1, d124, d121)); // N(M col 8r) at 1.x
-                m[(2, 16)] = d127;
-                let d128 = A::mul_add(
-                    -p.L2,
-                    d119,
-                    A::mul_add(s_q_w, d123, c_q_w * d122),
-                ); // N(M col 8r) at 1.y
-                let d129 = A::mul_add(c_q_imu, d124, s_q_imu * d125); // F(M col 8r) at 0.x
-                m[(0, 16)] = -d129;
-                let d130 = A::mul_add(-s_q_imu, d126, c_q_imu * d128); // N(M col 8r) at 0.z
-                m[(1, 16)] = -d130;
-                let d131 = p.MX7r - d99; // MSC7r.x
-                let d132 = p.MZ7r + d98; // MSC7r.z
-                let k7 = s_q5r * s_q5r; // sin² q5r
-                let k8 = s_q5r * c_q5r; // sin q5r cos q5r
-                let k9 = A::mul_add(2.0, k7, -1.0); // cos 2q5r
-                let d133 = d92 - d96; // JC8r: Jzz − Jxx
-                let d134 = A::mul_add(2.0, d94 * k8, k7 * d133); // JC8r rotated about y: Jzz − J'zz
-                let t17 = p.L8 * d88; // common subexpression
-                let d135 = p.XY7r + t11 - t12 - t15; // JC7r.xy
-                let d136 = A::mul_add(-k8, d133, A::mul_add(d94, k9, p.XZ7r)); // JC7r.xz
-                let d137 = p.YY7r + d97; // JC7r.yy
-                let d138 = p.YZ7r - t13 - t14 + t16; // JC7r.yz
-                let d139 = pc.pc13 - d88; // MSC7r.y
-                let d140 = A::mul_add(2.0, t17, d92 - d134) + pc.pc14; // JC7r.xx
-                m[(15, 15)] = d140;
-                let d141 = A::mul_add(2.0, t17, d96 + d134) + pc.pc15; // JC7r.zz
-                let d142 = A::mul_add(s_q4r, d132, c_q4r * d139); // MSC7r in 6r.y
-                let d143 = A::mul_add(-c_q4r, d132, s_q4r * d139); // MSC7r in 6r.z
-                let t18 = c_q4r * d135; // common subexpression
-                let t19 = s_q4r * d136; // common subexpression
-                let d144 = t18 + t19; // N(M col 7r) at 6r.y
-                m[(14, 15)] = -d144;
-                let t20 = s_q4r * d135; // common subexpression
-                let t21 = c_q4r * d136; // common subexpression
-                let d145 = t20 - t21; // N(M col 7r) at 6r.z
-                let d146 = s_q3r * d142; // F(M col 7r) at 5r.x
-                let d147 = c_q3r * d142; // F(M col 7r) at 5r.z
-                let d148 = A::mul_add(
-                    -p.L7,
-                    d146,
-                    A::mul_add(c_q3r, d145, s_q3r * d140),
-                ); // N(M col 7r) at 5r.z
-                let d149 = A::mul_add(
-                    -p.L7,
-                    d147,
-                    A::mul_add(-s_q3r, d145, c_q3r * d140),
-                ); // N(M col 7r) at 5r.x
-                m[(13, 15)] = d149;
-                let d150 = A::mul_add(s_q2r, d147, c_q2r * d143); // F(M col 7r) at 4r.y
-                let d151 = A::mul_add(-c_q2r, d147, s_q2r * d143); // F(M col 7r) at 4r.z
-                let d152 = A::mul_add(-s_q2r, d148, c_q2r * d144); // N(M col 7r) at 4r.y
-                m[(12, 15)] = -d152;
-                let d153 = A::mul_add(c_q2r, d148, s_q2r * d144); // N(M col 7r) at 4r.z
-                let d154 = A::mul_add(-s_q1r, d151, c_q1r * d146); // F(M col 7r) at 3.y
-                let d155 = A::mul_add(c_q1r, d151, s_q1r * d146); // F(M col 7r) at 3.z
-                let d156 = A::mul_add(
-                    p.L6,
-                    d155,
-                    A::mul_add(-s_q1r, d153, c_q1r * d149),
-                ); // N(M col 7r) at 3.y
-                m[(4, 15)] = -d156;
-                let d157 = A::mul_add(
-                    p.L5,
-                    d150,
-                    A::mul_add(-p.L6, d154, A::mul_add(c_q1r, d153, s_q1r * d149)),
-                ); // N(M col 7r) at 3.z
-                let d158 = A::mul_add(-p.L5, d155, d152); // N(M col 7r) at 3.x
-                let d159 = A::mul_add(s_q_torso, d155, c_q_torso * d150); // F(M col 7r) at 2.x
-                let d160 = A::mul_add(-c_q_torso, d155, s_q_torso * d150); // F(M col 7r) at 2.z
-                let d161 = A::mul_add(
-                    -p.L4,
-                    d154,
-                    A::mul_add(p.L3, d160, A::mul_add(s_q_torso, d157, c_q_torso * d158)),
-                ); // N(M col 7r) at 2.x
-                m[(3, 15)] = -d161;
-                let d162 = A::mul_add(p.L4, d159, d156); // N(M col 7r) at 2.y
-                let d163 = A::mul_add(
-                    -p.L3,
-                    d159,
-                    A::mul_add(-c_q_torso, d157, s_q_torso * d158),
-                ); // N(M col 7r) at 2.z
-                let d164 = A::mul_add(s_q_w, d160, c_q_w * d154); // F(M col 7r) at 1.y
-                let d165 = A::mul_add(-c_q_w, d160, s_q_w * d154); // F(M col 7r) at 1.z
-                let d166 = A::mul_add(p.L2, d164, A::mul_add(-p.L1, d165, d161)); // N(M col 7r) at 1.x
-                m[(2, 15)] = -d166;
-                let d167 = A::mul_add(
-                    -p.L2,
-                    d159,
-                    A::mul_add(s_q_w, d163, c_q_w * d162),
-                ); // N(M col 7r) at 1.y
-                let d168 = A::mul_add(
-                    p.L1,
-                    d159,
-                    A::mul_add(-c_q_w, d163, s_q_w * d162),
-                ); // N(M col 7r) at 1.z
-                let d169 = A::mul_add(c_q_imu, d165, s_q_imu * d164); // F(M col 7r) at 0.x
-                m[(0, 15)] = d169;
-                let d170 = A::mul_add(-s_q_imu, d168, c_q_imu * d167); // N(M col 7r) at 0.z
-                m[(1, 15)] = d170;
-                let d171 = p.MX6r - d131; // MSC6r.x
-                let d172 = p.MY6r - d142; // MSC6r.y
-                let d173 = p.MZ6r - d143; // MSC6r.z
-                let k10 = s_q4r * s_q4r; // sin² q4r
-                let k11 = s_q4r * c_q4r; // sin q4r cos q4r
-                let k12 = A::mul_add(2.0, k10, -1.0); // cos 2q4r
-                let d174 = d137 - d141; // JC7r: Jyy − Jzz
-                let d175 = A::mul_add(-2.0, d138 * k11, k10 * d174); // JC7r rotated about x: Jyy − J'yy
-                let d176 = p.XX6r + d140; // JC6r.xx
-                let d177 = p.XY6r + t18 + t19; // JC6r.xy
-                let d178 = p.XZ6r + t20 - t21; // JC6r.xz
-                let d179 = p.YY6r + d137 - d175; // JC6r.yy
-                m[(14, 14)] = d179;
-                let d180 = A::mul_add(k11, d174, A::mul_add(d138, k12, p.YZ6r)); // JC6r.yz
-                let d181 = p.ZZ6r + d141 + d175; // JC6r.zz
-                let d182 = A::mul_add(c_q3r, d173, s_q3r * d171); // MSC6r in 5r.z
-                let d183 = A::mul_add(-s_q3r, d173, c_q3r * d171); // MSC6r in 5r.x
-                let t22 = c_q3r * d177; // common subexpression
-                let t23 = s_q3r * d180; // common subexpression
-                let t24 = s_q3r * d177; // common subexpression
-                let t25 = c_q3r * d180; // common subexpression
-                let t26 = p.L7 * d183; // common subexpression
-                let t27 = p.L7 * d182; // common subexpression
-                let d184 = t22 - t23 - t26; // N(M col 6r) at 5r.x
-                m[(13, 14)] = -d184;
-                let d185 = t24 + t25 - t27; // N(M col 6r) at 5r.z
-                let d186 = s_q2r * d183; // F(M col 6r) at 4r.y
-                let d187 = c_q2r * d183; // F(M col 6r) at 4r.z
-                let d188 = A::mul_add(-s_q2r, d185, c_q2r * d179); // N(M col 6r) at 4r.y
-                m[(12, 14)] = d188;
-                let d189 = A::mul_add(c_q2r, d185, s_q2r * d179); // N(M col 6r) at 4r.z
-                let d190 = A::mul_add(s_q1r, d187, c_q1r * d182); // F(M col 6r) at 3.y
-                let d191 = A::mul_add(-c_q1r, d187, s_q1r * d182); // F(M col 6r) at 3.z
-                let d192 = A::mul_add(-p.L5, d191, d188); // N(M col 6r) at 3.x
-                let d193 = A::mul_add(
-                    p.L6,
-                    d191,
-                    A::mul_add(-s_q1r, d189, c_q1r * d184),
-                ); // N(M col 6r) at 3.y
-                m[(4, 14)] = d193;
-                let d194 = A::mul_add(
-                    p.L5,
-                    d186,
-                    A::mul_add(-p.L6, d190, A::mul_add(c_q1r, d189, s_q1r * d184)),
-                ); // N(M col 6r) at 3.z
-                let d195 = A::mul_add(s_q_torso, d191, c_q_torso * d186); // F(M col 6r) at 2.x
-                let d196 = A::mul_add(-c_q_torso, d191, s_q_torso * d186); // F(M col 6r) at 2.z
-                let d197 = A::mul_add(
-                    -p.L4,
-                    d190,
-                    A::mul_add(p.L3, d196, A::mul_add(s_q_torso, d194, c_q_torso * d192)),
-                ); // N(M col 6r) at 2.x
-                m[(3, 14)] = d197;
-                let d198 = A::mul_add(p.L4, d195, d193); // N(M col 6r) at 2.y
-                let d199 = A::mul_add(
-                    -p.L3,
-                    d195,
-                    A::mul_add(-c_q_torso, d194, s_q_torso * d192),
-                ); // N(M col 6r) at 2.z
-                let d200 = A::mul_add(-c_q_w, d196, s_q_w * d190); // F(M col 6r) at 1.z
-                let d201 = A::mul_add(s_q_w, d196, c_q_w * d190); // F(M col 6r) at 1.y
-                let d202 = A::mul_add(
-                    p.L1,
-                    d195,
-                    A::mul_add(-c_q_w, d199, s_q_w * d198),
-                ); // N(M col 6r) at 1.z
-                let d203 = A::mul_add(p.L2, d201, A::mul_add(-p.L1, d200, d197)); // N(M col 6r) at 1.x
-                m[(2, 14)] = d203;
-                let d204 = A::mul_add(
-                    -p.L2,
-                    d195,
-                    A::mul_add(s_q_w, d199, c_q_w * d198),
-                ); // N(M col 6r) at 1.y
-                let d205 = A::mul_add(c_q_imu, d200, s_q_imu * d201); // F(M col 6r) at 0.x
-                m[(0, 14)] = -d205;
-                let d206 = A::mul_add(-s_q_imu, d202, c_q_imu * d204); // N(M col 6r) at 0.z
-                m[(1, 14)] = -d206;
-                let d207 = p.MX5r - d183; // MSC5r.x
-                let d208 = p.MZ5r + d182; // MSC5r.z
-                let k13 = s_q3r * s_q3r; // sin² q3r
-                let k14 = s_q3r * c_q3r; // sin q3r cos q3r
-                let k15 = A::mul_add(2.0, k13, -1.0); // cos 2q3r
-                let d209 = d176 - d181; // JC6r: Jzz − Jxx
-                let d210 = A::mul_add(2.0, d178 * k14, k13 * d209); // JC6r rotated about y: Jzz − J'zz
-                let t28 = p.L7 * d172; // common subexpression
-                let d211 = p.XY5r + t22 - t23 - t26; // JC5r.xy
-                let d212 = A::mul_add(-k14, d209, A::mul_add(d178, k15, p.XZ5r)); // JC5r.xz
-                let d213 = p.YY5r + d179; // JC5r.yy
-                let d214 = p.YZ5r - t24 - t25 + t27; // JC5r.yz
-                let d215 = pc.pc19 - d172; // MSC5r.y
-                let d216 = A::mul_add(2.0, t28, d176 - d210) + pc.pc20; // JC5r.xx
-                m[(13, 13)] = d216;
-                let d217 = A::mul_add(2.0, t28, d181 + d210) + pc.pc21; // JC5r.zz
-                let d218 = A::mul_add(s_q2r, d208, c_q2r * d215); // MSC5r in 4r.y
-                let d219 = A::mul_add(-c_q2r, d208, s_q2r * d215); // MSC5r in 4r.z
-                let t29 = c_q2r * d211; // common subexpression
-                let t30 = s_q2r * d212; // common subexpression
-                let d220 = t29 + t30; // N(M col 5r) at 4r.y
-                m[(12, 13)] = -d220;
-                let t31 = s_q2r * d211; // common subexpression
-                let t32 = c_q2r * d212; // common subexpression
-                let d221 = t31 - t32; // N(M col 5r) at 4r.z
-                let d222 = s_q1r * d218; // F(M col 5r) at 3.y
-                let d223 = c_q1r * d218; // F(M col 5r) at 3.z
-                let d224 = A::mul_add(
-                    -p.L6,
-                    d223,
-                    A::mul_add(-s_q1r, d221, c_q1r * d216),
-                ); // N(M col 5r) at 3.y
-                m[(4, 13)] = -d224;
-                let d225 = A::mul_add(
-                    p.L5,
-                    d219,
-                    A::mul_add(-p.L6, d222, A::mul_add(c_q1r, d221, s_q1r * d216)),
-                ); // N(M col 5r) at 3.z
-                let d226 = A::mul_add(p.L5, d223, d220); // N(M col 5r) at 3.x
-                let d227 = A::mul_add(-s_q_torso, d223, c_q_torso * d219); // F(M col 5r) at 2.x
-                let d228 = A::mul_add(c_q_torso, d223, s_q_torso * d219); // F(M col 5r) at 2.z
-                let d229 = A::mul_add(
-                    -p.L4,
-                    d222,
-                    A::mul_add(p.L3, d228, A::mul_add(s_q_torso, d225, c_q_torso * d226)),
-                ); // N(M col 5r) at 2.x
-                m[(3, 13)] = -d229;
-                let d230 = A::mul_add(p.L4, d227, d224); // N(M col 5r) at 2.y
-                let d231 = A::mul_add(
-                    -p.L3,
-                    d227,
-                    A::mul_add(-c_q_torso, d225, s_q_torso * d226),
-                ); // N(M col 5r) at 2.z
-                let d232 = A::mul_add(s_q_w, d228, c_q_w * d222); // F(M col 5r) at 1.y
-                let d233 = A::mul_add(-c_q_w, d228, s_q_w * d222); // F(M col 5r) at 1.z
-                let d234 = A::mul_add(p.L2, d232, A::mul_add(-p.L1, d233, d229)); // N(M col 5r) at 1.x
-                m[(2, 13)] = -d234;
-                let d235 = A::mul_add(
-                    -p.L2,
-                    d227,
-                    A::mul_add(s_q_w, d231, c_q_w * d230),
-                ); // N(M col 5r) at 1.y
-                let d236 = A::mul_add(
-                    p.L1,
-                    d227,
-                    A::mul_add(-c_q_w, d231, s_q_w * d230),
-                ); // N(M col 5r) at 1.z
-                let d237 = A::mul_add(c_q_imu, d233, s_q_imu * d232); // F(M col 5r) at 0.x
-                m[(0, 13)] = d237;
-                let d238 = A::mul_add(-s_q_imu, d236, c_q_imu * d235); // N(M col 5r) at 0.z
-                m[(1, 13)] = d238;
-                let d239 = p.MX4r - d207; // MSC4r.x
-                let d240 = p.MY4r - d218; // MSC4r.y
-                let d241 = p.MZ4r - d219; // MSC4r.z
-                let k16 = s_q2r * s_q2r; // sin² q2r
-                let k17 = s_q2r * c_q2r; // sin q2r cos q2r
-                let k18 = A::mul_add(2.0, k16, -1.0); // cos 2q2r
-                let d242 = d213 - d217; // JC5r: Jyy − Jzz
-                let d243 = A::mul_add(-2.0, d214 * k17, k16 * d242); // JC5r rotated about x: Jyy − J'yy
-                let d244 = p.XX4r + d216; // JC4r.xx
-                let d245 = p.XY4r + t29 + t30; // JC4r.xy
-                let d246 = p.XZ4r + t31 - t32; // JC4r.xz
-                let d247 = p.YY4r + d213 - d243; // JC4r.yy
-                m[(12, 12)] = d247;
-                let d248 = A::mul_add(k17, d242, A::mul_add(d214, k18, p.YZ4r)); // JC4r.yz
-                let d249 = p.ZZ4r + d217 + d243; // JC4r.zz
-                let d250 = A::mul_add(-s_q1r, d241, c_q1r * d239); // MSC4r in 3.y
-                let d251 = A::mul_add(c_q1r, d241, s_q1r * d239); // MSC4r in 3.z
-                let t33 = c_q1r * d245; // common subexpression
-                let t34 = s_q1r * d248; // common subexpression
-                let t35 = s_q1r * d245; // common subexpression
-                let t36 = c_q1r * d248; // common subexpression
-                let t37 = p.L5 * d250; // common subexpression
-                let t38 = p.L6 * d250; // common subexpression
-                let t39 = p.L6 * d251; // common subexpression
-                let d252 = d247 + t37; // N(M col 4r) at 3.x
-                let d253 = t33 - t34 - t38; // N(M col 4r) at 3.y
-                m[(4, 12)] = d253;
-                let d254 = t35 + t36 - t39; // N(M col 4r) at 3.z
-                let d255 = s_q_torso * d250; // F(M col 4r) at 2.x
-                let d256 = c_q_torso * d250; // F(M col 4r) at 2.z
-                let d257 = A::mul_add(
-                    -p.L4,
-                    d251,
-                    A::mul_add(p.L3, d256, A::mul_add(s_q_torso, d254, c_q_torso * d252)),
-                ); // N(M col 4r) at 2.x
-                m[(3, 12)] = d257;
-                let d258 = A::mul_add(-p.L4, d255, d253); // N(M col 4r) at 2.y
-                let d259 = A::mul_add(
-                    p.L3,
-                    d255,
-                    A::mul_add(-c_q_torso, d254, s_q_torso * d252),
-                ); // N(M col 4r) at 2.z
-                let d260 = A::mul_add(-c_q_w, d256, s_q_w * d251); // F(M col 4r) at 1.z
-                let d261 = A::mul_add(s_q_w, d256, c_q_w * d251); // F(M col 4r) at 1.y
-                let d262 = A::mul_add(
-                    -p.L1,
-                    d255,
-                    A::mul_add(-c_q_w, d259, s_q_w * d258),
-                ); // N(M col 4r) at 1.z
-                let d263 = A::mul_add(p.L2, d261, A::mul_add(-p.L1, d260, d257)); // N(M col 4r) at 1.x
-                m[(2, 12)] = d263;
-                let d264 = A::mul_add(p.L2, d255, A::mul_add(s_q_w, d259, c_q_w * d258)); // N(M col 4r) at 1.y
-                let d265 = A::mul_add(c_q_imu, d260, s_q_imu * d261); // F(M col 4r) at 0.x
-                m[(0, 12)] = -d265;
-                let d266 = A::mul_add(-s_q_imu, d262, c_q_imu * d264); // N(M col 4r) at 0.z
-                m[(1, 12)] = -d266;
-                let k19 = s_q1r * s_q1r; // sin² q1r
-                let k20 = s_q1r * c_q1r; // sin q1r cos q1r
-                let k21 = A::mul_add(2.0, k19, -1.0); // cos 2q1r
-                let d267 = d244 - d249; // JC4r: Jzz − Jxx
-                let d268 = A::mul_add(2.0, d246 * k20, k19 * d267); // JC4r rotated about y: Jzz − J'zz
-                let t40 = p.L6 * d240; // common subexpression
                 let d269 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
+                let d1 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
                 let d270 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
+                let d2 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
                 let t41 = p.XZ10l * c_q7l; // common subexpression
+                let t1 = p.XZ10r * c_q7r; // common subexpression
                 let t42 = p.YZ10l * s_q7l; // common subexpression
+                let t2 = p.YZ10r * s_q7r; // common subexpression
                 let t43 = p.XZ10l * s_q7l; // common subexpression
+                let t3 = p.XZ10r * s_q7r; // common subexpression
                 let t44 = p.YZ10l * c_q7l; // common subexpression
+                let t4 = p.YZ10r * c_q7r; // common subexpression
                 let t45 = p.L9 * d270; // common subexpression
+                let t5 = p.L9 * d2; // common subexpression
                 let t46 = p.L9 * d269; // common subexpression
+                let t6 = p.L9 * d1; // common subexpression
                 let d271 = t41 + t42 - t45; // N(M col 10l) at 9l.x
                 m[(10, 11)] = -d271;
+                let d3 = t1 + t2 - t5; // N(M col 10r) at 9r.x
+                m[(17, 18)] = -d3;
                 let d272 = t43 - t44 - t46; // N(M col 10l) at 9l.z
+                let d4 = t3 - t4 - t6; // N(M col 10r) at 9r.z
                 let d273 = d270 * s_q6l; // F(M col 10l) at 8l.y
+                let d5 = d2 * s_q6r; // F(M col 10r) at 8r.y
                 let d274 = d270 * c_q6l; // F(M col 10l) at 8l.z
+                let d6 = d2 * c_q6r; // F(M col 10r) at 8r.z
                 let d275 = A::mul_add(-d272, s_q6l, p.ZZ10l * c_q6l); // N(M col 10l) at 8l.y
                 m[(9, 11)] = d275;
+                let d7 = A::mul_add(-d4, s_q6r, p.ZZ10r * c_q6r); // N(M col 10r) at 8r.y
+                m[(16, 18)] = d7;
                 let d276 = A::mul_add(d272, c_q6l, p.ZZ10l * s_q6l); // N(M col 10l) at 8l.z
+                let d8 = A::mul_add(d4, c_q6r, p.ZZ10r * s_q6r); // N(M col 10r) at 8r.z
                 let d277 = A::mul_add(d274, s_q5l, d269 * c_q5l); // F(M col 10l) at 7l.x
+                let d9 = A::mul_add(d6, s_q5r, d1 * c_q5r); // F(M col 10r) at 7r.x
                 let d278 = A::mul_add(-d274, c_q5l, d269 * s_q5l); // F(M col 10l) at 7l.z
+                let d10 = A::mul_add(-d6, c_q5r, d1 * s_q5r); // F(M col 10r) at 7r.z
                 let d279 = A::mul_add(
                     p.L8,
                     d278,
                     A::mul_add(-d276, s_q5l, d271 * c_q5l),
                 ); // N(M col 10l) at 7l.x
                 m[(8, 11)] = -d279;
+                let d11 = A::mul_add(p.L8, d10, A::mul_add(-d8, s_q5r, d3 * c_q5r)); // N(M col 10r) at 7r.x
+                m[(15, 18)] = -d11;
                 let d280 = A::mul_add(
                     -p.L8,
                     d277,
                     A::mul_add(d276, c_q5l, d271 * s_q5l),
                 ); // N(M col 10l) at 7l.z
+                let d12 = A::mul_add(-p.L8, d9, A::mul_add(d8, c_q5r, d3 * s_q5r)); // N(M col 10r) at 7r.z
                 let d281 = A::mul_add(-d278, s_q4l, d273 * c_q4l); // F(M col 10l) at 6l.y
+                let d13 = A::mul_add(-d10, s_q4r, d5 * c_q4r); // F(M col 10r) at 6r.y
                 let d282 = A::mul_add(d278, c_q4l, d273 * s_q4l); // F(M col 10l) at 6l.z
+                let d14 = A::mul_add(d10, c_q4r, d5 * s_q4r); // F(M col 10r) at 6r.z
                 let d283 = A::mul_add(-d280, s_q4l, d275 * c_q4l); // N(M col 10l) at 6l.y
                 m[(7, 11)] = d283;
+                let d15 = A::mul_add(-d12, s_q4r, d7 * c_q4r); // N(M col 10r) at 6r.y
+                m[(14, 18)] = d15;
                 let d284 = A::mul_add(d280, c_q4l, d275 * s_q4l); // N(M col 10l) at 6l.z
+                let d16 = A::mul_add(d12, c_q4r, d7 * s_q4r); // N(M col 10r) at 6r.z
                 let d285 = A::mul_add(-d282, s_q3l, d277 * c_q3l); // F(M col 10l) at 5l.x
+                let d17 = A::mul_add(-d14, s_q3r, d9 * c_q3r); // F(M col 10r) at 5r.x
                 let d286 = A::mul_add(d282, c_q3l, d277 * s_q3l); // F(M col 10l) at 5l.z
+                let d18 = A::mul_add(d14, c_q3r, d9 * s_q3r); // F(M col 10r) at 5r.z
                 let d287 = A::mul_add(
                     p.L7,
                     d286,
                     A::mul_add(-d284, s_q3l, d279 * c_q3l),
                 ); // N(M col 10l) at 5l.x
                 m[(6, 11)] = -d287;
+                let d19 = A::mul_add(p.L7, d18, A::mul_add(-d16, s_q3r, d11 * c_q3r)); // N(M col 10r) at 5r.x
+                m[(13, 18)] = -d19;
                 let d288 = A::mul_add(
                     -p.L7,
                     d285,
                     A::mul_add(d284, c_q3l, d279 * s_q3l),
                 ); // N(M col 10l) at 5l.z
+                let d20 = A::mul_add(-p.L7, d17, A::mul_add(d16, c_q3r, d11 * s_q3r)); // N(M col 10r) at 5r.z
                 let d289 = A::mul_add(-d286, s_q2l, d281 * c_q2l); // F(M col 10l) at 4l.y
+                let d21 = A::mul_add(-d18, s_q2r, d13 * c_q2r); // F(M col 10r) at 4r.y
                 let d290 = A::mul_add(d286, c_q2l, d281 * s_q2l); // F(M col 10l) at 4l.z
+                let d22 = A::mul_add(d18, c_q2r, d13 * s_q2r); // F(M col 10r) at 4r.z
                 let d291 = A::mul_add(-d288, s_q2l, d283 * c_q2l); // N(M col 10l) at 4l.y
                 m[(5, 11)] = d291;
+                let d23 = A::mul_add(-d20, s_q2r, d15 * c_q2r); // N(M col 10r) at 4r.y
+                m[(12, 18)] = d23;
                 let d292 = A::mul_add(d288, c_q2l, d283 * s_q2l); // N(M col 10l) at 4l.z
+                let d24 = A::mul_add(d20, c_q2r, d15 * s_q2r); // N(M col 10r) at 4r.z
                 let d293 = A::mul_add(d290, c_q1l, d285 * s_q1l); // F(M col 10l) at 3.z
+                let d26 = A::mul_add(d22, c_q1r, d17 * s_q1r); // F(M col 10r) at 3.z
                 let d294 = A::mul_add(-d290, s_q1l, d285 * c_q1l); // F(M col 10l) at 3.y
+                let d25 = A::mul_add(-d22, s_q1r, d17 * c_q1r); // F(M col 10r) at 3.y
                 let d295 = A::mul_add(
                     p.L5,
                     d289,
                     A::mul_add(-p.L6, d294, A::mul_add(d292, c_q1l, d287 * s_q1l)),
                 ); // N(M col 10l) at 3.z
+                let d29 = A::mul_add(
+                    p.L5,
+                    d21,
+                    A::mul_add(-p.L6, d25, A::mul_add(d24, c_q1r, d19 * s_q1r)),
+                ); // N(M col 10r) at 3.z
                 let d296 = A::mul_add(-p.L5, d293, d291); // N(M col 10l) at 3.x
+                let d27 = A::mul_add(-p.L5, d26, d23); // N(M col 10r) at 3.x
                 let d297 = A::mul_add(
                     p.L6,
                     d293,
                     A::mul_add(-d292, s_q1l, d287 * c_q1l),
                 ); // N(M col 10l) at 3.y
                 m[(4, 11)] = d297;
+                let d28 = A::mul_add(p.L6, d26, A::mul_add(-d24, s_q1r, d19 * c_q1r)); // N(M col 10r) at 3.y
+                m[(4, 18)] = d28;
                 let d298 = A::mul_add(s_q_torso, d293, c_q_torso * d289); // F(M col 10l) at 2.x
+                let d30 = A::mul_add(s_q_torso, d26, c_q_torso * d21); // F(M col 10r) at 2.x
+                let d33 = A::mul_add(-p.L4, d30, -d28); // N(M col 10r) at 2.y
                 let d299 = A::mul_add(-c_q_torso, d293, s_q_torso * d289); // F(M col 10l) at 2.z
+                let d31 = A::mul_add(-c_q_torso, d26, s_q_torso * d21); // F(M col 10r) at 2.z
+                let d32 = A::mul_add(
+                    -p.L3,
+                    d31,
+                    A::mul_add(-d29, s_q_torso, A::mul_add(-d27, c_q_torso, d25 * p.L4)),
+                ); // N(M col 10r) at 2.x
+                m[(3, 18)] = -d32;
+                let d35 = A::mul_add(-d31, c_q_w, d25 * s_q_w); // F(M col 10r) at 1.z
+                let d36 = A::mul_add(d31, s_q_w, d25 * c_q_w); // F(M col 10r) at 1.y
                 let d300 = A::mul_add(
                     p.L4,
                     d294,
@@ -8623,98 +9512,173 @@ mod generated {
                     d298,
                     A::mul_add(-c_q_torso, d295, s_q_torso * d296),
                 ); // N(M col 10l) at 2.z
+                let d34 = A::mul_add(
+                    -p.L3,
+                    d30,
+                    A::mul_add(-c_q_torso, d29, s_q_torso * d27),
+                ); // N(M col 10r) at 2.z
                 let d302 = A::mul_add(-p.L4, d298, d297); // N(M col 10l) at 2.y
                 let d303 = A::mul_add(c_q_w, d299, s_q_w * d294); // F(M col 10l) at 1.z
                 let d304 = A::mul_add(-s_q_w, d299, c_q_w * d294); // F(M col 10l) at 1.y
                 let d305 = A::mul_add(-p.L2, d304, A::mul_add(p.L1, d303, d300)); // N(M col 10l) at 1.x
                 m[(2, 11)] = -d305;
+                let d38 = A::mul_add(-p.L2, d36, A::mul_add(p.L1, d35, d32)); // N(M col 10r) at 1.x
+                m[(2, 18)] = -d38;
                 let d306 = A::mul_add(
                     -p.L1,
                     d298,
                     A::mul_add(c_q_w, d301, s_q_w * d302),
                 ); // N(M col 10l) at 1.z
+                let d37 = A::mul_add(-p.L1, d30, A::mul_add(c_q_w, d34, s_q_w * d33)); // N(M col 10r) at 1.z
                 let d307 = A::mul_add(
                     p.L2,
                     d298,
                     A::mul_add(-s_q_w, d301, c_q_w * d302),
                 ); // N(M col 10l) at 1.y
+                let d39 = A::mul_add(p.L2, d30, A::mul_add(-s_q_w, d34, c_q_w * d33)); // N(M col 10r) at 1.y
                 let d308 = A::mul_add(c_q_imu, d303, s_q_imu * d304); // F(M col 10l) at 0.x
                 m[(0, 11)] = -d308;
+                let d40 = A::mul_add(c_q_imu, d35, s_q_imu * d36); // F(M col 10r) at 0.x
+                m[(0, 18)] = -d40;
                 let d309 = A::mul_add(-s_q_imu, d306, c_q_imu * d307); // N(M col 10l) at 0.z
                 m[(1, 11)] = -d309;
+                let d41 = A::mul_add(-s_q_imu, d37, c_q_imu * d39); // N(M col 10r) at 0.z
+                m[(1, 18)] = d41;
                 let d310 = p.MX9l - d270; // MSC9l.x
+                let d42 = p.MX9r - d2; // MSC9r.x
                 let d311 = p.MZ9l + d269; // MSC9l.z
+                let d43 = p.MZ9r + d1; // MSC9r.z
                 let k22 = s_q7l * s_q7l; // sin² q7l
+                let k1 = s_q7r * s_q7r; // sin² q7r
                 let k23 = s_q7l * c_q7l; // sin q7l cos q7l
+                let k2 = s_q7r * c_q7r; // sin q7r cos q7r
                 let k24 = A::mul_add(2.0, k22, -1.0); // cos 2q7l
+                let k3 = A::mul_add(2.0, k1, -1.0); // cos 2q7r
                 let d312 = A::mul_add(-2.0, p.XY10l * k23, k22 * pc.pc26); // JC10l rotated about z: Jxx − J'xx
+                let d44 = A::mul_add(-2.0, p.XY10r * k2, k1 * pc.pc3); // JC10r rotated about z: Jxx − J'xx
                 let d313 = p.XY9l + t41 + t42 - t45; // JC9l.xy
+                let d45 = p.XY9r + t1 + t2 - t5; // JC9r.xy
                 let d314 = A::mul_add(-k23, pc.pc26, A::mul_add(-p.XY10l, k24, p.XZ9l)); // JC9l.xz
+                let d46 = A::mul_add(-k2, pc.pc3, A::mul_add(-p.XY10r, k3, p.XZ9r)); // JC9r.xz
                 let d315 = p.YZ9l - t43 + t44 + t46; // JC9l.yz
+                let d47 = p.YZ9r - t3 + t4 + t6; // JC9r.yz
                 let d316 = pc.pc30 - d312; // JC9l.xx
                 m[(10, 10)] = d316;
+                let d48 = pc.pc7 - d44; // JC9r.xx
+                m[(17, 17)] = d48;
                 let d317 = d312 + pc.pc31; // JC9l.zz
+                let d49 = d44 + pc.pc8; // JC9r.zz
                 let d318 = A::mul_add(s_q6l, d311, c_q6l * pc.pc25); // MSC9l in 8l.y
+                let d50 = A::mul_add(s_q6r, d43, c_q6r * pc.pc2); // MSC9r in 8r.y
                 let d319 = A::mul_add(-c_q6l, d311, s_q6l * pc.pc25); // MSC9l in 8l.z
+                let d51 = A::mul_add(-c_q6r, d43, s_q6r * pc.pc2); // MSC9r in 8r.z
                 let t47 = c_q6l * d313; // common subexpression
+                let t7 = c_q6r * d45; // common subexpression
                 let t48 = s_q6l * d314; // common subexpression
+                let t8 = s_q6r * d46; // common subexpression
                 let d320 = t47 + t48; // N(M col 9l) at 8l.y
                 m[(9, 10)] = -d320;
+                let d52 = t7 + t8; // N(M col 9r) at 8r.y
+                m[(16, 17)] = -d52;
                 let t49 = s_q6l * d313; // common subexpression
+                let t9 = s_q6r * d45; // common subexpression
                 let t50 = c_q6l * d314; // common subexpression
+                let t10 = c_q6r * d46; // common subexpression
                 let d321 = t49 - t50; // N(M col 9l) at 8l.z
+                let d53 = t9 - t10; // N(M col 9r) at 8r.z
                 let d322 = s_q5l * d318; // F(M col 9l) at 7l.x
+                let d54 = s_q5r * d50; // F(M col 9r) at 7r.x
                 let d323 = c_q5l * d318; // F(M col 9l) at 7l.z
+                let d55 = c_q5r * d50; // F(M col 9r) at 7r.z
                 let d324 = A::mul_add(
                     -p.L8,
                     d322,
                     A::mul_add(c_q5l, d321, s_q5l * d316),
                 ); // N(M col 9l) at 7l.z
+                let d56 = A::mul_add(-p.L8, d54, A::mul_add(c_q5r, d53, s_q5r * d48)); // N(M col 9r) at 7r.z
                 let d325 = A::mul_add(
                     -p.L8,
                     d323,
                     A::mul_add(-s_q5l, d321, c_q5l * d316),
                 ); // N(M col 9l) at 7l.x
                 m[(8, 10)] = d325;
+                let d57 = A::mul_add(-p.L8, d55, A::mul_add(-s_q5r, d53, c_q5r * d48)); // N(M col 9r) at 7r.x
+                m[(15, 17)] = d57;
                 let d326 = A::mul_add(s_q4l, d323, c_q4l * d319); // F(M col 9l) at 6l.y
+                let d58 = A::mul_add(s_q4r, d55, c_q4r * d51); // F(M col 9r) at 6r.y
                 let d327 = A::mul_add(-c_q4l, d323, s_q4l * d319); // F(M col 9l) at 6l.z
+                let d59 = A::mul_add(-c_q4r, d55, s_q4r * d51); // F(M col 9r) at 6r.z
                 let d328 = A::mul_add(-s_q4l, d324, c_q4l * d320); // N(M col 9l) at 6l.y
                 m[(7, 10)] = -d328;
+                let d60 = A::mul_add(-s_q4r, d56, c_q4r * d52); // N(M col 9r) at 6r.y
+                m[(14, 17)] = -d60;
                 let d329 = A::mul_add(c_q4l, d324, s_q4l * d320); // N(M col 9l) at 6l.z
+                let d61 = A::mul_add(c_q4r, d56, s_q4r * d52); // N(M col 9r) at 6r.z
                 let d330 = A::mul_add(c_q3l, d327, s_q3l * d322); // F(M col 9l) at 5l.z
+                let d62 = A::mul_add(c_q3r, d59, s_q3r * d54); // F(M col 9r) at 5r.z
                 let d331 = A::mul_add(-s_q3l, d327, c_q3l * d322); // F(M col 9l) at 5l.x
+                let d63 = A::mul_add(-s_q3r, d59, c_q3r * d54); // F(M col 9r) at 5r.x
                 let d332 = A::mul_add(
                     -p.L7,
                     d331,
                     A::mul_add(c_q3l, d329, s_q3l * d325),
                 ); // N(M col 9l) at 5l.z
+                let d64 = A::mul_add(-p.L7, d63, A::mul_add(c_q3r, d61, s_q3r * d57)); // N(M col 9r) at 5r.z
                 let d333 = A::mul_add(
                     p.L7,
                     d330,
                     A::mul_add(-s_q3l, d329, c_q3l * d325),
                 ); // N(M col 9l) at 5l.x
                 m[(6, 10)] = d333;
+                let d65 = A::mul_add(p.L7, d62, A::mul_add(-s_q3r, d61, c_q3r * d57)); // N(M col 9r) at 5r.x
+                m[(13, 17)] = d65;
                 let d334 = A::mul_add(-s_q2l, d330, c_q2l * d326); // F(M col 9l) at 4l.y
+                let d66 = A::mul_add(-s_q2r, d62, c_q2r * d58); // F(M col 9r) at 4r.y
                 let d335 = A::mul_add(c_q2l, d330, s_q2l * d326); // F(M col 9l) at 4l.z
+                let d67 = A::mul_add(c_q2r, d62, s_q2r * d58); // F(M col 9r) at 4r.z
                 let d336 = A::mul_add(-s_q2l, d332, c_q2l * d328); // N(M col 9l) at 4l.y
                 m[(5, 10)] = -d336;
+                let d68 = A::mul_add(-s_q2r, d64, c_q2r * d60); // N(M col 9r) at 4r.y
+                m[(12, 17)] = -d68;
                 let d337 = A::mul_add(c_q2l, d332, s_q2l * d328); // N(M col 9l) at 4l.z
+                let d69 = A::mul_add(c_q2r, d64, s_q2r * d60); // N(M col 9r) at 4r.z
                 let d338 = A::mul_add(-s_q1l, d335, c_q1l * d331); // F(M col 9l) at 3.y
+                let d70 = A::mul_add(-s_q1r, d67, c_q1r * d63); // F(M col 9r) at 3.y
                 let d339 = A::mul_add(c_q1l, d335, s_q1l * d331); // F(M col 9l) at 3.z
+                let d71 = A::mul_add(c_q1r, d67, s_q1r * d63); // F(M col 9r) at 3.z
                 let d340 = A::mul_add(-p.L5, d339, d336); // N(M col 9l) at 3.x
+                let d74 = A::mul_add(-p.L5, d71, d68); // N(M col 9r) at 3.x
                 let d341 = A::mul_add(
                     p.L6,
                     d339,
                     A::mul_add(-s_q1l, d337, c_q1l * d333),
                 ); // N(M col 9l) at 3.y
                 m[(4, 10)] = -d341;
+                let d72 = A::mul_add(p.L6, d71, A::mul_add(-s_q1r, d69, c_q1r * d65)); // N(M col 9r) at 3.y
+                m[(4, 17)] = -d72;
                 let d342 = A::mul_add(
                     p.L5,
                     d334,
                     A::mul_add(-p.L6, d338, A::mul_add(c_q1l, d337, s_q1l * d333)),
                 ); // N(M col 9l) at 3.z
+                let d73 = A::mul_add(
+                    p.L5,
+                    d66,
+                    A::mul_add(-p.L6, d70, A::mul_add(c_q1r, d69, s_q1r * d65)),
+                ); // N(M col 9r) at 3.z
                 let d343 = A::mul_add(s_q_torso, d339, c_q_torso * d334); // F(M col 9l) at 2.x
+                let d75 = A::mul_add(s_q_torso, d71, c_q_torso * d66); // F(M col 9r) at 2.x
+                let d78 = A::mul_add(-p.L4, d75, -d72); // N(M col 9r) at 2.y
                 let d344 = A::mul_add(-c_q_torso, d339, s_q_torso * d334); // F(M col 9l) at 2.z
+                let d76 = A::mul_add(-c_q_torso, d71, s_q_torso * d66); // F(M col 9r) at 2.z
+                let d77 = A::mul_add(
+                    -p.L3,
+                    d76,
+                    A::mul_add(-s_q_torso, d73, A::mul_add(-c_q_torso, d74, p.L4 * d70)),
+                ); // N(M col 9r) at 2.x
+                m[(3, 17)] = d77;
+                let d80 = A::mul_add(s_q_w, d76, c_q_w * d70); // F(M col 9r) at 1.y
+                let d81 = A::mul_add(-c_q_w, d76, s_q_w * d70); // F(M col 9r) at 1.z
                 let d345 = A::mul_add(-p.L4, d343, d341); // N(M col 9l) at 2.y
                 let d346 = A::mul_add(
                     p.L4,
@@ -8727,6 +9691,11 @@ mod generated {
                     d343,
                     A::mul_add(-c_q_torso, d342, s_q_torso * d340),
                 ); // N(M col 9l) at 2.z
+                let d79 = A::mul_add(
+                    -p.L3,
+                    d75,
+                    A::mul_add(-c_q_torso, d73, s_q_torso * d74),
+                ); // N(M col 9r) at 2.z
                 let d348 = A::mul_add(-s_q_w, d344, c_q_w * d338); // F(M col 9l) at 1.y
                 let d349 = A::mul_add(c_q_w, d344, s_q_w * d338); // F(M col 9l) at 1.z
                 let d350 = A::mul_add(
@@ -8734,82 +9703,168 @@ mod generated {
                     d343,
                     A::mul_add(-s_q_w, d347, c_q_w * d345),
                 ); // N(M col 9l) at 1.y
+                let d83 = A::mul_add(p.L2, d75, A::mul_add(-s_q_w, d79, c_q_w * d78)); // N(M col 9r) at 1.y
                 let d351 = A::mul_add(-p.L2, d348, A::mul_add(p.L1, d349, d346)); // N(M col 9l) at 1.x
                 m[(2, 10)] = d351;
+                let d82 = A::mul_add(-p.L2, d80, A::mul_add(p.L1, d81, d77)); // N(M col 9r) at 1.x
+                m[(2, 17)] = d82;
                 let d352 = A::mul_add(
                     -p.L1,
                     d343,
                     A::mul_add(c_q_w, d347, s_q_w * d345),
                 ); // N(M col 9l) at 1.z
+                let d84 = A::mul_add(-p.L1, d75, A::mul_add(c_q_w, d79, s_q_w * d78)); // N(M col 9r) at 1.z
                 let d353 = A::mul_add(c_q_imu, d349, s_q_imu * d348); // F(M col 9l) at 0.x
                 m[(0, 10)] = d353;
+                let d85 = A::mul_add(c_q_imu, d81, s_q_imu * d80); // F(M col 9r) at 0.x
+                m[(0, 17)] = d85;
                 let d354 = A::mul_add(-s_q_imu, d352, c_q_imu * d350); // N(M col 9l) at 0.z
                 m[(1, 10)] = d354;
+                let d86 = A::mul_add(-s_q_imu, d84, c_q_imu * d83); // N(M col 9r) at 0.z
+                m[(1, 17)] = -d86;
                 let d355 = p.MX8l - d310; // MSC8l.x
+                let d87 = p.MX8r - d42; // MSC8r.x
                 let d356 = p.MY8l - d318; // MSC8l.y
+                let d88 = p.MY8r - d50; // MSC8r.y
                 let d357 = p.MZ8l - d319; // MSC8l.z
+                let d89 = p.MZ8r - d51; // MSC8r.z
                 let k25 = s_q6l * s_q6l; // sin² q6l
+                let k4 = s_q6r * s_q6r; // sin² q6r
                 let k26 = s_q6l * c_q6l; // sin q6l cos q6l
+                let k5 = s_q6r * c_q6r; // sin q6r cos q6r
                 let k27 = A::mul_add(2.0, k25, -1.0); // cos 2q6l
+                let k6 = A::mul_add(2.0, k4, -1.0); // cos 2q6r
+                let d90 = pc.pc6 - d49; // JC9r: Jyy − Jzz
                 let d358 = pc.pc29 - d317; // JC9l: Jyy − Jzz
                 let d359 = A::mul_add(-2.0, d315 * k26, k25 * d358); // JC9l rotated about x: Jyy − J'yy
+                let d91 = A::mul_add(-2.0, d47 * k5, k4 * d90); // JC9r rotated about x: Jyy − J'yy
                 let d360 = p.XX8l + d316; // JC8l.xx
+                let d92 = p.XX8r + d48; // JC8r.xx
                 let d361 = p.XY8l + t47 + t48; // JC8l.xy
+                let d93 = p.XY8r + t7 + t8; // JC8r.xy
                 let d362 = p.XZ8l + t49 - t50; // JC8l.xz
+                let d94 = p.XZ8r + t9 - t10; // JC8r.xz
                 let d363 = A::mul_add(k26, d358, A::mul_add(d315, k27, p.YZ8l)); // JC8l.yz
+                let d95 = A::mul_add(k5, d90, A::mul_add(d47, k6, p.YZ8r)); // JC8r.yz
                 let d364 = p.ZZ8l + d317 + d359; // JC8l.zz
+                let d96 = p.ZZ8r + d49 + d91; // JC8r.zz
                 let d365 = pc.pc33 - d359; // JC8l.yy
                 m[(9, 9)] = d365;
+                let d97 = pc.pc10 - d91; // JC8r.yy
+                m[(16, 16)] = d97;
                 let d366 = A::mul_add(c_q5l, d357, s_q5l * d355); // MSC8l in 7l.z
+                let d98 = A::mul_add(c_q5r, d89, s_q5r * d87); // MSC8r in 7r.z
                 let d367 = A::mul_add(-s_q5l, d357, c_q5l * d355); // MSC8l in 7l.x
+                let d99 = A::mul_add(-s_q5r, d89, c_q5r * d87); // MSC8r in 7r.x
                 let t51 = c_q5l * d361; // common subexpression
+                let t11 = c_q5r * d93; // common subexpression
                 let t52 = s_q5l * d363; // common subexpression
+                let t12 = s_q5r * d95; // common subexpression
                 let t53 = s_q5l * d361; // common subexpression
+                let t13 = s_q5r * d93; // common subexpression
                 let t54 = c_q5l * d363; // common subexpression
+                let t14 = c_q5r * d95; // common subexpression
                 let t55 = p.L8 * d367; // common subexpression
+                let t15 = p.L8 * d99; // common subexpression
                 let t56 = p.L8 * d366; // common subexpression
+                let t16 = p.L8 * d98; // common subexpression
                 let d368 = t51 - t52 - t55; // N(M col 8l) at 7l.x
                 m[(8, 9)] = -d368;
+                let d100 = t11 - t12 - t15; // N(M col 8r) at 7r.x
+                m[(15, 16)] = -d100;
                 let d369 = t53 + t54 - t56; // N(M col 8l) at 7l.z
+                let d101 = t13 + t14 - t16; // N(M col 8r) at 7r.z
                 let d370 = s_q4l * d367; // F(M col 8l) at 6l.y
+                let d102 = s_q4r * d99; // F(M col 8r) at 6r.y
                 let d371 = c_q4l * d367; // F(M col 8l) at 6l.z
+                let d103 = c_q4r * d99; // F(M col 8r) at 6r.z
                 let d372 = A::mul_add(-s_q4l, d369, c_q4l * d365); // N(M col 8l) at 6l.y
                 m[(7, 9)] = d372;
+                let d104 = A::mul_add(-s_q4r, d101, c_q4r * d97); // N(M col 8r) at 6r.y
+                m[(14, 16)] = d104;
                 let d373 = A::mul_add(c_q4l, d369, s_q4l * d365); // N(M col 8l) at 6l.z
+                let d105 = A::mul_add(c_q4r, d101, s_q4r * d97); // N(M col 8r) at 6r.z
                 let d374 = A::mul_add(s_q3l, d371, c_q3l * d366); // F(M col 8l) at 5l.x
+                let d106 = A::mul_add(s_q3r, d103, c_q3r * d98); // F(M col 8r) at 5r.x
                 let d375 = A::mul_add(-c_q3l, d371, s_q3l * d366); // F(M col 8l) at 5l.z
+                let d107 = A::mul_add(-c_q3r, d103, s_q3r * d98); // F(M col 8r) at 5r.z
                 let d376 = A::mul_add(
                     p.L7,
                     d375,
                     A::mul_add(-s_q3l, d373, c_q3l * d368),
                 ); // N(M col 8l) at 5l.x
                 m[(6, 9)] = -d376;
+                let d108 = A::mul_add(
+                    p.L7,
+                    d107,
+                    A::mul_add(-s_q3r, d105, c_q3r * d100),
+                ); // N(M col 8r) at 5r.x
+                m[(13, 16)] = -d108;
                 let d377 = A::mul_add(
                     -p.L7,
                     d374,
                     A::mul_add(c_q3l, d373, s_q3l * d368),
                 ); // N(M col 8l) at 5l.z
+                let d109 = A::mul_add(
+                    -p.L7,
+                    d106,
+                    A::mul_add(c_q3r, d105, s_q3r * d100),
+                ); // N(M col 8r) at 5r.z
                 let d378 = A::mul_add(-s_q2l, d375, c_q2l * d370); // F(M col 8l) at 4l.y
+                let d110 = A::mul_add(-s_q2r, d107, c_q2r * d102); // F(M col 8r) at 4r.y
                 let d379 = A::mul_add(c_q2l, d375, s_q2l * d370); // F(M col 8l) at 4l.z
+                let d111 = A::mul_add(c_q2r, d107, s_q2r * d102); // F(M col 8r) at 4r.z
                 let d380 = A::mul_add(-s_q2l, d377, c_q2l * d372); // N(M col 8l) at 4l.y
                 m[(5, 9)] = d380;
+                let d112 = A::mul_add(-s_q2r, d109, c_q2r * d104); // N(M col 8r) at 4r.y
+                m[(12, 16)] = d112;
                 let d381 = A::mul_add(c_q2l, d377, s_q2l * d372); // N(M col 8l) at 4l.z
+                let d113 = A::mul_add(c_q2r, d109, s_q2r * d104); // N(M col 8r) at 4r.z
                 let d382 = A::mul_add(c_q1l, d379, s_q1l * d374); // F(M col 8l) at 3.z
+                let d115 = A::mul_add(c_q1r, d111, s_q1r * d106); // F(M col 8r) at 3.z
                 let d383 = A::mul_add(-s_q1l, d379, c_q1l * d374); // F(M col 8l) at 3.y
+                let d114 = A::mul_add(-s_q1r, d111, c_q1r * d106); // F(M col 8r) at 3.y
                 let d384 = A::mul_add(
                     p.L5,
                     d378,
                     A::mul_add(-p.L6, d383, A::mul_add(c_q1l, d381, s_q1l * d376)),
                 ); // N(M col 8l) at 3.z
+                let d118 = A::mul_add(
+                    p.L5,
+                    d110,
+                    A::mul_add(-p.L6, d114, A::mul_add(c_q1r, d113, s_q1r * d108)),
+                ); // N(M col 8r) at 3.z
                 let d385 = A::mul_add(-p.L5, d382, d380); // N(M col 8l) at 3.x
+                let d116 = A::mul_add(-p.L5, d115, d112); // N(M col 8r) at 3.x
                 let d386 = A::mul_add(
                     p.L6,
                     d382,
                     A::mul_add(-s_q1l, d381, c_q1l * d376),
                 ); // N(M col 8l) at 3.y
                 m[(4, 9)] = d386;
+                let d117 = A::mul_add(
+                    p.L6,
+                    d115,
+                    A::mul_add(-s_q1r, d113, c_q1r * d108),
+                ); // N(M col 8r) at 3.y
+                m[(4, 16)] = d117;
                 let d387 = A::mul_add(s_q_torso, d382, c_q_torso * d378); // F(M col 8l) at 2.x
+                let d119 = A::mul_add(s_q_torso, d115, c_q_torso * d110); // F(M col 8r) at 2.x
+                let d122 = A::mul_add(-p.L4, d119, -d117); // N(M col 8r) at 2.y
                 let d388 = A::mul_add(-c_q_torso, d382, s_q_torso * d378); // F(M col 8l) at 2.z
+                let d120 = A::mul_add(-c_q_torso, d115, s_q_torso * d110); // F(M col 8r) at 2.z
+                let d121 = A::mul_add(
+                    -p.L3,
+                    d120,
+                    A::mul_add(
+                        -s_q_torso,
+                        d118,
+                        A::mul_add(-c_q_torso, d116, p.L4 * d114),
+                    ),
+                ); // N(M col 8r) at 2.x
+                m[(3, 16)] = -d121;
+                let d124 = A::mul_add(-c_q_w, d120, s_q_w * d114); // F(M col 8r) at 1.z
+                let d125 = A::mul_add(s_q_w, d120, c_q_w * d114); // F(M col 8r) at 1.y
                 let d389 = A::mul_add(
                     p.L4,
                     d383,
@@ -8821,84 +9876,177 @@ mod generated {
                     d387,
                     A::mul_add(-c_q_torso, d384, s_q_torso * d385),
                 ); // N(M col 8l) at 2.z
+                let d123 = A::mul_add(
+                    -p.L3,
+                    d119,
+                    A::mul_add(-c_q_torso, d118, s_q_torso * d116),
+                ); // N(M col 8r) at 2.z
                 let d391 = A::mul_add(-p.L4, d387, d386); // N(M col 8l) at 2.y
                 let d392 = A::mul_add(c_q_w, d388, s_q_w * d383); // F(M col 8l) at 1.z
                 let d393 = A::mul_add(-s_q_w, d388, c_q_w * d383); // F(M col 8l) at 1.y
                 let d394 = A::mul_add(-p.L2, d393, A::mul_add(p.L1, d392, d389)); // N(M col 8l) at 1.x
                 m[(2, 9)] = -d394;
+                let d127 = A::mul_add(-p.L2, d125, A::mul_add(p.L1, d124, d121)); // N(M col 8r) at 1.x
+                m[(2, 16)] = -d127;
                 let d395 = A::mul_add(
                     -p.L1,
                     d387,
                     A::mul_add(c_q_w, d390, s_q_w * d391),
                 ); // N(M col 8l) at 1.z
+                let d126 = A::mul_add(
+                    -p.L1,
+                    d119,
+                    A::mul_add(c_q_w, d123, s_q_w * d122),
+                ); // N(M col 8r) at 1.z
                 let d396 = A::mul_add(
                     p.L2,
                     d387,
                     A::mul_add(-s_q_w, d390, c_q_w * d391),
                 ); // N(M col 8l) at 1.y
+                let d128 = A::mul_add(
+                    p.L2,
+                    d119,
+                    A::mul_add(-s_q_w, d123, c_q_w * d122),
+                ); // N(M col 8r) at 1.y
                 let d397 = A::mul_add(c_q_imu, d392, s_q_imu * d393); // F(M col 8l) at 0.x
                 m[(0, 9)] = -d397;
+                let d129 = A::mul_add(c_q_imu, d124, s_q_imu * d125); // F(M col 8r) at 0.x
+                m[(0, 16)] = -d129;
                 let d398 = A::mul_add(-s_q_imu, d395, c_q_imu * d396); // N(M col 8l) at 0.z
                 m[(1, 9)] = -d398;
+                let d130 = A::mul_add(-s_q_imu, d126, c_q_imu * d128); // N(M col 8r) at 0.z
+                m[(1, 16)] = d130;
                 let d399 = p.MX7l - d367; // MSC7l.x
+                let d131 = p.MX7r - d99; // MSC7r.x
                 let d400 = p.MZ7l + d366; // MSC7l.z
+                let d132 = p.MZ7r + d98; // MSC7r.z
                 let k28 = s_q5l * s_q5l; // sin² q5l
+                let k7 = s_q5r * s_q5r; // sin² q5r
                 let k29 = s_q5l * c_q5l; // sin q5l cos q5l
+                let k8 = s_q5r * c_q5r; // sin q5r cos q5r
                 let k30 = A::mul_add(2.0, k28, -1.0); // cos 2q5l
+                let k9 = A::mul_add(2.0, k7, -1.0); // cos 2q5r
                 let d401 = d360 - d364; // JC8l: Jzz − Jxx
+                let d133 = d92 - d96; // JC8r: Jzz − Jxx
                 let d402 = A::mul_add(2.0, d362 * k29, k28 * d401); // JC8l rotated about y: Jzz − J'zz
+                let d134 = A::mul_add(2.0, d94 * k8, k7 * d133); // JC8r rotated about y: Jzz − J'zz
                 let t57 = p.L8 * d356; // common subexpression
+                let t17 = p.L8 * d88; // common subexpression
                 let d403 = p.XY7l + t51 - t52 - t55; // JC7l.xy
+                let d135 = p.XY7r + t11 - t12 - t15; // JC7r.xy
                 let d404 = A::mul_add(-k29, d401, A::mul_add(d362, k30, p.XZ7l)); // JC7l.xz
+                let d136 = A::mul_add(-k8, d133, A::mul_add(d94, k9, p.XZ7r)); // JC7r.xz
                 let d405 = p.YY7l + d365; // JC7l.yy
+                let d137 = p.YY7r + d97; // JC7r.yy
                 let d406 = p.YZ7l - t53 - t54 + t56; // JC7l.yz
+                let d138 = p.YZ7r - t13 - t14 + t16; // JC7r.yz
                 let d407 = pc.pc36 - d356; // MSC7l.y
+                let d139 = pc.pc13 - d88; // MSC7r.y
                 let d408 = A::mul_add(2.0, t57, d360 - d402) + pc.pc37; // JC7l.xx
                 m[(8, 8)] = d408;
+                let d140 = A::mul_add(2.0, t17, d92 - d134) + pc.pc14; // JC7r.xx
+                m[(15, 15)] = d140;
                 let d409 = A::mul_add(2.0, t57, d364 + d402) + pc.pc38; // JC7l.zz
+                let d141 = A::mul_add(2.0, t17, d96 + d134) + pc.pc15; // JC7r.zz
                 let d410 = A::mul_add(s_q4l, d400, c_q4l * d407); // MSC7l in 6l.y
+                let d142 = A::mul_add(s_q4r, d132, c_q4r * d139); // MSC7r in 6r.y
                 let d411 = A::mul_add(-c_q4l, d400, s_q4l * d407); // MSC7l in 6l.z
+                let d143 = A::mul_add(-c_q4r, d132, s_q4r * d139); // MSC7r in 6r.z
                 let t58 = c_q4l * d403; // common subexpression
+                let t18 = c_q4r * d135; // common subexpression
                 let t59 = s_q4l * d404; // common subexpression
+                let t19 = s_q4r * d136; // common subexpression
                 let d412 = t58 + t59; // N(M col 7l) at 6l.y
                 m[(7, 8)] = -d412;
+                let d144 = t18 + t19; // N(M col 7r) at 6r.y
+                m[(14, 15)] = -d144;
                 let t60 = s_q4l * d403; // common subexpression
+                let t20 = s_q4r * d135; // common subexpression
                 let t61 = c_q4l * d404; // common subexpression
+                let t21 = c_q4r * d136; // common subexpression
                 let d413 = t60 - t61; // N(M col 7l) at 6l.z
+                let d145 = t20 - t21; // N(M col 7r) at 6r.z
                 let d414 = s_q3l * d410; // F(M col 7l) at 5l.x
+                let d146 = s_q3r * d142; // F(M col 7r) at 5r.x
                 let d415 = c_q3l * d410; // F(M col 7l) at 5l.z
+                let d147 = c_q3r * d142; // F(M col 7r) at 5r.z
                 let d416 = A::mul_add(
                     -p.L7,
                     d414,
                     A::mul_add(c_q3l, d413, s_q3l * d408),
                 ); // N(M col 7l) at 5l.z
+                let d148 = A::mul_add(
+                    -p.L7,
+                    d146,
+                    A::mul_add(c_q3r, d145, s_q3r * d140),
+                ); // N(M col 7r) at 5r.z
                 let d417 = A::mul_add(
                     -p.L7,
                     d415,
                     A::mul_add(-s_q3l, d413, c_q3l * d408),
                 ); // N(M col 7l) at 5l.x
                 m[(6, 8)] = d417;
+                let d149 = A::mul_add(
+                    -p.L7,
+                    d147,
+                    A::mul_add(-s_q3r, d145, c_q3r * d140),
+                ); // N(M col 7r) at 5r.x
+                m[(13, 15)] = d149;
                 let d418 = A::mul_add(s_q2l, d415, c_q2l * d411); // F(M col 7l) at 4l.y
+                let d150 = A::mul_add(s_q2r, d147, c_q2r * d143); // F(M col 7r) at 4r.y
                 let d419 = A::mul_add(-c_q2l, d415, s_q2l * d411); // F(M col 7l) at 4l.z
+                let d151 = A::mul_add(-c_q2r, d147, s_q2r * d143); // F(M col 7r) at 4r.z
                 let d420 = A::mul_add(-s_q2l, d416, c_q2l * d412); // N(M col 7l) at 4l.y
                 m[(5, 8)] = -d420;
+                let d152 = A::mul_add(-s_q2r, d148, c_q2r * d144); // N(M col 7r) at 4r.y
+                m[(12, 15)] = -d152;
                 let d421 = A::mul_add(c_q2l, d416, s_q2l * d412); // N(M col 7l) at 4l.z
+                let d153 = A::mul_add(c_q2r, d148, s_q2r * d144); // N(M col 7r) at 4r.z
                 let d422 = A::mul_add(-s_q1l, d419, c_q1l * d414); // F(M col 7l) at 3.y
+                let d154 = A::mul_add(-s_q1r, d151, c_q1r * d146); // F(M col 7r) at 3.y
                 let d423 = A::mul_add(c_q1l, d419, s_q1l * d414); // F(M col 7l) at 3.z
+                let d155 = A::mul_add(c_q1r, d151, s_q1r * d146); // F(M col 7r) at 3.z
                 let d424 = A::mul_add(-p.L5, d423, d420); // N(M col 7l) at 3.x
+                let d158 = A::mul_add(-p.L5, d155, d152); // N(M col 7r) at 3.x
                 let d425 = A::mul_add(
                     p.L6,
                     d423,
                     A::mul_add(-s_q1l, d421, c_q1l * d417),
                 ); // N(M col 7l) at 3.y
                 m[(4, 8)] = -d425;
+                let d156 = A::mul_add(
+                    p.L6,
+                    d155,
+                    A::mul_add(-s_q1r, d153, c_q1r * d149),
+                ); // N(M col 7r) at 3.y
+                m[(4, 15)] = -d156;
                 let d426 = A::mul_add(
                     p.L5,
                     d418,
                     A::mul_add(-p.L6, d422, A::mul_add(c_q1l, d421, s_q1l * d417)),
                 ); // N(M col 7l) at 3.z
+                let d157 = A::mul_add(
+                    p.L5,
+                    d150,
+                    A::mul_add(-p.L6, d154, A::mul_add(c_q1r, d153, s_q1r * d149)),
+                ); // N(M col 7r) at 3.z
                 let d427 = A::mul_add(s_q_torso, d423, c_q_torso * d418); // F(M col 7l) at 2.x
+                let d159 = A::mul_add(s_q_torso, d155, c_q_torso * d150); // F(M col 7r) at 2.x
+                let d162 = A::mul_add(-p.L4, d159, -d156); // N(M col 7r) at 2.y
                 let d428 = A::mul_add(-c_q_torso, d423, s_q_torso * d418); // F(M col 7l) at 2.z
+                let d160 = A::mul_add(-c_q_torso, d155, s_q_torso * d150); // F(M col 7r) at 2.z
+                let d161 = A::mul_add(
+                    -p.L3,
+                    d160,
+                    A::mul_add(
+                        -s_q_torso,
+                        d157,
+                        A::mul_add(-c_q_torso, d158, p.L4 * d154),
+                    ),
+                ); // N(M col 7r) at 2.x
+                m[(3, 15)] = d161;
+                let d164 = A::mul_add(s_q_w, d160, c_q_w * d154); // F(M col 7r) at 1.y
+                let d165 = A::mul_add(-c_q_w, d160, s_q_w * d154); // F(M col 7r) at 1.z
                 let d429 = A::mul_add(-p.L4, d427, d425); // N(M col 7l) at 2.y
                 let d430 = A::mul_add(
                     p.L4,
@@ -8911,6 +10059,11 @@ mod generated {
                     d427,
                     A::mul_add(-c_q_torso, d426, s_q_torso * d424),
                 ); // N(M col 7l) at 2.z
+                let d163 = A::mul_add(
+                    -p.L3,
+                    d159,
+                    A::mul_add(-c_q_torso, d157, s_q_torso * d158),
+                ); // N(M col 7r) at 2.z
                 let d432 = A::mul_add(-s_q_w, d428, c_q_w * d422); // F(M col 7l) at 1.y
                 let d433 = A::mul_add(c_q_w, d428, s_q_w * d422); // F(M col 7l) at 1.z
                 let d434 = A::mul_add(
@@ -8918,64 +10071,140 @@ mod generated {
                     d427,
                     A::mul_add(-s_q_w, d431, c_q_w * d429),
                 ); // N(M col 7l) at 1.y
+                let d167 = A::mul_add(
+                    p.L2,
+                    d159,
+                    A::mul_add(-s_q_w, d163, c_q_w * d162),
+                ); // N(M col 7r) at 1.y
                 let d435 = A::mul_add(-p.L2, d432, A::mul_add(p.L1, d433, d430)); // N(M col 7l) at 1.x
                 m[(2, 8)] = d435;
+                let d166 = A::mul_add(-p.L2, d164, A::mul_add(p.L1, d165, d161)); // N(M col 7r) at 1.x
+                m[(2, 15)] = d166;
                 let d436 = A::mul_add(
                     -p.L1,
                     d427,
                     A::mul_add(c_q_w, d431, s_q_w * d429),
                 ); // N(M col 7l) at 1.z
+                let d168 = A::mul_add(
+                    -p.L1,
+                    d159,
+                    A::mul_add(c_q_w, d163, s_q_w * d162),
+                ); // N(M col 7r) at 1.z
                 let d437 = A::mul_add(c_q_imu, d433, s_q_imu * d432); // F(M col 7l) at 0.x
                 m[(0, 8)] = d437;
+                let d169 = A::mul_add(c_q_imu, d165, s_q_imu * d164); // F(M col 7r) at 0.x
+                m[(0, 15)] = d169;
                 let d438 = A::mul_add(-s_q_imu, d436, c_q_imu * d434); // N(M col 7l) at 0.z
                 m[(1, 8)] = d438;
+                let d170 = A::mul_add(-s_q_imu, d168, c_q_imu * d167); // N(M col 7r) at 0.z
+                m[(1, 15)] = -d170;
                 let d439 = p.MX6l - d399; // MSC6l.x
+                let d171 = p.MX6r - d131; // MSC6r.x
                 let d440 = p.MY6l - d410; // MSC6l.y
+                let d172 = p.MY6r - d142; // MSC6r.y
                 let d441 = p.MZ6l - d411; // MSC6l.z
+                let d173 = p.MZ6r - d143; // MSC6r.z
                 let k31 = s_q4l * s_q4l; // sin² q4l
+                let k10 = s_q4r * s_q4r; // sin² q4r
                 let k32 = s_q4l * c_q4l; // sin q4l cos q4l
+                let k11 = s_q4r * c_q4r; // sin q4r cos q4r
                 let k33 = A::mul_add(2.0, k31, -1.0); // cos 2q4l
+                let k12 = A::mul_add(2.0, k10, -1.0); // cos 2q4r
                 let d442 = d405 - d409; // JC7l: Jyy − Jzz
+                let d174 = d137 - d141; // JC7r: Jyy − Jzz
                 let d443 = A::mul_add(-2.0, d406 * k32, k31 * d442); // JC7l rotated about x: Jyy − J'yy
+                let d175 = A::mul_add(-2.0, d138 * k11, k10 * d174); // JC7r rotated about x: Jyy − J'yy
                 let d444 = p.XX6l + d408; // JC6l.xx
+                let d176 = p.XX6r + d140; // JC6r.xx
                 let d445 = p.XY6l + t58 + t59; // JC6l.xy
+                let d177 = p.XY6r + t18 + t19; // JC6r.xy
                 let d446 = p.XZ6l + t60 - t61; // JC6l.xz
+                let d178 = p.XZ6r + t20 - t21; // JC6r.xz
                 let d447 = p.YY6l + d405 - d443; // JC6l.yy
                 m[(7, 7)] = d447;
+                let d179 = p.YY6r + d137 - d175; // JC6r.yy
+                m[(14, 14)] = d179;
                 let d448 = A::mul_add(k32, d442, A::mul_add(d406, k33, p.YZ6l)); // JC6l.yz
+                let d180 = A::mul_add(k11, d174, A::mul_add(d138, k12, p.YZ6r)); // JC6r.yz
                 let d449 = p.ZZ6l + d409 + d443; // JC6l.zz
+                let d181 = p.ZZ6r + d141 + d175; // JC6r.zz
                 let d450 = A::mul_add(c_q3l, d441, s_q3l * d439); // MSC6l in 5l.z
+                let d182 = A::mul_add(c_q3r, d173, s_q3r * d171); // MSC6r in 5r.z
                 let d451 = A::mul_add(-s_q3l, d441, c_q3l * d439); // MSC6l in 5l.x
+                let d183 = A::mul_add(-s_q3r, d173, c_q3r * d171); // MSC6r in 5r.x
                 let t62 = c_q3l * d445; // common subexpression
+                let t22 = c_q3r * d177; // common subexpression
                 let t63 = s_q3l * d448; // common subexpression
+                let t23 = s_q3r * d180; // common subexpression
                 let t64 = s_q3l * d445; // common subexpression
+                let t24 = s_q3r * d177; // common subexpression
                 let t65 = c_q3l * d448; // common subexpression
+                let t25 = c_q3r * d180; // common subexpression
                 let t66 = p.L7 * d451; // common subexpression
+                let t26 = p.L7 * d183; // common subexpression
                 let t67 = p.L7 * d450; // common subexpression
+                let t27 = p.L7 * d182; // common subexpression
                 let d452 = t62 - t63 - t66; // N(M col 6l) at 5l.x
                 m[(6, 7)] = -d452;
+                let d184 = t22 - t23 - t26; // N(M col 6r) at 5r.x
+                m[(13, 14)] = -d184;
                 let d453 = t64 + t65 - t67; // N(M col 6l) at 5l.z
+                let d185 = t24 + t25 - t27; // N(M col 6r) at 5r.z
                 let d454 = s_q2l * d451; // F(M col 6l) at 4l.y
+                let d186 = s_q2r * d183; // F(M col 6r) at 4r.y
                 let d455 = c_q2l * d451; // F(M col 6l) at 4l.z
+                let d187 = c_q2r * d183; // F(M col 6r) at 4r.z
                 let d456 = A::mul_add(-s_q2l, d453, c_q2l * d447); // N(M col 6l) at 4l.y
                 m[(5, 7)] = d456;
+                let d188 = A::mul_add(-s_q2r, d185, c_q2r * d179); // N(M col 6r) at 4r.y
+                m[(12, 14)] = d188;
                 let d457 = A::mul_add(c_q2l, d453, s_q2l * d447); // N(M col 6l) at 4l.z
+                let d189 = A::mul_add(c_q2r, d185, s_q2r * d179); // N(M col 6r) at 4r.z
                 let d458 = A::mul_add(-c_q1l, d455, s_q1l * d450); // F(M col 6l) at 3.z
+                let d191 = A::mul_add(-c_q1r, d187, s_q1r * d182); // F(M col 6r) at 3.z
                 let d459 = A::mul_add(s_q1l, d455, c_q1l * d450); // F(M col 6l) at 3.y
+                let d190 = A::mul_add(s_q1r, d187, c_q1r * d182); // F(M col 6r) at 3.y
                 let d460 = A::mul_add(
                     p.L5,
                     d454,
                     A::mul_add(-p.L6, d459, A::mul_add(c_q1l, d457, s_q1l * d452)),
                 ); // N(M col 6l) at 3.z
+                let d194 = A::mul_add(
+                    p.L5,
+                    d186,
+                    A::mul_add(-p.L6, d190, A::mul_add(c_q1r, d189, s_q1r * d184)),
+                ); // N(M col 6r) at 3.z
                 let d461 = A::mul_add(-p.L5, d458, d456); // N(M col 6l) at 3.x
+                let d192 = A::mul_add(-p.L5, d191, d188); // N(M col 6r) at 3.x
                 let d462 = A::mul_add(
                     p.L6,
                     d458,
                     A::mul_add(-s_q1l, d457, c_q1l * d452),
                 ); // N(M col 6l) at 3.y
                 m[(4, 7)] = d462;
+                let d193 = A::mul_add(
+                    p.L6,
+                    d191,
+                    A::mul_add(-s_q1r, d189, c_q1r * d184),
+                ); // N(M col 6r) at 3.y
+                m[(4, 14)] = d193;
                 let d463 = A::mul_add(s_q_torso, d458, c_q_torso * d454); // F(M col 6l) at 2.x
+                let d195 = A::mul_add(s_q_torso, d191, c_q_torso * d186); // F(M col 6r) at 2.x
+                let d198 = A::mul_add(-p.L4, d195, -d193); // N(M col 6r) at 2.y
                 let d464 = A::mul_add(-c_q_torso, d458, s_q_torso * d454); // F(M col 6l) at 2.z
+                let d196 = A::mul_add(-c_q_torso, d191, s_q_torso * d186); // F(M col 6r) at 2.z
+                let d197 = A::mul_add(
+                    -p.L3,
+                    d196,
+                    A::mul_add(
+                        -s_q_torso,
+                        d194,
+                        A::mul_add(-c_q_torso, d192, p.L4 * d190),
+                    ),
+                ); // N(M col 6r) at 2.x
+                m[(3, 14)] = -d197;
+                let d200 = A::mul_add(-c_q_w, d196, s_q_w * d190); // F(M col 6r) at 1.z
+                let d201 = A::mul_add(s_q_w, d196, c_q_w * d190); // F(M col 6r) at 1.y
                 let d465 = A::mul_add(
                     p.L4,
                     d459,
@@ -8987,66 +10216,141 @@ mod generated {
                     d463,
                     A::mul_add(-c_q_torso, d460, s_q_torso * d461),
                 ); // N(M col 6l) at 2.z
+                let d199 = A::mul_add(
+                    -p.L3,
+                    d195,
+                    A::mul_add(-c_q_torso, d194, s_q_torso * d192),
+                ); // N(M col 6r) at 2.z
                 let d467 = A::mul_add(-p.L4, d463, d462); // N(M col 6l) at 2.y
                 let d468 = A::mul_add(c_q_w, d464, s_q_w * d459); // F(M col 6l) at 1.z
                 let d469 = A::mul_add(-s_q_w, d464, c_q_w * d459); // F(M col 6l) at 1.y
                 let d470 = A::mul_add(-p.L2, d469, A::mul_add(p.L1, d468, d465)); // N(M col 6l) at 1.x
                 m[(2, 7)] = -d470;
+                let d203 = A::mul_add(-p.L2, d201, A::mul_add(p.L1, d200, d197)); // N(M col 6r) at 1.x
+                m[(2, 14)] = -d203;
                 let d471 = A::mul_add(
                     -p.L1,
                     d463,
                     A::mul_add(c_q_w, d466, s_q_w * d467),
                 ); // N(M col 6l) at 1.z
+                let d202 = A::mul_add(
+                    -p.L1,
+                    d195,
+                    A::mul_add(c_q_w, d199, s_q_w * d198),
+                ); // N(M col 6r) at 1.z
                 let d472 = A::mul_add(
                     p.L2,
                     d463,
                     A::mul_add(-s_q_w, d466, c_q_w * d467),
                 ); // N(M col 6l) at 1.y
+                let d204 = A::mul_add(
+                    p.L2,
+                    d195,
+                    A::mul_add(-s_q_w, d199, c_q_w * d198),
+                ); // N(M col 6r) at 1.y
                 let d473 = A::mul_add(c_q_imu, d468, s_q_imu * d469); // F(M col 6l) at 0.x
                 m[(0, 7)] = -d473;
+                let d205 = A::mul_add(c_q_imu, d200, s_q_imu * d201); // F(M col 6r) at 0.x
+                m[(0, 14)] = -d205;
                 let d474 = A::mul_add(-s_q_imu, d471, c_q_imu * d472); // N(M col 6l) at 0.z
                 m[(1, 7)] = -d474;
+                let d206 = A::mul_add(-s_q_imu, d202, c_q_imu * d204); // N(M col 6r) at 0.z
+                m[(1, 14)] = d206;
                 let d475 = p.MX5l - d451; // MSC5l.x
+                let d207 = p.MX5r - d183; // MSC5r.x
                 let d476 = p.MZ5l + d450; // MSC5l.z
+                let d208 = p.MZ5r + d182; // MSC5r.z
                 let k34 = s_q3l * s_q3l; // sin² q3l
+                let k13 = s_q3r * s_q3r; // sin² q3r
                 let k35 = s_q3l * c_q3l; // sin q3l cos q3l
+                let k14 = s_q3r * c_q3r; // sin q3r cos q3r
                 let k36 = A::mul_add(2.0, k34, -1.0); // cos 2q3l
+                let k15 = A::mul_add(2.0, k13, -1.0); // cos 2q3r
                 let d477 = d444 - d449; // JC6l: Jzz − Jxx
+                let d209 = d176 - d181; // JC6r: Jzz − Jxx
                 let d478 = A::mul_add(2.0, d446 * k35, k34 * d477); // JC6l rotated about y: Jzz − J'zz
+                let d210 = A::mul_add(2.0, d178 * k14, k13 * d209); // JC6r rotated about y: Jzz − J'zz
                 let t68 = p.L7 * d440; // common subexpression
+                let t28 = p.L7 * d172; // common subexpression
                 let d479 = p.XY5l + t62 - t63 - t66; // JC5l.xy
+                let d211 = p.XY5r + t22 - t23 - t26; // JC5r.xy
                 let d480 = A::mul_add(-k35, d477, A::mul_add(d446, k36, p.XZ5l)); // JC5l.xz
+                let d212 = A::mul_add(-k14, d209, A::mul_add(d178, k15, p.XZ5r)); // JC5r.xz
                 let d481 = p.YY5l + d447; // JC5l.yy
+                let d213 = p.YY5r + d179; // JC5r.yy
                 let d482 = p.YZ5l - t64 - t65 + t67; // JC5l.yz
+                let d214 = p.YZ5r - t24 - t25 + t27; // JC5r.yz
                 let d483 = pc.pc42 - d440; // MSC5l.y
+                let d215 = pc.pc19 - d172; // MSC5r.y
                 let d484 = A::mul_add(2.0, t68, d444 - d478) + pc.pc43; // JC5l.xx
                 m[(6, 6)] = d484;
+                let d216 = A::mul_add(2.0, t28, d176 - d210) + pc.pc20; // JC5r.xx
+                m[(13, 13)] = d216;
                 let d485 = A::mul_add(2.0, t68, d449 + d478) + pc.pc44; // JC5l.zz
+                let d217 = A::mul_add(2.0, t28, d181 + d210) + pc.pc21; // JC5r.zz
                 let d486 = A::mul_add(s_q2l, d476, c_q2l * d483); // MSC5l in 4l.y
+                let d218 = A::mul_add(s_q2r, d208, c_q2r * d215); // MSC5r in 4r.y
                 let d487 = A::mul_add(-c_q2l, d476, s_q2l * d483); // MSC5l in 4l.z
+                let d219 = A::mul_add(-c_q2r, d208, s_q2r * d215); // MSC5r in 4r.z
                 let t69 = c_q2l * d479; // common subexpression
+                let t29 = c_q2r * d211; // common subexpression
                 let t70 = s_q2l * d480; // common subexpression
+                let t30 = s_q2r * d212; // common subexpression
                 let d488 = t69 + t70; // N(M col 5l) at 4l.y
                 m[(5, 6)] = -d488;
+                let d220 = t29 + t30; // N(M col 5r) at 4r.y
+                m[(12, 13)] = -d220;
                 let t71 = s_q2l * d479; // common subexpression
+                let t31 = s_q2r * d211; // common subexpression
                 let t72 = c_q2l * d480; // common subexpression
+                let t32 = c_q2r * d212; // common subexpression
                 let d489 = t71 - t72; // N(M col 5l) at 4l.z
+                let d221 = t31 - t32; // N(M col 5r) at 4r.z
                 let d490 = s_q1l * d486; // F(M col 5l) at 3.y
+                let d222 = s_q1r * d218; // F(M col 5r) at 3.y
                 let d491 = c_q1l * d486; // F(M col 5l) at 3.z
+                let d223 = c_q1r * d218; // F(M col 5r) at 3.z
                 let d492 = A::mul_add(p.L5, d491, d488); // N(M col 5l) at 3.x
+                let d226 = A::mul_add(p.L5, d223, d220); // N(M col 5r) at 3.x
                 let d493 = A::mul_add(
                     -p.L6,
                     d491,
                     A::mul_add(-s_q1l, d489, c_q1l * d484),
                 ); // N(M col 5l) at 3.y
                 m[(4, 6)] = -d493;
+                let d224 = A::mul_add(
+                    -p.L6,
+                    d223,
+                    A::mul_add(-s_q1r, d221, c_q1r * d216),
+                ); // N(M col 5r) at 3.y
+                m[(4, 13)] = -d224;
                 let d494 = A::mul_add(
                     p.L5,
                     d487,
                     A::mul_add(-p.L6, d490, A::mul_add(c_q1l, d489, s_q1l * d484)),
                 ); // N(M col 5l) at 3.z
+                let d225 = A::mul_add(
+                    p.L5,
+                    d219,
+                    A::mul_add(-p.L6, d222, A::mul_add(c_q1r, d221, s_q1r * d216)),
+                ); // N(M col 5r) at 3.z
                 let d495 = A::mul_add(-s_q_torso, d491, c_q_torso * d487); // F(M col 5l) at 2.x
+                let d227 = A::mul_add(-s_q_torso, d223, c_q_torso * d219); // F(M col 5r) at 2.x
+                let d230 = A::mul_add(-p.L4, d227, -d224); // N(M col 5r) at 2.y
                 let d496 = A::mul_add(c_q_torso, d491, s_q_torso * d487); // F(M col 5l) at 2.z
+                let d228 = A::mul_add(c_q_torso, d223, s_q_torso * d219); // F(M col 5r) at 2.z
+                let d229 = A::mul_add(
+                    -p.L3,
+                    d228,
+                    A::mul_add(
+                        -s_q_torso,
+                        d225,
+                        A::mul_add(-c_q_torso, d226, p.L4 * d222),
+                    ),
+                ); // N(M col 5r) at 2.x
+                m[(3, 13)] = d229;
+                let d232 = A::mul_add(s_q_w, d228, c_q_w * d222); // F(M col 5r) at 1.y
+                let d233 = A::mul_add(-c_q_w, d228, s_q_w * d222); // F(M col 5r) at 1.z
                 let d497 = A::mul_add(-p.L4, d495, d493); // N(M col 5l) at 2.y
                 let d498 = A::mul_add(
                     p.L4,
@@ -9059,6 +10363,11 @@ mod generated {
                     d495,
                     A::mul_add(-c_q_torso, d494, s_q_torso * d492),
                 ); // N(M col 5l) at 2.z
+                let d231 = A::mul_add(
+                    -p.L3,
+                    d227,
+                    A::mul_add(-c_q_torso, d225, s_q_torso * d226),
+                ); // N(M col 5r) at 2.z
                 let d500 = A::mul_add(-s_q_w, d496, c_q_w * d490); // F(M col 5l) at 1.y
                 let d501 = A::mul_add(c_q_w, d496, s_q_w * d490); // F(M col 5l) at 1.z
                 let d502 = A::mul_add(
@@ -9066,47 +10375,106 @@ mod generated {
                     d495,
                     A::mul_add(-s_q_w, d499, c_q_w * d497),
                 ); // N(M col 5l) at 1.y
+                let d235 = A::mul_add(
+                    p.L2,
+                    d227,
+                    A::mul_add(-s_q_w, d231, c_q_w * d230),
+                ); // N(M col 5r) at 1.y
                 let d503 = A::mul_add(-p.L2, d500, A::mul_add(p.L1, d501, d498)); // N(M col 5l) at 1.x
                 m[(2, 6)] = d503;
+                let d234 = A::mul_add(-p.L2, d232, A::mul_add(p.L1, d233, d229)); // N(M col 5r) at 1.x
+                m[(2, 13)] = d234;
                 let d504 = A::mul_add(
                     -p.L1,
                     d495,
                     A::mul_add(c_q_w, d499, s_q_w * d497),
                 ); // N(M col 5l) at 1.z
+                let d236 = A::mul_add(
+                    -p.L1,
+                    d227,
+                    A::mul_add(c_q_w, d231, s_q_w * d230),
+                ); // N(M col 5r) at 1.z
                 let d505 = A::mul_add(c_q_imu, d501, s_q_imu * d500); // F(M col 5l) at 0.x
                 m[(0, 6)] = d505;
+                let d237 = A::mul_add(c_q_imu, d233, s_q_imu * d232); // F(M col 5r) at 0.x
+                m[(0, 13)] = d237;
                 let d506 = A::mul_add(-s_q_imu, d504, c_q_imu * d502); // N(M col 5l) at 0.z
                 m[(1, 6)] = d506;
+                let d238 = A::mul_add(-s_q_imu, d236, c_q_imu * d235); // N(M col 5r) at 0.z
+                m[(1, 13)] = -d238;
                 let d507 = p.MX4l - d475; // MSC4l.x
+                let d239 = p.MX4r - d207; // MSC4r.x
                 let d508 = p.MY4l - d486; // MSC4l.y
+                let d240 = p.MY4r - d218; // MSC4r.y
                 let d509 = p.MZ4l - d487; // MSC4l.z
+                let d241 = p.MZ4r - d219; // MSC4r.z
                 let k37 = s_q2l * s_q2l; // sin² q2l
+                let k16 = s_q2r * s_q2r; // sin² q2r
                 let k38 = s_q2l * c_q2l; // sin q2l cos q2l
+                let k17 = s_q2r * c_q2r; // sin q2r cos q2r
                 let k39 = A::mul_add(2.0, k37, -1.0); // cos 2q2l
+                let k18 = A::mul_add(2.0, k16, -1.0); // cos 2q2r
                 let d510 = d481 - d485; // JC5l: Jyy − Jzz
+                let d242 = d213 - d217; // JC5r: Jyy − Jzz
                 let d511 = A::mul_add(-2.0, d482 * k38, k37 * d510); // JC5l rotated about x: Jyy − J'yy
+                let d243 = A::mul_add(-2.0, d214 * k17, k16 * d242); // JC5r rotated about x: Jyy − J'yy
                 let d512 = p.XX4l + d484; // JC4l.xx
+                let d244 = p.XX4r + d216; // JC4r.xx
                 let d513 = p.XY4l + t69 + t70; // JC4l.xy
+                let d245 = p.XY4r + t29 + t30; // JC4r.xy
                 let d514 = p.XZ4l + t71 - t72; // JC4l.xz
+                let d246 = p.XZ4r + t31 - t32; // JC4r.xz
                 let d515 = p.YY4l + d481 - d511; // JC4l.yy
                 m[(5, 5)] = d515;
+                let d247 = p.YY4r + d213 - d243; // JC4r.yy
+                m[(12, 12)] = d247;
                 let d516 = A::mul_add(k38, d510, A::mul_add(d482, k39, p.YZ4l)); // JC4l.yz
+                let d248 = A::mul_add(k17, d242, A::mul_add(d214, k18, p.YZ4r)); // JC4r.yz
                 let d517 = p.ZZ4l + d485 + d511; // JC4l.zz
+                let d249 = p.ZZ4r + d217 + d243; // JC4r.zz
                 let d518 = A::mul_add(-s_q1l, d509, c_q1l * d507); // MSC4l in 3.y
+                let d250 = A::mul_add(-s_q1r, d241, c_q1r * d239); // MSC4r in 3.y
                 let d519 = A::mul_add(c_q1l, d509, s_q1l * d507); // MSC4l in 3.z
+                let d251 = A::mul_add(c_q1r, d241, s_q1r * d239); // MSC4r in 3.z
                 let t73 = c_q1l * d513; // common subexpression
+                let t33 = c_q1r * d245; // common subexpression
                 let t74 = s_q1l * d516; // common subexpression
+                let t34 = s_q1r * d248; // common subexpression
                 let t75 = s_q1l * d513; // common subexpression
+                let t35 = s_q1r * d245; // common subexpression
                 let t76 = c_q1l * d516; // common subexpression
+                let t36 = c_q1r * d248; // common subexpression
                 let t77 = p.L5 * d518; // common subexpression
+                let t37 = p.L5 * d250; // common subexpression
                 let t78 = p.L6 * d518; // common subexpression
+                let t38 = p.L6 * d250; // common subexpression
                 let t79 = p.L6 * d519; // common subexpression
+                let t39 = p.L6 * d251; // common subexpression
                 let d520 = t75 + t76 - t79; // N(M col 4l) at 3.z
+                let d254 = t35 + t36 - t39; // N(M col 4r) at 3.z
                 let d521 = d515 + t77; // N(M col 4l) at 3.x
+                let d252 = d247 + t37; // N(M col 4r) at 3.x
                 let d522 = t73 - t74 - t78; // N(M col 4l) at 3.y
                 m[(4, 5)] = d522;
+                let d253 = t33 - t34 - t38; // N(M col 4r) at 3.y
+                m[(4, 12)] = d253;
                 let d523 = s_q_torso * d518; // F(M col 4l) at 2.x
+                let d255 = s_q_torso * d250; // F(M col 4r) at 2.x
+                let d258 = A::mul_add(p.L4, d255, -d253); // N(M col 4r) at 2.y
                 let d524 = c_q_torso * d518; // F(M col 4l) at 2.z
+                let d256 = c_q_torso * d250; // F(M col 4r) at 2.z
+                let d257 = A::mul_add(
+                    -p.L3,
+                    d256,
+                    A::mul_add(
+                        -s_q_torso,
+                        d254,
+                        A::mul_add(-c_q_torso, d252, p.L4 * d251),
+                    ),
+                ); // N(M col 4r) at 2.x
+                m[(3, 12)] = -d257;
+                let d260 = A::mul_add(-c_q_w, d256, s_q_w * d251); // F(M col 4r) at 1.z
+                let d261 = A::mul_add(s_q_w, d256, c_q_w * d251); // F(M col 4r) at 1.y
                 let d525 = A::mul_add(
                     p.L4,
                     d519,
@@ -9118,28 +10486,51 @@ mod generated {
                     d523,
                     A::mul_add(-c_q_torso, d520, s_q_torso * d521),
                 ); // N(M col 4l) at 2.z
+                let d259 = A::mul_add(
+                    p.L3,
+                    d255,
+                    A::mul_add(-c_q_torso, d254, s_q_torso * d252),
+                ); // N(M col 4r) at 2.z
                 let d527 = A::mul_add(p.L4, d523, d522); // N(M col 4l) at 2.y
                 let d528 = A::mul_add(c_q_w, d524, s_q_w * d519); // F(M col 4l) at 1.z
                 let d529 = A::mul_add(-s_q_w, d524, c_q_w * d519); // F(M col 4l) at 1.y
                 let d530 = A::mul_add(-p.L2, d529, A::mul_add(p.L1, d528, d525)); // N(M col 4l) at 1.x
                 m[(2, 5)] = -d530;
+                let d263 = A::mul_add(-p.L2, d261, A::mul_add(p.L1, d260, d257)); // N(M col 4r) at 1.x
+                m[(2, 12)] = -d263;
                 let d531 = A::mul_add(p.L1, d523, A::mul_add(c_q_w, d526, s_q_w * d527)); // N(M col 4l) at 1.z
+                let d262 = A::mul_add(p.L1, d255, A::mul_add(c_q_w, d259, s_q_w * d258)); // N(M col 4r) at 1.z
                 let d532 = A::mul_add(
                     -p.L2,
                     d523,
                     A::mul_add(-s_q_w, d526, c_q_w * d527),
                 ); // N(M col 4l) at 1.y
+                let d264 = A::mul_add(
+                    -p.L2,
+                    d255,
+                    A::mul_add(-s_q_w, d259, c_q_w * d258),
+                ); // N(M col 4r) at 1.y
                 let d533 = A::mul_add(c_q_imu, d528, s_q_imu * d529); // F(M col 4l) at 0.x
                 m[(0, 5)] = -d533;
+                let d265 = A::mul_add(c_q_imu, d260, s_q_imu * d261); // F(M col 4r) at 0.x
+                m[(0, 12)] = -d265;
                 let d534 = A::mul_add(-s_q_imu, d531, c_q_imu * d532); // N(M col 4l) at 0.z
                 m[(1, 5)] = -d534;
+                let d266 = A::mul_add(-s_q_imu, d262, c_q_imu * d264); // N(M col 4r) at 0.z
+                m[(1, 12)] = d266;
                 let d535 = p.MZ3 + d251 - d519; // MSC3.z
                 let k40 = s_q1l * s_q1l; // sin² q1l
+                let k19 = s_q1r * s_q1r; // sin² q1r
                 let k41 = s_q1l * c_q1l; // sin q1l cos q1l
+                let k20 = s_q1r * c_q1r; // sin q1r cos q1r
                 let k42 = A::mul_add(2.0, k40, -1.0); // cos 2q1l
+                let k21 = A::mul_add(2.0, k19, -1.0); // cos 2q1r
                 let d536 = d512 - d517; // JC4l: Jzz − Jxx
+                let d267 = d244 - d249; // JC4r: Jzz − Jxx
                 let d537 = A::mul_add(2.0, d514 * k41, k40 * d536); // JC4l rotated about y: Jzz − J'zz
+                let d268 = A::mul_add(2.0, d246 * k20, k19 * d267); // JC4r rotated about y: Jzz − J'zz
                 let t80 = p.L6 * d508; // common subexpression
+                let t40 = p.L6 * d240; // common subexpression
                 let d538 = p.XZ3 - t35 - t36 + t39 - t75 - t76 + t79; // JC3.xz
                 let d539 = A::mul_add(
                     p.L5,
@@ -9865,9 +11256,23 @@ mod generated {
                 let k42 = k31 - t5 - t6 + t9 + t10; // a4l in 3|ud=0,g=0.z
                 let k43 = A::mul_add(c_q1l, k42, s_q1l * k41); // a4l|ud=0,g=0.z
                 let k44 = A::mul_add(-s_q1l, k42, c_q1l * k41); // a4l|ud=0,g=0.x
-                let d36 = A::mul_add(p.MY4l, k33, p.MZ4l * k34); // w4lxMS4l|ud=0,g=0.x
+                let k50 = A::mul_add(s_q2l, k43, c_q2l * k40); // a5l|ud=0,g=0.y
+                let k51 = A::mul_add(-c_q2l, k43, s_q2l * k40); // a5l|ud=0,g=0.z
+                let k102 = A::mul_add(-s_q1r, k20, c_q1r * k21); // w3 in 4r|ud=0,g=0.x
+                let k103 = A::mul_add(c_q1r, k20, s_q1r * k21); // w3 in 4r|ud=0,g=0.z
+                let k104 = A::mul_add(-k102, qd1r, A::mul_add(c_q1r, k23, s_q1r * k9)); // wd4r|ud=0,g=0.z
+                let k105 = -k19 - qd1r; // w4r|ud=0,g=0.y
+                let k106 = A::mul_add(k103, qd1r, A::mul_add(-s_q1r, k23, c_q1r * k9)); // wd4r|ud=0,g=0.x
+                let k107 = t1 + t2; // w3xP4r|ud=0,g=0.z
+                let k108 = A::mul_add(k21, k107, k30 - t3 + t7); // a4r in 3|ud=0,g=0.x
+                let k109 = A::mul_add(k19, k107, k28 + t4 + t8); // a4r in 3|ud=0,g=0.y
+                let k110 = k31 - t5 + t6 - t9 + t10; // a4r in 3|ud=0,g=0.z
+                let k111 = A::mul_add(-c_q1r, k110, s_q1r * k109); // a4r|ud=0,g=0.z
+                let k112 = A::mul_add(s_q1r, k110, c_q1r * k109); // a4r|ud=0,g=0.x
                 let d37 = A::mul_add(-p.MX4l, k34, p.MY4l * k32); // w4lxMS4l|ud=0,g=0.z
-                let d38 = A::mul_add(p.MZ4l, k32, p.MX4l * k33); // w4lxMS4l|ud=0,g=0.y
+                let d120 = A::mul_add(-p.MX4r, k105, p.MY4r * k102); // w4rxMS4r|ud=0,g=0.z
+                let d36 = A::mul_add(p.MY4l, k33, p.MZ4l * k34); // w4lxMS4l|ud=0,g=0.x
+                let d121 = A::mul_add(p.MY4r, k103, p.MZ4r * k105); // w4rxMS4r|ud=0,g=0.x
                 let d39 = A::mul_add(
                     -k32,
                     d37,
@@ -9877,6 +11282,8 @@ mod generated {
                         A::mul_add(p.MZ4l, k36, A::mul_add(p.MX4l, k35, p.m4l * k40)),
                     ),
                 ); // F4l|ud=0,g=0.y
+                let d38 = A::mul_add(p.MZ4l, k32, p.MX4l * k33); // w4lxMS4l|ud=0,g=0.y
+                let d122 = A::mul_add(p.MZ4r, k102, p.MX4r * k103); // w4rxMS4r|ud=0,g=0.y
                 let d40 = A::mul_add(
                     -k34,
                     d36,
@@ -9895,21 +11302,84 @@ mod generated {
                         A::mul_add(p.MY4l, k35, A::mul_add(-p.MZ4l, k22, p.m4l * k44)),
                     ),
                 ); // F4l|ud=0,g=0.x
+                let d123 = A::mul_add(
+                    -k105,
+                    d121,
+                    A::mul_add(
+                        -k102,
+                        d122,
+                        A::mul_add(p.MX4r, k22, A::mul_add(-p.MY4r, k106, p.m4r * k111)),
+                    ),
+                ); // F4r|ud=0,g=0.z
+                let d124 = A::mul_add(
+                    k103,
+                    d122,
+                    A::mul_add(
+                        -k105,
+                        d120,
+                        A::mul_add(p.MY4r, k104, A::mul_add(p.MZ4r, k22, p.m4r * k112)),
+                    ),
+                ); // F4r|ud=0,g=0.x
+                let d125 = A::mul_add(
+                    -k102,
+                    d120,
+                    A::mul_add(
+                        -k103,
+                        d121,
+                        A::mul_add(p.MZ4r, k106, A::mul_add(-p.m4r, k108, p.MX4r * k104)),
+                    ),
+                ); // F4r|ud=0,g=0.y
                 let d42 = A::mul_add(
                     -p.XZ4l,
                     k33,
                     A::mul_add(p.XY4l, k34, p.XX4l * k32),
                 ); // J4lw4l|ud=0,g=0.x
+                let d126 = A::mul_add(
+                    -p.XZ4r,
+                    k103,
+                    A::mul_add(p.XY4r, k105, p.XX4r * k102),
+                ); // J4rw4r|ud=0,g=0.x
                 let d43 = A::mul_add(
                     -p.YZ4l,
                     k33,
                     A::mul_add(p.YY4l, k34, p.XY4l * k32),
                 ); // J4lw4l|ud=0,g=0.y
+                let d127 = A::mul_add(
+                    -p.YZ4r,
+                    k103,
+                    A::mul_add(p.YY4r, k105, p.XY4r * k102),
+                ); // J4rw4r|ud=0,g=0.y
+                let d47 = A::mul_add(
+                    -p.MY4l,
+                    k44,
+                    A::mul_add(
+                        -p.MX4l,
+                        k40,
+                        A::mul_add(
+                            k34,
+                            d42,
+                            A::mul_add(
+                                -k32,
+                                d43,
+                                A::mul_add(
+                                    -p.ZZ4l,
+                                    k35,
+                                    A::mul_add(-p.YZ4l, k22, p.XZ4l * k36),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N4l|ud=0,g=0.z
                 let d44 = A::mul_add(
                     -p.ZZ4l,
                     k33,
                     A::mul_add(p.YZ4l, k34, p.XZ4l * k32),
                 ); // J4lw4l|ud=0,g=0.z
+                let d128 = A::mul_add(
+                    -p.ZZ4r,
+                    k103,
+                    A::mul_add(p.YZ4r, k105, p.XZ4r * k102),
+                ); // J4rw4r|ud=0,g=0.z
                 let d45 = A::mul_add(
                     p.MZ4l,
                     k40,
@@ -9952,773 +11422,6 @@ mod generated {
                         ),
                     ),
                 ); // N4l|ud=0,g=0.y
-                let d47 = A::mul_add(
-                    -p.MY4l,
-                    k44,
-                    A::mul_add(
-                        -p.MX4l,
-                        k40,
-                        A::mul_add(
-                            k34,
-                            d42,
-                            A::mul_add(
-                                -k32,
-                                d43,
-                                A::mul_add(
-                                    -p.ZZ4l,
-                                    k35,
-                                    A::mul_add(-p.YZ4l, k22, p.XZ4l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4l|ud=0,g=0.z
-                let k45 = A::mul_add(-s_q2l, k33, c_q2l * k34); // w4l in 5l|ud=0,g=0.y
-                let k46 = A::mul_add(c_q2l, k33, s_q2l * k34); // w4l in 5l|ud=0,g=0.z
-                let k47 = k32 + qd2l; // w5l|ud=0,g=0.x
-                let k48 = A::mul_add(-k46, qd2l, A::mul_add(s_q2l, k35, c_q2l * k22)); // wd5l|ud=0,g=0.y
-                let k49 = A::mul_add(k45, qd2l, A::mul_add(-c_q2l, k35, s_q2l * k22)); // wd5l|ud=0,g=0.z
-                let k50 = A::mul_add(s_q2l, k43, c_q2l * k40); // a5l|ud=0,g=0.y
-                let k51 = A::mul_add(-c_q2l, k43, s_q2l * k40); // a5l|ud=0,g=0.z
-                let d48 = A::mul_add(-p.MY5l, k46, p.MZ5l * k45); // w5lxMS5l|ud=0,g=0.x
-                let d49 = A::mul_add(-p.MZ5l, k47, p.MX5l * k46); // w5lxMS5l|ud=0,g=0.y
-                let d50 = A::mul_add(-p.MX5l, k45, p.MY5l * k47); // w5lxMS5l|ud=0,g=0.z
-                let d51 = A::mul_add(
-                    -k46,
-                    d49,
-                    A::mul_add(
-                        k45,
-                        d50,
-                        A::mul_add(p.MY5l, k49, A::mul_add(-p.MZ5l, k48, p.m5l * k44)),
-                    ),
-                ); // F5l|ud=0,g=0.x
-                let d52 = A::mul_add(
-                    k47,
-                    d50,
-                    A::mul_add(
-                        -k46,
-                        d48,
-                        A::mul_add(p.MZ5l, k36, A::mul_add(p.MX5l, k49, p.m5l * k50)),
-                    ),
-                ); // F5l|ud=0,g=0.y
-                let d53 = A::mul_add(
-                    k45,
-                    d48,
-                    A::mul_add(
-                        -k47,
-                        d49,
-                        A::mul_add(-p.MX5l, k48, A::mul_add(-p.MY5l, k36, p.m5l * k51)),
-                    ),
-                ); // F5l|ud=0,g=0.z
-                let d54 = A::mul_add(p.XZ5l, k46, A::mul_add(p.XY5l, k45, p.XX5l * k47)); // J5lw5l|ud=0,g=0.x
-                let d55 = A::mul_add(p.YZ5l, k46, A::mul_add(p.YY5l, k45, p.XY5l * k47)); // J5lw5l|ud=0,g=0.y
-                let d56 = A::mul_add(p.ZZ5l, k46, A::mul_add(p.YZ5l, k45, p.XZ5l * k47)); // J5lw5l|ud=0,g=0.z
-                let d57 = A::mul_add(
-                    p.MZ5l,
-                    k50,
-                    A::mul_add(
-                        -p.MY5l,
-                        k51,
-                        A::mul_add(
-                            -k46,
-                            d55,
-                            A::mul_add(
-                                k45,
-                                d56,
-                                A::mul_add(
-                                    -p.XZ5l,
-                                    k49,
-                                    A::mul_add(-p.XY5l, k48, p.XX5l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5l|ud=0,g=0.x
-                let d58 = A::mul_add(
-                    p.MX5l,
-                    k51,
-                    A::mul_add(
-                        p.MZ5l,
-                        k44,
-                        A::mul_add(
-                            -k47,
-                            d56,
-                            A::mul_add(
-                                k46,
-                                d54,
-                                A::mul_add(
-                                    -p.YZ5l,
-                                    k49,
-                                    A::mul_add(-p.YY5l, k48, p.XY5l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5l|ud=0,g=0.y
-                let d59 = A::mul_add(
-                    -p.MY5l,
-                    k44,
-                    A::mul_add(
-                        -p.MX5l,
-                        k50,
-                        A::mul_add(
-                            -k45,
-                            d54,
-                            A::mul_add(
-                                k47,
-                                d55,
-                                A::mul_add(
-                                    -p.ZZ5l,
-                                    k49,
-                                    A::mul_add(-p.YZ5l, k48, p.XZ5l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5l|ud=0,g=0.z
-                let k52 = A::mul_add(-s_q3l, k46, c_q3l * k47); // w5l in 6l|ud=0,g=0.x
-                let k53 = A::mul_add(c_q3l, k46, s_q3l * k47); // w5l in 6l|ud=0,g=0.z
-                let k54 = k45 - qd3l; // w6l|ud=0,g=0.y
-                let k55 = A::mul_add(-k52, qd3l, A::mul_add(-c_q3l, k49, s_q3l * k36)); // wd6l|ud=0,g=0.z
-                let k56 = A::mul_add(k53, qd3l, A::mul_add(s_q3l, k49, c_q3l * k36)); // wd6l|ud=0,g=0.x
-                let k57 = p.L7 * k46; // w5lxP6l|ud=0,g=0.x
-                let k58 = p.L7 * k47; // w5lxP6l|ud=0,g=0.z
-                let k59 = A::mul_add(-k45, k58, A::mul_add(-p.L7, k49, k44)); // a6l in 5l|ud=0,g=0.x
-                let k60 = A::mul_add(-k47, k58, A::mul_add(-k46, k57, k50)); // a6l in 5l|ud=0,g=0.y
-                let k61 = A::mul_add(k45, k57, A::mul_add(p.L7, k36, k51)); // a6l in 5l|ud=0,g=0.z
-                let k62 = A::mul_add(-c_q3l, k61, s_q3l * k59); // a6l|ud=0,g=0.z
-                let k63 = A::mul_add(s_q3l, k61, c_q3l * k59); // a6l|ud=0,g=0.x
-                let d60 = A::mul_add(p.MY6l, k53, p.MZ6l * k54); // w6lxMS6l|ud=0,g=0.x
-                let d61 = A::mul_add(-p.MX6l, k54, p.MY6l * k52); // w6lxMS6l|ud=0,g=0.z
-                let d62 = A::mul_add(p.MZ6l, k52, p.MX6l * k53); // w6lxMS6l|ud=0,g=0.y
-                let d63 = A::mul_add(
-                    -k52,
-                    d61,
-                    A::mul_add(
-                        -k53,
-                        d60,
-                        A::mul_add(p.MZ6l, k56, A::mul_add(p.MX6l, k55, p.m6l * k60)),
-                    ),
-                ); // F6l|ud=0,g=0.y
-                let d64 = A::mul_add(
-                    -k54,
-                    d60,
-                    A::mul_add(
-                        -k52,
-                        d62,
-                        A::mul_add(-p.MX6l, k48, A::mul_add(-p.MY6l, k56, p.m6l * k62)),
-                    ),
-                ); // F6l|ud=0,g=0.z
-                let d65 = A::mul_add(
-                    k53,
-                    d62,
-                    A::mul_add(
-                        -k54,
-                        d61,
-                        A::mul_add(p.MY6l, k55, A::mul_add(-p.MZ6l, k48, p.m6l * k63)),
-                    ),
-                ); // F6l|ud=0,g=0.x
-                let d66 = A::mul_add(
-                    -p.XZ6l,
-                    k53,
-                    A::mul_add(p.XY6l, k54, p.XX6l * k52),
-                ); // J6lw6l|ud=0,g=0.x
-                let d67 = A::mul_add(
-                    -p.YZ6l,
-                    k53,
-                    A::mul_add(p.YY6l, k54, p.XY6l * k52),
-                ); // J6lw6l|ud=0,g=0.y
-                let d68 = A::mul_add(
-                    -p.ZZ6l,
-                    k53,
-                    A::mul_add(p.YZ6l, k54, p.XZ6l * k52),
-                ); // J6lw6l|ud=0,g=0.z
-                let d69 = A::mul_add(
-                    p.MZ6l,
-                    k60,
-                    A::mul_add(
-                        -p.MY6l,
-                        k62,
-                        A::mul_add(
-                            -k53,
-                            d67,
-                            A::mul_add(
-                                -k54,
-                                d68,
-                                A::mul_add(
-                                    -p.XZ6l,
-                                    k55,
-                                    A::mul_add(-p.XY6l, k48, p.XX6l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6l|ud=0,g=0.x
-                let d70 = A::mul_add(
-                    p.MX6l,
-                    k62,
-                    A::mul_add(
-                        p.MZ6l,
-                        k63,
-                        A::mul_add(
-                            k52,
-                            d68,
-                            A::mul_add(
-                                k53,
-                                d66,
-                                A::mul_add(
-                                    -p.YZ6l,
-                                    k55,
-                                    A::mul_add(-p.YY6l, k48, p.XY6l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6l|ud=0,g=0.y
-                let d71 = A::mul_add(
-                    -p.MY6l,
-                    k63,
-                    A::mul_add(
-                        -p.MX6l,
-                        k60,
-                        A::mul_add(
-                            k54,
-                            d66,
-                            A::mul_add(
-                                -k52,
-                                d67,
-                                A::mul_add(
-                                    -p.ZZ6l,
-                                    k55,
-                                    A::mul_add(-p.YZ6l, k48, p.XZ6l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6l|ud=0,g=0.z
-                let k64 = A::mul_add(-s_q4l, k53, c_q4l * k54); // w6l in 7l|ud=0,g=0.y
-                let k65 = A::mul_add(c_q4l, k53, s_q4l * k54); // w6l in 7l|ud=0,g=0.z
-                let k66 = k52 + qd4l; // w7l|ud=0,g=0.x
-                let k67 = A::mul_add(-k65, qd4l, A::mul_add(s_q4l, k55, c_q4l * k48)); // wd7l|ud=0,g=0.y
-                let k68 = A::mul_add(k64, qd4l, A::mul_add(-c_q4l, k55, s_q4l * k48)); // wd7l|ud=0,g=0.z
-                let k69 = A::mul_add(s_q4l, k62, c_q4l * k60); // a7l|ud=0,g=0.y
-                let k70 = A::mul_add(-c_q4l, k62, s_q4l * k60); // a7l|ud=0,g=0.z
-                let d72 = A::mul_add(-p.MY7l, k65, p.MZ7l * k64); // w7lxMS7l|ud=0,g=0.x
-                let d73 = A::mul_add(-p.MZ7l, k66, p.MX7l * k65); // w7lxMS7l|ud=0,g=0.y
-                let d74 = A::mul_add(-p.MX7l, k64, p.MY7l * k66); // w7lxMS7l|ud=0,g=0.z
-                let d75 = A::mul_add(
-                    -k65,
-                    d73,
-                    A::mul_add(
-                        k64,
-                        d74,
-                        A::mul_add(p.MY7l, k68, A::mul_add(-p.MZ7l, k67, p.m7l * k63)),
-                    ),
-                ); // F7l|ud=0,g=0.x
-                let d76 = A::mul_add(
-                    k66,
-                    d74,
-                    A::mul_add(
-                        -k65,
-                        d72,
-                        A::mul_add(p.MZ7l, k56, A::mul_add(p.MX7l, k68, p.m7l * k69)),
-                    ),
-                ); // F7l|ud=0,g=0.y
-                let d77 = A::mul_add(
-                    k64,
-                    d72,
-                    A::mul_add(
-                        -k66,
-                        d73,
-                        A::mul_add(-p.MX7l, k67, A::mul_add(-p.MY7l, k56, p.m7l * k70)),
-                    ),
-                ); // F7l|ud=0,g=0.z
-                let d78 = A::mul_add(p.XZ7l, k65, A::mul_add(p.XY7l, k64, p.XX7l * k66)); // J7lw7l|ud=0,g=0.x
-                let d79 = A::mul_add(p.YZ7l, k65, A::mul_add(p.YY7l, k64, p.XY7l * k66)); // J7lw7l|ud=0,g=0.y
-                let d80 = A::mul_add(p.ZZ7l, k65, A::mul_add(p.YZ7l, k64, p.XZ7l * k66)); // J7lw7l|ud=0,g=0.z
-                let d81 = A::mul_add(
-                    p.MZ7l,
-                    k69,
-                    A::mul_add(
-                        -p.MY7l,
-                        k70,
-                        A::mul_add(
-                            -k65,
-                            d79,
-                            A::mul_add(
-                                k64,
-                                d80,
-                                A::mul_add(
-                                    -p.XZ7l,
-                                    k68,
-                                    A::mul_add(-p.XY7l, k67, p.XX7l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7l|ud=0,g=0.x
-                let d82 = A::mul_add(
-                    p.MX7l,
-                    k70,
-                    A::mul_add(
-                        p.MZ7l,
-                        k63,
-                        A::mul_add(
-                            -k66,
-                            d80,
-                            A::mul_add(
-                                k65,
-                                d78,
-                                A::mul_add(
-                                    -p.YZ7l,
-                                    k68,
-                                    A::mul_add(-p.YY7l, k67, p.XY7l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7l|ud=0,g=0.y
-                let d83 = A::mul_add(
-                    -p.MY7l,
-                    k63,
-                    A::mul_add(
-                        -p.MX7l,
-                        k69,
-                        A::mul_add(
-                            -k64,
-                            d78,
-                            A::mul_add(
-                                k66,
-                                d79,
-                                A::mul_add(
-                                    -p.ZZ7l,
-                                    k68,
-                                    A::mul_add(-p.YZ7l, k67, p.XZ7l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7l|ud=0,g=0.z
-                let k71 = A::mul_add(-s_q5l, k65, c_q5l * k66); // w7l in 8l|ud=0,g=0.x
-                let k72 = A::mul_add(c_q5l, k65, s_q5l * k66); // w7l in 8l|ud=0,g=0.z
-                let k73 = k64 - qd5l; // w8l|ud=0,g=0.y
-                let k74 = A::mul_add(-k71, qd5l, A::mul_add(-c_q5l, k68, s_q5l * k56)); // wd8l|ud=0,g=0.z
-                let k75 = A::mul_add(k72, qd5l, A::mul_add(s_q5l, k68, c_q5l * k56)); // wd8l|ud=0,g=0.x
-                let k76 = p.L8 * k65; // w7lxP8l|ud=0,g=0.x
-                let k77 = p.L8 * k66; // w7lxP8l|ud=0,g=0.z
-                let k78 = A::mul_add(-k64, k77, A::mul_add(-p.L8, k68, k63)); // a8l in 7l|ud=0,g=0.x
-                let k79 = A::mul_add(-k66, k77, A::mul_add(-k65, k76, k69)); // a8l in 7l|ud=0,g=0.y
-                let k80 = A::mul_add(k64, k76, A::mul_add(p.L8, k56, k70)); // a8l in 7l|ud=0,g=0.z
-                let k81 = A::mul_add(-c_q5l, k80, s_q5l * k78); // a8l|ud=0,g=0.z
-                let k82 = A::mul_add(s_q5l, k80, c_q5l * k78); // a8l|ud=0,g=0.x
-                let d84 = A::mul_add(p.MY8l, k72, p.MZ8l * k73); // w8lxMS8l|ud=0,g=0.x
-                let d85 = A::mul_add(-p.MX8l, k73, p.MY8l * k71); // w8lxMS8l|ud=0,g=0.z
-                let d86 = A::mul_add(p.MZ8l, k71, p.MX8l * k72); // w8lxMS8l|ud=0,g=0.y
-                let d87 = A::mul_add(
-                    -k71,
-                    d85,
-                    A::mul_add(
-                        -k72,
-                        d84,
-                        A::mul_add(p.MZ8l, k75, A::mul_add(p.MX8l, k74, p.m8l * k79)),
-                    ),
-                ); // F8l|ud=0,g=0.y
-                let d88 = A::mul_add(
-                    -k73,
-                    d84,
-                    A::mul_add(
-                        -k71,
-                        d86,
-                        A::mul_add(-p.MX8l, k67, A::mul_add(-p.MY8l, k75, p.m8l * k81)),
-                    ),
-                ); // F8l|ud=0,g=0.z
-                let d89 = A::mul_add(
-                    k72,
-                    d86,
-                    A::mul_add(
-                        -k73,
-                        d85,
-                        A::mul_add(p.MY8l, k74, A::mul_add(-p.MZ8l, k67, p.m8l * k82)),
-                    ),
-                ); // F8l|ud=0,g=0.x
-                let d90 = A::mul_add(
-                    -p.XZ8l,
-                    k72,
-                    A::mul_add(p.XY8l, k73, p.XX8l * k71),
-                ); // J8lw8l|ud=0,g=0.x
-                let d91 = A::mul_add(
-                    -p.YZ8l,
-                    k72,
-                    A::mul_add(p.YY8l, k73, p.XY8l * k71),
-                ); // J8lw8l|ud=0,g=0.y
-                let d92 = A::mul_add(
-                    -p.ZZ8l,
-                    k72,
-                    A::mul_add(p.YZ8l, k73, p.XZ8l * k71),
-                ); // J8lw8l|ud=0,g=0.z
-                let d93 = A::mul_add(
-                    p.MZ8l,
-                    k79,
-                    A::mul_add(
-                        -p.MY8l,
-                        k81,
-                        A::mul_add(
-                            -k72,
-                            d91,
-                            A::mul_add(
-                                -k73,
-                                d92,
-                                A::mul_add(
-                                    -p.XZ8l,
-                                    k74,
-                                    A::mul_add(-p.XY8l, k67, p.XX8l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8l|ud=0,g=0.x
-                let d94 = A::mul_add(
-                    p.MX8l,
-                    k81,
-                    A::mul_add(
-                        p.MZ8l,
-                        k82,
-                        A::mul_add(
-                            k71,
-                            d92,
-                            A::mul_add(
-                                k72,
-                                d90,
-                                A::mul_add(
-                                    -p.YZ8l,
-                                    k74,
-                                    A::mul_add(-p.YY8l, k67, p.XY8l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8l|ud=0,g=0.y
-                let d95 = A::mul_add(
-                    -p.MY8l,
-                    k82,
-                    A::mul_add(
-                        -p.MX8l,
-                        k79,
-                        A::mul_add(
-                            k73,
-                            d90,
-                            A::mul_add(
-                                -k71,
-                                d91,
-                                A::mul_add(
-                                    -p.ZZ8l,
-                                    k74,
-                                    A::mul_add(-p.YZ8l, k67, p.XZ8l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8l|ud=0,g=0.z
-                let k83 = A::mul_add(-s_q6l, k72, c_q6l * k73); // w8l in 9l|ud=0,g=0.y
-                let k84 = A::mul_add(c_q6l, k72, s_q6l * k73); // w8l in 9l|ud=0,g=0.z
-                let k85 = k71 + qd6l; // w9l|ud=0,g=0.x
-                let k86 = A::mul_add(-k84, qd6l, A::mul_add(s_q6l, k74, c_q6l * k67)); // wd9l|ud=0,g=0.y
-                let k87 = A::mul_add(k83, qd6l, A::mul_add(-c_q6l, k74, s_q6l * k67)); // wd9l|ud=0,g=0.z
-                let k88 = A::mul_add(s_q6l, k81, c_q6l * k79); // a9l|ud=0,g=0.y
-                let k89 = A::mul_add(-c_q6l, k81, s_q6l * k79); // a9l|ud=0,g=0.z
-                let d96 = A::mul_add(-p.MY9l, k84, p.MZ9l * k83); // w9lxMS9l|ud=0,g=0.x
-                let d97 = A::mul_add(-p.MZ9l, k85, p.MX9l * k84); // w9lxMS9l|ud=0,g=0.y
-                let d98 = A::mul_add(-p.MX9l, k83, p.MY9l * k85); // w9lxMS9l|ud=0,g=0.z
-                let d99 = A::mul_add(
-                    -k84,
-                    d97,
-                    A::mul_add(
-                        k83,
-                        d98,
-                        A::mul_add(p.MY9l, k87, A::mul_add(-p.MZ9l, k86, p.m9l * k82)),
-                    ),
-                ); // F9l|ud=0,g=0.x
-                let d100 = A::mul_add(
-                    k85,
-                    d98,
-                    A::mul_add(
-                        -k84,
-                        d96,
-                        A::mul_add(p.MZ9l, k75, A::mul_add(p.MX9l, k87, p.m9l * k88)),
-                    ),
-                ); // F9l|ud=0,g=0.y
-                let d101 = A::mul_add(
-                    k83,
-                    d96,
-                    A::mul_add(
-                        -k85,
-                        d97,
-                        A::mul_add(-p.MX9l, k86, A::mul_add(-p.MY9l, k75, p.m9l * k89)),
-                    ),
-                ); // F9l|ud=0,g=0.z
-                let d102 = A::mul_add(
-                    p.XZ9l,
-                    k84,
-                    A::mul_add(p.XY9l, k83, p.XX9l * k85),
-                ); // J9lw9l|ud=0,g=0.x
-                let d103 = A::mul_add(
-                    p.YZ9l,
-                    k84,
-                    A::mul_add(p.YY9l, k83, p.XY9l * k85),
-                ); // J9lw9l|ud=0,g=0.y
-                let d104 = A::mul_add(
-                    p.ZZ9l,
-                    k84,
-                    A::mul_add(p.YZ9l, k83, p.XZ9l * k85),
-                ); // J9lw9l|ud=0,g=0.z
-                let d105 = A::mul_add(
-                    p.MZ9l,
-                    k88,
-                    A::mul_add(
-                        -p.MY9l,
-                        k89,
-                        A::mul_add(
-                            -k84,
-                            d103,
-                            A::mul_add(
-                                k83,
-                                d104,
-                                A::mul_add(
-                                    -p.XZ9l,
-                                    k87,
-                                    A::mul_add(-p.XY9l, k86, p.XX9l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9l|ud=0,g=0.x
-                let d106 = A::mul_add(
-                    p.MX9l,
-                    k89,
-                    A::mul_add(
-                        p.MZ9l,
-                        k82,
-                        A::mul_add(
-                            -k85,
-                            d104,
-                            A::mul_add(
-                                k84,
-                                d102,
-                                A::mul_add(
-                                    -p.YZ9l,
-                                    k87,
-                                    A::mul_add(-p.YY9l, k86, p.XY9l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9l|ud=0,g=0.y
-                let d107 = A::mul_add(
-                    -p.MY9l,
-                    k82,
-                    A::mul_add(
-                        -p.MX9l,
-                        k88,
-                        A::mul_add(
-                            -k83,
-                            d102,
-                            A::mul_add(
-                                k85,
-                                d103,
-                                A::mul_add(
-                                    -p.ZZ9l,
-                                    k87,
-                                    A::mul_add(-p.YZ9l, k86, p.XZ9l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9l|ud=0,g=0.z
-                let k90 = A::mul_add(-s_q7l, k84, c_q7l * k85); // w9l in 10l|ud=0,g=0.x
-                let k91 = A::mul_add(c_q7l, k84, s_q7l * k85); // w9l in 10l|ud=0,g=0.y
-                let k92 = k83 - qd7l; // w10l|ud=0,g=0.z
-                let k93 = A::mul_add(k91, qd7l, A::mul_add(s_q7l, k87, c_q7l * k75)); // wd10l|ud=0,g=0.x
-                let k94 = A::mul_add(-k90, qd7l, A::mul_add(-c_q7l, k87, s_q7l * k75)); // wd10l|ud=0,g=0.y
-                let k95 = p.L9 * k84; // w9lxP10l|ud=0,g=0.x
-                let k96 = p.L9 * k85; // w9lxP10l|ud=0,g=0.z
-                let k97 = A::mul_add(-k83, k96, A::mul_add(-p.L9, k87, k82)); // a10l in 9l|ud=0,g=0.x
-                let k98 = A::mul_add(-k85, k96, A::mul_add(-k84, k95, k88)); // a10l in 9l|ud=0,g=0.y
-                let k99 = A::mul_add(k83, k95, A::mul_add(p.L9, k75, k89)); // a10l in 9l|ud=0,g=0.z
-                let k100 = A::mul_add(s_q7l, k99, c_q7l * k97); // a10l|ud=0,g=0.x
-                let k101 = A::mul_add(-c_q7l, k99, s_q7l * k97); // a10l|ud=0,g=0.y
-                let d108 = A::mul_add(-p.MY10l, k92, p.MZ10l * k91); // w10lxMS10l|ud=0,g=0.x
-                let d109 = A::mul_add(-p.MZ10l, k90, p.MX10l * k92); // w10lxMS10l|ud=0,g=0.y
-                let d110 = A::mul_add(-p.MX10l, k91, p.MY10l * k90); // w10lxMS10l|ud=0,g=0.z
-                let d111 = A::mul_add(
-                    -k91,
-                    d108,
-                    A::mul_add(
-                        k90,
-                        d109,
-                        A::mul_add(p.MX10l, k94, A::mul_add(-p.MY10l, k93, p.m10l * k98)),
-                    ),
-                ); // F10l|ud=0,g=0.z
-                let d112 = A::mul_add(
-                    k92,
-                    d109,
-                    A::mul_add(
-                        -k91,
-                        d110,
-                        A::mul_add(p.MY10l, k86, A::mul_add(p.MZ10l, k94, p.m10l * k100)),
-                    ),
-                ); // F10l|ud=0,g=0.x
-                let d113 = A::mul_add(
-                    k90,
-                    d110,
-                    A::mul_add(
-                        -k92,
-                        d108,
-                        A::mul_add(
-                            -p.MZ10l,
-                            k93,
-                            A::mul_add(-p.MX10l, k86, p.m10l * k101),
-                        ),
-                    ),
-                ); // F10l|ud=0,g=0.y
-                let d114 = A::mul_add(
-                    p.XZ10l,
-                    k92,
-                    A::mul_add(p.XY10l, k91, p.XX10l * k90),
-                ); // J10lw10l|ud=0,g=0.x
-                let d115 = A::mul_add(
-                    p.YZ10l,
-                    k92,
-                    A::mul_add(p.YY10l, k91, p.XY10l * k90),
-                ); // J10lw10l|ud=0,g=0.y
-                let d116 = A::mul_add(
-                    p.ZZ10l,
-                    k92,
-                    A::mul_add(p.YZ10l, k91, p.XZ10l * k90),
-                ); // J10lw10l|ud=0,g=0.z
-                let d117 = A::mul_add(
-                    -p.MZ10l,
-                    k101,
-                    A::mul_add(
-                        -p.MY10l,
-                        k98,
-                        A::mul_add(
-                            k92,
-                            d115,
-                            A::mul_add(
-                                -k91,
-                                d116,
-                                A::mul_add(
-                                    -p.XZ10l,
-                                    k86,
-                                    A::mul_add(p.XY10l, k94, p.XX10l * k93),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l|ud=0,g=0.x
-                let d118 = A::mul_add(
-                    p.MX10l,
-                    k98,
-                    A::mul_add(
-                        p.MZ10l,
-                        k100,
-                        A::mul_add(
-                            k90,
-                            d116,
-                            A::mul_add(
-                                -k92,
-                                d114,
-                                A::mul_add(
-                                    -p.YZ10l,
-                                    k86,
-                                    A::mul_add(p.YY10l, k94, p.XY10l * k93),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l|ud=0,g=0.y
-                let d119 = A::mul_add(
-                    -p.MY10l,
-                    k100,
-                    A::mul_add(
-                        p.MX10l,
-                        k101,
-                        A::mul_add(
-                            k91,
-                            d114,
-                            A::mul_add(
-                                -k90,
-                                d115,
-                                A::mul_add(
-                                    -p.ZZ10l,
-                                    k86,
-                                    A::mul_add(p.YZ10l, k94, p.XZ10l * k93),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l|ud=0,g=0.z
-                m[11] = d119;
-                let k102 = A::mul_add(-s_q1r, k20, c_q1r * k21); // w3 in 4r|ud=0,g=0.x
-                let k103 = A::mul_add(c_q1r, k20, s_q1r * k21); // w3 in 4r|ud=0,g=0.z
-                let k104 = A::mul_add(-k102, qd1r, A::mul_add(c_q1r, k23, s_q1r * k9)); // wd4r|ud=0,g=0.z
-                let k105 = k19 + qd1r; // w4r|ud=0,g=0.y
-                let k106 = A::mul_add(k103, qd1r, A::mul_add(-s_q1r, k23, c_q1r * k9)); // wd4r|ud=0,g=0.x
-                let k107 = t1 + t2; // w3xP4r|ud=0,g=0.z
-                let k108 = A::mul_add(k21, k107, k30 - t3 + t7); // a4r in 3|ud=0,g=0.x
-                let k109 = A::mul_add(k19, k107, k28 + t4 + t8); // a4r in 3|ud=0,g=0.y
-                let k110 = k31 - t5 + t6 - t9 + t10; // a4r in 3|ud=0,g=0.z
-                let k111 = A::mul_add(-c_q1r, k110, s_q1r * k109); // a4r|ud=0,g=0.z
-                let k112 = A::mul_add(s_q1r, k110, c_q1r * k109); // a4r|ud=0,g=0.x
-                let d120 = A::mul_add(p.MX4r, k105, p.MY4r * k102); // w4rxMS4r|ud=0,g=0.z
-                let d121 = A::mul_add(-p.MY4r, k103, p.MZ4r * k105); // w4rxMS4r|ud=0,g=0.x
-                let d122 = A::mul_add(p.MZ4r, k102, p.MX4r * k103); // w4rxMS4r|ud=0,g=0.y
-                let d123 = A::mul_add(
-                    -k105,
-                    d121,
-                    A::mul_add(
-                        -k102,
-                        d122,
-                        A::mul_add(p.MX4r, k22, A::mul_add(-p.MY4r, k106, p.m4r * k111)),
-                    ),
-                ); // F4r|ud=0,g=0.z
-                let d124 = A::mul_add(
-                    k103,
-                    d122,
-                    A::mul_add(
-                        k105,
-                        d120,
-                        A::mul_add(p.MY4r, k104, A::mul_add(p.MZ4r, k22, p.m4r * k112)),
-                    ),
-                ); // F4r|ud=0,g=0.x
-                let d125 = A::mul_add(
-                    k102,
-                    d120,
-                    A::mul_add(
-                        -k103,
-                        d121,
-                        A::mul_add(
-                            -p.MZ4r,
-                            k106,
-                            A::mul_add(-p.MX4r, k104, p.m4r * k108),
-                        ),
-                    ),
-                ); // F4r|ud=0,g=0.y
-                let d126 = A::mul_add(
-                    -p.XZ4r,
-                    k103,
-                    A::mul_add(-p.XY4r, k105, p.XX4r * k102),
-                ); // J4rw4r|ud=0,g=0.x
-                let d127 = A::mul_add(
-                    -p.YZ4r,
-                    k103,
-                    A::mul_add(-p.YY4r, k105, p.XY4r * k102),
-                ); // J4rw4r|ud=0,g=0.y
-                let d128 = A::mul_add(
-                    -p.ZZ4r,
-                    k103,
-                    A::mul_add(-p.YZ4r, k105, p.XZ4r * k102),
-                ); // J4rw4r|ud=0,g=0.z
                 let d129 = A::mul_add(
                     -p.MZ4r,
                     k108,
@@ -10729,7 +11432,7 @@ mod generated {
                             -k103,
                             d127,
                             A::mul_add(
-                                k105,
+                                -k105,
                                 d128,
                                 A::mul_add(
                                     -p.XZ4r,
@@ -10768,7 +11471,7 @@ mod generated {
                         p.MX4r,
                         k108,
                         A::mul_add(
-                            -k105,
+                            k105,
                             d126,
                             A::mul_add(
                                 -k102,
@@ -10782,85 +11485,173 @@ mod generated {
                         ),
                     ),
                 ); // N4r|ud=0,g=0.z
-                let k113 = A::mul_add(s_q2r, k103, c_q2r * k105); // w4r in 5r|ud=0,g=0.y
-                let k114 = A::mul_add(-c_q2r, k103, s_q2r * k105); // w4r in 5r|ud=0,g=0.z
+                let k45 = A::mul_add(-s_q2l, k33, c_q2l * k34); // w4l in 5l|ud=0,g=0.y
+                let k113 = A::mul_add(-s_q2r, k103, c_q2r * k105); // w4r in 5r|ud=0,g=0.y
+                let k49 = A::mul_add(k45, qd2l, A::mul_add(-c_q2l, k35, s_q2l * k22)); // wd5l|ud=0,g=0.z
+                let k46 = A::mul_add(c_q2l, k33, s_q2l * k34); // w4l in 5l|ud=0,g=0.z
+                let k114 = A::mul_add(c_q2r, k103, s_q2r * k105); // w4r in 5r|ud=0,g=0.z
+                let k48 = A::mul_add(-k46, qd2l, A::mul_add(s_q2l, k35, c_q2l * k22)); // wd5l|ud=0,g=0.y
                 let k115 = A::mul_add(
                     -k114,
                     qd2r,
-                    A::mul_add(-s_q2r, k104, c_q2r * k22),
+                    A::mul_add(-c_q2r, k22, s_q2r * k104),
                 ); // wd5r|ud=0,g=0.y
-                let k116 = A::mul_add(k113, qd2r, A::mul_add(c_q2r, k104, s_q2r * k22)); // wd5r|ud=0,g=0.z
+                let k116 = A::mul_add(
+                    -c_q2r,
+                    k104,
+                    A::mul_add(-s_q2r, k22, k113 * qd2r),
+                ); // wd5r|ud=0,g=0.z
+                let k47 = k32 + qd2l; // w5l|ud=0,g=0.x
                 let k117 = k102 + qd2r; // w5r|ud=0,g=0.x
-                let k118 = A::mul_add(-s_q2r, k111, c_q2r * k108); // a5r|ud=0,g=0.y
-                let k119 = A::mul_add(c_q2r, k111, s_q2r * k108); // a5r|ud=0,g=0.z
+                let k118 = A::mul_add(-c_q2r, k108, s_q2r * k111); // a5r|ud=0,g=0.y
+                let k119 = A::mul_add(-c_q2r, k111, -s_q2r * k108); // a5r|ud=0,g=0.z
+                let d48 = A::mul_add(-p.MY5l, k46, p.MZ5l * k45); // w5lxMS5l|ud=0,g=0.x
                 let d132 = A::mul_add(-p.MY5r, k114, p.MZ5r * k113); // w5rxMS5r|ud=0,g=0.x
-                let d133 = A::mul_add(p.MZ5r, k117, p.MX5r * k114); // w5rxMS5r|ud=0,g=0.y
-                let d134 = A::mul_add(p.MX5r, k113, p.MY5r * k117); // w5rxMS5r|ud=0,g=0.z
+                let d49 = A::mul_add(-p.MZ5l, k47, p.MX5l * k46); // w5lxMS5l|ud=0,g=0.y
+                let d133 = A::mul_add(-p.MZ5r, k117, p.MX5r * k114); // w5rxMS5r|ud=0,g=0.y
+                let d50 = A::mul_add(-p.MX5l, k45, p.MY5l * k47); // w5lxMS5l|ud=0,g=0.z
+                let d134 = A::mul_add(-p.MX5r, k113, p.MY5r * k117); // w5rxMS5r|ud=0,g=0.z
+                let d51 = A::mul_add(
+                    -k46,
+                    d49,
+                    A::mul_add(
+                        k45,
+                        d50,
+                        A::mul_add(p.MY5l, k49, A::mul_add(-p.MZ5l, k48, p.m5l * k44)),
+                    ),
+                ); // F5l|ud=0,g=0.x
                 let d135 = A::mul_add(
                     -k114,
                     d133,
                     A::mul_add(
-                        -k113,
+                        k113,
                         d134,
-                        A::mul_add(-p.MY5r, k116, A::mul_add(p.MZ5r, k115, p.m5r * k112)),
+                        A::mul_add(p.MY5r, k116, A::mul_add(-p.MZ5r, k115, p.m5r * k112)),
                     ),
                 ); // F5r|ud=0,g=0.x
+                let d52 = A::mul_add(
+                    k47,
+                    d50,
+                    A::mul_add(
+                        -k46,
+                        d48,
+                        A::mul_add(p.MZ5l, k36, A::mul_add(p.MX5l, k49, p.m5l * k50)),
+                    ),
+                ); // F5l|ud=0,g=0.y
                 let d136 = A::mul_add(
-                    -k117,
+                    k117,
                     d134,
                     A::mul_add(
-                        k114,
+                        -k114,
                         d132,
-                        A::mul_add(-p.MZ5r, k106, A::mul_add(p.MX5r, k116, p.m5r * k118)),
+                        A::mul_add(p.MZ5r, k106, A::mul_add(p.MX5r, k116, p.m5r * k118)),
                     ),
                 ); // F5r|ud=0,g=0.y
+                let d53 = A::mul_add(
+                    k45,
+                    d48,
+                    A::mul_add(
+                        -k47,
+                        d49,
+                        A::mul_add(-p.MX5l, k48, A::mul_add(-p.MY5l, k36, p.m5l * k51)),
+                    ),
+                ); // F5l|ud=0,g=0.z
                 let d137 = A::mul_add(
-                    -k113,
+                    k113,
                     d132,
                     A::mul_add(
                         -k117,
                         d133,
-                        A::mul_add(-p.MX5r, k115, A::mul_add(p.MY5r, k106, p.m5r * k119)),
+                        A::mul_add(
+                            -p.MX5r,
+                            k115,
+                            A::mul_add(-p.MY5r, k106, p.m5r * k119),
+                        ),
                     ),
                 ); // F5r|ud=0,g=0.z
+                let d54 = A::mul_add(p.XZ5l, k46, A::mul_add(p.XY5l, k45, p.XX5l * k47)); // J5lw5l|ud=0,g=0.x
                 let d138 = A::mul_add(
-                    -p.XZ5r,
+                    p.XZ5r,
                     k114,
-                    A::mul_add(-p.XY5r, k113, p.XX5r * k117),
+                    A::mul_add(p.XY5r, k113, p.XX5r * k117),
                 ); // J5rw5r|ud=0,g=0.x
+                let d55 = A::mul_add(p.YZ5l, k46, A::mul_add(p.YY5l, k45, p.XY5l * k47)); // J5lw5l|ud=0,g=0.y
                 let d139 = A::mul_add(
-                    -p.YZ5r,
+                    p.YZ5r,
                     k114,
-                    A::mul_add(-p.YY5r, k113, p.XY5r * k117),
+                    A::mul_add(p.YY5r, k113, p.XY5r * k117),
                 ); // J5rw5r|ud=0,g=0.y
+                let d56 = A::mul_add(p.ZZ5l, k46, A::mul_add(p.YZ5l, k45, p.XZ5l * k47)); // J5lw5l|ud=0,g=0.z
                 let d140 = A::mul_add(
-                    -p.ZZ5r,
+                    p.ZZ5r,
                     k114,
-                    A::mul_add(-p.YZ5r, k113, p.XZ5r * k117),
+                    A::mul_add(p.YZ5r, k113, p.XZ5r * k117),
                 ); // J5rw5r|ud=0,g=0.z
+                let d57 = A::mul_add(
+                    p.MZ5l,
+                    k50,
+                    A::mul_add(
+                        -p.MY5l,
+                        k51,
+                        A::mul_add(
+                            -k46,
+                            d55,
+                            A::mul_add(
+                                k45,
+                                d56,
+                                A::mul_add(
+                                    -p.XZ5l,
+                                    k49,
+                                    A::mul_add(-p.XY5l, k48, p.XX5l * k36),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N5l|ud=0,g=0.x
                 let d141 = A::mul_add(
-                    -p.MZ5r,
+                    p.MZ5r,
                     k118,
                     A::mul_add(
-                        p.MY5r,
+                        -p.MY5r,
                         k119,
                         A::mul_add(
-                            k114,
+                            -k114,
                             d139,
                             A::mul_add(
-                                -k113,
+                                k113,
                                 d140,
                                 A::mul_add(
-                                    p.XZ5r,
+                                    -p.XZ5r,
                                     k116,
-                                    A::mul_add(p.XY5r, k115, p.XX5r * k106),
+                                    A::mul_add(-p.XY5r, k115, p.XX5r * k106),
                                 ),
                             ),
                         ),
                     ),
                 ); // N5r|ud=0,g=0.x
+                let d58 = A::mul_add(
+                    p.MX5l,
+                    k51,
+                    A::mul_add(
+                        p.MZ5l,
+                        k44,
+                        A::mul_add(
+                            -k47,
+                            d56,
+                            A::mul_add(
+                                k46,
+                                d54,
+                                A::mul_add(
+                                    -p.YZ5l,
+                                    k49,
+                                    A::mul_add(-p.YY5l, k48, p.XY5l * k36),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N5l|ud=0,g=0.y
                 let d142 = A::mul_add(
-                    -p.MX5r,
+                    p.MX5r,
                     k119,
                     A::mul_add(
                         p.MZ5r,
@@ -10869,109 +11660,204 @@ mod generated {
                             -k117,
                             d140,
                             A::mul_add(
-                                -k114,
+                                k114,
                                 d138,
                                 A::mul_add(
-                                    p.YZ5r,
+                                    -p.YZ5r,
                                     k116,
-                                    A::mul_add(p.YY5r, k115, p.XY5r * k106),
+                                    A::mul_add(-p.YY5r, k115, p.XY5r * k106),
                                 ),
                             ),
                         ),
                     ),
                 ); // N5r|ud=0,g=0.y
+                let d59 = A::mul_add(
+                    -p.MY5l,
+                    k44,
+                    A::mul_add(
+                        -p.MX5l,
+                        k50,
+                        A::mul_add(
+                            -k45,
+                            d54,
+                            A::mul_add(
+                                k47,
+                                d55,
+                                A::mul_add(
+                                    -p.ZZ5l,
+                                    k49,
+                                    A::mul_add(-p.YZ5l, k48, p.XZ5l * k36),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N5l|ud=0,g=0.z
                 let d143 = A::mul_add(
                     -p.MY5r,
                     k112,
                     A::mul_add(
-                        p.MX5r,
+                        -p.MX5r,
                         k118,
                         A::mul_add(
-                            k113,
+                            -k113,
                             d138,
                             A::mul_add(
                                 k117,
                                 d139,
                                 A::mul_add(
-                                    p.ZZ5r,
+                                    -p.ZZ5r,
                                     k116,
-                                    A::mul_add(p.YZ5r, k115, p.XZ5r * k106),
+                                    A::mul_add(-p.YZ5r, k115, p.XZ5r * k106),
                                 ),
                             ),
                         ),
                     ),
                 ); // N5r|ud=0,g=0.z
-                let k120 = A::mul_add(s_q3r, k114, c_q3r * k117); // w5r in 6r|ud=0,g=0.x
-                let k121 = A::mul_add(-c_q3r, k114, s_q3r * k117); // w5r in 6r|ud=0,g=0.z
+                let k52 = A::mul_add(-s_q3l, k46, c_q3l * k47); // w5l in 6l|ud=0,g=0.x
+                let k120 = A::mul_add(-s_q3r, k114, c_q3r * k117); // w5r in 6r|ud=0,g=0.x
+                let k53 = A::mul_add(c_q3l, k46, s_q3l * k47); // w5l in 6l|ud=0,g=0.z
+                let k121 = A::mul_add(c_q3r, k114, s_q3r * k117); // w5r in 6r|ud=0,g=0.z
+                let k55 = A::mul_add(-k52, qd3l, A::mul_add(-c_q3l, k49, s_q3l * k36)); // wd6l|ud=0,g=0.z
                 let k122 = A::mul_add(
                     -k120,
                     qd3r,
-                    A::mul_add(c_q3r, k116, s_q3r * k106),
+                    A::mul_add(-c_q3r, k116, s_q3r * k106),
                 ); // wd6r|ud=0,g=0.z
-                let k123 = k113 + qd3r; // w6r|ud=0,g=0.y
-                let k124 = A::mul_add(
-                    k121,
-                    qd3r,
-                    A::mul_add(-s_q3r, k116, c_q3r * k106),
-                ); // wd6r|ud=0,g=0.x
+                let k54 = k45 - qd3l; // w6l|ud=0,g=0.y
+                let k123 = k113 - qd3r; // w6r|ud=0,g=0.y
+                let k56 = A::mul_add(k53, qd3l, A::mul_add(s_q3l, k49, c_q3l * k36)); // wd6l|ud=0,g=0.x
+                let k124 = A::mul_add(k121, qd3r, A::mul_add(s_q3r, k116, c_q3r * k106)); // wd6r|ud=0,g=0.x
+                let k57 = p.L7 * k46; // w5lxP6l|ud=0,g=0.x
                 let k125 = p.L7 * k114; // w5rxP6r|ud=0,g=0.x
+                let k58 = p.L7 * k47; // w5lxP6l|ud=0,g=0.z
                 let k126 = p.L7 * k117; // w5rxP6r|ud=0,g=0.z
-                let k127 = A::mul_add(k113, k126, A::mul_add(p.L7, k116, k112)); // a6r in 5r|ud=0,g=0.x
-                let k128 = A::mul_add(k117, k126, A::mul_add(k114, k125, k118)); // a6r in 5r|ud=0,g=0.y
-                let k129 = A::mul_add(-k113, k125, A::mul_add(-p.L7, k106, k119)); // a6r in 5r|ud=0,g=0.z
-                let k130 = A::mul_add(c_q3r, k129, s_q3r * k127); // a6r|ud=0,g=0.z
-                let k131 = A::mul_add(-s_q3r, k129, c_q3r * k127); // a6r|ud=0,g=0.x
-                let d144 = A::mul_add(p.MX6r, k123, p.MY6r * k120); // w6rxMS6r|ud=0,g=0.z
-                let d145 = A::mul_add(-p.MY6r, k121, p.MZ6r * k123); // w6rxMS6r|ud=0,g=0.x
+                let k59 = A::mul_add(-k45, k58, A::mul_add(-p.L7, k49, k44)); // a6l in 5l|ud=0,g=0.x
+                let k127 = A::mul_add(-k113, k126, A::mul_add(-p.L7, k116, k112)); // a6r in 5r|ud=0,g=0.x
+                let k60 = A::mul_add(-k47, k58, A::mul_add(-k46, k57, k50)); // a6l in 5l|ud=0,g=0.y
+                let k128 = A::mul_add(-k117, k126, A::mul_add(-k114, k125, k118)); // a6r in 5r|ud=0,g=0.y
+                let k61 = A::mul_add(k45, k57, A::mul_add(p.L7, k36, k51)); // a6l in 5l|ud=0,g=0.z
+                let k129 = A::mul_add(k113, k125, A::mul_add(p.L7, k106, k119)); // a6r in 5r|ud=0,g=0.z
+                let k62 = A::mul_add(-c_q3l, k61, s_q3l * k59); // a6l|ud=0,g=0.z
+                let k130 = A::mul_add(-c_q3r, k129, s_q3r * k127); // a6r|ud=0,g=0.z
+                let k63 = A::mul_add(s_q3l, k61, c_q3l * k59); // a6l|ud=0,g=0.x
+                let k131 = A::mul_add(s_q3r, k129, c_q3r * k127); // a6r|ud=0,g=0.x
+                let d61 = A::mul_add(-p.MX6l, k54, p.MY6l * k52); // w6lxMS6l|ud=0,g=0.z
+                let d144 = A::mul_add(-p.MX6r, k123, p.MY6r * k120); // w6rxMS6r|ud=0,g=0.z
+                let d60 = A::mul_add(p.MY6l, k53, p.MZ6l * k54); // w6lxMS6l|ud=0,g=0.x
+                let d145 = A::mul_add(p.MY6r, k121, p.MZ6r * k123); // w6rxMS6r|ud=0,g=0.x
+                let d62 = A::mul_add(p.MZ6l, k52, p.MX6l * k53); // w6lxMS6l|ud=0,g=0.y
                 let d146 = A::mul_add(p.MZ6r, k120, p.MX6r * k121); // w6rxMS6r|ud=0,g=0.y
+                let d64 = A::mul_add(
+                    -k54,
+                    d60,
+                    A::mul_add(
+                        -k52,
+                        d62,
+                        A::mul_add(-p.MX6l, k48, A::mul_add(-p.MY6l, k56, p.m6l * k62)),
+                    ),
+                ); // F6l|ud=0,g=0.z
                 let d147 = A::mul_add(
                     -k123,
                     d145,
                     A::mul_add(
                         -k120,
                         d146,
-                        A::mul_add(p.MX6r, k115, A::mul_add(-p.MY6r, k124, p.m6r * k130)),
+                        A::mul_add(
+                            -p.MX6r,
+                            k115,
+                            A::mul_add(-p.MY6r, k124, p.m6r * k130),
+                        ),
                     ),
                 ); // F6r|ud=0,g=0.z
+                let d65 = A::mul_add(
+                    k53,
+                    d62,
+                    A::mul_add(
+                        -k54,
+                        d61,
+                        A::mul_add(p.MY6l, k55, A::mul_add(-p.MZ6l, k48, p.m6l * k63)),
+                    ),
+                ); // F6l|ud=0,g=0.x
                 let d148 = A::mul_add(
                     k121,
                     d146,
                     A::mul_add(
-                        k123,
+                        -k123,
                         d144,
-                        A::mul_add(p.MY6r, k122, A::mul_add(p.MZ6r, k115, p.m6r * k131)),
+                        A::mul_add(p.MY6r, k122, A::mul_add(-p.MZ6r, k115, p.m6r * k131)),
                     ),
                 ); // F6r|ud=0,g=0.x
+                let d63 = A::mul_add(
+                    -k52,
+                    d61,
+                    A::mul_add(
+                        -k53,
+                        d60,
+                        A::mul_add(p.MZ6l, k56, A::mul_add(p.MX6l, k55, p.m6l * k60)),
+                    ),
+                ); // F6l|ud=0,g=0.y
                 let d149 = A::mul_add(
-                    k120,
+                    -k120,
                     d144,
                     A::mul_add(
                         -k121,
                         d145,
-                        A::mul_add(
-                            -p.MZ6r,
-                            k124,
-                            A::mul_add(-p.MX6r, k122, p.m6r * k128),
-                        ),
+                        A::mul_add(p.MZ6r, k124, A::mul_add(p.MX6r, k122, p.m6r * k128)),
                     ),
                 ); // F6r|ud=0,g=0.y
+                let d66 = A::mul_add(
+                    -p.XZ6l,
+                    k53,
+                    A::mul_add(p.XY6l, k54, p.XX6l * k52),
+                ); // J6lw6l|ud=0,g=0.x
                 let d150 = A::mul_add(
                     -p.XZ6r,
                     k121,
-                    A::mul_add(-p.XY6r, k123, p.XX6r * k120),
+                    A::mul_add(p.XY6r, k123, p.XX6r * k120),
                 ); // J6rw6r|ud=0,g=0.x
+                let d67 = A::mul_add(
+                    -p.YZ6l,
+                    k53,
+                    A::mul_add(p.YY6l, k54, p.XY6l * k52),
+                ); // J6lw6l|ud=0,g=0.y
                 let d151 = A::mul_add(
                     -p.YZ6r,
                     k121,
-                    A::mul_add(-p.YY6r, k123, p.XY6r * k120),
+                    A::mul_add(p.YY6r, k123, p.XY6r * k120),
                 ); // J6rw6r|ud=0,g=0.y
+                let d68 = A::mul_add(
+                    -p.ZZ6l,
+                    k53,
+                    A::mul_add(p.YZ6l, k54, p.XZ6l * k52),
+                ); // J6lw6l|ud=0,g=0.z
                 let d152 = A::mul_add(
                     -p.ZZ6r,
                     k121,
-                    A::mul_add(-p.YZ6r, k123, p.XZ6r * k120),
+                    A::mul_add(p.YZ6r, k123, p.XZ6r * k120),
                 ); // J6rw6r|ud=0,g=0.z
+                let d69 = A::mul_add(
+                    p.MZ6l,
+                    k60,
+                    A::mul_add(
+                        -p.MY6l,
+                        k62,
+                        A::mul_add(
+                            -k53,
+                            d67,
+                            A::mul_add(
+                                -k54,
+                                d68,
+                                A::mul_add(
+                                    -p.XZ6l,
+                                    k55,
+                                    A::mul_add(-p.XY6l, k48, p.XX6l * k56),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N6l|ud=0,g=0.x
                 let d153 = A::mul_add(
-                    -p.MZ6r,
+                    p.MZ6r,
                     k128,
                     A::mul_add(
                         -p.MY6r,
@@ -10980,17 +11866,38 @@ mod generated {
                             -k121,
                             d151,
                             A::mul_add(
-                                k123,
+                                -k123,
                                 d152,
                                 A::mul_add(
                                     -p.XZ6r,
                                     k122,
-                                    A::mul_add(p.XY6r, k115, p.XX6r * k124),
+                                    A::mul_add(-p.XY6r, k115, p.XX6r * k124),
                                 ),
                             ),
                         ),
                     ),
                 ); // N6r|ud=0,g=0.x
+                let d70 = A::mul_add(
+                    p.MX6l,
+                    k62,
+                    A::mul_add(
+                        p.MZ6l,
+                        k63,
+                        A::mul_add(
+                            k52,
+                            d68,
+                            A::mul_add(
+                                k53,
+                                d66,
+                                A::mul_add(
+                                    -p.YZ6l,
+                                    k55,
+                                    A::mul_add(-p.YY6l, k48, p.XY6l * k56),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N6l|ud=0,g=0.y
                 let d154 = A::mul_add(
                     p.MX6r,
                     k130,
@@ -11006,20 +11913,41 @@ mod generated {
                                 A::mul_add(
                                     -p.YZ6r,
                                     k122,
-                                    A::mul_add(p.YY6r, k115, p.XY6r * k124),
+                                    A::mul_add(-p.YY6r, k115, p.XY6r * k124),
                                 ),
                             ),
                         ),
                     ),
                 ); // N6r|ud=0,g=0.y
+                let d71 = A::mul_add(
+                    -p.MY6l,
+                    k63,
+                    A::mul_add(
+                        -p.MX6l,
+                        k60,
+                        A::mul_add(
+                            k54,
+                            d66,
+                            A::mul_add(
+                                -k52,
+                                d67,
+                                A::mul_add(
+                                    -p.ZZ6l,
+                                    k55,
+                                    A::mul_add(-p.YZ6l, k48, p.XZ6l * k56),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N6l|ud=0,g=0.z
                 let d155 = A::mul_add(
                     -p.MY6r,
                     k131,
                     A::mul_add(
-                        p.MX6r,
+                        -p.MX6r,
                         k128,
                         A::mul_add(
-                            -k123,
+                            k123,
                             d150,
                             A::mul_add(
                                 -k120,
@@ -11027,91 +11955,181 @@ mod generated {
                                 A::mul_add(
                                     -p.ZZ6r,
                                     k122,
-                                    A::mul_add(p.YZ6r, k115, p.XZ6r * k124),
+                                    A::mul_add(-p.YZ6r, k115, p.XZ6r * k124),
                                 ),
                             ),
                         ),
                     ),
                 ); // N6r|ud=0,g=0.z
-                let k132 = A::mul_add(s_q4r, k121, c_q4r * k123); // w6r in 7r|ud=0,g=0.y
-                let k133 = A::mul_add(-c_q4r, k121, s_q4r * k123); // w6r in 7r|ud=0,g=0.z
+                let k64 = A::mul_add(-s_q4l, k53, c_q4l * k54); // w6l in 7l|ud=0,g=0.y
+                let k132 = A::mul_add(-s_q4r, k121, c_q4r * k123); // w6r in 7r|ud=0,g=0.y
+                let k65 = A::mul_add(c_q4l, k53, s_q4l * k54); // w6l in 7l|ud=0,g=0.z
+                let k133 = A::mul_add(c_q4r, k121, s_q4r * k123); // w6r in 7r|ud=0,g=0.z
+                let k67 = A::mul_add(-k65, qd4l, A::mul_add(s_q4l, k55, c_q4l * k48)); // wd7l|ud=0,g=0.y
                 let k134 = A::mul_add(
                     -k133,
                     qd4r,
-                    A::mul_add(-s_q4r, k122, c_q4r * k115),
+                    A::mul_add(s_q4r, k122, c_q4r * k115),
                 ); // wd7r|ud=0,g=0.y
-                let k135 = A::mul_add(k132, qd4r, A::mul_add(c_q4r, k122, s_q4r * k115)); // wd7r|ud=0,g=0.z
+                let k68 = A::mul_add(k64, qd4l, A::mul_add(-c_q4l, k55, s_q4l * k48)); // wd7l|ud=0,g=0.z
+                let k135 = A::mul_add(
+                    k132,
+                    qd4r,
+                    A::mul_add(-c_q4r, k122, s_q4r * k115),
+                ); // wd7r|ud=0,g=0.z
+                let k66 = k52 + qd4l; // w7l|ud=0,g=0.x
                 let k136 = k120 + qd4r; // w7r|ud=0,g=0.x
-                let k137 = A::mul_add(-s_q4r, k130, c_q4r * k128); // a7r|ud=0,g=0.y
-                let k138 = A::mul_add(c_q4r, k130, s_q4r * k128); // a7r|ud=0,g=0.z
+                let k69 = A::mul_add(s_q4l, k62, c_q4l * k60); // a7l|ud=0,g=0.y
+                let k137 = A::mul_add(s_q4r, k130, c_q4r * k128); // a7r|ud=0,g=0.y
+                let k70 = A::mul_add(-c_q4l, k62, s_q4l * k60); // a7l|ud=0,g=0.z
+                let k138 = A::mul_add(-c_q4r, k130, s_q4r * k128); // a7r|ud=0,g=0.z
+                let d72 = A::mul_add(-p.MY7l, k65, p.MZ7l * k64); // w7lxMS7l|ud=0,g=0.x
                 let d156 = A::mul_add(-p.MY7r, k133, p.MZ7r * k132); // w7rxMS7r|ud=0,g=0.x
-                let d157 = A::mul_add(p.MZ7r, k136, p.MX7r * k133); // w7rxMS7r|ud=0,g=0.y
-                let d158 = A::mul_add(p.MX7r, k132, p.MY7r * k136); // w7rxMS7r|ud=0,g=0.z
+                let d73 = A::mul_add(-p.MZ7l, k66, p.MX7l * k65); // w7lxMS7l|ud=0,g=0.y
+                let d157 = A::mul_add(-p.MZ7r, k136, p.MX7r * k133); // w7rxMS7r|ud=0,g=0.y
+                let d74 = A::mul_add(-p.MX7l, k64, p.MY7l * k66); // w7lxMS7l|ud=0,g=0.z
+                let d158 = A::mul_add(-p.MX7r, k132, p.MY7r * k136); // w7rxMS7r|ud=0,g=0.z
+                let d75 = A::mul_add(
+                    -k65,
+                    d73,
+                    A::mul_add(
+                        k64,
+                        d74,
+                        A::mul_add(p.MY7l, k68, A::mul_add(-p.MZ7l, k67, p.m7l * k63)),
+                    ),
+                ); // F7l|ud=0,g=0.x
                 let d159 = A::mul_add(
                     -k133,
                     d157,
                     A::mul_add(
-                        -k132,
+                        k132,
                         d158,
-                        A::mul_add(-p.MY7r, k135, A::mul_add(p.MZ7r, k134, p.m7r * k131)),
+                        A::mul_add(p.MY7r, k135, A::mul_add(-p.MZ7r, k134, p.m7r * k131)),
                     ),
                 ); // F7r|ud=0,g=0.x
+                let d76 = A::mul_add(
+                    k66,
+                    d74,
+                    A::mul_add(
+                        -k65,
+                        d72,
+                        A::mul_add(p.MZ7l, k56, A::mul_add(p.MX7l, k68, p.m7l * k69)),
+                    ),
+                ); // F7l|ud=0,g=0.y
                 let d160 = A::mul_add(
-                    -k136,
+                    k136,
                     d158,
                     A::mul_add(
-                        k133,
+                        -k133,
                         d156,
-                        A::mul_add(-p.MZ7r, k124, A::mul_add(p.MX7r, k135, p.m7r * k137)),
+                        A::mul_add(p.MZ7r, k124, A::mul_add(p.MX7r, k135, p.m7r * k137)),
                     ),
                 ); // F7r|ud=0,g=0.y
+                let d77 = A::mul_add(
+                    k64,
+                    d72,
+                    A::mul_add(
+                        -k66,
+                        d73,
+                        A::mul_add(-p.MX7l, k67, A::mul_add(-p.MY7l, k56, p.m7l * k70)),
+                    ),
+                ); // F7l|ud=0,g=0.z
                 let d161 = A::mul_add(
-                    -k132,
+                    k132,
                     d156,
                     A::mul_add(
                         -k136,
                         d157,
-                        A::mul_add(-p.MX7r, k134, A::mul_add(p.MY7r, k124, p.m7r * k138)),
+                        A::mul_add(
+                            -p.MX7r,
+                            k134,
+                            A::mul_add(-p.MY7r, k124, p.m7r * k138),
+                        ),
                     ),
                 ); // F7r|ud=0,g=0.z
+                let d78 = A::mul_add(p.XZ7l, k65, A::mul_add(p.XY7l, k64, p.XX7l * k66)); // J7lw7l|ud=0,g=0.x
                 let d162 = A::mul_add(
-                    -p.XZ7r,
+                    p.XZ7r,
                     k133,
-                    A::mul_add(-p.XY7r, k132, p.XX7r * k136),
+                    A::mul_add(p.XY7r, k132, p.XX7r * k136),
                 ); // J7rw7r|ud=0,g=0.x
+                let d79 = A::mul_add(p.YZ7l, k65, A::mul_add(p.YY7l, k64, p.XY7l * k66)); // J7lw7l|ud=0,g=0.y
                 let d163 = A::mul_add(
-                    -p.YZ7r,
+                    p.YZ7r,
                     k133,
-                    A::mul_add(-p.YY7r, k132, p.XY7r * k136),
+                    A::mul_add(p.YY7r, k132, p.XY7r * k136),
                 ); // J7rw7r|ud=0,g=0.y
+                let d80 = A::mul_add(p.ZZ7l, k65, A::mul_add(p.YZ7l, k64, p.XZ7l * k66)); // J7lw7l|ud=0,g=0.z
                 let d164 = A::mul_add(
-                    -p.ZZ7r,
+                    p.ZZ7r,
                     k133,
-                    A::mul_add(-p.YZ7r, k132, p.XZ7r * k136),
+                    A::mul_add(p.YZ7r, k132, p.XZ7r * k136),
                 ); // J7rw7r|ud=0,g=0.z
+                let d81 = A::mul_add(
+                    p.MZ7l,
+                    k69,
+                    A::mul_add(
+                        -p.MY7l,
+                        k70,
+                        A::mul_add(
+                            -k65,
+                            d79,
+                            A::mul_add(
+                                k64,
+                                d80,
+                                A::mul_add(
+                                    -p.XZ7l,
+                                    k68,
+                                    A::mul_add(-p.XY7l, k67, p.XX7l * k56),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N7l|ud=0,g=0.x
                 let d165 = A::mul_add(
-                    -p.MZ7r,
+                    p.MZ7r,
                     k137,
                     A::mul_add(
-                        p.MY7r,
+                        -p.MY7r,
                         k138,
                         A::mul_add(
-                            k133,
+                            -k133,
                             d163,
                             A::mul_add(
-                                -k132,
+                                k132,
                                 d164,
                                 A::mul_add(
-                                    p.XZ7r,
+                                    -p.XZ7r,
                                     k135,
-                                    A::mul_add(p.XY7r, k134, p.XX7r * k124),
+                                    A::mul_add(-p.XY7r, k134, p.XX7r * k124),
                                 ),
                             ),
                         ),
                     ),
                 ); // N7r|ud=0,g=0.x
+                let d82 = A::mul_add(
+                    p.MX7l,
+                    k70,
+                    A::mul_add(
+                        p.MZ7l,
+                        k63,
+                        A::mul_add(
+                            -k66,
+                            d80,
+                            A::mul_add(
+                                k65,
+                                d78,
+                                A::mul_add(
+                                    -p.YZ7l,
+                                    k68,
+                                    A::mul_add(-p.YY7l, k67, p.XY7l * k56),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N7l|ud=0,g=0.y
                 let d166 = A::mul_add(
-                    -p.MX7r,
+                    p.MX7r,
                     k138,
                     A::mul_add(
                         p.MZ7r,
@@ -11120,109 +12138,204 @@ mod generated {
                             -k136,
                             d164,
                             A::mul_add(
-                                -k133,
+                                k133,
                                 d162,
                                 A::mul_add(
-                                    p.YZ7r,
+                                    -p.YZ7r,
                                     k135,
-                                    A::mul_add(p.YY7r, k134, p.XY7r * k124),
+                                    A::mul_add(-p.YY7r, k134, p.XY7r * k124),
                                 ),
                             ),
                         ),
                     ),
                 ); // N7r|ud=0,g=0.y
+                let d83 = A::mul_add(
+                    -p.MY7l,
+                    k63,
+                    A::mul_add(
+                        -p.MX7l,
+                        k69,
+                        A::mul_add(
+                            -k64,
+                            d78,
+                            A::mul_add(
+                                k66,
+                                d79,
+                                A::mul_add(
+                                    -p.ZZ7l,
+                                    k68,
+                                    A::mul_add(-p.YZ7l, k67, p.XZ7l * k56),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N7l|ud=0,g=0.z
                 let d167 = A::mul_add(
                     -p.MY7r,
                     k131,
                     A::mul_add(
-                        p.MX7r,
+                        -p.MX7r,
                         k137,
                         A::mul_add(
-                            k132,
+                            -k132,
                             d162,
                             A::mul_add(
                                 k136,
                                 d163,
                                 A::mul_add(
-                                    p.ZZ7r,
+                                    -p.ZZ7r,
                                     k135,
-                                    A::mul_add(p.YZ7r, k134, p.XZ7r * k124),
+                                    A::mul_add(-p.YZ7r, k134, p.XZ7r * k124),
                                 ),
                             ),
                         ),
                     ),
                 ); // N7r|ud=0,g=0.z
-                let k139 = A::mul_add(s_q5r, k133, c_q5r * k136); // w7r in 8r|ud=0,g=0.x
-                let k140 = A::mul_add(-c_q5r, k133, s_q5r * k136); // w7r in 8r|ud=0,g=0.z
+                let k71 = A::mul_add(-s_q5l, k65, c_q5l * k66); // w7l in 8l|ud=0,g=0.x
+                let k139 = A::mul_add(-s_q5r, k133, c_q5r * k136); // w7r in 8r|ud=0,g=0.x
+                let k72 = A::mul_add(c_q5l, k65, s_q5l * k66); // w7l in 8l|ud=0,g=0.z
+                let k140 = A::mul_add(c_q5r, k133, s_q5r * k136); // w7r in 8r|ud=0,g=0.z
+                let k74 = A::mul_add(-k71, qd5l, A::mul_add(-c_q5l, k68, s_q5l * k56)); // wd8l|ud=0,g=0.z
                 let k141 = A::mul_add(
                     -k139,
                     qd5r,
-                    A::mul_add(c_q5r, k135, s_q5r * k124),
+                    A::mul_add(-c_q5r, k135, s_q5r * k124),
                 ); // wd8r|ud=0,g=0.z
-                let k142 = k132 + qd5r; // w8r|ud=0,g=0.y
-                let k143 = A::mul_add(
-                    k140,
-                    qd5r,
-                    A::mul_add(-s_q5r, k135, c_q5r * k124),
-                ); // wd8r|ud=0,g=0.x
+                let k73 = k64 - qd5l; // w8l|ud=0,g=0.y
+                let k142 = k132 - qd5r; // w8r|ud=0,g=0.y
+                let k75 = A::mul_add(k72, qd5l, A::mul_add(s_q5l, k68, c_q5l * k56)); // wd8l|ud=0,g=0.x
+                let k143 = A::mul_add(k140, qd5r, A::mul_add(s_q5r, k135, c_q5r * k124)); // wd8r|ud=0,g=0.x
+                let k76 = p.L8 * k65; // w7lxP8l|ud=0,g=0.x
                 let k144 = p.L8 * k133; // w7rxP8r|ud=0,g=0.x
+                let k77 = p.L8 * k66; // w7lxP8l|ud=0,g=0.z
                 let k145 = p.L8 * k136; // w7rxP8r|ud=0,g=0.z
-                let k146 = A::mul_add(k132, k145, A::mul_add(p.L8, k135, k131)); // a8r in 7r|ud=0,g=0.x
-                let k147 = A::mul_add(k136, k145, A::mul_add(k133, k144, k137)); // a8r in 7r|ud=0,g=0.y
-                let k148 = A::mul_add(-k132, k144, A::mul_add(-p.L8, k124, k138)); // a8r in 7r|ud=0,g=0.z
-                let k149 = A::mul_add(c_q5r, k148, s_q5r * k146); // a8r|ud=0,g=0.z
-                let k150 = A::mul_add(-s_q5r, k148, c_q5r * k146); // a8r|ud=0,g=0.x
-                let d168 = A::mul_add(p.MX8r, k142, p.MY8r * k139); // w8rxMS8r|ud=0,g=0.z
-                let d169 = A::mul_add(-p.MY8r, k140, p.MZ8r * k142); // w8rxMS8r|ud=0,g=0.x
+                let k78 = A::mul_add(-k64, k77, A::mul_add(-p.L8, k68, k63)); // a8l in 7l|ud=0,g=0.x
+                let k146 = A::mul_add(-k132, k145, A::mul_add(-p.L8, k135, k131)); // a8r in 7r|ud=0,g=0.x
+                let k79 = A::mul_add(-k66, k77, A::mul_add(-k65, k76, k69)); // a8l in 7l|ud=0,g=0.y
+                let k147 = A::mul_add(-k136, k145, A::mul_add(-k133, k144, k137)); // a8r in 7r|ud=0,g=0.y
+                let k80 = A::mul_add(k64, k76, A::mul_add(p.L8, k56, k70)); // a8l in 7l|ud=0,g=0.z
+                let k148 = A::mul_add(k132, k144, A::mul_add(p.L8, k124, k138)); // a8r in 7r|ud=0,g=0.z
+                let k81 = A::mul_add(-c_q5l, k80, s_q5l * k78); // a8l|ud=0,g=0.z
+                let k149 = A::mul_add(-c_q5r, k148, s_q5r * k146); // a8r|ud=0,g=0.z
+                let k82 = A::mul_add(s_q5l, k80, c_q5l * k78); // a8l|ud=0,g=0.x
+                let k150 = A::mul_add(s_q5r, k148, c_q5r * k146); // a8r|ud=0,g=0.x
+                let d85 = A::mul_add(-p.MX8l, k73, p.MY8l * k71); // w8lxMS8l|ud=0,g=0.z
+                let d168 = A::mul_add(-p.MX8r, k142, p.MY8r * k139); // w8rxMS8r|ud=0,g=0.z
+                let d84 = A::mul_add(p.MY8l, k72, p.MZ8l * k73); // w8lxMS8l|ud=0,g=0.x
+                let d169 = A::mul_add(p.MY8r, k140, p.MZ8r * k142); // w8rxMS8r|ud=0,g=0.x
+                let d86 = A::mul_add(p.MZ8l, k71, p.MX8l * k72); // w8lxMS8l|ud=0,g=0.y
                 let d170 = A::mul_add(p.MZ8r, k139, p.MX8r * k140); // w8rxMS8r|ud=0,g=0.y
+                let d88 = A::mul_add(
+                    -k73,
+                    d84,
+                    A::mul_add(
+                        -k71,
+                        d86,
+                        A::mul_add(-p.MX8l, k67, A::mul_add(-p.MY8l, k75, p.m8l * k81)),
+                    ),
+                ); // F8l|ud=0,g=0.z
                 let d171 = A::mul_add(
                     -k142,
                     d169,
                     A::mul_add(
                         -k139,
                         d170,
-                        A::mul_add(p.MX8r, k134, A::mul_add(-p.MY8r, k143, p.m8r * k149)),
+                        A::mul_add(
+                            -p.MX8r,
+                            k134,
+                            A::mul_add(-p.MY8r, k143, p.m8r * k149),
+                        ),
                     ),
                 ); // F8r|ud=0,g=0.z
+                let d89 = A::mul_add(
+                    k72,
+                    d86,
+                    A::mul_add(
+                        -k73,
+                        d85,
+                        A::mul_add(p.MY8l, k74, A::mul_add(-p.MZ8l, k67, p.m8l * k82)),
+                    ),
+                ); // F8l|ud=0,g=0.x
                 let d172 = A::mul_add(
                     k140,
                     d170,
                     A::mul_add(
-                        k142,
+                        -k142,
                         d168,
-                        A::mul_add(p.MY8r, k141, A::mul_add(p.MZ8r, k134, p.m8r * k150)),
+                        A::mul_add(p.MY8r, k141, A::mul_add(-p.MZ8r, k134, p.m8r * k150)),
                     ),
                 ); // F8r|ud=0,g=0.x
+                let d87 = A::mul_add(
+                    -k71,
+                    d85,
+                    A::mul_add(
+                        -k72,
+                        d84,
+                        A::mul_add(p.MZ8l, k75, A::mul_add(p.MX8l, k74, p.m8l * k79)),
+                    ),
+                ); // F8l|ud=0,g=0.y
                 let d173 = A::mul_add(
-                    k139,
+                    -k139,
                     d168,
                     A::mul_add(
                         -k140,
                         d169,
-                        A::mul_add(
-                            -p.MZ8r,
-                            k143,
-                            A::mul_add(-p.MX8r, k141, p.m8r * k147),
-                        ),
+                        A::mul_add(p.MZ8r, k143, A::mul_add(p.MX8r, k141, p.m8r * k147)),
                     ),
                 ); // F8r|ud=0,g=0.y
+                let d90 = A::mul_add(
+                    -p.XZ8l,
+                    k72,
+                    A::mul_add(p.XY8l, k73, p.XX8l * k71),
+                ); // J8lw8l|ud=0,g=0.x
                 let d174 = A::mul_add(
                     -p.XZ8r,
                     k140,
-                    A::mul_add(-p.XY8r, k142, p.XX8r * k139),
+                    A::mul_add(p.XY8r, k142, p.XX8r * k139),
                 ); // J8rw8r|ud=0,g=0.x
+                let d91 = A::mul_add(
+                    -p.YZ8l,
+                    k72,
+                    A::mul_add(p.YY8l, k73, p.XY8l * k71),
+                ); // J8lw8l|ud=0,g=0.y
                 let d175 = A::mul_add(
                     -p.YZ8r,
                     k140,
-                    A::mul_add(-p.YY8r, k142, p.XY8r * k139),
+                    A::mul_add(p.YY8r, k142, p.XY8r * k139),
                 ); // J8rw8r|ud=0,g=0.y
+                let d92 = A::mul_add(
+                    -p.ZZ8l,
+                    k72,
+                    A::mul_add(p.YZ8l, k73, p.XZ8l * k71),
+                ); // J8lw8l|ud=0,g=0.z
                 let d176 = A::mul_add(
                     -p.ZZ8r,
                     k140,
-                    A::mul_add(-p.YZ8r, k142, p.XZ8r * k139),
+                    A::mul_add(p.YZ8r, k142, p.XZ8r * k139),
                 ); // J8rw8r|ud=0,g=0.z
+                let d93 = A::mul_add(
+                    p.MZ8l,
+                    k79,
+                    A::mul_add(
+                        -p.MY8l,
+                        k81,
+                        A::mul_add(
+                            -k72,
+                            d91,
+                            A::mul_add(
+                                -k73,
+                                d92,
+                                A::mul_add(
+                                    -p.XZ8l,
+                                    k74,
+                                    A::mul_add(-p.XY8l, k67, p.XX8l * k75),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8l|ud=0,g=0.x
                 let d177 = A::mul_add(
-                    -p.MZ8r,
+                    p.MZ8r,
                     k147,
                     A::mul_add(
                         -p.MY8r,
@@ -11231,17 +12344,38 @@ mod generated {
                             -k140,
                             d175,
                             A::mul_add(
-                                k142,
+                                -k142,
                                 d176,
                                 A::mul_add(
                                     -p.XZ8r,
                                     k141,
-                                    A::mul_add(p.XY8r, k134, p.XX8r * k143),
+                                    A::mul_add(-p.XY8r, k134, p.XX8r * k143),
                                 ),
                             ),
                         ),
                     ),
                 ); // N8r|ud=0,g=0.x
+                let d94 = A::mul_add(
+                    p.MX8l,
+                    k81,
+                    A::mul_add(
+                        p.MZ8l,
+                        k82,
+                        A::mul_add(
+                            k71,
+                            d92,
+                            A::mul_add(
+                                k72,
+                                d90,
+                                A::mul_add(
+                                    -p.YZ8l,
+                                    k74,
+                                    A::mul_add(-p.YY8l, k67, p.XY8l * k75),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8l|ud=0,g=0.y
                 let d178 = A::mul_add(
                     p.MX8r,
                     k149,
@@ -11257,20 +12391,41 @@ mod generated {
                                 A::mul_add(
                                     -p.YZ8r,
                                     k141,
-                                    A::mul_add(p.YY8r, k134, p.XY8r * k143),
+                                    A::mul_add(-p.YY8r, k134, p.XY8r * k143),
                                 ),
                             ),
                         ),
                     ),
                 ); // N8r|ud=0,g=0.y
+                let d95 = A::mul_add(
+                    -p.MY8l,
+                    k82,
+                    A::mul_add(
+                        -p.MX8l,
+                        k79,
+                        A::mul_add(
+                            k73,
+                            d90,
+                            A::mul_add(
+                                -k71,
+                                d91,
+                                A::mul_add(
+                                    -p.ZZ8l,
+                                    k74,
+                                    A::mul_add(-p.YZ8l, k67, p.XZ8l * k75),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8l|ud=0,g=0.z
                 let d179 = A::mul_add(
                     -p.MY8r,
                     k150,
                     A::mul_add(
-                        p.MX8r,
+                        -p.MX8r,
                         k147,
                         A::mul_add(
-                            -k142,
+                            k142,
                             d174,
                             A::mul_add(
                                 -k139,
@@ -11278,91 +12433,193 @@ mod generated {
                                 A::mul_add(
                                     -p.ZZ8r,
                                     k141,
-                                    A::mul_add(p.YZ8r, k134, p.XZ8r * k143),
+                                    A::mul_add(-p.YZ8r, k134, p.XZ8r * k143),
                                 ),
                             ),
                         ),
                     ),
                 ); // N8r|ud=0,g=0.z
-                let k151 = A::mul_add(s_q6r, k140, c_q6r * k142); // w8r in 9r|ud=0,g=0.y
-                let k152 = A::mul_add(-c_q6r, k140, s_q6r * k142); // w8r in 9r|ud=0,g=0.z
+                let k83 = A::mul_add(-s_q6l, k72, c_q6l * k73); // w8l in 9l|ud=0,g=0.y
+                let k151 = A::mul_add(-s_q6r, k140, c_q6r * k142); // w8r in 9r|ud=0,g=0.y
+                let k84 = A::mul_add(c_q6l, k72, s_q6l * k73); // w8l in 9l|ud=0,g=0.z
+                let k152 = A::mul_add(c_q6r, k140, s_q6r * k142); // w8r in 9r|ud=0,g=0.z
+                let k86 = A::mul_add(-k84, qd6l, A::mul_add(s_q6l, k74, c_q6l * k67)); // wd9l|ud=0,g=0.y
                 let k153 = A::mul_add(
                     -k152,
                     qd6r,
-                    A::mul_add(-s_q6r, k141, c_q6r * k134),
+                    A::mul_add(s_q6r, k141, c_q6r * k134),
                 ); // wd9r|ud=0,g=0.y
-                let k154 = A::mul_add(k151, qd6r, A::mul_add(c_q6r, k141, s_q6r * k134)); // wd9r|ud=0,g=0.z
+                let k87 = A::mul_add(k83, qd6l, A::mul_add(-c_q6l, k74, s_q6l * k67)); // wd9l|ud=0,g=0.z
+                let k154 = A::mul_add(
+                    k151,
+                    qd6r,
+                    A::mul_add(-c_q6r, k141, s_q6r * k134),
+                ); // wd9r|ud=0,g=0.z
+                let k85 = k71 + qd6l; // w9l|ud=0,g=0.x
                 let k155 = k139 + qd6r; // w9r|ud=0,g=0.x
-                let k156 = A::mul_add(-s_q6r, k149, c_q6r * k147); // a9r|ud=0,g=0.y
-                let k157 = A::mul_add(c_q6r, k149, s_q6r * k147); // a9r|ud=0,g=0.z
+                let k88 = A::mul_add(s_q6l, k81, c_q6l * k79); // a9l|ud=0,g=0.y
+                let k156 = A::mul_add(s_q6r, k149, c_q6r * k147); // a9r|ud=0,g=0.y
+                let k89 = A::mul_add(-c_q6l, k81, s_q6l * k79); // a9l|ud=0,g=0.z
+                let k157 = A::mul_add(-c_q6r, k149, s_q6r * k147); // a9r|ud=0,g=0.z
+                let d96 = A::mul_add(-p.MY9l, k84, p.MZ9l * k83); // w9lxMS9l|ud=0,g=0.x
                 let d180 = A::mul_add(-p.MY9r, k152, p.MZ9r * k151); // w9rxMS9r|ud=0,g=0.x
-                let d181 = A::mul_add(p.MZ9r, k155, p.MX9r * k152); // w9rxMS9r|ud=0,g=0.y
-                let d182 = A::mul_add(p.MX9r, k151, p.MY9r * k155); // w9rxMS9r|ud=0,g=0.z
+                let d97 = A::mul_add(-p.MZ9l, k85, p.MX9l * k84); // w9lxMS9l|ud=0,g=0.y
+                let d181 = A::mul_add(-p.MZ9r, k155, p.MX9r * k152); // w9rxMS9r|ud=0,g=0.y
+                let d98 = A::mul_add(-p.MX9l, k83, p.MY9l * k85); // w9lxMS9l|ud=0,g=0.z
+                let d182 = A::mul_add(-p.MX9r, k151, p.MY9r * k155); // w9rxMS9r|ud=0,g=0.z
+                let d99 = A::mul_add(
+                    -k84,
+                    d97,
+                    A::mul_add(
+                        k83,
+                        d98,
+                        A::mul_add(p.MY9l, k87, A::mul_add(-p.MZ9l, k86, p.m9l * k82)),
+                    ),
+                ); // F9l|ud=0,g=0.x
                 let d183 = A::mul_add(
                     -k152,
                     d181,
                     A::mul_add(
-                        -k151,
+                        k151,
                         d182,
-                        A::mul_add(-p.MY9r, k154, A::mul_add(p.MZ9r, k153, p.m9r * k150)),
+                        A::mul_add(p.MY9r, k154, A::mul_add(-p.MZ9r, k153, p.m9r * k150)),
                     ),
                 ); // F9r|ud=0,g=0.x
+                let d100 = A::mul_add(
+                    k85,
+                    d98,
+                    A::mul_add(
+                        -k84,
+                        d96,
+                        A::mul_add(p.MZ9l, k75, A::mul_add(p.MX9l, k87, p.m9l * k88)),
+                    ),
+                ); // F9l|ud=0,g=0.y
                 let d184 = A::mul_add(
-                    -k155,
+                    k155,
                     d182,
                     A::mul_add(
-                        k152,
+                        -k152,
                         d180,
-                        A::mul_add(-p.MZ9r, k143, A::mul_add(p.MX9r, k154, p.m9r * k156)),
+                        A::mul_add(p.MZ9r, k143, A::mul_add(p.MX9r, k154, p.m9r * k156)),
                     ),
                 ); // F9r|ud=0,g=0.y
+                let d101 = A::mul_add(
+                    k83,
+                    d96,
+                    A::mul_add(
+                        -k85,
+                        d97,
+                        A::mul_add(-p.MX9l, k86, A::mul_add(-p.MY9l, k75, p.m9l * k89)),
+                    ),
+                ); // F9l|ud=0,g=0.z
                 let d185 = A::mul_add(
-                    -k151,
+                    k151,
                     d180,
                     A::mul_add(
                         -k155,
                         d181,
-                        A::mul_add(-p.MX9r, k153, A::mul_add(p.MY9r, k143, p.m9r * k157)),
+                        A::mul_add(
+                            -p.MX9r,
+                            k153,
+                            A::mul_add(-p.MY9r, k143, p.m9r * k157),
+                        ),
                     ),
                 ); // F9r|ud=0,g=0.z
+                let d102 = A::mul_add(
+                    p.XZ9l,
+                    k84,
+                    A::mul_add(p.XY9l, k83, p.XX9l * k85),
+                ); // J9lw9l|ud=0,g=0.x
                 let d186 = A::mul_add(
-                    -p.XZ9r,
+                    p.XZ9r,
                     k152,
-                    A::mul_add(-p.XY9r, k151, p.XX9r * k155),
+                    A::mul_add(p.XY9r, k151, p.XX9r * k155),
                 ); // J9rw9r|ud=0,g=0.x
+                let d103 = A::mul_add(
+                    p.YZ9l,
+                    k84,
+                    A::mul_add(p.YY9l, k83, p.XY9l * k85),
+                ); // J9lw9l|ud=0,g=0.y
                 let d187 = A::mul_add(
-                    -p.YZ9r,
+                    p.YZ9r,
                     k152,
-                    A::mul_add(-p.YY9r, k151, p.XY9r * k155),
+                    A::mul_add(p.YY9r, k151, p.XY9r * k155),
                 ); // J9rw9r|ud=0,g=0.y
+                let d104 = A::mul_add(
+                    p.ZZ9l,
+                    k84,
+                    A::mul_add(p.YZ9l, k83, p.XZ9l * k85),
+                ); // J9lw9l|ud=0,g=0.z
                 let d188 = A::mul_add(
-                    -p.ZZ9r,
+                    p.ZZ9r,
                     k152,
-                    A::mul_add(-p.YZ9r, k151, p.XZ9r * k155),
+                    A::mul_add(p.YZ9r, k151, p.XZ9r * k155),
                 ); // J9rw9r|ud=0,g=0.z
+                let d105 = A::mul_add(
+                    p.MZ9l,
+                    k88,
+                    A::mul_add(
+                        -p.MY9l,
+                        k89,
+                        A::mul_add(
+                            -k84,
+                            d103,
+                            A::mul_add(
+                                k83,
+                                d104,
+                                A::mul_add(
+                                    -p.XZ9l,
+                                    k87,
+                                    A::mul_add(-p.XY9l, k86, p.XX9l * k75),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9l|ud=0,g=0.x
                 let d189 = A::mul_add(
-                    -p.MZ9r,
+                    p.MZ9r,
                     k156,
                     A::mul_add(
-                        p.MY9r,
+                        -p.MY9r,
                         k157,
                         A::mul_add(
-                            k152,
+                            -k152,
                             d187,
                             A::mul_add(
-                                -k151,
+                                k151,
                                 d188,
                                 A::mul_add(
-                                    p.XZ9r,
+                                    -p.XZ9r,
                                     k154,
-                                    A::mul_add(p.XY9r, k153, p.XX9r * k143),
+                                    A::mul_add(-p.XY9r, k153, p.XX9r * k143),
                                 ),
                             ),
                         ),
                     ),
                 ); // N9r|ud=0,g=0.x
+                let d106 = A::mul_add(
+                    p.MX9l,
+                    k89,
+                    A::mul_add(
+                        p.MZ9l,
+                        k82,
+                        A::mul_add(
+                            -k85,
+                            d104,
+                            A::mul_add(
+                                k84,
+                                d102,
+                                A::mul_add(
+                                    -p.YZ9l,
+                                    k87,
+                                    A::mul_add(-p.YY9l, k86, p.XY9l * k75),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9l|ud=0,g=0.y
                 let d190 = A::mul_add(
-                    -p.MX9r,
+                    p.MX9r,
                     k157,
                     A::mul_add(
                         p.MZ9r,
@@ -11371,61 +12628,102 @@ mod generated {
                             -k155,
                             d188,
                             A::mul_add(
-                                -k152,
+                                k152,
                                 d186,
                                 A::mul_add(
-                                    p.YZ9r,
+                                    -p.YZ9r,
                                     k154,
-                                    A::mul_add(p.YY9r, k153, p.XY9r * k143),
+                                    A::mul_add(-p.YY9r, k153, p.XY9r * k143),
                                 ),
                             ),
                         ),
                     ),
                 ); // N9r|ud=0,g=0.y
+                let d107 = A::mul_add(
+                    -p.MY9l,
+                    k82,
+                    A::mul_add(
+                        -p.MX9l,
+                        k88,
+                        A::mul_add(
+                            -k83,
+                            d102,
+                            A::mul_add(
+                                k85,
+                                d103,
+                                A::mul_add(
+                                    -p.ZZ9l,
+                                    k87,
+                                    A::mul_add(-p.YZ9l, k86, p.XZ9l * k75),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9l|ud=0,g=0.z
                 let d191 = A::mul_add(
                     -p.MY9r,
                     k150,
                     A::mul_add(
-                        p.MX9r,
+                        -p.MX9r,
                         k156,
                         A::mul_add(
-                            k151,
+                            -k151,
                             d186,
                             A::mul_add(
                                 k155,
                                 d187,
                                 A::mul_add(
-                                    p.ZZ9r,
+                                    -p.ZZ9r,
                                     k154,
-                                    A::mul_add(p.YZ9r, k153, p.XZ9r * k143),
+                                    A::mul_add(-p.YZ9r, k153, p.XZ9r * k143),
                                 ),
                             ),
                         ),
                     ),
                 ); // N9r|ud=0,g=0.z
-                let k158 = A::mul_add(s_q7r, k152, c_q7r * k155); // w9r in 10r|ud=0,g=0.x
-                let k159 = A::mul_add(-c_q7r, k152, s_q7r * k155); // w9r in 10r|ud=0,g=0.y
-                let k160 = k151 + qd7r; // w10r|ud=0,g=0.z
-                let k161 = A::mul_add(
-                    k159,
-                    qd7r,
-                    A::mul_add(-s_q7r, k154, c_q7r * k143),
-                ); // wd10r|ud=0,g=0.x
+                let k90 = A::mul_add(-s_q7l, k84, c_q7l * k85); // w9l in 10l|ud=0,g=0.x
+                let k158 = A::mul_add(-s_q7r, k152, c_q7r * k155); // w9r in 10r|ud=0,g=0.x
+                let k91 = A::mul_add(c_q7l, k84, s_q7l * k85); // w9l in 10l|ud=0,g=0.y
+                let k159 = A::mul_add(c_q7r, k152, s_q7r * k155); // w9r in 10r|ud=0,g=0.y
+                let k92 = k83 - qd7l; // w10l|ud=0,g=0.z
+                let k160 = k151 - qd7r; // w10r|ud=0,g=0.z
+                let k93 = A::mul_add(k91, qd7l, A::mul_add(s_q7l, k87, c_q7l * k75)); // wd10l|ud=0,g=0.x
+                let k161 = A::mul_add(k159, qd7r, A::mul_add(s_q7r, k154, c_q7r * k143)); // wd10r|ud=0,g=0.x
+                let k94 = A::mul_add(-k90, qd7l, A::mul_add(-c_q7l, k87, s_q7l * k75)); // wd10l|ud=0,g=0.y
                 let k162 = A::mul_add(
                     -k158,
                     qd7r,
-                    A::mul_add(c_q7r, k154, s_q7r * k143),
+                    A::mul_add(-c_q7r, k154, s_q7r * k143),
                 ); // wd10r|ud=0,g=0.y
+                let k95 = p.L9 * k84; // w9lxP10l|ud=0,g=0.x
                 let k163 = p.L9 * k152; // w9rxP10r|ud=0,g=0.x
+                let k96 = p.L9 * k85; // w9lxP10l|ud=0,g=0.z
                 let k164 = p.L9 * k155; // w9rxP10r|ud=0,g=0.z
-                let k165 = A::mul_add(k151, k164, A::mul_add(p.L9, k154, k150)); // a10r in 9r|ud=0,g=0.x
-                let k166 = A::mul_add(k155, k164, A::mul_add(k152, k163, k156)); // a10r in 9r|ud=0,g=0.y
-                let k167 = A::mul_add(-k151, k163, A::mul_add(-p.L9, k143, k157)); // a10r in 9r|ud=0,g=0.z
-                let k168 = A::mul_add(-s_q7r, k167, c_q7r * k165); // a10r|ud=0,g=0.x
-                let k169 = A::mul_add(c_q7r, k167, s_q7r * k165); // a10r|ud=0,g=0.y
-                let d192 = A::mul_add(p.MY10r, k160, p.MZ10r * k159); // w10rxMS10r|ud=0,g=0.x
+                let k97 = A::mul_add(-k83, k96, A::mul_add(-p.L9, k87, k82)); // a10l in 9l|ud=0,g=0.x
+                let k165 = A::mul_add(-k151, k164, A::mul_add(-p.L9, k154, k150)); // a10r in 9r|ud=0,g=0.x
+                let k98 = A::mul_add(-k85, k96, A::mul_add(-k84, k95, k88)); // a10l in 9l|ud=0,g=0.y
+                let k166 = A::mul_add(-k155, k164, A::mul_add(-k152, k163, k156)); // a10r in 9r|ud=0,g=0.y
+                let k99 = A::mul_add(k83, k95, A::mul_add(p.L9, k75, k89)); // a10l in 9l|ud=0,g=0.z
+                let k167 = A::mul_add(k151, k163, A::mul_add(p.L9, k143, k157)); // a10r in 9r|ud=0,g=0.z
+                let k100 = A::mul_add(s_q7l, k99, c_q7l * k97); // a10l|ud=0,g=0.x
+                let k168 = A::mul_add(s_q7r, k167, c_q7r * k165); // a10r|ud=0,g=0.x
+                let k101 = A::mul_add(-c_q7l, k99, s_q7l * k97); // a10l|ud=0,g=0.y
+                let k169 = A::mul_add(-c_q7r, k167, s_q7r * k165); // a10r|ud=0,g=0.y
+                let d108 = A::mul_add(-p.MY10l, k92, p.MZ10l * k91); // w10lxMS10l|ud=0,g=0.x
+                let d192 = A::mul_add(-p.MY10r, k160, p.MZ10r * k159); // w10rxMS10r|ud=0,g=0.x
+                let d110 = A::mul_add(-p.MX10l, k91, p.MY10l * k90); // w10lxMS10l|ud=0,g=0.z
                 let d193 = A::mul_add(-p.MX10r, k159, p.MY10r * k158); // w10rxMS10r|ud=0,g=0.z
-                let d194 = A::mul_add(p.MZ10r, k158, p.MX10r * k160); // w10rxMS10r|ud=0,g=0.y
+                let d109 = A::mul_add(-p.MZ10l, k90, p.MX10l * k92); // w10lxMS10l|ud=0,g=0.y
+                let d194 = A::mul_add(-p.MZ10r, k158, p.MX10r * k160); // w10rxMS10r|ud=0,g=0.y
+                let d112 = A::mul_add(
+                    k92,
+                    d109,
+                    A::mul_add(
+                        -k91,
+                        d110,
+                        A::mul_add(p.MY10l, k86, A::mul_add(p.MZ10l, k94, p.m10l * k100)),
+                    ),
+                ); // F10l|ud=0,g=0.x
                 let d195 = A::mul_add(
                     k160,
                     d194,
@@ -11433,67 +12731,125 @@ mod generated {
                         -k159,
                         d193,
                         A::mul_add(
-                            -p.MY10r,
+                            p.MY10r,
                             k153,
                             A::mul_add(p.MZ10r, k162, p.m10r * k168),
                         ),
                     ),
                 ); // F10r|ud=0,g=0.x
+                let d113 = A::mul_add(
+                    k90,
+                    d110,
+                    A::mul_add(
+                        -k92,
+                        d108,
+                        A::mul_add(
+                            -p.MZ10l,
+                            k93,
+                            A::mul_add(-p.MX10l, k86, p.m10l * k101),
+                        ),
+                    ),
+                ); // F10l|ud=0,g=0.y
                 let d196 = A::mul_add(
                     k158,
                     d193,
                     A::mul_add(
-                        k160,
+                        -k160,
                         d192,
                         A::mul_add(
                             -p.MZ10r,
                             k161,
-                            A::mul_add(p.MX10r, k153, p.m10r * k169),
+                            A::mul_add(-p.MX10r, k153, p.m10r * k169),
                         ),
                     ),
                 ); // F10r|ud=0,g=0.y
+                let d111 = A::mul_add(
+                    -k91,
+                    d108,
+                    A::mul_add(
+                        k90,
+                        d109,
+                        A::mul_add(p.MX10l, k94, A::mul_add(-p.MY10l, k93, p.m10l * k98)),
+                    ),
+                ); // F10l|ud=0,g=0.z
                 let d197 = A::mul_add(
-                    k159,
+                    -k159,
                     d192,
                     A::mul_add(
                         k158,
                         d194,
                         A::mul_add(
-                            -p.MX10r,
+                            p.MX10r,
                             k162,
-                            A::mul_add(p.MY10r, k161, p.m10r * k166),
+                            A::mul_add(-p.MY10r, k161, p.m10r * k166),
                         ),
                     ),
                 ); // F10r|ud=0,g=0.z
+                let d114 = A::mul_add(
+                    p.XZ10l,
+                    k92,
+                    A::mul_add(p.XY10l, k91, p.XX10l * k90),
+                ); // J10lw10l|ud=0,g=0.x
                 let d198 = A::mul_add(
-                    -p.XZ10r,
+                    p.XZ10r,
                     k160,
                     A::mul_add(p.XY10r, k159, p.XX10r * k158),
                 ); // J10rw10r|ud=0,g=0.x
+                let d115 = A::mul_add(
+                    p.YZ10l,
+                    k92,
+                    A::mul_add(p.YY10l, k91, p.XY10l * k90),
+                ); // J10lw10l|ud=0,g=0.y
                 let d199 = A::mul_add(
-                    -p.YZ10r,
+                    p.YZ10r,
                     k160,
                     A::mul_add(p.YY10r, k159, p.XY10r * k158),
                 ); // J10rw10r|ud=0,g=0.y
+                let d116 = A::mul_add(
+                    p.ZZ10l,
+                    k92,
+                    A::mul_add(p.YZ10l, k91, p.XZ10l * k90),
+                ); // J10lw10l|ud=0,g=0.z
                 let d200 = A::mul_add(
-                    -p.ZZ10r,
+                    p.ZZ10r,
                     k160,
                     A::mul_add(p.YZ10r, k159, p.XZ10r * k158),
                 ); // J10rw10r|ud=0,g=0.z
+                let d117 = A::mul_add(
+                    -p.MZ10l,
+                    k101,
+                    A::mul_add(
+                        -p.MY10l,
+                        k98,
+                        A::mul_add(
+                            k92,
+                            d115,
+                            A::mul_add(
+                                -k91,
+                                d116,
+                                A::mul_add(
+                                    -p.XZ10l,
+                                    k86,
+                                    A::mul_add(p.XY10l, k94, p.XX10l * k93),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10l|ud=0,g=0.x
                 let d201 = A::mul_add(
                     -p.MZ10r,
                     k169,
                     A::mul_add(
-                        p.MY10r,
+                        -p.MY10r,
                         k166,
                         A::mul_add(
-                            -k160,
+                            k160,
                             d199,
                             A::mul_add(
                                 -k159,
                                 d200,
                                 A::mul_add(
-                                    p.XZ10r,
+                                    -p.XZ10r,
                                     k153,
                                     A::mul_add(p.XY10r, k162, p.XX10r * k161),
                                 ),
@@ -11501,8 +12857,29 @@ mod generated {
                         ),
                     ),
                 ); // N10r|ud=0,g=0.x
+                let d118 = A::mul_add(
+                    p.MX10l,
+                    k98,
+                    A::mul_add(
+                        p.MZ10l,
+                        k100,
+                        A::mul_add(
+                            k90,
+                            d116,
+                            A::mul_add(
+                                -k92,
+                                d114,
+                                A::mul_add(
+                                    -p.YZ10l,
+                                    k86,
+                                    A::mul_add(p.YY10l, k94, p.XY10l * k93),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10l|ud=0,g=0.y
                 let d202 = A::mul_add(
-                    -p.MX10r,
+                    p.MX10r,
                     k166,
                     A::mul_add(
                         p.MZ10r,
@@ -11511,10 +12888,10 @@ mod generated {
                             k158,
                             d200,
                             A::mul_add(
-                                k160,
+                                -k160,
                                 d198,
                                 A::mul_add(
-                                    p.YZ10r,
+                                    -p.YZ10r,
                                     k153,
                                     A::mul_add(p.YY10r, k162, p.XY10r * k161),
                                 ),
@@ -11522,6 +12899,28 @@ mod generated {
                         ),
                     ),
                 ); // N10r|ud=0,g=0.y
+                let d119 = A::mul_add(
+                    -p.MY10l,
+                    k100,
+                    A::mul_add(
+                        p.MX10l,
+                        k101,
+                        A::mul_add(
+                            k91,
+                            d114,
+                            A::mul_add(
+                                -k90,
+                                d115,
+                                A::mul_add(
+                                    -p.ZZ10l,
+                                    k86,
+                                    A::mul_add(p.YZ10l, k94, p.XZ10l * k93),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10l|ud=0,g=0.z
+                m[11] = d119;
                 let d203 = A::mul_add(
                     -p.MY10r,
                     k168,
@@ -11535,7 +12934,7 @@ mod generated {
                                 -k158,
                                 d199,
                                 A::mul_add(
-                                    p.ZZ10r,
+                                    -p.ZZ10r,
                                     k153,
                                     A::mul_add(p.YZ10r, k162, p.XZ10r * k161),
                                 ),
@@ -11544,95 +12943,176 @@ mod generated {
                     ),
                 ); // N10r|ud=0,g=0.z
                 m[18] = d203;
+                let d260 = A::mul_add(s_q7l, d113, c_q7l * d112); // f10l in 9l|ud=0,g=0.x
                 let d204 = A::mul_add(s_q7r, d196, c_q7r * d195); // f10r in 9r|ud=0,g=0.x
+                let d261 = A::mul_add(-c_q7l, d113, s_q7l * d112); // f10l in 9l|ud=0,g=0.z
                 let d205 = A::mul_add(-c_q7r, d196, s_q7r * d195); // f10r in 9r|ud=0,g=0.z
+                let d262 = d99 + d260; // f9l|ud=0,g=0.x
                 let d206 = d183 + d204; // f9r|ud=0,g=0.x
-                let d207 = d184 + d197; // f9r|ud=0,g=0.y
-                let d208 = d185 - d205; // f9r|ud=0,g=0.z
+                let d263 = d106 + d119; // n9l|ud=0,g=0.y
                 let d209 = d190 + d203; // n9r|ud=0,g=0.y
+                let d264 = A::mul_add(
+                    p.L9,
+                    d261,
+                    A::mul_add(s_q7l, d118, A::mul_add(c_q7l, d117, d105)),
+                ); // n9l|ud=0,g=0.x
+                m[10] = -d264;
                 let d210 = A::mul_add(
                     p.L9,
                     d205,
                     A::mul_add(s_q7r, d202, A::mul_add(c_q7r, d201, d189)),
                 ); // n9r|ud=0,g=0.x
                 m[17] = -d210;
+                let d265 = A::mul_add(
+                    p.L9,
+                    d260,
+                    A::mul_add(c_q7l, d118, A::mul_add(-s_q7l, d117, d107)),
+                ); // n9l|ud=0,g=0.z
                 let d211 = A::mul_add(
                     p.L9,
                     d204,
                     A::mul_add(c_q7r, d202, A::mul_add(-s_q7r, d201, d191)),
                 ); // n9r|ud=0,g=0.z
+                let d266 = d100 + d111; // f9l|ud=0,g=0.y
+                let d207 = d184 + d197; // f9r|ud=0,g=0.y
+                let d267 = d101 + d261; // f9l|ud=0,g=0.z
+                let d208 = d185 + d205; // f9r|ud=0,g=0.z
+                let d268 = A::mul_add(s_q6l, d267, c_q6l * d266); // f9l in 8l|ud=0,g=0.y
                 let d212 = A::mul_add(s_q6r, d208, c_q6r * d207); // f9r in 8r|ud=0,g=0.y
+                let d269 = A::mul_add(-c_q6l, d267, s_q6l * d266); // f9l in 8l|ud=0,g=0.z
                 let d213 = A::mul_add(-c_q6r, d208, s_q6r * d207); // f9r in 8r|ud=0,g=0.z
-                let d214 = d171 - d213; // f8r|ud=0,g=0.z
-                let d215 = d172 + d206; // f8r|ud=0,g=0.x
+                let d270 = d87 + d268; // f8l|ud=0,g=0.y
                 let d216 = d173 + d212; // f8r|ud=0,g=0.y
+                let d271 = d88 + d269; // f8l|ud=0,g=0.z
+                let d214 = d171 + d213; // f8r|ud=0,g=0.z
+                let d272 = d89 + d262; // f8l|ud=0,g=0.x
+                let d215 = d172 + d206; // f8r|ud=0,g=0.x
+                let d273 = d93 + d264; // n8l|ud=0,g=0.x
                 let d217 = d177 + d210; // n8r|ud=0,g=0.x
+                let d274 = A::mul_add(s_q6l, d265, A::mul_add(c_q6l, d263, d94)); // n8l|ud=0,g=0.y
+                m[9] = d274;
                 let d218 = A::mul_add(s_q6r, d211, A::mul_add(c_q6r, d209, d178)); // n8r|ud=0,g=0.y
                 m[16] = d218;
+                let d275 = A::mul_add(-c_q6l, d265, A::mul_add(s_q6l, d263, d95)); // n8l|ud=0,g=0.z
                 let d219 = A::mul_add(-c_q6r, d211, A::mul_add(s_q6r, d209, d179)); // n8r|ud=0,g=0.z
+                let d276 = A::mul_add(s_q5l, d271, c_q5l * d272); // f8l in 7l|ud=0,g=0.x
                 let d220 = A::mul_add(s_q5r, d214, c_q5r * d215); // f8r in 7r|ud=0,g=0.x
+                let d277 = A::mul_add(-c_q5l, d271, s_q5l * d272); // f8l in 7l|ud=0,g=0.z
                 let d221 = A::mul_add(-c_q5r, d214, s_q5r * d215); // f8r in 7r|ud=0,g=0.z
+                let d278 = d75 + d276; // f7l|ud=0,g=0.x
                 let d222 = d159 + d220; // f7r|ud=0,g=0.x
-                let d223 = d160 + d216; // f7r|ud=0,g=0.y
-                let d224 = d161 - d221; // f7r|ud=0,g=0.z
+                let d279 = d82 + d274; // n7l|ud=0,g=0.y
                 let d225 = d166 + d218; // n7r|ud=0,g=0.y
+                let d280 = A::mul_add(
+                    p.L8,
+                    d277,
+                    A::mul_add(-s_q5l, d275, A::mul_add(c_q5l, d273, d81)),
+                ); // n7l|ud=0,g=0.x
+                m[8] = -d280;
                 let d226 = A::mul_add(
                     p.L8,
                     d221,
                     A::mul_add(-s_q5r, d219, A::mul_add(c_q5r, d217, d165)),
                 ); // n7r|ud=0,g=0.x
                 m[15] = -d226;
+                let d281 = A::mul_add(
+                    p.L8,
+                    d276,
+                    A::mul_add(-c_q5l, d275, A::mul_add(-s_q5l, d273, d83)),
+                ); // n7l|ud=0,g=0.z
                 let d227 = A::mul_add(
                     p.L8,
                     d220,
                     A::mul_add(-c_q5r, d219, A::mul_add(-s_q5r, d217, d167)),
                 ); // n7r|ud=0,g=0.z
+                let d282 = d76 + d270; // f7l|ud=0,g=0.y
+                let d223 = d160 + d216; // f7r|ud=0,g=0.y
+                let d283 = d77 + d277; // f7l|ud=0,g=0.z
+                let d224 = d161 + d221; // f7r|ud=0,g=0.z
+                let d284 = A::mul_add(s_q4l, d283, c_q4l * d282); // f7l in 6l|ud=0,g=0.y
                 let d228 = A::mul_add(s_q4r, d224, c_q4r * d223); // f7r in 6r|ud=0,g=0.y
+                let d285 = A::mul_add(-c_q4l, d283, s_q4l * d282); // f7l in 6l|ud=0,g=0.z
                 let d229 = A::mul_add(-c_q4r, d224, s_q4r * d223); // f7r in 6r|ud=0,g=0.z
-                let d230 = d147 - d229; // f6r|ud=0,g=0.z
-                let d231 = d148 + d222; // f6r|ud=0,g=0.x
+                let d286 = d63 + d284; // f6l|ud=0,g=0.y
                 let d232 = d149 + d228; // f6r|ud=0,g=0.y
+                let d287 = d64 + d285; // f6l|ud=0,g=0.z
+                let d230 = d147 + d229; // f6r|ud=0,g=0.z
+                let d288 = d65 + d278; // f6l|ud=0,g=0.x
+                let d231 = d148 + d222; // f6r|ud=0,g=0.x
+                let d289 = d69 + d280; // n6l|ud=0,g=0.x
                 let d233 = d153 + d226; // n6r|ud=0,g=0.x
+                let d290 = A::mul_add(s_q4l, d281, A::mul_add(c_q4l, d279, d70)); // n6l|ud=0,g=0.y
+                m[7] = d290;
                 let d234 = A::mul_add(s_q4r, d227, A::mul_add(c_q4r, d225, d154)); // n6r|ud=0,g=0.y
                 m[14] = d234;
+                let d291 = A::mul_add(-c_q4l, d281, A::mul_add(s_q4l, d279, d71)); // n6l|ud=0,g=0.z
                 let d235 = A::mul_add(-c_q4r, d227, A::mul_add(s_q4r, d225, d155)); // n6r|ud=0,g=0.z
+                let d292 = A::mul_add(s_q3l, d287, c_q3l * d288); // f6l in 5l|ud=0,g=0.x
                 let d236 = A::mul_add(s_q3r, d230, c_q3r * d231); // f6r in 5r|ud=0,g=0.x
+                let d293 = A::mul_add(-c_q3l, d287, s_q3l * d288); // f6l in 5l|ud=0,g=0.z
                 let d237 = A::mul_add(-c_q3r, d230, s_q3r * d231); // f6r in 5r|ud=0,g=0.z
+                let d294 = d51 + d292; // f5l|ud=0,g=0.x
                 let d238 = d135 + d236; // f5r|ud=0,g=0.x
-                let d239 = d136 + d232; // f5r|ud=0,g=0.y
-                let d240 = d137 - d237; // f5r|ud=0,g=0.z
+                let d295 = d58 + d290; // n5l|ud=0,g=0.y
                 let d241 = d142 + d234; // n5r|ud=0,g=0.y
+                let d296 = A::mul_add(
+                    p.L7,
+                    d293,
+                    A::mul_add(-s_q3l, d291, A::mul_add(c_q3l, d289, d57)),
+                ); // n5l|ud=0,g=0.x
+                m[6] = -d296;
                 let d242 = A::mul_add(
                     p.L7,
                     d237,
                     A::mul_add(-s_q3r, d235, A::mul_add(c_q3r, d233, d141)),
                 ); // n5r|ud=0,g=0.x
                 m[13] = -d242;
+                let d297 = A::mul_add(
+                    p.L7,
+                    d292,
+                    A::mul_add(-c_q3l, d291, A::mul_add(-s_q3l, d289, d59)),
+                ); // n5l|ud=0,g=0.z
                 let d243 = A::mul_add(
                     p.L7,
                     d236,
                     A::mul_add(-c_q3r, d235, A::mul_add(-s_q3r, d233, d143)),
                 ); // n5r|ud=0,g=0.z
+                let d298 = d52 + d286; // f5l|ud=0,g=0.y
+                let d239 = d136 + d232; // f5r|ud=0,g=0.y
+                let d299 = d53 + d293; // f5l|ud=0,g=0.z
+                let d240 = d137 + d237; // f5r|ud=0,g=0.z
+                let d300 = A::mul_add(s_q2l, d299, c_q2l * d298); // f5l in 4l|ud=0,g=0.y
                 let d244 = A::mul_add(s_q2r, d240, c_q2r * d239); // f5r in 4r|ud=0,g=0.y
+                let d301 = A::mul_add(-c_q2l, d299, s_q2l * d298); // f5l in 4l|ud=0,g=0.z
                 let d245 = A::mul_add(-c_q2r, d240, s_q2r * d239); // f5r in 4r|ud=0,g=0.z
-                let d246 = d123 - d245; // f4r|ud=0,g=0.z
-                let d247 = d124 + d238; // f4r|ud=0,g=0.x
+                let d302 = d39 + d300; // f4l|ud=0,g=0.y
                 let d248 = d125 + d244; // f4r|ud=0,g=0.y
+                let d254 = d27 - d248; // f3|ud=0,g=0.x
+                let d303 = d40 + d301; // f4l|ud=0,g=0.z
+                let d246 = d123 + d245; // f4r|ud=0,g=0.z
+                let d304 = d41 + d294; // f4l|ud=0,g=0.x
+                let d247 = d124 + d238; // f4r|ud=0,g=0.x
+                let d305 = d45 + d296; // n4l|ud=0,g=0.x
                 let d249 = d129 + d242; // n4r|ud=0,g=0.x
+                let d306 = A::mul_add(s_q2l, d297, A::mul_add(c_q2l, d295, d46)); // n4l|ud=0,g=0.y
+                m[5] = d306;
                 let d250 = A::mul_add(s_q2r, d243, A::mul_add(c_q2r, d241, d130)); // n4r|ud=0,g=0.y
                 m[12] = d250;
+                let d307 = A::mul_add(-c_q2l, d297, A::mul_add(s_q2l, d295, d47)); // n4l|ud=0,g=0.z
                 let d251 = A::mul_add(-c_q2r, d243, A::mul_add(s_q2r, d241, d131)); // n4r|ud=0,g=0.z
-                let d252 = A::mul_add(s_q1r, d246, c_q1r * d247); // f4r in 3|ud=0,g=0.y
+                let d308 = A::mul_add(-c_q1l, d303, s_q1l * d304); // f4l in 3|ud=0,g=0.z
                 let d253 = A::mul_add(-c_q1r, d246, s_q1r * d247); // f4r in 3|ud=0,g=0.z
-                let d254 = d27 + d248; // f3|ud=0,g=0.x
                 let d255 = A::mul_add(-p.L5, d253, d33 + d250); // n3|ud=0,g=0.x
                 let d256 = A::mul_add(
                     -p.L6,
                     d253,
                     A::mul_add(s_q1r, d251, A::mul_add(-c_q1r, d249, d34)),
                 ); // n3|ud=0,g=0.y
+                let d259 = d29 + d253; // f3|ud=0,g=0.z
+                let d309 = A::mul_add(s_q1l, d303, c_q1l * d304); // f4l in 3|ud=0,g=0.y
+                let d252 = A::mul_add(s_q1r, d246, c_q1r * d247); // f4r in 3|ud=0,g=0.y
                 let d257 = A::mul_add(
-                    -p.L5,
+                    p.L5,
                     d248,
                     A::mul_add(
                         p.L6,
@@ -11641,87 +13121,6 @@ mod generated {
                     ),
                 ); // n3|ud=0,g=0.z
                 let d258 = d28 + d252; // f3|ud=0,g=0.y
-                let d259 = d29 + d253; // f3|ud=0,g=0.z
-                let d260 = A::mul_add(s_q7l, d113, c_q7l * d112); // f10l in 9l|ud=0,g=0.x
-                let d261 = A::mul_add(-c_q7l, d113, s_q7l * d112); // f10l in 9l|ud=0,g=0.z
-                let d262 = d99 + d260; // f9l|ud=0,g=0.x
-                let d263 = d106 + d119; // n9l|ud=0,g=0.y
-                let d264 = A::mul_add(
-                    p.L9,
-                    d261,
-                    A::mul_add(s_q7l, d118, A::mul_add(c_q7l, d117, d105)),
-                ); // n9l|ud=0,g=0.x
-                m[10] = -d264;
-                let d265 = A::mul_add(
-                    p.L9,
-                    d260,
-                    A::mul_add(c_q7l, d118, A::mul_add(-s_q7l, d117, d107)),
-                ); // n9l|ud=0,g=0.z
-                let d266 = d100 + d111; // f9l|ud=0,g=0.y
-                let d267 = d101 + d261; // f9l|ud=0,g=0.z
-                let d268 = A::mul_add(s_q6l, d267, c_q6l * d266); // f9l in 8l|ud=0,g=0.y
-                let d269 = A::mul_add(-c_q6l, d267, s_q6l * d266); // f9l in 8l|ud=0,g=0.z
-                let d270 = d87 + d268; // f8l|ud=0,g=0.y
-                let d271 = d88 + d269; // f8l|ud=0,g=0.z
-                let d272 = d89 + d262; // f8l|ud=0,g=0.x
-                let d273 = d93 + d264; // n8l|ud=0,g=0.x
-                let d274 = A::mul_add(s_q6l, d265, A::mul_add(c_q6l, d263, d94)); // n8l|ud=0,g=0.y
-                m[9] = d274;
-                let d275 = A::mul_add(-c_q6l, d265, A::mul_add(s_q6l, d263, d95)); // n8l|ud=0,g=0.z
-                let d276 = A::mul_add(s_q5l, d271, c_q5l * d272); // f8l in 7l|ud=0,g=0.x
-                let d277 = A::mul_add(-c_q5l, d271, s_q5l * d272); // f8l in 7l|ud=0,g=0.z
-                let d278 = d75 + d276; // f7l|ud=0,g=0.x
-                let d279 = d82 + d274; // n7l|ud=0,g=0.y
-                let d280 = A::mul_add(
-                    p.L8,
-                    d277,
-                    A::mul_add(-s_q5l, d275, A::mul_add(c_q5l, d273, d81)),
-                ); // n7l|ud=0,g=0.x
-                m[8] = -d280;
-                let d281 = A::mul_add(
-                    p.L8,
-                    d276,
-                    A::mul_add(-c_q5l, d275, A::mul_add(-s_q5l, d273, d83)),
-                ); // n7l|ud=0,g=0.z
-                let d282 = d76 + d270; // f7l|ud=0,g=0.y
-                let d283 = d77 + d277; // f7l|ud=0,g=0.z
-                let d284 = A::mul_add(s_q4l, d283, c_q4l * d282); // f7l in 6l|ud=0,g=0.y
-                let d285 = A::mul_add(-c_q4l, d283, s_q4l * d282); // f7l in 6l|ud=0,g=0.z
-                let d286 = d63 + d284; // f6l|ud=0,g=0.y
-                let d287 = d64 + d285; // f6l|ud=0,g=0.z
-                let d288 = d65 + d278; // f6l|ud=0,g=0.x
-                let d289 = d69 + d280; // n6l|ud=0,g=0.x
-                let d290 = A::mul_add(s_q4l, d281, A::mul_add(c_q4l, d279, d70)); // n6l|ud=0,g=0.y
-                m[7] = d290;
-                let d291 = A::mul_add(-c_q4l, d281, A::mul_add(s_q4l, d279, d71)); // n6l|ud=0,g=0.z
-                let d292 = A::mul_add(s_q3l, d287, c_q3l * d288); // f6l in 5l|ud=0,g=0.x
-                let d293 = A::mul_add(-c_q3l, d287, s_q3l * d288); // f6l in 5l|ud=0,g=0.z
-                let d294 = d51 + d292; // f5l|ud=0,g=0.x
-                let d295 = d58 + d290; // n5l|ud=0,g=0.y
-                let d296 = A::mul_add(
-                    p.L7,
-                    d293,
-                    A::mul_add(-s_q3l, d291, A::mul_add(c_q3l, d289, d57)),
-                ); // n5l|ud=0,g=0.x
-                m[6] = -d296;
-                let d297 = A::mul_add(
-                    p.L7,
-                    d292,
-                    A::mul_add(-c_q3l, d291, A::mul_add(-s_q3l, d289, d59)),
-                ); // n5l|ud=0,g=0.z
-                let d298 = d52 + d286; // f5l|ud=0,g=0.y
-                let d299 = d53 + d293; // f5l|ud=0,g=0.z
-                let d300 = A::mul_add(s_q2l, d299, c_q2l * d298); // f5l in 4l|ud=0,g=0.y
-                let d301 = A::mul_add(-c_q2l, d299, s_q2l * d298); // f5l in 4l|ud=0,g=0.z
-                let d302 = d39 + d300; // f4l|ud=0,g=0.y
-                let d303 = d40 + d301; // f4l|ud=0,g=0.z
-                let d304 = d41 + d294; // f4l|ud=0,g=0.x
-                let d305 = d45 + d296; // n4l|ud=0,g=0.x
-                let d306 = A::mul_add(s_q2l, d297, A::mul_add(c_q2l, d295, d46)); // n4l|ud=0,g=0.y
-                m[5] = d306;
-                let d307 = A::mul_add(-c_q2l, d297, A::mul_add(s_q2l, d295, d47)); // n4l|ud=0,g=0.z
-                let d308 = A::mul_add(-c_q1l, d303, s_q1l * d304); // f4l in 3|ud=0,g=0.z
-                let d309 = A::mul_add(s_q1l, d303, c_q1l * d304); // f4l in 3|ud=0,g=0.y
                 let d310 = d254 + d302; // f3|ud=0,g=0.x
                 let d311 = A::mul_add(p.L5, d308, d255 - d306); // n3|ud=0,g=0.x
                 let d312 = A::mul_add(
@@ -11888,108 +13287,108 @@ mod generated {
                 let d6 = c_q_torso * d4; // gravity acceleration in 3.z
                 let d7 = A::mul_add(s_q1l, d6, c_q1l * d3); // gravity acceleration in 4l.x
                 let d8 = A::mul_add(-c_q1l, d6, s_q1l * d3); // gravity acceleration in 4l.z
+                let d21 = A::mul_add(-c_q1r, d3, s_q1r * d6); // gravity acceleration in 4r.x
+                let d22 = A::mul_add(-c_q1r, d6, -s_q1r * d3); // gravity acceleration in 4r.z
                 let d9 = A::mul_add(s_q2l, d8, c_q2l * d5); // gravity acceleration in 5l.y
+                let d23 = A::mul_add(s_q2r, d22, c_q2r * d5); // gravity acceleration in 5r.y
                 let d10 = A::mul_add(-c_q2l, d8, s_q2l * d5); // gravity acceleration in 5l.z
+                let d24 = A::mul_add(-c_q2r, d22, s_q2r * d5); // gravity acceleration in 5r.z
                 let d11 = A::mul_add(s_q3l, d10, c_q3l * d7); // gravity acceleration in 6l.x
+                let d25 = A::mul_add(s_q3r, d24, c_q3r * d21); // gravity acceleration in 6r.x
                 let d12 = A::mul_add(-c_q3l, d10, s_q3l * d7); // gravity acceleration in 6l.z
+                let d26 = A::mul_add(-c_q3r, d24, s_q3r * d21); // gravity acceleration in 6r.z
                 let d13 = A::mul_add(s_q4l, d12, c_q4l * d9); // gravity acceleration in 7l.y
+                let d27 = A::mul_add(s_q4r, d26, c_q4r * d23); // gravity acceleration in 7r.y
                 let d14 = A::mul_add(-c_q4l, d12, s_q4l * d9); // gravity acceleration in 7l.z
+                let d28 = A::mul_add(-c_q4r, d26, s_q4r * d23); // gravity acceleration in 7r.z
                 let d15 = A::mul_add(s_q5l, d14, c_q5l * d11); // gravity acceleration in 8l.x
+                let d29 = A::mul_add(s_q5r, d28, c_q5r * d25); // gravity acceleration in 8r.x
                 let d16 = A::mul_add(-c_q5l, d14, s_q5l * d11); // gravity acceleration in 8l.z
+                let d30 = A::mul_add(-c_q5r, d28, s_q5r * d25); // gravity acceleration in 8r.z
                 let d17 = A::mul_add(s_q6l, d16, c_q6l * d13); // gravity acceleration in 9l.y
+                let d31 = A::mul_add(s_q6r, d30, c_q6r * d27); // gravity acceleration in 9r.y
                 let d18 = A::mul_add(-c_q6l, d16, s_q6l * d13); // gravity acceleration in 9l.z
+                let d32 = A::mul_add(-c_q6r, d30, s_q6r * d27); // gravity acceleration in 9r.z
                 let d19 = A::mul_add(s_q7l, d18, c_q7l * d15); // gravity acceleration in 10l.x
+                let d33 = A::mul_add(s_q7r, d32, c_q7r * d29); // gravity acceleration in 10r.x
                 let d20 = A::mul_add(-c_q7l, d18, s_q7l * d15); // gravity acceleration in 10l.y
                 m[11] = A::mul_add(-p.MX10l, d20, p.MY10l * d19);
-                let d21 = A::mul_add(-s_q1r, d6, c_q1r * d3); // gravity acceleration in 4r.x
-                let d22 = A::mul_add(c_q1r, d6, s_q1r * d3); // gravity acceleration in 4r.z
-                let d23 = A::mul_add(-s_q2r, d22, c_q2r * d5); // gravity acceleration in 5r.y
-                let d24 = A::mul_add(c_q2r, d22, s_q2r * d5); // gravity acceleration in 5r.z
-                let d25 = A::mul_add(-s_q3r, d24, c_q3r * d21); // gravity acceleration in 6r.x
-                let d26 = A::mul_add(c_q3r, d24, s_q3r * d21); // gravity acceleration in 6r.z
-                let d27 = A::mul_add(-s_q4r, d26, c_q4r * d23); // gravity acceleration in 7r.y
-                let d28 = A::mul_add(c_q4r, d26, s_q4r * d23); // gravity acceleration in 7r.z
-                let d29 = A::mul_add(-s_q5r, d28, c_q5r * d25); // gravity acceleration in 8r.x
-                let d30 = A::mul_add(c_q5r, d28, s_q5r * d25); // gravity acceleration in 8r.z
-                let d31 = A::mul_add(-s_q6r, d30, c_q6r * d27); // gravity acceleration in 9r.y
-                let d32 = A::mul_add(c_q6r, d30, s_q6r * d27); // gravity acceleration in 9r.z
-                let d33 = A::mul_add(-s_q7r, d32, c_q7r * d29); // gravity acceleration in 10r.x
-                let d34 = A::mul_add(c_q7r, d32, s_q7r * d29); // gravity acceleration in 10r.y
-                m[18] = A::mul_add(-p.MX10r, d34, p.MY10r * d33);
-                let d35 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
-                let d36 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
-                let d37 = p.MX9r - d36; // MSC9r.x
-                let d38 = p.MZ9r + d35; // MSC9r.z
-                m[17] = A::mul_add(-d38, d31, pc.pc2 * d32);
-                let d39 = A::mul_add(s_q6r, d38, c_q6r * pc.pc2); // MSC9r in 8r.y
-                let d40 = A::mul_add(-c_q6r, d38, s_q6r * pc.pc2); // MSC9r in 8r.z
-                let d41 = p.MX8r - d37; // MSC8r.x
-                let d42 = p.MY8r - d39; // MSC8r.y
-                let d43 = p.MZ8r - d40; // MSC8r.z
-                m[16] = A::mul_add(-d41, d30, -d43 * d29);
-                let d44 = A::mul_add(c_q5r, d43, s_q5r * d41); // MSC8r in 7r.z
-                let d45 = A::mul_add(-s_q5r, d43, c_q5r * d41); // MSC8r in 7r.x
-                let d46 = p.MX7r - d45; // MSC7r.x
-                let d47 = p.MZ7r + d44; // MSC7r.z
-                let d48 = pc.pc13 - d42; // MSC7r.y
-                m[15] = A::mul_add(-d47, d27, d48 * d28);
-                let d49 = A::mul_add(s_q4r, d47, c_q4r * d48); // MSC7r in 6r.y
-                let d50 = A::mul_add(-c_q4r, d47, s_q4r * d48); // MSC7r in 6r.z
-                let d51 = p.MX6r - d46; // MSC6r.x
-                let d52 = p.MY6r - d49; // MSC6r.y
-                let d53 = p.MZ6r - d50; // MSC6r.z
-                m[14] = A::mul_add(-d51, d26, -d53 * d25);
-                let d54 = A::mul_add(c_q3r, d53, s_q3r * d51); // MSC6r in 5r.z
-                let d55 = A::mul_add(-s_q3r, d53, c_q3r * d51); // MSC6r in 5r.x
-                let d56 = p.MX5r - d55; // MSC5r.x
-                let d57 = p.MZ5r + d54; // MSC5r.z
-                let d58 = pc.pc19 - d52; // MSC5r.y
-                m[13] = A::mul_add(-d57, d23, d58 * d24);
-                let d59 = A::mul_add(s_q2r, d57, c_q2r * d58); // MSC5r in 4r.y
-                let d60 = A::mul_add(-c_q2r, d57, s_q2r * d58); // MSC5r in 4r.z
-                let d61 = p.MX4r - d56; // MSC4r.x
-                let d62 = p.MY4r - d59; // MSC4r.y
-                let d63 = p.MZ4r - d60; // MSC4r.z
-                m[12] = A::mul_add(-d61, d22, -d63 * d21);
-                let d64 = A::mul_add(-s_q1r, d63, c_q1r * d61); // MSC4r in 3.y
-                let d65 = A::mul_add(c_q1r, d63, s_q1r * d61); // MSC4r in 3.z
+                let d34 = A::mul_add(-c_q7r, d32, s_q7r * d29); // gravity acceleration in 10r.y
+                m[18] = A::mul_add(-p.MY10r, d33, p.MX10r * d34);
                 let d66 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
+                let d35 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
                 let d67 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
+                let d36 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
                 let d68 = p.MX9l - d67; // MSC9l.x
+                let d37 = p.MX9r - d36; // MSC9r.x
                 let d69 = p.MZ9l + d66; // MSC9l.z
                 m[10] = A::mul_add(-pc.pc25, d18, d69 * d17);
+                let d38 = p.MZ9r + d35; // MSC9r.z
+                m[17] = A::mul_add(-d38, d31, pc.pc2 * d32);
                 let d70 = A::mul_add(s_q6l, d69, c_q6l * pc.pc25); // MSC9l in 8l.y
+                let d39 = A::mul_add(s_q6r, d38, c_q6r * pc.pc2); // MSC9r in 8r.y
                 let d71 = A::mul_add(-c_q6l, d69, s_q6l * pc.pc25); // MSC9l in 8l.z
+                let d40 = A::mul_add(-c_q6r, d38, s_q6r * pc.pc2); // MSC9r in 8r.z
                 let d72 = p.MX8l - d68; // MSC8l.x
+                let d41 = p.MX8r - d37; // MSC8r.x
                 let d73 = p.MY8l - d70; // MSC8l.y
+                let d42 = p.MY8r - d39; // MSC8r.y
                 let d74 = p.MZ8l - d71; // MSC8l.z
                 m[9] = A::mul_add(-d72, d16, -d74 * d15);
+                let d43 = p.MZ8r - d40; // MSC8r.z
+                m[16] = A::mul_add(d41, d30, d43 * d29);
                 let d75 = A::mul_add(c_q5l, d74, s_q5l * d72); // MSC8l in 7l.z
+                let d44 = A::mul_add(c_q5r, d43, s_q5r * d41); // MSC8r in 7r.z
                 let d76 = A::mul_add(-s_q5l, d74, c_q5l * d72); // MSC8l in 7l.x
+                let d45 = A::mul_add(-s_q5r, d43, c_q5r * d41); // MSC8r in 7r.x
                 let d77 = p.MX7l - d76; // MSC7l.x
+                let d46 = p.MX7r - d45; // MSC7r.x
                 let d78 = p.MZ7l + d75; // MSC7l.z
+                let d47 = p.MZ7r + d44; // MSC7r.z
                 let d79 = pc.pc36 - d73; // MSC7l.y
                 m[8] = A::mul_add(-d79, d14, d78 * d13);
+                let d48 = pc.pc13 - d42; // MSC7r.y
+                m[15] = A::mul_add(-d47, d27, d48 * d28);
                 let d80 = A::mul_add(s_q4l, d78, c_q4l * d79); // MSC7l in 6l.y
+                let d49 = A::mul_add(s_q4r, d47, c_q4r * d48); // MSC7r in 6r.y
                 let d81 = A::mul_add(-c_q4l, d78, s_q4l * d79); // MSC7l in 6l.z
+                let d50 = A::mul_add(-c_q4r, d47, s_q4r * d48); // MSC7r in 6r.z
                 let d82 = p.MX6l - d77; // MSC6l.x
+                let d51 = p.MX6r - d46; // MSC6r.x
                 let d83 = p.MY6l - d80; // MSC6l.y
+                let d52 = p.MY6r - d49; // MSC6r.y
                 let d84 = p.MZ6l - d81; // MSC6l.z
                 m[7] = A::mul_add(-d82, d12, -d84 * d11);
+                let d53 = p.MZ6r - d50; // MSC6r.z
+                m[14] = A::mul_add(d51, d26, d53 * d25);
                 let d85 = A::mul_add(c_q3l, d84, s_q3l * d82); // MSC6l in 5l.z
+                let d54 = A::mul_add(c_q3r, d53, s_q3r * d51); // MSC6r in 5r.z
                 let d86 = A::mul_add(-s_q3l, d84, c_q3l * d82); // MSC6l in 5l.x
+                let d55 = A::mul_add(-s_q3r, d53, c_q3r * d51); // MSC6r in 5r.x
                 let d87 = p.MX5l - d86; // MSC5l.x
+                let d56 = p.MX5r - d55; // MSC5r.x
                 let d88 = p.MZ5l + d85; // MSC5l.z
+                let d57 = p.MZ5r + d54; // MSC5r.z
                 let d89 = pc.pc42 - d83; // MSC5l.y
                 m[6] = A::mul_add(-d89, d10, d88 * d9);
+                let d58 = pc.pc19 - d52; // MSC5r.y
+                m[13] = A::mul_add(-d57, d23, d58 * d24);
                 let d90 = A::mul_add(s_q2l, d88, c_q2l * d89); // MSC5l in 4l.y
+                let d59 = A::mul_add(s_q2r, d57, c_q2r * d58); // MSC5r in 4r.y
                 let d91 = A::mul_add(-c_q2l, d88, s_q2l * d89); // MSC5l in 4l.z
+                let d60 = A::mul_add(-c_q2r, d57, s_q2r * d58); // MSC5r in 4r.z
                 let d92 = p.MX4l - d87; // MSC4l.x
+                let d61 = p.MX4r - d56; // MSC4r.x
                 let d93 = p.MY4l - d90; // MSC4l.y
+                let d62 = p.MY4r - d59; // MSC4r.y
                 let d94 = p.MZ4l - d91; // MSC4l.z
                 m[5] = A::mul_add(-d92, d8, -d94 * d7);
+                let d63 = p.MZ4r - d60; // MSC4r.z
+                m[12] = A::mul_add(d61, d22, d63 * d21);
                 let d95 = A::mul_add(-s_q1l, d94, c_q1l * d92); // MSC4l in 3.y
+                let d64 = A::mul_add(-s_q1r, d63, c_q1r * d61); // MSC4r in 3.y
                 let d96 = A::mul_add(c_q1l, d94, s_q1l * d92); // MSC4l in 3.z
+                let d65 = A::mul_add(c_q1r, d63, s_q1r * d61); // MSC4r in 3.z
                 let d97 = p.MZ3 + d65 - d96; // MSC3.z
                 let d98 = d93 - d62 + pc.pc47; // MSC3.x
                 m[4] = A::mul_add(-d98, d6, d97 * d5);
@@ -12474,18 +13873,24 @@ mod generated {
                 let d48 = t9 + t10 + d33 + t5 - t6; // a4l in 3.z
                 let d49 = A::mul_add(c_q1l, d48, s_q1l * d47); // a4l.z
                 let d50 = A::mul_add(-s_q1l, d48, c_q1l * d47); // a4l.x
-                let d51 = A::mul_add(p.MY4l, k27, p.MZ4l * k28); // w4lxMS4l|ud=0,g=0.x
+                let d63 = A::mul_add(s_q2l, d49, c_q2l * d46); // a5l.y
+                let d64 = A::mul_add(-c_q2l, d49, s_q2l * d46); // a5l.z
+                let k77 = A::mul_add(-s_q1r, k17, c_q1r * k18); // w3 in 4r|ud=0,g=0.x
+                let k78 = A::mul_add(c_q1r, k17, s_q1r * k18); // w3 in 4r|ud=0,g=0.z
+                let k79 = qdd1r - k19; // wd4r.y
+                let k80 = -k16 - qd1r; // w4r|ud=0,g=0.y
+                let k81 = A::mul_add(s_q1r, k21, A::mul_add(c_q1r, k20, k78 * qd1r)); // wd4r.x
+                let k82 = A::mul_add(c_q1r, k21, A::mul_add(-s_q1r, k20, k77 * qd1r)); // wd4r.z
+                let k83 = t1 + t2; // w3xP4r|ud=0,g=0.z
+                let d156 = A::mul_add(k18, k83, t7) + d32 + t3; // a4r in 3.x
+                let d157 = t9 - t10 - d33 - t5 - t6; // a4r in 3.z
+                let d158 = A::mul_add(k16, k83, t8) - d30 - t4; // a4r in 3.y
+                let d159 = A::mul_add(c_q1r, d157, s_q1r * d158); // a4r.z
+                let d160 = A::mul_add(-s_q1r, d157, c_q1r * d158); // a4r.x
                 let d52 = A::mul_add(-p.MX4l, k28, p.MY4l * k26); // w4lxMS4l|ud=0,g=0.z
-                let d53 = A::mul_add(p.MZ4l, k26, p.MX4l * k27); // w4lxMS4l|ud=0,g=0.y
-                let d54 = A::mul_add(
-                    p.MY4l,
-                    k31,
-                    A::mul_add(
-                        -p.MZ4l,
-                        k30,
-                        A::mul_add(-p.m4l, d50, A::mul_add(-k27, d53, k28 * d52)),
-                    ),
-                ); // F4l.x
+                let d161 = A::mul_add(-p.MX4r, k80, p.MY4r * k77); // w4rxMS4r|ud=0,g=0.z
+                let d51 = A::mul_add(p.MY4l, k27, p.MZ4l * k28); // w4lxMS4l|ud=0,g=0.x
+                let d162 = A::mul_add(p.MY4r, k78, p.MZ4r * k80); // w4rxMS4r|ud=0,g=0.x
                 let d55 = A::mul_add(
                     -p.MZ4l,
                     k29,
@@ -12495,6 +13900,35 @@ mod generated {
                         A::mul_add(-p.m4l, d46, A::mul_add(k26, d52, k27 * d51)),
                     ),
                 ); // F4l.y
+                let d53 = A::mul_add(p.MZ4l, k26, p.MX4l * k27); // w4lxMS4l|ud=0,g=0.y
+                let d163 = A::mul_add(p.MZ4r, k77, p.MX4r * k78); // w4rxMS4r|ud=0,g=0.y
+                let d164 = A::mul_add(
+                    -p.MZ4r,
+                    k81,
+                    A::mul_add(
+                        p.MX4r,
+                        k82,
+                        A::mul_add(p.m4r, d156, A::mul_add(k77, d161, k78 * d162)),
+                    ),
+                ); // F4r.y
+                let d54 = A::mul_add(
+                    p.MY4l,
+                    k31,
+                    A::mul_add(
+                        -p.MZ4l,
+                        k30,
+                        A::mul_add(-p.m4l, d50, A::mul_add(-k27, d53, k28 * d52)),
+                    ),
+                ); // F4l.x
+                let d165 = A::mul_add(
+                    p.MY4r,
+                    k82,
+                    A::mul_add(
+                        -p.MZ4r,
+                        k79,
+                        A::mul_add(-p.m4r, d160, A::mul_add(-k78, d163, k80 * d161)),
+                    ),
+                ); // F4r.x
                 let d56 = A::mul_add(
                     -p.MX4l,
                     k30,
@@ -12504,38 +13938,35 @@ mod generated {
                         A::mul_add(-p.m4l, d49, A::mul_add(k28, d51, k26 * d53)),
                     ),
                 ); // F4l.z
+                let d166 = A::mul_add(
+                    -p.MX4r,
+                    k79,
+                    A::mul_add(
+                        p.MY4r,
+                        k81,
+                        A::mul_add(-p.m4r, d159, A::mul_add(k80, d162, k77 * d163)),
+                    ),
+                ); // F4r.z
                 let d57 = A::mul_add(
                     -p.XZ4l,
                     k27,
                     A::mul_add(p.XY4l, k28, p.XX4l * k26),
                 ); // J4lw4l|ud=0,g=0.x
+                let d167 = A::mul_add(
+                    -p.XZ4r,
+                    k78,
+                    A::mul_add(p.XY4r, k80, p.XX4r * k77),
+                ); // J4rw4r|ud=0,g=0.x
                 let d58 = A::mul_add(
                     -p.YZ4l,
                     k27,
                     A::mul_add(p.YY4l, k28, p.XY4l * k26),
                 ); // J4lw4l|ud=0,g=0.y
-                let d59 = A::mul_add(
-                    -p.ZZ4l,
-                    k27,
-                    A::mul_add(p.YZ4l, k28, p.XZ4l * k26),
-                ); // J4lw4l|ud=0,g=0.z
-                let d60 = A::mul_add(
-                    -p.MZ4l,
-                    d46,
-                    A::mul_add(
-                        p.MY4l,
-                        d49,
-                        A::mul_add(
-                            -p.XZ4l,
-                            k31,
-                            A::mul_add(
-                                -p.XY4l,
-                                k30,
-                                A::mul_add(-p.XX4l, k29, A::mul_add(k27, d58, k28 * d59)),
-                            ),
-                        ),
-                    ),
-                ); // N4l.x
+                let d168 = A::mul_add(
+                    -p.YZ4r,
+                    k78,
+                    A::mul_add(p.YY4r, k80, p.XY4r * k77),
+                ); // J4rw4r|ud=0,g=0.y
                 let d61 = A::mul_add(
                     p.MY4l,
                     d50,
@@ -12553,6 +13984,67 @@ mod generated {
                         ),
                     ),
                 ); // N4l.z
+                let d59 = A::mul_add(
+                    -p.ZZ4l,
+                    k27,
+                    A::mul_add(p.YZ4l, k28, p.XZ4l * k26),
+                ); // J4lw4l|ud=0,g=0.z
+                let d169 = A::mul_add(
+                    -p.ZZ4r,
+                    k78,
+                    A::mul_add(p.YZ4r, k80, p.XZ4r * k77),
+                ); // J4rw4r|ud=0,g=0.z
+                let d60 = A::mul_add(
+                    -p.MZ4l,
+                    d46,
+                    A::mul_add(
+                        p.MY4l,
+                        d49,
+                        A::mul_add(
+                            -p.XZ4l,
+                            k31,
+                            A::mul_add(
+                                -p.XY4l,
+                                k30,
+                                A::mul_add(-p.XX4l, k29, A::mul_add(k27, d58, k28 * d59)),
+                            ),
+                        ),
+                    ),
+                ); // N4l.x
+                let d170 = A::mul_add(
+                    p.MY4r,
+                    d160,
+                    A::mul_add(
+                        -p.MX4r,
+                        d156,
+                        A::mul_add(
+                            -p.ZZ4r,
+                            k82,
+                            A::mul_add(
+                                -p.YZ4r,
+                                k79,
+                                A::mul_add(-p.XZ4r, k81, A::mul_add(-k80, d167, k77 * d168)),
+                            ),
+                        ),
+                    ),
+                ); // N4r.z
+                let d171 = A::mul_add(
+                    p.MZ4r,
+                    d156,
+                    A::mul_add(
+                        p.MY4r,
+                        d159,
+                        A::mul_add(
+                            -p.XZ4r,
+                            k82,
+                            A::mul_add(
+                                -p.XY4r,
+                                k79,
+                                A::mul_add(-p.XX4r, k81, A::mul_add(k78, d168, k80 * d169)),
+                            ),
+                        ),
+                    ),
+                ); // N4r.x
                 let d62 = A::mul_add(
                     p.MX4l,
                     d49,
@@ -12570,26 +14062,43 @@ mod generated {
                         ),
                     ),
                 ); // N4l.y
-                let k35 = A::mul_add(-s_q2l, k27, c_q2l * k28); // w4l in 5l|ud=0,g=0.y
-                let k36 = A::mul_add(c_q2l, k27, s_q2l * k28); // w4l in 5l|ud=0,g=0.z
-                let k37 = k29 - qdd2l; // wd5l.x
-                let k38 = A::mul_add(s_q2l, k31, A::mul_add(c_q2l, k30, k36 * qd2l)); // wd5l.y
-                let k39 = k26 + qd2l; // w5l|ud=0,g=0.x
-                let k40 = A::mul_add(c_q2l, k31, A::mul_add(-s_q2l, k30, k35 * qd2l)); // wd5l.z
-                let d63 = A::mul_add(s_q2l, d49, c_q2l * d46); // a5l.y
-                let d64 = A::mul_add(-c_q2l, d49, s_q2l * d46); // a5l.z
-                let d65 = A::mul_add(-p.MY5l, k36, p.MZ5l * k35); // w5lxMS5l|ud=0,g=0.x
-                let d66 = A::mul_add(-p.MZ5l, k39, p.MX5l * k36); // w5lxMS5l|ud=0,g=0.y
-                let d67 = A::mul_add(-p.MX5l, k35, p.MY5l * k39); // w5lxMS5l|ud=0,g=0.z
-                let d68 = A::mul_add(
-                    p.MY5l,
-                    k40,
+                let d172 = A::mul_add(
+                    p.MX4r,
+                    d159,
                     A::mul_add(
-                        p.MZ5l,
-                        k38,
-                        A::mul_add(p.m5l, d50, A::mul_add(-k36, d66, k35 * d67)),
+                        p.MZ4r,
+                        d160,
+                        A::mul_add(
+                            p.YZ4r,
+                            k82,
+                            A::mul_add(
+                                p.YY4r,
+                                k79,
+                                A::mul_add(p.XY4r, k81, A::mul_add(k77, d169, k78 * d167)),
+                            ),
+                        ),
                     ),
-                ); // F5l.x
+                ); // N4r.y
+                let k35 = A::mul_add(-s_q2l, k27, c_q2l * k28); // w4l in 5l|ud=0,g=0.y
+                let k84 = A::mul_add(-s_q2r, k78, c_q2r * k80); // w4r in 5r|ud=0,g=0.y
+                let k36 = A::mul_add(c_q2l, k27, s_q2l * k28); // w4l in 5l|ud=0,g=0.z
+                let k85 = A::mul_add(c_q2r, k78, s_q2r * k80); // w4r in 5r|ud=0,g=0.z
+                let k37 = k29 - qdd2l; // wd5l.x
+                let k86 = k81 - qdd2r; // wd5r.x
+                let k40 = A::mul_add(c_q2l, k31, A::mul_add(-s_q2l, k30, k35 * qd2l)); // wd5l.z
+                let k87 = A::mul_add(c_q2r, k82, A::mul_add(-s_q2r, k79, k84 * qd2r)); // wd5r.z
+                let k39 = k26 + qd2l; // w5l|ud=0,g=0.x
+                let k88 = k77 + qd2r; // w5r|ud=0,g=0.x
+                let k38 = A::mul_add(s_q2l, k31, A::mul_add(c_q2l, k30, k36 * qd2l)); // wd5l.y
+                let k89 = A::mul_add(s_q2r, k82, A::mul_add(c_q2r, k79, k85 * qd2r)); // wd5r.y
+                let d173 = A::mul_add(-c_q2r, d156, s_q2r * d159); // a5r.y
+                let d174 = A::mul_add(-c_q2r, d159, -s_q2r * d156); // a5r.z
+                let d65 = A::mul_add(-p.MY5l, k36, p.MZ5l * k35); // w5lxMS5l|ud=0,g=0.x
+                let d175 = A::mul_add(-p.MY5r, k85, p.MZ5r * k84); // w5rxMS5r|ud=0,g=0.x
+                let d66 = A::mul_add(-p.MZ5l, k39, p.MX5l * k36); // w5lxMS5l|ud=0,g=0.y
+                let d176 = A::mul_add(-p.MZ5r, k88, p.MX5r * k85); // w5rxMS5r|ud=0,g=0.y
+                let d67 = A::mul_add(-p.MX5l, k35, p.MY5l * k39); // w5lxMS5l|ud=0,g=0.z
+                let d177 = A::mul_add(-p.MX5r, k84, p.MY5r * k88); // w5rxMS5r|ud=0,g=0.z
                 let d69 = A::mul_add(
                     -p.MZ5l,
                     k37,
@@ -12599,6 +14108,33 @@ mod generated {
                         A::mul_add(-p.m5l, d63, A::mul_add(-k39, d67, k36 * d65)),
                     ),
                 ); // F5l.y
+                let d178 = A::mul_add(
+                    -p.MZ5r,
+                    k86,
+                    A::mul_add(
+                        -p.MX5r,
+                        k87,
+                        A::mul_add(-p.m5r, d173, A::mul_add(-k88, d177, k85 * d175)),
+                    ),
+                ); // F5r.y
+                let d68 = A::mul_add(
+                    p.MY5l,
+                    k40,
+                    A::mul_add(
+                        p.MZ5l,
+                        k38,
+                        A::mul_add(p.m5l, d50, A::mul_add(-k36, d66, k35 * d67)),
+                    ),
+                ); // F5l.x
+                let d179 = A::mul_add(
+                    p.MY5r,
+                    k87,
+                    A::mul_add(
+                        p.MZ5r,
+                        k89,
+                        A::mul_add(p.m5r, d160, A::mul_add(-k85, d176, k84 * d177)),
+                    ),
+                ); // F5r.x
                 let d70 = A::mul_add(
                     -p.MX5l,
                     k38,
@@ -12608,43 +14144,33 @@ mod generated {
                         A::mul_add(-p.m5l, d64, A::mul_add(-k35, d65, k39 * d66)),
                     ),
                 ); // F5l.z
+                let d180 = A::mul_add(
+                    -p.MX5r,
+                    k89,
+                    A::mul_add(
+                        p.MY5r,
+                        k86,
+                        A::mul_add(-p.m5r, d174, A::mul_add(-k84, d175, k88 * d176)),
+                    ),
+                ); // F5r.z
                 let d71 = A::mul_add(p.XZ5l, k36, A::mul_add(p.XY5l, k35, p.XX5l * k39)); // J5lw5l|ud=0,g=0.x
+                let d181 = A::mul_add(
+                    p.XZ5r,
+                    k85,
+                    A::mul_add(p.XY5r, k84, p.XX5r * k88),
+                ); // J5rw5r|ud=0,g=0.x
                 let d72 = A::mul_add(p.YZ5l, k36, A::mul_add(p.YY5l, k35, p.XY5l * k39)); // J5lw5l|ud=0,g=0.y
+                let d182 = A::mul_add(
+                    p.YZ5r,
+                    k85,
+                    A::mul_add(p.YY5r, k84, p.XY5r * k88),
+                ); // J5rw5r|ud=0,g=0.y
                 let d73 = A::mul_add(p.ZZ5l, k36, A::mul_add(p.YZ5l, k35, p.XZ5l * k39)); // J5lw5l|ud=0,g=0.z
-                let d74 = A::mul_add(
-                    p.MZ5l,
-                    d63,
-                    A::mul_add(
-                        -p.MY5l,
-                        d64,
-                        A::mul_add(
-                            -p.XZ5l,
-                            k40,
-                            A::mul_add(
-                                p.XY5l,
-                                k38,
-                                A::mul_add(p.XX5l, k37, A::mul_add(-k36, d72, k35 * d73)),
-                            ),
-                        ),
-                    ),
-                ); // N5l.x
-                let d75 = A::mul_add(
-                    p.MX5l,
-                    d64,
-                    A::mul_add(
-                        p.MZ5l,
-                        d50,
-                        A::mul_add(
-                            -p.YZ5l,
-                            k40,
-                            A::mul_add(
-                                p.YY5l,
-                                k38,
-                                A::mul_add(p.XY5l, k37, A::mul_add(-k39, d73, k36 * d71)),
-                            ),
-                        ),
-                    ),
-                ); // N5l.y
+                let d183 = A::mul_add(
+                    p.ZZ5r,
+                    k85,
+                    A::mul_add(p.YZ5r, k84, p.XZ5r * k88),
+                ); // J5rw5r|ud=0,g=0.z
                 let d76 = A::mul_add(
                     -p.MY5l,
                     d50,
@@ -12662,31 +14188,123 @@ mod generated {
                         ),
                     ),
                 ); // N5l.z
-                let k41 = A::mul_add(-s_q3l, k36, c_q3l * k39); // w5l in 6l|ud=0,g=0.x
-                let k42 = A::mul_add(c_q3l, k36, s_q3l * k39); // w5l in 6l|ud=0,g=0.z
-                let k43 = k35 - qd3l; // w6l|ud=0,g=0.y
-                let k44 = A::mul_add(s_q3l, k40, A::mul_add(c_q3l, k37, k42 * qd3l)); // wd6l.x
-                let k45 = k38 + qdd3l; // wd6l.y
-                let k46 = A::mul_add(c_q3l, k40, A::mul_add(-s_q3l, k37, k41 * qd3l)); // wd6l.z
-                let k47 = p.L7 * k36; // w5lxP6l|ud=0,g=0.x
-                let k48 = p.L7 * k39; // w5lxP6l|ud=0,g=0.z
-                let d77 = A::mul_add(k39, k48, k36 * k47) - d63; // a6l in 5l.y
-                let d78 = A::mul_add(p.L7, k40, A::mul_add(k35, k48, -d50)); // a6l in 5l.x
-                let d79 = A::mul_add(p.L7, k37, A::mul_add(k35, k47, d64)); // a6l in 5l.z
-                let d80 = A::mul_add(-s_q3l, d79, c_q3l * d78); // a6l.x
-                let d81 = A::mul_add(c_q3l, d79, s_q3l * d78); // a6l.z
-                let d82 = A::mul_add(p.MY6l, k42, p.MZ6l * k43); // w6lxMS6l|ud=0,g=0.x
-                let d83 = A::mul_add(-p.MX6l, k43, p.MY6l * k41); // w6lxMS6l|ud=0,g=0.z
-                let d84 = A::mul_add(p.MZ6l, k41, p.MX6l * k42); // w6lxMS6l|ud=0,g=0.y
-                let d85 = A::mul_add(
-                    p.MY6l,
-                    k46,
+                let d184 = A::mul_add(
+                    -p.MY5r,
+                    d160,
                     A::mul_add(
-                        -p.MZ6l,
-                        k45,
-                        A::mul_add(p.m6l, d80, A::mul_add(-k42, d84, k43 * d83)),
+                        -p.MX5r,
+                        d173,
+                        A::mul_add(
+                            -p.ZZ5r,
+                            k87,
+                            A::mul_add(
+                                p.YZ5r,
+                                k89,
+                                A::mul_add(p.XZ5r, k86, A::mul_add(-k84, d181, k88 * d182)),
+                            ),
+                        ),
                     ),
-                ); // F6l.x
+                ); // N5r.z
+                let d74 = A::mul_add(
+                    p.MZ5l,
+                    d63,
+                    A::mul_add(
+                        -p.MY5l,
+                        d64,
+                        A::mul_add(
+                            -p.XZ5l,
+                            k40,
+                            A::mul_add(
+                                p.XY5l,
+                                k38,
+                                A::mul_add(p.XX5l, k37, A::mul_add(-k36, d72, k35 * d73)),
+                            ),
+                        ),
+                    ),
+                ); // N5l.x
+                let d185 = A::mul_add(
+                    p.MZ5r,
+                    d173,
+                    A::mul_add(
+                        -p.MY5r,
+                        d174,
+                        A::mul_add(
+                            -p.XZ5r,
+                            k87,
+                            A::mul_add(
+                                p.XY5r,
+                                k89,
+                                A::mul_add(p.XX5r, k86, A::mul_add(-k85, d182, k84 * d183)),
+                            ),
+                        ),
+                    ),
+                ); // N5r.x
+                let d75 = A::mul_add(
+                    p.MX5l,
+                    d64,
+                    A::mul_add(
+                        p.MZ5l,
+                        d50,
+                        A::mul_add(
+                            -p.YZ5l,
+                            k40,
+                            A::mul_add(
+                                p.YY5l,
+                                k38,
+                                A::mul_add(p.XY5l, k37, A::mul_add(-k39, d73, k36 * d71)),
+                            ),
+                        ),
+                    ),
+                ); // N5l.y
+                let d186 = A::mul_add(
+                    p.MX5r,
+                    d174,
+                    A::mul_add(
+                        p.MZ5r,
+                        d160,
+                        A::mul_add(
+                            -p.YZ5r,
+                            k87,
+                            A::mul_add(
+                                p.YY5r,
+                                k89,
+                                A::mul_add(p.XY5r, k86, A::mul_add(-k88, d183, k85 * d181)),
+                            ),
+                        ),
+                    ),
+                ); // N5r.y
+                let k41 = A::mul_add(-s_q3l, k36, c_q3l * k39); // w5l in 6l|ud=0,g=0.x
+                let k90 = A::mul_add(-s_q3r, k85, c_q3r * k88); // w5r in 6r|ud=0,g=0.x
+                let k42 = A::mul_add(c_q3l, k36, s_q3l * k39); // w5l in 6l|ud=0,g=0.z
+                let k91 = A::mul_add(c_q3r, k85, s_q3r * k88); // w5r in 6r|ud=0,g=0.z
+                let k45 = k38 + qdd3l; // wd6l.y
+                let k92 = k89 + qdd3r; // wd6r.y
+                let k43 = k35 - qd3l; // w6l|ud=0,g=0.y
+                let k93 = k84 - qd3r; // w6r|ud=0,g=0.y
+                let k44 = A::mul_add(s_q3l, k40, A::mul_add(c_q3l, k37, k42 * qd3l)); // wd6l.x
+                let k94 = A::mul_add(s_q3r, k87, A::mul_add(c_q3r, k86, k91 * qd3r)); // wd6r.x
+                let k46 = A::mul_add(c_q3l, k40, A::mul_add(-s_q3l, k37, k41 * qd3l)); // wd6l.z
+                let k95 = A::mul_add(c_q3r, k87, A::mul_add(-s_q3r, k86, k90 * qd3r)); // wd6r.z
+                let k47 = p.L7 * k36; // w5lxP6l|ud=0,g=0.x
+                let k96 = p.L7 * k85; // w5rxP6r|ud=0,g=0.x
+                let k48 = p.L7 * k39; // w5lxP6l|ud=0,g=0.z
+                let k97 = p.L7 * k88; // w5rxP6r|ud=0,g=0.z
+                let d78 = A::mul_add(p.L7, k40, A::mul_add(k35, k48, -d50)); // a6l in 5l.x
+                let d187 = A::mul_add(p.L7, k87, A::mul_add(k84, k97, -d160)); // a6r in 5r.x
+                let d77 = A::mul_add(k39, k48, k36 * k47) - d63; // a6l in 5l.y
+                let d188 = A::mul_add(k88, k97, k85 * k96) - d173; // a6r in 5r.y
+                let d79 = A::mul_add(p.L7, k37, A::mul_add(k35, k47, d64)); // a6l in 5l.z
+                let d189 = A::mul_add(p.L7, k86, A::mul_add(k84, k96, d174)); // a6r in 5r.z
+                let d81 = A::mul_add(c_q3l, d79, s_q3l * d78); // a6l.z
+                let d190 = A::mul_add(c_q3r, d189, s_q3r * d187); // a6r.z
+                let d80 = A::mul_add(-s_q3l, d79, c_q3l * d78); // a6l.x
+                let d191 = A::mul_add(-s_q3r, d189, c_q3r * d187); // a6r.x
+                let d83 = A::mul_add(-p.MX6l, k43, p.MY6l * k41); // w6lxMS6l|ud=0,g=0.z
+                let d192 = A::mul_add(-p.MX6r, k93, p.MY6r * k90); // w6rxMS6r|ud=0,g=0.z
+                let d82 = A::mul_add(p.MY6l, k42, p.MZ6l * k43); // w6lxMS6l|ud=0,g=0.x
+                let d193 = A::mul_add(p.MY6r, k91, p.MZ6r * k93); // w6rxMS6r|ud=0,g=0.x
+                let d84 = A::mul_add(p.MZ6l, k41, p.MX6l * k42); // w6lxMS6l|ud=0,g=0.y
+                let d194 = A::mul_add(p.MZ6r, k90, p.MX6r * k91); // w6rxMS6r|ud=0,g=0.y
                 let d86 = A::mul_add(
                     -p.MZ6l,
                     k44,
@@ -12696,6 +14314,33 @@ mod generated {
                         A::mul_add(p.m6l, d77, A::mul_add(k41, d83, k42 * d82)),
                     ),
                 ); // F6l.y
+                let d195 = A::mul_add(
+                    -p.MZ6r,
+                    k94,
+                    A::mul_add(
+                        p.MX6r,
+                        k95,
+                        A::mul_add(p.m6r, d188, A::mul_add(k90, d192, k91 * d193)),
+                    ),
+                ); // F6r.y
+                let d85 = A::mul_add(
+                    p.MY6l,
+                    k46,
+                    A::mul_add(
+                        -p.MZ6l,
+                        k45,
+                        A::mul_add(p.m6l, d80, A::mul_add(-k42, d84, k43 * d83)),
+                    ),
+                ); // F6l.x
+                let d196 = A::mul_add(
+                    p.MY6r,
+                    k95,
+                    A::mul_add(
+                        -p.MZ6r,
+                        k92,
+                        A::mul_add(p.m6r, d191, A::mul_add(-k91, d194, k93 * d192)),
+                    ),
+                ); // F6r.x
                 let d87 = A::mul_add(
                     -p.MX6l,
                     k45,
@@ -12705,38 +14350,45 @@ mod generated {
                         A::mul_add(p.m6l, d81, A::mul_add(k43, d82, k41 * d84)),
                     ),
                 ); // F6l.z
+                let d197 = A::mul_add(
+                    -p.MX6r,
+                    k92,
+                    A::mul_add(
+                        p.MY6r,
+                        k94,
+                        A::mul_add(p.m6r, d190, A::mul_add(k93, d193, k90 * d194)),
+                    ),
+                ); // F6r.z
                 let d88 = A::mul_add(
                     -p.XZ6l,
                     k42,
                     A::mul_add(p.XY6l, k43, p.XX6l * k41),
                 ); // J6lw6l|ud=0,g=0.x
+                let d198 = A::mul_add(
+                    -p.XZ6r,
+                    k91,
+                    A::mul_add(p.XY6r, k93, p.XX6r * k90),
+                ); // J6rw6r|ud=0,g=0.x
                 let d89 = A::mul_add(
                     -p.YZ6l,
                     k42,
                     A::mul_add(p.YY6l, k43, p.XY6l * k41),
                 ); // J6lw6l|ud=0,g=0.y
+                let d199 = A::mul_add(
+                    -p.YZ6r,
+                    k91,
+                    A::mul_add(p.YY6r, k93, p.XY6r * k90),
+                ); // J6rw6r|ud=0,g=0.y
                 let d90 = A::mul_add(
                     -p.ZZ6l,
                     k42,
                     A::mul_add(p.YZ6l, k43, p.XZ6l * k41),
                 ); // J6lw6l|ud=0,g=0.z
-                let d91 = A::mul_add(
-                    p.MZ6l,
-                    d77,
-                    A::mul_add(
-                        -p.MY6l,
-                        d81,
-                        A::mul_add(
-                            -p.XZ6l,
-                            k46,
-                            A::mul_add(
-                                -p.XY6l,
-                                k45,
-                                A::mul_add(-p.XX6l, k44, A::mul_add(k42, d89, k43 * d90)),
-                            ),
-                        ),
-                    ),
-                ); // N6l.x
+                let d200 = A::mul_add(
+                    -p.ZZ6r,
+                    k91,
+                    A::mul_add(p.YZ6r, k93, p.XZ6r * k90),
+                ); // J6rw6r|ud=0,g=0.z
                 let d92 = A::mul_add(
                     -p.MY6l,
                     d80,
@@ -12754,6 +14406,57 @@ mod generated {
                         ),
                     ),
                 ); // N6l.z
+                let d201 = A::mul_add(
+                    -p.MY6r,
+                    d191,
+                    A::mul_add(
+                        -p.MX6r,
+                        d188,
+                        A::mul_add(
+                            -p.ZZ6r,
+                            k95,
+                            A::mul_add(
+                                -p.YZ6r,
+                                k92,
+                                A::mul_add(-p.XZ6r, k94, A::mul_add(-k93, d198, k90 * d199)),
+                            ),
+                        ),
+                    ),
+                ); // N6r.z
+                let d91 = A::mul_add(
+                    p.MZ6l,
+                    d77,
+                    A::mul_add(
+                        -p.MY6l,
+                        d81,
+                        A::mul_add(
+                            -p.XZ6l,
+                            k46,
+                            A::mul_add(
+                                -p.XY6l,
+                                k45,
+                                A::mul_add(-p.XX6l, k44, A::mul_add(k42, d89, k43 * d90)),
+                            ),
+                        ),
+                    ),
+                ); // N6l.x
+                let d202 = A::mul_add(
+                    p.MZ6r,
+                    d188,
+                    A::mul_add(
+                        -p.MY6r,
+                        d190,
+                        A::mul_add(
+                            -p.XZ6r,
+                            k95,
+                            A::mul_add(
+                                -p.XY6r,
+                                k92,
+                                A::mul_add(-p.XX6r, k94, A::mul_add(k91, d199, k93 * d200)),
+                            ),
+                        ),
+                    ),
+                ); // N6r.x
                 let d93 = A::mul_add(
                     -p.MX6l,
                     d81,
@@ -12771,26 +14474,45 @@ mod generated {
                         ),
                     ),
                 ); // N6l.y
-                let k49 = A::mul_add(-s_q4l, k42, c_q4l * k43); // w6l in 7l|ud=0,g=0.y
-                let k50 = A::mul_add(c_q4l, k42, s_q4l * k43); // w6l in 7l|ud=0,g=0.z
-                let k51 = k44 - qdd4l; // wd7l.x
-                let k52 = A::mul_add(s_q4l, k46, A::mul_add(c_q4l, k45, k50 * qd4l)); // wd7l.y
-                let k53 = k41 + qd4l; // w7l|ud=0,g=0.x
-                let k54 = A::mul_add(c_q4l, k46, A::mul_add(-s_q4l, k45, k49 * qd4l)); // wd7l.z
-                let d94 = A::mul_add(s_q4l, d81, c_q4l * d77); // a7l.y
-                let d95 = A::mul_add(-c_q4l, d81, s_q4l * d77); // a7l.z
-                let d96 = A::mul_add(-p.MY7l, k50, p.MZ7l * k49); // w7lxMS7l|ud=0,g=0.x
-                let d97 = A::mul_add(-p.MZ7l, k53, p.MX7l * k50); // w7lxMS7l|ud=0,g=0.y
-                let d98 = A::mul_add(-p.MX7l, k49, p.MY7l * k53); // w7lxMS7l|ud=0,g=0.z
-                let d99 = A::mul_add(
-                    p.MY7l,
-                    k54,
+                let d203 = A::mul_add(
+                    -p.MX6r,
+                    d190,
                     A::mul_add(
-                        p.MZ7l,
-                        k52,
-                        A::mul_add(-p.m7l, d80, A::mul_add(-k50, d97, k49 * d98)),
+                        -p.MZ6r,
+                        d191,
+                        A::mul_add(
+                            p.YZ6r,
+                            k95,
+                            A::mul_add(
+                                p.YY6r,
+                                k92,
+                                A::mul_add(p.XY6r, k94, A::mul_add(k90, d200, k91 * d198)),
+                            ),
+                        ),
                     ),
-                ); // F7l.x
+                ); // N6r.y
+                let k49 = A::mul_add(-s_q4l, k42, c_q4l * k43); // w6l in 7l|ud=0,g=0.y
+                let k98 = A::mul_add(-s_q4r, k91, c_q4r * k93); // w6r in 7r|ud=0,g=0.y
+                let k50 = A::mul_add(c_q4l, k42, s_q4l * k43); // w6l in 7l|ud=0,g=0.z
+                let k99 = A::mul_add(c_q4r, k91, s_q4r * k93); // w6r in 7r|ud=0,g=0.z
+                let k51 = k44 - qdd4l; // wd7l.x
+                let k100 = k94 - qdd4r; // wd7r.x
+                let k54 = A::mul_add(c_q4l, k46, A::mul_add(-s_q4l, k45, k49 * qd4l)); // wd7l.z
+                let k101 = A::mul_add(c_q4r, k95, A::mul_add(-s_q4r, k92, k98 * qd4r)); // wd7r.z
+                let k53 = k41 + qd4l; // w7l|ud=0,g=0.x
+                let k102 = k90 + qd4r; // w7r|ud=0,g=0.x
+                let k52 = A::mul_add(s_q4l, k46, A::mul_add(c_q4l, k45, k50 * qd4l)); // wd7l.y
+                let k103 = A::mul_add(s_q4r, k95, A::mul_add(c_q4r, k92, k99 * qd4r)); // wd7r.y
+                let d94 = A::mul_add(s_q4l, d81, c_q4l * d77); // a7l.y
+                let d204 = A::mul_add(s_q4r, d190, c_q4r * d188); // a7r.y
+                let d95 = A::mul_add(-c_q4l, d81, s_q4l * d77); // a7l.z
+                let d205 = A::mul_add(-c_q4r, d190, s_q4r * d188); // a7r.z
+                let d96 = A::mul_add(-p.MY7l, k50, p.MZ7l * k49); // w7lxMS7l|ud=0,g=0.x
+                let d206 = A::mul_add(-p.MY7r, k99, p.MZ7r * k98); // w7rxMS7r|ud=0,g=0.x
+                let d97 = A::mul_add(-p.MZ7l, k53, p.MX7l * k50); // w7lxMS7l|ud=0,g=0.y
+                let d207 = A::mul_add(-p.MZ7r, k102, p.MX7r * k99); // w7rxMS7r|ud=0,g=0.y
+                let d98 = A::mul_add(-p.MX7l, k49, p.MY7l * k53); // w7lxMS7l|ud=0,g=0.z
+                let d208 = A::mul_add(-p.MX7r, k98, p.MY7r * k102); // w7rxMS7r|ud=0,g=0.z
                 let d100 = A::mul_add(
                     -p.MZ7l,
                     k51,
@@ -12800,6 +14522,33 @@ mod generated {
                         A::mul_add(p.m7l, d94, A::mul_add(-k53, d98, k50 * d96)),
                     ),
                 ); // F7l.y
+                let d209 = A::mul_add(
+                    -p.MZ7r,
+                    k100,
+                    A::mul_add(
+                        -p.MX7r,
+                        k101,
+                        A::mul_add(p.m7r, d204, A::mul_add(-k102, d208, k99 * d206)),
+                    ),
+                ); // F7r.y
+                let d99 = A::mul_add(
+                    p.MY7l,
+                    k54,
+                    A::mul_add(
+                        p.MZ7l,
+                        k52,
+                        A::mul_add(-p.m7l, d80, A::mul_add(-k50, d97, k49 * d98)),
+                    ),
+                ); // F7l.x
+                let d210 = A::mul_add(
+                    p.MY7r,
+                    k101,
+                    A::mul_add(
+                        p.MZ7r,
+                        k103,
+                        A::mul_add(-p.m7r, d191, A::mul_add(-k99, d207, k98 * d208)),
+                    ),
+                ); // F7r.x
                 let d101 = A::mul_add(
                     -p.MX7l,
                     k52,
@@ -12809,55 +14558,45 @@ mod generated {
                         A::mul_add(p.m7l, d95, A::mul_add(-k49, d96, k53 * d97)),
                     ),
                 ); // F7l.z
+                let d211 = A::mul_add(
+                    -p.MX7r,
+                    k103,
+                    A::mul_add(
+                        p.MY7r,
+                        k100,
+                        A::mul_add(p.m7r, d205, A::mul_add(-k98, d206, k102 * d207)),
+                    ),
+                ); // F7r.z
                 let d102 = A::mul_add(
                     p.XZ7l,
                     k50,
                     A::mul_add(p.XY7l, k49, p.XX7l * k53),
                 ); // J7lw7l|ud=0,g=0.x
+                let d212 = A::mul_add(
+                    p.XZ7r,
+                    k99,
+                    A::mul_add(p.XY7r, k98, p.XX7r * k102),
+                ); // J7rw7r|ud=0,g=0.x
                 let d103 = A::mul_add(
                     p.YZ7l,
                     k50,
                     A::mul_add(p.YY7l, k49, p.XY7l * k53),
                 ); // J7lw7l|ud=0,g=0.y
+                let d213 = A::mul_add(
+                    p.YZ7r,
+                    k99,
+                    A::mul_add(p.YY7r, k98, p.XY7r * k102),
+                ); // J7rw7r|ud=0,g=0.y
                 let d104 = A::mul_add(
                     p.ZZ7l,
                     k50,
                     A::mul_add(p.YZ7l, k49, p.XZ7l * k53),
                 ); // J7lw7l|ud=0,g=0.z
-                let d105 = A::mul_add(
-                    -p.MZ7l,
-                    d94,
-                    A::mul_add(
-                        p.MY7l,
-                        d95,
-                        A::mul_add(
-                            -p.XZ7l,
-                            k54,
-                            A::mul_add(
-                                p.XY7l,
-                                k52,
-                                A::mul_add(p.XX7l, k51, A::mul_add(-k50, d103, k49 * d104)),
-                            ),
-                        ),
-                    ),
-                ); // N7l.x
-                let d106 = A::mul_add(
-                    -p.MX7l,
-                    d95,
-                    A::mul_add(
-                        -p.MZ7l,
-                        d80,
-                        A::mul_add(
-                            -p.YZ7l,
-                            k54,
-                            A::mul_add(
-                                p.YY7l,
-                                k52,
-                                A::mul_add(p.XY7l, k51, A::mul_add(-k53, d104, k50 * d102)),
-                            ),
-                        ),
-                    ),
-                ); // N7l.y
+                let d214 = A::mul_add(
+                    p.ZZ7r,
+                    k99,
+                    A::mul_add(p.YZ7r, k98, p.XZ7r * k102),
+                ); // J7rw7r|ud=0,g=0.z
                 let d107 = A::mul_add(
                     p.MY7l,
                     d80,
@@ -12875,31 +14614,135 @@ mod generated {
                         ),
                     ),
                 ); // N7l.z
-                let k55 = A::mul_add(-s_q5l, k50, c_q5l * k53); // w7l in 8l|ud=0,g=0.x
-                let k56 = A::mul_add(c_q5l, k50, s_q5l * k53); // w7l in 8l|ud=0,g=0.z
-                let k57 = k49 - qd5l; // w8l|ud=0,g=0.y
-                let k58 = A::mul_add(s_q5l, k54, A::mul_add(c_q5l, k51, k56 * qd5l)); // wd8l.x
-                let k59 = k52 + qdd5l; // wd8l.y
-                let k60 = A::mul_add(c_q5l, k54, A::mul_add(-s_q5l, k51, k55 * qd5l)); // wd8l.z
-                let k61 = p.L8 * k50; // w7lxP8l|ud=0,g=0.x
-                let k62 = p.L8 * k53; // w7lxP8l|ud=0,g=0.z
-                let d108 = A::mul_add(k53, k62, k50 * k61) + d94; // a8l in 7l.y
-                let d109 = A::mul_add(p.L8, k54, A::mul_add(k49, k62, d80)); // a8l in 7l.x
-                let d110 = A::mul_add(p.L8, k51, A::mul_add(k49, k61, -d95)); // a8l in 7l.z
-                let d111 = A::mul_add(-s_q5l, d110, c_q5l * d109); // a8l.x
-                let d112 = A::mul_add(c_q5l, d110, s_q5l * d109); // a8l.z
-                let d113 = A::mul_add(p.MY8l, k56, p.MZ8l * k57); // w8lxMS8l|ud=0,g=0.x
-                let d114 = A::mul_add(-p.MX8l, k57, p.MY8l * k55); // w8lxMS8l|ud=0,g=0.z
-                let d115 = A::mul_add(p.MZ8l, k55, p.MX8l * k56); // w8lxMS8l|ud=0,g=0.y
-                let d116 = A::mul_add(
-                    p.MY8l,
-                    k60,
+                let d215 = A::mul_add(
+                    p.MY7r,
+                    d191,
                     A::mul_add(
-                        -p.MZ8l,
-                        k59,
-                        A::mul_add(p.m8l, d111, A::mul_add(-k56, d115, k57 * d114)),
+                        p.MX7r,
+                        d204,
+                        A::mul_add(
+                            -p.ZZ7r,
+                            k101,
+                            A::mul_add(
+                                p.YZ7r,
+                                k103,
+                                A::mul_add(
+                                    p.XZ7r,
+                                    k100,
+                                    A::mul_add(-k98, d212, k102 * d213),
+                                ),
+                            ),
+                        ),
                     ),
-                ); // F8l.x
+                ); // N7r.z
+                let d105 = A::mul_add(
+                    -p.MZ7l,
+                    d94,
+                    A::mul_add(
+                        p.MY7l,
+                        d95,
+                        A::mul_add(
+                            -p.XZ7l,
+                            k54,
+                            A::mul_add(
+                                p.XY7l,
+                                k52,
+                                A::mul_add(p.XX7l, k51, A::mul_add(-k50, d103, k49 * d104)),
+                            ),
+                        ),
+                    ),
+                ); // N7l.x
+                let d216 = A::mul_add(
+                    -p.MZ7r,
+                    d204,
+                    A::mul_add(
+                        p.MY7r,
+                        d205,
+                        A::mul_add(
+                            -p.XZ7r,
+                            k101,
+                            A::mul_add(
+                                p.XY7r,
+                                k103,
+                                A::mul_add(p.XX7r, k100, A::mul_add(-k99, d213, k98 * d214)),
+                            ),
+                        ),
+                    ),
+                ); // N7r.x
+                let d106 = A::mul_add(
+                    -p.MX7l,
+                    d95,
+                    A::mul_add(
+                        -p.MZ7l,
+                        d80,
+                        A::mul_add(
+                            -p.YZ7l,
+                            k54,
+                            A::mul_add(
+                                p.YY7l,
+                                k52,
+                                A::mul_add(p.XY7l, k51, A::mul_add(-k53, d104, k50 * d102)),
+                            ),
+                        ),
+                    ),
+                ); // N7l.y
+                let d217 = A::mul_add(
+                    -p.MX7r,
+                    d205,
+                    A::mul_add(
+                        -p.MZ7r,
+                        d191,
+                        A::mul_add(
+                            -p.YZ7r,
+                            k101,
+                            A::mul_add(
+                                p.YY7r,
+                                k103,
+                                A::mul_add(
+                                    p.XY7r,
+                                    k100,
+                                    A::mul_add(-k102, d214, k99 * d212),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N7r.y
+                let k55 = A::mul_add(-s_q5l, k50, c_q5l * k53); // w7l in 8l|ud=0,g=0.x
+                let k104 = A::mul_add(-s_q5r, k99, c_q5r * k102); // w7r in 8r|ud=0,g=0.x
+                let k56 = A::mul_add(c_q5l, k50, s_q5l * k53); // w7l in 8l|ud=0,g=0.z
+                let k105 = A::mul_add(c_q5r, k99, s_q5r * k102); // w7r in 8r|ud=0,g=0.z
+                let k59 = k52 + qdd5l; // wd8l.y
+                let k106 = k103 + qdd5r; // wd8r.y
+                let k57 = k49 - qd5l; // w8l|ud=0,g=0.y
+                let k107 = k98 - qd5r; // w8r|ud=0,g=0.y
+                let k58 = A::mul_add(s_q5l, k54, A::mul_add(c_q5l, k51, k56 * qd5l)); // wd8l.x
+                let k108 = A::mul_add(s_q5r, k101, A::mul_add(c_q5r, k100, k105 * qd5r)); // wd8r.x
+                let k60 = A::mul_add(c_q5l, k54, A::mul_add(-s_q5l, k51, k55 * qd5l)); // wd8l.z
+                let k109 = A::mul_add(
+                    c_q5r,
+                    k101,
+                    A::mul_add(-s_q5r, k100, k104 * qd5r),
+                ); // wd8r.z
+                let k61 = p.L8 * k50; // w7lxP8l|ud=0,g=0.x
+                let k110 = p.L8 * k99; // w7rxP8r|ud=0,g=0.x
+                let k62 = p.L8 * k53; // w7lxP8l|ud=0,g=0.z
+                let k111 = p.L8 * k102; // w7rxP8r|ud=0,g=0.z
+                let d109 = A::mul_add(p.L8, k54, A::mul_add(k49, k62, d80)); // a8l in 7l.x
+                let d218 = A::mul_add(p.L8, k101, A::mul_add(k98, k111, d191)); // a8r in 7r.x
+                let d108 = A::mul_add(k53, k62, k50 * k61) + d94; // a8l in 7l.y
+                let d219 = A::mul_add(k102, k111, k99 * k110) + d204; // a8r in 7r.y
+                let d110 = A::mul_add(p.L8, k51, A::mul_add(k49, k61, -d95)); // a8l in 7l.z
+                let d220 = A::mul_add(p.L8, k100, A::mul_add(k98, k110, -d205)); // a8r in 7r.z
+                let d112 = A::mul_add(c_q5l, d110, s_q5l * d109); // a8l.z
+                let d221 = A::mul_add(c_q5r, d220, s_q5r * d218); // a8r.z
+                let d111 = A::mul_add(-s_q5l, d110, c_q5l * d109); // a8l.x
+                let d222 = A::mul_add(-s_q5r, d220, c_q5r * d218); // a8r.x
+                let d114 = A::mul_add(-p.MX8l, k57, p.MY8l * k55); // w8lxMS8l|ud=0,g=0.z
+                let d223 = A::mul_add(-p.MX8r, k107, p.MY8r * k104); // w8rxMS8r|ud=0,g=0.z
+                let d113 = A::mul_add(p.MY8l, k56, p.MZ8l * k57); // w8lxMS8l|ud=0,g=0.x
+                let d224 = A::mul_add(p.MY8r, k105, p.MZ8r * k107); // w8rxMS8r|ud=0,g=0.x
+                let d115 = A::mul_add(p.MZ8l, k55, p.MX8l * k56); // w8lxMS8l|ud=0,g=0.y
+                let d225 = A::mul_add(p.MZ8r, k104, p.MX8r * k105); // w8rxMS8r|ud=0,g=0.y
                 let d117 = A::mul_add(
                     -p.MZ8l,
                     k58,
@@ -12909,6 +14752,33 @@ mod generated {
                         A::mul_add(p.m8l, d108, A::mul_add(k55, d114, k56 * d113)),
                     ),
                 ); // F8l.y
+                let d226 = A::mul_add(
+                    -p.MZ8r,
+                    k108,
+                    A::mul_add(
+                        p.MX8r,
+                        k109,
+                        A::mul_add(p.m8r, d219, A::mul_add(k104, d223, k105 * d224)),
+                    ),
+                ); // F8r.y
+                let d116 = A::mul_add(
+                    p.MY8l,
+                    k60,
+                    A::mul_add(
+                        -p.MZ8l,
+                        k59,
+                        A::mul_add(p.m8l, d111, A::mul_add(-k56, d115, k57 * d114)),
+                    ),
+                ); // F8l.x
+                let d227 = A::mul_add(
+                    p.MY8r,
+                    k109,
+                    A::mul_add(
+                        -p.MZ8r,
+                        k106,
+                        A::mul_add(p.m8r, d222, A::mul_add(-k105, d225, k107 * d223)),
+                    ),
+                ); // F8r.x
                 let d118 = A::mul_add(
                     -p.MX8l,
                     k59,
@@ -12918,38 +14788,45 @@ mod generated {
                         A::mul_add(p.m8l, d112, A::mul_add(k57, d113, k55 * d115)),
                     ),
                 ); // F8l.z
+                let d228 = A::mul_add(
+                    -p.MX8r,
+                    k106,
+                    A::mul_add(
+                        p.MY8r,
+                        k108,
+                        A::mul_add(p.m8r, d221, A::mul_add(k107, d224, k104 * d225)),
+                    ),
+                ); // F8r.z
                 let d119 = A::mul_add(
                     -p.XZ8l,
                     k56,
                     A::mul_add(p.XY8l, k57, p.XX8l * k55),
                 ); // J8lw8l|ud=0,g=0.x
+                let d229 = A::mul_add(
+                    -p.XZ8r,
+                    k105,
+                    A::mul_add(p.XY8r, k107, p.XX8r * k104),
+                ); // J8rw8r|ud=0,g=0.x
                 let d120 = A::mul_add(
                     -p.YZ8l,
                     k56,
                     A::mul_add(p.YY8l, k57, p.XY8l * k55),
                 ); // J8lw8l|ud=0,g=0.y
+                let d230 = A::mul_add(
+                    -p.YZ8r,
+                    k105,
+                    A::mul_add(p.YY8r, k107, p.XY8r * k104),
+                ); // J8rw8r|ud=0,g=0.y
                 let d121 = A::mul_add(
                     -p.ZZ8l,
                     k56,
                     A::mul_add(p.YZ8l, k57, p.XZ8l * k55),
                 ); // J8lw8l|ud=0,g=0.z
-                let d122 = A::mul_add(
-                    p.MZ8l,
-                    d108,
-                    A::mul_add(
-                        -p.MY8l,
-                        d112,
-                        A::mul_add(
-                            -p.XZ8l,
-                            k60,
-                            A::mul_add(
-                                -p.XY8l,
-                                k59,
-                                A::mul_add(-p.XX8l, k58, A::mul_add(k56, d120, k57 * d121)),
-                            ),
-                        ),
-                    ),
-                ); // N8l.x
+                let d231 = A::mul_add(
+                    -p.ZZ8r,
+                    k105,
+                    A::mul_add(p.YZ8r, k107, p.XZ8r * k104),
+                ); // J8rw8r|ud=0,g=0.z
                 let d123 = A::mul_add(
                     -p.MY8l,
                     d111,
@@ -12967,6 +14844,65 @@ mod generated {
                         ),
                     ),
                 ); // N8l.z
+                let d232 = A::mul_add(
+                    -p.MY8r,
+                    d222,
+                    A::mul_add(
+                        -p.MX8r,
+                        d219,
+                        A::mul_add(
+                            -p.ZZ8r,
+                            k109,
+                            A::mul_add(
+                                -p.YZ8r,
+                                k106,
+                                A::mul_add(
+                                    -p.XZ8r,
+                                    k108,
+                                    A::mul_add(-k107, d229, k104 * d230),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8r.z
+                let d122 = A::mul_add(
+                    p.MZ8l,
+                    d108,
+                    A::mul_add(
+                        -p.MY8l,
+                        d112,
+                        A::mul_add(
+                            -p.XZ8l,
+                            k60,
+                            A::mul_add(
+                                -p.XY8l,
+                                k59,
+                                A::mul_add(-p.XX8l, k58, A::mul_add(k56, d120, k57 * d121)),
+                            ),
+                        ),
+                    ),
+                ); // N8l.x
+                let d233 = A::mul_add(
+                    p.MZ8r,
+                    d219,
+                    A::mul_add(
+                        -p.MY8r,
+                        d221,
+                        A::mul_add(
+                            -p.XZ8r,
+                            k109,
+                            A::mul_add(
+                                -p.XY8r,
+                                k106,
+                                A::mul_add(
+                                    -p.XX8r,
+                                    k108,
+                                    A::mul_add(k105, d230, k107 * d231),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N8r.x
                 let d124 = A::mul_add(
                     -p.MX8l,
                     d112,
@@ -12984,26 +14920,53 @@ mod generated {
                         ),
                     ),
                 ); // N8l.y
-                let k63 = A::mul_add(-s_q6l, k56, c_q6l * k57); // w8l in 9l|ud=0,g=0.y
-                let k64 = A::mul_add(c_q6l, k56, s_q6l * k57); // w8l in 9l|ud=0,g=0.z
-                let k65 = k58 - qdd6l; // wd9l.x
-                let k66 = A::mul_add(s_q6l, k60, A::mul_add(c_q6l, k59, k64 * qd6l)); // wd9l.y
-                let k67 = k55 + qd6l; // w9l|ud=0,g=0.x
-                let k68 = A::mul_add(c_q6l, k60, A::mul_add(-s_q6l, k59, k63 * qd6l)); // wd9l.z
-                let d125 = A::mul_add(s_q6l, d112, c_q6l * d108); // a9l.y
-                let d126 = A::mul_add(-c_q6l, d112, s_q6l * d108); // a9l.z
-                let d127 = A::mul_add(-p.MY9l, k64, p.MZ9l * k63); // w9lxMS9l|ud=0,g=0.x
-                let d128 = A::mul_add(-p.MZ9l, k67, p.MX9l * k64); // w9lxMS9l|ud=0,g=0.y
-                let d129 = A::mul_add(-p.MX9l, k63, p.MY9l * k67); // w9lxMS9l|ud=0,g=0.z
-                let d130 = A::mul_add(
-                    p.MY9l,
-                    k68,
+                let d234 = A::mul_add(
+                    -p.MX8r,
+                    d221,
                     A::mul_add(
-                        p.MZ9l,
-                        k66,
-                        A::mul_add(-p.m9l, d111, A::mul_add(-k64, d128, k63 * d129)),
+                        -p.MZ8r,
+                        d222,
+                        A::mul_add(
+                            p.YZ8r,
+                            k109,
+                            A::mul_add(
+                                p.YY8r,
+                                k106,
+                                A::mul_add(
+                                    p.XY8r,
+                                    k108,
+                                    A::mul_add(k104, d231, k105 * d229),
+                                ),
+                            ),
+                        ),
                     ),
-                ); // F9l.x
+                ); // N8r.y
+                let k63 = A::mul_add(-s_q6l, k56, c_q6l * k57); // w8l in 9l|ud=0,g=0.y
+                let k112 = A::mul_add(-s_q6r, k105, c_q6r * k107); // w8r in 9r|ud=0,g=0.y
+                let k64 = A::mul_add(c_q6l, k56, s_q6l * k57); // w8l in 9l|ud=0,g=0.z
+                let k113 = A::mul_add(c_q6r, k105, s_q6r * k107); // w8r in 9r|ud=0,g=0.z
+                let k65 = k58 - qdd6l; // wd9l.x
+                let k114 = k108 - qdd6r; // wd9r.x
+                let k68 = A::mul_add(c_q6l, k60, A::mul_add(-s_q6l, k59, k63 * qd6l)); // wd9l.z
+                let k115 = A::mul_add(
+                    c_q6r,
+                    k109,
+                    A::mul_add(-s_q6r, k106, k112 * qd6r),
+                ); // wd9r.z
+                let k67 = k55 + qd6l; // w9l|ud=0,g=0.x
+                let k116 = k104 + qd6r; // w9r|ud=0,g=0.x
+                let k66 = A::mul_add(s_q6l, k60, A::mul_add(c_q6l, k59, k64 * qd6l)); // wd9l.y
+                let k117 = A::mul_add(s_q6r, k109, A::mul_add(c_q6r, k106, k113 * qd6r)); // wd9r.y
+                let d125 = A::mul_add(s_q6l, d112, c_q6l * d108); // a9l.y
+                let d235 = A::mul_add(s_q6r, d221, c_q6r * d219); // a9r.y
+                let d126 = A::mul_add(-c_q6l, d112, s_q6l * d108); // a9l.z
+                let d236 = A::mul_add(-c_q6r, d221, s_q6r * d219); // a9r.z
+                let d127 = A::mul_add(-p.MY9l, k64, p.MZ9l * k63); // w9lxMS9l|ud=0,g=0.x
+                let d237 = A::mul_add(-p.MY9r, k113, p.MZ9r * k112); // w9rxMS9r|ud=0,g=0.x
+                let d128 = A::mul_add(-p.MZ9l, k67, p.MX9l * k64); // w9lxMS9l|ud=0,g=0.y
+                let d238 = A::mul_add(-p.MZ9r, k116, p.MX9r * k113); // w9rxMS9r|ud=0,g=0.y
+                let d129 = A::mul_add(-p.MX9l, k63, p.MY9l * k67); // w9lxMS9l|ud=0,g=0.z
+                let d239 = A::mul_add(-p.MX9r, k112, p.MY9r * k116); // w9rxMS9r|ud=0,g=0.z
                 let d131 = A::mul_add(
                     -p.MZ9l,
                     k65,
@@ -13013,6 +14976,33 @@ mod generated {
                         A::mul_add(p.m9l, d125, A::mul_add(-k67, d129, k64 * d127)),
                     ),
                 ); // F9l.y
+                let d240 = A::mul_add(
+                    -p.MZ9r,
+                    k114,
+                    A::mul_add(
+                        -p.MX9r,
+                        k115,
+                        A::mul_add(p.m9r, d235, A::mul_add(-k116, d239, k113 * d237)),
+                    ),
+                ); // F9r.y
+                let d130 = A::mul_add(
+                    p.MY9l,
+                    k68,
+                    A::mul_add(
+                        p.MZ9l,
+                        k66,
+                        A::mul_add(-p.m9l, d111, A::mul_add(-k64, d128, k63 * d129)),
+                    ),
+                ); // F9l.x
+                let d241 = A::mul_add(
+                    p.MY9r,
+                    k115,
+                    A::mul_add(
+                        p.MZ9r,
+                        k117,
+                        A::mul_add(-p.m9r, d222, A::mul_add(-k113, d238, k112 * d239)),
+                    ),
+                ); // F9r.x
                 let d132 = A::mul_add(
                     -p.MX9l,
                     k66,
@@ -13022,55 +15012,45 @@ mod generated {
                         A::mul_add(p.m9l, d126, A::mul_add(-k63, d127, k67 * d128)),
                     ),
                 ); // F9l.z
+                let d242 = A::mul_add(
+                    -p.MX9r,
+                    k117,
+                    A::mul_add(
+                        p.MY9r,
+                        k114,
+                        A::mul_add(p.m9r, d236, A::mul_add(-k112, d237, k116 * d238)),
+                    ),
+                ); // F9r.z
                 let d133 = A::mul_add(
                     p.XZ9l,
                     k64,
                     A::mul_add(p.XY9l, k63, p.XX9l * k67),
                 ); // J9lw9l|ud=0,g=0.x
+                let d243 = A::mul_add(
+                    p.XZ9r,
+                    k113,
+                    A::mul_add(p.XY9r, k112, p.XX9r * k116),
+                ); // J9rw9r|ud=0,g=0.x
                 let d134 = A::mul_add(
                     p.YZ9l,
                     k64,
                     A::mul_add(p.YY9l, k63, p.XY9l * k67),
                 ); // J9lw9l|ud=0,g=0.y
+                let d244 = A::mul_add(
+                    p.YZ9r,
+                    k113,
+                    A::mul_add(p.YY9r, k112, p.XY9r * k116),
+                ); // J9rw9r|ud=0,g=0.y
                 let d135 = A::mul_add(
                     p.ZZ9l,
                     k64,
                     A::mul_add(p.YZ9l, k63, p.XZ9l * k67),
                 ); // J9lw9l|ud=0,g=0.z
-                let d136 = A::mul_add(
-                    -p.MZ9l,
-                    d125,
-                    A::mul_add(
-                        p.MY9l,
-                        d126,
-                        A::mul_add(
-                            -p.XZ9l,
-                            k68,
-                            A::mul_add(
-                                p.XY9l,
-                                k66,
-                                A::mul_add(p.XX9l, k65, A::mul_add(-k64, d134, k63 * d135)),
-                            ),
-                        ),
-                    ),
-                ); // N9l.x
-                let d137 = A::mul_add(
-                    -p.MX9l,
-                    d126,
-                    A::mul_add(
-                        -p.MZ9l,
-                        d111,
-                        A::mul_add(
-                            -p.YZ9l,
-                            k68,
-                            A::mul_add(
-                                p.YY9l,
-                                k66,
-                                A::mul_add(p.XY9l, k65, A::mul_add(-k67, d135, k64 * d133)),
-                            ),
-                        ),
-                    ),
-                ); // N9l.y
+                let d245 = A::mul_add(
+                    p.ZZ9r,
+                    k113,
+                    A::mul_add(p.YZ9r, k112, p.XZ9r * k116),
+                ); // J9rw9r|ud=0,g=0.z
                 let d138 = A::mul_add(
                     p.MY9l,
                     d111,
@@ -13088,22 +15068,139 @@ mod generated {
                         ),
                     ),
                 ); // N9l.z
+                let d246 = A::mul_add(
+                    p.MY9r,
+                    d222,
+                    A::mul_add(
+                        p.MX9r,
+                        d235,
+                        A::mul_add(
+                            -p.ZZ9r,
+                            k115,
+                            A::mul_add(
+                                p.YZ9r,
+                                k117,
+                                A::mul_add(
+                                    p.XZ9r,
+                                    k114,
+                                    A::mul_add(-k112, d243, k116 * d244),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9r.z
+                let d136 = A::mul_add(
+                    -p.MZ9l,
+                    d125,
+                    A::mul_add(
+                        p.MY9l,
+                        d126,
+                        A::mul_add(
+                            -p.XZ9l,
+                            k68,
+                            A::mul_add(
+                                p.XY9l,
+                                k66,
+                                A::mul_add(p.XX9l, k65, A::mul_add(-k64, d134, k63 * d135)),
+                            ),
+                        ),
+                    ),
+                ); // N9l.x
+                let d247 = A::mul_add(
+                    -p.MZ9r,
+                    d235,
+                    A::mul_add(
+                        p.MY9r,
+                        d236,
+                        A::mul_add(
+                            -p.XZ9r,
+                            k115,
+                            A::mul_add(
+                                p.XY9r,
+                                k117,
+                                A::mul_add(
+                                    p.XX9r,
+                                    k114,
+                                    A::mul_add(-k113, d244, k112 * d245),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9r.x
+                let d137 = A::mul_add(
+                    -p.MX9l,
+                    d126,
+                    A::mul_add(
+                        -p.MZ9l,
+                        d111,
+                        A::mul_add(
+                            -p.YZ9l,
+                            k68,
+                            A::mul_add(
+                                p.YY9l,
+                                k66,
+                                A::mul_add(p.XY9l, k65, A::mul_add(-k67, d135, k64 * d133)),
+                            ),
+                        ),
+                    ),
+                ); // N9l.y
+                let d248 = A::mul_add(
+                    -p.MX9r,
+                    d236,
+                    A::mul_add(
+                        -p.MZ9r,
+                        d222,
+                        A::mul_add(
+                            -p.YZ9r,
+                            k115,
+                            A::mul_add(
+                                p.YY9r,
+                                k117,
+                                A::mul_add(
+                                    p.XY9r,
+                                    k114,
+                                    A::mul_add(-k116, d245, k113 * d243),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N9r.y
                 let k69 = A::mul_add(-s_q7l, k64, c_q7l * k67); // w9l in 10l|ud=0,g=0.x
+                let k118 = A::mul_add(-s_q7r, k113, c_q7r * k116); // w9r in 10r|ud=0,g=0.x
                 let k70 = A::mul_add(c_q7l, k64, s_q7l * k67); // w9l in 10l|ud=0,g=0.y
-                let k71 = k63 - qd7l; // w10l|ud=0,g=0.z
-                let k72 = A::mul_add(c_q7l, k68, A::mul_add(-s_q7l, k65, k69 * qd7l)); // wd10l.y
-                let k73 = A::mul_add(s_q7l, k68, A::mul_add(c_q7l, k65, k70 * qd7l)); // wd10l.x
+                let k119 = A::mul_add(c_q7r, k113, s_q7r * k116); // w9r in 10r|ud=0,g=0.y
                 let k74 = k66 + qdd7l; // wd10l.z
+                let k120 = k117 + qdd7r; // wd10r.z
+                let k72 = A::mul_add(c_q7l, k68, A::mul_add(-s_q7l, k65, k69 * qd7l)); // wd10l.y
+                let k121 = A::mul_add(
+                    c_q7r,
+                    k115,
+                    A::mul_add(-s_q7r, k114, k118 * qd7r),
+                ); // wd10r.y
+                let k71 = k63 - qd7l; // w10l|ud=0,g=0.z
+                let k122 = k112 - qd7r; // w10r|ud=0,g=0.z
+                let k73 = A::mul_add(s_q7l, k68, A::mul_add(c_q7l, k65, k70 * qd7l)); // wd10l.x
+                let k123 = A::mul_add(s_q7r, k115, A::mul_add(c_q7r, k114, k119 * qd7r)); // wd10r.x
                 let k75 = p.L9 * k64; // w9lxP10l|ud=0,g=0.x
+                let k124 = p.L9 * k113; // w9rxP10r|ud=0,g=0.x
                 let k76 = p.L9 * k67; // w9lxP10l|ud=0,g=0.z
-                let d139 = A::mul_add(k67, k76, k64 * k75) + d125; // a10l in 9l.y
+                let k125 = p.L9 * k116; // w9rxP10r|ud=0,g=0.z
                 let d140 = A::mul_add(p.L9, k68, A::mul_add(k63, k76, d111)); // a10l in 9l.x
+                let d249 = A::mul_add(p.L9, k115, A::mul_add(k112, k125, d222)); // a10r in 9r.x
+                let d139 = A::mul_add(k67, k76, k64 * k75) + d125; // a10l in 9l.y
+                let d250 = A::mul_add(k116, k125, k113 * k124) + d235; // a10r in 9r.y
                 let d141 = A::mul_add(p.L9, k65, A::mul_add(k63, k75, -d126)); // a10l in 9l.z
+                let d251 = A::mul_add(p.L9, k114, A::mul_add(k112, k124, -d236)); // a10r in 9r.z
                 let d142 = A::mul_add(-s_q7l, d141, c_q7l * d140); // a10l.x
+                let d252 = A::mul_add(-s_q7r, d251, c_q7r * d249); // a10r.x
                 let d143 = A::mul_add(c_q7l, d141, s_q7l * d140); // a10l.y
+                let d253 = A::mul_add(c_q7r, d251, s_q7r * d249); // a10r.y
                 let d144 = A::mul_add(-p.MY10l, k71, p.MZ10l * k70); // w10lxMS10l|ud=0,g=0.x
-                let d145 = A::mul_add(-p.MZ10l, k69, p.MX10l * k71); // w10lxMS10l|ud=0,g=0.y
+                let d254 = A::mul_add(-p.MY10r, k122, p.MZ10r * k119); // w10rxMS10r|ud=0,g=0.x
                 let d146 = A::mul_add(-p.MX10l, k70, p.MY10l * k69); // w10lxMS10l|ud=0,g=0.z
+                let d255 = A::mul_add(-p.MX10r, k119, p.MY10r * k118); // w10rxMS10r|ud=0,g=0.z
+                let d145 = A::mul_add(-p.MZ10l, k69, p.MX10l * k71); // w10lxMS10l|ud=0,g=0.y
+                let d256 = A::mul_add(-p.MZ10r, k118, p.MX10r * k122); // w10rxMS10r|ud=0,g=0.y
                 let d147 = A::mul_add(
                     p.MY10l,
                     k74,
@@ -13113,6 +15210,15 @@ mod generated {
                         A::mul_add(p.m10l, d142, A::mul_add(-k71, d145, k70 * d146)),
                     ),
                 ); // F10l.x
+                let d257 = A::mul_add(
+                    p.MY10r,
+                    k120,
+                    A::mul_add(
+                        p.MZ10r,
+                        k121,
+                        A::mul_add(p.m10r, d252, A::mul_add(-k122, d256, k119 * d255)),
+                    ),
+                ); // F10r.x
                 let d148 = A::mul_add(
                     p.MZ10l,
                     k73,
@@ -13122,6 +15228,15 @@ mod generated {
                         A::mul_add(p.m10l, d143, A::mul_add(-k69, d146, k71 * d144)),
                     ),
                 ); // F10l.y
+                let d258 = A::mul_add(
+                    p.MZ10r,
+                    k123,
+                    A::mul_add(
+                        -p.MX10r,
+                        k120,
+                        A::mul_add(p.m10r, d253, A::mul_add(-k118, d255, k122 * d254)),
+                    ),
+                ); // F10r.y
                 let d149 = A::mul_add(
                     -p.MX10l,
                     k72,
@@ -13131,21 +15246,45 @@ mod generated {
                         A::mul_add(-p.m10l, d139, A::mul_add(-k70, d144, k69 * d145)),
                     ),
                 ); // F10l.z
+                let d259 = A::mul_add(
+                    -p.MX10r,
+                    k121,
+                    A::mul_add(
+                        -p.MY10r,
+                        k123,
+                        A::mul_add(-p.m10r, d250, A::mul_add(-k119, d254, k118 * d256)),
+                    ),
+                ); // F10r.z
                 let d150 = A::mul_add(
                     p.XZ10l,
                     k71,
                     A::mul_add(p.XY10l, k70, p.XX10l * k69),
                 ); // J10lw10l|ud=0,g=0.x
+                let d260 = A::mul_add(
+                    p.XZ10r,
+                    k122,
+                    A::mul_add(p.XY10r, k119, p.XX10r * k118),
+                ); // J10rw10r|ud=0,g=0.x
                 let d151 = A::mul_add(
                     p.YZ10l,
                     k71,
                     A::mul_add(p.YY10l, k70, p.XY10l * k69),
                 ); // J10lw10l|ud=0,g=0.y
+                let d261 = A::mul_add(
+                    p.YZ10r,
+                    k122,
+                    A::mul_add(p.YY10r, k119, p.XY10r * k118),
+                ); // J10rw10r|ud=0,g=0.y
                 let d152 = A::mul_add(
                     p.ZZ10l,
                     k71,
                     A::mul_add(p.YZ10l, k70, p.XZ10l * k69),
                 ); // J10lw10l|ud=0,g=0.z
+                let d262 = A::mul_add(
+                    p.ZZ10r,
+                    k122,
+                    A::mul_add(p.YZ10r, k119, p.XZ10r * k118),
+                ); // J10rw10r|ud=0,g=0.z
                 let d153 = A::mul_add(
                     -p.MZ10l,
                     d143,
@@ -13167,27 +15306,27 @@ mod generated {
                         ),
                     ),
                 ); // N10l.x
-                let d154 = A::mul_add(
-                    p.MX10l,
-                    d139,
+                let d263 = A::mul_add(
+                    -p.MZ10r,
+                    d253,
                     A::mul_add(
-                        p.MZ10l,
-                        d142,
+                        -p.MY10r,
+                        d250,
                         A::mul_add(
-                            -p.YZ10l,
-                            k74,
+                            -p.XZ10r,
+                            k120,
                             A::mul_add(
-                                p.YY10l,
-                                k72,
+                                p.XY10r,
+                                k121,
                                 A::mul_add(
-                                    -p.XY10l,
-                                    k73,
-                                    A::mul_add(-k69, d152, k71 * d150),
+                                    -p.XX10r,
+                                    k123,
+                                    A::mul_add(-k122, d261, k119 * d262),
                                 ),
                             ),
                         ),
                     ),
-                ); // N10l.y
+                ); // N10r.x
                 let d155 = A::mul_add(
                     -p.MY10l,
                     d142,
@@ -13210,787 +15349,14 @@ mod generated {
                     ),
                 ); // N10l.z
                 m[11] = -d155;
-                let k77 = A::mul_add(-s_q1r, k17, c_q1r * k18); // w3 in 4r|ud=0,g=0.x
-                let k78 = A::mul_add(c_q1r, k17, s_q1r * k18); // w3 in 4r|ud=0,g=0.z
-                let k79 = k19 - qdd1r; // wd4r.y
-                let k80 = k16 + qd1r; // w4r|ud=0,g=0.y
-                let k81 = A::mul_add(s_q1r, k21, A::mul_add(c_q1r, k20, k78 * qd1r)); // wd4r.x
-                let k82 = A::mul_add(c_q1r, k21, A::mul_add(-s_q1r, k20, k77 * qd1r)); // wd4r.z
-                let k83 = t1 + t2; // w3xP4r|ud=0,g=0.z
-                let d156 = A::mul_add(k18, k83, t7) + d32 + t3; // a4r in 3.x
-                let d157 = t9 - t10 - d33 - t5 - t6; // a4r in 3.z
-                let d158 = A::mul_add(k16, k83, t8) - d30 - t4; // a4r in 3.y
-                let d159 = A::mul_add(c_q1r, d157, s_q1r * d158); // a4r.z
-                let d160 = A::mul_add(-s_q1r, d157, c_q1r * d158); // a4r.x
-                let d161 = A::mul_add(p.MX4r, k80, p.MY4r * k77); // w4rxMS4r|ud=0,g=0.z
-                let d162 = A::mul_add(-p.MY4r, k78, p.MZ4r * k80); // w4rxMS4r|ud=0,g=0.x
-                let d163 = A::mul_add(p.MZ4r, k77, p.MX4r * k78); // w4rxMS4r|ud=0,g=0.y
-                let d164 = A::mul_add(
-                    p.MZ4r,
-                    k81,
-                    A::mul_add(
-                        -p.MX4r,
-                        k82,
-                        A::mul_add(-p.m4r, d156, A::mul_add(-k77, d161, k78 * d162)),
-                    ),
-                ); // F4r.y
-                let d165 = A::mul_add(
-                    -p.MY4r,
-                    k82,
-                    A::mul_add(
-                        -p.MZ4r,
-                        k79,
-                        A::mul_add(p.m4r, d160, A::mul_add(k78, d163, k80 * d161)),
-                    ),
-                ); // F4r.x
-                let d166 = A::mul_add(
-                    p.MX4r,
-                    k79,
-                    A::mul_add(
-                        p.MY4r,
-                        k81,
-                        A::mul_add(-p.m4r, d159, A::mul_add(k80, d162, k77 * d163)),
-                    ),
-                ); // F4r.z
-                let d167 = A::mul_add(
-                    -p.XZ4r,
-                    k78,
-                    A::mul_add(-p.XY4r, k80, p.XX4r * k77),
-                ); // J4rw4r|ud=0,g=0.x
-                let d168 = A::mul_add(
-                    -p.YZ4r,
-                    k78,
-                    A::mul_add(-p.YY4r, k80, p.XY4r * k77),
-                ); // J4rw4r|ud=0,g=0.y
-                let d169 = A::mul_add(
-                    -p.ZZ4r,
-                    k78,
-                    A::mul_add(-p.YZ4r, k80, p.XZ4r * k77),
-                ); // J4rw4r|ud=0,g=0.z
-                let d170 = A::mul_add(
-                    p.MY4r,
-                    d160,
-                    A::mul_add(
-                        -p.MX4r,
-                        d156,
-                        A::mul_add(
-                            -p.ZZ4r,
-                            k82,
-                            A::mul_add(
-                                p.YZ4r,
-                                k79,
-                                A::mul_add(-p.XZ4r, k81, A::mul_add(k80, d167, k77 * d168)),
-                            ),
-                        ),
-                    ),
-                ); // N4r.z
-                let d171 = A::mul_add(
-                    -p.MZ4r,
-                    d156,
-                    A::mul_add(
-                        -p.MY4r,
-                        d159,
-                        A::mul_add(
-                            p.XZ4r,
-                            k82,
-                            A::mul_add(
-                                -p.XY4r,
-                                k79,
-                                A::mul_add(p.XX4r, k81, A::mul_add(-k78, d168, k80 * d169)),
-                            ),
-                        ),
-                    ),
-                ); // N4r.x
-                let d172 = A::mul_add(
-                    p.MX4r,
-                    d159,
-                    A::mul_add(
-                        p.MZ4r,
-                        d160,
-                        A::mul_add(
-                            p.YZ4r,
-                            k82,
-                            A::mul_add(
-                                -p.YY4r,
-                                k79,
-                                A::mul_add(p.XY4r, k81, A::mul_add(k77, d169, k78 * d167)),
-                            ),
-                        ),
-                    ),
-                ); // N4r.y
-                let k84 = A::mul_add(s_q2r, k78, c_q2r * k80); // w4r in 5r|ud=0,g=0.y
-                let k85 = A::mul_add(-c_q2r, k78, s_q2r * k80); // w4r in 5r|ud=0,g=0.z
-                let k86 = k81 - qdd2r; // wd5r.x
-                let k87 = A::mul_add(-c_q2r, k82, A::mul_add(-s_q2r, k79, k84 * qd2r)); // wd5r.z
-                let k88 = k77 + qd2r; // w5r|ud=0,g=0.x
-                let k89 = A::mul_add(-s_q2r, k82, A::mul_add(c_q2r, k79, k85 * qd2r)); // wd5r.y
-                let d173 = A::mul_add(-s_q2r, d159, c_q2r * d156); // a5r.y
-                let d174 = A::mul_add(c_q2r, d159, s_q2r * d156); // a5r.z
-                let d175 = A::mul_add(-p.MY5r, k85, p.MZ5r * k84); // w5rxMS5r|ud=0,g=0.x
-                let d176 = A::mul_add(p.MZ5r, k88, p.MX5r * k85); // w5rxMS5r|ud=0,g=0.y
-                let d177 = A::mul_add(p.MX5r, k84, p.MY5r * k88); // w5rxMS5r|ud=0,g=0.z
-                let d178 = A::mul_add(
-                    -p.MZ5r,
-                    k86,
-                    A::mul_add(
-                        p.MX5r,
-                        k87,
-                        A::mul_add(p.m5r, d173, A::mul_add(-k88, d177, k85 * d175)),
-                    ),
-                ); // F5r.y
-                let d179 = A::mul_add(
-                    p.MY5r,
-                    k87,
-                    A::mul_add(
-                        p.MZ5r,
-                        k89,
-                        A::mul_add(-p.m5r, d160, A::mul_add(k85, d176, k84 * d177)),
-                    ),
-                ); // F5r.x
-                let d180 = A::mul_add(
-                    -p.MX5r,
-                    k89,
-                    A::mul_add(
-                        -p.MY5r,
-                        k86,
-                        A::mul_add(-p.m5r, d174, A::mul_add(k84, d175, k88 * d176)),
-                    ),
-                ); // F5r.z
-                let d181 = A::mul_add(
-                    -p.XZ5r,
-                    k85,
-                    A::mul_add(-p.XY5r, k84, p.XX5r * k88),
-                ); // J5rw5r|ud=0,g=0.x
-                let d182 = A::mul_add(
-                    -p.YZ5r,
-                    k85,
-                    A::mul_add(-p.YY5r, k84, p.XY5r * k88),
-                ); // J5rw5r|ud=0,g=0.y
-                let d183 = A::mul_add(
-                    -p.ZZ5r,
-                    k85,
-                    A::mul_add(-p.YZ5r, k84, p.XZ5r * k88),
-                ); // J5rw5r|ud=0,g=0.z
-                let d184 = A::mul_add(
-                    -p.MY5r,
-                    d160,
-                    A::mul_add(
-                        p.MX5r,
-                        d173,
-                        A::mul_add(
-                            p.ZZ5r,
-                            k87,
-                            A::mul_add(
-                                -p.YZ5r,
-                                k89,
-                                A::mul_add(p.XZ5r, k86, A::mul_add(k84, d181, k88 * d182)),
-                            ),
-                        ),
-                    ),
-                ); // N5r.z
-                let d185 = A::mul_add(
-                    p.MZ5r,
-                    d173,
-                    A::mul_add(
-                        -p.MY5r,
-                        d174,
-                        A::mul_add(
-                            -p.XZ5r,
-                            k87,
-                            A::mul_add(
-                                p.XY5r,
-                                k89,
-                                A::mul_add(-p.XX5r, k86, A::mul_add(-k85, d182, k84 * d183)),
-                            ),
-                        ),
-                    ),
-                ); // N5r.x
-                let d186 = A::mul_add(
-                    p.MX5r,
-                    d174,
-                    A::mul_add(
-                        -p.MZ5r,
-                        d160,
-                        A::mul_add(
-                            -p.YZ5r,
-                            k87,
-                            A::mul_add(
-                                p.YY5r,
-                                k89,
-                                A::mul_add(-p.XY5r, k86, A::mul_add(k88, d183, k85 * d181)),
-                            ),
-                        ),
-                    ),
-                ); // N5r.y
-                let k90 = A::mul_add(s_q3r, k85, c_q3r * k88); // w5r in 6r|ud=0,g=0.x
-                let k91 = A::mul_add(-c_q3r, k85, s_q3r * k88); // w5r in 6r|ud=0,g=0.z
-                let k92 = k89 - qdd3r; // wd6r.y
-                let k93 = k84 + qd3r; // w6r|ud=0,g=0.y
-                let k94 = A::mul_add(-s_q3r, k87, A::mul_add(c_q3r, k86, k91 * qd3r)); // wd6r.x
-                let k95 = A::mul_add(-c_q3r, k87, A::mul_add(-s_q3r, k86, k90 * qd3r)); // wd6r.z
-                let k96 = p.L7 * k85; // w5rxP6r|ud=0,g=0.x
-                let k97 = p.L7 * k88; // w5rxP6r|ud=0,g=0.z
-                let d187 = A::mul_add(p.L7, k87, A::mul_add(k84, k97, d160)); // a6r in 5r.x
-                let d188 = A::mul_add(k88, k97, k85 * k96) + d173; // a6r in 5r.y
-                let d189 = A::mul_add(p.L7, k86, A::mul_add(k84, k96, -d174)); // a6r in 5r.z
-                let d190 = A::mul_add(-c_q3r, d189, s_q3r * d187); // a6r.z
-                let d191 = A::mul_add(s_q3r, d189, c_q3r * d187); // a6r.x
-                let d192 = A::mul_add(p.MX6r, k93, p.MY6r * k90); // w6rxMS6r|ud=0,g=0.z
-                let d193 = A::mul_add(-p.MY6r, k91, p.MZ6r * k93); // w6rxMS6r|ud=0,g=0.x
-                let d194 = A::mul_add(p.MZ6r, k90, p.MX6r * k91); // w6rxMS6r|ud=0,g=0.y
-                let d195 = A::mul_add(
-                    p.MZ6r,
-                    k94,
-                    A::mul_add(
-                        -p.MX6r,
-                        k95,
-                        A::mul_add(-p.m6r, d188, A::mul_add(-k90, d192, k91 * d193)),
-                    ),
-                ); // F6r.y
-                let d196 = A::mul_add(
-                    -p.MY6r,
-                    k95,
-                    A::mul_add(
-                        -p.MZ6r,
-                        k92,
-                        A::mul_add(p.m6r, d191, A::mul_add(k91, d194, k93 * d192)),
-                    ),
-                ); // F6r.x
-                let d197 = A::mul_add(
-                    p.MX6r,
-                    k92,
-                    A::mul_add(
-                        p.MY6r,
-                        k94,
-                        A::mul_add(-p.m6r, d190, A::mul_add(k93, d193, k90 * d194)),
-                    ),
-                ); // F6r.z
-                let d198 = A::mul_add(
-                    -p.XZ6r,
-                    k91,
-                    A::mul_add(-p.XY6r, k93, p.XX6r * k90),
-                ); // J6rw6r|ud=0,g=0.x
-                let d199 = A::mul_add(
-                    -p.YZ6r,
-                    k91,
-                    A::mul_add(-p.YY6r, k93, p.XY6r * k90),
-                ); // J6rw6r|ud=0,g=0.y
-                let d200 = A::mul_add(
-                    -p.ZZ6r,
-                    k91,
-                    A::mul_add(-p.YZ6r, k93, p.XZ6r * k90),
-                ); // J6rw6r|ud=0,g=0.z
-                let d201 = A::mul_add(
-                    p.MY6r,
-                    d191,
-                    A::mul_add(
-                        -p.MX6r,
-                        d188,
-                        A::mul_add(
-                            -p.ZZ6r,
-                            k95,
-                            A::mul_add(
-                                p.YZ6r,
-                                k92,
-                                A::mul_add(-p.XZ6r, k94, A::mul_add(k93, d198, k90 * d199)),
-                            ),
-                        ),
-                    ),
-                ); // N6r.z
-                let d202 = A::mul_add(
-                    -p.MZ6r,
-                    d188,
-                    A::mul_add(
-                        -p.MY6r,
-                        d190,
-                        A::mul_add(
-                            p.XZ6r,
-                            k95,
-                            A::mul_add(
-                                -p.XY6r,
-                                k92,
-                                A::mul_add(p.XX6r, k94, A::mul_add(-k91, d199, k93 * d200)),
-                            ),
-                        ),
-                    ),
-                ); // N6r.x
-                let d203 = A::mul_add(
-                    p.MX6r,
-                    d190,
-                    A::mul_add(
-                        p.MZ6r,
-                        d191,
-                        A::mul_add(
-                            p.YZ6r,
-                            k95,
-                            A::mul_add(
-                                -p.YY6r,
-                                k92,
-                                A::mul_add(p.XY6r, k94, A::mul_add(k90, d200, k91 * d198)),
-                            ),
-                        ),
-                    ),
-                ); // N6r.y
-                let k98 = A::mul_add(s_q4r, k91, c_q4r * k93); // w6r in 7r|ud=0,g=0.y
-                let k99 = A::mul_add(-c_q4r, k91, s_q4r * k93); // w6r in 7r|ud=0,g=0.z
-                let k100 = k94 - qdd4r; // wd7r.x
-                let k101 = A::mul_add(-c_q4r, k95, A::mul_add(-s_q4r, k92, k98 * qd4r)); // wd7r.z
-                let k102 = k90 + qd4r; // w7r|ud=0,g=0.x
-                let k103 = A::mul_add(-s_q4r, k95, A::mul_add(c_q4r, k92, k99 * qd4r)); // wd7r.y
-                let d204 = A::mul_add(-s_q4r, d190, c_q4r * d188); // a7r.y
-                let d205 = A::mul_add(c_q4r, d190, s_q4r * d188); // a7r.z
-                let d206 = A::mul_add(-p.MY7r, k99, p.MZ7r * k98); // w7rxMS7r|ud=0,g=0.x
-                let d207 = A::mul_add(p.MZ7r, k102, p.MX7r * k99); // w7rxMS7r|ud=0,g=0.y
-                let d208 = A::mul_add(p.MX7r, k98, p.MY7r * k102); // w7rxMS7r|ud=0,g=0.z
-                let d209 = A::mul_add(
-                    -p.MZ7r,
-                    k100,
-                    A::mul_add(
-                        p.MX7r,
-                        k101,
-                        A::mul_add(p.m7r, d204, A::mul_add(-k102, d208, k99 * d206)),
-                    ),
-                ); // F7r.y
-                let d210 = A::mul_add(
-                    p.MY7r,
-                    k101,
-                    A::mul_add(
-                        p.MZ7r,
-                        k103,
-                        A::mul_add(-p.m7r, d191, A::mul_add(k99, d207, k98 * d208)),
-                    ),
-                ); // F7r.x
-                let d211 = A::mul_add(
-                    -p.MX7r,
-                    k103,
-                    A::mul_add(
-                        -p.MY7r,
-                        k100,
-                        A::mul_add(-p.m7r, d205, A::mul_add(k98, d206, k102 * d207)),
-                    ),
-                ); // F7r.z
-                let d212 = A::mul_add(
-                    -p.XZ7r,
-                    k99,
-                    A::mul_add(-p.XY7r, k98, p.XX7r * k102),
-                ); // J7rw7r|ud=0,g=0.x
-                let d213 = A::mul_add(
-                    -p.YZ7r,
-                    k99,
-                    A::mul_add(-p.YY7r, k98, p.XY7r * k102),
-                ); // J7rw7r|ud=0,g=0.y
-                let d214 = A::mul_add(
-                    -p.ZZ7r,
-                    k99,
-                    A::mul_add(-p.YZ7r, k98, p.XZ7r * k102),
-                ); // J7rw7r|ud=0,g=0.z
-                let d215 = A::mul_add(
-                    -p.MY7r,
-                    d191,
-                    A::mul_add(
-                        p.MX7r,
-                        d204,
-                        A::mul_add(
-                            p.ZZ7r,
-                            k101,
-                            A::mul_add(
-                                -p.YZ7r,
-                                k103,
-                                A::mul_add(p.XZ7r, k100, A::mul_add(k98, d212, k102 * d213)),
-                            ),
-                        ),
-                    ),
-                ); // N7r.z
-                let d216 = A::mul_add(
-                    p.MZ7r,
-                    d204,
-                    A::mul_add(
-                        -p.MY7r,
-                        d205,
-                        A::mul_add(
-                            -p.XZ7r,
-                            k101,
-                            A::mul_add(
-                                p.XY7r,
-                                k103,
-                                A::mul_add(
-                                    -p.XX7r,
-                                    k100,
-                                    A::mul_add(-k99, d213, k98 * d214),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7r.x
-                let d217 = A::mul_add(
-                    p.MX7r,
-                    d205,
-                    A::mul_add(
-                        -p.MZ7r,
-                        d191,
-                        A::mul_add(
-                            -p.YZ7r,
-                            k101,
-                            A::mul_add(
-                                p.YY7r,
-                                k103,
-                                A::mul_add(
-                                    -p.XY7r,
-                                    k100,
-                                    A::mul_add(k102, d214, k99 * d212),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7r.y
-                let k104 = A::mul_add(s_q5r, k99, c_q5r * k102); // w7r in 8r|ud=0,g=0.x
-                let k105 = A::mul_add(-c_q5r, k99, s_q5r * k102); // w7r in 8r|ud=0,g=0.z
-                let k106 = k103 - qdd5r; // wd8r.y
-                let k107 = k98 + qd5r; // w8r|ud=0,g=0.y
-                let k108 = A::mul_add(
-                    -s_q5r,
-                    k101,
-                    A::mul_add(c_q5r, k100, k105 * qd5r),
-                ); // wd8r.x
-                let k109 = A::mul_add(
-                    -c_q5r,
-                    k101,
-                    A::mul_add(-s_q5r, k100, k104 * qd5r),
-                ); // wd8r.z
-                let k110 = p.L8 * k99; // w7rxP8r|ud=0,g=0.x
-                let k111 = p.L8 * k102; // w7rxP8r|ud=0,g=0.z
-                let d218 = A::mul_add(p.L8, k101, A::mul_add(k98, k111, d191)); // a8r in 7r.x
-                let d219 = A::mul_add(k102, k111, k99 * k110) + d204; // a8r in 7r.y
-                let d220 = A::mul_add(p.L8, k100, A::mul_add(k98, k110, -d205)); // a8r in 7r.z
-                let d221 = A::mul_add(-c_q5r, d220, s_q5r * d218); // a8r.z
-                let d222 = A::mul_add(s_q5r, d220, c_q5r * d218); // a8r.x
-                let d223 = A::mul_add(p.MX8r, k107, p.MY8r * k104); // w8rxMS8r|ud=0,g=0.z
-                let d224 = A::mul_add(-p.MY8r, k105, p.MZ8r * k107); // w8rxMS8r|ud=0,g=0.x
-                let d225 = A::mul_add(p.MZ8r, k104, p.MX8r * k105); // w8rxMS8r|ud=0,g=0.y
-                let d226 = A::mul_add(
-                    p.MZ8r,
-                    k108,
-                    A::mul_add(
-                        -p.MX8r,
-                        k109,
-                        A::mul_add(-p.m8r, d219, A::mul_add(-k104, d223, k105 * d224)),
-                    ),
-                ); // F8r.y
-                let d227 = A::mul_add(
-                    -p.MY8r,
-                    k109,
-                    A::mul_add(
-                        -p.MZ8r,
-                        k106,
-                        A::mul_add(p.m8r, d222, A::mul_add(k105, d225, k107 * d223)),
-                    ),
-                ); // F8r.x
-                let d228 = A::mul_add(
-                    p.MX8r,
-                    k106,
-                    A::mul_add(
-                        p.MY8r,
-                        k108,
-                        A::mul_add(-p.m8r, d221, A::mul_add(k107, d224, k104 * d225)),
-                    ),
-                ); // F8r.z
-                let d229 = A::mul_add(
-                    -p.XZ8r,
-                    k105,
-                    A::mul_add(-p.XY8r, k107, p.XX8r * k104),
-                ); // J8rw8r|ud=0,g=0.x
-                let d230 = A::mul_add(
-                    -p.YZ8r,
-                    k105,
-                    A::mul_add(-p.YY8r, k107, p.XY8r * k104),
-                ); // J8rw8r|ud=0,g=0.y
-                let d231 = A::mul_add(
-                    -p.ZZ8r,
-                    k105,
-                    A::mul_add(-p.YZ8r, k107, p.XZ8r * k104),
-                ); // J8rw8r|ud=0,g=0.z
-                let d232 = A::mul_add(
-                    p.MY8r,
-                    d222,
-                    A::mul_add(
-                        -p.MX8r,
-                        d219,
-                        A::mul_add(
-                            -p.ZZ8r,
-                            k109,
-                            A::mul_add(
-                                p.YZ8r,
-                                k106,
-                                A::mul_add(
-                                    -p.XZ8r,
-                                    k108,
-                                    A::mul_add(k107, d229, k104 * d230),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r.z
-                let d233 = A::mul_add(
-                    -p.MZ8r,
-                    d219,
-                    A::mul_add(
-                        -p.MY8r,
-                        d221,
-                        A::mul_add(
-                            p.XZ8r,
-                            k109,
-                            A::mul_add(
-                                -p.XY8r,
-                                k106,
-                                A::mul_add(
-                                    p.XX8r,
-                                    k108,
-                                    A::mul_add(-k105, d230, k107 * d231),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r.x
-                let d234 = A::mul_add(
-                    p.MX8r,
-                    d221,
-                    A::mul_add(
-                        p.MZ8r,
-                        d222,
-                        A::mul_add(
-                            p.YZ8r,
-                            k109,
-                            A::mul_add(
-                                -p.YY8r,
-                                k106,
-                                A::mul_add(
-                                    p.XY8r,
-                                    k108,
-                                    A::mul_add(k104, d231, k105 * d229),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r.y
-                let k112 = A::mul_add(s_q6r, k105, c_q6r * k107); // w8r in 9r|ud=0,g=0.y
-                let k113 = A::mul_add(-c_q6r, k105, s_q6r * k107); // w8r in 9r|ud=0,g=0.z
-                let k114 = k108 - qdd6r; // wd9r.x
-                let k115 = A::mul_add(
-                    -c_q6r,
-                    k109,
-                    A::mul_add(-s_q6r, k106, k112 * qd6r),
-                ); // wd9r.z
-                let k116 = k104 + qd6r; // w9r|ud=0,g=0.x
-                let k117 = A::mul_add(
-                    -s_q6r,
-                    k109,
-                    A::mul_add(c_q6r, k106, k113 * qd6r),
-                ); // wd9r.y
-                let d235 = A::mul_add(-s_q6r, d221, c_q6r * d219); // a9r.y
-                let d236 = A::mul_add(c_q6r, d221, s_q6r * d219); // a9r.z
-                let d237 = A::mul_add(-p.MY9r, k113, p.MZ9r * k112); // w9rxMS9r|ud=0,g=0.x
-                let d238 = A::mul_add(p.MZ9r, k116, p.MX9r * k113); // w9rxMS9r|ud=0,g=0.y
-                let d239 = A::mul_add(p.MX9r, k112, p.MY9r * k116); // w9rxMS9r|ud=0,g=0.z
-                let d240 = A::mul_add(
-                    -p.MZ9r,
-                    k114,
-                    A::mul_add(
-                        p.MX9r,
-                        k115,
-                        A::mul_add(p.m9r, d235, A::mul_add(-k116, d239, k113 * d237)),
-                    ),
-                ); // F9r.y
-                let d241 = A::mul_add(
-                    p.MY9r,
-                    k115,
-                    A::mul_add(
-                        p.MZ9r,
-                        k117,
-                        A::mul_add(-p.m9r, d222, A::mul_add(k113, d238, k112 * d239)),
-                    ),
-                ); // F9r.x
-                let d242 = A::mul_add(
-                    -p.MX9r,
-                    k117,
-                    A::mul_add(
-                        -p.MY9r,
-                        k114,
-                        A::mul_add(-p.m9r, d236, A::mul_add(k112, d237, k116 * d238)),
-                    ),
-                ); // F9r.z
-                let d243 = A::mul_add(
-                    -p.XZ9r,
-                    k113,
-                    A::mul_add(-p.XY9r, k112, p.XX9r * k116),
-                ); // J9rw9r|ud=0,g=0.x
-                let d244 = A::mul_add(
-                    -p.YZ9r,
-                    k113,
-                    A::mul_add(-p.YY9r, k112, p.XY9r * k116),
-                ); // J9rw9r|ud=0,g=0.y
-                let d245 = A::mul_add(
-                    -p.ZZ9r,
-                    k113,
-                    A::mul_add(-p.YZ9r, k112, p.XZ9r * k116),
-                ); // J9rw9r|ud=0,g=0.z
-                let d246 = A::mul_add(
-                    -p.MY9r,
-                    d222,
-                    A::mul_add(
-                        p.MX9r,
-                        d235,
-                        A::mul_add(
-                            p.ZZ9r,
-                            k115,
-                            A::mul_add(
-                                -p.YZ9r,
-                                k117,
-                                A::mul_add(
-                                    p.XZ9r,
-                                    k114,
-                                    A::mul_add(k112, d243, k116 * d244),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r.z
-                let d247 = A::mul_add(
-                    p.MZ9r,
-                    d235,
-                    A::mul_add(
-                        -p.MY9r,
-                        d236,
-                        A::mul_add(
-                            -p.XZ9r,
-                            k115,
-                            A::mul_add(
-                                p.XY9r,
-                                k117,
-                                A::mul_add(
-                                    -p.XX9r,
-                                    k114,
-                                    A::mul_add(-k113, d244, k112 * d245),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r.x
-                let d248 = A::mul_add(
-                    p.MX9r,
-                    d236,
-                    A::mul_add(
-                        -p.MZ9r,
-                        d222,
-                        A::mul_add(
-                            -p.YZ9r,
-                            k115,
-                            A::mul_add(
-                                p.YY9r,
-                                k117,
-                                A::mul_add(
-                                    -p.XY9r,
-                                    k114,
-                                    A::mul_add(k116, d245, k113 * d243),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r.y
-                let k118 = A::mul_add(s_q7r, k113, c_q7r * k116); // w9r in 10r|ud=0,g=0.x
-                let k119 = A::mul_add(-c_q7r, k113, s_q7r * k116); // w9r in 10r|ud=0,g=0.y
-                let k120 = k117 - qdd7r; // wd10r.z
-                let k121 = A::mul_add(
-                    -c_q7r,
-                    k115,
-                    A::mul_add(-s_q7r, k114, k118 * qd7r),
-                ); // wd10r.y
-                let k122 = k112 + qd7r; // w10r|ud=0,g=0.z
-                let k123 = A::mul_add(
-                    -s_q7r,
-                    k115,
-                    A::mul_add(c_q7r, k114, k119 * qd7r),
-                ); // wd10r.x
-                let k124 = p.L9 * k113; // w9rxP10r|ud=0,g=0.x
-                let k125 = p.L9 * k116; // w9rxP10r|ud=0,g=0.z
-                let d249 = A::mul_add(p.L9, k115, A::mul_add(k112, k125, d222)); // a10r in 9r.x
-                let d250 = A::mul_add(k116, k125, k113 * k124) + d235; // a10r in 9r.y
-                let d251 = A::mul_add(p.L9, k114, A::mul_add(k112, k124, -d236)); // a10r in 9r.z
-                let d252 = A::mul_add(s_q7r, d251, c_q7r * d249); // a10r.x
-                let d253 = A::mul_add(-c_q7r, d251, s_q7r * d249); // a10r.y
-                let d254 = A::mul_add(p.MY10r, k122, p.MZ10r * k119); // w10rxMS10r|ud=0,g=0.x
-                let d255 = A::mul_add(-p.MX10r, k119, p.MY10r * k118); // w10rxMS10r|ud=0,g=0.z
-                let d256 = A::mul_add(p.MZ10r, k118, p.MX10r * k122); // w10rxMS10r|ud=0,g=0.y
-                let d257 = A::mul_add(
-                    -p.MY10r,
-                    k120,
-                    A::mul_add(
-                        p.MZ10r,
-                        k121,
-                        A::mul_add(-p.m10r, d252, A::mul_add(-k122, d256, k119 * d255)),
-                    ),
-                ); // F10r.x
-                let d258 = A::mul_add(
-                    -p.MZ10r,
-                    k123,
-                    A::mul_add(
-                        -p.MX10r,
-                        k120,
-                        A::mul_add(p.m10r, d253, A::mul_add(k118, d255, k122 * d254)),
-                    ),
-                ); // F10r.y
-                let d259 = A::mul_add(
-                    p.MX10r,
-                    k121,
-                    A::mul_add(
-                        p.MY10r,
-                        k123,
-                        A::mul_add(p.m10r, d250, A::mul_add(k119, d254, k118 * d256)),
-                    ),
-                ); // F10r.z
-                let d260 = A::mul_add(
-                    -p.XZ10r,
-                    k122,
-                    A::mul_add(p.XY10r, k119, p.XX10r * k118),
-                ); // J10rw10r|ud=0,g=0.x
-                let d261 = A::mul_add(
-                    -p.YZ10r,
-                    k122,
-                    A::mul_add(p.YY10r, k119, p.XY10r * k118),
-                ); // J10rw10r|ud=0,g=0.y
-                let d262 = A::mul_add(
-                    -p.ZZ10r,
-                    k122,
-                    A::mul_add(p.YZ10r, k119, p.XZ10r * k118),
-                ); // J10rw10r|ud=0,g=0.z
-                let d263 = A::mul_add(
-                    p.MZ10r,
-                    d253,
-                    A::mul_add(
-                        -p.MY10r,
-                        d250,
-                        A::mul_add(
-                            p.XZ10r,
-                            k120,
-                            A::mul_add(
-                                p.XY10r,
-                                k121,
-                                A::mul_add(
-                                    -p.XX10r,
-                                    k123,
-                                    A::mul_add(k122, d261, k119 * d262),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r.x
                 let d264 = A::mul_add(
-                    p.MY10r,
+                    -p.MY10r,
                     d252,
                     A::mul_add(
-                        -p.MX10r,
+                        p.MX10r,
                         d253,
                         A::mul_add(
-                            p.ZZ10r,
+                            -p.ZZ10r,
                             k120,
                             A::mul_add(
                                 p.YZ10r,
@@ -14005,8 +15371,29 @@ mod generated {
                     ),
                 ); // N10r.z
                 m[18] = -d264;
+                let d154 = A::mul_add(
+                    p.MX10l,
+                    d139,
+                    A::mul_add(
+                        p.MZ10l,
+                        d142,
+                        A::mul_add(
+                            -p.YZ10l,
+                            k74,
+                            A::mul_add(
+                                p.YY10l,
+                                k72,
+                                A::mul_add(
+                                    -p.XY10l,
+                                    k73,
+                                    A::mul_add(-k69, d152, k71 * d150),
+                                ),
+                            ),
+                        ),
+                    ),
+                ); // N10l.y
                 let d265 = A::mul_add(
-                    -p.MX10r,
+                    p.MX10r,
                     d250,
                     A::mul_add(
                         p.MZ10r,
@@ -14015,195 +15402,195 @@ mod generated {
                             -p.YZ10r,
                             k120,
                             A::mul_add(
-                                -p.YY10r,
+                                p.YY10r,
                                 k121,
                                 A::mul_add(
-                                    p.XY10r,
+                                    -p.XY10r,
                                     k123,
-                                    A::mul_add(k118, d262, k122 * d260),
+                                    A::mul_add(-k118, d262, k122 * d260),
                                 ),
                             ),
                         ),
                     ),
                 ); // N10r.y
-                let d266 = A::mul_add(c_q7r, d258, s_q7r * d257); // f10r in 9r.z
-                let d267 = A::mul_add(-s_q7r, d258, c_q7r * d257); // f10r in 9r.x
-                let d268 = d240 + d259; // f9r.y
-                let d269 = A::mul_add(
-                    -p.L9,
-                    d267,
-                    A::mul_add(c_q7r, d265, A::mul_add(s_q7r, d263, d246)),
-                ); // n9r.z
-                let d270 = d241 + d267; // f9r.x
-                let d271 = d242 - d266; // f9r.z
-                let d272 = A::mul_add(
-                    p.L9,
-                    d266,
-                    A::mul_add(-s_q7r, d265, A::mul_add(c_q7r, d263, d247)),
-                ); // n9r.x
-                m[17] = d272;
-                let d273 = d248 + d264; // n9r.y
-                let d274 = A::mul_add(-s_q6r, d271, c_q6r * d268); // f9r in 8r.y
-                let d275 = A::mul_add(c_q6r, d271, s_q6r * d268); // f9r in 8r.z
-                let d276 = d226 - d274; // f8r.y
-                let d277 = A::mul_add(c_q6r, d269, A::mul_add(s_q6r, d273, d232)); // n8r.z
-                let d278 = d227 - d270; // f8r.x
-                let d279 = d228 + d275; // f8r.z
-                let d280 = d233 - d272; // n8r.x
-                let d281 = A::mul_add(s_q6r, d269, A::mul_add(-c_q6r, d273, d234)); // n8r.y
-                m[16] = d281;
-                let d282 = A::mul_add(-s_q5r, d279, c_q5r * d278); // f8r in 7r.x
-                let d283 = A::mul_add(c_q5r, d279, s_q5r * d278); // f8r in 7r.z
-                let d284 = d209 - d276; // f7r.y
-                let d285 = A::mul_add(
-                    p.L8,
-                    d282,
-                    A::mul_add(c_q5r, d277, A::mul_add(-s_q5r, d280, d215)),
-                ); // n7r.z
-                let d286 = d210 - d282; // f7r.x
-                let d287 = d211 + d283; // f7r.z
-                let d288 = A::mul_add(
-                    -p.L8,
-                    d283,
-                    A::mul_add(-s_q5r, d277, A::mul_add(-c_q5r, d280, d216)),
-                ); // n7r.x
-                m[15] = d288;
-                let d289 = d217 - d281; // n7r.y
-                let d290 = A::mul_add(-s_q4r, d287, c_q4r * d284); // f7r in 6r.y
-                let d291 = A::mul_add(c_q4r, d287, s_q4r * d284); // f7r in 6r.z
-                let d292 = d195 - d290; // f6r.y
-                let d293 = A::mul_add(c_q4r, d285, A::mul_add(s_q4r, d289, d201)); // n6r.z
-                let d294 = d196 - d286; // f6r.x
-                let d295 = d197 + d291; // f6r.z
-                let d296 = d202 - d288; // n6r.x
-                let d297 = A::mul_add(s_q4r, d285, A::mul_add(-c_q4r, d289, d203)); // n6r.y
-                m[14] = d297;
-                let d298 = A::mul_add(-s_q3r, d295, c_q3r * d294); // f6r in 5r.x
-                let d299 = A::mul_add(c_q3r, d295, s_q3r * d294); // f6r in 5r.z
-                let d300 = d178 - d292; // f5r.y
-                let d301 = A::mul_add(
-                    p.L7,
-                    d298,
-                    A::mul_add(c_q3r, d293, A::mul_add(-s_q3r, d296, d184)),
-                ); // n5r.z
-                let d302 = d179 - d298; // f5r.x
-                let d303 = d180 + d299; // f5r.z
-                let d304 = A::mul_add(
-                    -p.L7,
-                    d299,
-                    A::mul_add(-s_q3r, d293, A::mul_add(-c_q3r, d296, d185)),
-                ); // n5r.x
-                m[13] = d304;
-                let d305 = d186 - d297; // n5r.y
-                let d306 = A::mul_add(-s_q2r, d303, c_q2r * d300); // f5r in 4r.y
-                let d307 = A::mul_add(c_q2r, d303, s_q2r * d300); // f5r in 4r.z
-                let d308 = d164 - d306; // f4r.y
-                let d309 = A::mul_add(c_q2r, d301, A::mul_add(s_q2r, d305, d170)); // n4r.z
-                let d310 = d165 - d302; // f4r.x
-                let d311 = d166 + d307; // f4r.z
-                let d312 = d171 - d304; // n4r.x
-                let d313 = A::mul_add(s_q2r, d301, A::mul_add(-c_q2r, d305, d172)); // n4r.y
-                m[12] = d313;
-                let d314 = A::mul_add(-s_q1r, d311, c_q1r * d310); // f4r in 3.y
-                let d315 = A::mul_add(c_q1r, d311, s_q1r * d310); // f4r in 3.z
-                let d316 = d37 - d308; // f3.x
-                let d317 = A::mul_add(-p.L5, d315, d43 + d313); // n3.x
-                let d318 = A::mul_add(
-                    p.L5,
-                    d308,
-                    A::mul_add(
-                        p.L6,
-                        d314,
-                        A::mul_add(c_q1r, d309, A::mul_add(-s_q1r, d312, d44)),
-                    ),
-                ); // n3.z
-                let d319 = d38 + d314; // f3.y
-                let d320 = d39 + d315; // f3.z
-                let d321 = A::mul_add(
-                    p.L6,
-                    d315,
-                    A::mul_add(s_q1r, d309, A::mul_add(c_q1r, d312, d45)),
-                ); // n3.y
                 let d322 = A::mul_add(-c_q7l, d148, s_q7l * d147); // f10l in 9l.z
+                let d266 = A::mul_add(-c_q7r, d258, s_q7r * d257); // f10r in 9r.z
                 let d323 = A::mul_add(s_q7l, d148, c_q7l * d147); // f10l in 9l.x
+                let d267 = A::mul_add(s_q7r, d258, c_q7r * d257); // f10r in 9r.x
                 let d324 = d130 - d323; // f9l.x
+                let d270 = d241 - d267; // f9r.x
                 let d325 = d131 - d149; // f9l.y
+                let d268 = d240 - d259; // f9r.y
                 let d326 = d132 + d322; // f9l.z
+                let d271 = d242 + d266; // f9r.z
                 let d327 = d137 - d155; // n9l.y
+                let d273 = d248 - d264; // n9r.y
                 let d328 = A::mul_add(
                     -p.L9,
                     d322,
                     A::mul_add(-s_q7l, d154, A::mul_add(-c_q7l, d153, d136)),
                 ); // n9l.x
                 m[10] = -d328;
+                let d272 = A::mul_add(
+                    -p.L9,
+                    d266,
+                    A::mul_add(-s_q7r, d265, A::mul_add(-c_q7r, d263, d247)),
+                ); // n9r.x
+                m[17] = -d272;
                 let d329 = A::mul_add(
                     -p.L9,
                     d323,
                     A::mul_add(-c_q7l, d154, A::mul_add(s_q7l, d153, d138)),
                 ); // n9l.z
+                let d269 = A::mul_add(
+                    -p.L9,
+                    d267,
+                    A::mul_add(-c_q7r, d265, A::mul_add(s_q7r, d263, d246)),
+                ); // n9r.z
                 let d330 = A::mul_add(s_q6l, d326, c_q6l * d325); // f9l in 8l.y
+                let d274 = A::mul_add(s_q6r, d271, c_q6r * d268); // f9r in 8r.y
                 let d331 = A::mul_add(-c_q6l, d326, s_q6l * d325); // f9l in 8l.z
+                let d275 = A::mul_add(-c_q6r, d271, s_q6r * d268); // f9r in 8r.z
                 let d332 = d116 - d324; // f8l.x
+                let d278 = d227 - d270; // f8r.x
                 let d333 = d122 - d328; // n8l.x
+                let d280 = d233 - d272; // n8r.x
                 let d334 = A::mul_add(c_q6l, d329, A::mul_add(-s_q6l, d327, d123)); // n8l.z
+                let d277 = A::mul_add(c_q6r, d269, A::mul_add(-s_q6r, d273, d232)); // n8r.z
                 let d335 = d117 + d330; // f8l.y
+                let d276 = d226 + d274; // f8r.y
                 let d336 = d118 + d331; // f8l.z
+                let d279 = d228 + d275; // f8r.z
                 let d337 = A::mul_add(s_q6l, d329, A::mul_add(c_q6l, d327, d124)); // n8l.y
                 m[9] = d337;
+                let d281 = A::mul_add(s_q6r, d269, A::mul_add(c_q6r, d273, d234)); // n8r.y
+                m[16] = d281;
                 let d338 = A::mul_add(-c_q5l, d336, s_q5l * d332); // f8l in 7l.z
+                let d283 = A::mul_add(-c_q5r, d279, s_q5r * d278); // f8r in 7r.z
                 let d339 = A::mul_add(s_q5l, d336, c_q5l * d332); // f8l in 7l.x
+                let d282 = A::mul_add(s_q5r, d279, c_q5r * d278); // f8r in 7r.x
                 let d340 = d99 - d339; // f7l.x
+                let d286 = d210 - d282; // f7r.x
                 let d341 = d100 + d335; // f7l.y
+                let d284 = d209 + d276; // f7r.y
                 let d342 = d101 + d338; // f7l.z
+                let d287 = d211 + d283; // f7r.z
                 let d343 = d106 + d337; // n7l.y
+                let d289 = d217 + d281; // n7r.y
                 let d344 = A::mul_add(
                     -p.L8,
                     d338,
                     A::mul_add(s_q5l, d334, A::mul_add(-c_q5l, d333, d105)),
                 ); // n7l.x
                 m[8] = -d344;
+                let d288 = A::mul_add(
+                    -p.L8,
+                    d283,
+                    A::mul_add(s_q5r, d277, A::mul_add(-c_q5r, d280, d216)),
+                ); // n7r.x
+                m[15] = -d288;
                 let d345 = A::mul_add(
                     -p.L8,
                     d339,
                     A::mul_add(c_q5l, d334, A::mul_add(s_q5l, d333, d107)),
                 ); // n7l.z
+                let d285 = A::mul_add(
+                    -p.L8,
+                    d282,
+                    A::mul_add(c_q5r, d277, A::mul_add(s_q5r, d280, d215)),
+                ); // n7r.z
                 let d346 = A::mul_add(s_q4l, d342, c_q4l * d341); // f7l in 6l.y
+                let d290 = A::mul_add(s_q4r, d287, c_q4r * d284); // f7r in 6r.y
                 let d347 = A::mul_add(-c_q4l, d342, s_q4l * d341); // f7l in 6l.z
+                let d291 = A::mul_add(-c_q4r, d287, s_q4r * d284); // f7r in 6r.z
                 let d348 = d85 - d340; // f6l.x
+                let d294 = d196 - d286; // f6r.x
                 let d349 = d91 - d344; // n6l.x
+                let d296 = d202 - d288; // n6r.x
                 let d350 = A::mul_add(c_q4l, d345, A::mul_add(-s_q4l, d343, d92)); // n6l.z
+                let d293 = A::mul_add(c_q4r, d285, A::mul_add(-s_q4r, d289, d201)); // n6r.z
                 let d351 = d86 + d346; // f6l.y
+                let d292 = d195 + d290; // f6r.y
                 let d352 = d87 + d347; // f6l.z
+                let d295 = d197 + d291; // f6r.z
                 let d353 = A::mul_add(s_q4l, d345, A::mul_add(c_q4l, d343, d93)); // n6l.y
                 m[7] = d353;
+                let d297 = A::mul_add(s_q4r, d285, A::mul_add(c_q4r, d289, d203)); // n6r.y
+                m[14] = d297;
                 let d354 = A::mul_add(-c_q3l, d352, s_q3l * d348); // f6l in 5l.z
+                let d299 = A::mul_add(-c_q3r, d295, s_q3r * d294); // f6r in 5r.z
                 let d355 = A::mul_add(s_q3l, d352, c_q3l * d348); // f6l in 5l.x
+                let d298 = A::mul_add(s_q3r, d295, c_q3r * d294); // f6r in 5r.x
                 let d356 = d68 - d355; // f5l.x
+                let d302 = d179 - d298; // f5r.x
                 let d357 = d69 + d351; // f5l.y
+                let d300 = d178 + d292; // f5r.y
                 let d358 = d70 + d354; // f5l.z
+                let d303 = d180 + d299; // f5r.z
                 let d359 = d75 + d353; // n5l.y
+                let d305 = d186 + d297; // n5r.y
                 let d360 = A::mul_add(
                     -p.L7,
                     d354,
                     A::mul_add(s_q3l, d350, A::mul_add(-c_q3l, d349, d74)),
                 ); // n5l.x
                 m[6] = -d360;
+                let d304 = A::mul_add(
+                    -p.L7,
+                    d299,
+                    A::mul_add(s_q3r, d293, A::mul_add(-c_q3r, d296, d185)),
+                ); // n5r.x
+                m[13] = -d304;
                 let d361 = A::mul_add(
                     -p.L7,
                     d355,
                     A::mul_add(c_q3l, d350, A::mul_add(s_q3l, d349, d76)),
                 ); // n5l.z
+                let d301 = A::mul_add(
+                    -p.L7,
+                    d298,
+                    A::mul_add(c_q3r, d293, A::mul_add(s_q3r, d296, d184)),
+                ); // n5r.z
                 let d362 = A::mul_add(s_q2l, d358, c_q2l * d357); // f5l in 4l.y
+                let d306 = A::mul_add(s_q2r, d303, c_q2r * d300); // f5r in 4r.y
                 let d363 = A::mul_add(-c_q2l, d358, s_q2l * d357); // f5l in 4l.z
+                let d307 = A::mul_add(-c_q2r, d303, s_q2r * d300); // f5r in 4r.z
                 let d364 = d54 - d356; // f4l.x
+                let d310 = d165 - d302; // f4r.x
                 let d365 = d60 - d360; // n4l.x
+                let d312 = d171 - d304; // n4r.x
                 let d366 = A::mul_add(c_q2l, d361, A::mul_add(-s_q2l, d359, d61)); // n4l.z
+                let d309 = A::mul_add(c_q2r, d301, A::mul_add(-s_q2r, d305, d170)); // n4r.z
                 let d367 = d55 + d362; // f4l.y
+                let d308 = d164 + d306; // f4r.y
+                let d316 = d37 + d308; // f3.x
                 let d368 = d56 + d363; // f4l.z
+                let d311 = d166 + d307; // f4r.z
                 let d369 = A::mul_add(s_q2l, d361, A::mul_add(c_q2l, d359, d62)); // n4l.y
                 m[5] = d369;
+                let d313 = A::mul_add(s_q2r, d301, A::mul_add(c_q2r, d305, d172)); // n4r.y
+                m[12] = d313;
                 let d370 = A::mul_add(s_q1l, d368, c_q1l * d364); // f4l in 3.y
+                let d314 = A::mul_add(s_q1r, d311, c_q1r * d310); // f4r in 3.y
+                let d318 = A::mul_add(
+                    -p.L5,
+                    d308,
+                    A::mul_add(
+                        -p.L6,
+                        d314,
+                        A::mul_add(c_q1r, d309, A::mul_add(s_q1r, d312, d44)),
+                    ),
+                ); // n3.z
+                let d319 = d38 - d314; // f3.y
                 let d371 = A::mul_add(-c_q1l, d368, s_q1l * d364); // f4l in 3.z
+                let d315 = A::mul_add(-c_q1r, d311, s_q1r * d310); // f4r in 3.z
+                let d317 = A::mul_add(p.L5, d315, d43 + d313); // n3.x
+                let d320 = d39 - d315; // f3.z
+                let d321 = A::mul_add(
+                    -p.L6,
+                    d315,
+                    A::mul_add(s_q1r, d309, A::mul_add(-c_q1r, d312, d45)),
+                ); // n3.y
                 let d372 = d316 - d367; // f3.x
                 let d373 = A::mul_add(-p.L5, d371, d317 - d369); // n3.x
                 let d374 = A::mul_add(

@@ -22,6 +22,8 @@ use crate::kane::{Derivation, Function};
 use crate::options::{DerivativesForm, LOOPED_ABOVE_FLOPS, ParamMode};
 use crate::registry::FunctionId;
 
+pub mod lanes;
+
 /// A leaf of a lowered expression.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Leaf {
@@ -378,6 +380,9 @@ pub struct FunctionProgram {
     /// The loop form of a regressor, when the derivation chose it: what the emitted function
     /// runs instead of `program` (which stays the reference for evaluation and counts).
     pub looped: Option<LoopProgram>,
+    /// The two-lane form of `program` (arms in lanes, see [`lanes`]), when
+    /// [`lanes::apply`] paired its statements: `program` is then the rewritten program.
+    pub lanes: Option<lanes::LanePlan>,
 }
 
 /// A regressor's loop form, lowered: the straight-line part and the loop's tables.
@@ -428,6 +433,9 @@ pub struct Lowered {
     /// straight-line program of [`Lowered::functions`] (which the batched form, `listing` and
     /// the interpreter keep using).
     pub derivative_loop: Option<LoopedProgram>,
+    /// The mirrors of the leaves, when [`lanes::apply`] paired a function's statements (what
+    /// the emitter prints for a leaf in two lanes).
+    pub lane_leaves: Option<lanes::LaneLeaves>,
 }
 
 /// The program of the looped `inverse_dynamics_derivatives`: its outputs `(offset, 0, value)`
@@ -521,6 +529,7 @@ pub fn lower_with(d: &Derivation, form: DerivativesForm) -> Lowered {
                 frame: f.frame,
                 program,
                 looped,
+                lanes: None,
             }
         })
         .collect();
@@ -583,6 +592,7 @@ pub fn lower_with(d: &Derivation, form: DerivativesForm) -> Lowered {
         regressors: d.regressors.clone(),
         combined,
         derivative_loop,
+        lane_leaves: None,
     }
 }
 

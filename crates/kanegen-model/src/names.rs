@@ -42,7 +42,7 @@ use crate::ident::{is_keyword, sanitize_identifier};
 use crate::ir::{JointKind, Model};
 
 /// Names that generated function bodies bind or call besides the model's names and the
-/// statement locals (`k1`, `d1`, `t1`, `pc1`): inputs (`p`, `pc`, `q`, `u`, `ud`, and `_p`,
+/// statement locals (`k1`, `d1`, `t1`, `pc1`, `d5_d90`): the two-lane multiply-add `lanes`, inputs (`p`, `pc`, `q`, `u`, `ud`, and `_p`,
 /// `_pc` when unused), results (`m`, `out`), the symmetric copy loop (`s`, `c`, `r`), the
 /// batched trigonometry (`sin_q`, `cos_q`, `sin_cos_n`), and `Params::from_array`'s argument `v`.
 pub const RESERVED_LOCALS: &[&str] = &[
@@ -402,10 +402,13 @@ mod tests {
 
     #[test]
     fn statement_local_shapes_are_recognised() {
-        for n in ["k1", "d12", "t3", "pc40"] {
+        // `d5_d90`: a pair of statements in two lanes.
+        for n in ["k1", "d12", "t3", "pc40", "d5_d90", "k1_t2"] {
             assert!(is_generated_local(n) && is_reserved(n), "{n}");
         }
-        for n in ["k", "d1a", "pc", "kd1", "K1", "qd1", "t_1"] {
+        for n in [
+            "k", "d1a", "pc", "kd1", "K1", "qd1", "t_1", "d5_", "d5_x1", "d5_d6_d7",
+        ] {
             assert!(!is_generated_local(n), "{n}");
         }
     }

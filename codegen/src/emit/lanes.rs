@@ -3,9 +3,9 @@
 //! expression with every leaf that differs between the subtrees given in both lanes:
 //!
 //! ```text
-//! let d7_d97 = lanes.mul_add(-d4_d94, F64x2::new(s_q6l, s_q6r), F64x2::new(p.ZZ10l, p.ZZ10r) * F64x2::new(c_q6l, c_q6r)); // N(M col 10l) at 8l.y | N(M col 10r) at 8r.y
-//! let d7 = d7_d97.lo();
-//! let d97 = d7_d97.hi();
+//! let d275_d7 = lanes.mul_add(-d272_d4, F64x2::new(s_q6l, s_q6r), F64x2::new(p.ZZ10l, p.ZZ10r) * F64x2::new(c_q6l, c_q6r)); // N(M col 10l) at 8l.y | N(M col 10r) at 8r.y
+//! let d275 = d275_d7.lo();
+//! let d7 = d275_d7.hi();
 //! ```
 //!
 //! Shared values (the trunk's statements, shared parameters, constants) are `f64` operands,
@@ -118,7 +118,12 @@ pub(super) fn lane_block(
             code.push_str(&format!("let {name} = "));
             lane_printer.expr_text_with(names, &s.expr, false, true, &mut code);
             code.push(';');
-            block.push(code.clone(), &format!("{} | {}", s.comment, right.comment));
+            let label = if right.comment == s.comment {
+                s.comment.clone()
+            } else {
+                format!("{} | {}", s.comment, right.comment)
+            };
+            block.push(code.clone(), &label);
             for (j, lane) in [(k, "lo"), (k + 1, "hi")] {
                 if scalar_read[j] {
                     let scalar = &p.stmts[j].name;

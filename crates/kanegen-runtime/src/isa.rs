@@ -19,11 +19,12 @@
 //! three-operand VEX encodings and 256-bit vectors where LLVM vectorizes. Calling a
 //! `#[target_feature]` function needs `unsafe` (the CPU must have the features); this module
 //! holds that call (the same in [`dispatch`], [`dispatch_fused_with`], through which
-//! [`dispatch_fused`] runs, and [`dispatch_fused_wide_with`], which also calls the x86-64-v4
-//! copy), right after the check that
-//! the features are present; the crate's only other `unsafe` block is the same kind of call in
+//! [`dispatch_fused`] runs, [`dispatch_pair_with`], and [`dispatch_fused_wide_with`], which
+//! also calls the x86-64-v4 copy), right after the check that
+//! the features are present; the crate's other `unsafe` blocks are the same kind of call in
 //! [`crate::derivative_steps::run`] (its AVX2 kernel, after [`active`] reported x86-64-v3 or
-//! x86-64-v4).
+//! x86-64-v4) and the SSE2 and FMA intrinsics of [`crate::pair`] (two lanes; its FMA only
+//! behind a [`FusedPair`], which [`dispatch_pair_with`] makes after the same check).
 //!
 //! Results: Rust never fuses `a * b + c` into a fused multiply-add on its own. Generated
 //! functions therefore print their sums of products as [`Arith::mul_add`] chains in a body

@@ -5,7 +5,7 @@
 //! geometry below their first joint, each with its own inertial parameters), the generator
 //! pairs every statement of one with the statement of the other that computes the same
 //! expression of the mirrored inputs, and prints each pair once, as a statement over
-//! [`F64x2`]: `let d5_d90 = lanes.mul_add(-d4_d89, s_q6l_s_q6r, …);`, left subtree in the low
+//! [`F64x2`]: `let d275_d7 = lanes.mul_add(-d272_d4, F64x2::new(s_q6l, s_q6r), …);`, left subtree in the low
 //! lane, right subtree in the high lane. Both lanes run the IEEE operations of the scalar
 //! statements they replace, in the same order, so **every value is the scalar program's bit
 //! for bit**: [`Plain`]'s multiply-add is a multiplication and an addition per lane, and

@@ -2342,12 +2342,12 @@ mod generated {
                     F64x2::new(s_q7l, s_q7r),
                     F64x2::new(p.MX10l, p.MX10r) * F64x2::new(c_q7l, c_q7r),
                 ); // MSC10l in 9l.x | MSC10r in 9r.x
-            let t41_t1 = F64x2::new(p.XZ10l, p.XZ10r) * F64x2::new(c_q7l, c_q7r); // common subexpression | common subexpression
-            let t42_t2 = F64x2::new(p.YZ10l, p.YZ10r) * F64x2::new(s_q7l, s_q7r); // common subexpression | common subexpression
-            let t43_t3 = F64x2::new(p.XZ10l, p.XZ10r) * F64x2::new(s_q7l, s_q7r); // common subexpression | common subexpression
-            let t44_t4 = F64x2::new(p.YZ10l, p.YZ10r) * F64x2::new(c_q7l, c_q7r); // common subexpression | common subexpression
-            let t45_t5 = p.L9 * d270_d2; // common subexpression | common subexpression
-            let t46_t6 = p.L9 * d269_d1; // common subexpression | common subexpression
+            let t41_t1 = F64x2::new(p.XZ10l, p.XZ10r) * F64x2::new(c_q7l, c_q7r); // common subexpression
+            let t42_t2 = F64x2::new(p.YZ10l, p.YZ10r) * F64x2::new(s_q7l, s_q7r); // common subexpression
+            let t43_t3 = F64x2::new(p.XZ10l, p.XZ10r) * F64x2::new(s_q7l, s_q7r); // common subexpression
+            let t44_t4 = F64x2::new(p.YZ10l, p.YZ10r) * F64x2::new(c_q7l, c_q7r); // common subexpression
+            let t45_t5 = p.L9 * d270_d2; // common subexpression
+            let t46_t6 = p.L9 * d269_d1; // common subexpression
             let d271_d3 = t41_t1 + t42_t2 - t45_t5; // N(M col 10l) at 9l.x | N(M col 10r) at 9r.x
             let d271 = d271_d3.lo();
             let d3 = d271_d3.hi();
@@ -2680,8 +2680,8 @@ mod generated {
                     d311_d43,
                     F64x2::new(s_q6l, s_q6r) * F64x2::new(pc.pc25, pc.pc2),
                 ); // MSC9l in 8l.z | MSC9r in 8r.z
-            let t47_t7 = F64x2::new(c_q6l, c_q6r) * d313_d45; // common subexpression | common subexpression
-            let t48_t8 = F64x2::new(s_q6l, s_q6r) * d314_d46; // common subexpression | common subexpression
+            let t47_t7 = F64x2::new(c_q6l, c_q6r) * d313_d45; // common subexpression
+            let t48_t8 = F64x2::new(s_q6l, s_q6r) * d314_d46; // common subexpression
             let d320_d52 = t47_t7 + t48_t8; // N(M col 9l) at 8l.y | N(M col 9r) at 8r.y
             let d320 = d320_d52.lo();
             let d52 = d320_d52.hi();
@@ -2689,8 +2689,8 @@ mod generated {
             m[(10, 9)] = m[(9, 10)];
             m[(16, 17)] = -d52;
             m[(17, 16)] = m[(16, 17)];
-            let t49_t9 = F64x2::new(s_q6l, s_q6r) * d313_d45; // common subexpression | common subexpression
-            let t50_t10 = F64x2::new(c_q6l, c_q6r) * d314_d46; // common subexpression | common subexpression
+            let t49_t9 = F64x2::new(s_q6l, s_q6r) * d313_d45; // common subexpression
+            let t50_t10 = F64x2::new(c_q6l, c_q6r) * d314_d46; // common subexpression
             let d321_d53 = t49_t9 - t50_t10; // N(M col 9l) at 8l.z | N(M col 9r) at 8r.z
             let d322_d54 = F64x2::new(s_q5l, s_q5r) * d318_d50; // F(M col 9l) at 7l.x | F(M col 9r) at 7r.x
             let d323_d55 = F64x2::new(c_q5l, c_q5r) * d318_d50; // F(M col 9l) at 7l.z | F(M col 9r) at 7r.z
@@ -2980,12 +2980,12 @@ mod generated {
                     d357_d89,
                     F64x2::new(c_q5l, c_q5r) * d355_d87,
                 ); // MSC8l in 7l.x | MSC8r in 7r.x
-            let t51_t11 = F64x2::new(c_q5l, c_q5r) * d361_d93; // common subexpression | common subexpression
-            let t52_t12 = F64x2::new(s_q5l, s_q5r) * d363_d95; // common subexpression | common subexpression
-            let t53_t13 = F64x2::new(s_q5l, s_q5r) * d361_d93; // common subexpression | common subexpression
-            let t54_t14 = F64x2::new(c_q5l, c_q5r) * d363_d95; // common subexpression | common subexpression
-            let t55_t15 = p.L8 * d367_d99; // common subexpression | common subexpression
-            let t56_t16 = p.L8 * d366_d98; // common subexpression | common subexpression
+            let t51_t11 = F64x2::new(c_q5l, c_q5r) * d361_d93; // common subexpression
+            let t52_t12 = F64x2::new(s_q5l, s_q5r) * d363_d95; // common subexpression
+            let t53_t13 = F64x2::new(s_q5l, s_q5r) * d361_d93; // common subexpression
+            let t54_t14 = F64x2::new(c_q5l, c_q5r) * d363_d95; // common subexpression
+            let t55_t15 = p.L8 * d367_d99; // common subexpression
+            let t56_t16 = p.L8 * d366_d98; // common subexpression
             let d368_d100 = t51_t11 - t52_t12 - t55_t15; // N(M col 8l) at 7l.x | N(M col 8r) at 7r.x
             let d368 = d368_d100.lo();
             let d100 = d368_d100.hi();
@@ -3213,7 +3213,7 @@ mod generated {
             let k30_k9 = lanes.mul_add(2.0, k28_k7, -1.0); // cos 2q5l | cos 2q5r
             let d401_d133 = d360_d92 - d364_d96; // JC8l: Jzz − Jxx | JC8r: Jzz − Jxx
             let d402_d134 = lanes.mul_add(2.0, d362_d94 * k29_k8, k28_k7 * d401_d133); // JC8l rotated about y: Jzz − J'zz | JC8r rotated about y: Jzz − J'zz
-            let t57_t17 = p.L8 * d356_d88; // common subexpression | common subexpression
+            let t57_t17 = p.L8 * d356_d88; // common subexpression
             let d403_d135 = F64x2::new(p.XY7l, p.XY7r) + t51_t11 - t52_t12 - t55_t15; // JC7l.xy | JC7r.xy
             let d404_d136 = lanes
                 .mul_add(
@@ -3244,8 +3244,8 @@ mod generated {
                     d400_d132,
                     F64x2::new(s_q4l, s_q4r) * d407_d139,
                 ); // MSC7l in 6l.z | MSC7r in 6r.z
-            let t58_t18 = F64x2::new(c_q4l, c_q4r) * d403_d135; // common subexpression | common subexpression
-            let t59_t19 = F64x2::new(s_q4l, s_q4r) * d404_d136; // common subexpression | common subexpression
+            let t58_t18 = F64x2::new(c_q4l, c_q4r) * d403_d135; // common subexpression
+            let t59_t19 = F64x2::new(s_q4l, s_q4r) * d404_d136; // common subexpression
             let d412_d144 = t58_t18 + t59_t19; // N(M col 7l) at 6l.y | N(M col 7r) at 6r.y
             let d412 = d412_d144.lo();
             let d144 = d412_d144.hi();
@@ -3253,8 +3253,8 @@ mod generated {
             m[(8, 7)] = m[(7, 8)];
             m[(14, 15)] = -d144;
             m[(15, 14)] = m[(14, 15)];
-            let t60_t20 = F64x2::new(s_q4l, s_q4r) * d403_d135; // common subexpression | common subexpression
-            let t61_t21 = F64x2::new(c_q4l, c_q4r) * d404_d136; // common subexpression | common subexpression
+            let t60_t20 = F64x2::new(s_q4l, s_q4r) * d403_d135; // common subexpression
+            let t61_t21 = F64x2::new(c_q4l, c_q4r) * d404_d136; // common subexpression
             let d413_d145 = t60_t20 - t61_t21; // N(M col 7l) at 6l.z | N(M col 7r) at 6r.z
             let d414_d146 = F64x2::new(s_q3l, s_q3r) * d410_d142; // F(M col 7l) at 5l.x | F(M col 7r) at 5r.x
             let d415_d147 = F64x2::new(c_q3l, c_q3r) * d410_d142; // F(M col 7l) at 5l.z | F(M col 7r) at 5r.z
@@ -3474,12 +3474,12 @@ mod generated {
                     d441_d173,
                     F64x2::new(c_q3l, c_q3r) * d439_d171,
                 ); // MSC6l in 5l.x | MSC6r in 5r.x
-            let t62_t22 = F64x2::new(c_q3l, c_q3r) * d445_d177; // common subexpression | common subexpression
-            let t63_t23 = F64x2::new(s_q3l, s_q3r) * d448_d180; // common subexpression | common subexpression
-            let t64_t24 = F64x2::new(s_q3l, s_q3r) * d445_d177; // common subexpression | common subexpression
-            let t65_t25 = F64x2::new(c_q3l, c_q3r) * d448_d180; // common subexpression | common subexpression
-            let t66_t26 = p.L7 * d451_d183; // common subexpression | common subexpression
-            let t67_t27 = p.L7 * d450_d182; // common subexpression | common subexpression
+            let t62_t22 = F64x2::new(c_q3l, c_q3r) * d445_d177; // common subexpression
+            let t63_t23 = F64x2::new(s_q3l, s_q3r) * d448_d180; // common subexpression
+            let t64_t24 = F64x2::new(s_q3l, s_q3r) * d445_d177; // common subexpression
+            let t65_t25 = F64x2::new(c_q3l, c_q3r) * d448_d180; // common subexpression
+            let t66_t26 = p.L7 * d451_d183; // common subexpression
+            let t67_t27 = p.L7 * d450_d182; // common subexpression
             let d452_d184 = t62_t22 - t63_t23 - t66_t26; // N(M col 6l) at 5l.x | N(M col 6r) at 5r.x
             let d452 = d452_d184.lo();
             let d184 = d452_d184.hi();
@@ -3637,7 +3637,7 @@ mod generated {
             let k36_k15 = lanes.mul_add(2.0, k34_k13, -1.0); // cos 2q3l | cos 2q3r
             let d477_d209 = d444_d176 - d449_d181; // JC6l: Jzz − Jxx | JC6r: Jzz − Jxx
             let d478_d210 = lanes.mul_add(2.0, d446_d178 * k35_k14, k34_k13 * d477_d209); // JC6l rotated about y: Jzz − J'zz | JC6r rotated about y: Jzz − J'zz
-            let t68_t28 = p.L7 * d440_d172; // common subexpression | common subexpression
+            let t68_t28 = p.L7 * d440_d172; // common subexpression
             let d479_d211 = F64x2::new(p.XY5l, p.XY5r) + t62_t22 - t63_t23 - t66_t26; // JC5l.xy | JC5r.xy
             let d480_d212 = lanes
                 .mul_add(
@@ -3668,8 +3668,8 @@ mod generated {
                     d476_d208,
                     F64x2::new(s_q2l, s_q2r) * d483_d215,
                 ); // MSC5l in 4l.z | MSC5r in 4r.z
-            let t69_t29 = F64x2::new(c_q2l, c_q2r) * d479_d211; // common subexpression | common subexpression
-            let t70_t30 = F64x2::new(s_q2l, s_q2r) * d480_d212; // common subexpression | common subexpression
+            let t69_t29 = F64x2::new(c_q2l, c_q2r) * d479_d211; // common subexpression
+            let t70_t30 = F64x2::new(s_q2l, s_q2r) * d480_d212; // common subexpression
             let d488_d220 = t69_t29 + t70_t30; // N(M col 5l) at 4l.y | N(M col 5r) at 4r.y
             let d488 = d488_d220.lo();
             let d220 = d488_d220.hi();
@@ -3677,8 +3677,8 @@ mod generated {
             m[(6, 5)] = m[(5, 6)];
             m[(12, 13)] = -d220;
             m[(13, 12)] = m[(12, 13)];
-            let t71_t31 = F64x2::new(s_q2l, s_q2r) * d479_d211; // common subexpression | common subexpression
-            let t72_t32 = F64x2::new(c_q2l, c_q2r) * d480_d212; // common subexpression | common subexpression
+            let t71_t31 = F64x2::new(s_q2l, s_q2r) * d479_d211; // common subexpression
+            let t72_t32 = F64x2::new(c_q2l, c_q2r) * d480_d212; // common subexpression
             let d489_d221 = t71_t31 - t72_t32; // N(M col 5l) at 4l.z | N(M col 5r) at 4r.z
             let d490_d222 = F64x2::new(s_q1l, s_q1r) * d486_d218; // F(M col 5l) at 3.y | F(M col 5r) at 3.y
             let d490 = d490_d222.lo();
@@ -3840,25 +3840,25 @@ mod generated {
                 ); // MSC4l in 3.z | MSC4r in 3.z
             let d519 = d519_d251.lo();
             let d251 = d519_d251.hi();
-            let t73_t33 = F64x2::new(c_q1l, c_q1r) * d513_d245; // common subexpression | common subexpression
+            let t73_t33 = F64x2::new(c_q1l, c_q1r) * d513_d245; // common subexpression
             let t73 = t73_t33.lo();
             let t33 = t73_t33.hi();
-            let t74_t34 = F64x2::new(s_q1l, s_q1r) * d516_d248; // common subexpression | common subexpression
+            let t74_t34 = F64x2::new(s_q1l, s_q1r) * d516_d248; // common subexpression
             let t74 = t74_t34.lo();
             let t34 = t74_t34.hi();
-            let t75_t35 = F64x2::new(s_q1l, s_q1r) * d513_d245; // common subexpression | common subexpression
+            let t75_t35 = F64x2::new(s_q1l, s_q1r) * d513_d245; // common subexpression
             let t75 = t75_t35.lo();
             let t35 = t75_t35.hi();
-            let t76_t36 = F64x2::new(c_q1l, c_q1r) * d516_d248; // common subexpression | common subexpression
+            let t76_t36 = F64x2::new(c_q1l, c_q1r) * d516_d248; // common subexpression
             let t76 = t76_t36.lo();
             let t36 = t76_t36.hi();
-            let t77_t37 = p.L5 * d518_d250; // common subexpression | common subexpression
+            let t77_t37 = p.L5 * d518_d250; // common subexpression
             let t77 = t77_t37.lo();
             let t37 = t77_t37.hi();
-            let t78_t38 = p.L6 * d518_d250; // common subexpression | common subexpression
+            let t78_t38 = p.L6 * d518_d250; // common subexpression
             let t78 = t78_t38.lo();
             let t38 = t78_t38.hi();
-            let t79_t39 = p.L6 * d519_d251; // common subexpression | common subexpression
+            let t79_t39 = p.L6 * d519_d251; // common subexpression
             let t79 = t79_t39.lo();
             let t39 = t79_t39.hi();
             let d520_d254 = t75_t35 + t76_t36 - t79_t39; // N(M col 4l) at 3.z | N(M col 4r) at 3.z
@@ -3958,7 +3958,7 @@ mod generated {
             let d537_d268 = lanes.mul_add(2.0, d514_d246 * k41_k20, k40_k19 * d536_d267); // JC4l rotated about y: Jzz − J'zz | JC4r rotated about y: Jzz − J'zz
             let d537 = d537_d268.lo();
             let d268 = d537_d268.hi();
-            let t80_t40 = p.L6 * d508_d240; // common subexpression | common subexpression
+            let t80_t40 = p.L6 * d508_d240; // common subexpression
             let t80 = t80_t40.lo();
             let t40 = t80_t40.hi();
             let d538 = p.XZ3 - t35 - t36 + t39 - t75 - t76 + t79; // JC3.xz

@@ -104,8 +104,16 @@ pub(super) fn function(
         store_text_after(&mut stores, e, format!("w[{k}] = {v};"));
     }
     let stored: Vec<&LExpr> = nonzero_outputs(p).map(|(_, _, e)| e).collect();
-    let block =
-        printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true);
+    let lanes = super::function::lanes_in(cx, p, looped.lanes.as_ref());
+    let block = match lanes {
+        Some((leaves, plan)) => {
+            super::lanes::lane_block(&printer, &cx.leaf_names, leaves, p, plan, stores)
+        }
+        None => {
+            printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true)
+        }
+    };
+    let lanes = lanes.is_some();
     let body = cx.blocks.placeholder(block);
     let unused = unused_inputs(spec.inputs, p, &reads);
     let t = scalar_type(cx.precision);
@@ -133,13 +141,18 @@ pub(super) fn function(
     let state = super::items::arg_names(spec.inputs);
     let call = super::function::call_body_into(
         cx,
-        super::function::Copies::BaselineAndV3,
+        if lanes {
+            super::function::Copies::Lanes
+        } else {
+            super::function::Copies::BaselineAndV3
+        },
         quote!(),
         quote!(#pass_params #state,),
         quote!(m),
     );
     let call = quote!(#call;);
     let tables = tables(&looped.plan);
+    let (generics, lanes_arg) = super::function::body_generics(cx, lanes);
     let into = ident(&format!("{}_into", spec.name));
     let onto = ident(&format!("{}_onto", spec.name));
     let into_doc = format!(
@@ -177,7 +190,7 @@ pub(super) fn function(
         #[inline(never)]
         fn #onto(#outer_params #args, m: &mut #mat) {
             #[inline(always)]
-            fn body<A: kanegen_runtime::isa::Arith<#t>>(#param_args #args, m: &mut #mat) {
+            fn body<#generics>(#lanes_arg #param_args #args, m: &mut #mat) {
                 #body
             }
             #call

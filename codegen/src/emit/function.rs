@@ -490,9 +490,18 @@ pub(super) fn lanes_of<'a>(
     cx: &'a Context<'_>,
     f: &'a FunctionProgram,
 ) -> Option<(&'a LaneLeaves, &'a LanePlan)> {
+    lanes_in(cx, &f.program, f.lanes.as_ref())
+}
+
+/// [`lanes_of`] for program `p` with plan `plan`.
+pub(super) fn lanes_in<'a>(
+    cx: &'a Context<'_>,
+    p: &Program,
+    plan: Option<&'a LanePlan>,
+) -> Option<(&'a LaneLeaves, &'a LanePlan)> {
     let leaves = cx.low.lane_leaves.as_ref()?;
-    let plan = f.lanes.as_ref()?;
-    (cx.precision == crate::Precision::F64 && f.program.stmts.len() <= cx.split_above)
+    let plan = plan?;
+    (cx.precision == crate::Precision::F64 && p.stmts.len() <= cx.split_above)
         .then_some((leaves, plan))
 }
 
@@ -723,7 +732,7 @@ pub(super) fn generic_body(
 
 /// The generic parameters of a function body (`A: Arith<f64>`, and with `lanes` the two-lane
 /// multiply-add `P: PairArith`) and, with `lanes`, its first argument `lanes: P,`.
-fn body_generics(cx: &Context<'_>, lanes: bool) -> (TokenStream, TokenStream) {
+pub(super) fn body_generics(cx: &Context<'_>, lanes: bool) -> (TokenStream, TokenStream) {
     let t = scalar_type(cx.precision);
     if lanes {
         (

@@ -446,6 +446,8 @@ pub struct LoopedProgram {
     pub program: Program,
     /// The tables of the loop.
     pub plan: crate::kane::DerivativeLoop,
+    /// The two-lane form of `program` (see [`lanes`]), when [`lanes::apply`] paired it.
+    pub lanes: Option<lanes::LanePlan>,
 }
 
 /// The program of one combined function: one straight-line program whose outputs are the
@@ -577,6 +579,7 @@ pub fn lower_with(d: &Derivation, form: DerivativesForm) -> Lowered {
                 &mut pre,
             ),
             plan: l.plan.clone(),
+            lanes: None,
         });
     let (precompute, pre_slots) = lower_precompute(&d.arena, &pre);
     Lowered {

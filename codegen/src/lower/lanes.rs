@@ -260,13 +260,15 @@ fn map_expr(
     })
 }
 
-/// A key of `e` that ignores signs and the order of terms and factors.
-fn unsigned_key(e: &LExpr, out: &mut String) {
+/// A key of `e` that ignores the order of terms and factors, and with `signed == false` also
+/// the signs of coefficients and constants.
+fn sorted_key(e: &LExpr, signed: bool, out: &mut String) {
     use std::fmt::Write;
+    let num = |v: f64| if signed { v } else { v.abs() };
     match e {
         LExpr::Leaf(l) => {
             let _ = match l {
-                Leaf::Const(c) => write!(out, "c{}", c.abs()),
+                Leaf::Const(c) => write!(out, "c{}", num(*c)),
                 other => write!(out, "{other:?}"),
             };
         }
@@ -274,20 +276,20 @@ fn unsigned_key(e: &LExpr, out: &mut String) {
             let mut parts: Vec<String> = terms
                 .iter()
                 .map(|(k, t)| {
-                    let mut s = format!("{}*", k.abs());
-                    unsigned_key(t, &mut s);
+                    let mut s = format!("{}*", num(*k));
+                    sorted_key(t, signed, &mut s);
                     s
                 })
                 .collect();
             parts.sort_unstable();
-            let _ = write!(out, "S{}[{}]", constant.abs(), parts.join(","));
+            let _ = write!(out, "S{}[{}]", num(*constant), parts.join(","));
         }
         LExpr::Prod(f) => {
             let mut parts: Vec<String> = f
                 .iter()
                 .map(|(b, p)| {
                     let mut s = String::new();
-                    unsigned_key(b, &mut s);
+                    sorted_key(b, signed, &mut s);
                     format!("{s}^{p}")
                 })
                 .collect();
@@ -297,9 +299,10 @@ fn unsigned_key(e: &LExpr, out: &mut String) {
     }
 }
 
+/// A key of `e` that ignores signs and the order of terms and factors.
 fn key(e: &LExpr) -> String {
     let mut s = String::new();
-    unsigned_key(e, &mut s);
+    sorted_key(e, false, &mut s);
     s
 }
 
@@ -489,25 +492,9 @@ fn pre_mirror(low: &Lowered, mirror: &Mirror) -> Vec<Option<usize>> {
 
 /// A key of `e` that ignores only the order of terms and factors.
 fn exact_key(e: &LExpr) -> String {
-    match e {
-        LExpr::Leaf(l) => format!("{l:?}"),
-        LExpr::Sum { constant, terms } => {
-            let mut parts: Vec<String> = terms
-                .iter()
-                .map(|(k, t)| format!("{k}*{}", exact_key(t)))
-                .collect();
-            parts.sort_unstable();
-            format!("S{constant}[{}]", parts.join(","))
-        }
-        LExpr::Prod(f) => {
-            let mut parts: Vec<String> = f
-                .iter()
-                .map(|(b, p)| format!("{}^{p}", exact_key(b)))
-                .collect();
-            parts.sort_unstable();
-            format!("P[{}]", parts.join(","))
-        }
-    }
+    let mut s = String::new();
+    sorted_key(e, true, &mut s);
+    s
 }
 
 /// What [`pair`] found for one statement.

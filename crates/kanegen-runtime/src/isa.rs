@@ -19,7 +19,7 @@
 //! three-operand VEX encodings and 256-bit vectors where LLVM vectorizes. Calling a
 //! `#[target_feature]` function needs `unsafe` (the CPU must have the features); this module
 //! holds that call (the same in [`dispatch`], [`dispatch_fused_with`], through which
-//! [`dispatch_fused`] runs, [`dispatch_pair_with`], and [`dispatch_fused_wide_with`], which
+//! [`dispatch_fused`] and [`dispatch_pair_with`] run, and [`dispatch_fused_wide_with`], which
 //! also calls the x86-64-v4 copy), right after the check that
 //! the features are present; the crate's other `unsafe` blocks are the same kind of call in
 //! [`crate::derivative_steps::run`] (its AVX2 kernel, after [`active`] reported x86-64-v3 or
@@ -257,30 +257,6 @@ if_dispatching! {
         plain(arg)
     }
 
-    /// [`dispatch_fused_with`] for a body with paired statements (see [`crate::pair`]): the
-    /// copy that runs also gets the two-lane multiply-add of its instruction set,
-    /// [`Plain`] for the baseline copy and a [`FusedPair`] for the x86-64-v3 copy, which
-    /// is made here, after the check that the CPU has FMA.
-    #[inline(always)]
-    pub fn dispatch_pair_with<T, R>(
-        arg: T,
-        plain: impl FnOnce(T, Plain) -> R,
-        fused: impl FnOnce(T, FusedPair) -> R,
-    ) -> R {
-        if active_code() >= V3 {
-            // SAFETY: as in `dispatch_fused_with` above (the same check before the same call);
-            // the `FusedPair` is made after that check, where the CPU has FMA.
-            #[allow(unsafe_code)]
-            unsafe {
-                return run_v3(
-                    #[inline(always)]
-                    || fused(arg, FusedPair::new_unchecked()),
-                );
-            }
-        }
-        plain(arg, Plain)
-    }
-
     /// [`dispatch_fused_with`] with a third copy, compiled for x86-64-v4 (AVX-512: 8 `f64`
     /// lanes per register, 32 registers), run when [`active`] is [`Isa::X86_64V4`]: what the
     /// batched functions and [`crate::trig::sin_cos_slice`] use, whose loops over the states
@@ -346,32 +322,6 @@ if_not_dispatching! {
         }
     }
 
-    /// [`dispatch_fused_with`] for a body with paired statements: one copy, with the
-    /// two-lane multiply-add of [`native_pair`].
-    #[inline(always)]
-    pub fn dispatch_pair_with<T, R>(
-        arg: T,
-        plain: impl FnOnce(T, Plain) -> R,
-        fused: impl FnOnce(T, FusedPair) -> R,
-    ) -> R {
-        #[cfg(all(
-            feature = "std",
-            any(target_feature = "fma", target_arch = "aarch64")
-        ))]
-        {
-            let _ = plain;
-            fused(arg, native_pair())
-        }
-        #[cfg(not(all(
-            feature = "std",
-            any(target_feature = "fma", target_arch = "aarch64")
-        )))]
-        {
-            let _ = fused;
-            plain(arg, native_pair())
-        }
-    }
-
     /// [`dispatch_fused_with`]: this build has one copy of every function.
     #[inline(always)]
     pub fn dispatch_fused_wide_with<T, R>(
@@ -396,6 +346,26 @@ pub fn dispatch_fused<R>(plain: impl FnOnce() -> R, fused: impl FnOnce() -> R) -
         |()| plain(),
         #[inline(always)]
         |()| fused(),
+    )
+}
+
+/// [`dispatch_fused_with`] for a body with paired statements (see [`crate::pair`]): the copy
+/// that runs also gets the two-lane multiply-add of its instruction set, [`Plain`] for the
+/// baseline copy and a [`FusedPair`] for the fused one. [`dispatch_fused_with`] runs `fused`
+/// only in the x86-64-v3 copy after the CPU was found to have it (FMA included), or, without
+/// dispatch, in a build compiled with FMA (or on aarch64): where a [`FusedPair`] may exist.
+#[inline(always)]
+pub fn dispatch_pair_with<T, R>(
+    arg: T,
+    plain: impl FnOnce(T, Plain) -> R,
+    fused: impl FnOnce(T, FusedPair) -> R,
+) -> R {
+    dispatch_fused_with(
+        arg,
+        #[inline(always)]
+        |arg| plain(arg, Plain),
+        #[inline(always)]
+        |arg| fused(arg, FusedPair::new_unchecked()),
     )
 }
 

@@ -161,7 +161,6 @@ pub struct FusedPair {
 impl FusedPair {
     /// For [`crate::isa`] only: the caller makes sure that the CPU has FMA (x86-64).
     #[inline(always)]
-    #[allow(dead_code)] // builds without dispatch and without FMA never make one
     pub(crate) const fn new_unchecked() -> Self {
         Self { _fma_present: () }
     }

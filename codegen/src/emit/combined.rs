@@ -133,7 +133,7 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
         generic_body(cx, c.spec.inputs, (param_args, false), &quote!(#ty), body);
     let (args, arg_doc) = state_args(cx, c.spec.inputs);
     let doc = format!(
-        " Combined function: {} in one straight-line program (every sine, cosine and shared intermediate value computed once); each field equals the separate function's value (bit for bit in the baseline copy; in the x86-64-v3 copy, which fuses multiply-adds, to rounding where a product is shared here and inline there).",
+        " Combined function: {} in one straight-line program (every sine, cosine and shared intermediate value computed once); each field equals the separate function's value (bit for bit in the baseline copy; in the x86-64-v3 copy, which fuses multiply-adds, to rounding where a product is shared here and inline there; to rounding also for a separate function computed with mirrored lanes, which adds one subtree's sums in the other's order).",
         c.spec
             .parts
             .iter()

@@ -42,6 +42,7 @@ options (stats, listing, emit; `show` takes only the URDF import options):
   --functions LIST        the generated functions, comma-separated (default: `default`;
                           `all`, or names: mass_matrix,coriolis,gravity,inverse_dynamics,coriolis_matrix)
   --no-coriolis-matrix    leave out the Coriolis matrix C(q, u)
+  --mirrored-lanes        compute mirrored subtrees (two identical arms) in two SIMD lanes
   --f32                   emit an f32 module (emit only)
   --out FILE              write the module to FILE (emit only)
 
@@ -114,6 +115,8 @@ columns (per call of each generated function; `precompute` runs once per paramet
            adds above, executed as one instruction there: flops - fma instructions)
   live     the most intermediate values alive at once (register pressure: x86-64 has 16
            vector registers, more live values spill to the stack)
+  lanes    statement pairs computed in two lanes, one per mirrored subtree (--mirrored-lanes;
+           `-`: none)
 next:
   kanegen listing MODEL                 the K/D substitution listing of every function
   kanegen emit MODEL --out FILE         the generated Rust module
@@ -157,6 +160,7 @@ fn run(args: Vec<String>) -> Result<(), Failure> {
     if args.f32 {
         builder = builder.precision(kanegen::Precision::F32);
     }
+    builder = builder.mirrored_lanes(args.mirrored_lanes);
     let start = std::time::Instant::now();
     let g = builder.generate().map_err(|e| error(&e))?;
     let elapsed = start.elapsed();
@@ -219,7 +223,12 @@ impl Command {
             "--drop-links",
             "--name",
         ];
-        const GENERATOR: [&str; 3] = ["--baked", "--functions", "--no-coriolis-matrix"];
+        const GENERATOR: [&str; 4] = [
+            "--baked",
+            "--functions",
+            "--no-coriolis-matrix",
+            "--mirrored-lanes",
+        ];
         URDF.contains(&option)
             || (self != Command::Show && GENERATOR.contains(&option))
             || (self == Command::Emit && ["--f32", "--out"].contains(&option))
@@ -233,6 +242,7 @@ struct Args {
     baked: bool,
     functions: Option<FunctionSet>,
     no_coriolis_matrix: bool,
+    mirrored_lanes: bool,
     f32: bool,
     out: Option<String>,
     wheeled: Option<[String; 3]>,
@@ -278,6 +288,7 @@ fn parse(args: Vec<String>) -> Result<Option<Args>, String> {
         baked: false,
         functions: None,
         no_coriolis_matrix: false,
+        mirrored_lanes: false,
         f32: false,
         out: None,
         wheeled: None,
@@ -316,7 +327,12 @@ fn parse(args: Vec<String>) -> Result<Option<Args>, String> {
 }
 
 /// The options that take no value.
-const FLAGS: [&str; 3] = ["--baked", "--no-coriolis-matrix", "--f32"];
+const FLAGS: [&str; 4] = [
+    "--baked",
+    "--no-coriolis-matrix",
+    "--mirrored-lanes",
+    "--f32",
+];
 
 /// Whether `arg` is one of the options of the command line.
 fn is_option(arg: &str) -> bool {
@@ -337,6 +353,7 @@ impl Args {
         match arg {
             "--baked" => self.baked = true,
             "--no-coriolis-matrix" => self.no_coriolis_matrix = true,
+            "--mirrored-lanes" => self.mirrored_lanes = true,
             "--f32" => self.f32 = true,
             "--out" => self.out = Some(value()?),
             "--functions" => self.functions = Some(value()?.parse().map_err(|e| format!("{e}"))?),

@@ -6,6 +6,7 @@ use std::fmt::Write as _;
 use crate::Generated;
 use crate::expr::{Atom, ExprId, VarKind};
 use crate::lower::Program;
+use crate::lower::lanes::LanePlan;
 use crate::registry::{Dim, Shape};
 
 /// A per-function summary: K/D counts and op counts, as printed by `kanegen stats`.
@@ -38,14 +39,26 @@ pub fn stats(g: &Generated) -> String {
     );
     let _ = writeln!(
         s,
-        "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>6} {:>6}",
-        "function", "K", "D", "temps", "adds", "muls", "divs", "sin/cos", "flops", "fma", "live"
+        "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>6} {:>6} {:>6}",
+        "function",
+        "K",
+        "D",
+        "temps",
+        "adds",
+        "muls",
+        "divs",
+        "sin/cos",
+        "flops",
+        "fma",
+        "live",
+        "lanes"
     );
-    let mut row = |name: &str, p: &Program| {
+    let mut row = |name: &str, p: &Program, lanes: Option<&LanePlan>| {
         let temps = p.stmts.len() - p.k_vars - p.d_vars;
+        let lanes = lanes.map_or("-".to_owned(), |l| l.lane_pairs().to_string());
         let _ = writeln!(
             s,
-            "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>6} {:>6}",
+            "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>6} {:>6} {:>6}",
             name,
             p.k_vars,
             p.d_vars,
@@ -56,20 +69,21 @@ pub fn stats(g: &Generated) -> String {
             p.ops.sincos,
             p.ops.flops(),
             p.ops.fmas,
-            p.max_live()
+            p.max_live(),
+            lanes
         );
     };
     if d.options.params.is_runtime() {
-        row("precompute (once)", &g.lowered.precompute);
+        row("precompute (once)", &g.lowered.precompute, None);
     }
     for f in &g.lowered.functions {
-        row(&f.program.name, &f.program);
+        row(&f.program.name, &f.program, f.lanes.as_ref());
     }
     for c in &g.lowered.combined {
-        row(&c.program.name, &c.program);
+        row(&c.program.name, &c.program, None);
     }
     if let Some(l) = &g.lowered.derivative_loop {
-        row("  looped: setup", &l.program);
+        row("  looped: setup", &l.program, l.lanes.as_ref());
         let _ = writeln!(
             s,
             "  looped: loop     {} steps up, workspace {} values; {} flops in the loop (dense 4-wide transforms), {} in all (the emitted form)",

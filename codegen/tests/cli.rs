@@ -45,6 +45,7 @@ fn stats_explains_its_columns_and_what_to_run_next() {
         "  flops",
         "  fma",
         "  live",
+        "  lanes",
     ] {
         assert!(
             out.contains(key),
@@ -54,6 +55,35 @@ fn stats_explains_its_columns_and_what_to_run_next() {
     }
     assert!(out.contains("per call"), "{out}");
     assert!(out.contains("next:\n  kanegen listing MODEL"), "{out}");
+}
+
+#[test]
+fn stats_counts_the_lane_pairs_of_mirrored_subtrees() {
+    let row = |out: &str, name: &str| -> String {
+        out.lines()
+            .find(|l| l.starts_with(&format!("{name} ")))
+            .unwrap_or_else(|| panic!("no row {name}:\n{out}"))
+            .to_owned()
+    };
+    let krang = model("krang.toml");
+    let plain = stdout(&kanegen(&["stats", &krang]));
+    let lanes = kanegen(&["stats", &krang, "--mirrored-lanes"]);
+    assert!(lanes.status.success(), "{}", stderr(&lanes));
+    let lanes = stdout(&lanes);
+    for f in ["mass_matrix", "coriolis", "inverse_dynamics"] {
+        let (a, b) = (row(&plain, f), row(&lanes, f));
+        assert!(a.trim_end().ends_with(" -"), "{a}");
+        let pairs: usize = b
+            .split_whitespace()
+            .last()
+            .unwrap()
+            .parse()
+            .expect("a count");
+        assert!(pairs > 100, "{b}");
+        // The same operations, paired or not.
+        let flops = |r: &str| r.split_whitespace().nth(8).map(str::to_owned);
+        assert_eq!(flops(&a), flops(&b), "{a}\n{b}");
+    }
 }
 
 #[test]

@@ -662,6 +662,7 @@ pub fn pair(p: &Program, mirror: &Mirror, pre: &[Option<usize>]) -> Option<(Prog
     let mut out = Program {
         stmts,
         outputs,
+        sincos: interleaved(&p.sincos, mirror),
         ..p.clone()
     };
     super::apply_order(&mut out, &order);
@@ -733,6 +734,24 @@ fn sides(p: &Program, map: &LeafMap<'_>) -> Vec<Option<bool>> {
         sides.push(side);
     }
     sides
+}
+
+/// The joint angles `sincos` with each mirrored pair next to each other (first subtree's
+/// first), so that a pair's sines (and cosines) are adjacent in the batched `sin_cos_n`
+/// result and one 16-byte load fills both lanes.
+fn interleaved(sincos: &[usize], mirror: &Mirror) -> Vec<usize> {
+    let mut out = Vec::with_capacity(sincos.len());
+    for &s in sincos {
+        let m = mirror.speeds[s];
+        if out.contains(&s) {
+            continue;
+        }
+        out.push(s);
+        if m != s && sincos.contains(&m) {
+            out.push(m);
+        }
+    }
+    out
 }
 
 /// `e` with every statement `k` read with its sign flipped where `flip[k]`.

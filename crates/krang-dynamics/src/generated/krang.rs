@@ -2181,18 +2181,18 @@ mod generated {
                 q[3],
                 q[4],
                 q[5],
-                q[6],
-                q[7],
-                q[8],
-                q[9],
-                q[10],
-                q[11],
                 q[12],
+                q[6],
                 q[13],
+                q[7],
                 q[14],
+                q[8],
                 q[15],
+                q[9],
                 q[16],
+                q[10],
                 q[17],
+                q[11],
                 q[18],
             ]);
             let s_q_imu = sin_q[0];
@@ -2203,30 +2203,30 @@ mod generated {
             let c_q_torso = cos_q[2];
             let s_q1l = sin_q[3];
             let c_q1l = cos_q[3];
-            let s_q2l = sin_q[4];
-            let c_q2l = cos_q[4];
-            let s_q3l = sin_q[5];
-            let c_q3l = cos_q[5];
-            let s_q4l = sin_q[6];
-            let c_q4l = cos_q[6];
-            let s_q5l = sin_q[7];
-            let c_q5l = cos_q[7];
-            let s_q6l = sin_q[8];
-            let c_q6l = cos_q[8];
-            let s_q7l = sin_q[9];
-            let c_q7l = cos_q[9];
-            let s_q1r = sin_q[10];
-            let c_q1r = cos_q[10];
-            let s_q2r = sin_q[11];
-            let c_q2r = cos_q[11];
-            let s_q3r = sin_q[12];
-            let c_q3r = cos_q[12];
-            let s_q4r = sin_q[13];
-            let c_q4r = cos_q[13];
-            let s_q5r = sin_q[14];
-            let c_q5r = cos_q[14];
-            let s_q6r = sin_q[15];
-            let c_q6r = cos_q[15];
+            let s_q1r = sin_q[4];
+            let c_q1r = cos_q[4];
+            let s_q2l = sin_q[5];
+            let c_q2l = cos_q[5];
+            let s_q2r = sin_q[6];
+            let c_q2r = cos_q[6];
+            let s_q3l = sin_q[7];
+            let c_q3l = cos_q[7];
+            let s_q3r = sin_q[8];
+            let c_q3r = cos_q[8];
+            let s_q4l = sin_q[9];
+            let c_q4l = cos_q[9];
+            let s_q4r = sin_q[10];
+            let c_q4r = cos_q[10];
+            let s_q5l = sin_q[11];
+            let c_q5l = cos_q[11];
+            let s_q5r = sin_q[12];
+            let c_q5r = cos_q[12];
+            let s_q6l = sin_q[13];
+            let c_q6l = cos_q[13];
+            let s_q6r = sin_q[14];
+            let c_q6r = cos_q[14];
+            let s_q7l = sin_q[15];
+            let c_q7l = cos_q[15];
             let s_q7r = sin_q[16];
             let c_q7r = cos_q[16];
             m[(0, 0)] = pc.pc69;
@@ -4135,18 +4135,18 @@ mod generated {
                 q[3],
                 q[4],
                 q[5],
-                q[6],
-                q[7],
-                q[8],
-                q[9],
-                q[10],
-                q[11],
                 q[12],
+                q[6],
                 q[13],
+                q[7],
                 q[14],
+                q[8],
                 q[15],
+                q[9],
                 q[16],
+                q[10],
                 q[17],
+                q[11],
                 q[18],
             ]);
             let s_q_imu = sin_q[0];
@@ -4157,30 +4157,30 @@ mod generated {
             let c_q_torso = cos_q[2];
             let s_q1l = sin_q[3];
             let c_q1l = cos_q[3];
-            let s_q2l = sin_q[4];
-            let c_q2l = cos_q[4];
-            let s_q3l = sin_q[5];
-            let c_q3l = cos_q[5];
-            let s_q4l = sin_q[6];
-            let c_q4l = cos_q[6];
-            let s_q5l = sin_q[7];
-            let c_q5l = cos_q[7];
-            let s_q6l = sin_q[8];
-            let c_q6l = cos_q[8];
-            let s_q7l = sin_q[9];
-            let c_q7l = cos_q[9];
-            let s_q1r = sin_q[10];
-            let c_q1r = cos_q[10];
-            let s_q2r = sin_q[11];
-            let c_q2r = cos_q[11];
-            let s_q3r = sin_q[12];
-            let c_q3r = cos_q[12];
-            let s_q4r = sin_q[13];
-            let c_q4r = cos_q[13];
-            let s_q5r = sin_q[14];
-            let c_q5r = cos_q[14];
-            let s_q6r = sin_q[15];
-            let c_q6r = cos_q[15];
+            let s_q1r = sin_q[4];
+            let c_q1r = cos_q[4];
+            let s_q2l = sin_q[5];
+            let c_q2l = cos_q[5];
+            let s_q2r = sin_q[6];
+            let c_q2r = cos_q[6];
+            let s_q3l = sin_q[7];
+            let c_q3l = cos_q[7];
+            let s_q3r = sin_q[8];
+            let c_q3r = cos_q[8];
+            let s_q4l = sin_q[9];
+            let c_q4l = cos_q[9];
+            let s_q4r = sin_q[10];
+            let c_q4r = cos_q[10];
+            let s_q5l = sin_q[11];
+            let c_q5l = cos_q[11];
+            let s_q5r = sin_q[12];
+            let c_q5r = cos_q[12];
+            let s_q6l = sin_q[13];
+            let c_q6l = cos_q[13];
+            let s_q6r = sin_q[14];
+            let c_q6r = cos_q[14];
+            let s_q7l = sin_q[15];
+            let c_q7l = cos_q[15];
             let s_q7r = sin_q[16];
             let c_q7r = cos_q[16];
             let xd = u[0];
@@ -6610,18 +6610,18 @@ mod generated {
                 q[3],
                 q[4],
                 q[5],
-                q[6],
-                q[7],
-                q[8],
-                q[9],
-                q[10],
-                q[11],
                 q[12],
+                q[6],
                 q[13],
+                q[7],
                 q[14],
+                q[8],
                 q[15],
+                q[9],
                 q[16],
+                q[10],
                 q[17],
+                q[11],
                 q[18],
             ]);
             let s_q_imu = sin_q[0];
@@ -6632,30 +6632,30 @@ mod generated {
             let c_q_torso = cos_q[2];
             let s_q1l = sin_q[3];
             let c_q1l = cos_q[3];
-            let s_q2l = sin_q[4];
-            let c_q2l = cos_q[4];
-            let s_q3l = sin_q[5];
-            let c_q3l = cos_q[5];
-            let s_q4l = sin_q[6];
-            let c_q4l = cos_q[6];
-            let s_q5l = sin_q[7];
-            let c_q5l = cos_q[7];
-            let s_q6l = sin_q[8];
-            let c_q6l = cos_q[8];
-            let s_q7l = sin_q[9];
-            let c_q7l = cos_q[9];
-            let s_q1r = sin_q[10];
-            let c_q1r = cos_q[10];
-            let s_q2r = sin_q[11];
-            let c_q2r = cos_q[11];
-            let s_q3r = sin_q[12];
-            let c_q3r = cos_q[12];
-            let s_q4r = sin_q[13];
-            let c_q4r = cos_q[13];
-            let s_q5r = sin_q[14];
-            let c_q5r = cos_q[14];
-            let s_q6r = sin_q[15];
-            let c_q6r = cos_q[15];
+            let s_q1r = sin_q[4];
+            let c_q1r = cos_q[4];
+            let s_q2l = sin_q[5];
+            let c_q2l = cos_q[5];
+            let s_q2r = sin_q[6];
+            let c_q2r = cos_q[6];
+            let s_q3l = sin_q[7];
+            let c_q3l = cos_q[7];
+            let s_q3r = sin_q[8];
+            let c_q3r = cos_q[8];
+            let s_q4l = sin_q[9];
+            let c_q4l = cos_q[9];
+            let s_q4r = sin_q[10];
+            let c_q4r = cos_q[10];
+            let s_q5l = sin_q[11];
+            let c_q5l = cos_q[11];
+            let s_q5r = sin_q[12];
+            let c_q5r = cos_q[12];
+            let s_q6l = sin_q[13];
+            let c_q6l = cos_q[13];
+            let s_q6r = sin_q[14];
+            let c_q6r = cos_q[14];
+            let s_q7l = sin_q[15];
+            let c_q7l = cos_q[15];
             let s_q7r = sin_q[16];
             let c_q7r = cos_q[16];
             let mut out = SVector::<f64, 19>::zeros();
@@ -6959,18 +6959,18 @@ mod generated {
                 q[3],
                 q[4],
                 q[5],
-                q[6],
-                q[7],
-                q[8],
-                q[9],
-                q[10],
-                q[11],
                 q[12],
+                q[6],
                 q[13],
+                q[7],
                 q[14],
+                q[8],
                 q[15],
+                q[9],
                 q[16],
+                q[10],
                 q[17],
+                q[11],
                 q[18],
             ]);
             let s_q_imu = sin_q[0];
@@ -6981,30 +6981,30 @@ mod generated {
             let c_q_torso = cos_q[2];
             let s_q1l = sin_q[3];
             let c_q1l = cos_q[3];
-            let s_q2l = sin_q[4];
-            let c_q2l = cos_q[4];
-            let s_q3l = sin_q[5];
-            let c_q3l = cos_q[5];
-            let s_q4l = sin_q[6];
-            let c_q4l = cos_q[6];
-            let s_q5l = sin_q[7];
-            let c_q5l = cos_q[7];
-            let s_q6l = sin_q[8];
-            let c_q6l = cos_q[8];
-            let s_q7l = sin_q[9];
-            let c_q7l = cos_q[9];
-            let s_q1r = sin_q[10];
-            let c_q1r = cos_q[10];
-            let s_q2r = sin_q[11];
-            let c_q2r = cos_q[11];
-            let s_q3r = sin_q[12];
-            let c_q3r = cos_q[12];
-            let s_q4r = sin_q[13];
-            let c_q4r = cos_q[13];
-            let s_q5r = sin_q[14];
-            let c_q5r = cos_q[14];
-            let s_q6r = sin_q[15];
-            let c_q6r = cos_q[15];
+            let s_q1r = sin_q[4];
+            let c_q1r = cos_q[4];
+            let s_q2l = sin_q[5];
+            let c_q2l = cos_q[5];
+            let s_q2r = sin_q[6];
+            let c_q2r = cos_q[6];
+            let s_q3l = sin_q[7];
+            let c_q3l = cos_q[7];
+            let s_q3r = sin_q[8];
+            let c_q3r = cos_q[8];
+            let s_q4l = sin_q[9];
+            let c_q4l = cos_q[9];
+            let s_q4r = sin_q[10];
+            let c_q4r = cos_q[10];
+            let s_q5l = sin_q[11];
+            let c_q5l = cos_q[11];
+            let s_q5r = sin_q[12];
+            let c_q5r = cos_q[12];
+            let s_q6l = sin_q[13];
+            let c_q6l = cos_q[13];
+            let s_q6r = sin_q[14];
+            let c_q6r = cos_q[14];
+            let s_q7l = sin_q[15];
+            let c_q7l = cos_q[15];
             let s_q7r = sin_q[16];
             let c_q7r = cos_q[16];
             let xd = u[0];
@@ -9324,18 +9324,18 @@ mod generated {
                 q[3].0,
                 q[4].0,
                 q[5].0,
-                q[6].0,
-                q[7].0,
-                q[8].0,
-                q[9].0,
-                q[10].0,
-                q[11].0,
                 q[12].0,
+                q[6].0,
                 q[13].0,
+                q[7].0,
                 q[14].0,
+                q[8].0,
                 q[15].0,
+                q[9].0,
                 q[16].0,
+                q[10].0,
                 q[17].0,
+                q[11].0,
                 q[18].0,
             ]);
             for (l, m) in out.iter_mut().enumerate() {
@@ -9347,30 +9347,30 @@ mod generated {
                 let c_q_torso = cos_q[2][l];
                 let s_q1l = sin_q[3][l];
                 let c_q1l = cos_q[3][l];
-                let s_q2l = sin_q[4][l];
-                let c_q2l = cos_q[4][l];
-                let s_q3l = sin_q[5][l];
-                let c_q3l = cos_q[5][l];
-                let s_q4l = sin_q[6][l];
-                let c_q4l = cos_q[6][l];
-                let s_q5l = sin_q[7][l];
-                let c_q5l = cos_q[7][l];
-                let s_q6l = sin_q[8][l];
-                let c_q6l = cos_q[8][l];
-                let s_q7l = sin_q[9][l];
-                let c_q7l = cos_q[9][l];
-                let s_q1r = sin_q[10][l];
-                let c_q1r = cos_q[10][l];
-                let s_q2r = sin_q[11][l];
-                let c_q2r = cos_q[11][l];
-                let s_q3r = sin_q[12][l];
-                let c_q3r = cos_q[12][l];
-                let s_q4r = sin_q[13][l];
-                let c_q4r = cos_q[13][l];
-                let s_q5r = sin_q[14][l];
-                let c_q5r = cos_q[14][l];
-                let s_q6r = sin_q[15][l];
-                let c_q6r = cos_q[15][l];
+                let s_q1r = sin_q[4][l];
+                let c_q1r = cos_q[4][l];
+                let s_q2l = sin_q[5][l];
+                let c_q2l = cos_q[5][l];
+                let s_q2r = sin_q[6][l];
+                let c_q2r = cos_q[6][l];
+                let s_q3l = sin_q[7][l];
+                let c_q3l = cos_q[7][l];
+                let s_q3r = sin_q[8][l];
+                let c_q3r = cos_q[8][l];
+                let s_q4l = sin_q[9][l];
+                let c_q4l = cos_q[9][l];
+                let s_q4r = sin_q[10][l];
+                let c_q4r = cos_q[10][l];
+                let s_q5l = sin_q[11][l];
+                let c_q5l = cos_q[11][l];
+                let s_q5r = sin_q[12][l];
+                let c_q5r = cos_q[12][l];
+                let s_q6l = sin_q[13][l];
+                let c_q6l = cos_q[13][l];
+                let s_q6r = sin_q[14][l];
+                let c_q6r = cos_q[14][l];
+                let s_q7l = sin_q[15][l];
+                let c_q7l = cos_q[15][l];
                 let s_q7r = sin_q[16][l];
                 let c_q7r = cos_q[16][l];
                 m[(0, 0)] = pc.pc69;
@@ -10943,18 +10943,18 @@ mod generated {
                 q[3].0,
                 q[4].0,
                 q[5].0,
-                q[6].0,
-                q[7].0,
-                q[8].0,
-                q[9].0,
-                q[10].0,
-                q[11].0,
                 q[12].0,
+                q[6].0,
                 q[13].0,
+                q[7].0,
                 q[14].0,
+                q[8].0,
                 q[15].0,
+                q[9].0,
                 q[16].0,
+                q[10].0,
                 q[17].0,
+                q[11].0,
                 q[18].0,
             ]);
             for (l, m) in out.iter_mut().enumerate() {
@@ -10966,30 +10966,30 @@ mod generated {
                 let c_q_torso = cos_q[2][l];
                 let s_q1l = sin_q[3][l];
                 let c_q1l = cos_q[3][l];
-                let s_q2l = sin_q[4][l];
-                let c_q2l = cos_q[4][l];
-                let s_q3l = sin_q[5][l];
-                let c_q3l = cos_q[5][l];
-                let s_q4l = sin_q[6][l];
-                let c_q4l = cos_q[6][l];
-                let s_q5l = sin_q[7][l];
-                let c_q5l = cos_q[7][l];
-                let s_q6l = sin_q[8][l];
-                let c_q6l = cos_q[8][l];
-                let s_q7l = sin_q[9][l];
-                let c_q7l = cos_q[9][l];
-                let s_q1r = sin_q[10][l];
-                let c_q1r = cos_q[10][l];
-                let s_q2r = sin_q[11][l];
-                let c_q2r = cos_q[11][l];
-                let s_q3r = sin_q[12][l];
-                let c_q3r = cos_q[12][l];
-                let s_q4r = sin_q[13][l];
-                let c_q4r = cos_q[13][l];
-                let s_q5r = sin_q[14][l];
-                let c_q5r = cos_q[14][l];
-                let s_q6r = sin_q[15][l];
-                let c_q6r = cos_q[15][l];
+                let s_q1r = sin_q[4][l];
+                let c_q1r = cos_q[4][l];
+                let s_q2l = sin_q[5][l];
+                let c_q2l = cos_q[5][l];
+                let s_q2r = sin_q[6][l];
+                let c_q2r = cos_q[6][l];
+                let s_q3l = sin_q[7][l];
+                let c_q3l = cos_q[7][l];
+                let s_q3r = sin_q[8][l];
+                let c_q3r = cos_q[8][l];
+                let s_q4l = sin_q[9][l];
+                let c_q4l = cos_q[9][l];
+                let s_q4r = sin_q[10][l];
+                let c_q4r = cos_q[10][l];
+                let s_q5l = sin_q[11][l];
+                let c_q5l = cos_q[11][l];
+                let s_q5r = sin_q[12][l];
+                let c_q5r = cos_q[12][l];
+                let s_q6l = sin_q[13][l];
+                let c_q6l = cos_q[13][l];
+                let s_q6r = sin_q[14][l];
+                let c_q6r = cos_q[14][l];
+                let s_q7l = sin_q[15][l];
+                let c_q7l = cos_q[15][l];
                 let s_q7r = sin_q[16][l];
                 let c_q7r = cos_q[16][l];
                 let xd = u[0].0[l];
@@ -13230,18 +13230,18 @@ mod generated {
                 q[3].0,
                 q[4].0,
                 q[5].0,
-                q[6].0,
-                q[7].0,
-                q[8].0,
-                q[9].0,
-                q[10].0,
-                q[11].0,
                 q[12].0,
+                q[6].0,
                 q[13].0,
+                q[7].0,
                 q[14].0,
+                q[8].0,
                 q[15].0,
+                q[9].0,
                 q[16].0,
+                q[10].0,
                 q[17].0,
+                q[11].0,
                 q[18].0,
             ]);
             for (l, m) in out.iter_mut().enumerate() {
@@ -13253,30 +13253,30 @@ mod generated {
                 let c_q_torso = cos_q[2][l];
                 let s_q1l = sin_q[3][l];
                 let c_q1l = cos_q[3][l];
-                let s_q2l = sin_q[4][l];
-                let c_q2l = cos_q[4][l];
-                let s_q3l = sin_q[5][l];
-                let c_q3l = cos_q[5][l];
-                let s_q4l = sin_q[6][l];
-                let c_q4l = cos_q[6][l];
-                let s_q5l = sin_q[7][l];
-                let c_q5l = cos_q[7][l];
-                let s_q6l = sin_q[8][l];
-                let c_q6l = cos_q[8][l];
-                let s_q7l = sin_q[9][l];
-                let c_q7l = cos_q[9][l];
-                let s_q1r = sin_q[10][l];
-                let c_q1r = cos_q[10][l];
-                let s_q2r = sin_q[11][l];
-                let c_q2r = cos_q[11][l];
-                let s_q3r = sin_q[12][l];
-                let c_q3r = cos_q[12][l];
-                let s_q4r = sin_q[13][l];
-                let c_q4r = cos_q[13][l];
-                let s_q5r = sin_q[14][l];
-                let c_q5r = cos_q[14][l];
-                let s_q6r = sin_q[15][l];
-                let c_q6r = cos_q[15][l];
+                let s_q1r = sin_q[4][l];
+                let c_q1r = cos_q[4][l];
+                let s_q2l = sin_q[5][l];
+                let c_q2l = cos_q[5][l];
+                let s_q2r = sin_q[6][l];
+                let c_q2r = cos_q[6][l];
+                let s_q3l = sin_q[7][l];
+                let c_q3l = cos_q[7][l];
+                let s_q3r = sin_q[8][l];
+                let c_q3r = cos_q[8][l];
+                let s_q4l = sin_q[9][l];
+                let c_q4l = cos_q[9][l];
+                let s_q4r = sin_q[10][l];
+                let c_q4r = cos_q[10][l];
+                let s_q5l = sin_q[11][l];
+                let c_q5l = cos_q[11][l];
+                let s_q5r = sin_q[12][l];
+                let c_q5r = cos_q[12][l];
+                let s_q6l = sin_q[13][l];
+                let c_q6l = cos_q[13][l];
+                let s_q6r = sin_q[14][l];
+                let c_q6r = cos_q[14][l];
+                let s_q7l = sin_q[15][l];
+                let c_q7l = cos_q[15][l];
                 let s_q7r = sin_q[16][l];
                 let c_q7r = cos_q[16][l];
                 let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
@@ -13460,18 +13460,18 @@ mod generated {
                 q[3].0,
                 q[4].0,
                 q[5].0,
-                q[6].0,
-                q[7].0,
-                q[8].0,
-                q[9].0,
-                q[10].0,
-                q[11].0,
                 q[12].0,
+                q[6].0,
                 q[13].0,
+                q[7].0,
                 q[14].0,
+                q[8].0,
                 q[15].0,
+                q[9].0,
                 q[16].0,
+                q[10].0,
                 q[17].0,
+                q[11].0,
                 q[18].0,
             ]);
             for (l, m) in out.iter_mut().enumerate() {
@@ -13483,30 +13483,30 @@ mod generated {
                 let c_q_torso = cos_q[2][l];
                 let s_q1l = sin_q[3][l];
                 let c_q1l = cos_q[3][l];
-                let s_q2l = sin_q[4][l];
-                let c_q2l = cos_q[4][l];
-                let s_q3l = sin_q[5][l];
-                let c_q3l = cos_q[5][l];
-                let s_q4l = sin_q[6][l];
-                let c_q4l = cos_q[6][l];
-                let s_q5l = sin_q[7][l];
-                let c_q5l = cos_q[7][l];
-                let s_q6l = sin_q[8][l];
-                let c_q6l = cos_q[8][l];
-                let s_q7l = sin_q[9][l];
-                let c_q7l = cos_q[9][l];
-                let s_q1r = sin_q[10][l];
-                let c_q1r = cos_q[10][l];
-                let s_q2r = sin_q[11][l];
-                let c_q2r = cos_q[11][l];
-                let s_q3r = sin_q[12][l];
-                let c_q3r = cos_q[12][l];
-                let s_q4r = sin_q[13][l];
-                let c_q4r = cos_q[13][l];
-                let s_q5r = sin_q[14][l];
-                let c_q5r = cos_q[14][l];
-                let s_q6r = sin_q[15][l];
-                let c_q6r = cos_q[15][l];
+                let s_q1r = sin_q[4][l];
+                let c_q1r = cos_q[4][l];
+                let s_q2l = sin_q[5][l];
+                let c_q2l = cos_q[5][l];
+                let s_q2r = sin_q[6][l];
+                let c_q2r = cos_q[6][l];
+                let s_q3l = sin_q[7][l];
+                let c_q3l = cos_q[7][l];
+                let s_q3r = sin_q[8][l];
+                let c_q3r = cos_q[8][l];
+                let s_q4l = sin_q[9][l];
+                let c_q4l = cos_q[9][l];
+                let s_q4r = sin_q[10][l];
+                let c_q4r = cos_q[10][l];
+                let s_q5l = sin_q[11][l];
+                let c_q5l = cos_q[11][l];
+                let s_q5r = sin_q[12][l];
+                let c_q5r = cos_q[12][l];
+                let s_q6l = sin_q[13][l];
+                let c_q6l = cos_q[13][l];
+                let s_q6r = sin_q[14][l];
+                let c_q6r = cos_q[14][l];
+                let s_q7l = sin_q[15][l];
+                let c_q7l = cos_q[15][l];
                 let s_q7r = sin_q[16][l];
                 let c_q7r = cos_q[16][l];
                 let xd = u[0].0[l];

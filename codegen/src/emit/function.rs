@@ -685,7 +685,9 @@ pub(super) fn outer_params(cx: &Context<'_>) -> (TokenStream, TokenStream) {
 /// with `Fused` for x86-64-v3, and `kanegen_runtime::isa::dispatch_fused` runs the copy for the
 /// CPU (the closures and the body inline into each copy); without, once with `Native` (fused
 /// when the crate is compiled with FMA). `param_args` are the inner function's parameters (`_p`
-/// when it does not read them).
+/// when it does not read them); with `lanes` (a body with paired statements, see
+/// [`super::lanes`]) the body also takes the copy's two-lane multiply-add `lanes: P` first,
+/// passed by `isa::dispatch_pair_with` (`isa::native_pair()` without dispatch).
 pub(super) fn generic_body(
     cx: &Context<'_>,
     inputs: Inputs,

@@ -414,8 +414,9 @@ impl Builder {
     /// Mirrored subtrees in two SIMD lanes ("arms in lanes", default `false`; `f64` modules):
     /// where the model has two sibling subtrees of the same shape (Krang's arms: the same
     /// joints, axes and geometry below their first joint, each with its own inertial
-    /// parameters), the single-state M, c, g, τ, C and nonlinear effects compute each pair of
-    /// mirrored statements once, the first subtree in the low lane of a
+    /// parameters), the single-state M, c, g, τ, C, nonlinear effects and centre-of-mass
+    /// functions, the combined functions and the looped derivatives' straight-line part compute
+    /// each pair of mirrored statements once, the first subtree in the low lane of a
     /// `kanegen_runtime::pair::F64x2` and the second in the high lane. Every result entry is
     /// computed with the same operations as the scalar statements, in the same order (tested
     /// bit for bit); the right subtree's sums are printed in the left's order. Models without

@@ -8,7 +8,8 @@ use quote::quote;
 
 use super::Context;
 use super::function::{
-    Reads, generic_body, prologue, result_type, state_args, store_after, unused_inputs,
+    Reads, Stores, generic_body, prologue, result_type, state_args, store_after, store_text_after,
+    text, unused_inputs,
 };
 use super::items::arg_names;
 use super::print::{ident, idx};
@@ -61,7 +62,10 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
 
     // The body: `out` is a tuple with one element per part (an isometry's is `(rotation,
     // translation)`), filled by stores after the statements they read.
+    let lanes = super::function::lanes_in(cx, p, c.lanes.as_ref());
     let mut stores: Vec<TokenStream> = vec![TokenStream::new(); p.stmts.len() + 1];
+    // The same stores as text lines, for the two-lane block (`emit::lanes`).
+    let mut text_stores: Stores = vec![Vec::new(); p.stmts.len() + 1];
     let mut stored = false;
     let mut inits = Vec::new();
     let mut finals = Vec::new();
@@ -75,6 +79,22 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
             .collect();
         stored |= !entries.is_empty();
         for &(r, col, ref e) in entries {
+            if lanes.is_some() {
+                let v = text(cx, &printer, e);
+                let line = match shape {
+                    Shape::Vector => format!("out.{i}[{r}] = core::hint::black_box({v});"),
+                    Shape::Scalar => format!("out.{i} = {v};"),
+                    Shape::Isometry if col == 3 => format!("out.{i}.1[{r}] = {v};"),
+                    Shape::Isometry => format!("out.{i}.0[({r}, {col})] = {v};"),
+                    _ => format!("out.{i}[({r}, {col})] = {v};"),
+                };
+                store_text_after(&mut text_stores, e, line);
+                if *shape == Shape::SymmetricMatrix && r != col {
+                    let copy = format!("out.{i}[({col}, {r})] = out.{i}[({r}, {col})];");
+                    store_text_after(&mut text_stores, e, copy);
+                }
+                continue;
+            }
             let v = printer.expr_fused(&cx.leaf_names, e);
             let (translation, diagonal) = (col == 3, r == col);
             let (r, col) = (idx(r), idx(col));
@@ -116,7 +136,17 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
             }
         }
     }
-    let body = printer.statements_fused(&cx.leaf_names, &stores);
+    let body = match lanes {
+        Some((leaves, plan)) => cx.blocks.placeholder(super::lanes::lane_block(
+            &printer,
+            &cx.leaf_names,
+            leaves,
+            p,
+            plan,
+            text_stores,
+        )),
+        None => printer.statements_fused(&cx.leaf_names, &stores),
+    };
     let prologue = prologue(cx, p, &reads);
     let unused = unused_inputs(c.spec.inputs, p, &reads);
     let mutable = if stored { quote!(mut) } else { quote!() };
@@ -129,11 +159,16 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
     };
     let param_args = super::function::param_args(cx, &reads);
     // Generic over the multiply-add, as the separate functions (whose bits it gives).
-    let (param_args, body) =
-        generic_body(cx, c.spec.inputs, (param_args, false), &quote!(#ty), body);
+    let (param_args, body) = generic_body(
+        cx,
+        c.spec.inputs,
+        (param_args, lanes.is_some()),
+        &quote!(#ty),
+        body,
+    );
     let (args, arg_doc) = state_args(cx, c.spec.inputs);
     let doc = format!(
-        " Combined function: {} in one straight-line program (every sine, cosine and shared intermediate value computed once); each field equals the separate function's value (bit for bit in the baseline copy; in the x86-64-v3 copy, which fuses multiply-adds, to rounding where a product is shared here and inline there; to rounding also for a separate function computed with mirrored lanes, which adds one subtree's sums in the other's order).",
+        " Combined function: {} in one straight-line program (every sine, cosine and shared intermediate value computed once); each field equals the separate function's value (bit for bit in the baseline copy; in the x86-64-v3 copy, which fuses multiply-adds, to rounding where a product is shared here and inline there; with mirrored lanes, to rounding also for a per-frame part of the second subtree, which this program adds in the first subtree's order).",
         c.spec
             .parts
             .iter()

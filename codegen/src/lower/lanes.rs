@@ -36,14 +36,18 @@ use crate::kane::{Derivation, Mirror};
 use crate::registry::FunctionId;
 
 /// The functions whose single-state form gets lanes (when [`apply`] finds pairs): M, c, g, τ,
-/// C and the nonlinear effects.
-pub const LANE_FUNCTIONS: [FunctionId; 6] = [
+/// C, the nonlinear effects and the centre of mass's position, Jacobian and bias acceleration
+/// (the per-frame functions compute one frame, which has no mirror within the function).
+pub const LANE_FUNCTIONS: [FunctionId; 9] = [
     FunctionId::MassMatrix,
     FunctionId::Coriolis,
     FunctionId::Gravity,
     FunctionId::InverseDynamics,
     FunctionId::CoriolisMatrix,
     FunctionId::NonlinearEffects,
+    FunctionId::CenterOfMass,
+    FunctionId::ComJacobian,
+    FunctionId::ComBiasAcceleration,
 ];
 
 /// A statement's part in the two-lane form.
@@ -129,6 +133,16 @@ pub fn apply(low: &mut Lowered, d: &Derivation) {
         f.program = program;
         f.lanes = Some(plan);
     }
+    // The combined functions (a controller's terms in one program).
+    for c in &mut low.combined {
+        let Some((program, plan)) = pair(&c.program, mirror, &pre) else {
+            continue;
+        };
+        if plan.lane_pairs() > 0 && same_values(&c.program, &program, d.dof, &params, &pre_values) {
+            c.program = program;
+            c.lanes = Some(plan);
+        }
+    }
     // The straight-line part of the looped derivatives (its outputs: the workspace).
     if let Some(looped) = &mut low.derivative_loop
         && let Some((program, plan)) = pair(&looped.program, mirror, &pre)
@@ -139,6 +153,7 @@ pub fn apply(low: &mut Lowered, d: &Derivation) {
         looped.lanes = Some(plan);
     }
     let paired = low.functions.iter().any(|f| f.lanes.is_some())
+        || low.combined.iter().any(|c| c.lanes.is_some())
         || low
             .derivative_loop
             .as_ref()
@@ -991,6 +1006,43 @@ mod tests {
             .collect();
         let pre = plain.precompute_values(&params);
         assert!(same_values(&a.program, &b.program, d.dof, &params, &pre));
+    }
+
+    #[test]
+    fn combined_programs_pair_and_give_the_same_parts() {
+        use crate::combined::{Combined, resolve};
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let model = Model::from_toml_file(root.join("models/krang.toml")).expect("loads");
+        let mut c = Combined::new("whole_body_terms")
+            .with(FunctionId::MassMatrix)
+            .with(FunctionId::NonlinearEffects)
+            .with(FunctionId::ComJacobian);
+        for hand in ["left_hand", "right_hand"] {
+            c = c.with_frame(FunctionId::FrameBiasAcceleration, hand);
+        }
+        let combined = resolve(&model, &[c]).expect("resolves");
+        let d = crate::kane::derive_with(&model, Options::default(), &combined);
+        let plain = super::super::lower(&d);
+        let mut paired = plain.clone();
+        apply(&mut paired, &d);
+        let plan = paired.combined[0]
+            .lanes
+            .as_ref()
+            .expect("the combined program pairs");
+        assert!(plan.lane_pairs() > 300, "{}", plan.lane_pairs());
+        let n = d.dof;
+        for k in 0..10 {
+            let params: Vec<f64> = (0..model.params.len())
+                .map(|i| 1.0 + draw(k * 1000 + i, 0.5))
+                .collect();
+            let q: Vec<f64> = (0..n).map(|i| draw(k * 77 + i, 3.1)).collect();
+            let u: Vec<f64> = (0..n).map(|i| draw(k * 91 + i + 500, 2.0)).collect();
+            let a = plain.evaluate_combined(0, &params, &q, &u, &[]);
+            let b = paired.evaluate_combined(0, &params, &q, &u, &[]);
+            for (x, y) in a.iter().flatten().zip(b.iter().flatten()) {
+                assert!((x - y).abs() <= 1e-12 * (1.0 + x.abs()), "{x} against {y}");
+            }
+        }
     }
 
     #[test]

@@ -460,6 +460,8 @@ pub struct CombinedProgram {
     pub program: Program,
     /// Per part, its range in `program.outputs`.
     pub parts: Vec<std::ops::Range<usize>>,
+    /// The two-lane form of `program` (see [`lanes`]), when [`lanes::apply`] paired it.
+    pub lanes: Option<lanes::LanePlan>,
 }
 
 impl Lowered {
@@ -551,6 +553,7 @@ pub fn lower_with(d: &Derivation, form: DerivativesForm) -> Lowered {
                 spec: c.spec.clone(),
                 program,
                 parts,
+                lanes: None,
             }
         })
         .collect();

@@ -95,14 +95,18 @@ impl LaneLeaves {
     /// The leaf of the other subtree in `l`'s place (`l` itself when shared; `None` for a
     /// statement or a slot without a mirror).
     pub fn leaf(&self, l: Leaf) -> Option<Leaf> {
-        match l {
-            Leaf::Local(_) => None,
-            _ => LeafMap {
-                mirror: &self.mirror,
-                pre: &self.pre,
-            }
-            .leaf(l),
-        }
+        let s = |i: usize| self.mirror.speeds[i];
+        Some(match l {
+            Leaf::Const(c) => Leaf::Const(c),
+            Leaf::Param(p) => Leaf::Param(self.mirror.params[p]),
+            Leaf::Pre(k) => Leaf::Pre(self.pre.get(k).copied().flatten()?),
+            Leaf::Speed(i) => Leaf::Speed(s(i)),
+            Leaf::Accel(i) => Leaf::Accel(s(i)),
+            Leaf::Sin(i) => Leaf::Sin(s(i)),
+            Leaf::Cos(i) => Leaf::Cos(s(i)),
+            Leaf::Coord(i) => Leaf::Coord(s(i)),
+            Leaf::Local(_) => return None,
+        })
     }
 }
 
@@ -116,53 +120,42 @@ pub fn apply(low: &mut Lowered, d: &Derivation) {
     let Some(mirror) = &d.mirror else {
         return;
     };
-    let pre = pre_mirror(low, mirror);
+    let mut leaves = LaneLeaves {
+        mirror: mirror.clone(),
+        pre: Vec::new(),
+    };
+    leaves.pre = pre_mirror(low, &leaves);
     let params: Vec<f64> = test_inputs(mirror.params.len(), 1.0);
     let pre_values = low.precompute_values(&params);
+    // `p` paired, if it has a lane pair and the rewrite computes what `p` does.
+    let paired = |p: &Program| {
+        pair(p, &leaves).filter(|(q, plan)| {
+            plan.lane_pairs() > 0 && same_values(p, q, d.dof, &params, &pre_values)
+        })
+    };
+    let mut any = false;
     for f in &mut low.functions {
         if f.frame.is_some() || f.looped.is_some() || !LANE_FUNCTIONS.contains(&f.id) {
             continue;
         }
-        let Some((program, plan)) = pair(&f.program, mirror, &pre) else {
-            continue;
-        };
-        if plan.lane_pairs() == 0 || !same_values(&f.program, &program, d.dof, &params, &pre_values)
-        {
-            continue;
+        if let Some((program, plan)) = paired(&f.program) {
+            (f.program, f.lanes, any) = (program, Some(plan), true);
         }
-        f.program = program;
-        f.lanes = Some(plan);
     }
     // The combined functions (a controller's terms in one program).
     for c in &mut low.combined {
-        let Some((program, plan)) = pair(&c.program, mirror, &pre) else {
-            continue;
-        };
-        if plan.lane_pairs() > 0 && same_values(&c.program, &program, d.dof, &params, &pre_values) {
-            c.program = program;
-            c.lanes = Some(plan);
+        if let Some((program, plan)) = paired(&c.program) {
+            (c.program, c.lanes, any) = (program, Some(plan), true);
         }
     }
     // The straight-line part of the looped derivatives (its outputs: the workspace).
     if let Some(looped) = &mut low.derivative_loop
-        && let Some((program, plan)) = pair(&looped.program, mirror, &pre)
-        && plan.lane_pairs() > 0
-        && same_values(&looped.program, &program, d.dof, &params, &pre_values)
+        && let Some((program, plan)) = paired(&looped.program)
     {
-        looped.program = program;
-        looped.lanes = Some(plan);
+        (looped.program, looped.lanes, any) = (program, Some(plan), true);
     }
-    let paired = low.functions.iter().any(|f| f.lanes.is_some())
-        || low.combined.iter().any(|c| c.lanes.is_some())
-        || low
-            .derivative_loop
-            .as_ref()
-            .is_some_and(|l| l.lanes.is_some());
-    if paired {
-        low.lane_leaves = Some(LaneLeaves {
-            mirror: mirror.clone(),
-            pre,
-        });
+    if any {
+        low.lane_leaves = Some(leaves);
     }
 }
 
@@ -187,68 +180,13 @@ fn same_values(a: &Program, b: &Program, n: usize, params: &[f64], pre: &[f64]) 
             .iter()
             .map(|v| v * 0.7 + shift)
             .collect();
-        let (la, lb) = (
-            super::run(a, params, pre, &q, &u, &ud),
-            super::run(b, params, pre, &q, &u, &ud),
-        );
-        let out = |p: &Program, l: &[f64]| -> Vec<f64> {
-            p.outputs
-                .iter()
-                .map(|(_, _, e)| eval_with(e, params, pre, &q, &u, &ud, l))
-                .collect()
-        };
-        let (oa, ob) = (out(a, &la), out(b, &lb));
+        let oa = super::output_values(a, params, pre, &q, &u, &ud);
+        let ob = super::output_values(b, params, pre, &q, &u, &ud);
         let scale = oa.iter().fold(1.0f64, |m, v| m.max(v.abs()));
         oa.iter()
             .zip(&ob)
             .all(|(x, y)| (x - y).abs() <= 1e-9 * scale && x.is_finite() == y.is_finite())
     })
-}
-
-#[allow(clippy::too_many_arguments)]
-fn eval_with(
-    e: &LExpr,
-    params: &[f64],
-    pre: &[f64],
-    q: &[f64],
-    u: &[f64],
-    ud: &[f64],
-    locals: &[f64],
-) -> f64 {
-    super::EvalCtx {
-        params,
-        pre,
-        q,
-        u,
-        ud,
-        locals,
-    }
-    .eval(e)
-}
-
-/// How leaves map to the other subtree's.
-struct LeafMap<'a> {
-    mirror: &'a Mirror,
-    /// Precomputed slot → its mirror slot (`None`: no mirror).
-    pre: &'a [Option<usize>],
-}
-
-impl LeafMap<'_> {
-    /// The mirror of leaf `l` other than a statement (`None` when it has none).
-    fn leaf(&self, l: Leaf) -> Option<Leaf> {
-        let s = |i: usize| self.mirror.speeds[i];
-        Some(match l {
-            Leaf::Const(c) => Leaf::Const(c),
-            Leaf::Param(p) => Leaf::Param(self.mirror.params[p]),
-            Leaf::Pre(k) => Leaf::Pre(self.pre.get(k).copied().flatten()?),
-            Leaf::Speed(i) => Leaf::Speed(s(i)),
-            Leaf::Accel(i) => Leaf::Accel(s(i)),
-            Leaf::Sin(i) => Leaf::Sin(s(i)),
-            Leaf::Cos(i) => Leaf::Cos(s(i)),
-            Leaf::Coord(i) => Leaf::Coord(s(i)),
-            Leaf::Local(i) => Leaf::Local(i),
-        })
-    }
 }
 
 /// `e` with its leaves mapped by `leaf` (statements by `local`); `None` if one has no image.
@@ -480,10 +418,8 @@ fn equations(left_mapped: &LExpr, right: &LExpr) -> Option<Vec<(Vec<usize>, bool
 
 /// The mirror of each precomputed slot: slots whose statements are each other's exact
 /// mirror (same terms and signs), or their own.
-fn pre_mirror(low: &Lowered, mirror: &Mirror) -> Vec<Option<usize>> {
+fn pre_mirror(low: &Lowered, map: &LaneLeaves) -> Vec<Option<usize>> {
     let p = &low.precompute;
-    let none: Vec<Option<usize>> = Vec::new();
-    let map = LeafMap { mirror, pre: &none };
     let mut by_text: FxHashMap<String, usize> = FxHashMap::default();
     for (j, s) in p.stmts.iter().enumerate() {
         by_text.entry(exact_key(&s.expr)).or_insert(j);
@@ -527,11 +463,20 @@ enum Found {
     RightOf(usize),
 }
 
+/// The statement a pair's sign variable is kept under: a right statement's left, else the
+/// statement itself.
+fn sign_var(found: &[Found], k: usize) -> usize {
+    match found[k] {
+        Found::RightOf(l) => l,
+        _ => k,
+    }
+}
+
 /// The program `p` rewritten and reordered for two lanes, and its plan (see the module docs);
 /// `None` when no statement pairs.
-pub fn pair(p: &Program, mirror: &Mirror, pre: &[Option<usize>]) -> Option<(Program, LanePlan)> {
+pub fn pair(p: &Program, map: &LaneLeaves) -> Option<(Program, LanePlan)> {
     let n = p.stmts.len();
-    let map = LeafMap { mirror, pre };
+    let mirror = &map.mirror;
     let mut by_key: FxHashMap<String, Vec<usize>> = FxHashMap::default();
     for (j, s) in p.stmts.iter().enumerate() {
         by_key.entry(key(&s.expr)).or_default().push(j);
@@ -578,17 +523,13 @@ pub fn pair(p: &Program, mirror: &Mirror, pre: &[Option<usize>]) -> Option<(Prog
                 };
                 // The variables of the mapped expression are the images; the sign of a pair
                 // is kept under its left statement: map each image back.
-                let left_of = |k: usize| match found[k] {
-                    Found::RightOf(l) => l,
-                    _ => k,
-                };
                 let saved = (parity.parent.clone(), parity.flip.clone());
                 let mut ok = j != i || parity.union(i, parity.one(), false);
                 for (vars, v) in &eqs {
                     if !ok {
                         break;
                     }
-                    let vars: Vec<usize> = vars.iter().map(|&k| left_of(k)).collect();
+                    let vars: Vec<usize> = vars.iter().map(|&k| sign_var(&found, k)).collect();
                     ok = parity.term(i, &vars, *v);
                 }
                 if ok {
@@ -626,13 +567,8 @@ pub fn pair(p: &Program, mirror: &Mirror, pre: &[Option<usize>]) -> Option<(Prog
     // Each pair's sign variable is its first statement's; the sign is carried by its right
     // statement, which is the one of the second subtree: pairs found second subtree first
     // are turned around, so that the low lane always holds the first subtree.
-    let var: Vec<usize> = (0..n)
-        .map(|k| match found[k] {
-            Found::RightOf(l) => l,
-            _ => k,
-        })
-        .collect();
-    let side = sides(p, &map);
+    let var: Vec<usize> = (0..n).map(|k| sign_var(&found, k)).collect();
+    let side = sides(p, map);
     for i in 0..n {
         let (j, lane) = match found[i] {
             Found::Lane(j) => (j, true),
@@ -721,8 +657,8 @@ pub fn pair(p: &Program, mirror: &Mirror, pre: &[Option<usize>]) -> Option<(Prog
 /// second, `None`: neither, or both): that of the first leaf it reads that has another
 /// mirror (a lower speed or parameter index is the first subtree's), else that of the first
 /// statement it reads that has one.
-fn sides(p: &Program, map: &LeafMap<'_>) -> Vec<Option<bool>> {
-    fn walk(e: &LExpr, map: &LeafMap<'_>, sides: &[Option<bool>]) -> Option<bool> {
+fn sides(p: &Program, map: &LaneLeaves) -> Vec<Option<bool>> {
+    fn walk(e: &LExpr, map: &LaneLeaves, sides: &[Option<bool>]) -> Option<bool> {
         match e {
             LExpr::Leaf(Leaf::Local(k)) => sides[*k],
             LExpr::Leaf(l) => {

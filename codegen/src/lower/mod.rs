@@ -1084,17 +1084,12 @@ impl Lowered {
         let p = self
             .function_at(id, frame)
             .unwrap_or_else(|| panic!("the lowered model has no function `{id}`"));
-        let q = &self.expand_angles(q);
-        let locals = run(p, params, &pre, q, u, ud);
-        let ctx = EvalCtx {
-            params,
-            pre: &pre,
-            q,
-            u,
-            ud,
-            locals: &locals,
-        };
-        let entries = p.outputs.iter().map(|(r, c, e)| (*r, *c, ctx.eval(e)));
+        let values = output_values(p, params, &pre, &self.expand_angles(q), u, ud);
+        let entries = p
+            .outputs
+            .iter()
+            .zip(values)
+            .map(|((r, c, _), v)| (*r, *c, v));
         id.spec().shape.dense_in(&self.sizes, entries)
     }
 }
@@ -1119,24 +1114,13 @@ impl Lowered {
             .looped
             .as_ref()?;
         let pre = self.precompute_values(params);
-        let q = &self.expand_angles(q);
         let p = &lp.program;
-        let locals = run(p, params, &pre, q, u, ud);
-        let ctx = EvalCtx {
-            params,
-            pre: &pre,
-            q,
-            u,
-            ud,
-            locals: &locals,
-        };
-        let kin = p.outputs[..lp.kin_len]
-            .iter()
-            .map(|(_, _, e)| ctx.eval(e))
-            .collect();
+        let values = output_values(p, params, &pre, &self.expand_angles(q), u, ud);
+        let kin = values[..lp.kin_len].to_vec();
         let extra = p.outputs[lp.kin_len..]
             .iter()
-            .map(|(r, c, e)| (*r, *c, ctx.eval(e)))
+            .zip(&values[lp.kin_len..])
+            .map(|((r, c, _), v)| (*r, *c, *v))
             .collect();
         Some((kin, extra))
     }
@@ -1157,16 +1141,7 @@ impl Lowered {
         let pre = self.precompute_values(params);
         let c = &self.combined[index];
         let p = &c.program;
-        let q = &self.expand_angles(q);
-        let locals = run(p, params, &pre, q, u, ud);
-        let ctx = EvalCtx {
-            params,
-            pre: &pre,
-            q,
-            u,
-            ud,
-            locals: &locals,
-        };
+        let values = output_values(p, params, &pre, &self.expand_angles(q), u, ud);
         c.spec
             .parts
             .iter()
@@ -1174,7 +1149,8 @@ impl Lowered {
             .map(|(part, range)| {
                 let entries = p.outputs[range.clone()]
                     .iter()
-                    .map(|(r, col, e)| (*r, *col, ctx.eval(e)));
+                    .zip(&values[range.clone()])
+                    .map(|((r, col, _), v)| (*r, *col, *v));
                 part.function.spec().shape.dense_in(&self.sizes, entries)
             })
             .collect()
@@ -1231,6 +1207,28 @@ impl EvalCtx<'_> {
                 .fold(1.0, |acc, (b, p)| acc * self.eval(b).powi(*p)),
         }
     }
+}
+
+/// The values of `p`'s outputs, in order, at one input point (`q` with the mimic angles
+/// expanded, see [`Lowered::expand_angles`]).
+fn output_values(
+    p: &Program,
+    params: &[f64],
+    pre: &[f64],
+    q: &[f64],
+    u: &[f64],
+    ud: &[f64],
+) -> Vec<f64> {
+    let locals = run(p, params, pre, q, u, ud);
+    let ctx = EvalCtx {
+        params,
+        pre,
+        q,
+        u,
+        ud,
+        locals: &locals,
+    };
+    p.outputs.iter().map(|(_, _, e)| ctx.eval(e)).collect()
 }
 
 fn run(p: &Program, params: &[f64], pre: &[f64], q: &[f64], u: &[f64], ud: &[f64]) -> Vec<f64> {

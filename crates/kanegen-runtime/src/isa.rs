@@ -372,20 +372,17 @@ pub fn dispatch_pair_with<T, R>(
 /// The two-lane multiply-add that goes with [`Native`] (for a module generated without
 /// dispatch, `kanegen::Builder::isa_dispatch(false)`): a [`FusedPair`] when the build enables
 /// FMA (and `std` is on; aarch64), [`Plain`] otherwise.
-#[cfg(all(feature = "std", any(target_feature = "fma", target_arch = "aarch64")))]
 #[inline(always)]
 pub fn native_pair() -> NativePair {
     // The build enables FMA (x86-64) or the lanes are portable (aarch64): see `FusedPair`.
-    FusedPair::new_unchecked()
-}
-
-/// The two-lane multiply-add that goes with [`Native`] (for a module generated without
-/// dispatch, `kanegen::Builder::isa_dispatch(false)`): a [`FusedPair`] when the build enables
-/// FMA (and `std` is on; aarch64), [`Plain`] otherwise.
-#[cfg(not(all(feature = "std", any(target_feature = "fma", target_arch = "aarch64"))))]
-#[inline(always)]
-pub fn native_pair() -> NativePair {
-    Plain
+    #[cfg(all(feature = "std", any(target_feature = "fma", target_arch = "aarch64")))]
+    {
+        FusedPair::new_unchecked()
+    }
+    #[cfg(not(all(feature = "std", any(target_feature = "fma", target_arch = "aarch64"))))]
+    {
+        Plain
+    }
 }
 
 /// What [`native_pair`] returns.

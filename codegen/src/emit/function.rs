@@ -420,7 +420,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     } else {
         (outputs, Vec::new())
     };
-    let lanes = lanes_of(cx, f);
+    let lanes = lanes_in(cx, p, f.lanes.as_ref());
     let block = match lanes {
         Some((leaves, plan)) => {
             super::lanes::lane_block(&printer, &cx.leaf_names, leaves, p, plan, stores)
@@ -484,16 +484,9 @@ pub(super) fn has_into(f: &FunctionProgram) -> bool {
     f.frame.is_none() && matches!(f.id.spec().shape, Shape::SymmetricMatrix | Shape::Matrix)
 }
 
-/// The lane plan `f` is emitted with, if any: the lowering paired its statements (see
-/// [`crate::lower::lanes`]), the module is `f64` and the function is not split into blocks.
-pub(super) fn lanes_of<'a>(
-    cx: &'a Context<'_>,
-    f: &'a FunctionProgram,
-) -> Option<(&'a LaneLeaves, &'a LanePlan)> {
-    lanes_in(cx, &f.program, f.lanes.as_ref())
-}
-
-/// [`lanes_of`] for program `p` with plan `plan`.
+/// The lane plan program `p` is emitted with, if any: the lowering paired its statements
+/// (`plan`, see [`crate::lower::lanes`]), the module is `f64` and the function is not split
+/// into blocks.
 pub(super) fn lanes_in<'a>(
     cx: &'a Context<'_>,
     p: &Program,

@@ -8,8 +8,8 @@ use quote::quote;
 
 use super::Context;
 use super::function::{
-    Reads, Stores, generic_body, prologue, result_type, state_args, store_after, store_text_after,
-    text, unused_inputs,
+    Reads, Stores, generic_body, prologue, result_type, state_args, store_text_after, text,
+    unused_inputs,
 };
 use super::items::arg_names;
 use super::print::{ident, idx};
@@ -63,54 +63,34 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
     // The body: `out` is a tuple with one element per part (an isometry's is `(rotation,
     // translation)`), filled by stores after the statements they read.
     let lanes = super::function::lanes_in(cx, p, c.lanes.as_ref());
-    let mut stores: Vec<TokenStream> = vec![TokenStream::new(); p.stmts.len() + 1];
-    // The same stores as text lines, for the two-lane block (`emit::lanes`).
-    let mut text_stores: Stores = vec![Vec::new(); p.stmts.len() + 1];
-    let mut stored = false;
+    // Text lines by position (see `Printer::statement_block`), for either block form.
+    let mut stores: Stores = vec![Vec::new(); p.stmts.len() + 1];
+    let mut stored_exprs: Vec<&LExpr> = Vec::new();
     let mut inits = Vec::new();
     let mut finals = Vec::new();
     for (i, (shape, range)) in shapes.iter().zip(&c.parts).enumerate() {
         let k = syn::Index::from(i);
         let (rows, cols) = shape.size_in(&cx.low.sizes);
         let (rl, cl) = (idx(rows), idx(cols));
-        let entries: Vec<&(usize, usize, LExpr)> = p.outputs[range.clone()]
+        let entries = p.outputs[range.clone()]
             .iter()
-            .filter(|(_, _, e)| !matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0))
-            .collect();
-        stored |= !entries.is_empty();
-        for &(r, col, ref e) in entries {
-            if lanes.is_some() {
-                let v = text(cx, &printer, e);
-                let line = match shape {
-                    Shape::Vector => format!("out.{i}[{r}] = core::hint::black_box({v});"),
-                    Shape::Scalar => format!("out.{i} = {v};"),
-                    Shape::Isometry if col == 3 => format!("out.{i}.1[{r}] = {v};"),
-                    Shape::Isometry => format!("out.{i}.0[({r}, {col})] = {v};"),
-                    _ => format!("out.{i}[({r}, {col})] = {v};"),
-                };
-                store_text_after(&mut text_stores, e, line);
-                if *shape == Shape::SymmetricMatrix && r != col {
-                    let copy = format!("out.{i}[({col}, {r})] = out.{i}[({r}, {col})];");
-                    store_text_after(&mut text_stores, e, copy);
-                }
-                continue;
-            }
-            let v = printer.expr_fused(&cx.leaf_names, e);
-            let (translation, diagonal) = (col == 3, r == col);
-            let (r, col) = (idx(r), idx(col));
-            let store = match shape {
-                Shape::Vector => quote!(out.#k[#r] = core::hint::black_box(#v);),
-                Shape::Scalar => quote!(out.#k = #v;),
-                Shape::Isometry if translation => quote!(out.#k.1[#r] = #v;),
-                Shape::Isometry => quote!(out.#k.0[(#r, #col)] = #v;),
-                // The lower entry right after its upper twin, as the separate `mass_matrix`.
-                Shape::SymmetricMatrix if !diagonal => quote! {
-                    out.#k[(#r, #col)] = #v;
-                    out.#k[(#col, #r)] = out.#k[(#r, #col)];
-                },
-                _ => quote!(out.#k[(#r, #col)] = #v;),
+            .filter(|(_, _, e)| !matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0));
+        for (r, col, e) in entries {
+            let v = text(cx, &printer, e);
+            let line = match shape {
+                Shape::Vector => format!("out.{i}[{r}] = core::hint::black_box({v});"),
+                Shape::Scalar => format!("out.{i} = {v};"),
+                Shape::Isometry if *col == 3 => format!("out.{i}.1[{r}] = {v};"),
+                Shape::Isometry => format!("out.{i}.0[({r}, {col})] = {v};"),
+                _ => format!("out.{i}[({r}, {col})] = {v};"),
             };
-            store_after(&mut stores, e, store);
+            store_text_after(&mut stores, e, line);
+            // The lower entry right after its upper twin, as the separate `mass_matrix`.
+            if *shape == Shape::SymmetricMatrix && r != col {
+                let copy = format!("out.{i}[({col}, {r})] = out.{i}[({r}, {col})];");
+                store_text_after(&mut stores, e, copy);
+            }
+            stored_exprs.push(e);
         }
         let f = &fields[i];
         match shape {
@@ -136,17 +116,20 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
             }
         }
     }
-    let body = match lanes {
-        Some((leaves, plan)) => cx.blocks.placeholder(super::lanes::lane_block(
-            &printer,
+    let stored = !stored_exprs.is_empty();
+    let block = match lanes {
+        Some((leaves, plan)) => {
+            super::lanes::lane_block(&printer, &cx.leaf_names, leaves, p, plan, stores)
+        }
+        None => printer.statement_block(
             &cx.leaf_names,
-            leaves,
-            p,
-            plan,
-            text_stores,
-        )),
-        None => printer.statements_fused(&cx.leaf_names, &stores),
+            stores,
+            (&stored_exprs, &[]),
+            cx.split_above,
+            true,
+        ),
     };
+    let body = cx.blocks.placeholder(block);
     let prologue = prologue(cx, p, &reads);
     let unused = unused_inputs(c.spec.inputs, p, &reads);
     let mutable = if stored { quote!(mut) } else { quote!() };

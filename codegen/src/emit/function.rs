@@ -208,11 +208,6 @@ pub(super) fn nonzero_outputs(p: &Program) -> impl Iterator<Item = &(usize, usiz
         .filter(|(_, _, e)| !matches!(e, LExpr::Leaf(Leaf::Const(z)) if *z == 0.0))
 }
 
-/// Add `store` to the stores placed right after the last statement `e` reads.
-pub(super) fn store_after(stores: &mut [TokenStream], e: &LExpr, store: TokenStream) {
-    stores[last_local(e).map_or(0, |i| i + 1)].extend(store);
-}
-
 /// Add the text line `store` to the stores placed right after the last statement `e` reads.
 pub(super) fn store_text_after(stores: &mut [Vec<String>], e: &LExpr, store: String) {
     stores[last_local(e).map_or(0, |i| i + 1)].push(store);

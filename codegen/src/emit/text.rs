@@ -238,29 +238,6 @@ impl Printer<'_> {
         block
     }
 
-    /// `e` with multiply-add chains ([`Printer::expr_text_with`]) as tokens, for the token
-    /// printers (combined functions). The text is what the statements print, which the
-    /// formatted module parses; should it not parse, the plain tokens.
-    pub(super) fn expr_fused(&self, names: &LeafNames, e: &LExpr) -> TokenStream {
-        let mut s = String::new();
-        self.expr_text_with(names, e, false, true, &mut s);
-        s.parse().unwrap_or_else(|_| self.expr(e, false))
-    }
-
-    /// [`Printer::statements`] with multiply-add chains ([`Printer::expr_fused`]).
-    pub(super) fn statements_fused(&self, names: &LeafNames, after: &[TokenStream]) -> TokenStream {
-        let mut ts = after.first().cloned().unwrap_or_default();
-        for (i, s) in self.stmts.iter().enumerate() {
-            let id = super::print::ident(&s.name);
-            let e = self.expr_fused(names, &s.expr);
-            ts.extend(quote!(let #id = #e;));
-            if let Some(a) = after.get(i + 1) {
-                ts.extend(a.clone());
-            }
-        }
-        ts
-    }
-
     /// Per statement, the position of its last reader: a statement's index, the statement a
     /// store follows, or `n` for the end.
     fn last_uses(&self, stored: &[&LExpr], read_at_end: &[&LExpr]) -> Vec<usize> {

@@ -8,8 +8,10 @@
 //!
 //! Ids: `simd/<function>/<isa>` (one state per call) and `simd/<function>/<isa>/batch<L>` (one
 //! call of `<function>_batch_into` with `L` states: divide by `L` for the time per state;
-//! `batch<L>_by_value`: `mass_matrix_batch`, which returns the results). The states cycle
-//! through the profile driver's 64 random ones.
+//! `batch<L>_by_value`: `mass_matrix_batch`, which returns the results), `…/soa<L>` (the
+//! structure-of-arrays form `<function>_batch_soa_into`) and `simd/<function>_into/<isa>` (M
+//! and C written into a kept matrix). The states cycle through the profile driver's 64 random
+//! ones.
 
 use std::hint::black_box;
 use std::time::Duration;
@@ -17,6 +19,8 @@ use std::time::Duration;
 use criterion::{Criterion, criterion_group, criterion_main};
 use krang_dynamics::Krang;
 use krang_dynamics::isa::{self, Isa};
+use krang_dynamics::lanes::{Lanes, soa};
+use nalgebra::{SMatrix, SVector};
 
 /// The 64 states the profile driver (`crates/krang-dynamics/examples/profile.rs`) cycles
 /// through, so that its figures and this bench's measure the same inputs.
@@ -92,6 +96,66 @@ fn bench_batch<const L: usize>(c: &mut Criterion, k: &Krang, s: &[(V, V, V)], ta
     });
 }
 
+/// The structure-of-arrays forms (`<function>_batch_soa_into`): the same `L` states as
+/// [`bench_batch`], built once with `lanes::soa`, into results kept across calls. Ids
+/// `simd/<function>/<isa>/soa<L>`.
+fn bench_batch_soa<const L: usize>(c: &mut Criterion, k: &Krang, s: &[(V, V, V)], tag: &str) {
+    let batches: Vec<_> = (0..64)
+        .step_by(L)
+        .map(|i| {
+            let (q, u, ud) = batch::<L>(s, i);
+            (soa(&q), soa(&u), soa(&ud))
+        })
+        .collect();
+    let n = batches.len();
+    let mut i = 0;
+    let mut m = SMatrix::<Lanes<L>, 19, 19>::from_element(Lanes::splat(0.0));
+    let mut v = SVector::<Lanes<L>, 19>::from_element(Lanes::splat(0.0));
+    c.bench_function(&format!("simd/mass_matrix/{tag}/soa{L}"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            black_box(k).mass_matrix_batch_soa_into(black_box(&batches[i].0), &mut m);
+            black_box(&m);
+        })
+    });
+    c.bench_function(&format!("simd/coriolis/{tag}/soa{L}"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            let (q, u, _) = &batches[i];
+            black_box(k).coriolis_batch_soa_into(black_box(q), black_box(u), &mut v);
+            black_box(&v);
+        })
+    });
+    c.bench_function(&format!("simd/gravity/{tag}/soa{L}"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            black_box(k).gravity_batch_soa_into(black_box(&batches[i].0), &mut v);
+            black_box(&v);
+        })
+    });
+    c.bench_function(&format!("simd/inverse_dynamics/{tag}/soa{L}"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            let (q, u, ud) = &batches[i];
+            black_box(k).inverse_dynamics_batch_soa_into(
+                black_box(q),
+                black_box(u),
+                black_box(ud),
+                &mut v,
+            );
+            black_box(&v);
+        })
+    });
+    c.bench_function(&format!("simd/coriolis_matrix/{tag}/soa{L}"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            let (q, u, _) = &batches[i];
+            black_box(k).coriolis_matrix_batch_soa_into(black_box(q), black_box(u), &mut m);
+            black_box(&m);
+        })
+    });
+}
+
 fn simd(c: &mut Criterion) {
     let k = Krang::default();
     let s = states();
@@ -130,8 +194,25 @@ fn simd(c: &mut Criterion) {
                 black_box(&k).coriolis_matrix(black_box(&s[i].0), black_box(&s[i].1))
             })
         });
+        let mut m = SMatrix::<f64, 19, 19>::zeros();
+        c.bench_function(&format!("simd/mass_matrix_into/{tag}"), |b| {
+            b.iter(|| {
+                i = (i + 1) & 63;
+                black_box(&k).mass_matrix_into(black_box(&s[i].0), &mut m);
+                black_box(&m);
+            })
+        });
+        c.bench_function(&format!("simd/coriolis_matrix_into/{tag}"), |b| {
+            b.iter(|| {
+                i = (i + 1) & 63;
+                black_box(&k).coriolis_matrix_into(black_box(&s[i].0), black_box(&s[i].1), &mut m);
+                black_box(&m);
+            })
+        });
         bench_batch::<4>(c, &k, &s, tag);
         bench_batch::<8>(c, &k, &s, tag);
+        bench_batch_soa::<4>(c, &k, &s, tag);
+        bench_batch_soa::<8>(c, &k, &s, tag);
     }
     isa::select(isa::detected()).unwrap();
 }

@@ -7,7 +7,9 @@
 //! copy and the single-state ones their x86-64-v3 copy: the same fused operations), on random
 //! parameter sets and states (angles of all sizes, including a huge one that takes the slow
 //! sin/cos path in one lane). The `_into` forms write every entry of the caller's
-//! results (filled with NaN before the call) and give the by-value forms' bits.
+//! results (filled with NaN before the call) and give the by-value forms' bits. The
+//! structure-of-arrays forms (`*_batch_soa`, at 3 and 8 states) give the array-of-states
+//! forms' bits in every lane.
 
 mod common;
 
@@ -111,6 +113,62 @@ fn check_batch<const L: usize>(k: &kd::Krang, q: &[V; L], u: &[V; L], ud: &[V; L
     assert!(same_bits(&flat_v(&vi), &flat_v(&tb)), "baked τ into");
 }
 
+/// Every structure-of-arrays batched function (`*_batch_soa`, inputs and results in lanes)
+/// gives, in lane `l` of every entry, the bits of the array-of-states form's result `l` (which
+/// [`check_batch`] compares with the single-state function), and its `_into` form writes every
+/// entry of a NaN-filled result with the by-value form's bits.
+fn check_soa<const L: usize>(k: &kd::Krang, q: &[V; L], u: &[V; L], ud: &[V; L]) {
+    use kd::lanes::{Lanes, soa, state};
+    let (qs, us, uds) = (soa(q), soa(u), soa(ud));
+    let lanes = |name: &str, a: &[f64], b: &[f64]| assert!(same_bits(a, b), "{name}, {L} states");
+    let m = k.mass_matrix_batch_soa(&qs);
+    let c = k.coriolis_batch_soa(&qs, &us);
+    let g = k.gravity_batch_soa(&qs);
+    let t = k.inverse_dynamics_batch_soa(&qs, &us, &uds);
+    let cm = k.coriolis_matrix_batch_soa(&qs, &us);
+    let mb = kd::baked::mass_matrix_batch_soa(&qs);
+    let tb = kd::baked::inverse_dynamics_batch_soa(&qs, &us, &uds);
+    let (m0, c0, g0) = (
+        k.mass_matrix_batch(q),
+        k.coriolis_batch(q, u),
+        k.gravity_batch(q),
+    );
+    let (t0, cm0) = (
+        k.inverse_dynamics_batch(q, u, ud),
+        k.coriolis_matrix_batch(q, u),
+    );
+    let (mb0, tb0) = (
+        kd::baked::mass_matrix_batch(q),
+        kd::baked::inverse_dynamics_batch(q, u, ud),
+    );
+    for l in 0..L {
+        lanes("M", state(&m, l).as_slice(), m0[l].as_slice());
+        lanes("c", state(&c, l).as_slice(), c0[l].as_slice());
+        lanes("g", state(&g, l).as_slice(), g0[l].as_slice());
+        lanes("τ", state(&t, l).as_slice(), t0[l].as_slice());
+        lanes("C", state(&cm, l).as_slice(), cm0[l].as_slice());
+        lanes("baked M", state(&mb, l).as_slice(), mb0[l].as_slice());
+        lanes("baked τ", state(&tb, l).as_slice(), tb0[l].as_slice());
+    }
+    let bits = |a: &[Lanes<L>]| -> Vec<f64> { a.iter().flat_map(|x| x.0).collect() };
+    let nan = Lanes::splat(f64::NAN);
+    let mut mi = nalgebra::SMatrix::<Lanes<L>, 19, 19>::from_element(nan);
+    k.mass_matrix_batch_soa_into(&qs, &mut mi);
+    lanes("M into", &bits(mi.as_slice()), &bits(m.as_slice()));
+    let mut mi = nalgebra::SMatrix::<Lanes<L>, 19, 19>::from_element(nan);
+    k.coriolis_matrix_batch_soa_into(&qs, &us, &mut mi);
+    lanes("C into", &bits(mi.as_slice()), &bits(cm.as_slice()));
+    let mut vi = SVector::<Lanes<L>, 19>::from_element(nan);
+    k.coriolis_batch_soa_into(&qs, &us, &mut vi);
+    lanes("c into", &bits(vi.as_slice()), &bits(c.as_slice()));
+    let mut vi = SVector::<Lanes<L>, 19>::from_element(nan);
+    k.gravity_batch_soa_into(&qs, &mut vi);
+    lanes("g into", &bits(vi.as_slice()), &bits(g.as_slice()));
+    let mut vi = SVector::<Lanes<L>, 19>::from_element(nan);
+    k.inverse_dynamics_batch_soa_into(&qs, &us, &uds, &mut vi);
+    lanes("τ into", &bits(vi.as_slice()), &bits(t.as_slice()));
+}
+
 #[test]
 fn batched_functions_equal_the_single_state_functions_bit_for_bit() {
     let _one_at_a_time = isa_lock();
@@ -124,6 +182,7 @@ fn batched_functions_equal_the_single_state_functions_bit_for_bit() {
             check_batch(&k, &q1, &u1, &ud1);
             let (q3, u3, ud3) = states::<3>(&mut uniform);
             check_batch(&k, &q3, &u3, &ud3);
+            check_soa(&k, &q3, &u3, &ud3);
             let (mut q4, u4, ud4) = states::<4>(&mut uniform);
             if draw % 5 == 0 {
                 // One lane with a huge angle: that batch takes the per-lane slow sin/cos.
@@ -132,6 +191,7 @@ fn batched_functions_equal_the_single_state_functions_bit_for_bit() {
             check_batch(&k, &q4, &u4, &ud4);
             let (q8, u8, ud8) = states::<8>(&mut uniform);
             check_batch(&k, &q8, &u8, &ud8);
+            check_soa(&k, &q8, &u8, &ud8);
         }
     }
     isa::select(isa::detected()).unwrap();

@@ -224,3 +224,42 @@ fn batched_coriolis_matrix_is_split_into_two_loops_by_rows_and_the_others_are_no
         (12..19).collect::<Vec<_>>()
     );
 }
+
+#[test]
+fn structure_of_arrays_batches_loop_like_the_array_of_states_ones_and_store_whole_entries() {
+    let emit = kanegen::EmitOptions {
+        batch: true,
+        ..kanegen::EmitOptions::default()
+    };
+    let g = kanegen::generate_with(krang(), kanegen::Options::default(), &emit).expect("generates");
+    // The body of `NAME_batch_soa_into`: from its signature to the next public item.
+    let body = |name: &str| {
+        let from = g
+            .source
+            .find(&format!("pub fn {name}_batch_soa_into<"))
+            .unwrap_or_else(|| panic!("{name}_batch_soa_into is emitted"));
+        let rest = &g.source[from + 1..];
+        let to = rest.find("\n    pub fn ").unwrap_or(rest.len());
+        rest[..to].to_owned()
+    };
+    for (name, loops) in [
+        ("mass_matrix", 1),
+        ("coriolis", 1),
+        ("gravity", 1),
+        ("inverse_dynamics", 1),
+        ("coriolis_matrix", 2),
+    ] {
+        let b = body(name);
+        assert_eq!(b.matches("for l in 0..L").count(), loops, "{name}");
+        // Inputs in lanes are copied, not transposed; entries are stored lane by lane in the
+        // loop, and no per-state result is touched.
+        assert!(b.contains("let q = &{ *q };"), "{name}");
+        assert!(!b.contains("lanes::inputs"), "{name}");
+        assert!(b.contains("].0[l] = "), "{name}");
+        assert!(!b.contains("out.iter_mut()"), "{name}");
+    }
+    // M's lower triangle: whole entries copied after the loop.
+    let m = body("mass_matrix");
+    let after = &m[m.find("for l in 0..L").unwrap()..];
+    assert!(after.contains("out[(1, 0)] = out[(0, 1)];"));
+}

@@ -1,6 +1,9 @@
 //! Batched functions: the statements of one generated function evaluated at `L` states per
-//! call (`mass_matrix_batch_into(p, pc, &[q; L], &mut [SMatrix; L])`, and the by-value
-//! `mass_matrix_batch(p, pc, &[q; L]) -> [SMatrix; L]`).
+//! call, in two layouts ([`Layout`]): an array of states (`mass_matrix_batch_into(p, pc,
+//! &[q; L], &mut [SMatrix; L])`, and the by-value `mass_matrix_batch(p, pc, &[q; L]) ->
+//! [SMatrix; L]`) and a structure of arrays (`mass_matrix_batch_soa_into(p, pc,
+//! &SVector<Lanes<L>, N>, &mut SMatrix<Lanes<L>, N, N>)` and `mass_matrix_batch_soa`), whose
+//! inputs need no transposition and whose result entries are stored as whole vectors.
 //!
 //! The body is a loop over the states around the single-state function's statements, printed
 //! exactly as there (the same multiply-add chains, generic over `A: Arith<f64>` and dispatched
@@ -42,42 +45,110 @@ fn batched(f: &FunctionProgram) -> bool {
         )
 }
 
-/// The name of the batched form of `spec`'s function.
-fn batch_name(spec: &FunctionSpec) -> proc_macro2::Ident {
-    ident(&format!("{}_batch", spec.name))
+/// How a batched function takes its `L` states and gives its `L` results.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Layout {
+    /// An array of states: `&[SVector<f64, N>; L]` per input, `&mut [SMatrix<f64, R, C>; L]`
+    /// out (`NAME_batch`, `NAME_batch_into`). The inputs are transposed to lane-major order in
+    /// the call, and each result entry is scattered into the `L` results.
+    States,
+    /// A structure of arrays: `&SVector<Lanes<L>, N>` per input, `&mut SMatrix<Lanes<L>, R,
+    /// C>` out, every entry holding the `L` states' values (`NAME_batch_soa`,
+    /// `NAME_batch_soa_into`): the inputs are read as they are and each result entry is one
+    /// vector store.
+    Lanes,
 }
 
-/// The state arguments: `&[SVector<f64, N>; L]` per input.
-fn args(cx: &Context<'_>, inputs: Inputs) -> TokenStream {
-    let nl = idx(cx.low.dof);
-    let v = quote!(&[SVector<f64, #nl>; L]);
-    match inputs {
-        Inputs::Q => quote!(q: #v),
-        Inputs::QU => quote!(q: #v, u: #v),
-        Inputs::QUUd => quote!(q: #v, u: #v, ud: #v),
+impl Layout {
+    const ALL: [Layout; 2] = [Layout::States, Layout::Lanes];
+
+    /// The by-value function's name (the `_into` form adds `_into`).
+    fn name(self, spec: &FunctionSpec) -> String {
+        match self {
+            Layout::States => format!("{}_batch", spec.name),
+            Layout::Lanes => format!("{}_batch_soa", spec.name),
+        }
+    }
+
+    /// The state arguments: `&[SVector<f64, N>; L]` or `&SVector<Lanes<L>, N>` per input.
+    fn args(self, cx: &Context<'_>, inputs: Inputs) -> TokenStream {
+        let nl = idx(cx.low.dof);
+        let v = match self {
+            Layout::States => quote!(&[SVector<f64, #nl>; L]),
+            Layout::Lanes => quote!(&SVector<kanegen_runtime::lanes::Lanes<L>, #nl>),
+        };
+        match inputs {
+            Inputs::Q => quote!(q: #v),
+            Inputs::QU => quote!(q: #v, u: #v),
+            Inputs::QUUd => quote!(q: #v, u: #v, ud: #v),
+        }
+    }
+
+    /// The result type: `[SMatrix<f64, R, C>; L]` or `SMatrix<Lanes<L>, R, C>`.
+    fn result(self, cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
+        match self {
+            Layout::States => {
+                let ty = return_type(cx, spec);
+                quote!([#ty; L])
+            }
+            Layout::Lanes => {
+                let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
+                let (r, c) = (idx(rows), idx(cols));
+                if cols == 1 {
+                    quote!(SVector<kanegen_runtime::lanes::Lanes<L>, #r>)
+                } else {
+                    quote!(SMatrix<kanegen_runtime::lanes::Lanes<L>, #r, #c>)
+                }
+            }
+        }
+    }
+
+    /// The initialised result of the by-value form, which the `_into` form then overwrites.
+    fn zeros(self, cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
+        let ty = self.result(cx, spec);
+        match self {
+            Layout::States => {
+                let one = return_type(cx, spec);
+                quote!([<#one>::zeros(); L])
+            }
+            Layout::Lanes => {
+                quote!(<#ty>::from_element(kanegen_runtime::lanes::Lanes::splat(0.0)))
+            }
+        }
+    }
+
+    /// Result entry `(r, c)` (`r` of a vector) in the loop over the states (`l`): `m[(r, c)]`
+    /// of state `l`'s result, or lane `l` of `out[(r, c)]`.
+    fn entry_in_loop(self, r: usize, c: usize, vector: bool) -> String {
+        let at = if vector {
+            format!("[{r}]")
+        } else {
+            format!("[({r}, {c})]")
+        };
+        match self {
+            Layout::States => format!("m{at}"),
+            Layout::Lanes => format!("out{at}.0[l]"),
+        }
     }
 }
 
-/// The output argument of the `_into` form: `&mut [SMatrix<f64, R, C>; L]`.
-fn out_arg(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
-    let ty = return_type(cx, spec);
-    quote!(out: &mut [#ty; L])
-}
-
-/// The lane-major bindings before the loop: the inputs the program reads transposed
-/// (`let q = kanegen_runtime::lanes::inputs(q);`, `[Lanes<L>; N]`) and per joint angle one
-/// lane-wise `sin_cos`.
-fn lane_inputs(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
+/// The lane-major bindings before the loop: the inputs the program reads, transposed
+/// (`let q = kanegen_runtime::lanes::inputs(q);`, `[Lanes<L>; N]`) or, already in lanes,
+/// copied (`let q = &{ *q };`: like the parameters, a local the result stores cannot
+/// overwrite), and per joint angle one lane-wise `sin_cos`.
+fn lane_inputs(cx: &Context<'_>, p: &Program, reads: &Reads, layout: Layout) -> TokenStream {
     let mut ts = TokenStream::new();
     let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
-    if reads_q {
-        ts.extend(quote!(let q = kanegen_runtime::lanes::inputs(q);));
-    }
-    if reads.speed.contains(&true) {
-        ts.extend(quote!(let u = kanegen_runtime::lanes::inputs(u);));
-    }
-    if reads.accel.contains(&true) {
-        ts.extend(quote!(let ud = kanegen_runtime::lanes::inputs(ud);));
+    let read = [
+        (reads_q, quote!(q)),
+        (reads.speed.contains(&true), quote!(u)),
+        (reads.accel.contains(&true), quote!(ud)),
+    ];
+    for (_, x) in read.iter().filter(|(r, _)| *r) {
+        ts.extend(match layout {
+            Layout::States => quote!(let #x = kanegen_runtime::lanes::inputs(#x);),
+            Layout::Lanes => quote!(let #x = &{ *#x };),
+        });
     }
     if !p.sincos.is_empty() {
         // All angles of all states in one call (a dependent joint's from its master's).
@@ -201,15 +272,17 @@ fn loop_parts<'p>(p: &'p Program, reads: &Reads) -> Vec<Cow<'p, Program>> {
 /// The result stores inside the loop: every nonzero entry of `p` right after the last
 /// statement it reads (with multiply-add chains), into the caller's result `m` (text lines by
 /// position, see [`Printer::statement_block`]).
-fn loop_stores(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, vector: bool) -> Stores {
+fn loop_stores(
+    cx: &Context<'_>,
+    printer: &Printer<'_>,
+    p: &Program,
+    vector: bool,
+    layout: Layout,
+) -> Stores {
     let mut stores: Stores = vec![Vec::new(); p.stmts.len() + 1];
     for (r, c, e) in nonzero_outputs(p) {
         let v = text(cx, printer, e);
-        let entry = if vector {
-            format!("m[{r}]")
-        } else {
-            format!("m[({r}, {c})]")
-        };
+        let entry = layout.entry_in_loop(*r, *c, vector);
         store_text_after(&mut stores, e, format!("{entry} = {v};"));
     }
     stores
@@ -221,16 +294,24 @@ fn loop_stores(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, vector: boo
 /// so nothing is zeroed first. The mirrored entries and the zeros stay out of the vectorized
 /// loop: LLVM merges adjacent zero stores into `memset` calls, and a loop with a call is not
 /// vectorized; with the mirrored stores in it (as a copy or as the value again) Krang's M was
-/// not vectorized either ("loop not vectorized: runtime pointer checks needed").
-fn after_stores(cx: &Context<'_>, p: &Program, shape: Shape) -> TokenStream {
+/// not vectorized either ("loop not vectorized: runtime pointer checks needed"). In the
+/// structure-of-arrays layout they copy (or zero) whole entries of `out`, all lanes at once.
+fn after_stores(cx: &Context<'_>, p: &Program, shape: Shape, layout: Layout) -> TokenStream {
     let (rows, cols) = shape.size_in(&cx.low.sizes);
     let vector = cols == 1;
+    let (m, zero) = match layout {
+        Layout::States => (quote!(m), quote!(0.0)),
+        Layout::Lanes => (
+            quote!(out),
+            quote!(kanegen_runtime::lanes::Lanes::splat(0.0)),
+        ),
+    };
     let entry = |r: usize, c: usize| {
         let (ri, ci) = (idx(r), idx(c));
         if vector {
-            quote!(m[#ri])
+            quote!(#m[#ri])
         } else {
-            quote!(m[(#ri, #ci)])
+            quote!(#m[(#ri, #ci)])
         }
     };
     let mirror = shape == Shape::SymmetricMatrix;
@@ -248,54 +329,88 @@ fn after_stores(cx: &Context<'_>, p: &Program, shape: Shape) -> TokenStream {
     for (r, c) in (0..cols).flat_map(|c| (0..rows).map(move |r| (r, c))) {
         if !written[c * rows + r] {
             let to = entry(r, c);
-            after.extend(quote!(#to = 0.0;));
+            after.extend(quote!(#to = #zero;));
         }
     }
     after
 }
 
-/// The batched free functions of `f` (`NAME_batch_into` and `NAME_batch`), or nothing if it
-/// has none.
+/// The batched free functions of `f` in both layouts (`NAME_batch_into` and `NAME_batch`,
+/// `NAME_batch_soa_into` and `NAME_batch_soa`), or nothing if it has none.
 ///
-/// The body is one loop over the lanes, `for (l, m) in out.iter_mut().enumerate()` (several
-/// for a result with more entries than one vectorized loop can store: [`loop_parts`]), around
-/// the single-state function's statements, printed as they are (multiply-add chains over
-/// `A: Arith<f64>` included) and storing into the caller's result `m`: LLVM's loop vectorizer
-/// then runs the whole body on vectors across the states (four lanes per AVX2 register, two
-/// per SSE2 register). Before the loop: the inputs in lane-major order, the lane-wise sines
-/// and cosines, and copies of the parameter structs (`let p = &{ *p };`) — without those the
-/// vectorizer needs run-time checks that the result stores do not overwrite parameters it
-/// reads, and gives up ("loop not vectorized: runtime pointer checks needed").
+/// The body is one loop over the lanes (several for a result with more entries than one
+/// vectorized loop can store: [`loop_parts`]) around the single-state function's statements,
+/// printed as they are (multiply-add chains over `A: Arith<f64>` included) and storing into
+/// the caller's result: LLVM's loop vectorizer then runs the whole body on vectors across the
+/// states (four lanes per AVX2 register, two per SSE2 register). Before the loop: the inputs in
+/// lane-major order, the lane-wise sines and cosines, and copies of the parameter structs
+/// (`let p = &{ *p };`) — without those the vectorizer needs run-time checks that the result
+/// stores do not overwrite parameters it reads, and gives up ("loop not vectorized: runtime
+/// pointer checks needed").
 pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     if !batched(f) {
         return TokenStream::new();
     }
+    Layout::ALL
+        .iter()
+        .map(|&layout| function_in(cx, f, layout))
+        .collect()
+}
+
+/// The doc comments of the by-value and `_into` batched forms of `single` in `layout`.
+fn docs(single: &str, layout: Layout) -> (String, String) {
+    match layout {
+        Layout::States => (
+            format!(
+                " [`{single}`] at `L` states per call: entry `l` of the result is `{single}` \
+                 at entry `l` of the inputs, bit for bit with the same instruction set (the \
+                 same statements in a loop over the states, vectorized across them). Returns \
+                 the results by value; [`{single}_batch_into`] writes them into the caller's \
+                 array instead (no zeroed array, no copy)."
+            ),
+            format!(
+                " [`{single}`] at `L` states per call, into `out`: entry `l` of `out` becomes \
+                 `{single}` at entry `l` of the inputs, bit for bit with the same instruction \
+                 set (the same statements in a loop over the states, vectorized across them). \
+                 Every entry of `out` is written."
+            ),
+        ),
+        Layout::Lanes => (
+            format!(
+                " [`{single}`] at `L` states per call, structure of arrays: lane `l` of every \
+                 input entry is state `l` (`kanegen_runtime::lanes::soa` builds them from an \
+                 array of states), and lane `l` of every result entry is `{single}` at state \
+                 `l`, bit for bit with the same instruction set. Returns the result by value; \
+                 [`{single}_batch_soa_into`] writes into the caller's instead."
+            ),
+            format!(
+                " [`{single}`] at `L` states per call, structure of arrays, into `out`: lane \
+                 `l` of every entry of `out` becomes `{single}` at lane `l` of the inputs, bit \
+                 for bit with the same instruction set; every entry is written. The fastest \
+                 batched form: the inputs are read as they are and every result entry is one \
+                 vector store (the array-of-states form [`{single}_batch_into`] transposes \
+                 and scatters)."
+            ),
+        ),
+    }
+}
+
+/// [`function`] in one layout.
+fn function_in(cx: &Context<'_>, f: &FunctionProgram, layout: Layout) -> TokenStream {
     let spec = f.id.spec();
     let p = &f.program;
     let reads = Reads::of(p, cx.low.dof);
-    let name = batch_name(spec);
-    let name_into = ident(&format!("{}_batch_into", spec.name));
-    let single = spec.name;
-    let doc = format!(
-        " [`{single}`] at `L` states per call: entry `l` of the result is `{single}` at \
-         entry `l` of the inputs, bit for bit with the same instruction set (the same \
-         statements in a loop over the states, vectorized across them). Returns the results \
-         by value; [`{single}_batch_into`] writes them into the caller's array instead (no \
-         zeroed array, no copy)."
-    );
-    let doc_into = format!(
-        " [`{single}`] at `L` states per call, into `out`: entry `l` of `out` becomes \
-         `{single}` at entry `l` of the inputs, bit for bit with the same instruction set \
-         (the same statements in a loop over the states, vectorized across them). Every \
-         entry of `out` is written."
-    );
+    let by_value = layout.name(spec);
+    let name = ident(&by_value);
+    let name_into = ident(&format!("{by_value}_into"));
+    let (doc, doc_into) = docs(spec.name, layout);
     let param_args = super::function::param_args(cx, &reads);
     let (outer_params, pass_params) = super::function::outer_params(cx);
-    let state = args(cx, spec.inputs);
+    let state = layout.args(cx, spec.inputs);
     let names = arg_names(spec.inputs);
-    let out = out_arg(cx, spec);
-    let lane_inputs = lane_inputs(cx, p, &reads);
-    let ty = return_type(cx, spec);
+    let ty = layout.result(cx, spec);
+    let out = quote!(out: &mut #ty);
+    let lane_inputs = lane_inputs(cx, p, &reads, layout);
     let vector = spec.shape.size_in(&cx.low.sizes).1 == 1;
     // One loop per part (one part unless the result has more entries than a vectorized loop
     // can store).
@@ -304,23 +419,23 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         let printer = cx.printer(&part.stmts);
         let part_reads = Reads::of(&part, cx.low.dof);
         let lane_values = lane_values(cx, &part, &part_reads);
-        let stores = loop_stores(cx, &printer, &part, vector);
+        let stores = loop_stores(cx, &printer, &part, vector, layout);
         let stored: Vec<&LExpr> = nonzero_outputs(&part).map(|(_, _, e)| e).collect();
         let block =
             printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true);
         let statements = cx.blocks.placeholder(block);
-        let lane_loop = if lane_values.is_empty() {
-            quote!(for m in out.iter_mut())
-        } else {
-            quote!(for (l, m) in out.iter_mut().enumerate())
+        let lane_loop = match layout {
+            Layout::States if lane_values.is_empty() => quote!(for m in out.iter_mut()),
+            Layout::States => quote!(for (l, m) in out.iter_mut().enumerate()),
+            Layout::Lanes => quote!(for l in 0..L),
         };
         loops.extend(quote!(#lane_loop { #lane_values #statements }));
     }
-    let after = after_stores(cx, p, spec.shape);
-    let after_loop = if after.is_empty() {
-        TokenStream::new()
-    } else {
-        quote!(for m in out.iter_mut() { #after })
+    let after = after_stores(cx, p, spec.shape, layout);
+    let after_loop = match layout {
+        _ if after.is_empty() => TokenStream::new(),
+        Layout::States => quote!(for m in out.iter_mut() { #after }),
+        Layout::Lanes => after,
     };
     let unused = unused_inputs(spec.inputs, p, &reads);
     // Local copies of the parameters: the result stores cannot alias them (see above).
@@ -340,6 +455,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         quote!(#pass_params #names,),
         quote!(out),
     );
+    let zeros = layout.zeros(cx, spec);
     quote! {
         #[doc = #doc_into]
         #[inline(never)]
@@ -359,38 +475,43 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
 
         #[doc = #doc]
         #[inline]
-        pub fn #name<const L: usize>(#outer_params #state) -> [#ty; L] {
-            let mut out = [<#ty>::zeros(); L];
+        pub fn #name<const L: usize>(#outer_params #state) -> #ty {
+            let mut out = #zeros;
             #name_into(#pass_params #names, &mut out);
             out
         }
     }
 }
 
-/// The wrapper's methods for the batched functions (by value and `_into`).
+/// The wrapper's methods for the batched functions (by value and `_into`, both layouts).
 pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
-    cx.low
-        .functions
-        .iter()
-        .filter(|f| batched(f))
-        .map(|f| {
+    let mut methods = TokenStream::new();
+    for f in cx.low.functions.iter().filter(|f| batched(f)) {
+        for layout in Layout::ALL {
             let spec = f.id.spec();
-            let name = batch_name(spec);
-            let name_into = ident(&format!("{}_batch_into", spec.name));
+            let by_value = layout.name(spec);
+            let name = ident(&by_value);
+            let name_into = ident(&format!("{by_value}_into"));
+            let how = match layout {
+                Layout::States => "entry `l` of the result at entry `l` of the inputs",
+                Layout::Lanes => {
+                    "structure of arrays: lane `l` of the result's entries at lane `l` of the \
+                     inputs'"
+                }
+            };
             let doc = format!(
-                " [`Self::{}`] at `L` states per call (entry `l` of the result at entry `l` of \
-                 the inputs, bit for bit with the same instruction set; vectorized across the \
-                 states). [`Self::{}_batch_into`] writes into the caller's array instead.",
-                spec.name, spec.name
-            );
-            let doc_into = format!(
-                " [`Self::{}`] at `L` states per call, written into `out` (every entry; entry \
-                 `l` at entry `l` of the inputs, bit for bit with the same instruction set).",
+                " [`Self::{}`] at `L` states per call ({how}, bit for bit with the same \
+                 instruction set; vectorized across the states). [`Self::{by_value}_into`] \
+                 writes into the caller's result instead.",
                 spec.name
             );
-            let state = args(cx, spec.inputs);
-            let out = out_arg(cx, spec);
-            let ty = return_type(cx, spec);
+            let doc_into = format!(
+                " [`Self::{}`] at `L` states per call, written into `out` (every entry; {how}, \
+                 bit for bit with the same instruction set).",
+                spec.name
+            );
+            let state = layout.args(cx, spec.inputs);
+            let ty = layout.result(cx, spec);
             let names = arg_names(spec.inputs);
             let (call, call_into) = if cx.low.params.is_runtime() {
                 (
@@ -400,18 +521,19 @@ pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
             } else {
                 (quote!(#name(#names)), quote!(#name_into(#names, out)))
             };
-            quote! {
+            methods.extend(quote! {
                 #[doc = #doc]
                 #[inline]
-                pub fn #name<const L: usize>(&self, #state) -> [#ty; L] {
+                pub fn #name<const L: usize>(&self, #state) -> #ty {
                     #call
                 }
                 #[doc = #doc_into]
                 #[inline]
-                pub fn #name_into<const L: usize>(&self, #state, #out) {
+                pub fn #name_into<const L: usize>(&self, #state, out: &mut #ty) {
                     #call_into
                 }
-            }
-        })
-        .collect()
+            });
+        }
+    }
+    methods
 }

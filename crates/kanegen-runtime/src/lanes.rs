@@ -27,7 +27,7 @@
 
 use core::ops::{Add, Div, Mul, Neg, Sub};
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 /// `L` values of one quantity, one per state of a batch (see the [module docs](self)).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,6 +91,39 @@ impl<const L: usize> Neg for Lanes<L> {
     fn neg(self) -> Lanes<L> {
         Lanes(core::array::from_fn(|l| -self.0[l]))
     }
+}
+
+/// The structure-of-arrays form of `L` states, what the `*_batch_soa` functions take: entry
+/// `i` holds entry `i` of every state (`soa(x)[i].0[l] == x[l][i]`). A sampler that builds its
+/// states in this form directly skips the copy.
+///
+/// ```
+/// use kanegen_runtime::lanes::{soa, Lanes};
+/// use nalgebra::SVector;
+/// let x = [SVector::<f64, 2>::new(1.0, 2.0), SVector::<f64, 2>::new(3.0, 4.0)];
+/// assert_eq!(soa(&x)[1], Lanes([2.0, 4.0]));
+/// ```
+#[inline]
+pub fn soa<const N: usize, const L: usize>(x: &[SVector<f64, N>; L]) -> SVector<Lanes<L>, N> {
+    SVector::from_fn(|i, _| Lanes::gather(x, i))
+}
+
+/// State `l` of a structure-of-arrays result (a `*_batch_soa` function's vector or matrix of
+/// [`Lanes`]): entry `(r, c)` is lane `l` of entry `(r, c)`. For tests and for reading one
+/// sample back; a consumer that works across the states reads the lanes directly.
+///
+/// ```
+/// use kanegen_runtime::lanes::{state, Lanes};
+/// use nalgebra::SMatrix;
+/// let m = SMatrix::<Lanes<2>, 1, 2>::new(Lanes([1.0, 2.0]), Lanes([3.0, 4.0]));
+/// assert_eq!(state(&m, 1), SMatrix::<f64, 1, 2>::new(2.0, 4.0));
+/// ```
+#[inline]
+pub fn state<const R: usize, const C: usize, const L: usize>(
+    m: &SMatrix<Lanes<L>, R, C>,
+    l: usize,
+) -> SMatrix<f64, R, C> {
+    m.map(|x| x.0[l])
 }
 
 /// `(sin x, cos x)` of every angle `k` in every lane `l` (`x[k][l]`), in one call of

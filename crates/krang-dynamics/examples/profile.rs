@@ -12,7 +12,8 @@
 //!
 //! Arguments: a function (`mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, or `all`;
 //! a suffix `_b4` or `_b8` calls the batched form (`_batch_into`, into arrays kept across
-//! calls) with 4 or 8 states, counted as one call; with
+//! calls) with 4 or 8 states, counted as one call, `_s8` the structure-of-arrays form
+//! (`_batch_soa_into`) with 8 states (M, c and τ); with
 //! the feature `derivatives` also `inverse_dynamics_derivatives`; with the feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
 //! `com_jacobian` and `sin_cos_17`), the
@@ -24,6 +25,8 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use krang_dynamics::Krang;
+use krang_dynamics::lanes::{Lanes, soa};
+use nalgebra::{SMatrix, SVector};
 
 mod profile_states;
 use profile_states::{V, states};
@@ -42,6 +45,10 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> f64 {
     let b8: Vec<_> = (0..64)
         .map(|i| (batch::<8>(s, i), batch_u::<8>(s, i)))
         .collect();
+    // The structure-of-arrays forms (`_s8`: `_batch_soa_into`, 8 states).
+    let s8: Vec<_> = b8.iter().map(|(q, u)| (soa(q), soa(u))).collect();
+    let mut ms8 = SMatrix::<Lanes<8>, 19, 19>::from_element(Lanes::splat(0.0));
+    let mut vs8 = SVector::<Lanes<8>, 19>::from_element(Lanes::splat(0.0));
     for i in 0..calls {
         let (q, u, ud) = &s[i & 63];
         acc += match f {
@@ -88,6 +95,21 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> f64 {
                 let (q, u) = (black_box(q), black_box(u));
                 black_box(k).inverse_dynamics_batch_into(q, u, u, &mut v8);
                 black_box(&v8)[1][7]
+            }
+            "mass_matrix_s8" => {
+                black_box(k).mass_matrix_batch_soa_into(black_box(&s8[i & 63].0), &mut ms8);
+                black_box(&ms8)[(5, 3)].0[1]
+            }
+            "coriolis_s8" => {
+                let (q, u) = &s8[i & 63];
+                black_box(k).coriolis_batch_soa_into(black_box(q), black_box(u), &mut vs8);
+                black_box(&vs8)[7].0[1]
+            }
+            "inverse_dynamics_s8" => {
+                let (q, u) = &s8[i & 63];
+                let (q, u) = (black_box(q), black_box(u));
+                black_box(k).inverse_dynamics_batch_soa_into(q, u, u, &mut vs8);
+                black_box(&vs8)[7].0[1]
             }
             #[cfg(feature = "derivatives")]
             "inverse_dynamics_derivatives" => {

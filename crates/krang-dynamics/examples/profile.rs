@@ -13,7 +13,7 @@
 //! Arguments: a function (`mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, or `all`;
 //! a suffix `_b4` or `_b8` calls the batched form (`_batch_into`, into arrays kept across
 //! calls) with 4 or 8 states, counted as one call, `_s8` the structure-of-arrays form
-//! (`_batch_soa_into`) with 8 states (M, c and τ); with
+//! (`_batch_soa_into`) with 8 states; with
 //! the feature `derivatives` also `inverse_dynamics_derivatives`; with the feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
 //! `com_jacobian` and `sin_cos_17`), the
@@ -31,22 +31,35 @@ use nalgebra::{SMatrix, SVector};
 mod profile_states;
 use profile_states::{V, states};
 
-fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> f64 {
+/// The batched inputs: coordinates and speeds of 4 or 8 consecutive states from each state,
+/// and the 8-state ones in structure-of-arrays form (`_s8`). Made once, before any timing.
+struct Batches {
+    b4: Vec<([V; 4], [V; 4])>,
+    b8: Vec<([V; 8], [V; 8])>,
+    s8: Vec<(SVector<Lanes<8>, 19>, SVector<Lanes<8>, 19>)>,
+}
+
+impl Batches {
+    fn new(s: &[(V, V, V)]) -> Self {
+        let b4: Vec<_> = (0..64)
+            .map(|i| (batch::<4>(s, i), batch_u::<4>(s, i)))
+            .collect();
+        let b8: Vec<_> = (0..64)
+            .map(|i| (batch::<8>(s, i), batch_u::<8>(s, i)))
+            .collect();
+        let s8 = b8.iter().map(|(q, u)| (soa(q), soa(u))).collect();
+        Batches { b4, b8, s8 }
+    }
+}
+
+fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> f64 {
     let mut acc = 0.0;
+    let Batches { b4, b8, s8 } = batches;
     // The batched forms write into these (`_into`: no zeroed array, no copy of the results).
     let mut m4 = [nalgebra::SMatrix::<f64, 19, 19>::zeros(); 4];
     let mut m8 = [nalgebra::SMatrix::<f64, 19, 19>::zeros(); 8];
     let mut v4 = [V::zeros(); 4];
     let mut v8 = [V::zeros(); 8];
-    // The batches, made once (not timed): coordinates and speeds of 4 or 8 consecutive states.
-    let b4: Vec<_> = (0..64)
-        .map(|i| (batch::<4>(s, i), batch_u::<4>(s, i)))
-        .collect();
-    let b8: Vec<_> = (0..64)
-        .map(|i| (batch::<8>(s, i), batch_u::<8>(s, i)))
-        .collect();
-    // The structure-of-arrays forms (`_s8`: `_batch_soa_into`, 8 states).
-    let s8: Vec<_> = b8.iter().map(|(q, u)| (soa(q), soa(u))).collect();
     let mut ms8 = SMatrix::<Lanes<8>, 19, 19>::from_element(Lanes::splat(0.0));
     let mut vs8 = SVector::<Lanes<8>, 19>::from_element(Lanes::splat(0.0));
     for i in 0..calls {
@@ -103,6 +116,10 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> f64 {
             "coriolis_s8" => {
                 let (q, u) = &s8[i & 63];
                 black_box(k).coriolis_batch_soa_into(black_box(q), black_box(u), &mut vs8);
+                black_box(&vs8)[7].0[1]
+            }
+            "gravity_s8" => {
+                black_box(k).gravity_batch_soa_into(black_box(&s8[i & 63].0), &mut vs8);
                 black_box(&vs8)[7].0[1]
             }
             "inverse_dynamics_s8" => {
@@ -188,6 +205,7 @@ fn main() {
     eprintln!("instruction set: {}", kanegen_runtime::isa::active());
     let k = Krang::default();
     let s = states();
+    let batches = Batches::new(&s);
     let names = ["mass_matrix", "coriolis", "gravity", "inverse_dynamics"];
     let list: Vec<&str> = if f == "all" { names.to_vec() } else { vec![f] };
     for name in list {
@@ -197,7 +215,7 @@ fn main() {
         let batch = 1000.min(calls.max(1));
         for _ in 0..calls.div_ceil(batch) {
             let t = Instant::now();
-            sink += run(&k, name, &s, batch);
+            sink += run(&k, name, &s, &batches, batch);
             best = best.min(t.elapsed().as_secs_f64() * 1e9 / batch as f64);
         }
         println!("{name:<17} {best:8.1} ns/call (fastest batch of {batch}) [{sink:.3e}]");

@@ -398,7 +398,11 @@ impl Builder {
     /// Batched functions (default `false`; `f64` modules): `mass_matrix_batch(p, pc, &[q; L])
     /// -> [SMatrix; L]` and likewise for every function with a vector or matrix result and no
     /// frame argument (free functions and wrapper methods), the single-state statements
-    /// evaluated at `L` states per call in SIMD lanes, bit for bit the single-state results.
+    /// evaluated at `L` states per call in SIMD lanes, bit for bit the single-state results;
+    /// and the structure-of-arrays forms `mass_matrix_batch_soa(p, pc, &SVector<Lanes<L>, N>)
+    /// -> SMatrix<Lanes<L>, N, N>` (each entry the `L` states' values side by side: no
+    /// transposition, one vector store per entry; the faster form). `_into` forms of both
+    /// write into the caller's results.
     /// Generic in `L`: nothing is compiled for a batch size nobody calls. Unoptimised builds
     /// keep every statement's lanes on the stack (Krang at `L = 8`: more than a thread's
     /// default 2 MB); optimised builds need a few KB.

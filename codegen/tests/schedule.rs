@@ -168,26 +168,34 @@ fn restricted_programs_give_their_entries_bits_and_hold_only_what_they_read() {
     assert!(statements > full.stmts.len());
 }
 
-/// The emitted batched functions of Krang: the Coriolis matrix (260 entries, 53 lane inputs:
-/// over the 240 locations one vectorized loop may touch) in two loops over the states, rows
-/// 0–11 and 12–18, each storing only its own rows; M, c, g and τ in one loop each.
-#[test]
-fn batched_coriolis_matrix_is_split_into_two_loops_by_rows_and_the_others_are_not() {
+/// Krang's module with the batched functions.
+fn batched_krang() -> String {
     let emit = kanegen::EmitOptions {
         batch: true,
         ..kanegen::EmitOptions::default()
     };
     let g = kanegen::generate_with(krang(), kanegen::Options::default(), &emit).expect("generates");
-    // The body of `NAME_batch_into`: from its signature to the next public item.
-    let body = |name: &str| {
-        let from = g
-            .source
-            .find(&format!("pub fn {name}_batch_into<"))
-            .unwrap_or_else(|| panic!("{name}_batch_into is emitted"));
-        let rest = &g.source[from + 1..];
-        let to = rest.find("\n    pub fn ").unwrap_or(rest.len());
-        rest[..to].to_owned()
-    };
+    g.source
+}
+
+/// The body of the generated function `name` (generic): from its signature to the next public
+/// item.
+fn function_body(source: &str, name: &str) -> String {
+    let from = source
+        .find(&format!("pub fn {name}<"))
+        .unwrap_or_else(|| panic!("{name} is emitted"));
+    let rest = &source[from + 1..];
+    let to = rest.find("\n    pub fn ").unwrap_or(rest.len());
+    rest[..to].to_owned()
+}
+
+/// The emitted batched functions of Krang: the Coriolis matrix (260 entries, 53 lane inputs:
+/// over the 240 locations one vectorized loop may touch) in two loops over the states, rows
+/// 0–11 and 12–18, each storing only its own rows; M, c, g and τ in one loop each.
+#[test]
+fn batched_coriolis_matrix_is_split_into_two_loops_by_rows_and_the_others_are_not() {
+    let source = batched_krang();
+    let body = |name: &str| function_body(&source, &format!("{name}_batch_into"));
     let loops = |text: &str| {
         text.matches("for (l, m) in out.iter_mut().enumerate()")
             .count()
@@ -227,21 +235,8 @@ fn batched_coriolis_matrix_is_split_into_two_loops_by_rows_and_the_others_are_no
 
 #[test]
 fn structure_of_arrays_batches_loop_like_the_array_of_states_ones_and_store_whole_entries() {
-    let emit = kanegen::EmitOptions {
-        batch: true,
-        ..kanegen::EmitOptions::default()
-    };
-    let g = kanegen::generate_with(krang(), kanegen::Options::default(), &emit).expect("generates");
-    // The body of `NAME_batch_soa_into`: from its signature to the next public item.
-    let body = |name: &str| {
-        let from = g
-            .source
-            .find(&format!("pub fn {name}_batch_soa_into<"))
-            .unwrap_or_else(|| panic!("{name}_batch_soa_into is emitted"));
-        let rest = &g.source[from + 1..];
-        let to = rest.find("\n    pub fn ").unwrap_or(rest.len());
-        rest[..to].to_owned()
-    };
+    let source = batched_krang();
+    let body = |name: &str| function_body(&source, &format!("{name}_batch_soa_into"));
     for (name, loops) in [
         ("mass_matrix", 1),
         ("coriolis", 1),

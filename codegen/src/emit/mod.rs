@@ -62,7 +62,9 @@ pub struct EmitOptions {
     pub isa_dispatch: bool,
     /// Batched functions (default `false`): `mass_matrix_batch`, `coriolis_batch`, … for `L`
     /// states per call (`f64` modules; every function whose result is a vector or matrix and
-    /// that takes no frame), the single-state statements over `kanegen_runtime::lanes::Lanes`.
+    /// that takes no frame), the single-state statements in a loop over the states, vectorized
+    /// across them; each in two layouts: an array of states (`NAME_batch[_into]`) and a
+    /// structure of arrays over `kanegen_runtime::lanes::Lanes` (`NAME_batch_soa[_into]`).
     pub batch: bool,
     /// Mirrored subtrees in two SIMD lanes (default `false`): see
     /// [`crate::Builder::mirrored_lanes`]. Read by [`crate::generate_combined`], which pairs

@@ -29,10 +29,11 @@ fn main() {
         .precision(kanegen::Precision::F32)
         .output("two_link_all_baked_f32.rs")
         .run();
-    // A gripper with <mimic> fingers (exact constraints), every registry function, for
-    // `tests/mimic.rs`.
+    // A gripper with <mimic> fingers (exact constraints), every registry function and the
+    // batched forms, for `tests/mimic.rs`.
     kanegen::Builder::urdf("models/mimic_gripper.urdf", UrdfOptions::default())
         .functions(kanegen::FunctionSet::all())
+        .batch(true)
         .output("mimic_gripper_all.rs")
         .run();
     kanegen::Builder::urdf("models/Krang.urdf", krang_urdf_options())

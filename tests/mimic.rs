@@ -184,6 +184,46 @@ fn reduced_dynamics_equal_the_unconstrained_tree_projected_by_the_constraint_map
     }
 }
 
+/// Regression: the batched functions of a model with mimic joints (whose dependent joints'
+/// sines and cosines are indexed past the independent speeds) are generated — the generator
+/// panicked ("index out of bounds: the len is 5 but the index is 7") — and give, in every lane
+/// of both layouts, the single-state function's bits with the same instruction set.
+#[test]
+fn batched_functions_of_a_model_with_mimic_joints_equal_the_single_state_ones() {
+    use kanegen_runtime::lanes::{soa, state};
+    let model = load(MimicMode::Exact);
+    let mut uniform = rng(17);
+    for _ in 0..20 {
+        let p = random_physical_params(&model, &mut uniform);
+        let k = gripper::MimicGripper::new(gripper::Params::from_array(
+            p.try_into().expect("91 parameters"),
+        ));
+        let states: [_; 3] = std::array::from_fn(|_| {
+            let (q, u, _) = random_state(&mut uniform, 5);
+            (sv::<5>(&q), sv::<5>(&u))
+        });
+        let (q, u) = (states.map(|s| s.0), states.map(|s| s.1));
+        let (m, c) = (k.mass_matrix_batch(&q), k.coriolis_batch(&q, &u));
+        let (ms, cs) = (
+            k.mass_matrix_batch_soa(&soa(&q)),
+            k.coriolis_batch_soa(&soa(&q), &soa(&u)),
+        );
+        for l in 0..3 {
+            let (m1, c1) = (k.mass_matrix(&q[l]), k.coriolis(&q[l], &u[l]));
+            assert!(same_bits(m[l].as_slice(), m1.as_slice()), "M lane {l}");
+            assert!(same_bits(c[l].as_slice(), c1.as_slice()), "c lane {l}");
+            assert!(
+                same_bits(state(&ms, l).as_slice(), m1.as_slice()),
+                "SoA M lane {l}"
+            );
+            assert!(
+                same_bits(state(&cs, l).as_slice(), c1.as_slice()),
+                "SoA c lane {l}"
+            );
+        }
+    }
+}
+
 #[test]
 fn frame_jacobians_are_the_independent_models_times_the_constraint_map() {
     let exact = load(MimicMode::Exact);

@@ -399,7 +399,7 @@ fn docs(single: &str, layout: Layout) -> (String, String) {
 fn function_in(cx: &Context<'_>, f: &FunctionProgram, layout: Layout) -> TokenStream {
     let spec = f.id.spec();
     let p = &f.program;
-    let reads = Reads::of(p, cx.low.dof);
+    let reads = Reads::of(p, cx.model.speeds.len());
     let by_value = layout.name(spec);
     let name = ident(&by_value);
     let name_into = ident(&format!("{by_value}_into"));
@@ -417,7 +417,7 @@ fn function_in(cx: &Context<'_>, f: &FunctionProgram, layout: Layout) -> TokenSt
     let mut loops = TokenStream::new();
     for part in loop_parts(p, &reads) {
         let printer = cx.printer(&part.stmts);
-        let part_reads = Reads::of(&part, cx.low.dof);
+        let part_reads = Reads::of(&part, cx.model.speeds.len());
         let lane_values = lane_values(cx, &part, &part_reads);
         let stores = loop_stores(cx, &printer, &part, vector, layout);
         let stored: Vec<&LExpr> = nonzero_outputs(&part).map(|(_, _, e)| e).collect();

@@ -280,6 +280,33 @@ fn every_corpus_robot_matches_the_reference() {
     }
 }
 
+/// Every corpus robot (mimic joints, fixed-joint merges, many branches) is emitted with the
+/// batched functions in both layouts and with mirrored subtrees in lanes, without an error or
+/// a panic. Regression: batched emission for a model with mimic joints panicked (an index out
+/// of bounds), which no Krang-only test could see. (The emitted source is compiled for Krang,
+/// the fixed-wheel tree and the mimic gripper by the crates' build scripts.)
+#[test]
+fn every_corpus_robot_emits_batched_and_lane_paired_code() {
+    for entry in CORPUS {
+        let model: Model = import(entry).model;
+        let functions = [FunctionId::MassMatrix, FunctionId::Coriolis];
+        let options = Options {
+            functions: functions.into_iter().collect(),
+            ..Options::default()
+        };
+        let emit = kanegen::EmitOptions {
+            batch: true,
+            mirrored_lanes: true,
+            ..kanegen::EmitOptions::default()
+        };
+        let g = kanegen::generate_with(model, options, &emit)
+            .unwrap_or_else(|e| panic!("{}: generation: {e}", entry.file));
+        for f in ["mass_matrix_batch_into<", "coriolis_batch_soa_into<"] {
+            assert!(g.source.contains(f), "{}: {f}", entry.file);
+        }
+    }
+}
+
 #[test]
 fn corpus_covers_ten_robots_of_different_kinds() {
     assert!(CORPUS.len() >= 10);

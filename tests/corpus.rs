@@ -283,8 +283,8 @@ fn every_corpus_robot_matches_the_reference() {
 /// Every corpus robot (mimic joints, fixed-joint merges, many branches) is emitted with the
 /// batched functions in both layouts and with mirrored subtrees in lanes, without an error or
 /// a panic. Regression: batched emission for a model with mimic joints panicked (an index out
-/// of bounds), which no Krang-only test could see. (The emitted source is compiled for Krang,
-/// the fixed-wheel tree and the mimic gripper by the crates' build scripts.)
+/// of bounds), which no Krang-only test could see. (The emitted batched source is compiled
+/// for Krang, with runtime and baked parameters, and the mimic gripper by the build scripts.)
 #[test]
 fn every_corpus_robot_emits_batched_and_lane_paired_code() {
     for entry in CORPUS {

@@ -105,29 +105,39 @@ impl Layout {
 
     /// The initialised result of the by-value form, which the `_into` form then overwrites.
     fn zeros(self, cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
-        let ty = self.result(cx, spec);
         match self {
             Layout::States => {
                 let one = return_type(cx, spec);
                 quote!([<#one>::zeros(); L])
             }
             Layout::Lanes => {
+                let ty = self.result(cx, spec);
                 quote!(<#ty>::from_element(kanegen_runtime::lanes::Lanes::splat(0.0)))
             }
+        }
+    }
+
+    /// The variable whose entries the stores write: state `l`'s result `m` (bound by the loop
+    /// over `out`), or `out` itself, whose every entry holds all lanes.
+    fn target(self) -> &'static str {
+        match self {
+            Layout::States => "m",
+            Layout::Lanes => "out",
         }
     }
 
     /// Result entry `(r, c)` (`r` of a vector) in the loop over the states (`l`): `m[(r, c)]`
     /// of state `l`'s result, or lane `l` of `out[(r, c)]`.
     fn entry_in_loop(self, r: usize, c: usize, vector: bool) -> String {
+        let target = self.target();
         let at = if vector {
             format!("[{r}]")
         } else {
             format!("[({r}, {c})]")
         };
         match self {
-            Layout::States => format!("m{at}"),
-            Layout::Lanes => format!("out{at}.0[l]"),
+            Layout::States => format!("{target}{at}"),
+            Layout::Lanes => format!("{target}{at}.0[l]"),
         }
     }
 }
@@ -299,12 +309,10 @@ fn loop_stores(
 fn after_stores(cx: &Context<'_>, p: &Program, shape: Shape, layout: Layout) -> TokenStream {
     let (rows, cols) = shape.size_in(&cx.low.sizes);
     let vector = cols == 1;
-    let (m, zero) = match layout {
-        Layout::States => (quote!(m), quote!(0.0)),
-        Layout::Lanes => (
-            quote!(out),
-            quote!(kanegen_runtime::lanes::Lanes::splat(0.0)),
-        ),
+    let m = ident(layout.target());
+    let zero = match layout {
+        Layout::States => quote!(0.0),
+        Layout::Lanes => quote!(kanegen_runtime::lanes::Lanes::splat(0.0)),
     };
     let entry = |r: usize, c: usize| {
         let (ri, ci) = (idx(r), idx(c));

@@ -117,18 +117,7 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
         }
     }
     let stored = !stored_exprs.is_empty();
-    let block = match lanes {
-        Some((leaves, plan)) => {
-            super::lanes::lane_block(&printer, &cx.leaf_names, leaves, p, plan, stores)
-        }
-        None => printer.statement_block(
-            &cx.leaf_names,
-            stores,
-            (&stored_exprs, &[]),
-            cx.split_above,
-            true,
-        ),
-    };
+    let block = super::function::body_block(cx, &printer, p, lanes, stores, (&stored_exprs, &[]));
     let body = cx.blocks.placeholder(block);
     let prologue = prologue(cx, p, &reads);
     let unused = unused_inputs(c.spec.inputs, p, &reads);

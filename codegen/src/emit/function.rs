@@ -416,18 +416,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         (outputs, Vec::new())
     };
     let lanes = lanes_in(cx, p, f.lanes.as_ref());
-    let block = match lanes {
-        Some((leaves, plan)) => {
-            super::lanes::lane_block(&printer, &cx.leaf_names, leaves, p, plan, stores)
-        }
-        None => printer.statement_block(
-            &cx.leaf_names,
-            stores,
-            (&stored, &read_at_end),
-            cx.split_above,
-            true,
-        ),
-    };
+    let block = body_block(cx, &printer, p, lanes, stores, (&stored, &read_at_end));
     let body = cx.blocks.placeholder(block);
     let unused = unused_inputs(spec.inputs, p, &reads);
     let lanes = lanes.is_some();
@@ -491,6 +480,25 @@ pub(super) fn lanes_in<'a>(
     let plan = plan?;
     (cx.precision == crate::Precision::F64 && p.stmts.len() <= cx.split_above)
         .then_some((leaves, plan))
+}
+
+/// The statements of `p` with `stores` placed after the statements they read: the lane block
+/// where the statements are paired (`lanes`, from [`lanes_in`]), else the plain statement block
+/// (which keeps the `stored` and `read_at_end` values visible across its split blocks).
+pub(super) fn body_block(
+    cx: &Context<'_>,
+    printer: &Printer<'_>,
+    p: &Program,
+    lanes: Option<(&LaneLeaves, &LanePlan)>,
+    stores: Vec<Vec<String>>,
+    outputs: (&[&LExpr], &[&LExpr]),
+) -> super::text::Block {
+    match lanes {
+        Some((leaves, plan)) => {
+            super::lanes::lane_block(printer, &cx.leaf_names, leaves, p, plan, stores)
+        }
+        None => printer.statement_block(&cx.leaf_names, stores, outputs, cx.split_above, true),
+    }
 }
 
 /// `m[(r, c)] = 0.0;` for every entry of an n×n result that no store of [`result`] writes (the

@@ -178,45 +178,42 @@ fn batched_krang() -> String {
     g.source
 }
 
-/// The body of the generated function `name` (generic): from its signature to the next public
-/// item.
+/// The body of the generated function `name` (generic, public or not): from its signature to
+/// the next item.
 fn function_body(source: &str, name: &str) -> String {
     let from = source
-        .find(&format!("pub fn {name}<"))
+        .find(&format!("fn {name}<"))
         .unwrap_or_else(|| panic!("{name} is emitted"));
     let rest = &source[from + 1..];
-    let to = rest.find("\n    pub fn ").unwrap_or(rest.len());
+    let to = ["\n    pub fn ", "\n    fn ", "\n    #[doc"]
+        .iter()
+        .filter_map(|end| rest.find(end))
+        .min()
+        .unwrap_or(rest.len());
     rest[..to].to_owned()
 }
 
 /// The emitted batched functions of Krang: the Coriolis matrix (260 entries, 53 lane inputs:
 /// over the 240 locations one vectorized loop may touch) in two loops over the states, rows
-/// 0–11 and 12–18, each storing only its own rows; M, c, g and τ in one loop each.
+/// 0–11 and 12–18, each storing only its own rows; M, c, g and τ in one loop each. The loops
+/// are in the body both layouts share (`NAME_batch_body`).
 #[test]
 fn batched_coriolis_matrix_is_split_into_two_loops_by_rows_and_the_others_are_not() {
     let source = batched_krang();
-    let body = |name: &str| function_body(&source, &format!("{name}_batch_into"));
-    let loops = |text: &str| {
-        text.matches("for (l, m) in out.iter_mut().enumerate()")
-            .count()
-    };
+    let body = |name: &str| function_body(&source, &format!("{name}_batch_body"));
+    let loops = |text: &str| text.matches("for l in 0..L").count();
     for name in ["mass_matrix", "coriolis", "gravity", "inverse_dynamics"] {
         assert_eq!(loops(&body(name)), 1, "{name}");
     }
     let c = body("coriolis_matrix");
     assert_eq!(loops(&c), 2);
-    let second = c
-        .rfind("for (l, m) in out.iter_mut().enumerate()")
-        .expect("two loops");
+    let second = c.rfind("for l in 0..L").expect("two loops");
     let rows = |text: &str| -> Vec<usize> {
         let mut rows: Vec<usize> = text
-            .match_indices("m[(")
+            .match_indices("out.set(")
             .filter_map(|(i, _)| {
-                let rest = &text[i + 3..];
-                let r = &rest[..rest.find(',')?];
-                // Stores only: `m[(r, c)] = …`.
-                rest.find(")] =").filter(|&e| e < 12)?;
-                r.parse().ok()
+                let rest = &text[i + 8..];
+                rest[..rest.find(',')?].parse().ok()
             })
             .collect();
         rows.sort_unstable();
@@ -224,19 +221,16 @@ fn batched_coriolis_matrix_is_split_into_two_loops_by_rows_and_the_others_are_no
         rows
     };
     assert_eq!(rows(&c[..second]), (0..12).collect::<Vec<_>>());
-    let after = c[second..]
-        .find("for m in out.iter_mut()")
-        .unwrap_or(c.len() - second);
-    assert_eq!(
-        rows(&c[second..second + after]),
-        (12..19).collect::<Vec<_>>()
-    );
+    assert_eq!(rows(&c[second..]), (12..19).collect::<Vec<_>>());
 }
 
+/// Both layouts run the one shared body (emitted once) between their own input conversion and
+/// the entries no statement stores: the array of states transposes its inputs and completes
+/// each state's result; the structure of arrays copies its inputs and copies or zeroes whole
+/// entries, all lanes at once.
 #[test]
-fn structure_of_arrays_batches_loop_like_the_array_of_states_ones_and_store_whole_entries() {
+fn both_batched_layouts_share_one_body_and_differ_only_in_inputs_and_the_entries_after_it() {
     let source = batched_krang();
-    let body = |name: &str| function_body(&source, &format!("{name}_batch_soa_into"));
     for (name, loops) in [
         ("mass_matrix", 1),
         ("coriolis", 1),
@@ -244,17 +238,35 @@ fn structure_of_arrays_batches_loop_like_the_array_of_states_ones_and_store_whol
         ("inverse_dynamics", 1),
         ("coriolis_matrix", 2),
     ] {
-        let b = body(name);
-        assert_eq!(b.matches("for l in 0..L").count(), loops, "{name}");
-        // Inputs in lanes are copied, not transposed; entries are stored lane by lane in the
-        // loop, and no per-state result is touched.
-        assert!(b.contains("let q = &{ *q };"), "{name}");
-        assert!(!b.contains("lanes::inputs"), "{name}");
-        assert!(b.contains("].0[l] = "), "{name}");
-        assert!(!b.contains("out.iter_mut()"), "{name}");
+        let shared = format!("{name}_batch_body");
+        assert_eq!(
+            source.matches(&format!("fn {shared}<")).count(),
+            1,
+            "{name}"
+        );
+        assert_eq!(
+            function_body(&source, &shared)
+                .matches("for l in 0..L")
+                .count(),
+            loops,
+            "{name}"
+        );
+        let states = function_body(&source, &format!("{name}_batch_into"));
+        let lanes = function_body(&source, &format!("{name}_batch_soa_into"));
+        for (b, inputs) in [
+            (&states, "lanes::inputs(q)"),
+            (&lanes, "lanes::inputs_soa(q)"),
+        ] {
+            assert!(b.contains(inputs), "{name}");
+            assert!(b.contains(&format!("{shared}::<A, _, L>(")), "{name}");
+            assert!(!b.contains("for l in 0..L"), "{name}");
+        }
+        assert!(!lanes.contains("out.iter_mut()"), "{name}");
     }
-    // M's lower triangle: whole entries copied after the loop.
-    let m = body("mass_matrix");
-    let after = &m[m.find("for l in 0..L").unwrap()..];
-    assert!(after.contains("out[(1, 0)] = out[(0, 1)];"));
+    // M's lower triangle: copied after the shared body, per state or as whole entries.
+    let m = function_body(&source, "mass_matrix_batch_into");
+    assert!(m.contains("for m in out.iter_mut()"));
+    assert!(m.contains("m[(1, 0)] = m[(0, 1)];"));
+    let m = function_body(&source, "mass_matrix_batch_soa_into");
+    assert!(m.contains("out[(1, 0)] = out[(0, 1)];"));
 }

@@ -10,11 +10,15 @@
 //! like the single-state function, with an x86-64-v4 copy more: `isa::dispatch_fused_wide_with`),
 //! so lane `l` is the single-state value at state `l`, bit for bit with the same instruction
 //! set (the x86-64-v4 copy gives the x86-64-v3 copy's bits). LLVM's loop vectorizer runs the
-//! loop body on vectors across the states. Only the bindings of the inputs (transposed to
-//! lane-major order, sines and cosines lane by lane, before the loop) and the result stores
-//! (straight into the caller's `L` results) differ; a result with more entries than one
+//! loop body on vectors across the states. The body is emitted once per function
+//! (`NAME_batch_body`, [`shared_body`]) and inlined into both layouts' functions: it reads the
+//! inputs as lanes (`&[Lanes<L>; N]`), computes the sines and cosines lane by lane before the
+//! loop, and stores each entry through the layout's `kanegen_runtime::lanes::LaneStore`
+//! (`out.set(r, c, l, value)`: straight into the caller's `L` results, or into lane `l` of an
+//! entry). Each layout's function converts its inputs to lanes (transposed, or copied) and
+//! writes the entries no statement stores after the body. A result with more entries than one
 //! vectorized loop can store is computed in several loops ([`loop_parts`]). `L` is a const
-//! generic: one emitted body for every batch size.
+//! generic: one emitted body for every batch size and both layouts.
 //! README "Instruction sets at run time and batched evaluation" has the measurements.
 
 use std::borrow::Cow;
@@ -117,49 +121,32 @@ impl Layout {
         }
     }
 
-    /// The variable whose entries the stores write: state `l`'s result `m` (bound by the loop
-    /// over `out`), or `out` itself, whose every entry holds all lanes.
-    fn target(self) -> &'static str {
+    /// The body's copy of the state arguments: transposed to lane-major order
+    /// (`lanes::inputs`) or, already in lanes, copied (`lanes::inputs_soa`: like the parameters,
+    /// a local the result stores cannot overwrite). Either way an array `[Lanes<L>; N]`.
+    fn inputs(self, x: &TokenStream) -> TokenStream {
         match self {
-            Layout::States => "m",
-            Layout::Lanes => "out",
-        }
-    }
-
-    /// Result entry `(r, c)` (`r` of a vector) in the loop over the states (`l`): `m[(r, c)]`
-    /// of state `l`'s result, or lane `l` of `out[(r, c)]`.
-    fn entry_in_loop(self, r: usize, c: usize, vector: bool) -> String {
-        let target = self.target();
-        let at = if vector {
-            format!("[{r}]")
-        } else {
-            format!("[({r}, {c})]")
-        };
-        match self {
-            Layout::States => format!("{target}{at}"),
-            Layout::Lanes => format!("{target}{at}.0[l]"),
+            Layout::States => quote!(let #x = kanegen_runtime::lanes::inputs(#x);),
+            Layout::Lanes => quote!(let #x = kanegen_runtime::lanes::inputs_soa(#x);),
         }
     }
 }
 
-/// The lane-major bindings before the loop: the inputs the program reads, transposed
-/// (`let q = kanegen_runtime::lanes::inputs(q);`, `[Lanes<L>; N]`) or, already in lanes,
-/// copied (`let q = &{ *q };`: like the parameters, a local the result stores cannot
-/// overwrite), and per joint angle one lane-wise `sin_cos`.
-fn lane_inputs(cx: &Context<'_>, p: &Program, reads: &Reads, layout: Layout) -> TokenStream {
-    let mut ts = TokenStream::new();
+/// The lane inputs the program reads, as `(read, name)`: `q` (also for the sines and cosines),
+/// `u`, `ud`.
+fn read_inputs(p: &Program, reads: &Reads) -> [(bool, TokenStream); 3] {
     let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
-    let read = [
+    [
         (reads_q, quote!(q)),
         (reads.speed.contains(&true), quote!(u)),
         (reads.accel.contains(&true), quote!(ud)),
-    ];
-    for (_, x) in read.iter().filter(|(r, _)| *r) {
-        ts.extend(match layout {
-            Layout::States => quote!(let #x = kanegen_runtime::lanes::inputs(#x);),
-            Layout::Lanes => quote!(let #x = &{ *#x };),
-        });
-    }
+    ]
+}
+
+/// The sines and cosines before the loop: all joint angles of all states in one lane-wise
+/// `sin_cos` (a dependent joint's angle from its master's).
+fn lane_sin_cos(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
+    let mut ts = TokenStream::new();
     if !p.sincos.is_empty() {
         // All angles of all states in one call (a dependent joint's from its master's).
         let angles = p.sincos.iter().map(|&s| {
@@ -280,20 +267,14 @@ fn loop_parts<'p>(p: &'p Program, reads: &Reads) -> Vec<Cow<'p, Program>> {
 }
 
 /// The result stores inside the loop: every nonzero entry of `p` right after the last
-/// statement it reads (with multiply-add chains), into the caller's result `m` (text lines by
-/// position, see [`Printer::statement_block`]).
-fn loop_stores(
-    cx: &Context<'_>,
-    printer: &Printer<'_>,
-    p: &Program,
-    vector: bool,
-    layout: Layout,
-) -> Stores {
+/// statement it reads (with multiply-add chains), as `out.set(r, c, l, value)` through the
+/// layout's `kanegen_runtime::lanes::LaneStore` (text lines by position, see
+/// [`Printer::statement_block`]).
+fn loop_stores(cx: &Context<'_>, printer: &Printer<'_>, p: &Program) -> Stores {
     let mut stores: Stores = vec![Vec::new(); p.stmts.len() + 1];
     for (r, c, e) in nonzero_outputs(p) {
         let v = text(cx, printer, e);
-        let entry = layout.entry_in_loop(*r, *c, vector);
-        store_text_after(&mut stores, e, format!("{entry} = {v};"));
+        store_text_after(&mut stores, e, format!("out.set({r}, {c}, l, {v});"));
     }
     stores
 }
@@ -309,7 +290,12 @@ fn loop_stores(
 fn after_stores(cx: &Context<'_>, p: &Program, shape: Shape, layout: Layout) -> TokenStream {
     let (rows, cols) = shape.size_in(&cx.low.sizes);
     let vector = cols == 1;
-    let m = ident(layout.target());
+    // State `l`'s result `m` (bound by the loop over `out` around these stores) or `out`
+    // itself, whose every entry holds all lanes.
+    let m = match layout {
+        Layout::States => quote!(m),
+        Layout::Lanes => quote!(out),
+    };
     let zero = match layout {
         Layout::States => quote!(0.0),
         Layout::Lanes => quote!(kanegen_runtime::lanes::Lanes::splat(0.0)),
@@ -344,25 +330,94 @@ fn after_stores(cx: &Context<'_>, p: &Program, shape: Shape, layout: Layout) -> 
 }
 
 /// The batched free functions of `f` in both layouts (`NAME_batch_into` and `NAME_batch`,
-/// `NAME_batch_soa_into` and `NAME_batch_soa`), or nothing if it has none.
+/// `NAME_batch_soa_into` and `NAME_batch_soa`) and the body they share (`NAME_batch_body`), or
+/// nothing if it has none.
 ///
-/// The body is one loop over the lanes (several for a result with more entries than one
-/// vectorized loop can store: [`loop_parts`]) around the single-state function's statements,
-/// printed as they are (multiply-add chains over `A: Arith<f64>` included) and storing into
-/// the caller's result: LLVM's loop vectorizer then runs the whole body on vectors across the
-/// states (four lanes per AVX2 register, two per SSE2 register). Before the loop: the inputs in
-/// lane-major order, the lane-wise sines and cosines, and copies of the parameter structs
-/// (`let p = &{ *p };`) — without those the vectorizer needs run-time checks that the result
-/// stores do not overwrite parameters it reads, and gives up ("loop not vectorized: runtime
-/// pointer checks needed").
+/// The shared body ([`shared_body`]) is one loop over the lanes (several for a result with more
+/// entries than one vectorized loop can store: [`loop_parts`]) around the single-state
+/// function's statements, printed as they are (multiply-add chains over `A: Arith<f64>`
+/// included) and storing each entry through the layout's `LaneStore`: LLVM's loop vectorizer
+/// then runs the whole body on vectors across the states (four lanes per AVX2 register, two
+/// per SSE2 register, eight per AVX-512 register). Each layout's function converts its inputs
+/// to lanes, runs the shared body inlined into its own dispatched copies and then writes the
+/// entries no statement stores ([`after_stores`]).
 pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     if !batched(f) {
         return TokenStream::new();
     }
-    Layout::ALL
-        .iter()
-        .map(|&layout| function_in(cx, f, layout))
-        .collect()
+    let mut items = shared_body(cx, f);
+    items.extend(Layout::ALL.iter().map(|&layout| function_in(cx, f, layout)));
+    items
+}
+
+/// The name of the body `f`'s batched functions share.
+fn body_name(f: &FunctionProgram) -> proc_macro2::Ident {
+    ident(&format!("{}_batch_body", f.id.spec().name))
+}
+
+/// `NAME_batch_body::<A, S, L>(params, q, u, ud, out)`, private and `#[inline(always)]`: the
+/// statements of `f` for `L` states, from the inputs it reads as lanes (`&[Lanes<L>; N]` each)
+/// into any `S: kanegen_runtime::lanes::LaneStore<L>` (both layouts' results). Before the
+/// loops: copies of the parameter structs (`let p = &{ *p };`) — without those the vectorizer
+/// needs run-time checks that the result stores do not overwrite parameters it reads, and gives
+/// up ("loop not vectorized: runtime pointer checks needed") — and the lane-wise sines and
+/// cosines.
+fn shared_body(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
+    let spec = f.id.spec();
+    let p = &f.program;
+    let reads = Reads::of(p, cx.model.speeds.len());
+    let name = body_name(f);
+    let doc = format!(
+        " The statements of [`{0}_batch_into`] and [`{0}_batch_soa_into`] for `L` states: \
+         lane `l` of every input is state `l`, and each result entry of state `l` goes to \
+         `out.set(row, column, l, value)`.",
+        spec.name
+    );
+    let param_args = super::function::param_args(cx, &reads);
+    let nl = idx(cx.low.dof);
+    let lanes_ty = quote!(&[kanegen_runtime::lanes::Lanes<L>; #nl]);
+    let inputs = read_inputs(p, &reads)
+        .into_iter()
+        .filter(|(read, _)| *read)
+        .map(|(_, x)| quote!(#x: #lanes_ty,));
+    let sin_cos = lane_sin_cos(cx, p, &reads);
+    // One loop per part (one part unless the result has more entries than a vectorized loop
+    // can store).
+    let mut loops = TokenStream::new();
+    for part in loop_parts(p, &reads) {
+        let printer = cx.printer(&part.stmts);
+        let part_reads = Reads::of(&part, cx.model.speeds.len());
+        let lane_values = lane_values(cx, &part, &part_reads);
+        let stores = loop_stores(cx, &printer, &part);
+        let stored: Vec<&LExpr> = nonzero_outputs(&part).map(|(_, _, e)| e).collect();
+        let block =
+            printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true);
+        let statements = cx.blocks.placeholder(block);
+        loops.extend(quote!(for l in 0..L { #lane_values #statements }));
+    }
+    // Local copies of the parameters: the result stores cannot alias them (see above).
+    let mut copies = TokenStream::new();
+    if cx.low.params.is_runtime() {
+        if reads.param {
+            copies.extend(quote!(let p = &{ *p };));
+        }
+        if reads.pre {
+            copies.extend(quote!(let pc = &{ *pc };));
+        }
+    }
+    quote! {
+        #[doc = #doc]
+        #[inline(always)]
+        fn #name<
+            A: kanegen_runtime::isa::Arith<f64>,
+            S: kanegen_runtime::lanes::LaneStore<L>,
+            const L: usize,
+        >(#param_args #(#inputs)* out: &mut S) {
+            #copies
+            #sin_cos
+            #loops
+        }
+    }
 }
 
 /// The doc comments of the by-value and `_into` batched forms of `single` in `layout`.
@@ -403,7 +458,8 @@ fn docs(single: &str, layout: Layout) -> (String, String) {
     }
 }
 
-/// [`function`] in one layout.
+/// [`function`] in one layout: the inputs the program reads converted to lanes, the shared
+/// body ([`shared_body`]) inlined into each dispatched copy, then [`after_stores`].
 fn function_in(cx: &Context<'_>, f: &FunctionProgram, layout: Layout) -> TokenStream {
     let spec = f.id.spec();
     let p = &f.program;
@@ -412,33 +468,18 @@ fn function_in(cx: &Context<'_>, f: &FunctionProgram, layout: Layout) -> TokenSt
     let name = ident(&by_value);
     let name_into = ident(&format!("{by_value}_into"));
     let (doc, doc_into) = docs(spec.name, layout);
-    let param_args = super::function::param_args(cx, &reads);
     let (outer_params, pass_params) = super::function::outer_params(cx);
     let state = layout.args(cx, spec.inputs);
     let names = arg_names(spec.inputs);
     let ty = layout.result(cx, spec);
     let out = quote!(out: &mut #ty);
-    let lane_inputs = lane_inputs(cx, p, &reads, layout);
-    let vector = spec.shape.size_in(&cx.low.sizes).1 == 1;
-    // One loop per part (one part unless the result has more entries than a vectorized loop
-    // can store).
-    let mut loops = TokenStream::new();
-    for part in loop_parts(p, &reads) {
-        let printer = cx.printer(&part.stmts);
-        let part_reads = Reads::of(&part, cx.model.speeds.len());
-        let lane_values = lane_values(cx, &part, &part_reads);
-        let stores = loop_stores(cx, &printer, &part, vector, layout);
-        let stored: Vec<&LExpr> = nonzero_outputs(&part).map(|(_, _, e)| e).collect();
-        let block =
-            printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true);
-        let statements = cx.blocks.placeholder(block);
-        let lane_loop = match layout {
-            Layout::States if lane_values.is_empty() => quote!(for m in out.iter_mut()),
-            Layout::States => quote!(for (l, m) in out.iter_mut().enumerate()),
-            Layout::Lanes => quote!(for l in 0..L),
-        };
-        loops.extend(quote!(#lane_loop { #lane_values #statements }));
-    }
+    let read = read_inputs(p, &reads);
+    let converted = read
+        .iter()
+        .filter(|(r, _)| *r)
+        .map(|(_, x)| layout.inputs(x));
+    let passed = read.iter().filter(|(r, _)| *r).map(|(_, x)| quote!(&#x,));
+    let shared = body_name(f);
     let after = after_stores(cx, p, spec.shape, layout);
     let after_loop = match layout {
         _ if after.is_empty() => TokenStream::new(),
@@ -446,16 +487,6 @@ fn function_in(cx: &Context<'_>, f: &FunctionProgram, layout: Layout) -> TokenSt
         Layout::Lanes => after,
     };
     let unused = unused_inputs(spec.inputs, p, &reads);
-    // Local copies of the parameters: the result stores cannot alias them (see above).
-    let mut copies = TokenStream::new();
-    if cx.low.params.is_runtime() {
-        if reads.param {
-            copies.extend(quote!(let p = &{ *p };));
-        }
-        if reads.pre {
-            copies.extend(quote!(let pc = &{ *pc };));
-        }
-    }
     let call = super::function::call_body_into(
         cx,
         super::function::Copies::WithV4,
@@ -470,12 +501,11 @@ fn function_in(cx: &Context<'_>, f: &FunctionProgram, layout: Layout) -> TokenSt
         pub fn #name_into<const L: usize>(#outer_params #state, #out) {
             #[inline(always)]
             fn body<A: kanegen_runtime::isa::Arith<f64>, const L: usize>(
-                #param_args #state, #out
+                #outer_params #state, #out
             ) {
                 #unused
-                #copies
-                #lane_inputs
-                #loops
+                #(#converted)*
+                #shared::<A, _, L>(#pass_params #(#passed)* out);
                 #after_loop
             }
             #call

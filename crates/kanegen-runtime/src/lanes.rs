@@ -12,7 +12,10 @@
 //! all joint angles of all states are computed in one loop, inline in the batched function's
 //! copy ([`sin_cos_n_inline`]; [`sin_cos_n`] is the same as a dispatched call). [`Lanes<L>`] (`L` `f64`s with lane-wise operators, `f64`
 //! operands applied to every lane) holds the transposed inputs and forms a dependent (mimic)
-//! joint's angle from its master's.
+//! joint's angle from its master's. The structure-of-arrays forms (`*_batch_soa_into`) take
+//! and give every entry as a [`Lanes<L>`] ([`soa`], [`state`]; their inputs are copied by
+//! [`inputs_soa`]); both forms run one body emitted once per function, which stores each
+//! entry through [`LaneStore`].
 //!
 //! `L` is a const generic of the batch functions: any `L ≥ 1` works; 4 (one AVX2 register) and
 //! 8 are the sizes the benchmarks measure.
@@ -179,4 +182,48 @@ pub fn inputs<const L: usize, const N: usize>(x: &[SVector<f64, N>; L]) -> [Lane
     }
     core::hint::black_box(&mut t);
     t
+}
+
+/// The structure-of-arrays inputs of a batched function as the body reads them: a copy, so
+/// that the result stores cannot overwrite them (without it LLVM's loop vectorizer needs
+/// run-time checks and gives up). The form [`inputs`] gives for an array of states.
+#[inline(always)]
+pub fn inputs_soa<const L: usize, const N: usize>(x: &SVector<Lanes<L>, N>) -> [Lanes<L>; N] {
+    x.data.0[0]
+}
+
+/// Where the body shared by a generated module's two batched forms of a function
+/// (`NAME_batch_body`, inlined into `NAME_batch_into` and `NAME_batch_soa_into`) stores result
+/// entry `(r, c)` of state `l` (`c = 0` for a vector): entry `(r, c)` of the `l`-th result of
+/// an array of states, or lane `l` of entry `(r, c)` of a structure-of-arrays result. With
+/// constant `r`, `c` and `l < L` from the loop over the states, the index checks fold away and
+/// the store is what each layout wrote inline before.
+///
+/// ```
+/// use kanegen_runtime::lanes::{LaneStore, Lanes};
+/// use nalgebra::{SMatrix, SVector};
+/// let mut states = [SVector::<f64, 2>::zeros(); 3];
+/// states.set(1, 0, 2, 5.0);
+/// assert_eq!(states[2][1], 5.0);
+/// let mut soa = SMatrix::<Lanes<3>, 2, 1>::from_element(Lanes::splat(0.0));
+/// soa.set(1, 0, 2, 5.0);
+/// assert_eq!(soa[1].0[2], 5.0);
+/// ```
+pub trait LaneStore<const L: usize> {
+    /// Entry `(r, c)` of state `l` becomes `v`.
+    fn set(&mut self, r: usize, c: usize, l: usize, v: f64);
+}
+
+impl<const R: usize, const C: usize, const L: usize> LaneStore<L> for [SMatrix<f64, R, C>; L] {
+    #[inline(always)]
+    fn set(&mut self, r: usize, c: usize, l: usize, v: f64) {
+        self[l][(r, c)] = v;
+    }
+}
+
+impl<const R: usize, const C: usize, const L: usize> LaneStore<L> for SMatrix<Lanes<L>, R, C> {
+    #[inline(always)]
+    fn set(&mut self, r: usize, c: usize, l: usize, v: f64) {
+        self[(r, c)].0[l] = v;
+    }
 }

@@ -9297,6 +9297,1157 @@ mod generated {
             |(), lanes| body::<kanegen_runtime::isa::Fused, _>(lanes, p, pc, q, u, ud),
         )
     }
+    /// The statements of [`mass_matrix_batch_into`] and [`mass_matrix_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to `out.set(row, column, l, value)`.
+    #[inline(always)]
+    fn mass_matrix_batch_body<
+        A: kanegen_runtime::isa::Arith<f64>,
+        S: kanegen_runtime::lanes::LaneStore<L>,
+        const L: usize,
+    >(
+        p: &Params,
+        pc: &Precomputed,
+        q: &[kanegen_runtime::lanes::Lanes<L>; 19],
+        out: &mut S,
+    ) {
+        let p = &{ *p };
+        let pc = &{ *pc };
+        let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
+            A,
+            _,
+            L,
+        >([
+            q[2].0,
+            q[3].0,
+            q[4].0,
+            q[5].0,
+            q[12].0,
+            q[6].0,
+            q[13].0,
+            q[7].0,
+            q[14].0,
+            q[8].0,
+            q[15].0,
+            q[9].0,
+            q[16].0,
+            q[10].0,
+            q[17].0,
+            q[11].0,
+            q[18].0,
+        ]);
+        for l in 0..L {
+            let s_q_imu = sin_q[0][l];
+            let c_q_imu = cos_q[0][l];
+            let s_q_w = sin_q[1][l];
+            let c_q_w = cos_q[1][l];
+            let s_q_torso = sin_q[2][l];
+            let c_q_torso = cos_q[2][l];
+            let s_q1l = sin_q[3][l];
+            let c_q1l = cos_q[3][l];
+            let s_q1r = sin_q[4][l];
+            let c_q1r = cos_q[4][l];
+            let s_q2l = sin_q[5][l];
+            let c_q2l = cos_q[5][l];
+            let s_q2r = sin_q[6][l];
+            let c_q2r = cos_q[6][l];
+            let s_q3l = sin_q[7][l];
+            let c_q3l = cos_q[7][l];
+            let s_q3r = sin_q[8][l];
+            let c_q3r = cos_q[8][l];
+            let s_q4l = sin_q[9][l];
+            let c_q4l = cos_q[9][l];
+            let s_q4r = sin_q[10][l];
+            let c_q4r = cos_q[10][l];
+            let s_q5l = sin_q[11][l];
+            let c_q5l = cos_q[11][l];
+            let s_q5r = sin_q[12][l];
+            let c_q5r = cos_q[12][l];
+            let s_q6l = sin_q[13][l];
+            let c_q6l = cos_q[13][l];
+            let s_q6r = sin_q[14][l];
+            let c_q6r = cos_q[14][l];
+            let s_q7l = sin_q[15][l];
+            let c_q7l = cos_q[15][l];
+            let s_q7r = sin_q[16][l];
+            let c_q7r = cos_q[16][l];
+            out.set(0, 0, l, pc.pc69);
+            out.set(11, 11, l, p.ZZ10l);
+            out.set(18, 18, l, p.ZZ10r);
+            let d269 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
+            let d1 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
+            let d270 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
+            let d2 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
+            let t41 = p.XZ10l * c_q7l; // common subexpression
+            let t1 = p.XZ10r * c_q7r; // common subexpression
+            let t42 = p.YZ10l * s_q7l; // common subexpression
+            let t2 = p.YZ10r * s_q7r; // common subexpression
+            let t43 = p.XZ10l * s_q7l; // common subexpression
+            let t3 = p.XZ10r * s_q7r; // common subexpression
+            let t44 = p.YZ10l * c_q7l; // common subexpression
+            let t4 = p.YZ10r * c_q7r; // common subexpression
+            let t45 = p.L9 * d270; // common subexpression
+            let t5 = p.L9 * d2; // common subexpression
+            let t46 = p.L9 * d269; // common subexpression
+            let t6 = p.L9 * d1; // common subexpression
+            let d271 = t41 + t42 - t45; // N(M col 10l) at 9l.x
+            out.set(10, 11, l, -d271);
+            let d3 = t1 + t2 - t5; // N(M col 10r) at 9r.x
+            out.set(17, 18, l, -d3);
+            let d272 = t43 - t44 - t46; // N(M col 10l) at 9l.z
+            let d4 = t3 - t4 - t6; // N(M col 10r) at 9r.z
+            let d273 = d270 * s_q6l; // F(M col 10l) at 8l.y
+            let d5 = d2 * s_q6r; // F(M col 10r) at 8r.y
+            let d274 = d270 * c_q6l; // F(M col 10l) at 8l.z
+            let d6 = d2 * c_q6r; // F(M col 10r) at 8r.z
+            let d275 = A::mul_add(-d272, s_q6l, p.ZZ10l * c_q6l); // N(M col 10l) at 8l.y
+            out.set(9, 11, l, d275);
+            let d7 = A::mul_add(-d4, s_q6r, p.ZZ10r * c_q6r); // N(M col 10r) at 8r.y
+            out.set(16, 18, l, d7);
+            let d276 = A::mul_add(d272, c_q6l, p.ZZ10l * s_q6l); // N(M col 10l) at 8l.z
+            let d8 = A::mul_add(d4, c_q6r, p.ZZ10r * s_q6r); // N(M col 10r) at 8r.z
+            let d277 = A::mul_add(d274, s_q5l, d269 * c_q5l); // F(M col 10l) at 7l.x
+            let d9 = A::mul_add(d6, s_q5r, d1 * c_q5r); // F(M col 10r) at 7r.x
+            let d278 = A::mul_add(-d274, c_q5l, d269 * s_q5l); // F(M col 10l) at 7l.z
+            let d10 = A::mul_add(-d6, c_q5r, d1 * s_q5r); // F(M col 10r) at 7r.z
+            let d279 = A::mul_add(p.L8, d278, A::mul_add(-d276, s_q5l, d271 * c_q5l)); // N(M col 10l) at 7l.x
+            out.set(8, 11, l, -d279);
+            let d11 = A::mul_add(p.L8, d10, A::mul_add(-d8, s_q5r, d3 * c_q5r)); // N(M col 10r) at 7r.x
+            out.set(15, 18, l, -d11);
+            let d280 = A::mul_add(-p.L8, d277, A::mul_add(d276, c_q5l, d271 * s_q5l)); // N(M col 10l) at 7l.z
+            let d12 = A::mul_add(-p.L8, d9, A::mul_add(d8, c_q5r, d3 * s_q5r)); // N(M col 10r) at 7r.z
+            let d281 = A::mul_add(-d278, s_q4l, d273 * c_q4l); // F(M col 10l) at 6l.y
+            let d13 = A::mul_add(-d10, s_q4r, d5 * c_q4r); // F(M col 10r) at 6r.y
+            let d282 = A::mul_add(d278, c_q4l, d273 * s_q4l); // F(M col 10l) at 6l.z
+            let d14 = A::mul_add(d10, c_q4r, d5 * s_q4r); // F(M col 10r) at 6r.z
+            let d283 = A::mul_add(-d280, s_q4l, d275 * c_q4l); // N(M col 10l) at 6l.y
+            out.set(7, 11, l, d283);
+            let d15 = A::mul_add(-d12, s_q4r, d7 * c_q4r); // N(M col 10r) at 6r.y
+            out.set(14, 18, l, d15);
+            let d284 = A::mul_add(d280, c_q4l, d275 * s_q4l); // N(M col 10l) at 6l.z
+            let d16 = A::mul_add(d12, c_q4r, d7 * s_q4r); // N(M col 10r) at 6r.z
+            let d285 = A::mul_add(-d282, s_q3l, d277 * c_q3l); // F(M col 10l) at 5l.x
+            let d17 = A::mul_add(-d14, s_q3r, d9 * c_q3r); // F(M col 10r) at 5r.x
+            let d286 = A::mul_add(d282, c_q3l, d277 * s_q3l); // F(M col 10l) at 5l.z
+            let d18 = A::mul_add(d14, c_q3r, d9 * s_q3r); // F(M col 10r) at 5r.z
+            let d287 = A::mul_add(p.L7, d286, A::mul_add(-d284, s_q3l, d279 * c_q3l)); // N(M col 10l) at 5l.x
+            out.set(6, 11, l, -d287);
+            let d19 = A::mul_add(p.L7, d18, A::mul_add(-d16, s_q3r, d11 * c_q3r)); // N(M col 10r) at 5r.x
+            out.set(13, 18, l, -d19);
+            let d288 = A::mul_add(-p.L7, d285, A::mul_add(d284, c_q3l, d279 * s_q3l)); // N(M col 10l) at 5l.z
+            let d20 = A::mul_add(-p.L7, d17, A::mul_add(d16, c_q3r, d11 * s_q3r)); // N(M col 10r) at 5r.z
+            let d289 = A::mul_add(-d286, s_q2l, d281 * c_q2l); // F(M col 10l) at 4l.y
+            let d21 = A::mul_add(-d18, s_q2r, d13 * c_q2r); // F(M col 10r) at 4r.y
+            let d290 = A::mul_add(d286, c_q2l, d281 * s_q2l); // F(M col 10l) at 4l.z
+            let d22 = A::mul_add(d18, c_q2r, d13 * s_q2r); // F(M col 10r) at 4r.z
+            let d291 = A::mul_add(-d288, s_q2l, d283 * c_q2l); // N(M col 10l) at 4l.y
+            out.set(5, 11, l, d291);
+            let d23 = A::mul_add(-d20, s_q2r, d15 * c_q2r); // N(M col 10r) at 4r.y
+            out.set(12, 18, l, d23);
+            let d292 = A::mul_add(d288, c_q2l, d283 * s_q2l); // N(M col 10l) at 4l.z
+            let d24 = A::mul_add(d20, c_q2r, d15 * s_q2r); // N(M col 10r) at 4r.z
+            let d293 = A::mul_add(d290, c_q1l, d285 * s_q1l); // F(M col 10l) at 3.z
+            let d26 = A::mul_add(d22, c_q1r, d17 * s_q1r); // F(M col 10r) at 3.z
+            let d294 = A::mul_add(-d290, s_q1l, d285 * c_q1l); // F(M col 10l) at 3.y
+            let d25 = A::mul_add(-d22, s_q1r, d17 * c_q1r); // F(M col 10r) at 3.y
+            let d295 = A::mul_add(
+                p.L5,
+                d289,
+                A::mul_add(-p.L6, d294, A::mul_add(d292, c_q1l, d287 * s_q1l)),
+            ); // N(M col 10l) at 3.z
+            let d29 = A::mul_add(
+                p.L5,
+                d21,
+                A::mul_add(-p.L6, d25, A::mul_add(d24, c_q1r, d19 * s_q1r)),
+            ); // N(M col 10r) at 3.z
+            let d296 = A::mul_add(-p.L5, d293, d291); // N(M col 10l) at 3.x
+            let d27 = A::mul_add(-p.L5, d26, d23); // N(M col 10r) at 3.x
+            let d297 = A::mul_add(p.L6, d293, A::mul_add(-d292, s_q1l, d287 * c_q1l)); // N(M col 10l) at 3.y
+            out.set(4, 11, l, d297);
+            let d28 = A::mul_add(p.L6, d26, A::mul_add(-d24, s_q1r, d19 * c_q1r)); // N(M col 10r) at 3.y
+            out.set(4, 18, l, d28);
+            let d298 = A::mul_add(s_q_torso, d293, c_q_torso * d289); // F(M col 10l) at 2.x
+            let d30 = A::mul_add(s_q_torso, d26, c_q_torso * d21); // F(M col 10r) at 2.x
+            let d33 = A::mul_add(-p.L4, d30, -d28); // N(M col 10r) at 2.y
+            let d299 = A::mul_add(-c_q_torso, d293, s_q_torso * d289); // F(M col 10l) at 2.z
+            let d31 = A::mul_add(-c_q_torso, d26, s_q_torso * d21); // F(M col 10r) at 2.z
+            let d32 = A::mul_add(
+                -p.L3,
+                d31,
+                A::mul_add(-d29, s_q_torso, A::mul_add(-d27, c_q_torso, d25 * p.L4)),
+            ); // N(M col 10r) at 2.x
+            out.set(3, 18, l, -d32);
+            let d35 = A::mul_add(-d31, c_q_w, d25 * s_q_w); // F(M col 10r) at 1.z
+            let d36 = A::mul_add(d31, s_q_w, d25 * c_q_w); // F(M col 10r) at 1.y
+            let d300 = A::mul_add(
+                p.L4,
+                d294,
+                A::mul_add(p.L3, d299, A::mul_add(s_q_torso, d295, c_q_torso * d296)),
+            ); // N(M col 10l) at 2.x
+            out.set(3, 11, l, -d300);
+            let d301 = A::mul_add(
+                -p.L3,
+                d298,
+                A::mul_add(-c_q_torso, d295, s_q_torso * d296),
+            ); // N(M col 10l) at 2.z
+            let d34 = A::mul_add(
+                -p.L3,
+                d30,
+                A::mul_add(-c_q_torso, d29, s_q_torso * d27),
+            ); // N(M col 10r) at 2.z
+            let d302 = A::mul_add(-p.L4, d298, d297); // N(M col 10l) at 2.y
+            let d303 = A::mul_add(c_q_w, d299, s_q_w * d294); // F(M col 10l) at 1.z
+            let d304 = A::mul_add(-s_q_w, d299, c_q_w * d294); // F(M col 10l) at 1.y
+            let d305 = A::mul_add(-p.L2, d304, A::mul_add(p.L1, d303, d300)); // N(M col 10l) at 1.x
+            out.set(2, 11, l, -d305);
+            let d38 = A::mul_add(-p.L2, d36, A::mul_add(p.L1, d35, d32)); // N(M col 10r) at 1.x
+            out.set(2, 18, l, -d38);
+            let d306 = A::mul_add(-p.L1, d298, A::mul_add(c_q_w, d301, s_q_w * d302)); // N(M col 10l) at 1.z
+            let d37 = A::mul_add(-p.L1, d30, A::mul_add(c_q_w, d34, s_q_w * d33)); // N(M col 10r) at 1.z
+            let d307 = A::mul_add(p.L2, d298, A::mul_add(-s_q_w, d301, c_q_w * d302)); // N(M col 10l) at 1.y
+            let d39 = A::mul_add(p.L2, d30, A::mul_add(-s_q_w, d34, c_q_w * d33)); // N(M col 10r) at 1.y
+            let d308 = A::mul_add(c_q_imu, d303, s_q_imu * d304); // F(M col 10l) at 0.x
+            out.set(0, 11, l, -d308);
+            let d40 = A::mul_add(c_q_imu, d35, s_q_imu * d36); // F(M col 10r) at 0.x
+            out.set(0, 18, l, -d40);
+            let d309 = A::mul_add(-s_q_imu, d306, c_q_imu * d307); // N(M col 10l) at 0.z
+            out.set(1, 11, l, -d309);
+            let d41 = A::mul_add(-s_q_imu, d37, c_q_imu * d39); // N(M col 10r) at 0.z
+            out.set(1, 18, l, d41);
+            let d310 = p.MX9l - d270; // MSC9l.x
+            let d42 = p.MX9r - d2; // MSC9r.x
+            let d311 = p.MZ9l + d269; // MSC9l.z
+            let d43 = p.MZ9r + d1; // MSC9r.z
+            let k22 = s_q7l * s_q7l; // sin² q7l
+            let k1 = s_q7r * s_q7r; // sin² q7r
+            let k23 = s_q7l * c_q7l; // sin q7l cos q7l
+            let k2 = s_q7r * c_q7r; // sin q7r cos q7r
+            let k24 = A::mul_add(2.0, k22, -1.0); // cos 2q7l
+            let k3 = A::mul_add(2.0, k1, -1.0); // cos 2q7r
+            let d312 = A::mul_add(-2.0, p.XY10l * k23, k22 * pc.pc26); // JC10l rotated about z: Jxx − J'xx
+            let d44 = A::mul_add(-2.0, p.XY10r * k2, k1 * pc.pc3); // JC10r rotated about z: Jxx − J'xx
+            let d313 = p.XY9l + t41 + t42 - t45; // JC9l.xy
+            let d45 = p.XY9r + t1 + t2 - t5; // JC9r.xy
+            let d314 = A::mul_add(-k23, pc.pc26, A::mul_add(-p.XY10l, k24, p.XZ9l)); // JC9l.xz
+            let d46 = A::mul_add(-k2, pc.pc3, A::mul_add(-p.XY10r, k3, p.XZ9r)); // JC9r.xz
+            let d315 = p.YZ9l - t43 + t44 + t46; // JC9l.yz
+            let d47 = p.YZ9r - t3 + t4 + t6; // JC9r.yz
+            let d316 = pc.pc30 - d312; // JC9l.xx
+            out.set(10, 10, l, d316);
+            let d48 = pc.pc7 - d44; // JC9r.xx
+            out.set(17, 17, l, d48);
+            let d317 = d312 + pc.pc31; // JC9l.zz
+            let d49 = d44 + pc.pc8; // JC9r.zz
+            let d318 = A::mul_add(s_q6l, d311, c_q6l * pc.pc25); // MSC9l in 8l.y
+            let d50 = A::mul_add(s_q6r, d43, c_q6r * pc.pc2); // MSC9r in 8r.y
+            let d319 = A::mul_add(-c_q6l, d311, s_q6l * pc.pc25); // MSC9l in 8l.z
+            let d51 = A::mul_add(-c_q6r, d43, s_q6r * pc.pc2); // MSC9r in 8r.z
+            let t47 = c_q6l * d313; // common subexpression
+            let t7 = c_q6r * d45; // common subexpression
+            let t48 = s_q6l * d314; // common subexpression
+            let t8 = s_q6r * d46; // common subexpression
+            let d320 = t47 + t48; // N(M col 9l) at 8l.y
+            out.set(9, 10, l, -d320);
+            let d52 = t7 + t8; // N(M col 9r) at 8r.y
+            out.set(16, 17, l, -d52);
+            let t49 = s_q6l * d313; // common subexpression
+            let t9 = s_q6r * d45; // common subexpression
+            let t50 = c_q6l * d314; // common subexpression
+            let t10 = c_q6r * d46; // common subexpression
+            let d321 = t49 - t50; // N(M col 9l) at 8l.z
+            let d53 = t9 - t10; // N(M col 9r) at 8r.z
+            let d322 = s_q5l * d318; // F(M col 9l) at 7l.x
+            let d54 = s_q5r * d50; // F(M col 9r) at 7r.x
+            let d323 = c_q5l * d318; // F(M col 9l) at 7l.z
+            let d55 = c_q5r * d50; // F(M col 9r) at 7r.z
+            let d324 = A::mul_add(-p.L8, d322, A::mul_add(c_q5l, d321, s_q5l * d316)); // N(M col 9l) at 7l.z
+            let d56 = A::mul_add(-p.L8, d54, A::mul_add(c_q5r, d53, s_q5r * d48)); // N(M col 9r) at 7r.z
+            let d325 = A::mul_add(-p.L8, d323, A::mul_add(-s_q5l, d321, c_q5l * d316)); // N(M col 9l) at 7l.x
+            out.set(8, 10, l, d325);
+            let d57 = A::mul_add(-p.L8, d55, A::mul_add(-s_q5r, d53, c_q5r * d48)); // N(M col 9r) at 7r.x
+            out.set(15, 17, l, d57);
+            let d326 = A::mul_add(s_q4l, d323, c_q4l * d319); // F(M col 9l) at 6l.y
+            let d58 = A::mul_add(s_q4r, d55, c_q4r * d51); // F(M col 9r) at 6r.y
+            let d327 = A::mul_add(-c_q4l, d323, s_q4l * d319); // F(M col 9l) at 6l.z
+            let d59 = A::mul_add(-c_q4r, d55, s_q4r * d51); // F(M col 9r) at 6r.z
+            let d328 = A::mul_add(-s_q4l, d324, c_q4l * d320); // N(M col 9l) at 6l.y
+            out.set(7, 10, l, -d328);
+            let d60 = A::mul_add(-s_q4r, d56, c_q4r * d52); // N(M col 9r) at 6r.y
+            out.set(14, 17, l, -d60);
+            let d329 = A::mul_add(c_q4l, d324, s_q4l * d320); // N(M col 9l) at 6l.z
+            let d61 = A::mul_add(c_q4r, d56, s_q4r * d52); // N(M col 9r) at 6r.z
+            let d330 = A::mul_add(c_q3l, d327, s_q3l * d322); // F(M col 9l) at 5l.z
+            let d62 = A::mul_add(c_q3r, d59, s_q3r * d54); // F(M col 9r) at 5r.z
+            let d331 = A::mul_add(-s_q3l, d327, c_q3l * d322); // F(M col 9l) at 5l.x
+            let d63 = A::mul_add(-s_q3r, d59, c_q3r * d54); // F(M col 9r) at 5r.x
+            let d332 = A::mul_add(-p.L7, d331, A::mul_add(c_q3l, d329, s_q3l * d325)); // N(M col 9l) at 5l.z
+            let d64 = A::mul_add(-p.L7, d63, A::mul_add(c_q3r, d61, s_q3r * d57)); // N(M col 9r) at 5r.z
+            let d333 = A::mul_add(p.L7, d330, A::mul_add(-s_q3l, d329, c_q3l * d325)); // N(M col 9l) at 5l.x
+            out.set(6, 10, l, d333);
+            let d65 = A::mul_add(p.L7, d62, A::mul_add(-s_q3r, d61, c_q3r * d57)); // N(M col 9r) at 5r.x
+            out.set(13, 17, l, d65);
+            let d334 = A::mul_add(-s_q2l, d330, c_q2l * d326); // F(M col 9l) at 4l.y
+            let d66 = A::mul_add(-s_q2r, d62, c_q2r * d58); // F(M col 9r) at 4r.y
+            let d335 = A::mul_add(c_q2l, d330, s_q2l * d326); // F(M col 9l) at 4l.z
+            let d67 = A::mul_add(c_q2r, d62, s_q2r * d58); // F(M col 9r) at 4r.z
+            let d336 = A::mul_add(-s_q2l, d332, c_q2l * d328); // N(M col 9l) at 4l.y
+            out.set(5, 10, l, -d336);
+            let d68 = A::mul_add(-s_q2r, d64, c_q2r * d60); // N(M col 9r) at 4r.y
+            out.set(12, 17, l, -d68);
+            let d337 = A::mul_add(c_q2l, d332, s_q2l * d328); // N(M col 9l) at 4l.z
+            let d69 = A::mul_add(c_q2r, d64, s_q2r * d60); // N(M col 9r) at 4r.z
+            let d338 = A::mul_add(-s_q1l, d335, c_q1l * d331); // F(M col 9l) at 3.y
+            let d70 = A::mul_add(-s_q1r, d67, c_q1r * d63); // F(M col 9r) at 3.y
+            let d339 = A::mul_add(c_q1l, d335, s_q1l * d331); // F(M col 9l) at 3.z
+            let d71 = A::mul_add(c_q1r, d67, s_q1r * d63); // F(M col 9r) at 3.z
+            let d340 = A::mul_add(-p.L5, d339, d336); // N(M col 9l) at 3.x
+            let d74 = A::mul_add(-p.L5, d71, d68); // N(M col 9r) at 3.x
+            let d341 = A::mul_add(p.L6, d339, A::mul_add(-s_q1l, d337, c_q1l * d333)); // N(M col 9l) at 3.y
+            out.set(4, 10, l, -d341);
+            let d72 = A::mul_add(p.L6, d71, A::mul_add(-s_q1r, d69, c_q1r * d65)); // N(M col 9r) at 3.y
+            out.set(4, 17, l, -d72);
+            let d342 = A::mul_add(
+                p.L5,
+                d334,
+                A::mul_add(-p.L6, d338, A::mul_add(c_q1l, d337, s_q1l * d333)),
+            ); // N(M col 9l) at 3.z
+            let d73 = A::mul_add(
+                p.L5,
+                d66,
+                A::mul_add(-p.L6, d70, A::mul_add(c_q1r, d69, s_q1r * d65)),
+            ); // N(M col 9r) at 3.z
+            let d343 = A::mul_add(s_q_torso, d339, c_q_torso * d334); // F(M col 9l) at 2.x
+            let d75 = A::mul_add(s_q_torso, d71, c_q_torso * d66); // F(M col 9r) at 2.x
+            let d78 = A::mul_add(-p.L4, d75, -d72); // N(M col 9r) at 2.y
+            let d344 = A::mul_add(-c_q_torso, d339, s_q_torso * d334); // F(M col 9l) at 2.z
+            let d76 = A::mul_add(-c_q_torso, d71, s_q_torso * d66); // F(M col 9r) at 2.z
+            let d77 = A::mul_add(
+                -p.L3,
+                d76,
+                A::mul_add(-s_q_torso, d73, A::mul_add(-c_q_torso, d74, p.L4 * d70)),
+            ); // N(M col 9r) at 2.x
+            out.set(3, 17, l, d77);
+            let d80 = A::mul_add(s_q_w, d76, c_q_w * d70); // F(M col 9r) at 1.y
+            let d81 = A::mul_add(-c_q_w, d76, s_q_w * d70); // F(M col 9r) at 1.z
+            let d345 = A::mul_add(-p.L4, d343, d341); // N(M col 9l) at 2.y
+            let d346 = A::mul_add(
+                p.L4,
+                d338,
+                A::mul_add(p.L3, d344, A::mul_add(s_q_torso, d342, c_q_torso * d340)),
+            ); // N(M col 9l) at 2.x
+            out.set(3, 10, l, d346);
+            let d347 = A::mul_add(
+                -p.L3,
+                d343,
+                A::mul_add(-c_q_torso, d342, s_q_torso * d340),
+            ); // N(M col 9l) at 2.z
+            let d79 = A::mul_add(
+                -p.L3,
+                d75,
+                A::mul_add(-c_q_torso, d73, s_q_torso * d74),
+            ); // N(M col 9r) at 2.z
+            let d348 = A::mul_add(-s_q_w, d344, c_q_w * d338); // F(M col 9l) at 1.y
+            let d349 = A::mul_add(c_q_w, d344, s_q_w * d338); // F(M col 9l) at 1.z
+            let d350 = A::mul_add(p.L2, d343, A::mul_add(-s_q_w, d347, c_q_w * d345)); // N(M col 9l) at 1.y
+            let d83 = A::mul_add(p.L2, d75, A::mul_add(-s_q_w, d79, c_q_w * d78)); // N(M col 9r) at 1.y
+            let d351 = A::mul_add(-p.L2, d348, A::mul_add(p.L1, d349, d346)); // N(M col 9l) at 1.x
+            out.set(2, 10, l, d351);
+            let d82 = A::mul_add(-p.L2, d80, A::mul_add(p.L1, d81, d77)); // N(M col 9r) at 1.x
+            out.set(2, 17, l, d82);
+            let d352 = A::mul_add(-p.L1, d343, A::mul_add(c_q_w, d347, s_q_w * d345)); // N(M col 9l) at 1.z
+            let d84 = A::mul_add(-p.L1, d75, A::mul_add(c_q_w, d79, s_q_w * d78)); // N(M col 9r) at 1.z
+            let d353 = A::mul_add(c_q_imu, d349, s_q_imu * d348); // F(M col 9l) at 0.x
+            out.set(0, 10, l, d353);
+            let d85 = A::mul_add(c_q_imu, d81, s_q_imu * d80); // F(M col 9r) at 0.x
+            out.set(0, 17, l, d85);
+            let d354 = A::mul_add(-s_q_imu, d352, c_q_imu * d350); // N(M col 9l) at 0.z
+            out.set(1, 10, l, d354);
+            let d86 = A::mul_add(-s_q_imu, d84, c_q_imu * d83); // N(M col 9r) at 0.z
+            out.set(1, 17, l, -d86);
+            let d355 = p.MX8l - d310; // MSC8l.x
+            let d87 = p.MX8r - d42; // MSC8r.x
+            let d356 = p.MY8l - d318; // MSC8l.y
+            let d88 = p.MY8r - d50; // MSC8r.y
+            let d357 = p.MZ8l - d319; // MSC8l.z
+            let d89 = p.MZ8r - d51; // MSC8r.z
+            let k25 = s_q6l * s_q6l; // sin² q6l
+            let k4 = s_q6r * s_q6r; // sin² q6r
+            let k26 = s_q6l * c_q6l; // sin q6l cos q6l
+            let k5 = s_q6r * c_q6r; // sin q6r cos q6r
+            let k27 = A::mul_add(2.0, k25, -1.0); // cos 2q6l
+            let k6 = A::mul_add(2.0, k4, -1.0); // cos 2q6r
+            let d90 = pc.pc6 - d49; // JC9r: Jyy − Jzz
+            let d358 = pc.pc29 - d317; // JC9l: Jyy − Jzz
+            let d359 = A::mul_add(-2.0, d315 * k26, k25 * d358); // JC9l rotated about x: Jyy − J'yy
+            let d91 = A::mul_add(-2.0, d47 * k5, k4 * d90); // JC9r rotated about x: Jyy − J'yy
+            let d360 = p.XX8l + d316; // JC8l.xx
+            let d92 = p.XX8r + d48; // JC8r.xx
+            let d361 = p.XY8l + t47 + t48; // JC8l.xy
+            let d93 = p.XY8r + t7 + t8; // JC8r.xy
+            let d362 = p.XZ8l + t49 - t50; // JC8l.xz
+            let d94 = p.XZ8r + t9 - t10; // JC8r.xz
+            let d363 = A::mul_add(k26, d358, A::mul_add(d315, k27, p.YZ8l)); // JC8l.yz
+            let d95 = A::mul_add(k5, d90, A::mul_add(d47, k6, p.YZ8r)); // JC8r.yz
+            let d364 = p.ZZ8l + d317 + d359; // JC8l.zz
+            let d96 = p.ZZ8r + d49 + d91; // JC8r.zz
+            let d365 = pc.pc33 - d359; // JC8l.yy
+            out.set(9, 9, l, d365);
+            let d97 = pc.pc10 - d91; // JC8r.yy
+            out.set(16, 16, l, d97);
+            let d366 = A::mul_add(c_q5l, d357, s_q5l * d355); // MSC8l in 7l.z
+            let d98 = A::mul_add(c_q5r, d89, s_q5r * d87); // MSC8r in 7r.z
+            let d367 = A::mul_add(-s_q5l, d357, c_q5l * d355); // MSC8l in 7l.x
+            let d99 = A::mul_add(-s_q5r, d89, c_q5r * d87); // MSC8r in 7r.x
+            let t51 = c_q5l * d361; // common subexpression
+            let t11 = c_q5r * d93; // common subexpression
+            let t52 = s_q5l * d363; // common subexpression
+            let t12 = s_q5r * d95; // common subexpression
+            let t53 = s_q5l * d361; // common subexpression
+            let t13 = s_q5r * d93; // common subexpression
+            let t54 = c_q5l * d363; // common subexpression
+            let t14 = c_q5r * d95; // common subexpression
+            let t55 = p.L8 * d367; // common subexpression
+            let t15 = p.L8 * d99; // common subexpression
+            let t56 = p.L8 * d366; // common subexpression
+            let t16 = p.L8 * d98; // common subexpression
+            let d368 = t51 - t52 - t55; // N(M col 8l) at 7l.x
+            out.set(8, 9, l, -d368);
+            let d100 = t11 - t12 - t15; // N(M col 8r) at 7r.x
+            out.set(15, 16, l, -d100);
+            let d369 = t53 + t54 - t56; // N(M col 8l) at 7l.z
+            let d101 = t13 + t14 - t16; // N(M col 8r) at 7r.z
+            let d370 = s_q4l * d367; // F(M col 8l) at 6l.y
+            let d102 = s_q4r * d99; // F(M col 8r) at 6r.y
+            let d371 = c_q4l * d367; // F(M col 8l) at 6l.z
+            let d103 = c_q4r * d99; // F(M col 8r) at 6r.z
+            let d372 = A::mul_add(-s_q4l, d369, c_q4l * d365); // N(M col 8l) at 6l.y
+            out.set(7, 9, l, d372);
+            let d104 = A::mul_add(-s_q4r, d101, c_q4r * d97); // N(M col 8r) at 6r.y
+            out.set(14, 16, l, d104);
+            let d373 = A::mul_add(c_q4l, d369, s_q4l * d365); // N(M col 8l) at 6l.z
+            let d105 = A::mul_add(c_q4r, d101, s_q4r * d97); // N(M col 8r) at 6r.z
+            let d374 = A::mul_add(s_q3l, d371, c_q3l * d366); // F(M col 8l) at 5l.x
+            let d106 = A::mul_add(s_q3r, d103, c_q3r * d98); // F(M col 8r) at 5r.x
+            let d375 = A::mul_add(-c_q3l, d371, s_q3l * d366); // F(M col 8l) at 5l.z
+            let d107 = A::mul_add(-c_q3r, d103, s_q3r * d98); // F(M col 8r) at 5r.z
+            let d376 = A::mul_add(p.L7, d375, A::mul_add(-s_q3l, d373, c_q3l * d368)); // N(M col 8l) at 5l.x
+            out.set(6, 9, l, -d376);
+            let d108 = A::mul_add(p.L7, d107, A::mul_add(-s_q3r, d105, c_q3r * d100)); // N(M col 8r) at 5r.x
+            out.set(13, 16, l, -d108);
+            let d377 = A::mul_add(-p.L7, d374, A::mul_add(c_q3l, d373, s_q3l * d368)); // N(M col 8l) at 5l.z
+            let d109 = A::mul_add(-p.L7, d106, A::mul_add(c_q3r, d105, s_q3r * d100)); // N(M col 8r) at 5r.z
+            let d378 = A::mul_add(-s_q2l, d375, c_q2l * d370); // F(M col 8l) at 4l.y
+            let d110 = A::mul_add(-s_q2r, d107, c_q2r * d102); // F(M col 8r) at 4r.y
+            let d379 = A::mul_add(c_q2l, d375, s_q2l * d370); // F(M col 8l) at 4l.z
+            let d111 = A::mul_add(c_q2r, d107, s_q2r * d102); // F(M col 8r) at 4r.z
+            let d380 = A::mul_add(-s_q2l, d377, c_q2l * d372); // N(M col 8l) at 4l.y
+            out.set(5, 9, l, d380);
+            let d112 = A::mul_add(-s_q2r, d109, c_q2r * d104); // N(M col 8r) at 4r.y
+            out.set(12, 16, l, d112);
+            let d381 = A::mul_add(c_q2l, d377, s_q2l * d372); // N(M col 8l) at 4l.z
+            let d113 = A::mul_add(c_q2r, d109, s_q2r * d104); // N(M col 8r) at 4r.z
+            let d382 = A::mul_add(c_q1l, d379, s_q1l * d374); // F(M col 8l) at 3.z
+            let d115 = A::mul_add(c_q1r, d111, s_q1r * d106); // F(M col 8r) at 3.z
+            let d383 = A::mul_add(-s_q1l, d379, c_q1l * d374); // F(M col 8l) at 3.y
+            let d114 = A::mul_add(-s_q1r, d111, c_q1r * d106); // F(M col 8r) at 3.y
+            let d384 = A::mul_add(
+                p.L5,
+                d378,
+                A::mul_add(-p.L6, d383, A::mul_add(c_q1l, d381, s_q1l * d376)),
+            ); // N(M col 8l) at 3.z
+            let d118 = A::mul_add(
+                p.L5,
+                d110,
+                A::mul_add(-p.L6, d114, A::mul_add(c_q1r, d113, s_q1r * d108)),
+            ); // N(M col 8r) at 3.z
+            let d385 = A::mul_add(-p.L5, d382, d380); // N(M col 8l) at 3.x
+            let d116 = A::mul_add(-p.L5, d115, d112); // N(M col 8r) at 3.x
+            let d386 = A::mul_add(p.L6, d382, A::mul_add(-s_q1l, d381, c_q1l * d376)); // N(M col 8l) at 3.y
+            out.set(4, 9, l, d386);
+            let d117 = A::mul_add(p.L6, d115, A::mul_add(-s_q1r, d113, c_q1r * d108)); // N(M col 8r) at 3.y
+            out.set(4, 16, l, d117);
+            let d387 = A::mul_add(s_q_torso, d382, c_q_torso * d378); // F(M col 8l) at 2.x
+            let d119 = A::mul_add(s_q_torso, d115, c_q_torso * d110); // F(M col 8r) at 2.x
+            let d122 = A::mul_add(-p.L4, d119, -d117); // N(M col 8r) at 2.y
+            let d388 = A::mul_add(-c_q_torso, d382, s_q_torso * d378); // F(M col 8l) at 2.z
+            let d120 = A::mul_add(-c_q_torso, d115, s_q_torso * d110); // F(M col 8r) at 2.z
+            let d121 = A::mul_add(
+                -p.L3,
+                d120,
+                A::mul_add(-s_q_torso, d118, A::mul_add(-c_q_torso, d116, p.L4 * d114)),
+            ); // N(M col 8r) at 2.x
+            out.set(3, 16, l, -d121);
+            let d124 = A::mul_add(-c_q_w, d120, s_q_w * d114); // F(M col 8r) at 1.z
+            let d125 = A::mul_add(s_q_w, d120, c_q_w * d114); // F(M col 8r) at 1.y
+            let d389 = A::mul_add(
+                p.L4,
+                d383,
+                A::mul_add(p.L3, d388, A::mul_add(s_q_torso, d384, c_q_torso * d385)),
+            ); // N(M col 8l) at 2.x
+            out.set(3, 9, l, -d389);
+            let d390 = A::mul_add(
+                -p.L3,
+                d387,
+                A::mul_add(-c_q_torso, d384, s_q_torso * d385),
+            ); // N(M col 8l) at 2.z
+            let d123 = A::mul_add(
+                -p.L3,
+                d119,
+                A::mul_add(-c_q_torso, d118, s_q_torso * d116),
+            ); // N(M col 8r) at 2.z
+            let d391 = A::mul_add(-p.L4, d387, d386); // N(M col 8l) at 2.y
+            let d392 = A::mul_add(c_q_w, d388, s_q_w * d383); // F(M col 8l) at 1.z
+            let d393 = A::mul_add(-s_q_w, d388, c_q_w * d383); // F(M col 8l) at 1.y
+            let d394 = A::mul_add(-p.L2, d393, A::mul_add(p.L1, d392, d389)); // N(M col 8l) at 1.x
+            out.set(2, 9, l, -d394);
+            let d127 = A::mul_add(-p.L2, d125, A::mul_add(p.L1, d124, d121)); // N(M col 8r) at 1.x
+            out.set(2, 16, l, -d127);
+            let d395 = A::mul_add(-p.L1, d387, A::mul_add(c_q_w, d390, s_q_w * d391)); // N(M col 8l) at 1.z
+            let d126 = A::mul_add(-p.L1, d119, A::mul_add(c_q_w, d123, s_q_w * d122)); // N(M col 8r) at 1.z
+            let d396 = A::mul_add(p.L2, d387, A::mul_add(-s_q_w, d390, c_q_w * d391)); // N(M col 8l) at 1.y
+            let d128 = A::mul_add(p.L2, d119, A::mul_add(-s_q_w, d123, c_q_w * d122)); // N(M col 8r) at 1.y
+            let d397 = A::mul_add(c_q_imu, d392, s_q_imu * d393); // F(M col 8l) at 0.x
+            out.set(0, 9, l, -d397);
+            let d129 = A::mul_add(c_q_imu, d124, s_q_imu * d125); // F(M col 8r) at 0.x
+            out.set(0, 16, l, -d129);
+            let d398 = A::mul_add(-s_q_imu, d395, c_q_imu * d396); // N(M col 8l) at 0.z
+            out.set(1, 9, l, -d398);
+            let d130 = A::mul_add(-s_q_imu, d126, c_q_imu * d128); // N(M col 8r) at 0.z
+            out.set(1, 16, l, d130);
+            let d399 = p.MX7l - d367; // MSC7l.x
+            let d131 = p.MX7r - d99; // MSC7r.x
+            let d400 = p.MZ7l + d366; // MSC7l.z
+            let d132 = p.MZ7r + d98; // MSC7r.z
+            let k28 = s_q5l * s_q5l; // sin² q5l
+            let k7 = s_q5r * s_q5r; // sin² q5r
+            let k29 = s_q5l * c_q5l; // sin q5l cos q5l
+            let k8 = s_q5r * c_q5r; // sin q5r cos q5r
+            let k30 = A::mul_add(2.0, k28, -1.0); // cos 2q5l
+            let k9 = A::mul_add(2.0, k7, -1.0); // cos 2q5r
+            let d401 = d360 - d364; // JC8l: Jzz − Jxx
+            let d133 = d92 - d96; // JC8r: Jzz − Jxx
+            let d402 = A::mul_add(2.0, d362 * k29, k28 * d401); // JC8l rotated about y: Jzz − J'zz
+            let d134 = A::mul_add(2.0, d94 * k8, k7 * d133); // JC8r rotated about y: Jzz − J'zz
+            let t57 = p.L8 * d356; // common subexpression
+            let t17 = p.L8 * d88; // common subexpression
+            let d403 = p.XY7l + t51 - t52 - t55; // JC7l.xy
+            let d135 = p.XY7r + t11 - t12 - t15; // JC7r.xy
+            let d404 = A::mul_add(-k29, d401, A::mul_add(d362, k30, p.XZ7l)); // JC7l.xz
+            let d136 = A::mul_add(-k8, d133, A::mul_add(d94, k9, p.XZ7r)); // JC7r.xz
+            let d405 = p.YY7l + d365; // JC7l.yy
+            let d137 = p.YY7r + d97; // JC7r.yy
+            let d406 = p.YZ7l - t53 - t54 + t56; // JC7l.yz
+            let d138 = p.YZ7r - t13 - t14 + t16; // JC7r.yz
+            let d407 = pc.pc36 - d356; // MSC7l.y
+            let d139 = pc.pc13 - d88; // MSC7r.y
+            let d408 = A::mul_add(2.0, t57, d360 - d402) + pc.pc37; // JC7l.xx
+            out.set(8, 8, l, d408);
+            let d140 = A::mul_add(2.0, t17, d92 - d134) + pc.pc14; // JC7r.xx
+            out.set(15, 15, l, d140);
+            let d409 = A::mul_add(2.0, t57, d364 + d402) + pc.pc38; // JC7l.zz
+            let d141 = A::mul_add(2.0, t17, d96 + d134) + pc.pc15; // JC7r.zz
+            let d410 = A::mul_add(s_q4l, d400, c_q4l * d407); // MSC7l in 6l.y
+            let d142 = A::mul_add(s_q4r, d132, c_q4r * d139); // MSC7r in 6r.y
+            let d411 = A::mul_add(-c_q4l, d400, s_q4l * d407); // MSC7l in 6l.z
+            let d143 = A::mul_add(-c_q4r, d132, s_q4r * d139); // MSC7r in 6r.z
+            let t58 = c_q4l * d403; // common subexpression
+            let t18 = c_q4r * d135; // common subexpression
+            let t59 = s_q4l * d404; // common subexpression
+            let t19 = s_q4r * d136; // common subexpression
+            let d412 = t58 + t59; // N(M col 7l) at 6l.y
+            out.set(7, 8, l, -d412);
+            let d144 = t18 + t19; // N(M col 7r) at 6r.y
+            out.set(14, 15, l, -d144);
+            let t60 = s_q4l * d403; // common subexpression
+            let t20 = s_q4r * d135; // common subexpression
+            let t61 = c_q4l * d404; // common subexpression
+            let t21 = c_q4r * d136; // common subexpression
+            let d413 = t60 - t61; // N(M col 7l) at 6l.z
+            let d145 = t20 - t21; // N(M col 7r) at 6r.z
+            let d414 = s_q3l * d410; // F(M col 7l) at 5l.x
+            let d146 = s_q3r * d142; // F(M col 7r) at 5r.x
+            let d415 = c_q3l * d410; // F(M col 7l) at 5l.z
+            let d147 = c_q3r * d142; // F(M col 7r) at 5r.z
+            let d416 = A::mul_add(-p.L7, d414, A::mul_add(c_q3l, d413, s_q3l * d408)); // N(M col 7l) at 5l.z
+            let d148 = A::mul_add(-p.L7, d146, A::mul_add(c_q3r, d145, s_q3r * d140)); // N(M col 7r) at 5r.z
+            let d417 = A::mul_add(-p.L7, d415, A::mul_add(-s_q3l, d413, c_q3l * d408)); // N(M col 7l) at 5l.x
+            out.set(6, 8, l, d417);
+            let d149 = A::mul_add(-p.L7, d147, A::mul_add(-s_q3r, d145, c_q3r * d140)); // N(M col 7r) at 5r.x
+            out.set(13, 15, l, d149);
+            let d418 = A::mul_add(s_q2l, d415, c_q2l * d411); // F(M col 7l) at 4l.y
+            let d150 = A::mul_add(s_q2r, d147, c_q2r * d143); // F(M col 7r) at 4r.y
+            let d419 = A::mul_add(-c_q2l, d415, s_q2l * d411); // F(M col 7l) at 4l.z
+            let d151 = A::mul_add(-c_q2r, d147, s_q2r * d143); // F(M col 7r) at 4r.z
+            let d420 = A::mul_add(-s_q2l, d416, c_q2l * d412); // N(M col 7l) at 4l.y
+            out.set(5, 8, l, -d420);
+            let d152 = A::mul_add(-s_q2r, d148, c_q2r * d144); // N(M col 7r) at 4r.y
+            out.set(12, 15, l, -d152);
+            let d421 = A::mul_add(c_q2l, d416, s_q2l * d412); // N(M col 7l) at 4l.z
+            let d153 = A::mul_add(c_q2r, d148, s_q2r * d144); // N(M col 7r) at 4r.z
+            let d422 = A::mul_add(-s_q1l, d419, c_q1l * d414); // F(M col 7l) at 3.y
+            let d154 = A::mul_add(-s_q1r, d151, c_q1r * d146); // F(M col 7r) at 3.y
+            let d423 = A::mul_add(c_q1l, d419, s_q1l * d414); // F(M col 7l) at 3.z
+            let d155 = A::mul_add(c_q1r, d151, s_q1r * d146); // F(M col 7r) at 3.z
+            let d424 = A::mul_add(-p.L5, d423, d420); // N(M col 7l) at 3.x
+            let d158 = A::mul_add(-p.L5, d155, d152); // N(M col 7r) at 3.x
+            let d425 = A::mul_add(p.L6, d423, A::mul_add(-s_q1l, d421, c_q1l * d417)); // N(M col 7l) at 3.y
+            out.set(4, 8, l, -d425);
+            let d156 = A::mul_add(p.L6, d155, A::mul_add(-s_q1r, d153, c_q1r * d149)); // N(M col 7r) at 3.y
+            out.set(4, 15, l, -d156);
+            let d426 = A::mul_add(
+                p.L5,
+                d418,
+                A::mul_add(-p.L6, d422, A::mul_add(c_q1l, d421, s_q1l * d417)),
+            ); // N(M col 7l) at 3.z
+            let d157 = A::mul_add(
+                p.L5,
+                d150,
+                A::mul_add(-p.L6, d154, A::mul_add(c_q1r, d153, s_q1r * d149)),
+            ); // N(M col 7r) at 3.z
+            let d427 = A::mul_add(s_q_torso, d423, c_q_torso * d418); // F(M col 7l) at 2.x
+            let d159 = A::mul_add(s_q_torso, d155, c_q_torso * d150); // F(M col 7r) at 2.x
+            let d162 = A::mul_add(-p.L4, d159, -d156); // N(M col 7r) at 2.y
+            let d428 = A::mul_add(-c_q_torso, d423, s_q_torso * d418); // F(M col 7l) at 2.z
+            let d160 = A::mul_add(-c_q_torso, d155, s_q_torso * d150); // F(M col 7r) at 2.z
+            let d161 = A::mul_add(
+                -p.L3,
+                d160,
+                A::mul_add(-s_q_torso, d157, A::mul_add(-c_q_torso, d158, p.L4 * d154)),
+            ); // N(M col 7r) at 2.x
+            out.set(3, 15, l, d161);
+            let d164 = A::mul_add(s_q_w, d160, c_q_w * d154); // F(M col 7r) at 1.y
+            let d165 = A::mul_add(-c_q_w, d160, s_q_w * d154); // F(M col 7r) at 1.z
+            let d429 = A::mul_add(-p.L4, d427, d425); // N(M col 7l) at 2.y
+            let d430 = A::mul_add(
+                p.L4,
+                d422,
+                A::mul_add(p.L3, d428, A::mul_add(s_q_torso, d426, c_q_torso * d424)),
+            ); // N(M col 7l) at 2.x
+            out.set(3, 8, l, d430);
+            let d431 = A::mul_add(
+                -p.L3,
+                d427,
+                A::mul_add(-c_q_torso, d426, s_q_torso * d424),
+            ); // N(M col 7l) at 2.z
+            let d163 = A::mul_add(
+                -p.L3,
+                d159,
+                A::mul_add(-c_q_torso, d157, s_q_torso * d158),
+            ); // N(M col 7r) at 2.z
+            let d432 = A::mul_add(-s_q_w, d428, c_q_w * d422); // F(M col 7l) at 1.y
+            let d433 = A::mul_add(c_q_w, d428, s_q_w * d422); // F(M col 7l) at 1.z
+            let d434 = A::mul_add(p.L2, d427, A::mul_add(-s_q_w, d431, c_q_w * d429)); // N(M col 7l) at 1.y
+            let d167 = A::mul_add(p.L2, d159, A::mul_add(-s_q_w, d163, c_q_w * d162)); // N(M col 7r) at 1.y
+            let d435 = A::mul_add(-p.L2, d432, A::mul_add(p.L1, d433, d430)); // N(M col 7l) at 1.x
+            out.set(2, 8, l, d435);
+            let d166 = A::mul_add(-p.L2, d164, A::mul_add(p.L1, d165, d161)); // N(M col 7r) at 1.x
+            out.set(2, 15, l, d166);
+            let d436 = A::mul_add(-p.L1, d427, A::mul_add(c_q_w, d431, s_q_w * d429)); // N(M col 7l) at 1.z
+            let d168 = A::mul_add(-p.L1, d159, A::mul_add(c_q_w, d163, s_q_w * d162)); // N(M col 7r) at 1.z
+            let d437 = A::mul_add(c_q_imu, d433, s_q_imu * d432); // F(M col 7l) at 0.x
+            out.set(0, 8, l, d437);
+            let d169 = A::mul_add(c_q_imu, d165, s_q_imu * d164); // F(M col 7r) at 0.x
+            out.set(0, 15, l, d169);
+            let d438 = A::mul_add(-s_q_imu, d436, c_q_imu * d434); // N(M col 7l) at 0.z
+            out.set(1, 8, l, d438);
+            let d170 = A::mul_add(-s_q_imu, d168, c_q_imu * d167); // N(M col 7r) at 0.z
+            out.set(1, 15, l, -d170);
+            let d439 = p.MX6l - d399; // MSC6l.x
+            let d171 = p.MX6r - d131; // MSC6r.x
+            let d440 = p.MY6l - d410; // MSC6l.y
+            let d172 = p.MY6r - d142; // MSC6r.y
+            let d441 = p.MZ6l - d411; // MSC6l.z
+            let d173 = p.MZ6r - d143; // MSC6r.z
+            let k31 = s_q4l * s_q4l; // sin² q4l
+            let k10 = s_q4r * s_q4r; // sin² q4r
+            let k32 = s_q4l * c_q4l; // sin q4l cos q4l
+            let k11 = s_q4r * c_q4r; // sin q4r cos q4r
+            let k33 = A::mul_add(2.0, k31, -1.0); // cos 2q4l
+            let k12 = A::mul_add(2.0, k10, -1.0); // cos 2q4r
+            let d442 = d405 - d409; // JC7l: Jyy − Jzz
+            let d174 = d137 - d141; // JC7r: Jyy − Jzz
+            let d443 = A::mul_add(-2.0, d406 * k32, k31 * d442); // JC7l rotated about x: Jyy − J'yy
+            let d175 = A::mul_add(-2.0, d138 * k11, k10 * d174); // JC7r rotated about x: Jyy − J'yy
+            let d444 = p.XX6l + d408; // JC6l.xx
+            let d176 = p.XX6r + d140; // JC6r.xx
+            let d445 = p.XY6l + t58 + t59; // JC6l.xy
+            let d177 = p.XY6r + t18 + t19; // JC6r.xy
+            let d446 = p.XZ6l + t60 - t61; // JC6l.xz
+            let d178 = p.XZ6r + t20 - t21; // JC6r.xz
+            let d447 = p.YY6l + d405 - d443; // JC6l.yy
+            out.set(7, 7, l, d447);
+            let d179 = p.YY6r + d137 - d175; // JC6r.yy
+            out.set(14, 14, l, d179);
+            let d448 = A::mul_add(k32, d442, A::mul_add(d406, k33, p.YZ6l)); // JC6l.yz
+            let d180 = A::mul_add(k11, d174, A::mul_add(d138, k12, p.YZ6r)); // JC6r.yz
+            let d449 = p.ZZ6l + d409 + d443; // JC6l.zz
+            let d181 = p.ZZ6r + d141 + d175; // JC6r.zz
+            let d450 = A::mul_add(c_q3l, d441, s_q3l * d439); // MSC6l in 5l.z
+            let d182 = A::mul_add(c_q3r, d173, s_q3r * d171); // MSC6r in 5r.z
+            let d451 = A::mul_add(-s_q3l, d441, c_q3l * d439); // MSC6l in 5l.x
+            let d183 = A::mul_add(-s_q3r, d173, c_q3r * d171); // MSC6r in 5r.x
+            let t62 = c_q3l * d445; // common subexpression
+            let t22 = c_q3r * d177; // common subexpression
+            let t63 = s_q3l * d448; // common subexpression
+            let t23 = s_q3r * d180; // common subexpression
+            let t64 = s_q3l * d445; // common subexpression
+            let t24 = s_q3r * d177; // common subexpression
+            let t65 = c_q3l * d448; // common subexpression
+            let t25 = c_q3r * d180; // common subexpression
+            let t66 = p.L7 * d451; // common subexpression
+            let t26 = p.L7 * d183; // common subexpression
+            let t67 = p.L7 * d450; // common subexpression
+            let t27 = p.L7 * d182; // common subexpression
+            let d452 = t62 - t63 - t66; // N(M col 6l) at 5l.x
+            out.set(6, 7, l, -d452);
+            let d184 = t22 - t23 - t26; // N(M col 6r) at 5r.x
+            out.set(13, 14, l, -d184);
+            let d453 = t64 + t65 - t67; // N(M col 6l) at 5l.z
+            let d185 = t24 + t25 - t27; // N(M col 6r) at 5r.z
+            let d454 = s_q2l * d451; // F(M col 6l) at 4l.y
+            let d186 = s_q2r * d183; // F(M col 6r) at 4r.y
+            let d455 = c_q2l * d451; // F(M col 6l) at 4l.z
+            let d187 = c_q2r * d183; // F(M col 6r) at 4r.z
+            let d456 = A::mul_add(-s_q2l, d453, c_q2l * d447); // N(M col 6l) at 4l.y
+            out.set(5, 7, l, d456);
+            let d188 = A::mul_add(-s_q2r, d185, c_q2r * d179); // N(M col 6r) at 4r.y
+            out.set(12, 14, l, d188);
+            let d457 = A::mul_add(c_q2l, d453, s_q2l * d447); // N(M col 6l) at 4l.z
+            let d189 = A::mul_add(c_q2r, d185, s_q2r * d179); // N(M col 6r) at 4r.z
+            let d458 = A::mul_add(-c_q1l, d455, s_q1l * d450); // F(M col 6l) at 3.z
+            let d191 = A::mul_add(-c_q1r, d187, s_q1r * d182); // F(M col 6r) at 3.z
+            let d459 = A::mul_add(s_q1l, d455, c_q1l * d450); // F(M col 6l) at 3.y
+            let d190 = A::mul_add(s_q1r, d187, c_q1r * d182); // F(M col 6r) at 3.y
+            let d460 = A::mul_add(
+                p.L5,
+                d454,
+                A::mul_add(-p.L6, d459, A::mul_add(c_q1l, d457, s_q1l * d452)),
+            ); // N(M col 6l) at 3.z
+            let d194 = A::mul_add(
+                p.L5,
+                d186,
+                A::mul_add(-p.L6, d190, A::mul_add(c_q1r, d189, s_q1r * d184)),
+            ); // N(M col 6r) at 3.z
+            let d461 = A::mul_add(-p.L5, d458, d456); // N(M col 6l) at 3.x
+            let d192 = A::mul_add(-p.L5, d191, d188); // N(M col 6r) at 3.x
+            let d462 = A::mul_add(p.L6, d458, A::mul_add(-s_q1l, d457, c_q1l * d452)); // N(M col 6l) at 3.y
+            out.set(4, 7, l, d462);
+            let d193 = A::mul_add(p.L6, d191, A::mul_add(-s_q1r, d189, c_q1r * d184)); // N(M col 6r) at 3.y
+            out.set(4, 14, l, d193);
+            let d463 = A::mul_add(s_q_torso, d458, c_q_torso * d454); // F(M col 6l) at 2.x
+            let d195 = A::mul_add(s_q_torso, d191, c_q_torso * d186); // F(M col 6r) at 2.x
+            let d198 = A::mul_add(-p.L4, d195, -d193); // N(M col 6r) at 2.y
+            let d464 = A::mul_add(-c_q_torso, d458, s_q_torso * d454); // F(M col 6l) at 2.z
+            let d196 = A::mul_add(-c_q_torso, d191, s_q_torso * d186); // F(M col 6r) at 2.z
+            let d197 = A::mul_add(
+                -p.L3,
+                d196,
+                A::mul_add(-s_q_torso, d194, A::mul_add(-c_q_torso, d192, p.L4 * d190)),
+            ); // N(M col 6r) at 2.x
+            out.set(3, 14, l, -d197);
+            let d200 = A::mul_add(-c_q_w, d196, s_q_w * d190); // F(M col 6r) at 1.z
+            let d201 = A::mul_add(s_q_w, d196, c_q_w * d190); // F(M col 6r) at 1.y
+            let d465 = A::mul_add(
+                p.L4,
+                d459,
+                A::mul_add(p.L3, d464, A::mul_add(s_q_torso, d460, c_q_torso * d461)),
+            ); // N(M col 6l) at 2.x
+            out.set(3, 7, l, -d465);
+            let d466 = A::mul_add(
+                -p.L3,
+                d463,
+                A::mul_add(-c_q_torso, d460, s_q_torso * d461),
+            ); // N(M col 6l) at 2.z
+            let d199 = A::mul_add(
+                -p.L3,
+                d195,
+                A::mul_add(-c_q_torso, d194, s_q_torso * d192),
+            ); // N(M col 6r) at 2.z
+            let d467 = A::mul_add(-p.L4, d463, d462); // N(M col 6l) at 2.y
+            let d468 = A::mul_add(c_q_w, d464, s_q_w * d459); // F(M col 6l) at 1.z
+            let d469 = A::mul_add(-s_q_w, d464, c_q_w * d459); // F(M col 6l) at 1.y
+            let d470 = A::mul_add(-p.L2, d469, A::mul_add(p.L1, d468, d465)); // N(M col 6l) at 1.x
+            out.set(2, 7, l, -d470);
+            let d203 = A::mul_add(-p.L2, d201, A::mul_add(p.L1, d200, d197)); // N(M col 6r) at 1.x
+            out.set(2, 14, l, -d203);
+            let d471 = A::mul_add(-p.L1, d463, A::mul_add(c_q_w, d466, s_q_w * d467)); // N(M col 6l) at 1.z
+            let d202 = A::mul_add(-p.L1, d195, A::mul_add(c_q_w, d199, s_q_w * d198)); // N(M col 6r) at 1.z
+            let d472 = A::mul_add(p.L2, d463, A::mul_add(-s_q_w, d466, c_q_w * d467)); // N(M col 6l) at 1.y
+            let d204 = A::mul_add(p.L2, d195, A::mul_add(-s_q_w, d199, c_q_w * d198)); // N(M col 6r) at 1.y
+            let d473 = A::mul_add(c_q_imu, d468, s_q_imu * d469); // F(M col 6l) at 0.x
+            out.set(0, 7, l, -d473);
+            let d205 = A::mul_add(c_q_imu, d200, s_q_imu * d201); // F(M col 6r) at 0.x
+            out.set(0, 14, l, -d205);
+            let d474 = A::mul_add(-s_q_imu, d471, c_q_imu * d472); // N(M col 6l) at 0.z
+            out.set(1, 7, l, -d474);
+            let d206 = A::mul_add(-s_q_imu, d202, c_q_imu * d204); // N(M col 6r) at 0.z
+            out.set(1, 14, l, d206);
+            let d475 = p.MX5l - d451; // MSC5l.x
+            let d207 = p.MX5r - d183; // MSC5r.x
+            let d476 = p.MZ5l + d450; // MSC5l.z
+            let d208 = p.MZ5r + d182; // MSC5r.z
+            let k34 = s_q3l * s_q3l; // sin² q3l
+            let k13 = s_q3r * s_q3r; // sin² q3r
+            let k35 = s_q3l * c_q3l; // sin q3l cos q3l
+            let k14 = s_q3r * c_q3r; // sin q3r cos q3r
+            let k36 = A::mul_add(2.0, k34, -1.0); // cos 2q3l
+            let k15 = A::mul_add(2.0, k13, -1.0); // cos 2q3r
+            let d477 = d444 - d449; // JC6l: Jzz − Jxx
+            let d209 = d176 - d181; // JC6r: Jzz − Jxx
+            let d478 = A::mul_add(2.0, d446 * k35, k34 * d477); // JC6l rotated about y: Jzz − J'zz
+            let d210 = A::mul_add(2.0, d178 * k14, k13 * d209); // JC6r rotated about y: Jzz − J'zz
+            let t68 = p.L7 * d440; // common subexpression
+            let t28 = p.L7 * d172; // common subexpression
+            let d479 = p.XY5l + t62 - t63 - t66; // JC5l.xy
+            let d211 = p.XY5r + t22 - t23 - t26; // JC5r.xy
+            let d480 = A::mul_add(-k35, d477, A::mul_add(d446, k36, p.XZ5l)); // JC5l.xz
+            let d212 = A::mul_add(-k14, d209, A::mul_add(d178, k15, p.XZ5r)); // JC5r.xz
+            let d481 = p.YY5l + d447; // JC5l.yy
+            let d213 = p.YY5r + d179; // JC5r.yy
+            let d482 = p.YZ5l - t64 - t65 + t67; // JC5l.yz
+            let d214 = p.YZ5r - t24 - t25 + t27; // JC5r.yz
+            let d483 = pc.pc42 - d440; // MSC5l.y
+            let d215 = pc.pc19 - d172; // MSC5r.y
+            let d484 = A::mul_add(2.0, t68, d444 - d478) + pc.pc43; // JC5l.xx
+            out.set(6, 6, l, d484);
+            let d216 = A::mul_add(2.0, t28, d176 - d210) + pc.pc20; // JC5r.xx
+            out.set(13, 13, l, d216);
+            let d485 = A::mul_add(2.0, t68, d449 + d478) + pc.pc44; // JC5l.zz
+            let d217 = A::mul_add(2.0, t28, d181 + d210) + pc.pc21; // JC5r.zz
+            let d486 = A::mul_add(s_q2l, d476, c_q2l * d483); // MSC5l in 4l.y
+            let d218 = A::mul_add(s_q2r, d208, c_q2r * d215); // MSC5r in 4r.y
+            let d487 = A::mul_add(-c_q2l, d476, s_q2l * d483); // MSC5l in 4l.z
+            let d219 = A::mul_add(-c_q2r, d208, s_q2r * d215); // MSC5r in 4r.z
+            let t69 = c_q2l * d479; // common subexpression
+            let t29 = c_q2r * d211; // common subexpression
+            let t70 = s_q2l * d480; // common subexpression
+            let t30 = s_q2r * d212; // common subexpression
+            let d488 = t69 + t70; // N(M col 5l) at 4l.y
+            out.set(5, 6, l, -d488);
+            let d220 = t29 + t30; // N(M col 5r) at 4r.y
+            out.set(12, 13, l, -d220);
+            let t71 = s_q2l * d479; // common subexpression
+            let t31 = s_q2r * d211; // common subexpression
+            let t72 = c_q2l * d480; // common subexpression
+            let t32 = c_q2r * d212; // common subexpression
+            let d489 = t71 - t72; // N(M col 5l) at 4l.z
+            let d221 = t31 - t32; // N(M col 5r) at 4r.z
+            let d490 = s_q1l * d486; // F(M col 5l) at 3.y
+            let d222 = s_q1r * d218; // F(M col 5r) at 3.y
+            let d491 = c_q1l * d486; // F(M col 5l) at 3.z
+            let d223 = c_q1r * d218; // F(M col 5r) at 3.z
+            let d492 = A::mul_add(p.L5, d491, d488); // N(M col 5l) at 3.x
+            let d226 = A::mul_add(p.L5, d223, d220); // N(M col 5r) at 3.x
+            let d493 = A::mul_add(-p.L6, d491, A::mul_add(-s_q1l, d489, c_q1l * d484)); // N(M col 5l) at 3.y
+            out.set(4, 6, l, -d493);
+            let d224 = A::mul_add(-p.L6, d223, A::mul_add(-s_q1r, d221, c_q1r * d216)); // N(M col 5r) at 3.y
+            out.set(4, 13, l, -d224);
+            let d494 = A::mul_add(
+                p.L5,
+                d487,
+                A::mul_add(-p.L6, d490, A::mul_add(c_q1l, d489, s_q1l * d484)),
+            ); // N(M col 5l) at 3.z
+            let d225 = A::mul_add(
+                p.L5,
+                d219,
+                A::mul_add(-p.L6, d222, A::mul_add(c_q1r, d221, s_q1r * d216)),
+            ); // N(M col 5r) at 3.z
+            let d495 = A::mul_add(-s_q_torso, d491, c_q_torso * d487); // F(M col 5l) at 2.x
+            let d227 = A::mul_add(-s_q_torso, d223, c_q_torso * d219); // F(M col 5r) at 2.x
+            let d230 = A::mul_add(-p.L4, d227, -d224); // N(M col 5r) at 2.y
+            let d496 = A::mul_add(c_q_torso, d491, s_q_torso * d487); // F(M col 5l) at 2.z
+            let d228 = A::mul_add(c_q_torso, d223, s_q_torso * d219); // F(M col 5r) at 2.z
+            let d229 = A::mul_add(
+                -p.L3,
+                d228,
+                A::mul_add(-s_q_torso, d225, A::mul_add(-c_q_torso, d226, p.L4 * d222)),
+            ); // N(M col 5r) at 2.x
+            out.set(3, 13, l, d229);
+            let d232 = A::mul_add(s_q_w, d228, c_q_w * d222); // F(M col 5r) at 1.y
+            let d233 = A::mul_add(-c_q_w, d228, s_q_w * d222); // F(M col 5r) at 1.z
+            let d497 = A::mul_add(-p.L4, d495, d493); // N(M col 5l) at 2.y
+            let d498 = A::mul_add(
+                p.L4,
+                d490,
+                A::mul_add(p.L3, d496, A::mul_add(s_q_torso, d494, c_q_torso * d492)),
+            ); // N(M col 5l) at 2.x
+            out.set(3, 6, l, d498);
+            let d499 = A::mul_add(
+                -p.L3,
+                d495,
+                A::mul_add(-c_q_torso, d494, s_q_torso * d492),
+            ); // N(M col 5l) at 2.z
+            let d231 = A::mul_add(
+                -p.L3,
+                d227,
+                A::mul_add(-c_q_torso, d225, s_q_torso * d226),
+            ); // N(M col 5r) at 2.z
+            let d500 = A::mul_add(-s_q_w, d496, c_q_w * d490); // F(M col 5l) at 1.y
+            let d501 = A::mul_add(c_q_w, d496, s_q_w * d490); // F(M col 5l) at 1.z
+            let d502 = A::mul_add(p.L2, d495, A::mul_add(-s_q_w, d499, c_q_w * d497)); // N(M col 5l) at 1.y
+            let d235 = A::mul_add(p.L2, d227, A::mul_add(-s_q_w, d231, c_q_w * d230)); // N(M col 5r) at 1.y
+            let d503 = A::mul_add(-p.L2, d500, A::mul_add(p.L1, d501, d498)); // N(M col 5l) at 1.x
+            out.set(2, 6, l, d503);
+            let d234 = A::mul_add(-p.L2, d232, A::mul_add(p.L1, d233, d229)); // N(M col 5r) at 1.x
+            out.set(2, 13, l, d234);
+            let d504 = A::mul_add(-p.L1, d495, A::mul_add(c_q_w, d499, s_q_w * d497)); // N(M col 5l) at 1.z
+            let d236 = A::mul_add(-p.L1, d227, A::mul_add(c_q_w, d231, s_q_w * d230)); // N(M col 5r) at 1.z
+            let d505 = A::mul_add(c_q_imu, d501, s_q_imu * d500); // F(M col 5l) at 0.x
+            out.set(0, 6, l, d505);
+            let d237 = A::mul_add(c_q_imu, d233, s_q_imu * d232); // F(M col 5r) at 0.x
+            out.set(0, 13, l, d237);
+            let d506 = A::mul_add(-s_q_imu, d504, c_q_imu * d502); // N(M col 5l) at 0.z
+            out.set(1, 6, l, d506);
+            let d238 = A::mul_add(-s_q_imu, d236, c_q_imu * d235); // N(M col 5r) at 0.z
+            out.set(1, 13, l, -d238);
+            let d507 = p.MX4l - d475; // MSC4l.x
+            let d239 = p.MX4r - d207; // MSC4r.x
+            let d508 = p.MY4l - d486; // MSC4l.y
+            let d240 = p.MY4r - d218; // MSC4r.y
+            let d509 = p.MZ4l - d487; // MSC4l.z
+            let d241 = p.MZ4r - d219; // MSC4r.z
+            let k37 = s_q2l * s_q2l; // sin² q2l
+            let k16 = s_q2r * s_q2r; // sin² q2r
+            let k38 = s_q2l * c_q2l; // sin q2l cos q2l
+            let k17 = s_q2r * c_q2r; // sin q2r cos q2r
+            let k39 = A::mul_add(2.0, k37, -1.0); // cos 2q2l
+            let k18 = A::mul_add(2.0, k16, -1.0); // cos 2q2r
+            let d510 = d481 - d485; // JC5l: Jyy − Jzz
+            let d242 = d213 - d217; // JC5r: Jyy − Jzz
+            let d511 = A::mul_add(-2.0, d482 * k38, k37 * d510); // JC5l rotated about x: Jyy − J'yy
+            let d243 = A::mul_add(-2.0, d214 * k17, k16 * d242); // JC5r rotated about x: Jyy − J'yy
+            let d512 = p.XX4l + d484; // JC4l.xx
+            let d244 = p.XX4r + d216; // JC4r.xx
+            let d513 = p.XY4l + t69 + t70; // JC4l.xy
+            let d245 = p.XY4r + t29 + t30; // JC4r.xy
+            let d514 = p.XZ4l + t71 - t72; // JC4l.xz
+            let d246 = p.XZ4r + t31 - t32; // JC4r.xz
+            let d515 = p.YY4l + d481 - d511; // JC4l.yy
+            out.set(5, 5, l, d515);
+            let d247 = p.YY4r + d213 - d243; // JC4r.yy
+            out.set(12, 12, l, d247);
+            let d516 = A::mul_add(k38, d510, A::mul_add(d482, k39, p.YZ4l)); // JC4l.yz
+            let d248 = A::mul_add(k17, d242, A::mul_add(d214, k18, p.YZ4r)); // JC4r.yz
+            let d517 = p.ZZ4l + d485 + d511; // JC4l.zz
+            let d249 = p.ZZ4r + d217 + d243; // JC4r.zz
+            let d518 = A::mul_add(-s_q1l, d509, c_q1l * d507); // MSC4l in 3.y
+            let d250 = A::mul_add(-s_q1r, d241, c_q1r * d239); // MSC4r in 3.y
+            let d519 = A::mul_add(c_q1l, d509, s_q1l * d507); // MSC4l in 3.z
+            let d251 = A::mul_add(c_q1r, d241, s_q1r * d239); // MSC4r in 3.z
+            let t73 = c_q1l * d513; // common subexpression
+            let t33 = c_q1r * d245; // common subexpression
+            let t74 = s_q1l * d516; // common subexpression
+            let t34 = s_q1r * d248; // common subexpression
+            let t75 = s_q1l * d513; // common subexpression
+            let t35 = s_q1r * d245; // common subexpression
+            let t76 = c_q1l * d516; // common subexpression
+            let t36 = c_q1r * d248; // common subexpression
+            let t77 = p.L5 * d518; // common subexpression
+            let t37 = p.L5 * d250; // common subexpression
+            let t78 = p.L6 * d518; // common subexpression
+            let t38 = p.L6 * d250; // common subexpression
+            let t79 = p.L6 * d519; // common subexpression
+            let t39 = p.L6 * d251; // common subexpression
+            let d520 = t75 + t76 - t79; // N(M col 4l) at 3.z
+            let d254 = t35 + t36 - t39; // N(M col 4r) at 3.z
+            let d521 = d515 + t77; // N(M col 4l) at 3.x
+            let d252 = d247 + t37; // N(M col 4r) at 3.x
+            let d522 = t73 - t74 - t78; // N(M col 4l) at 3.y
+            out.set(4, 5, l, d522);
+            let d253 = t33 - t34 - t38; // N(M col 4r) at 3.y
+            out.set(4, 12, l, d253);
+            let d523 = s_q_torso * d518; // F(M col 4l) at 2.x
+            let d255 = s_q_torso * d250; // F(M col 4r) at 2.x
+            let d258 = A::mul_add(p.L4, d255, -d253); // N(M col 4r) at 2.y
+            let d524 = c_q_torso * d518; // F(M col 4l) at 2.z
+            let d256 = c_q_torso * d250; // F(M col 4r) at 2.z
+            let d257 = A::mul_add(
+                -p.L3,
+                d256,
+                A::mul_add(-s_q_torso, d254, A::mul_add(-c_q_torso, d252, p.L4 * d251)),
+            ); // N(M col 4r) at 2.x
+            out.set(3, 12, l, -d257);
+            let d260 = A::mul_add(-c_q_w, d256, s_q_w * d251); // F(M col 4r) at 1.z
+            let d261 = A::mul_add(s_q_w, d256, c_q_w * d251); // F(M col 4r) at 1.y
+            let d525 = A::mul_add(
+                p.L4,
+                d519,
+                A::mul_add(p.L3, d524, A::mul_add(s_q_torso, d520, c_q_torso * d521)),
+            ); // N(M col 4l) at 2.x
+            out.set(3, 5, l, -d525);
+            let d526 = A::mul_add(
+                p.L3,
+                d523,
+                A::mul_add(-c_q_torso, d520, s_q_torso * d521),
+            ); // N(M col 4l) at 2.z
+            let d259 = A::mul_add(
+                p.L3,
+                d255,
+                A::mul_add(-c_q_torso, d254, s_q_torso * d252),
+            ); // N(M col 4r) at 2.z
+            let d527 = A::mul_add(p.L4, d523, d522); // N(M col 4l) at 2.y
+            let d528 = A::mul_add(c_q_w, d524, s_q_w * d519); // F(M col 4l) at 1.z
+            let d529 = A::mul_add(-s_q_w, d524, c_q_w * d519); // F(M col 4l) at 1.y
+            let d530 = A::mul_add(-p.L2, d529, A::mul_add(p.L1, d528, d525)); // N(M col 4l) at 1.x
+            out.set(2, 5, l, -d530);
+            let d263 = A::mul_add(-p.L2, d261, A::mul_add(p.L1, d260, d257)); // N(M col 4r) at 1.x
+            out.set(2, 12, l, -d263);
+            let d531 = A::mul_add(p.L1, d523, A::mul_add(c_q_w, d526, s_q_w * d527)); // N(M col 4l) at 1.z
+            let d262 = A::mul_add(p.L1, d255, A::mul_add(c_q_w, d259, s_q_w * d258)); // N(M col 4r) at 1.z
+            let d532 = A::mul_add(-p.L2, d523, A::mul_add(-s_q_w, d526, c_q_w * d527)); // N(M col 4l) at 1.y
+            let d264 = A::mul_add(-p.L2, d255, A::mul_add(-s_q_w, d259, c_q_w * d258)); // N(M col 4r) at 1.y
+            let d533 = A::mul_add(c_q_imu, d528, s_q_imu * d529); // F(M col 4l) at 0.x
+            out.set(0, 5, l, -d533);
+            let d265 = A::mul_add(c_q_imu, d260, s_q_imu * d261); // F(M col 4r) at 0.x
+            out.set(0, 12, l, -d265);
+            let d534 = A::mul_add(-s_q_imu, d531, c_q_imu * d532); // N(M col 4l) at 0.z
+            out.set(1, 5, l, -d534);
+            let d266 = A::mul_add(-s_q_imu, d262, c_q_imu * d264); // N(M col 4r) at 0.z
+            out.set(1, 12, l, d266);
+            let d535 = p.MZ3 + d251 - d519; // MSC3.z
+            let k40 = s_q1l * s_q1l; // sin² q1l
+            let k19 = s_q1r * s_q1r; // sin² q1r
+            let k41 = s_q1l * c_q1l; // sin q1l cos q1l
+            let k20 = s_q1r * c_q1r; // sin q1r cos q1r
+            let k42 = A::mul_add(2.0, k40, -1.0); // cos 2q1l
+            let k21 = A::mul_add(2.0, k19, -1.0); // cos 2q1r
+            let d536 = d512 - d517; // JC4l: Jzz − Jxx
+            let d267 = d244 - d249; // JC4r: Jzz − Jxx
+            let d537 = A::mul_add(2.0, d514 * k41, k40 * d536); // JC4l rotated about y: Jzz − J'zz
+            let d268 = A::mul_add(2.0, d246 * k20, k19 * d267); // JC4r rotated about y: Jzz − J'zz
+            let t80 = p.L6 * d508; // common subexpression
+            let t40 = p.L6 * d240; // common subexpression
+            let d538 = p.XZ3 - t35 - t36 + t39 - t75 - t76 + t79; // JC3.xz
+            let d539 = A::mul_add(
+                p.L5,
+                d519,
+                A::mul_add(
+                    -k41,
+                    d536,
+                    A::mul_add(
+                        d514,
+                        k42,
+                        A::mul_add(
+                            -p.L5,
+                            d251,
+                            A::mul_add(k20, d267, A::mul_add(-d246, k21, p.YZ3)),
+                        ),
+                    ),
+                ),
+            ); // JC3.yz
+            let d540 = d508 - d240 + pc.pc47; // MSC3.x
+            let d541 = d250 + d518 + pc.pc48; // MSC3.y
+            let d542 = A::mul_add(2.0, t77, A::mul_add(2.0, t37, d247) + d515) + pc.pc49; // JC3.xx
+            let d543 = A::mul_add(
+                -p.L5,
+                d508,
+                A::mul_add(p.L5, d240, t34 - t33 + t38) + t73 - t74 - t78,
+            ) + pc.pc50; // JC3.xy
+            let d544 = A::mul_add(
+                2.0,
+                t80,
+                A::mul_add(2.0, t40, d244 - d268) + d512 - d537,
+            ) + pc.pc51; // JC3.yy
+            out.set(4, 4, l, d544);
+            let d545 = A::mul_add(
+                2.0,
+                t80,
+                A::mul_add(
+                    2.0,
+                    t77,
+                    A::mul_add(2.0, t40, A::mul_add(2.0, t37, d249) + d268) + d517,
+                ) + d537,
+            ) + pc.pc52; // JC3.zz
+            let d546 = A::mul_add(-s_q_torso, d535, c_q_torso * d540); // MSC3 in 2.x
+            let d547 = A::mul_add(c_q_torso, d535, s_q_torso * d540); // MSC3 in 2.z
+            let t81 = c_q_torso * d543; // common subexpression
+            let t82 = s_q_torso * d539; // common subexpression
+            let t83 = s_q_torso * d543; // common subexpression
+            let t84 = c_q_torso * d539; // common subexpression
+            let t85 = p.L3 * d546; // common subexpression
+            let t86 = p.L4 * d547; // common subexpression
+            let t87 = p.L3 * d547; // common subexpression
+            let d548 = t81 - t82 - t85; // N(M col 3) at 2.x
+            out.set(3, 4, l, -d548);
+            let d549 = t83 + t84 - t87; // N(M col 3) at 2.z
+            let d550 = d544 - t86; // N(M col 3) at 2.y
+            let d551 = s_q_w * d546; // F(M col 3) at 1.y
+            let d552 = c_q_w * d546; // F(M col 3) at 1.z
+            let d553 = A::mul_add(-p.L2, d551, A::mul_add(-p.L1, d552, d548)); // N(M col 3) at 1.x
+            out.set(2, 4, l, -d553);
+            let d554 = A::mul_add(-p.L1, d547, A::mul_add(c_q_w, d549, s_q_w * d550)); // N(M col 3) at 1.z
+            let d555 = A::mul_add(p.L2, d547, A::mul_add(-s_q_w, d549, c_q_w * d550)); // N(M col 3) at 1.y
+            let d556 = A::mul_add(-c_q_imu, d552, s_q_imu * d551); // F(M col 3) at 0.x
+            out.set(0, 4, l, -d556);
+            let d557 = A::mul_add(-s_q_imu, d554, c_q_imu * d555); // N(M col 3) at 0.z
+            out.set(1, 4, l, -d557);
+            let d558 = p.MX2 - d546; // MSC2.x
+            let k43 = s_q_torso * s_q_torso; // sin² q_torso
+            let k44 = s_q_torso * c_q_torso; // sin q_torso cos q_torso
+            let k45 = A::mul_add(2.0, k43, -1.0); // cos 2q_torso
+            let d559 = d542 - d545; // JC3: Jzz − Jxx
+            let d560 = A::mul_add(2.0, d538 * k44, k43 * d559); // JC3 rotated about y: Jzz − J'zz
+            let t88 = p.L3 * d541; // common subexpression
+            let d561 = p.XY2 - t81 + t82 + t85; // JC2.xy
+            let d562 = A::mul_add(
+                p.L4,
+                d546,
+                A::mul_add(k44, d559, A::mul_add(-d538, k45, p.XZ2)),
+            ); // JC2.xz
+            let d563 = d541 + pc.pc54; // MSC2.y
+            let d564 = pc.pc55 - d547; // MSC2.z
+            let d565 = A::mul_add(2.0, t88, A::mul_add(-2.0, t86, d542) - d560)
+                + pc.pc56; // JC2.xx
+            out.set(3, 3, l, d565);
+            let d566 = A::mul_add(-2.0, t86, d544) + pc.pc57; // JC2.yy
+            let d567 = A::mul_add(-p.L4, d541, t87 - t83 - t84) + pc.pc58; // JC2.yz
+            let d568 = A::mul_add(2.0, t88, d545 + d560) + pc.pc59; // JC2.zz
+            let d569 = A::mul_add(s_q_w, d564, c_q_w * d563); // MSC2 in 1.y
+            let d570 = A::mul_add(-c_q_w, d564, s_q_w * d563); // MSC2 in 1.z
+            let t89 = c_q_w * d561; // common subexpression
+            let t90 = s_q_w * d562; // common subexpression
+            let t91 = s_q_w * d561; // common subexpression
+            let t92 = c_q_w * d562; // common subexpression
+            let d571 = t91 - t92; // N(M col 2) at 1.z
+            let t93 = p.L1 * d569; // common subexpression
+            let t94 = p.L2 * d570; // common subexpression
+            let d572 = d565 + t93 + t94; // N(M col 2) at 1.x
+            out.set(2, 3, l, d572);
+            let d573 = t89 + t90; // N(M col 2) at 1.y
+            let d574 = A::mul_add(-c_q_imu, d569, s_q_imu * d570); // F(M col 2) at 0.x
+            out.set(0, 3, l, -d574);
+            let d575 = A::mul_add(-s_q_imu, d571, c_q_imu * d573); // N(M col 2) at 0.z
+            out.set(1, 3, l, -d575);
+            let d576 = p.MX1 + d558; // MSC1.x
+            out.set(0, 1, l, d576);
+            let k46 = s_q_w * s_q_w; // sin² q_w
+            let k47 = s_q_w * c_q_w; // sin q_w cos q_w
+            let k48 = A::mul_add(2.0, k46, -1.0); // cos 2q_w
+            let d577 = d566 - d568; // JC2: Jyy − Jzz
+            let d578 = A::mul_add(-2.0, d567 * k47, k46 * d577); // JC2 rotated about x: Jyy − J'yy
+            let d579 = A::mul_add(-p.L1, d558, p.XY1 + t89 + t90); // JC1.xy
+            let d580 = A::mul_add(p.L2, d558, p.XZ1 - t91 + t92); // JC1.xz
+            let d581 = d569 + pc.pc61; // MSC1.y
+            let d582 = pc.pc62 - d570; // MSC1.z
+            let d583 = A::mul_add(2.0, t94, A::mul_add(2.0, t93, d565)) + pc.pc63; // JC1.xx
+            out.set(2, 2, l, d583);
+            let d584 = A::mul_add(2.0, t94, d566) - d578 + pc.pc64; // JC1.yy
+            let d585 = A::mul_add(
+                p.L1,
+                d570,
+                A::mul_add(-k47, d577, A::mul_add(-d567, k48, p.L2 * d569)),
+            ) + pc.pc65; // JC1.yz
+            let d586 = A::mul_add(2.0, t93, d568) + d578 + pc.pc66; // JC1.zz
+            let d587 = A::mul_add(s_q_imu, d582, c_q_imu * d581); // MSC1 in 0.z
+            out.set(0, 2, l, d587);
+            let d588 = A::mul_add(s_q_imu, d580, c_q_imu * d579); // N(M col 1) at 0.z
+            out.set(1, 2, l, -d588);
+            let k49 = s_q_imu * s_q_imu; // sin² q_imu
+            let k50 = s_q_imu * c_q_imu; // sin q_imu cos q_imu
+            let d589 = d584 - d586; // JC1: Jyy − Jzz
+            let d590 = A::mul_add(-2.0, d585 * k50, k49 * d589); // JC1 rotated about x: Jyy − J'yy
+            let d591 = d584 - d590; // JC0
+            out.set(1, 1, l, d591 + pc.pc68);
+        }
+    }
     /// [`mass_matrix`] at `L` states per call, into `out`: entry `l` of `out` becomes `mass_matrix` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
     #[inline(never)]
     pub fn mass_matrix_batch_into<const L: usize>(
@@ -9312,1366 +10463,8 @@ mod generated {
             q: &[SVector<f64, 19>; L],
             out: &mut [SMatrix<f64, 19, 19>; L],
         ) {
-            let p = &{ *p };
-            let pc = &{ *pc };
             let q = kanegen_runtime::lanes::inputs(q);
-            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
-                A,
-                _,
-                L,
-            >([
-                q[2].0,
-                q[3].0,
-                q[4].0,
-                q[5].0,
-                q[12].0,
-                q[6].0,
-                q[13].0,
-                q[7].0,
-                q[14].0,
-                q[8].0,
-                q[15].0,
-                q[9].0,
-                q[16].0,
-                q[10].0,
-                q[17].0,
-                q[11].0,
-                q[18].0,
-            ]);
-            for (l, m) in out.iter_mut().enumerate() {
-                let s_q_imu = sin_q[0][l];
-                let c_q_imu = cos_q[0][l];
-                let s_q_w = sin_q[1][l];
-                let c_q_w = cos_q[1][l];
-                let s_q_torso = sin_q[2][l];
-                let c_q_torso = cos_q[2][l];
-                let s_q1l = sin_q[3][l];
-                let c_q1l = cos_q[3][l];
-                let s_q1r = sin_q[4][l];
-                let c_q1r = cos_q[4][l];
-                let s_q2l = sin_q[5][l];
-                let c_q2l = cos_q[5][l];
-                let s_q2r = sin_q[6][l];
-                let c_q2r = cos_q[6][l];
-                let s_q3l = sin_q[7][l];
-                let c_q3l = cos_q[7][l];
-                let s_q3r = sin_q[8][l];
-                let c_q3r = cos_q[8][l];
-                let s_q4l = sin_q[9][l];
-                let c_q4l = cos_q[9][l];
-                let s_q4r = sin_q[10][l];
-                let c_q4r = cos_q[10][l];
-                let s_q5l = sin_q[11][l];
-                let c_q5l = cos_q[11][l];
-                let s_q5r = sin_q[12][l];
-                let c_q5r = cos_q[12][l];
-                let s_q6l = sin_q[13][l];
-                let c_q6l = cos_q[13][l];
-                let s_q6r = sin_q[14][l];
-                let c_q6r = cos_q[14][l];
-                let s_q7l = sin_q[15][l];
-                let c_q7l = cos_q[15][l];
-                let s_q7r = sin_q[16][l];
-                let c_q7r = cos_q[16][l];
-                m[(0, 0)] = pc.pc69;
-                m[(11, 11)] = p.ZZ10l;
-                m[(18, 18)] = p.ZZ10r;
-                let d269 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
-                let d1 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
-                let d270 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
-                let d2 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
-                let t41 = p.XZ10l * c_q7l; // common subexpression
-                let t1 = p.XZ10r * c_q7r; // common subexpression
-                let t42 = p.YZ10l * s_q7l; // common subexpression
-                let t2 = p.YZ10r * s_q7r; // common subexpression
-                let t43 = p.XZ10l * s_q7l; // common subexpression
-                let t3 = p.XZ10r * s_q7r; // common subexpression
-                let t44 = p.YZ10l * c_q7l; // common subexpression
-                let t4 = p.YZ10r * c_q7r; // common subexpression
-                let t45 = p.L9 * d270; // common subexpression
-                let t5 = p.L9 * d2; // common subexpression
-                let t46 = p.L9 * d269; // common subexpression
-                let t6 = p.L9 * d1; // common subexpression
-                let d271 = t41 + t42 - t45; // N(M col 10l) at 9l.x
-                m[(10, 11)] = -d271;
-                let d3 = t1 + t2 - t5; // N(M col 10r) at 9r.x
-                m[(17, 18)] = -d3;
-                let d272 = t43 - t44 - t46; // N(M col 10l) at 9l.z
-                let d4 = t3 - t4 - t6; // N(M col 10r) at 9r.z
-                let d273 = d270 * s_q6l; // F(M col 10l) at 8l.y
-                let d5 = d2 * s_q6r; // F(M col 10r) at 8r.y
-                let d274 = d270 * c_q6l; // F(M col 10l) at 8l.z
-                let d6 = d2 * c_q6r; // F(M col 10r) at 8r.z
-                let d275 = A::mul_add(-d272, s_q6l, p.ZZ10l * c_q6l); // N(M col 10l) at 8l.y
-                m[(9, 11)] = d275;
-                let d7 = A::mul_add(-d4, s_q6r, p.ZZ10r * c_q6r); // N(M col 10r) at 8r.y
-                m[(16, 18)] = d7;
-                let d276 = A::mul_add(d272, c_q6l, p.ZZ10l * s_q6l); // N(M col 10l) at 8l.z
-                let d8 = A::mul_add(d4, c_q6r, p.ZZ10r * s_q6r); // N(M col 10r) at 8r.z
-                let d277 = A::mul_add(d274, s_q5l, d269 * c_q5l); // F(M col 10l) at 7l.x
-                let d9 = A::mul_add(d6, s_q5r, d1 * c_q5r); // F(M col 10r) at 7r.x
-                let d278 = A::mul_add(-d274, c_q5l, d269 * s_q5l); // F(M col 10l) at 7l.z
-                let d10 = A::mul_add(-d6, c_q5r, d1 * s_q5r); // F(M col 10r) at 7r.z
-                let d279 = A::mul_add(
-                    p.L8,
-                    d278,
-                    A::mul_add(-d276, s_q5l, d271 * c_q5l),
-                ); // N(M col 10l) at 7l.x
-                m[(8, 11)] = -d279;
-                let d11 = A::mul_add(p.L8, d10, A::mul_add(-d8, s_q5r, d3 * c_q5r)); // N(M col 10r) at 7r.x
-                m[(15, 18)] = -d11;
-                let d280 = A::mul_add(
-                    -p.L8,
-                    d277,
-                    A::mul_add(d276, c_q5l, d271 * s_q5l),
-                ); // N(M col 10l) at 7l.z
-                let d12 = A::mul_add(-p.L8, d9, A::mul_add(d8, c_q5r, d3 * s_q5r)); // N(M col 10r) at 7r.z
-                let d281 = A::mul_add(-d278, s_q4l, d273 * c_q4l); // F(M col 10l) at 6l.y
-                let d13 = A::mul_add(-d10, s_q4r, d5 * c_q4r); // F(M col 10r) at 6r.y
-                let d282 = A::mul_add(d278, c_q4l, d273 * s_q4l); // F(M col 10l) at 6l.z
-                let d14 = A::mul_add(d10, c_q4r, d5 * s_q4r); // F(M col 10r) at 6r.z
-                let d283 = A::mul_add(-d280, s_q4l, d275 * c_q4l); // N(M col 10l) at 6l.y
-                m[(7, 11)] = d283;
-                let d15 = A::mul_add(-d12, s_q4r, d7 * c_q4r); // N(M col 10r) at 6r.y
-                m[(14, 18)] = d15;
-                let d284 = A::mul_add(d280, c_q4l, d275 * s_q4l); // N(M col 10l) at 6l.z
-                let d16 = A::mul_add(d12, c_q4r, d7 * s_q4r); // N(M col 10r) at 6r.z
-                let d285 = A::mul_add(-d282, s_q3l, d277 * c_q3l); // F(M col 10l) at 5l.x
-                let d17 = A::mul_add(-d14, s_q3r, d9 * c_q3r); // F(M col 10r) at 5r.x
-                let d286 = A::mul_add(d282, c_q3l, d277 * s_q3l); // F(M col 10l) at 5l.z
-                let d18 = A::mul_add(d14, c_q3r, d9 * s_q3r); // F(M col 10r) at 5r.z
-                let d287 = A::mul_add(
-                    p.L7,
-                    d286,
-                    A::mul_add(-d284, s_q3l, d279 * c_q3l),
-                ); // N(M col 10l) at 5l.x
-                m[(6, 11)] = -d287;
-                let d19 = A::mul_add(p.L7, d18, A::mul_add(-d16, s_q3r, d11 * c_q3r)); // N(M col 10r) at 5r.x
-                m[(13, 18)] = -d19;
-                let d288 = A::mul_add(
-                    -p.L7,
-                    d285,
-                    A::mul_add(d284, c_q3l, d279 * s_q3l),
-                ); // N(M col 10l) at 5l.z
-                let d20 = A::mul_add(-p.L7, d17, A::mul_add(d16, c_q3r, d11 * s_q3r)); // N(M col 10r) at 5r.z
-                let d289 = A::mul_add(-d286, s_q2l, d281 * c_q2l); // F(M col 10l) at 4l.y
-                let d21 = A::mul_add(-d18, s_q2r, d13 * c_q2r); // F(M col 10r) at 4r.y
-                let d290 = A::mul_add(d286, c_q2l, d281 * s_q2l); // F(M col 10l) at 4l.z
-                let d22 = A::mul_add(d18, c_q2r, d13 * s_q2r); // F(M col 10r) at 4r.z
-                let d291 = A::mul_add(-d288, s_q2l, d283 * c_q2l); // N(M col 10l) at 4l.y
-                m[(5, 11)] = d291;
-                let d23 = A::mul_add(-d20, s_q2r, d15 * c_q2r); // N(M col 10r) at 4r.y
-                m[(12, 18)] = d23;
-                let d292 = A::mul_add(d288, c_q2l, d283 * s_q2l); // N(M col 10l) at 4l.z
-                let d24 = A::mul_add(d20, c_q2r, d15 * s_q2r); // N(M col 10r) at 4r.z
-                let d293 = A::mul_add(d290, c_q1l, d285 * s_q1l); // F(M col 10l) at 3.z
-                let d26 = A::mul_add(d22, c_q1r, d17 * s_q1r); // F(M col 10r) at 3.z
-                let d294 = A::mul_add(-d290, s_q1l, d285 * c_q1l); // F(M col 10l) at 3.y
-                let d25 = A::mul_add(-d22, s_q1r, d17 * c_q1r); // F(M col 10r) at 3.y
-                let d295 = A::mul_add(
-                    p.L5,
-                    d289,
-                    A::mul_add(-p.L6, d294, A::mul_add(d292, c_q1l, d287 * s_q1l)),
-                ); // N(M col 10l) at 3.z
-                let d29 = A::mul_add(
-                    p.L5,
-                    d21,
-                    A::mul_add(-p.L6, d25, A::mul_add(d24, c_q1r, d19 * s_q1r)),
-                ); // N(M col 10r) at 3.z
-                let d296 = A::mul_add(-p.L5, d293, d291); // N(M col 10l) at 3.x
-                let d27 = A::mul_add(-p.L5, d26, d23); // N(M col 10r) at 3.x
-                let d297 = A::mul_add(
-                    p.L6,
-                    d293,
-                    A::mul_add(-d292, s_q1l, d287 * c_q1l),
-                ); // N(M col 10l) at 3.y
-                m[(4, 11)] = d297;
-                let d28 = A::mul_add(p.L6, d26, A::mul_add(-d24, s_q1r, d19 * c_q1r)); // N(M col 10r) at 3.y
-                m[(4, 18)] = d28;
-                let d298 = A::mul_add(s_q_torso, d293, c_q_torso * d289); // F(M col 10l) at 2.x
-                let d30 = A::mul_add(s_q_torso, d26, c_q_torso * d21); // F(M col 10r) at 2.x
-                let d33 = A::mul_add(-p.L4, d30, -d28); // N(M col 10r) at 2.y
-                let d299 = A::mul_add(-c_q_torso, d293, s_q_torso * d289); // F(M col 10l) at 2.z
-                let d31 = A::mul_add(-c_q_torso, d26, s_q_torso * d21); // F(M col 10r) at 2.z
-                let d32 = A::mul_add(
-                    -p.L3,
-                    d31,
-                    A::mul_add(-d29, s_q_torso, A::mul_add(-d27, c_q_torso, d25 * p.L4)),
-                ); // N(M col 10r) at 2.x
-                m[(3, 18)] = -d32;
-                let d35 = A::mul_add(-d31, c_q_w, d25 * s_q_w); // F(M col 10r) at 1.z
-                let d36 = A::mul_add(d31, s_q_w, d25 * c_q_w); // F(M col 10r) at 1.y
-                let d300 = A::mul_add(
-                    p.L4,
-                    d294,
-                    A::mul_add(p.L3, d299, A::mul_add(s_q_torso, d295, c_q_torso * d296)),
-                ); // N(M col 10l) at 2.x
-                m[(3, 11)] = -d300;
-                let d301 = A::mul_add(
-                    -p.L3,
-                    d298,
-                    A::mul_add(-c_q_torso, d295, s_q_torso * d296),
-                ); // N(M col 10l) at 2.z
-                let d34 = A::mul_add(
-                    -p.L3,
-                    d30,
-                    A::mul_add(-c_q_torso, d29, s_q_torso * d27),
-                ); // N(M col 10r) at 2.z
-                let d302 = A::mul_add(-p.L4, d298, d297); // N(M col 10l) at 2.y
-                let d303 = A::mul_add(c_q_w, d299, s_q_w * d294); // F(M col 10l) at 1.z
-                let d304 = A::mul_add(-s_q_w, d299, c_q_w * d294); // F(M col 10l) at 1.y
-                let d305 = A::mul_add(-p.L2, d304, A::mul_add(p.L1, d303, d300)); // N(M col 10l) at 1.x
-                m[(2, 11)] = -d305;
-                let d38 = A::mul_add(-p.L2, d36, A::mul_add(p.L1, d35, d32)); // N(M col 10r) at 1.x
-                m[(2, 18)] = -d38;
-                let d306 = A::mul_add(
-                    -p.L1,
-                    d298,
-                    A::mul_add(c_q_w, d301, s_q_w * d302),
-                ); // N(M col 10l) at 1.z
-                let d37 = A::mul_add(-p.L1, d30, A::mul_add(c_q_w, d34, s_q_w * d33)); // N(M col 10r) at 1.z
-                let d307 = A::mul_add(
-                    p.L2,
-                    d298,
-                    A::mul_add(-s_q_w, d301, c_q_w * d302),
-                ); // N(M col 10l) at 1.y
-                let d39 = A::mul_add(p.L2, d30, A::mul_add(-s_q_w, d34, c_q_w * d33)); // N(M col 10r) at 1.y
-                let d308 = A::mul_add(c_q_imu, d303, s_q_imu * d304); // F(M col 10l) at 0.x
-                m[(0, 11)] = -d308;
-                let d40 = A::mul_add(c_q_imu, d35, s_q_imu * d36); // F(M col 10r) at 0.x
-                m[(0, 18)] = -d40;
-                let d309 = A::mul_add(-s_q_imu, d306, c_q_imu * d307); // N(M col 10l) at 0.z
-                m[(1, 11)] = -d309;
-                let d41 = A::mul_add(-s_q_imu, d37, c_q_imu * d39); // N(M col 10r) at 0.z
-                m[(1, 18)] = d41;
-                let d310 = p.MX9l - d270; // MSC9l.x
-                let d42 = p.MX9r - d2; // MSC9r.x
-                let d311 = p.MZ9l + d269; // MSC9l.z
-                let d43 = p.MZ9r + d1; // MSC9r.z
-                let k22 = s_q7l * s_q7l; // sin² q7l
-                let k1 = s_q7r * s_q7r; // sin² q7r
-                let k23 = s_q7l * c_q7l; // sin q7l cos q7l
-                let k2 = s_q7r * c_q7r; // sin q7r cos q7r
-                let k24 = A::mul_add(2.0, k22, -1.0); // cos 2q7l
-                let k3 = A::mul_add(2.0, k1, -1.0); // cos 2q7r
-                let d312 = A::mul_add(-2.0, p.XY10l * k23, k22 * pc.pc26); // JC10l rotated about z: Jxx − J'xx
-                let d44 = A::mul_add(-2.0, p.XY10r * k2, k1 * pc.pc3); // JC10r rotated about z: Jxx − J'xx
-                let d313 = p.XY9l + t41 + t42 - t45; // JC9l.xy
-                let d45 = p.XY9r + t1 + t2 - t5; // JC9r.xy
-                let d314 = A::mul_add(-k23, pc.pc26, A::mul_add(-p.XY10l, k24, p.XZ9l)); // JC9l.xz
-                let d46 = A::mul_add(-k2, pc.pc3, A::mul_add(-p.XY10r, k3, p.XZ9r)); // JC9r.xz
-                let d315 = p.YZ9l - t43 + t44 + t46; // JC9l.yz
-                let d47 = p.YZ9r - t3 + t4 + t6; // JC9r.yz
-                let d316 = pc.pc30 - d312; // JC9l.xx
-                m[(10, 10)] = d316;
-                let d48 = pc.pc7 - d44; // JC9r.xx
-                m[(17, 17)] = d48;
-                let d317 = d312 + pc.pc31; // JC9l.zz
-                let d49 = d44 + pc.pc8; // JC9r.zz
-                let d318 = A::mul_add(s_q6l, d311, c_q6l * pc.pc25); // MSC9l in 8l.y
-                let d50 = A::mul_add(s_q6r, d43, c_q6r * pc.pc2); // MSC9r in 8r.y
-                let d319 = A::mul_add(-c_q6l, d311, s_q6l * pc.pc25); // MSC9l in 8l.z
-                let d51 = A::mul_add(-c_q6r, d43, s_q6r * pc.pc2); // MSC9r in 8r.z
-                let t47 = c_q6l * d313; // common subexpression
-                let t7 = c_q6r * d45; // common subexpression
-                let t48 = s_q6l * d314; // common subexpression
-                let t8 = s_q6r * d46; // common subexpression
-                let d320 = t47 + t48; // N(M col 9l) at 8l.y
-                m[(9, 10)] = -d320;
-                let d52 = t7 + t8; // N(M col 9r) at 8r.y
-                m[(16, 17)] = -d52;
-                let t49 = s_q6l * d313; // common subexpression
-                let t9 = s_q6r * d45; // common subexpression
-                let t50 = c_q6l * d314; // common subexpression
-                let t10 = c_q6r * d46; // common subexpression
-                let d321 = t49 - t50; // N(M col 9l) at 8l.z
-                let d53 = t9 - t10; // N(M col 9r) at 8r.z
-                let d322 = s_q5l * d318; // F(M col 9l) at 7l.x
-                let d54 = s_q5r * d50; // F(M col 9r) at 7r.x
-                let d323 = c_q5l * d318; // F(M col 9l) at 7l.z
-                let d55 = c_q5r * d50; // F(M col 9r) at 7r.z
-                let d324 = A::mul_add(
-                    -p.L8,
-                    d322,
-                    A::mul_add(c_q5l, d321, s_q5l * d316),
-                ); // N(M col 9l) at 7l.z
-                let d56 = A::mul_add(-p.L8, d54, A::mul_add(c_q5r, d53, s_q5r * d48)); // N(M col 9r) at 7r.z
-                let d325 = A::mul_add(
-                    -p.L8,
-                    d323,
-                    A::mul_add(-s_q5l, d321, c_q5l * d316),
-                ); // N(M col 9l) at 7l.x
-                m[(8, 10)] = d325;
-                let d57 = A::mul_add(-p.L8, d55, A::mul_add(-s_q5r, d53, c_q5r * d48)); // N(M col 9r) at 7r.x
-                m[(15, 17)] = d57;
-                let d326 = A::mul_add(s_q4l, d323, c_q4l * d319); // F(M col 9l) at 6l.y
-                let d58 = A::mul_add(s_q4r, d55, c_q4r * d51); // F(M col 9r) at 6r.y
-                let d327 = A::mul_add(-c_q4l, d323, s_q4l * d319); // F(M col 9l) at 6l.z
-                let d59 = A::mul_add(-c_q4r, d55, s_q4r * d51); // F(M col 9r) at 6r.z
-                let d328 = A::mul_add(-s_q4l, d324, c_q4l * d320); // N(M col 9l) at 6l.y
-                m[(7, 10)] = -d328;
-                let d60 = A::mul_add(-s_q4r, d56, c_q4r * d52); // N(M col 9r) at 6r.y
-                m[(14, 17)] = -d60;
-                let d329 = A::mul_add(c_q4l, d324, s_q4l * d320); // N(M col 9l) at 6l.z
-                let d61 = A::mul_add(c_q4r, d56, s_q4r * d52); // N(M col 9r) at 6r.z
-                let d330 = A::mul_add(c_q3l, d327, s_q3l * d322); // F(M col 9l) at 5l.z
-                let d62 = A::mul_add(c_q3r, d59, s_q3r * d54); // F(M col 9r) at 5r.z
-                let d331 = A::mul_add(-s_q3l, d327, c_q3l * d322); // F(M col 9l) at 5l.x
-                let d63 = A::mul_add(-s_q3r, d59, c_q3r * d54); // F(M col 9r) at 5r.x
-                let d332 = A::mul_add(
-                    -p.L7,
-                    d331,
-                    A::mul_add(c_q3l, d329, s_q3l * d325),
-                ); // N(M col 9l) at 5l.z
-                let d64 = A::mul_add(-p.L7, d63, A::mul_add(c_q3r, d61, s_q3r * d57)); // N(M col 9r) at 5r.z
-                let d333 = A::mul_add(
-                    p.L7,
-                    d330,
-                    A::mul_add(-s_q3l, d329, c_q3l * d325),
-                ); // N(M col 9l) at 5l.x
-                m[(6, 10)] = d333;
-                let d65 = A::mul_add(p.L7, d62, A::mul_add(-s_q3r, d61, c_q3r * d57)); // N(M col 9r) at 5r.x
-                m[(13, 17)] = d65;
-                let d334 = A::mul_add(-s_q2l, d330, c_q2l * d326); // F(M col 9l) at 4l.y
-                let d66 = A::mul_add(-s_q2r, d62, c_q2r * d58); // F(M col 9r) at 4r.y
-                let d335 = A::mul_add(c_q2l, d330, s_q2l * d326); // F(M col 9l) at 4l.z
-                let d67 = A::mul_add(c_q2r, d62, s_q2r * d58); // F(M col 9r) at 4r.z
-                let d336 = A::mul_add(-s_q2l, d332, c_q2l * d328); // N(M col 9l) at 4l.y
-                m[(5, 10)] = -d336;
-                let d68 = A::mul_add(-s_q2r, d64, c_q2r * d60); // N(M col 9r) at 4r.y
-                m[(12, 17)] = -d68;
-                let d337 = A::mul_add(c_q2l, d332, s_q2l * d328); // N(M col 9l) at 4l.z
-                let d69 = A::mul_add(c_q2r, d64, s_q2r * d60); // N(M col 9r) at 4r.z
-                let d338 = A::mul_add(-s_q1l, d335, c_q1l * d331); // F(M col 9l) at 3.y
-                let d70 = A::mul_add(-s_q1r, d67, c_q1r * d63); // F(M col 9r) at 3.y
-                let d339 = A::mul_add(c_q1l, d335, s_q1l * d331); // F(M col 9l) at 3.z
-                let d71 = A::mul_add(c_q1r, d67, s_q1r * d63); // F(M col 9r) at 3.z
-                let d340 = A::mul_add(-p.L5, d339, d336); // N(M col 9l) at 3.x
-                let d74 = A::mul_add(-p.L5, d71, d68); // N(M col 9r) at 3.x
-                let d341 = A::mul_add(
-                    p.L6,
-                    d339,
-                    A::mul_add(-s_q1l, d337, c_q1l * d333),
-                ); // N(M col 9l) at 3.y
-                m[(4, 10)] = -d341;
-                let d72 = A::mul_add(p.L6, d71, A::mul_add(-s_q1r, d69, c_q1r * d65)); // N(M col 9r) at 3.y
-                m[(4, 17)] = -d72;
-                let d342 = A::mul_add(
-                    p.L5,
-                    d334,
-                    A::mul_add(-p.L6, d338, A::mul_add(c_q1l, d337, s_q1l * d333)),
-                ); // N(M col 9l) at 3.z
-                let d73 = A::mul_add(
-                    p.L5,
-                    d66,
-                    A::mul_add(-p.L6, d70, A::mul_add(c_q1r, d69, s_q1r * d65)),
-                ); // N(M col 9r) at 3.z
-                let d343 = A::mul_add(s_q_torso, d339, c_q_torso * d334); // F(M col 9l) at 2.x
-                let d75 = A::mul_add(s_q_torso, d71, c_q_torso * d66); // F(M col 9r) at 2.x
-                let d78 = A::mul_add(-p.L4, d75, -d72); // N(M col 9r) at 2.y
-                let d344 = A::mul_add(-c_q_torso, d339, s_q_torso * d334); // F(M col 9l) at 2.z
-                let d76 = A::mul_add(-c_q_torso, d71, s_q_torso * d66); // F(M col 9r) at 2.z
-                let d77 = A::mul_add(
-                    -p.L3,
-                    d76,
-                    A::mul_add(-s_q_torso, d73, A::mul_add(-c_q_torso, d74, p.L4 * d70)),
-                ); // N(M col 9r) at 2.x
-                m[(3, 17)] = d77;
-                let d80 = A::mul_add(s_q_w, d76, c_q_w * d70); // F(M col 9r) at 1.y
-                let d81 = A::mul_add(-c_q_w, d76, s_q_w * d70); // F(M col 9r) at 1.z
-                let d345 = A::mul_add(-p.L4, d343, d341); // N(M col 9l) at 2.y
-                let d346 = A::mul_add(
-                    p.L4,
-                    d338,
-                    A::mul_add(p.L3, d344, A::mul_add(s_q_torso, d342, c_q_torso * d340)),
-                ); // N(M col 9l) at 2.x
-                m[(3, 10)] = d346;
-                let d347 = A::mul_add(
-                    -p.L3,
-                    d343,
-                    A::mul_add(-c_q_torso, d342, s_q_torso * d340),
-                ); // N(M col 9l) at 2.z
-                let d79 = A::mul_add(
-                    -p.L3,
-                    d75,
-                    A::mul_add(-c_q_torso, d73, s_q_torso * d74),
-                ); // N(M col 9r) at 2.z
-                let d348 = A::mul_add(-s_q_w, d344, c_q_w * d338); // F(M col 9l) at 1.y
-                let d349 = A::mul_add(c_q_w, d344, s_q_w * d338); // F(M col 9l) at 1.z
-                let d350 = A::mul_add(
-                    p.L2,
-                    d343,
-                    A::mul_add(-s_q_w, d347, c_q_w * d345),
-                ); // N(M col 9l) at 1.y
-                let d83 = A::mul_add(p.L2, d75, A::mul_add(-s_q_w, d79, c_q_w * d78)); // N(M col 9r) at 1.y
-                let d351 = A::mul_add(-p.L2, d348, A::mul_add(p.L1, d349, d346)); // N(M col 9l) at 1.x
-                m[(2, 10)] = d351;
-                let d82 = A::mul_add(-p.L2, d80, A::mul_add(p.L1, d81, d77)); // N(M col 9r) at 1.x
-                m[(2, 17)] = d82;
-                let d352 = A::mul_add(
-                    -p.L1,
-                    d343,
-                    A::mul_add(c_q_w, d347, s_q_w * d345),
-                ); // N(M col 9l) at 1.z
-                let d84 = A::mul_add(-p.L1, d75, A::mul_add(c_q_w, d79, s_q_w * d78)); // N(M col 9r) at 1.z
-                let d353 = A::mul_add(c_q_imu, d349, s_q_imu * d348); // F(M col 9l) at 0.x
-                m[(0, 10)] = d353;
-                let d85 = A::mul_add(c_q_imu, d81, s_q_imu * d80); // F(M col 9r) at 0.x
-                m[(0, 17)] = d85;
-                let d354 = A::mul_add(-s_q_imu, d352, c_q_imu * d350); // N(M col 9l) at 0.z
-                m[(1, 10)] = d354;
-                let d86 = A::mul_add(-s_q_imu, d84, c_q_imu * d83); // N(M col 9r) at 0.z
-                m[(1, 17)] = -d86;
-                let d355 = p.MX8l - d310; // MSC8l.x
-                let d87 = p.MX8r - d42; // MSC8r.x
-                let d356 = p.MY8l - d318; // MSC8l.y
-                let d88 = p.MY8r - d50; // MSC8r.y
-                let d357 = p.MZ8l - d319; // MSC8l.z
-                let d89 = p.MZ8r - d51; // MSC8r.z
-                let k25 = s_q6l * s_q6l; // sin² q6l
-                let k4 = s_q6r * s_q6r; // sin² q6r
-                let k26 = s_q6l * c_q6l; // sin q6l cos q6l
-                let k5 = s_q6r * c_q6r; // sin q6r cos q6r
-                let k27 = A::mul_add(2.0, k25, -1.0); // cos 2q6l
-                let k6 = A::mul_add(2.0, k4, -1.0); // cos 2q6r
-                let d90 = pc.pc6 - d49; // JC9r: Jyy − Jzz
-                let d358 = pc.pc29 - d317; // JC9l: Jyy − Jzz
-                let d359 = A::mul_add(-2.0, d315 * k26, k25 * d358); // JC9l rotated about x: Jyy − J'yy
-                let d91 = A::mul_add(-2.0, d47 * k5, k4 * d90); // JC9r rotated about x: Jyy − J'yy
-                let d360 = p.XX8l + d316; // JC8l.xx
-                let d92 = p.XX8r + d48; // JC8r.xx
-                let d361 = p.XY8l + t47 + t48; // JC8l.xy
-                let d93 = p.XY8r + t7 + t8; // JC8r.xy
-                let d362 = p.XZ8l + t49 - t50; // JC8l.xz
-                let d94 = p.XZ8r + t9 - t10; // JC8r.xz
-                let d363 = A::mul_add(k26, d358, A::mul_add(d315, k27, p.YZ8l)); // JC8l.yz
-                let d95 = A::mul_add(k5, d90, A::mul_add(d47, k6, p.YZ8r)); // JC8r.yz
-                let d364 = p.ZZ8l + d317 + d359; // JC8l.zz
-                let d96 = p.ZZ8r + d49 + d91; // JC8r.zz
-                let d365 = pc.pc33 - d359; // JC8l.yy
-                m[(9, 9)] = d365;
-                let d97 = pc.pc10 - d91; // JC8r.yy
-                m[(16, 16)] = d97;
-                let d366 = A::mul_add(c_q5l, d357, s_q5l * d355); // MSC8l in 7l.z
-                let d98 = A::mul_add(c_q5r, d89, s_q5r * d87); // MSC8r in 7r.z
-                let d367 = A::mul_add(-s_q5l, d357, c_q5l * d355); // MSC8l in 7l.x
-                let d99 = A::mul_add(-s_q5r, d89, c_q5r * d87); // MSC8r in 7r.x
-                let t51 = c_q5l * d361; // common subexpression
-                let t11 = c_q5r * d93; // common subexpression
-                let t52 = s_q5l * d363; // common subexpression
-                let t12 = s_q5r * d95; // common subexpression
-                let t53 = s_q5l * d361; // common subexpression
-                let t13 = s_q5r * d93; // common subexpression
-                let t54 = c_q5l * d363; // common subexpression
-                let t14 = c_q5r * d95; // common subexpression
-                let t55 = p.L8 * d367; // common subexpression
-                let t15 = p.L8 * d99; // common subexpression
-                let t56 = p.L8 * d366; // common subexpression
-                let t16 = p.L8 * d98; // common subexpression
-                let d368 = t51 - t52 - t55; // N(M col 8l) at 7l.x
-                m[(8, 9)] = -d368;
-                let d100 = t11 - t12 - t15; // N(M col 8r) at 7r.x
-                m[(15, 16)] = -d100;
-                let d369 = t53 + t54 - t56; // N(M col 8l) at 7l.z
-                let d101 = t13 + t14 - t16; // N(M col 8r) at 7r.z
-                let d370 = s_q4l * d367; // F(M col 8l) at 6l.y
-                let d102 = s_q4r * d99; // F(M col 8r) at 6r.y
-                let d371 = c_q4l * d367; // F(M col 8l) at 6l.z
-                let d103 = c_q4r * d99; // F(M col 8r) at 6r.z
-                let d372 = A::mul_add(-s_q4l, d369, c_q4l * d365); // N(M col 8l) at 6l.y
-                m[(7, 9)] = d372;
-                let d104 = A::mul_add(-s_q4r, d101, c_q4r * d97); // N(M col 8r) at 6r.y
-                m[(14, 16)] = d104;
-                let d373 = A::mul_add(c_q4l, d369, s_q4l * d365); // N(M col 8l) at 6l.z
-                let d105 = A::mul_add(c_q4r, d101, s_q4r * d97); // N(M col 8r) at 6r.z
-                let d374 = A::mul_add(s_q3l, d371, c_q3l * d366); // F(M col 8l) at 5l.x
-                let d106 = A::mul_add(s_q3r, d103, c_q3r * d98); // F(M col 8r) at 5r.x
-                let d375 = A::mul_add(-c_q3l, d371, s_q3l * d366); // F(M col 8l) at 5l.z
-                let d107 = A::mul_add(-c_q3r, d103, s_q3r * d98); // F(M col 8r) at 5r.z
-                let d376 = A::mul_add(
-                    p.L7,
-                    d375,
-                    A::mul_add(-s_q3l, d373, c_q3l * d368),
-                ); // N(M col 8l) at 5l.x
-                m[(6, 9)] = -d376;
-                let d108 = A::mul_add(
-                    p.L7,
-                    d107,
-                    A::mul_add(-s_q3r, d105, c_q3r * d100),
-                ); // N(M col 8r) at 5r.x
-                m[(13, 16)] = -d108;
-                let d377 = A::mul_add(
-                    -p.L7,
-                    d374,
-                    A::mul_add(c_q3l, d373, s_q3l * d368),
-                ); // N(M col 8l) at 5l.z
-                let d109 = A::mul_add(
-                    -p.L7,
-                    d106,
-                    A::mul_add(c_q3r, d105, s_q3r * d100),
-                ); // N(M col 8r) at 5r.z
-                let d378 = A::mul_add(-s_q2l, d375, c_q2l * d370); // F(M col 8l) at 4l.y
-                let d110 = A::mul_add(-s_q2r, d107, c_q2r * d102); // F(M col 8r) at 4r.y
-                let d379 = A::mul_add(c_q2l, d375, s_q2l * d370); // F(M col 8l) at 4l.z
-                let d111 = A::mul_add(c_q2r, d107, s_q2r * d102); // F(M col 8r) at 4r.z
-                let d380 = A::mul_add(-s_q2l, d377, c_q2l * d372); // N(M col 8l) at 4l.y
-                m[(5, 9)] = d380;
-                let d112 = A::mul_add(-s_q2r, d109, c_q2r * d104); // N(M col 8r) at 4r.y
-                m[(12, 16)] = d112;
-                let d381 = A::mul_add(c_q2l, d377, s_q2l * d372); // N(M col 8l) at 4l.z
-                let d113 = A::mul_add(c_q2r, d109, s_q2r * d104); // N(M col 8r) at 4r.z
-                let d382 = A::mul_add(c_q1l, d379, s_q1l * d374); // F(M col 8l) at 3.z
-                let d115 = A::mul_add(c_q1r, d111, s_q1r * d106); // F(M col 8r) at 3.z
-                let d383 = A::mul_add(-s_q1l, d379, c_q1l * d374); // F(M col 8l) at 3.y
-                let d114 = A::mul_add(-s_q1r, d111, c_q1r * d106); // F(M col 8r) at 3.y
-                let d384 = A::mul_add(
-                    p.L5,
-                    d378,
-                    A::mul_add(-p.L6, d383, A::mul_add(c_q1l, d381, s_q1l * d376)),
-                ); // N(M col 8l) at 3.z
-                let d118 = A::mul_add(
-                    p.L5,
-                    d110,
-                    A::mul_add(-p.L6, d114, A::mul_add(c_q1r, d113, s_q1r * d108)),
-                ); // N(M col 8r) at 3.z
-                let d385 = A::mul_add(-p.L5, d382, d380); // N(M col 8l) at 3.x
-                let d116 = A::mul_add(-p.L5, d115, d112); // N(M col 8r) at 3.x
-                let d386 = A::mul_add(
-                    p.L6,
-                    d382,
-                    A::mul_add(-s_q1l, d381, c_q1l * d376),
-                ); // N(M col 8l) at 3.y
-                m[(4, 9)] = d386;
-                let d117 = A::mul_add(
-                    p.L6,
-                    d115,
-                    A::mul_add(-s_q1r, d113, c_q1r * d108),
-                ); // N(M col 8r) at 3.y
-                m[(4, 16)] = d117;
-                let d387 = A::mul_add(s_q_torso, d382, c_q_torso * d378); // F(M col 8l) at 2.x
-                let d119 = A::mul_add(s_q_torso, d115, c_q_torso * d110); // F(M col 8r) at 2.x
-                let d122 = A::mul_add(-p.L4, d119, -d117); // N(M col 8r) at 2.y
-                let d388 = A::mul_add(-c_q_torso, d382, s_q_torso * d378); // F(M col 8l) at 2.z
-                let d120 = A::mul_add(-c_q_torso, d115, s_q_torso * d110); // F(M col 8r) at 2.z
-                let d121 = A::mul_add(
-                    -p.L3,
-                    d120,
-                    A::mul_add(
-                        -s_q_torso,
-                        d118,
-                        A::mul_add(-c_q_torso, d116, p.L4 * d114),
-                    ),
-                ); // N(M col 8r) at 2.x
-                m[(3, 16)] = -d121;
-                let d124 = A::mul_add(-c_q_w, d120, s_q_w * d114); // F(M col 8r) at 1.z
-                let d125 = A::mul_add(s_q_w, d120, c_q_w * d114); // F(M col 8r) at 1.y
-                let d389 = A::mul_add(
-                    p.L4,
-                    d383,
-                    A::mul_add(p.L3, d388, A::mul_add(s_q_torso, d384, c_q_torso * d385)),
-                ); // N(M col 8l) at 2.x
-                m[(3, 9)] = -d389;
-                let d390 = A::mul_add(
-                    -p.L3,
-                    d387,
-                    A::mul_add(-c_q_torso, d384, s_q_torso * d385),
-                ); // N(M col 8l) at 2.z
-                let d123 = A::mul_add(
-                    -p.L3,
-                    d119,
-                    A::mul_add(-c_q_torso, d118, s_q_torso * d116),
-                ); // N(M col 8r) at 2.z
-                let d391 = A::mul_add(-p.L4, d387, d386); // N(M col 8l) at 2.y
-                let d392 = A::mul_add(c_q_w, d388, s_q_w * d383); // F(M col 8l) at 1.z
-                let d393 = A::mul_add(-s_q_w, d388, c_q_w * d383); // F(M col 8l) at 1.y
-                let d394 = A::mul_add(-p.L2, d393, A::mul_add(p.L1, d392, d389)); // N(M col 8l) at 1.x
-                m[(2, 9)] = -d394;
-                let d127 = A::mul_add(-p.L2, d125, A::mul_add(p.L1, d124, d121)); // N(M col 8r) at 1.x
-                m[(2, 16)] = -d127;
-                let d395 = A::mul_add(
-                    -p.L1,
-                    d387,
-                    A::mul_add(c_q_w, d390, s_q_w * d391),
-                ); // N(M col 8l) at 1.z
-                let d126 = A::mul_add(
-                    -p.L1,
-                    d119,
-                    A::mul_add(c_q_w, d123, s_q_w * d122),
-                ); // N(M col 8r) at 1.z
-                let d396 = A::mul_add(
-                    p.L2,
-                    d387,
-                    A::mul_add(-s_q_w, d390, c_q_w * d391),
-                ); // N(M col 8l) at 1.y
-                let d128 = A::mul_add(
-                    p.L2,
-                    d119,
-                    A::mul_add(-s_q_w, d123, c_q_w * d122),
-                ); // N(M col 8r) at 1.y
-                let d397 = A::mul_add(c_q_imu, d392, s_q_imu * d393); // F(M col 8l) at 0.x
-                m[(0, 9)] = -d397;
-                let d129 = A::mul_add(c_q_imu, d124, s_q_imu * d125); // F(M col 8r) at 0.x
-                m[(0, 16)] = -d129;
-                let d398 = A::mul_add(-s_q_imu, d395, c_q_imu * d396); // N(M col 8l) at 0.z
-                m[(1, 9)] = -d398;
-                let d130 = A::mul_add(-s_q_imu, d126, c_q_imu * d128); // N(M col 8r) at 0.z
-                m[(1, 16)] = d130;
-                let d399 = p.MX7l - d367; // MSC7l.x
-                let d131 = p.MX7r - d99; // MSC7r.x
-                let d400 = p.MZ7l + d366; // MSC7l.z
-                let d132 = p.MZ7r + d98; // MSC7r.z
-                let k28 = s_q5l * s_q5l; // sin² q5l
-                let k7 = s_q5r * s_q5r; // sin² q5r
-                let k29 = s_q5l * c_q5l; // sin q5l cos q5l
-                let k8 = s_q5r * c_q5r; // sin q5r cos q5r
-                let k30 = A::mul_add(2.0, k28, -1.0); // cos 2q5l
-                let k9 = A::mul_add(2.0, k7, -1.0); // cos 2q5r
-                let d401 = d360 - d364; // JC8l: Jzz − Jxx
-                let d133 = d92 - d96; // JC8r: Jzz − Jxx
-                let d402 = A::mul_add(2.0, d362 * k29, k28 * d401); // JC8l rotated about y: Jzz − J'zz
-                let d134 = A::mul_add(2.0, d94 * k8, k7 * d133); // JC8r rotated about y: Jzz − J'zz
-                let t57 = p.L8 * d356; // common subexpression
-                let t17 = p.L8 * d88; // common subexpression
-                let d403 = p.XY7l + t51 - t52 - t55; // JC7l.xy
-                let d135 = p.XY7r + t11 - t12 - t15; // JC7r.xy
-                let d404 = A::mul_add(-k29, d401, A::mul_add(d362, k30, p.XZ7l)); // JC7l.xz
-                let d136 = A::mul_add(-k8, d133, A::mul_add(d94, k9, p.XZ7r)); // JC7r.xz
-                let d405 = p.YY7l + d365; // JC7l.yy
-                let d137 = p.YY7r + d97; // JC7r.yy
-                let d406 = p.YZ7l - t53 - t54 + t56; // JC7l.yz
-                let d138 = p.YZ7r - t13 - t14 + t16; // JC7r.yz
-                let d407 = pc.pc36 - d356; // MSC7l.y
-                let d139 = pc.pc13 - d88; // MSC7r.y
-                let d408 = A::mul_add(2.0, t57, d360 - d402) + pc.pc37; // JC7l.xx
-                m[(8, 8)] = d408;
-                let d140 = A::mul_add(2.0, t17, d92 - d134) + pc.pc14; // JC7r.xx
-                m[(15, 15)] = d140;
-                let d409 = A::mul_add(2.0, t57, d364 + d402) + pc.pc38; // JC7l.zz
-                let d141 = A::mul_add(2.0, t17, d96 + d134) + pc.pc15; // JC7r.zz
-                let d410 = A::mul_add(s_q4l, d400, c_q4l * d407); // MSC7l in 6l.y
-                let d142 = A::mul_add(s_q4r, d132, c_q4r * d139); // MSC7r in 6r.y
-                let d411 = A::mul_add(-c_q4l, d400, s_q4l * d407); // MSC7l in 6l.z
-                let d143 = A::mul_add(-c_q4r, d132, s_q4r * d139); // MSC7r in 6r.z
-                let t58 = c_q4l * d403; // common subexpression
-                let t18 = c_q4r * d135; // common subexpression
-                let t59 = s_q4l * d404; // common subexpression
-                let t19 = s_q4r * d136; // common subexpression
-                let d412 = t58 + t59; // N(M col 7l) at 6l.y
-                m[(7, 8)] = -d412;
-                let d144 = t18 + t19; // N(M col 7r) at 6r.y
-                m[(14, 15)] = -d144;
-                let t60 = s_q4l * d403; // common subexpression
-                let t20 = s_q4r * d135; // common subexpression
-                let t61 = c_q4l * d404; // common subexpression
-                let t21 = c_q4r * d136; // common subexpression
-                let d413 = t60 - t61; // N(M col 7l) at 6l.z
-                let d145 = t20 - t21; // N(M col 7r) at 6r.z
-                let d414 = s_q3l * d410; // F(M col 7l) at 5l.x
-                let d146 = s_q3r * d142; // F(M col 7r) at 5r.x
-                let d415 = c_q3l * d410; // F(M col 7l) at 5l.z
-                let d147 = c_q3r * d142; // F(M col 7r) at 5r.z
-                let d416 = A::mul_add(
-                    -p.L7,
-                    d414,
-                    A::mul_add(c_q3l, d413, s_q3l * d408),
-                ); // N(M col 7l) at 5l.z
-                let d148 = A::mul_add(
-                    -p.L7,
-                    d146,
-                    A::mul_add(c_q3r, d145, s_q3r * d140),
-                ); // N(M col 7r) at 5r.z
-                let d417 = A::mul_add(
-                    -p.L7,
-                    d415,
-                    A::mul_add(-s_q3l, d413, c_q3l * d408),
-                ); // N(M col 7l) at 5l.x
-                m[(6, 8)] = d417;
-                let d149 = A::mul_add(
-                    -p.L7,
-                    d147,
-                    A::mul_add(-s_q3r, d145, c_q3r * d140),
-                ); // N(M col 7r) at 5r.x
-                m[(13, 15)] = d149;
-                let d418 = A::mul_add(s_q2l, d415, c_q2l * d411); // F(M col 7l) at 4l.y
-                let d150 = A::mul_add(s_q2r, d147, c_q2r * d143); // F(M col 7r) at 4r.y
-                let d419 = A::mul_add(-c_q2l, d415, s_q2l * d411); // F(M col 7l) at 4l.z
-                let d151 = A::mul_add(-c_q2r, d147, s_q2r * d143); // F(M col 7r) at 4r.z
-                let d420 = A::mul_add(-s_q2l, d416, c_q2l * d412); // N(M col 7l) at 4l.y
-                m[(5, 8)] = -d420;
-                let d152 = A::mul_add(-s_q2r, d148, c_q2r * d144); // N(M col 7r) at 4r.y
-                m[(12, 15)] = -d152;
-                let d421 = A::mul_add(c_q2l, d416, s_q2l * d412); // N(M col 7l) at 4l.z
-                let d153 = A::mul_add(c_q2r, d148, s_q2r * d144); // N(M col 7r) at 4r.z
-                let d422 = A::mul_add(-s_q1l, d419, c_q1l * d414); // F(M col 7l) at 3.y
-                let d154 = A::mul_add(-s_q1r, d151, c_q1r * d146); // F(M col 7r) at 3.y
-                let d423 = A::mul_add(c_q1l, d419, s_q1l * d414); // F(M col 7l) at 3.z
-                let d155 = A::mul_add(c_q1r, d151, s_q1r * d146); // F(M col 7r) at 3.z
-                let d424 = A::mul_add(-p.L5, d423, d420); // N(M col 7l) at 3.x
-                let d158 = A::mul_add(-p.L5, d155, d152); // N(M col 7r) at 3.x
-                let d425 = A::mul_add(
-                    p.L6,
-                    d423,
-                    A::mul_add(-s_q1l, d421, c_q1l * d417),
-                ); // N(M col 7l) at 3.y
-                m[(4, 8)] = -d425;
-                let d156 = A::mul_add(
-                    p.L6,
-                    d155,
-                    A::mul_add(-s_q1r, d153, c_q1r * d149),
-                ); // N(M col 7r) at 3.y
-                m[(4, 15)] = -d156;
-                let d426 = A::mul_add(
-                    p.L5,
-                    d418,
-                    A::mul_add(-p.L6, d422, A::mul_add(c_q1l, d421, s_q1l * d417)),
-                ); // N(M col 7l) at 3.z
-                let d157 = A::mul_add(
-                    p.L5,
-                    d150,
-                    A::mul_add(-p.L6, d154, A::mul_add(c_q1r, d153, s_q1r * d149)),
-                ); // N(M col 7r) at 3.z
-                let d427 = A::mul_add(s_q_torso, d423, c_q_torso * d418); // F(M col 7l) at 2.x
-                let d159 = A::mul_add(s_q_torso, d155, c_q_torso * d150); // F(M col 7r) at 2.x
-                let d162 = A::mul_add(-p.L4, d159, -d156); // N(M col 7r) at 2.y
-                let d428 = A::mul_add(-c_q_torso, d423, s_q_torso * d418); // F(M col 7l) at 2.z
-                let d160 = A::mul_add(-c_q_torso, d155, s_q_torso * d150); // F(M col 7r) at 2.z
-                let d161 = A::mul_add(
-                    -p.L3,
-                    d160,
-                    A::mul_add(
-                        -s_q_torso,
-                        d157,
-                        A::mul_add(-c_q_torso, d158, p.L4 * d154),
-                    ),
-                ); // N(M col 7r) at 2.x
-                m[(3, 15)] = d161;
-                let d164 = A::mul_add(s_q_w, d160, c_q_w * d154); // F(M col 7r) at 1.y
-                let d165 = A::mul_add(-c_q_w, d160, s_q_w * d154); // F(M col 7r) at 1.z
-                let d429 = A::mul_add(-p.L4, d427, d425); // N(M col 7l) at 2.y
-                let d430 = A::mul_add(
-                    p.L4,
-                    d422,
-                    A::mul_add(p.L3, d428, A::mul_add(s_q_torso, d426, c_q_torso * d424)),
-                ); // N(M col 7l) at 2.x
-                m[(3, 8)] = d430;
-                let d431 = A::mul_add(
-                    -p.L3,
-                    d427,
-                    A::mul_add(-c_q_torso, d426, s_q_torso * d424),
-                ); // N(M col 7l) at 2.z
-                let d163 = A::mul_add(
-                    -p.L3,
-                    d159,
-                    A::mul_add(-c_q_torso, d157, s_q_torso * d158),
-                ); // N(M col 7r) at 2.z
-                let d432 = A::mul_add(-s_q_w, d428, c_q_w * d422); // F(M col 7l) at 1.y
-                let d433 = A::mul_add(c_q_w, d428, s_q_w * d422); // F(M col 7l) at 1.z
-                let d434 = A::mul_add(
-                    p.L2,
-                    d427,
-                    A::mul_add(-s_q_w, d431, c_q_w * d429),
-                ); // N(M col 7l) at 1.y
-                let d167 = A::mul_add(
-                    p.L2,
-                    d159,
-                    A::mul_add(-s_q_w, d163, c_q_w * d162),
-                ); // N(M col 7r) at 1.y
-                let d435 = A::mul_add(-p.L2, d432, A::mul_add(p.L1, d433, d430)); // N(M col 7l) at 1.x
-                m[(2, 8)] = d435;
-                let d166 = A::mul_add(-p.L2, d164, A::mul_add(p.L1, d165, d161)); // N(M col 7r) at 1.x
-                m[(2, 15)] = d166;
-                let d436 = A::mul_add(
-                    -p.L1,
-                    d427,
-                    A::mul_add(c_q_w, d431, s_q_w * d429),
-                ); // N(M col 7l) at 1.z
-                let d168 = A::mul_add(
-                    -p.L1,
-                    d159,
-                    A::mul_add(c_q_w, d163, s_q_w * d162),
-                ); // N(M col 7r) at 1.z
-                let d437 = A::mul_add(c_q_imu, d433, s_q_imu * d432); // F(M col 7l) at 0.x
-                m[(0, 8)] = d437;
-                let d169 = A::mul_add(c_q_imu, d165, s_q_imu * d164); // F(M col 7r) at 0.x
-                m[(0, 15)] = d169;
-                let d438 = A::mul_add(-s_q_imu, d436, c_q_imu * d434); // N(M col 7l) at 0.z
-                m[(1, 8)] = d438;
-                let d170 = A::mul_add(-s_q_imu, d168, c_q_imu * d167); // N(M col 7r) at 0.z
-                m[(1, 15)] = -d170;
-                let d439 = p.MX6l - d399; // MSC6l.x
-                let d171 = p.MX6r - d131; // MSC6r.x
-                let d440 = p.MY6l - d410; // MSC6l.y
-                let d172 = p.MY6r - d142; // MSC6r.y
-                let d441 = p.MZ6l - d411; // MSC6l.z
-                let d173 = p.MZ6r - d143; // MSC6r.z
-                let k31 = s_q4l * s_q4l; // sin² q4l
-                let k10 = s_q4r * s_q4r; // sin² q4r
-                let k32 = s_q4l * c_q4l; // sin q4l cos q4l
-                let k11 = s_q4r * c_q4r; // sin q4r cos q4r
-                let k33 = A::mul_add(2.0, k31, -1.0); // cos 2q4l
-                let k12 = A::mul_add(2.0, k10, -1.0); // cos 2q4r
-                let d442 = d405 - d409; // JC7l: Jyy − Jzz
-                let d174 = d137 - d141; // JC7r: Jyy − Jzz
-                let d443 = A::mul_add(-2.0, d406 * k32, k31 * d442); // JC7l rotated about x: Jyy − J'yy
-                let d175 = A::mul_add(-2.0, d138 * k11, k10 * d174); // JC7r rotated about x: Jyy − J'yy
-                let d444 = p.XX6l + d408; // JC6l.xx
-                let d176 = p.XX6r + d140; // JC6r.xx
-                let d445 = p.XY6l + t58 + t59; // JC6l.xy
-                let d177 = p.XY6r + t18 + t19; // JC6r.xy
-                let d446 = p.XZ6l + t60 - t61; // JC6l.xz
-                let d178 = p.XZ6r + t20 - t21; // JC6r.xz
-                let d447 = p.YY6l + d405 - d443; // JC6l.yy
-                m[(7, 7)] = d447;
-                let d179 = p.YY6r + d137 - d175; // JC6r.yy
-                m[(14, 14)] = d179;
-                let d448 = A::mul_add(k32, d442, A::mul_add(d406, k33, p.YZ6l)); // JC6l.yz
-                let d180 = A::mul_add(k11, d174, A::mul_add(d138, k12, p.YZ6r)); // JC6r.yz
-                let d449 = p.ZZ6l + d409 + d443; // JC6l.zz
-                let d181 = p.ZZ6r + d141 + d175; // JC6r.zz
-                let d450 = A::mul_add(c_q3l, d441, s_q3l * d439); // MSC6l in 5l.z
-                let d182 = A::mul_add(c_q3r, d173, s_q3r * d171); // MSC6r in 5r.z
-                let d451 = A::mul_add(-s_q3l, d441, c_q3l * d439); // MSC6l in 5l.x
-                let d183 = A::mul_add(-s_q3r, d173, c_q3r * d171); // MSC6r in 5r.x
-                let t62 = c_q3l * d445; // common subexpression
-                let t22 = c_q3r * d177; // common subexpression
-                let t63 = s_q3l * d448; // common subexpression
-                let t23 = s_q3r * d180; // common subexpression
-                let t64 = s_q3l * d445; // common subexpression
-                let t24 = s_q3r * d177; // common subexpression
-                let t65 = c_q3l * d448; // common subexpression
-                let t25 = c_q3r * d180; // common subexpression
-                let t66 = p.L7 * d451; // common subexpression
-                let t26 = p.L7 * d183; // common subexpression
-                let t67 = p.L7 * d450; // common subexpression
-                let t27 = p.L7 * d182; // common subexpression
-                let d452 = t62 - t63 - t66; // N(M col 6l) at 5l.x
-                m[(6, 7)] = -d452;
-                let d184 = t22 - t23 - t26; // N(M col 6r) at 5r.x
-                m[(13, 14)] = -d184;
-                let d453 = t64 + t65 - t67; // N(M col 6l) at 5l.z
-                let d185 = t24 + t25 - t27; // N(M col 6r) at 5r.z
-                let d454 = s_q2l * d451; // F(M col 6l) at 4l.y
-                let d186 = s_q2r * d183; // F(M col 6r) at 4r.y
-                let d455 = c_q2l * d451; // F(M col 6l) at 4l.z
-                let d187 = c_q2r * d183; // F(M col 6r) at 4r.z
-                let d456 = A::mul_add(-s_q2l, d453, c_q2l * d447); // N(M col 6l) at 4l.y
-                m[(5, 7)] = d456;
-                let d188 = A::mul_add(-s_q2r, d185, c_q2r * d179); // N(M col 6r) at 4r.y
-                m[(12, 14)] = d188;
-                let d457 = A::mul_add(c_q2l, d453, s_q2l * d447); // N(M col 6l) at 4l.z
-                let d189 = A::mul_add(c_q2r, d185, s_q2r * d179); // N(M col 6r) at 4r.z
-                let d458 = A::mul_add(-c_q1l, d455, s_q1l * d450); // F(M col 6l) at 3.z
-                let d191 = A::mul_add(-c_q1r, d187, s_q1r * d182); // F(M col 6r) at 3.z
-                let d459 = A::mul_add(s_q1l, d455, c_q1l * d450); // F(M col 6l) at 3.y
-                let d190 = A::mul_add(s_q1r, d187, c_q1r * d182); // F(M col 6r) at 3.y
-                let d460 = A::mul_add(
-                    p.L5,
-                    d454,
-                    A::mul_add(-p.L6, d459, A::mul_add(c_q1l, d457, s_q1l * d452)),
-                ); // N(M col 6l) at 3.z
-                let d194 = A::mul_add(
-                    p.L5,
-                    d186,
-                    A::mul_add(-p.L6, d190, A::mul_add(c_q1r, d189, s_q1r * d184)),
-                ); // N(M col 6r) at 3.z
-                let d461 = A::mul_add(-p.L5, d458, d456); // N(M col 6l) at 3.x
-                let d192 = A::mul_add(-p.L5, d191, d188); // N(M col 6r) at 3.x
-                let d462 = A::mul_add(
-                    p.L6,
-                    d458,
-                    A::mul_add(-s_q1l, d457, c_q1l * d452),
-                ); // N(M col 6l) at 3.y
-                m[(4, 7)] = d462;
-                let d193 = A::mul_add(
-                    p.L6,
-                    d191,
-                    A::mul_add(-s_q1r, d189, c_q1r * d184),
-                ); // N(M col 6r) at 3.y
-                m[(4, 14)] = d193;
-                let d463 = A::mul_add(s_q_torso, d458, c_q_torso * d454); // F(M col 6l) at 2.x
-                let d195 = A::mul_add(s_q_torso, d191, c_q_torso * d186); // F(M col 6r) at 2.x
-                let d198 = A::mul_add(-p.L4, d195, -d193); // N(M col 6r) at 2.y
-                let d464 = A::mul_add(-c_q_torso, d458, s_q_torso * d454); // F(M col 6l) at 2.z
-                let d196 = A::mul_add(-c_q_torso, d191, s_q_torso * d186); // F(M col 6r) at 2.z
-                let d197 = A::mul_add(
-                    -p.L3,
-                    d196,
-                    A::mul_add(
-                        -s_q_torso,
-                        d194,
-                        A::mul_add(-c_q_torso, d192, p.L4 * d190),
-                    ),
-                ); // N(M col 6r) at 2.x
-                m[(3, 14)] = -d197;
-                let d200 = A::mul_add(-c_q_w, d196, s_q_w * d190); // F(M col 6r) at 1.z
-                let d201 = A::mul_add(s_q_w, d196, c_q_w * d190); // F(M col 6r) at 1.y
-                let d465 = A::mul_add(
-                    p.L4,
-                    d459,
-                    A::mul_add(p.L3, d464, A::mul_add(s_q_torso, d460, c_q_torso * d461)),
-                ); // N(M col 6l) at 2.x
-                m[(3, 7)] = -d465;
-                let d466 = A::mul_add(
-                    -p.L3,
-                    d463,
-                    A::mul_add(-c_q_torso, d460, s_q_torso * d461),
-                ); // N(M col 6l) at 2.z
-                let d199 = A::mul_add(
-                    -p.L3,
-                    d195,
-                    A::mul_add(-c_q_torso, d194, s_q_torso * d192),
-                ); // N(M col 6r) at 2.z
-                let d467 = A::mul_add(-p.L4, d463, d462); // N(M col 6l) at 2.y
-                let d468 = A::mul_add(c_q_w, d464, s_q_w * d459); // F(M col 6l) at 1.z
-                let d469 = A::mul_add(-s_q_w, d464, c_q_w * d459); // F(M col 6l) at 1.y
-                let d470 = A::mul_add(-p.L2, d469, A::mul_add(p.L1, d468, d465)); // N(M col 6l) at 1.x
-                m[(2, 7)] = -d470;
-                let d203 = A::mul_add(-p.L2, d201, A::mul_add(p.L1, d200, d197)); // N(M col 6r) at 1.x
-                m[(2, 14)] = -d203;
-                let d471 = A::mul_add(
-                    -p.L1,
-                    d463,
-                    A::mul_add(c_q_w, d466, s_q_w * d467),
-                ); // N(M col 6l) at 1.z
-                let d202 = A::mul_add(
-                    -p.L1,
-                    d195,
-                    A::mul_add(c_q_w, d199, s_q_w * d198),
-                ); // N(M col 6r) at 1.z
-                let d472 = A::mul_add(
-                    p.L2,
-                    d463,
-                    A::mul_add(-s_q_w, d466, c_q_w * d467),
-                ); // N(M col 6l) at 1.y
-                let d204 = A::mul_add(
-                    p.L2,
-                    d195,
-                    A::mul_add(-s_q_w, d199, c_q_w * d198),
-                ); // N(M col 6r) at 1.y
-                let d473 = A::mul_add(c_q_imu, d468, s_q_imu * d469); // F(M col 6l) at 0.x
-                m[(0, 7)] = -d473;
-                let d205 = A::mul_add(c_q_imu, d200, s_q_imu * d201); // F(M col 6r) at 0.x
-                m[(0, 14)] = -d205;
-                let d474 = A::mul_add(-s_q_imu, d471, c_q_imu * d472); // N(M col 6l) at 0.z
-                m[(1, 7)] = -d474;
-                let d206 = A::mul_add(-s_q_imu, d202, c_q_imu * d204); // N(M col 6r) at 0.z
-                m[(1, 14)] = d206;
-                let d475 = p.MX5l - d451; // MSC5l.x
-                let d207 = p.MX5r - d183; // MSC5r.x
-                let d476 = p.MZ5l + d450; // MSC5l.z
-                let d208 = p.MZ5r + d182; // MSC5r.z
-                let k34 = s_q3l * s_q3l; // sin² q3l
-                let k13 = s_q3r * s_q3r; // sin² q3r
-                let k35 = s_q3l * c_q3l; // sin q3l cos q3l
-                let k14 = s_q3r * c_q3r; // sin q3r cos q3r
-                let k36 = A::mul_add(2.0, k34, -1.0); // cos 2q3l
-                let k15 = A::mul_add(2.0, k13, -1.0); // cos 2q3r
-                let d477 = d444 - d449; // JC6l: Jzz − Jxx
-                let d209 = d176 - d181; // JC6r: Jzz − Jxx
-                let d478 = A::mul_add(2.0, d446 * k35, k34 * d477); // JC6l rotated about y: Jzz − J'zz
-                let d210 = A::mul_add(2.0, d178 * k14, k13 * d209); // JC6r rotated about y: Jzz − J'zz
-                let t68 = p.L7 * d440; // common subexpression
-                let t28 = p.L7 * d172; // common subexpression
-                let d479 = p.XY5l + t62 - t63 - t66; // JC5l.xy
-                let d211 = p.XY5r + t22 - t23 - t26; // JC5r.xy
-                let d480 = A::mul_add(-k35, d477, A::mul_add(d446, k36, p.XZ5l)); // JC5l.xz
-                let d212 = A::mul_add(-k14, d209, A::mul_add(d178, k15, p.XZ5r)); // JC5r.xz
-                let d481 = p.YY5l + d447; // JC5l.yy
-                let d213 = p.YY5r + d179; // JC5r.yy
-                let d482 = p.YZ5l - t64 - t65 + t67; // JC5l.yz
-                let d214 = p.YZ5r - t24 - t25 + t27; // JC5r.yz
-                let d483 = pc.pc42 - d440; // MSC5l.y
-                let d215 = pc.pc19 - d172; // MSC5r.y
-                let d484 = A::mul_add(2.0, t68, d444 - d478) + pc.pc43; // JC5l.xx
-                m[(6, 6)] = d484;
-                let d216 = A::mul_add(2.0, t28, d176 - d210) + pc.pc20; // JC5r.xx
-                m[(13, 13)] = d216;
-                let d485 = A::mul_add(2.0, t68, d449 + d478) + pc.pc44; // JC5l.zz
-                let d217 = A::mul_add(2.0, t28, d181 + d210) + pc.pc21; // JC5r.zz
-                let d486 = A::mul_add(s_q2l, d476, c_q2l * d483); // MSC5l in 4l.y
-                let d218 = A::mul_add(s_q2r, d208, c_q2r * d215); // MSC5r in 4r.y
-                let d487 = A::mul_add(-c_q2l, d476, s_q2l * d483); // MSC5l in 4l.z
-                let d219 = A::mul_add(-c_q2r, d208, s_q2r * d215); // MSC5r in 4r.z
-                let t69 = c_q2l * d479; // common subexpression
-                let t29 = c_q2r * d211; // common subexpression
-                let t70 = s_q2l * d480; // common subexpression
-                let t30 = s_q2r * d212; // common subexpression
-                let d488 = t69 + t70; // N(M col 5l) at 4l.y
-                m[(5, 6)] = -d488;
-                let d220 = t29 + t30; // N(M col 5r) at 4r.y
-                m[(12, 13)] = -d220;
-                let t71 = s_q2l * d479; // common subexpression
-                let t31 = s_q2r * d211; // common subexpression
-                let t72 = c_q2l * d480; // common subexpression
-                let t32 = c_q2r * d212; // common subexpression
-                let d489 = t71 - t72; // N(M col 5l) at 4l.z
-                let d221 = t31 - t32; // N(M col 5r) at 4r.z
-                let d490 = s_q1l * d486; // F(M col 5l) at 3.y
-                let d222 = s_q1r * d218; // F(M col 5r) at 3.y
-                let d491 = c_q1l * d486; // F(M col 5l) at 3.z
-                let d223 = c_q1r * d218; // F(M col 5r) at 3.z
-                let d492 = A::mul_add(p.L5, d491, d488); // N(M col 5l) at 3.x
-                let d226 = A::mul_add(p.L5, d223, d220); // N(M col 5r) at 3.x
-                let d493 = A::mul_add(
-                    -p.L6,
-                    d491,
-                    A::mul_add(-s_q1l, d489, c_q1l * d484),
-                ); // N(M col 5l) at 3.y
-                m[(4, 6)] = -d493;
-                let d224 = A::mul_add(
-                    -p.L6,
-                    d223,
-                    A::mul_add(-s_q1r, d221, c_q1r * d216),
-                ); // N(M col 5r) at 3.y
-                m[(4, 13)] = -d224;
-                let d494 = A::mul_add(
-                    p.L5,
-                    d487,
-                    A::mul_add(-p.L6, d490, A::mul_add(c_q1l, d489, s_q1l * d484)),
-                ); // N(M col 5l) at 3.z
-                let d225 = A::mul_add(
-                    p.L5,
-                    d219,
-                    A::mul_add(-p.L6, d222, A::mul_add(c_q1r, d221, s_q1r * d216)),
-                ); // N(M col 5r) at 3.z
-                let d495 = A::mul_add(-s_q_torso, d491, c_q_torso * d487); // F(M col 5l) at 2.x
-                let d227 = A::mul_add(-s_q_torso, d223, c_q_torso * d219); // F(M col 5r) at 2.x
-                let d230 = A::mul_add(-p.L4, d227, -d224); // N(M col 5r) at 2.y
-                let d496 = A::mul_add(c_q_torso, d491, s_q_torso * d487); // F(M col 5l) at 2.z
-                let d228 = A::mul_add(c_q_torso, d223, s_q_torso * d219); // F(M col 5r) at 2.z
-                let d229 = A::mul_add(
-                    -p.L3,
-                    d228,
-                    A::mul_add(
-                        -s_q_torso,
-                        d225,
-                        A::mul_add(-c_q_torso, d226, p.L4 * d222),
-                    ),
-                ); // N(M col 5r) at 2.x
-                m[(3, 13)] = d229;
-                let d232 = A::mul_add(s_q_w, d228, c_q_w * d222); // F(M col 5r) at 1.y
-                let d233 = A::mul_add(-c_q_w, d228, s_q_w * d222); // F(M col 5r) at 1.z
-                let d497 = A::mul_add(-p.L4, d495, d493); // N(M col 5l) at 2.y
-                let d498 = A::mul_add(
-                    p.L4,
-                    d490,
-                    A::mul_add(p.L3, d496, A::mul_add(s_q_torso, d494, c_q_torso * d492)),
-                ); // N(M col 5l) at 2.x
-                m[(3, 6)] = d498;
-                let d499 = A::mul_add(
-                    -p.L3,
-                    d495,
-                    A::mul_add(-c_q_torso, d494, s_q_torso * d492),
-                ); // N(M col 5l) at 2.z
-                let d231 = A::mul_add(
-                    -p.L3,
-                    d227,
-                    A::mul_add(-c_q_torso, d225, s_q_torso * d226),
-                ); // N(M col 5r) at 2.z
-                let d500 = A::mul_add(-s_q_w, d496, c_q_w * d490); // F(M col 5l) at 1.y
-                let d501 = A::mul_add(c_q_w, d496, s_q_w * d490); // F(M col 5l) at 1.z
-                let d502 = A::mul_add(
-                    p.L2,
-                    d495,
-                    A::mul_add(-s_q_w, d499, c_q_w * d497),
-                ); // N(M col 5l) at 1.y
-                let d235 = A::mul_add(
-                    p.L2,
-                    d227,
-                    A::mul_add(-s_q_w, d231, c_q_w * d230),
-                ); // N(M col 5r) at 1.y
-                let d503 = A::mul_add(-p.L2, d500, A::mul_add(p.L1, d501, d498)); // N(M col 5l) at 1.x
-                m[(2, 6)] = d503;
-                let d234 = A::mul_add(-p.L2, d232, A::mul_add(p.L1, d233, d229)); // N(M col 5r) at 1.x
-                m[(2, 13)] = d234;
-                let d504 = A::mul_add(
-                    -p.L1,
-                    d495,
-                    A::mul_add(c_q_w, d499, s_q_w * d497),
-                ); // N(M col 5l) at 1.z
-                let d236 = A::mul_add(
-                    -p.L1,
-                    d227,
-                    A::mul_add(c_q_w, d231, s_q_w * d230),
-                ); // N(M col 5r) at 1.z
-                let d505 = A::mul_add(c_q_imu, d501, s_q_imu * d500); // F(M col 5l) at 0.x
-                m[(0, 6)] = d505;
-                let d237 = A::mul_add(c_q_imu, d233, s_q_imu * d232); // F(M col 5r) at 0.x
-                m[(0, 13)] = d237;
-                let d506 = A::mul_add(-s_q_imu, d504, c_q_imu * d502); // N(M col 5l) at 0.z
-                m[(1, 6)] = d506;
-                let d238 = A::mul_add(-s_q_imu, d236, c_q_imu * d235); // N(M col 5r) at 0.z
-                m[(1, 13)] = -d238;
-                let d507 = p.MX4l - d475; // MSC4l.x
-                let d239 = p.MX4r - d207; // MSC4r.x
-                let d508 = p.MY4l - d486; // MSC4l.y
-                let d240 = p.MY4r - d218; // MSC4r.y
-                let d509 = p.MZ4l - d487; // MSC4l.z
-                let d241 = p.MZ4r - d219; // MSC4r.z
-                let k37 = s_q2l * s_q2l; // sin² q2l
-                let k16 = s_q2r * s_q2r; // sin² q2r
-                let k38 = s_q2l * c_q2l; // sin q2l cos q2l
-                let k17 = s_q2r * c_q2r; // sin q2r cos q2r
-                let k39 = A::mul_add(2.0, k37, -1.0); // cos 2q2l
-                let k18 = A::mul_add(2.0, k16, -1.0); // cos 2q2r
-                let d510 = d481 - d485; // JC5l: Jyy − Jzz
-                let d242 = d213 - d217; // JC5r: Jyy − Jzz
-                let d511 = A::mul_add(-2.0, d482 * k38, k37 * d510); // JC5l rotated about x: Jyy − J'yy
-                let d243 = A::mul_add(-2.0, d214 * k17, k16 * d242); // JC5r rotated about x: Jyy − J'yy
-                let d512 = p.XX4l + d484; // JC4l.xx
-                let d244 = p.XX4r + d216; // JC4r.xx
-                let d513 = p.XY4l + t69 + t70; // JC4l.xy
-                let d245 = p.XY4r + t29 + t30; // JC4r.xy
-                let d514 = p.XZ4l + t71 - t72; // JC4l.xz
-                let d246 = p.XZ4r + t31 - t32; // JC4r.xz
-                let d515 = p.YY4l + d481 - d511; // JC4l.yy
-                m[(5, 5)] = d515;
-                let d247 = p.YY4r + d213 - d243; // JC4r.yy
-                m[(12, 12)] = d247;
-                let d516 = A::mul_add(k38, d510, A::mul_add(d482, k39, p.YZ4l)); // JC4l.yz
-                let d248 = A::mul_add(k17, d242, A::mul_add(d214, k18, p.YZ4r)); // JC4r.yz
-                let d517 = p.ZZ4l + d485 + d511; // JC4l.zz
-                let d249 = p.ZZ4r + d217 + d243; // JC4r.zz
-                let d518 = A::mul_add(-s_q1l, d509, c_q1l * d507); // MSC4l in 3.y
-                let d250 = A::mul_add(-s_q1r, d241, c_q1r * d239); // MSC4r in 3.y
-                let d519 = A::mul_add(c_q1l, d509, s_q1l * d507); // MSC4l in 3.z
-                let d251 = A::mul_add(c_q1r, d241, s_q1r * d239); // MSC4r in 3.z
-                let t73 = c_q1l * d513; // common subexpression
-                let t33 = c_q1r * d245; // common subexpression
-                let t74 = s_q1l * d516; // common subexpression
-                let t34 = s_q1r * d248; // common subexpression
-                let t75 = s_q1l * d513; // common subexpression
-                let t35 = s_q1r * d245; // common subexpression
-                let t76 = c_q1l * d516; // common subexpression
-                let t36 = c_q1r * d248; // common subexpression
-                let t77 = p.L5 * d518; // common subexpression
-                let t37 = p.L5 * d250; // common subexpression
-                let t78 = p.L6 * d518; // common subexpression
-                let t38 = p.L6 * d250; // common subexpression
-                let t79 = p.L6 * d519; // common subexpression
-                let t39 = p.L6 * d251; // common subexpression
-                let d520 = t75 + t76 - t79; // N(M col 4l) at 3.z
-                let d254 = t35 + t36 - t39; // N(M col 4r) at 3.z
-                let d521 = d515 + t77; // N(M col 4l) at 3.x
-                let d252 = d247 + t37; // N(M col 4r) at 3.x
-                let d522 = t73 - t74 - t78; // N(M col 4l) at 3.y
-                m[(4, 5)] = d522;
-                let d253 = t33 - t34 - t38; // N(M col 4r) at 3.y
-                m[(4, 12)] = d253;
-                let d523 = s_q_torso * d518; // F(M col 4l) at 2.x
-                let d255 = s_q_torso * d250; // F(M col 4r) at 2.x
-                let d258 = A::mul_add(p.L4, d255, -d253); // N(M col 4r) at 2.y
-                let d524 = c_q_torso * d518; // F(M col 4l) at 2.z
-                let d256 = c_q_torso * d250; // F(M col 4r) at 2.z
-                let d257 = A::mul_add(
-                    -p.L3,
-                    d256,
-                    A::mul_add(
-                        -s_q_torso,
-                        d254,
-                        A::mul_add(-c_q_torso, d252, p.L4 * d251),
-                    ),
-                ); // N(M col 4r) at 2.x
-                m[(3, 12)] = -d257;
-                let d260 = A::mul_add(-c_q_w, d256, s_q_w * d251); // F(M col 4r) at 1.z
-                let d261 = A::mul_add(s_q_w, d256, c_q_w * d251); // F(M col 4r) at 1.y
-                let d525 = A::mul_add(
-                    p.L4,
-                    d519,
-                    A::mul_add(p.L3, d524, A::mul_add(s_q_torso, d520, c_q_torso * d521)),
-                ); // N(M col 4l) at 2.x
-                m[(3, 5)] = -d525;
-                let d526 = A::mul_add(
-                    p.L3,
-                    d523,
-                    A::mul_add(-c_q_torso, d520, s_q_torso * d521),
-                ); // N(M col 4l) at 2.z
-                let d259 = A::mul_add(
-                    p.L3,
-                    d255,
-                    A::mul_add(-c_q_torso, d254, s_q_torso * d252),
-                ); // N(M col 4r) at 2.z
-                let d527 = A::mul_add(p.L4, d523, d522); // N(M col 4l) at 2.y
-                let d528 = A::mul_add(c_q_w, d524, s_q_w * d519); // F(M col 4l) at 1.z
-                let d529 = A::mul_add(-s_q_w, d524, c_q_w * d519); // F(M col 4l) at 1.y
-                let d530 = A::mul_add(-p.L2, d529, A::mul_add(p.L1, d528, d525)); // N(M col 4l) at 1.x
-                m[(2, 5)] = -d530;
-                let d263 = A::mul_add(-p.L2, d261, A::mul_add(p.L1, d260, d257)); // N(M col 4r) at 1.x
-                m[(2, 12)] = -d263;
-                let d531 = A::mul_add(p.L1, d523, A::mul_add(c_q_w, d526, s_q_w * d527)); // N(M col 4l) at 1.z
-                let d262 = A::mul_add(p.L1, d255, A::mul_add(c_q_w, d259, s_q_w * d258)); // N(M col 4r) at 1.z
-                let d532 = A::mul_add(
-                    -p.L2,
-                    d523,
-                    A::mul_add(-s_q_w, d526, c_q_w * d527),
-                ); // N(M col 4l) at 1.y
-                let d264 = A::mul_add(
-                    -p.L2,
-                    d255,
-                    A::mul_add(-s_q_w, d259, c_q_w * d258),
-                ); // N(M col 4r) at 1.y
-                let d533 = A::mul_add(c_q_imu, d528, s_q_imu * d529); // F(M col 4l) at 0.x
-                m[(0, 5)] = -d533;
-                let d265 = A::mul_add(c_q_imu, d260, s_q_imu * d261); // F(M col 4r) at 0.x
-                m[(0, 12)] = -d265;
-                let d534 = A::mul_add(-s_q_imu, d531, c_q_imu * d532); // N(M col 4l) at 0.z
-                m[(1, 5)] = -d534;
-                let d266 = A::mul_add(-s_q_imu, d262, c_q_imu * d264); // N(M col 4r) at 0.z
-                m[(1, 12)] = d266;
-                let d535 = p.MZ3 + d251 - d519; // MSC3.z
-                let k40 = s_q1l * s_q1l; // sin² q1l
-                let k19 = s_q1r * s_q1r; // sin² q1r
-                let k41 = s_q1l * c_q1l; // sin q1l cos q1l
-                let k20 = s_q1r * c_q1r; // sin q1r cos q1r
-                let k42 = A::mul_add(2.0, k40, -1.0); // cos 2q1l
-                let k21 = A::mul_add(2.0, k19, -1.0); // cos 2q1r
-                let d536 = d512 - d517; // JC4l: Jzz − Jxx
-                let d267 = d244 - d249; // JC4r: Jzz − Jxx
-                let d537 = A::mul_add(2.0, d514 * k41, k40 * d536); // JC4l rotated about y: Jzz − J'zz
-                let d268 = A::mul_add(2.0, d246 * k20, k19 * d267); // JC4r rotated about y: Jzz − J'zz
-                let t80 = p.L6 * d508; // common subexpression
-                let t40 = p.L6 * d240; // common subexpression
-                let d538 = p.XZ3 - t35 - t36 + t39 - t75 - t76 + t79; // JC3.xz
-                let d539 = A::mul_add(
-                    p.L5,
-                    d519,
-                    A::mul_add(
-                        -k41,
-                        d536,
-                        A::mul_add(
-                            d514,
-                            k42,
-                            A::mul_add(
-                                -p.L5,
-                                d251,
-                                A::mul_add(k20, d267, A::mul_add(-d246, k21, p.YZ3)),
-                            ),
-                        ),
-                    ),
-                ); // JC3.yz
-                let d540 = d508 - d240 + pc.pc47; // MSC3.x
-                let d541 = d250 + d518 + pc.pc48; // MSC3.y
-                let d542 = A::mul_add(2.0, t77, A::mul_add(2.0, t37, d247) + d515)
-                    + pc.pc49; // JC3.xx
-                let d543 = A::mul_add(
-                    -p.L5,
-                    d508,
-                    A::mul_add(p.L5, d240, t34 - t33 + t38) + t73 - t74 - t78,
-                ) + pc.pc50; // JC3.xy
-                let d544 = A::mul_add(
-                    2.0,
-                    t80,
-                    A::mul_add(2.0, t40, d244 - d268) + d512 - d537,
-                ) + pc.pc51; // JC3.yy
-                m[(4, 4)] = d544;
-                let d545 = A::mul_add(
-                    2.0,
-                    t80,
-                    A::mul_add(
-                        2.0,
-                        t77,
-                        A::mul_add(2.0, t40, A::mul_add(2.0, t37, d249) + d268) + d517,
-                    ) + d537,
-                ) + pc.pc52; // JC3.zz
-                let d546 = A::mul_add(-s_q_torso, d535, c_q_torso * d540); // MSC3 in 2.x
-                let d547 = A::mul_add(c_q_torso, d535, s_q_torso * d540); // MSC3 in 2.z
-                let t81 = c_q_torso * d543; // common subexpression
-                let t82 = s_q_torso * d539; // common subexpression
-                let t83 = s_q_torso * d543; // common subexpression
-                let t84 = c_q_torso * d539; // common subexpression
-                let t85 = p.L3 * d546; // common subexpression
-                let t86 = p.L4 * d547; // common subexpression
-                let t87 = p.L3 * d547; // common subexpression
-                let d548 = t81 - t82 - t85; // N(M col 3) at 2.x
-                m[(3, 4)] = -d548;
-                let d549 = t83 + t84 - t87; // N(M col 3) at 2.z
-                let d550 = d544 - t86; // N(M col 3) at 2.y
-                let d551 = s_q_w * d546; // F(M col 3) at 1.y
-                let d552 = c_q_w * d546; // F(M col 3) at 1.z
-                let d553 = A::mul_add(-p.L2, d551, A::mul_add(-p.L1, d552, d548)); // N(M col 3) at 1.x
-                m[(2, 4)] = -d553;
-                let d554 = A::mul_add(
-                    -p.L1,
-                    d547,
-                    A::mul_add(c_q_w, d549, s_q_w * d550),
-                ); // N(M col 3) at 1.z
-                let d555 = A::mul_add(
-                    p.L2,
-                    d547,
-                    A::mul_add(-s_q_w, d549, c_q_w * d550),
-                ); // N(M col 3) at 1.y
-                let d556 = A::mul_add(-c_q_imu, d552, s_q_imu * d551); // F(M col 3) at 0.x
-                m[(0, 4)] = -d556;
-                let d557 = A::mul_add(-s_q_imu, d554, c_q_imu * d555); // N(M col 3) at 0.z
-                m[(1, 4)] = -d557;
-                let d558 = p.MX2 - d546; // MSC2.x
-                let k43 = s_q_torso * s_q_torso; // sin² q_torso
-                let k44 = s_q_torso * c_q_torso; // sin q_torso cos q_torso
-                let k45 = A::mul_add(2.0, k43, -1.0); // cos 2q_torso
-                let d559 = d542 - d545; // JC3: Jzz − Jxx
-                let d560 = A::mul_add(2.0, d538 * k44, k43 * d559); // JC3 rotated about y: Jzz − J'zz
-                let t88 = p.L3 * d541; // common subexpression
-                let d561 = p.XY2 - t81 + t82 + t85; // JC2.xy
-                let d562 = A::mul_add(
-                    p.L4,
-                    d546,
-                    A::mul_add(k44, d559, A::mul_add(-d538, k45, p.XZ2)),
-                ); // JC2.xz
-                let d563 = d541 + pc.pc54; // MSC2.y
-                let d564 = pc.pc55 - d547; // MSC2.z
-                let d565 = A::mul_add(2.0, t88, A::mul_add(-2.0, t86, d542) - d560)
-                    + pc.pc56; // JC2.xx
-                m[(3, 3)] = d565;
-                let d566 = A::mul_add(-2.0, t86, d544) + pc.pc57; // JC2.yy
-                let d567 = A::mul_add(-p.L4, d541, t87 - t83 - t84) + pc.pc58; // JC2.yz
-                let d568 = A::mul_add(2.0, t88, d545 + d560) + pc.pc59; // JC2.zz
-                let d569 = A::mul_add(s_q_w, d564, c_q_w * d563); // MSC2 in 1.y
-                let d570 = A::mul_add(-c_q_w, d564, s_q_w * d563); // MSC2 in 1.z
-                let t89 = c_q_w * d561; // common subexpression
-                let t90 = s_q_w * d562; // common subexpression
-                let t91 = s_q_w * d561; // common subexpression
-                let t92 = c_q_w * d562; // common subexpression
-                let d571 = t91 - t92; // N(M col 2) at 1.z
-                let t93 = p.L1 * d569; // common subexpression
-                let t94 = p.L2 * d570; // common subexpression
-                let d572 = d565 + t93 + t94; // N(M col 2) at 1.x
-                m[(2, 3)] = d572;
-                let d573 = t89 + t90; // N(M col 2) at 1.y
-                let d574 = A::mul_add(-c_q_imu, d569, s_q_imu * d570); // F(M col 2) at 0.x
-                m[(0, 3)] = -d574;
-                let d575 = A::mul_add(-s_q_imu, d571, c_q_imu * d573); // N(M col 2) at 0.z
-                m[(1, 3)] = -d575;
-                let d576 = p.MX1 + d558; // MSC1.x
-                m[(0, 1)] = d576;
-                let k46 = s_q_w * s_q_w; // sin² q_w
-                let k47 = s_q_w * c_q_w; // sin q_w cos q_w
-                let k48 = A::mul_add(2.0, k46, -1.0); // cos 2q_w
-                let d577 = d566 - d568; // JC2: Jyy − Jzz
-                let d578 = A::mul_add(-2.0, d567 * k47, k46 * d577); // JC2 rotated about x: Jyy − J'yy
-                let d579 = A::mul_add(-p.L1, d558, p.XY1 + t89 + t90); // JC1.xy
-                let d580 = A::mul_add(p.L2, d558, p.XZ1 - t91 + t92); // JC1.xz
-                let d581 = d569 + pc.pc61; // MSC1.y
-                let d582 = pc.pc62 - d570; // MSC1.z
-                let d583 = A::mul_add(2.0, t94, A::mul_add(2.0, t93, d565)) + pc.pc63; // JC1.xx
-                m[(2, 2)] = d583;
-                let d584 = A::mul_add(2.0, t94, d566) - d578 + pc.pc64; // JC1.yy
-                let d585 = A::mul_add(
-                    p.L1,
-                    d570,
-                    A::mul_add(-k47, d577, A::mul_add(-d567, k48, p.L2 * d569)),
-                ) + pc.pc65; // JC1.yz
-                let d586 = A::mul_add(2.0, t93, d568) + d578 + pc.pc66; // JC1.zz
-                let d587 = A::mul_add(s_q_imu, d582, c_q_imu * d581); // MSC1 in 0.z
-                m[(0, 2)] = d587;
-                let d588 = A::mul_add(s_q_imu, d580, c_q_imu * d579); // N(M col 1) at 0.z
-                m[(1, 2)] = -d588;
-                let k49 = s_q_imu * s_q_imu; // sin² q_imu
-                let k50 = s_q_imu * c_q_imu; // sin q_imu cos q_imu
-                let d589 = d584 - d586; // JC1: Jyy − Jzz
-                let d590 = A::mul_add(-2.0, d585 * k50, k49 * d589); // JC1 rotated about x: Jyy − J'yy
-                let d591 = d584 - d590; // JC0
-                m[(1, 1)] = d591 + pc.pc68;
-            }
+            mass_matrix_batch_body::<A, _, L>(p, pc, &q, out);
             for m in out.iter_mut() {
                 m[(1, 0)] = m[(0, 1)];
                 m[(2, 0)] = m[(0, 2)];
@@ -10929,1366 +10722,8 @@ mod generated {
             q: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
             out: &mut SMatrix<kanegen_runtime::lanes::Lanes<L>, 19, 19>,
         ) {
-            let p = &{ *p };
-            let pc = &{ *pc };
-            let q = &{ *q };
-            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
-                A,
-                _,
-                L,
-            >([
-                q[2].0,
-                q[3].0,
-                q[4].0,
-                q[5].0,
-                q[12].0,
-                q[6].0,
-                q[13].0,
-                q[7].0,
-                q[14].0,
-                q[8].0,
-                q[15].0,
-                q[9].0,
-                q[16].0,
-                q[10].0,
-                q[17].0,
-                q[11].0,
-                q[18].0,
-            ]);
-            for l in 0..L {
-                let s_q_imu = sin_q[0][l];
-                let c_q_imu = cos_q[0][l];
-                let s_q_w = sin_q[1][l];
-                let c_q_w = cos_q[1][l];
-                let s_q_torso = sin_q[2][l];
-                let c_q_torso = cos_q[2][l];
-                let s_q1l = sin_q[3][l];
-                let c_q1l = cos_q[3][l];
-                let s_q1r = sin_q[4][l];
-                let c_q1r = cos_q[4][l];
-                let s_q2l = sin_q[5][l];
-                let c_q2l = cos_q[5][l];
-                let s_q2r = sin_q[6][l];
-                let c_q2r = cos_q[6][l];
-                let s_q3l = sin_q[7][l];
-                let c_q3l = cos_q[7][l];
-                let s_q3r = sin_q[8][l];
-                let c_q3r = cos_q[8][l];
-                let s_q4l = sin_q[9][l];
-                let c_q4l = cos_q[9][l];
-                let s_q4r = sin_q[10][l];
-                let c_q4r = cos_q[10][l];
-                let s_q5l = sin_q[11][l];
-                let c_q5l = cos_q[11][l];
-                let s_q5r = sin_q[12][l];
-                let c_q5r = cos_q[12][l];
-                let s_q6l = sin_q[13][l];
-                let c_q6l = cos_q[13][l];
-                let s_q6r = sin_q[14][l];
-                let c_q6r = cos_q[14][l];
-                let s_q7l = sin_q[15][l];
-                let c_q7l = cos_q[15][l];
-                let s_q7r = sin_q[16][l];
-                let c_q7r = cos_q[16][l];
-                out[(0, 0)].0[l] = pc.pc69;
-                out[(11, 11)].0[l] = p.ZZ10l;
-                out[(18, 18)].0[l] = p.ZZ10r;
-                let d269 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
-                let d1 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
-                let d270 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
-                let d2 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
-                let t41 = p.XZ10l * c_q7l; // common subexpression
-                let t1 = p.XZ10r * c_q7r; // common subexpression
-                let t42 = p.YZ10l * s_q7l; // common subexpression
-                let t2 = p.YZ10r * s_q7r; // common subexpression
-                let t43 = p.XZ10l * s_q7l; // common subexpression
-                let t3 = p.XZ10r * s_q7r; // common subexpression
-                let t44 = p.YZ10l * c_q7l; // common subexpression
-                let t4 = p.YZ10r * c_q7r; // common subexpression
-                let t45 = p.L9 * d270; // common subexpression
-                let t5 = p.L9 * d2; // common subexpression
-                let t46 = p.L9 * d269; // common subexpression
-                let t6 = p.L9 * d1; // common subexpression
-                let d271 = t41 + t42 - t45; // N(M col 10l) at 9l.x
-                out[(10, 11)].0[l] = -d271;
-                let d3 = t1 + t2 - t5; // N(M col 10r) at 9r.x
-                out[(17, 18)].0[l] = -d3;
-                let d272 = t43 - t44 - t46; // N(M col 10l) at 9l.z
-                let d4 = t3 - t4 - t6; // N(M col 10r) at 9r.z
-                let d273 = d270 * s_q6l; // F(M col 10l) at 8l.y
-                let d5 = d2 * s_q6r; // F(M col 10r) at 8r.y
-                let d274 = d270 * c_q6l; // F(M col 10l) at 8l.z
-                let d6 = d2 * c_q6r; // F(M col 10r) at 8r.z
-                let d275 = A::mul_add(-d272, s_q6l, p.ZZ10l * c_q6l); // N(M col 10l) at 8l.y
-                out[(9, 11)].0[l] = d275;
-                let d7 = A::mul_add(-d4, s_q6r, p.ZZ10r * c_q6r); // N(M col 10r) at 8r.y
-                out[(16, 18)].0[l] = d7;
-                let d276 = A::mul_add(d272, c_q6l, p.ZZ10l * s_q6l); // N(M col 10l) at 8l.z
-                let d8 = A::mul_add(d4, c_q6r, p.ZZ10r * s_q6r); // N(M col 10r) at 8r.z
-                let d277 = A::mul_add(d274, s_q5l, d269 * c_q5l); // F(M col 10l) at 7l.x
-                let d9 = A::mul_add(d6, s_q5r, d1 * c_q5r); // F(M col 10r) at 7r.x
-                let d278 = A::mul_add(-d274, c_q5l, d269 * s_q5l); // F(M col 10l) at 7l.z
-                let d10 = A::mul_add(-d6, c_q5r, d1 * s_q5r); // F(M col 10r) at 7r.z
-                let d279 = A::mul_add(
-                    p.L8,
-                    d278,
-                    A::mul_add(-d276, s_q5l, d271 * c_q5l),
-                ); // N(M col 10l) at 7l.x
-                out[(8, 11)].0[l] = -d279;
-                let d11 = A::mul_add(p.L8, d10, A::mul_add(-d8, s_q5r, d3 * c_q5r)); // N(M col 10r) at 7r.x
-                out[(15, 18)].0[l] = -d11;
-                let d280 = A::mul_add(
-                    -p.L8,
-                    d277,
-                    A::mul_add(d276, c_q5l, d271 * s_q5l),
-                ); // N(M col 10l) at 7l.z
-                let d12 = A::mul_add(-p.L8, d9, A::mul_add(d8, c_q5r, d3 * s_q5r)); // N(M col 10r) at 7r.z
-                let d281 = A::mul_add(-d278, s_q4l, d273 * c_q4l); // F(M col 10l) at 6l.y
-                let d13 = A::mul_add(-d10, s_q4r, d5 * c_q4r); // F(M col 10r) at 6r.y
-                let d282 = A::mul_add(d278, c_q4l, d273 * s_q4l); // F(M col 10l) at 6l.z
-                let d14 = A::mul_add(d10, c_q4r, d5 * s_q4r); // F(M col 10r) at 6r.z
-                let d283 = A::mul_add(-d280, s_q4l, d275 * c_q4l); // N(M col 10l) at 6l.y
-                out[(7, 11)].0[l] = d283;
-                let d15 = A::mul_add(-d12, s_q4r, d7 * c_q4r); // N(M col 10r) at 6r.y
-                out[(14, 18)].0[l] = d15;
-                let d284 = A::mul_add(d280, c_q4l, d275 * s_q4l); // N(M col 10l) at 6l.z
-                let d16 = A::mul_add(d12, c_q4r, d7 * s_q4r); // N(M col 10r) at 6r.z
-                let d285 = A::mul_add(-d282, s_q3l, d277 * c_q3l); // F(M col 10l) at 5l.x
-                let d17 = A::mul_add(-d14, s_q3r, d9 * c_q3r); // F(M col 10r) at 5r.x
-                let d286 = A::mul_add(d282, c_q3l, d277 * s_q3l); // F(M col 10l) at 5l.z
-                let d18 = A::mul_add(d14, c_q3r, d9 * s_q3r); // F(M col 10r) at 5r.z
-                let d287 = A::mul_add(
-                    p.L7,
-                    d286,
-                    A::mul_add(-d284, s_q3l, d279 * c_q3l),
-                ); // N(M col 10l) at 5l.x
-                out[(6, 11)].0[l] = -d287;
-                let d19 = A::mul_add(p.L7, d18, A::mul_add(-d16, s_q3r, d11 * c_q3r)); // N(M col 10r) at 5r.x
-                out[(13, 18)].0[l] = -d19;
-                let d288 = A::mul_add(
-                    -p.L7,
-                    d285,
-                    A::mul_add(d284, c_q3l, d279 * s_q3l),
-                ); // N(M col 10l) at 5l.z
-                let d20 = A::mul_add(-p.L7, d17, A::mul_add(d16, c_q3r, d11 * s_q3r)); // N(M col 10r) at 5r.z
-                let d289 = A::mul_add(-d286, s_q2l, d281 * c_q2l); // F(M col 10l) at 4l.y
-                let d21 = A::mul_add(-d18, s_q2r, d13 * c_q2r); // F(M col 10r) at 4r.y
-                let d290 = A::mul_add(d286, c_q2l, d281 * s_q2l); // F(M col 10l) at 4l.z
-                let d22 = A::mul_add(d18, c_q2r, d13 * s_q2r); // F(M col 10r) at 4r.z
-                let d291 = A::mul_add(-d288, s_q2l, d283 * c_q2l); // N(M col 10l) at 4l.y
-                out[(5, 11)].0[l] = d291;
-                let d23 = A::mul_add(-d20, s_q2r, d15 * c_q2r); // N(M col 10r) at 4r.y
-                out[(12, 18)].0[l] = d23;
-                let d292 = A::mul_add(d288, c_q2l, d283 * s_q2l); // N(M col 10l) at 4l.z
-                let d24 = A::mul_add(d20, c_q2r, d15 * s_q2r); // N(M col 10r) at 4r.z
-                let d293 = A::mul_add(d290, c_q1l, d285 * s_q1l); // F(M col 10l) at 3.z
-                let d26 = A::mul_add(d22, c_q1r, d17 * s_q1r); // F(M col 10r) at 3.z
-                let d294 = A::mul_add(-d290, s_q1l, d285 * c_q1l); // F(M col 10l) at 3.y
-                let d25 = A::mul_add(-d22, s_q1r, d17 * c_q1r); // F(M col 10r) at 3.y
-                let d295 = A::mul_add(
-                    p.L5,
-                    d289,
-                    A::mul_add(-p.L6, d294, A::mul_add(d292, c_q1l, d287 * s_q1l)),
-                ); // N(M col 10l) at 3.z
-                let d29 = A::mul_add(
-                    p.L5,
-                    d21,
-                    A::mul_add(-p.L6, d25, A::mul_add(d24, c_q1r, d19 * s_q1r)),
-                ); // N(M col 10r) at 3.z
-                let d296 = A::mul_add(-p.L5, d293, d291); // N(M col 10l) at 3.x
-                let d27 = A::mul_add(-p.L5, d26, d23); // N(M col 10r) at 3.x
-                let d297 = A::mul_add(
-                    p.L6,
-                    d293,
-                    A::mul_add(-d292, s_q1l, d287 * c_q1l),
-                ); // N(M col 10l) at 3.y
-                out[(4, 11)].0[l] = d297;
-                let d28 = A::mul_add(p.L6, d26, A::mul_add(-d24, s_q1r, d19 * c_q1r)); // N(M col 10r) at 3.y
-                out[(4, 18)].0[l] = d28;
-                let d298 = A::mul_add(s_q_torso, d293, c_q_torso * d289); // F(M col 10l) at 2.x
-                let d30 = A::mul_add(s_q_torso, d26, c_q_torso * d21); // F(M col 10r) at 2.x
-                let d33 = A::mul_add(-p.L4, d30, -d28); // N(M col 10r) at 2.y
-                let d299 = A::mul_add(-c_q_torso, d293, s_q_torso * d289); // F(M col 10l) at 2.z
-                let d31 = A::mul_add(-c_q_torso, d26, s_q_torso * d21); // F(M col 10r) at 2.z
-                let d32 = A::mul_add(
-                    -p.L3,
-                    d31,
-                    A::mul_add(-d29, s_q_torso, A::mul_add(-d27, c_q_torso, d25 * p.L4)),
-                ); // N(M col 10r) at 2.x
-                out[(3, 18)].0[l] = -d32;
-                let d35 = A::mul_add(-d31, c_q_w, d25 * s_q_w); // F(M col 10r) at 1.z
-                let d36 = A::mul_add(d31, s_q_w, d25 * c_q_w); // F(M col 10r) at 1.y
-                let d300 = A::mul_add(
-                    p.L4,
-                    d294,
-                    A::mul_add(p.L3, d299, A::mul_add(s_q_torso, d295, c_q_torso * d296)),
-                ); // N(M col 10l) at 2.x
-                out[(3, 11)].0[l] = -d300;
-                let d301 = A::mul_add(
-                    -p.L3,
-                    d298,
-                    A::mul_add(-c_q_torso, d295, s_q_torso * d296),
-                ); // N(M col 10l) at 2.z
-                let d34 = A::mul_add(
-                    -p.L3,
-                    d30,
-                    A::mul_add(-c_q_torso, d29, s_q_torso * d27),
-                ); // N(M col 10r) at 2.z
-                let d302 = A::mul_add(-p.L4, d298, d297); // N(M col 10l) at 2.y
-                let d303 = A::mul_add(c_q_w, d299, s_q_w * d294); // F(M col 10l) at 1.z
-                let d304 = A::mul_add(-s_q_w, d299, c_q_w * d294); // F(M col 10l) at 1.y
-                let d305 = A::mul_add(-p.L2, d304, A::mul_add(p.L1, d303, d300)); // N(M col 10l) at 1.x
-                out[(2, 11)].0[l] = -d305;
-                let d38 = A::mul_add(-p.L2, d36, A::mul_add(p.L1, d35, d32)); // N(M col 10r) at 1.x
-                out[(2, 18)].0[l] = -d38;
-                let d306 = A::mul_add(
-                    -p.L1,
-                    d298,
-                    A::mul_add(c_q_w, d301, s_q_w * d302),
-                ); // N(M col 10l) at 1.z
-                let d37 = A::mul_add(-p.L1, d30, A::mul_add(c_q_w, d34, s_q_w * d33)); // N(M col 10r) at 1.z
-                let d307 = A::mul_add(
-                    p.L2,
-                    d298,
-                    A::mul_add(-s_q_w, d301, c_q_w * d302),
-                ); // N(M col 10l) at 1.y
-                let d39 = A::mul_add(p.L2, d30, A::mul_add(-s_q_w, d34, c_q_w * d33)); // N(M col 10r) at 1.y
-                let d308 = A::mul_add(c_q_imu, d303, s_q_imu * d304); // F(M col 10l) at 0.x
-                out[(0, 11)].0[l] = -d308;
-                let d40 = A::mul_add(c_q_imu, d35, s_q_imu * d36); // F(M col 10r) at 0.x
-                out[(0, 18)].0[l] = -d40;
-                let d309 = A::mul_add(-s_q_imu, d306, c_q_imu * d307); // N(M col 10l) at 0.z
-                out[(1, 11)].0[l] = -d309;
-                let d41 = A::mul_add(-s_q_imu, d37, c_q_imu * d39); // N(M col 10r) at 0.z
-                out[(1, 18)].0[l] = d41;
-                let d310 = p.MX9l - d270; // MSC9l.x
-                let d42 = p.MX9r - d2; // MSC9r.x
-                let d311 = p.MZ9l + d269; // MSC9l.z
-                let d43 = p.MZ9r + d1; // MSC9r.z
-                let k22 = s_q7l * s_q7l; // sin² q7l
-                let k1 = s_q7r * s_q7r; // sin² q7r
-                let k23 = s_q7l * c_q7l; // sin q7l cos q7l
-                let k2 = s_q7r * c_q7r; // sin q7r cos q7r
-                let k24 = A::mul_add(2.0, k22, -1.0); // cos 2q7l
-                let k3 = A::mul_add(2.0, k1, -1.0); // cos 2q7r
-                let d312 = A::mul_add(-2.0, p.XY10l * k23, k22 * pc.pc26); // JC10l rotated about z: Jxx − J'xx
-                let d44 = A::mul_add(-2.0, p.XY10r * k2, k1 * pc.pc3); // JC10r rotated about z: Jxx − J'xx
-                let d313 = p.XY9l + t41 + t42 - t45; // JC9l.xy
-                let d45 = p.XY9r + t1 + t2 - t5; // JC9r.xy
-                let d314 = A::mul_add(-k23, pc.pc26, A::mul_add(-p.XY10l, k24, p.XZ9l)); // JC9l.xz
-                let d46 = A::mul_add(-k2, pc.pc3, A::mul_add(-p.XY10r, k3, p.XZ9r)); // JC9r.xz
-                let d315 = p.YZ9l - t43 + t44 + t46; // JC9l.yz
-                let d47 = p.YZ9r - t3 + t4 + t6; // JC9r.yz
-                let d316 = pc.pc30 - d312; // JC9l.xx
-                out[(10, 10)].0[l] = d316;
-                let d48 = pc.pc7 - d44; // JC9r.xx
-                out[(17, 17)].0[l] = d48;
-                let d317 = d312 + pc.pc31; // JC9l.zz
-                let d49 = d44 + pc.pc8; // JC9r.zz
-                let d318 = A::mul_add(s_q6l, d311, c_q6l * pc.pc25); // MSC9l in 8l.y
-                let d50 = A::mul_add(s_q6r, d43, c_q6r * pc.pc2); // MSC9r in 8r.y
-                let d319 = A::mul_add(-c_q6l, d311, s_q6l * pc.pc25); // MSC9l in 8l.z
-                let d51 = A::mul_add(-c_q6r, d43, s_q6r * pc.pc2); // MSC9r in 8r.z
-                let t47 = c_q6l * d313; // common subexpression
-                let t7 = c_q6r * d45; // common subexpression
-                let t48 = s_q6l * d314; // common subexpression
-                let t8 = s_q6r * d46; // common subexpression
-                let d320 = t47 + t48; // N(M col 9l) at 8l.y
-                out[(9, 10)].0[l] = -d320;
-                let d52 = t7 + t8; // N(M col 9r) at 8r.y
-                out[(16, 17)].0[l] = -d52;
-                let t49 = s_q6l * d313; // common subexpression
-                let t9 = s_q6r * d45; // common subexpression
-                let t50 = c_q6l * d314; // common subexpression
-                let t10 = c_q6r * d46; // common subexpression
-                let d321 = t49 - t50; // N(M col 9l) at 8l.z
-                let d53 = t9 - t10; // N(M col 9r) at 8r.z
-                let d322 = s_q5l * d318; // F(M col 9l) at 7l.x
-                let d54 = s_q5r * d50; // F(M col 9r) at 7r.x
-                let d323 = c_q5l * d318; // F(M col 9l) at 7l.z
-                let d55 = c_q5r * d50; // F(M col 9r) at 7r.z
-                let d324 = A::mul_add(
-                    -p.L8,
-                    d322,
-                    A::mul_add(c_q5l, d321, s_q5l * d316),
-                ); // N(M col 9l) at 7l.z
-                let d56 = A::mul_add(-p.L8, d54, A::mul_add(c_q5r, d53, s_q5r * d48)); // N(M col 9r) at 7r.z
-                let d325 = A::mul_add(
-                    -p.L8,
-                    d323,
-                    A::mul_add(-s_q5l, d321, c_q5l * d316),
-                ); // N(M col 9l) at 7l.x
-                out[(8, 10)].0[l] = d325;
-                let d57 = A::mul_add(-p.L8, d55, A::mul_add(-s_q5r, d53, c_q5r * d48)); // N(M col 9r) at 7r.x
-                out[(15, 17)].0[l] = d57;
-                let d326 = A::mul_add(s_q4l, d323, c_q4l * d319); // F(M col 9l) at 6l.y
-                let d58 = A::mul_add(s_q4r, d55, c_q4r * d51); // F(M col 9r) at 6r.y
-                let d327 = A::mul_add(-c_q4l, d323, s_q4l * d319); // F(M col 9l) at 6l.z
-                let d59 = A::mul_add(-c_q4r, d55, s_q4r * d51); // F(M col 9r) at 6r.z
-                let d328 = A::mul_add(-s_q4l, d324, c_q4l * d320); // N(M col 9l) at 6l.y
-                out[(7, 10)].0[l] = -d328;
-                let d60 = A::mul_add(-s_q4r, d56, c_q4r * d52); // N(M col 9r) at 6r.y
-                out[(14, 17)].0[l] = -d60;
-                let d329 = A::mul_add(c_q4l, d324, s_q4l * d320); // N(M col 9l) at 6l.z
-                let d61 = A::mul_add(c_q4r, d56, s_q4r * d52); // N(M col 9r) at 6r.z
-                let d330 = A::mul_add(c_q3l, d327, s_q3l * d322); // F(M col 9l) at 5l.z
-                let d62 = A::mul_add(c_q3r, d59, s_q3r * d54); // F(M col 9r) at 5r.z
-                let d331 = A::mul_add(-s_q3l, d327, c_q3l * d322); // F(M col 9l) at 5l.x
-                let d63 = A::mul_add(-s_q3r, d59, c_q3r * d54); // F(M col 9r) at 5r.x
-                let d332 = A::mul_add(
-                    -p.L7,
-                    d331,
-                    A::mul_add(c_q3l, d329, s_q3l * d325),
-                ); // N(M col 9l) at 5l.z
-                let d64 = A::mul_add(-p.L7, d63, A::mul_add(c_q3r, d61, s_q3r * d57)); // N(M col 9r) at 5r.z
-                let d333 = A::mul_add(
-                    p.L7,
-                    d330,
-                    A::mul_add(-s_q3l, d329, c_q3l * d325),
-                ); // N(M col 9l) at 5l.x
-                out[(6, 10)].0[l] = d333;
-                let d65 = A::mul_add(p.L7, d62, A::mul_add(-s_q3r, d61, c_q3r * d57)); // N(M col 9r) at 5r.x
-                out[(13, 17)].0[l] = d65;
-                let d334 = A::mul_add(-s_q2l, d330, c_q2l * d326); // F(M col 9l) at 4l.y
-                let d66 = A::mul_add(-s_q2r, d62, c_q2r * d58); // F(M col 9r) at 4r.y
-                let d335 = A::mul_add(c_q2l, d330, s_q2l * d326); // F(M col 9l) at 4l.z
-                let d67 = A::mul_add(c_q2r, d62, s_q2r * d58); // F(M col 9r) at 4r.z
-                let d336 = A::mul_add(-s_q2l, d332, c_q2l * d328); // N(M col 9l) at 4l.y
-                out[(5, 10)].0[l] = -d336;
-                let d68 = A::mul_add(-s_q2r, d64, c_q2r * d60); // N(M col 9r) at 4r.y
-                out[(12, 17)].0[l] = -d68;
-                let d337 = A::mul_add(c_q2l, d332, s_q2l * d328); // N(M col 9l) at 4l.z
-                let d69 = A::mul_add(c_q2r, d64, s_q2r * d60); // N(M col 9r) at 4r.z
-                let d338 = A::mul_add(-s_q1l, d335, c_q1l * d331); // F(M col 9l) at 3.y
-                let d70 = A::mul_add(-s_q1r, d67, c_q1r * d63); // F(M col 9r) at 3.y
-                let d339 = A::mul_add(c_q1l, d335, s_q1l * d331); // F(M col 9l) at 3.z
-                let d71 = A::mul_add(c_q1r, d67, s_q1r * d63); // F(M col 9r) at 3.z
-                let d340 = A::mul_add(-p.L5, d339, d336); // N(M col 9l) at 3.x
-                let d74 = A::mul_add(-p.L5, d71, d68); // N(M col 9r) at 3.x
-                let d341 = A::mul_add(
-                    p.L6,
-                    d339,
-                    A::mul_add(-s_q1l, d337, c_q1l * d333),
-                ); // N(M col 9l) at 3.y
-                out[(4, 10)].0[l] = -d341;
-                let d72 = A::mul_add(p.L6, d71, A::mul_add(-s_q1r, d69, c_q1r * d65)); // N(M col 9r) at 3.y
-                out[(4, 17)].0[l] = -d72;
-                let d342 = A::mul_add(
-                    p.L5,
-                    d334,
-                    A::mul_add(-p.L6, d338, A::mul_add(c_q1l, d337, s_q1l * d333)),
-                ); // N(M col 9l) at 3.z
-                let d73 = A::mul_add(
-                    p.L5,
-                    d66,
-                    A::mul_add(-p.L6, d70, A::mul_add(c_q1r, d69, s_q1r * d65)),
-                ); // N(M col 9r) at 3.z
-                let d343 = A::mul_add(s_q_torso, d339, c_q_torso * d334); // F(M col 9l) at 2.x
-                let d75 = A::mul_add(s_q_torso, d71, c_q_torso * d66); // F(M col 9r) at 2.x
-                let d78 = A::mul_add(-p.L4, d75, -d72); // N(M col 9r) at 2.y
-                let d344 = A::mul_add(-c_q_torso, d339, s_q_torso * d334); // F(M col 9l) at 2.z
-                let d76 = A::mul_add(-c_q_torso, d71, s_q_torso * d66); // F(M col 9r) at 2.z
-                let d77 = A::mul_add(
-                    -p.L3,
-                    d76,
-                    A::mul_add(-s_q_torso, d73, A::mul_add(-c_q_torso, d74, p.L4 * d70)),
-                ); // N(M col 9r) at 2.x
-                out[(3, 17)].0[l] = d77;
-                let d80 = A::mul_add(s_q_w, d76, c_q_w * d70); // F(M col 9r) at 1.y
-                let d81 = A::mul_add(-c_q_w, d76, s_q_w * d70); // F(M col 9r) at 1.z
-                let d345 = A::mul_add(-p.L4, d343, d341); // N(M col 9l) at 2.y
-                let d346 = A::mul_add(
-                    p.L4,
-                    d338,
-                    A::mul_add(p.L3, d344, A::mul_add(s_q_torso, d342, c_q_torso * d340)),
-                ); // N(M col 9l) at 2.x
-                out[(3, 10)].0[l] = d346;
-                let d347 = A::mul_add(
-                    -p.L3,
-                    d343,
-                    A::mul_add(-c_q_torso, d342, s_q_torso * d340),
-                ); // N(M col 9l) at 2.z
-                let d79 = A::mul_add(
-                    -p.L3,
-                    d75,
-                    A::mul_add(-c_q_torso, d73, s_q_torso * d74),
-                ); // N(M col 9r) at 2.z
-                let d348 = A::mul_add(-s_q_w, d344, c_q_w * d338); // F(M col 9l) at 1.y
-                let d349 = A::mul_add(c_q_w, d344, s_q_w * d338); // F(M col 9l) at 1.z
-                let d350 = A::mul_add(
-                    p.L2,
-                    d343,
-                    A::mul_add(-s_q_w, d347, c_q_w * d345),
-                ); // N(M col 9l) at 1.y
-                let d83 = A::mul_add(p.L2, d75, A::mul_add(-s_q_w, d79, c_q_w * d78)); // N(M col 9r) at 1.y
-                let d351 = A::mul_add(-p.L2, d348, A::mul_add(p.L1, d349, d346)); // N(M col 9l) at 1.x
-                out[(2, 10)].0[l] = d351;
-                let d82 = A::mul_add(-p.L2, d80, A::mul_add(p.L1, d81, d77)); // N(M col 9r) at 1.x
-                out[(2, 17)].0[l] = d82;
-                let d352 = A::mul_add(
-                    -p.L1,
-                    d343,
-                    A::mul_add(c_q_w, d347, s_q_w * d345),
-                ); // N(M col 9l) at 1.z
-                let d84 = A::mul_add(-p.L1, d75, A::mul_add(c_q_w, d79, s_q_w * d78)); // N(M col 9r) at 1.z
-                let d353 = A::mul_add(c_q_imu, d349, s_q_imu * d348); // F(M col 9l) at 0.x
-                out[(0, 10)].0[l] = d353;
-                let d85 = A::mul_add(c_q_imu, d81, s_q_imu * d80); // F(M col 9r) at 0.x
-                out[(0, 17)].0[l] = d85;
-                let d354 = A::mul_add(-s_q_imu, d352, c_q_imu * d350); // N(M col 9l) at 0.z
-                out[(1, 10)].0[l] = d354;
-                let d86 = A::mul_add(-s_q_imu, d84, c_q_imu * d83); // N(M col 9r) at 0.z
-                out[(1, 17)].0[l] = -d86;
-                let d355 = p.MX8l - d310; // MSC8l.x
-                let d87 = p.MX8r - d42; // MSC8r.x
-                let d356 = p.MY8l - d318; // MSC8l.y
-                let d88 = p.MY8r - d50; // MSC8r.y
-                let d357 = p.MZ8l - d319; // MSC8l.z
-                let d89 = p.MZ8r - d51; // MSC8r.z
-                let k25 = s_q6l * s_q6l; // sin² q6l
-                let k4 = s_q6r * s_q6r; // sin² q6r
-                let k26 = s_q6l * c_q6l; // sin q6l cos q6l
-                let k5 = s_q6r * c_q6r; // sin q6r cos q6r
-                let k27 = A::mul_add(2.0, k25, -1.0); // cos 2q6l
-                let k6 = A::mul_add(2.0, k4, -1.0); // cos 2q6r
-                let d90 = pc.pc6 - d49; // JC9r: Jyy − Jzz
-                let d358 = pc.pc29 - d317; // JC9l: Jyy − Jzz
-                let d359 = A::mul_add(-2.0, d315 * k26, k25 * d358); // JC9l rotated about x: Jyy − J'yy
-                let d91 = A::mul_add(-2.0, d47 * k5, k4 * d90); // JC9r rotated about x: Jyy − J'yy
-                let d360 = p.XX8l + d316; // JC8l.xx
-                let d92 = p.XX8r + d48; // JC8r.xx
-                let d361 = p.XY8l + t47 + t48; // JC8l.xy
-                let d93 = p.XY8r + t7 + t8; // JC8r.xy
-                let d362 = p.XZ8l + t49 - t50; // JC8l.xz
-                let d94 = p.XZ8r + t9 - t10; // JC8r.xz
-                let d363 = A::mul_add(k26, d358, A::mul_add(d315, k27, p.YZ8l)); // JC8l.yz
-                let d95 = A::mul_add(k5, d90, A::mul_add(d47, k6, p.YZ8r)); // JC8r.yz
-                let d364 = p.ZZ8l + d317 + d359; // JC8l.zz
-                let d96 = p.ZZ8r + d49 + d91; // JC8r.zz
-                let d365 = pc.pc33 - d359; // JC8l.yy
-                out[(9, 9)].0[l] = d365;
-                let d97 = pc.pc10 - d91; // JC8r.yy
-                out[(16, 16)].0[l] = d97;
-                let d366 = A::mul_add(c_q5l, d357, s_q5l * d355); // MSC8l in 7l.z
-                let d98 = A::mul_add(c_q5r, d89, s_q5r * d87); // MSC8r in 7r.z
-                let d367 = A::mul_add(-s_q5l, d357, c_q5l * d355); // MSC8l in 7l.x
-                let d99 = A::mul_add(-s_q5r, d89, c_q5r * d87); // MSC8r in 7r.x
-                let t51 = c_q5l * d361; // common subexpression
-                let t11 = c_q5r * d93; // common subexpression
-                let t52 = s_q5l * d363; // common subexpression
-                let t12 = s_q5r * d95; // common subexpression
-                let t53 = s_q5l * d361; // common subexpression
-                let t13 = s_q5r * d93; // common subexpression
-                let t54 = c_q5l * d363; // common subexpression
-                let t14 = c_q5r * d95; // common subexpression
-                let t55 = p.L8 * d367; // common subexpression
-                let t15 = p.L8 * d99; // common subexpression
-                let t56 = p.L8 * d366; // common subexpression
-                let t16 = p.L8 * d98; // common subexpression
-                let d368 = t51 - t52 - t55; // N(M col 8l) at 7l.x
-                out[(8, 9)].0[l] = -d368;
-                let d100 = t11 - t12 - t15; // N(M col 8r) at 7r.x
-                out[(15, 16)].0[l] = -d100;
-                let d369 = t53 + t54 - t56; // N(M col 8l) at 7l.z
-                let d101 = t13 + t14 - t16; // N(M col 8r) at 7r.z
-                let d370 = s_q4l * d367; // F(M col 8l) at 6l.y
-                let d102 = s_q4r * d99; // F(M col 8r) at 6r.y
-                let d371 = c_q4l * d367; // F(M col 8l) at 6l.z
-                let d103 = c_q4r * d99; // F(M col 8r) at 6r.z
-                let d372 = A::mul_add(-s_q4l, d369, c_q4l * d365); // N(M col 8l) at 6l.y
-                out[(7, 9)].0[l] = d372;
-                let d104 = A::mul_add(-s_q4r, d101, c_q4r * d97); // N(M col 8r) at 6r.y
-                out[(14, 16)].0[l] = d104;
-                let d373 = A::mul_add(c_q4l, d369, s_q4l * d365); // N(M col 8l) at 6l.z
-                let d105 = A::mul_add(c_q4r, d101, s_q4r * d97); // N(M col 8r) at 6r.z
-                let d374 = A::mul_add(s_q3l, d371, c_q3l * d366); // F(M col 8l) at 5l.x
-                let d106 = A::mul_add(s_q3r, d103, c_q3r * d98); // F(M col 8r) at 5r.x
-                let d375 = A::mul_add(-c_q3l, d371, s_q3l * d366); // F(M col 8l) at 5l.z
-                let d107 = A::mul_add(-c_q3r, d103, s_q3r * d98); // F(M col 8r) at 5r.z
-                let d376 = A::mul_add(
-                    p.L7,
-                    d375,
-                    A::mul_add(-s_q3l, d373, c_q3l * d368),
-                ); // N(M col 8l) at 5l.x
-                out[(6, 9)].0[l] = -d376;
-                let d108 = A::mul_add(
-                    p.L7,
-                    d107,
-                    A::mul_add(-s_q3r, d105, c_q3r * d100),
-                ); // N(M col 8r) at 5r.x
-                out[(13, 16)].0[l] = -d108;
-                let d377 = A::mul_add(
-                    -p.L7,
-                    d374,
-                    A::mul_add(c_q3l, d373, s_q3l * d368),
-                ); // N(M col 8l) at 5l.z
-                let d109 = A::mul_add(
-                    -p.L7,
-                    d106,
-                    A::mul_add(c_q3r, d105, s_q3r * d100),
-                ); // N(M col 8r) at 5r.z
-                let d378 = A::mul_add(-s_q2l, d375, c_q2l * d370); // F(M col 8l) at 4l.y
-                let d110 = A::mul_add(-s_q2r, d107, c_q2r * d102); // F(M col 8r) at 4r.y
-                let d379 = A::mul_add(c_q2l, d375, s_q2l * d370); // F(M col 8l) at 4l.z
-                let d111 = A::mul_add(c_q2r, d107, s_q2r * d102); // F(M col 8r) at 4r.z
-                let d380 = A::mul_add(-s_q2l, d377, c_q2l * d372); // N(M col 8l) at 4l.y
-                out[(5, 9)].0[l] = d380;
-                let d112 = A::mul_add(-s_q2r, d109, c_q2r * d104); // N(M col 8r) at 4r.y
-                out[(12, 16)].0[l] = d112;
-                let d381 = A::mul_add(c_q2l, d377, s_q2l * d372); // N(M col 8l) at 4l.z
-                let d113 = A::mul_add(c_q2r, d109, s_q2r * d104); // N(M col 8r) at 4r.z
-                let d382 = A::mul_add(c_q1l, d379, s_q1l * d374); // F(M col 8l) at 3.z
-                let d115 = A::mul_add(c_q1r, d111, s_q1r * d106); // F(M col 8r) at 3.z
-                let d383 = A::mul_add(-s_q1l, d379, c_q1l * d374); // F(M col 8l) at 3.y
-                let d114 = A::mul_add(-s_q1r, d111, c_q1r * d106); // F(M col 8r) at 3.y
-                let d384 = A::mul_add(
-                    p.L5,
-                    d378,
-                    A::mul_add(-p.L6, d383, A::mul_add(c_q1l, d381, s_q1l * d376)),
-                ); // N(M col 8l) at 3.z
-                let d118 = A::mul_add(
-                    p.L5,
-                    d110,
-                    A::mul_add(-p.L6, d114, A::mul_add(c_q1r, d113, s_q1r * d108)),
-                ); // N(M col 8r) at 3.z
-                let d385 = A::mul_add(-p.L5, d382, d380); // N(M col 8l) at 3.x
-                let d116 = A::mul_add(-p.L5, d115, d112); // N(M col 8r) at 3.x
-                let d386 = A::mul_add(
-                    p.L6,
-                    d382,
-                    A::mul_add(-s_q1l, d381, c_q1l * d376),
-                ); // N(M col 8l) at 3.y
-                out[(4, 9)].0[l] = d386;
-                let d117 = A::mul_add(
-                    p.L6,
-                    d115,
-                    A::mul_add(-s_q1r, d113, c_q1r * d108),
-                ); // N(M col 8r) at 3.y
-                out[(4, 16)].0[l] = d117;
-                let d387 = A::mul_add(s_q_torso, d382, c_q_torso * d378); // F(M col 8l) at 2.x
-                let d119 = A::mul_add(s_q_torso, d115, c_q_torso * d110); // F(M col 8r) at 2.x
-                let d122 = A::mul_add(-p.L4, d119, -d117); // N(M col 8r) at 2.y
-                let d388 = A::mul_add(-c_q_torso, d382, s_q_torso * d378); // F(M col 8l) at 2.z
-                let d120 = A::mul_add(-c_q_torso, d115, s_q_torso * d110); // F(M col 8r) at 2.z
-                let d121 = A::mul_add(
-                    -p.L3,
-                    d120,
-                    A::mul_add(
-                        -s_q_torso,
-                        d118,
-                        A::mul_add(-c_q_torso, d116, p.L4 * d114),
-                    ),
-                ); // N(M col 8r) at 2.x
-                out[(3, 16)].0[l] = -d121;
-                let d124 = A::mul_add(-c_q_w, d120, s_q_w * d114); // F(M col 8r) at 1.z
-                let d125 = A::mul_add(s_q_w, d120, c_q_w * d114); // F(M col 8r) at 1.y
-                let d389 = A::mul_add(
-                    p.L4,
-                    d383,
-                    A::mul_add(p.L3, d388, A::mul_add(s_q_torso, d384, c_q_torso * d385)),
-                ); // N(M col 8l) at 2.x
-                out[(3, 9)].0[l] = -d389;
-                let d390 = A::mul_add(
-                    -p.L3,
-                    d387,
-                    A::mul_add(-c_q_torso, d384, s_q_torso * d385),
-                ); // N(M col 8l) at 2.z
-                let d123 = A::mul_add(
-                    -p.L3,
-                    d119,
-                    A::mul_add(-c_q_torso, d118, s_q_torso * d116),
-                ); // N(M col 8r) at 2.z
-                let d391 = A::mul_add(-p.L4, d387, d386); // N(M col 8l) at 2.y
-                let d392 = A::mul_add(c_q_w, d388, s_q_w * d383); // F(M col 8l) at 1.z
-                let d393 = A::mul_add(-s_q_w, d388, c_q_w * d383); // F(M col 8l) at 1.y
-                let d394 = A::mul_add(-p.L2, d393, A::mul_add(p.L1, d392, d389)); // N(M col 8l) at 1.x
-                out[(2, 9)].0[l] = -d394;
-                let d127 = A::mul_add(-p.L2, d125, A::mul_add(p.L1, d124, d121)); // N(M col 8r) at 1.x
-                out[(2, 16)].0[l] = -d127;
-                let d395 = A::mul_add(
-                    -p.L1,
-                    d387,
-                    A::mul_add(c_q_w, d390, s_q_w * d391),
-                ); // N(M col 8l) at 1.z
-                let d126 = A::mul_add(
-                    -p.L1,
-                    d119,
-                    A::mul_add(c_q_w, d123, s_q_w * d122),
-                ); // N(M col 8r) at 1.z
-                let d396 = A::mul_add(
-                    p.L2,
-                    d387,
-                    A::mul_add(-s_q_w, d390, c_q_w * d391),
-                ); // N(M col 8l) at 1.y
-                let d128 = A::mul_add(
-                    p.L2,
-                    d119,
-                    A::mul_add(-s_q_w, d123, c_q_w * d122),
-                ); // N(M col 8r) at 1.y
-                let d397 = A::mul_add(c_q_imu, d392, s_q_imu * d393); // F(M col 8l) at 0.x
-                out[(0, 9)].0[l] = -d397;
-                let d129 = A::mul_add(c_q_imu, d124, s_q_imu * d125); // F(M col 8r) at 0.x
-                out[(0, 16)].0[l] = -d129;
-                let d398 = A::mul_add(-s_q_imu, d395, c_q_imu * d396); // N(M col 8l) at 0.z
-                out[(1, 9)].0[l] = -d398;
-                let d130 = A::mul_add(-s_q_imu, d126, c_q_imu * d128); // N(M col 8r) at 0.z
-                out[(1, 16)].0[l] = d130;
-                let d399 = p.MX7l - d367; // MSC7l.x
-                let d131 = p.MX7r - d99; // MSC7r.x
-                let d400 = p.MZ7l + d366; // MSC7l.z
-                let d132 = p.MZ7r + d98; // MSC7r.z
-                let k28 = s_q5l * s_q5l; // sin² q5l
-                let k7 = s_q5r * s_q5r; // sin² q5r
-                let k29 = s_q5l * c_q5l; // sin q5l cos q5l
-                let k8 = s_q5r * c_q5r; // sin q5r cos q5r
-                let k30 = A::mul_add(2.0, k28, -1.0); // cos 2q5l
-                let k9 = A::mul_add(2.0, k7, -1.0); // cos 2q5r
-                let d401 = d360 - d364; // JC8l: Jzz − Jxx
-                let d133 = d92 - d96; // JC8r: Jzz − Jxx
-                let d402 = A::mul_add(2.0, d362 * k29, k28 * d401); // JC8l rotated about y: Jzz − J'zz
-                let d134 = A::mul_add(2.0, d94 * k8, k7 * d133); // JC8r rotated about y: Jzz − J'zz
-                let t57 = p.L8 * d356; // common subexpression
-                let t17 = p.L8 * d88; // common subexpression
-                let d403 = p.XY7l + t51 - t52 - t55; // JC7l.xy
-                let d135 = p.XY7r + t11 - t12 - t15; // JC7r.xy
-                let d404 = A::mul_add(-k29, d401, A::mul_add(d362, k30, p.XZ7l)); // JC7l.xz
-                let d136 = A::mul_add(-k8, d133, A::mul_add(d94, k9, p.XZ7r)); // JC7r.xz
-                let d405 = p.YY7l + d365; // JC7l.yy
-                let d137 = p.YY7r + d97; // JC7r.yy
-                let d406 = p.YZ7l - t53 - t54 + t56; // JC7l.yz
-                let d138 = p.YZ7r - t13 - t14 + t16; // JC7r.yz
-                let d407 = pc.pc36 - d356; // MSC7l.y
-                let d139 = pc.pc13 - d88; // MSC7r.y
-                let d408 = A::mul_add(2.0, t57, d360 - d402) + pc.pc37; // JC7l.xx
-                out[(8, 8)].0[l] = d408;
-                let d140 = A::mul_add(2.0, t17, d92 - d134) + pc.pc14; // JC7r.xx
-                out[(15, 15)].0[l] = d140;
-                let d409 = A::mul_add(2.0, t57, d364 + d402) + pc.pc38; // JC7l.zz
-                let d141 = A::mul_add(2.0, t17, d96 + d134) + pc.pc15; // JC7r.zz
-                let d410 = A::mul_add(s_q4l, d400, c_q4l * d407); // MSC7l in 6l.y
-                let d142 = A::mul_add(s_q4r, d132, c_q4r * d139); // MSC7r in 6r.y
-                let d411 = A::mul_add(-c_q4l, d400, s_q4l * d407); // MSC7l in 6l.z
-                let d143 = A::mul_add(-c_q4r, d132, s_q4r * d139); // MSC7r in 6r.z
-                let t58 = c_q4l * d403; // common subexpression
-                let t18 = c_q4r * d135; // common subexpression
-                let t59 = s_q4l * d404; // common subexpression
-                let t19 = s_q4r * d136; // common subexpression
-                let d412 = t58 + t59; // N(M col 7l) at 6l.y
-                out[(7, 8)].0[l] = -d412;
-                let d144 = t18 + t19; // N(M col 7r) at 6r.y
-                out[(14, 15)].0[l] = -d144;
-                let t60 = s_q4l * d403; // common subexpression
-                let t20 = s_q4r * d135; // common subexpression
-                let t61 = c_q4l * d404; // common subexpression
-                let t21 = c_q4r * d136; // common subexpression
-                let d413 = t60 - t61; // N(M col 7l) at 6l.z
-                let d145 = t20 - t21; // N(M col 7r) at 6r.z
-                let d414 = s_q3l * d410; // F(M col 7l) at 5l.x
-                let d146 = s_q3r * d142; // F(M col 7r) at 5r.x
-                let d415 = c_q3l * d410; // F(M col 7l) at 5l.z
-                let d147 = c_q3r * d142; // F(M col 7r) at 5r.z
-                let d416 = A::mul_add(
-                    -p.L7,
-                    d414,
-                    A::mul_add(c_q3l, d413, s_q3l * d408),
-                ); // N(M col 7l) at 5l.z
-                let d148 = A::mul_add(
-                    -p.L7,
-                    d146,
-                    A::mul_add(c_q3r, d145, s_q3r * d140),
-                ); // N(M col 7r) at 5r.z
-                let d417 = A::mul_add(
-                    -p.L7,
-                    d415,
-                    A::mul_add(-s_q3l, d413, c_q3l * d408),
-                ); // N(M col 7l) at 5l.x
-                out[(6, 8)].0[l] = d417;
-                let d149 = A::mul_add(
-                    -p.L7,
-                    d147,
-                    A::mul_add(-s_q3r, d145, c_q3r * d140),
-                ); // N(M col 7r) at 5r.x
-                out[(13, 15)].0[l] = d149;
-                let d418 = A::mul_add(s_q2l, d415, c_q2l * d411); // F(M col 7l) at 4l.y
-                let d150 = A::mul_add(s_q2r, d147, c_q2r * d143); // F(M col 7r) at 4r.y
-                let d419 = A::mul_add(-c_q2l, d415, s_q2l * d411); // F(M col 7l) at 4l.z
-                let d151 = A::mul_add(-c_q2r, d147, s_q2r * d143); // F(M col 7r) at 4r.z
-                let d420 = A::mul_add(-s_q2l, d416, c_q2l * d412); // N(M col 7l) at 4l.y
-                out[(5, 8)].0[l] = -d420;
-                let d152 = A::mul_add(-s_q2r, d148, c_q2r * d144); // N(M col 7r) at 4r.y
-                out[(12, 15)].0[l] = -d152;
-                let d421 = A::mul_add(c_q2l, d416, s_q2l * d412); // N(M col 7l) at 4l.z
-                let d153 = A::mul_add(c_q2r, d148, s_q2r * d144); // N(M col 7r) at 4r.z
-                let d422 = A::mul_add(-s_q1l, d419, c_q1l * d414); // F(M col 7l) at 3.y
-                let d154 = A::mul_add(-s_q1r, d151, c_q1r * d146); // F(M col 7r) at 3.y
-                let d423 = A::mul_add(c_q1l, d419, s_q1l * d414); // F(M col 7l) at 3.z
-                let d155 = A::mul_add(c_q1r, d151, s_q1r * d146); // F(M col 7r) at 3.z
-                let d424 = A::mul_add(-p.L5, d423, d420); // N(M col 7l) at 3.x
-                let d158 = A::mul_add(-p.L5, d155, d152); // N(M col 7r) at 3.x
-                let d425 = A::mul_add(
-                    p.L6,
-                    d423,
-                    A::mul_add(-s_q1l, d421, c_q1l * d417),
-                ); // N(M col 7l) at 3.y
-                out[(4, 8)].0[l] = -d425;
-                let d156 = A::mul_add(
-                    p.L6,
-                    d155,
-                    A::mul_add(-s_q1r, d153, c_q1r * d149),
-                ); // N(M col 7r) at 3.y
-                out[(4, 15)].0[l] = -d156;
-                let d426 = A::mul_add(
-                    p.L5,
-                    d418,
-                    A::mul_add(-p.L6, d422, A::mul_add(c_q1l, d421, s_q1l * d417)),
-                ); // N(M col 7l) at 3.z
-                let d157 = A::mul_add(
-                    p.L5,
-                    d150,
-                    A::mul_add(-p.L6, d154, A::mul_add(c_q1r, d153, s_q1r * d149)),
-                ); // N(M col 7r) at 3.z
-                let d427 = A::mul_add(s_q_torso, d423, c_q_torso * d418); // F(M col 7l) at 2.x
-                let d159 = A::mul_add(s_q_torso, d155, c_q_torso * d150); // F(M col 7r) at 2.x
-                let d162 = A::mul_add(-p.L4, d159, -d156); // N(M col 7r) at 2.y
-                let d428 = A::mul_add(-c_q_torso, d423, s_q_torso * d418); // F(M col 7l) at 2.z
-                let d160 = A::mul_add(-c_q_torso, d155, s_q_torso * d150); // F(M col 7r) at 2.z
-                let d161 = A::mul_add(
-                    -p.L3,
-                    d160,
-                    A::mul_add(
-                        -s_q_torso,
-                        d157,
-                        A::mul_add(-c_q_torso, d158, p.L4 * d154),
-                    ),
-                ); // N(M col 7r) at 2.x
-                out[(3, 15)].0[l] = d161;
-                let d164 = A::mul_add(s_q_w, d160, c_q_w * d154); // F(M col 7r) at 1.y
-                let d165 = A::mul_add(-c_q_w, d160, s_q_w * d154); // F(M col 7r) at 1.z
-                let d429 = A::mul_add(-p.L4, d427, d425); // N(M col 7l) at 2.y
-                let d430 = A::mul_add(
-                    p.L4,
-                    d422,
-                    A::mul_add(p.L3, d428, A::mul_add(s_q_torso, d426, c_q_torso * d424)),
-                ); // N(M col 7l) at 2.x
-                out[(3, 8)].0[l] = d430;
-                let d431 = A::mul_add(
-                    -p.L3,
-                    d427,
-                    A::mul_add(-c_q_torso, d426, s_q_torso * d424),
-                ); // N(M col 7l) at 2.z
-                let d163 = A::mul_add(
-                    -p.L3,
-                    d159,
-                    A::mul_add(-c_q_torso, d157, s_q_torso * d158),
-                ); // N(M col 7r) at 2.z
-                let d432 = A::mul_add(-s_q_w, d428, c_q_w * d422); // F(M col 7l) at 1.y
-                let d433 = A::mul_add(c_q_w, d428, s_q_w * d422); // F(M col 7l) at 1.z
-                let d434 = A::mul_add(
-                    p.L2,
-                    d427,
-                    A::mul_add(-s_q_w, d431, c_q_w * d429),
-                ); // N(M col 7l) at 1.y
-                let d167 = A::mul_add(
-                    p.L2,
-                    d159,
-                    A::mul_add(-s_q_w, d163, c_q_w * d162),
-                ); // N(M col 7r) at 1.y
-                let d435 = A::mul_add(-p.L2, d432, A::mul_add(p.L1, d433, d430)); // N(M col 7l) at 1.x
-                out[(2, 8)].0[l] = d435;
-                let d166 = A::mul_add(-p.L2, d164, A::mul_add(p.L1, d165, d161)); // N(M col 7r) at 1.x
-                out[(2, 15)].0[l] = d166;
-                let d436 = A::mul_add(
-                    -p.L1,
-                    d427,
-                    A::mul_add(c_q_w, d431, s_q_w * d429),
-                ); // N(M col 7l) at 1.z
-                let d168 = A::mul_add(
-                    -p.L1,
-                    d159,
-                    A::mul_add(c_q_w, d163, s_q_w * d162),
-                ); // N(M col 7r) at 1.z
-                let d437 = A::mul_add(c_q_imu, d433, s_q_imu * d432); // F(M col 7l) at 0.x
-                out[(0, 8)].0[l] = d437;
-                let d169 = A::mul_add(c_q_imu, d165, s_q_imu * d164); // F(M col 7r) at 0.x
-                out[(0, 15)].0[l] = d169;
-                let d438 = A::mul_add(-s_q_imu, d436, c_q_imu * d434); // N(M col 7l) at 0.z
-                out[(1, 8)].0[l] = d438;
-                let d170 = A::mul_add(-s_q_imu, d168, c_q_imu * d167); // N(M col 7r) at 0.z
-                out[(1, 15)].0[l] = -d170;
-                let d439 = p.MX6l - d399; // MSC6l.x
-                let d171 = p.MX6r - d131; // MSC6r.x
-                let d440 = p.MY6l - d410; // MSC6l.y
-                let d172 = p.MY6r - d142; // MSC6r.y
-                let d441 = p.MZ6l - d411; // MSC6l.z
-                let d173 = p.MZ6r - d143; // MSC6r.z
-                let k31 = s_q4l * s_q4l; // sin² q4l
-                let k10 = s_q4r * s_q4r; // sin² q4r
-                let k32 = s_q4l * c_q4l; // sin q4l cos q4l
-                let k11 = s_q4r * c_q4r; // sin q4r cos q4r
-                let k33 = A::mul_add(2.0, k31, -1.0); // cos 2q4l
-                let k12 = A::mul_add(2.0, k10, -1.0); // cos 2q4r
-                let d442 = d405 - d409; // JC7l: Jyy − Jzz
-                let d174 = d137 - d141; // JC7r: Jyy − Jzz
-                let d443 = A::mul_add(-2.0, d406 * k32, k31 * d442); // JC7l rotated about x: Jyy − J'yy
-                let d175 = A::mul_add(-2.0, d138 * k11, k10 * d174); // JC7r rotated about x: Jyy − J'yy
-                let d444 = p.XX6l + d408; // JC6l.xx
-                let d176 = p.XX6r + d140; // JC6r.xx
-                let d445 = p.XY6l + t58 + t59; // JC6l.xy
-                let d177 = p.XY6r + t18 + t19; // JC6r.xy
-                let d446 = p.XZ6l + t60 - t61; // JC6l.xz
-                let d178 = p.XZ6r + t20 - t21; // JC6r.xz
-                let d447 = p.YY6l + d405 - d443; // JC6l.yy
-                out[(7, 7)].0[l] = d447;
-                let d179 = p.YY6r + d137 - d175; // JC6r.yy
-                out[(14, 14)].0[l] = d179;
-                let d448 = A::mul_add(k32, d442, A::mul_add(d406, k33, p.YZ6l)); // JC6l.yz
-                let d180 = A::mul_add(k11, d174, A::mul_add(d138, k12, p.YZ6r)); // JC6r.yz
-                let d449 = p.ZZ6l + d409 + d443; // JC6l.zz
-                let d181 = p.ZZ6r + d141 + d175; // JC6r.zz
-                let d450 = A::mul_add(c_q3l, d441, s_q3l * d439); // MSC6l in 5l.z
-                let d182 = A::mul_add(c_q3r, d173, s_q3r * d171); // MSC6r in 5r.z
-                let d451 = A::mul_add(-s_q3l, d441, c_q3l * d439); // MSC6l in 5l.x
-                let d183 = A::mul_add(-s_q3r, d173, c_q3r * d171); // MSC6r in 5r.x
-                let t62 = c_q3l * d445; // common subexpression
-                let t22 = c_q3r * d177; // common subexpression
-                let t63 = s_q3l * d448; // common subexpression
-                let t23 = s_q3r * d180; // common subexpression
-                let t64 = s_q3l * d445; // common subexpression
-                let t24 = s_q3r * d177; // common subexpression
-                let t65 = c_q3l * d448; // common subexpression
-                let t25 = c_q3r * d180; // common subexpression
-                let t66 = p.L7 * d451; // common subexpression
-                let t26 = p.L7 * d183; // common subexpression
-                let t67 = p.L7 * d450; // common subexpression
-                let t27 = p.L7 * d182; // common subexpression
-                let d452 = t62 - t63 - t66; // N(M col 6l) at 5l.x
-                out[(6, 7)].0[l] = -d452;
-                let d184 = t22 - t23 - t26; // N(M col 6r) at 5r.x
-                out[(13, 14)].0[l] = -d184;
-                let d453 = t64 + t65 - t67; // N(M col 6l) at 5l.z
-                let d185 = t24 + t25 - t27; // N(M col 6r) at 5r.z
-                let d454 = s_q2l * d451; // F(M col 6l) at 4l.y
-                let d186 = s_q2r * d183; // F(M col 6r) at 4r.y
-                let d455 = c_q2l * d451; // F(M col 6l) at 4l.z
-                let d187 = c_q2r * d183; // F(M col 6r) at 4r.z
-                let d456 = A::mul_add(-s_q2l, d453, c_q2l * d447); // N(M col 6l) at 4l.y
-                out[(5, 7)].0[l] = d456;
-                let d188 = A::mul_add(-s_q2r, d185, c_q2r * d179); // N(M col 6r) at 4r.y
-                out[(12, 14)].0[l] = d188;
-                let d457 = A::mul_add(c_q2l, d453, s_q2l * d447); // N(M col 6l) at 4l.z
-                let d189 = A::mul_add(c_q2r, d185, s_q2r * d179); // N(M col 6r) at 4r.z
-                let d458 = A::mul_add(-c_q1l, d455, s_q1l * d450); // F(M col 6l) at 3.z
-                let d191 = A::mul_add(-c_q1r, d187, s_q1r * d182); // F(M col 6r) at 3.z
-                let d459 = A::mul_add(s_q1l, d455, c_q1l * d450); // F(M col 6l) at 3.y
-                let d190 = A::mul_add(s_q1r, d187, c_q1r * d182); // F(M col 6r) at 3.y
-                let d460 = A::mul_add(
-                    p.L5,
-                    d454,
-                    A::mul_add(-p.L6, d459, A::mul_add(c_q1l, d457, s_q1l * d452)),
-                ); // N(M col 6l) at 3.z
-                let d194 = A::mul_add(
-                    p.L5,
-                    d186,
-                    A::mul_add(-p.L6, d190, A::mul_add(c_q1r, d189, s_q1r * d184)),
-                ); // N(M col 6r) at 3.z
-                let d461 = A::mul_add(-p.L5, d458, d456); // N(M col 6l) at 3.x
-                let d192 = A::mul_add(-p.L5, d191, d188); // N(M col 6r) at 3.x
-                let d462 = A::mul_add(
-                    p.L6,
-                    d458,
-                    A::mul_add(-s_q1l, d457, c_q1l * d452),
-                ); // N(M col 6l) at 3.y
-                out[(4, 7)].0[l] = d462;
-                let d193 = A::mul_add(
-                    p.L6,
-                    d191,
-                    A::mul_add(-s_q1r, d189, c_q1r * d184),
-                ); // N(M col 6r) at 3.y
-                out[(4, 14)].0[l] = d193;
-                let d463 = A::mul_add(s_q_torso, d458, c_q_torso * d454); // F(M col 6l) at 2.x
-                let d195 = A::mul_add(s_q_torso, d191, c_q_torso * d186); // F(M col 6r) at 2.x
-                let d198 = A::mul_add(-p.L4, d195, -d193); // N(M col 6r) at 2.y
-                let d464 = A::mul_add(-c_q_torso, d458, s_q_torso * d454); // F(M col 6l) at 2.z
-                let d196 = A::mul_add(-c_q_torso, d191, s_q_torso * d186); // F(M col 6r) at 2.z
-                let d197 = A::mul_add(
-                    -p.L3,
-                    d196,
-                    A::mul_add(
-                        -s_q_torso,
-                        d194,
-                        A::mul_add(-c_q_torso, d192, p.L4 * d190),
-                    ),
-                ); // N(M col 6r) at 2.x
-                out[(3, 14)].0[l] = -d197;
-                let d200 = A::mul_add(-c_q_w, d196, s_q_w * d190); // F(M col 6r) at 1.z
-                let d201 = A::mul_add(s_q_w, d196, c_q_w * d190); // F(M col 6r) at 1.y
-                let d465 = A::mul_add(
-                    p.L4,
-                    d459,
-                    A::mul_add(p.L3, d464, A::mul_add(s_q_torso, d460, c_q_torso * d461)),
-                ); // N(M col 6l) at 2.x
-                out[(3, 7)].0[l] = -d465;
-                let d466 = A::mul_add(
-                    -p.L3,
-                    d463,
-                    A::mul_add(-c_q_torso, d460, s_q_torso * d461),
-                ); // N(M col 6l) at 2.z
-                let d199 = A::mul_add(
-                    -p.L3,
-                    d195,
-                    A::mul_add(-c_q_torso, d194, s_q_torso * d192),
-                ); // N(M col 6r) at 2.z
-                let d467 = A::mul_add(-p.L4, d463, d462); // N(M col 6l) at 2.y
-                let d468 = A::mul_add(c_q_w, d464, s_q_w * d459); // F(M col 6l) at 1.z
-                let d469 = A::mul_add(-s_q_w, d464, c_q_w * d459); // F(M col 6l) at 1.y
-                let d470 = A::mul_add(-p.L2, d469, A::mul_add(p.L1, d468, d465)); // N(M col 6l) at 1.x
-                out[(2, 7)].0[l] = -d470;
-                let d203 = A::mul_add(-p.L2, d201, A::mul_add(p.L1, d200, d197)); // N(M col 6r) at 1.x
-                out[(2, 14)].0[l] = -d203;
-                let d471 = A::mul_add(
-                    -p.L1,
-                    d463,
-                    A::mul_add(c_q_w, d466, s_q_w * d467),
-                ); // N(M col 6l) at 1.z
-                let d202 = A::mul_add(
-                    -p.L1,
-                    d195,
-                    A::mul_add(c_q_w, d199, s_q_w * d198),
-                ); // N(M col 6r) at 1.z
-                let d472 = A::mul_add(
-                    p.L2,
-                    d463,
-                    A::mul_add(-s_q_w, d466, c_q_w * d467),
-                ); // N(M col 6l) at 1.y
-                let d204 = A::mul_add(
-                    p.L2,
-                    d195,
-                    A::mul_add(-s_q_w, d199, c_q_w * d198),
-                ); // N(M col 6r) at 1.y
-                let d473 = A::mul_add(c_q_imu, d468, s_q_imu * d469); // F(M col 6l) at 0.x
-                out[(0, 7)].0[l] = -d473;
-                let d205 = A::mul_add(c_q_imu, d200, s_q_imu * d201); // F(M col 6r) at 0.x
-                out[(0, 14)].0[l] = -d205;
-                let d474 = A::mul_add(-s_q_imu, d471, c_q_imu * d472); // N(M col 6l) at 0.z
-                out[(1, 7)].0[l] = -d474;
-                let d206 = A::mul_add(-s_q_imu, d202, c_q_imu * d204); // N(M col 6r) at 0.z
-                out[(1, 14)].0[l] = d206;
-                let d475 = p.MX5l - d451; // MSC5l.x
-                let d207 = p.MX5r - d183; // MSC5r.x
-                let d476 = p.MZ5l + d450; // MSC5l.z
-                let d208 = p.MZ5r + d182; // MSC5r.z
-                let k34 = s_q3l * s_q3l; // sin² q3l
-                let k13 = s_q3r * s_q3r; // sin² q3r
-                let k35 = s_q3l * c_q3l; // sin q3l cos q3l
-                let k14 = s_q3r * c_q3r; // sin q3r cos q3r
-                let k36 = A::mul_add(2.0, k34, -1.0); // cos 2q3l
-                let k15 = A::mul_add(2.0, k13, -1.0); // cos 2q3r
-                let d477 = d444 - d449; // JC6l: Jzz − Jxx
-                let d209 = d176 - d181; // JC6r: Jzz − Jxx
-                let d478 = A::mul_add(2.0, d446 * k35, k34 * d477); // JC6l rotated about y: Jzz − J'zz
-                let d210 = A::mul_add(2.0, d178 * k14, k13 * d209); // JC6r rotated about y: Jzz − J'zz
-                let t68 = p.L7 * d440; // common subexpression
-                let t28 = p.L7 * d172; // common subexpression
-                let d479 = p.XY5l + t62 - t63 - t66; // JC5l.xy
-                let d211 = p.XY5r + t22 - t23 - t26; // JC5r.xy
-                let d480 = A::mul_add(-k35, d477, A::mul_add(d446, k36, p.XZ5l)); // JC5l.xz
-                let d212 = A::mul_add(-k14, d209, A::mul_add(d178, k15, p.XZ5r)); // JC5r.xz
-                let d481 = p.YY5l + d447; // JC5l.yy
-                let d213 = p.YY5r + d179; // JC5r.yy
-                let d482 = p.YZ5l - t64 - t65 + t67; // JC5l.yz
-                let d214 = p.YZ5r - t24 - t25 + t27; // JC5r.yz
-                let d483 = pc.pc42 - d440; // MSC5l.y
-                let d215 = pc.pc19 - d172; // MSC5r.y
-                let d484 = A::mul_add(2.0, t68, d444 - d478) + pc.pc43; // JC5l.xx
-                out[(6, 6)].0[l] = d484;
-                let d216 = A::mul_add(2.0, t28, d176 - d210) + pc.pc20; // JC5r.xx
-                out[(13, 13)].0[l] = d216;
-                let d485 = A::mul_add(2.0, t68, d449 + d478) + pc.pc44; // JC5l.zz
-                let d217 = A::mul_add(2.0, t28, d181 + d210) + pc.pc21; // JC5r.zz
-                let d486 = A::mul_add(s_q2l, d476, c_q2l * d483); // MSC5l in 4l.y
-                let d218 = A::mul_add(s_q2r, d208, c_q2r * d215); // MSC5r in 4r.y
-                let d487 = A::mul_add(-c_q2l, d476, s_q2l * d483); // MSC5l in 4l.z
-                let d219 = A::mul_add(-c_q2r, d208, s_q2r * d215); // MSC5r in 4r.z
-                let t69 = c_q2l * d479; // common subexpression
-                let t29 = c_q2r * d211; // common subexpression
-                let t70 = s_q2l * d480; // common subexpression
-                let t30 = s_q2r * d212; // common subexpression
-                let d488 = t69 + t70; // N(M col 5l) at 4l.y
-                out[(5, 6)].0[l] = -d488;
-                let d220 = t29 + t30; // N(M col 5r) at 4r.y
-                out[(12, 13)].0[l] = -d220;
-                let t71 = s_q2l * d479; // common subexpression
-                let t31 = s_q2r * d211; // common subexpression
-                let t72 = c_q2l * d480; // common subexpression
-                let t32 = c_q2r * d212; // common subexpression
-                let d489 = t71 - t72; // N(M col 5l) at 4l.z
-                let d221 = t31 - t32; // N(M col 5r) at 4r.z
-                let d490 = s_q1l * d486; // F(M col 5l) at 3.y
-                let d222 = s_q1r * d218; // F(M col 5r) at 3.y
-                let d491 = c_q1l * d486; // F(M col 5l) at 3.z
-                let d223 = c_q1r * d218; // F(M col 5r) at 3.z
-                let d492 = A::mul_add(p.L5, d491, d488); // N(M col 5l) at 3.x
-                let d226 = A::mul_add(p.L5, d223, d220); // N(M col 5r) at 3.x
-                let d493 = A::mul_add(
-                    -p.L6,
-                    d491,
-                    A::mul_add(-s_q1l, d489, c_q1l * d484),
-                ); // N(M col 5l) at 3.y
-                out[(4, 6)].0[l] = -d493;
-                let d224 = A::mul_add(
-                    -p.L6,
-                    d223,
-                    A::mul_add(-s_q1r, d221, c_q1r * d216),
-                ); // N(M col 5r) at 3.y
-                out[(4, 13)].0[l] = -d224;
-                let d494 = A::mul_add(
-                    p.L5,
-                    d487,
-                    A::mul_add(-p.L6, d490, A::mul_add(c_q1l, d489, s_q1l * d484)),
-                ); // N(M col 5l) at 3.z
-                let d225 = A::mul_add(
-                    p.L5,
-                    d219,
-                    A::mul_add(-p.L6, d222, A::mul_add(c_q1r, d221, s_q1r * d216)),
-                ); // N(M col 5r) at 3.z
-                let d495 = A::mul_add(-s_q_torso, d491, c_q_torso * d487); // F(M col 5l) at 2.x
-                let d227 = A::mul_add(-s_q_torso, d223, c_q_torso * d219); // F(M col 5r) at 2.x
-                let d230 = A::mul_add(-p.L4, d227, -d224); // N(M col 5r) at 2.y
-                let d496 = A::mul_add(c_q_torso, d491, s_q_torso * d487); // F(M col 5l) at 2.z
-                let d228 = A::mul_add(c_q_torso, d223, s_q_torso * d219); // F(M col 5r) at 2.z
-                let d229 = A::mul_add(
-                    -p.L3,
-                    d228,
-                    A::mul_add(
-                        -s_q_torso,
-                        d225,
-                        A::mul_add(-c_q_torso, d226, p.L4 * d222),
-                    ),
-                ); // N(M col 5r) at 2.x
-                out[(3, 13)].0[l] = d229;
-                let d232 = A::mul_add(s_q_w, d228, c_q_w * d222); // F(M col 5r) at 1.y
-                let d233 = A::mul_add(-c_q_w, d228, s_q_w * d222); // F(M col 5r) at 1.z
-                let d497 = A::mul_add(-p.L4, d495, d493); // N(M col 5l) at 2.y
-                let d498 = A::mul_add(
-                    p.L4,
-                    d490,
-                    A::mul_add(p.L3, d496, A::mul_add(s_q_torso, d494, c_q_torso * d492)),
-                ); // N(M col 5l) at 2.x
-                out[(3, 6)].0[l] = d498;
-                let d499 = A::mul_add(
-                    -p.L3,
-                    d495,
-                    A::mul_add(-c_q_torso, d494, s_q_torso * d492),
-                ); // N(M col 5l) at 2.z
-                let d231 = A::mul_add(
-                    -p.L3,
-                    d227,
-                    A::mul_add(-c_q_torso, d225, s_q_torso * d226),
-                ); // N(M col 5r) at 2.z
-                let d500 = A::mul_add(-s_q_w, d496, c_q_w * d490); // F(M col 5l) at 1.y
-                let d501 = A::mul_add(c_q_w, d496, s_q_w * d490); // F(M col 5l) at 1.z
-                let d502 = A::mul_add(
-                    p.L2,
-                    d495,
-                    A::mul_add(-s_q_w, d499, c_q_w * d497),
-                ); // N(M col 5l) at 1.y
-                let d235 = A::mul_add(
-                    p.L2,
-                    d227,
-                    A::mul_add(-s_q_w, d231, c_q_w * d230),
-                ); // N(M col 5r) at 1.y
-                let d503 = A::mul_add(-p.L2, d500, A::mul_add(p.L1, d501, d498)); // N(M col 5l) at 1.x
-                out[(2, 6)].0[l] = d503;
-                let d234 = A::mul_add(-p.L2, d232, A::mul_add(p.L1, d233, d229)); // N(M col 5r) at 1.x
-                out[(2, 13)].0[l] = d234;
-                let d504 = A::mul_add(
-                    -p.L1,
-                    d495,
-                    A::mul_add(c_q_w, d499, s_q_w * d497),
-                ); // N(M col 5l) at 1.z
-                let d236 = A::mul_add(
-                    -p.L1,
-                    d227,
-                    A::mul_add(c_q_w, d231, s_q_w * d230),
-                ); // N(M col 5r) at 1.z
-                let d505 = A::mul_add(c_q_imu, d501, s_q_imu * d500); // F(M col 5l) at 0.x
-                out[(0, 6)].0[l] = d505;
-                let d237 = A::mul_add(c_q_imu, d233, s_q_imu * d232); // F(M col 5r) at 0.x
-                out[(0, 13)].0[l] = d237;
-                let d506 = A::mul_add(-s_q_imu, d504, c_q_imu * d502); // N(M col 5l) at 0.z
-                out[(1, 6)].0[l] = d506;
-                let d238 = A::mul_add(-s_q_imu, d236, c_q_imu * d235); // N(M col 5r) at 0.z
-                out[(1, 13)].0[l] = -d238;
-                let d507 = p.MX4l - d475; // MSC4l.x
-                let d239 = p.MX4r - d207; // MSC4r.x
-                let d508 = p.MY4l - d486; // MSC4l.y
-                let d240 = p.MY4r - d218; // MSC4r.y
-                let d509 = p.MZ4l - d487; // MSC4l.z
-                let d241 = p.MZ4r - d219; // MSC4r.z
-                let k37 = s_q2l * s_q2l; // sin² q2l
-                let k16 = s_q2r * s_q2r; // sin² q2r
-                let k38 = s_q2l * c_q2l; // sin q2l cos q2l
-                let k17 = s_q2r * c_q2r; // sin q2r cos q2r
-                let k39 = A::mul_add(2.0, k37, -1.0); // cos 2q2l
-                let k18 = A::mul_add(2.0, k16, -1.0); // cos 2q2r
-                let d510 = d481 - d485; // JC5l: Jyy − Jzz
-                let d242 = d213 - d217; // JC5r: Jyy − Jzz
-                let d511 = A::mul_add(-2.0, d482 * k38, k37 * d510); // JC5l rotated about x: Jyy − J'yy
-                let d243 = A::mul_add(-2.0, d214 * k17, k16 * d242); // JC5r rotated about x: Jyy − J'yy
-                let d512 = p.XX4l + d484; // JC4l.xx
-                let d244 = p.XX4r + d216; // JC4r.xx
-                let d513 = p.XY4l + t69 + t70; // JC4l.xy
-                let d245 = p.XY4r + t29 + t30; // JC4r.xy
-                let d514 = p.XZ4l + t71 - t72; // JC4l.xz
-                let d246 = p.XZ4r + t31 - t32; // JC4r.xz
-                let d515 = p.YY4l + d481 - d511; // JC4l.yy
-                out[(5, 5)].0[l] = d515;
-                let d247 = p.YY4r + d213 - d243; // JC4r.yy
-                out[(12, 12)].0[l] = d247;
-                let d516 = A::mul_add(k38, d510, A::mul_add(d482, k39, p.YZ4l)); // JC4l.yz
-                let d248 = A::mul_add(k17, d242, A::mul_add(d214, k18, p.YZ4r)); // JC4r.yz
-                let d517 = p.ZZ4l + d485 + d511; // JC4l.zz
-                let d249 = p.ZZ4r + d217 + d243; // JC4r.zz
-                let d518 = A::mul_add(-s_q1l, d509, c_q1l * d507); // MSC4l in 3.y
-                let d250 = A::mul_add(-s_q1r, d241, c_q1r * d239); // MSC4r in 3.y
-                let d519 = A::mul_add(c_q1l, d509, s_q1l * d507); // MSC4l in 3.z
-                let d251 = A::mul_add(c_q1r, d241, s_q1r * d239); // MSC4r in 3.z
-                let t73 = c_q1l * d513; // common subexpression
-                let t33 = c_q1r * d245; // common subexpression
-                let t74 = s_q1l * d516; // common subexpression
-                let t34 = s_q1r * d248; // common subexpression
-                let t75 = s_q1l * d513; // common subexpression
-                let t35 = s_q1r * d245; // common subexpression
-                let t76 = c_q1l * d516; // common subexpression
-                let t36 = c_q1r * d248; // common subexpression
-                let t77 = p.L5 * d518; // common subexpression
-                let t37 = p.L5 * d250; // common subexpression
-                let t78 = p.L6 * d518; // common subexpression
-                let t38 = p.L6 * d250; // common subexpression
-                let t79 = p.L6 * d519; // common subexpression
-                let t39 = p.L6 * d251; // common subexpression
-                let d520 = t75 + t76 - t79; // N(M col 4l) at 3.z
-                let d254 = t35 + t36 - t39; // N(M col 4r) at 3.z
-                let d521 = d515 + t77; // N(M col 4l) at 3.x
-                let d252 = d247 + t37; // N(M col 4r) at 3.x
-                let d522 = t73 - t74 - t78; // N(M col 4l) at 3.y
-                out[(4, 5)].0[l] = d522;
-                let d253 = t33 - t34 - t38; // N(M col 4r) at 3.y
-                out[(4, 12)].0[l] = d253;
-                let d523 = s_q_torso * d518; // F(M col 4l) at 2.x
-                let d255 = s_q_torso * d250; // F(M col 4r) at 2.x
-                let d258 = A::mul_add(p.L4, d255, -d253); // N(M col 4r) at 2.y
-                let d524 = c_q_torso * d518; // F(M col 4l) at 2.z
-                let d256 = c_q_torso * d250; // F(M col 4r) at 2.z
-                let d257 = A::mul_add(
-                    -p.L3,
-                    d256,
-                    A::mul_add(
-                        -s_q_torso,
-                        d254,
-                        A::mul_add(-c_q_torso, d252, p.L4 * d251),
-                    ),
-                ); // N(M col 4r) at 2.x
-                out[(3, 12)].0[l] = -d257;
-                let d260 = A::mul_add(-c_q_w, d256, s_q_w * d251); // F(M col 4r) at 1.z
-                let d261 = A::mul_add(s_q_w, d256, c_q_w * d251); // F(M col 4r) at 1.y
-                let d525 = A::mul_add(
-                    p.L4,
-                    d519,
-                    A::mul_add(p.L3, d524, A::mul_add(s_q_torso, d520, c_q_torso * d521)),
-                ); // N(M col 4l) at 2.x
-                out[(3, 5)].0[l] = -d525;
-                let d526 = A::mul_add(
-                    p.L3,
-                    d523,
-                    A::mul_add(-c_q_torso, d520, s_q_torso * d521),
-                ); // N(M col 4l) at 2.z
-                let d259 = A::mul_add(
-                    p.L3,
-                    d255,
-                    A::mul_add(-c_q_torso, d254, s_q_torso * d252),
-                ); // N(M col 4r) at 2.z
-                let d527 = A::mul_add(p.L4, d523, d522); // N(M col 4l) at 2.y
-                let d528 = A::mul_add(c_q_w, d524, s_q_w * d519); // F(M col 4l) at 1.z
-                let d529 = A::mul_add(-s_q_w, d524, c_q_w * d519); // F(M col 4l) at 1.y
-                let d530 = A::mul_add(-p.L2, d529, A::mul_add(p.L1, d528, d525)); // N(M col 4l) at 1.x
-                out[(2, 5)].0[l] = -d530;
-                let d263 = A::mul_add(-p.L2, d261, A::mul_add(p.L1, d260, d257)); // N(M col 4r) at 1.x
-                out[(2, 12)].0[l] = -d263;
-                let d531 = A::mul_add(p.L1, d523, A::mul_add(c_q_w, d526, s_q_w * d527)); // N(M col 4l) at 1.z
-                let d262 = A::mul_add(p.L1, d255, A::mul_add(c_q_w, d259, s_q_w * d258)); // N(M col 4r) at 1.z
-                let d532 = A::mul_add(
-                    -p.L2,
-                    d523,
-                    A::mul_add(-s_q_w, d526, c_q_w * d527),
-                ); // N(M col 4l) at 1.y
-                let d264 = A::mul_add(
-                    -p.L2,
-                    d255,
-                    A::mul_add(-s_q_w, d259, c_q_w * d258),
-                ); // N(M col 4r) at 1.y
-                let d533 = A::mul_add(c_q_imu, d528, s_q_imu * d529); // F(M col 4l) at 0.x
-                out[(0, 5)].0[l] = -d533;
-                let d265 = A::mul_add(c_q_imu, d260, s_q_imu * d261); // F(M col 4r) at 0.x
-                out[(0, 12)].0[l] = -d265;
-                let d534 = A::mul_add(-s_q_imu, d531, c_q_imu * d532); // N(M col 4l) at 0.z
-                out[(1, 5)].0[l] = -d534;
-                let d266 = A::mul_add(-s_q_imu, d262, c_q_imu * d264); // N(M col 4r) at 0.z
-                out[(1, 12)].0[l] = d266;
-                let d535 = p.MZ3 + d251 - d519; // MSC3.z
-                let k40 = s_q1l * s_q1l; // sin² q1l
-                let k19 = s_q1r * s_q1r; // sin² q1r
-                let k41 = s_q1l * c_q1l; // sin q1l cos q1l
-                let k20 = s_q1r * c_q1r; // sin q1r cos q1r
-                let k42 = A::mul_add(2.0, k40, -1.0); // cos 2q1l
-                let k21 = A::mul_add(2.0, k19, -1.0); // cos 2q1r
-                let d536 = d512 - d517; // JC4l: Jzz − Jxx
-                let d267 = d244 - d249; // JC4r: Jzz − Jxx
-                let d537 = A::mul_add(2.0, d514 * k41, k40 * d536); // JC4l rotated about y: Jzz − J'zz
-                let d268 = A::mul_add(2.0, d246 * k20, k19 * d267); // JC4r rotated about y: Jzz − J'zz
-                let t80 = p.L6 * d508; // common subexpression
-                let t40 = p.L6 * d240; // common subexpression
-                let d538 = p.XZ3 - t35 - t36 + t39 - t75 - t76 + t79; // JC3.xz
-                let d539 = A::mul_add(
-                    p.L5,
-                    d519,
-                    A::mul_add(
-                        -k41,
-                        d536,
-                        A::mul_add(
-                            d514,
-                            k42,
-                            A::mul_add(
-                                -p.L5,
-                                d251,
-                                A::mul_add(k20, d267, A::mul_add(-d246, k21, p.YZ3)),
-                            ),
-                        ),
-                    ),
-                ); // JC3.yz
-                let d540 = d508 - d240 + pc.pc47; // MSC3.x
-                let d541 = d250 + d518 + pc.pc48; // MSC3.y
-                let d542 = A::mul_add(2.0, t77, A::mul_add(2.0, t37, d247) + d515)
-                    + pc.pc49; // JC3.xx
-                let d543 = A::mul_add(
-                    -p.L5,
-                    d508,
-                    A::mul_add(p.L5, d240, t34 - t33 + t38) + t73 - t74 - t78,
-                ) + pc.pc50; // JC3.xy
-                let d544 = A::mul_add(
-                    2.0,
-                    t80,
-                    A::mul_add(2.0, t40, d244 - d268) + d512 - d537,
-                ) + pc.pc51; // JC3.yy
-                out[(4, 4)].0[l] = d544;
-                let d545 = A::mul_add(
-                    2.0,
-                    t80,
-                    A::mul_add(
-                        2.0,
-                        t77,
-                        A::mul_add(2.0, t40, A::mul_add(2.0, t37, d249) + d268) + d517,
-                    ) + d537,
-                ) + pc.pc52; // JC3.zz
-                let d546 = A::mul_add(-s_q_torso, d535, c_q_torso * d540); // MSC3 in 2.x
-                let d547 = A::mul_add(c_q_torso, d535, s_q_torso * d540); // MSC3 in 2.z
-                let t81 = c_q_torso * d543; // common subexpression
-                let t82 = s_q_torso * d539; // common subexpression
-                let t83 = s_q_torso * d543; // common subexpression
-                let t84 = c_q_torso * d539; // common subexpression
-                let t85 = p.L3 * d546; // common subexpression
-                let t86 = p.L4 * d547; // common subexpression
-                let t87 = p.L3 * d547; // common subexpression
-                let d548 = t81 - t82 - t85; // N(M col 3) at 2.x
-                out[(3, 4)].0[l] = -d548;
-                let d549 = t83 + t84 - t87; // N(M col 3) at 2.z
-                let d550 = d544 - t86; // N(M col 3) at 2.y
-                let d551 = s_q_w * d546; // F(M col 3) at 1.y
-                let d552 = c_q_w * d546; // F(M col 3) at 1.z
-                let d553 = A::mul_add(-p.L2, d551, A::mul_add(-p.L1, d552, d548)); // N(M col 3) at 1.x
-                out[(2, 4)].0[l] = -d553;
-                let d554 = A::mul_add(
-                    -p.L1,
-                    d547,
-                    A::mul_add(c_q_w, d549, s_q_w * d550),
-                ); // N(M col 3) at 1.z
-                let d555 = A::mul_add(
-                    p.L2,
-                    d547,
-                    A::mul_add(-s_q_w, d549, c_q_w * d550),
-                ); // N(M col 3) at 1.y
-                let d556 = A::mul_add(-c_q_imu, d552, s_q_imu * d551); // F(M col 3) at 0.x
-                out[(0, 4)].0[l] = -d556;
-                let d557 = A::mul_add(-s_q_imu, d554, c_q_imu * d555); // N(M col 3) at 0.z
-                out[(1, 4)].0[l] = -d557;
-                let d558 = p.MX2 - d546; // MSC2.x
-                let k43 = s_q_torso * s_q_torso; // sin² q_torso
-                let k44 = s_q_torso * c_q_torso; // sin q_torso cos q_torso
-                let k45 = A::mul_add(2.0, k43, -1.0); // cos 2q_torso
-                let d559 = d542 - d545; // JC3: Jzz − Jxx
-                let d560 = A::mul_add(2.0, d538 * k44, k43 * d559); // JC3 rotated about y: Jzz − J'zz
-                let t88 = p.L3 * d541; // common subexpression
-                let d561 = p.XY2 - t81 + t82 + t85; // JC2.xy
-                let d562 = A::mul_add(
-                    p.L4,
-                    d546,
-                    A::mul_add(k44, d559, A::mul_add(-d538, k45, p.XZ2)),
-                ); // JC2.xz
-                let d563 = d541 + pc.pc54; // MSC2.y
-                let d564 = pc.pc55 - d547; // MSC2.z
-                let d565 = A::mul_add(2.0, t88, A::mul_add(-2.0, t86, d542) - d560)
-                    + pc.pc56; // JC2.xx
-                out[(3, 3)].0[l] = d565;
-                let d566 = A::mul_add(-2.0, t86, d544) + pc.pc57; // JC2.yy
-                let d567 = A::mul_add(-p.L4, d541, t87 - t83 - t84) + pc.pc58; // JC2.yz
-                let d568 = A::mul_add(2.0, t88, d545 + d560) + pc.pc59; // JC2.zz
-                let d569 = A::mul_add(s_q_w, d564, c_q_w * d563); // MSC2 in 1.y
-                let d570 = A::mul_add(-c_q_w, d564, s_q_w * d563); // MSC2 in 1.z
-                let t89 = c_q_w * d561; // common subexpression
-                let t90 = s_q_w * d562; // common subexpression
-                let t91 = s_q_w * d561; // common subexpression
-                let t92 = c_q_w * d562; // common subexpression
-                let d571 = t91 - t92; // N(M col 2) at 1.z
-                let t93 = p.L1 * d569; // common subexpression
-                let t94 = p.L2 * d570; // common subexpression
-                let d572 = d565 + t93 + t94; // N(M col 2) at 1.x
-                out[(2, 3)].0[l] = d572;
-                let d573 = t89 + t90; // N(M col 2) at 1.y
-                let d574 = A::mul_add(-c_q_imu, d569, s_q_imu * d570); // F(M col 2) at 0.x
-                out[(0, 3)].0[l] = -d574;
-                let d575 = A::mul_add(-s_q_imu, d571, c_q_imu * d573); // N(M col 2) at 0.z
-                out[(1, 3)].0[l] = -d575;
-                let d576 = p.MX1 + d558; // MSC1.x
-                out[(0, 1)].0[l] = d576;
-                let k46 = s_q_w * s_q_w; // sin² q_w
-                let k47 = s_q_w * c_q_w; // sin q_w cos q_w
-                let k48 = A::mul_add(2.0, k46, -1.0); // cos 2q_w
-                let d577 = d566 - d568; // JC2: Jyy − Jzz
-                let d578 = A::mul_add(-2.0, d567 * k47, k46 * d577); // JC2 rotated about x: Jyy − J'yy
-                let d579 = A::mul_add(-p.L1, d558, p.XY1 + t89 + t90); // JC1.xy
-                let d580 = A::mul_add(p.L2, d558, p.XZ1 - t91 + t92); // JC1.xz
-                let d581 = d569 + pc.pc61; // MSC1.y
-                let d582 = pc.pc62 - d570; // MSC1.z
-                let d583 = A::mul_add(2.0, t94, A::mul_add(2.0, t93, d565)) + pc.pc63; // JC1.xx
-                out[(2, 2)].0[l] = d583;
-                let d584 = A::mul_add(2.0, t94, d566) - d578 + pc.pc64; // JC1.yy
-                let d585 = A::mul_add(
-                    p.L1,
-                    d570,
-                    A::mul_add(-k47, d577, A::mul_add(-d567, k48, p.L2 * d569)),
-                ) + pc.pc65; // JC1.yz
-                let d586 = A::mul_add(2.0, t93, d568) + d578 + pc.pc66; // JC1.zz
-                let d587 = A::mul_add(s_q_imu, d582, c_q_imu * d581); // MSC1 in 0.z
-                out[(0, 2)].0[l] = d587;
-                let d588 = A::mul_add(s_q_imu, d580, c_q_imu * d579); // N(M col 1) at 0.z
-                out[(1, 2)].0[l] = -d588;
-                let k49 = s_q_imu * s_q_imu; // sin² q_imu
-                let k50 = s_q_imu * c_q_imu; // sin q_imu cos q_imu
-                let d589 = d584 - d586; // JC1: Jyy − Jzz
-                let d590 = A::mul_add(-2.0, d585 * k50, k49 * d589); // JC1 rotated about x: Jyy − J'yy
-                let d591 = d584 - d590; // JC0
-                out[(1, 1)].0[l] = d591 + pc.pc68;
-            }
+            let q = kanegen_runtime::lanes::inputs_soa(q);
+            mass_matrix_batch_body::<A, _, L>(p, pc, &q, out);
             out[(1, 0)] = out[(0, 1)];
             out[(2, 0)] = out[(0, 2)];
             out[(3, 0)] = out[(0, 3)];
@@ -12533,6 +10968,2097 @@ mod generated {
         mass_matrix_batch_soa_into(p, pc, q, &mut out);
         out
     }
+    /// The statements of [`coriolis_batch_into`] and [`coriolis_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to `out.set(row, column, l, value)`.
+    #[inline(always)]
+    fn coriolis_batch_body<
+        A: kanegen_runtime::isa::Arith<f64>,
+        S: kanegen_runtime::lanes::LaneStore<L>,
+        const L: usize,
+    >(
+        p: &Params,
+        _pc: &Precomputed,
+        q: &[kanegen_runtime::lanes::Lanes<L>; 19],
+        u: &[kanegen_runtime::lanes::Lanes<L>; 19],
+        out: &mut S,
+    ) {
+        let p = &{ *p };
+        let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
+            A,
+            _,
+            L,
+        >([
+            q[2].0,
+            q[3].0,
+            q[4].0,
+            q[5].0,
+            q[12].0,
+            q[6].0,
+            q[13].0,
+            q[7].0,
+            q[14].0,
+            q[8].0,
+            q[15].0,
+            q[9].0,
+            q[16].0,
+            q[10].0,
+            q[17].0,
+            q[11].0,
+            q[18].0,
+        ]);
+        for l in 0..L {
+            let s_q_imu = sin_q[0][l];
+            let c_q_imu = cos_q[0][l];
+            let s_q_w = sin_q[1][l];
+            let c_q_w = cos_q[1][l];
+            let s_q_torso = sin_q[2][l];
+            let c_q_torso = cos_q[2][l];
+            let s_q1l = sin_q[3][l];
+            let c_q1l = cos_q[3][l];
+            let s_q1r = sin_q[4][l];
+            let c_q1r = cos_q[4][l];
+            let s_q2l = sin_q[5][l];
+            let c_q2l = cos_q[5][l];
+            let s_q2r = sin_q[6][l];
+            let c_q2r = cos_q[6][l];
+            let s_q3l = sin_q[7][l];
+            let c_q3l = cos_q[7][l];
+            let s_q3r = sin_q[8][l];
+            let c_q3r = cos_q[8][l];
+            let s_q4l = sin_q[9][l];
+            let c_q4l = cos_q[9][l];
+            let s_q4r = sin_q[10][l];
+            let c_q4r = cos_q[10][l];
+            let s_q5l = sin_q[11][l];
+            let c_q5l = cos_q[11][l];
+            let s_q5r = sin_q[12][l];
+            let c_q5r = cos_q[12][l];
+            let s_q6l = sin_q[13][l];
+            let c_q6l = cos_q[13][l];
+            let s_q6r = sin_q[14][l];
+            let c_q6r = cos_q[14][l];
+            let s_q7l = sin_q[15][l];
+            let c_q7l = cos_q[15][l];
+            let s_q7r = sin_q[16][l];
+            let c_q7r = cos_q[16][l];
+            let xd = u[0].0[l];
+            let psid = u[1].0[l];
+            let qd_imu = u[2].0[l];
+            let qd_w = u[3].0[l];
+            let qd_torso = u[4].0[l];
+            let qd1l = u[5].0[l];
+            let qd2l = u[6].0[l];
+            let qd3l = u[7].0[l];
+            let qd4l = u[8].0[l];
+            let qd5l = u[9].0[l];
+            let qd6l = u[10].0[l];
+            let qd7l = u[11].0[l];
+            let qd1r = u[12].0[l];
+            let qd2r = u[13].0[l];
+            let qd3r = u[14].0[l];
+            let qd4r = u[15].0[l];
+            let qd5r = u[16].0[l];
+            let qd6r = u[17].0[l];
+            let qd7r = u[18].0[l];
+            let k1 = xd * psid; // a0|ud=0,g=0.y
+            let k2 = c_q_imu * psid; // w0 in 1|ud=0,g=0.y
+            let k3 = s_q_imu * psid; // w0 in 1|ud=0,g=0.z
+            let k4 = k3 * qd_imu; // wd1|ud=0,g=0.y
+            let k5 = k2 * qd_imu; // wd1|ud=0,g=0.z
+            let d1 = A::mul_add(-p.MY1, k3, p.MZ1 * k2); // w1xMS1|ud=0,g=0.x
+            let d2 = A::mul_add(p.MZ1, qd_imu, p.MX1 * k3); // w1xMS1|ud=0,g=0.y
+            let d3 = A::mul_add(p.MX1, k2, p.MY1 * qd_imu); // w1xMS1|ud=0,g=0.z
+            let d4 = A::mul_add(-qd_imu, d3, A::mul_add(k3, d1, p.MX1 * k5)); // F1|ud=0,g=0.y
+            let d5 = A::mul_add(-k2, d1, A::mul_add(-qd_imu, d2, p.MX1 * k4)); // F1|ud=0,g=0.z
+            let d6 = A::mul_add(-p.XZ1, k3, A::mul_add(-p.XY1, k2, p.XX1 * qd_imu)); // J1w1|ud=0,g=0.x
+            let d7 = A::mul_add(-p.YZ1, k3, A::mul_add(-p.YY1, k2, p.XY1 * qd_imu)); // J1w1|ud=0,g=0.y
+            let d8 = A::mul_add(-p.ZZ1, k3, A::mul_add(-p.YZ1, k2, p.XZ1 * qd_imu)); // J1w1|ud=0,g=0.z
+            let d9 = A::mul_add(
+                -k3,
+                d7,
+                A::mul_add(k2, d8, A::mul_add(-p.XZ1, k5, p.XY1 * k4)),
+            ); // N1|ud=0,g=0.x
+            let d10 = A::mul_add(
+                p.MZ1,
+                k1,
+                A::mul_add(
+                    qd_imu,
+                    d8,
+                    A::mul_add(k3, d6, A::mul_add(-p.YZ1, k5, p.YY1 * k4)),
+                ),
+            ); // N1|ud=0,g=0.y
+            let d11 = A::mul_add(
+                -p.MY1,
+                k1,
+                A::mul_add(
+                    -k2,
+                    d6,
+                    A::mul_add(-qd_imu, d7, A::mul_add(-p.ZZ1, k5, p.YZ1 * k4)),
+                ),
+            ); // N1|ud=0,g=0.z
+            let k6 = A::mul_add(-s_q_w, k3, c_q_w * k2); // w1 in 2|ud=0,g=0.y
+            let k7 = A::mul_add(c_q_w, k3, s_q_w * k2); // w1 in 2|ud=0,g=0.z
+            let k8 = qd_imu + qd_w; // w2|ud=0,g=0.x
+            let k9 = A::mul_add(k7, qd_w, A::mul_add(s_q_w, k5, c_q_w * k4)); // wd2|ud=0,g=0.y
+            let k10 = A::mul_add(-k6, qd_w, A::mul_add(-c_q_w, k5, s_q_w * k4)); // wd2|ud=0,g=0.z
+            let k11 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+            let k12 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+            let k13 = A::mul_add(p.L1, k3, p.L2 * k2); // w1xP2|ud=0,g=0.x
+            let k14 = A::mul_add(k2, k13, qd_imu * k11); // a2 in 1|ud=0,g=0.z
+            let k15 = A::mul_add(
+                -k3,
+                k11,
+                A::mul_add(k2, k12, A::mul_add(p.L1, k5, A::mul_add(-p.L2, k4, k1))),
+            ); // a2 in 1|ud=0,g=0.x
+            let k16 = A::mul_add(qd_imu, k12, k3 * k13); // a2 in 1|ud=0,g=0.y
+            let k17 = A::mul_add(s_q_w, k14, c_q_w * k16); // a2|ud=0,g=0.y
+            let k18 = A::mul_add(-c_q_w, k14, s_q_w * k16); // a2|ud=0,g=0.z
+            let d12 = A::mul_add(-p.MY2, k7, p.MZ2 * k6); // w2xMS2|ud=0,g=0.x
+            let d13 = A::mul_add(p.MZ2, k8, p.MX2 * k7); // w2xMS2|ud=0,g=0.y
+            let d14 = A::mul_add(p.MX2, k6, p.MY2 * k8); // w2xMS2|ud=0,g=0.z
+            let d15 = A::mul_add(
+                k7,
+                d13,
+                A::mul_add(
+                    k6,
+                    d14,
+                    A::mul_add(-p.MY2, k10, A::mul_add(p.MZ2, k9, p.m2 * k15)),
+                ),
+            ); // F2|ud=0,g=0.x
+            let d16 = A::mul_add(
+                k8,
+                d14,
+                A::mul_add(-k7, d12, A::mul_add(p.MX2, k10, p.m2 * k17)),
+            ); // F2|ud=0,g=0.y
+            let d17 = A::mul_add(
+                k6,
+                d12,
+                A::mul_add(k8, d13, A::mul_add(-p.MX2, k9, p.m2 * k18)),
+            ); // F2|ud=0,g=0.z
+            let d18 = A::mul_add(-p.XZ2, k7, A::mul_add(-p.XY2, k6, p.XX2 * k8)); // J2w2|ud=0,g=0.x
+            let d19 = A::mul_add(-p.YZ2, k7, A::mul_add(-p.YY2, k6, p.XY2 * k8)); // J2w2|ud=0,g=0.y
+            let d20 = A::mul_add(-p.ZZ2, k7, A::mul_add(-p.YZ2, k6, p.XZ2 * k8)); // J2w2|ud=0,g=0.z
+            let d21 = A::mul_add(
+                -p.MZ2,
+                k17,
+                A::mul_add(
+                    p.MY2,
+                    k18,
+                    A::mul_add(
+                        -k7,
+                        d19,
+                        A::mul_add(k6, d20, A::mul_add(p.XZ2, k10, p.XY2 * k9)),
+                    ),
+                ),
+            ); // N2|ud=0,g=0.x
+            let d22 = A::mul_add(
+                -p.MX2,
+                k18,
+                A::mul_add(
+                    p.MZ2,
+                    k15,
+                    A::mul_add(
+                        k8,
+                        d20,
+                        A::mul_add(k7, d18, A::mul_add(p.YZ2, k10, p.YY2 * k9)),
+                    ),
+                ),
+            ); // N2|ud=0,g=0.y
+            let d23 = A::mul_add(
+                -p.MY2,
+                k15,
+                A::mul_add(
+                    p.MX2,
+                    k17,
+                    A::mul_add(
+                        -k6,
+                        d18,
+                        A::mul_add(-k8, d19, A::mul_add(p.ZZ2, k10, p.YZ2 * k9)),
+                    ),
+                ),
+            ); // N2|ud=0,g=0.z
+            let k19 = A::mul_add(-s_q_torso, k7, c_q_torso * k8); // w2 in 3|ud=0,g=0.x
+            let k20 = A::mul_add(c_q_torso, k7, s_q_torso * k8); // w2 in 3|ud=0,g=0.z
+            let k21 = k6 - qd_torso; // w3|ud=0,g=0.y
+            let k22 = A::mul_add(-k20, qd_torso, s_q_torso * k10); // wd3|ud=0,g=0.x
+            let k23 = A::mul_add(-k19, qd_torso, c_q_torso * k10); // wd3|ud=0,g=0.z
+            let k24 = A::mul_add(-p.L3, k7, p.L4 * k6); // w2xP3|ud=0,g=0.x
+            let k25 = p.L4 * k8; // w2xP3|ud=0,g=0.y
+            let k26 = p.L3 * k8; // w2xP3|ud=0,g=0.z
+            let k27 = A::mul_add(
+                k7,
+                k25,
+                A::mul_add(k6, k26, A::mul_add(-p.L3, k10, A::mul_add(p.L4, k9, k15))),
+            ); // a3 in 2|ud=0,g=0.x
+            let k28 = A::mul_add(k8, k26, A::mul_add(-k7, k24, k17)); // a3 in 2|ud=0,g=0.y
+            let k29 = A::mul_add(k6, k24, A::mul_add(k8, k25, k18)); // a3 in 2|ud=0,g=0.z
+            let k30 = A::mul_add(s_q_torso, k29, c_q_torso * k27); // a3|ud=0,g=0.x
+            let k31 = A::mul_add(-c_q_torso, k29, s_q_torso * k27); // a3|ud=0,g=0.z
+            let d24 = A::mul_add(p.MY3, k20, p.MZ3 * k21); // w3xMS3|ud=0,g=0.x
+            let d25 = A::mul_add(-p.MX3, k21, p.MY3 * k19); // w3xMS3|ud=0,g=0.z
+            let d26 = A::mul_add(p.MZ3, k19, p.MX3 * k20); // w3xMS3|ud=0,g=0.y
+            let d27 = A::mul_add(
+                -k20,
+                d26,
+                A::mul_add(
+                    k21,
+                    d25,
+                    A::mul_add(-p.MY3, k23, A::mul_add(-p.MZ3, k9, p.m3 * k30)),
+                ),
+            ); // F3|ud=0,g=0.x
+            let d28 = A::mul_add(
+                k19,
+                d25,
+                A::mul_add(
+                    k20,
+                    d24,
+                    A::mul_add(p.MZ3, k22, A::mul_add(-p.MX3, k23, p.m3 * k28)),
+                ),
+            ); // F3|ud=0,g=0.y
+            let d29 = A::mul_add(
+                k21,
+                d24,
+                A::mul_add(
+                    k19,
+                    d26,
+                    A::mul_add(-p.MX3, k9, A::mul_add(-p.MY3, k22, p.m3 * k31)),
+                ),
+            ); // F3|ud=0,g=0.z
+            let d30 = A::mul_add(-p.XZ3, k20, A::mul_add(p.XY3, k21, p.XX3 * k19)); // J3w3|ud=0,g=0.x
+            let d31 = A::mul_add(-p.YZ3, k20, A::mul_add(p.YY3, k21, p.XY3 * k19)); // J3w3|ud=0,g=0.y
+            let d32 = A::mul_add(-p.ZZ3, k20, A::mul_add(p.YZ3, k21, p.XZ3 * k19)); // J3w3|ud=0,g=0.z
+            let d33 = A::mul_add(
+                p.MZ3,
+                k28,
+                A::mul_add(
+                    -p.MY3,
+                    k31,
+                    A::mul_add(
+                        k20,
+                        d31,
+                        A::mul_add(
+                            k21,
+                            d32,
+                            A::mul_add(p.XZ3, k23, A::mul_add(-p.XY3, k9, p.XX3 * k22)),
+                        ),
+                    ),
+                ),
+            ); // N3|ud=0,g=0.x
+            let d34 = A::mul_add(
+                p.MX3,
+                k31,
+                A::mul_add(
+                    p.MZ3,
+                    k30,
+                    A::mul_add(
+                        -k19,
+                        d32,
+                        A::mul_add(
+                            -k20,
+                            d30,
+                            A::mul_add(p.YZ3, k23, A::mul_add(-p.YY3, k9, p.XY3 * k22)),
+                        ),
+                    ),
+                ),
+            ); // N3|ud=0,g=0.y
+            let d35 = A::mul_add(
+                -p.MY3,
+                k30,
+                A::mul_add(
+                    -p.MX3,
+                    k28,
+                    A::mul_add(
+                        -k21,
+                        d30,
+                        A::mul_add(
+                            k19,
+                            d31,
+                            A::mul_add(p.ZZ3, k23, A::mul_add(-p.YZ3, k9, p.XZ3 * k22)),
+                        ),
+                    ),
+                ),
+            ); // N3|ud=0,g=0.z
+            let k32 = A::mul_add(s_q1l, k20, c_q1l * k21); // w3 in 4l|ud=0,g=0.x
+            let k33 = A::mul_add(-c_q1l, k20, s_q1l * k21); // w3 in 4l|ud=0,g=0.z
+            let k34 = k19 - qd1l; // w4l|ud=0,g=0.y
+            let k35 = A::mul_add(-k32, qd1l, A::mul_add(-c_q1l, k23, s_q1l * k9)); // wd4l|ud=0,g=0.z
+            let k36 = A::mul_add(k33, qd1l, A::mul_add(s_q1l, k23, c_q1l * k9)); // wd4l|ud=0,g=0.x
+            let k37 = p.L5 * k20; // w3xP4l|ud=0,g=0.x
+            let k38 = p.L6 * k20; // w3xP4l|ud=0,g=0.y
+            let t1 = p.L5 * k19; // common subexpression
+            let t2 = p.L6 * k21; // common subexpression
+            let k39 = t1 - t2; // w3xP4l|ud=0,g=0.z
+            let t3 = p.L5 * k23; // common subexpression
+            let t4 = p.L6 * k23; // common subexpression
+            let t5 = p.L5 * k22; // common subexpression
+            let t6 = p.L6 * k9; // common subexpression
+            let t7 = k20 * k38; // common subexpression
+            let t8 = k20 * k37; // common subexpression
+            let t9 = k19 * k38; // common subexpression
+            let t10 = k21 * k37; // common subexpression
+            let k40 = A::mul_add(k21, k39, k30 - t3) - t7; // a4l in 3|ud=0,g=0.x
+            let k41 = A::mul_add(k19, k39, k28 - t4 + t8); // a4l in 3|ud=0,g=0.y
+            let k42 = k31 - t5 - t6 + t9 + t10; // a4l in 3|ud=0,g=0.z
+            let k43 = A::mul_add(c_q1l, k42, s_q1l * k41); // a4l|ud=0,g=0.z
+            let k44 = A::mul_add(-s_q1l, k42, c_q1l * k41); // a4l|ud=0,g=0.x
+            let k50 = A::mul_add(s_q2l, k43, c_q2l * k40); // a5l|ud=0,g=0.y
+            let k51 = A::mul_add(-c_q2l, k43, s_q2l * k40); // a5l|ud=0,g=0.z
+            let k102 = A::mul_add(-s_q1r, k20, c_q1r * k21); // w3 in 4r|ud=0,g=0.x
+            let k103 = A::mul_add(c_q1r, k20, s_q1r * k21); // w3 in 4r|ud=0,g=0.z
+            let k104 = A::mul_add(-k102, qd1r, A::mul_add(c_q1r, k23, s_q1r * k9)); // wd4r|ud=0,g=0.z
+            let k105 = -k19 - qd1r; // w4r|ud=0,g=0.y
+            let k106 = A::mul_add(k103, qd1r, A::mul_add(-s_q1r, k23, c_q1r * k9)); // wd4r|ud=0,g=0.x
+            let k107 = t1 + t2; // w3xP4r|ud=0,g=0.z
+            let k108 = A::mul_add(k21, k107, k30 - t3 + t7); // a4r in 3|ud=0,g=0.x
+            let k109 = A::mul_add(k19, k107, k28 + t4 + t8); // a4r in 3|ud=0,g=0.y
+            let k110 = k31 - t5 + t6 - t9 + t10; // a4r in 3|ud=0,g=0.z
+            let k111 = A::mul_add(-c_q1r, k110, s_q1r * k109); // a4r|ud=0,g=0.z
+            let k112 = A::mul_add(s_q1r, k110, c_q1r * k109); // a4r|ud=0,g=0.x
+            let d37 = A::mul_add(-p.MX4l, k34, p.MY4l * k32); // w4lxMS4l|ud=0,g=0.z
+            let d120 = A::mul_add(-p.MX4r, k105, p.MY4r * k102); // w4rxMS4r|ud=0,g=0.z
+            let d36 = A::mul_add(p.MY4l, k33, p.MZ4l * k34); // w4lxMS4l|ud=0,g=0.x
+            let d121 = A::mul_add(p.MY4r, k103, p.MZ4r * k105); // w4rxMS4r|ud=0,g=0.x
+            let d39 = A::mul_add(
+                -k32,
+                d37,
+                A::mul_add(
+                    -k33,
+                    d36,
+                    A::mul_add(p.MZ4l, k36, A::mul_add(p.MX4l, k35, p.m4l * k40)),
+                ),
+            ); // F4l|ud=0,g=0.y
+            let d38 = A::mul_add(p.MZ4l, k32, p.MX4l * k33); // w4lxMS4l|ud=0,g=0.y
+            let d122 = A::mul_add(p.MZ4r, k102, p.MX4r * k103); // w4rxMS4r|ud=0,g=0.y
+            let d40 = A::mul_add(
+                -k34,
+                d36,
+                A::mul_add(
+                    -k32,
+                    d38,
+                    A::mul_add(-p.MX4l, k22, A::mul_add(-p.MY4l, k36, p.m4l * k43)),
+                ),
+            ); // F4l|ud=0,g=0.z
+            let d41 = A::mul_add(
+                k33,
+                d38,
+                A::mul_add(
+                    -k34,
+                    d37,
+                    A::mul_add(p.MY4l, k35, A::mul_add(-p.MZ4l, k22, p.m4l * k44)),
+                ),
+            ); // F4l|ud=0,g=0.x
+            let d123 = A::mul_add(
+                -k105,
+                d121,
+                A::mul_add(
+                    -k102,
+                    d122,
+                    A::mul_add(p.MX4r, k22, A::mul_add(-p.MY4r, k106, p.m4r * k111)),
+                ),
+            ); // F4r|ud=0,g=0.z
+            let d124 = A::mul_add(
+                k103,
+                d122,
+                A::mul_add(
+                    -k105,
+                    d120,
+                    A::mul_add(p.MY4r, k104, A::mul_add(p.MZ4r, k22, p.m4r * k112)),
+                ),
+            ); // F4r|ud=0,g=0.x
+            let d125 = A::mul_add(
+                -k102,
+                d120,
+                A::mul_add(
+                    -k103,
+                    d121,
+                    A::mul_add(p.MZ4r, k106, A::mul_add(-p.m4r, k108, p.MX4r * k104)),
+                ),
+            ); // F4r|ud=0,g=0.y
+            let d42 = A::mul_add(-p.XZ4l, k33, A::mul_add(p.XY4l, k34, p.XX4l * k32)); // J4lw4l|ud=0,g=0.x
+            let d126 = A::mul_add(
+                -p.XZ4r,
+                k103,
+                A::mul_add(p.XY4r, k105, p.XX4r * k102),
+            ); // J4rw4r|ud=0,g=0.x
+            let d43 = A::mul_add(-p.YZ4l, k33, A::mul_add(p.YY4l, k34, p.XY4l * k32)); // J4lw4l|ud=0,g=0.y
+            let d127 = A::mul_add(
+                -p.YZ4r,
+                k103,
+                A::mul_add(p.YY4r, k105, p.XY4r * k102),
+            ); // J4rw4r|ud=0,g=0.y
+            let d47 = A::mul_add(
+                -p.MY4l,
+                k44,
+                A::mul_add(
+                    -p.MX4l,
+                    k40,
+                    A::mul_add(
+                        k34,
+                        d42,
+                        A::mul_add(
+                            -k32,
+                            d43,
+                            A::mul_add(
+                                -p.ZZ4l,
+                                k35,
+                                A::mul_add(-p.YZ4l, k22, p.XZ4l * k36),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N4l|ud=0,g=0.z
+            let d44 = A::mul_add(-p.ZZ4l, k33, A::mul_add(p.YZ4l, k34, p.XZ4l * k32)); // J4lw4l|ud=0,g=0.z
+            let d128 = A::mul_add(
+                -p.ZZ4r,
+                k103,
+                A::mul_add(p.YZ4r, k105, p.XZ4r * k102),
+            ); // J4rw4r|ud=0,g=0.z
+            let d45 = A::mul_add(
+                p.MZ4l,
+                k40,
+                A::mul_add(
+                    -p.MY4l,
+                    k43,
+                    A::mul_add(
+                        -k33,
+                        d43,
+                        A::mul_add(
+                            -k34,
+                            d44,
+                            A::mul_add(
+                                -p.XZ4l,
+                                k35,
+                                A::mul_add(-p.XY4l, k22, p.XX4l * k36),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N4l|ud=0,g=0.x
+            let d46 = A::mul_add(
+                p.MX4l,
+                k43,
+                A::mul_add(
+                    p.MZ4l,
+                    k44,
+                    A::mul_add(
+                        k32,
+                        d44,
+                        A::mul_add(
+                            k33,
+                            d42,
+                            A::mul_add(
+                                -p.YZ4l,
+                                k35,
+                                A::mul_add(-p.YY4l, k22, p.XY4l * k36),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N4l|ud=0,g=0.y
+            let d129 = A::mul_add(
+                -p.MZ4r,
+                k108,
+                A::mul_add(
+                    -p.MY4r,
+                    k111,
+                    A::mul_add(
+                        -k103,
+                        d127,
+                        A::mul_add(
+                            -k105,
+                            d128,
+                            A::mul_add(
+                                -p.XZ4r,
+                                k104,
+                                A::mul_add(p.XY4r, k22, p.XX4r * k106),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N4r|ud=0,g=0.x
+            let d130 = A::mul_add(
+                p.MX4r,
+                k111,
+                A::mul_add(
+                    p.MZ4r,
+                    k112,
+                    A::mul_add(
+                        k102,
+                        d128,
+                        A::mul_add(
+                            k103,
+                            d126,
+                            A::mul_add(
+                                -p.YZ4r,
+                                k104,
+                                A::mul_add(p.YY4r, k22, p.XY4r * k106),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N4r|ud=0,g=0.y
+            let d131 = A::mul_add(
+                -p.MY4r,
+                k112,
+                A::mul_add(
+                    p.MX4r,
+                    k108,
+                    A::mul_add(
+                        k105,
+                        d126,
+                        A::mul_add(
+                            -k102,
+                            d127,
+                            A::mul_add(
+                                -p.ZZ4r,
+                                k104,
+                                A::mul_add(p.YZ4r, k22, p.XZ4r * k106),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N4r|ud=0,g=0.z
+            let k45 = A::mul_add(-s_q2l, k33, c_q2l * k34); // w4l in 5l|ud=0,g=0.y
+            let k113 = A::mul_add(-s_q2r, k103, c_q2r * k105); // w4r in 5r|ud=0,g=0.y
+            let k49 = A::mul_add(k45, qd2l, A::mul_add(-c_q2l, k35, s_q2l * k22)); // wd5l|ud=0,g=0.z
+            let k46 = A::mul_add(c_q2l, k33, s_q2l * k34); // w4l in 5l|ud=0,g=0.z
+            let k114 = A::mul_add(c_q2r, k103, s_q2r * k105); // w4r in 5r|ud=0,g=0.z
+            let k48 = A::mul_add(-k46, qd2l, A::mul_add(s_q2l, k35, c_q2l * k22)); // wd5l|ud=0,g=0.y
+            let k115 = A::mul_add(-k114, qd2r, A::mul_add(-c_q2r, k22, s_q2r * k104)); // wd5r|ud=0,g=0.y
+            let k116 = A::mul_add(-c_q2r, k104, A::mul_add(-s_q2r, k22, k113 * qd2r)); // wd5r|ud=0,g=0.z
+            let k47 = k32 + qd2l; // w5l|ud=0,g=0.x
+            let k117 = k102 + qd2r; // w5r|ud=0,g=0.x
+            let k118 = A::mul_add(-c_q2r, k108, s_q2r * k111); // a5r|ud=0,g=0.y
+            let k119 = A::mul_add(-c_q2r, k111, -s_q2r * k108); // a5r|ud=0,g=0.z
+            let d48 = A::mul_add(-p.MY5l, k46, p.MZ5l * k45); // w5lxMS5l|ud=0,g=0.x
+            let d132 = A::mul_add(-p.MY5r, k114, p.MZ5r * k113); // w5rxMS5r|ud=0,g=0.x
+            let d49 = A::mul_add(-p.MZ5l, k47, p.MX5l * k46); // w5lxMS5l|ud=0,g=0.y
+            let d133 = A::mul_add(-p.MZ5r, k117, p.MX5r * k114); // w5rxMS5r|ud=0,g=0.y
+            let d50 = A::mul_add(-p.MX5l, k45, p.MY5l * k47); // w5lxMS5l|ud=0,g=0.z
+            let d134 = A::mul_add(-p.MX5r, k113, p.MY5r * k117); // w5rxMS5r|ud=0,g=0.z
+            let d51 = A::mul_add(
+                -k46,
+                d49,
+                A::mul_add(
+                    k45,
+                    d50,
+                    A::mul_add(p.MY5l, k49, A::mul_add(-p.MZ5l, k48, p.m5l * k44)),
+                ),
+            ); // F5l|ud=0,g=0.x
+            let d135 = A::mul_add(
+                -k114,
+                d133,
+                A::mul_add(
+                    k113,
+                    d134,
+                    A::mul_add(p.MY5r, k116, A::mul_add(-p.MZ5r, k115, p.m5r * k112)),
+                ),
+            ); // F5r|ud=0,g=0.x
+            let d52 = A::mul_add(
+                k47,
+                d50,
+                A::mul_add(
+                    -k46,
+                    d48,
+                    A::mul_add(p.MZ5l, k36, A::mul_add(p.MX5l, k49, p.m5l * k50)),
+                ),
+            ); // F5l|ud=0,g=0.y
+            let d136 = A::mul_add(
+                k117,
+                d134,
+                A::mul_add(
+                    -k114,
+                    d132,
+                    A::mul_add(p.MZ5r, k106, A::mul_add(p.MX5r, k116, p.m5r * k118)),
+                ),
+            ); // F5r|ud=0,g=0.y
+            let d53 = A::mul_add(
+                k45,
+                d48,
+                A::mul_add(
+                    -k47,
+                    d49,
+                    A::mul_add(-p.MX5l, k48, A::mul_add(-p.MY5l, k36, p.m5l * k51)),
+                ),
+            ); // F5l|ud=0,g=0.z
+            let d137 = A::mul_add(
+                k113,
+                d132,
+                A::mul_add(
+                    -k117,
+                    d133,
+                    A::mul_add(-p.MX5r, k115, A::mul_add(-p.MY5r, k106, p.m5r * k119)),
+                ),
+            ); // F5r|ud=0,g=0.z
+            let d54 = A::mul_add(p.XZ5l, k46, A::mul_add(p.XY5l, k45, p.XX5l * k47)); // J5lw5l|ud=0,g=0.x
+            let d138 = A::mul_add(p.XZ5r, k114, A::mul_add(p.XY5r, k113, p.XX5r * k117)); // J5rw5r|ud=0,g=0.x
+            let d55 = A::mul_add(p.YZ5l, k46, A::mul_add(p.YY5l, k45, p.XY5l * k47)); // J5lw5l|ud=0,g=0.y
+            let d139 = A::mul_add(p.YZ5r, k114, A::mul_add(p.YY5r, k113, p.XY5r * k117)); // J5rw5r|ud=0,g=0.y
+            let d56 = A::mul_add(p.ZZ5l, k46, A::mul_add(p.YZ5l, k45, p.XZ5l * k47)); // J5lw5l|ud=0,g=0.z
+            let d140 = A::mul_add(p.ZZ5r, k114, A::mul_add(p.YZ5r, k113, p.XZ5r * k117)); // J5rw5r|ud=0,g=0.z
+            let d57 = A::mul_add(
+                p.MZ5l,
+                k50,
+                A::mul_add(
+                    -p.MY5l,
+                    k51,
+                    A::mul_add(
+                        -k46,
+                        d55,
+                        A::mul_add(
+                            k45,
+                            d56,
+                            A::mul_add(
+                                -p.XZ5l,
+                                k49,
+                                A::mul_add(-p.XY5l, k48, p.XX5l * k36),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N5l|ud=0,g=0.x
+            let d141 = A::mul_add(
+                p.MZ5r,
+                k118,
+                A::mul_add(
+                    -p.MY5r,
+                    k119,
+                    A::mul_add(
+                        -k114,
+                        d139,
+                        A::mul_add(
+                            k113,
+                            d140,
+                            A::mul_add(
+                                -p.XZ5r,
+                                k116,
+                                A::mul_add(-p.XY5r, k115, p.XX5r * k106),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N5r|ud=0,g=0.x
+            let d58 = A::mul_add(
+                p.MX5l,
+                k51,
+                A::mul_add(
+                    p.MZ5l,
+                    k44,
+                    A::mul_add(
+                        -k47,
+                        d56,
+                        A::mul_add(
+                            k46,
+                            d54,
+                            A::mul_add(
+                                -p.YZ5l,
+                                k49,
+                                A::mul_add(-p.YY5l, k48, p.XY5l * k36),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N5l|ud=0,g=0.y
+            let d142 = A::mul_add(
+                p.MX5r,
+                k119,
+                A::mul_add(
+                    p.MZ5r,
+                    k112,
+                    A::mul_add(
+                        -k117,
+                        d140,
+                        A::mul_add(
+                            k114,
+                            d138,
+                            A::mul_add(
+                                -p.YZ5r,
+                                k116,
+                                A::mul_add(-p.YY5r, k115, p.XY5r * k106),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N5r|ud=0,g=0.y
+            let d59 = A::mul_add(
+                -p.MY5l,
+                k44,
+                A::mul_add(
+                    -p.MX5l,
+                    k50,
+                    A::mul_add(
+                        -k45,
+                        d54,
+                        A::mul_add(
+                            k47,
+                            d55,
+                            A::mul_add(
+                                -p.ZZ5l,
+                                k49,
+                                A::mul_add(-p.YZ5l, k48, p.XZ5l * k36),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N5l|ud=0,g=0.z
+            let d143 = A::mul_add(
+                -p.MY5r,
+                k112,
+                A::mul_add(
+                    -p.MX5r,
+                    k118,
+                    A::mul_add(
+                        -k113,
+                        d138,
+                        A::mul_add(
+                            k117,
+                            d139,
+                            A::mul_add(
+                                -p.ZZ5r,
+                                k116,
+                                A::mul_add(-p.YZ5r, k115, p.XZ5r * k106),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N5r|ud=0,g=0.z
+            let k52 = A::mul_add(-s_q3l, k46, c_q3l * k47); // w5l in 6l|ud=0,g=0.x
+            let k120 = A::mul_add(-s_q3r, k114, c_q3r * k117); // w5r in 6r|ud=0,g=0.x
+            let k53 = A::mul_add(c_q3l, k46, s_q3l * k47); // w5l in 6l|ud=0,g=0.z
+            let k121 = A::mul_add(c_q3r, k114, s_q3r * k117); // w5r in 6r|ud=0,g=0.z
+            let k55 = A::mul_add(-k52, qd3l, A::mul_add(-c_q3l, k49, s_q3l * k36)); // wd6l|ud=0,g=0.z
+            let k122 = A::mul_add(-k120, qd3r, A::mul_add(-c_q3r, k116, s_q3r * k106)); // wd6r|ud=0,g=0.z
+            let k54 = k45 - qd3l; // w6l|ud=0,g=0.y
+            let k123 = k113 - qd3r; // w6r|ud=0,g=0.y
+            let k56 = A::mul_add(k53, qd3l, A::mul_add(s_q3l, k49, c_q3l * k36)); // wd6l|ud=0,g=0.x
+            let k124 = A::mul_add(k121, qd3r, A::mul_add(s_q3r, k116, c_q3r * k106)); // wd6r|ud=0,g=0.x
+            let k57 = p.L7 * k46; // w5lxP6l|ud=0,g=0.x
+            let k125 = p.L7 * k114; // w5rxP6r|ud=0,g=0.x
+            let k58 = p.L7 * k47; // w5lxP6l|ud=0,g=0.z
+            let k126 = p.L7 * k117; // w5rxP6r|ud=0,g=0.z
+            let k59 = A::mul_add(-k45, k58, A::mul_add(-p.L7, k49, k44)); // a6l in 5l|ud=0,g=0.x
+            let k127 = A::mul_add(-k113, k126, A::mul_add(-p.L7, k116, k112)); // a6r in 5r|ud=0,g=0.x
+            let k60 = A::mul_add(-k47, k58, A::mul_add(-k46, k57, k50)); // a6l in 5l|ud=0,g=0.y
+            let k128 = A::mul_add(-k117, k126, A::mul_add(-k114, k125, k118)); // a6r in 5r|ud=0,g=0.y
+            let k61 = A::mul_add(k45, k57, A::mul_add(p.L7, k36, k51)); // a6l in 5l|ud=0,g=0.z
+            let k129 = A::mul_add(k113, k125, A::mul_add(p.L7, k106, k119)); // a6r in 5r|ud=0,g=0.z
+            let k62 = A::mul_add(-c_q3l, k61, s_q3l * k59); // a6l|ud=0,g=0.z
+            let k130 = A::mul_add(-c_q3r, k129, s_q3r * k127); // a6r|ud=0,g=0.z
+            let k63 = A::mul_add(s_q3l, k61, c_q3l * k59); // a6l|ud=0,g=0.x
+            let k131 = A::mul_add(s_q3r, k129, c_q3r * k127); // a6r|ud=0,g=0.x
+            let d61 = A::mul_add(-p.MX6l, k54, p.MY6l * k52); // w6lxMS6l|ud=0,g=0.z
+            let d144 = A::mul_add(-p.MX6r, k123, p.MY6r * k120); // w6rxMS6r|ud=0,g=0.z
+            let d60 = A::mul_add(p.MY6l, k53, p.MZ6l * k54); // w6lxMS6l|ud=0,g=0.x
+            let d145 = A::mul_add(p.MY6r, k121, p.MZ6r * k123); // w6rxMS6r|ud=0,g=0.x
+            let d62 = A::mul_add(p.MZ6l, k52, p.MX6l * k53); // w6lxMS6l|ud=0,g=0.y
+            let d146 = A::mul_add(p.MZ6r, k120, p.MX6r * k121); // w6rxMS6r|ud=0,g=0.y
+            let d64 = A::mul_add(
+                -k54,
+                d60,
+                A::mul_add(
+                    -k52,
+                    d62,
+                    A::mul_add(-p.MX6l, k48, A::mul_add(-p.MY6l, k56, p.m6l * k62)),
+                ),
+            ); // F6l|ud=0,g=0.z
+            let d147 = A::mul_add(
+                -k123,
+                d145,
+                A::mul_add(
+                    -k120,
+                    d146,
+                    A::mul_add(-p.MX6r, k115, A::mul_add(-p.MY6r, k124, p.m6r * k130)),
+                ),
+            ); // F6r|ud=0,g=0.z
+            let d65 = A::mul_add(
+                k53,
+                d62,
+                A::mul_add(
+                    -k54,
+                    d61,
+                    A::mul_add(p.MY6l, k55, A::mul_add(-p.MZ6l, k48, p.m6l * k63)),
+                ),
+            ); // F6l|ud=0,g=0.x
+            let d148 = A::mul_add(
+                k121,
+                d146,
+                A::mul_add(
+                    -k123,
+                    d144,
+                    A::mul_add(p.MY6r, k122, A::mul_add(-p.MZ6r, k115, p.m6r * k131)),
+                ),
+            ); // F6r|ud=0,g=0.x
+            let d63 = A::mul_add(
+                -k52,
+                d61,
+                A::mul_add(
+                    -k53,
+                    d60,
+                    A::mul_add(p.MZ6l, k56, A::mul_add(p.MX6l, k55, p.m6l * k60)),
+                ),
+            ); // F6l|ud=0,g=0.y
+            let d149 = A::mul_add(
+                -k120,
+                d144,
+                A::mul_add(
+                    -k121,
+                    d145,
+                    A::mul_add(p.MZ6r, k124, A::mul_add(p.MX6r, k122, p.m6r * k128)),
+                ),
+            ); // F6r|ud=0,g=0.y
+            let d66 = A::mul_add(-p.XZ6l, k53, A::mul_add(p.XY6l, k54, p.XX6l * k52)); // J6lw6l|ud=0,g=0.x
+            let d150 = A::mul_add(
+                -p.XZ6r,
+                k121,
+                A::mul_add(p.XY6r, k123, p.XX6r * k120),
+            ); // J6rw6r|ud=0,g=0.x
+            let d67 = A::mul_add(-p.YZ6l, k53, A::mul_add(p.YY6l, k54, p.XY6l * k52)); // J6lw6l|ud=0,g=0.y
+            let d151 = A::mul_add(
+                -p.YZ6r,
+                k121,
+                A::mul_add(p.YY6r, k123, p.XY6r * k120),
+            ); // J6rw6r|ud=0,g=0.y
+            let d68 = A::mul_add(-p.ZZ6l, k53, A::mul_add(p.YZ6l, k54, p.XZ6l * k52)); // J6lw6l|ud=0,g=0.z
+            let d152 = A::mul_add(
+                -p.ZZ6r,
+                k121,
+                A::mul_add(p.YZ6r, k123, p.XZ6r * k120),
+            ); // J6rw6r|ud=0,g=0.z
+            let d69 = A::mul_add(
+                p.MZ6l,
+                k60,
+                A::mul_add(
+                    -p.MY6l,
+                    k62,
+                    A::mul_add(
+                        -k53,
+                        d67,
+                        A::mul_add(
+                            -k54,
+                            d68,
+                            A::mul_add(
+                                -p.XZ6l,
+                                k55,
+                                A::mul_add(-p.XY6l, k48, p.XX6l * k56),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N6l|ud=0,g=0.x
+            let d153 = A::mul_add(
+                p.MZ6r,
+                k128,
+                A::mul_add(
+                    -p.MY6r,
+                    k130,
+                    A::mul_add(
+                        -k121,
+                        d151,
+                        A::mul_add(
+                            -k123,
+                            d152,
+                            A::mul_add(
+                                -p.XZ6r,
+                                k122,
+                                A::mul_add(-p.XY6r, k115, p.XX6r * k124),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N6r|ud=0,g=0.x
+            let d70 = A::mul_add(
+                p.MX6l,
+                k62,
+                A::mul_add(
+                    p.MZ6l,
+                    k63,
+                    A::mul_add(
+                        k52,
+                        d68,
+                        A::mul_add(
+                            k53,
+                            d66,
+                            A::mul_add(
+                                -p.YZ6l,
+                                k55,
+                                A::mul_add(-p.YY6l, k48, p.XY6l * k56),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N6l|ud=0,g=0.y
+            let d154 = A::mul_add(
+                p.MX6r,
+                k130,
+                A::mul_add(
+                    p.MZ6r,
+                    k131,
+                    A::mul_add(
+                        k120,
+                        d152,
+                        A::mul_add(
+                            k121,
+                            d150,
+                            A::mul_add(
+                                -p.YZ6r,
+                                k122,
+                                A::mul_add(-p.YY6r, k115, p.XY6r * k124),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N6r|ud=0,g=0.y
+            let d71 = A::mul_add(
+                -p.MY6l,
+                k63,
+                A::mul_add(
+                    -p.MX6l,
+                    k60,
+                    A::mul_add(
+                        k54,
+                        d66,
+                        A::mul_add(
+                            -k52,
+                            d67,
+                            A::mul_add(
+                                -p.ZZ6l,
+                                k55,
+                                A::mul_add(-p.YZ6l, k48, p.XZ6l * k56),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N6l|ud=0,g=0.z
+            let d155 = A::mul_add(
+                -p.MY6r,
+                k131,
+                A::mul_add(
+                    -p.MX6r,
+                    k128,
+                    A::mul_add(
+                        k123,
+                        d150,
+                        A::mul_add(
+                            -k120,
+                            d151,
+                            A::mul_add(
+                                -p.ZZ6r,
+                                k122,
+                                A::mul_add(-p.YZ6r, k115, p.XZ6r * k124),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N6r|ud=0,g=0.z
+            let k64 = A::mul_add(-s_q4l, k53, c_q4l * k54); // w6l in 7l|ud=0,g=0.y
+            let k132 = A::mul_add(-s_q4r, k121, c_q4r * k123); // w6r in 7r|ud=0,g=0.y
+            let k65 = A::mul_add(c_q4l, k53, s_q4l * k54); // w6l in 7l|ud=0,g=0.z
+            let k133 = A::mul_add(c_q4r, k121, s_q4r * k123); // w6r in 7r|ud=0,g=0.z
+            let k67 = A::mul_add(-k65, qd4l, A::mul_add(s_q4l, k55, c_q4l * k48)); // wd7l|ud=0,g=0.y
+            let k134 = A::mul_add(-k133, qd4r, A::mul_add(s_q4r, k122, c_q4r * k115)); // wd7r|ud=0,g=0.y
+            let k68 = A::mul_add(k64, qd4l, A::mul_add(-c_q4l, k55, s_q4l * k48)); // wd7l|ud=0,g=0.z
+            let k135 = A::mul_add(k132, qd4r, A::mul_add(-c_q4r, k122, s_q4r * k115)); // wd7r|ud=0,g=0.z
+            let k66 = k52 + qd4l; // w7l|ud=0,g=0.x
+            let k136 = k120 + qd4r; // w7r|ud=0,g=0.x
+            let k69 = A::mul_add(s_q4l, k62, c_q4l * k60); // a7l|ud=0,g=0.y
+            let k137 = A::mul_add(s_q4r, k130, c_q4r * k128); // a7r|ud=0,g=0.y
+            let k70 = A::mul_add(-c_q4l, k62, s_q4l * k60); // a7l|ud=0,g=0.z
+            let k138 = A::mul_add(-c_q4r, k130, s_q4r * k128); // a7r|ud=0,g=0.z
+            let d72 = A::mul_add(-p.MY7l, k65, p.MZ7l * k64); // w7lxMS7l|ud=0,g=0.x
+            let d156 = A::mul_add(-p.MY7r, k133, p.MZ7r * k132); // w7rxMS7r|ud=0,g=0.x
+            let d73 = A::mul_add(-p.MZ7l, k66, p.MX7l * k65); // w7lxMS7l|ud=0,g=0.y
+            let d157 = A::mul_add(-p.MZ7r, k136, p.MX7r * k133); // w7rxMS7r|ud=0,g=0.y
+            let d74 = A::mul_add(-p.MX7l, k64, p.MY7l * k66); // w7lxMS7l|ud=0,g=0.z
+            let d158 = A::mul_add(-p.MX7r, k132, p.MY7r * k136); // w7rxMS7r|ud=0,g=0.z
+            let d75 = A::mul_add(
+                -k65,
+                d73,
+                A::mul_add(
+                    k64,
+                    d74,
+                    A::mul_add(p.MY7l, k68, A::mul_add(-p.MZ7l, k67, p.m7l * k63)),
+                ),
+            ); // F7l|ud=0,g=0.x
+            let d159 = A::mul_add(
+                -k133,
+                d157,
+                A::mul_add(
+                    k132,
+                    d158,
+                    A::mul_add(p.MY7r, k135, A::mul_add(-p.MZ7r, k134, p.m7r * k131)),
+                ),
+            ); // F7r|ud=0,g=0.x
+            let d76 = A::mul_add(
+                k66,
+                d74,
+                A::mul_add(
+                    -k65,
+                    d72,
+                    A::mul_add(p.MZ7l, k56, A::mul_add(p.MX7l, k68, p.m7l * k69)),
+                ),
+            ); // F7l|ud=0,g=0.y
+            let d160 = A::mul_add(
+                k136,
+                d158,
+                A::mul_add(
+                    -k133,
+                    d156,
+                    A::mul_add(p.MZ7r, k124, A::mul_add(p.MX7r, k135, p.m7r * k137)),
+                ),
+            ); // F7r|ud=0,g=0.y
+            let d77 = A::mul_add(
+                k64,
+                d72,
+                A::mul_add(
+                    -k66,
+                    d73,
+                    A::mul_add(-p.MX7l, k67, A::mul_add(-p.MY7l, k56, p.m7l * k70)),
+                ),
+            ); // F7l|ud=0,g=0.z
+            let d161 = A::mul_add(
+                k132,
+                d156,
+                A::mul_add(
+                    -k136,
+                    d157,
+                    A::mul_add(-p.MX7r, k134, A::mul_add(-p.MY7r, k124, p.m7r * k138)),
+                ),
+            ); // F7r|ud=0,g=0.z
+            let d78 = A::mul_add(p.XZ7l, k65, A::mul_add(p.XY7l, k64, p.XX7l * k66)); // J7lw7l|ud=0,g=0.x
+            let d162 = A::mul_add(p.XZ7r, k133, A::mul_add(p.XY7r, k132, p.XX7r * k136)); // J7rw7r|ud=0,g=0.x
+            let d79 = A::mul_add(p.YZ7l, k65, A::mul_add(p.YY7l, k64, p.XY7l * k66)); // J7lw7l|ud=0,g=0.y
+            let d163 = A::mul_add(p.YZ7r, k133, A::mul_add(p.YY7r, k132, p.XY7r * k136)); // J7rw7r|ud=0,g=0.y
+            let d80 = A::mul_add(p.ZZ7l, k65, A::mul_add(p.YZ7l, k64, p.XZ7l * k66)); // J7lw7l|ud=0,g=0.z
+            let d164 = A::mul_add(p.ZZ7r, k133, A::mul_add(p.YZ7r, k132, p.XZ7r * k136)); // J7rw7r|ud=0,g=0.z
+            let d81 = A::mul_add(
+                p.MZ7l,
+                k69,
+                A::mul_add(
+                    -p.MY7l,
+                    k70,
+                    A::mul_add(
+                        -k65,
+                        d79,
+                        A::mul_add(
+                            k64,
+                            d80,
+                            A::mul_add(
+                                -p.XZ7l,
+                                k68,
+                                A::mul_add(-p.XY7l, k67, p.XX7l * k56),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N7l|ud=0,g=0.x
+            let d165 = A::mul_add(
+                p.MZ7r,
+                k137,
+                A::mul_add(
+                    -p.MY7r,
+                    k138,
+                    A::mul_add(
+                        -k133,
+                        d163,
+                        A::mul_add(
+                            k132,
+                            d164,
+                            A::mul_add(
+                                -p.XZ7r,
+                                k135,
+                                A::mul_add(-p.XY7r, k134, p.XX7r * k124),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N7r|ud=0,g=0.x
+            let d82 = A::mul_add(
+                p.MX7l,
+                k70,
+                A::mul_add(
+                    p.MZ7l,
+                    k63,
+                    A::mul_add(
+                        -k66,
+                        d80,
+                        A::mul_add(
+                            k65,
+                            d78,
+                            A::mul_add(
+                                -p.YZ7l,
+                                k68,
+                                A::mul_add(-p.YY7l, k67, p.XY7l * k56),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N7l|ud=0,g=0.y
+            let d166 = A::mul_add(
+                p.MX7r,
+                k138,
+                A::mul_add(
+                    p.MZ7r,
+                    k131,
+                    A::mul_add(
+                        -k136,
+                        d164,
+                        A::mul_add(
+                            k133,
+                            d162,
+                            A::mul_add(
+                                -p.YZ7r,
+                                k135,
+                                A::mul_add(-p.YY7r, k134, p.XY7r * k124),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N7r|ud=0,g=0.y
+            let d83 = A::mul_add(
+                -p.MY7l,
+                k63,
+                A::mul_add(
+                    -p.MX7l,
+                    k69,
+                    A::mul_add(
+                        -k64,
+                        d78,
+                        A::mul_add(
+                            k66,
+                            d79,
+                            A::mul_add(
+                                -p.ZZ7l,
+                                k68,
+                                A::mul_add(-p.YZ7l, k67, p.XZ7l * k56),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N7l|ud=0,g=0.z
+            let d167 = A::mul_add(
+                -p.MY7r,
+                k131,
+                A::mul_add(
+                    -p.MX7r,
+                    k137,
+                    A::mul_add(
+                        -k132,
+                        d162,
+                        A::mul_add(
+                            k136,
+                            d163,
+                            A::mul_add(
+                                -p.ZZ7r,
+                                k135,
+                                A::mul_add(-p.YZ7r, k134, p.XZ7r * k124),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N7r|ud=0,g=0.z
+            let k71 = A::mul_add(-s_q5l, k65, c_q5l * k66); // w7l in 8l|ud=0,g=0.x
+            let k139 = A::mul_add(-s_q5r, k133, c_q5r * k136); // w7r in 8r|ud=0,g=0.x
+            let k72 = A::mul_add(c_q5l, k65, s_q5l * k66); // w7l in 8l|ud=0,g=0.z
+            let k140 = A::mul_add(c_q5r, k133, s_q5r * k136); // w7r in 8r|ud=0,g=0.z
+            let k74 = A::mul_add(-k71, qd5l, A::mul_add(-c_q5l, k68, s_q5l * k56)); // wd8l|ud=0,g=0.z
+            let k141 = A::mul_add(-k139, qd5r, A::mul_add(-c_q5r, k135, s_q5r * k124)); // wd8r|ud=0,g=0.z
+            let k73 = k64 - qd5l; // w8l|ud=0,g=0.y
+            let k142 = k132 - qd5r; // w8r|ud=0,g=0.y
+            let k75 = A::mul_add(k72, qd5l, A::mul_add(s_q5l, k68, c_q5l * k56)); // wd8l|ud=0,g=0.x
+            let k143 = A::mul_add(k140, qd5r, A::mul_add(s_q5r, k135, c_q5r * k124)); // wd8r|ud=0,g=0.x
+            let k76 = p.L8 * k65; // w7lxP8l|ud=0,g=0.x
+            let k144 = p.L8 * k133; // w7rxP8r|ud=0,g=0.x
+            let k77 = p.L8 * k66; // w7lxP8l|ud=0,g=0.z
+            let k145 = p.L8 * k136; // w7rxP8r|ud=0,g=0.z
+            let k78 = A::mul_add(-k64, k77, A::mul_add(-p.L8, k68, k63)); // a8l in 7l|ud=0,g=0.x
+            let k146 = A::mul_add(-k132, k145, A::mul_add(-p.L8, k135, k131)); // a8r in 7r|ud=0,g=0.x
+            let k79 = A::mul_add(-k66, k77, A::mul_add(-k65, k76, k69)); // a8l in 7l|ud=0,g=0.y
+            let k147 = A::mul_add(-k136, k145, A::mul_add(-k133, k144, k137)); // a8r in 7r|ud=0,g=0.y
+            let k80 = A::mul_add(k64, k76, A::mul_add(p.L8, k56, k70)); // a8l in 7l|ud=0,g=0.z
+            let k148 = A::mul_add(k132, k144, A::mul_add(p.L8, k124, k138)); // a8r in 7r|ud=0,g=0.z
+            let k81 = A::mul_add(-c_q5l, k80, s_q5l * k78); // a8l|ud=0,g=0.z
+            let k149 = A::mul_add(-c_q5r, k148, s_q5r * k146); // a8r|ud=0,g=0.z
+            let k82 = A::mul_add(s_q5l, k80, c_q5l * k78); // a8l|ud=0,g=0.x
+            let k150 = A::mul_add(s_q5r, k148, c_q5r * k146); // a8r|ud=0,g=0.x
+            let d85 = A::mul_add(-p.MX8l, k73, p.MY8l * k71); // w8lxMS8l|ud=0,g=0.z
+            let d168 = A::mul_add(-p.MX8r, k142, p.MY8r * k139); // w8rxMS8r|ud=0,g=0.z
+            let d84 = A::mul_add(p.MY8l, k72, p.MZ8l * k73); // w8lxMS8l|ud=0,g=0.x
+            let d169 = A::mul_add(p.MY8r, k140, p.MZ8r * k142); // w8rxMS8r|ud=0,g=0.x
+            let d86 = A::mul_add(p.MZ8l, k71, p.MX8l * k72); // w8lxMS8l|ud=0,g=0.y
+            let d170 = A::mul_add(p.MZ8r, k139, p.MX8r * k140); // w8rxMS8r|ud=0,g=0.y
+            let d88 = A::mul_add(
+                -k73,
+                d84,
+                A::mul_add(
+                    -k71,
+                    d86,
+                    A::mul_add(-p.MX8l, k67, A::mul_add(-p.MY8l, k75, p.m8l * k81)),
+                ),
+            ); // F8l|ud=0,g=0.z
+            let d171 = A::mul_add(
+                -k142,
+                d169,
+                A::mul_add(
+                    -k139,
+                    d170,
+                    A::mul_add(-p.MX8r, k134, A::mul_add(-p.MY8r, k143, p.m8r * k149)),
+                ),
+            ); // F8r|ud=0,g=0.z
+            let d89 = A::mul_add(
+                k72,
+                d86,
+                A::mul_add(
+                    -k73,
+                    d85,
+                    A::mul_add(p.MY8l, k74, A::mul_add(-p.MZ8l, k67, p.m8l * k82)),
+                ),
+            ); // F8l|ud=0,g=0.x
+            let d172 = A::mul_add(
+                k140,
+                d170,
+                A::mul_add(
+                    -k142,
+                    d168,
+                    A::mul_add(p.MY8r, k141, A::mul_add(-p.MZ8r, k134, p.m8r * k150)),
+                ),
+            ); // F8r|ud=0,g=0.x
+            let d87 = A::mul_add(
+                -k71,
+                d85,
+                A::mul_add(
+                    -k72,
+                    d84,
+                    A::mul_add(p.MZ8l, k75, A::mul_add(p.MX8l, k74, p.m8l * k79)),
+                ),
+            ); // F8l|ud=0,g=0.y
+            let d173 = A::mul_add(
+                -k139,
+                d168,
+                A::mul_add(
+                    -k140,
+                    d169,
+                    A::mul_add(p.MZ8r, k143, A::mul_add(p.MX8r, k141, p.m8r * k147)),
+                ),
+            ); // F8r|ud=0,g=0.y
+            let d90 = A::mul_add(-p.XZ8l, k72, A::mul_add(p.XY8l, k73, p.XX8l * k71)); // J8lw8l|ud=0,g=0.x
+            let d174 = A::mul_add(
+                -p.XZ8r,
+                k140,
+                A::mul_add(p.XY8r, k142, p.XX8r * k139),
+            ); // J8rw8r|ud=0,g=0.x
+            let d91 = A::mul_add(-p.YZ8l, k72, A::mul_add(p.YY8l, k73, p.XY8l * k71)); // J8lw8l|ud=0,g=0.y
+            let d175 = A::mul_add(
+                -p.YZ8r,
+                k140,
+                A::mul_add(p.YY8r, k142, p.XY8r * k139),
+            ); // J8rw8r|ud=0,g=0.y
+            let d92 = A::mul_add(-p.ZZ8l, k72, A::mul_add(p.YZ8l, k73, p.XZ8l * k71)); // J8lw8l|ud=0,g=0.z
+            let d176 = A::mul_add(
+                -p.ZZ8r,
+                k140,
+                A::mul_add(p.YZ8r, k142, p.XZ8r * k139),
+            ); // J8rw8r|ud=0,g=0.z
+            let d93 = A::mul_add(
+                p.MZ8l,
+                k79,
+                A::mul_add(
+                    -p.MY8l,
+                    k81,
+                    A::mul_add(
+                        -k72,
+                        d91,
+                        A::mul_add(
+                            -k73,
+                            d92,
+                            A::mul_add(
+                                -p.XZ8l,
+                                k74,
+                                A::mul_add(-p.XY8l, k67, p.XX8l * k75),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N8l|ud=0,g=0.x
+            let d177 = A::mul_add(
+                p.MZ8r,
+                k147,
+                A::mul_add(
+                    -p.MY8r,
+                    k149,
+                    A::mul_add(
+                        -k140,
+                        d175,
+                        A::mul_add(
+                            -k142,
+                            d176,
+                            A::mul_add(
+                                -p.XZ8r,
+                                k141,
+                                A::mul_add(-p.XY8r, k134, p.XX8r * k143),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N8r|ud=0,g=0.x
+            let d94 = A::mul_add(
+                p.MX8l,
+                k81,
+                A::mul_add(
+                    p.MZ8l,
+                    k82,
+                    A::mul_add(
+                        k71,
+                        d92,
+                        A::mul_add(
+                            k72,
+                            d90,
+                            A::mul_add(
+                                -p.YZ8l,
+                                k74,
+                                A::mul_add(-p.YY8l, k67, p.XY8l * k75),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N8l|ud=0,g=0.y
+            let d178 = A::mul_add(
+                p.MX8r,
+                k149,
+                A::mul_add(
+                    p.MZ8r,
+                    k150,
+                    A::mul_add(
+                        k139,
+                        d176,
+                        A::mul_add(
+                            k140,
+                            d174,
+                            A::mul_add(
+                                -p.YZ8r,
+                                k141,
+                                A::mul_add(-p.YY8r, k134, p.XY8r * k143),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N8r|ud=0,g=0.y
+            let d95 = A::mul_add(
+                -p.MY8l,
+                k82,
+                A::mul_add(
+                    -p.MX8l,
+                    k79,
+                    A::mul_add(
+                        k73,
+                        d90,
+                        A::mul_add(
+                            -k71,
+                            d91,
+                            A::mul_add(
+                                -p.ZZ8l,
+                                k74,
+                                A::mul_add(-p.YZ8l, k67, p.XZ8l * k75),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N8l|ud=0,g=0.z
+            let d179 = A::mul_add(
+                -p.MY8r,
+                k150,
+                A::mul_add(
+                    -p.MX8r,
+                    k147,
+                    A::mul_add(
+                        k142,
+                        d174,
+                        A::mul_add(
+                            -k139,
+                            d175,
+                            A::mul_add(
+                                -p.ZZ8r,
+                                k141,
+                                A::mul_add(-p.YZ8r, k134, p.XZ8r * k143),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N8r|ud=0,g=0.z
+            let k83 = A::mul_add(-s_q6l, k72, c_q6l * k73); // w8l in 9l|ud=0,g=0.y
+            let k151 = A::mul_add(-s_q6r, k140, c_q6r * k142); // w8r in 9r|ud=0,g=0.y
+            let k84 = A::mul_add(c_q6l, k72, s_q6l * k73); // w8l in 9l|ud=0,g=0.z
+            let k152 = A::mul_add(c_q6r, k140, s_q6r * k142); // w8r in 9r|ud=0,g=0.z
+            let k86 = A::mul_add(-k84, qd6l, A::mul_add(s_q6l, k74, c_q6l * k67)); // wd9l|ud=0,g=0.y
+            let k153 = A::mul_add(-k152, qd6r, A::mul_add(s_q6r, k141, c_q6r * k134)); // wd9r|ud=0,g=0.y
+            let k87 = A::mul_add(k83, qd6l, A::mul_add(-c_q6l, k74, s_q6l * k67)); // wd9l|ud=0,g=0.z
+            let k154 = A::mul_add(k151, qd6r, A::mul_add(-c_q6r, k141, s_q6r * k134)); // wd9r|ud=0,g=0.z
+            let k85 = k71 + qd6l; // w9l|ud=0,g=0.x
+            let k155 = k139 + qd6r; // w9r|ud=0,g=0.x
+            let k88 = A::mul_add(s_q6l, k81, c_q6l * k79); // a9l|ud=0,g=0.y
+            let k156 = A::mul_add(s_q6r, k149, c_q6r * k147); // a9r|ud=0,g=0.y
+            let k89 = A::mul_add(-c_q6l, k81, s_q6l * k79); // a9l|ud=0,g=0.z
+            let k157 = A::mul_add(-c_q6r, k149, s_q6r * k147); // a9r|ud=0,g=0.z
+            let d96 = A::mul_add(-p.MY9l, k84, p.MZ9l * k83); // w9lxMS9l|ud=0,g=0.x
+            let d180 = A::mul_add(-p.MY9r, k152, p.MZ9r * k151); // w9rxMS9r|ud=0,g=0.x
+            let d97 = A::mul_add(-p.MZ9l, k85, p.MX9l * k84); // w9lxMS9l|ud=0,g=0.y
+            let d181 = A::mul_add(-p.MZ9r, k155, p.MX9r * k152); // w9rxMS9r|ud=0,g=0.y
+            let d98 = A::mul_add(-p.MX9l, k83, p.MY9l * k85); // w9lxMS9l|ud=0,g=0.z
+            let d182 = A::mul_add(-p.MX9r, k151, p.MY9r * k155); // w9rxMS9r|ud=0,g=0.z
+            let d99 = A::mul_add(
+                -k84,
+                d97,
+                A::mul_add(
+                    k83,
+                    d98,
+                    A::mul_add(p.MY9l, k87, A::mul_add(-p.MZ9l, k86, p.m9l * k82)),
+                ),
+            ); // F9l|ud=0,g=0.x
+            let d183 = A::mul_add(
+                -k152,
+                d181,
+                A::mul_add(
+                    k151,
+                    d182,
+                    A::mul_add(p.MY9r, k154, A::mul_add(-p.MZ9r, k153, p.m9r * k150)),
+                ),
+            ); // F9r|ud=0,g=0.x
+            let d100 = A::mul_add(
+                k85,
+                d98,
+                A::mul_add(
+                    -k84,
+                    d96,
+                    A::mul_add(p.MZ9l, k75, A::mul_add(p.MX9l, k87, p.m9l * k88)),
+                ),
+            ); // F9l|ud=0,g=0.y
+            let d184 = A::mul_add(
+                k155,
+                d182,
+                A::mul_add(
+                    -k152,
+                    d180,
+                    A::mul_add(p.MZ9r, k143, A::mul_add(p.MX9r, k154, p.m9r * k156)),
+                ),
+            ); // F9r|ud=0,g=0.y
+            let d101 = A::mul_add(
+                k83,
+                d96,
+                A::mul_add(
+                    -k85,
+                    d97,
+                    A::mul_add(-p.MX9l, k86, A::mul_add(-p.MY9l, k75, p.m9l * k89)),
+                ),
+            ); // F9l|ud=0,g=0.z
+            let d185 = A::mul_add(
+                k151,
+                d180,
+                A::mul_add(
+                    -k155,
+                    d181,
+                    A::mul_add(-p.MX9r, k153, A::mul_add(-p.MY9r, k143, p.m9r * k157)),
+                ),
+            ); // F9r|ud=0,g=0.z
+            let d102 = A::mul_add(p.XZ9l, k84, A::mul_add(p.XY9l, k83, p.XX9l * k85)); // J9lw9l|ud=0,g=0.x
+            let d186 = A::mul_add(p.XZ9r, k152, A::mul_add(p.XY9r, k151, p.XX9r * k155)); // J9rw9r|ud=0,g=0.x
+            let d103 = A::mul_add(p.YZ9l, k84, A::mul_add(p.YY9l, k83, p.XY9l * k85)); // J9lw9l|ud=0,g=0.y
+            let d187 = A::mul_add(p.YZ9r, k152, A::mul_add(p.YY9r, k151, p.XY9r * k155)); // J9rw9r|ud=0,g=0.y
+            let d104 = A::mul_add(p.ZZ9l, k84, A::mul_add(p.YZ9l, k83, p.XZ9l * k85)); // J9lw9l|ud=0,g=0.z
+            let d188 = A::mul_add(p.ZZ9r, k152, A::mul_add(p.YZ9r, k151, p.XZ9r * k155)); // J9rw9r|ud=0,g=0.z
+            let d105 = A::mul_add(
+                p.MZ9l,
+                k88,
+                A::mul_add(
+                    -p.MY9l,
+                    k89,
+                    A::mul_add(
+                        -k84,
+                        d103,
+                        A::mul_add(
+                            k83,
+                            d104,
+                            A::mul_add(
+                                -p.XZ9l,
+                                k87,
+                                A::mul_add(-p.XY9l, k86, p.XX9l * k75),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N9l|ud=0,g=0.x
+            let d189 = A::mul_add(
+                p.MZ9r,
+                k156,
+                A::mul_add(
+                    -p.MY9r,
+                    k157,
+                    A::mul_add(
+                        -k152,
+                        d187,
+                        A::mul_add(
+                            k151,
+                            d188,
+                            A::mul_add(
+                                -p.XZ9r,
+                                k154,
+                                A::mul_add(-p.XY9r, k153, p.XX9r * k143),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N9r|ud=0,g=0.x
+            let d106 = A::mul_add(
+                p.MX9l,
+                k89,
+                A::mul_add(
+                    p.MZ9l,
+                    k82,
+                    A::mul_add(
+                        -k85,
+                        d104,
+                        A::mul_add(
+                            k84,
+                            d102,
+                            A::mul_add(
+                                -p.YZ9l,
+                                k87,
+                                A::mul_add(-p.YY9l, k86, p.XY9l * k75),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N9l|ud=0,g=0.y
+            let d190 = A::mul_add(
+                p.MX9r,
+                k157,
+                A::mul_add(
+                    p.MZ9r,
+                    k150,
+                    A::mul_add(
+                        -k155,
+                        d188,
+                        A::mul_add(
+                            k152,
+                            d186,
+                            A::mul_add(
+                                -p.YZ9r,
+                                k154,
+                                A::mul_add(-p.YY9r, k153, p.XY9r * k143),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N9r|ud=0,g=0.y
+            let d107 = A::mul_add(
+                -p.MY9l,
+                k82,
+                A::mul_add(
+                    -p.MX9l,
+                    k88,
+                    A::mul_add(
+                        -k83,
+                        d102,
+                        A::mul_add(
+                            k85,
+                            d103,
+                            A::mul_add(
+                                -p.ZZ9l,
+                                k87,
+                                A::mul_add(-p.YZ9l, k86, p.XZ9l * k75),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N9l|ud=0,g=0.z
+            let d191 = A::mul_add(
+                -p.MY9r,
+                k150,
+                A::mul_add(
+                    -p.MX9r,
+                    k156,
+                    A::mul_add(
+                        -k151,
+                        d186,
+                        A::mul_add(
+                            k155,
+                            d187,
+                            A::mul_add(
+                                -p.ZZ9r,
+                                k154,
+                                A::mul_add(-p.YZ9r, k153, p.XZ9r * k143),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N9r|ud=0,g=0.z
+            let k90 = A::mul_add(-s_q7l, k84, c_q7l * k85); // w9l in 10l|ud=0,g=0.x
+            let k158 = A::mul_add(-s_q7r, k152, c_q7r * k155); // w9r in 10r|ud=0,g=0.x
+            let k91 = A::mul_add(c_q7l, k84, s_q7l * k85); // w9l in 10l|ud=0,g=0.y
+            let k159 = A::mul_add(c_q7r, k152, s_q7r * k155); // w9r in 10r|ud=0,g=0.y
+            let k92 = k83 - qd7l; // w10l|ud=0,g=0.z
+            let k160 = k151 - qd7r; // w10r|ud=0,g=0.z
+            let k93 = A::mul_add(k91, qd7l, A::mul_add(s_q7l, k87, c_q7l * k75)); // wd10l|ud=0,g=0.x
+            let k161 = A::mul_add(k159, qd7r, A::mul_add(s_q7r, k154, c_q7r * k143)); // wd10r|ud=0,g=0.x
+            let k94 = A::mul_add(-k90, qd7l, A::mul_add(-c_q7l, k87, s_q7l * k75)); // wd10l|ud=0,g=0.y
+            let k162 = A::mul_add(-k158, qd7r, A::mul_add(-c_q7r, k154, s_q7r * k143)); // wd10r|ud=0,g=0.y
+            let k95 = p.L9 * k84; // w9lxP10l|ud=0,g=0.x
+            let k163 = p.L9 * k152; // w9rxP10r|ud=0,g=0.x
+            let k96 = p.L9 * k85; // w9lxP10l|ud=0,g=0.z
+            let k164 = p.L9 * k155; // w9rxP10r|ud=0,g=0.z
+            let k97 = A::mul_add(-k83, k96, A::mul_add(-p.L9, k87, k82)); // a10l in 9l|ud=0,g=0.x
+            let k165 = A::mul_add(-k151, k164, A::mul_add(-p.L9, k154, k150)); // a10r in 9r|ud=0,g=0.x
+            let k98 = A::mul_add(-k85, k96, A::mul_add(-k84, k95, k88)); // a10l in 9l|ud=0,g=0.y
+            let k166 = A::mul_add(-k155, k164, A::mul_add(-k152, k163, k156)); // a10r in 9r|ud=0,g=0.y
+            let k99 = A::mul_add(k83, k95, A::mul_add(p.L9, k75, k89)); // a10l in 9l|ud=0,g=0.z
+            let k167 = A::mul_add(k151, k163, A::mul_add(p.L9, k143, k157)); // a10r in 9r|ud=0,g=0.z
+            let k100 = A::mul_add(s_q7l, k99, c_q7l * k97); // a10l|ud=0,g=0.x
+            let k168 = A::mul_add(s_q7r, k167, c_q7r * k165); // a10r|ud=0,g=0.x
+            let k101 = A::mul_add(-c_q7l, k99, s_q7l * k97); // a10l|ud=0,g=0.y
+            let k169 = A::mul_add(-c_q7r, k167, s_q7r * k165); // a10r|ud=0,g=0.y
+            let d108 = A::mul_add(-p.MY10l, k92, p.MZ10l * k91); // w10lxMS10l|ud=0,g=0.x
+            let d192 = A::mul_add(-p.MY10r, k160, p.MZ10r * k159); // w10rxMS10r|ud=0,g=0.x
+            let d110 = A::mul_add(-p.MX10l, k91, p.MY10l * k90); // w10lxMS10l|ud=0,g=0.z
+            let d193 = A::mul_add(-p.MX10r, k159, p.MY10r * k158); // w10rxMS10r|ud=0,g=0.z
+            let d109 = A::mul_add(-p.MZ10l, k90, p.MX10l * k92); // w10lxMS10l|ud=0,g=0.y
+            let d194 = A::mul_add(-p.MZ10r, k158, p.MX10r * k160); // w10rxMS10r|ud=0,g=0.y
+            let d112 = A::mul_add(
+                k92,
+                d109,
+                A::mul_add(
+                    -k91,
+                    d110,
+                    A::mul_add(p.MY10l, k86, A::mul_add(p.MZ10l, k94, p.m10l * k100)),
+                ),
+            ); // F10l|ud=0,g=0.x
+            let d195 = A::mul_add(
+                k160,
+                d194,
+                A::mul_add(
+                    -k159,
+                    d193,
+                    A::mul_add(p.MY10r, k153, A::mul_add(p.MZ10r, k162, p.m10r * k168)),
+                ),
+            ); // F10r|ud=0,g=0.x
+            let d113 = A::mul_add(
+                k90,
+                d110,
+                A::mul_add(
+                    -k92,
+                    d108,
+                    A::mul_add(-p.MZ10l, k93, A::mul_add(-p.MX10l, k86, p.m10l * k101)),
+                ),
+            ); // F10l|ud=0,g=0.y
+            let d196 = A::mul_add(
+                k158,
+                d193,
+                A::mul_add(
+                    -k160,
+                    d192,
+                    A::mul_add(-p.MZ10r, k161, A::mul_add(-p.MX10r, k153, p.m10r * k169)),
+                ),
+            ); // F10r|ud=0,g=0.y
+            let d111 = A::mul_add(
+                -k91,
+                d108,
+                A::mul_add(
+                    k90,
+                    d109,
+                    A::mul_add(p.MX10l, k94, A::mul_add(-p.MY10l, k93, p.m10l * k98)),
+                ),
+            ); // F10l|ud=0,g=0.z
+            let d197 = A::mul_add(
+                -k159,
+                d192,
+                A::mul_add(
+                    k158,
+                    d194,
+                    A::mul_add(p.MX10r, k162, A::mul_add(-p.MY10r, k161, p.m10r * k166)),
+                ),
+            ); // F10r|ud=0,g=0.z
+            let d114 = A::mul_add(p.XZ10l, k92, A::mul_add(p.XY10l, k91, p.XX10l * k90)); // J10lw10l|ud=0,g=0.x
+            let d198 = A::mul_add(
+                p.XZ10r,
+                k160,
+                A::mul_add(p.XY10r, k159, p.XX10r * k158),
+            ); // J10rw10r|ud=0,g=0.x
+            let d115 = A::mul_add(p.YZ10l, k92, A::mul_add(p.YY10l, k91, p.XY10l * k90)); // J10lw10l|ud=0,g=0.y
+            let d199 = A::mul_add(
+                p.YZ10r,
+                k160,
+                A::mul_add(p.YY10r, k159, p.XY10r * k158),
+            ); // J10rw10r|ud=0,g=0.y
+            let d116 = A::mul_add(p.ZZ10l, k92, A::mul_add(p.YZ10l, k91, p.XZ10l * k90)); // J10lw10l|ud=0,g=0.z
+            let d200 = A::mul_add(
+                p.ZZ10r,
+                k160,
+                A::mul_add(p.YZ10r, k159, p.XZ10r * k158),
+            ); // J10rw10r|ud=0,g=0.z
+            let d117 = A::mul_add(
+                -p.MZ10l,
+                k101,
+                A::mul_add(
+                    -p.MY10l,
+                    k98,
+                    A::mul_add(
+                        k92,
+                        d115,
+                        A::mul_add(
+                            -k91,
+                            d116,
+                            A::mul_add(
+                                -p.XZ10l,
+                                k86,
+                                A::mul_add(p.XY10l, k94, p.XX10l * k93),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N10l|ud=0,g=0.x
+            let d201 = A::mul_add(
+                -p.MZ10r,
+                k169,
+                A::mul_add(
+                    -p.MY10r,
+                    k166,
+                    A::mul_add(
+                        k160,
+                        d199,
+                        A::mul_add(
+                            -k159,
+                            d200,
+                            A::mul_add(
+                                -p.XZ10r,
+                                k153,
+                                A::mul_add(p.XY10r, k162, p.XX10r * k161),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N10r|ud=0,g=0.x
+            let d118 = A::mul_add(
+                p.MX10l,
+                k98,
+                A::mul_add(
+                    p.MZ10l,
+                    k100,
+                    A::mul_add(
+                        k90,
+                        d116,
+                        A::mul_add(
+                            -k92,
+                            d114,
+                            A::mul_add(
+                                -p.YZ10l,
+                                k86,
+                                A::mul_add(p.YY10l, k94, p.XY10l * k93),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N10l|ud=0,g=0.y
+            let d202 = A::mul_add(
+                p.MX10r,
+                k166,
+                A::mul_add(
+                    p.MZ10r,
+                    k168,
+                    A::mul_add(
+                        k158,
+                        d200,
+                        A::mul_add(
+                            -k160,
+                            d198,
+                            A::mul_add(
+                                -p.YZ10r,
+                                k153,
+                                A::mul_add(p.YY10r, k162, p.XY10r * k161),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N10r|ud=0,g=0.y
+            let d119 = A::mul_add(
+                -p.MY10l,
+                k100,
+                A::mul_add(
+                    p.MX10l,
+                    k101,
+                    A::mul_add(
+                        k91,
+                        d114,
+                        A::mul_add(
+                            -k90,
+                            d115,
+                            A::mul_add(
+                                -p.ZZ10l,
+                                k86,
+                                A::mul_add(p.YZ10l, k94, p.XZ10l * k93),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N10l|ud=0,g=0.z
+            out.set(11, 0, l, d119);
+            let d203 = A::mul_add(
+                -p.MY10r,
+                k168,
+                A::mul_add(
+                    p.MX10r,
+                    k169,
+                    A::mul_add(
+                        k159,
+                        d198,
+                        A::mul_add(
+                            -k158,
+                            d199,
+                            A::mul_add(
+                                -p.ZZ10r,
+                                k153,
+                                A::mul_add(p.YZ10r, k162, p.XZ10r * k161),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N10r|ud=0,g=0.z
+            out.set(18, 0, l, d203);
+            let d260 = A::mul_add(s_q7l, d113, c_q7l * d112); // f10l in 9l|ud=0,g=0.x
+            let d204 = A::mul_add(s_q7r, d196, c_q7r * d195); // f10r in 9r|ud=0,g=0.x
+            let d261 = A::mul_add(-c_q7l, d113, s_q7l * d112); // f10l in 9l|ud=0,g=0.z
+            let d205 = A::mul_add(-c_q7r, d196, s_q7r * d195); // f10r in 9r|ud=0,g=0.z
+            let d262 = d99 + d260; // f9l|ud=0,g=0.x
+            let d206 = d183 + d204; // f9r|ud=0,g=0.x
+            let d263 = d106 + d119; // n9l|ud=0,g=0.y
+            let d209 = d190 + d203; // n9r|ud=0,g=0.y
+            let d264 = A::mul_add(
+                p.L9,
+                d261,
+                A::mul_add(s_q7l, d118, A::mul_add(c_q7l, d117, d105)),
+            ); // n9l|ud=0,g=0.x
+            out.set(10, 0, l, -d264);
+            let d210 = A::mul_add(
+                p.L9,
+                d205,
+                A::mul_add(s_q7r, d202, A::mul_add(c_q7r, d201, d189)),
+            ); // n9r|ud=0,g=0.x
+            out.set(17, 0, l, -d210);
+            let d265 = A::mul_add(
+                p.L9,
+                d260,
+                A::mul_add(c_q7l, d118, A::mul_add(-s_q7l, d117, d107)),
+            ); // n9l|ud=0,g=0.z
+            let d211 = A::mul_add(
+                p.L9,
+                d204,
+                A::mul_add(c_q7r, d202, A::mul_add(-s_q7r, d201, d191)),
+            ); // n9r|ud=0,g=0.z
+            let d266 = d100 + d111; // f9l|ud=0,g=0.y
+            let d207 = d184 + d197; // f9r|ud=0,g=0.y
+            let d267 = d101 + d261; // f9l|ud=0,g=0.z
+            let d208 = d185 + d205; // f9r|ud=0,g=0.z
+            let d268 = A::mul_add(s_q6l, d267, c_q6l * d266); // f9l in 8l|ud=0,g=0.y
+            let d212 = A::mul_add(s_q6r, d208, c_q6r * d207); // f9r in 8r|ud=0,g=0.y
+            let d269 = A::mul_add(-c_q6l, d267, s_q6l * d266); // f9l in 8l|ud=0,g=0.z
+            let d213 = A::mul_add(-c_q6r, d208, s_q6r * d207); // f9r in 8r|ud=0,g=0.z
+            let d270 = d87 + d268; // f8l|ud=0,g=0.y
+            let d216 = d173 + d212; // f8r|ud=0,g=0.y
+            let d271 = d88 + d269; // f8l|ud=0,g=0.z
+            let d214 = d171 + d213; // f8r|ud=0,g=0.z
+            let d272 = d89 + d262; // f8l|ud=0,g=0.x
+            let d215 = d172 + d206; // f8r|ud=0,g=0.x
+            let d273 = d93 + d264; // n8l|ud=0,g=0.x
+            let d217 = d177 + d210; // n8r|ud=0,g=0.x
+            let d274 = A::mul_add(s_q6l, d265, A::mul_add(c_q6l, d263, d94)); // n8l|ud=0,g=0.y
+            out.set(9, 0, l, d274);
+            let d218 = A::mul_add(s_q6r, d211, A::mul_add(c_q6r, d209, d178)); // n8r|ud=0,g=0.y
+            out.set(16, 0, l, d218);
+            let d275 = A::mul_add(-c_q6l, d265, A::mul_add(s_q6l, d263, d95)); // n8l|ud=0,g=0.z
+            let d219 = A::mul_add(-c_q6r, d211, A::mul_add(s_q6r, d209, d179)); // n8r|ud=0,g=0.z
+            let d276 = A::mul_add(s_q5l, d271, c_q5l * d272); // f8l in 7l|ud=0,g=0.x
+            let d220 = A::mul_add(s_q5r, d214, c_q5r * d215); // f8r in 7r|ud=0,g=0.x
+            let d277 = A::mul_add(-c_q5l, d271, s_q5l * d272); // f8l in 7l|ud=0,g=0.z
+            let d221 = A::mul_add(-c_q5r, d214, s_q5r * d215); // f8r in 7r|ud=0,g=0.z
+            let d278 = d75 + d276; // f7l|ud=0,g=0.x
+            let d222 = d159 + d220; // f7r|ud=0,g=0.x
+            let d279 = d82 + d274; // n7l|ud=0,g=0.y
+            let d225 = d166 + d218; // n7r|ud=0,g=0.y
+            let d280 = A::mul_add(
+                p.L8,
+                d277,
+                A::mul_add(-s_q5l, d275, A::mul_add(c_q5l, d273, d81)),
+            ); // n7l|ud=0,g=0.x
+            out.set(8, 0, l, -d280);
+            let d226 = A::mul_add(
+                p.L8,
+                d221,
+                A::mul_add(-s_q5r, d219, A::mul_add(c_q5r, d217, d165)),
+            ); // n7r|ud=0,g=0.x
+            out.set(15, 0, l, -d226);
+            let d281 = A::mul_add(
+                p.L8,
+                d276,
+                A::mul_add(-c_q5l, d275, A::mul_add(-s_q5l, d273, d83)),
+            ); // n7l|ud=0,g=0.z
+            let d227 = A::mul_add(
+                p.L8,
+                d220,
+                A::mul_add(-c_q5r, d219, A::mul_add(-s_q5r, d217, d167)),
+            ); // n7r|ud=0,g=0.z
+            let d282 = d76 + d270; // f7l|ud=0,g=0.y
+            let d223 = d160 + d216; // f7r|ud=0,g=0.y
+            let d283 = d77 + d277; // f7l|ud=0,g=0.z
+            let d224 = d161 + d221; // f7r|ud=0,g=0.z
+            let d284 = A::mul_add(s_q4l, d283, c_q4l * d282); // f7l in 6l|ud=0,g=0.y
+            let d228 = A::mul_add(s_q4r, d224, c_q4r * d223); // f7r in 6r|ud=0,g=0.y
+            let d285 = A::mul_add(-c_q4l, d283, s_q4l * d282); // f7l in 6l|ud=0,g=0.z
+            let d229 = A::mul_add(-c_q4r, d224, s_q4r * d223); // f7r in 6r|ud=0,g=0.z
+            let d286 = d63 + d284; // f6l|ud=0,g=0.y
+            let d232 = d149 + d228; // f6r|ud=0,g=0.y
+            let d287 = d64 + d285; // f6l|ud=0,g=0.z
+            let d230 = d147 + d229; // f6r|ud=0,g=0.z
+            let d288 = d65 + d278; // f6l|ud=0,g=0.x
+            let d231 = d148 + d222; // f6r|ud=0,g=0.x
+            let d289 = d69 + d280; // n6l|ud=0,g=0.x
+            let d233 = d153 + d226; // n6r|ud=0,g=0.x
+            let d290 = A::mul_add(s_q4l, d281, A::mul_add(c_q4l, d279, d70)); // n6l|ud=0,g=0.y
+            out.set(7, 0, l, d290);
+            let d234 = A::mul_add(s_q4r, d227, A::mul_add(c_q4r, d225, d154)); // n6r|ud=0,g=0.y
+            out.set(14, 0, l, d234);
+            let d291 = A::mul_add(-c_q4l, d281, A::mul_add(s_q4l, d279, d71)); // n6l|ud=0,g=0.z
+            let d235 = A::mul_add(-c_q4r, d227, A::mul_add(s_q4r, d225, d155)); // n6r|ud=0,g=0.z
+            let d292 = A::mul_add(s_q3l, d287, c_q3l * d288); // f6l in 5l|ud=0,g=0.x
+            let d236 = A::mul_add(s_q3r, d230, c_q3r * d231); // f6r in 5r|ud=0,g=0.x
+            let d293 = A::mul_add(-c_q3l, d287, s_q3l * d288); // f6l in 5l|ud=0,g=0.z
+            let d237 = A::mul_add(-c_q3r, d230, s_q3r * d231); // f6r in 5r|ud=0,g=0.z
+            let d294 = d51 + d292; // f5l|ud=0,g=0.x
+            let d238 = d135 + d236; // f5r|ud=0,g=0.x
+            let d295 = d58 + d290; // n5l|ud=0,g=0.y
+            let d241 = d142 + d234; // n5r|ud=0,g=0.y
+            let d296 = A::mul_add(
+                p.L7,
+                d293,
+                A::mul_add(-s_q3l, d291, A::mul_add(c_q3l, d289, d57)),
+            ); // n5l|ud=0,g=0.x
+            out.set(6, 0, l, -d296);
+            let d242 = A::mul_add(
+                p.L7,
+                d237,
+                A::mul_add(-s_q3r, d235, A::mul_add(c_q3r, d233, d141)),
+            ); // n5r|ud=0,g=0.x
+            out.set(13, 0, l, -d242);
+            let d297 = A::mul_add(
+                p.L7,
+                d292,
+                A::mul_add(-c_q3l, d291, A::mul_add(-s_q3l, d289, d59)),
+            ); // n5l|ud=0,g=0.z
+            let d243 = A::mul_add(
+                p.L7,
+                d236,
+                A::mul_add(-c_q3r, d235, A::mul_add(-s_q3r, d233, d143)),
+            ); // n5r|ud=0,g=0.z
+            let d298 = d52 + d286; // f5l|ud=0,g=0.y
+            let d239 = d136 + d232; // f5r|ud=0,g=0.y
+            let d299 = d53 + d293; // f5l|ud=0,g=0.z
+            let d240 = d137 + d237; // f5r|ud=0,g=0.z
+            let d300 = A::mul_add(s_q2l, d299, c_q2l * d298); // f5l in 4l|ud=0,g=0.y
+            let d244 = A::mul_add(s_q2r, d240, c_q2r * d239); // f5r in 4r|ud=0,g=0.y
+            let d301 = A::mul_add(-c_q2l, d299, s_q2l * d298); // f5l in 4l|ud=0,g=0.z
+            let d245 = A::mul_add(-c_q2r, d240, s_q2r * d239); // f5r in 4r|ud=0,g=0.z
+            let d302 = d39 + d300; // f4l|ud=0,g=0.y
+            let d248 = d125 + d244; // f4r|ud=0,g=0.y
+            let d254 = d27 - d248; // f3|ud=0,g=0.x
+            let d303 = d40 + d301; // f4l|ud=0,g=0.z
+            let d246 = d123 + d245; // f4r|ud=0,g=0.z
+            let d304 = d41 + d294; // f4l|ud=0,g=0.x
+            let d247 = d124 + d238; // f4r|ud=0,g=0.x
+            let d305 = d45 + d296; // n4l|ud=0,g=0.x
+            let d249 = d129 + d242; // n4r|ud=0,g=0.x
+            let d306 = A::mul_add(s_q2l, d297, A::mul_add(c_q2l, d295, d46)); // n4l|ud=0,g=0.y
+            out.set(5, 0, l, d306);
+            let d250 = A::mul_add(s_q2r, d243, A::mul_add(c_q2r, d241, d130)); // n4r|ud=0,g=0.y
+            out.set(12, 0, l, d250);
+            let d307 = A::mul_add(-c_q2l, d297, A::mul_add(s_q2l, d295, d47)); // n4l|ud=0,g=0.z
+            let d251 = A::mul_add(-c_q2r, d243, A::mul_add(s_q2r, d241, d131)); // n4r|ud=0,g=0.z
+            let d308 = A::mul_add(-c_q1l, d303, s_q1l * d304); // f4l in 3|ud=0,g=0.z
+            let d253 = A::mul_add(-c_q1r, d246, s_q1r * d247); // f4r in 3|ud=0,g=0.z
+            let d255 = A::mul_add(-p.L5, d253, d33 + d250); // n3|ud=0,g=0.x
+            let d256 = A::mul_add(
+                -p.L6,
+                d253,
+                A::mul_add(s_q1r, d251, A::mul_add(-c_q1r, d249, d34)),
+            ); // n3|ud=0,g=0.y
+            let d259 = d29 + d253; // f3|ud=0,g=0.z
+            let d309 = A::mul_add(s_q1l, d303, c_q1l * d304); // f4l in 3|ud=0,g=0.y
+            let d252 = A::mul_add(s_q1r, d246, c_q1r * d247); // f4r in 3|ud=0,g=0.y
+            let d257 = A::mul_add(
+                p.L5,
+                d248,
+                A::mul_add(
+                    p.L6,
+                    d252,
+                    A::mul_add(-c_q1r, d251, A::mul_add(-s_q1r, d249, d35)),
+                ),
+            ); // n3|ud=0,g=0.z
+            let d258 = d28 + d252; // f3|ud=0,g=0.y
+            let d310 = d254 + d302; // f3|ud=0,g=0.x
+            let d311 = A::mul_add(p.L5, d308, d255 - d306); // n3|ud=0,g=0.x
+            let d312 = A::mul_add(
+                -p.L6,
+                d308,
+                A::mul_add(s_q1l, d307, A::mul_add(-c_q1l, d305, d256)),
+            ); // n3|ud=0,g=0.y
+            out.set(4, 0, l, -d312);
+            let d313 = A::mul_add(
+                -p.L5,
+                d302,
+                A::mul_add(
+                    -p.L6,
+                    d309,
+                    A::mul_add(c_q1l, d307, A::mul_add(s_q1l, d305, d257)),
+                ),
+            ); // n3|ud=0,g=0.z
+            let d314 = d258 + d309; // f3|ud=0,g=0.y
+            let d315 = d259 - d308; // f3|ud=0,g=0.z
+            let d316 = A::mul_add(s_q_torso, d315, c_q_torso * d310); // f3 in 2|ud=0,g=0.x
+            let d317 = A::mul_add(-c_q_torso, d315, s_q_torso * d310); // f3 in 2|ud=0,g=0.z
+            let d318 = d15 + d316; // f2|ud=0,g=0.x
+            let d319 = d16 + d314; // f2|ud=0,g=0.y
+            let d320 = d17 + d317; // f2|ud=0,g=0.z
+            let d321 = A::mul_add(
+                -p.L4,
+                d314,
+                A::mul_add(
+                    p.L3,
+                    d317,
+                    A::mul_add(-s_q_torso, d313, A::mul_add(c_q_torso, d311, d21)),
+                ),
+            ); // n2|ud=0,g=0.x
+            out.set(3, 0, l, d321);
+            let d322 = A::mul_add(p.L4, d316, d22 - d312); // n2|ud=0,g=0.y
+            let d323 = A::mul_add(
+                -p.L3,
+                d316,
+                A::mul_add(c_q_torso, d313, A::mul_add(s_q_torso, d311, d23)),
+            ); // n2|ud=0,g=0.z
+            let d324 = A::mul_add(-c_q_w, d320, s_q_w * d319); // f2 in 1|ud=0,g=0.z
+            let d325 = A::mul_add(s_q_w, d320, c_q_w * d319); // f2 in 1|ud=0,g=0.y
+            let d326 = d4 - d325; // f1|ud=0,g=0.y
+            let d327 = d5 + d324; // f1|ud=0,g=0.z
+            let d328 = A::mul_add(p.L2, d325, A::mul_add(-p.L1, d324, d9 + d321)); // n1|ud=0,g=0.x
+            out.set(2, 0, l, d328);
+            let d329 = A::mul_add(
+                -p.L2,
+                d318,
+                A::mul_add(s_q_w, d323, A::mul_add(c_q_w, d322, d10)),
+            ); // n1|ud=0,g=0.y
+            let d330 = A::mul_add(
+                -p.L1,
+                d318,
+                A::mul_add(c_q_w, d323, A::mul_add(-s_q_w, d322, d11)),
+            ); // n1|ud=0,g=0.z
+            let d331 = A::mul_add(-c_q_imu, d327, s_q_imu * d326); // f1 in 0|ud=0,g=0.x
+            out.set(0, 0, l, d331);
+            let d332 = A::mul_add(s_q_imu, d330, c_q_imu * d329); // n0|ud=0,g=0.z
+            out.set(1, 0, l, -d332);
+        }
+    }
     /// [`coriolis`] at `L` states per call, into `out`: entry `l` of `out` becomes `coriolis` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
     #[inline(never)]
     pub fn coriolis_batch_into<const L: usize>(
@@ -12545,2262 +13071,14 @@ mod generated {
         #[inline(always)]
         fn body<A: kanegen_runtime::isa::Arith<f64>, const L: usize>(
             p: &Params,
-            _pc: &Precomputed,
+            pc: &Precomputed,
             q: &[SVector<f64, 19>; L],
             u: &[SVector<f64, 19>; L],
             out: &mut [SVector<f64, 19>; L],
         ) {
-            let p = &{ *p };
             let q = kanegen_runtime::lanes::inputs(q);
             let u = kanegen_runtime::lanes::inputs(u);
-            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
-                A,
-                _,
-                L,
-            >([
-                q[2].0,
-                q[3].0,
-                q[4].0,
-                q[5].0,
-                q[12].0,
-                q[6].0,
-                q[13].0,
-                q[7].0,
-                q[14].0,
-                q[8].0,
-                q[15].0,
-                q[9].0,
-                q[16].0,
-                q[10].0,
-                q[17].0,
-                q[11].0,
-                q[18].0,
-            ]);
-            for (l, m) in out.iter_mut().enumerate() {
-                let s_q_imu = sin_q[0][l];
-                let c_q_imu = cos_q[0][l];
-                let s_q_w = sin_q[1][l];
-                let c_q_w = cos_q[1][l];
-                let s_q_torso = sin_q[2][l];
-                let c_q_torso = cos_q[2][l];
-                let s_q1l = sin_q[3][l];
-                let c_q1l = cos_q[3][l];
-                let s_q1r = sin_q[4][l];
-                let c_q1r = cos_q[4][l];
-                let s_q2l = sin_q[5][l];
-                let c_q2l = cos_q[5][l];
-                let s_q2r = sin_q[6][l];
-                let c_q2r = cos_q[6][l];
-                let s_q3l = sin_q[7][l];
-                let c_q3l = cos_q[7][l];
-                let s_q3r = sin_q[8][l];
-                let c_q3r = cos_q[8][l];
-                let s_q4l = sin_q[9][l];
-                let c_q4l = cos_q[9][l];
-                let s_q4r = sin_q[10][l];
-                let c_q4r = cos_q[10][l];
-                let s_q5l = sin_q[11][l];
-                let c_q5l = cos_q[11][l];
-                let s_q5r = sin_q[12][l];
-                let c_q5r = cos_q[12][l];
-                let s_q6l = sin_q[13][l];
-                let c_q6l = cos_q[13][l];
-                let s_q6r = sin_q[14][l];
-                let c_q6r = cos_q[14][l];
-                let s_q7l = sin_q[15][l];
-                let c_q7l = cos_q[15][l];
-                let s_q7r = sin_q[16][l];
-                let c_q7r = cos_q[16][l];
-                let xd = u[0].0[l];
-                let psid = u[1].0[l];
-                let qd_imu = u[2].0[l];
-                let qd_w = u[3].0[l];
-                let qd_torso = u[4].0[l];
-                let qd1l = u[5].0[l];
-                let qd2l = u[6].0[l];
-                let qd3l = u[7].0[l];
-                let qd4l = u[8].0[l];
-                let qd5l = u[9].0[l];
-                let qd6l = u[10].0[l];
-                let qd7l = u[11].0[l];
-                let qd1r = u[12].0[l];
-                let qd2r = u[13].0[l];
-                let qd3r = u[14].0[l];
-                let qd4r = u[15].0[l];
-                let qd5r = u[16].0[l];
-                let qd6r = u[17].0[l];
-                let qd7r = u[18].0[l];
-                let k1 = xd * psid; // a0|ud=0,g=0.y
-                let k2 = c_q_imu * psid; // w0 in 1|ud=0,g=0.y
-                let k3 = s_q_imu * psid; // w0 in 1|ud=0,g=0.z
-                let k4 = k3 * qd_imu; // wd1|ud=0,g=0.y
-                let k5 = k2 * qd_imu; // wd1|ud=0,g=0.z
-                let d1 = A::mul_add(-p.MY1, k3, p.MZ1 * k2); // w1xMS1|ud=0,g=0.x
-                let d2 = A::mul_add(p.MZ1, qd_imu, p.MX1 * k3); // w1xMS1|ud=0,g=0.y
-                let d3 = A::mul_add(p.MX1, k2, p.MY1 * qd_imu); // w1xMS1|ud=0,g=0.z
-                let d4 = A::mul_add(-qd_imu, d3, A::mul_add(k3, d1, p.MX1 * k5)); // F1|ud=0,g=0.y
-                let d5 = A::mul_add(-k2, d1, A::mul_add(-qd_imu, d2, p.MX1 * k4)); // F1|ud=0,g=0.z
-                let d6 = A::mul_add(-p.XZ1, k3, A::mul_add(-p.XY1, k2, p.XX1 * qd_imu)); // J1w1|ud=0,g=0.x
-                let d7 = A::mul_add(-p.YZ1, k3, A::mul_add(-p.YY1, k2, p.XY1 * qd_imu)); // J1w1|ud=0,g=0.y
-                let d8 = A::mul_add(-p.ZZ1, k3, A::mul_add(-p.YZ1, k2, p.XZ1 * qd_imu)); // J1w1|ud=0,g=0.z
-                let d9 = A::mul_add(
-                    -k3,
-                    d7,
-                    A::mul_add(k2, d8, A::mul_add(-p.XZ1, k5, p.XY1 * k4)),
-                ); // N1|ud=0,g=0.x
-                let d10 = A::mul_add(
-                    p.MZ1,
-                    k1,
-                    A::mul_add(
-                        qd_imu,
-                        d8,
-                        A::mul_add(k3, d6, A::mul_add(-p.YZ1, k5, p.YY1 * k4)),
-                    ),
-                ); // N1|ud=0,g=0.y
-                let d11 = A::mul_add(
-                    -p.MY1,
-                    k1,
-                    A::mul_add(
-                        -k2,
-                        d6,
-                        A::mul_add(-qd_imu, d7, A::mul_add(-p.ZZ1, k5, p.YZ1 * k4)),
-                    ),
-                ); // N1|ud=0,g=0.z
-                let k6 = A::mul_add(-s_q_w, k3, c_q_w * k2); // w1 in 2|ud=0,g=0.y
-                let k7 = A::mul_add(c_q_w, k3, s_q_w * k2); // w1 in 2|ud=0,g=0.z
-                let k8 = qd_imu + qd_w; // w2|ud=0,g=0.x
-                let k9 = A::mul_add(k7, qd_w, A::mul_add(s_q_w, k5, c_q_w * k4)); // wd2|ud=0,g=0.y
-                let k10 = A::mul_add(-k6, qd_w, A::mul_add(-c_q_w, k5, s_q_w * k4)); // wd2|ud=0,g=0.z
-                let k11 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-                let k12 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-                let k13 = A::mul_add(p.L1, k3, p.L2 * k2); // w1xP2|ud=0,g=0.x
-                let k14 = A::mul_add(k2, k13, qd_imu * k11); // a2 in 1|ud=0,g=0.z
-                let k15 = A::mul_add(
-                    -k3,
-                    k11,
-                    A::mul_add(k2, k12, A::mul_add(p.L1, k5, A::mul_add(-p.L2, k4, k1))),
-                ); // a2 in 1|ud=0,g=0.x
-                let k16 = A::mul_add(qd_imu, k12, k3 * k13); // a2 in 1|ud=0,g=0.y
-                let k17 = A::mul_add(s_q_w, k14, c_q_w * k16); // a2|ud=0,g=0.y
-                let k18 = A::mul_add(-c_q_w, k14, s_q_w * k16); // a2|ud=0,g=0.z
-                let d12 = A::mul_add(-p.MY2, k7, p.MZ2 * k6); // w2xMS2|ud=0,g=0.x
-                let d13 = A::mul_add(p.MZ2, k8, p.MX2 * k7); // w2xMS2|ud=0,g=0.y
-                let d14 = A::mul_add(p.MX2, k6, p.MY2 * k8); // w2xMS2|ud=0,g=0.z
-                let d15 = A::mul_add(
-                    k7,
-                    d13,
-                    A::mul_add(
-                        k6,
-                        d14,
-                        A::mul_add(-p.MY2, k10, A::mul_add(p.MZ2, k9, p.m2 * k15)),
-                    ),
-                ); // F2|ud=0,g=0.x
-                let d16 = A::mul_add(
-                    k8,
-                    d14,
-                    A::mul_add(-k7, d12, A::mul_add(p.MX2, k10, p.m2 * k17)),
-                ); // F2|ud=0,g=0.y
-                let d17 = A::mul_add(
-                    k6,
-                    d12,
-                    A::mul_add(k8, d13, A::mul_add(-p.MX2, k9, p.m2 * k18)),
-                ); // F2|ud=0,g=0.z
-                let d18 = A::mul_add(-p.XZ2, k7, A::mul_add(-p.XY2, k6, p.XX2 * k8)); // J2w2|ud=0,g=0.x
-                let d19 = A::mul_add(-p.YZ2, k7, A::mul_add(-p.YY2, k6, p.XY2 * k8)); // J2w2|ud=0,g=0.y
-                let d20 = A::mul_add(-p.ZZ2, k7, A::mul_add(-p.YZ2, k6, p.XZ2 * k8)); // J2w2|ud=0,g=0.z
-                let d21 = A::mul_add(
-                    -p.MZ2,
-                    k17,
-                    A::mul_add(
-                        p.MY2,
-                        k18,
-                        A::mul_add(
-                            -k7,
-                            d19,
-                            A::mul_add(k6, d20, A::mul_add(p.XZ2, k10, p.XY2 * k9)),
-                        ),
-                    ),
-                ); // N2|ud=0,g=0.x
-                let d22 = A::mul_add(
-                    -p.MX2,
-                    k18,
-                    A::mul_add(
-                        p.MZ2,
-                        k15,
-                        A::mul_add(
-                            k8,
-                            d20,
-                            A::mul_add(k7, d18, A::mul_add(p.YZ2, k10, p.YY2 * k9)),
-                        ),
-                    ),
-                ); // N2|ud=0,g=0.y
-                let d23 = A::mul_add(
-                    -p.MY2,
-                    k15,
-                    A::mul_add(
-                        p.MX2,
-                        k17,
-                        A::mul_add(
-                            -k6,
-                            d18,
-                            A::mul_add(-k8, d19, A::mul_add(p.ZZ2, k10, p.YZ2 * k9)),
-                        ),
-                    ),
-                ); // N2|ud=0,g=0.z
-                let k19 = A::mul_add(-s_q_torso, k7, c_q_torso * k8); // w2 in 3|ud=0,g=0.x
-                let k20 = A::mul_add(c_q_torso, k7, s_q_torso * k8); // w2 in 3|ud=0,g=0.z
-                let k21 = k6 - qd_torso; // w3|ud=0,g=0.y
-                let k22 = A::mul_add(-k20, qd_torso, s_q_torso * k10); // wd3|ud=0,g=0.x
-                let k23 = A::mul_add(-k19, qd_torso, c_q_torso * k10); // wd3|ud=0,g=0.z
-                let k24 = A::mul_add(-p.L3, k7, p.L4 * k6); // w2xP3|ud=0,g=0.x
-                let k25 = p.L4 * k8; // w2xP3|ud=0,g=0.y
-                let k26 = p.L3 * k8; // w2xP3|ud=0,g=0.z
-                let k27 = A::mul_add(
-                    k7,
-                    k25,
-                    A::mul_add(
-                        k6,
-                        k26,
-                        A::mul_add(-p.L3, k10, A::mul_add(p.L4, k9, k15)),
-                    ),
-                ); // a3 in 2|ud=0,g=0.x
-                let k28 = A::mul_add(k8, k26, A::mul_add(-k7, k24, k17)); // a3 in 2|ud=0,g=0.y
-                let k29 = A::mul_add(k6, k24, A::mul_add(k8, k25, k18)); // a3 in 2|ud=0,g=0.z
-                let k30 = A::mul_add(s_q_torso, k29, c_q_torso * k27); // a3|ud=0,g=0.x
-                let k31 = A::mul_add(-c_q_torso, k29, s_q_torso * k27); // a3|ud=0,g=0.z
-                let d24 = A::mul_add(p.MY3, k20, p.MZ3 * k21); // w3xMS3|ud=0,g=0.x
-                let d25 = A::mul_add(-p.MX3, k21, p.MY3 * k19); // w3xMS3|ud=0,g=0.z
-                let d26 = A::mul_add(p.MZ3, k19, p.MX3 * k20); // w3xMS3|ud=0,g=0.y
-                let d27 = A::mul_add(
-                    -k20,
-                    d26,
-                    A::mul_add(
-                        k21,
-                        d25,
-                        A::mul_add(-p.MY3, k23, A::mul_add(-p.MZ3, k9, p.m3 * k30)),
-                    ),
-                ); // F3|ud=0,g=0.x
-                let d28 = A::mul_add(
-                    k19,
-                    d25,
-                    A::mul_add(
-                        k20,
-                        d24,
-                        A::mul_add(p.MZ3, k22, A::mul_add(-p.MX3, k23, p.m3 * k28)),
-                    ),
-                ); // F3|ud=0,g=0.y
-                let d29 = A::mul_add(
-                    k21,
-                    d24,
-                    A::mul_add(
-                        k19,
-                        d26,
-                        A::mul_add(-p.MX3, k9, A::mul_add(-p.MY3, k22, p.m3 * k31)),
-                    ),
-                ); // F3|ud=0,g=0.z
-                let d30 = A::mul_add(-p.XZ3, k20, A::mul_add(p.XY3, k21, p.XX3 * k19)); // J3w3|ud=0,g=0.x
-                let d31 = A::mul_add(-p.YZ3, k20, A::mul_add(p.YY3, k21, p.XY3 * k19)); // J3w3|ud=0,g=0.y
-                let d32 = A::mul_add(-p.ZZ3, k20, A::mul_add(p.YZ3, k21, p.XZ3 * k19)); // J3w3|ud=0,g=0.z
-                let d33 = A::mul_add(
-                    p.MZ3,
-                    k28,
-                    A::mul_add(
-                        -p.MY3,
-                        k31,
-                        A::mul_add(
-                            k20,
-                            d31,
-                            A::mul_add(
-                                k21,
-                                d32,
-                                A::mul_add(p.XZ3, k23, A::mul_add(-p.XY3, k9, p.XX3 * k22)),
-                            ),
-                        ),
-                    ),
-                ); // N3|ud=0,g=0.x
-                let d34 = A::mul_add(
-                    p.MX3,
-                    k31,
-                    A::mul_add(
-                        p.MZ3,
-                        k30,
-                        A::mul_add(
-                            -k19,
-                            d32,
-                            A::mul_add(
-                                -k20,
-                                d30,
-                                A::mul_add(p.YZ3, k23, A::mul_add(-p.YY3, k9, p.XY3 * k22)),
-                            ),
-                        ),
-                    ),
-                ); // N3|ud=0,g=0.y
-                let d35 = A::mul_add(
-                    -p.MY3,
-                    k30,
-                    A::mul_add(
-                        -p.MX3,
-                        k28,
-                        A::mul_add(
-                            -k21,
-                            d30,
-                            A::mul_add(
-                                k19,
-                                d31,
-                                A::mul_add(p.ZZ3, k23, A::mul_add(-p.YZ3, k9, p.XZ3 * k22)),
-                            ),
-                        ),
-                    ),
-                ); // N3|ud=0,g=0.z
-                let k32 = A::mul_add(s_q1l, k20, c_q1l * k21); // w3 in 4l|ud=0,g=0.x
-                let k33 = A::mul_add(-c_q1l, k20, s_q1l * k21); // w3 in 4l|ud=0,g=0.z
-                let k34 = k19 - qd1l; // w4l|ud=0,g=0.y
-                let k35 = A::mul_add(-k32, qd1l, A::mul_add(-c_q1l, k23, s_q1l * k9)); // wd4l|ud=0,g=0.z
-                let k36 = A::mul_add(k33, qd1l, A::mul_add(s_q1l, k23, c_q1l * k9)); // wd4l|ud=0,g=0.x
-                let k37 = p.L5 * k20; // w3xP4l|ud=0,g=0.x
-                let k38 = p.L6 * k20; // w3xP4l|ud=0,g=0.y
-                let t1 = p.L5 * k19; // common subexpression
-                let t2 = p.L6 * k21; // common subexpression
-                let k39 = t1 - t2; // w3xP4l|ud=0,g=0.z
-                let t3 = p.L5 * k23; // common subexpression
-                let t4 = p.L6 * k23; // common subexpression
-                let t5 = p.L5 * k22; // common subexpression
-                let t6 = p.L6 * k9; // common subexpression
-                let t7 = k20 * k38; // common subexpression
-                let t8 = k20 * k37; // common subexpression
-                let t9 = k19 * k38; // common subexpression
-                let t10 = k21 * k37; // common subexpression
-                let k40 = A::mul_add(k21, k39, k30 - t3) - t7; // a4l in 3|ud=0,g=0.x
-                let k41 = A::mul_add(k19, k39, k28 - t4 + t8); // a4l in 3|ud=0,g=0.y
-                let k42 = k31 - t5 - t6 + t9 + t10; // a4l in 3|ud=0,g=0.z
-                let k43 = A::mul_add(c_q1l, k42, s_q1l * k41); // a4l|ud=0,g=0.z
-                let k44 = A::mul_add(-s_q1l, k42, c_q1l * k41); // a4l|ud=0,g=0.x
-                let k50 = A::mul_add(s_q2l, k43, c_q2l * k40); // a5l|ud=0,g=0.y
-                let k51 = A::mul_add(-c_q2l, k43, s_q2l * k40); // a5l|ud=0,g=0.z
-                let k102 = A::mul_add(-s_q1r, k20, c_q1r * k21); // w3 in 4r|ud=0,g=0.x
-                let k103 = A::mul_add(c_q1r, k20, s_q1r * k21); // w3 in 4r|ud=0,g=0.z
-                let k104 = A::mul_add(-k102, qd1r, A::mul_add(c_q1r, k23, s_q1r * k9)); // wd4r|ud=0,g=0.z
-                let k105 = -k19 - qd1r; // w4r|ud=0,g=0.y
-                let k106 = A::mul_add(k103, qd1r, A::mul_add(-s_q1r, k23, c_q1r * k9)); // wd4r|ud=0,g=0.x
-                let k107 = t1 + t2; // w3xP4r|ud=0,g=0.z
-                let k108 = A::mul_add(k21, k107, k30 - t3 + t7); // a4r in 3|ud=0,g=0.x
-                let k109 = A::mul_add(k19, k107, k28 + t4 + t8); // a4r in 3|ud=0,g=0.y
-                let k110 = k31 - t5 + t6 - t9 + t10; // a4r in 3|ud=0,g=0.z
-                let k111 = A::mul_add(-c_q1r, k110, s_q1r * k109); // a4r|ud=0,g=0.z
-                let k112 = A::mul_add(s_q1r, k110, c_q1r * k109); // a4r|ud=0,g=0.x
-                let d37 = A::mul_add(-p.MX4l, k34, p.MY4l * k32); // w4lxMS4l|ud=0,g=0.z
-                let d120 = A::mul_add(-p.MX4r, k105, p.MY4r * k102); // w4rxMS4r|ud=0,g=0.z
-                let d36 = A::mul_add(p.MY4l, k33, p.MZ4l * k34); // w4lxMS4l|ud=0,g=0.x
-                let d121 = A::mul_add(p.MY4r, k103, p.MZ4r * k105); // w4rxMS4r|ud=0,g=0.x
-                let d39 = A::mul_add(
-                    -k32,
-                    d37,
-                    A::mul_add(
-                        -k33,
-                        d36,
-                        A::mul_add(p.MZ4l, k36, A::mul_add(p.MX4l, k35, p.m4l * k40)),
-                    ),
-                ); // F4l|ud=0,g=0.y
-                let d38 = A::mul_add(p.MZ4l, k32, p.MX4l * k33); // w4lxMS4l|ud=0,g=0.y
-                let d122 = A::mul_add(p.MZ4r, k102, p.MX4r * k103); // w4rxMS4r|ud=0,g=0.y
-                let d40 = A::mul_add(
-                    -k34,
-                    d36,
-                    A::mul_add(
-                        -k32,
-                        d38,
-                        A::mul_add(-p.MX4l, k22, A::mul_add(-p.MY4l, k36, p.m4l * k43)),
-                    ),
-                ); // F4l|ud=0,g=0.z
-                let d41 = A::mul_add(
-                    k33,
-                    d38,
-                    A::mul_add(
-                        -k34,
-                        d37,
-                        A::mul_add(p.MY4l, k35, A::mul_add(-p.MZ4l, k22, p.m4l * k44)),
-                    ),
-                ); // F4l|ud=0,g=0.x
-                let d123 = A::mul_add(
-                    -k105,
-                    d121,
-                    A::mul_add(
-                        -k102,
-                        d122,
-                        A::mul_add(p.MX4r, k22, A::mul_add(-p.MY4r, k106, p.m4r * k111)),
-                    ),
-                ); // F4r|ud=0,g=0.z
-                let d124 = A::mul_add(
-                    k103,
-                    d122,
-                    A::mul_add(
-                        -k105,
-                        d120,
-                        A::mul_add(p.MY4r, k104, A::mul_add(p.MZ4r, k22, p.m4r * k112)),
-                    ),
-                ); // F4r|ud=0,g=0.x
-                let d125 = A::mul_add(
-                    -k102,
-                    d120,
-                    A::mul_add(
-                        -k103,
-                        d121,
-                        A::mul_add(p.MZ4r, k106, A::mul_add(-p.m4r, k108, p.MX4r * k104)),
-                    ),
-                ); // F4r|ud=0,g=0.y
-                let d42 = A::mul_add(
-                    -p.XZ4l,
-                    k33,
-                    A::mul_add(p.XY4l, k34, p.XX4l * k32),
-                ); // J4lw4l|ud=0,g=0.x
-                let d126 = A::mul_add(
-                    -p.XZ4r,
-                    k103,
-                    A::mul_add(p.XY4r, k105, p.XX4r * k102),
-                ); // J4rw4r|ud=0,g=0.x
-                let d43 = A::mul_add(
-                    -p.YZ4l,
-                    k33,
-                    A::mul_add(p.YY4l, k34, p.XY4l * k32),
-                ); // J4lw4l|ud=0,g=0.y
-                let d127 = A::mul_add(
-                    -p.YZ4r,
-                    k103,
-                    A::mul_add(p.YY4r, k105, p.XY4r * k102),
-                ); // J4rw4r|ud=0,g=0.y
-                let d47 = A::mul_add(
-                    -p.MY4l,
-                    k44,
-                    A::mul_add(
-                        -p.MX4l,
-                        k40,
-                        A::mul_add(
-                            k34,
-                            d42,
-                            A::mul_add(
-                                -k32,
-                                d43,
-                                A::mul_add(
-                                    -p.ZZ4l,
-                                    k35,
-                                    A::mul_add(-p.YZ4l, k22, p.XZ4l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4l|ud=0,g=0.z
-                let d44 = A::mul_add(
-                    -p.ZZ4l,
-                    k33,
-                    A::mul_add(p.YZ4l, k34, p.XZ4l * k32),
-                ); // J4lw4l|ud=0,g=0.z
-                let d128 = A::mul_add(
-                    -p.ZZ4r,
-                    k103,
-                    A::mul_add(p.YZ4r, k105, p.XZ4r * k102),
-                ); // J4rw4r|ud=0,g=0.z
-                let d45 = A::mul_add(
-                    p.MZ4l,
-                    k40,
-                    A::mul_add(
-                        -p.MY4l,
-                        k43,
-                        A::mul_add(
-                            -k33,
-                            d43,
-                            A::mul_add(
-                                -k34,
-                                d44,
-                                A::mul_add(
-                                    -p.XZ4l,
-                                    k35,
-                                    A::mul_add(-p.XY4l, k22, p.XX4l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4l|ud=0,g=0.x
-                let d46 = A::mul_add(
-                    p.MX4l,
-                    k43,
-                    A::mul_add(
-                        p.MZ4l,
-                        k44,
-                        A::mul_add(
-                            k32,
-                            d44,
-                            A::mul_add(
-                                k33,
-                                d42,
-                                A::mul_add(
-                                    -p.YZ4l,
-                                    k35,
-                                    A::mul_add(-p.YY4l, k22, p.XY4l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4l|ud=0,g=0.y
-                let d129 = A::mul_add(
-                    -p.MZ4r,
-                    k108,
-                    A::mul_add(
-                        -p.MY4r,
-                        k111,
-                        A::mul_add(
-                            -k103,
-                            d127,
-                            A::mul_add(
-                                -k105,
-                                d128,
-                                A::mul_add(
-                                    -p.XZ4r,
-                                    k104,
-                                    A::mul_add(p.XY4r, k22, p.XX4r * k106),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4r|ud=0,g=0.x
-                let d130 = A::mul_add(
-                    p.MX4r,
-                    k111,
-                    A::mul_add(
-                        p.MZ4r,
-                        k112,
-                        A::mul_add(
-                            k102,
-                            d128,
-                            A::mul_add(
-                                k103,
-                                d126,
-                                A::mul_add(
-                                    -p.YZ4r,
-                                    k104,
-                                    A::mul_add(p.YY4r, k22, p.XY4r * k106),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4r|ud=0,g=0.y
-                let d131 = A::mul_add(
-                    -p.MY4r,
-                    k112,
-                    A::mul_add(
-                        p.MX4r,
-                        k108,
-                        A::mul_add(
-                            k105,
-                            d126,
-                            A::mul_add(
-                                -k102,
-                                d127,
-                                A::mul_add(
-                                    -p.ZZ4r,
-                                    k104,
-                                    A::mul_add(p.YZ4r, k22, p.XZ4r * k106),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4r|ud=0,g=0.z
-                let k45 = A::mul_add(-s_q2l, k33, c_q2l * k34); // w4l in 5l|ud=0,g=0.y
-                let k113 = A::mul_add(-s_q2r, k103, c_q2r * k105); // w4r in 5r|ud=0,g=0.y
-                let k49 = A::mul_add(k45, qd2l, A::mul_add(-c_q2l, k35, s_q2l * k22)); // wd5l|ud=0,g=0.z
-                let k46 = A::mul_add(c_q2l, k33, s_q2l * k34); // w4l in 5l|ud=0,g=0.z
-                let k114 = A::mul_add(c_q2r, k103, s_q2r * k105); // w4r in 5r|ud=0,g=0.z
-                let k48 = A::mul_add(-k46, qd2l, A::mul_add(s_q2l, k35, c_q2l * k22)); // wd5l|ud=0,g=0.y
-                let k115 = A::mul_add(
-                    -k114,
-                    qd2r,
-                    A::mul_add(-c_q2r, k22, s_q2r * k104),
-                ); // wd5r|ud=0,g=0.y
-                let k116 = A::mul_add(
-                    -c_q2r,
-                    k104,
-                    A::mul_add(-s_q2r, k22, k113 * qd2r),
-                ); // wd5r|ud=0,g=0.z
-                let k47 = k32 + qd2l; // w5l|ud=0,g=0.x
-                let k117 = k102 + qd2r; // w5r|ud=0,g=0.x
-                let k118 = A::mul_add(-c_q2r, k108, s_q2r * k111); // a5r|ud=0,g=0.y
-                let k119 = A::mul_add(-c_q2r, k111, -s_q2r * k108); // a5r|ud=0,g=0.z
-                let d48 = A::mul_add(-p.MY5l, k46, p.MZ5l * k45); // w5lxMS5l|ud=0,g=0.x
-                let d132 = A::mul_add(-p.MY5r, k114, p.MZ5r * k113); // w5rxMS5r|ud=0,g=0.x
-                let d49 = A::mul_add(-p.MZ5l, k47, p.MX5l * k46); // w5lxMS5l|ud=0,g=0.y
-                let d133 = A::mul_add(-p.MZ5r, k117, p.MX5r * k114); // w5rxMS5r|ud=0,g=0.y
-                let d50 = A::mul_add(-p.MX5l, k45, p.MY5l * k47); // w5lxMS5l|ud=0,g=0.z
-                let d134 = A::mul_add(-p.MX5r, k113, p.MY5r * k117); // w5rxMS5r|ud=0,g=0.z
-                let d51 = A::mul_add(
-                    -k46,
-                    d49,
-                    A::mul_add(
-                        k45,
-                        d50,
-                        A::mul_add(p.MY5l, k49, A::mul_add(-p.MZ5l, k48, p.m5l * k44)),
-                    ),
-                ); // F5l|ud=0,g=0.x
-                let d135 = A::mul_add(
-                    -k114,
-                    d133,
-                    A::mul_add(
-                        k113,
-                        d134,
-                        A::mul_add(p.MY5r, k116, A::mul_add(-p.MZ5r, k115, p.m5r * k112)),
-                    ),
-                ); // F5r|ud=0,g=0.x
-                let d52 = A::mul_add(
-                    k47,
-                    d50,
-                    A::mul_add(
-                        -k46,
-                        d48,
-                        A::mul_add(p.MZ5l, k36, A::mul_add(p.MX5l, k49, p.m5l * k50)),
-                    ),
-                ); // F5l|ud=0,g=0.y
-                let d136 = A::mul_add(
-                    k117,
-                    d134,
-                    A::mul_add(
-                        -k114,
-                        d132,
-                        A::mul_add(p.MZ5r, k106, A::mul_add(p.MX5r, k116, p.m5r * k118)),
-                    ),
-                ); // F5r|ud=0,g=0.y
-                let d53 = A::mul_add(
-                    k45,
-                    d48,
-                    A::mul_add(
-                        -k47,
-                        d49,
-                        A::mul_add(-p.MX5l, k48, A::mul_add(-p.MY5l, k36, p.m5l * k51)),
-                    ),
-                ); // F5l|ud=0,g=0.z
-                let d137 = A::mul_add(
-                    k113,
-                    d132,
-                    A::mul_add(
-                        -k117,
-                        d133,
-                        A::mul_add(
-                            -p.MX5r,
-                            k115,
-                            A::mul_add(-p.MY5r, k106, p.m5r * k119),
-                        ),
-                    ),
-                ); // F5r|ud=0,g=0.z
-                let d54 = A::mul_add(p.XZ5l, k46, A::mul_add(p.XY5l, k45, p.XX5l * k47)); // J5lw5l|ud=0,g=0.x
-                let d138 = A::mul_add(
-                    p.XZ5r,
-                    k114,
-                    A::mul_add(p.XY5r, k113, p.XX5r * k117),
-                ); // J5rw5r|ud=0,g=0.x
-                let d55 = A::mul_add(p.YZ5l, k46, A::mul_add(p.YY5l, k45, p.XY5l * k47)); // J5lw5l|ud=0,g=0.y
-                let d139 = A::mul_add(
-                    p.YZ5r,
-                    k114,
-                    A::mul_add(p.YY5r, k113, p.XY5r * k117),
-                ); // J5rw5r|ud=0,g=0.y
-                let d56 = A::mul_add(p.ZZ5l, k46, A::mul_add(p.YZ5l, k45, p.XZ5l * k47)); // J5lw5l|ud=0,g=0.z
-                let d140 = A::mul_add(
-                    p.ZZ5r,
-                    k114,
-                    A::mul_add(p.YZ5r, k113, p.XZ5r * k117),
-                ); // J5rw5r|ud=0,g=0.z
-                let d57 = A::mul_add(
-                    p.MZ5l,
-                    k50,
-                    A::mul_add(
-                        -p.MY5l,
-                        k51,
-                        A::mul_add(
-                            -k46,
-                            d55,
-                            A::mul_add(
-                                k45,
-                                d56,
-                                A::mul_add(
-                                    -p.XZ5l,
-                                    k49,
-                                    A::mul_add(-p.XY5l, k48, p.XX5l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5l|ud=0,g=0.x
-                let d141 = A::mul_add(
-                    p.MZ5r,
-                    k118,
-                    A::mul_add(
-                        -p.MY5r,
-                        k119,
-                        A::mul_add(
-                            -k114,
-                            d139,
-                            A::mul_add(
-                                k113,
-                                d140,
-                                A::mul_add(
-                                    -p.XZ5r,
-                                    k116,
-                                    A::mul_add(-p.XY5r, k115, p.XX5r * k106),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5r|ud=0,g=0.x
-                let d58 = A::mul_add(
-                    p.MX5l,
-                    k51,
-                    A::mul_add(
-                        p.MZ5l,
-                        k44,
-                        A::mul_add(
-                            -k47,
-                            d56,
-                            A::mul_add(
-                                k46,
-                                d54,
-                                A::mul_add(
-                                    -p.YZ5l,
-                                    k49,
-                                    A::mul_add(-p.YY5l, k48, p.XY5l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5l|ud=0,g=0.y
-                let d142 = A::mul_add(
-                    p.MX5r,
-                    k119,
-                    A::mul_add(
-                        p.MZ5r,
-                        k112,
-                        A::mul_add(
-                            -k117,
-                            d140,
-                            A::mul_add(
-                                k114,
-                                d138,
-                                A::mul_add(
-                                    -p.YZ5r,
-                                    k116,
-                                    A::mul_add(-p.YY5r, k115, p.XY5r * k106),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5r|ud=0,g=0.y
-                let d59 = A::mul_add(
-                    -p.MY5l,
-                    k44,
-                    A::mul_add(
-                        -p.MX5l,
-                        k50,
-                        A::mul_add(
-                            -k45,
-                            d54,
-                            A::mul_add(
-                                k47,
-                                d55,
-                                A::mul_add(
-                                    -p.ZZ5l,
-                                    k49,
-                                    A::mul_add(-p.YZ5l, k48, p.XZ5l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5l|ud=0,g=0.z
-                let d143 = A::mul_add(
-                    -p.MY5r,
-                    k112,
-                    A::mul_add(
-                        -p.MX5r,
-                        k118,
-                        A::mul_add(
-                            -k113,
-                            d138,
-                            A::mul_add(
-                                k117,
-                                d139,
-                                A::mul_add(
-                                    -p.ZZ5r,
-                                    k116,
-                                    A::mul_add(-p.YZ5r, k115, p.XZ5r * k106),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5r|ud=0,g=0.z
-                let k52 = A::mul_add(-s_q3l, k46, c_q3l * k47); // w5l in 6l|ud=0,g=0.x
-                let k120 = A::mul_add(-s_q3r, k114, c_q3r * k117); // w5r in 6r|ud=0,g=0.x
-                let k53 = A::mul_add(c_q3l, k46, s_q3l * k47); // w5l in 6l|ud=0,g=0.z
-                let k121 = A::mul_add(c_q3r, k114, s_q3r * k117); // w5r in 6r|ud=0,g=0.z
-                let k55 = A::mul_add(-k52, qd3l, A::mul_add(-c_q3l, k49, s_q3l * k36)); // wd6l|ud=0,g=0.z
-                let k122 = A::mul_add(
-                    -k120,
-                    qd3r,
-                    A::mul_add(-c_q3r, k116, s_q3r * k106),
-                ); // wd6r|ud=0,g=0.z
-                let k54 = k45 - qd3l; // w6l|ud=0,g=0.y
-                let k123 = k113 - qd3r; // w6r|ud=0,g=0.y
-                let k56 = A::mul_add(k53, qd3l, A::mul_add(s_q3l, k49, c_q3l * k36)); // wd6l|ud=0,g=0.x
-                let k124 = A::mul_add(k121, qd3r, A::mul_add(s_q3r, k116, c_q3r * k106)); // wd6r|ud=0,g=0.x
-                let k57 = p.L7 * k46; // w5lxP6l|ud=0,g=0.x
-                let k125 = p.L7 * k114; // w5rxP6r|ud=0,g=0.x
-                let k58 = p.L7 * k47; // w5lxP6l|ud=0,g=0.z
-                let k126 = p.L7 * k117; // w5rxP6r|ud=0,g=0.z
-                let k59 = A::mul_add(-k45, k58, A::mul_add(-p.L7, k49, k44)); // a6l in 5l|ud=0,g=0.x
-                let k127 = A::mul_add(-k113, k126, A::mul_add(-p.L7, k116, k112)); // a6r in 5r|ud=0,g=0.x
-                let k60 = A::mul_add(-k47, k58, A::mul_add(-k46, k57, k50)); // a6l in 5l|ud=0,g=0.y
-                let k128 = A::mul_add(-k117, k126, A::mul_add(-k114, k125, k118)); // a6r in 5r|ud=0,g=0.y
-                let k61 = A::mul_add(k45, k57, A::mul_add(p.L7, k36, k51)); // a6l in 5l|ud=0,g=0.z
-                let k129 = A::mul_add(k113, k125, A::mul_add(p.L7, k106, k119)); // a6r in 5r|ud=0,g=0.z
-                let k62 = A::mul_add(-c_q3l, k61, s_q3l * k59); // a6l|ud=0,g=0.z
-                let k130 = A::mul_add(-c_q3r, k129, s_q3r * k127); // a6r|ud=0,g=0.z
-                let k63 = A::mul_add(s_q3l, k61, c_q3l * k59); // a6l|ud=0,g=0.x
-                let k131 = A::mul_add(s_q3r, k129, c_q3r * k127); // a6r|ud=0,g=0.x
-                let d61 = A::mul_add(-p.MX6l, k54, p.MY6l * k52); // w6lxMS6l|ud=0,g=0.z
-                let d144 = A::mul_add(-p.MX6r, k123, p.MY6r * k120); // w6rxMS6r|ud=0,g=0.z
-                let d60 = A::mul_add(p.MY6l, k53, p.MZ6l * k54); // w6lxMS6l|ud=0,g=0.x
-                let d145 = A::mul_add(p.MY6r, k121, p.MZ6r * k123); // w6rxMS6r|ud=0,g=0.x
-                let d62 = A::mul_add(p.MZ6l, k52, p.MX6l * k53); // w6lxMS6l|ud=0,g=0.y
-                let d146 = A::mul_add(p.MZ6r, k120, p.MX6r * k121); // w6rxMS6r|ud=0,g=0.y
-                let d64 = A::mul_add(
-                    -k54,
-                    d60,
-                    A::mul_add(
-                        -k52,
-                        d62,
-                        A::mul_add(-p.MX6l, k48, A::mul_add(-p.MY6l, k56, p.m6l * k62)),
-                    ),
-                ); // F6l|ud=0,g=0.z
-                let d147 = A::mul_add(
-                    -k123,
-                    d145,
-                    A::mul_add(
-                        -k120,
-                        d146,
-                        A::mul_add(
-                            -p.MX6r,
-                            k115,
-                            A::mul_add(-p.MY6r, k124, p.m6r * k130),
-                        ),
-                    ),
-                ); // F6r|ud=0,g=0.z
-                let d65 = A::mul_add(
-                    k53,
-                    d62,
-                    A::mul_add(
-                        -k54,
-                        d61,
-                        A::mul_add(p.MY6l, k55, A::mul_add(-p.MZ6l, k48, p.m6l * k63)),
-                    ),
-                ); // F6l|ud=0,g=0.x
-                let d148 = A::mul_add(
-                    k121,
-                    d146,
-                    A::mul_add(
-                        -k123,
-                        d144,
-                        A::mul_add(p.MY6r, k122, A::mul_add(-p.MZ6r, k115, p.m6r * k131)),
-                    ),
-                ); // F6r|ud=0,g=0.x
-                let d63 = A::mul_add(
-                    -k52,
-                    d61,
-                    A::mul_add(
-                        -k53,
-                        d60,
-                        A::mul_add(p.MZ6l, k56, A::mul_add(p.MX6l, k55, p.m6l * k60)),
-                    ),
-                ); // F6l|ud=0,g=0.y
-                let d149 = A::mul_add(
-                    -k120,
-                    d144,
-                    A::mul_add(
-                        -k121,
-                        d145,
-                        A::mul_add(p.MZ6r, k124, A::mul_add(p.MX6r, k122, p.m6r * k128)),
-                    ),
-                ); // F6r|ud=0,g=0.y
-                let d66 = A::mul_add(
-                    -p.XZ6l,
-                    k53,
-                    A::mul_add(p.XY6l, k54, p.XX6l * k52),
-                ); // J6lw6l|ud=0,g=0.x
-                let d150 = A::mul_add(
-                    -p.XZ6r,
-                    k121,
-                    A::mul_add(p.XY6r, k123, p.XX6r * k120),
-                ); // J6rw6r|ud=0,g=0.x
-                let d67 = A::mul_add(
-                    -p.YZ6l,
-                    k53,
-                    A::mul_add(p.YY6l, k54, p.XY6l * k52),
-                ); // J6lw6l|ud=0,g=0.y
-                let d151 = A::mul_add(
-                    -p.YZ6r,
-                    k121,
-                    A::mul_add(p.YY6r, k123, p.XY6r * k120),
-                ); // J6rw6r|ud=0,g=0.y
-                let d68 = A::mul_add(
-                    -p.ZZ6l,
-                    k53,
-                    A::mul_add(p.YZ6l, k54, p.XZ6l * k52),
-                ); // J6lw6l|ud=0,g=0.z
-                let d152 = A::mul_add(
-                    -p.ZZ6r,
-                    k121,
-                    A::mul_add(p.YZ6r, k123, p.XZ6r * k120),
-                ); // J6rw6r|ud=0,g=0.z
-                let d69 = A::mul_add(
-                    p.MZ6l,
-                    k60,
-                    A::mul_add(
-                        -p.MY6l,
-                        k62,
-                        A::mul_add(
-                            -k53,
-                            d67,
-                            A::mul_add(
-                                -k54,
-                                d68,
-                                A::mul_add(
-                                    -p.XZ6l,
-                                    k55,
-                                    A::mul_add(-p.XY6l, k48, p.XX6l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6l|ud=0,g=0.x
-                let d153 = A::mul_add(
-                    p.MZ6r,
-                    k128,
-                    A::mul_add(
-                        -p.MY6r,
-                        k130,
-                        A::mul_add(
-                            -k121,
-                            d151,
-                            A::mul_add(
-                                -k123,
-                                d152,
-                                A::mul_add(
-                                    -p.XZ6r,
-                                    k122,
-                                    A::mul_add(-p.XY6r, k115, p.XX6r * k124),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6r|ud=0,g=0.x
-                let d70 = A::mul_add(
-                    p.MX6l,
-                    k62,
-                    A::mul_add(
-                        p.MZ6l,
-                        k63,
-                        A::mul_add(
-                            k52,
-                            d68,
-                            A::mul_add(
-                                k53,
-                                d66,
-                                A::mul_add(
-                                    -p.YZ6l,
-                                    k55,
-                                    A::mul_add(-p.YY6l, k48, p.XY6l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6l|ud=0,g=0.y
-                let d154 = A::mul_add(
-                    p.MX6r,
-                    k130,
-                    A::mul_add(
-                        p.MZ6r,
-                        k131,
-                        A::mul_add(
-                            k120,
-                            d152,
-                            A::mul_add(
-                                k121,
-                                d150,
-                                A::mul_add(
-                                    -p.YZ6r,
-                                    k122,
-                                    A::mul_add(-p.YY6r, k115, p.XY6r * k124),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6r|ud=0,g=0.y
-                let d71 = A::mul_add(
-                    -p.MY6l,
-                    k63,
-                    A::mul_add(
-                        -p.MX6l,
-                        k60,
-                        A::mul_add(
-                            k54,
-                            d66,
-                            A::mul_add(
-                                -k52,
-                                d67,
-                                A::mul_add(
-                                    -p.ZZ6l,
-                                    k55,
-                                    A::mul_add(-p.YZ6l, k48, p.XZ6l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6l|ud=0,g=0.z
-                let d155 = A::mul_add(
-                    -p.MY6r,
-                    k131,
-                    A::mul_add(
-                        -p.MX6r,
-                        k128,
-                        A::mul_add(
-                            k123,
-                            d150,
-                            A::mul_add(
-                                -k120,
-                                d151,
-                                A::mul_add(
-                                    -p.ZZ6r,
-                                    k122,
-                                    A::mul_add(-p.YZ6r, k115, p.XZ6r * k124),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6r|ud=0,g=0.z
-                let k64 = A::mul_add(-s_q4l, k53, c_q4l * k54); // w6l in 7l|ud=0,g=0.y
-                let k132 = A::mul_add(-s_q4r, k121, c_q4r * k123); // w6r in 7r|ud=0,g=0.y
-                let k65 = A::mul_add(c_q4l, k53, s_q4l * k54); // w6l in 7l|ud=0,g=0.z
-                let k133 = A::mul_add(c_q4r, k121, s_q4r * k123); // w6r in 7r|ud=0,g=0.z
-                let k67 = A::mul_add(-k65, qd4l, A::mul_add(s_q4l, k55, c_q4l * k48)); // wd7l|ud=0,g=0.y
-                let k134 = A::mul_add(
-                    -k133,
-                    qd4r,
-                    A::mul_add(s_q4r, k122, c_q4r * k115),
-                ); // wd7r|ud=0,g=0.y
-                let k68 = A::mul_add(k64, qd4l, A::mul_add(-c_q4l, k55, s_q4l * k48)); // wd7l|ud=0,g=0.z
-                let k135 = A::mul_add(
-                    k132,
-                    qd4r,
-                    A::mul_add(-c_q4r, k122, s_q4r * k115),
-                ); // wd7r|ud=0,g=0.z
-                let k66 = k52 + qd4l; // w7l|ud=0,g=0.x
-                let k136 = k120 + qd4r; // w7r|ud=0,g=0.x
-                let k69 = A::mul_add(s_q4l, k62, c_q4l * k60); // a7l|ud=0,g=0.y
-                let k137 = A::mul_add(s_q4r, k130, c_q4r * k128); // a7r|ud=0,g=0.y
-                let k70 = A::mul_add(-c_q4l, k62, s_q4l * k60); // a7l|ud=0,g=0.z
-                let k138 = A::mul_add(-c_q4r, k130, s_q4r * k128); // a7r|ud=0,g=0.z
-                let d72 = A::mul_add(-p.MY7l, k65, p.MZ7l * k64); // w7lxMS7l|ud=0,g=0.x
-                let d156 = A::mul_add(-p.MY7r, k133, p.MZ7r * k132); // w7rxMS7r|ud=0,g=0.x
-                let d73 = A::mul_add(-p.MZ7l, k66, p.MX7l * k65); // w7lxMS7l|ud=0,g=0.y
-                let d157 = A::mul_add(-p.MZ7r, k136, p.MX7r * k133); // w7rxMS7r|ud=0,g=0.y
-                let d74 = A::mul_add(-p.MX7l, k64, p.MY7l * k66); // w7lxMS7l|ud=0,g=0.z
-                let d158 = A::mul_add(-p.MX7r, k132, p.MY7r * k136); // w7rxMS7r|ud=0,g=0.z
-                let d75 = A::mul_add(
-                    -k65,
-                    d73,
-                    A::mul_add(
-                        k64,
-                        d74,
-                        A::mul_add(p.MY7l, k68, A::mul_add(-p.MZ7l, k67, p.m7l * k63)),
-                    ),
-                ); // F7l|ud=0,g=0.x
-                let d159 = A::mul_add(
-                    -k133,
-                    d157,
-                    A::mul_add(
-                        k132,
-                        d158,
-                        A::mul_add(p.MY7r, k135, A::mul_add(-p.MZ7r, k134, p.m7r * k131)),
-                    ),
-                ); // F7r|ud=0,g=0.x
-                let d76 = A::mul_add(
-                    k66,
-                    d74,
-                    A::mul_add(
-                        -k65,
-                        d72,
-                        A::mul_add(p.MZ7l, k56, A::mul_add(p.MX7l, k68, p.m7l * k69)),
-                    ),
-                ); // F7l|ud=0,g=0.y
-                let d160 = A::mul_add(
-                    k136,
-                    d158,
-                    A::mul_add(
-                        -k133,
-                        d156,
-                        A::mul_add(p.MZ7r, k124, A::mul_add(p.MX7r, k135, p.m7r * k137)),
-                    ),
-                ); // F7r|ud=0,g=0.y
-                let d77 = A::mul_add(
-                    k64,
-                    d72,
-                    A::mul_add(
-                        -k66,
-                        d73,
-                        A::mul_add(-p.MX7l, k67, A::mul_add(-p.MY7l, k56, p.m7l * k70)),
-                    ),
-                ); // F7l|ud=0,g=0.z
-                let d161 = A::mul_add(
-                    k132,
-                    d156,
-                    A::mul_add(
-                        -k136,
-                        d157,
-                        A::mul_add(
-                            -p.MX7r,
-                            k134,
-                            A::mul_add(-p.MY7r, k124, p.m7r * k138),
-                        ),
-                    ),
-                ); // F7r|ud=0,g=0.z
-                let d78 = A::mul_add(p.XZ7l, k65, A::mul_add(p.XY7l, k64, p.XX7l * k66)); // J7lw7l|ud=0,g=0.x
-                let d162 = A::mul_add(
-                    p.XZ7r,
-                    k133,
-                    A::mul_add(p.XY7r, k132, p.XX7r * k136),
-                ); // J7rw7r|ud=0,g=0.x
-                let d79 = A::mul_add(p.YZ7l, k65, A::mul_add(p.YY7l, k64, p.XY7l * k66)); // J7lw7l|ud=0,g=0.y
-                let d163 = A::mul_add(
-                    p.YZ7r,
-                    k133,
-                    A::mul_add(p.YY7r, k132, p.XY7r * k136),
-                ); // J7rw7r|ud=0,g=0.y
-                let d80 = A::mul_add(p.ZZ7l, k65, A::mul_add(p.YZ7l, k64, p.XZ7l * k66)); // J7lw7l|ud=0,g=0.z
-                let d164 = A::mul_add(
-                    p.ZZ7r,
-                    k133,
-                    A::mul_add(p.YZ7r, k132, p.XZ7r * k136),
-                ); // J7rw7r|ud=0,g=0.z
-                let d81 = A::mul_add(
-                    p.MZ7l,
-                    k69,
-                    A::mul_add(
-                        -p.MY7l,
-                        k70,
-                        A::mul_add(
-                            -k65,
-                            d79,
-                            A::mul_add(
-                                k64,
-                                d80,
-                                A::mul_add(
-                                    -p.XZ7l,
-                                    k68,
-                                    A::mul_add(-p.XY7l, k67, p.XX7l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7l|ud=0,g=0.x
-                let d165 = A::mul_add(
-                    p.MZ7r,
-                    k137,
-                    A::mul_add(
-                        -p.MY7r,
-                        k138,
-                        A::mul_add(
-                            -k133,
-                            d163,
-                            A::mul_add(
-                                k132,
-                                d164,
-                                A::mul_add(
-                                    -p.XZ7r,
-                                    k135,
-                                    A::mul_add(-p.XY7r, k134, p.XX7r * k124),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7r|ud=0,g=0.x
-                let d82 = A::mul_add(
-                    p.MX7l,
-                    k70,
-                    A::mul_add(
-                        p.MZ7l,
-                        k63,
-                        A::mul_add(
-                            -k66,
-                            d80,
-                            A::mul_add(
-                                k65,
-                                d78,
-                                A::mul_add(
-                                    -p.YZ7l,
-                                    k68,
-                                    A::mul_add(-p.YY7l, k67, p.XY7l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7l|ud=0,g=0.y
-                let d166 = A::mul_add(
-                    p.MX7r,
-                    k138,
-                    A::mul_add(
-                        p.MZ7r,
-                        k131,
-                        A::mul_add(
-                            -k136,
-                            d164,
-                            A::mul_add(
-                                k133,
-                                d162,
-                                A::mul_add(
-                                    -p.YZ7r,
-                                    k135,
-                                    A::mul_add(-p.YY7r, k134, p.XY7r * k124),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7r|ud=0,g=0.y
-                let d83 = A::mul_add(
-                    -p.MY7l,
-                    k63,
-                    A::mul_add(
-                        -p.MX7l,
-                        k69,
-                        A::mul_add(
-                            -k64,
-                            d78,
-                            A::mul_add(
-                                k66,
-                                d79,
-                                A::mul_add(
-                                    -p.ZZ7l,
-                                    k68,
-                                    A::mul_add(-p.YZ7l, k67, p.XZ7l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7l|ud=0,g=0.z
-                let d167 = A::mul_add(
-                    -p.MY7r,
-                    k131,
-                    A::mul_add(
-                        -p.MX7r,
-                        k137,
-                        A::mul_add(
-                            -k132,
-                            d162,
-                            A::mul_add(
-                                k136,
-                                d163,
-                                A::mul_add(
-                                    -p.ZZ7r,
-                                    k135,
-                                    A::mul_add(-p.YZ7r, k134, p.XZ7r * k124),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7r|ud=0,g=0.z
-                let k71 = A::mul_add(-s_q5l, k65, c_q5l * k66); // w7l in 8l|ud=0,g=0.x
-                let k139 = A::mul_add(-s_q5r, k133, c_q5r * k136); // w7r in 8r|ud=0,g=0.x
-                let k72 = A::mul_add(c_q5l, k65, s_q5l * k66); // w7l in 8l|ud=0,g=0.z
-                let k140 = A::mul_add(c_q5r, k133, s_q5r * k136); // w7r in 8r|ud=0,g=0.z
-                let k74 = A::mul_add(-k71, qd5l, A::mul_add(-c_q5l, k68, s_q5l * k56)); // wd8l|ud=0,g=0.z
-                let k141 = A::mul_add(
-                    -k139,
-                    qd5r,
-                    A::mul_add(-c_q5r, k135, s_q5r * k124),
-                ); // wd8r|ud=0,g=0.z
-                let k73 = k64 - qd5l; // w8l|ud=0,g=0.y
-                let k142 = k132 - qd5r; // w8r|ud=0,g=0.y
-                let k75 = A::mul_add(k72, qd5l, A::mul_add(s_q5l, k68, c_q5l * k56)); // wd8l|ud=0,g=0.x
-                let k143 = A::mul_add(k140, qd5r, A::mul_add(s_q5r, k135, c_q5r * k124)); // wd8r|ud=0,g=0.x
-                let k76 = p.L8 * k65; // w7lxP8l|ud=0,g=0.x
-                let k144 = p.L8 * k133; // w7rxP8r|ud=0,g=0.x
-                let k77 = p.L8 * k66; // w7lxP8l|ud=0,g=0.z
-                let k145 = p.L8 * k136; // w7rxP8r|ud=0,g=0.z
-                let k78 = A::mul_add(-k64, k77, A::mul_add(-p.L8, k68, k63)); // a8l in 7l|ud=0,g=0.x
-                let k146 = A::mul_add(-k132, k145, A::mul_add(-p.L8, k135, k131)); // a8r in 7r|ud=0,g=0.x
-                let k79 = A::mul_add(-k66, k77, A::mul_add(-k65, k76, k69)); // a8l in 7l|ud=0,g=0.y
-                let k147 = A::mul_add(-k136, k145, A::mul_add(-k133, k144, k137)); // a8r in 7r|ud=0,g=0.y
-                let k80 = A::mul_add(k64, k76, A::mul_add(p.L8, k56, k70)); // a8l in 7l|ud=0,g=0.z
-                let k148 = A::mul_add(k132, k144, A::mul_add(p.L8, k124, k138)); // a8r in 7r|ud=0,g=0.z
-                let k81 = A::mul_add(-c_q5l, k80, s_q5l * k78); // a8l|ud=0,g=0.z
-                let k149 = A::mul_add(-c_q5r, k148, s_q5r * k146); // a8r|ud=0,g=0.z
-                let k82 = A::mul_add(s_q5l, k80, c_q5l * k78); // a8l|ud=0,g=0.x
-                let k150 = A::mul_add(s_q5r, k148, c_q5r * k146); // a8r|ud=0,g=0.x
-                let d85 = A::mul_add(-p.MX8l, k73, p.MY8l * k71); // w8lxMS8l|ud=0,g=0.z
-                let d168 = A::mul_add(-p.MX8r, k142, p.MY8r * k139); // w8rxMS8r|ud=0,g=0.z
-                let d84 = A::mul_add(p.MY8l, k72, p.MZ8l * k73); // w8lxMS8l|ud=0,g=0.x
-                let d169 = A::mul_add(p.MY8r, k140, p.MZ8r * k142); // w8rxMS8r|ud=0,g=0.x
-                let d86 = A::mul_add(p.MZ8l, k71, p.MX8l * k72); // w8lxMS8l|ud=0,g=0.y
-                let d170 = A::mul_add(p.MZ8r, k139, p.MX8r * k140); // w8rxMS8r|ud=0,g=0.y
-                let d88 = A::mul_add(
-                    -k73,
-                    d84,
-                    A::mul_add(
-                        -k71,
-                        d86,
-                        A::mul_add(-p.MX8l, k67, A::mul_add(-p.MY8l, k75, p.m8l * k81)),
-                    ),
-                ); // F8l|ud=0,g=0.z
-                let d171 = A::mul_add(
-                    -k142,
-                    d169,
-                    A::mul_add(
-                        -k139,
-                        d170,
-                        A::mul_add(
-                            -p.MX8r,
-                            k134,
-                            A::mul_add(-p.MY8r, k143, p.m8r * k149),
-                        ),
-                    ),
-                ); // F8r|ud=0,g=0.z
-                let d89 = A::mul_add(
-                    k72,
-                    d86,
-                    A::mul_add(
-                        -k73,
-                        d85,
-                        A::mul_add(p.MY8l, k74, A::mul_add(-p.MZ8l, k67, p.m8l * k82)),
-                    ),
-                ); // F8l|ud=0,g=0.x
-                let d172 = A::mul_add(
-                    k140,
-                    d170,
-                    A::mul_add(
-                        -k142,
-                        d168,
-                        A::mul_add(p.MY8r, k141, A::mul_add(-p.MZ8r, k134, p.m8r * k150)),
-                    ),
-                ); // F8r|ud=0,g=0.x
-                let d87 = A::mul_add(
-                    -k71,
-                    d85,
-                    A::mul_add(
-                        -k72,
-                        d84,
-                        A::mul_add(p.MZ8l, k75, A::mul_add(p.MX8l, k74, p.m8l * k79)),
-                    ),
-                ); // F8l|ud=0,g=0.y
-                let d173 = A::mul_add(
-                    -k139,
-                    d168,
-                    A::mul_add(
-                        -k140,
-                        d169,
-                        A::mul_add(p.MZ8r, k143, A::mul_add(p.MX8r, k141, p.m8r * k147)),
-                    ),
-                ); // F8r|ud=0,g=0.y
-                let d90 = A::mul_add(
-                    -p.XZ8l,
-                    k72,
-                    A::mul_add(p.XY8l, k73, p.XX8l * k71),
-                ); // J8lw8l|ud=0,g=0.x
-                let d174 = A::mul_add(
-                    -p.XZ8r,
-                    k140,
-                    A::mul_add(p.XY8r, k142, p.XX8r * k139),
-                ); // J8rw8r|ud=0,g=0.x
-                let d91 = A::mul_add(
-                    -p.YZ8l,
-                    k72,
-                    A::mul_add(p.YY8l, k73, p.XY8l * k71),
-                ); // J8lw8l|ud=0,g=0.y
-                let d175 = A::mul_add(
-                    -p.YZ8r,
-                    k140,
-                    A::mul_add(p.YY8r, k142, p.XY8r * k139),
-                ); // J8rw8r|ud=0,g=0.y
-                let d92 = A::mul_add(
-                    -p.ZZ8l,
-                    k72,
-                    A::mul_add(p.YZ8l, k73, p.XZ8l * k71),
-                ); // J8lw8l|ud=0,g=0.z
-                let d176 = A::mul_add(
-                    -p.ZZ8r,
-                    k140,
-                    A::mul_add(p.YZ8r, k142, p.XZ8r * k139),
-                ); // J8rw8r|ud=0,g=0.z
-                let d93 = A::mul_add(
-                    p.MZ8l,
-                    k79,
-                    A::mul_add(
-                        -p.MY8l,
-                        k81,
-                        A::mul_add(
-                            -k72,
-                            d91,
-                            A::mul_add(
-                                -k73,
-                                d92,
-                                A::mul_add(
-                                    -p.XZ8l,
-                                    k74,
-                                    A::mul_add(-p.XY8l, k67, p.XX8l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8l|ud=0,g=0.x
-                let d177 = A::mul_add(
-                    p.MZ8r,
-                    k147,
-                    A::mul_add(
-                        -p.MY8r,
-                        k149,
-                        A::mul_add(
-                            -k140,
-                            d175,
-                            A::mul_add(
-                                -k142,
-                                d176,
-                                A::mul_add(
-                                    -p.XZ8r,
-                                    k141,
-                                    A::mul_add(-p.XY8r, k134, p.XX8r * k143),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r|ud=0,g=0.x
-                let d94 = A::mul_add(
-                    p.MX8l,
-                    k81,
-                    A::mul_add(
-                        p.MZ8l,
-                        k82,
-                        A::mul_add(
-                            k71,
-                            d92,
-                            A::mul_add(
-                                k72,
-                                d90,
-                                A::mul_add(
-                                    -p.YZ8l,
-                                    k74,
-                                    A::mul_add(-p.YY8l, k67, p.XY8l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8l|ud=0,g=0.y
-                let d178 = A::mul_add(
-                    p.MX8r,
-                    k149,
-                    A::mul_add(
-                        p.MZ8r,
-                        k150,
-                        A::mul_add(
-                            k139,
-                            d176,
-                            A::mul_add(
-                                k140,
-                                d174,
-                                A::mul_add(
-                                    -p.YZ8r,
-                                    k141,
-                                    A::mul_add(-p.YY8r, k134, p.XY8r * k143),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r|ud=0,g=0.y
-                let d95 = A::mul_add(
-                    -p.MY8l,
-                    k82,
-                    A::mul_add(
-                        -p.MX8l,
-                        k79,
-                        A::mul_add(
-                            k73,
-                            d90,
-                            A::mul_add(
-                                -k71,
-                                d91,
-                                A::mul_add(
-                                    -p.ZZ8l,
-                                    k74,
-                                    A::mul_add(-p.YZ8l, k67, p.XZ8l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8l|ud=0,g=0.z
-                let d179 = A::mul_add(
-                    -p.MY8r,
-                    k150,
-                    A::mul_add(
-                        -p.MX8r,
-                        k147,
-                        A::mul_add(
-                            k142,
-                            d174,
-                            A::mul_add(
-                                -k139,
-                                d175,
-                                A::mul_add(
-                                    -p.ZZ8r,
-                                    k141,
-                                    A::mul_add(-p.YZ8r, k134, p.XZ8r * k143),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r|ud=0,g=0.z
-                let k83 = A::mul_add(-s_q6l, k72, c_q6l * k73); // w8l in 9l|ud=0,g=0.y
-                let k151 = A::mul_add(-s_q6r, k140, c_q6r * k142); // w8r in 9r|ud=0,g=0.y
-                let k84 = A::mul_add(c_q6l, k72, s_q6l * k73); // w8l in 9l|ud=0,g=0.z
-                let k152 = A::mul_add(c_q6r, k140, s_q6r * k142); // w8r in 9r|ud=0,g=0.z
-                let k86 = A::mul_add(-k84, qd6l, A::mul_add(s_q6l, k74, c_q6l * k67)); // wd9l|ud=0,g=0.y
-                let k153 = A::mul_add(
-                    -k152,
-                    qd6r,
-                    A::mul_add(s_q6r, k141, c_q6r * k134),
-                ); // wd9r|ud=0,g=0.y
-                let k87 = A::mul_add(k83, qd6l, A::mul_add(-c_q6l, k74, s_q6l * k67)); // wd9l|ud=0,g=0.z
-                let k154 = A::mul_add(
-                    k151,
-                    qd6r,
-                    A::mul_add(-c_q6r, k141, s_q6r * k134),
-                ); // wd9r|ud=0,g=0.z
-                let k85 = k71 + qd6l; // w9l|ud=0,g=0.x
-                let k155 = k139 + qd6r; // w9r|ud=0,g=0.x
-                let k88 = A::mul_add(s_q6l, k81, c_q6l * k79); // a9l|ud=0,g=0.y
-                let k156 = A::mul_add(s_q6r, k149, c_q6r * k147); // a9r|ud=0,g=0.y
-                let k89 = A::mul_add(-c_q6l, k81, s_q6l * k79); // a9l|ud=0,g=0.z
-                let k157 = A::mul_add(-c_q6r, k149, s_q6r * k147); // a9r|ud=0,g=0.z
-                let d96 = A::mul_add(-p.MY9l, k84, p.MZ9l * k83); // w9lxMS9l|ud=0,g=0.x
-                let d180 = A::mul_add(-p.MY9r, k152, p.MZ9r * k151); // w9rxMS9r|ud=0,g=0.x
-                let d97 = A::mul_add(-p.MZ9l, k85, p.MX9l * k84); // w9lxMS9l|ud=0,g=0.y
-                let d181 = A::mul_add(-p.MZ9r, k155, p.MX9r * k152); // w9rxMS9r|ud=0,g=0.y
-                let d98 = A::mul_add(-p.MX9l, k83, p.MY9l * k85); // w9lxMS9l|ud=0,g=0.z
-                let d182 = A::mul_add(-p.MX9r, k151, p.MY9r * k155); // w9rxMS9r|ud=0,g=0.z
-                let d99 = A::mul_add(
-                    -k84,
-                    d97,
-                    A::mul_add(
-                        k83,
-                        d98,
-                        A::mul_add(p.MY9l, k87, A::mul_add(-p.MZ9l, k86, p.m9l * k82)),
-                    ),
-                ); // F9l|ud=0,g=0.x
-                let d183 = A::mul_add(
-                    -k152,
-                    d181,
-                    A::mul_add(
-                        k151,
-                        d182,
-                        A::mul_add(p.MY9r, k154, A::mul_add(-p.MZ9r, k153, p.m9r * k150)),
-                    ),
-                ); // F9r|ud=0,g=0.x
-                let d100 = A::mul_add(
-                    k85,
-                    d98,
-                    A::mul_add(
-                        -k84,
-                        d96,
-                        A::mul_add(p.MZ9l, k75, A::mul_add(p.MX9l, k87, p.m9l * k88)),
-                    ),
-                ); // F9l|ud=0,g=0.y
-                let d184 = A::mul_add(
-                    k155,
-                    d182,
-                    A::mul_add(
-                        -k152,
-                        d180,
-                        A::mul_add(p.MZ9r, k143, A::mul_add(p.MX9r, k154, p.m9r * k156)),
-                    ),
-                ); // F9r|ud=0,g=0.y
-                let d101 = A::mul_add(
-                    k83,
-                    d96,
-                    A::mul_add(
-                        -k85,
-                        d97,
-                        A::mul_add(-p.MX9l, k86, A::mul_add(-p.MY9l, k75, p.m9l * k89)),
-                    ),
-                ); // F9l|ud=0,g=0.z
-                let d185 = A::mul_add(
-                    k151,
-                    d180,
-                    A::mul_add(
-                        -k155,
-                        d181,
-                        A::mul_add(
-                            -p.MX9r,
-                            k153,
-                            A::mul_add(-p.MY9r, k143, p.m9r * k157),
-                        ),
-                    ),
-                ); // F9r|ud=0,g=0.z
-                let d102 = A::mul_add(
-                    p.XZ9l,
-                    k84,
-                    A::mul_add(p.XY9l, k83, p.XX9l * k85),
-                ); // J9lw9l|ud=0,g=0.x
-                let d186 = A::mul_add(
-                    p.XZ9r,
-                    k152,
-                    A::mul_add(p.XY9r, k151, p.XX9r * k155),
-                ); // J9rw9r|ud=0,g=0.x
-                let d103 = A::mul_add(
-                    p.YZ9l,
-                    k84,
-                    A::mul_add(p.YY9l, k83, p.XY9l * k85),
-                ); // J9lw9l|ud=0,g=0.y
-                let d187 = A::mul_add(
-                    p.YZ9r,
-                    k152,
-                    A::mul_add(p.YY9r, k151, p.XY9r * k155),
-                ); // J9rw9r|ud=0,g=0.y
-                let d104 = A::mul_add(
-                    p.ZZ9l,
-                    k84,
-                    A::mul_add(p.YZ9l, k83, p.XZ9l * k85),
-                ); // J9lw9l|ud=0,g=0.z
-                let d188 = A::mul_add(
-                    p.ZZ9r,
-                    k152,
-                    A::mul_add(p.YZ9r, k151, p.XZ9r * k155),
-                ); // J9rw9r|ud=0,g=0.z
-                let d105 = A::mul_add(
-                    p.MZ9l,
-                    k88,
-                    A::mul_add(
-                        -p.MY9l,
-                        k89,
-                        A::mul_add(
-                            -k84,
-                            d103,
-                            A::mul_add(
-                                k83,
-                                d104,
-                                A::mul_add(
-                                    -p.XZ9l,
-                                    k87,
-                                    A::mul_add(-p.XY9l, k86, p.XX9l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9l|ud=0,g=0.x
-                let d189 = A::mul_add(
-                    p.MZ9r,
-                    k156,
-                    A::mul_add(
-                        -p.MY9r,
-                        k157,
-                        A::mul_add(
-                            -k152,
-                            d187,
-                            A::mul_add(
-                                k151,
-                                d188,
-                                A::mul_add(
-                                    -p.XZ9r,
-                                    k154,
-                                    A::mul_add(-p.XY9r, k153, p.XX9r * k143),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r|ud=0,g=0.x
-                let d106 = A::mul_add(
-                    p.MX9l,
-                    k89,
-                    A::mul_add(
-                        p.MZ9l,
-                        k82,
-                        A::mul_add(
-                            -k85,
-                            d104,
-                            A::mul_add(
-                                k84,
-                                d102,
-                                A::mul_add(
-                                    -p.YZ9l,
-                                    k87,
-                                    A::mul_add(-p.YY9l, k86, p.XY9l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9l|ud=0,g=0.y
-                let d190 = A::mul_add(
-                    p.MX9r,
-                    k157,
-                    A::mul_add(
-                        p.MZ9r,
-                        k150,
-                        A::mul_add(
-                            -k155,
-                            d188,
-                            A::mul_add(
-                                k152,
-                                d186,
-                                A::mul_add(
-                                    -p.YZ9r,
-                                    k154,
-                                    A::mul_add(-p.YY9r, k153, p.XY9r * k143),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r|ud=0,g=0.y
-                let d107 = A::mul_add(
-                    -p.MY9l,
-                    k82,
-                    A::mul_add(
-                        -p.MX9l,
-                        k88,
-                        A::mul_add(
-                            -k83,
-                            d102,
-                            A::mul_add(
-                                k85,
-                                d103,
-                                A::mul_add(
-                                    -p.ZZ9l,
-                                    k87,
-                                    A::mul_add(-p.YZ9l, k86, p.XZ9l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9l|ud=0,g=0.z
-                let d191 = A::mul_add(
-                    -p.MY9r,
-                    k150,
-                    A::mul_add(
-                        -p.MX9r,
-                        k156,
-                        A::mul_add(
-                            -k151,
-                            d186,
-                            A::mul_add(
-                                k155,
-                                d187,
-                                A::mul_add(
-                                    -p.ZZ9r,
-                                    k154,
-                                    A::mul_add(-p.YZ9r, k153, p.XZ9r * k143),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r|ud=0,g=0.z
-                let k90 = A::mul_add(-s_q7l, k84, c_q7l * k85); // w9l in 10l|ud=0,g=0.x
-                let k158 = A::mul_add(-s_q7r, k152, c_q7r * k155); // w9r in 10r|ud=0,g=0.x
-                let k91 = A::mul_add(c_q7l, k84, s_q7l * k85); // w9l in 10l|ud=0,g=0.y
-                let k159 = A::mul_add(c_q7r, k152, s_q7r * k155); // w9r in 10r|ud=0,g=0.y
-                let k92 = k83 - qd7l; // w10l|ud=0,g=0.z
-                let k160 = k151 - qd7r; // w10r|ud=0,g=0.z
-                let k93 = A::mul_add(k91, qd7l, A::mul_add(s_q7l, k87, c_q7l * k75)); // wd10l|ud=0,g=0.x
-                let k161 = A::mul_add(k159, qd7r, A::mul_add(s_q7r, k154, c_q7r * k143)); // wd10r|ud=0,g=0.x
-                let k94 = A::mul_add(-k90, qd7l, A::mul_add(-c_q7l, k87, s_q7l * k75)); // wd10l|ud=0,g=0.y
-                let k162 = A::mul_add(
-                    -k158,
-                    qd7r,
-                    A::mul_add(-c_q7r, k154, s_q7r * k143),
-                ); // wd10r|ud=0,g=0.y
-                let k95 = p.L9 * k84; // w9lxP10l|ud=0,g=0.x
-                let k163 = p.L9 * k152; // w9rxP10r|ud=0,g=0.x
-                let k96 = p.L9 * k85; // w9lxP10l|ud=0,g=0.z
-                let k164 = p.L9 * k155; // w9rxP10r|ud=0,g=0.z
-                let k97 = A::mul_add(-k83, k96, A::mul_add(-p.L9, k87, k82)); // a10l in 9l|ud=0,g=0.x
-                let k165 = A::mul_add(-k151, k164, A::mul_add(-p.L9, k154, k150)); // a10r in 9r|ud=0,g=0.x
-                let k98 = A::mul_add(-k85, k96, A::mul_add(-k84, k95, k88)); // a10l in 9l|ud=0,g=0.y
-                let k166 = A::mul_add(-k155, k164, A::mul_add(-k152, k163, k156)); // a10r in 9r|ud=0,g=0.y
-                let k99 = A::mul_add(k83, k95, A::mul_add(p.L9, k75, k89)); // a10l in 9l|ud=0,g=0.z
-                let k167 = A::mul_add(k151, k163, A::mul_add(p.L9, k143, k157)); // a10r in 9r|ud=0,g=0.z
-                let k100 = A::mul_add(s_q7l, k99, c_q7l * k97); // a10l|ud=0,g=0.x
-                let k168 = A::mul_add(s_q7r, k167, c_q7r * k165); // a10r|ud=0,g=0.x
-                let k101 = A::mul_add(-c_q7l, k99, s_q7l * k97); // a10l|ud=0,g=0.y
-                let k169 = A::mul_add(-c_q7r, k167, s_q7r * k165); // a10r|ud=0,g=0.y
-                let d108 = A::mul_add(-p.MY10l, k92, p.MZ10l * k91); // w10lxMS10l|ud=0,g=0.x
-                let d192 = A::mul_add(-p.MY10r, k160, p.MZ10r * k159); // w10rxMS10r|ud=0,g=0.x
-                let d110 = A::mul_add(-p.MX10l, k91, p.MY10l * k90); // w10lxMS10l|ud=0,g=0.z
-                let d193 = A::mul_add(-p.MX10r, k159, p.MY10r * k158); // w10rxMS10r|ud=0,g=0.z
-                let d109 = A::mul_add(-p.MZ10l, k90, p.MX10l * k92); // w10lxMS10l|ud=0,g=0.y
-                let d194 = A::mul_add(-p.MZ10r, k158, p.MX10r * k160); // w10rxMS10r|ud=0,g=0.y
-                let d112 = A::mul_add(
-                    k92,
-                    d109,
-                    A::mul_add(
-                        -k91,
-                        d110,
-                        A::mul_add(p.MY10l, k86, A::mul_add(p.MZ10l, k94, p.m10l * k100)),
-                    ),
-                ); // F10l|ud=0,g=0.x
-                let d195 = A::mul_add(
-                    k160,
-                    d194,
-                    A::mul_add(
-                        -k159,
-                        d193,
-                        A::mul_add(
-                            p.MY10r,
-                            k153,
-                            A::mul_add(p.MZ10r, k162, p.m10r * k168),
-                        ),
-                    ),
-                ); // F10r|ud=0,g=0.x
-                let d113 = A::mul_add(
-                    k90,
-                    d110,
-                    A::mul_add(
-                        -k92,
-                        d108,
-                        A::mul_add(
-                            -p.MZ10l,
-                            k93,
-                            A::mul_add(-p.MX10l, k86, p.m10l * k101),
-                        ),
-                    ),
-                ); // F10l|ud=0,g=0.y
-                let d196 = A::mul_add(
-                    k158,
-                    d193,
-                    A::mul_add(
-                        -k160,
-                        d192,
-                        A::mul_add(
-                            -p.MZ10r,
-                            k161,
-                            A::mul_add(-p.MX10r, k153, p.m10r * k169),
-                        ),
-                    ),
-                ); // F10r|ud=0,g=0.y
-                let d111 = A::mul_add(
-                    -k91,
-                    d108,
-                    A::mul_add(
-                        k90,
-                        d109,
-                        A::mul_add(p.MX10l, k94, A::mul_add(-p.MY10l, k93, p.m10l * k98)),
-                    ),
-                ); // F10l|ud=0,g=0.z
-                let d197 = A::mul_add(
-                    -k159,
-                    d192,
-                    A::mul_add(
-                        k158,
-                        d194,
-                        A::mul_add(
-                            p.MX10r,
-                            k162,
-                            A::mul_add(-p.MY10r, k161, p.m10r * k166),
-                        ),
-                    ),
-                ); // F10r|ud=0,g=0.z
-                let d114 = A::mul_add(
-                    p.XZ10l,
-                    k92,
-                    A::mul_add(p.XY10l, k91, p.XX10l * k90),
-                ); // J10lw10l|ud=0,g=0.x
-                let d198 = A::mul_add(
-                    p.XZ10r,
-                    k160,
-                    A::mul_add(p.XY10r, k159, p.XX10r * k158),
-                ); // J10rw10r|ud=0,g=0.x
-                let d115 = A::mul_add(
-                    p.YZ10l,
-                    k92,
-                    A::mul_add(p.YY10l, k91, p.XY10l * k90),
-                ); // J10lw10l|ud=0,g=0.y
-                let d199 = A::mul_add(
-                    p.YZ10r,
-                    k160,
-                    A::mul_add(p.YY10r, k159, p.XY10r * k158),
-                ); // J10rw10r|ud=0,g=0.y
-                let d116 = A::mul_add(
-                    p.ZZ10l,
-                    k92,
-                    A::mul_add(p.YZ10l, k91, p.XZ10l * k90),
-                ); // J10lw10l|ud=0,g=0.z
-                let d200 = A::mul_add(
-                    p.ZZ10r,
-                    k160,
-                    A::mul_add(p.YZ10r, k159, p.XZ10r * k158),
-                ); // J10rw10r|ud=0,g=0.z
-                let d117 = A::mul_add(
-                    -p.MZ10l,
-                    k101,
-                    A::mul_add(
-                        -p.MY10l,
-                        k98,
-                        A::mul_add(
-                            k92,
-                            d115,
-                            A::mul_add(
-                                -k91,
-                                d116,
-                                A::mul_add(
-                                    -p.XZ10l,
-                                    k86,
-                                    A::mul_add(p.XY10l, k94, p.XX10l * k93),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l|ud=0,g=0.x
-                let d201 = A::mul_add(
-                    -p.MZ10r,
-                    k169,
-                    A::mul_add(
-                        -p.MY10r,
-                        k166,
-                        A::mul_add(
-                            k160,
-                            d199,
-                            A::mul_add(
-                                -k159,
-                                d200,
-                                A::mul_add(
-                                    -p.XZ10r,
-                                    k153,
-                                    A::mul_add(p.XY10r, k162, p.XX10r * k161),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r|ud=0,g=0.x
-                let d118 = A::mul_add(
-                    p.MX10l,
-                    k98,
-                    A::mul_add(
-                        p.MZ10l,
-                        k100,
-                        A::mul_add(
-                            k90,
-                            d116,
-                            A::mul_add(
-                                -k92,
-                                d114,
-                                A::mul_add(
-                                    -p.YZ10l,
-                                    k86,
-                                    A::mul_add(p.YY10l, k94, p.XY10l * k93),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l|ud=0,g=0.y
-                let d202 = A::mul_add(
-                    p.MX10r,
-                    k166,
-                    A::mul_add(
-                        p.MZ10r,
-                        k168,
-                        A::mul_add(
-                            k158,
-                            d200,
-                            A::mul_add(
-                                -k160,
-                                d198,
-                                A::mul_add(
-                                    -p.YZ10r,
-                                    k153,
-                                    A::mul_add(p.YY10r, k162, p.XY10r * k161),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r|ud=0,g=0.y
-                let d119 = A::mul_add(
-                    -p.MY10l,
-                    k100,
-                    A::mul_add(
-                        p.MX10l,
-                        k101,
-                        A::mul_add(
-                            k91,
-                            d114,
-                            A::mul_add(
-                                -k90,
-                                d115,
-                                A::mul_add(
-                                    -p.ZZ10l,
-                                    k86,
-                                    A::mul_add(p.YZ10l, k94, p.XZ10l * k93),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l|ud=0,g=0.z
-                m[11] = d119;
-                let d203 = A::mul_add(
-                    -p.MY10r,
-                    k168,
-                    A::mul_add(
-                        p.MX10r,
-                        k169,
-                        A::mul_add(
-                            k159,
-                            d198,
-                            A::mul_add(
-                                -k158,
-                                d199,
-                                A::mul_add(
-                                    -p.ZZ10r,
-                                    k153,
-                                    A::mul_add(p.YZ10r, k162, p.XZ10r * k161),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r|ud=0,g=0.z
-                m[18] = d203;
-                let d260 = A::mul_add(s_q7l, d113, c_q7l * d112); // f10l in 9l|ud=0,g=0.x
-                let d204 = A::mul_add(s_q7r, d196, c_q7r * d195); // f10r in 9r|ud=0,g=0.x
-                let d261 = A::mul_add(-c_q7l, d113, s_q7l * d112); // f10l in 9l|ud=0,g=0.z
-                let d205 = A::mul_add(-c_q7r, d196, s_q7r * d195); // f10r in 9r|ud=0,g=0.z
-                let d262 = d99 + d260; // f9l|ud=0,g=0.x
-                let d206 = d183 + d204; // f9r|ud=0,g=0.x
-                let d263 = d106 + d119; // n9l|ud=0,g=0.y
-                let d209 = d190 + d203; // n9r|ud=0,g=0.y
-                let d264 = A::mul_add(
-                    p.L9,
-                    d261,
-                    A::mul_add(s_q7l, d118, A::mul_add(c_q7l, d117, d105)),
-                ); // n9l|ud=0,g=0.x
-                m[10] = -d264;
-                let d210 = A::mul_add(
-                    p.L9,
-                    d205,
-                    A::mul_add(s_q7r, d202, A::mul_add(c_q7r, d201, d189)),
-                ); // n9r|ud=0,g=0.x
-                m[17] = -d210;
-                let d265 = A::mul_add(
-                    p.L9,
-                    d260,
-                    A::mul_add(c_q7l, d118, A::mul_add(-s_q7l, d117, d107)),
-                ); // n9l|ud=0,g=0.z
-                let d211 = A::mul_add(
-                    p.L9,
-                    d204,
-                    A::mul_add(c_q7r, d202, A::mul_add(-s_q7r, d201, d191)),
-                ); // n9r|ud=0,g=0.z
-                let d266 = d100 + d111; // f9l|ud=0,g=0.y
-                let d207 = d184 + d197; // f9r|ud=0,g=0.y
-                let d267 = d101 + d261; // f9l|ud=0,g=0.z
-                let d208 = d185 + d205; // f9r|ud=0,g=0.z
-                let d268 = A::mul_add(s_q6l, d267, c_q6l * d266); // f9l in 8l|ud=0,g=0.y
-                let d212 = A::mul_add(s_q6r, d208, c_q6r * d207); // f9r in 8r|ud=0,g=0.y
-                let d269 = A::mul_add(-c_q6l, d267, s_q6l * d266); // f9l in 8l|ud=0,g=0.z
-                let d213 = A::mul_add(-c_q6r, d208, s_q6r * d207); // f9r in 8r|ud=0,g=0.z
-                let d270 = d87 + d268; // f8l|ud=0,g=0.y
-                let d216 = d173 + d212; // f8r|ud=0,g=0.y
-                let d271 = d88 + d269; // f8l|ud=0,g=0.z
-                let d214 = d171 + d213; // f8r|ud=0,g=0.z
-                let d272 = d89 + d262; // f8l|ud=0,g=0.x
-                let d215 = d172 + d206; // f8r|ud=0,g=0.x
-                let d273 = d93 + d264; // n8l|ud=0,g=0.x
-                let d217 = d177 + d210; // n8r|ud=0,g=0.x
-                let d274 = A::mul_add(s_q6l, d265, A::mul_add(c_q6l, d263, d94)); // n8l|ud=0,g=0.y
-                m[9] = d274;
-                let d218 = A::mul_add(s_q6r, d211, A::mul_add(c_q6r, d209, d178)); // n8r|ud=0,g=0.y
-                m[16] = d218;
-                let d275 = A::mul_add(-c_q6l, d265, A::mul_add(s_q6l, d263, d95)); // n8l|ud=0,g=0.z
-                let d219 = A::mul_add(-c_q6r, d211, A::mul_add(s_q6r, d209, d179)); // n8r|ud=0,g=0.z
-                let d276 = A::mul_add(s_q5l, d271, c_q5l * d272); // f8l in 7l|ud=0,g=0.x
-                let d220 = A::mul_add(s_q5r, d214, c_q5r * d215); // f8r in 7r|ud=0,g=0.x
-                let d277 = A::mul_add(-c_q5l, d271, s_q5l * d272); // f8l in 7l|ud=0,g=0.z
-                let d221 = A::mul_add(-c_q5r, d214, s_q5r * d215); // f8r in 7r|ud=0,g=0.z
-                let d278 = d75 + d276; // f7l|ud=0,g=0.x
-                let d222 = d159 + d220; // f7r|ud=0,g=0.x
-                let d279 = d82 + d274; // n7l|ud=0,g=0.y
-                let d225 = d166 + d218; // n7r|ud=0,g=0.y
-                let d280 = A::mul_add(
-                    p.L8,
-                    d277,
-                    A::mul_add(-s_q5l, d275, A::mul_add(c_q5l, d273, d81)),
-                ); // n7l|ud=0,g=0.x
-                m[8] = -d280;
-                let d226 = A::mul_add(
-                    p.L8,
-                    d221,
-                    A::mul_add(-s_q5r, d219, A::mul_add(c_q5r, d217, d165)),
-                ); // n7r|ud=0,g=0.x
-                m[15] = -d226;
-                let d281 = A::mul_add(
-                    p.L8,
-                    d276,
-                    A::mul_add(-c_q5l, d275, A::mul_add(-s_q5l, d273, d83)),
-                ); // n7l|ud=0,g=0.z
-                let d227 = A::mul_add(
-                    p.L8,
-                    d220,
-                    A::mul_add(-c_q5r, d219, A::mul_add(-s_q5r, d217, d167)),
-                ); // n7r|ud=0,g=0.z
-                let d282 = d76 + d270; // f7l|ud=0,g=0.y
-                let d223 = d160 + d216; // f7r|ud=0,g=0.y
-                let d283 = d77 + d277; // f7l|ud=0,g=0.z
-                let d224 = d161 + d221; // f7r|ud=0,g=0.z
-                let d284 = A::mul_add(s_q4l, d283, c_q4l * d282); // f7l in 6l|ud=0,g=0.y
-                let d228 = A::mul_add(s_q4r, d224, c_q4r * d223); // f7r in 6r|ud=0,g=0.y
-                let d285 = A::mul_add(-c_q4l, d283, s_q4l * d282); // f7l in 6l|ud=0,g=0.z
-                let d229 = A::mul_add(-c_q4r, d224, s_q4r * d223); // f7r in 6r|ud=0,g=0.z
-                let d286 = d63 + d284; // f6l|ud=0,g=0.y
-                let d232 = d149 + d228; // f6r|ud=0,g=0.y
-                let d287 = d64 + d285; // f6l|ud=0,g=0.z
-                let d230 = d147 + d229; // f6r|ud=0,g=0.z
-                let d288 = d65 + d278; // f6l|ud=0,g=0.x
-                let d231 = d148 + d222; // f6r|ud=0,g=0.x
-                let d289 = d69 + d280; // n6l|ud=0,g=0.x
-                let d233 = d153 + d226; // n6r|ud=0,g=0.x
-                let d290 = A::mul_add(s_q4l, d281, A::mul_add(c_q4l, d279, d70)); // n6l|ud=0,g=0.y
-                m[7] = d290;
-                let d234 = A::mul_add(s_q4r, d227, A::mul_add(c_q4r, d225, d154)); // n6r|ud=0,g=0.y
-                m[14] = d234;
-                let d291 = A::mul_add(-c_q4l, d281, A::mul_add(s_q4l, d279, d71)); // n6l|ud=0,g=0.z
-                let d235 = A::mul_add(-c_q4r, d227, A::mul_add(s_q4r, d225, d155)); // n6r|ud=0,g=0.z
-                let d292 = A::mul_add(s_q3l, d287, c_q3l * d288); // f6l in 5l|ud=0,g=0.x
-                let d236 = A::mul_add(s_q3r, d230, c_q3r * d231); // f6r in 5r|ud=0,g=0.x
-                let d293 = A::mul_add(-c_q3l, d287, s_q3l * d288); // f6l in 5l|ud=0,g=0.z
-                let d237 = A::mul_add(-c_q3r, d230, s_q3r * d231); // f6r in 5r|ud=0,g=0.z
-                let d294 = d51 + d292; // f5l|ud=0,g=0.x
-                let d238 = d135 + d236; // f5r|ud=0,g=0.x
-                let d295 = d58 + d290; // n5l|ud=0,g=0.y
-                let d241 = d142 + d234; // n5r|ud=0,g=0.y
-                let d296 = A::mul_add(
-                    p.L7,
-                    d293,
-                    A::mul_add(-s_q3l, d291, A::mul_add(c_q3l, d289, d57)),
-                ); // n5l|ud=0,g=0.x
-                m[6] = -d296;
-                let d242 = A::mul_add(
-                    p.L7,
-                    d237,
-                    A::mul_add(-s_q3r, d235, A::mul_add(c_q3r, d233, d141)),
-                ); // n5r|ud=0,g=0.x
-                m[13] = -d242;
-                let d297 = A::mul_add(
-                    p.L7,
-                    d292,
-                    A::mul_add(-c_q3l, d291, A::mul_add(-s_q3l, d289, d59)),
-                ); // n5l|ud=0,g=0.z
-                let d243 = A::mul_add(
-                    p.L7,
-                    d236,
-                    A::mul_add(-c_q3r, d235, A::mul_add(-s_q3r, d233, d143)),
-                ); // n5r|ud=0,g=0.z
-                let d298 = d52 + d286; // f5l|ud=0,g=0.y
-                let d239 = d136 + d232; // f5r|ud=0,g=0.y
-                let d299 = d53 + d293; // f5l|ud=0,g=0.z
-                let d240 = d137 + d237; // f5r|ud=0,g=0.z
-                let d300 = A::mul_add(s_q2l, d299, c_q2l * d298); // f5l in 4l|ud=0,g=0.y
-                let d244 = A::mul_add(s_q2r, d240, c_q2r * d239); // f5r in 4r|ud=0,g=0.y
-                let d301 = A::mul_add(-c_q2l, d299, s_q2l * d298); // f5l in 4l|ud=0,g=0.z
-                let d245 = A::mul_add(-c_q2r, d240, s_q2r * d239); // f5r in 4r|ud=0,g=0.z
-                let d302 = d39 + d300; // f4l|ud=0,g=0.y
-                let d248 = d125 + d244; // f4r|ud=0,g=0.y
-                let d254 = d27 - d248; // f3|ud=0,g=0.x
-                let d303 = d40 + d301; // f4l|ud=0,g=0.z
-                let d246 = d123 + d245; // f4r|ud=0,g=0.z
-                let d304 = d41 + d294; // f4l|ud=0,g=0.x
-                let d247 = d124 + d238; // f4r|ud=0,g=0.x
-                let d305 = d45 + d296; // n4l|ud=0,g=0.x
-                let d249 = d129 + d242; // n4r|ud=0,g=0.x
-                let d306 = A::mul_add(s_q2l, d297, A::mul_add(c_q2l, d295, d46)); // n4l|ud=0,g=0.y
-                m[5] = d306;
-                let d250 = A::mul_add(s_q2r, d243, A::mul_add(c_q2r, d241, d130)); // n4r|ud=0,g=0.y
-                m[12] = d250;
-                let d307 = A::mul_add(-c_q2l, d297, A::mul_add(s_q2l, d295, d47)); // n4l|ud=0,g=0.z
-                let d251 = A::mul_add(-c_q2r, d243, A::mul_add(s_q2r, d241, d131)); // n4r|ud=0,g=0.z
-                let d308 = A::mul_add(-c_q1l, d303, s_q1l * d304); // f4l in 3|ud=0,g=0.z
-                let d253 = A::mul_add(-c_q1r, d246, s_q1r * d247); // f4r in 3|ud=0,g=0.z
-                let d255 = A::mul_add(-p.L5, d253, d33 + d250); // n3|ud=0,g=0.x
-                let d256 = A::mul_add(
-                    -p.L6,
-                    d253,
-                    A::mul_add(s_q1r, d251, A::mul_add(-c_q1r, d249, d34)),
-                ); // n3|ud=0,g=0.y
-                let d259 = d29 + d253; // f3|ud=0,g=0.z
-                let d309 = A::mul_add(s_q1l, d303, c_q1l * d304); // f4l in 3|ud=0,g=0.y
-                let d252 = A::mul_add(s_q1r, d246, c_q1r * d247); // f4r in 3|ud=0,g=0.y
-                let d257 = A::mul_add(
-                    p.L5,
-                    d248,
-                    A::mul_add(
-                        p.L6,
-                        d252,
-                        A::mul_add(-c_q1r, d251, A::mul_add(-s_q1r, d249, d35)),
-                    ),
-                ); // n3|ud=0,g=0.z
-                let d258 = d28 + d252; // f3|ud=0,g=0.y
-                let d310 = d254 + d302; // f3|ud=0,g=0.x
-                let d311 = A::mul_add(p.L5, d308, d255 - d306); // n3|ud=0,g=0.x
-                let d312 = A::mul_add(
-                    -p.L6,
-                    d308,
-                    A::mul_add(s_q1l, d307, A::mul_add(-c_q1l, d305, d256)),
-                ); // n3|ud=0,g=0.y
-                m[4] = -d312;
-                let d313 = A::mul_add(
-                    -p.L5,
-                    d302,
-                    A::mul_add(
-                        -p.L6,
-                        d309,
-                        A::mul_add(c_q1l, d307, A::mul_add(s_q1l, d305, d257)),
-                    ),
-                ); // n3|ud=0,g=0.z
-                let d314 = d258 + d309; // f3|ud=0,g=0.y
-                let d315 = d259 - d308; // f3|ud=0,g=0.z
-                let d316 = A::mul_add(s_q_torso, d315, c_q_torso * d310); // f3 in 2|ud=0,g=0.x
-                let d317 = A::mul_add(-c_q_torso, d315, s_q_torso * d310); // f3 in 2|ud=0,g=0.z
-                let d318 = d15 + d316; // f2|ud=0,g=0.x
-                let d319 = d16 + d314; // f2|ud=0,g=0.y
-                let d320 = d17 + d317; // f2|ud=0,g=0.z
-                let d321 = A::mul_add(
-                    -p.L4,
-                    d314,
-                    A::mul_add(
-                        p.L3,
-                        d317,
-                        A::mul_add(-s_q_torso, d313, A::mul_add(c_q_torso, d311, d21)),
-                    ),
-                ); // n2|ud=0,g=0.x
-                m[3] = d321;
-                let d322 = A::mul_add(p.L4, d316, d22 - d312); // n2|ud=0,g=0.y
-                let d323 = A::mul_add(
-                    -p.L3,
-                    d316,
-                    A::mul_add(c_q_torso, d313, A::mul_add(s_q_torso, d311, d23)),
-                ); // n2|ud=0,g=0.z
-                let d324 = A::mul_add(-c_q_w, d320, s_q_w * d319); // f2 in 1|ud=0,g=0.z
-                let d325 = A::mul_add(s_q_w, d320, c_q_w * d319); // f2 in 1|ud=0,g=0.y
-                let d326 = d4 - d325; // f1|ud=0,g=0.y
-                let d327 = d5 + d324; // f1|ud=0,g=0.z
-                let d328 = A::mul_add(p.L2, d325, A::mul_add(-p.L1, d324, d9 + d321)); // n1|ud=0,g=0.x
-                m[2] = d328;
-                let d329 = A::mul_add(
-                    -p.L2,
-                    d318,
-                    A::mul_add(s_q_w, d323, A::mul_add(c_q_w, d322, d10)),
-                ); // n1|ud=0,g=0.y
-                let d330 = A::mul_add(
-                    -p.L1,
-                    d318,
-                    A::mul_add(c_q_w, d323, A::mul_add(-s_q_w, d322, d11)),
-                ); // n1|ud=0,g=0.z
-                let d331 = A::mul_add(-c_q_imu, d327, s_q_imu * d326); // f1 in 0|ud=0,g=0.x
-                m[0] = d331;
-                let d332 = A::mul_add(s_q_imu, d330, c_q_imu * d329); // n0|ud=0,g=0.z
-                m[1] = -d332;
-            }
+            coriolis_batch_body::<A, _, L>(p, pc, &q, &u, out);
         }
         kanegen_runtime::isa::dispatch_fused_wide_with(
             out,
@@ -14834,2262 +13112,14 @@ mod generated {
         #[inline(always)]
         fn body<A: kanegen_runtime::isa::Arith<f64>, const L: usize>(
             p: &Params,
-            _pc: &Precomputed,
+            pc: &Precomputed,
             q: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
             u: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
             out: &mut SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
         ) {
-            let p = &{ *p };
-            let q = &{ *q };
-            let u = &{ *u };
-            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
-                A,
-                _,
-                L,
-            >([
-                q[2].0,
-                q[3].0,
-                q[4].0,
-                q[5].0,
-                q[12].0,
-                q[6].0,
-                q[13].0,
-                q[7].0,
-                q[14].0,
-                q[8].0,
-                q[15].0,
-                q[9].0,
-                q[16].0,
-                q[10].0,
-                q[17].0,
-                q[11].0,
-                q[18].0,
-            ]);
-            for l in 0..L {
-                let s_q_imu = sin_q[0][l];
-                let c_q_imu = cos_q[0][l];
-                let s_q_w = sin_q[1][l];
-                let c_q_w = cos_q[1][l];
-                let s_q_torso = sin_q[2][l];
-                let c_q_torso = cos_q[2][l];
-                let s_q1l = sin_q[3][l];
-                let c_q1l = cos_q[3][l];
-                let s_q1r = sin_q[4][l];
-                let c_q1r = cos_q[4][l];
-                let s_q2l = sin_q[5][l];
-                let c_q2l = cos_q[5][l];
-                let s_q2r = sin_q[6][l];
-                let c_q2r = cos_q[6][l];
-                let s_q3l = sin_q[7][l];
-                let c_q3l = cos_q[7][l];
-                let s_q3r = sin_q[8][l];
-                let c_q3r = cos_q[8][l];
-                let s_q4l = sin_q[9][l];
-                let c_q4l = cos_q[9][l];
-                let s_q4r = sin_q[10][l];
-                let c_q4r = cos_q[10][l];
-                let s_q5l = sin_q[11][l];
-                let c_q5l = cos_q[11][l];
-                let s_q5r = sin_q[12][l];
-                let c_q5r = cos_q[12][l];
-                let s_q6l = sin_q[13][l];
-                let c_q6l = cos_q[13][l];
-                let s_q6r = sin_q[14][l];
-                let c_q6r = cos_q[14][l];
-                let s_q7l = sin_q[15][l];
-                let c_q7l = cos_q[15][l];
-                let s_q7r = sin_q[16][l];
-                let c_q7r = cos_q[16][l];
-                let xd = u[0].0[l];
-                let psid = u[1].0[l];
-                let qd_imu = u[2].0[l];
-                let qd_w = u[3].0[l];
-                let qd_torso = u[4].0[l];
-                let qd1l = u[5].0[l];
-                let qd2l = u[6].0[l];
-                let qd3l = u[7].0[l];
-                let qd4l = u[8].0[l];
-                let qd5l = u[9].0[l];
-                let qd6l = u[10].0[l];
-                let qd7l = u[11].0[l];
-                let qd1r = u[12].0[l];
-                let qd2r = u[13].0[l];
-                let qd3r = u[14].0[l];
-                let qd4r = u[15].0[l];
-                let qd5r = u[16].0[l];
-                let qd6r = u[17].0[l];
-                let qd7r = u[18].0[l];
-                let k1 = xd * psid; // a0|ud=0,g=0.y
-                let k2 = c_q_imu * psid; // w0 in 1|ud=0,g=0.y
-                let k3 = s_q_imu * psid; // w0 in 1|ud=0,g=0.z
-                let k4 = k3 * qd_imu; // wd1|ud=0,g=0.y
-                let k5 = k2 * qd_imu; // wd1|ud=0,g=0.z
-                let d1 = A::mul_add(-p.MY1, k3, p.MZ1 * k2); // w1xMS1|ud=0,g=0.x
-                let d2 = A::mul_add(p.MZ1, qd_imu, p.MX1 * k3); // w1xMS1|ud=0,g=0.y
-                let d3 = A::mul_add(p.MX1, k2, p.MY1 * qd_imu); // w1xMS1|ud=0,g=0.z
-                let d4 = A::mul_add(-qd_imu, d3, A::mul_add(k3, d1, p.MX1 * k5)); // F1|ud=0,g=0.y
-                let d5 = A::mul_add(-k2, d1, A::mul_add(-qd_imu, d2, p.MX1 * k4)); // F1|ud=0,g=0.z
-                let d6 = A::mul_add(-p.XZ1, k3, A::mul_add(-p.XY1, k2, p.XX1 * qd_imu)); // J1w1|ud=0,g=0.x
-                let d7 = A::mul_add(-p.YZ1, k3, A::mul_add(-p.YY1, k2, p.XY1 * qd_imu)); // J1w1|ud=0,g=0.y
-                let d8 = A::mul_add(-p.ZZ1, k3, A::mul_add(-p.YZ1, k2, p.XZ1 * qd_imu)); // J1w1|ud=0,g=0.z
-                let d9 = A::mul_add(
-                    -k3,
-                    d7,
-                    A::mul_add(k2, d8, A::mul_add(-p.XZ1, k5, p.XY1 * k4)),
-                ); // N1|ud=0,g=0.x
-                let d10 = A::mul_add(
-                    p.MZ1,
-                    k1,
-                    A::mul_add(
-                        qd_imu,
-                        d8,
-                        A::mul_add(k3, d6, A::mul_add(-p.YZ1, k5, p.YY1 * k4)),
-                    ),
-                ); // N1|ud=0,g=0.y
-                let d11 = A::mul_add(
-                    -p.MY1,
-                    k1,
-                    A::mul_add(
-                        -k2,
-                        d6,
-                        A::mul_add(-qd_imu, d7, A::mul_add(-p.ZZ1, k5, p.YZ1 * k4)),
-                    ),
-                ); // N1|ud=0,g=0.z
-                let k6 = A::mul_add(-s_q_w, k3, c_q_w * k2); // w1 in 2|ud=0,g=0.y
-                let k7 = A::mul_add(c_q_w, k3, s_q_w * k2); // w1 in 2|ud=0,g=0.z
-                let k8 = qd_imu + qd_w; // w2|ud=0,g=0.x
-                let k9 = A::mul_add(k7, qd_w, A::mul_add(s_q_w, k5, c_q_w * k4)); // wd2|ud=0,g=0.y
-                let k10 = A::mul_add(-k6, qd_w, A::mul_add(-c_q_w, k5, s_q_w * k4)); // wd2|ud=0,g=0.z
-                let k11 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-                let k12 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-                let k13 = A::mul_add(p.L1, k3, p.L2 * k2); // w1xP2|ud=0,g=0.x
-                let k14 = A::mul_add(k2, k13, qd_imu * k11); // a2 in 1|ud=0,g=0.z
-                let k15 = A::mul_add(
-                    -k3,
-                    k11,
-                    A::mul_add(k2, k12, A::mul_add(p.L1, k5, A::mul_add(-p.L2, k4, k1))),
-                ); // a2 in 1|ud=0,g=0.x
-                let k16 = A::mul_add(qd_imu, k12, k3 * k13); // a2 in 1|ud=0,g=0.y
-                let k17 = A::mul_add(s_q_w, k14, c_q_w * k16); // a2|ud=0,g=0.y
-                let k18 = A::mul_add(-c_q_w, k14, s_q_w * k16); // a2|ud=0,g=0.z
-                let d12 = A::mul_add(-p.MY2, k7, p.MZ2 * k6); // w2xMS2|ud=0,g=0.x
-                let d13 = A::mul_add(p.MZ2, k8, p.MX2 * k7); // w2xMS2|ud=0,g=0.y
-                let d14 = A::mul_add(p.MX2, k6, p.MY2 * k8); // w2xMS2|ud=0,g=0.z
-                let d15 = A::mul_add(
-                    k7,
-                    d13,
-                    A::mul_add(
-                        k6,
-                        d14,
-                        A::mul_add(-p.MY2, k10, A::mul_add(p.MZ2, k9, p.m2 * k15)),
-                    ),
-                ); // F2|ud=0,g=0.x
-                let d16 = A::mul_add(
-                    k8,
-                    d14,
-                    A::mul_add(-k7, d12, A::mul_add(p.MX2, k10, p.m2 * k17)),
-                ); // F2|ud=0,g=0.y
-                let d17 = A::mul_add(
-                    k6,
-                    d12,
-                    A::mul_add(k8, d13, A::mul_add(-p.MX2, k9, p.m2 * k18)),
-                ); // F2|ud=0,g=0.z
-                let d18 = A::mul_add(-p.XZ2, k7, A::mul_add(-p.XY2, k6, p.XX2 * k8)); // J2w2|ud=0,g=0.x
-                let d19 = A::mul_add(-p.YZ2, k7, A::mul_add(-p.YY2, k6, p.XY2 * k8)); // J2w2|ud=0,g=0.y
-                let d20 = A::mul_add(-p.ZZ2, k7, A::mul_add(-p.YZ2, k6, p.XZ2 * k8)); // J2w2|ud=0,g=0.z
-                let d21 = A::mul_add(
-                    -p.MZ2,
-                    k17,
-                    A::mul_add(
-                        p.MY2,
-                        k18,
-                        A::mul_add(
-                            -k7,
-                            d19,
-                            A::mul_add(k6, d20, A::mul_add(p.XZ2, k10, p.XY2 * k9)),
-                        ),
-                    ),
-                ); // N2|ud=0,g=0.x
-                let d22 = A::mul_add(
-                    -p.MX2,
-                    k18,
-                    A::mul_add(
-                        p.MZ2,
-                        k15,
-                        A::mul_add(
-                            k8,
-                            d20,
-                            A::mul_add(k7, d18, A::mul_add(p.YZ2, k10, p.YY2 * k9)),
-                        ),
-                    ),
-                ); // N2|ud=0,g=0.y
-                let d23 = A::mul_add(
-                    -p.MY2,
-                    k15,
-                    A::mul_add(
-                        p.MX2,
-                        k17,
-                        A::mul_add(
-                            -k6,
-                            d18,
-                            A::mul_add(-k8, d19, A::mul_add(p.ZZ2, k10, p.YZ2 * k9)),
-                        ),
-                    ),
-                ); // N2|ud=0,g=0.z
-                let k19 = A::mul_add(-s_q_torso, k7, c_q_torso * k8); // w2 in 3|ud=0,g=0.x
-                let k20 = A::mul_add(c_q_torso, k7, s_q_torso * k8); // w2 in 3|ud=0,g=0.z
-                let k21 = k6 - qd_torso; // w3|ud=0,g=0.y
-                let k22 = A::mul_add(-k20, qd_torso, s_q_torso * k10); // wd3|ud=0,g=0.x
-                let k23 = A::mul_add(-k19, qd_torso, c_q_torso * k10); // wd3|ud=0,g=0.z
-                let k24 = A::mul_add(-p.L3, k7, p.L4 * k6); // w2xP3|ud=0,g=0.x
-                let k25 = p.L4 * k8; // w2xP3|ud=0,g=0.y
-                let k26 = p.L3 * k8; // w2xP3|ud=0,g=0.z
-                let k27 = A::mul_add(
-                    k7,
-                    k25,
-                    A::mul_add(
-                        k6,
-                        k26,
-                        A::mul_add(-p.L3, k10, A::mul_add(p.L4, k9, k15)),
-                    ),
-                ); // a3 in 2|ud=0,g=0.x
-                let k28 = A::mul_add(k8, k26, A::mul_add(-k7, k24, k17)); // a3 in 2|ud=0,g=0.y
-                let k29 = A::mul_add(k6, k24, A::mul_add(k8, k25, k18)); // a3 in 2|ud=0,g=0.z
-                let k30 = A::mul_add(s_q_torso, k29, c_q_torso * k27); // a3|ud=0,g=0.x
-                let k31 = A::mul_add(-c_q_torso, k29, s_q_torso * k27); // a3|ud=0,g=0.z
-                let d24 = A::mul_add(p.MY3, k20, p.MZ3 * k21); // w3xMS3|ud=0,g=0.x
-                let d25 = A::mul_add(-p.MX3, k21, p.MY3 * k19); // w3xMS3|ud=0,g=0.z
-                let d26 = A::mul_add(p.MZ3, k19, p.MX3 * k20); // w3xMS3|ud=0,g=0.y
-                let d27 = A::mul_add(
-                    -k20,
-                    d26,
-                    A::mul_add(
-                        k21,
-                        d25,
-                        A::mul_add(-p.MY3, k23, A::mul_add(-p.MZ3, k9, p.m3 * k30)),
-                    ),
-                ); // F3|ud=0,g=0.x
-                let d28 = A::mul_add(
-                    k19,
-                    d25,
-                    A::mul_add(
-                        k20,
-                        d24,
-                        A::mul_add(p.MZ3, k22, A::mul_add(-p.MX3, k23, p.m3 * k28)),
-                    ),
-                ); // F3|ud=0,g=0.y
-                let d29 = A::mul_add(
-                    k21,
-                    d24,
-                    A::mul_add(
-                        k19,
-                        d26,
-                        A::mul_add(-p.MX3, k9, A::mul_add(-p.MY3, k22, p.m3 * k31)),
-                    ),
-                ); // F3|ud=0,g=0.z
-                let d30 = A::mul_add(-p.XZ3, k20, A::mul_add(p.XY3, k21, p.XX3 * k19)); // J3w3|ud=0,g=0.x
-                let d31 = A::mul_add(-p.YZ3, k20, A::mul_add(p.YY3, k21, p.XY3 * k19)); // J3w3|ud=0,g=0.y
-                let d32 = A::mul_add(-p.ZZ3, k20, A::mul_add(p.YZ3, k21, p.XZ3 * k19)); // J3w3|ud=0,g=0.z
-                let d33 = A::mul_add(
-                    p.MZ3,
-                    k28,
-                    A::mul_add(
-                        -p.MY3,
-                        k31,
-                        A::mul_add(
-                            k20,
-                            d31,
-                            A::mul_add(
-                                k21,
-                                d32,
-                                A::mul_add(p.XZ3, k23, A::mul_add(-p.XY3, k9, p.XX3 * k22)),
-                            ),
-                        ),
-                    ),
-                ); // N3|ud=0,g=0.x
-                let d34 = A::mul_add(
-                    p.MX3,
-                    k31,
-                    A::mul_add(
-                        p.MZ3,
-                        k30,
-                        A::mul_add(
-                            -k19,
-                            d32,
-                            A::mul_add(
-                                -k20,
-                                d30,
-                                A::mul_add(p.YZ3, k23, A::mul_add(-p.YY3, k9, p.XY3 * k22)),
-                            ),
-                        ),
-                    ),
-                ); // N3|ud=0,g=0.y
-                let d35 = A::mul_add(
-                    -p.MY3,
-                    k30,
-                    A::mul_add(
-                        -p.MX3,
-                        k28,
-                        A::mul_add(
-                            -k21,
-                            d30,
-                            A::mul_add(
-                                k19,
-                                d31,
-                                A::mul_add(p.ZZ3, k23, A::mul_add(-p.YZ3, k9, p.XZ3 * k22)),
-                            ),
-                        ),
-                    ),
-                ); // N3|ud=0,g=0.z
-                let k32 = A::mul_add(s_q1l, k20, c_q1l * k21); // w3 in 4l|ud=0,g=0.x
-                let k33 = A::mul_add(-c_q1l, k20, s_q1l * k21); // w3 in 4l|ud=0,g=0.z
-                let k34 = k19 - qd1l; // w4l|ud=0,g=0.y
-                let k35 = A::mul_add(-k32, qd1l, A::mul_add(-c_q1l, k23, s_q1l * k9)); // wd4l|ud=0,g=0.z
-                let k36 = A::mul_add(k33, qd1l, A::mul_add(s_q1l, k23, c_q1l * k9)); // wd4l|ud=0,g=0.x
-                let k37 = p.L5 * k20; // w3xP4l|ud=0,g=0.x
-                let k38 = p.L6 * k20; // w3xP4l|ud=0,g=0.y
-                let t1 = p.L5 * k19; // common subexpression
-                let t2 = p.L6 * k21; // common subexpression
-                let k39 = t1 - t2; // w3xP4l|ud=0,g=0.z
-                let t3 = p.L5 * k23; // common subexpression
-                let t4 = p.L6 * k23; // common subexpression
-                let t5 = p.L5 * k22; // common subexpression
-                let t6 = p.L6 * k9; // common subexpression
-                let t7 = k20 * k38; // common subexpression
-                let t8 = k20 * k37; // common subexpression
-                let t9 = k19 * k38; // common subexpression
-                let t10 = k21 * k37; // common subexpression
-                let k40 = A::mul_add(k21, k39, k30 - t3) - t7; // a4l in 3|ud=0,g=0.x
-                let k41 = A::mul_add(k19, k39, k28 - t4 + t8); // a4l in 3|ud=0,g=0.y
-                let k42 = k31 - t5 - t6 + t9 + t10; // a4l in 3|ud=0,g=0.z
-                let k43 = A::mul_add(c_q1l, k42, s_q1l * k41); // a4l|ud=0,g=0.z
-                let k44 = A::mul_add(-s_q1l, k42, c_q1l * k41); // a4l|ud=0,g=0.x
-                let k50 = A::mul_add(s_q2l, k43, c_q2l * k40); // a5l|ud=0,g=0.y
-                let k51 = A::mul_add(-c_q2l, k43, s_q2l * k40); // a5l|ud=0,g=0.z
-                let k102 = A::mul_add(-s_q1r, k20, c_q1r * k21); // w3 in 4r|ud=0,g=0.x
-                let k103 = A::mul_add(c_q1r, k20, s_q1r * k21); // w3 in 4r|ud=0,g=0.z
-                let k104 = A::mul_add(-k102, qd1r, A::mul_add(c_q1r, k23, s_q1r * k9)); // wd4r|ud=0,g=0.z
-                let k105 = -k19 - qd1r; // w4r|ud=0,g=0.y
-                let k106 = A::mul_add(k103, qd1r, A::mul_add(-s_q1r, k23, c_q1r * k9)); // wd4r|ud=0,g=0.x
-                let k107 = t1 + t2; // w3xP4r|ud=0,g=0.z
-                let k108 = A::mul_add(k21, k107, k30 - t3 + t7); // a4r in 3|ud=0,g=0.x
-                let k109 = A::mul_add(k19, k107, k28 + t4 + t8); // a4r in 3|ud=0,g=0.y
-                let k110 = k31 - t5 + t6 - t9 + t10; // a4r in 3|ud=0,g=0.z
-                let k111 = A::mul_add(-c_q1r, k110, s_q1r * k109); // a4r|ud=0,g=0.z
-                let k112 = A::mul_add(s_q1r, k110, c_q1r * k109); // a4r|ud=0,g=0.x
-                let d37 = A::mul_add(-p.MX4l, k34, p.MY4l * k32); // w4lxMS4l|ud=0,g=0.z
-                let d120 = A::mul_add(-p.MX4r, k105, p.MY4r * k102); // w4rxMS4r|ud=0,g=0.z
-                let d36 = A::mul_add(p.MY4l, k33, p.MZ4l * k34); // w4lxMS4l|ud=0,g=0.x
-                let d121 = A::mul_add(p.MY4r, k103, p.MZ4r * k105); // w4rxMS4r|ud=0,g=0.x
-                let d39 = A::mul_add(
-                    -k32,
-                    d37,
-                    A::mul_add(
-                        -k33,
-                        d36,
-                        A::mul_add(p.MZ4l, k36, A::mul_add(p.MX4l, k35, p.m4l * k40)),
-                    ),
-                ); // F4l|ud=0,g=0.y
-                let d38 = A::mul_add(p.MZ4l, k32, p.MX4l * k33); // w4lxMS4l|ud=0,g=0.y
-                let d122 = A::mul_add(p.MZ4r, k102, p.MX4r * k103); // w4rxMS4r|ud=0,g=0.y
-                let d40 = A::mul_add(
-                    -k34,
-                    d36,
-                    A::mul_add(
-                        -k32,
-                        d38,
-                        A::mul_add(-p.MX4l, k22, A::mul_add(-p.MY4l, k36, p.m4l * k43)),
-                    ),
-                ); // F4l|ud=0,g=0.z
-                let d41 = A::mul_add(
-                    k33,
-                    d38,
-                    A::mul_add(
-                        -k34,
-                        d37,
-                        A::mul_add(p.MY4l, k35, A::mul_add(-p.MZ4l, k22, p.m4l * k44)),
-                    ),
-                ); // F4l|ud=0,g=0.x
-                let d123 = A::mul_add(
-                    -k105,
-                    d121,
-                    A::mul_add(
-                        -k102,
-                        d122,
-                        A::mul_add(p.MX4r, k22, A::mul_add(-p.MY4r, k106, p.m4r * k111)),
-                    ),
-                ); // F4r|ud=0,g=0.z
-                let d124 = A::mul_add(
-                    k103,
-                    d122,
-                    A::mul_add(
-                        -k105,
-                        d120,
-                        A::mul_add(p.MY4r, k104, A::mul_add(p.MZ4r, k22, p.m4r * k112)),
-                    ),
-                ); // F4r|ud=0,g=0.x
-                let d125 = A::mul_add(
-                    -k102,
-                    d120,
-                    A::mul_add(
-                        -k103,
-                        d121,
-                        A::mul_add(p.MZ4r, k106, A::mul_add(-p.m4r, k108, p.MX4r * k104)),
-                    ),
-                ); // F4r|ud=0,g=0.y
-                let d42 = A::mul_add(
-                    -p.XZ4l,
-                    k33,
-                    A::mul_add(p.XY4l, k34, p.XX4l * k32),
-                ); // J4lw4l|ud=0,g=0.x
-                let d126 = A::mul_add(
-                    -p.XZ4r,
-                    k103,
-                    A::mul_add(p.XY4r, k105, p.XX4r * k102),
-                ); // J4rw4r|ud=0,g=0.x
-                let d43 = A::mul_add(
-                    -p.YZ4l,
-                    k33,
-                    A::mul_add(p.YY4l, k34, p.XY4l * k32),
-                ); // J4lw4l|ud=0,g=0.y
-                let d127 = A::mul_add(
-                    -p.YZ4r,
-                    k103,
-                    A::mul_add(p.YY4r, k105, p.XY4r * k102),
-                ); // J4rw4r|ud=0,g=0.y
-                let d47 = A::mul_add(
-                    -p.MY4l,
-                    k44,
-                    A::mul_add(
-                        -p.MX4l,
-                        k40,
-                        A::mul_add(
-                            k34,
-                            d42,
-                            A::mul_add(
-                                -k32,
-                                d43,
-                                A::mul_add(
-                                    -p.ZZ4l,
-                                    k35,
-                                    A::mul_add(-p.YZ4l, k22, p.XZ4l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4l|ud=0,g=0.z
-                let d44 = A::mul_add(
-                    -p.ZZ4l,
-                    k33,
-                    A::mul_add(p.YZ4l, k34, p.XZ4l * k32),
-                ); // J4lw4l|ud=0,g=0.z
-                let d128 = A::mul_add(
-                    -p.ZZ4r,
-                    k103,
-                    A::mul_add(p.YZ4r, k105, p.XZ4r * k102),
-                ); // J4rw4r|ud=0,g=0.z
-                let d45 = A::mul_add(
-                    p.MZ4l,
-                    k40,
-                    A::mul_add(
-                        -p.MY4l,
-                        k43,
-                        A::mul_add(
-                            -k33,
-                            d43,
-                            A::mul_add(
-                                -k34,
-                                d44,
-                                A::mul_add(
-                                    -p.XZ4l,
-                                    k35,
-                                    A::mul_add(-p.XY4l, k22, p.XX4l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4l|ud=0,g=0.x
-                let d46 = A::mul_add(
-                    p.MX4l,
-                    k43,
-                    A::mul_add(
-                        p.MZ4l,
-                        k44,
-                        A::mul_add(
-                            k32,
-                            d44,
-                            A::mul_add(
-                                k33,
-                                d42,
-                                A::mul_add(
-                                    -p.YZ4l,
-                                    k35,
-                                    A::mul_add(-p.YY4l, k22, p.XY4l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4l|ud=0,g=0.y
-                let d129 = A::mul_add(
-                    -p.MZ4r,
-                    k108,
-                    A::mul_add(
-                        -p.MY4r,
-                        k111,
-                        A::mul_add(
-                            -k103,
-                            d127,
-                            A::mul_add(
-                                -k105,
-                                d128,
-                                A::mul_add(
-                                    -p.XZ4r,
-                                    k104,
-                                    A::mul_add(p.XY4r, k22, p.XX4r * k106),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4r|ud=0,g=0.x
-                let d130 = A::mul_add(
-                    p.MX4r,
-                    k111,
-                    A::mul_add(
-                        p.MZ4r,
-                        k112,
-                        A::mul_add(
-                            k102,
-                            d128,
-                            A::mul_add(
-                                k103,
-                                d126,
-                                A::mul_add(
-                                    -p.YZ4r,
-                                    k104,
-                                    A::mul_add(p.YY4r, k22, p.XY4r * k106),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4r|ud=0,g=0.y
-                let d131 = A::mul_add(
-                    -p.MY4r,
-                    k112,
-                    A::mul_add(
-                        p.MX4r,
-                        k108,
-                        A::mul_add(
-                            k105,
-                            d126,
-                            A::mul_add(
-                                -k102,
-                                d127,
-                                A::mul_add(
-                                    -p.ZZ4r,
-                                    k104,
-                                    A::mul_add(p.YZ4r, k22, p.XZ4r * k106),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N4r|ud=0,g=0.z
-                let k45 = A::mul_add(-s_q2l, k33, c_q2l * k34); // w4l in 5l|ud=0,g=0.y
-                let k113 = A::mul_add(-s_q2r, k103, c_q2r * k105); // w4r in 5r|ud=0,g=0.y
-                let k49 = A::mul_add(k45, qd2l, A::mul_add(-c_q2l, k35, s_q2l * k22)); // wd5l|ud=0,g=0.z
-                let k46 = A::mul_add(c_q2l, k33, s_q2l * k34); // w4l in 5l|ud=0,g=0.z
-                let k114 = A::mul_add(c_q2r, k103, s_q2r * k105); // w4r in 5r|ud=0,g=0.z
-                let k48 = A::mul_add(-k46, qd2l, A::mul_add(s_q2l, k35, c_q2l * k22)); // wd5l|ud=0,g=0.y
-                let k115 = A::mul_add(
-                    -k114,
-                    qd2r,
-                    A::mul_add(-c_q2r, k22, s_q2r * k104),
-                ); // wd5r|ud=0,g=0.y
-                let k116 = A::mul_add(
-                    -c_q2r,
-                    k104,
-                    A::mul_add(-s_q2r, k22, k113 * qd2r),
-                ); // wd5r|ud=0,g=0.z
-                let k47 = k32 + qd2l; // w5l|ud=0,g=0.x
-                let k117 = k102 + qd2r; // w5r|ud=0,g=0.x
-                let k118 = A::mul_add(-c_q2r, k108, s_q2r * k111); // a5r|ud=0,g=0.y
-                let k119 = A::mul_add(-c_q2r, k111, -s_q2r * k108); // a5r|ud=0,g=0.z
-                let d48 = A::mul_add(-p.MY5l, k46, p.MZ5l * k45); // w5lxMS5l|ud=0,g=0.x
-                let d132 = A::mul_add(-p.MY5r, k114, p.MZ5r * k113); // w5rxMS5r|ud=0,g=0.x
-                let d49 = A::mul_add(-p.MZ5l, k47, p.MX5l * k46); // w5lxMS5l|ud=0,g=0.y
-                let d133 = A::mul_add(-p.MZ5r, k117, p.MX5r * k114); // w5rxMS5r|ud=0,g=0.y
-                let d50 = A::mul_add(-p.MX5l, k45, p.MY5l * k47); // w5lxMS5l|ud=0,g=0.z
-                let d134 = A::mul_add(-p.MX5r, k113, p.MY5r * k117); // w5rxMS5r|ud=0,g=0.z
-                let d51 = A::mul_add(
-                    -k46,
-                    d49,
-                    A::mul_add(
-                        k45,
-                        d50,
-                        A::mul_add(p.MY5l, k49, A::mul_add(-p.MZ5l, k48, p.m5l * k44)),
-                    ),
-                ); // F5l|ud=0,g=0.x
-                let d135 = A::mul_add(
-                    -k114,
-                    d133,
-                    A::mul_add(
-                        k113,
-                        d134,
-                        A::mul_add(p.MY5r, k116, A::mul_add(-p.MZ5r, k115, p.m5r * k112)),
-                    ),
-                ); // F5r|ud=0,g=0.x
-                let d52 = A::mul_add(
-                    k47,
-                    d50,
-                    A::mul_add(
-                        -k46,
-                        d48,
-                        A::mul_add(p.MZ5l, k36, A::mul_add(p.MX5l, k49, p.m5l * k50)),
-                    ),
-                ); // F5l|ud=0,g=0.y
-                let d136 = A::mul_add(
-                    k117,
-                    d134,
-                    A::mul_add(
-                        -k114,
-                        d132,
-                        A::mul_add(p.MZ5r, k106, A::mul_add(p.MX5r, k116, p.m5r * k118)),
-                    ),
-                ); // F5r|ud=0,g=0.y
-                let d53 = A::mul_add(
-                    k45,
-                    d48,
-                    A::mul_add(
-                        -k47,
-                        d49,
-                        A::mul_add(-p.MX5l, k48, A::mul_add(-p.MY5l, k36, p.m5l * k51)),
-                    ),
-                ); // F5l|ud=0,g=0.z
-                let d137 = A::mul_add(
-                    k113,
-                    d132,
-                    A::mul_add(
-                        -k117,
-                        d133,
-                        A::mul_add(
-                            -p.MX5r,
-                            k115,
-                            A::mul_add(-p.MY5r, k106, p.m5r * k119),
-                        ),
-                    ),
-                ); // F5r|ud=0,g=0.z
-                let d54 = A::mul_add(p.XZ5l, k46, A::mul_add(p.XY5l, k45, p.XX5l * k47)); // J5lw5l|ud=0,g=0.x
-                let d138 = A::mul_add(
-                    p.XZ5r,
-                    k114,
-                    A::mul_add(p.XY5r, k113, p.XX5r * k117),
-                ); // J5rw5r|ud=0,g=0.x
-                let d55 = A::mul_add(p.YZ5l, k46, A::mul_add(p.YY5l, k45, p.XY5l * k47)); // J5lw5l|ud=0,g=0.y
-                let d139 = A::mul_add(
-                    p.YZ5r,
-                    k114,
-                    A::mul_add(p.YY5r, k113, p.XY5r * k117),
-                ); // J5rw5r|ud=0,g=0.y
-                let d56 = A::mul_add(p.ZZ5l, k46, A::mul_add(p.YZ5l, k45, p.XZ5l * k47)); // J5lw5l|ud=0,g=0.z
-                let d140 = A::mul_add(
-                    p.ZZ5r,
-                    k114,
-                    A::mul_add(p.YZ5r, k113, p.XZ5r * k117),
-                ); // J5rw5r|ud=0,g=0.z
-                let d57 = A::mul_add(
-                    p.MZ5l,
-                    k50,
-                    A::mul_add(
-                        -p.MY5l,
-                        k51,
-                        A::mul_add(
-                            -k46,
-                            d55,
-                            A::mul_add(
-                                k45,
-                                d56,
-                                A::mul_add(
-                                    -p.XZ5l,
-                                    k49,
-                                    A::mul_add(-p.XY5l, k48, p.XX5l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5l|ud=0,g=0.x
-                let d141 = A::mul_add(
-                    p.MZ5r,
-                    k118,
-                    A::mul_add(
-                        -p.MY5r,
-                        k119,
-                        A::mul_add(
-                            -k114,
-                            d139,
-                            A::mul_add(
-                                k113,
-                                d140,
-                                A::mul_add(
-                                    -p.XZ5r,
-                                    k116,
-                                    A::mul_add(-p.XY5r, k115, p.XX5r * k106),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5r|ud=0,g=0.x
-                let d58 = A::mul_add(
-                    p.MX5l,
-                    k51,
-                    A::mul_add(
-                        p.MZ5l,
-                        k44,
-                        A::mul_add(
-                            -k47,
-                            d56,
-                            A::mul_add(
-                                k46,
-                                d54,
-                                A::mul_add(
-                                    -p.YZ5l,
-                                    k49,
-                                    A::mul_add(-p.YY5l, k48, p.XY5l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5l|ud=0,g=0.y
-                let d142 = A::mul_add(
-                    p.MX5r,
-                    k119,
-                    A::mul_add(
-                        p.MZ5r,
-                        k112,
-                        A::mul_add(
-                            -k117,
-                            d140,
-                            A::mul_add(
-                                k114,
-                                d138,
-                                A::mul_add(
-                                    -p.YZ5r,
-                                    k116,
-                                    A::mul_add(-p.YY5r, k115, p.XY5r * k106),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5r|ud=0,g=0.y
-                let d59 = A::mul_add(
-                    -p.MY5l,
-                    k44,
-                    A::mul_add(
-                        -p.MX5l,
-                        k50,
-                        A::mul_add(
-                            -k45,
-                            d54,
-                            A::mul_add(
-                                k47,
-                                d55,
-                                A::mul_add(
-                                    -p.ZZ5l,
-                                    k49,
-                                    A::mul_add(-p.YZ5l, k48, p.XZ5l * k36),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5l|ud=0,g=0.z
-                let d143 = A::mul_add(
-                    -p.MY5r,
-                    k112,
-                    A::mul_add(
-                        -p.MX5r,
-                        k118,
-                        A::mul_add(
-                            -k113,
-                            d138,
-                            A::mul_add(
-                                k117,
-                                d139,
-                                A::mul_add(
-                                    -p.ZZ5r,
-                                    k116,
-                                    A::mul_add(-p.YZ5r, k115, p.XZ5r * k106),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N5r|ud=0,g=0.z
-                let k52 = A::mul_add(-s_q3l, k46, c_q3l * k47); // w5l in 6l|ud=0,g=0.x
-                let k120 = A::mul_add(-s_q3r, k114, c_q3r * k117); // w5r in 6r|ud=0,g=0.x
-                let k53 = A::mul_add(c_q3l, k46, s_q3l * k47); // w5l in 6l|ud=0,g=0.z
-                let k121 = A::mul_add(c_q3r, k114, s_q3r * k117); // w5r in 6r|ud=0,g=0.z
-                let k55 = A::mul_add(-k52, qd3l, A::mul_add(-c_q3l, k49, s_q3l * k36)); // wd6l|ud=0,g=0.z
-                let k122 = A::mul_add(
-                    -k120,
-                    qd3r,
-                    A::mul_add(-c_q3r, k116, s_q3r * k106),
-                ); // wd6r|ud=0,g=0.z
-                let k54 = k45 - qd3l; // w6l|ud=0,g=0.y
-                let k123 = k113 - qd3r; // w6r|ud=0,g=0.y
-                let k56 = A::mul_add(k53, qd3l, A::mul_add(s_q3l, k49, c_q3l * k36)); // wd6l|ud=0,g=0.x
-                let k124 = A::mul_add(k121, qd3r, A::mul_add(s_q3r, k116, c_q3r * k106)); // wd6r|ud=0,g=0.x
-                let k57 = p.L7 * k46; // w5lxP6l|ud=0,g=0.x
-                let k125 = p.L7 * k114; // w5rxP6r|ud=0,g=0.x
-                let k58 = p.L7 * k47; // w5lxP6l|ud=0,g=0.z
-                let k126 = p.L7 * k117; // w5rxP6r|ud=0,g=0.z
-                let k59 = A::mul_add(-k45, k58, A::mul_add(-p.L7, k49, k44)); // a6l in 5l|ud=0,g=0.x
-                let k127 = A::mul_add(-k113, k126, A::mul_add(-p.L7, k116, k112)); // a6r in 5r|ud=0,g=0.x
-                let k60 = A::mul_add(-k47, k58, A::mul_add(-k46, k57, k50)); // a6l in 5l|ud=0,g=0.y
-                let k128 = A::mul_add(-k117, k126, A::mul_add(-k114, k125, k118)); // a6r in 5r|ud=0,g=0.y
-                let k61 = A::mul_add(k45, k57, A::mul_add(p.L7, k36, k51)); // a6l in 5l|ud=0,g=0.z
-                let k129 = A::mul_add(k113, k125, A::mul_add(p.L7, k106, k119)); // a6r in 5r|ud=0,g=0.z
-                let k62 = A::mul_add(-c_q3l, k61, s_q3l * k59); // a6l|ud=0,g=0.z
-                let k130 = A::mul_add(-c_q3r, k129, s_q3r * k127); // a6r|ud=0,g=0.z
-                let k63 = A::mul_add(s_q3l, k61, c_q3l * k59); // a6l|ud=0,g=0.x
-                let k131 = A::mul_add(s_q3r, k129, c_q3r * k127); // a6r|ud=0,g=0.x
-                let d61 = A::mul_add(-p.MX6l, k54, p.MY6l * k52); // w6lxMS6l|ud=0,g=0.z
-                let d144 = A::mul_add(-p.MX6r, k123, p.MY6r * k120); // w6rxMS6r|ud=0,g=0.z
-                let d60 = A::mul_add(p.MY6l, k53, p.MZ6l * k54); // w6lxMS6l|ud=0,g=0.x
-                let d145 = A::mul_add(p.MY6r, k121, p.MZ6r * k123); // w6rxMS6r|ud=0,g=0.x
-                let d62 = A::mul_add(p.MZ6l, k52, p.MX6l * k53); // w6lxMS6l|ud=0,g=0.y
-                let d146 = A::mul_add(p.MZ6r, k120, p.MX6r * k121); // w6rxMS6r|ud=0,g=0.y
-                let d64 = A::mul_add(
-                    -k54,
-                    d60,
-                    A::mul_add(
-                        -k52,
-                        d62,
-                        A::mul_add(-p.MX6l, k48, A::mul_add(-p.MY6l, k56, p.m6l * k62)),
-                    ),
-                ); // F6l|ud=0,g=0.z
-                let d147 = A::mul_add(
-                    -k123,
-                    d145,
-                    A::mul_add(
-                        -k120,
-                        d146,
-                        A::mul_add(
-                            -p.MX6r,
-                            k115,
-                            A::mul_add(-p.MY6r, k124, p.m6r * k130),
-                        ),
-                    ),
-                ); // F6r|ud=0,g=0.z
-                let d65 = A::mul_add(
-                    k53,
-                    d62,
-                    A::mul_add(
-                        -k54,
-                        d61,
-                        A::mul_add(p.MY6l, k55, A::mul_add(-p.MZ6l, k48, p.m6l * k63)),
-                    ),
-                ); // F6l|ud=0,g=0.x
-                let d148 = A::mul_add(
-                    k121,
-                    d146,
-                    A::mul_add(
-                        -k123,
-                        d144,
-                        A::mul_add(p.MY6r, k122, A::mul_add(-p.MZ6r, k115, p.m6r * k131)),
-                    ),
-                ); // F6r|ud=0,g=0.x
-                let d63 = A::mul_add(
-                    -k52,
-                    d61,
-                    A::mul_add(
-                        -k53,
-                        d60,
-                        A::mul_add(p.MZ6l, k56, A::mul_add(p.MX6l, k55, p.m6l * k60)),
-                    ),
-                ); // F6l|ud=0,g=0.y
-                let d149 = A::mul_add(
-                    -k120,
-                    d144,
-                    A::mul_add(
-                        -k121,
-                        d145,
-                        A::mul_add(p.MZ6r, k124, A::mul_add(p.MX6r, k122, p.m6r * k128)),
-                    ),
-                ); // F6r|ud=0,g=0.y
-                let d66 = A::mul_add(
-                    -p.XZ6l,
-                    k53,
-                    A::mul_add(p.XY6l, k54, p.XX6l * k52),
-                ); // J6lw6l|ud=0,g=0.x
-                let d150 = A::mul_add(
-                    -p.XZ6r,
-                    k121,
-                    A::mul_add(p.XY6r, k123, p.XX6r * k120),
-                ); // J6rw6r|ud=0,g=0.x
-                let d67 = A::mul_add(
-                    -p.YZ6l,
-                    k53,
-                    A::mul_add(p.YY6l, k54, p.XY6l * k52),
-                ); // J6lw6l|ud=0,g=0.y
-                let d151 = A::mul_add(
-                    -p.YZ6r,
-                    k121,
-                    A::mul_add(p.YY6r, k123, p.XY6r * k120),
-                ); // J6rw6r|ud=0,g=0.y
-                let d68 = A::mul_add(
-                    -p.ZZ6l,
-                    k53,
-                    A::mul_add(p.YZ6l, k54, p.XZ6l * k52),
-                ); // J6lw6l|ud=0,g=0.z
-                let d152 = A::mul_add(
-                    -p.ZZ6r,
-                    k121,
-                    A::mul_add(p.YZ6r, k123, p.XZ6r * k120),
-                ); // J6rw6r|ud=0,g=0.z
-                let d69 = A::mul_add(
-                    p.MZ6l,
-                    k60,
-                    A::mul_add(
-                        -p.MY6l,
-                        k62,
-                        A::mul_add(
-                            -k53,
-                            d67,
-                            A::mul_add(
-                                -k54,
-                                d68,
-                                A::mul_add(
-                                    -p.XZ6l,
-                                    k55,
-                                    A::mul_add(-p.XY6l, k48, p.XX6l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6l|ud=0,g=0.x
-                let d153 = A::mul_add(
-                    p.MZ6r,
-                    k128,
-                    A::mul_add(
-                        -p.MY6r,
-                        k130,
-                        A::mul_add(
-                            -k121,
-                            d151,
-                            A::mul_add(
-                                -k123,
-                                d152,
-                                A::mul_add(
-                                    -p.XZ6r,
-                                    k122,
-                                    A::mul_add(-p.XY6r, k115, p.XX6r * k124),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6r|ud=0,g=0.x
-                let d70 = A::mul_add(
-                    p.MX6l,
-                    k62,
-                    A::mul_add(
-                        p.MZ6l,
-                        k63,
-                        A::mul_add(
-                            k52,
-                            d68,
-                            A::mul_add(
-                                k53,
-                                d66,
-                                A::mul_add(
-                                    -p.YZ6l,
-                                    k55,
-                                    A::mul_add(-p.YY6l, k48, p.XY6l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6l|ud=0,g=0.y
-                let d154 = A::mul_add(
-                    p.MX6r,
-                    k130,
-                    A::mul_add(
-                        p.MZ6r,
-                        k131,
-                        A::mul_add(
-                            k120,
-                            d152,
-                            A::mul_add(
-                                k121,
-                                d150,
-                                A::mul_add(
-                                    -p.YZ6r,
-                                    k122,
-                                    A::mul_add(-p.YY6r, k115, p.XY6r * k124),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6r|ud=0,g=0.y
-                let d71 = A::mul_add(
-                    -p.MY6l,
-                    k63,
-                    A::mul_add(
-                        -p.MX6l,
-                        k60,
-                        A::mul_add(
-                            k54,
-                            d66,
-                            A::mul_add(
-                                -k52,
-                                d67,
-                                A::mul_add(
-                                    -p.ZZ6l,
-                                    k55,
-                                    A::mul_add(-p.YZ6l, k48, p.XZ6l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6l|ud=0,g=0.z
-                let d155 = A::mul_add(
-                    -p.MY6r,
-                    k131,
-                    A::mul_add(
-                        -p.MX6r,
-                        k128,
-                        A::mul_add(
-                            k123,
-                            d150,
-                            A::mul_add(
-                                -k120,
-                                d151,
-                                A::mul_add(
-                                    -p.ZZ6r,
-                                    k122,
-                                    A::mul_add(-p.YZ6r, k115, p.XZ6r * k124),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N6r|ud=0,g=0.z
-                let k64 = A::mul_add(-s_q4l, k53, c_q4l * k54); // w6l in 7l|ud=0,g=0.y
-                let k132 = A::mul_add(-s_q4r, k121, c_q4r * k123); // w6r in 7r|ud=0,g=0.y
-                let k65 = A::mul_add(c_q4l, k53, s_q4l * k54); // w6l in 7l|ud=0,g=0.z
-                let k133 = A::mul_add(c_q4r, k121, s_q4r * k123); // w6r in 7r|ud=0,g=0.z
-                let k67 = A::mul_add(-k65, qd4l, A::mul_add(s_q4l, k55, c_q4l * k48)); // wd7l|ud=0,g=0.y
-                let k134 = A::mul_add(
-                    -k133,
-                    qd4r,
-                    A::mul_add(s_q4r, k122, c_q4r * k115),
-                ); // wd7r|ud=0,g=0.y
-                let k68 = A::mul_add(k64, qd4l, A::mul_add(-c_q4l, k55, s_q4l * k48)); // wd7l|ud=0,g=0.z
-                let k135 = A::mul_add(
-                    k132,
-                    qd4r,
-                    A::mul_add(-c_q4r, k122, s_q4r * k115),
-                ); // wd7r|ud=0,g=0.z
-                let k66 = k52 + qd4l; // w7l|ud=0,g=0.x
-                let k136 = k120 + qd4r; // w7r|ud=0,g=0.x
-                let k69 = A::mul_add(s_q4l, k62, c_q4l * k60); // a7l|ud=0,g=0.y
-                let k137 = A::mul_add(s_q4r, k130, c_q4r * k128); // a7r|ud=0,g=0.y
-                let k70 = A::mul_add(-c_q4l, k62, s_q4l * k60); // a7l|ud=0,g=0.z
-                let k138 = A::mul_add(-c_q4r, k130, s_q4r * k128); // a7r|ud=0,g=0.z
-                let d72 = A::mul_add(-p.MY7l, k65, p.MZ7l * k64); // w7lxMS7l|ud=0,g=0.x
-                let d156 = A::mul_add(-p.MY7r, k133, p.MZ7r * k132); // w7rxMS7r|ud=0,g=0.x
-                let d73 = A::mul_add(-p.MZ7l, k66, p.MX7l * k65); // w7lxMS7l|ud=0,g=0.y
-                let d157 = A::mul_add(-p.MZ7r, k136, p.MX7r * k133); // w7rxMS7r|ud=0,g=0.y
-                let d74 = A::mul_add(-p.MX7l, k64, p.MY7l * k66); // w7lxMS7l|ud=0,g=0.z
-                let d158 = A::mul_add(-p.MX7r, k132, p.MY7r * k136); // w7rxMS7r|ud=0,g=0.z
-                let d75 = A::mul_add(
-                    -k65,
-                    d73,
-                    A::mul_add(
-                        k64,
-                        d74,
-                        A::mul_add(p.MY7l, k68, A::mul_add(-p.MZ7l, k67, p.m7l * k63)),
-                    ),
-                ); // F7l|ud=0,g=0.x
-                let d159 = A::mul_add(
-                    -k133,
-                    d157,
-                    A::mul_add(
-                        k132,
-                        d158,
-                        A::mul_add(p.MY7r, k135, A::mul_add(-p.MZ7r, k134, p.m7r * k131)),
-                    ),
-                ); // F7r|ud=0,g=0.x
-                let d76 = A::mul_add(
-                    k66,
-                    d74,
-                    A::mul_add(
-                        -k65,
-                        d72,
-                        A::mul_add(p.MZ7l, k56, A::mul_add(p.MX7l, k68, p.m7l * k69)),
-                    ),
-                ); // F7l|ud=0,g=0.y
-                let d160 = A::mul_add(
-                    k136,
-                    d158,
-                    A::mul_add(
-                        -k133,
-                        d156,
-                        A::mul_add(p.MZ7r, k124, A::mul_add(p.MX7r, k135, p.m7r * k137)),
-                    ),
-                ); // F7r|ud=0,g=0.y
-                let d77 = A::mul_add(
-                    k64,
-                    d72,
-                    A::mul_add(
-                        -k66,
-                        d73,
-                        A::mul_add(-p.MX7l, k67, A::mul_add(-p.MY7l, k56, p.m7l * k70)),
-                    ),
-                ); // F7l|ud=0,g=0.z
-                let d161 = A::mul_add(
-                    k132,
-                    d156,
-                    A::mul_add(
-                        -k136,
-                        d157,
-                        A::mul_add(
-                            -p.MX7r,
-                            k134,
-                            A::mul_add(-p.MY7r, k124, p.m7r * k138),
-                        ),
-                    ),
-                ); // F7r|ud=0,g=0.z
-                let d78 = A::mul_add(p.XZ7l, k65, A::mul_add(p.XY7l, k64, p.XX7l * k66)); // J7lw7l|ud=0,g=0.x
-                let d162 = A::mul_add(
-                    p.XZ7r,
-                    k133,
-                    A::mul_add(p.XY7r, k132, p.XX7r * k136),
-                ); // J7rw7r|ud=0,g=0.x
-                let d79 = A::mul_add(p.YZ7l, k65, A::mul_add(p.YY7l, k64, p.XY7l * k66)); // J7lw7l|ud=0,g=0.y
-                let d163 = A::mul_add(
-                    p.YZ7r,
-                    k133,
-                    A::mul_add(p.YY7r, k132, p.XY7r * k136),
-                ); // J7rw7r|ud=0,g=0.y
-                let d80 = A::mul_add(p.ZZ7l, k65, A::mul_add(p.YZ7l, k64, p.XZ7l * k66)); // J7lw7l|ud=0,g=0.z
-                let d164 = A::mul_add(
-                    p.ZZ7r,
-                    k133,
-                    A::mul_add(p.YZ7r, k132, p.XZ7r * k136),
-                ); // J7rw7r|ud=0,g=0.z
-                let d81 = A::mul_add(
-                    p.MZ7l,
-                    k69,
-                    A::mul_add(
-                        -p.MY7l,
-                        k70,
-                        A::mul_add(
-                            -k65,
-                            d79,
-                            A::mul_add(
-                                k64,
-                                d80,
-                                A::mul_add(
-                                    -p.XZ7l,
-                                    k68,
-                                    A::mul_add(-p.XY7l, k67, p.XX7l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7l|ud=0,g=0.x
-                let d165 = A::mul_add(
-                    p.MZ7r,
-                    k137,
-                    A::mul_add(
-                        -p.MY7r,
-                        k138,
-                        A::mul_add(
-                            -k133,
-                            d163,
-                            A::mul_add(
-                                k132,
-                                d164,
-                                A::mul_add(
-                                    -p.XZ7r,
-                                    k135,
-                                    A::mul_add(-p.XY7r, k134, p.XX7r * k124),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7r|ud=0,g=0.x
-                let d82 = A::mul_add(
-                    p.MX7l,
-                    k70,
-                    A::mul_add(
-                        p.MZ7l,
-                        k63,
-                        A::mul_add(
-                            -k66,
-                            d80,
-                            A::mul_add(
-                                k65,
-                                d78,
-                                A::mul_add(
-                                    -p.YZ7l,
-                                    k68,
-                                    A::mul_add(-p.YY7l, k67, p.XY7l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7l|ud=0,g=0.y
-                let d166 = A::mul_add(
-                    p.MX7r,
-                    k138,
-                    A::mul_add(
-                        p.MZ7r,
-                        k131,
-                        A::mul_add(
-                            -k136,
-                            d164,
-                            A::mul_add(
-                                k133,
-                                d162,
-                                A::mul_add(
-                                    -p.YZ7r,
-                                    k135,
-                                    A::mul_add(-p.YY7r, k134, p.XY7r * k124),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7r|ud=0,g=0.y
-                let d83 = A::mul_add(
-                    -p.MY7l,
-                    k63,
-                    A::mul_add(
-                        -p.MX7l,
-                        k69,
-                        A::mul_add(
-                            -k64,
-                            d78,
-                            A::mul_add(
-                                k66,
-                                d79,
-                                A::mul_add(
-                                    -p.ZZ7l,
-                                    k68,
-                                    A::mul_add(-p.YZ7l, k67, p.XZ7l * k56),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7l|ud=0,g=0.z
-                let d167 = A::mul_add(
-                    -p.MY7r,
-                    k131,
-                    A::mul_add(
-                        -p.MX7r,
-                        k137,
-                        A::mul_add(
-                            -k132,
-                            d162,
-                            A::mul_add(
-                                k136,
-                                d163,
-                                A::mul_add(
-                                    -p.ZZ7r,
-                                    k135,
-                                    A::mul_add(-p.YZ7r, k134, p.XZ7r * k124),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7r|ud=0,g=0.z
-                let k71 = A::mul_add(-s_q5l, k65, c_q5l * k66); // w7l in 8l|ud=0,g=0.x
-                let k139 = A::mul_add(-s_q5r, k133, c_q5r * k136); // w7r in 8r|ud=0,g=0.x
-                let k72 = A::mul_add(c_q5l, k65, s_q5l * k66); // w7l in 8l|ud=0,g=0.z
-                let k140 = A::mul_add(c_q5r, k133, s_q5r * k136); // w7r in 8r|ud=0,g=0.z
-                let k74 = A::mul_add(-k71, qd5l, A::mul_add(-c_q5l, k68, s_q5l * k56)); // wd8l|ud=0,g=0.z
-                let k141 = A::mul_add(
-                    -k139,
-                    qd5r,
-                    A::mul_add(-c_q5r, k135, s_q5r * k124),
-                ); // wd8r|ud=0,g=0.z
-                let k73 = k64 - qd5l; // w8l|ud=0,g=0.y
-                let k142 = k132 - qd5r; // w8r|ud=0,g=0.y
-                let k75 = A::mul_add(k72, qd5l, A::mul_add(s_q5l, k68, c_q5l * k56)); // wd8l|ud=0,g=0.x
-                let k143 = A::mul_add(k140, qd5r, A::mul_add(s_q5r, k135, c_q5r * k124)); // wd8r|ud=0,g=0.x
-                let k76 = p.L8 * k65; // w7lxP8l|ud=0,g=0.x
-                let k144 = p.L8 * k133; // w7rxP8r|ud=0,g=0.x
-                let k77 = p.L8 * k66; // w7lxP8l|ud=0,g=0.z
-                let k145 = p.L8 * k136; // w7rxP8r|ud=0,g=0.z
-                let k78 = A::mul_add(-k64, k77, A::mul_add(-p.L8, k68, k63)); // a8l in 7l|ud=0,g=0.x
-                let k146 = A::mul_add(-k132, k145, A::mul_add(-p.L8, k135, k131)); // a8r in 7r|ud=0,g=0.x
-                let k79 = A::mul_add(-k66, k77, A::mul_add(-k65, k76, k69)); // a8l in 7l|ud=0,g=0.y
-                let k147 = A::mul_add(-k136, k145, A::mul_add(-k133, k144, k137)); // a8r in 7r|ud=0,g=0.y
-                let k80 = A::mul_add(k64, k76, A::mul_add(p.L8, k56, k70)); // a8l in 7l|ud=0,g=0.z
-                let k148 = A::mul_add(k132, k144, A::mul_add(p.L8, k124, k138)); // a8r in 7r|ud=0,g=0.z
-                let k81 = A::mul_add(-c_q5l, k80, s_q5l * k78); // a8l|ud=0,g=0.z
-                let k149 = A::mul_add(-c_q5r, k148, s_q5r * k146); // a8r|ud=0,g=0.z
-                let k82 = A::mul_add(s_q5l, k80, c_q5l * k78); // a8l|ud=0,g=0.x
-                let k150 = A::mul_add(s_q5r, k148, c_q5r * k146); // a8r|ud=0,g=0.x
-                let d85 = A::mul_add(-p.MX8l, k73, p.MY8l * k71); // w8lxMS8l|ud=0,g=0.z
-                let d168 = A::mul_add(-p.MX8r, k142, p.MY8r * k139); // w8rxMS8r|ud=0,g=0.z
-                let d84 = A::mul_add(p.MY8l, k72, p.MZ8l * k73); // w8lxMS8l|ud=0,g=0.x
-                let d169 = A::mul_add(p.MY8r, k140, p.MZ8r * k142); // w8rxMS8r|ud=0,g=0.x
-                let d86 = A::mul_add(p.MZ8l, k71, p.MX8l * k72); // w8lxMS8l|ud=0,g=0.y
-                let d170 = A::mul_add(p.MZ8r, k139, p.MX8r * k140); // w8rxMS8r|ud=0,g=0.y
-                let d88 = A::mul_add(
-                    -k73,
-                    d84,
-                    A::mul_add(
-                        -k71,
-                        d86,
-                        A::mul_add(-p.MX8l, k67, A::mul_add(-p.MY8l, k75, p.m8l * k81)),
-                    ),
-                ); // F8l|ud=0,g=0.z
-                let d171 = A::mul_add(
-                    -k142,
-                    d169,
-                    A::mul_add(
-                        -k139,
-                        d170,
-                        A::mul_add(
-                            -p.MX8r,
-                            k134,
-                            A::mul_add(-p.MY8r, k143, p.m8r * k149),
-                        ),
-                    ),
-                ); // F8r|ud=0,g=0.z
-                let d89 = A::mul_add(
-                    k72,
-                    d86,
-                    A::mul_add(
-                        -k73,
-                        d85,
-                        A::mul_add(p.MY8l, k74, A::mul_add(-p.MZ8l, k67, p.m8l * k82)),
-                    ),
-                ); // F8l|ud=0,g=0.x
-                let d172 = A::mul_add(
-                    k140,
-                    d170,
-                    A::mul_add(
-                        -k142,
-                        d168,
-                        A::mul_add(p.MY8r, k141, A::mul_add(-p.MZ8r, k134, p.m8r * k150)),
-                    ),
-                ); // F8r|ud=0,g=0.x
-                let d87 = A::mul_add(
-                    -k71,
-                    d85,
-                    A::mul_add(
-                        -k72,
-                        d84,
-                        A::mul_add(p.MZ8l, k75, A::mul_add(p.MX8l, k74, p.m8l * k79)),
-                    ),
-                ); // F8l|ud=0,g=0.y
-                let d173 = A::mul_add(
-                    -k139,
-                    d168,
-                    A::mul_add(
-                        -k140,
-                        d169,
-                        A::mul_add(p.MZ8r, k143, A::mul_add(p.MX8r, k141, p.m8r * k147)),
-                    ),
-                ); // F8r|ud=0,g=0.y
-                let d90 = A::mul_add(
-                    -p.XZ8l,
-                    k72,
-                    A::mul_add(p.XY8l, k73, p.XX8l * k71),
-                ); // J8lw8l|ud=0,g=0.x
-                let d174 = A::mul_add(
-                    -p.XZ8r,
-                    k140,
-                    A::mul_add(p.XY8r, k142, p.XX8r * k139),
-                ); // J8rw8r|ud=0,g=0.x
-                let d91 = A::mul_add(
-                    -p.YZ8l,
-                    k72,
-                    A::mul_add(p.YY8l, k73, p.XY8l * k71),
-                ); // J8lw8l|ud=0,g=0.y
-                let d175 = A::mul_add(
-                    -p.YZ8r,
-                    k140,
-                    A::mul_add(p.YY8r, k142, p.XY8r * k139),
-                ); // J8rw8r|ud=0,g=0.y
-                let d92 = A::mul_add(
-                    -p.ZZ8l,
-                    k72,
-                    A::mul_add(p.YZ8l, k73, p.XZ8l * k71),
-                ); // J8lw8l|ud=0,g=0.z
-                let d176 = A::mul_add(
-                    -p.ZZ8r,
-                    k140,
-                    A::mul_add(p.YZ8r, k142, p.XZ8r * k139),
-                ); // J8rw8r|ud=0,g=0.z
-                let d93 = A::mul_add(
-                    p.MZ8l,
-                    k79,
-                    A::mul_add(
-                        -p.MY8l,
-                        k81,
-                        A::mul_add(
-                            -k72,
-                            d91,
-                            A::mul_add(
-                                -k73,
-                                d92,
-                                A::mul_add(
-                                    -p.XZ8l,
-                                    k74,
-                                    A::mul_add(-p.XY8l, k67, p.XX8l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8l|ud=0,g=0.x
-                let d177 = A::mul_add(
-                    p.MZ8r,
-                    k147,
-                    A::mul_add(
-                        -p.MY8r,
-                        k149,
-                        A::mul_add(
-                            -k140,
-                            d175,
-                            A::mul_add(
-                                -k142,
-                                d176,
-                                A::mul_add(
-                                    -p.XZ8r,
-                                    k141,
-                                    A::mul_add(-p.XY8r, k134, p.XX8r * k143),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r|ud=0,g=0.x
-                let d94 = A::mul_add(
-                    p.MX8l,
-                    k81,
-                    A::mul_add(
-                        p.MZ8l,
-                        k82,
-                        A::mul_add(
-                            k71,
-                            d92,
-                            A::mul_add(
-                                k72,
-                                d90,
-                                A::mul_add(
-                                    -p.YZ8l,
-                                    k74,
-                                    A::mul_add(-p.YY8l, k67, p.XY8l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8l|ud=0,g=0.y
-                let d178 = A::mul_add(
-                    p.MX8r,
-                    k149,
-                    A::mul_add(
-                        p.MZ8r,
-                        k150,
-                        A::mul_add(
-                            k139,
-                            d176,
-                            A::mul_add(
-                                k140,
-                                d174,
-                                A::mul_add(
-                                    -p.YZ8r,
-                                    k141,
-                                    A::mul_add(-p.YY8r, k134, p.XY8r * k143),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r|ud=0,g=0.y
-                let d95 = A::mul_add(
-                    -p.MY8l,
-                    k82,
-                    A::mul_add(
-                        -p.MX8l,
-                        k79,
-                        A::mul_add(
-                            k73,
-                            d90,
-                            A::mul_add(
-                                -k71,
-                                d91,
-                                A::mul_add(
-                                    -p.ZZ8l,
-                                    k74,
-                                    A::mul_add(-p.YZ8l, k67, p.XZ8l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8l|ud=0,g=0.z
-                let d179 = A::mul_add(
-                    -p.MY8r,
-                    k150,
-                    A::mul_add(
-                        -p.MX8r,
-                        k147,
-                        A::mul_add(
-                            k142,
-                            d174,
-                            A::mul_add(
-                                -k139,
-                                d175,
-                                A::mul_add(
-                                    -p.ZZ8r,
-                                    k141,
-                                    A::mul_add(-p.YZ8r, k134, p.XZ8r * k143),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r|ud=0,g=0.z
-                let k83 = A::mul_add(-s_q6l, k72, c_q6l * k73); // w8l in 9l|ud=0,g=0.y
-                let k151 = A::mul_add(-s_q6r, k140, c_q6r * k142); // w8r in 9r|ud=0,g=0.y
-                let k84 = A::mul_add(c_q6l, k72, s_q6l * k73); // w8l in 9l|ud=0,g=0.z
-                let k152 = A::mul_add(c_q6r, k140, s_q6r * k142); // w8r in 9r|ud=0,g=0.z
-                let k86 = A::mul_add(-k84, qd6l, A::mul_add(s_q6l, k74, c_q6l * k67)); // wd9l|ud=0,g=0.y
-                let k153 = A::mul_add(
-                    -k152,
-                    qd6r,
-                    A::mul_add(s_q6r, k141, c_q6r * k134),
-                ); // wd9r|ud=0,g=0.y
-                let k87 = A::mul_add(k83, qd6l, A::mul_add(-c_q6l, k74, s_q6l * k67)); // wd9l|ud=0,g=0.z
-                let k154 = A::mul_add(
-                    k151,
-                    qd6r,
-                    A::mul_add(-c_q6r, k141, s_q6r * k134),
-                ); // wd9r|ud=0,g=0.z
-                let k85 = k71 + qd6l; // w9l|ud=0,g=0.x
-                let k155 = k139 + qd6r; // w9r|ud=0,g=0.x
-                let k88 = A::mul_add(s_q6l, k81, c_q6l * k79); // a9l|ud=0,g=0.y
-                let k156 = A::mul_add(s_q6r, k149, c_q6r * k147); // a9r|ud=0,g=0.y
-                let k89 = A::mul_add(-c_q6l, k81, s_q6l * k79); // a9l|ud=0,g=0.z
-                let k157 = A::mul_add(-c_q6r, k149, s_q6r * k147); // a9r|ud=0,g=0.z
-                let d96 = A::mul_add(-p.MY9l, k84, p.MZ9l * k83); // w9lxMS9l|ud=0,g=0.x
-                let d180 = A::mul_add(-p.MY9r, k152, p.MZ9r * k151); // w9rxMS9r|ud=0,g=0.x
-                let d97 = A::mul_add(-p.MZ9l, k85, p.MX9l * k84); // w9lxMS9l|ud=0,g=0.y
-                let d181 = A::mul_add(-p.MZ9r, k155, p.MX9r * k152); // w9rxMS9r|ud=0,g=0.y
-                let d98 = A::mul_add(-p.MX9l, k83, p.MY9l * k85); // w9lxMS9l|ud=0,g=0.z
-                let d182 = A::mul_add(-p.MX9r, k151, p.MY9r * k155); // w9rxMS9r|ud=0,g=0.z
-                let d99 = A::mul_add(
-                    -k84,
-                    d97,
-                    A::mul_add(
-                        k83,
-                        d98,
-                        A::mul_add(p.MY9l, k87, A::mul_add(-p.MZ9l, k86, p.m9l * k82)),
-                    ),
-                ); // F9l|ud=0,g=0.x
-                let d183 = A::mul_add(
-                    -k152,
-                    d181,
-                    A::mul_add(
-                        k151,
-                        d182,
-                        A::mul_add(p.MY9r, k154, A::mul_add(-p.MZ9r, k153, p.m9r * k150)),
-                    ),
-                ); // F9r|ud=0,g=0.x
-                let d100 = A::mul_add(
-                    k85,
-                    d98,
-                    A::mul_add(
-                        -k84,
-                        d96,
-                        A::mul_add(p.MZ9l, k75, A::mul_add(p.MX9l, k87, p.m9l * k88)),
-                    ),
-                ); // F9l|ud=0,g=0.y
-                let d184 = A::mul_add(
-                    k155,
-                    d182,
-                    A::mul_add(
-                        -k152,
-                        d180,
-                        A::mul_add(p.MZ9r, k143, A::mul_add(p.MX9r, k154, p.m9r * k156)),
-                    ),
-                ); // F9r|ud=0,g=0.y
-                let d101 = A::mul_add(
-                    k83,
-                    d96,
-                    A::mul_add(
-                        -k85,
-                        d97,
-                        A::mul_add(-p.MX9l, k86, A::mul_add(-p.MY9l, k75, p.m9l * k89)),
-                    ),
-                ); // F9l|ud=0,g=0.z
-                let d185 = A::mul_add(
-                    k151,
-                    d180,
-                    A::mul_add(
-                        -k155,
-                        d181,
-                        A::mul_add(
-                            -p.MX9r,
-                            k153,
-                            A::mul_add(-p.MY9r, k143, p.m9r * k157),
-                        ),
-                    ),
-                ); // F9r|ud=0,g=0.z
-                let d102 = A::mul_add(
-                    p.XZ9l,
-                    k84,
-                    A::mul_add(p.XY9l, k83, p.XX9l * k85),
-                ); // J9lw9l|ud=0,g=0.x
-                let d186 = A::mul_add(
-                    p.XZ9r,
-                    k152,
-                    A::mul_add(p.XY9r, k151, p.XX9r * k155),
-                ); // J9rw9r|ud=0,g=0.x
-                let d103 = A::mul_add(
-                    p.YZ9l,
-                    k84,
-                    A::mul_add(p.YY9l, k83, p.XY9l * k85),
-                ); // J9lw9l|ud=0,g=0.y
-                let d187 = A::mul_add(
-                    p.YZ9r,
-                    k152,
-                    A::mul_add(p.YY9r, k151, p.XY9r * k155),
-                ); // J9rw9r|ud=0,g=0.y
-                let d104 = A::mul_add(
-                    p.ZZ9l,
-                    k84,
-                    A::mul_add(p.YZ9l, k83, p.XZ9l * k85),
-                ); // J9lw9l|ud=0,g=0.z
-                let d188 = A::mul_add(
-                    p.ZZ9r,
-                    k152,
-                    A::mul_add(p.YZ9r, k151, p.XZ9r * k155),
-                ); // J9rw9r|ud=0,g=0.z
-                let d105 = A::mul_add(
-                    p.MZ9l,
-                    k88,
-                    A::mul_add(
-                        -p.MY9l,
-                        k89,
-                        A::mul_add(
-                            -k84,
-                            d103,
-                            A::mul_add(
-                                k83,
-                                d104,
-                                A::mul_add(
-                                    -p.XZ9l,
-                                    k87,
-                                    A::mul_add(-p.XY9l, k86, p.XX9l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9l|ud=0,g=0.x
-                let d189 = A::mul_add(
-                    p.MZ9r,
-                    k156,
-                    A::mul_add(
-                        -p.MY9r,
-                        k157,
-                        A::mul_add(
-                            -k152,
-                            d187,
-                            A::mul_add(
-                                k151,
-                                d188,
-                                A::mul_add(
-                                    -p.XZ9r,
-                                    k154,
-                                    A::mul_add(-p.XY9r, k153, p.XX9r * k143),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r|ud=0,g=0.x
-                let d106 = A::mul_add(
-                    p.MX9l,
-                    k89,
-                    A::mul_add(
-                        p.MZ9l,
-                        k82,
-                        A::mul_add(
-                            -k85,
-                            d104,
-                            A::mul_add(
-                                k84,
-                                d102,
-                                A::mul_add(
-                                    -p.YZ9l,
-                                    k87,
-                                    A::mul_add(-p.YY9l, k86, p.XY9l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9l|ud=0,g=0.y
-                let d190 = A::mul_add(
-                    p.MX9r,
-                    k157,
-                    A::mul_add(
-                        p.MZ9r,
-                        k150,
-                        A::mul_add(
-                            -k155,
-                            d188,
-                            A::mul_add(
-                                k152,
-                                d186,
-                                A::mul_add(
-                                    -p.YZ9r,
-                                    k154,
-                                    A::mul_add(-p.YY9r, k153, p.XY9r * k143),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r|ud=0,g=0.y
-                let d107 = A::mul_add(
-                    -p.MY9l,
-                    k82,
-                    A::mul_add(
-                        -p.MX9l,
-                        k88,
-                        A::mul_add(
-                            -k83,
-                            d102,
-                            A::mul_add(
-                                k85,
-                                d103,
-                                A::mul_add(
-                                    -p.ZZ9l,
-                                    k87,
-                                    A::mul_add(-p.YZ9l, k86, p.XZ9l * k75),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9l|ud=0,g=0.z
-                let d191 = A::mul_add(
-                    -p.MY9r,
-                    k150,
-                    A::mul_add(
-                        -p.MX9r,
-                        k156,
-                        A::mul_add(
-                            -k151,
-                            d186,
-                            A::mul_add(
-                                k155,
-                                d187,
-                                A::mul_add(
-                                    -p.ZZ9r,
-                                    k154,
-                                    A::mul_add(-p.YZ9r, k153, p.XZ9r * k143),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r|ud=0,g=0.z
-                let k90 = A::mul_add(-s_q7l, k84, c_q7l * k85); // w9l in 10l|ud=0,g=0.x
-                let k158 = A::mul_add(-s_q7r, k152, c_q7r * k155); // w9r in 10r|ud=0,g=0.x
-                let k91 = A::mul_add(c_q7l, k84, s_q7l * k85); // w9l in 10l|ud=0,g=0.y
-                let k159 = A::mul_add(c_q7r, k152, s_q7r * k155); // w9r in 10r|ud=0,g=0.y
-                let k92 = k83 - qd7l; // w10l|ud=0,g=0.z
-                let k160 = k151 - qd7r; // w10r|ud=0,g=0.z
-                let k93 = A::mul_add(k91, qd7l, A::mul_add(s_q7l, k87, c_q7l * k75)); // wd10l|ud=0,g=0.x
-                let k161 = A::mul_add(k159, qd7r, A::mul_add(s_q7r, k154, c_q7r * k143)); // wd10r|ud=0,g=0.x
-                let k94 = A::mul_add(-k90, qd7l, A::mul_add(-c_q7l, k87, s_q7l * k75)); // wd10l|ud=0,g=0.y
-                let k162 = A::mul_add(
-                    -k158,
-                    qd7r,
-                    A::mul_add(-c_q7r, k154, s_q7r * k143),
-                ); // wd10r|ud=0,g=0.y
-                let k95 = p.L9 * k84; // w9lxP10l|ud=0,g=0.x
-                let k163 = p.L9 * k152; // w9rxP10r|ud=0,g=0.x
-                let k96 = p.L9 * k85; // w9lxP10l|ud=0,g=0.z
-                let k164 = p.L9 * k155; // w9rxP10r|ud=0,g=0.z
-                let k97 = A::mul_add(-k83, k96, A::mul_add(-p.L9, k87, k82)); // a10l in 9l|ud=0,g=0.x
-                let k165 = A::mul_add(-k151, k164, A::mul_add(-p.L9, k154, k150)); // a10r in 9r|ud=0,g=0.x
-                let k98 = A::mul_add(-k85, k96, A::mul_add(-k84, k95, k88)); // a10l in 9l|ud=0,g=0.y
-                let k166 = A::mul_add(-k155, k164, A::mul_add(-k152, k163, k156)); // a10r in 9r|ud=0,g=0.y
-                let k99 = A::mul_add(k83, k95, A::mul_add(p.L9, k75, k89)); // a10l in 9l|ud=0,g=0.z
-                let k167 = A::mul_add(k151, k163, A::mul_add(p.L9, k143, k157)); // a10r in 9r|ud=0,g=0.z
-                let k100 = A::mul_add(s_q7l, k99, c_q7l * k97); // a10l|ud=0,g=0.x
-                let k168 = A::mul_add(s_q7r, k167, c_q7r * k165); // a10r|ud=0,g=0.x
-                let k101 = A::mul_add(-c_q7l, k99, s_q7l * k97); // a10l|ud=0,g=0.y
-                let k169 = A::mul_add(-c_q7r, k167, s_q7r * k165); // a10r|ud=0,g=0.y
-                let d108 = A::mul_add(-p.MY10l, k92, p.MZ10l * k91); // w10lxMS10l|ud=0,g=0.x
-                let d192 = A::mul_add(-p.MY10r, k160, p.MZ10r * k159); // w10rxMS10r|ud=0,g=0.x
-                let d110 = A::mul_add(-p.MX10l, k91, p.MY10l * k90); // w10lxMS10l|ud=0,g=0.z
-                let d193 = A::mul_add(-p.MX10r, k159, p.MY10r * k158); // w10rxMS10r|ud=0,g=0.z
-                let d109 = A::mul_add(-p.MZ10l, k90, p.MX10l * k92); // w10lxMS10l|ud=0,g=0.y
-                let d194 = A::mul_add(-p.MZ10r, k158, p.MX10r * k160); // w10rxMS10r|ud=0,g=0.y
-                let d112 = A::mul_add(
-                    k92,
-                    d109,
-                    A::mul_add(
-                        -k91,
-                        d110,
-                        A::mul_add(p.MY10l, k86, A::mul_add(p.MZ10l, k94, p.m10l * k100)),
-                    ),
-                ); // F10l|ud=0,g=0.x
-                let d195 = A::mul_add(
-                    k160,
-                    d194,
-                    A::mul_add(
-                        -k159,
-                        d193,
-                        A::mul_add(
-                            p.MY10r,
-                            k153,
-                            A::mul_add(p.MZ10r, k162, p.m10r * k168),
-                        ),
-                    ),
-                ); // F10r|ud=0,g=0.x
-                let d113 = A::mul_add(
-                    k90,
-                    d110,
-                    A::mul_add(
-                        -k92,
-                        d108,
-                        A::mul_add(
-                            -p.MZ10l,
-                            k93,
-                            A::mul_add(-p.MX10l, k86, p.m10l * k101),
-                        ),
-                    ),
-                ); // F10l|ud=0,g=0.y
-                let d196 = A::mul_add(
-                    k158,
-                    d193,
-                    A::mul_add(
-                        -k160,
-                        d192,
-                        A::mul_add(
-                            -p.MZ10r,
-                            k161,
-                            A::mul_add(-p.MX10r, k153, p.m10r * k169),
-                        ),
-                    ),
-                ); // F10r|ud=0,g=0.y
-                let d111 = A::mul_add(
-                    -k91,
-                    d108,
-                    A::mul_add(
-                        k90,
-                        d109,
-                        A::mul_add(p.MX10l, k94, A::mul_add(-p.MY10l, k93, p.m10l * k98)),
-                    ),
-                ); // F10l|ud=0,g=0.z
-                let d197 = A::mul_add(
-                    -k159,
-                    d192,
-                    A::mul_add(
-                        k158,
-                        d194,
-                        A::mul_add(
-                            p.MX10r,
-                            k162,
-                            A::mul_add(-p.MY10r, k161, p.m10r * k166),
-                        ),
-                    ),
-                ); // F10r|ud=0,g=0.z
-                let d114 = A::mul_add(
-                    p.XZ10l,
-                    k92,
-                    A::mul_add(p.XY10l, k91, p.XX10l * k90),
-                ); // J10lw10l|ud=0,g=0.x
-                let d198 = A::mul_add(
-                    p.XZ10r,
-                    k160,
-                    A::mul_add(p.XY10r, k159, p.XX10r * k158),
-                ); // J10rw10r|ud=0,g=0.x
-                let d115 = A::mul_add(
-                    p.YZ10l,
-                    k92,
-                    A::mul_add(p.YY10l, k91, p.XY10l * k90),
-                ); // J10lw10l|ud=0,g=0.y
-                let d199 = A::mul_add(
-                    p.YZ10r,
-                    k160,
-                    A::mul_add(p.YY10r, k159, p.XY10r * k158),
-                ); // J10rw10r|ud=0,g=0.y
-                let d116 = A::mul_add(
-                    p.ZZ10l,
-                    k92,
-                    A::mul_add(p.YZ10l, k91, p.XZ10l * k90),
-                ); // J10lw10l|ud=0,g=0.z
-                let d200 = A::mul_add(
-                    p.ZZ10r,
-                    k160,
-                    A::mul_add(p.YZ10r, k159, p.XZ10r * k158),
-                ); // J10rw10r|ud=0,g=0.z
-                let d117 = A::mul_add(
-                    -p.MZ10l,
-                    k101,
-                    A::mul_add(
-                        -p.MY10l,
-                        k98,
-                        A::mul_add(
-                            k92,
-                            d115,
-                            A::mul_add(
-                                -k91,
-                                d116,
-                                A::mul_add(
-                                    -p.XZ10l,
-                                    k86,
-                                    A::mul_add(p.XY10l, k94, p.XX10l * k93),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l|ud=0,g=0.x
-                let d201 = A::mul_add(
-                    -p.MZ10r,
-                    k169,
-                    A::mul_add(
-                        -p.MY10r,
-                        k166,
-                        A::mul_add(
-                            k160,
-                            d199,
-                            A::mul_add(
-                                -k159,
-                                d200,
-                                A::mul_add(
-                                    -p.XZ10r,
-                                    k153,
-                                    A::mul_add(p.XY10r, k162, p.XX10r * k161),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r|ud=0,g=0.x
-                let d118 = A::mul_add(
-                    p.MX10l,
-                    k98,
-                    A::mul_add(
-                        p.MZ10l,
-                        k100,
-                        A::mul_add(
-                            k90,
-                            d116,
-                            A::mul_add(
-                                -k92,
-                                d114,
-                                A::mul_add(
-                                    -p.YZ10l,
-                                    k86,
-                                    A::mul_add(p.YY10l, k94, p.XY10l * k93),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l|ud=0,g=0.y
-                let d202 = A::mul_add(
-                    p.MX10r,
-                    k166,
-                    A::mul_add(
-                        p.MZ10r,
-                        k168,
-                        A::mul_add(
-                            k158,
-                            d200,
-                            A::mul_add(
-                                -k160,
-                                d198,
-                                A::mul_add(
-                                    -p.YZ10r,
-                                    k153,
-                                    A::mul_add(p.YY10r, k162, p.XY10r * k161),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r|ud=0,g=0.y
-                let d119 = A::mul_add(
-                    -p.MY10l,
-                    k100,
-                    A::mul_add(
-                        p.MX10l,
-                        k101,
-                        A::mul_add(
-                            k91,
-                            d114,
-                            A::mul_add(
-                                -k90,
-                                d115,
-                                A::mul_add(
-                                    -p.ZZ10l,
-                                    k86,
-                                    A::mul_add(p.YZ10l, k94, p.XZ10l * k93),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l|ud=0,g=0.z
-                out[11].0[l] = d119;
-                let d203 = A::mul_add(
-                    -p.MY10r,
-                    k168,
-                    A::mul_add(
-                        p.MX10r,
-                        k169,
-                        A::mul_add(
-                            k159,
-                            d198,
-                            A::mul_add(
-                                -k158,
-                                d199,
-                                A::mul_add(
-                                    -p.ZZ10r,
-                                    k153,
-                                    A::mul_add(p.YZ10r, k162, p.XZ10r * k161),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r|ud=0,g=0.z
-                out[18].0[l] = d203;
-                let d260 = A::mul_add(s_q7l, d113, c_q7l * d112); // f10l in 9l|ud=0,g=0.x
-                let d204 = A::mul_add(s_q7r, d196, c_q7r * d195); // f10r in 9r|ud=0,g=0.x
-                let d261 = A::mul_add(-c_q7l, d113, s_q7l * d112); // f10l in 9l|ud=0,g=0.z
-                let d205 = A::mul_add(-c_q7r, d196, s_q7r * d195); // f10r in 9r|ud=0,g=0.z
-                let d262 = d99 + d260; // f9l|ud=0,g=0.x
-                let d206 = d183 + d204; // f9r|ud=0,g=0.x
-                let d263 = d106 + d119; // n9l|ud=0,g=0.y
-                let d209 = d190 + d203; // n9r|ud=0,g=0.y
-                let d264 = A::mul_add(
-                    p.L9,
-                    d261,
-                    A::mul_add(s_q7l, d118, A::mul_add(c_q7l, d117, d105)),
-                ); // n9l|ud=0,g=0.x
-                out[10].0[l] = -d264;
-                let d210 = A::mul_add(
-                    p.L9,
-                    d205,
-                    A::mul_add(s_q7r, d202, A::mul_add(c_q7r, d201, d189)),
-                ); // n9r|ud=0,g=0.x
-                out[17].0[l] = -d210;
-                let d265 = A::mul_add(
-                    p.L9,
-                    d260,
-                    A::mul_add(c_q7l, d118, A::mul_add(-s_q7l, d117, d107)),
-                ); // n9l|ud=0,g=0.z
-                let d211 = A::mul_add(
-                    p.L9,
-                    d204,
-                    A::mul_add(c_q7r, d202, A::mul_add(-s_q7r, d201, d191)),
-                ); // n9r|ud=0,g=0.z
-                let d266 = d100 + d111; // f9l|ud=0,g=0.y
-                let d207 = d184 + d197; // f9r|ud=0,g=0.y
-                let d267 = d101 + d261; // f9l|ud=0,g=0.z
-                let d208 = d185 + d205; // f9r|ud=0,g=0.z
-                let d268 = A::mul_add(s_q6l, d267, c_q6l * d266); // f9l in 8l|ud=0,g=0.y
-                let d212 = A::mul_add(s_q6r, d208, c_q6r * d207); // f9r in 8r|ud=0,g=0.y
-                let d269 = A::mul_add(-c_q6l, d267, s_q6l * d266); // f9l in 8l|ud=0,g=0.z
-                let d213 = A::mul_add(-c_q6r, d208, s_q6r * d207); // f9r in 8r|ud=0,g=0.z
-                let d270 = d87 + d268; // f8l|ud=0,g=0.y
-                let d216 = d173 + d212; // f8r|ud=0,g=0.y
-                let d271 = d88 + d269; // f8l|ud=0,g=0.z
-                let d214 = d171 + d213; // f8r|ud=0,g=0.z
-                let d272 = d89 + d262; // f8l|ud=0,g=0.x
-                let d215 = d172 + d206; // f8r|ud=0,g=0.x
-                let d273 = d93 + d264; // n8l|ud=0,g=0.x
-                let d217 = d177 + d210; // n8r|ud=0,g=0.x
-                let d274 = A::mul_add(s_q6l, d265, A::mul_add(c_q6l, d263, d94)); // n8l|ud=0,g=0.y
-                out[9].0[l] = d274;
-                let d218 = A::mul_add(s_q6r, d211, A::mul_add(c_q6r, d209, d178)); // n8r|ud=0,g=0.y
-                out[16].0[l] = d218;
-                let d275 = A::mul_add(-c_q6l, d265, A::mul_add(s_q6l, d263, d95)); // n8l|ud=0,g=0.z
-                let d219 = A::mul_add(-c_q6r, d211, A::mul_add(s_q6r, d209, d179)); // n8r|ud=0,g=0.z
-                let d276 = A::mul_add(s_q5l, d271, c_q5l * d272); // f8l in 7l|ud=0,g=0.x
-                let d220 = A::mul_add(s_q5r, d214, c_q5r * d215); // f8r in 7r|ud=0,g=0.x
-                let d277 = A::mul_add(-c_q5l, d271, s_q5l * d272); // f8l in 7l|ud=0,g=0.z
-                let d221 = A::mul_add(-c_q5r, d214, s_q5r * d215); // f8r in 7r|ud=0,g=0.z
-                let d278 = d75 + d276; // f7l|ud=0,g=0.x
-                let d222 = d159 + d220; // f7r|ud=0,g=0.x
-                let d279 = d82 + d274; // n7l|ud=0,g=0.y
-                let d225 = d166 + d218; // n7r|ud=0,g=0.y
-                let d280 = A::mul_add(
-                    p.L8,
-                    d277,
-                    A::mul_add(-s_q5l, d275, A::mul_add(c_q5l, d273, d81)),
-                ); // n7l|ud=0,g=0.x
-                out[8].0[l] = -d280;
-                let d226 = A::mul_add(
-                    p.L8,
-                    d221,
-                    A::mul_add(-s_q5r, d219, A::mul_add(c_q5r, d217, d165)),
-                ); // n7r|ud=0,g=0.x
-                out[15].0[l] = -d226;
-                let d281 = A::mul_add(
-                    p.L8,
-                    d276,
-                    A::mul_add(-c_q5l, d275, A::mul_add(-s_q5l, d273, d83)),
-                ); // n7l|ud=0,g=0.z
-                let d227 = A::mul_add(
-                    p.L8,
-                    d220,
-                    A::mul_add(-c_q5r, d219, A::mul_add(-s_q5r, d217, d167)),
-                ); // n7r|ud=0,g=0.z
-                let d282 = d76 + d270; // f7l|ud=0,g=0.y
-                let d223 = d160 + d216; // f7r|ud=0,g=0.y
-                let d283 = d77 + d277; // f7l|ud=0,g=0.z
-                let d224 = d161 + d221; // f7r|ud=0,g=0.z
-                let d284 = A::mul_add(s_q4l, d283, c_q4l * d282); // f7l in 6l|ud=0,g=0.y
-                let d228 = A::mul_add(s_q4r, d224, c_q4r * d223); // f7r in 6r|ud=0,g=0.y
-                let d285 = A::mul_add(-c_q4l, d283, s_q4l * d282); // f7l in 6l|ud=0,g=0.z
-                let d229 = A::mul_add(-c_q4r, d224, s_q4r * d223); // f7r in 6r|ud=0,g=0.z
-                let d286 = d63 + d284; // f6l|ud=0,g=0.y
-                let d232 = d149 + d228; // f6r|ud=0,g=0.y
-                let d287 = d64 + d285; // f6l|ud=0,g=0.z
-                let d230 = d147 + d229; // f6r|ud=0,g=0.z
-                let d288 = d65 + d278; // f6l|ud=0,g=0.x
-                let d231 = d148 + d222; // f6r|ud=0,g=0.x
-                let d289 = d69 + d280; // n6l|ud=0,g=0.x
-                let d233 = d153 + d226; // n6r|ud=0,g=0.x
-                let d290 = A::mul_add(s_q4l, d281, A::mul_add(c_q4l, d279, d70)); // n6l|ud=0,g=0.y
-                out[7].0[l] = d290;
-                let d234 = A::mul_add(s_q4r, d227, A::mul_add(c_q4r, d225, d154)); // n6r|ud=0,g=0.y
-                out[14].0[l] = d234;
-                let d291 = A::mul_add(-c_q4l, d281, A::mul_add(s_q4l, d279, d71)); // n6l|ud=0,g=0.z
-                let d235 = A::mul_add(-c_q4r, d227, A::mul_add(s_q4r, d225, d155)); // n6r|ud=0,g=0.z
-                let d292 = A::mul_add(s_q3l, d287, c_q3l * d288); // f6l in 5l|ud=0,g=0.x
-                let d236 = A::mul_add(s_q3r, d230, c_q3r * d231); // f6r in 5r|ud=0,g=0.x
-                let d293 = A::mul_add(-c_q3l, d287, s_q3l * d288); // f6l in 5l|ud=0,g=0.z
-                let d237 = A::mul_add(-c_q3r, d230, s_q3r * d231); // f6r in 5r|ud=0,g=0.z
-                let d294 = d51 + d292; // f5l|ud=0,g=0.x
-                let d238 = d135 + d236; // f5r|ud=0,g=0.x
-                let d295 = d58 + d290; // n5l|ud=0,g=0.y
-                let d241 = d142 + d234; // n5r|ud=0,g=0.y
-                let d296 = A::mul_add(
-                    p.L7,
-                    d293,
-                    A::mul_add(-s_q3l, d291, A::mul_add(c_q3l, d289, d57)),
-                ); // n5l|ud=0,g=0.x
-                out[6].0[l] = -d296;
-                let d242 = A::mul_add(
-                    p.L7,
-                    d237,
-                    A::mul_add(-s_q3r, d235, A::mul_add(c_q3r, d233, d141)),
-                ); // n5r|ud=0,g=0.x
-                out[13].0[l] = -d242;
-                let d297 = A::mul_add(
-                    p.L7,
-                    d292,
-                    A::mul_add(-c_q3l, d291, A::mul_add(-s_q3l, d289, d59)),
-                ); // n5l|ud=0,g=0.z
-                let d243 = A::mul_add(
-                    p.L7,
-                    d236,
-                    A::mul_add(-c_q3r, d235, A::mul_add(-s_q3r, d233, d143)),
-                ); // n5r|ud=0,g=0.z
-                let d298 = d52 + d286; // f5l|ud=0,g=0.y
-                let d239 = d136 + d232; // f5r|ud=0,g=0.y
-                let d299 = d53 + d293; // f5l|ud=0,g=0.z
-                let d240 = d137 + d237; // f5r|ud=0,g=0.z
-                let d300 = A::mul_add(s_q2l, d299, c_q2l * d298); // f5l in 4l|ud=0,g=0.y
-                let d244 = A::mul_add(s_q2r, d240, c_q2r * d239); // f5r in 4r|ud=0,g=0.y
-                let d301 = A::mul_add(-c_q2l, d299, s_q2l * d298); // f5l in 4l|ud=0,g=0.z
-                let d245 = A::mul_add(-c_q2r, d240, s_q2r * d239); // f5r in 4r|ud=0,g=0.z
-                let d302 = d39 + d300; // f4l|ud=0,g=0.y
-                let d248 = d125 + d244; // f4r|ud=0,g=0.y
-                let d254 = d27 - d248; // f3|ud=0,g=0.x
-                let d303 = d40 + d301; // f4l|ud=0,g=0.z
-                let d246 = d123 + d245; // f4r|ud=0,g=0.z
-                let d304 = d41 + d294; // f4l|ud=0,g=0.x
-                let d247 = d124 + d238; // f4r|ud=0,g=0.x
-                let d305 = d45 + d296; // n4l|ud=0,g=0.x
-                let d249 = d129 + d242; // n4r|ud=0,g=0.x
-                let d306 = A::mul_add(s_q2l, d297, A::mul_add(c_q2l, d295, d46)); // n4l|ud=0,g=0.y
-                out[5].0[l] = d306;
-                let d250 = A::mul_add(s_q2r, d243, A::mul_add(c_q2r, d241, d130)); // n4r|ud=0,g=0.y
-                out[12].0[l] = d250;
-                let d307 = A::mul_add(-c_q2l, d297, A::mul_add(s_q2l, d295, d47)); // n4l|ud=0,g=0.z
-                let d251 = A::mul_add(-c_q2r, d243, A::mul_add(s_q2r, d241, d131)); // n4r|ud=0,g=0.z
-                let d308 = A::mul_add(-c_q1l, d303, s_q1l * d304); // f4l in 3|ud=0,g=0.z
-                let d253 = A::mul_add(-c_q1r, d246, s_q1r * d247); // f4r in 3|ud=0,g=0.z
-                let d255 = A::mul_add(-p.L5, d253, d33 + d250); // n3|ud=0,g=0.x
-                let d256 = A::mul_add(
-                    -p.L6,
-                    d253,
-                    A::mul_add(s_q1r, d251, A::mul_add(-c_q1r, d249, d34)),
-                ); // n3|ud=0,g=0.y
-                let d259 = d29 + d253; // f3|ud=0,g=0.z
-                let d309 = A::mul_add(s_q1l, d303, c_q1l * d304); // f4l in 3|ud=0,g=0.y
-                let d252 = A::mul_add(s_q1r, d246, c_q1r * d247); // f4r in 3|ud=0,g=0.y
-                let d257 = A::mul_add(
-                    p.L5,
-                    d248,
-                    A::mul_add(
-                        p.L6,
-                        d252,
-                        A::mul_add(-c_q1r, d251, A::mul_add(-s_q1r, d249, d35)),
-                    ),
-                ); // n3|ud=0,g=0.z
-                let d258 = d28 + d252; // f3|ud=0,g=0.y
-                let d310 = d254 + d302; // f3|ud=0,g=0.x
-                let d311 = A::mul_add(p.L5, d308, d255 - d306); // n3|ud=0,g=0.x
-                let d312 = A::mul_add(
-                    -p.L6,
-                    d308,
-                    A::mul_add(s_q1l, d307, A::mul_add(-c_q1l, d305, d256)),
-                ); // n3|ud=0,g=0.y
-                out[4].0[l] = -d312;
-                let d313 = A::mul_add(
-                    -p.L5,
-                    d302,
-                    A::mul_add(
-                        -p.L6,
-                        d309,
-                        A::mul_add(c_q1l, d307, A::mul_add(s_q1l, d305, d257)),
-                    ),
-                ); // n3|ud=0,g=0.z
-                let d314 = d258 + d309; // f3|ud=0,g=0.y
-                let d315 = d259 - d308; // f3|ud=0,g=0.z
-                let d316 = A::mul_add(s_q_torso, d315, c_q_torso * d310); // f3 in 2|ud=0,g=0.x
-                let d317 = A::mul_add(-c_q_torso, d315, s_q_torso * d310); // f3 in 2|ud=0,g=0.z
-                let d318 = d15 + d316; // f2|ud=0,g=0.x
-                let d319 = d16 + d314; // f2|ud=0,g=0.y
-                let d320 = d17 + d317; // f2|ud=0,g=0.z
-                let d321 = A::mul_add(
-                    -p.L4,
-                    d314,
-                    A::mul_add(
-                        p.L3,
-                        d317,
-                        A::mul_add(-s_q_torso, d313, A::mul_add(c_q_torso, d311, d21)),
-                    ),
-                ); // n2|ud=0,g=0.x
-                out[3].0[l] = d321;
-                let d322 = A::mul_add(p.L4, d316, d22 - d312); // n2|ud=0,g=0.y
-                let d323 = A::mul_add(
-                    -p.L3,
-                    d316,
-                    A::mul_add(c_q_torso, d313, A::mul_add(s_q_torso, d311, d23)),
-                ); // n2|ud=0,g=0.z
-                let d324 = A::mul_add(-c_q_w, d320, s_q_w * d319); // f2 in 1|ud=0,g=0.z
-                let d325 = A::mul_add(s_q_w, d320, c_q_w * d319); // f2 in 1|ud=0,g=0.y
-                let d326 = d4 - d325; // f1|ud=0,g=0.y
-                let d327 = d5 + d324; // f1|ud=0,g=0.z
-                let d328 = A::mul_add(p.L2, d325, A::mul_add(-p.L1, d324, d9 + d321)); // n1|ud=0,g=0.x
-                out[2].0[l] = d328;
-                let d329 = A::mul_add(
-                    -p.L2,
-                    d318,
-                    A::mul_add(s_q_w, d323, A::mul_add(c_q_w, d322, d10)),
-                ); // n1|ud=0,g=0.y
-                let d330 = A::mul_add(
-                    -p.L1,
-                    d318,
-                    A::mul_add(c_q_w, d323, A::mul_add(-s_q_w, d322, d11)),
-                ); // n1|ud=0,g=0.z
-                let d331 = A::mul_add(-c_q_imu, d327, s_q_imu * d326); // f1 in 0|ud=0,g=0.x
-                out[0].0[l] = d331;
-                let d332 = A::mul_add(s_q_imu, d330, c_q_imu * d329); // n0|ud=0,g=0.z
-                out[1].0[l] = -d332;
-            }
+            let q = kanegen_runtime::lanes::inputs_soa(q);
+            let u = kanegen_runtime::lanes::inputs_soa(u);
+            coriolis_batch_body::<A, _, L>(p, pc, &q, &u, out);
         }
         kanegen_runtime::isa::dispatch_fused_wide_with(
             out,
@@ -17114,6 +13144,203 @@ mod generated {
         coriolis_batch_soa_into(p, pc, q, u, &mut out);
         out
     }
+    /// The statements of [`gravity_batch_into`] and [`gravity_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to `out.set(row, column, l, value)`.
+    #[inline(always)]
+    fn gravity_batch_body<
+        A: kanegen_runtime::isa::Arith<f64>,
+        S: kanegen_runtime::lanes::LaneStore<L>,
+        const L: usize,
+    >(
+        p: &Params,
+        pc: &Precomputed,
+        q: &[kanegen_runtime::lanes::Lanes<L>; 19],
+        out: &mut S,
+    ) {
+        let p = &{ *p };
+        let pc = &{ *pc };
+        let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
+            A,
+            _,
+            L,
+        >([
+            q[2].0,
+            q[3].0,
+            q[4].0,
+            q[5].0,
+            q[12].0,
+            q[6].0,
+            q[13].0,
+            q[7].0,
+            q[14].0,
+            q[8].0,
+            q[15].0,
+            q[9].0,
+            q[16].0,
+            q[10].0,
+            q[17].0,
+            q[11].0,
+            q[18].0,
+        ]);
+        for l in 0..L {
+            let s_q_imu = sin_q[0][l];
+            let c_q_imu = cos_q[0][l];
+            let s_q_w = sin_q[1][l];
+            let c_q_w = cos_q[1][l];
+            let s_q_torso = sin_q[2][l];
+            let c_q_torso = cos_q[2][l];
+            let s_q1l = sin_q[3][l];
+            let c_q1l = cos_q[3][l];
+            let s_q1r = sin_q[4][l];
+            let c_q1r = cos_q[4][l];
+            let s_q2l = sin_q[5][l];
+            let c_q2l = cos_q[5][l];
+            let s_q2r = sin_q[6][l];
+            let c_q2r = cos_q[6][l];
+            let s_q3l = sin_q[7][l];
+            let c_q3l = cos_q[7][l];
+            let s_q3r = sin_q[8][l];
+            let c_q3r = cos_q[8][l];
+            let s_q4l = sin_q[9][l];
+            let c_q4l = cos_q[9][l];
+            let s_q4r = sin_q[10][l];
+            let c_q4r = cos_q[10][l];
+            let s_q5l = sin_q[11][l];
+            let c_q5l = cos_q[11][l];
+            let s_q5r = sin_q[12][l];
+            let c_q5r = cos_q[12][l];
+            let s_q6l = sin_q[13][l];
+            let c_q6l = cos_q[13][l];
+            let s_q6r = sin_q[14][l];
+            let c_q6r = cos_q[14][l];
+            let s_q7l = sin_q[15][l];
+            let c_q7l = cos_q[15][l];
+            let s_q7r = sin_q[16][l];
+            let c_q7r = cos_q[16][l];
+            let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
+            let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
+            let d3 = A::mul_add(-s_q_w, d2, c_q_w * d1); // gravity acceleration in 2.y
+            let d4 = A::mul_add(c_q_w, d2, s_q_w * d1); // gravity acceleration in 2.z
+            let d5 = s_q_torso * d4; // gravity acceleration in 3.x
+            let d6 = c_q_torso * d4; // gravity acceleration in 3.z
+            let d7 = A::mul_add(s_q1l, d6, c_q1l * d3); // gravity acceleration in 4l.x
+            let d8 = A::mul_add(-c_q1l, d6, s_q1l * d3); // gravity acceleration in 4l.z
+            let d21 = A::mul_add(-c_q1r, d3, s_q1r * d6); // gravity acceleration in 4r.x
+            let d22 = A::mul_add(-c_q1r, d6, -s_q1r * d3); // gravity acceleration in 4r.z
+            let d9 = A::mul_add(s_q2l, d8, c_q2l * d5); // gravity acceleration in 5l.y
+            let d23 = A::mul_add(s_q2r, d22, c_q2r * d5); // gravity acceleration in 5r.y
+            let d10 = A::mul_add(-c_q2l, d8, s_q2l * d5); // gravity acceleration in 5l.z
+            let d24 = A::mul_add(-c_q2r, d22, s_q2r * d5); // gravity acceleration in 5r.z
+            let d11 = A::mul_add(s_q3l, d10, c_q3l * d7); // gravity acceleration in 6l.x
+            let d25 = A::mul_add(s_q3r, d24, c_q3r * d21); // gravity acceleration in 6r.x
+            let d12 = A::mul_add(-c_q3l, d10, s_q3l * d7); // gravity acceleration in 6l.z
+            let d26 = A::mul_add(-c_q3r, d24, s_q3r * d21); // gravity acceleration in 6r.z
+            let d13 = A::mul_add(s_q4l, d12, c_q4l * d9); // gravity acceleration in 7l.y
+            let d27 = A::mul_add(s_q4r, d26, c_q4r * d23); // gravity acceleration in 7r.y
+            let d14 = A::mul_add(-c_q4l, d12, s_q4l * d9); // gravity acceleration in 7l.z
+            let d28 = A::mul_add(-c_q4r, d26, s_q4r * d23); // gravity acceleration in 7r.z
+            let d15 = A::mul_add(s_q5l, d14, c_q5l * d11); // gravity acceleration in 8l.x
+            let d29 = A::mul_add(s_q5r, d28, c_q5r * d25); // gravity acceleration in 8r.x
+            let d16 = A::mul_add(-c_q5l, d14, s_q5l * d11); // gravity acceleration in 8l.z
+            let d30 = A::mul_add(-c_q5r, d28, s_q5r * d25); // gravity acceleration in 8r.z
+            let d17 = A::mul_add(s_q6l, d16, c_q6l * d13); // gravity acceleration in 9l.y
+            let d31 = A::mul_add(s_q6r, d30, c_q6r * d27); // gravity acceleration in 9r.y
+            let d18 = A::mul_add(-c_q6l, d16, s_q6l * d13); // gravity acceleration in 9l.z
+            let d32 = A::mul_add(-c_q6r, d30, s_q6r * d27); // gravity acceleration in 9r.z
+            let d19 = A::mul_add(s_q7l, d18, c_q7l * d15); // gravity acceleration in 10l.x
+            let d33 = A::mul_add(s_q7r, d32, c_q7r * d29); // gravity acceleration in 10r.x
+            let d20 = A::mul_add(-c_q7l, d18, s_q7l * d15); // gravity acceleration in 10l.y
+            out.set(11, 0, l, A::mul_add(-p.MX10l, d20, p.MY10l * d19));
+            let d34 = A::mul_add(-c_q7r, d32, s_q7r * d29); // gravity acceleration in 10r.y
+            out.set(18, 0, l, A::mul_add(-p.MY10r, d33, p.MX10r * d34));
+            let d66 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
+            let d35 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
+            let d67 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
+            let d36 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
+            let d68 = p.MX9l - d67; // MSC9l.x
+            let d37 = p.MX9r - d36; // MSC9r.x
+            let d69 = p.MZ9l + d66; // MSC9l.z
+            out.set(10, 0, l, A::mul_add(-pc.pc25, d18, d69 * d17));
+            let d38 = p.MZ9r + d35; // MSC9r.z
+            out.set(17, 0, l, A::mul_add(-d38, d31, pc.pc2 * d32));
+            let d70 = A::mul_add(s_q6l, d69, c_q6l * pc.pc25); // MSC9l in 8l.y
+            let d39 = A::mul_add(s_q6r, d38, c_q6r * pc.pc2); // MSC9r in 8r.y
+            let d71 = A::mul_add(-c_q6l, d69, s_q6l * pc.pc25); // MSC9l in 8l.z
+            let d40 = A::mul_add(-c_q6r, d38, s_q6r * pc.pc2); // MSC9r in 8r.z
+            let d72 = p.MX8l - d68; // MSC8l.x
+            let d41 = p.MX8r - d37; // MSC8r.x
+            let d73 = p.MY8l - d70; // MSC8l.y
+            let d42 = p.MY8r - d39; // MSC8r.y
+            let d74 = p.MZ8l - d71; // MSC8l.z
+            out.set(9, 0, l, A::mul_add(-d72, d16, -d74 * d15));
+            let d43 = p.MZ8r - d40; // MSC8r.z
+            out.set(16, 0, l, A::mul_add(d41, d30, d43 * d29));
+            let d75 = A::mul_add(c_q5l, d74, s_q5l * d72); // MSC8l in 7l.z
+            let d44 = A::mul_add(c_q5r, d43, s_q5r * d41); // MSC8r in 7r.z
+            let d76 = A::mul_add(-s_q5l, d74, c_q5l * d72); // MSC8l in 7l.x
+            let d45 = A::mul_add(-s_q5r, d43, c_q5r * d41); // MSC8r in 7r.x
+            let d77 = p.MX7l - d76; // MSC7l.x
+            let d46 = p.MX7r - d45; // MSC7r.x
+            let d78 = p.MZ7l + d75; // MSC7l.z
+            let d47 = p.MZ7r + d44; // MSC7r.z
+            let d79 = pc.pc36 - d73; // MSC7l.y
+            out.set(8, 0, l, A::mul_add(-d79, d14, d78 * d13));
+            let d48 = pc.pc13 - d42; // MSC7r.y
+            out.set(15, 0, l, A::mul_add(-d47, d27, d48 * d28));
+            let d80 = A::mul_add(s_q4l, d78, c_q4l * d79); // MSC7l in 6l.y
+            let d49 = A::mul_add(s_q4r, d47, c_q4r * d48); // MSC7r in 6r.y
+            let d81 = A::mul_add(-c_q4l, d78, s_q4l * d79); // MSC7l in 6l.z
+            let d50 = A::mul_add(-c_q4r, d47, s_q4r * d48); // MSC7r in 6r.z
+            let d82 = p.MX6l - d77; // MSC6l.x
+            let d51 = p.MX6r - d46; // MSC6r.x
+            let d83 = p.MY6l - d80; // MSC6l.y
+            let d52 = p.MY6r - d49; // MSC6r.y
+            let d84 = p.MZ6l - d81; // MSC6l.z
+            out.set(7, 0, l, A::mul_add(-d82, d12, -d84 * d11));
+            let d53 = p.MZ6r - d50; // MSC6r.z
+            out.set(14, 0, l, A::mul_add(d51, d26, d53 * d25));
+            let d85 = A::mul_add(c_q3l, d84, s_q3l * d82); // MSC6l in 5l.z
+            let d54 = A::mul_add(c_q3r, d53, s_q3r * d51); // MSC6r in 5r.z
+            let d86 = A::mul_add(-s_q3l, d84, c_q3l * d82); // MSC6l in 5l.x
+            let d55 = A::mul_add(-s_q3r, d53, c_q3r * d51); // MSC6r in 5r.x
+            let d87 = p.MX5l - d86; // MSC5l.x
+            let d56 = p.MX5r - d55; // MSC5r.x
+            let d88 = p.MZ5l + d85; // MSC5l.z
+            let d57 = p.MZ5r + d54; // MSC5r.z
+            let d89 = pc.pc42 - d83; // MSC5l.y
+            out.set(6, 0, l, A::mul_add(-d89, d10, d88 * d9));
+            let d58 = pc.pc19 - d52; // MSC5r.y
+            out.set(13, 0, l, A::mul_add(-d57, d23, d58 * d24));
+            let d90 = A::mul_add(s_q2l, d88, c_q2l * d89); // MSC5l in 4l.y
+            let d59 = A::mul_add(s_q2r, d57, c_q2r * d58); // MSC5r in 4r.y
+            let d91 = A::mul_add(-c_q2l, d88, s_q2l * d89); // MSC5l in 4l.z
+            let d60 = A::mul_add(-c_q2r, d57, s_q2r * d58); // MSC5r in 4r.z
+            let d92 = p.MX4l - d87; // MSC4l.x
+            let d61 = p.MX4r - d56; // MSC4r.x
+            let d93 = p.MY4l - d90; // MSC4l.y
+            let d62 = p.MY4r - d59; // MSC4r.y
+            let d94 = p.MZ4l - d91; // MSC4l.z
+            out.set(5, 0, l, A::mul_add(-d92, d8, -d94 * d7));
+            let d63 = p.MZ4r - d60; // MSC4r.z
+            out.set(12, 0, l, A::mul_add(d61, d22, d63 * d21));
+            let d95 = A::mul_add(-s_q1l, d94, c_q1l * d92); // MSC4l in 3.y
+            let d64 = A::mul_add(-s_q1r, d63, c_q1r * d61); // MSC4r in 3.y
+            let d96 = A::mul_add(c_q1l, d94, s_q1l * d92); // MSC4l in 3.z
+            let d65 = A::mul_add(c_q1r, d63, s_q1r * d61); // MSC4r in 3.z
+            let d97 = p.MZ3 + d65 - d96; // MSC3.z
+            let d98 = d93 - d62 + pc.pc47; // MSC3.x
+            out.set(4, 0, l, A::mul_add(-d98, d6, d97 * d5));
+            let d99 = d64 + d95 + pc.pc48; // MSC3.y
+            let d100 = A::mul_add(c_q_torso, d97, s_q_torso * d98); // MSC3 in 2.z
+            let d101 = d99 + pc.pc54; // MSC2.y
+            let d102 = pc.pc55 - d100; // MSC2.z
+            out.set(3, 0, l, A::mul_add(-d101, d4, d102 * d3));
+            let d103 = A::mul_add(s_q_w, d102, c_q_w * d101); // MSC2 in 1.y
+            let d104 = A::mul_add(-c_q_w, d102, s_q_w * d101); // MSC2 in 1.z
+            let d105 = d103 + pc.pc61; // MSC1.y
+            let d106 = pc.pc62 - d104; // MSC1.z
+            out.set(2, 0, l, A::mul_add(-d105, d2, d106 * d1));
+        }
+    }
     /// [`gravity`] at `L` states per call, into `out`: entry `l` of `out` becomes `gravity` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
     #[inline(never)]
     pub fn gravity_batch_into<const L: usize>(
@@ -17129,191 +13356,8 @@ mod generated {
             q: &[SVector<f64, 19>; L],
             out: &mut [SVector<f64, 19>; L],
         ) {
-            let p = &{ *p };
-            let pc = &{ *pc };
             let q = kanegen_runtime::lanes::inputs(q);
-            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
-                A,
-                _,
-                L,
-            >([
-                q[2].0,
-                q[3].0,
-                q[4].0,
-                q[5].0,
-                q[12].0,
-                q[6].0,
-                q[13].0,
-                q[7].0,
-                q[14].0,
-                q[8].0,
-                q[15].0,
-                q[9].0,
-                q[16].0,
-                q[10].0,
-                q[17].0,
-                q[11].0,
-                q[18].0,
-            ]);
-            for (l, m) in out.iter_mut().enumerate() {
-                let s_q_imu = sin_q[0][l];
-                let c_q_imu = cos_q[0][l];
-                let s_q_w = sin_q[1][l];
-                let c_q_w = cos_q[1][l];
-                let s_q_torso = sin_q[2][l];
-                let c_q_torso = cos_q[2][l];
-                let s_q1l = sin_q[3][l];
-                let c_q1l = cos_q[3][l];
-                let s_q1r = sin_q[4][l];
-                let c_q1r = cos_q[4][l];
-                let s_q2l = sin_q[5][l];
-                let c_q2l = cos_q[5][l];
-                let s_q2r = sin_q[6][l];
-                let c_q2r = cos_q[6][l];
-                let s_q3l = sin_q[7][l];
-                let c_q3l = cos_q[7][l];
-                let s_q3r = sin_q[8][l];
-                let c_q3r = cos_q[8][l];
-                let s_q4l = sin_q[9][l];
-                let c_q4l = cos_q[9][l];
-                let s_q4r = sin_q[10][l];
-                let c_q4r = cos_q[10][l];
-                let s_q5l = sin_q[11][l];
-                let c_q5l = cos_q[11][l];
-                let s_q5r = sin_q[12][l];
-                let c_q5r = cos_q[12][l];
-                let s_q6l = sin_q[13][l];
-                let c_q6l = cos_q[13][l];
-                let s_q6r = sin_q[14][l];
-                let c_q6r = cos_q[14][l];
-                let s_q7l = sin_q[15][l];
-                let c_q7l = cos_q[15][l];
-                let s_q7r = sin_q[16][l];
-                let c_q7r = cos_q[16][l];
-                let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
-                let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
-                let d3 = A::mul_add(-s_q_w, d2, c_q_w * d1); // gravity acceleration in 2.y
-                let d4 = A::mul_add(c_q_w, d2, s_q_w * d1); // gravity acceleration in 2.z
-                let d5 = s_q_torso * d4; // gravity acceleration in 3.x
-                let d6 = c_q_torso * d4; // gravity acceleration in 3.z
-                let d7 = A::mul_add(s_q1l, d6, c_q1l * d3); // gravity acceleration in 4l.x
-                let d8 = A::mul_add(-c_q1l, d6, s_q1l * d3); // gravity acceleration in 4l.z
-                let d21 = A::mul_add(-c_q1r, d3, s_q1r * d6); // gravity acceleration in 4r.x
-                let d22 = A::mul_add(-c_q1r, d6, -s_q1r * d3); // gravity acceleration in 4r.z
-                let d9 = A::mul_add(s_q2l, d8, c_q2l * d5); // gravity acceleration in 5l.y
-                let d23 = A::mul_add(s_q2r, d22, c_q2r * d5); // gravity acceleration in 5r.y
-                let d10 = A::mul_add(-c_q2l, d8, s_q2l * d5); // gravity acceleration in 5l.z
-                let d24 = A::mul_add(-c_q2r, d22, s_q2r * d5); // gravity acceleration in 5r.z
-                let d11 = A::mul_add(s_q3l, d10, c_q3l * d7); // gravity acceleration in 6l.x
-                let d25 = A::mul_add(s_q3r, d24, c_q3r * d21); // gravity acceleration in 6r.x
-                let d12 = A::mul_add(-c_q3l, d10, s_q3l * d7); // gravity acceleration in 6l.z
-                let d26 = A::mul_add(-c_q3r, d24, s_q3r * d21); // gravity acceleration in 6r.z
-                let d13 = A::mul_add(s_q4l, d12, c_q4l * d9); // gravity acceleration in 7l.y
-                let d27 = A::mul_add(s_q4r, d26, c_q4r * d23); // gravity acceleration in 7r.y
-                let d14 = A::mul_add(-c_q4l, d12, s_q4l * d9); // gravity acceleration in 7l.z
-                let d28 = A::mul_add(-c_q4r, d26, s_q4r * d23); // gravity acceleration in 7r.z
-                let d15 = A::mul_add(s_q5l, d14, c_q5l * d11); // gravity acceleration in 8l.x
-                let d29 = A::mul_add(s_q5r, d28, c_q5r * d25); // gravity acceleration in 8r.x
-                let d16 = A::mul_add(-c_q5l, d14, s_q5l * d11); // gravity acceleration in 8l.z
-                let d30 = A::mul_add(-c_q5r, d28, s_q5r * d25); // gravity acceleration in 8r.z
-                let d17 = A::mul_add(s_q6l, d16, c_q6l * d13); // gravity acceleration in 9l.y
-                let d31 = A::mul_add(s_q6r, d30, c_q6r * d27); // gravity acceleration in 9r.y
-                let d18 = A::mul_add(-c_q6l, d16, s_q6l * d13); // gravity acceleration in 9l.z
-                let d32 = A::mul_add(-c_q6r, d30, s_q6r * d27); // gravity acceleration in 9r.z
-                let d19 = A::mul_add(s_q7l, d18, c_q7l * d15); // gravity acceleration in 10l.x
-                let d33 = A::mul_add(s_q7r, d32, c_q7r * d29); // gravity acceleration in 10r.x
-                let d20 = A::mul_add(-c_q7l, d18, s_q7l * d15); // gravity acceleration in 10l.y
-                m[11] = A::mul_add(-p.MX10l, d20, p.MY10l * d19);
-                let d34 = A::mul_add(-c_q7r, d32, s_q7r * d29); // gravity acceleration in 10r.y
-                m[18] = A::mul_add(-p.MY10r, d33, p.MX10r * d34);
-                let d66 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
-                let d35 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
-                let d67 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
-                let d36 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
-                let d68 = p.MX9l - d67; // MSC9l.x
-                let d37 = p.MX9r - d36; // MSC9r.x
-                let d69 = p.MZ9l + d66; // MSC9l.z
-                m[10] = A::mul_add(-pc.pc25, d18, d69 * d17);
-                let d38 = p.MZ9r + d35; // MSC9r.z
-                m[17] = A::mul_add(-d38, d31, pc.pc2 * d32);
-                let d70 = A::mul_add(s_q6l, d69, c_q6l * pc.pc25); // MSC9l in 8l.y
-                let d39 = A::mul_add(s_q6r, d38, c_q6r * pc.pc2); // MSC9r in 8r.y
-                let d71 = A::mul_add(-c_q6l, d69, s_q6l * pc.pc25); // MSC9l in 8l.z
-                let d40 = A::mul_add(-c_q6r, d38, s_q6r * pc.pc2); // MSC9r in 8r.z
-                let d72 = p.MX8l - d68; // MSC8l.x
-                let d41 = p.MX8r - d37; // MSC8r.x
-                let d73 = p.MY8l - d70; // MSC8l.y
-                let d42 = p.MY8r - d39; // MSC8r.y
-                let d74 = p.MZ8l - d71; // MSC8l.z
-                m[9] = A::mul_add(-d72, d16, -d74 * d15);
-                let d43 = p.MZ8r - d40; // MSC8r.z
-                m[16] = A::mul_add(d41, d30, d43 * d29);
-                let d75 = A::mul_add(c_q5l, d74, s_q5l * d72); // MSC8l in 7l.z
-                let d44 = A::mul_add(c_q5r, d43, s_q5r * d41); // MSC8r in 7r.z
-                let d76 = A::mul_add(-s_q5l, d74, c_q5l * d72); // MSC8l in 7l.x
-                let d45 = A::mul_add(-s_q5r, d43, c_q5r * d41); // MSC8r in 7r.x
-                let d77 = p.MX7l - d76; // MSC7l.x
-                let d46 = p.MX7r - d45; // MSC7r.x
-                let d78 = p.MZ7l + d75; // MSC7l.z
-                let d47 = p.MZ7r + d44; // MSC7r.z
-                let d79 = pc.pc36 - d73; // MSC7l.y
-                m[8] = A::mul_add(-d79, d14, d78 * d13);
-                let d48 = pc.pc13 - d42; // MSC7r.y
-                m[15] = A::mul_add(-d47, d27, d48 * d28);
-                let d80 = A::mul_add(s_q4l, d78, c_q4l * d79); // MSC7l in 6l.y
-                let d49 = A::mul_add(s_q4r, d47, c_q4r * d48); // MSC7r in 6r.y
-                let d81 = A::mul_add(-c_q4l, d78, s_q4l * d79); // MSC7l in 6l.z
-                let d50 = A::mul_add(-c_q4r, d47, s_q4r * d48); // MSC7r in 6r.z
-                let d82 = p.MX6l - d77; // MSC6l.x
-                let d51 = p.MX6r - d46; // MSC6r.x
-                let d83 = p.MY6l - d80; // MSC6l.y
-                let d52 = p.MY6r - d49; // MSC6r.y
-                let d84 = p.MZ6l - d81; // MSC6l.z
-                m[7] = A::mul_add(-d82, d12, -d84 * d11);
-                let d53 = p.MZ6r - d50; // MSC6r.z
-                m[14] = A::mul_add(d51, d26, d53 * d25);
-                let d85 = A::mul_add(c_q3l, d84, s_q3l * d82); // MSC6l in 5l.z
-                let d54 = A::mul_add(c_q3r, d53, s_q3r * d51); // MSC6r in 5r.z
-                let d86 = A::mul_add(-s_q3l, d84, c_q3l * d82); // MSC6l in 5l.x
-                let d55 = A::mul_add(-s_q3r, d53, c_q3r * d51); // MSC6r in 5r.x
-                let d87 = p.MX5l - d86; // MSC5l.x
-                let d56 = p.MX5r - d55; // MSC5r.x
-                let d88 = p.MZ5l + d85; // MSC5l.z
-                let d57 = p.MZ5r + d54; // MSC5r.z
-                let d89 = pc.pc42 - d83; // MSC5l.y
-                m[6] = A::mul_add(-d89, d10, d88 * d9);
-                let d58 = pc.pc19 - d52; // MSC5r.y
-                m[13] = A::mul_add(-d57, d23, d58 * d24);
-                let d90 = A::mul_add(s_q2l, d88, c_q2l * d89); // MSC5l in 4l.y
-                let d59 = A::mul_add(s_q2r, d57, c_q2r * d58); // MSC5r in 4r.y
-                let d91 = A::mul_add(-c_q2l, d88, s_q2l * d89); // MSC5l in 4l.z
-                let d60 = A::mul_add(-c_q2r, d57, s_q2r * d58); // MSC5r in 4r.z
-                let d92 = p.MX4l - d87; // MSC4l.x
-                let d61 = p.MX4r - d56; // MSC4r.x
-                let d93 = p.MY4l - d90; // MSC4l.y
-                let d62 = p.MY4r - d59; // MSC4r.y
-                let d94 = p.MZ4l - d91; // MSC4l.z
-                m[5] = A::mul_add(-d92, d8, -d94 * d7);
-                let d63 = p.MZ4r - d60; // MSC4r.z
-                m[12] = A::mul_add(d61, d22, d63 * d21);
-                let d95 = A::mul_add(-s_q1l, d94, c_q1l * d92); // MSC4l in 3.y
-                let d64 = A::mul_add(-s_q1r, d63, c_q1r * d61); // MSC4r in 3.y
-                let d96 = A::mul_add(c_q1l, d94, s_q1l * d92); // MSC4l in 3.z
-                let d65 = A::mul_add(c_q1r, d63, s_q1r * d61); // MSC4r in 3.z
-                let d97 = p.MZ3 + d65 - d96; // MSC3.z
-                let d98 = d93 - d62 + pc.pc47; // MSC3.x
-                m[4] = A::mul_add(-d98, d6, d97 * d5);
-                let d99 = d64 + d95 + pc.pc48; // MSC3.y
-                let d100 = A::mul_add(c_q_torso, d97, s_q_torso * d98); // MSC3 in 2.z
-                let d101 = d99 + pc.pc54; // MSC2.y
-                let d102 = pc.pc55 - d100; // MSC2.z
-                m[3] = A::mul_add(-d101, d4, d102 * d3);
-                let d103 = A::mul_add(s_q_w, d102, c_q_w * d101); // MSC2 in 1.y
-                let d104 = A::mul_add(-c_q_w, d102, s_q_w * d101); // MSC2 in 1.z
-                let d105 = d103 + pc.pc61; // MSC1.y
-                let d106 = pc.pc62 - d104; // MSC1.z
-                m[2] = A::mul_add(-d105, d2, d106 * d1);
-            }
+            gravity_batch_body::<A, _, L>(p, pc, &q, out);
             for m in out.iter_mut() {
                 m[0] = 0.0;
                 m[1] = 0.0;
@@ -17353,191 +13397,8 @@ mod generated {
             q: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
             out: &mut SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
         ) {
-            let p = &{ *p };
-            let pc = &{ *pc };
-            let q = &{ *q };
-            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
-                A,
-                _,
-                L,
-            >([
-                q[2].0,
-                q[3].0,
-                q[4].0,
-                q[5].0,
-                q[12].0,
-                q[6].0,
-                q[13].0,
-                q[7].0,
-                q[14].0,
-                q[8].0,
-                q[15].0,
-                q[9].0,
-                q[16].0,
-                q[10].0,
-                q[17].0,
-                q[11].0,
-                q[18].0,
-            ]);
-            for l in 0..L {
-                let s_q_imu = sin_q[0][l];
-                let c_q_imu = cos_q[0][l];
-                let s_q_w = sin_q[1][l];
-                let c_q_w = cos_q[1][l];
-                let s_q_torso = sin_q[2][l];
-                let c_q_torso = cos_q[2][l];
-                let s_q1l = sin_q[3][l];
-                let c_q1l = cos_q[3][l];
-                let s_q1r = sin_q[4][l];
-                let c_q1r = cos_q[4][l];
-                let s_q2l = sin_q[5][l];
-                let c_q2l = cos_q[5][l];
-                let s_q2r = sin_q[6][l];
-                let c_q2r = cos_q[6][l];
-                let s_q3l = sin_q[7][l];
-                let c_q3l = cos_q[7][l];
-                let s_q3r = sin_q[8][l];
-                let c_q3r = cos_q[8][l];
-                let s_q4l = sin_q[9][l];
-                let c_q4l = cos_q[9][l];
-                let s_q4r = sin_q[10][l];
-                let c_q4r = cos_q[10][l];
-                let s_q5l = sin_q[11][l];
-                let c_q5l = cos_q[11][l];
-                let s_q5r = sin_q[12][l];
-                let c_q5r = cos_q[12][l];
-                let s_q6l = sin_q[13][l];
-                let c_q6l = cos_q[13][l];
-                let s_q6r = sin_q[14][l];
-                let c_q6r = cos_q[14][l];
-                let s_q7l = sin_q[15][l];
-                let c_q7l = cos_q[15][l];
-                let s_q7r = sin_q[16][l];
-                let c_q7r = cos_q[16][l];
-                let d1 = c_q_imu * p.g; // gravity acceleration in 1.y
-                let d2 = s_q_imu * p.g; // gravity acceleration in 1.z
-                let d3 = A::mul_add(-s_q_w, d2, c_q_w * d1); // gravity acceleration in 2.y
-                let d4 = A::mul_add(c_q_w, d2, s_q_w * d1); // gravity acceleration in 2.z
-                let d5 = s_q_torso * d4; // gravity acceleration in 3.x
-                let d6 = c_q_torso * d4; // gravity acceleration in 3.z
-                let d7 = A::mul_add(s_q1l, d6, c_q1l * d3); // gravity acceleration in 4l.x
-                let d8 = A::mul_add(-c_q1l, d6, s_q1l * d3); // gravity acceleration in 4l.z
-                let d21 = A::mul_add(-c_q1r, d3, s_q1r * d6); // gravity acceleration in 4r.x
-                let d22 = A::mul_add(-c_q1r, d6, -s_q1r * d3); // gravity acceleration in 4r.z
-                let d9 = A::mul_add(s_q2l, d8, c_q2l * d5); // gravity acceleration in 5l.y
-                let d23 = A::mul_add(s_q2r, d22, c_q2r * d5); // gravity acceleration in 5r.y
-                let d10 = A::mul_add(-c_q2l, d8, s_q2l * d5); // gravity acceleration in 5l.z
-                let d24 = A::mul_add(-c_q2r, d22, s_q2r * d5); // gravity acceleration in 5r.z
-                let d11 = A::mul_add(s_q3l, d10, c_q3l * d7); // gravity acceleration in 6l.x
-                let d25 = A::mul_add(s_q3r, d24, c_q3r * d21); // gravity acceleration in 6r.x
-                let d12 = A::mul_add(-c_q3l, d10, s_q3l * d7); // gravity acceleration in 6l.z
-                let d26 = A::mul_add(-c_q3r, d24, s_q3r * d21); // gravity acceleration in 6r.z
-                let d13 = A::mul_add(s_q4l, d12, c_q4l * d9); // gravity acceleration in 7l.y
-                let d27 = A::mul_add(s_q4r, d26, c_q4r * d23); // gravity acceleration in 7r.y
-                let d14 = A::mul_add(-c_q4l, d12, s_q4l * d9); // gravity acceleration in 7l.z
-                let d28 = A::mul_add(-c_q4r, d26, s_q4r * d23); // gravity acceleration in 7r.z
-                let d15 = A::mul_add(s_q5l, d14, c_q5l * d11); // gravity acceleration in 8l.x
-                let d29 = A::mul_add(s_q5r, d28, c_q5r * d25); // gravity acceleration in 8r.x
-                let d16 = A::mul_add(-c_q5l, d14, s_q5l * d11); // gravity acceleration in 8l.z
-                let d30 = A::mul_add(-c_q5r, d28, s_q5r * d25); // gravity acceleration in 8r.z
-                let d17 = A::mul_add(s_q6l, d16, c_q6l * d13); // gravity acceleration in 9l.y
-                let d31 = A::mul_add(s_q6r, d30, c_q6r * d27); // gravity acceleration in 9r.y
-                let d18 = A::mul_add(-c_q6l, d16, s_q6l * d13); // gravity acceleration in 9l.z
-                let d32 = A::mul_add(-c_q6r, d30, s_q6r * d27); // gravity acceleration in 9r.z
-                let d19 = A::mul_add(s_q7l, d18, c_q7l * d15); // gravity acceleration in 10l.x
-                let d33 = A::mul_add(s_q7r, d32, c_q7r * d29); // gravity acceleration in 10r.x
-                let d20 = A::mul_add(-c_q7l, d18, s_q7l * d15); // gravity acceleration in 10l.y
-                out[11].0[l] = A::mul_add(-p.MX10l, d20, p.MY10l * d19);
-                let d34 = A::mul_add(-c_q7r, d32, s_q7r * d29); // gravity acceleration in 10r.y
-                out[18].0[l] = A::mul_add(-p.MY10r, d33, p.MX10r * d34);
-                let d66 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
-                let d35 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
-                let d67 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
-                let d36 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
-                let d68 = p.MX9l - d67; // MSC9l.x
-                let d37 = p.MX9r - d36; // MSC9r.x
-                let d69 = p.MZ9l + d66; // MSC9l.z
-                out[10].0[l] = A::mul_add(-pc.pc25, d18, d69 * d17);
-                let d38 = p.MZ9r + d35; // MSC9r.z
-                out[17].0[l] = A::mul_add(-d38, d31, pc.pc2 * d32);
-                let d70 = A::mul_add(s_q6l, d69, c_q6l * pc.pc25); // MSC9l in 8l.y
-                let d39 = A::mul_add(s_q6r, d38, c_q6r * pc.pc2); // MSC9r in 8r.y
-                let d71 = A::mul_add(-c_q6l, d69, s_q6l * pc.pc25); // MSC9l in 8l.z
-                let d40 = A::mul_add(-c_q6r, d38, s_q6r * pc.pc2); // MSC9r in 8r.z
-                let d72 = p.MX8l - d68; // MSC8l.x
-                let d41 = p.MX8r - d37; // MSC8r.x
-                let d73 = p.MY8l - d70; // MSC8l.y
-                let d42 = p.MY8r - d39; // MSC8r.y
-                let d74 = p.MZ8l - d71; // MSC8l.z
-                out[9].0[l] = A::mul_add(-d72, d16, -d74 * d15);
-                let d43 = p.MZ8r - d40; // MSC8r.z
-                out[16].0[l] = A::mul_add(d41, d30, d43 * d29);
-                let d75 = A::mul_add(c_q5l, d74, s_q5l * d72); // MSC8l in 7l.z
-                let d44 = A::mul_add(c_q5r, d43, s_q5r * d41); // MSC8r in 7r.z
-                let d76 = A::mul_add(-s_q5l, d74, c_q5l * d72); // MSC8l in 7l.x
-                let d45 = A::mul_add(-s_q5r, d43, c_q5r * d41); // MSC8r in 7r.x
-                let d77 = p.MX7l - d76; // MSC7l.x
-                let d46 = p.MX7r - d45; // MSC7r.x
-                let d78 = p.MZ7l + d75; // MSC7l.z
-                let d47 = p.MZ7r + d44; // MSC7r.z
-                let d79 = pc.pc36 - d73; // MSC7l.y
-                out[8].0[l] = A::mul_add(-d79, d14, d78 * d13);
-                let d48 = pc.pc13 - d42; // MSC7r.y
-                out[15].0[l] = A::mul_add(-d47, d27, d48 * d28);
-                let d80 = A::mul_add(s_q4l, d78, c_q4l * d79); // MSC7l in 6l.y
-                let d49 = A::mul_add(s_q4r, d47, c_q4r * d48); // MSC7r in 6r.y
-                let d81 = A::mul_add(-c_q4l, d78, s_q4l * d79); // MSC7l in 6l.z
-                let d50 = A::mul_add(-c_q4r, d47, s_q4r * d48); // MSC7r in 6r.z
-                let d82 = p.MX6l - d77; // MSC6l.x
-                let d51 = p.MX6r - d46; // MSC6r.x
-                let d83 = p.MY6l - d80; // MSC6l.y
-                let d52 = p.MY6r - d49; // MSC6r.y
-                let d84 = p.MZ6l - d81; // MSC6l.z
-                out[7].0[l] = A::mul_add(-d82, d12, -d84 * d11);
-                let d53 = p.MZ6r - d50; // MSC6r.z
-                out[14].0[l] = A::mul_add(d51, d26, d53 * d25);
-                let d85 = A::mul_add(c_q3l, d84, s_q3l * d82); // MSC6l in 5l.z
-                let d54 = A::mul_add(c_q3r, d53, s_q3r * d51); // MSC6r in 5r.z
-                let d86 = A::mul_add(-s_q3l, d84, c_q3l * d82); // MSC6l in 5l.x
-                let d55 = A::mul_add(-s_q3r, d53, c_q3r * d51); // MSC6r in 5r.x
-                let d87 = p.MX5l - d86; // MSC5l.x
-                let d56 = p.MX5r - d55; // MSC5r.x
-                let d88 = p.MZ5l + d85; // MSC5l.z
-                let d57 = p.MZ5r + d54; // MSC5r.z
-                let d89 = pc.pc42 - d83; // MSC5l.y
-                out[6].0[l] = A::mul_add(-d89, d10, d88 * d9);
-                let d58 = pc.pc19 - d52; // MSC5r.y
-                out[13].0[l] = A::mul_add(-d57, d23, d58 * d24);
-                let d90 = A::mul_add(s_q2l, d88, c_q2l * d89); // MSC5l in 4l.y
-                let d59 = A::mul_add(s_q2r, d57, c_q2r * d58); // MSC5r in 4r.y
-                let d91 = A::mul_add(-c_q2l, d88, s_q2l * d89); // MSC5l in 4l.z
-                let d60 = A::mul_add(-c_q2r, d57, s_q2r * d58); // MSC5r in 4r.z
-                let d92 = p.MX4l - d87; // MSC4l.x
-                let d61 = p.MX4r - d56; // MSC4r.x
-                let d93 = p.MY4l - d90; // MSC4l.y
-                let d62 = p.MY4r - d59; // MSC4r.y
-                let d94 = p.MZ4l - d91; // MSC4l.z
-                out[5].0[l] = A::mul_add(-d92, d8, -d94 * d7);
-                let d63 = p.MZ4r - d60; // MSC4r.z
-                out[12].0[l] = A::mul_add(d61, d22, d63 * d21);
-                let d95 = A::mul_add(-s_q1l, d94, c_q1l * d92); // MSC4l in 3.y
-                let d64 = A::mul_add(-s_q1r, d63, c_q1r * d61); // MSC4r in 3.y
-                let d96 = A::mul_add(c_q1l, d94, s_q1l * d92); // MSC4l in 3.z
-                let d65 = A::mul_add(c_q1r, d63, s_q1r * d61); // MSC4r in 3.z
-                let d97 = p.MZ3 + d65 - d96; // MSC3.z
-                let d98 = d93 - d62 + pc.pc47; // MSC3.x
-                out[4].0[l] = A::mul_add(-d98, d6, d97 * d5);
-                let d99 = d64 + d95 + pc.pc48; // MSC3.y
-                let d100 = A::mul_add(c_q_torso, d97, s_q_torso * d98); // MSC3 in 2.z
-                let d101 = d99 + pc.pc54; // MSC2.y
-                let d102 = pc.pc55 - d100; // MSC2.z
-                out[3].0[l] = A::mul_add(-d101, d4, d102 * d3);
-                let d103 = A::mul_add(s_q_w, d102, c_q_w * d101); // MSC2 in 1.y
-                let d104 = A::mul_add(-c_q_w, d102, s_q_w * d101); // MSC2 in 1.z
-                let d105 = d103 + pc.pc61; // MSC1.y
-                let d106 = pc.pc62 - d104; // MSC1.z
-                out[2].0[l] = A::mul_add(-d105, d2, d106 * d1);
-            }
+            let q = kanegen_runtime::lanes::inputs_soa(q);
+            gravity_batch_body::<A, _, L>(p, pc, &q, out);
             out[0] = kanegen_runtime::lanes::Lanes::splat(0.0);
             out[1] = kanegen_runtime::lanes::Lanes::splat(0.0);
         }
@@ -17563,6 +13424,2048 @@ mod generated {
         gravity_batch_soa_into(p, pc, q, &mut out);
         out
     }
+    /// The statements of [`inverse_dynamics_batch_into`] and [`inverse_dynamics_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to `out.set(row, column, l, value)`.
+    #[inline(always)]
+    fn inverse_dynamics_batch_body<
+        A: kanegen_runtime::isa::Arith<f64>,
+        S: kanegen_runtime::lanes::LaneStore<L>,
+        const L: usize,
+    >(
+        p: &Params,
+        pc: &Precomputed,
+        q: &[kanegen_runtime::lanes::Lanes<L>; 19],
+        u: &[kanegen_runtime::lanes::Lanes<L>; 19],
+        ud: &[kanegen_runtime::lanes::Lanes<L>; 19],
+        out: &mut S,
+    ) {
+        let p = &{ *p };
+        let pc = &{ *pc };
+        let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
+            A,
+            _,
+            L,
+        >([
+            q[2].0,
+            q[3].0,
+            q[4].0,
+            q[5].0,
+            q[12].0,
+            q[6].0,
+            q[13].0,
+            q[7].0,
+            q[14].0,
+            q[8].0,
+            q[15].0,
+            q[9].0,
+            q[16].0,
+            q[10].0,
+            q[17].0,
+            q[11].0,
+            q[18].0,
+        ]);
+        for l in 0..L {
+            let s_q_imu = sin_q[0][l];
+            let c_q_imu = cos_q[0][l];
+            let s_q_w = sin_q[1][l];
+            let c_q_w = cos_q[1][l];
+            let s_q_torso = sin_q[2][l];
+            let c_q_torso = cos_q[2][l];
+            let s_q1l = sin_q[3][l];
+            let c_q1l = cos_q[3][l];
+            let s_q1r = sin_q[4][l];
+            let c_q1r = cos_q[4][l];
+            let s_q2l = sin_q[5][l];
+            let c_q2l = cos_q[5][l];
+            let s_q2r = sin_q[6][l];
+            let c_q2r = cos_q[6][l];
+            let s_q3l = sin_q[7][l];
+            let c_q3l = cos_q[7][l];
+            let s_q3r = sin_q[8][l];
+            let c_q3r = cos_q[8][l];
+            let s_q4l = sin_q[9][l];
+            let c_q4l = cos_q[9][l];
+            let s_q4r = sin_q[10][l];
+            let c_q4r = cos_q[10][l];
+            let s_q5l = sin_q[11][l];
+            let c_q5l = cos_q[11][l];
+            let s_q5r = sin_q[12][l];
+            let c_q5r = cos_q[12][l];
+            let s_q6l = sin_q[13][l];
+            let c_q6l = cos_q[13][l];
+            let s_q6r = sin_q[14][l];
+            let c_q6r = cos_q[14][l];
+            let s_q7l = sin_q[15][l];
+            let c_q7l = cos_q[15][l];
+            let s_q7r = sin_q[16][l];
+            let c_q7r = cos_q[16][l];
+            let xd = u[0].0[l];
+            let xdd = ud[0].0[l];
+            let psid = u[1].0[l];
+            let psidd = ud[1].0[l];
+            let qd_imu = u[2].0[l];
+            let qdd_imu = ud[2].0[l];
+            let qd_w = u[3].0[l];
+            let qdd_w = ud[3].0[l];
+            let qd_torso = u[4].0[l];
+            let qdd_torso = ud[4].0[l];
+            let qd1l = u[5].0[l];
+            let qdd1l = ud[5].0[l];
+            let qd2l = u[6].0[l];
+            let qdd2l = ud[6].0[l];
+            let qd3l = u[7].0[l];
+            let qdd3l = ud[7].0[l];
+            let qd4l = u[8].0[l];
+            let qdd4l = ud[8].0[l];
+            let qd5l = u[9].0[l];
+            let qdd5l = ud[9].0[l];
+            let qd6l = u[10].0[l];
+            let qdd6l = ud[10].0[l];
+            let qd7l = u[11].0[l];
+            let qdd7l = ud[11].0[l];
+            let qd1r = u[12].0[l];
+            let qdd1r = ud[12].0[l];
+            let qd2r = u[13].0[l];
+            let qdd2r = ud[13].0[l];
+            let qd3r = u[14].0[l];
+            let qdd3r = ud[14].0[l];
+            let qd4r = u[15].0[l];
+            let qdd4r = ud[15].0[l];
+            let qd5r = u[16].0[l];
+            let qdd5r = ud[16].0[l];
+            let qd6r = u[17].0[l];
+            let qdd6r = ud[17].0[l];
+            let qd7r = u[18].0[l];
+            let qdd7r = ud[18].0[l];
+            let k1 = xd * psid; // a0|ud=0,g=0.y
+            let k2 = c_q_imu * psid; // w0 in 1|ud=0,g=0.y
+            let k3 = s_q_imu * psid; // w0 in 1|ud=0,g=0.z
+            let k4 = A::mul_add(s_q_imu, psidd, k2 * qd_imu); // wd1.z
+            let k5 = A::mul_add(-c_q_imu, psidd, k3 * qd_imu); // wd1.y
+            let d1 = A::mul_add(s_q_imu, xdd, c_q_imu * p.g); // a1.y
+            let d2 = A::mul_add(-c_q_imu, xdd, s_q_imu * p.g); // a1.z
+            let d3 = A::mul_add(-p.MY1, k3, p.MZ1 * k2); // w1xMS1|ud=0,g=0.x
+            let d4 = A::mul_add(p.MZ1, qd_imu, p.MX1 * k3); // w1xMS1|ud=0,g=0.y
+            let d5 = A::mul_add(p.MX1, k2, p.MY1 * qd_imu); // w1xMS1|ud=0,g=0.z
+            let d6 = A::mul_add(
+                p.MZ1,
+                qdd_imu,
+                A::mul_add(
+                    p.MX1,
+                    k4,
+                    A::mul_add(p.m1, d1, A::mul_add(-qd_imu, d5, k3 * d3)),
+                ),
+            ); // F1.y
+            let d7 = A::mul_add(
+                -p.MX1,
+                k5,
+                A::mul_add(
+                    p.MY1,
+                    qdd_imu,
+                    A::mul_add(-p.m1, d2, A::mul_add(k2, d3, qd_imu * d4)),
+                ),
+            ); // F1.z
+            let d8 = A::mul_add(-p.XZ1, k3, A::mul_add(-p.XY1, k2, p.XX1 * qd_imu)); // J1w1|ud=0,g=0.x
+            let d9 = A::mul_add(-p.YZ1, k3, A::mul_add(-p.YY1, k2, p.XY1 * qd_imu)); // J1w1|ud=0,g=0.y
+            let d10 = A::mul_add(-p.ZZ1, k3, A::mul_add(-p.YZ1, k2, p.XZ1 * qd_imu)); // J1w1|ud=0,g=0.z
+            let d11 = A::mul_add(
+                p.MX1,
+                d1,
+                A::mul_add(
+                    p.ZZ1,
+                    k4,
+                    A::mul_add(
+                        -p.YZ1,
+                        k5,
+                        A::mul_add(
+                            -p.XZ1,
+                            qdd_imu,
+                            A::mul_add(p.MY1, k1, A::mul_add(k2, d8, qd_imu * d9)),
+                        ),
+                    ),
+                ),
+            ); // N1.z
+            let d12 = A::mul_add(
+                p.MZ1,
+                d1,
+                A::mul_add(
+                    -p.MY1,
+                    d2,
+                    A::mul_add(
+                        -p.XZ1,
+                        k4,
+                        A::mul_add(
+                            p.XY1,
+                            k5,
+                            A::mul_add(p.XX1, qdd_imu, A::mul_add(-k3, d9, k2 * d10)),
+                        ),
+                    ),
+                ),
+            ); // N1.x
+            let d13 = A::mul_add(
+                p.MX1,
+                d2,
+                A::mul_add(
+                    -p.YZ1,
+                    k4,
+                    A::mul_add(
+                        p.YY1,
+                        k5,
+                        A::mul_add(
+                            p.XY1,
+                            qdd_imu,
+                            A::mul_add(p.MZ1, k1, A::mul_add(qd_imu, d10, k3 * d8)),
+                        ),
+                    ),
+                ),
+            ); // N1.y
+            let k6 = A::mul_add(-s_q_w, k3, c_q_w * k2); // w1 in 2|ud=0,g=0.y
+            let k7 = A::mul_add(c_q_w, k3, s_q_w * k2); // w1 in 2|ud=0,g=0.z
+            let k8 = A::mul_add(c_q_w, k4, A::mul_add(-s_q_w, k5, k6 * qd_w)); // wd2.z
+            let k9 = qd_imu + qd_w; // w2|ud=0,g=0.x
+            let k10 = qdd_imu + qdd_w; // wd2.x
+            let k11 = A::mul_add(s_q_w, k4, A::mul_add(c_q_w, k5, k7 * qd_w)); // wd2.y
+            let k12 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+            let k13 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+            let k14 = A::mul_add(p.L1, k3, p.L2 * k2); // w1xP2|ud=0,g=0.x
+            let d14 = A::mul_add(-p.L1, qdd_imu, A::mul_add(k2, k14, qd_imu * k12) + d2); // a2 in 1.z
+            let k15 = A::mul_add(
+                p.L1,
+                k4,
+                A::mul_add(-p.L2, k5, A::mul_add(-k3, k12, A::mul_add(k2, k13, k1))),
+            ); // a2 in 1.x
+            let d15 = A::mul_add(p.L2, qdd_imu, A::mul_add(qd_imu, k13, k3 * k14) - d1); // a2 in 1.y
+            let d16 = A::mul_add(s_q_w, d14, c_q_w * d15); // a2.y
+            let d17 = A::mul_add(-c_q_w, d14, s_q_w * d15); // a2.z
+            let d18 = A::mul_add(-p.MY2, k7, p.MZ2 * k6); // w2xMS2|ud=0,g=0.x
+            let d19 = A::mul_add(p.MZ2, k9, p.MX2 * k7); // w2xMS2|ud=0,g=0.y
+            let d20 = A::mul_add(p.MX2, k6, p.MY2 * k9); // w2xMS2|ud=0,g=0.z
+            let d21 = A::mul_add(
+                p.MZ2,
+                k10,
+                A::mul_add(
+                    p.MX2,
+                    k8,
+                    A::mul_add(-p.m2, d16, A::mul_add(-k9, d20, k7 * d18)),
+                ),
+            ); // F2.y
+            let d22 = A::mul_add(
+                p.MY2,
+                k8,
+                A::mul_add(
+                    p.MZ2,
+                    k11,
+                    A::mul_add(p.m2, k15, A::mul_add(k7, d19, k6 * d20)),
+                ),
+            ); // F2.x
+            let d23 = A::mul_add(
+                -p.MX2,
+                k11,
+                A::mul_add(
+                    p.MY2,
+                    k10,
+                    A::mul_add(p.m2, d17, A::mul_add(k6, d18, k9 * d19)),
+                ),
+            ); // F2.z
+            let d24 = A::mul_add(-p.XZ2, k7, A::mul_add(-p.XY2, k6, p.XX2 * k9)); // J2w2|ud=0,g=0.x
+            let d25 = A::mul_add(-p.YZ2, k7, A::mul_add(-p.YY2, k6, p.XY2 * k9)); // J2w2|ud=0,g=0.y
+            let d26 = A::mul_add(-p.ZZ2, k7, A::mul_add(-p.YZ2, k6, p.XZ2 * k9)); // J2w2|ud=0,g=0.z
+            let d27 = A::mul_add(
+                p.MY2,
+                k15,
+                A::mul_add(
+                    -p.MX2,
+                    d16,
+                    A::mul_add(
+                        p.ZZ2,
+                        k8,
+                        A::mul_add(
+                            -p.YZ2,
+                            k11,
+                            A::mul_add(-p.XZ2, k10, A::mul_add(k6, d24, k9 * d25)),
+                        ),
+                    ),
+                ),
+            ); // N2.z
+            let d28 = A::mul_add(
+                -p.MZ2,
+                d16,
+                A::mul_add(
+                    p.MY2,
+                    d17,
+                    A::mul_add(
+                        -p.XZ2,
+                        k8,
+                        A::mul_add(
+                            p.XY2,
+                            k11,
+                            A::mul_add(p.XX2, k10, A::mul_add(-k7, d25, k6 * d26)),
+                        ),
+                    ),
+                ),
+            ); // N2.x
+            let d29 = A::mul_add(
+                -p.MX2,
+                d17,
+                A::mul_add(
+                    p.MZ2,
+                    k15,
+                    A::mul_add(
+                        -p.YZ2,
+                        k8,
+                        A::mul_add(
+                            p.YY2,
+                            k11,
+                            A::mul_add(p.XY2, k10, A::mul_add(k9, d26, k7 * d24)),
+                        ),
+                    ),
+                ),
+            ); // N2.y
+            let k16 = A::mul_add(-s_q_torso, k7, c_q_torso * k9); // w2 in 3|ud=0,g=0.x
+            let k17 = A::mul_add(c_q_torso, k7, s_q_torso * k9); // w2 in 3|ud=0,g=0.z
+            let k18 = k6 - qd_torso; // w3|ud=0,g=0.y
+            let k19 = A::mul_add(
+                s_q_torso,
+                k8,
+                A::mul_add(-c_q_torso, k10, k17 * qd_torso),
+            ); // wd3.x
+            let k20 = k11 + qdd_torso; // wd3.y
+            let k21 = A::mul_add(
+                c_q_torso,
+                k8,
+                A::mul_add(s_q_torso, k10, k16 * qd_torso),
+            ); // wd3.z
+            let k22 = A::mul_add(-p.L3, k7, p.L4 * k6); // w2xP3|ud=0,g=0.x
+            let k23 = p.L4 * k9; // w2xP3|ud=0,g=0.y
+            let k24 = p.L3 * k9; // w2xP3|ud=0,g=0.z
+            let d30 = A::mul_add(p.L4, k10, A::mul_add(-k9, k24, k7 * k22) - d16); // a3 in 2.y
+            let k25 = A::mul_add(
+                p.L3,
+                k8,
+                A::mul_add(p.L4, k11, A::mul_add(k7, k23, k6 * k24) + k15),
+            ); // a3 in 2.x
+            let d31 = A::mul_add(p.L3, k10, A::mul_add(k6, k22, k9 * k23) + d17); // a3 in 2.z
+            let d32 = A::mul_add(s_q_torso, d31, c_q_torso * k25); // a3.x
+            let d33 = A::mul_add(-c_q_torso, d31, s_q_torso * k25); // a3.z
+            let d34 = A::mul_add(p.MY3, k17, p.MZ3 * k18); // w3xMS3|ud=0,g=0.x
+            let d35 = A::mul_add(-p.MX3, k18, p.MY3 * k16); // w3xMS3|ud=0,g=0.z
+            let d36 = A::mul_add(p.MZ3, k16, p.MX3 * k17); // w3xMS3|ud=0,g=0.y
+            let d37 = A::mul_add(
+                p.MY3,
+                k21,
+                A::mul_add(
+                    -p.MZ3,
+                    k20,
+                    A::mul_add(p.m3, d32, A::mul_add(-k17, d36, k18 * d35)),
+                ),
+            ); // F3.x
+            let d38 = A::mul_add(
+                -p.MZ3,
+                k19,
+                A::mul_add(
+                    p.MX3,
+                    k21,
+                    A::mul_add(-p.m3, d30, A::mul_add(k16, d35, k17 * d34)),
+                ),
+            ); // F3.y
+            let d39 = A::mul_add(
+                -p.MX3,
+                k20,
+                A::mul_add(
+                    p.MY3,
+                    k19,
+                    A::mul_add(p.m3, d33, A::mul_add(k18, d34, k16 * d36)),
+                ),
+            ); // F3.z
+            let d40 = A::mul_add(-p.XZ3, k17, A::mul_add(p.XY3, k18, p.XX3 * k16)); // J3w3|ud=0,g=0.x
+            let d41 = A::mul_add(-p.YZ3, k17, A::mul_add(p.YY3, k18, p.XY3 * k16)); // J3w3|ud=0,g=0.y
+            let d42 = A::mul_add(-p.ZZ3, k17, A::mul_add(p.YZ3, k18, p.XZ3 * k16)); // J3w3|ud=0,g=0.z
+            let d43 = A::mul_add(
+                -p.MZ3,
+                d30,
+                A::mul_add(
+                    -p.MY3,
+                    d33,
+                    A::mul_add(
+                        -p.XZ3,
+                        k21,
+                        A::mul_add(
+                            -p.XY3,
+                            k20,
+                            A::mul_add(-p.XX3, k19, A::mul_add(k17, d41, k18 * d42)),
+                        ),
+                    ),
+                ),
+            ); // N3.x
+            let d44 = A::mul_add(
+                -p.MY3,
+                d32,
+                A::mul_add(
+                    p.MX3,
+                    d30,
+                    A::mul_add(
+                        -p.ZZ3,
+                        k21,
+                        A::mul_add(
+                            -p.YZ3,
+                            k20,
+                            A::mul_add(-p.XZ3, k19, A::mul_add(-k18, d40, k16 * d41)),
+                        ),
+                    ),
+                ),
+            ); // N3.z
+            let d45 = A::mul_add(
+                -p.MX3,
+                d33,
+                A::mul_add(
+                    -p.MZ3,
+                    d32,
+                    A::mul_add(
+                        p.YZ3,
+                        k21,
+                        A::mul_add(
+                            p.YY3,
+                            k20,
+                            A::mul_add(p.XY3, k19, A::mul_add(k16, d42, k17 * d40)),
+                        ),
+                    ),
+                ),
+            ); // N3.y
+            let k26 = A::mul_add(s_q1l, k17, c_q1l * k18); // w3 in 4l|ud=0,g=0.x
+            let k27 = A::mul_add(-c_q1l, k17, s_q1l * k18); // w3 in 4l|ud=0,g=0.z
+            let k28 = k16 - qd1l; // w4l|ud=0,g=0.y
+            let k29 = A::mul_add(-s_q1l, k21, A::mul_add(c_q1l, k20, k27 * qd1l)); // wd4l.x
+            let k30 = k19 + qdd1l; // wd4l.y
+            let k31 = A::mul_add(-c_q1l, k21, A::mul_add(-s_q1l, k20, k26 * qd1l)); // wd4l.z
+            let k32 = p.L5 * k17; // w3xP4l|ud=0,g=0.x
+            let k33 = p.L6 * k17; // w3xP4l|ud=0,g=0.y
+            let t1 = p.L5 * k16; // common subexpression
+            let t2 = p.L6 * k18; // common subexpression
+            let k34 = t1 - t2; // w3xP4l|ud=0,g=0.z
+            let t3 = p.L5 * k21; // common subexpression
+            let t4 = p.L6 * k21; // common subexpression
+            let t5 = p.L5 * k19; // common subexpression
+            let t6 = p.L6 * k20; // common subexpression
+            let t7 = k17 * k33; // common subexpression
+            let t8 = k17 * k32; // common subexpression
+            let t9 = k16 * k33; // common subexpression
+            let t10 = k18 * k32; // common subexpression
+            let d46 = A::mul_add(k18, k34, -t7) + d32 + t3; // a4l in 3.x
+            let d47 = A::mul_add(k16, k34, t8) - d30 + t4; // a4l in 3.y
+            let d48 = t9 + t10 + d33 + t5 - t6; // a4l in 3.z
+            let d49 = A::mul_add(c_q1l, d48, s_q1l * d47); // a4l.z
+            let d50 = A::mul_add(-s_q1l, d48, c_q1l * d47); // a4l.x
+            let d63 = A::mul_add(s_q2l, d49, c_q2l * d46); // a5l.y
+            let d64 = A::mul_add(-c_q2l, d49, s_q2l * d46); // a5l.z
+            let k77 = A::mul_add(-s_q1r, k17, c_q1r * k18); // w3 in 4r|ud=0,g=0.x
+            let k78 = A::mul_add(c_q1r, k17, s_q1r * k18); // w3 in 4r|ud=0,g=0.z
+            let k79 = qdd1r - k19; // wd4r.y
+            let k80 = -k16 - qd1r; // w4r|ud=0,g=0.y
+            let k81 = A::mul_add(s_q1r, k21, A::mul_add(c_q1r, k20, k78 * qd1r)); // wd4r.x
+            let k82 = A::mul_add(c_q1r, k21, A::mul_add(-s_q1r, k20, k77 * qd1r)); // wd4r.z
+            let k83 = t1 + t2; // w3xP4r|ud=0,g=0.z
+            let d156 = A::mul_add(k18, k83, t7) + d32 + t3; // a4r in 3.x
+            let d157 = t9 - t10 - d33 - t5 - t6; // a4r in 3.z
+            let d158 = A::mul_add(k16, k83, t8) - d30 - t4; // a4r in 3.y
+            let d159 = A::mul_add(c_q1r, d157, s_q1r * d158); // a4r.z
+            let d160 = A::mul_add(-s_q1r, d157, c_q1r * d158); // a4r.x
+            let d52 = A::mul_add(-p.MX4l, k28, p.MY4l * k26); // w4lxMS4l|ud=0,g=0.z
+            let d161 = A::mul_add(-p.MX4r, k80, p.MY4r * k77); // w4rxMS4r|ud=0,g=0.z
+            let d51 = A::mul_add(p.MY4l, k27, p.MZ4l * k28); // w4lxMS4l|ud=0,g=0.x
+            let d162 = A::mul_add(p.MY4r, k78, p.MZ4r * k80); // w4rxMS4r|ud=0,g=0.x
+            let d55 = A::mul_add(
+                -p.MZ4l,
+                k29,
+                A::mul_add(
+                    p.MX4l,
+                    k31,
+                    A::mul_add(-p.m4l, d46, A::mul_add(k26, d52, k27 * d51)),
+                ),
+            ); // F4l.y
+            let d53 = A::mul_add(p.MZ4l, k26, p.MX4l * k27); // w4lxMS4l|ud=0,g=0.y
+            let d163 = A::mul_add(p.MZ4r, k77, p.MX4r * k78); // w4rxMS4r|ud=0,g=0.y
+            let d164 = A::mul_add(
+                -p.MZ4r,
+                k81,
+                A::mul_add(
+                    p.MX4r,
+                    k82,
+                    A::mul_add(p.m4r, d156, A::mul_add(k77, d161, k78 * d162)),
+                ),
+            ); // F4r.y
+            let d54 = A::mul_add(
+                p.MY4l,
+                k31,
+                A::mul_add(
+                    -p.MZ4l,
+                    k30,
+                    A::mul_add(-p.m4l, d50, A::mul_add(-k27, d53, k28 * d52)),
+                ),
+            ); // F4l.x
+            let d165 = A::mul_add(
+                p.MY4r,
+                k82,
+                A::mul_add(
+                    -p.MZ4r,
+                    k79,
+                    A::mul_add(-p.m4r, d160, A::mul_add(-k78, d163, k80 * d161)),
+                ),
+            ); // F4r.x
+            let d56 = A::mul_add(
+                -p.MX4l,
+                k30,
+                A::mul_add(
+                    p.MY4l,
+                    k29,
+                    A::mul_add(-p.m4l, d49, A::mul_add(k28, d51, k26 * d53)),
+                ),
+            ); // F4l.z
+            let d166 = A::mul_add(
+                -p.MX4r,
+                k79,
+                A::mul_add(
+                    p.MY4r,
+                    k81,
+                    A::mul_add(-p.m4r, d159, A::mul_add(k80, d162, k77 * d163)),
+                ),
+            ); // F4r.z
+            let d57 = A::mul_add(-p.XZ4l, k27, A::mul_add(p.XY4l, k28, p.XX4l * k26)); // J4lw4l|ud=0,g=0.x
+            let d167 = A::mul_add(-p.XZ4r, k78, A::mul_add(p.XY4r, k80, p.XX4r * k77)); // J4rw4r|ud=0,g=0.x
+            let d58 = A::mul_add(-p.YZ4l, k27, A::mul_add(p.YY4l, k28, p.XY4l * k26)); // J4lw4l|ud=0,g=0.y
+            let d168 = A::mul_add(-p.YZ4r, k78, A::mul_add(p.YY4r, k80, p.XY4r * k77)); // J4rw4r|ud=0,g=0.y
+            let d61 = A::mul_add(
+                p.MY4l,
+                d50,
+                A::mul_add(
+                    p.MX4l,
+                    d46,
+                    A::mul_add(
+                        -p.ZZ4l,
+                        k31,
+                        A::mul_add(
+                            -p.YZ4l,
+                            k30,
+                            A::mul_add(-p.XZ4l, k29, A::mul_add(-k28, d57, k26 * d58)),
+                        ),
+                    ),
+                ),
+            ); // N4l.z
+            let d59 = A::mul_add(-p.ZZ4l, k27, A::mul_add(p.YZ4l, k28, p.XZ4l * k26)); // J4lw4l|ud=0,g=0.z
+            let d169 = A::mul_add(-p.ZZ4r, k78, A::mul_add(p.YZ4r, k80, p.XZ4r * k77)); // J4rw4r|ud=0,g=0.z
+            let d60 = A::mul_add(
+                -p.MZ4l,
+                d46,
+                A::mul_add(
+                    p.MY4l,
+                    d49,
+                    A::mul_add(
+                        -p.XZ4l,
+                        k31,
+                        A::mul_add(
+                            -p.XY4l,
+                            k30,
+                            A::mul_add(-p.XX4l, k29, A::mul_add(k27, d58, k28 * d59)),
+                        ),
+                    ),
+                ),
+            ); // N4l.x
+            let d170 = A::mul_add(
+                p.MY4r,
+                d160,
+                A::mul_add(
+                    -p.MX4r,
+                    d156,
+                    A::mul_add(
+                        -p.ZZ4r,
+                        k82,
+                        A::mul_add(
+                            -p.YZ4r,
+                            k79,
+                            A::mul_add(-p.XZ4r, k81, A::mul_add(-k80, d167, k77 * d168)),
+                        ),
+                    ),
+                ),
+            ); // N4r.z
+            let d171 = A::mul_add(
+                p.MZ4r,
+                d156,
+                A::mul_add(
+                    p.MY4r,
+                    d159,
+                    A::mul_add(
+                        -p.XZ4r,
+                        k82,
+                        A::mul_add(
+                            -p.XY4r,
+                            k79,
+                            A::mul_add(-p.XX4r, k81, A::mul_add(k78, d168, k80 * d169)),
+                        ),
+                    ),
+                ),
+            ); // N4r.x
+            let d62 = A::mul_add(
+                p.MX4l,
+                d49,
+                A::mul_add(
+                    p.MZ4l,
+                    d50,
+                    A::mul_add(
+                        p.YZ4l,
+                        k31,
+                        A::mul_add(
+                            p.YY4l,
+                            k30,
+                            A::mul_add(p.XY4l, k29, A::mul_add(k26, d59, k27 * d57)),
+                        ),
+                    ),
+                ),
+            ); // N4l.y
+            let d172 = A::mul_add(
+                p.MX4r,
+                d159,
+                A::mul_add(
+                    p.MZ4r,
+                    d160,
+                    A::mul_add(
+                        p.YZ4r,
+                        k82,
+                        A::mul_add(
+                            p.YY4r,
+                            k79,
+                            A::mul_add(p.XY4r, k81, A::mul_add(k77, d169, k78 * d167)),
+                        ),
+                    ),
+                ),
+            ); // N4r.y
+            let k35 = A::mul_add(-s_q2l, k27, c_q2l * k28); // w4l in 5l|ud=0,g=0.y
+            let k84 = A::mul_add(-s_q2r, k78, c_q2r * k80); // w4r in 5r|ud=0,g=0.y
+            let k36 = A::mul_add(c_q2l, k27, s_q2l * k28); // w4l in 5l|ud=0,g=0.z
+            let k85 = A::mul_add(c_q2r, k78, s_q2r * k80); // w4r in 5r|ud=0,g=0.z
+            let k37 = k29 - qdd2l; // wd5l.x
+            let k86 = k81 - qdd2r; // wd5r.x
+            let k40 = A::mul_add(c_q2l, k31, A::mul_add(-s_q2l, k30, k35 * qd2l)); // wd5l.z
+            let k87 = A::mul_add(c_q2r, k82, A::mul_add(-s_q2r, k79, k84 * qd2r)); // wd5r.z
+            let k39 = k26 + qd2l; // w5l|ud=0,g=0.x
+            let k88 = k77 + qd2r; // w5r|ud=0,g=0.x
+            let k38 = A::mul_add(s_q2l, k31, A::mul_add(c_q2l, k30, k36 * qd2l)); // wd5l.y
+            let k89 = A::mul_add(s_q2r, k82, A::mul_add(c_q2r, k79, k85 * qd2r)); // wd5r.y
+            let d173 = A::mul_add(-c_q2r, d156, s_q2r * d159); // a5r.y
+            let d174 = A::mul_add(-c_q2r, d159, -s_q2r * d156); // a5r.z
+            let d65 = A::mul_add(-p.MY5l, k36, p.MZ5l * k35); // w5lxMS5l|ud=0,g=0.x
+            let d175 = A::mul_add(-p.MY5r, k85, p.MZ5r * k84); // w5rxMS5r|ud=0,g=0.x
+            let d66 = A::mul_add(-p.MZ5l, k39, p.MX5l * k36); // w5lxMS5l|ud=0,g=0.y
+            let d176 = A::mul_add(-p.MZ5r, k88, p.MX5r * k85); // w5rxMS5r|ud=0,g=0.y
+            let d67 = A::mul_add(-p.MX5l, k35, p.MY5l * k39); // w5lxMS5l|ud=0,g=0.z
+            let d177 = A::mul_add(-p.MX5r, k84, p.MY5r * k88); // w5rxMS5r|ud=0,g=0.z
+            let d69 = A::mul_add(
+                -p.MZ5l,
+                k37,
+                A::mul_add(
+                    -p.MX5l,
+                    k40,
+                    A::mul_add(-p.m5l, d63, A::mul_add(-k39, d67, k36 * d65)),
+                ),
+            ); // F5l.y
+            let d178 = A::mul_add(
+                -p.MZ5r,
+                k86,
+                A::mul_add(
+                    -p.MX5r,
+                    k87,
+                    A::mul_add(-p.m5r, d173, A::mul_add(-k88, d177, k85 * d175)),
+                ),
+            ); // F5r.y
+            let d68 = A::mul_add(
+                p.MY5l,
+                k40,
+                A::mul_add(
+                    p.MZ5l,
+                    k38,
+                    A::mul_add(p.m5l, d50, A::mul_add(-k36, d66, k35 * d67)),
+                ),
+            ); // F5l.x
+            let d179 = A::mul_add(
+                p.MY5r,
+                k87,
+                A::mul_add(
+                    p.MZ5r,
+                    k89,
+                    A::mul_add(p.m5r, d160, A::mul_add(-k85, d176, k84 * d177)),
+                ),
+            ); // F5r.x
+            let d70 = A::mul_add(
+                -p.MX5l,
+                k38,
+                A::mul_add(
+                    p.MY5l,
+                    k37,
+                    A::mul_add(-p.m5l, d64, A::mul_add(-k35, d65, k39 * d66)),
+                ),
+            ); // F5l.z
+            let d180 = A::mul_add(
+                -p.MX5r,
+                k89,
+                A::mul_add(
+                    p.MY5r,
+                    k86,
+                    A::mul_add(-p.m5r, d174, A::mul_add(-k84, d175, k88 * d176)),
+                ),
+            ); // F5r.z
+            let d71 = A::mul_add(p.XZ5l, k36, A::mul_add(p.XY5l, k35, p.XX5l * k39)); // J5lw5l|ud=0,g=0.x
+            let d181 = A::mul_add(p.XZ5r, k85, A::mul_add(p.XY5r, k84, p.XX5r * k88)); // J5rw5r|ud=0,g=0.x
+            let d72 = A::mul_add(p.YZ5l, k36, A::mul_add(p.YY5l, k35, p.XY5l * k39)); // J5lw5l|ud=0,g=0.y
+            let d182 = A::mul_add(p.YZ5r, k85, A::mul_add(p.YY5r, k84, p.XY5r * k88)); // J5rw5r|ud=0,g=0.y
+            let d73 = A::mul_add(p.ZZ5l, k36, A::mul_add(p.YZ5l, k35, p.XZ5l * k39)); // J5lw5l|ud=0,g=0.z
+            let d183 = A::mul_add(p.ZZ5r, k85, A::mul_add(p.YZ5r, k84, p.XZ5r * k88)); // J5rw5r|ud=0,g=0.z
+            let d76 = A::mul_add(
+                -p.MY5l,
+                d50,
+                A::mul_add(
+                    -p.MX5l,
+                    d63,
+                    A::mul_add(
+                        -p.ZZ5l,
+                        k40,
+                        A::mul_add(
+                            p.YZ5l,
+                            k38,
+                            A::mul_add(p.XZ5l, k37, A::mul_add(-k35, d71, k39 * d72)),
+                        ),
+                    ),
+                ),
+            ); // N5l.z
+            let d184 = A::mul_add(
+                -p.MY5r,
+                d160,
+                A::mul_add(
+                    -p.MX5r,
+                    d173,
+                    A::mul_add(
+                        -p.ZZ5r,
+                        k87,
+                        A::mul_add(
+                            p.YZ5r,
+                            k89,
+                            A::mul_add(p.XZ5r, k86, A::mul_add(-k84, d181, k88 * d182)),
+                        ),
+                    ),
+                ),
+            ); // N5r.z
+            let d74 = A::mul_add(
+                p.MZ5l,
+                d63,
+                A::mul_add(
+                    -p.MY5l,
+                    d64,
+                    A::mul_add(
+                        -p.XZ5l,
+                        k40,
+                        A::mul_add(
+                            p.XY5l,
+                            k38,
+                            A::mul_add(p.XX5l, k37, A::mul_add(-k36, d72, k35 * d73)),
+                        ),
+                    ),
+                ),
+            ); // N5l.x
+            let d185 = A::mul_add(
+                p.MZ5r,
+                d173,
+                A::mul_add(
+                    -p.MY5r,
+                    d174,
+                    A::mul_add(
+                        -p.XZ5r,
+                        k87,
+                        A::mul_add(
+                            p.XY5r,
+                            k89,
+                            A::mul_add(p.XX5r, k86, A::mul_add(-k85, d182, k84 * d183)),
+                        ),
+                    ),
+                ),
+            ); // N5r.x
+            let d75 = A::mul_add(
+                p.MX5l,
+                d64,
+                A::mul_add(
+                    p.MZ5l,
+                    d50,
+                    A::mul_add(
+                        -p.YZ5l,
+                        k40,
+                        A::mul_add(
+                            p.YY5l,
+                            k38,
+                            A::mul_add(p.XY5l, k37, A::mul_add(-k39, d73, k36 * d71)),
+                        ),
+                    ),
+                ),
+            ); // N5l.y
+            let d186 = A::mul_add(
+                p.MX5r,
+                d174,
+                A::mul_add(
+                    p.MZ5r,
+                    d160,
+                    A::mul_add(
+                        -p.YZ5r,
+                        k87,
+                        A::mul_add(
+                            p.YY5r,
+                            k89,
+                            A::mul_add(p.XY5r, k86, A::mul_add(-k88, d183, k85 * d181)),
+                        ),
+                    ),
+                ),
+            ); // N5r.y
+            let k41 = A::mul_add(-s_q3l, k36, c_q3l * k39); // w5l in 6l|ud=0,g=0.x
+            let k90 = A::mul_add(-s_q3r, k85, c_q3r * k88); // w5r in 6r|ud=0,g=0.x
+            let k42 = A::mul_add(c_q3l, k36, s_q3l * k39); // w5l in 6l|ud=0,g=0.z
+            let k91 = A::mul_add(c_q3r, k85, s_q3r * k88); // w5r in 6r|ud=0,g=0.z
+            let k45 = k38 + qdd3l; // wd6l.y
+            let k92 = k89 + qdd3r; // wd6r.y
+            let k43 = k35 - qd3l; // w6l|ud=0,g=0.y
+            let k93 = k84 - qd3r; // w6r|ud=0,g=0.y
+            let k44 = A::mul_add(s_q3l, k40, A::mul_add(c_q3l, k37, k42 * qd3l)); // wd6l.x
+            let k94 = A::mul_add(s_q3r, k87, A::mul_add(c_q3r, k86, k91 * qd3r)); // wd6r.x
+            let k46 = A::mul_add(c_q3l, k40, A::mul_add(-s_q3l, k37, k41 * qd3l)); // wd6l.z
+            let k95 = A::mul_add(c_q3r, k87, A::mul_add(-s_q3r, k86, k90 * qd3r)); // wd6r.z
+            let k47 = p.L7 * k36; // w5lxP6l|ud=0,g=0.x
+            let k96 = p.L7 * k85; // w5rxP6r|ud=0,g=0.x
+            let k48 = p.L7 * k39; // w5lxP6l|ud=0,g=0.z
+            let k97 = p.L7 * k88; // w5rxP6r|ud=0,g=0.z
+            let d78 = A::mul_add(p.L7, k40, A::mul_add(k35, k48, -d50)); // a6l in 5l.x
+            let d187 = A::mul_add(p.L7, k87, A::mul_add(k84, k97, -d160)); // a6r in 5r.x
+            let d77 = A::mul_add(k39, k48, k36 * k47) - d63; // a6l in 5l.y
+            let d188 = A::mul_add(k88, k97, k85 * k96) - d173; // a6r in 5r.y
+            let d79 = A::mul_add(p.L7, k37, A::mul_add(k35, k47, d64)); // a6l in 5l.z
+            let d189 = A::mul_add(p.L7, k86, A::mul_add(k84, k96, d174)); // a6r in 5r.z
+            let d81 = A::mul_add(c_q3l, d79, s_q3l * d78); // a6l.z
+            let d190 = A::mul_add(c_q3r, d189, s_q3r * d187); // a6r.z
+            let d80 = A::mul_add(-s_q3l, d79, c_q3l * d78); // a6l.x
+            let d191 = A::mul_add(-s_q3r, d189, c_q3r * d187); // a6r.x
+            let d83 = A::mul_add(-p.MX6l, k43, p.MY6l * k41); // w6lxMS6l|ud=0,g=0.z
+            let d192 = A::mul_add(-p.MX6r, k93, p.MY6r * k90); // w6rxMS6r|ud=0,g=0.z
+            let d82 = A::mul_add(p.MY6l, k42, p.MZ6l * k43); // w6lxMS6l|ud=0,g=0.x
+            let d193 = A::mul_add(p.MY6r, k91, p.MZ6r * k93); // w6rxMS6r|ud=0,g=0.x
+            let d84 = A::mul_add(p.MZ6l, k41, p.MX6l * k42); // w6lxMS6l|ud=0,g=0.y
+            let d194 = A::mul_add(p.MZ6r, k90, p.MX6r * k91); // w6rxMS6r|ud=0,g=0.y
+            let d86 = A::mul_add(
+                -p.MZ6l,
+                k44,
+                A::mul_add(
+                    p.MX6l,
+                    k46,
+                    A::mul_add(p.m6l, d77, A::mul_add(k41, d83, k42 * d82)),
+                ),
+            ); // F6l.y
+            let d195 = A::mul_add(
+                -p.MZ6r,
+                k94,
+                A::mul_add(
+                    p.MX6r,
+                    k95,
+                    A::mul_add(p.m6r, d188, A::mul_add(k90, d192, k91 * d193)),
+                ),
+            ); // F6r.y
+            let d85 = A::mul_add(
+                p.MY6l,
+                k46,
+                A::mul_add(
+                    -p.MZ6l,
+                    k45,
+                    A::mul_add(p.m6l, d80, A::mul_add(-k42, d84, k43 * d83)),
+                ),
+            ); // F6l.x
+            let d196 = A::mul_add(
+                p.MY6r,
+                k95,
+                A::mul_add(
+                    -p.MZ6r,
+                    k92,
+                    A::mul_add(p.m6r, d191, A::mul_add(-k91, d194, k93 * d192)),
+                ),
+            ); // F6r.x
+            let d87 = A::mul_add(
+                -p.MX6l,
+                k45,
+                A::mul_add(
+                    p.MY6l,
+                    k44,
+                    A::mul_add(p.m6l, d81, A::mul_add(k43, d82, k41 * d84)),
+                ),
+            ); // F6l.z
+            let d197 = A::mul_add(
+                -p.MX6r,
+                k92,
+                A::mul_add(
+                    p.MY6r,
+                    k94,
+                    A::mul_add(p.m6r, d190, A::mul_add(k93, d193, k90 * d194)),
+                ),
+            ); // F6r.z
+            let d88 = A::mul_add(-p.XZ6l, k42, A::mul_add(p.XY6l, k43, p.XX6l * k41)); // J6lw6l|ud=0,g=0.x
+            let d198 = A::mul_add(-p.XZ6r, k91, A::mul_add(p.XY6r, k93, p.XX6r * k90)); // J6rw6r|ud=0,g=0.x
+            let d89 = A::mul_add(-p.YZ6l, k42, A::mul_add(p.YY6l, k43, p.XY6l * k41)); // J6lw6l|ud=0,g=0.y
+            let d199 = A::mul_add(-p.YZ6r, k91, A::mul_add(p.YY6r, k93, p.XY6r * k90)); // J6rw6r|ud=0,g=0.y
+            let d90 = A::mul_add(-p.ZZ6l, k42, A::mul_add(p.YZ6l, k43, p.XZ6l * k41)); // J6lw6l|ud=0,g=0.z
+            let d200 = A::mul_add(-p.ZZ6r, k91, A::mul_add(p.YZ6r, k93, p.XZ6r * k90)); // J6rw6r|ud=0,g=0.z
+            let d92 = A::mul_add(
+                -p.MY6l,
+                d80,
+                A::mul_add(
+                    -p.MX6l,
+                    d77,
+                    A::mul_add(
+                        -p.ZZ6l,
+                        k46,
+                        A::mul_add(
+                            -p.YZ6l,
+                            k45,
+                            A::mul_add(-p.XZ6l, k44, A::mul_add(-k43, d88, k41 * d89)),
+                        ),
+                    ),
+                ),
+            ); // N6l.z
+            let d201 = A::mul_add(
+                -p.MY6r,
+                d191,
+                A::mul_add(
+                    -p.MX6r,
+                    d188,
+                    A::mul_add(
+                        -p.ZZ6r,
+                        k95,
+                        A::mul_add(
+                            -p.YZ6r,
+                            k92,
+                            A::mul_add(-p.XZ6r, k94, A::mul_add(-k93, d198, k90 * d199)),
+                        ),
+                    ),
+                ),
+            ); // N6r.z
+            let d91 = A::mul_add(
+                p.MZ6l,
+                d77,
+                A::mul_add(
+                    -p.MY6l,
+                    d81,
+                    A::mul_add(
+                        -p.XZ6l,
+                        k46,
+                        A::mul_add(
+                            -p.XY6l,
+                            k45,
+                            A::mul_add(-p.XX6l, k44, A::mul_add(k42, d89, k43 * d90)),
+                        ),
+                    ),
+                ),
+            ); // N6l.x
+            let d202 = A::mul_add(
+                p.MZ6r,
+                d188,
+                A::mul_add(
+                    -p.MY6r,
+                    d190,
+                    A::mul_add(
+                        -p.XZ6r,
+                        k95,
+                        A::mul_add(
+                            -p.XY6r,
+                            k92,
+                            A::mul_add(-p.XX6r, k94, A::mul_add(k91, d199, k93 * d200)),
+                        ),
+                    ),
+                ),
+            ); // N6r.x
+            let d93 = A::mul_add(
+                -p.MX6l,
+                d81,
+                A::mul_add(
+                    -p.MZ6l,
+                    d80,
+                    A::mul_add(
+                        p.YZ6l,
+                        k46,
+                        A::mul_add(
+                            p.YY6l,
+                            k45,
+                            A::mul_add(p.XY6l, k44, A::mul_add(k41, d90, k42 * d88)),
+                        ),
+                    ),
+                ),
+            ); // N6l.y
+            let d203 = A::mul_add(
+                -p.MX6r,
+                d190,
+                A::mul_add(
+                    -p.MZ6r,
+                    d191,
+                    A::mul_add(
+                        p.YZ6r,
+                        k95,
+                        A::mul_add(
+                            p.YY6r,
+                            k92,
+                            A::mul_add(p.XY6r, k94, A::mul_add(k90, d200, k91 * d198)),
+                        ),
+                    ),
+                ),
+            ); // N6r.y
+            let k49 = A::mul_add(-s_q4l, k42, c_q4l * k43); // w6l in 7l|ud=0,g=0.y
+            let k98 = A::mul_add(-s_q4r, k91, c_q4r * k93); // w6r in 7r|ud=0,g=0.y
+            let k50 = A::mul_add(c_q4l, k42, s_q4l * k43); // w6l in 7l|ud=0,g=0.z
+            let k99 = A::mul_add(c_q4r, k91, s_q4r * k93); // w6r in 7r|ud=0,g=0.z
+            let k51 = k44 - qdd4l; // wd7l.x
+            let k100 = k94 - qdd4r; // wd7r.x
+            let k54 = A::mul_add(c_q4l, k46, A::mul_add(-s_q4l, k45, k49 * qd4l)); // wd7l.z
+            let k101 = A::mul_add(c_q4r, k95, A::mul_add(-s_q4r, k92, k98 * qd4r)); // wd7r.z
+            let k53 = k41 + qd4l; // w7l|ud=0,g=0.x
+            let k102 = k90 + qd4r; // w7r|ud=0,g=0.x
+            let k52 = A::mul_add(s_q4l, k46, A::mul_add(c_q4l, k45, k50 * qd4l)); // wd7l.y
+            let k103 = A::mul_add(s_q4r, k95, A::mul_add(c_q4r, k92, k99 * qd4r)); // wd7r.y
+            let d94 = A::mul_add(s_q4l, d81, c_q4l * d77); // a7l.y
+            let d204 = A::mul_add(s_q4r, d190, c_q4r * d188); // a7r.y
+            let d95 = A::mul_add(-c_q4l, d81, s_q4l * d77); // a7l.z
+            let d205 = A::mul_add(-c_q4r, d190, s_q4r * d188); // a7r.z
+            let d96 = A::mul_add(-p.MY7l, k50, p.MZ7l * k49); // w7lxMS7l|ud=0,g=0.x
+            let d206 = A::mul_add(-p.MY7r, k99, p.MZ7r * k98); // w7rxMS7r|ud=0,g=0.x
+            let d97 = A::mul_add(-p.MZ7l, k53, p.MX7l * k50); // w7lxMS7l|ud=0,g=0.y
+            let d207 = A::mul_add(-p.MZ7r, k102, p.MX7r * k99); // w7rxMS7r|ud=0,g=0.y
+            let d98 = A::mul_add(-p.MX7l, k49, p.MY7l * k53); // w7lxMS7l|ud=0,g=0.z
+            let d208 = A::mul_add(-p.MX7r, k98, p.MY7r * k102); // w7rxMS7r|ud=0,g=0.z
+            let d100 = A::mul_add(
+                -p.MZ7l,
+                k51,
+                A::mul_add(
+                    -p.MX7l,
+                    k54,
+                    A::mul_add(p.m7l, d94, A::mul_add(-k53, d98, k50 * d96)),
+                ),
+            ); // F7l.y
+            let d209 = A::mul_add(
+                -p.MZ7r,
+                k100,
+                A::mul_add(
+                    -p.MX7r,
+                    k101,
+                    A::mul_add(p.m7r, d204, A::mul_add(-k102, d208, k99 * d206)),
+                ),
+            ); // F7r.y
+            let d99 = A::mul_add(
+                p.MY7l,
+                k54,
+                A::mul_add(
+                    p.MZ7l,
+                    k52,
+                    A::mul_add(-p.m7l, d80, A::mul_add(-k50, d97, k49 * d98)),
+                ),
+            ); // F7l.x
+            let d210 = A::mul_add(
+                p.MY7r,
+                k101,
+                A::mul_add(
+                    p.MZ7r,
+                    k103,
+                    A::mul_add(-p.m7r, d191, A::mul_add(-k99, d207, k98 * d208)),
+                ),
+            ); // F7r.x
+            let d101 = A::mul_add(
+                -p.MX7l,
+                k52,
+                A::mul_add(
+                    p.MY7l,
+                    k51,
+                    A::mul_add(p.m7l, d95, A::mul_add(-k49, d96, k53 * d97)),
+                ),
+            ); // F7l.z
+            let d211 = A::mul_add(
+                -p.MX7r,
+                k103,
+                A::mul_add(
+                    p.MY7r,
+                    k100,
+                    A::mul_add(p.m7r, d205, A::mul_add(-k98, d206, k102 * d207)),
+                ),
+            ); // F7r.z
+            let d102 = A::mul_add(p.XZ7l, k50, A::mul_add(p.XY7l, k49, p.XX7l * k53)); // J7lw7l|ud=0,g=0.x
+            let d212 = A::mul_add(p.XZ7r, k99, A::mul_add(p.XY7r, k98, p.XX7r * k102)); // J7rw7r|ud=0,g=0.x
+            let d103 = A::mul_add(p.YZ7l, k50, A::mul_add(p.YY7l, k49, p.XY7l * k53)); // J7lw7l|ud=0,g=0.y
+            let d213 = A::mul_add(p.YZ7r, k99, A::mul_add(p.YY7r, k98, p.XY7r * k102)); // J7rw7r|ud=0,g=0.y
+            let d104 = A::mul_add(p.ZZ7l, k50, A::mul_add(p.YZ7l, k49, p.XZ7l * k53)); // J7lw7l|ud=0,g=0.z
+            let d214 = A::mul_add(p.ZZ7r, k99, A::mul_add(p.YZ7r, k98, p.XZ7r * k102)); // J7rw7r|ud=0,g=0.z
+            let d107 = A::mul_add(
+                p.MY7l,
+                d80,
+                A::mul_add(
+                    p.MX7l,
+                    d94,
+                    A::mul_add(
+                        -p.ZZ7l,
+                        k54,
+                        A::mul_add(
+                            p.YZ7l,
+                            k52,
+                            A::mul_add(p.XZ7l, k51, A::mul_add(-k49, d102, k53 * d103)),
+                        ),
+                    ),
+                ),
+            ); // N7l.z
+            let d215 = A::mul_add(
+                p.MY7r,
+                d191,
+                A::mul_add(
+                    p.MX7r,
+                    d204,
+                    A::mul_add(
+                        -p.ZZ7r,
+                        k101,
+                        A::mul_add(
+                            p.YZ7r,
+                            k103,
+                            A::mul_add(p.XZ7r, k100, A::mul_add(-k98, d212, k102 * d213)),
+                        ),
+                    ),
+                ),
+            ); // N7r.z
+            let d105 = A::mul_add(
+                -p.MZ7l,
+                d94,
+                A::mul_add(
+                    p.MY7l,
+                    d95,
+                    A::mul_add(
+                        -p.XZ7l,
+                        k54,
+                        A::mul_add(
+                            p.XY7l,
+                            k52,
+                            A::mul_add(p.XX7l, k51, A::mul_add(-k50, d103, k49 * d104)),
+                        ),
+                    ),
+                ),
+            ); // N7l.x
+            let d216 = A::mul_add(
+                -p.MZ7r,
+                d204,
+                A::mul_add(
+                    p.MY7r,
+                    d205,
+                    A::mul_add(
+                        -p.XZ7r,
+                        k101,
+                        A::mul_add(
+                            p.XY7r,
+                            k103,
+                            A::mul_add(p.XX7r, k100, A::mul_add(-k99, d213, k98 * d214)),
+                        ),
+                    ),
+                ),
+            ); // N7r.x
+            let d106 = A::mul_add(
+                -p.MX7l,
+                d95,
+                A::mul_add(
+                    -p.MZ7l,
+                    d80,
+                    A::mul_add(
+                        -p.YZ7l,
+                        k54,
+                        A::mul_add(
+                            p.YY7l,
+                            k52,
+                            A::mul_add(p.XY7l, k51, A::mul_add(-k53, d104, k50 * d102)),
+                        ),
+                    ),
+                ),
+            ); // N7l.y
+            let d217 = A::mul_add(
+                -p.MX7r,
+                d205,
+                A::mul_add(
+                    -p.MZ7r,
+                    d191,
+                    A::mul_add(
+                        -p.YZ7r,
+                        k101,
+                        A::mul_add(
+                            p.YY7r,
+                            k103,
+                            A::mul_add(p.XY7r, k100, A::mul_add(-k102, d214, k99 * d212)),
+                        ),
+                    ),
+                ),
+            ); // N7r.y
+            let k55 = A::mul_add(-s_q5l, k50, c_q5l * k53); // w7l in 8l|ud=0,g=0.x
+            let k104 = A::mul_add(-s_q5r, k99, c_q5r * k102); // w7r in 8r|ud=0,g=0.x
+            let k56 = A::mul_add(c_q5l, k50, s_q5l * k53); // w7l in 8l|ud=0,g=0.z
+            let k105 = A::mul_add(c_q5r, k99, s_q5r * k102); // w7r in 8r|ud=0,g=0.z
+            let k59 = k52 + qdd5l; // wd8l.y
+            let k106 = k103 + qdd5r; // wd8r.y
+            let k57 = k49 - qd5l; // w8l|ud=0,g=0.y
+            let k107 = k98 - qd5r; // w8r|ud=0,g=0.y
+            let k58 = A::mul_add(s_q5l, k54, A::mul_add(c_q5l, k51, k56 * qd5l)); // wd8l.x
+            let k108 = A::mul_add(s_q5r, k101, A::mul_add(c_q5r, k100, k105 * qd5r)); // wd8r.x
+            let k60 = A::mul_add(c_q5l, k54, A::mul_add(-s_q5l, k51, k55 * qd5l)); // wd8l.z
+            let k109 = A::mul_add(c_q5r, k101, A::mul_add(-s_q5r, k100, k104 * qd5r)); // wd8r.z
+            let k61 = p.L8 * k50; // w7lxP8l|ud=0,g=0.x
+            let k110 = p.L8 * k99; // w7rxP8r|ud=0,g=0.x
+            let k62 = p.L8 * k53; // w7lxP8l|ud=0,g=0.z
+            let k111 = p.L8 * k102; // w7rxP8r|ud=0,g=0.z
+            let d109 = A::mul_add(p.L8, k54, A::mul_add(k49, k62, d80)); // a8l in 7l.x
+            let d218 = A::mul_add(p.L8, k101, A::mul_add(k98, k111, d191)); // a8r in 7r.x
+            let d108 = A::mul_add(k53, k62, k50 * k61) + d94; // a8l in 7l.y
+            let d219 = A::mul_add(k102, k111, k99 * k110) + d204; // a8r in 7r.y
+            let d110 = A::mul_add(p.L8, k51, A::mul_add(k49, k61, -d95)); // a8l in 7l.z
+            let d220 = A::mul_add(p.L8, k100, A::mul_add(k98, k110, -d205)); // a8r in 7r.z
+            let d112 = A::mul_add(c_q5l, d110, s_q5l * d109); // a8l.z
+            let d221 = A::mul_add(c_q5r, d220, s_q5r * d218); // a8r.z
+            let d111 = A::mul_add(-s_q5l, d110, c_q5l * d109); // a8l.x
+            let d222 = A::mul_add(-s_q5r, d220, c_q5r * d218); // a8r.x
+            let d114 = A::mul_add(-p.MX8l, k57, p.MY8l * k55); // w8lxMS8l|ud=0,g=0.z
+            let d223 = A::mul_add(-p.MX8r, k107, p.MY8r * k104); // w8rxMS8r|ud=0,g=0.z
+            let d113 = A::mul_add(p.MY8l, k56, p.MZ8l * k57); // w8lxMS8l|ud=0,g=0.x
+            let d224 = A::mul_add(p.MY8r, k105, p.MZ8r * k107); // w8rxMS8r|ud=0,g=0.x
+            let d115 = A::mul_add(p.MZ8l, k55, p.MX8l * k56); // w8lxMS8l|ud=0,g=0.y
+            let d225 = A::mul_add(p.MZ8r, k104, p.MX8r * k105); // w8rxMS8r|ud=0,g=0.y
+            let d117 = A::mul_add(
+                -p.MZ8l,
+                k58,
+                A::mul_add(
+                    p.MX8l,
+                    k60,
+                    A::mul_add(p.m8l, d108, A::mul_add(k55, d114, k56 * d113)),
+                ),
+            ); // F8l.y
+            let d226 = A::mul_add(
+                -p.MZ8r,
+                k108,
+                A::mul_add(
+                    p.MX8r,
+                    k109,
+                    A::mul_add(p.m8r, d219, A::mul_add(k104, d223, k105 * d224)),
+                ),
+            ); // F8r.y
+            let d116 = A::mul_add(
+                p.MY8l,
+                k60,
+                A::mul_add(
+                    -p.MZ8l,
+                    k59,
+                    A::mul_add(p.m8l, d111, A::mul_add(-k56, d115, k57 * d114)),
+                ),
+            ); // F8l.x
+            let d227 = A::mul_add(
+                p.MY8r,
+                k109,
+                A::mul_add(
+                    -p.MZ8r,
+                    k106,
+                    A::mul_add(p.m8r, d222, A::mul_add(-k105, d225, k107 * d223)),
+                ),
+            ); // F8r.x
+            let d118 = A::mul_add(
+                -p.MX8l,
+                k59,
+                A::mul_add(
+                    p.MY8l,
+                    k58,
+                    A::mul_add(p.m8l, d112, A::mul_add(k57, d113, k55 * d115)),
+                ),
+            ); // F8l.z
+            let d228 = A::mul_add(
+                -p.MX8r,
+                k106,
+                A::mul_add(
+                    p.MY8r,
+                    k108,
+                    A::mul_add(p.m8r, d221, A::mul_add(k107, d224, k104 * d225)),
+                ),
+            ); // F8r.z
+            let d119 = A::mul_add(-p.XZ8l, k56, A::mul_add(p.XY8l, k57, p.XX8l * k55)); // J8lw8l|ud=0,g=0.x
+            let d229 = A::mul_add(
+                -p.XZ8r,
+                k105,
+                A::mul_add(p.XY8r, k107, p.XX8r * k104),
+            ); // J8rw8r|ud=0,g=0.x
+            let d120 = A::mul_add(-p.YZ8l, k56, A::mul_add(p.YY8l, k57, p.XY8l * k55)); // J8lw8l|ud=0,g=0.y
+            let d230 = A::mul_add(
+                -p.YZ8r,
+                k105,
+                A::mul_add(p.YY8r, k107, p.XY8r * k104),
+            ); // J8rw8r|ud=0,g=0.y
+            let d121 = A::mul_add(-p.ZZ8l, k56, A::mul_add(p.YZ8l, k57, p.XZ8l * k55)); // J8lw8l|ud=0,g=0.z
+            let d231 = A::mul_add(
+                -p.ZZ8r,
+                k105,
+                A::mul_add(p.YZ8r, k107, p.XZ8r * k104),
+            ); // J8rw8r|ud=0,g=0.z
+            let d123 = A::mul_add(
+                -p.MY8l,
+                d111,
+                A::mul_add(
+                    -p.MX8l,
+                    d108,
+                    A::mul_add(
+                        -p.ZZ8l,
+                        k60,
+                        A::mul_add(
+                            -p.YZ8l,
+                            k59,
+                            A::mul_add(-p.XZ8l, k58, A::mul_add(-k57, d119, k55 * d120)),
+                        ),
+                    ),
+                ),
+            ); // N8l.z
+            let d232 = A::mul_add(
+                -p.MY8r,
+                d222,
+                A::mul_add(
+                    -p.MX8r,
+                    d219,
+                    A::mul_add(
+                        -p.ZZ8r,
+                        k109,
+                        A::mul_add(
+                            -p.YZ8r,
+                            k106,
+                            A::mul_add(
+                                -p.XZ8r,
+                                k108,
+                                A::mul_add(-k107, d229, k104 * d230),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N8r.z
+            let d122 = A::mul_add(
+                p.MZ8l,
+                d108,
+                A::mul_add(
+                    -p.MY8l,
+                    d112,
+                    A::mul_add(
+                        -p.XZ8l,
+                        k60,
+                        A::mul_add(
+                            -p.XY8l,
+                            k59,
+                            A::mul_add(-p.XX8l, k58, A::mul_add(k56, d120, k57 * d121)),
+                        ),
+                    ),
+                ),
+            ); // N8l.x
+            let d233 = A::mul_add(
+                p.MZ8r,
+                d219,
+                A::mul_add(
+                    -p.MY8r,
+                    d221,
+                    A::mul_add(
+                        -p.XZ8r,
+                        k109,
+                        A::mul_add(
+                            -p.XY8r,
+                            k106,
+                            A::mul_add(
+                                -p.XX8r,
+                                k108,
+                                A::mul_add(k105, d230, k107 * d231),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N8r.x
+            let d124 = A::mul_add(
+                -p.MX8l,
+                d112,
+                A::mul_add(
+                    -p.MZ8l,
+                    d111,
+                    A::mul_add(
+                        p.YZ8l,
+                        k60,
+                        A::mul_add(
+                            p.YY8l,
+                            k59,
+                            A::mul_add(p.XY8l, k58, A::mul_add(k55, d121, k56 * d119)),
+                        ),
+                    ),
+                ),
+            ); // N8l.y
+            let d234 = A::mul_add(
+                -p.MX8r,
+                d221,
+                A::mul_add(
+                    -p.MZ8r,
+                    d222,
+                    A::mul_add(
+                        p.YZ8r,
+                        k109,
+                        A::mul_add(
+                            p.YY8r,
+                            k106,
+                            A::mul_add(p.XY8r, k108, A::mul_add(k104, d231, k105 * d229)),
+                        ),
+                    ),
+                ),
+            ); // N8r.y
+            let k63 = A::mul_add(-s_q6l, k56, c_q6l * k57); // w8l in 9l|ud=0,g=0.y
+            let k112 = A::mul_add(-s_q6r, k105, c_q6r * k107); // w8r in 9r|ud=0,g=0.y
+            let k64 = A::mul_add(c_q6l, k56, s_q6l * k57); // w8l in 9l|ud=0,g=0.z
+            let k113 = A::mul_add(c_q6r, k105, s_q6r * k107); // w8r in 9r|ud=0,g=0.z
+            let k65 = k58 - qdd6l; // wd9l.x
+            let k114 = k108 - qdd6r; // wd9r.x
+            let k68 = A::mul_add(c_q6l, k60, A::mul_add(-s_q6l, k59, k63 * qd6l)); // wd9l.z
+            let k115 = A::mul_add(c_q6r, k109, A::mul_add(-s_q6r, k106, k112 * qd6r)); // wd9r.z
+            let k67 = k55 + qd6l; // w9l|ud=0,g=0.x
+            let k116 = k104 + qd6r; // w9r|ud=0,g=0.x
+            let k66 = A::mul_add(s_q6l, k60, A::mul_add(c_q6l, k59, k64 * qd6l)); // wd9l.y
+            let k117 = A::mul_add(s_q6r, k109, A::mul_add(c_q6r, k106, k113 * qd6r)); // wd9r.y
+            let d125 = A::mul_add(s_q6l, d112, c_q6l * d108); // a9l.y
+            let d235 = A::mul_add(s_q6r, d221, c_q6r * d219); // a9r.y
+            let d126 = A::mul_add(-c_q6l, d112, s_q6l * d108); // a9l.z
+            let d236 = A::mul_add(-c_q6r, d221, s_q6r * d219); // a9r.z
+            let d127 = A::mul_add(-p.MY9l, k64, p.MZ9l * k63); // w9lxMS9l|ud=0,g=0.x
+            let d237 = A::mul_add(-p.MY9r, k113, p.MZ9r * k112); // w9rxMS9r|ud=0,g=0.x
+            let d128 = A::mul_add(-p.MZ9l, k67, p.MX9l * k64); // w9lxMS9l|ud=0,g=0.y
+            let d238 = A::mul_add(-p.MZ9r, k116, p.MX9r * k113); // w9rxMS9r|ud=0,g=0.y
+            let d129 = A::mul_add(-p.MX9l, k63, p.MY9l * k67); // w9lxMS9l|ud=0,g=0.z
+            let d239 = A::mul_add(-p.MX9r, k112, p.MY9r * k116); // w9rxMS9r|ud=0,g=0.z
+            let d131 = A::mul_add(
+                -p.MZ9l,
+                k65,
+                A::mul_add(
+                    -p.MX9l,
+                    k68,
+                    A::mul_add(p.m9l, d125, A::mul_add(-k67, d129, k64 * d127)),
+                ),
+            ); // F9l.y
+            let d240 = A::mul_add(
+                -p.MZ9r,
+                k114,
+                A::mul_add(
+                    -p.MX9r,
+                    k115,
+                    A::mul_add(p.m9r, d235, A::mul_add(-k116, d239, k113 * d237)),
+                ),
+            ); // F9r.y
+            let d130 = A::mul_add(
+                p.MY9l,
+                k68,
+                A::mul_add(
+                    p.MZ9l,
+                    k66,
+                    A::mul_add(-p.m9l, d111, A::mul_add(-k64, d128, k63 * d129)),
+                ),
+            ); // F9l.x
+            let d241 = A::mul_add(
+                p.MY9r,
+                k115,
+                A::mul_add(
+                    p.MZ9r,
+                    k117,
+                    A::mul_add(-p.m9r, d222, A::mul_add(-k113, d238, k112 * d239)),
+                ),
+            ); // F9r.x
+            let d132 = A::mul_add(
+                -p.MX9l,
+                k66,
+                A::mul_add(
+                    p.MY9l,
+                    k65,
+                    A::mul_add(p.m9l, d126, A::mul_add(-k63, d127, k67 * d128)),
+                ),
+            ); // F9l.z
+            let d242 = A::mul_add(
+                -p.MX9r,
+                k117,
+                A::mul_add(
+                    p.MY9r,
+                    k114,
+                    A::mul_add(p.m9r, d236, A::mul_add(-k112, d237, k116 * d238)),
+                ),
+            ); // F9r.z
+            let d133 = A::mul_add(p.XZ9l, k64, A::mul_add(p.XY9l, k63, p.XX9l * k67)); // J9lw9l|ud=0,g=0.x
+            let d243 = A::mul_add(p.XZ9r, k113, A::mul_add(p.XY9r, k112, p.XX9r * k116)); // J9rw9r|ud=0,g=0.x
+            let d134 = A::mul_add(p.YZ9l, k64, A::mul_add(p.YY9l, k63, p.XY9l * k67)); // J9lw9l|ud=0,g=0.y
+            let d244 = A::mul_add(p.YZ9r, k113, A::mul_add(p.YY9r, k112, p.XY9r * k116)); // J9rw9r|ud=0,g=0.y
+            let d135 = A::mul_add(p.ZZ9l, k64, A::mul_add(p.YZ9l, k63, p.XZ9l * k67)); // J9lw9l|ud=0,g=0.z
+            let d245 = A::mul_add(p.ZZ9r, k113, A::mul_add(p.YZ9r, k112, p.XZ9r * k116)); // J9rw9r|ud=0,g=0.z
+            let d138 = A::mul_add(
+                p.MY9l,
+                d111,
+                A::mul_add(
+                    p.MX9l,
+                    d125,
+                    A::mul_add(
+                        -p.ZZ9l,
+                        k68,
+                        A::mul_add(
+                            p.YZ9l,
+                            k66,
+                            A::mul_add(p.XZ9l, k65, A::mul_add(-k63, d133, k67 * d134)),
+                        ),
+                    ),
+                ),
+            ); // N9l.z
+            let d246 = A::mul_add(
+                p.MY9r,
+                d222,
+                A::mul_add(
+                    p.MX9r,
+                    d235,
+                    A::mul_add(
+                        -p.ZZ9r,
+                        k115,
+                        A::mul_add(
+                            p.YZ9r,
+                            k117,
+                            A::mul_add(
+                                p.XZ9r,
+                                k114,
+                                A::mul_add(-k112, d243, k116 * d244),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N9r.z
+            let d136 = A::mul_add(
+                -p.MZ9l,
+                d125,
+                A::mul_add(
+                    p.MY9l,
+                    d126,
+                    A::mul_add(
+                        -p.XZ9l,
+                        k68,
+                        A::mul_add(
+                            p.XY9l,
+                            k66,
+                            A::mul_add(p.XX9l, k65, A::mul_add(-k64, d134, k63 * d135)),
+                        ),
+                    ),
+                ),
+            ); // N9l.x
+            let d247 = A::mul_add(
+                -p.MZ9r,
+                d235,
+                A::mul_add(
+                    p.MY9r,
+                    d236,
+                    A::mul_add(
+                        -p.XZ9r,
+                        k115,
+                        A::mul_add(
+                            p.XY9r,
+                            k117,
+                            A::mul_add(
+                                p.XX9r,
+                                k114,
+                                A::mul_add(-k113, d244, k112 * d245),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N9r.x
+            let d137 = A::mul_add(
+                -p.MX9l,
+                d126,
+                A::mul_add(
+                    -p.MZ9l,
+                    d111,
+                    A::mul_add(
+                        -p.YZ9l,
+                        k68,
+                        A::mul_add(
+                            p.YY9l,
+                            k66,
+                            A::mul_add(p.XY9l, k65, A::mul_add(-k67, d135, k64 * d133)),
+                        ),
+                    ),
+                ),
+            ); // N9l.y
+            let d248 = A::mul_add(
+                -p.MX9r,
+                d236,
+                A::mul_add(
+                    -p.MZ9r,
+                    d222,
+                    A::mul_add(
+                        -p.YZ9r,
+                        k115,
+                        A::mul_add(
+                            p.YY9r,
+                            k117,
+                            A::mul_add(
+                                p.XY9r,
+                                k114,
+                                A::mul_add(-k116, d245, k113 * d243),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N9r.y
+            let k69 = A::mul_add(-s_q7l, k64, c_q7l * k67); // w9l in 10l|ud=0,g=0.x
+            let k118 = A::mul_add(-s_q7r, k113, c_q7r * k116); // w9r in 10r|ud=0,g=0.x
+            let k70 = A::mul_add(c_q7l, k64, s_q7l * k67); // w9l in 10l|ud=0,g=0.y
+            let k119 = A::mul_add(c_q7r, k113, s_q7r * k116); // w9r in 10r|ud=0,g=0.y
+            let k74 = k66 + qdd7l; // wd10l.z
+            let k120 = k117 + qdd7r; // wd10r.z
+            let k72 = A::mul_add(c_q7l, k68, A::mul_add(-s_q7l, k65, k69 * qd7l)); // wd10l.y
+            let k121 = A::mul_add(c_q7r, k115, A::mul_add(-s_q7r, k114, k118 * qd7r)); // wd10r.y
+            let k71 = k63 - qd7l; // w10l|ud=0,g=0.z
+            let k122 = k112 - qd7r; // w10r|ud=0,g=0.z
+            let k73 = A::mul_add(s_q7l, k68, A::mul_add(c_q7l, k65, k70 * qd7l)); // wd10l.x
+            let k123 = A::mul_add(s_q7r, k115, A::mul_add(c_q7r, k114, k119 * qd7r)); // wd10r.x
+            let k75 = p.L9 * k64; // w9lxP10l|ud=0,g=0.x
+            let k124 = p.L9 * k113; // w9rxP10r|ud=0,g=0.x
+            let k76 = p.L9 * k67; // w9lxP10l|ud=0,g=0.z
+            let k125 = p.L9 * k116; // w9rxP10r|ud=0,g=0.z
+            let d140 = A::mul_add(p.L9, k68, A::mul_add(k63, k76, d111)); // a10l in 9l.x
+            let d249 = A::mul_add(p.L9, k115, A::mul_add(k112, k125, d222)); // a10r in 9r.x
+            let d139 = A::mul_add(k67, k76, k64 * k75) + d125; // a10l in 9l.y
+            let d250 = A::mul_add(k116, k125, k113 * k124) + d235; // a10r in 9r.y
+            let d141 = A::mul_add(p.L9, k65, A::mul_add(k63, k75, -d126)); // a10l in 9l.z
+            let d251 = A::mul_add(p.L9, k114, A::mul_add(k112, k124, -d236)); // a10r in 9r.z
+            let d142 = A::mul_add(-s_q7l, d141, c_q7l * d140); // a10l.x
+            let d252 = A::mul_add(-s_q7r, d251, c_q7r * d249); // a10r.x
+            let d143 = A::mul_add(c_q7l, d141, s_q7l * d140); // a10l.y
+            let d253 = A::mul_add(c_q7r, d251, s_q7r * d249); // a10r.y
+            let d144 = A::mul_add(-p.MY10l, k71, p.MZ10l * k70); // w10lxMS10l|ud=0,g=0.x
+            let d254 = A::mul_add(-p.MY10r, k122, p.MZ10r * k119); // w10rxMS10r|ud=0,g=0.x
+            let d146 = A::mul_add(-p.MX10l, k70, p.MY10l * k69); // w10lxMS10l|ud=0,g=0.z
+            let d255 = A::mul_add(-p.MX10r, k119, p.MY10r * k118); // w10rxMS10r|ud=0,g=0.z
+            let d145 = A::mul_add(-p.MZ10l, k69, p.MX10l * k71); // w10lxMS10l|ud=0,g=0.y
+            let d256 = A::mul_add(-p.MZ10r, k118, p.MX10r * k122); // w10rxMS10r|ud=0,g=0.y
+            let d147 = A::mul_add(
+                p.MY10l,
+                k74,
+                A::mul_add(
+                    p.MZ10l,
+                    k72,
+                    A::mul_add(p.m10l, d142, A::mul_add(-k71, d145, k70 * d146)),
+                ),
+            ); // F10l.x
+            let d257 = A::mul_add(
+                p.MY10r,
+                k120,
+                A::mul_add(
+                    p.MZ10r,
+                    k121,
+                    A::mul_add(p.m10r, d252, A::mul_add(-k122, d256, k119 * d255)),
+                ),
+            ); // F10r.x
+            let d148 = A::mul_add(
+                p.MZ10l,
+                k73,
+                A::mul_add(
+                    -p.MX10l,
+                    k74,
+                    A::mul_add(p.m10l, d143, A::mul_add(-k69, d146, k71 * d144)),
+                ),
+            ); // F10l.y
+            let d258 = A::mul_add(
+                p.MZ10r,
+                k123,
+                A::mul_add(
+                    -p.MX10r,
+                    k120,
+                    A::mul_add(p.m10r, d253, A::mul_add(-k118, d255, k122 * d254)),
+                ),
+            ); // F10r.y
+            let d149 = A::mul_add(
+                -p.MX10l,
+                k72,
+                A::mul_add(
+                    -p.MY10l,
+                    k73,
+                    A::mul_add(-p.m10l, d139, A::mul_add(-k70, d144, k69 * d145)),
+                ),
+            ); // F10l.z
+            let d259 = A::mul_add(
+                -p.MX10r,
+                k121,
+                A::mul_add(
+                    -p.MY10r,
+                    k123,
+                    A::mul_add(-p.m10r, d250, A::mul_add(-k119, d254, k118 * d256)),
+                ),
+            ); // F10r.z
+            let d150 = A::mul_add(p.XZ10l, k71, A::mul_add(p.XY10l, k70, p.XX10l * k69)); // J10lw10l|ud=0,g=0.x
+            let d260 = A::mul_add(
+                p.XZ10r,
+                k122,
+                A::mul_add(p.XY10r, k119, p.XX10r * k118),
+            ); // J10rw10r|ud=0,g=0.x
+            let d151 = A::mul_add(p.YZ10l, k71, A::mul_add(p.YY10l, k70, p.XY10l * k69)); // J10lw10l|ud=0,g=0.y
+            let d261 = A::mul_add(
+                p.YZ10r,
+                k122,
+                A::mul_add(p.YY10r, k119, p.XY10r * k118),
+            ); // J10rw10r|ud=0,g=0.y
+            let d152 = A::mul_add(p.ZZ10l, k71, A::mul_add(p.YZ10l, k70, p.XZ10l * k69)); // J10lw10l|ud=0,g=0.z
+            let d262 = A::mul_add(
+                p.ZZ10r,
+                k122,
+                A::mul_add(p.YZ10r, k119, p.XZ10r * k118),
+            ); // J10rw10r|ud=0,g=0.z
+            let d153 = A::mul_add(
+                -p.MZ10l,
+                d143,
+                A::mul_add(
+                    -p.MY10l,
+                    d139,
+                    A::mul_add(
+                        -p.XZ10l,
+                        k74,
+                        A::mul_add(
+                            p.XY10l,
+                            k72,
+                            A::mul_add(-p.XX10l, k73, A::mul_add(-k71, d151, k70 * d152)),
+                        ),
+                    ),
+                ),
+            ); // N10l.x
+            let d263 = A::mul_add(
+                -p.MZ10r,
+                d253,
+                A::mul_add(
+                    -p.MY10r,
+                    d250,
+                    A::mul_add(
+                        -p.XZ10r,
+                        k120,
+                        A::mul_add(
+                            p.XY10r,
+                            k121,
+                            A::mul_add(
+                                -p.XX10r,
+                                k123,
+                                A::mul_add(-k122, d261, k119 * d262),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N10r.x
+            let d155 = A::mul_add(
+                -p.MY10l,
+                d142,
+                A::mul_add(
+                    p.MX10l,
+                    d143,
+                    A::mul_add(
+                        -p.ZZ10l,
+                        k74,
+                        A::mul_add(
+                            p.YZ10l,
+                            k72,
+                            A::mul_add(-p.XZ10l, k73, A::mul_add(-k70, d150, k69 * d151)),
+                        ),
+                    ),
+                ),
+            ); // N10l.z
+            out.set(11, 0, l, -d155);
+            let d264 = A::mul_add(
+                -p.MY10r,
+                d252,
+                A::mul_add(
+                    p.MX10r,
+                    d253,
+                    A::mul_add(
+                        -p.ZZ10r,
+                        k120,
+                        A::mul_add(
+                            p.YZ10r,
+                            k121,
+                            A::mul_add(
+                                -p.XZ10r,
+                                k123,
+                                A::mul_add(-k119, d260, k118 * d261),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N10r.z
+            out.set(18, 0, l, -d264);
+            let d154 = A::mul_add(
+                p.MX10l,
+                d139,
+                A::mul_add(
+                    p.MZ10l,
+                    d142,
+                    A::mul_add(
+                        -p.YZ10l,
+                        k74,
+                        A::mul_add(
+                            p.YY10l,
+                            k72,
+                            A::mul_add(-p.XY10l, k73, A::mul_add(-k69, d152, k71 * d150)),
+                        ),
+                    ),
+                ),
+            ); // N10l.y
+            let d265 = A::mul_add(
+                p.MX10r,
+                d250,
+                A::mul_add(
+                    p.MZ10r,
+                    d252,
+                    A::mul_add(
+                        -p.YZ10r,
+                        k120,
+                        A::mul_add(
+                            p.YY10r,
+                            k121,
+                            A::mul_add(
+                                -p.XY10r,
+                                k123,
+                                A::mul_add(-k118, d262, k122 * d260),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N10r.y
+            let d322 = A::mul_add(-c_q7l, d148, s_q7l * d147); // f10l in 9l.z
+            let d266 = A::mul_add(-c_q7r, d258, s_q7r * d257); // f10r in 9r.z
+            let d323 = A::mul_add(s_q7l, d148, c_q7l * d147); // f10l in 9l.x
+            let d267 = A::mul_add(s_q7r, d258, c_q7r * d257); // f10r in 9r.x
+            let d324 = d130 - d323; // f9l.x
+            let d270 = d241 - d267; // f9r.x
+            let d325 = d131 - d149; // f9l.y
+            let d268 = d240 - d259; // f9r.y
+            let d326 = d132 + d322; // f9l.z
+            let d271 = d242 + d266; // f9r.z
+            let d327 = d137 - d155; // n9l.y
+            let d273 = d248 - d264; // n9r.y
+            let d328 = A::mul_add(
+                -p.L9,
+                d322,
+                A::mul_add(-s_q7l, d154, A::mul_add(-c_q7l, d153, d136)),
+            ); // n9l.x
+            out.set(10, 0, l, -d328);
+            let d272 = A::mul_add(
+                -p.L9,
+                d266,
+                A::mul_add(-s_q7r, d265, A::mul_add(-c_q7r, d263, d247)),
+            ); // n9r.x
+            out.set(17, 0, l, -d272);
+            let d329 = A::mul_add(
+                -p.L9,
+                d323,
+                A::mul_add(-c_q7l, d154, A::mul_add(s_q7l, d153, d138)),
+            ); // n9l.z
+            let d269 = A::mul_add(
+                -p.L9,
+                d267,
+                A::mul_add(-c_q7r, d265, A::mul_add(s_q7r, d263, d246)),
+            ); // n9r.z
+            let d330 = A::mul_add(s_q6l, d326, c_q6l * d325); // f9l in 8l.y
+            let d274 = A::mul_add(s_q6r, d271, c_q6r * d268); // f9r in 8r.y
+            let d331 = A::mul_add(-c_q6l, d326, s_q6l * d325); // f9l in 8l.z
+            let d275 = A::mul_add(-c_q6r, d271, s_q6r * d268); // f9r in 8r.z
+            let d332 = d116 - d324; // f8l.x
+            let d278 = d227 - d270; // f8r.x
+            let d333 = d122 - d328; // n8l.x
+            let d280 = d233 - d272; // n8r.x
+            let d334 = A::mul_add(c_q6l, d329, A::mul_add(-s_q6l, d327, d123)); // n8l.z
+            let d277 = A::mul_add(c_q6r, d269, A::mul_add(-s_q6r, d273, d232)); // n8r.z
+            let d335 = d117 + d330; // f8l.y
+            let d276 = d226 + d274; // f8r.y
+            let d336 = d118 + d331; // f8l.z
+            let d279 = d228 + d275; // f8r.z
+            let d337 = A::mul_add(s_q6l, d329, A::mul_add(c_q6l, d327, d124)); // n8l.y
+            out.set(9, 0, l, d337);
+            let d281 = A::mul_add(s_q6r, d269, A::mul_add(c_q6r, d273, d234)); // n8r.y
+            out.set(16, 0, l, d281);
+            let d338 = A::mul_add(-c_q5l, d336, s_q5l * d332); // f8l in 7l.z
+            let d283 = A::mul_add(-c_q5r, d279, s_q5r * d278); // f8r in 7r.z
+            let d339 = A::mul_add(s_q5l, d336, c_q5l * d332); // f8l in 7l.x
+            let d282 = A::mul_add(s_q5r, d279, c_q5r * d278); // f8r in 7r.x
+            let d340 = d99 - d339; // f7l.x
+            let d286 = d210 - d282; // f7r.x
+            let d341 = d100 + d335; // f7l.y
+            let d284 = d209 + d276; // f7r.y
+            let d342 = d101 + d338; // f7l.z
+            let d287 = d211 + d283; // f7r.z
+            let d343 = d106 + d337; // n7l.y
+            let d289 = d217 + d281; // n7r.y
+            let d344 = A::mul_add(
+                -p.L8,
+                d338,
+                A::mul_add(s_q5l, d334, A::mul_add(-c_q5l, d333, d105)),
+            ); // n7l.x
+            out.set(8, 0, l, -d344);
+            let d288 = A::mul_add(
+                -p.L8,
+                d283,
+                A::mul_add(s_q5r, d277, A::mul_add(-c_q5r, d280, d216)),
+            ); // n7r.x
+            out.set(15, 0, l, -d288);
+            let d345 = A::mul_add(
+                -p.L8,
+                d339,
+                A::mul_add(c_q5l, d334, A::mul_add(s_q5l, d333, d107)),
+            ); // n7l.z
+            let d285 = A::mul_add(
+                -p.L8,
+                d282,
+                A::mul_add(c_q5r, d277, A::mul_add(s_q5r, d280, d215)),
+            ); // n7r.z
+            let d346 = A::mul_add(s_q4l, d342, c_q4l * d341); // f7l in 6l.y
+            let d290 = A::mul_add(s_q4r, d287, c_q4r * d284); // f7r in 6r.y
+            let d347 = A::mul_add(-c_q4l, d342, s_q4l * d341); // f7l in 6l.z
+            let d291 = A::mul_add(-c_q4r, d287, s_q4r * d284); // f7r in 6r.z
+            let d348 = d85 - d340; // f6l.x
+            let d294 = d196 - d286; // f6r.x
+            let d349 = d91 - d344; // n6l.x
+            let d296 = d202 - d288; // n6r.x
+            let d350 = A::mul_add(c_q4l, d345, A::mul_add(-s_q4l, d343, d92)); // n6l.z
+            let d293 = A::mul_add(c_q4r, d285, A::mul_add(-s_q4r, d289, d201)); // n6r.z
+            let d351 = d86 + d346; // f6l.y
+            let d292 = d195 + d290; // f6r.y
+            let d352 = d87 + d347; // f6l.z
+            let d295 = d197 + d291; // f6r.z
+            let d353 = A::mul_add(s_q4l, d345, A::mul_add(c_q4l, d343, d93)); // n6l.y
+            out.set(7, 0, l, d353);
+            let d297 = A::mul_add(s_q4r, d285, A::mul_add(c_q4r, d289, d203)); // n6r.y
+            out.set(14, 0, l, d297);
+            let d354 = A::mul_add(-c_q3l, d352, s_q3l * d348); // f6l in 5l.z
+            let d299 = A::mul_add(-c_q3r, d295, s_q3r * d294); // f6r in 5r.z
+            let d355 = A::mul_add(s_q3l, d352, c_q3l * d348); // f6l in 5l.x
+            let d298 = A::mul_add(s_q3r, d295, c_q3r * d294); // f6r in 5r.x
+            let d356 = d68 - d355; // f5l.x
+            let d302 = d179 - d298; // f5r.x
+            let d357 = d69 + d351; // f5l.y
+            let d300 = d178 + d292; // f5r.y
+            let d358 = d70 + d354; // f5l.z
+            let d303 = d180 + d299; // f5r.z
+            let d359 = d75 + d353; // n5l.y
+            let d305 = d186 + d297; // n5r.y
+            let d360 = A::mul_add(
+                -p.L7,
+                d354,
+                A::mul_add(s_q3l, d350, A::mul_add(-c_q3l, d349, d74)),
+            ); // n5l.x
+            out.set(6, 0, l, -d360);
+            let d304 = A::mul_add(
+                -p.L7,
+                d299,
+                A::mul_add(s_q3r, d293, A::mul_add(-c_q3r, d296, d185)),
+            ); // n5r.x
+            out.set(13, 0, l, -d304);
+            let d361 = A::mul_add(
+                -p.L7,
+                d355,
+                A::mul_add(c_q3l, d350, A::mul_add(s_q3l, d349, d76)),
+            ); // n5l.z
+            let d301 = A::mul_add(
+                -p.L7,
+                d298,
+                A::mul_add(c_q3r, d293, A::mul_add(s_q3r, d296, d184)),
+            ); // n5r.z
+            let d362 = A::mul_add(s_q2l, d358, c_q2l * d357); // f5l in 4l.y
+            let d306 = A::mul_add(s_q2r, d303, c_q2r * d300); // f5r in 4r.y
+            let d363 = A::mul_add(-c_q2l, d358, s_q2l * d357); // f5l in 4l.z
+            let d307 = A::mul_add(-c_q2r, d303, s_q2r * d300); // f5r in 4r.z
+            let d364 = d54 - d356; // f4l.x
+            let d310 = d165 - d302; // f4r.x
+            let d365 = d60 - d360; // n4l.x
+            let d312 = d171 - d304; // n4r.x
+            let d366 = A::mul_add(c_q2l, d361, A::mul_add(-s_q2l, d359, d61)); // n4l.z
+            let d309 = A::mul_add(c_q2r, d301, A::mul_add(-s_q2r, d305, d170)); // n4r.z
+            let d367 = d55 + d362; // f4l.y
+            let d308 = d164 + d306; // f4r.y
+            let d316 = d37 + d308; // f3.x
+            let d368 = d56 + d363; // f4l.z
+            let d311 = d166 + d307; // f4r.z
+            let d369 = A::mul_add(s_q2l, d361, A::mul_add(c_q2l, d359, d62)); // n4l.y
+            out.set(5, 0, l, d369);
+            let d313 = A::mul_add(s_q2r, d301, A::mul_add(c_q2r, d305, d172)); // n4r.y
+            out.set(12, 0, l, d313);
+            let d370 = A::mul_add(s_q1l, d368, c_q1l * d364); // f4l in 3.y
+            let d314 = A::mul_add(s_q1r, d311, c_q1r * d310); // f4r in 3.y
+            let d318 = A::mul_add(
+                -p.L5,
+                d308,
+                A::mul_add(
+                    -p.L6,
+                    d314,
+                    A::mul_add(c_q1r, d309, A::mul_add(s_q1r, d312, d44)),
+                ),
+            ); // n3.z
+            let d319 = d38 - d314; // f3.y
+            let d371 = A::mul_add(-c_q1l, d368, s_q1l * d364); // f4l in 3.z
+            let d315 = A::mul_add(-c_q1r, d311, s_q1r * d310); // f4r in 3.z
+            let d317 = A::mul_add(p.L5, d315, d43 + d313); // n3.x
+            let d320 = d39 - d315; // f3.z
+            let d321 = A::mul_add(
+                -p.L6,
+                d315,
+                A::mul_add(s_q1r, d309, A::mul_add(-c_q1r, d312, d45)),
+            ); // n3.y
+            let d372 = d316 - d367; // f3.x
+            let d373 = A::mul_add(-p.L5, d371, d317 - d369); // n3.x
+            let d374 = A::mul_add(
+                p.L5,
+                d367,
+                A::mul_add(
+                    p.L6,
+                    d370,
+                    A::mul_add(-c_q1l, d366, A::mul_add(-s_q1l, d365, d318)),
+                ),
+            ); // n3.z
+            let d375 = d319 - d370; // f3.y
+            let d376 = d320 + d371; // f3.z
+            let d377 = A::mul_add(
+                -p.L6,
+                d371,
+                A::mul_add(s_q1l, d366, A::mul_add(-c_q1l, d365, d321)),
+            ); // n3.y
+            out.set(4, 0, l, d377);
+            let d378 = A::mul_add(s_q_torso, d376, c_q_torso * d372); // f3 in 2.x
+            let d379 = A::mul_add(-c_q_torso, d376, s_q_torso * d372); // f3 in 2.z
+            let d380 = d21 - d375; // f2.y
+            let d381 = A::mul_add(
+                p.L3,
+                d378,
+                A::mul_add(-c_q_torso, d374, A::mul_add(-s_q_torso, d373, d27)),
+            ); // n2.z
+            let d382 = d22 + d378; // f2.x
+            let d383 = d23 + d379; // f2.z
+            let d384 = A::mul_add(
+                -p.L4,
+                d375,
+                A::mul_add(
+                    p.L3,
+                    d379,
+                    A::mul_add(-s_q_torso, d374, A::mul_add(c_q_torso, d373, d28)),
+                ),
+            ); // n2.x
+            out.set(3, 0, l, d384);
+            let d385 = A::mul_add(p.L4, d378, d29 + d377); // n2.y
+            let d386 = A::mul_add(-s_q_w, d383, c_q_w * d380); // f2 in 1.y
+            let d387 = A::mul_add(c_q_w, d383, s_q_w * d380); // f2 in 1.z
+            let d388 = d6 + d386; // f1.y
+            let d389 = A::mul_add(
+                p.L1,
+                d382,
+                A::mul_add(c_q_w, d381, A::mul_add(s_q_w, d385, d11)),
+            ); // n1.z
+            let d390 = d7 + d387; // f1.z
+            let d391 = A::mul_add(-p.L2, d386, A::mul_add(p.L1, d387, d12 + d384)); // n1.x
+            out.set(2, 0, l, d391);
+            let d392 = A::mul_add(
+                -p.L2,
+                d382,
+                A::mul_add(-s_q_w, d381, A::mul_add(c_q_w, d385, d13)),
+            ); // n1.y
+            let d393 = A::mul_add(c_q_imu, d390, s_q_imu * d388); // f1 in 0.x
+            out.set(0, 0, l, A::mul_add(pc.pc67, xdd, d393));
+            let d394 = A::mul_add(-s_q_imu, d389, c_q_imu * d392); // n0.z
+            out.set(1, 0, l, A::mul_add(pc.pc68, psidd, -d394));
+        }
+    }
     /// [`inverse_dynamics`] at `L` states per call, into `out`: entry `l` of `out` becomes `inverse_dynamics` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
     #[inline(never)]
     pub fn inverse_dynamics_batch_into<const L: usize>(
@@ -17582,2212 +15485,10 @@ mod generated {
             ud: &[SVector<f64, 19>; L],
             out: &mut [SVector<f64, 19>; L],
         ) {
-            let p = &{ *p };
-            let pc = &{ *pc };
             let q = kanegen_runtime::lanes::inputs(q);
             let u = kanegen_runtime::lanes::inputs(u);
             let ud = kanegen_runtime::lanes::inputs(ud);
-            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
-                A,
-                _,
-                L,
-            >([
-                q[2].0,
-                q[3].0,
-                q[4].0,
-                q[5].0,
-                q[12].0,
-                q[6].0,
-                q[13].0,
-                q[7].0,
-                q[14].0,
-                q[8].0,
-                q[15].0,
-                q[9].0,
-                q[16].0,
-                q[10].0,
-                q[17].0,
-                q[11].0,
-                q[18].0,
-            ]);
-            for (l, m) in out.iter_mut().enumerate() {
-                let s_q_imu = sin_q[0][l];
-                let c_q_imu = cos_q[0][l];
-                let s_q_w = sin_q[1][l];
-                let c_q_w = cos_q[1][l];
-                let s_q_torso = sin_q[2][l];
-                let c_q_torso = cos_q[2][l];
-                let s_q1l = sin_q[3][l];
-                let c_q1l = cos_q[3][l];
-                let s_q1r = sin_q[4][l];
-                let c_q1r = cos_q[4][l];
-                let s_q2l = sin_q[5][l];
-                let c_q2l = cos_q[5][l];
-                let s_q2r = sin_q[6][l];
-                let c_q2r = cos_q[6][l];
-                let s_q3l = sin_q[7][l];
-                let c_q3l = cos_q[7][l];
-                let s_q3r = sin_q[8][l];
-                let c_q3r = cos_q[8][l];
-                let s_q4l = sin_q[9][l];
-                let c_q4l = cos_q[9][l];
-                let s_q4r = sin_q[10][l];
-                let c_q4r = cos_q[10][l];
-                let s_q5l = sin_q[11][l];
-                let c_q5l = cos_q[11][l];
-                let s_q5r = sin_q[12][l];
-                let c_q5r = cos_q[12][l];
-                let s_q6l = sin_q[13][l];
-                let c_q6l = cos_q[13][l];
-                let s_q6r = sin_q[14][l];
-                let c_q6r = cos_q[14][l];
-                let s_q7l = sin_q[15][l];
-                let c_q7l = cos_q[15][l];
-                let s_q7r = sin_q[16][l];
-                let c_q7r = cos_q[16][l];
-                let xd = u[0].0[l];
-                let xdd = ud[0].0[l];
-                let psid = u[1].0[l];
-                let psidd = ud[1].0[l];
-                let qd_imu = u[2].0[l];
-                let qdd_imu = ud[2].0[l];
-                let qd_w = u[3].0[l];
-                let qdd_w = ud[3].0[l];
-                let qd_torso = u[4].0[l];
-                let qdd_torso = ud[4].0[l];
-                let qd1l = u[5].0[l];
-                let qdd1l = ud[5].0[l];
-                let qd2l = u[6].0[l];
-                let qdd2l = ud[6].0[l];
-                let qd3l = u[7].0[l];
-                let qdd3l = ud[7].0[l];
-                let qd4l = u[8].0[l];
-                let qdd4l = ud[8].0[l];
-                let qd5l = u[9].0[l];
-                let qdd5l = ud[9].0[l];
-                let qd6l = u[10].0[l];
-                let qdd6l = ud[10].0[l];
-                let qd7l = u[11].0[l];
-                let qdd7l = ud[11].0[l];
-                let qd1r = u[12].0[l];
-                let qdd1r = ud[12].0[l];
-                let qd2r = u[13].0[l];
-                let qdd2r = ud[13].0[l];
-                let qd3r = u[14].0[l];
-                let qdd3r = ud[14].0[l];
-                let qd4r = u[15].0[l];
-                let qdd4r = ud[15].0[l];
-                let qd5r = u[16].0[l];
-                let qdd5r = ud[16].0[l];
-                let qd6r = u[17].0[l];
-                let qdd6r = ud[17].0[l];
-                let qd7r = u[18].0[l];
-                let qdd7r = ud[18].0[l];
-                let k1 = xd * psid; // a0|ud=0,g=0.y
-                let k2 = c_q_imu * psid; // w0 in 1|ud=0,g=0.y
-                let k3 = s_q_imu * psid; // w0 in 1|ud=0,g=0.z
-                let k4 = A::mul_add(s_q_imu, psidd, k2 * qd_imu); // wd1.z
-                let k5 = A::mul_add(-c_q_imu, psidd, k3 * qd_imu); // wd1.y
-                let d1 = A::mul_add(s_q_imu, xdd, c_q_imu * p.g); // a1.y
-                let d2 = A::mul_add(-c_q_imu, xdd, s_q_imu * p.g); // a1.z
-                let d3 = A::mul_add(-p.MY1, k3, p.MZ1 * k2); // w1xMS1|ud=0,g=0.x
-                let d4 = A::mul_add(p.MZ1, qd_imu, p.MX1 * k3); // w1xMS1|ud=0,g=0.y
-                let d5 = A::mul_add(p.MX1, k2, p.MY1 * qd_imu); // w1xMS1|ud=0,g=0.z
-                let d6 = A::mul_add(
-                    p.MZ1,
-                    qdd_imu,
-                    A::mul_add(
-                        p.MX1,
-                        k4,
-                        A::mul_add(p.m1, d1, A::mul_add(-qd_imu, d5, k3 * d3)),
-                    ),
-                ); // F1.y
-                let d7 = A::mul_add(
-                    -p.MX1,
-                    k5,
-                    A::mul_add(
-                        p.MY1,
-                        qdd_imu,
-                        A::mul_add(-p.m1, d2, A::mul_add(k2, d3, qd_imu * d4)),
-                    ),
-                ); // F1.z
-                let d8 = A::mul_add(-p.XZ1, k3, A::mul_add(-p.XY1, k2, p.XX1 * qd_imu)); // J1w1|ud=0,g=0.x
-                let d9 = A::mul_add(-p.YZ1, k3, A::mul_add(-p.YY1, k2, p.XY1 * qd_imu)); // J1w1|ud=0,g=0.y
-                let d10 = A::mul_add(-p.ZZ1, k3, A::mul_add(-p.YZ1, k2, p.XZ1 * qd_imu)); // J1w1|ud=0,g=0.z
-                let d11 = A::mul_add(
-                    p.MX1,
-                    d1,
-                    A::mul_add(
-                        p.ZZ1,
-                        k4,
-                        A::mul_add(
-                            -p.YZ1,
-                            k5,
-                            A::mul_add(
-                                -p.XZ1,
-                                qdd_imu,
-                                A::mul_add(p.MY1, k1, A::mul_add(k2, d8, qd_imu * d9)),
-                            ),
-                        ),
-                    ),
-                ); // N1.z
-                let d12 = A::mul_add(
-                    p.MZ1,
-                    d1,
-                    A::mul_add(
-                        -p.MY1,
-                        d2,
-                        A::mul_add(
-                            -p.XZ1,
-                            k4,
-                            A::mul_add(
-                                p.XY1,
-                                k5,
-                                A::mul_add(p.XX1, qdd_imu, A::mul_add(-k3, d9, k2 * d10)),
-                            ),
-                        ),
-                    ),
-                ); // N1.x
-                let d13 = A::mul_add(
-                    p.MX1,
-                    d2,
-                    A::mul_add(
-                        -p.YZ1,
-                        k4,
-                        A::mul_add(
-                            p.YY1,
-                            k5,
-                            A::mul_add(
-                                p.XY1,
-                                qdd_imu,
-                                A::mul_add(p.MZ1, k1, A::mul_add(qd_imu, d10, k3 * d8)),
-                            ),
-                        ),
-                    ),
-                ); // N1.y
-                let k6 = A::mul_add(-s_q_w, k3, c_q_w * k2); // w1 in 2|ud=0,g=0.y
-                let k7 = A::mul_add(c_q_w, k3, s_q_w * k2); // w1 in 2|ud=0,g=0.z
-                let k8 = A::mul_add(c_q_w, k4, A::mul_add(-s_q_w, k5, k6 * qd_w)); // wd2.z
-                let k9 = qd_imu + qd_w; // w2|ud=0,g=0.x
-                let k10 = qdd_imu + qdd_w; // wd2.x
-                let k11 = A::mul_add(s_q_w, k4, A::mul_add(c_q_w, k5, k7 * qd_w)); // wd2.y
-                let k12 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-                let k13 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-                let k14 = A::mul_add(p.L1, k3, p.L2 * k2); // w1xP2|ud=0,g=0.x
-                let d14 = A::mul_add(
-                    -p.L1,
-                    qdd_imu,
-                    A::mul_add(k2, k14, qd_imu * k12) + d2,
-                ); // a2 in 1.z
-                let k15 = A::mul_add(
-                    p.L1,
-                    k4,
-                    A::mul_add(-p.L2, k5, A::mul_add(-k3, k12, A::mul_add(k2, k13, k1))),
-                ); // a2 in 1.x
-                let d15 = A::mul_add(
-                    p.L2,
-                    qdd_imu,
-                    A::mul_add(qd_imu, k13, k3 * k14) - d1,
-                ); // a2 in 1.y
-                let d16 = A::mul_add(s_q_w, d14, c_q_w * d15); // a2.y
-                let d17 = A::mul_add(-c_q_w, d14, s_q_w * d15); // a2.z
-                let d18 = A::mul_add(-p.MY2, k7, p.MZ2 * k6); // w2xMS2|ud=0,g=0.x
-                let d19 = A::mul_add(p.MZ2, k9, p.MX2 * k7); // w2xMS2|ud=0,g=0.y
-                let d20 = A::mul_add(p.MX2, k6, p.MY2 * k9); // w2xMS2|ud=0,g=0.z
-                let d21 = A::mul_add(
-                    p.MZ2,
-                    k10,
-                    A::mul_add(
-                        p.MX2,
-                        k8,
-                        A::mul_add(-p.m2, d16, A::mul_add(-k9, d20, k7 * d18)),
-                    ),
-                ); // F2.y
-                let d22 = A::mul_add(
-                    p.MY2,
-                    k8,
-                    A::mul_add(
-                        p.MZ2,
-                        k11,
-                        A::mul_add(p.m2, k15, A::mul_add(k7, d19, k6 * d20)),
-                    ),
-                ); // F2.x
-                let d23 = A::mul_add(
-                    -p.MX2,
-                    k11,
-                    A::mul_add(
-                        p.MY2,
-                        k10,
-                        A::mul_add(p.m2, d17, A::mul_add(k6, d18, k9 * d19)),
-                    ),
-                ); // F2.z
-                let d24 = A::mul_add(-p.XZ2, k7, A::mul_add(-p.XY2, k6, p.XX2 * k9)); // J2w2|ud=0,g=0.x
-                let d25 = A::mul_add(-p.YZ2, k7, A::mul_add(-p.YY2, k6, p.XY2 * k9)); // J2w2|ud=0,g=0.y
-                let d26 = A::mul_add(-p.ZZ2, k7, A::mul_add(-p.YZ2, k6, p.XZ2 * k9)); // J2w2|ud=0,g=0.z
-                let d27 = A::mul_add(
-                    p.MY2,
-                    k15,
-                    A::mul_add(
-                        -p.MX2,
-                        d16,
-                        A::mul_add(
-                            p.ZZ2,
-                            k8,
-                            A::mul_add(
-                                -p.YZ2,
-                                k11,
-                                A::mul_add(-p.XZ2, k10, A::mul_add(k6, d24, k9 * d25)),
-                            ),
-                        ),
-                    ),
-                ); // N2.z
-                let d28 = A::mul_add(
-                    -p.MZ2,
-                    d16,
-                    A::mul_add(
-                        p.MY2,
-                        d17,
-                        A::mul_add(
-                            -p.XZ2,
-                            k8,
-                            A::mul_add(
-                                p.XY2,
-                                k11,
-                                A::mul_add(p.XX2, k10, A::mul_add(-k7, d25, k6 * d26)),
-                            ),
-                        ),
-                    ),
-                ); // N2.x
-                let d29 = A::mul_add(
-                    -p.MX2,
-                    d17,
-                    A::mul_add(
-                        p.MZ2,
-                        k15,
-                        A::mul_add(
-                            -p.YZ2,
-                            k8,
-                            A::mul_add(
-                                p.YY2,
-                                k11,
-                                A::mul_add(p.XY2, k10, A::mul_add(k9, d26, k7 * d24)),
-                            ),
-                        ),
-                    ),
-                ); // N2.y
-                let k16 = A::mul_add(-s_q_torso, k7, c_q_torso * k9); // w2 in 3|ud=0,g=0.x
-                let k17 = A::mul_add(c_q_torso, k7, s_q_torso * k9); // w2 in 3|ud=0,g=0.z
-                let k18 = k6 - qd_torso; // w3|ud=0,g=0.y
-                let k19 = A::mul_add(
-                    s_q_torso,
-                    k8,
-                    A::mul_add(-c_q_torso, k10, k17 * qd_torso),
-                ); // wd3.x
-                let k20 = k11 + qdd_torso; // wd3.y
-                let k21 = A::mul_add(
-                    c_q_torso,
-                    k8,
-                    A::mul_add(s_q_torso, k10, k16 * qd_torso),
-                ); // wd3.z
-                let k22 = A::mul_add(-p.L3, k7, p.L4 * k6); // w2xP3|ud=0,g=0.x
-                let k23 = p.L4 * k9; // w2xP3|ud=0,g=0.y
-                let k24 = p.L3 * k9; // w2xP3|ud=0,g=0.z
-                let d30 = A::mul_add(p.L4, k10, A::mul_add(-k9, k24, k7 * k22) - d16); // a3 in 2.y
-                let k25 = A::mul_add(
-                    p.L3,
-                    k8,
-                    A::mul_add(p.L4, k11, A::mul_add(k7, k23, k6 * k24) + k15),
-                ); // a3 in 2.x
-                let d31 = A::mul_add(p.L3, k10, A::mul_add(k6, k22, k9 * k23) + d17); // a3 in 2.z
-                let d32 = A::mul_add(s_q_torso, d31, c_q_torso * k25); // a3.x
-                let d33 = A::mul_add(-c_q_torso, d31, s_q_torso * k25); // a3.z
-                let d34 = A::mul_add(p.MY3, k17, p.MZ3 * k18); // w3xMS3|ud=0,g=0.x
-                let d35 = A::mul_add(-p.MX3, k18, p.MY3 * k16); // w3xMS3|ud=0,g=0.z
-                let d36 = A::mul_add(p.MZ3, k16, p.MX3 * k17); // w3xMS3|ud=0,g=0.y
-                let d37 = A::mul_add(
-                    p.MY3,
-                    k21,
-                    A::mul_add(
-                        -p.MZ3,
-                        k20,
-                        A::mul_add(p.m3, d32, A::mul_add(-k17, d36, k18 * d35)),
-                    ),
-                ); // F3.x
-                let d38 = A::mul_add(
-                    -p.MZ3,
-                    k19,
-                    A::mul_add(
-                        p.MX3,
-                        k21,
-                        A::mul_add(-p.m3, d30, A::mul_add(k16, d35, k17 * d34)),
-                    ),
-                ); // F3.y
-                let d39 = A::mul_add(
-                    -p.MX3,
-                    k20,
-                    A::mul_add(
-                        p.MY3,
-                        k19,
-                        A::mul_add(p.m3, d33, A::mul_add(k18, d34, k16 * d36)),
-                    ),
-                ); // F3.z
-                let d40 = A::mul_add(-p.XZ3, k17, A::mul_add(p.XY3, k18, p.XX3 * k16)); // J3w3|ud=0,g=0.x
-                let d41 = A::mul_add(-p.YZ3, k17, A::mul_add(p.YY3, k18, p.XY3 * k16)); // J3w3|ud=0,g=0.y
-                let d42 = A::mul_add(-p.ZZ3, k17, A::mul_add(p.YZ3, k18, p.XZ3 * k16)); // J3w3|ud=0,g=0.z
-                let d43 = A::mul_add(
-                    -p.MZ3,
-                    d30,
-                    A::mul_add(
-                        -p.MY3,
-                        d33,
-                        A::mul_add(
-                            -p.XZ3,
-                            k21,
-                            A::mul_add(
-                                -p.XY3,
-                                k20,
-                                A::mul_add(-p.XX3, k19, A::mul_add(k17, d41, k18 * d42)),
-                            ),
-                        ),
-                    ),
-                ); // N3.x
-                let d44 = A::mul_add(
-                    -p.MY3,
-                    d32,
-                    A::mul_add(
-                        p.MX3,
-                        d30,
-                        A::mul_add(
-                            -p.ZZ3,
-                            k21,
-                            A::mul_add(
-                                -p.YZ3,
-                                k20,
-                                A::mul_add(-p.XZ3, k19, A::mul_add(-k18, d40, k16 * d41)),
-                            ),
-                        ),
-                    ),
-                ); // N3.z
-                let d45 = A::mul_add(
-                    -p.MX3,
-                    d33,
-                    A::mul_add(
-                        -p.MZ3,
-                        d32,
-                        A::mul_add(
-                            p.YZ3,
-                            k21,
-                            A::mul_add(
-                                p.YY3,
-                                k20,
-                                A::mul_add(p.XY3, k19, A::mul_add(k16, d42, k17 * d40)),
-                            ),
-                        ),
-                    ),
-                ); // N3.y
-                let k26 = A::mul_add(s_q1l, k17, c_q1l * k18); // w3 in 4l|ud=0,g=0.x
-                let k27 = A::mul_add(-c_q1l, k17, s_q1l * k18); // w3 in 4l|ud=0,g=0.z
-                let k28 = k16 - qd1l; // w4l|ud=0,g=0.y
-                let k29 = A::mul_add(-s_q1l, k21, A::mul_add(c_q1l, k20, k27 * qd1l)); // wd4l.x
-                let k30 = k19 + qdd1l; // wd4l.y
-                let k31 = A::mul_add(-c_q1l, k21, A::mul_add(-s_q1l, k20, k26 * qd1l)); // wd4l.z
-                let k32 = p.L5 * k17; // w3xP4l|ud=0,g=0.x
-                let k33 = p.L6 * k17; // w3xP4l|ud=0,g=0.y
-                let t1 = p.L5 * k16; // common subexpression
-                let t2 = p.L6 * k18; // common subexpression
-                let k34 = t1 - t2; // w3xP4l|ud=0,g=0.z
-                let t3 = p.L5 * k21; // common subexpression
-                let t4 = p.L6 * k21; // common subexpression
-                let t5 = p.L5 * k19; // common subexpression
-                let t6 = p.L6 * k20; // common subexpression
-                let t7 = k17 * k33; // common subexpression
-                let t8 = k17 * k32; // common subexpression
-                let t9 = k16 * k33; // common subexpression
-                let t10 = k18 * k32; // common subexpression
-                let d46 = A::mul_add(k18, k34, -t7) + d32 + t3; // a4l in 3.x
-                let d47 = A::mul_add(k16, k34, t8) - d30 + t4; // a4l in 3.y
-                let d48 = t9 + t10 + d33 + t5 - t6; // a4l in 3.z
-                let d49 = A::mul_add(c_q1l, d48, s_q1l * d47); // a4l.z
-                let d50 = A::mul_add(-s_q1l, d48, c_q1l * d47); // a4l.x
-                let d63 = A::mul_add(s_q2l, d49, c_q2l * d46); // a5l.y
-                let d64 = A::mul_add(-c_q2l, d49, s_q2l * d46); // a5l.z
-                let k77 = A::mul_add(-s_q1r, k17, c_q1r * k18); // w3 in 4r|ud=0,g=0.x
-                let k78 = A::mul_add(c_q1r, k17, s_q1r * k18); // w3 in 4r|ud=0,g=0.z
-                let k79 = qdd1r - k19; // wd4r.y
-                let k80 = -k16 - qd1r; // w4r|ud=0,g=0.y
-                let k81 = A::mul_add(s_q1r, k21, A::mul_add(c_q1r, k20, k78 * qd1r)); // wd4r.x
-                let k82 = A::mul_add(c_q1r, k21, A::mul_add(-s_q1r, k20, k77 * qd1r)); // wd4r.z
-                let k83 = t1 + t2; // w3xP4r|ud=0,g=0.z
-                let d156 = A::mul_add(k18, k83, t7) + d32 + t3; // a4r in 3.x
-                let d157 = t9 - t10 - d33 - t5 - t6; // a4r in 3.z
-                let d158 = A::mul_add(k16, k83, t8) - d30 - t4; // a4r in 3.y
-                let d159 = A::mul_add(c_q1r, d157, s_q1r * d158); // a4r.z
-                let d160 = A::mul_add(-s_q1r, d157, c_q1r * d158); // a4r.x
-                let d52 = A::mul_add(-p.MX4l, k28, p.MY4l * k26); // w4lxMS4l|ud=0,g=0.z
-                let d161 = A::mul_add(-p.MX4r, k80, p.MY4r * k77); // w4rxMS4r|ud=0,g=0.z
-                let d51 = A::mul_add(p.MY4l, k27, p.MZ4l * k28); // w4lxMS4l|ud=0,g=0.x
-                let d162 = A::mul_add(p.MY4r, k78, p.MZ4r * k80); // w4rxMS4r|ud=0,g=0.x
-                let d55 = A::mul_add(
-                    -p.MZ4l,
-                    k29,
-                    A::mul_add(
-                        p.MX4l,
-                        k31,
-                        A::mul_add(-p.m4l, d46, A::mul_add(k26, d52, k27 * d51)),
-                    ),
-                ); // F4l.y
-                let d53 = A::mul_add(p.MZ4l, k26, p.MX4l * k27); // w4lxMS4l|ud=0,g=0.y
-                let d163 = A::mul_add(p.MZ4r, k77, p.MX4r * k78); // w4rxMS4r|ud=0,g=0.y
-                let d164 = A::mul_add(
-                    -p.MZ4r,
-                    k81,
-                    A::mul_add(
-                        p.MX4r,
-                        k82,
-                        A::mul_add(p.m4r, d156, A::mul_add(k77, d161, k78 * d162)),
-                    ),
-                ); // F4r.y
-                let d54 = A::mul_add(
-                    p.MY4l,
-                    k31,
-                    A::mul_add(
-                        -p.MZ4l,
-                        k30,
-                        A::mul_add(-p.m4l, d50, A::mul_add(-k27, d53, k28 * d52)),
-                    ),
-                ); // F4l.x
-                let d165 = A::mul_add(
-                    p.MY4r,
-                    k82,
-                    A::mul_add(
-                        -p.MZ4r,
-                        k79,
-                        A::mul_add(-p.m4r, d160, A::mul_add(-k78, d163, k80 * d161)),
-                    ),
-                ); // F4r.x
-                let d56 = A::mul_add(
-                    -p.MX4l,
-                    k30,
-                    A::mul_add(
-                        p.MY4l,
-                        k29,
-                        A::mul_add(-p.m4l, d49, A::mul_add(k28, d51, k26 * d53)),
-                    ),
-                ); // F4l.z
-                let d166 = A::mul_add(
-                    -p.MX4r,
-                    k79,
-                    A::mul_add(
-                        p.MY4r,
-                        k81,
-                        A::mul_add(-p.m4r, d159, A::mul_add(k80, d162, k77 * d163)),
-                    ),
-                ); // F4r.z
-                let d57 = A::mul_add(
-                    -p.XZ4l,
-                    k27,
-                    A::mul_add(p.XY4l, k28, p.XX4l * k26),
-                ); // J4lw4l|ud=0,g=0.x
-                let d167 = A::mul_add(
-                    -p.XZ4r,
-                    k78,
-                    A::mul_add(p.XY4r, k80, p.XX4r * k77),
-                ); // J4rw4r|ud=0,g=0.x
-                let d58 = A::mul_add(
-                    -p.YZ4l,
-                    k27,
-                    A::mul_add(p.YY4l, k28, p.XY4l * k26),
-                ); // J4lw4l|ud=0,g=0.y
-                let d168 = A::mul_add(
-                    -p.YZ4r,
-                    k78,
-                    A::mul_add(p.YY4r, k80, p.XY4r * k77),
-                ); // J4rw4r|ud=0,g=0.y
-                let d61 = A::mul_add(
-                    p.MY4l,
-                    d50,
-                    A::mul_add(
-                        p.MX4l,
-                        d46,
-                        A::mul_add(
-                            -p.ZZ4l,
-                            k31,
-                            A::mul_add(
-                                -p.YZ4l,
-                                k30,
-                                A::mul_add(-p.XZ4l, k29, A::mul_add(-k28, d57, k26 * d58)),
-                            ),
-                        ),
-                    ),
-                ); // N4l.z
-                let d59 = A::mul_add(
-                    -p.ZZ4l,
-                    k27,
-                    A::mul_add(p.YZ4l, k28, p.XZ4l * k26),
-                ); // J4lw4l|ud=0,g=0.z
-                let d169 = A::mul_add(
-                    -p.ZZ4r,
-                    k78,
-                    A::mul_add(p.YZ4r, k80, p.XZ4r * k77),
-                ); // J4rw4r|ud=0,g=0.z
-                let d60 = A::mul_add(
-                    -p.MZ4l,
-                    d46,
-                    A::mul_add(
-                        p.MY4l,
-                        d49,
-                        A::mul_add(
-                            -p.XZ4l,
-                            k31,
-                            A::mul_add(
-                                -p.XY4l,
-                                k30,
-                                A::mul_add(-p.XX4l, k29, A::mul_add(k27, d58, k28 * d59)),
-                            ),
-                        ),
-                    ),
-                ); // N4l.x
-                let d170 = A::mul_add(
-                    p.MY4r,
-                    d160,
-                    A::mul_add(
-                        -p.MX4r,
-                        d156,
-                        A::mul_add(
-                            -p.ZZ4r,
-                            k82,
-                            A::mul_add(
-                                -p.YZ4r,
-                                k79,
-                                A::mul_add(-p.XZ4r, k81, A::mul_add(-k80, d167, k77 * d168)),
-                            ),
-                        ),
-                    ),
-                ); // N4r.z
-                let d171 = A::mul_add(
-                    p.MZ4r,
-                    d156,
-                    A::mul_add(
-                        p.MY4r,
-                        d159,
-                        A::mul_add(
-                            -p.XZ4r,
-                            k82,
-                            A::mul_add(
-                                -p.XY4r,
-                                k79,
-                                A::mul_add(-p.XX4r, k81, A::mul_add(k78, d168, k80 * d169)),
-                            ),
-                        ),
-                    ),
-                ); // N4r.x
-                let d62 = A::mul_add(
-                    p.MX4l,
-                    d49,
-                    A::mul_add(
-                        p.MZ4l,
-                        d50,
-                        A::mul_add(
-                            p.YZ4l,
-                            k31,
-                            A::mul_add(
-                                p.YY4l,
-                                k30,
-                                A::mul_add(p.XY4l, k29, A::mul_add(k26, d59, k27 * d57)),
-                            ),
-                        ),
-                    ),
-                ); // N4l.y
-                let d172 = A::mul_add(
-                    p.MX4r,
-                    d159,
-                    A::mul_add(
-                        p.MZ4r,
-                        d160,
-                        A::mul_add(
-                            p.YZ4r,
-                            k82,
-                            A::mul_add(
-                                p.YY4r,
-                                k79,
-                                A::mul_add(p.XY4r, k81, A::mul_add(k77, d169, k78 * d167)),
-                            ),
-                        ),
-                    ),
-                ); // N4r.y
-                let k35 = A::mul_add(-s_q2l, k27, c_q2l * k28); // w4l in 5l|ud=0,g=0.y
-                let k84 = A::mul_add(-s_q2r, k78, c_q2r * k80); // w4r in 5r|ud=0,g=0.y
-                let k36 = A::mul_add(c_q2l, k27, s_q2l * k28); // w4l in 5l|ud=0,g=0.z
-                let k85 = A::mul_add(c_q2r, k78, s_q2r * k80); // w4r in 5r|ud=0,g=0.z
-                let k37 = k29 - qdd2l; // wd5l.x
-                let k86 = k81 - qdd2r; // wd5r.x
-                let k40 = A::mul_add(c_q2l, k31, A::mul_add(-s_q2l, k30, k35 * qd2l)); // wd5l.z
-                let k87 = A::mul_add(c_q2r, k82, A::mul_add(-s_q2r, k79, k84 * qd2r)); // wd5r.z
-                let k39 = k26 + qd2l; // w5l|ud=0,g=0.x
-                let k88 = k77 + qd2r; // w5r|ud=0,g=0.x
-                let k38 = A::mul_add(s_q2l, k31, A::mul_add(c_q2l, k30, k36 * qd2l)); // wd5l.y
-                let k89 = A::mul_add(s_q2r, k82, A::mul_add(c_q2r, k79, k85 * qd2r)); // wd5r.y
-                let d173 = A::mul_add(-c_q2r, d156, s_q2r * d159); // a5r.y
-                let d174 = A::mul_add(-c_q2r, d159, -s_q2r * d156); // a5r.z
-                let d65 = A::mul_add(-p.MY5l, k36, p.MZ5l * k35); // w5lxMS5l|ud=0,g=0.x
-                let d175 = A::mul_add(-p.MY5r, k85, p.MZ5r * k84); // w5rxMS5r|ud=0,g=0.x
-                let d66 = A::mul_add(-p.MZ5l, k39, p.MX5l * k36); // w5lxMS5l|ud=0,g=0.y
-                let d176 = A::mul_add(-p.MZ5r, k88, p.MX5r * k85); // w5rxMS5r|ud=0,g=0.y
-                let d67 = A::mul_add(-p.MX5l, k35, p.MY5l * k39); // w5lxMS5l|ud=0,g=0.z
-                let d177 = A::mul_add(-p.MX5r, k84, p.MY5r * k88); // w5rxMS5r|ud=0,g=0.z
-                let d69 = A::mul_add(
-                    -p.MZ5l,
-                    k37,
-                    A::mul_add(
-                        -p.MX5l,
-                        k40,
-                        A::mul_add(-p.m5l, d63, A::mul_add(-k39, d67, k36 * d65)),
-                    ),
-                ); // F5l.y
-                let d178 = A::mul_add(
-                    -p.MZ5r,
-                    k86,
-                    A::mul_add(
-                        -p.MX5r,
-                        k87,
-                        A::mul_add(-p.m5r, d173, A::mul_add(-k88, d177, k85 * d175)),
-                    ),
-                ); // F5r.y
-                let d68 = A::mul_add(
-                    p.MY5l,
-                    k40,
-                    A::mul_add(
-                        p.MZ5l,
-                        k38,
-                        A::mul_add(p.m5l, d50, A::mul_add(-k36, d66, k35 * d67)),
-                    ),
-                ); // F5l.x
-                let d179 = A::mul_add(
-                    p.MY5r,
-                    k87,
-                    A::mul_add(
-                        p.MZ5r,
-                        k89,
-                        A::mul_add(p.m5r, d160, A::mul_add(-k85, d176, k84 * d177)),
-                    ),
-                ); // F5r.x
-                let d70 = A::mul_add(
-                    -p.MX5l,
-                    k38,
-                    A::mul_add(
-                        p.MY5l,
-                        k37,
-                        A::mul_add(-p.m5l, d64, A::mul_add(-k35, d65, k39 * d66)),
-                    ),
-                ); // F5l.z
-                let d180 = A::mul_add(
-                    -p.MX5r,
-                    k89,
-                    A::mul_add(
-                        p.MY5r,
-                        k86,
-                        A::mul_add(-p.m5r, d174, A::mul_add(-k84, d175, k88 * d176)),
-                    ),
-                ); // F5r.z
-                let d71 = A::mul_add(p.XZ5l, k36, A::mul_add(p.XY5l, k35, p.XX5l * k39)); // J5lw5l|ud=0,g=0.x
-                let d181 = A::mul_add(
-                    p.XZ5r,
-                    k85,
-                    A::mul_add(p.XY5r, k84, p.XX5r * k88),
-                ); // J5rw5r|ud=0,g=0.x
-                let d72 = A::mul_add(p.YZ5l, k36, A::mul_add(p.YY5l, k35, p.XY5l * k39)); // J5lw5l|ud=0,g=0.y
-                let d182 = A::mul_add(
-                    p.YZ5r,
-                    k85,
-                    A::mul_add(p.YY5r, k84, p.XY5r * k88),
-                ); // J5rw5r|ud=0,g=0.y
-                let d73 = A::mul_add(p.ZZ5l, k36, A::mul_add(p.YZ5l, k35, p.XZ5l * k39)); // J5lw5l|ud=0,g=0.z
-                let d183 = A::mul_add(
-                    p.ZZ5r,
-                    k85,
-                    A::mul_add(p.YZ5r, k84, p.XZ5r * k88),
-                ); // J5rw5r|ud=0,g=0.z
-                let d76 = A::mul_add(
-                    -p.MY5l,
-                    d50,
-                    A::mul_add(
-                        -p.MX5l,
-                        d63,
-                        A::mul_add(
-                            -p.ZZ5l,
-                            k40,
-                            A::mul_add(
-                                p.YZ5l,
-                                k38,
-                                A::mul_add(p.XZ5l, k37, A::mul_add(-k35, d71, k39 * d72)),
-                            ),
-                        ),
-                    ),
-                ); // N5l.z
-                let d184 = A::mul_add(
-                    -p.MY5r,
-                    d160,
-                    A::mul_add(
-                        -p.MX5r,
-                        d173,
-                        A::mul_add(
-                            -p.ZZ5r,
-                            k87,
-                            A::mul_add(
-                                p.YZ5r,
-                                k89,
-                                A::mul_add(p.XZ5r, k86, A::mul_add(-k84, d181, k88 * d182)),
-                            ),
-                        ),
-                    ),
-                ); // N5r.z
-                let d74 = A::mul_add(
-                    p.MZ5l,
-                    d63,
-                    A::mul_add(
-                        -p.MY5l,
-                        d64,
-                        A::mul_add(
-                            -p.XZ5l,
-                            k40,
-                            A::mul_add(
-                                p.XY5l,
-                                k38,
-                                A::mul_add(p.XX5l, k37, A::mul_add(-k36, d72, k35 * d73)),
-                            ),
-                        ),
-                    ),
-                ); // N5l.x
-                let d185 = A::mul_add(
-                    p.MZ5r,
-                    d173,
-                    A::mul_add(
-                        -p.MY5r,
-                        d174,
-                        A::mul_add(
-                            -p.XZ5r,
-                            k87,
-                            A::mul_add(
-                                p.XY5r,
-                                k89,
-                                A::mul_add(p.XX5r, k86, A::mul_add(-k85, d182, k84 * d183)),
-                            ),
-                        ),
-                    ),
-                ); // N5r.x
-                let d75 = A::mul_add(
-                    p.MX5l,
-                    d64,
-                    A::mul_add(
-                        p.MZ5l,
-                        d50,
-                        A::mul_add(
-                            -p.YZ5l,
-                            k40,
-                            A::mul_add(
-                                p.YY5l,
-                                k38,
-                                A::mul_add(p.XY5l, k37, A::mul_add(-k39, d73, k36 * d71)),
-                            ),
-                        ),
-                    ),
-                ); // N5l.y
-                let d186 = A::mul_add(
-                    p.MX5r,
-                    d174,
-                    A::mul_add(
-                        p.MZ5r,
-                        d160,
-                        A::mul_add(
-                            -p.YZ5r,
-                            k87,
-                            A::mul_add(
-                                p.YY5r,
-                                k89,
-                                A::mul_add(p.XY5r, k86, A::mul_add(-k88, d183, k85 * d181)),
-                            ),
-                        ),
-                    ),
-                ); // N5r.y
-                let k41 = A::mul_add(-s_q3l, k36, c_q3l * k39); // w5l in 6l|ud=0,g=0.x
-                let k90 = A::mul_add(-s_q3r, k85, c_q3r * k88); // w5r in 6r|ud=0,g=0.x
-                let k42 = A::mul_add(c_q3l, k36, s_q3l * k39); // w5l in 6l|ud=0,g=0.z
-                let k91 = A::mul_add(c_q3r, k85, s_q3r * k88); // w5r in 6r|ud=0,g=0.z
-                let k45 = k38 + qdd3l; // wd6l.y
-                let k92 = k89 + qdd3r; // wd6r.y
-                let k43 = k35 - qd3l; // w6l|ud=0,g=0.y
-                let k93 = k84 - qd3r; // w6r|ud=0,g=0.y
-                let k44 = A::mul_add(s_q3l, k40, A::mul_add(c_q3l, k37, k42 * qd3l)); // wd6l.x
-                let k94 = A::mul_add(s_q3r, k87, A::mul_add(c_q3r, k86, k91 * qd3r)); // wd6r.x
-                let k46 = A::mul_add(c_q3l, k40, A::mul_add(-s_q3l, k37, k41 * qd3l)); // wd6l.z
-                let k95 = A::mul_add(c_q3r, k87, A::mul_add(-s_q3r, k86, k90 * qd3r)); // wd6r.z
-                let k47 = p.L7 * k36; // w5lxP6l|ud=0,g=0.x
-                let k96 = p.L7 * k85; // w5rxP6r|ud=0,g=0.x
-                let k48 = p.L7 * k39; // w5lxP6l|ud=0,g=0.z
-                let k97 = p.L7 * k88; // w5rxP6r|ud=0,g=0.z
-                let d78 = A::mul_add(p.L7, k40, A::mul_add(k35, k48, -d50)); // a6l in 5l.x
-                let d187 = A::mul_add(p.L7, k87, A::mul_add(k84, k97, -d160)); // a6r in 5r.x
-                let d77 = A::mul_add(k39, k48, k36 * k47) - d63; // a6l in 5l.y
-                let d188 = A::mul_add(k88, k97, k85 * k96) - d173; // a6r in 5r.y
-                let d79 = A::mul_add(p.L7, k37, A::mul_add(k35, k47, d64)); // a6l in 5l.z
-                let d189 = A::mul_add(p.L7, k86, A::mul_add(k84, k96, d174)); // a6r in 5r.z
-                let d81 = A::mul_add(c_q3l, d79, s_q3l * d78); // a6l.z
-                let d190 = A::mul_add(c_q3r, d189, s_q3r * d187); // a6r.z
-                let d80 = A::mul_add(-s_q3l, d79, c_q3l * d78); // a6l.x
-                let d191 = A::mul_add(-s_q3r, d189, c_q3r * d187); // a6r.x
-                let d83 = A::mul_add(-p.MX6l, k43, p.MY6l * k41); // w6lxMS6l|ud=0,g=0.z
-                let d192 = A::mul_add(-p.MX6r, k93, p.MY6r * k90); // w6rxMS6r|ud=0,g=0.z
-                let d82 = A::mul_add(p.MY6l, k42, p.MZ6l * k43); // w6lxMS6l|ud=0,g=0.x
-                let d193 = A::mul_add(p.MY6r, k91, p.MZ6r * k93); // w6rxMS6r|ud=0,g=0.x
-                let d84 = A::mul_add(p.MZ6l, k41, p.MX6l * k42); // w6lxMS6l|ud=0,g=0.y
-                let d194 = A::mul_add(p.MZ6r, k90, p.MX6r * k91); // w6rxMS6r|ud=0,g=0.y
-                let d86 = A::mul_add(
-                    -p.MZ6l,
-                    k44,
-                    A::mul_add(
-                        p.MX6l,
-                        k46,
-                        A::mul_add(p.m6l, d77, A::mul_add(k41, d83, k42 * d82)),
-                    ),
-                ); // F6l.y
-                let d195 = A::mul_add(
-                    -p.MZ6r,
-                    k94,
-                    A::mul_add(
-                        p.MX6r,
-                        k95,
-                        A::mul_add(p.m6r, d188, A::mul_add(k90, d192, k91 * d193)),
-                    ),
-                ); // F6r.y
-                let d85 = A::mul_add(
-                    p.MY6l,
-                    k46,
-                    A::mul_add(
-                        -p.MZ6l,
-                        k45,
-                        A::mul_add(p.m6l, d80, A::mul_add(-k42, d84, k43 * d83)),
-                    ),
-                ); // F6l.x
-                let d196 = A::mul_add(
-                    p.MY6r,
-                    k95,
-                    A::mul_add(
-                        -p.MZ6r,
-                        k92,
-                        A::mul_add(p.m6r, d191, A::mul_add(-k91, d194, k93 * d192)),
-                    ),
-                ); // F6r.x
-                let d87 = A::mul_add(
-                    -p.MX6l,
-                    k45,
-                    A::mul_add(
-                        p.MY6l,
-                        k44,
-                        A::mul_add(p.m6l, d81, A::mul_add(k43, d82, k41 * d84)),
-                    ),
-                ); // F6l.z
-                let d197 = A::mul_add(
-                    -p.MX6r,
-                    k92,
-                    A::mul_add(
-                        p.MY6r,
-                        k94,
-                        A::mul_add(p.m6r, d190, A::mul_add(k93, d193, k90 * d194)),
-                    ),
-                ); // F6r.z
-                let d88 = A::mul_add(
-                    -p.XZ6l,
-                    k42,
-                    A::mul_add(p.XY6l, k43, p.XX6l * k41),
-                ); // J6lw6l|ud=0,g=0.x
-                let d198 = A::mul_add(
-                    -p.XZ6r,
-                    k91,
-                    A::mul_add(p.XY6r, k93, p.XX6r * k90),
-                ); // J6rw6r|ud=0,g=0.x
-                let d89 = A::mul_add(
-                    -p.YZ6l,
-                    k42,
-                    A::mul_add(p.YY6l, k43, p.XY6l * k41),
-                ); // J6lw6l|ud=0,g=0.y
-                let d199 = A::mul_add(
-                    -p.YZ6r,
-                    k91,
-                    A::mul_add(p.YY6r, k93, p.XY6r * k90),
-                ); // J6rw6r|ud=0,g=0.y
-                let d90 = A::mul_add(
-                    -p.ZZ6l,
-                    k42,
-                    A::mul_add(p.YZ6l, k43, p.XZ6l * k41),
-                ); // J6lw6l|ud=0,g=0.z
-                let d200 = A::mul_add(
-                    -p.ZZ6r,
-                    k91,
-                    A::mul_add(p.YZ6r, k93, p.XZ6r * k90),
-                ); // J6rw6r|ud=0,g=0.z
-                let d92 = A::mul_add(
-                    -p.MY6l,
-                    d80,
-                    A::mul_add(
-                        -p.MX6l,
-                        d77,
-                        A::mul_add(
-                            -p.ZZ6l,
-                            k46,
-                            A::mul_add(
-                                -p.YZ6l,
-                                k45,
-                                A::mul_add(-p.XZ6l, k44, A::mul_add(-k43, d88, k41 * d89)),
-                            ),
-                        ),
-                    ),
-                ); // N6l.z
-                let d201 = A::mul_add(
-                    -p.MY6r,
-                    d191,
-                    A::mul_add(
-                        -p.MX6r,
-                        d188,
-                        A::mul_add(
-                            -p.ZZ6r,
-                            k95,
-                            A::mul_add(
-                                -p.YZ6r,
-                                k92,
-                                A::mul_add(-p.XZ6r, k94, A::mul_add(-k93, d198, k90 * d199)),
-                            ),
-                        ),
-                    ),
-                ); // N6r.z
-                let d91 = A::mul_add(
-                    p.MZ6l,
-                    d77,
-                    A::mul_add(
-                        -p.MY6l,
-                        d81,
-                        A::mul_add(
-                            -p.XZ6l,
-                            k46,
-                            A::mul_add(
-                                -p.XY6l,
-                                k45,
-                                A::mul_add(-p.XX6l, k44, A::mul_add(k42, d89, k43 * d90)),
-                            ),
-                        ),
-                    ),
-                ); // N6l.x
-                let d202 = A::mul_add(
-                    p.MZ6r,
-                    d188,
-                    A::mul_add(
-                        -p.MY6r,
-                        d190,
-                        A::mul_add(
-                            -p.XZ6r,
-                            k95,
-                            A::mul_add(
-                                -p.XY6r,
-                                k92,
-                                A::mul_add(-p.XX6r, k94, A::mul_add(k91, d199, k93 * d200)),
-                            ),
-                        ),
-                    ),
-                ); // N6r.x
-                let d93 = A::mul_add(
-                    -p.MX6l,
-                    d81,
-                    A::mul_add(
-                        -p.MZ6l,
-                        d80,
-                        A::mul_add(
-                            p.YZ6l,
-                            k46,
-                            A::mul_add(
-                                p.YY6l,
-                                k45,
-                                A::mul_add(p.XY6l, k44, A::mul_add(k41, d90, k42 * d88)),
-                            ),
-                        ),
-                    ),
-                ); // N6l.y
-                let d203 = A::mul_add(
-                    -p.MX6r,
-                    d190,
-                    A::mul_add(
-                        -p.MZ6r,
-                        d191,
-                        A::mul_add(
-                            p.YZ6r,
-                            k95,
-                            A::mul_add(
-                                p.YY6r,
-                                k92,
-                                A::mul_add(p.XY6r, k94, A::mul_add(k90, d200, k91 * d198)),
-                            ),
-                        ),
-                    ),
-                ); // N6r.y
-                let k49 = A::mul_add(-s_q4l, k42, c_q4l * k43); // w6l in 7l|ud=0,g=0.y
-                let k98 = A::mul_add(-s_q4r, k91, c_q4r * k93); // w6r in 7r|ud=0,g=0.y
-                let k50 = A::mul_add(c_q4l, k42, s_q4l * k43); // w6l in 7l|ud=0,g=0.z
-                let k99 = A::mul_add(c_q4r, k91, s_q4r * k93); // w6r in 7r|ud=0,g=0.z
-                let k51 = k44 - qdd4l; // wd7l.x
-                let k100 = k94 - qdd4r; // wd7r.x
-                let k54 = A::mul_add(c_q4l, k46, A::mul_add(-s_q4l, k45, k49 * qd4l)); // wd7l.z
-                let k101 = A::mul_add(c_q4r, k95, A::mul_add(-s_q4r, k92, k98 * qd4r)); // wd7r.z
-                let k53 = k41 + qd4l; // w7l|ud=0,g=0.x
-                let k102 = k90 + qd4r; // w7r|ud=0,g=0.x
-                let k52 = A::mul_add(s_q4l, k46, A::mul_add(c_q4l, k45, k50 * qd4l)); // wd7l.y
-                let k103 = A::mul_add(s_q4r, k95, A::mul_add(c_q4r, k92, k99 * qd4r)); // wd7r.y
-                let d94 = A::mul_add(s_q4l, d81, c_q4l * d77); // a7l.y
-                let d204 = A::mul_add(s_q4r, d190, c_q4r * d188); // a7r.y
-                let d95 = A::mul_add(-c_q4l, d81, s_q4l * d77); // a7l.z
-                let d205 = A::mul_add(-c_q4r, d190, s_q4r * d188); // a7r.z
-                let d96 = A::mul_add(-p.MY7l, k50, p.MZ7l * k49); // w7lxMS7l|ud=0,g=0.x
-                let d206 = A::mul_add(-p.MY7r, k99, p.MZ7r * k98); // w7rxMS7r|ud=0,g=0.x
-                let d97 = A::mul_add(-p.MZ7l, k53, p.MX7l * k50); // w7lxMS7l|ud=0,g=0.y
-                let d207 = A::mul_add(-p.MZ7r, k102, p.MX7r * k99); // w7rxMS7r|ud=0,g=0.y
-                let d98 = A::mul_add(-p.MX7l, k49, p.MY7l * k53); // w7lxMS7l|ud=0,g=0.z
-                let d208 = A::mul_add(-p.MX7r, k98, p.MY7r * k102); // w7rxMS7r|ud=0,g=0.z
-                let d100 = A::mul_add(
-                    -p.MZ7l,
-                    k51,
-                    A::mul_add(
-                        -p.MX7l,
-                        k54,
-                        A::mul_add(p.m7l, d94, A::mul_add(-k53, d98, k50 * d96)),
-                    ),
-                ); // F7l.y
-                let d209 = A::mul_add(
-                    -p.MZ7r,
-                    k100,
-                    A::mul_add(
-                        -p.MX7r,
-                        k101,
-                        A::mul_add(p.m7r, d204, A::mul_add(-k102, d208, k99 * d206)),
-                    ),
-                ); // F7r.y
-                let d99 = A::mul_add(
-                    p.MY7l,
-                    k54,
-                    A::mul_add(
-                        p.MZ7l,
-                        k52,
-                        A::mul_add(-p.m7l, d80, A::mul_add(-k50, d97, k49 * d98)),
-                    ),
-                ); // F7l.x
-                let d210 = A::mul_add(
-                    p.MY7r,
-                    k101,
-                    A::mul_add(
-                        p.MZ7r,
-                        k103,
-                        A::mul_add(-p.m7r, d191, A::mul_add(-k99, d207, k98 * d208)),
-                    ),
-                ); // F7r.x
-                let d101 = A::mul_add(
-                    -p.MX7l,
-                    k52,
-                    A::mul_add(
-                        p.MY7l,
-                        k51,
-                        A::mul_add(p.m7l, d95, A::mul_add(-k49, d96, k53 * d97)),
-                    ),
-                ); // F7l.z
-                let d211 = A::mul_add(
-                    -p.MX7r,
-                    k103,
-                    A::mul_add(
-                        p.MY7r,
-                        k100,
-                        A::mul_add(p.m7r, d205, A::mul_add(-k98, d206, k102 * d207)),
-                    ),
-                ); // F7r.z
-                let d102 = A::mul_add(
-                    p.XZ7l,
-                    k50,
-                    A::mul_add(p.XY7l, k49, p.XX7l * k53),
-                ); // J7lw7l|ud=0,g=0.x
-                let d212 = A::mul_add(
-                    p.XZ7r,
-                    k99,
-                    A::mul_add(p.XY7r, k98, p.XX7r * k102),
-                ); // J7rw7r|ud=0,g=0.x
-                let d103 = A::mul_add(
-                    p.YZ7l,
-                    k50,
-                    A::mul_add(p.YY7l, k49, p.XY7l * k53),
-                ); // J7lw7l|ud=0,g=0.y
-                let d213 = A::mul_add(
-                    p.YZ7r,
-                    k99,
-                    A::mul_add(p.YY7r, k98, p.XY7r * k102),
-                ); // J7rw7r|ud=0,g=0.y
-                let d104 = A::mul_add(
-                    p.ZZ7l,
-                    k50,
-                    A::mul_add(p.YZ7l, k49, p.XZ7l * k53),
-                ); // J7lw7l|ud=0,g=0.z
-                let d214 = A::mul_add(
-                    p.ZZ7r,
-                    k99,
-                    A::mul_add(p.YZ7r, k98, p.XZ7r * k102),
-                ); // J7rw7r|ud=0,g=0.z
-                let d107 = A::mul_add(
-                    p.MY7l,
-                    d80,
-                    A::mul_add(
-                        p.MX7l,
-                        d94,
-                        A::mul_add(
-                            -p.ZZ7l,
-                            k54,
-                            A::mul_add(
-                                p.YZ7l,
-                                k52,
-                                A::mul_add(p.XZ7l, k51, A::mul_add(-k49, d102, k53 * d103)),
-                            ),
-                        ),
-                    ),
-                ); // N7l.z
-                let d215 = A::mul_add(
-                    p.MY7r,
-                    d191,
-                    A::mul_add(
-                        p.MX7r,
-                        d204,
-                        A::mul_add(
-                            -p.ZZ7r,
-                            k101,
-                            A::mul_add(
-                                p.YZ7r,
-                                k103,
-                                A::mul_add(
-                                    p.XZ7r,
-                                    k100,
-                                    A::mul_add(-k98, d212, k102 * d213),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7r.z
-                let d105 = A::mul_add(
-                    -p.MZ7l,
-                    d94,
-                    A::mul_add(
-                        p.MY7l,
-                        d95,
-                        A::mul_add(
-                            -p.XZ7l,
-                            k54,
-                            A::mul_add(
-                                p.XY7l,
-                                k52,
-                                A::mul_add(p.XX7l, k51, A::mul_add(-k50, d103, k49 * d104)),
-                            ),
-                        ),
-                    ),
-                ); // N7l.x
-                let d216 = A::mul_add(
-                    -p.MZ7r,
-                    d204,
-                    A::mul_add(
-                        p.MY7r,
-                        d205,
-                        A::mul_add(
-                            -p.XZ7r,
-                            k101,
-                            A::mul_add(
-                                p.XY7r,
-                                k103,
-                                A::mul_add(p.XX7r, k100, A::mul_add(-k99, d213, k98 * d214)),
-                            ),
-                        ),
-                    ),
-                ); // N7r.x
-                let d106 = A::mul_add(
-                    -p.MX7l,
-                    d95,
-                    A::mul_add(
-                        -p.MZ7l,
-                        d80,
-                        A::mul_add(
-                            -p.YZ7l,
-                            k54,
-                            A::mul_add(
-                                p.YY7l,
-                                k52,
-                                A::mul_add(p.XY7l, k51, A::mul_add(-k53, d104, k50 * d102)),
-                            ),
-                        ),
-                    ),
-                ); // N7l.y
-                let d217 = A::mul_add(
-                    -p.MX7r,
-                    d205,
-                    A::mul_add(
-                        -p.MZ7r,
-                        d191,
-                        A::mul_add(
-                            -p.YZ7r,
-                            k101,
-                            A::mul_add(
-                                p.YY7r,
-                                k103,
-                                A::mul_add(
-                                    p.XY7r,
-                                    k100,
-                                    A::mul_add(-k102, d214, k99 * d212),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7r.y
-                let k55 = A::mul_add(-s_q5l, k50, c_q5l * k53); // w7l in 8l|ud=0,g=0.x
-                let k104 = A::mul_add(-s_q5r, k99, c_q5r * k102); // w7r in 8r|ud=0,g=0.x
-                let k56 = A::mul_add(c_q5l, k50, s_q5l * k53); // w7l in 8l|ud=0,g=0.z
-                let k105 = A::mul_add(c_q5r, k99, s_q5r * k102); // w7r in 8r|ud=0,g=0.z
-                let k59 = k52 + qdd5l; // wd8l.y
-                let k106 = k103 + qdd5r; // wd8r.y
-                let k57 = k49 - qd5l; // w8l|ud=0,g=0.y
-                let k107 = k98 - qd5r; // w8r|ud=0,g=0.y
-                let k58 = A::mul_add(s_q5l, k54, A::mul_add(c_q5l, k51, k56 * qd5l)); // wd8l.x
-                let k108 = A::mul_add(s_q5r, k101, A::mul_add(c_q5r, k100, k105 * qd5r)); // wd8r.x
-                let k60 = A::mul_add(c_q5l, k54, A::mul_add(-s_q5l, k51, k55 * qd5l)); // wd8l.z
-                let k109 = A::mul_add(
-                    c_q5r,
-                    k101,
-                    A::mul_add(-s_q5r, k100, k104 * qd5r),
-                ); // wd8r.z
-                let k61 = p.L8 * k50; // w7lxP8l|ud=0,g=0.x
-                let k110 = p.L8 * k99; // w7rxP8r|ud=0,g=0.x
-                let k62 = p.L8 * k53; // w7lxP8l|ud=0,g=0.z
-                let k111 = p.L8 * k102; // w7rxP8r|ud=0,g=0.z
-                let d109 = A::mul_add(p.L8, k54, A::mul_add(k49, k62, d80)); // a8l in 7l.x
-                let d218 = A::mul_add(p.L8, k101, A::mul_add(k98, k111, d191)); // a8r in 7r.x
-                let d108 = A::mul_add(k53, k62, k50 * k61) + d94; // a8l in 7l.y
-                let d219 = A::mul_add(k102, k111, k99 * k110) + d204; // a8r in 7r.y
-                let d110 = A::mul_add(p.L8, k51, A::mul_add(k49, k61, -d95)); // a8l in 7l.z
-                let d220 = A::mul_add(p.L8, k100, A::mul_add(k98, k110, -d205)); // a8r in 7r.z
-                let d112 = A::mul_add(c_q5l, d110, s_q5l * d109); // a8l.z
-                let d221 = A::mul_add(c_q5r, d220, s_q5r * d218); // a8r.z
-                let d111 = A::mul_add(-s_q5l, d110, c_q5l * d109); // a8l.x
-                let d222 = A::mul_add(-s_q5r, d220, c_q5r * d218); // a8r.x
-                let d114 = A::mul_add(-p.MX8l, k57, p.MY8l * k55); // w8lxMS8l|ud=0,g=0.z
-                let d223 = A::mul_add(-p.MX8r, k107, p.MY8r * k104); // w8rxMS8r|ud=0,g=0.z
-                let d113 = A::mul_add(p.MY8l, k56, p.MZ8l * k57); // w8lxMS8l|ud=0,g=0.x
-                let d224 = A::mul_add(p.MY8r, k105, p.MZ8r * k107); // w8rxMS8r|ud=0,g=0.x
-                let d115 = A::mul_add(p.MZ8l, k55, p.MX8l * k56); // w8lxMS8l|ud=0,g=0.y
-                let d225 = A::mul_add(p.MZ8r, k104, p.MX8r * k105); // w8rxMS8r|ud=0,g=0.y
-                let d117 = A::mul_add(
-                    -p.MZ8l,
-                    k58,
-                    A::mul_add(
-                        p.MX8l,
-                        k60,
-                        A::mul_add(p.m8l, d108, A::mul_add(k55, d114, k56 * d113)),
-                    ),
-                ); // F8l.y
-                let d226 = A::mul_add(
-                    -p.MZ8r,
-                    k108,
-                    A::mul_add(
-                        p.MX8r,
-                        k109,
-                        A::mul_add(p.m8r, d219, A::mul_add(k104, d223, k105 * d224)),
-                    ),
-                ); // F8r.y
-                let d116 = A::mul_add(
-                    p.MY8l,
-                    k60,
-                    A::mul_add(
-                        -p.MZ8l,
-                        k59,
-                        A::mul_add(p.m8l, d111, A::mul_add(-k56, d115, k57 * d114)),
-                    ),
-                ); // F8l.x
-                let d227 = A::mul_add(
-                    p.MY8r,
-                    k109,
-                    A::mul_add(
-                        -p.MZ8r,
-                        k106,
-                        A::mul_add(p.m8r, d222, A::mul_add(-k105, d225, k107 * d223)),
-                    ),
-                ); // F8r.x
-                let d118 = A::mul_add(
-                    -p.MX8l,
-                    k59,
-                    A::mul_add(
-                        p.MY8l,
-                        k58,
-                        A::mul_add(p.m8l, d112, A::mul_add(k57, d113, k55 * d115)),
-                    ),
-                ); // F8l.z
-                let d228 = A::mul_add(
-                    -p.MX8r,
-                    k106,
-                    A::mul_add(
-                        p.MY8r,
-                        k108,
-                        A::mul_add(p.m8r, d221, A::mul_add(k107, d224, k104 * d225)),
-                    ),
-                ); // F8r.z
-                let d119 = A::mul_add(
-                    -p.XZ8l,
-                    k56,
-                    A::mul_add(p.XY8l, k57, p.XX8l * k55),
-                ); // J8lw8l|ud=0,g=0.x
-                let d229 = A::mul_add(
-                    -p.XZ8r,
-                    k105,
-                    A::mul_add(p.XY8r, k107, p.XX8r * k104),
-                ); // J8rw8r|ud=0,g=0.x
-                let d120 = A::mul_add(
-                    -p.YZ8l,
-                    k56,
-                    A::mul_add(p.YY8l, k57, p.XY8l * k55),
-                ); // J8lw8l|ud=0,g=0.y
-                let d230 = A::mul_add(
-                    -p.YZ8r,
-                    k105,
-                    A::mul_add(p.YY8r, k107, p.XY8r * k104),
-                ); // J8rw8r|ud=0,g=0.y
-                let d121 = A::mul_add(
-                    -p.ZZ8l,
-                    k56,
-                    A::mul_add(p.YZ8l, k57, p.XZ8l * k55),
-                ); // J8lw8l|ud=0,g=0.z
-                let d231 = A::mul_add(
-                    -p.ZZ8r,
-                    k105,
-                    A::mul_add(p.YZ8r, k107, p.XZ8r * k104),
-                ); // J8rw8r|ud=0,g=0.z
-                let d123 = A::mul_add(
-                    -p.MY8l,
-                    d111,
-                    A::mul_add(
-                        -p.MX8l,
-                        d108,
-                        A::mul_add(
-                            -p.ZZ8l,
-                            k60,
-                            A::mul_add(
-                                -p.YZ8l,
-                                k59,
-                                A::mul_add(-p.XZ8l, k58, A::mul_add(-k57, d119, k55 * d120)),
-                            ),
-                        ),
-                    ),
-                ); // N8l.z
-                let d232 = A::mul_add(
-                    -p.MY8r,
-                    d222,
-                    A::mul_add(
-                        -p.MX8r,
-                        d219,
-                        A::mul_add(
-                            -p.ZZ8r,
-                            k109,
-                            A::mul_add(
-                                -p.YZ8r,
-                                k106,
-                                A::mul_add(
-                                    -p.XZ8r,
-                                    k108,
-                                    A::mul_add(-k107, d229, k104 * d230),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r.z
-                let d122 = A::mul_add(
-                    p.MZ8l,
-                    d108,
-                    A::mul_add(
-                        -p.MY8l,
-                        d112,
-                        A::mul_add(
-                            -p.XZ8l,
-                            k60,
-                            A::mul_add(
-                                -p.XY8l,
-                                k59,
-                                A::mul_add(-p.XX8l, k58, A::mul_add(k56, d120, k57 * d121)),
-                            ),
-                        ),
-                    ),
-                ); // N8l.x
-                let d233 = A::mul_add(
-                    p.MZ8r,
-                    d219,
-                    A::mul_add(
-                        -p.MY8r,
-                        d221,
-                        A::mul_add(
-                            -p.XZ8r,
-                            k109,
-                            A::mul_add(
-                                -p.XY8r,
-                                k106,
-                                A::mul_add(
-                                    -p.XX8r,
-                                    k108,
-                                    A::mul_add(k105, d230, k107 * d231),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r.x
-                let d124 = A::mul_add(
-                    -p.MX8l,
-                    d112,
-                    A::mul_add(
-                        -p.MZ8l,
-                        d111,
-                        A::mul_add(
-                            p.YZ8l,
-                            k60,
-                            A::mul_add(
-                                p.YY8l,
-                                k59,
-                                A::mul_add(p.XY8l, k58, A::mul_add(k55, d121, k56 * d119)),
-                            ),
-                        ),
-                    ),
-                ); // N8l.y
-                let d234 = A::mul_add(
-                    -p.MX8r,
-                    d221,
-                    A::mul_add(
-                        -p.MZ8r,
-                        d222,
-                        A::mul_add(
-                            p.YZ8r,
-                            k109,
-                            A::mul_add(
-                                p.YY8r,
-                                k106,
-                                A::mul_add(
-                                    p.XY8r,
-                                    k108,
-                                    A::mul_add(k104, d231, k105 * d229),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r.y
-                let k63 = A::mul_add(-s_q6l, k56, c_q6l * k57); // w8l in 9l|ud=0,g=0.y
-                let k112 = A::mul_add(-s_q6r, k105, c_q6r * k107); // w8r in 9r|ud=0,g=0.y
-                let k64 = A::mul_add(c_q6l, k56, s_q6l * k57); // w8l in 9l|ud=0,g=0.z
-                let k113 = A::mul_add(c_q6r, k105, s_q6r * k107); // w8r in 9r|ud=0,g=0.z
-                let k65 = k58 - qdd6l; // wd9l.x
-                let k114 = k108 - qdd6r; // wd9r.x
-                let k68 = A::mul_add(c_q6l, k60, A::mul_add(-s_q6l, k59, k63 * qd6l)); // wd9l.z
-                let k115 = A::mul_add(
-                    c_q6r,
-                    k109,
-                    A::mul_add(-s_q6r, k106, k112 * qd6r),
-                ); // wd9r.z
-                let k67 = k55 + qd6l; // w9l|ud=0,g=0.x
-                let k116 = k104 + qd6r; // w9r|ud=0,g=0.x
-                let k66 = A::mul_add(s_q6l, k60, A::mul_add(c_q6l, k59, k64 * qd6l)); // wd9l.y
-                let k117 = A::mul_add(s_q6r, k109, A::mul_add(c_q6r, k106, k113 * qd6r)); // wd9r.y
-                let d125 = A::mul_add(s_q6l, d112, c_q6l * d108); // a9l.y
-                let d235 = A::mul_add(s_q6r, d221, c_q6r * d219); // a9r.y
-                let d126 = A::mul_add(-c_q6l, d112, s_q6l * d108); // a9l.z
-                let d236 = A::mul_add(-c_q6r, d221, s_q6r * d219); // a9r.z
-                let d127 = A::mul_add(-p.MY9l, k64, p.MZ9l * k63); // w9lxMS9l|ud=0,g=0.x
-                let d237 = A::mul_add(-p.MY9r, k113, p.MZ9r * k112); // w9rxMS9r|ud=0,g=0.x
-                let d128 = A::mul_add(-p.MZ9l, k67, p.MX9l * k64); // w9lxMS9l|ud=0,g=0.y
-                let d238 = A::mul_add(-p.MZ9r, k116, p.MX9r * k113); // w9rxMS9r|ud=0,g=0.y
-                let d129 = A::mul_add(-p.MX9l, k63, p.MY9l * k67); // w9lxMS9l|ud=0,g=0.z
-                let d239 = A::mul_add(-p.MX9r, k112, p.MY9r * k116); // w9rxMS9r|ud=0,g=0.z
-                let d131 = A::mul_add(
-                    -p.MZ9l,
-                    k65,
-                    A::mul_add(
-                        -p.MX9l,
-                        k68,
-                        A::mul_add(p.m9l, d125, A::mul_add(-k67, d129, k64 * d127)),
-                    ),
-                ); // F9l.y
-                let d240 = A::mul_add(
-                    -p.MZ9r,
-                    k114,
-                    A::mul_add(
-                        -p.MX9r,
-                        k115,
-                        A::mul_add(p.m9r, d235, A::mul_add(-k116, d239, k113 * d237)),
-                    ),
-                ); // F9r.y
-                let d130 = A::mul_add(
-                    p.MY9l,
-                    k68,
-                    A::mul_add(
-                        p.MZ9l,
-                        k66,
-                        A::mul_add(-p.m9l, d111, A::mul_add(-k64, d128, k63 * d129)),
-                    ),
-                ); // F9l.x
-                let d241 = A::mul_add(
-                    p.MY9r,
-                    k115,
-                    A::mul_add(
-                        p.MZ9r,
-                        k117,
-                        A::mul_add(-p.m9r, d222, A::mul_add(-k113, d238, k112 * d239)),
-                    ),
-                ); // F9r.x
-                let d132 = A::mul_add(
-                    -p.MX9l,
-                    k66,
-                    A::mul_add(
-                        p.MY9l,
-                        k65,
-                        A::mul_add(p.m9l, d126, A::mul_add(-k63, d127, k67 * d128)),
-                    ),
-                ); // F9l.z
-                let d242 = A::mul_add(
-                    -p.MX9r,
-                    k117,
-                    A::mul_add(
-                        p.MY9r,
-                        k114,
-                        A::mul_add(p.m9r, d236, A::mul_add(-k112, d237, k116 * d238)),
-                    ),
-                ); // F9r.z
-                let d133 = A::mul_add(
-                    p.XZ9l,
-                    k64,
-                    A::mul_add(p.XY9l, k63, p.XX9l * k67),
-                ); // J9lw9l|ud=0,g=0.x
-                let d243 = A::mul_add(
-                    p.XZ9r,
-                    k113,
-                    A::mul_add(p.XY9r, k112, p.XX9r * k116),
-                ); // J9rw9r|ud=0,g=0.x
-                let d134 = A::mul_add(
-                    p.YZ9l,
-                    k64,
-                    A::mul_add(p.YY9l, k63, p.XY9l * k67),
-                ); // J9lw9l|ud=0,g=0.y
-                let d244 = A::mul_add(
-                    p.YZ9r,
-                    k113,
-                    A::mul_add(p.YY9r, k112, p.XY9r * k116),
-                ); // J9rw9r|ud=0,g=0.y
-                let d135 = A::mul_add(
-                    p.ZZ9l,
-                    k64,
-                    A::mul_add(p.YZ9l, k63, p.XZ9l * k67),
-                ); // J9lw9l|ud=0,g=0.z
-                let d245 = A::mul_add(
-                    p.ZZ9r,
-                    k113,
-                    A::mul_add(p.YZ9r, k112, p.XZ9r * k116),
-                ); // J9rw9r|ud=0,g=0.z
-                let d138 = A::mul_add(
-                    p.MY9l,
-                    d111,
-                    A::mul_add(
-                        p.MX9l,
-                        d125,
-                        A::mul_add(
-                            -p.ZZ9l,
-                            k68,
-                            A::mul_add(
-                                p.YZ9l,
-                                k66,
-                                A::mul_add(p.XZ9l, k65, A::mul_add(-k63, d133, k67 * d134)),
-                            ),
-                        ),
-                    ),
-                ); // N9l.z
-                let d246 = A::mul_add(
-                    p.MY9r,
-                    d222,
-                    A::mul_add(
-                        p.MX9r,
-                        d235,
-                        A::mul_add(
-                            -p.ZZ9r,
-                            k115,
-                            A::mul_add(
-                                p.YZ9r,
-                                k117,
-                                A::mul_add(
-                                    p.XZ9r,
-                                    k114,
-                                    A::mul_add(-k112, d243, k116 * d244),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r.z
-                let d136 = A::mul_add(
-                    -p.MZ9l,
-                    d125,
-                    A::mul_add(
-                        p.MY9l,
-                        d126,
-                        A::mul_add(
-                            -p.XZ9l,
-                            k68,
-                            A::mul_add(
-                                p.XY9l,
-                                k66,
-                                A::mul_add(p.XX9l, k65, A::mul_add(-k64, d134, k63 * d135)),
-                            ),
-                        ),
-                    ),
-                ); // N9l.x
-                let d247 = A::mul_add(
-                    -p.MZ9r,
-                    d235,
-                    A::mul_add(
-                        p.MY9r,
-                        d236,
-                        A::mul_add(
-                            -p.XZ9r,
-                            k115,
-                            A::mul_add(
-                                p.XY9r,
-                                k117,
-                                A::mul_add(
-                                    p.XX9r,
-                                    k114,
-                                    A::mul_add(-k113, d244, k112 * d245),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r.x
-                let d137 = A::mul_add(
-                    -p.MX9l,
-                    d126,
-                    A::mul_add(
-                        -p.MZ9l,
-                        d111,
-                        A::mul_add(
-                            -p.YZ9l,
-                            k68,
-                            A::mul_add(
-                                p.YY9l,
-                                k66,
-                                A::mul_add(p.XY9l, k65, A::mul_add(-k67, d135, k64 * d133)),
-                            ),
-                        ),
-                    ),
-                ); // N9l.y
-                let d248 = A::mul_add(
-                    -p.MX9r,
-                    d236,
-                    A::mul_add(
-                        -p.MZ9r,
-                        d222,
-                        A::mul_add(
-                            -p.YZ9r,
-                            k115,
-                            A::mul_add(
-                                p.YY9r,
-                                k117,
-                                A::mul_add(
-                                    p.XY9r,
-                                    k114,
-                                    A::mul_add(-k116, d245, k113 * d243),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r.y
-                let k69 = A::mul_add(-s_q7l, k64, c_q7l * k67); // w9l in 10l|ud=0,g=0.x
-                let k118 = A::mul_add(-s_q7r, k113, c_q7r * k116); // w9r in 10r|ud=0,g=0.x
-                let k70 = A::mul_add(c_q7l, k64, s_q7l * k67); // w9l in 10l|ud=0,g=0.y
-                let k119 = A::mul_add(c_q7r, k113, s_q7r * k116); // w9r in 10r|ud=0,g=0.y
-                let k74 = k66 + qdd7l; // wd10l.z
-                let k120 = k117 + qdd7r; // wd10r.z
-                let k72 = A::mul_add(c_q7l, k68, A::mul_add(-s_q7l, k65, k69 * qd7l)); // wd10l.y
-                let k121 = A::mul_add(
-                    c_q7r,
-                    k115,
-                    A::mul_add(-s_q7r, k114, k118 * qd7r),
-                ); // wd10r.y
-                let k71 = k63 - qd7l; // w10l|ud=0,g=0.z
-                let k122 = k112 - qd7r; // w10r|ud=0,g=0.z
-                let k73 = A::mul_add(s_q7l, k68, A::mul_add(c_q7l, k65, k70 * qd7l)); // wd10l.x
-                let k123 = A::mul_add(s_q7r, k115, A::mul_add(c_q7r, k114, k119 * qd7r)); // wd10r.x
-                let k75 = p.L9 * k64; // w9lxP10l|ud=0,g=0.x
-                let k124 = p.L9 * k113; // w9rxP10r|ud=0,g=0.x
-                let k76 = p.L9 * k67; // w9lxP10l|ud=0,g=0.z
-                let k125 = p.L9 * k116; // w9rxP10r|ud=0,g=0.z
-                let d140 = A::mul_add(p.L9, k68, A::mul_add(k63, k76, d111)); // a10l in 9l.x
-                let d249 = A::mul_add(p.L9, k115, A::mul_add(k112, k125, d222)); // a10r in 9r.x
-                let d139 = A::mul_add(k67, k76, k64 * k75) + d125; // a10l in 9l.y
-                let d250 = A::mul_add(k116, k125, k113 * k124) + d235; // a10r in 9r.y
-                let d141 = A::mul_add(p.L9, k65, A::mul_add(k63, k75, -d126)); // a10l in 9l.z
-                let d251 = A::mul_add(p.L9, k114, A::mul_add(k112, k124, -d236)); // a10r in 9r.z
-                let d142 = A::mul_add(-s_q7l, d141, c_q7l * d140); // a10l.x
-                let d252 = A::mul_add(-s_q7r, d251, c_q7r * d249); // a10r.x
-                let d143 = A::mul_add(c_q7l, d141, s_q7l * d140); // a10l.y
-                let d253 = A::mul_add(c_q7r, d251, s_q7r * d249); // a10r.y
-                let d144 = A::mul_add(-p.MY10l, k71, p.MZ10l * k70); // w10lxMS10l|ud=0,g=0.x
-                let d254 = A::mul_add(-p.MY10r, k122, p.MZ10r * k119); // w10rxMS10r|ud=0,g=0.x
-                let d146 = A::mul_add(-p.MX10l, k70, p.MY10l * k69); // w10lxMS10l|ud=0,g=0.z
-                let d255 = A::mul_add(-p.MX10r, k119, p.MY10r * k118); // w10rxMS10r|ud=0,g=0.z
-                let d145 = A::mul_add(-p.MZ10l, k69, p.MX10l * k71); // w10lxMS10l|ud=0,g=0.y
-                let d256 = A::mul_add(-p.MZ10r, k118, p.MX10r * k122); // w10rxMS10r|ud=0,g=0.y
-                let d147 = A::mul_add(
-                    p.MY10l,
-                    k74,
-                    A::mul_add(
-                        p.MZ10l,
-                        k72,
-                        A::mul_add(p.m10l, d142, A::mul_add(-k71, d145, k70 * d146)),
-                    ),
-                ); // F10l.x
-                let d257 = A::mul_add(
-                    p.MY10r,
-                    k120,
-                    A::mul_add(
-                        p.MZ10r,
-                        k121,
-                        A::mul_add(p.m10r, d252, A::mul_add(-k122, d256, k119 * d255)),
-                    ),
-                ); // F10r.x
-                let d148 = A::mul_add(
-                    p.MZ10l,
-                    k73,
-                    A::mul_add(
-                        -p.MX10l,
-                        k74,
-                        A::mul_add(p.m10l, d143, A::mul_add(-k69, d146, k71 * d144)),
-                    ),
-                ); // F10l.y
-                let d258 = A::mul_add(
-                    p.MZ10r,
-                    k123,
-                    A::mul_add(
-                        -p.MX10r,
-                        k120,
-                        A::mul_add(p.m10r, d253, A::mul_add(-k118, d255, k122 * d254)),
-                    ),
-                ); // F10r.y
-                let d149 = A::mul_add(
-                    -p.MX10l,
-                    k72,
-                    A::mul_add(
-                        -p.MY10l,
-                        k73,
-                        A::mul_add(-p.m10l, d139, A::mul_add(-k70, d144, k69 * d145)),
-                    ),
-                ); // F10l.z
-                let d259 = A::mul_add(
-                    -p.MX10r,
-                    k121,
-                    A::mul_add(
-                        -p.MY10r,
-                        k123,
-                        A::mul_add(-p.m10r, d250, A::mul_add(-k119, d254, k118 * d256)),
-                    ),
-                ); // F10r.z
-                let d150 = A::mul_add(
-                    p.XZ10l,
-                    k71,
-                    A::mul_add(p.XY10l, k70, p.XX10l * k69),
-                ); // J10lw10l|ud=0,g=0.x
-                let d260 = A::mul_add(
-                    p.XZ10r,
-                    k122,
-                    A::mul_add(p.XY10r, k119, p.XX10r * k118),
-                ); // J10rw10r|ud=0,g=0.x
-                let d151 = A::mul_add(
-                    p.YZ10l,
-                    k71,
-                    A::mul_add(p.YY10l, k70, p.XY10l * k69),
-                ); // J10lw10l|ud=0,g=0.y
-                let d261 = A::mul_add(
-                    p.YZ10r,
-                    k122,
-                    A::mul_add(p.YY10r, k119, p.XY10r * k118),
-                ); // J10rw10r|ud=0,g=0.y
-                let d152 = A::mul_add(
-                    p.ZZ10l,
-                    k71,
-                    A::mul_add(p.YZ10l, k70, p.XZ10l * k69),
-                ); // J10lw10l|ud=0,g=0.z
-                let d262 = A::mul_add(
-                    p.ZZ10r,
-                    k122,
-                    A::mul_add(p.YZ10r, k119, p.XZ10r * k118),
-                ); // J10rw10r|ud=0,g=0.z
-                let d153 = A::mul_add(
-                    -p.MZ10l,
-                    d143,
-                    A::mul_add(
-                        -p.MY10l,
-                        d139,
-                        A::mul_add(
-                            -p.XZ10l,
-                            k74,
-                            A::mul_add(
-                                p.XY10l,
-                                k72,
-                                A::mul_add(
-                                    -p.XX10l,
-                                    k73,
-                                    A::mul_add(-k71, d151, k70 * d152),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l.x
-                let d263 = A::mul_add(
-                    -p.MZ10r,
-                    d253,
-                    A::mul_add(
-                        -p.MY10r,
-                        d250,
-                        A::mul_add(
-                            -p.XZ10r,
-                            k120,
-                            A::mul_add(
-                                p.XY10r,
-                                k121,
-                                A::mul_add(
-                                    -p.XX10r,
-                                    k123,
-                                    A::mul_add(-k122, d261, k119 * d262),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r.x
-                let d155 = A::mul_add(
-                    -p.MY10l,
-                    d142,
-                    A::mul_add(
-                        p.MX10l,
-                        d143,
-                        A::mul_add(
-                            -p.ZZ10l,
-                            k74,
-                            A::mul_add(
-                                p.YZ10l,
-                                k72,
-                                A::mul_add(
-                                    -p.XZ10l,
-                                    k73,
-                                    A::mul_add(-k70, d150, k69 * d151),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l.z
-                m[11] = -d155;
-                let d264 = A::mul_add(
-                    -p.MY10r,
-                    d252,
-                    A::mul_add(
-                        p.MX10r,
-                        d253,
-                        A::mul_add(
-                            -p.ZZ10r,
-                            k120,
-                            A::mul_add(
-                                p.YZ10r,
-                                k121,
-                                A::mul_add(
-                                    -p.XZ10r,
-                                    k123,
-                                    A::mul_add(-k119, d260, k118 * d261),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r.z
-                m[18] = -d264;
-                let d154 = A::mul_add(
-                    p.MX10l,
-                    d139,
-                    A::mul_add(
-                        p.MZ10l,
-                        d142,
-                        A::mul_add(
-                            -p.YZ10l,
-                            k74,
-                            A::mul_add(
-                                p.YY10l,
-                                k72,
-                                A::mul_add(
-                                    -p.XY10l,
-                                    k73,
-                                    A::mul_add(-k69, d152, k71 * d150),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l.y
-                let d265 = A::mul_add(
-                    p.MX10r,
-                    d250,
-                    A::mul_add(
-                        p.MZ10r,
-                        d252,
-                        A::mul_add(
-                            -p.YZ10r,
-                            k120,
-                            A::mul_add(
-                                p.YY10r,
-                                k121,
-                                A::mul_add(
-                                    -p.XY10r,
-                                    k123,
-                                    A::mul_add(-k118, d262, k122 * d260),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r.y
-                let d322 = A::mul_add(-c_q7l, d148, s_q7l * d147); // f10l in 9l.z
-                let d266 = A::mul_add(-c_q7r, d258, s_q7r * d257); // f10r in 9r.z
-                let d323 = A::mul_add(s_q7l, d148, c_q7l * d147); // f10l in 9l.x
-                let d267 = A::mul_add(s_q7r, d258, c_q7r * d257); // f10r in 9r.x
-                let d324 = d130 - d323; // f9l.x
-                let d270 = d241 - d267; // f9r.x
-                let d325 = d131 - d149; // f9l.y
-                let d268 = d240 - d259; // f9r.y
-                let d326 = d132 + d322; // f9l.z
-                let d271 = d242 + d266; // f9r.z
-                let d327 = d137 - d155; // n9l.y
-                let d273 = d248 - d264; // n9r.y
-                let d328 = A::mul_add(
-                    -p.L9,
-                    d322,
-                    A::mul_add(-s_q7l, d154, A::mul_add(-c_q7l, d153, d136)),
-                ); // n9l.x
-                m[10] = -d328;
-                let d272 = A::mul_add(
-                    -p.L9,
-                    d266,
-                    A::mul_add(-s_q7r, d265, A::mul_add(-c_q7r, d263, d247)),
-                ); // n9r.x
-                m[17] = -d272;
-                let d329 = A::mul_add(
-                    -p.L9,
-                    d323,
-                    A::mul_add(-c_q7l, d154, A::mul_add(s_q7l, d153, d138)),
-                ); // n9l.z
-                let d269 = A::mul_add(
-                    -p.L9,
-                    d267,
-                    A::mul_add(-c_q7r, d265, A::mul_add(s_q7r, d263, d246)),
-                ); // n9r.z
-                let d330 = A::mul_add(s_q6l, d326, c_q6l * d325); // f9l in 8l.y
-                let d274 = A::mul_add(s_q6r, d271, c_q6r * d268); // f9r in 8r.y
-                let d331 = A::mul_add(-c_q6l, d326, s_q6l * d325); // f9l in 8l.z
-                let d275 = A::mul_add(-c_q6r, d271, s_q6r * d268); // f9r in 8r.z
-                let d332 = d116 - d324; // f8l.x
-                let d278 = d227 - d270; // f8r.x
-                let d333 = d122 - d328; // n8l.x
-                let d280 = d233 - d272; // n8r.x
-                let d334 = A::mul_add(c_q6l, d329, A::mul_add(-s_q6l, d327, d123)); // n8l.z
-                let d277 = A::mul_add(c_q6r, d269, A::mul_add(-s_q6r, d273, d232)); // n8r.z
-                let d335 = d117 + d330; // f8l.y
-                let d276 = d226 + d274; // f8r.y
-                let d336 = d118 + d331; // f8l.z
-                let d279 = d228 + d275; // f8r.z
-                let d337 = A::mul_add(s_q6l, d329, A::mul_add(c_q6l, d327, d124)); // n8l.y
-                m[9] = d337;
-                let d281 = A::mul_add(s_q6r, d269, A::mul_add(c_q6r, d273, d234)); // n8r.y
-                m[16] = d281;
-                let d338 = A::mul_add(-c_q5l, d336, s_q5l * d332); // f8l in 7l.z
-                let d283 = A::mul_add(-c_q5r, d279, s_q5r * d278); // f8r in 7r.z
-                let d339 = A::mul_add(s_q5l, d336, c_q5l * d332); // f8l in 7l.x
-                let d282 = A::mul_add(s_q5r, d279, c_q5r * d278); // f8r in 7r.x
-                let d340 = d99 - d339; // f7l.x
-                let d286 = d210 - d282; // f7r.x
-                let d341 = d100 + d335; // f7l.y
-                let d284 = d209 + d276; // f7r.y
-                let d342 = d101 + d338; // f7l.z
-                let d287 = d211 + d283; // f7r.z
-                let d343 = d106 + d337; // n7l.y
-                let d289 = d217 + d281; // n7r.y
-                let d344 = A::mul_add(
-                    -p.L8,
-                    d338,
-                    A::mul_add(s_q5l, d334, A::mul_add(-c_q5l, d333, d105)),
-                ); // n7l.x
-                m[8] = -d344;
-                let d288 = A::mul_add(
-                    -p.L8,
-                    d283,
-                    A::mul_add(s_q5r, d277, A::mul_add(-c_q5r, d280, d216)),
-                ); // n7r.x
-                m[15] = -d288;
-                let d345 = A::mul_add(
-                    -p.L8,
-                    d339,
-                    A::mul_add(c_q5l, d334, A::mul_add(s_q5l, d333, d107)),
-                ); // n7l.z
-                let d285 = A::mul_add(
-                    -p.L8,
-                    d282,
-                    A::mul_add(c_q5r, d277, A::mul_add(s_q5r, d280, d215)),
-                ); // n7r.z
-                let d346 = A::mul_add(s_q4l, d342, c_q4l * d341); // f7l in 6l.y
-                let d290 = A::mul_add(s_q4r, d287, c_q4r * d284); // f7r in 6r.y
-                let d347 = A::mul_add(-c_q4l, d342, s_q4l * d341); // f7l in 6l.z
-                let d291 = A::mul_add(-c_q4r, d287, s_q4r * d284); // f7r in 6r.z
-                let d348 = d85 - d340; // f6l.x
-                let d294 = d196 - d286; // f6r.x
-                let d349 = d91 - d344; // n6l.x
-                let d296 = d202 - d288; // n6r.x
-                let d350 = A::mul_add(c_q4l, d345, A::mul_add(-s_q4l, d343, d92)); // n6l.z
-                let d293 = A::mul_add(c_q4r, d285, A::mul_add(-s_q4r, d289, d201)); // n6r.z
-                let d351 = d86 + d346; // f6l.y
-                let d292 = d195 + d290; // f6r.y
-                let d352 = d87 + d347; // f6l.z
-                let d295 = d197 + d291; // f6r.z
-                let d353 = A::mul_add(s_q4l, d345, A::mul_add(c_q4l, d343, d93)); // n6l.y
-                m[7] = d353;
-                let d297 = A::mul_add(s_q4r, d285, A::mul_add(c_q4r, d289, d203)); // n6r.y
-                m[14] = d297;
-                let d354 = A::mul_add(-c_q3l, d352, s_q3l * d348); // f6l in 5l.z
-                let d299 = A::mul_add(-c_q3r, d295, s_q3r * d294); // f6r in 5r.z
-                let d355 = A::mul_add(s_q3l, d352, c_q3l * d348); // f6l in 5l.x
-                let d298 = A::mul_add(s_q3r, d295, c_q3r * d294); // f6r in 5r.x
-                let d356 = d68 - d355; // f5l.x
-                let d302 = d179 - d298; // f5r.x
-                let d357 = d69 + d351; // f5l.y
-                let d300 = d178 + d292; // f5r.y
-                let d358 = d70 + d354; // f5l.z
-                let d303 = d180 + d299; // f5r.z
-                let d359 = d75 + d353; // n5l.y
-                let d305 = d186 + d297; // n5r.y
-                let d360 = A::mul_add(
-                    -p.L7,
-                    d354,
-                    A::mul_add(s_q3l, d350, A::mul_add(-c_q3l, d349, d74)),
-                ); // n5l.x
-                m[6] = -d360;
-                let d304 = A::mul_add(
-                    -p.L7,
-                    d299,
-                    A::mul_add(s_q3r, d293, A::mul_add(-c_q3r, d296, d185)),
-                ); // n5r.x
-                m[13] = -d304;
-                let d361 = A::mul_add(
-                    -p.L7,
-                    d355,
-                    A::mul_add(c_q3l, d350, A::mul_add(s_q3l, d349, d76)),
-                ); // n5l.z
-                let d301 = A::mul_add(
-                    -p.L7,
-                    d298,
-                    A::mul_add(c_q3r, d293, A::mul_add(s_q3r, d296, d184)),
-                ); // n5r.z
-                let d362 = A::mul_add(s_q2l, d358, c_q2l * d357); // f5l in 4l.y
-                let d306 = A::mul_add(s_q2r, d303, c_q2r * d300); // f5r in 4r.y
-                let d363 = A::mul_add(-c_q2l, d358, s_q2l * d357); // f5l in 4l.z
-                let d307 = A::mul_add(-c_q2r, d303, s_q2r * d300); // f5r in 4r.z
-                let d364 = d54 - d356; // f4l.x
-                let d310 = d165 - d302; // f4r.x
-                let d365 = d60 - d360; // n4l.x
-                let d312 = d171 - d304; // n4r.x
-                let d366 = A::mul_add(c_q2l, d361, A::mul_add(-s_q2l, d359, d61)); // n4l.z
-                let d309 = A::mul_add(c_q2r, d301, A::mul_add(-s_q2r, d305, d170)); // n4r.z
-                let d367 = d55 + d362; // f4l.y
-                let d308 = d164 + d306; // f4r.y
-                let d316 = d37 + d308; // f3.x
-                let d368 = d56 + d363; // f4l.z
-                let d311 = d166 + d307; // f4r.z
-                let d369 = A::mul_add(s_q2l, d361, A::mul_add(c_q2l, d359, d62)); // n4l.y
-                m[5] = d369;
-                let d313 = A::mul_add(s_q2r, d301, A::mul_add(c_q2r, d305, d172)); // n4r.y
-                m[12] = d313;
-                let d370 = A::mul_add(s_q1l, d368, c_q1l * d364); // f4l in 3.y
-                let d314 = A::mul_add(s_q1r, d311, c_q1r * d310); // f4r in 3.y
-                let d318 = A::mul_add(
-                    -p.L5,
-                    d308,
-                    A::mul_add(
-                        -p.L6,
-                        d314,
-                        A::mul_add(c_q1r, d309, A::mul_add(s_q1r, d312, d44)),
-                    ),
-                ); // n3.z
-                let d319 = d38 - d314; // f3.y
-                let d371 = A::mul_add(-c_q1l, d368, s_q1l * d364); // f4l in 3.z
-                let d315 = A::mul_add(-c_q1r, d311, s_q1r * d310); // f4r in 3.z
-                let d317 = A::mul_add(p.L5, d315, d43 + d313); // n3.x
-                let d320 = d39 - d315; // f3.z
-                let d321 = A::mul_add(
-                    -p.L6,
-                    d315,
-                    A::mul_add(s_q1r, d309, A::mul_add(-c_q1r, d312, d45)),
-                ); // n3.y
-                let d372 = d316 - d367; // f3.x
-                let d373 = A::mul_add(-p.L5, d371, d317 - d369); // n3.x
-                let d374 = A::mul_add(
-                    p.L5,
-                    d367,
-                    A::mul_add(
-                        p.L6,
-                        d370,
-                        A::mul_add(-c_q1l, d366, A::mul_add(-s_q1l, d365, d318)),
-                    ),
-                ); // n3.z
-                let d375 = d319 - d370; // f3.y
-                let d376 = d320 + d371; // f3.z
-                let d377 = A::mul_add(
-                    -p.L6,
-                    d371,
-                    A::mul_add(s_q1l, d366, A::mul_add(-c_q1l, d365, d321)),
-                ); // n3.y
-                m[4] = d377;
-                let d378 = A::mul_add(s_q_torso, d376, c_q_torso * d372); // f3 in 2.x
-                let d379 = A::mul_add(-c_q_torso, d376, s_q_torso * d372); // f3 in 2.z
-                let d380 = d21 - d375; // f2.y
-                let d381 = A::mul_add(
-                    p.L3,
-                    d378,
-                    A::mul_add(-c_q_torso, d374, A::mul_add(-s_q_torso, d373, d27)),
-                ); // n2.z
-                let d382 = d22 + d378; // f2.x
-                let d383 = d23 + d379; // f2.z
-                let d384 = A::mul_add(
-                    -p.L4,
-                    d375,
-                    A::mul_add(
-                        p.L3,
-                        d379,
-                        A::mul_add(-s_q_torso, d374, A::mul_add(c_q_torso, d373, d28)),
-                    ),
-                ); // n2.x
-                m[3] = d384;
-                let d385 = A::mul_add(p.L4, d378, d29 + d377); // n2.y
-                let d386 = A::mul_add(-s_q_w, d383, c_q_w * d380); // f2 in 1.y
-                let d387 = A::mul_add(c_q_w, d383, s_q_w * d380); // f2 in 1.z
-                let d388 = d6 + d386; // f1.y
-                let d389 = A::mul_add(
-                    p.L1,
-                    d382,
-                    A::mul_add(c_q_w, d381, A::mul_add(s_q_w, d385, d11)),
-                ); // n1.z
-                let d390 = d7 + d387; // f1.z
-                let d391 = A::mul_add(-p.L2, d386, A::mul_add(p.L1, d387, d12 + d384)); // n1.x
-                m[2] = d391;
-                let d392 = A::mul_add(
-                    -p.L2,
-                    d382,
-                    A::mul_add(-s_q_w, d381, A::mul_add(c_q_w, d385, d13)),
-                ); // n1.y
-                let d393 = A::mul_add(c_q_imu, d390, s_q_imu * d388); // f1 in 0.x
-                m[0] = A::mul_add(pc.pc67, xdd, d393);
-                let d394 = A::mul_add(-s_q_imu, d389, c_q_imu * d392); // n0.z
-                m[1] = A::mul_add(pc.pc68, psidd, -d394);
-            }
+            inverse_dynamics_batch_body::<A, _, L>(p, pc, &q, &u, &ud, out);
         }
         kanegen_runtime::isa::dispatch_fused_wide_with(
             out,
@@ -19829,2212 +15530,10 @@ mod generated {
             ud: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
             out: &mut SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
         ) {
-            let p = &{ *p };
-            let pc = &{ *pc };
-            let q = &{ *q };
-            let u = &{ *u };
-            let ud = &{ *ud };
-            let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
-                A,
-                _,
-                L,
-            >([
-                q[2].0,
-                q[3].0,
-                q[4].0,
-                q[5].0,
-                q[12].0,
-                q[6].0,
-                q[13].0,
-                q[7].0,
-                q[14].0,
-                q[8].0,
-                q[15].0,
-                q[9].0,
-                q[16].0,
-                q[10].0,
-                q[17].0,
-                q[11].0,
-                q[18].0,
-            ]);
-            for l in 0..L {
-                let s_q_imu = sin_q[0][l];
-                let c_q_imu = cos_q[0][l];
-                let s_q_w = sin_q[1][l];
-                let c_q_w = cos_q[1][l];
-                let s_q_torso = sin_q[2][l];
-                let c_q_torso = cos_q[2][l];
-                let s_q1l = sin_q[3][l];
-                let c_q1l = cos_q[3][l];
-                let s_q1r = sin_q[4][l];
-                let c_q1r = cos_q[4][l];
-                let s_q2l = sin_q[5][l];
-                let c_q2l = cos_q[5][l];
-                let s_q2r = sin_q[6][l];
-                let c_q2r = cos_q[6][l];
-                let s_q3l = sin_q[7][l];
-                let c_q3l = cos_q[7][l];
-                let s_q3r = sin_q[8][l];
-                let c_q3r = cos_q[8][l];
-                let s_q4l = sin_q[9][l];
-                let c_q4l = cos_q[9][l];
-                let s_q4r = sin_q[10][l];
-                let c_q4r = cos_q[10][l];
-                let s_q5l = sin_q[11][l];
-                let c_q5l = cos_q[11][l];
-                let s_q5r = sin_q[12][l];
-                let c_q5r = cos_q[12][l];
-                let s_q6l = sin_q[13][l];
-                let c_q6l = cos_q[13][l];
-                let s_q6r = sin_q[14][l];
-                let c_q6r = cos_q[14][l];
-                let s_q7l = sin_q[15][l];
-                let c_q7l = cos_q[15][l];
-                let s_q7r = sin_q[16][l];
-                let c_q7r = cos_q[16][l];
-                let xd = u[0].0[l];
-                let xdd = ud[0].0[l];
-                let psid = u[1].0[l];
-                let psidd = ud[1].0[l];
-                let qd_imu = u[2].0[l];
-                let qdd_imu = ud[2].0[l];
-                let qd_w = u[3].0[l];
-                let qdd_w = ud[3].0[l];
-                let qd_torso = u[4].0[l];
-                let qdd_torso = ud[4].0[l];
-                let qd1l = u[5].0[l];
-                let qdd1l = ud[5].0[l];
-                let qd2l = u[6].0[l];
-                let qdd2l = ud[6].0[l];
-                let qd3l = u[7].0[l];
-                let qdd3l = ud[7].0[l];
-                let qd4l = u[8].0[l];
-                let qdd4l = ud[8].0[l];
-                let qd5l = u[9].0[l];
-                let qdd5l = ud[9].0[l];
-                let qd6l = u[10].0[l];
-                let qdd6l = ud[10].0[l];
-                let qd7l = u[11].0[l];
-                let qdd7l = ud[11].0[l];
-                let qd1r = u[12].0[l];
-                let qdd1r = ud[12].0[l];
-                let qd2r = u[13].0[l];
-                let qdd2r = ud[13].0[l];
-                let qd3r = u[14].0[l];
-                let qdd3r = ud[14].0[l];
-                let qd4r = u[15].0[l];
-                let qdd4r = ud[15].0[l];
-                let qd5r = u[16].0[l];
-                let qdd5r = ud[16].0[l];
-                let qd6r = u[17].0[l];
-                let qdd6r = ud[17].0[l];
-                let qd7r = u[18].0[l];
-                let qdd7r = ud[18].0[l];
-                let k1 = xd * psid; // a0|ud=0,g=0.y
-                let k2 = c_q_imu * psid; // w0 in 1|ud=0,g=0.y
-                let k3 = s_q_imu * psid; // w0 in 1|ud=0,g=0.z
-                let k4 = A::mul_add(s_q_imu, psidd, k2 * qd_imu); // wd1.z
-                let k5 = A::mul_add(-c_q_imu, psidd, k3 * qd_imu); // wd1.y
-                let d1 = A::mul_add(s_q_imu, xdd, c_q_imu * p.g); // a1.y
-                let d2 = A::mul_add(-c_q_imu, xdd, s_q_imu * p.g); // a1.z
-                let d3 = A::mul_add(-p.MY1, k3, p.MZ1 * k2); // w1xMS1|ud=0,g=0.x
-                let d4 = A::mul_add(p.MZ1, qd_imu, p.MX1 * k3); // w1xMS1|ud=0,g=0.y
-                let d5 = A::mul_add(p.MX1, k2, p.MY1 * qd_imu); // w1xMS1|ud=0,g=0.z
-                let d6 = A::mul_add(
-                    p.MZ1,
-                    qdd_imu,
-                    A::mul_add(
-                        p.MX1,
-                        k4,
-                        A::mul_add(p.m1, d1, A::mul_add(-qd_imu, d5, k3 * d3)),
-                    ),
-                ); // F1.y
-                let d7 = A::mul_add(
-                    -p.MX1,
-                    k5,
-                    A::mul_add(
-                        p.MY1,
-                        qdd_imu,
-                        A::mul_add(-p.m1, d2, A::mul_add(k2, d3, qd_imu * d4)),
-                    ),
-                ); // F1.z
-                let d8 = A::mul_add(-p.XZ1, k3, A::mul_add(-p.XY1, k2, p.XX1 * qd_imu)); // J1w1|ud=0,g=0.x
-                let d9 = A::mul_add(-p.YZ1, k3, A::mul_add(-p.YY1, k2, p.XY1 * qd_imu)); // J1w1|ud=0,g=0.y
-                let d10 = A::mul_add(-p.ZZ1, k3, A::mul_add(-p.YZ1, k2, p.XZ1 * qd_imu)); // J1w1|ud=0,g=0.z
-                let d11 = A::mul_add(
-                    p.MX1,
-                    d1,
-                    A::mul_add(
-                        p.ZZ1,
-                        k4,
-                        A::mul_add(
-                            -p.YZ1,
-                            k5,
-                            A::mul_add(
-                                -p.XZ1,
-                                qdd_imu,
-                                A::mul_add(p.MY1, k1, A::mul_add(k2, d8, qd_imu * d9)),
-                            ),
-                        ),
-                    ),
-                ); // N1.z
-                let d12 = A::mul_add(
-                    p.MZ1,
-                    d1,
-                    A::mul_add(
-                        -p.MY1,
-                        d2,
-                        A::mul_add(
-                            -p.XZ1,
-                            k4,
-                            A::mul_add(
-                                p.XY1,
-                                k5,
-                                A::mul_add(p.XX1, qdd_imu, A::mul_add(-k3, d9, k2 * d10)),
-                            ),
-                        ),
-                    ),
-                ); // N1.x
-                let d13 = A::mul_add(
-                    p.MX1,
-                    d2,
-                    A::mul_add(
-                        -p.YZ1,
-                        k4,
-                        A::mul_add(
-                            p.YY1,
-                            k5,
-                            A::mul_add(
-                                p.XY1,
-                                qdd_imu,
-                                A::mul_add(p.MZ1, k1, A::mul_add(qd_imu, d10, k3 * d8)),
-                            ),
-                        ),
-                    ),
-                ); // N1.y
-                let k6 = A::mul_add(-s_q_w, k3, c_q_w * k2); // w1 in 2|ud=0,g=0.y
-                let k7 = A::mul_add(c_q_w, k3, s_q_w * k2); // w1 in 2|ud=0,g=0.z
-                let k8 = A::mul_add(c_q_w, k4, A::mul_add(-s_q_w, k5, k6 * qd_w)); // wd2.z
-                let k9 = qd_imu + qd_w; // w2|ud=0,g=0.x
-                let k10 = qdd_imu + qdd_w; // wd2.x
-                let k11 = A::mul_add(s_q_w, k4, A::mul_add(c_q_w, k5, k7 * qd_w)); // wd2.y
-                let k12 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-                let k13 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-                let k14 = A::mul_add(p.L1, k3, p.L2 * k2); // w1xP2|ud=0,g=0.x
-                let d14 = A::mul_add(
-                    -p.L1,
-                    qdd_imu,
-                    A::mul_add(k2, k14, qd_imu * k12) + d2,
-                ); // a2 in 1.z
-                let k15 = A::mul_add(
-                    p.L1,
-                    k4,
-                    A::mul_add(-p.L2, k5, A::mul_add(-k3, k12, A::mul_add(k2, k13, k1))),
-                ); // a2 in 1.x
-                let d15 = A::mul_add(
-                    p.L2,
-                    qdd_imu,
-                    A::mul_add(qd_imu, k13, k3 * k14) - d1,
-                ); // a2 in 1.y
-                let d16 = A::mul_add(s_q_w, d14, c_q_w * d15); // a2.y
-                let d17 = A::mul_add(-c_q_w, d14, s_q_w * d15); // a2.z
-                let d18 = A::mul_add(-p.MY2, k7, p.MZ2 * k6); // w2xMS2|ud=0,g=0.x
-                let d19 = A::mul_add(p.MZ2, k9, p.MX2 * k7); // w2xMS2|ud=0,g=0.y
-                let d20 = A::mul_add(p.MX2, k6, p.MY2 * k9); // w2xMS2|ud=0,g=0.z
-                let d21 = A::mul_add(
-                    p.MZ2,
-                    k10,
-                    A::mul_add(
-                        p.MX2,
-                        k8,
-                        A::mul_add(-p.m2, d16, A::mul_add(-k9, d20, k7 * d18)),
-                    ),
-                ); // F2.y
-                let d22 = A::mul_add(
-                    p.MY2,
-                    k8,
-                    A::mul_add(
-                        p.MZ2,
-                        k11,
-                        A::mul_add(p.m2, k15, A::mul_add(k7, d19, k6 * d20)),
-                    ),
-                ); // F2.x
-                let d23 = A::mul_add(
-                    -p.MX2,
-                    k11,
-                    A::mul_add(
-                        p.MY2,
-                        k10,
-                        A::mul_add(p.m2, d17, A::mul_add(k6, d18, k9 * d19)),
-                    ),
-                ); // F2.z
-                let d24 = A::mul_add(-p.XZ2, k7, A::mul_add(-p.XY2, k6, p.XX2 * k9)); // J2w2|ud=0,g=0.x
-                let d25 = A::mul_add(-p.YZ2, k7, A::mul_add(-p.YY2, k6, p.XY2 * k9)); // J2w2|ud=0,g=0.y
-                let d26 = A::mul_add(-p.ZZ2, k7, A::mul_add(-p.YZ2, k6, p.XZ2 * k9)); // J2w2|ud=0,g=0.z
-                let d27 = A::mul_add(
-                    p.MY2,
-                    k15,
-                    A::mul_add(
-                        -p.MX2,
-                        d16,
-                        A::mul_add(
-                            p.ZZ2,
-                            k8,
-                            A::mul_add(
-                                -p.YZ2,
-                                k11,
-                                A::mul_add(-p.XZ2, k10, A::mul_add(k6, d24, k9 * d25)),
-                            ),
-                        ),
-                    ),
-                ); // N2.z
-                let d28 = A::mul_add(
-                    -p.MZ2,
-                    d16,
-                    A::mul_add(
-                        p.MY2,
-                        d17,
-                        A::mul_add(
-                            -p.XZ2,
-                            k8,
-                            A::mul_add(
-                                p.XY2,
-                                k11,
-                                A::mul_add(p.XX2, k10, A::mul_add(-k7, d25, k6 * d26)),
-                            ),
-                        ),
-                    ),
-                ); // N2.x
-                let d29 = A::mul_add(
-                    -p.MX2,
-                    d17,
-                    A::mul_add(
-                        p.MZ2,
-                        k15,
-                        A::mul_add(
-                            -p.YZ2,
-                            k8,
-                            A::mul_add(
-                                p.YY2,
-                                k11,
-                                A::mul_add(p.XY2, k10, A::mul_add(k9, d26, k7 * d24)),
-                            ),
-                        ),
-                    ),
-                ); // N2.y
-                let k16 = A::mul_add(-s_q_torso, k7, c_q_torso * k9); // w2 in 3|ud=0,g=0.x
-                let k17 = A::mul_add(c_q_torso, k7, s_q_torso * k9); // w2 in 3|ud=0,g=0.z
-                let k18 = k6 - qd_torso; // w3|ud=0,g=0.y
-                let k19 = A::mul_add(
-                    s_q_torso,
-                    k8,
-                    A::mul_add(-c_q_torso, k10, k17 * qd_torso),
-                ); // wd3.x
-                let k20 = k11 + qdd_torso; // wd3.y
-                let k21 = A::mul_add(
-                    c_q_torso,
-                    k8,
-                    A::mul_add(s_q_torso, k10, k16 * qd_torso),
-                ); // wd3.z
-                let k22 = A::mul_add(-p.L3, k7, p.L4 * k6); // w2xP3|ud=0,g=0.x
-                let k23 = p.L4 * k9; // w2xP3|ud=0,g=0.y
-                let k24 = p.L3 * k9; // w2xP3|ud=0,g=0.z
-                let d30 = A::mul_add(p.L4, k10, A::mul_add(-k9, k24, k7 * k22) - d16); // a3 in 2.y
-                let k25 = A::mul_add(
-                    p.L3,
-                    k8,
-                    A::mul_add(p.L4, k11, A::mul_add(k7, k23, k6 * k24) + k15),
-                ); // a3 in 2.x
-                let d31 = A::mul_add(p.L3, k10, A::mul_add(k6, k22, k9 * k23) + d17); // a3 in 2.z
-                let d32 = A::mul_add(s_q_torso, d31, c_q_torso * k25); // a3.x
-                let d33 = A::mul_add(-c_q_torso, d31, s_q_torso * k25); // a3.z
-                let d34 = A::mul_add(p.MY3, k17, p.MZ3 * k18); // w3xMS3|ud=0,g=0.x
-                let d35 = A::mul_add(-p.MX3, k18, p.MY3 * k16); // w3xMS3|ud=0,g=0.z
-                let d36 = A::mul_add(p.MZ3, k16, p.MX3 * k17); // w3xMS3|ud=0,g=0.y
-                let d37 = A::mul_add(
-                    p.MY3,
-                    k21,
-                    A::mul_add(
-                        -p.MZ3,
-                        k20,
-                        A::mul_add(p.m3, d32, A::mul_add(-k17, d36, k18 * d35)),
-                    ),
-                ); // F3.x
-                let d38 = A::mul_add(
-                    -p.MZ3,
-                    k19,
-                    A::mul_add(
-                        p.MX3,
-                        k21,
-                        A::mul_add(-p.m3, d30, A::mul_add(k16, d35, k17 * d34)),
-                    ),
-                ); // F3.y
-                let d39 = A::mul_add(
-                    -p.MX3,
-                    k20,
-                    A::mul_add(
-                        p.MY3,
-                        k19,
-                        A::mul_add(p.m3, d33, A::mul_add(k18, d34, k16 * d36)),
-                    ),
-                ); // F3.z
-                let d40 = A::mul_add(-p.XZ3, k17, A::mul_add(p.XY3, k18, p.XX3 * k16)); // J3w3|ud=0,g=0.x
-                let d41 = A::mul_add(-p.YZ3, k17, A::mul_add(p.YY3, k18, p.XY3 * k16)); // J3w3|ud=0,g=0.y
-                let d42 = A::mul_add(-p.ZZ3, k17, A::mul_add(p.YZ3, k18, p.XZ3 * k16)); // J3w3|ud=0,g=0.z
-                let d43 = A::mul_add(
-                    -p.MZ3,
-                    d30,
-                    A::mul_add(
-                        -p.MY3,
-                        d33,
-                        A::mul_add(
-                            -p.XZ3,
-                            k21,
-                            A::mul_add(
-                                -p.XY3,
-                                k20,
-                                A::mul_add(-p.XX3, k19, A::mul_add(k17, d41, k18 * d42)),
-                            ),
-                        ),
-                    ),
-                ); // N3.x
-                let d44 = A::mul_add(
-                    -p.MY3,
-                    d32,
-                    A::mul_add(
-                        p.MX3,
-                        d30,
-                        A::mul_add(
-                            -p.ZZ3,
-                            k21,
-                            A::mul_add(
-                                -p.YZ3,
-                                k20,
-                                A::mul_add(-p.XZ3, k19, A::mul_add(-k18, d40, k16 * d41)),
-                            ),
-                        ),
-                    ),
-                ); // N3.z
-                let d45 = A::mul_add(
-                    -p.MX3,
-                    d33,
-                    A::mul_add(
-                        -p.MZ3,
-                        d32,
-                        A::mul_add(
-                            p.YZ3,
-                            k21,
-                            A::mul_add(
-                                p.YY3,
-                                k20,
-                                A::mul_add(p.XY3, k19, A::mul_add(k16, d42, k17 * d40)),
-                            ),
-                        ),
-                    ),
-                ); // N3.y
-                let k26 = A::mul_add(s_q1l, k17, c_q1l * k18); // w3 in 4l|ud=0,g=0.x
-                let k27 = A::mul_add(-c_q1l, k17, s_q1l * k18); // w3 in 4l|ud=0,g=0.z
-                let k28 = k16 - qd1l; // w4l|ud=0,g=0.y
-                let k29 = A::mul_add(-s_q1l, k21, A::mul_add(c_q1l, k20, k27 * qd1l)); // wd4l.x
-                let k30 = k19 + qdd1l; // wd4l.y
-                let k31 = A::mul_add(-c_q1l, k21, A::mul_add(-s_q1l, k20, k26 * qd1l)); // wd4l.z
-                let k32 = p.L5 * k17; // w3xP4l|ud=0,g=0.x
-                let k33 = p.L6 * k17; // w3xP4l|ud=0,g=0.y
-                let t1 = p.L5 * k16; // common subexpression
-                let t2 = p.L6 * k18; // common subexpression
-                let k34 = t1 - t2; // w3xP4l|ud=0,g=0.z
-                let t3 = p.L5 * k21; // common subexpression
-                let t4 = p.L6 * k21; // common subexpression
-                let t5 = p.L5 * k19; // common subexpression
-                let t6 = p.L6 * k20; // common subexpression
-                let t7 = k17 * k33; // common subexpression
-                let t8 = k17 * k32; // common subexpression
-                let t9 = k16 * k33; // common subexpression
-                let t10 = k18 * k32; // common subexpression
-                let d46 = A::mul_add(k18, k34, -t7) + d32 + t3; // a4l in 3.x
-                let d47 = A::mul_add(k16, k34, t8) - d30 + t4; // a4l in 3.y
-                let d48 = t9 + t10 + d33 + t5 - t6; // a4l in 3.z
-                let d49 = A::mul_add(c_q1l, d48, s_q1l * d47); // a4l.z
-                let d50 = A::mul_add(-s_q1l, d48, c_q1l * d47); // a4l.x
-                let d63 = A::mul_add(s_q2l, d49, c_q2l * d46); // a5l.y
-                let d64 = A::mul_add(-c_q2l, d49, s_q2l * d46); // a5l.z
-                let k77 = A::mul_add(-s_q1r, k17, c_q1r * k18); // w3 in 4r|ud=0,g=0.x
-                let k78 = A::mul_add(c_q1r, k17, s_q1r * k18); // w3 in 4r|ud=0,g=0.z
-                let k79 = qdd1r - k19; // wd4r.y
-                let k80 = -k16 - qd1r; // w4r|ud=0,g=0.y
-                let k81 = A::mul_add(s_q1r, k21, A::mul_add(c_q1r, k20, k78 * qd1r)); // wd4r.x
-                let k82 = A::mul_add(c_q1r, k21, A::mul_add(-s_q1r, k20, k77 * qd1r)); // wd4r.z
-                let k83 = t1 + t2; // w3xP4r|ud=0,g=0.z
-                let d156 = A::mul_add(k18, k83, t7) + d32 + t3; // a4r in 3.x
-                let d157 = t9 - t10 - d33 - t5 - t6; // a4r in 3.z
-                let d158 = A::mul_add(k16, k83, t8) - d30 - t4; // a4r in 3.y
-                let d159 = A::mul_add(c_q1r, d157, s_q1r * d158); // a4r.z
-                let d160 = A::mul_add(-s_q1r, d157, c_q1r * d158); // a4r.x
-                let d52 = A::mul_add(-p.MX4l, k28, p.MY4l * k26); // w4lxMS4l|ud=0,g=0.z
-                let d161 = A::mul_add(-p.MX4r, k80, p.MY4r * k77); // w4rxMS4r|ud=0,g=0.z
-                let d51 = A::mul_add(p.MY4l, k27, p.MZ4l * k28); // w4lxMS4l|ud=0,g=0.x
-                let d162 = A::mul_add(p.MY4r, k78, p.MZ4r * k80); // w4rxMS4r|ud=0,g=0.x
-                let d55 = A::mul_add(
-                    -p.MZ4l,
-                    k29,
-                    A::mul_add(
-                        p.MX4l,
-                        k31,
-                        A::mul_add(-p.m4l, d46, A::mul_add(k26, d52, k27 * d51)),
-                    ),
-                ); // F4l.y
-                let d53 = A::mul_add(p.MZ4l, k26, p.MX4l * k27); // w4lxMS4l|ud=0,g=0.y
-                let d163 = A::mul_add(p.MZ4r, k77, p.MX4r * k78); // w4rxMS4r|ud=0,g=0.y
-                let d164 = A::mul_add(
-                    -p.MZ4r,
-                    k81,
-                    A::mul_add(
-                        p.MX4r,
-                        k82,
-                        A::mul_add(p.m4r, d156, A::mul_add(k77, d161, k78 * d162)),
-                    ),
-                ); // F4r.y
-                let d54 = A::mul_add(
-                    p.MY4l,
-                    k31,
-                    A::mul_add(
-                        -p.MZ4l,
-                        k30,
-                        A::mul_add(-p.m4l, d50, A::mul_add(-k27, d53, k28 * d52)),
-                    ),
-                ); // F4l.x
-                let d165 = A::mul_add(
-                    p.MY4r,
-                    k82,
-                    A::mul_add(
-                        -p.MZ4r,
-                        k79,
-                        A::mul_add(-p.m4r, d160, A::mul_add(-k78, d163, k80 * d161)),
-                    ),
-                ); // F4r.x
-                let d56 = A::mul_add(
-                    -p.MX4l,
-                    k30,
-                    A::mul_add(
-                        p.MY4l,
-                        k29,
-                        A::mul_add(-p.m4l, d49, A::mul_add(k28, d51, k26 * d53)),
-                    ),
-                ); // F4l.z
-                let d166 = A::mul_add(
-                    -p.MX4r,
-                    k79,
-                    A::mul_add(
-                        p.MY4r,
-                        k81,
-                        A::mul_add(-p.m4r, d159, A::mul_add(k80, d162, k77 * d163)),
-                    ),
-                ); // F4r.z
-                let d57 = A::mul_add(
-                    -p.XZ4l,
-                    k27,
-                    A::mul_add(p.XY4l, k28, p.XX4l * k26),
-                ); // J4lw4l|ud=0,g=0.x
-                let d167 = A::mul_add(
-                    -p.XZ4r,
-                    k78,
-                    A::mul_add(p.XY4r, k80, p.XX4r * k77),
-                ); // J4rw4r|ud=0,g=0.x
-                let d58 = A::mul_add(
-                    -p.YZ4l,
-                    k27,
-                    A::mul_add(p.YY4l, k28, p.XY4l * k26),
-                ); // J4lw4l|ud=0,g=0.y
-                let d168 = A::mul_add(
-                    -p.YZ4r,
-                    k78,
-                    A::mul_add(p.YY4r, k80, p.XY4r * k77),
-                ); // J4rw4r|ud=0,g=0.y
-                let d61 = A::mul_add(
-                    p.MY4l,
-                    d50,
-                    A::mul_add(
-                        p.MX4l,
-                        d46,
-                        A::mul_add(
-                            -p.ZZ4l,
-                            k31,
-                            A::mul_add(
-                                -p.YZ4l,
-                                k30,
-                                A::mul_add(-p.XZ4l, k29, A::mul_add(-k28, d57, k26 * d58)),
-                            ),
-                        ),
-                    ),
-                ); // N4l.z
-                let d59 = A::mul_add(
-                    -p.ZZ4l,
-                    k27,
-                    A::mul_add(p.YZ4l, k28, p.XZ4l * k26),
-                ); // J4lw4l|ud=0,g=0.z
-                let d169 = A::mul_add(
-                    -p.ZZ4r,
-                    k78,
-                    A::mul_add(p.YZ4r, k80, p.XZ4r * k77),
-                ); // J4rw4r|ud=0,g=0.z
-                let d60 = A::mul_add(
-                    -p.MZ4l,
-                    d46,
-                    A::mul_add(
-                        p.MY4l,
-                        d49,
-                        A::mul_add(
-                            -p.XZ4l,
-                            k31,
-                            A::mul_add(
-                                -p.XY4l,
-                                k30,
-                                A::mul_add(-p.XX4l, k29, A::mul_add(k27, d58, k28 * d59)),
-                            ),
-                        ),
-                    ),
-                ); // N4l.x
-                let d170 = A::mul_add(
-                    p.MY4r,
-                    d160,
-                    A::mul_add(
-                        -p.MX4r,
-                        d156,
-                        A::mul_add(
-                            -p.ZZ4r,
-                            k82,
-                            A::mul_add(
-                                -p.YZ4r,
-                                k79,
-                                A::mul_add(-p.XZ4r, k81, A::mul_add(-k80, d167, k77 * d168)),
-                            ),
-                        ),
-                    ),
-                ); // N4r.z
-                let d171 = A::mul_add(
-                    p.MZ4r,
-                    d156,
-                    A::mul_add(
-                        p.MY4r,
-                        d159,
-                        A::mul_add(
-                            -p.XZ4r,
-                            k82,
-                            A::mul_add(
-                                -p.XY4r,
-                                k79,
-                                A::mul_add(-p.XX4r, k81, A::mul_add(k78, d168, k80 * d169)),
-                            ),
-                        ),
-                    ),
-                ); // N4r.x
-                let d62 = A::mul_add(
-                    p.MX4l,
-                    d49,
-                    A::mul_add(
-                        p.MZ4l,
-                        d50,
-                        A::mul_add(
-                            p.YZ4l,
-                            k31,
-                            A::mul_add(
-                                p.YY4l,
-                                k30,
-                                A::mul_add(p.XY4l, k29, A::mul_add(k26, d59, k27 * d57)),
-                            ),
-                        ),
-                    ),
-                ); // N4l.y
-                let d172 = A::mul_add(
-                    p.MX4r,
-                    d159,
-                    A::mul_add(
-                        p.MZ4r,
-                        d160,
-                        A::mul_add(
-                            p.YZ4r,
-                            k82,
-                            A::mul_add(
-                                p.YY4r,
-                                k79,
-                                A::mul_add(p.XY4r, k81, A::mul_add(k77, d169, k78 * d167)),
-                            ),
-                        ),
-                    ),
-                ); // N4r.y
-                let k35 = A::mul_add(-s_q2l, k27, c_q2l * k28); // w4l in 5l|ud=0,g=0.y
-                let k84 = A::mul_add(-s_q2r, k78, c_q2r * k80); // w4r in 5r|ud=0,g=0.y
-                let k36 = A::mul_add(c_q2l, k27, s_q2l * k28); // w4l in 5l|ud=0,g=0.z
-                let k85 = A::mul_add(c_q2r, k78, s_q2r * k80); // w4r in 5r|ud=0,g=0.z
-                let k37 = k29 - qdd2l; // wd5l.x
-                let k86 = k81 - qdd2r; // wd5r.x
-                let k40 = A::mul_add(c_q2l, k31, A::mul_add(-s_q2l, k30, k35 * qd2l)); // wd5l.z
-                let k87 = A::mul_add(c_q2r, k82, A::mul_add(-s_q2r, k79, k84 * qd2r)); // wd5r.z
-                let k39 = k26 + qd2l; // w5l|ud=0,g=0.x
-                let k88 = k77 + qd2r; // w5r|ud=0,g=0.x
-                let k38 = A::mul_add(s_q2l, k31, A::mul_add(c_q2l, k30, k36 * qd2l)); // wd5l.y
-                let k89 = A::mul_add(s_q2r, k82, A::mul_add(c_q2r, k79, k85 * qd2r)); // wd5r.y
-                let d173 = A::mul_add(-c_q2r, d156, s_q2r * d159); // a5r.y
-                let d174 = A::mul_add(-c_q2r, d159, -s_q2r * d156); // a5r.z
-                let d65 = A::mul_add(-p.MY5l, k36, p.MZ5l * k35); // w5lxMS5l|ud=0,g=0.x
-                let d175 = A::mul_add(-p.MY5r, k85, p.MZ5r * k84); // w5rxMS5r|ud=0,g=0.x
-                let d66 = A::mul_add(-p.MZ5l, k39, p.MX5l * k36); // w5lxMS5l|ud=0,g=0.y
-                let d176 = A::mul_add(-p.MZ5r, k88, p.MX5r * k85); // w5rxMS5r|ud=0,g=0.y
-                let d67 = A::mul_add(-p.MX5l, k35, p.MY5l * k39); // w5lxMS5l|ud=0,g=0.z
-                let d177 = A::mul_add(-p.MX5r, k84, p.MY5r * k88); // w5rxMS5r|ud=0,g=0.z
-                let d69 = A::mul_add(
-                    -p.MZ5l,
-                    k37,
-                    A::mul_add(
-                        -p.MX5l,
-                        k40,
-                        A::mul_add(-p.m5l, d63, A::mul_add(-k39, d67, k36 * d65)),
-                    ),
-                ); // F5l.y
-                let d178 = A::mul_add(
-                    -p.MZ5r,
-                    k86,
-                    A::mul_add(
-                        -p.MX5r,
-                        k87,
-                        A::mul_add(-p.m5r, d173, A::mul_add(-k88, d177, k85 * d175)),
-                    ),
-                ); // F5r.y
-                let d68 = A::mul_add(
-                    p.MY5l,
-                    k40,
-                    A::mul_add(
-                        p.MZ5l,
-                        k38,
-                        A::mul_add(p.m5l, d50, A::mul_add(-k36, d66, k35 * d67)),
-                    ),
-                ); // F5l.x
-                let d179 = A::mul_add(
-                    p.MY5r,
-                    k87,
-                    A::mul_add(
-                        p.MZ5r,
-                        k89,
-                        A::mul_add(p.m5r, d160, A::mul_add(-k85, d176, k84 * d177)),
-                    ),
-                ); // F5r.x
-                let d70 = A::mul_add(
-                    -p.MX5l,
-                    k38,
-                    A::mul_add(
-                        p.MY5l,
-                        k37,
-                        A::mul_add(-p.m5l, d64, A::mul_add(-k35, d65, k39 * d66)),
-                    ),
-                ); // F5l.z
-                let d180 = A::mul_add(
-                    -p.MX5r,
-                    k89,
-                    A::mul_add(
-                        p.MY5r,
-                        k86,
-                        A::mul_add(-p.m5r, d174, A::mul_add(-k84, d175, k88 * d176)),
-                    ),
-                ); // F5r.z
-                let d71 = A::mul_add(p.XZ5l, k36, A::mul_add(p.XY5l, k35, p.XX5l * k39)); // J5lw5l|ud=0,g=0.x
-                let d181 = A::mul_add(
-                    p.XZ5r,
-                    k85,
-                    A::mul_add(p.XY5r, k84, p.XX5r * k88),
-                ); // J5rw5r|ud=0,g=0.x
-                let d72 = A::mul_add(p.YZ5l, k36, A::mul_add(p.YY5l, k35, p.XY5l * k39)); // J5lw5l|ud=0,g=0.y
-                let d182 = A::mul_add(
-                    p.YZ5r,
-                    k85,
-                    A::mul_add(p.YY5r, k84, p.XY5r * k88),
-                ); // J5rw5r|ud=0,g=0.y
-                let d73 = A::mul_add(p.ZZ5l, k36, A::mul_add(p.YZ5l, k35, p.XZ5l * k39)); // J5lw5l|ud=0,g=0.z
-                let d183 = A::mul_add(
-                    p.ZZ5r,
-                    k85,
-                    A::mul_add(p.YZ5r, k84, p.XZ5r * k88),
-                ); // J5rw5r|ud=0,g=0.z
-                let d76 = A::mul_add(
-                    -p.MY5l,
-                    d50,
-                    A::mul_add(
-                        -p.MX5l,
-                        d63,
-                        A::mul_add(
-                            -p.ZZ5l,
-                            k40,
-                            A::mul_add(
-                                p.YZ5l,
-                                k38,
-                                A::mul_add(p.XZ5l, k37, A::mul_add(-k35, d71, k39 * d72)),
-                            ),
-                        ),
-                    ),
-                ); // N5l.z
-                let d184 = A::mul_add(
-                    -p.MY5r,
-                    d160,
-                    A::mul_add(
-                        -p.MX5r,
-                        d173,
-                        A::mul_add(
-                            -p.ZZ5r,
-                            k87,
-                            A::mul_add(
-                                p.YZ5r,
-                                k89,
-                                A::mul_add(p.XZ5r, k86, A::mul_add(-k84, d181, k88 * d182)),
-                            ),
-                        ),
-                    ),
-                ); // N5r.z
-                let d74 = A::mul_add(
-                    p.MZ5l,
-                    d63,
-                    A::mul_add(
-                        -p.MY5l,
-                        d64,
-                        A::mul_add(
-                            -p.XZ5l,
-                            k40,
-                            A::mul_add(
-                                p.XY5l,
-                                k38,
-                                A::mul_add(p.XX5l, k37, A::mul_add(-k36, d72, k35 * d73)),
-                            ),
-                        ),
-                    ),
-                ); // N5l.x
-                let d185 = A::mul_add(
-                    p.MZ5r,
-                    d173,
-                    A::mul_add(
-                        -p.MY5r,
-                        d174,
-                        A::mul_add(
-                            -p.XZ5r,
-                            k87,
-                            A::mul_add(
-                                p.XY5r,
-                                k89,
-                                A::mul_add(p.XX5r, k86, A::mul_add(-k85, d182, k84 * d183)),
-                            ),
-                        ),
-                    ),
-                ); // N5r.x
-                let d75 = A::mul_add(
-                    p.MX5l,
-                    d64,
-                    A::mul_add(
-                        p.MZ5l,
-                        d50,
-                        A::mul_add(
-                            -p.YZ5l,
-                            k40,
-                            A::mul_add(
-                                p.YY5l,
-                                k38,
-                                A::mul_add(p.XY5l, k37, A::mul_add(-k39, d73, k36 * d71)),
-                            ),
-                        ),
-                    ),
-                ); // N5l.y
-                let d186 = A::mul_add(
-                    p.MX5r,
-                    d174,
-                    A::mul_add(
-                        p.MZ5r,
-                        d160,
-                        A::mul_add(
-                            -p.YZ5r,
-                            k87,
-                            A::mul_add(
-                                p.YY5r,
-                                k89,
-                                A::mul_add(p.XY5r, k86, A::mul_add(-k88, d183, k85 * d181)),
-                            ),
-                        ),
-                    ),
-                ); // N5r.y
-                let k41 = A::mul_add(-s_q3l, k36, c_q3l * k39); // w5l in 6l|ud=0,g=0.x
-                let k90 = A::mul_add(-s_q3r, k85, c_q3r * k88); // w5r in 6r|ud=0,g=0.x
-                let k42 = A::mul_add(c_q3l, k36, s_q3l * k39); // w5l in 6l|ud=0,g=0.z
-                let k91 = A::mul_add(c_q3r, k85, s_q3r * k88); // w5r in 6r|ud=0,g=0.z
-                let k45 = k38 + qdd3l; // wd6l.y
-                let k92 = k89 + qdd3r; // wd6r.y
-                let k43 = k35 - qd3l; // w6l|ud=0,g=0.y
-                let k93 = k84 - qd3r; // w6r|ud=0,g=0.y
-                let k44 = A::mul_add(s_q3l, k40, A::mul_add(c_q3l, k37, k42 * qd3l)); // wd6l.x
-                let k94 = A::mul_add(s_q3r, k87, A::mul_add(c_q3r, k86, k91 * qd3r)); // wd6r.x
-                let k46 = A::mul_add(c_q3l, k40, A::mul_add(-s_q3l, k37, k41 * qd3l)); // wd6l.z
-                let k95 = A::mul_add(c_q3r, k87, A::mul_add(-s_q3r, k86, k90 * qd3r)); // wd6r.z
-                let k47 = p.L7 * k36; // w5lxP6l|ud=0,g=0.x
-                let k96 = p.L7 * k85; // w5rxP6r|ud=0,g=0.x
-                let k48 = p.L7 * k39; // w5lxP6l|ud=0,g=0.z
-                let k97 = p.L7 * k88; // w5rxP6r|ud=0,g=0.z
-                let d78 = A::mul_add(p.L7, k40, A::mul_add(k35, k48, -d50)); // a6l in 5l.x
-                let d187 = A::mul_add(p.L7, k87, A::mul_add(k84, k97, -d160)); // a6r in 5r.x
-                let d77 = A::mul_add(k39, k48, k36 * k47) - d63; // a6l in 5l.y
-                let d188 = A::mul_add(k88, k97, k85 * k96) - d173; // a6r in 5r.y
-                let d79 = A::mul_add(p.L7, k37, A::mul_add(k35, k47, d64)); // a6l in 5l.z
-                let d189 = A::mul_add(p.L7, k86, A::mul_add(k84, k96, d174)); // a6r in 5r.z
-                let d81 = A::mul_add(c_q3l, d79, s_q3l * d78); // a6l.z
-                let d190 = A::mul_add(c_q3r, d189, s_q3r * d187); // a6r.z
-                let d80 = A::mul_add(-s_q3l, d79, c_q3l * d78); // a6l.x
-                let d191 = A::mul_add(-s_q3r, d189, c_q3r * d187); // a6r.x
-                let d83 = A::mul_add(-p.MX6l, k43, p.MY6l * k41); // w6lxMS6l|ud=0,g=0.z
-                let d192 = A::mul_add(-p.MX6r, k93, p.MY6r * k90); // w6rxMS6r|ud=0,g=0.z
-                let d82 = A::mul_add(p.MY6l, k42, p.MZ6l * k43); // w6lxMS6l|ud=0,g=0.x
-                let d193 = A::mul_add(p.MY6r, k91, p.MZ6r * k93); // w6rxMS6r|ud=0,g=0.x
-                let d84 = A::mul_add(p.MZ6l, k41, p.MX6l * k42); // w6lxMS6l|ud=0,g=0.y
-                let d194 = A::mul_add(p.MZ6r, k90, p.MX6r * k91); // w6rxMS6r|ud=0,g=0.y
-                let d86 = A::mul_add(
-                    -p.MZ6l,
-                    k44,
-                    A::mul_add(
-                        p.MX6l,
-                        k46,
-                        A::mul_add(p.m6l, d77, A::mul_add(k41, d83, k42 * d82)),
-                    ),
-                ); // F6l.y
-                let d195 = A::mul_add(
-                    -p.MZ6r,
-                    k94,
-                    A::mul_add(
-                        p.MX6r,
-                        k95,
-                        A::mul_add(p.m6r, d188, A::mul_add(k90, d192, k91 * d193)),
-                    ),
-                ); // F6r.y
-                let d85 = A::mul_add(
-                    p.MY6l,
-                    k46,
-                    A::mul_add(
-                        -p.MZ6l,
-                        k45,
-                        A::mul_add(p.m6l, d80, A::mul_add(-k42, d84, k43 * d83)),
-                    ),
-                ); // F6l.x
-                let d196 = A::mul_add(
-                    p.MY6r,
-                    k95,
-                    A::mul_add(
-                        -p.MZ6r,
-                        k92,
-                        A::mul_add(p.m6r, d191, A::mul_add(-k91, d194, k93 * d192)),
-                    ),
-                ); // F6r.x
-                let d87 = A::mul_add(
-                    -p.MX6l,
-                    k45,
-                    A::mul_add(
-                        p.MY6l,
-                        k44,
-                        A::mul_add(p.m6l, d81, A::mul_add(k43, d82, k41 * d84)),
-                    ),
-                ); // F6l.z
-                let d197 = A::mul_add(
-                    -p.MX6r,
-                    k92,
-                    A::mul_add(
-                        p.MY6r,
-                        k94,
-                        A::mul_add(p.m6r, d190, A::mul_add(k93, d193, k90 * d194)),
-                    ),
-                ); // F6r.z
-                let d88 = A::mul_add(
-                    -p.XZ6l,
-                    k42,
-                    A::mul_add(p.XY6l, k43, p.XX6l * k41),
-                ); // J6lw6l|ud=0,g=0.x
-                let d198 = A::mul_add(
-                    -p.XZ6r,
-                    k91,
-                    A::mul_add(p.XY6r, k93, p.XX6r * k90),
-                ); // J6rw6r|ud=0,g=0.x
-                let d89 = A::mul_add(
-                    -p.YZ6l,
-                    k42,
-                    A::mul_add(p.YY6l, k43, p.XY6l * k41),
-                ); // J6lw6l|ud=0,g=0.y
-                let d199 = A::mul_add(
-                    -p.YZ6r,
-                    k91,
-                    A::mul_add(p.YY6r, k93, p.XY6r * k90),
-                ); // J6rw6r|ud=0,g=0.y
-                let d90 = A::mul_add(
-                    -p.ZZ6l,
-                    k42,
-                    A::mul_add(p.YZ6l, k43, p.XZ6l * k41),
-                ); // J6lw6l|ud=0,g=0.z
-                let d200 = A::mul_add(
-                    -p.ZZ6r,
-                    k91,
-                    A::mul_add(p.YZ6r, k93, p.XZ6r * k90),
-                ); // J6rw6r|ud=0,g=0.z
-                let d92 = A::mul_add(
-                    -p.MY6l,
-                    d80,
-                    A::mul_add(
-                        -p.MX6l,
-                        d77,
-                        A::mul_add(
-                            -p.ZZ6l,
-                            k46,
-                            A::mul_add(
-                                -p.YZ6l,
-                                k45,
-                                A::mul_add(-p.XZ6l, k44, A::mul_add(-k43, d88, k41 * d89)),
-                            ),
-                        ),
-                    ),
-                ); // N6l.z
-                let d201 = A::mul_add(
-                    -p.MY6r,
-                    d191,
-                    A::mul_add(
-                        -p.MX6r,
-                        d188,
-                        A::mul_add(
-                            -p.ZZ6r,
-                            k95,
-                            A::mul_add(
-                                -p.YZ6r,
-                                k92,
-                                A::mul_add(-p.XZ6r, k94, A::mul_add(-k93, d198, k90 * d199)),
-                            ),
-                        ),
-                    ),
-                ); // N6r.z
-                let d91 = A::mul_add(
-                    p.MZ6l,
-                    d77,
-                    A::mul_add(
-                        -p.MY6l,
-                        d81,
-                        A::mul_add(
-                            -p.XZ6l,
-                            k46,
-                            A::mul_add(
-                                -p.XY6l,
-                                k45,
-                                A::mul_add(-p.XX6l, k44, A::mul_add(k42, d89, k43 * d90)),
-                            ),
-                        ),
-                    ),
-                ); // N6l.x
-                let d202 = A::mul_add(
-                    p.MZ6r,
-                    d188,
-                    A::mul_add(
-                        -p.MY6r,
-                        d190,
-                        A::mul_add(
-                            -p.XZ6r,
-                            k95,
-                            A::mul_add(
-                                -p.XY6r,
-                                k92,
-                                A::mul_add(-p.XX6r, k94, A::mul_add(k91, d199, k93 * d200)),
-                            ),
-                        ),
-                    ),
-                ); // N6r.x
-                let d93 = A::mul_add(
-                    -p.MX6l,
-                    d81,
-                    A::mul_add(
-                        -p.MZ6l,
-                        d80,
-                        A::mul_add(
-                            p.YZ6l,
-                            k46,
-                            A::mul_add(
-                                p.YY6l,
-                                k45,
-                                A::mul_add(p.XY6l, k44, A::mul_add(k41, d90, k42 * d88)),
-                            ),
-                        ),
-                    ),
-                ); // N6l.y
-                let d203 = A::mul_add(
-                    -p.MX6r,
-                    d190,
-                    A::mul_add(
-                        -p.MZ6r,
-                        d191,
-                        A::mul_add(
-                            p.YZ6r,
-                            k95,
-                            A::mul_add(
-                                p.YY6r,
-                                k92,
-                                A::mul_add(p.XY6r, k94, A::mul_add(k90, d200, k91 * d198)),
-                            ),
-                        ),
-                    ),
-                ); // N6r.y
-                let k49 = A::mul_add(-s_q4l, k42, c_q4l * k43); // w6l in 7l|ud=0,g=0.y
-                let k98 = A::mul_add(-s_q4r, k91, c_q4r * k93); // w6r in 7r|ud=0,g=0.y
-                let k50 = A::mul_add(c_q4l, k42, s_q4l * k43); // w6l in 7l|ud=0,g=0.z
-                let k99 = A::mul_add(c_q4r, k91, s_q4r * k93); // w6r in 7r|ud=0,g=0.z
-                let k51 = k44 - qdd4l; // wd7l.x
-                let k100 = k94 - qdd4r; // wd7r.x
-                let k54 = A::mul_add(c_q4l, k46, A::mul_add(-s_q4l, k45, k49 * qd4l)); // wd7l.z
-                let k101 = A::mul_add(c_q4r, k95, A::mul_add(-s_q4r, k92, k98 * qd4r)); // wd7r.z
-                let k53 = k41 + qd4l; // w7l|ud=0,g=0.x
-                let k102 = k90 + qd4r; // w7r|ud=0,g=0.x
-                let k52 = A::mul_add(s_q4l, k46, A::mul_add(c_q4l, k45, k50 * qd4l)); // wd7l.y
-                let k103 = A::mul_add(s_q4r, k95, A::mul_add(c_q4r, k92, k99 * qd4r)); // wd7r.y
-                let d94 = A::mul_add(s_q4l, d81, c_q4l * d77); // a7l.y
-                let d204 = A::mul_add(s_q4r, d190, c_q4r * d188); // a7r.y
-                let d95 = A::mul_add(-c_q4l, d81, s_q4l * d77); // a7l.z
-                let d205 = A::mul_add(-c_q4r, d190, s_q4r * d188); // a7r.z
-                let d96 = A::mul_add(-p.MY7l, k50, p.MZ7l * k49); // w7lxMS7l|ud=0,g=0.x
-                let d206 = A::mul_add(-p.MY7r, k99, p.MZ7r * k98); // w7rxMS7r|ud=0,g=0.x
-                let d97 = A::mul_add(-p.MZ7l, k53, p.MX7l * k50); // w7lxMS7l|ud=0,g=0.y
-                let d207 = A::mul_add(-p.MZ7r, k102, p.MX7r * k99); // w7rxMS7r|ud=0,g=0.y
-                let d98 = A::mul_add(-p.MX7l, k49, p.MY7l * k53); // w7lxMS7l|ud=0,g=0.z
-                let d208 = A::mul_add(-p.MX7r, k98, p.MY7r * k102); // w7rxMS7r|ud=0,g=0.z
-                let d100 = A::mul_add(
-                    -p.MZ7l,
-                    k51,
-                    A::mul_add(
-                        -p.MX7l,
-                        k54,
-                        A::mul_add(p.m7l, d94, A::mul_add(-k53, d98, k50 * d96)),
-                    ),
-                ); // F7l.y
-                let d209 = A::mul_add(
-                    -p.MZ7r,
-                    k100,
-                    A::mul_add(
-                        -p.MX7r,
-                        k101,
-                        A::mul_add(p.m7r, d204, A::mul_add(-k102, d208, k99 * d206)),
-                    ),
-                ); // F7r.y
-                let d99 = A::mul_add(
-                    p.MY7l,
-                    k54,
-                    A::mul_add(
-                        p.MZ7l,
-                        k52,
-                        A::mul_add(-p.m7l, d80, A::mul_add(-k50, d97, k49 * d98)),
-                    ),
-                ); // F7l.x
-                let d210 = A::mul_add(
-                    p.MY7r,
-                    k101,
-                    A::mul_add(
-                        p.MZ7r,
-                        k103,
-                        A::mul_add(-p.m7r, d191, A::mul_add(-k99, d207, k98 * d208)),
-                    ),
-                ); // F7r.x
-                let d101 = A::mul_add(
-                    -p.MX7l,
-                    k52,
-                    A::mul_add(
-                        p.MY7l,
-                        k51,
-                        A::mul_add(p.m7l, d95, A::mul_add(-k49, d96, k53 * d97)),
-                    ),
-                ); // F7l.z
-                let d211 = A::mul_add(
-                    -p.MX7r,
-                    k103,
-                    A::mul_add(
-                        p.MY7r,
-                        k100,
-                        A::mul_add(p.m7r, d205, A::mul_add(-k98, d206, k102 * d207)),
-                    ),
-                ); // F7r.z
-                let d102 = A::mul_add(
-                    p.XZ7l,
-                    k50,
-                    A::mul_add(p.XY7l, k49, p.XX7l * k53),
-                ); // J7lw7l|ud=0,g=0.x
-                let d212 = A::mul_add(
-                    p.XZ7r,
-                    k99,
-                    A::mul_add(p.XY7r, k98, p.XX7r * k102),
-                ); // J7rw7r|ud=0,g=0.x
-                let d103 = A::mul_add(
-                    p.YZ7l,
-                    k50,
-                    A::mul_add(p.YY7l, k49, p.XY7l * k53),
-                ); // J7lw7l|ud=0,g=0.y
-                let d213 = A::mul_add(
-                    p.YZ7r,
-                    k99,
-                    A::mul_add(p.YY7r, k98, p.XY7r * k102),
-                ); // J7rw7r|ud=0,g=0.y
-                let d104 = A::mul_add(
-                    p.ZZ7l,
-                    k50,
-                    A::mul_add(p.YZ7l, k49, p.XZ7l * k53),
-                ); // J7lw7l|ud=0,g=0.z
-                let d214 = A::mul_add(
-                    p.ZZ7r,
-                    k99,
-                    A::mul_add(p.YZ7r, k98, p.XZ7r * k102),
-                ); // J7rw7r|ud=0,g=0.z
-                let d107 = A::mul_add(
-                    p.MY7l,
-                    d80,
-                    A::mul_add(
-                        p.MX7l,
-                        d94,
-                        A::mul_add(
-                            -p.ZZ7l,
-                            k54,
-                            A::mul_add(
-                                p.YZ7l,
-                                k52,
-                                A::mul_add(p.XZ7l, k51, A::mul_add(-k49, d102, k53 * d103)),
-                            ),
-                        ),
-                    ),
-                ); // N7l.z
-                let d215 = A::mul_add(
-                    p.MY7r,
-                    d191,
-                    A::mul_add(
-                        p.MX7r,
-                        d204,
-                        A::mul_add(
-                            -p.ZZ7r,
-                            k101,
-                            A::mul_add(
-                                p.YZ7r,
-                                k103,
-                                A::mul_add(
-                                    p.XZ7r,
-                                    k100,
-                                    A::mul_add(-k98, d212, k102 * d213),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7r.z
-                let d105 = A::mul_add(
-                    -p.MZ7l,
-                    d94,
-                    A::mul_add(
-                        p.MY7l,
-                        d95,
-                        A::mul_add(
-                            -p.XZ7l,
-                            k54,
-                            A::mul_add(
-                                p.XY7l,
-                                k52,
-                                A::mul_add(p.XX7l, k51, A::mul_add(-k50, d103, k49 * d104)),
-                            ),
-                        ),
-                    ),
-                ); // N7l.x
-                let d216 = A::mul_add(
-                    -p.MZ7r,
-                    d204,
-                    A::mul_add(
-                        p.MY7r,
-                        d205,
-                        A::mul_add(
-                            -p.XZ7r,
-                            k101,
-                            A::mul_add(
-                                p.XY7r,
-                                k103,
-                                A::mul_add(p.XX7r, k100, A::mul_add(-k99, d213, k98 * d214)),
-                            ),
-                        ),
-                    ),
-                ); // N7r.x
-                let d106 = A::mul_add(
-                    -p.MX7l,
-                    d95,
-                    A::mul_add(
-                        -p.MZ7l,
-                        d80,
-                        A::mul_add(
-                            -p.YZ7l,
-                            k54,
-                            A::mul_add(
-                                p.YY7l,
-                                k52,
-                                A::mul_add(p.XY7l, k51, A::mul_add(-k53, d104, k50 * d102)),
-                            ),
-                        ),
-                    ),
-                ); // N7l.y
-                let d217 = A::mul_add(
-                    -p.MX7r,
-                    d205,
-                    A::mul_add(
-                        -p.MZ7r,
-                        d191,
-                        A::mul_add(
-                            -p.YZ7r,
-                            k101,
-                            A::mul_add(
-                                p.YY7r,
-                                k103,
-                                A::mul_add(
-                                    p.XY7r,
-                                    k100,
-                                    A::mul_add(-k102, d214, k99 * d212),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N7r.y
-                let k55 = A::mul_add(-s_q5l, k50, c_q5l * k53); // w7l in 8l|ud=0,g=0.x
-                let k104 = A::mul_add(-s_q5r, k99, c_q5r * k102); // w7r in 8r|ud=0,g=0.x
-                let k56 = A::mul_add(c_q5l, k50, s_q5l * k53); // w7l in 8l|ud=0,g=0.z
-                let k105 = A::mul_add(c_q5r, k99, s_q5r * k102); // w7r in 8r|ud=0,g=0.z
-                let k59 = k52 + qdd5l; // wd8l.y
-                let k106 = k103 + qdd5r; // wd8r.y
-                let k57 = k49 - qd5l; // w8l|ud=0,g=0.y
-                let k107 = k98 - qd5r; // w8r|ud=0,g=0.y
-                let k58 = A::mul_add(s_q5l, k54, A::mul_add(c_q5l, k51, k56 * qd5l)); // wd8l.x
-                let k108 = A::mul_add(s_q5r, k101, A::mul_add(c_q5r, k100, k105 * qd5r)); // wd8r.x
-                let k60 = A::mul_add(c_q5l, k54, A::mul_add(-s_q5l, k51, k55 * qd5l)); // wd8l.z
-                let k109 = A::mul_add(
-                    c_q5r,
-                    k101,
-                    A::mul_add(-s_q5r, k100, k104 * qd5r),
-                ); // wd8r.z
-                let k61 = p.L8 * k50; // w7lxP8l|ud=0,g=0.x
-                let k110 = p.L8 * k99; // w7rxP8r|ud=0,g=0.x
-                let k62 = p.L8 * k53; // w7lxP8l|ud=0,g=0.z
-                let k111 = p.L8 * k102; // w7rxP8r|ud=0,g=0.z
-                let d109 = A::mul_add(p.L8, k54, A::mul_add(k49, k62, d80)); // a8l in 7l.x
-                let d218 = A::mul_add(p.L8, k101, A::mul_add(k98, k111, d191)); // a8r in 7r.x
-                let d108 = A::mul_add(k53, k62, k50 * k61) + d94; // a8l in 7l.y
-                let d219 = A::mul_add(k102, k111, k99 * k110) + d204; // a8r in 7r.y
-                let d110 = A::mul_add(p.L8, k51, A::mul_add(k49, k61, -d95)); // a8l in 7l.z
-                let d220 = A::mul_add(p.L8, k100, A::mul_add(k98, k110, -d205)); // a8r in 7r.z
-                let d112 = A::mul_add(c_q5l, d110, s_q5l * d109); // a8l.z
-                let d221 = A::mul_add(c_q5r, d220, s_q5r * d218); // a8r.z
-                let d111 = A::mul_add(-s_q5l, d110, c_q5l * d109); // a8l.x
-                let d222 = A::mul_add(-s_q5r, d220, c_q5r * d218); // a8r.x
-                let d114 = A::mul_add(-p.MX8l, k57, p.MY8l * k55); // w8lxMS8l|ud=0,g=0.z
-                let d223 = A::mul_add(-p.MX8r, k107, p.MY8r * k104); // w8rxMS8r|ud=0,g=0.z
-                let d113 = A::mul_add(p.MY8l, k56, p.MZ8l * k57); // w8lxMS8l|ud=0,g=0.x
-                let d224 = A::mul_add(p.MY8r, k105, p.MZ8r * k107); // w8rxMS8r|ud=0,g=0.x
-                let d115 = A::mul_add(p.MZ8l, k55, p.MX8l * k56); // w8lxMS8l|ud=0,g=0.y
-                let d225 = A::mul_add(p.MZ8r, k104, p.MX8r * k105); // w8rxMS8r|ud=0,g=0.y
-                let d117 = A::mul_add(
-                    -p.MZ8l,
-                    k58,
-                    A::mul_add(
-                        p.MX8l,
-                        k60,
-                        A::mul_add(p.m8l, d108, A::mul_add(k55, d114, k56 * d113)),
-                    ),
-                ); // F8l.y
-                let d226 = A::mul_add(
-                    -p.MZ8r,
-                    k108,
-                    A::mul_add(
-                        p.MX8r,
-                        k109,
-                        A::mul_add(p.m8r, d219, A::mul_add(k104, d223, k105 * d224)),
-                    ),
-                ); // F8r.y
-                let d116 = A::mul_add(
-                    p.MY8l,
-                    k60,
-                    A::mul_add(
-                        -p.MZ8l,
-                        k59,
-                        A::mul_add(p.m8l, d111, A::mul_add(-k56, d115, k57 * d114)),
-                    ),
-                ); // F8l.x
-                let d227 = A::mul_add(
-                    p.MY8r,
-                    k109,
-                    A::mul_add(
-                        -p.MZ8r,
-                        k106,
-                        A::mul_add(p.m8r, d222, A::mul_add(-k105, d225, k107 * d223)),
-                    ),
-                ); // F8r.x
-                let d118 = A::mul_add(
-                    -p.MX8l,
-                    k59,
-                    A::mul_add(
-                        p.MY8l,
-                        k58,
-                        A::mul_add(p.m8l, d112, A::mul_add(k57, d113, k55 * d115)),
-                    ),
-                ); // F8l.z
-                let d228 = A::mul_add(
-                    -p.MX8r,
-                    k106,
-                    A::mul_add(
-                        p.MY8r,
-                        k108,
-                        A::mul_add(p.m8r, d221, A::mul_add(k107, d224, k104 * d225)),
-                    ),
-                ); // F8r.z
-                let d119 = A::mul_add(
-                    -p.XZ8l,
-                    k56,
-                    A::mul_add(p.XY8l, k57, p.XX8l * k55),
-                ); // J8lw8l|ud=0,g=0.x
-                let d229 = A::mul_add(
-                    -p.XZ8r,
-                    k105,
-                    A::mul_add(p.XY8r, k107, p.XX8r * k104),
-                ); // J8rw8r|ud=0,g=0.x
-                let d120 = A::mul_add(
-                    -p.YZ8l,
-                    k56,
-                    A::mul_add(p.YY8l, k57, p.XY8l * k55),
-                ); // J8lw8l|ud=0,g=0.y
-                let d230 = A::mul_add(
-                    -p.YZ8r,
-                    k105,
-                    A::mul_add(p.YY8r, k107, p.XY8r * k104),
-                ); // J8rw8r|ud=0,g=0.y
-                let d121 = A::mul_add(
-                    -p.ZZ8l,
-                    k56,
-                    A::mul_add(p.YZ8l, k57, p.XZ8l * k55),
-                ); // J8lw8l|ud=0,g=0.z
-                let d231 = A::mul_add(
-                    -p.ZZ8r,
-                    k105,
-                    A::mul_add(p.YZ8r, k107, p.XZ8r * k104),
-                ); // J8rw8r|ud=0,g=0.z
-                let d123 = A::mul_add(
-                    -p.MY8l,
-                    d111,
-                    A::mul_add(
-                        -p.MX8l,
-                        d108,
-                        A::mul_add(
-                            -p.ZZ8l,
-                            k60,
-                            A::mul_add(
-                                -p.YZ8l,
-                                k59,
-                                A::mul_add(-p.XZ8l, k58, A::mul_add(-k57, d119, k55 * d120)),
-                            ),
-                        ),
-                    ),
-                ); // N8l.z
-                let d232 = A::mul_add(
-                    -p.MY8r,
-                    d222,
-                    A::mul_add(
-                        -p.MX8r,
-                        d219,
-                        A::mul_add(
-                            -p.ZZ8r,
-                            k109,
-                            A::mul_add(
-                                -p.YZ8r,
-                                k106,
-                                A::mul_add(
-                                    -p.XZ8r,
-                                    k108,
-                                    A::mul_add(-k107, d229, k104 * d230),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r.z
-                let d122 = A::mul_add(
-                    p.MZ8l,
-                    d108,
-                    A::mul_add(
-                        -p.MY8l,
-                        d112,
-                        A::mul_add(
-                            -p.XZ8l,
-                            k60,
-                            A::mul_add(
-                                -p.XY8l,
-                                k59,
-                                A::mul_add(-p.XX8l, k58, A::mul_add(k56, d120, k57 * d121)),
-                            ),
-                        ),
-                    ),
-                ); // N8l.x
-                let d233 = A::mul_add(
-                    p.MZ8r,
-                    d219,
-                    A::mul_add(
-                        -p.MY8r,
-                        d221,
-                        A::mul_add(
-                            -p.XZ8r,
-                            k109,
-                            A::mul_add(
-                                -p.XY8r,
-                                k106,
-                                A::mul_add(
-                                    -p.XX8r,
-                                    k108,
-                                    A::mul_add(k105, d230, k107 * d231),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r.x
-                let d124 = A::mul_add(
-                    -p.MX8l,
-                    d112,
-                    A::mul_add(
-                        -p.MZ8l,
-                        d111,
-                        A::mul_add(
-                            p.YZ8l,
-                            k60,
-                            A::mul_add(
-                                p.YY8l,
-                                k59,
-                                A::mul_add(p.XY8l, k58, A::mul_add(k55, d121, k56 * d119)),
-                            ),
-                        ),
-                    ),
-                ); // N8l.y
-                let d234 = A::mul_add(
-                    -p.MX8r,
-                    d221,
-                    A::mul_add(
-                        -p.MZ8r,
-                        d222,
-                        A::mul_add(
-                            p.YZ8r,
-                            k109,
-                            A::mul_add(
-                                p.YY8r,
-                                k106,
-                                A::mul_add(
-                                    p.XY8r,
-                                    k108,
-                                    A::mul_add(k104, d231, k105 * d229),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N8r.y
-                let k63 = A::mul_add(-s_q6l, k56, c_q6l * k57); // w8l in 9l|ud=0,g=0.y
-                let k112 = A::mul_add(-s_q6r, k105, c_q6r * k107); // w8r in 9r|ud=0,g=0.y
-                let k64 = A::mul_add(c_q6l, k56, s_q6l * k57); // w8l in 9l|ud=0,g=0.z
-                let k113 = A::mul_add(c_q6r, k105, s_q6r * k107); // w8r in 9r|ud=0,g=0.z
-                let k65 = k58 - qdd6l; // wd9l.x
-                let k114 = k108 - qdd6r; // wd9r.x
-                let k68 = A::mul_add(c_q6l, k60, A::mul_add(-s_q6l, k59, k63 * qd6l)); // wd9l.z
-                let k115 = A::mul_add(
-                    c_q6r,
-                    k109,
-                    A::mul_add(-s_q6r, k106, k112 * qd6r),
-                ); // wd9r.z
-                let k67 = k55 + qd6l; // w9l|ud=0,g=0.x
-                let k116 = k104 + qd6r; // w9r|ud=0,g=0.x
-                let k66 = A::mul_add(s_q6l, k60, A::mul_add(c_q6l, k59, k64 * qd6l)); // wd9l.y
-                let k117 = A::mul_add(s_q6r, k109, A::mul_add(c_q6r, k106, k113 * qd6r)); // wd9r.y
-                let d125 = A::mul_add(s_q6l, d112, c_q6l * d108); // a9l.y
-                let d235 = A::mul_add(s_q6r, d221, c_q6r * d219); // a9r.y
-                let d126 = A::mul_add(-c_q6l, d112, s_q6l * d108); // a9l.z
-                let d236 = A::mul_add(-c_q6r, d221, s_q6r * d219); // a9r.z
-                let d127 = A::mul_add(-p.MY9l, k64, p.MZ9l * k63); // w9lxMS9l|ud=0,g=0.x
-                let d237 = A::mul_add(-p.MY9r, k113, p.MZ9r * k112); // w9rxMS9r|ud=0,g=0.x
-                let d128 = A::mul_add(-p.MZ9l, k67, p.MX9l * k64); // w9lxMS9l|ud=0,g=0.y
-                let d238 = A::mul_add(-p.MZ9r, k116, p.MX9r * k113); // w9rxMS9r|ud=0,g=0.y
-                let d129 = A::mul_add(-p.MX9l, k63, p.MY9l * k67); // w9lxMS9l|ud=0,g=0.z
-                let d239 = A::mul_add(-p.MX9r, k112, p.MY9r * k116); // w9rxMS9r|ud=0,g=0.z
-                let d131 = A::mul_add(
-                    -p.MZ9l,
-                    k65,
-                    A::mul_add(
-                        -p.MX9l,
-                        k68,
-                        A::mul_add(p.m9l, d125, A::mul_add(-k67, d129, k64 * d127)),
-                    ),
-                ); // F9l.y
-                let d240 = A::mul_add(
-                    -p.MZ9r,
-                    k114,
-                    A::mul_add(
-                        -p.MX9r,
-                        k115,
-                        A::mul_add(p.m9r, d235, A::mul_add(-k116, d239, k113 * d237)),
-                    ),
-                ); // F9r.y
-                let d130 = A::mul_add(
-                    p.MY9l,
-                    k68,
-                    A::mul_add(
-                        p.MZ9l,
-                        k66,
-                        A::mul_add(-p.m9l, d111, A::mul_add(-k64, d128, k63 * d129)),
-                    ),
-                ); // F9l.x
-                let d241 = A::mul_add(
-                    p.MY9r,
-                    k115,
-                    A::mul_add(
-                        p.MZ9r,
-                        k117,
-                        A::mul_add(-p.m9r, d222, A::mul_add(-k113, d238, k112 * d239)),
-                    ),
-                ); // F9r.x
-                let d132 = A::mul_add(
-                    -p.MX9l,
-                    k66,
-                    A::mul_add(
-                        p.MY9l,
-                        k65,
-                        A::mul_add(p.m9l, d126, A::mul_add(-k63, d127, k67 * d128)),
-                    ),
-                ); // F9l.z
-                let d242 = A::mul_add(
-                    -p.MX9r,
-                    k117,
-                    A::mul_add(
-                        p.MY9r,
-                        k114,
-                        A::mul_add(p.m9r, d236, A::mul_add(-k112, d237, k116 * d238)),
-                    ),
-                ); // F9r.z
-                let d133 = A::mul_add(
-                    p.XZ9l,
-                    k64,
-                    A::mul_add(p.XY9l, k63, p.XX9l * k67),
-                ); // J9lw9l|ud=0,g=0.x
-                let d243 = A::mul_add(
-                    p.XZ9r,
-                    k113,
-                    A::mul_add(p.XY9r, k112, p.XX9r * k116),
-                ); // J9rw9r|ud=0,g=0.x
-                let d134 = A::mul_add(
-                    p.YZ9l,
-                    k64,
-                    A::mul_add(p.YY9l, k63, p.XY9l * k67),
-                ); // J9lw9l|ud=0,g=0.y
-                let d244 = A::mul_add(
-                    p.YZ9r,
-                    k113,
-                    A::mul_add(p.YY9r, k112, p.XY9r * k116),
-                ); // J9rw9r|ud=0,g=0.y
-                let d135 = A::mul_add(
-                    p.ZZ9l,
-                    k64,
-                    A::mul_add(p.YZ9l, k63, p.XZ9l * k67),
-                ); // J9lw9l|ud=0,g=0.z
-                let d245 = A::mul_add(
-                    p.ZZ9r,
-                    k113,
-                    A::mul_add(p.YZ9r, k112, p.XZ9r * k116),
-                ); // J9rw9r|ud=0,g=0.z
-                let d138 = A::mul_add(
-                    p.MY9l,
-                    d111,
-                    A::mul_add(
-                        p.MX9l,
-                        d125,
-                        A::mul_add(
-                            -p.ZZ9l,
-                            k68,
-                            A::mul_add(
-                                p.YZ9l,
-                                k66,
-                                A::mul_add(p.XZ9l, k65, A::mul_add(-k63, d133, k67 * d134)),
-                            ),
-                        ),
-                    ),
-                ); // N9l.z
-                let d246 = A::mul_add(
-                    p.MY9r,
-                    d222,
-                    A::mul_add(
-                        p.MX9r,
-                        d235,
-                        A::mul_add(
-                            -p.ZZ9r,
-                            k115,
-                            A::mul_add(
-                                p.YZ9r,
-                                k117,
-                                A::mul_add(
-                                    p.XZ9r,
-                                    k114,
-                                    A::mul_add(-k112, d243, k116 * d244),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r.z
-                let d136 = A::mul_add(
-                    -p.MZ9l,
-                    d125,
-                    A::mul_add(
-                        p.MY9l,
-                        d126,
-                        A::mul_add(
-                            -p.XZ9l,
-                            k68,
-                            A::mul_add(
-                                p.XY9l,
-                                k66,
-                                A::mul_add(p.XX9l, k65, A::mul_add(-k64, d134, k63 * d135)),
-                            ),
-                        ),
-                    ),
-                ); // N9l.x
-                let d247 = A::mul_add(
-                    -p.MZ9r,
-                    d235,
-                    A::mul_add(
-                        p.MY9r,
-                        d236,
-                        A::mul_add(
-                            -p.XZ9r,
-                            k115,
-                            A::mul_add(
-                                p.XY9r,
-                                k117,
-                                A::mul_add(
-                                    p.XX9r,
-                                    k114,
-                                    A::mul_add(-k113, d244, k112 * d245),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r.x
-                let d137 = A::mul_add(
-                    -p.MX9l,
-                    d126,
-                    A::mul_add(
-                        -p.MZ9l,
-                        d111,
-                        A::mul_add(
-                            -p.YZ9l,
-                            k68,
-                            A::mul_add(
-                                p.YY9l,
-                                k66,
-                                A::mul_add(p.XY9l, k65, A::mul_add(-k67, d135, k64 * d133)),
-                            ),
-                        ),
-                    ),
-                ); // N9l.y
-                let d248 = A::mul_add(
-                    -p.MX9r,
-                    d236,
-                    A::mul_add(
-                        -p.MZ9r,
-                        d222,
-                        A::mul_add(
-                            -p.YZ9r,
-                            k115,
-                            A::mul_add(
-                                p.YY9r,
-                                k117,
-                                A::mul_add(
-                                    p.XY9r,
-                                    k114,
-                                    A::mul_add(-k116, d245, k113 * d243),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N9r.y
-                let k69 = A::mul_add(-s_q7l, k64, c_q7l * k67); // w9l in 10l|ud=0,g=0.x
-                let k118 = A::mul_add(-s_q7r, k113, c_q7r * k116); // w9r in 10r|ud=0,g=0.x
-                let k70 = A::mul_add(c_q7l, k64, s_q7l * k67); // w9l in 10l|ud=0,g=0.y
-                let k119 = A::mul_add(c_q7r, k113, s_q7r * k116); // w9r in 10r|ud=0,g=0.y
-                let k74 = k66 + qdd7l; // wd10l.z
-                let k120 = k117 + qdd7r; // wd10r.z
-                let k72 = A::mul_add(c_q7l, k68, A::mul_add(-s_q7l, k65, k69 * qd7l)); // wd10l.y
-                let k121 = A::mul_add(
-                    c_q7r,
-                    k115,
-                    A::mul_add(-s_q7r, k114, k118 * qd7r),
-                ); // wd10r.y
-                let k71 = k63 - qd7l; // w10l|ud=0,g=0.z
-                let k122 = k112 - qd7r; // w10r|ud=0,g=0.z
-                let k73 = A::mul_add(s_q7l, k68, A::mul_add(c_q7l, k65, k70 * qd7l)); // wd10l.x
-                let k123 = A::mul_add(s_q7r, k115, A::mul_add(c_q7r, k114, k119 * qd7r)); // wd10r.x
-                let k75 = p.L9 * k64; // w9lxP10l|ud=0,g=0.x
-                let k124 = p.L9 * k113; // w9rxP10r|ud=0,g=0.x
-                let k76 = p.L9 * k67; // w9lxP10l|ud=0,g=0.z
-                let k125 = p.L9 * k116; // w9rxP10r|ud=0,g=0.z
-                let d140 = A::mul_add(p.L9, k68, A::mul_add(k63, k76, d111)); // a10l in 9l.x
-                let d249 = A::mul_add(p.L9, k115, A::mul_add(k112, k125, d222)); // a10r in 9r.x
-                let d139 = A::mul_add(k67, k76, k64 * k75) + d125; // a10l in 9l.y
-                let d250 = A::mul_add(k116, k125, k113 * k124) + d235; // a10r in 9r.y
-                let d141 = A::mul_add(p.L9, k65, A::mul_add(k63, k75, -d126)); // a10l in 9l.z
-                let d251 = A::mul_add(p.L9, k114, A::mul_add(k112, k124, -d236)); // a10r in 9r.z
-                let d142 = A::mul_add(-s_q7l, d141, c_q7l * d140); // a10l.x
-                let d252 = A::mul_add(-s_q7r, d251, c_q7r * d249); // a10r.x
-                let d143 = A::mul_add(c_q7l, d141, s_q7l * d140); // a10l.y
-                let d253 = A::mul_add(c_q7r, d251, s_q7r * d249); // a10r.y
-                let d144 = A::mul_add(-p.MY10l, k71, p.MZ10l * k70); // w10lxMS10l|ud=0,g=0.x
-                let d254 = A::mul_add(-p.MY10r, k122, p.MZ10r * k119); // w10rxMS10r|ud=0,g=0.x
-                let d146 = A::mul_add(-p.MX10l, k70, p.MY10l * k69); // w10lxMS10l|ud=0,g=0.z
-                let d255 = A::mul_add(-p.MX10r, k119, p.MY10r * k118); // w10rxMS10r|ud=0,g=0.z
-                let d145 = A::mul_add(-p.MZ10l, k69, p.MX10l * k71); // w10lxMS10l|ud=0,g=0.y
-                let d256 = A::mul_add(-p.MZ10r, k118, p.MX10r * k122); // w10rxMS10r|ud=0,g=0.y
-                let d147 = A::mul_add(
-                    p.MY10l,
-                    k74,
-                    A::mul_add(
-                        p.MZ10l,
-                        k72,
-                        A::mul_add(p.m10l, d142, A::mul_add(-k71, d145, k70 * d146)),
-                    ),
-                ); // F10l.x
-                let d257 = A::mul_add(
-                    p.MY10r,
-                    k120,
-                    A::mul_add(
-                        p.MZ10r,
-                        k121,
-                        A::mul_add(p.m10r, d252, A::mul_add(-k122, d256, k119 * d255)),
-                    ),
-                ); // F10r.x
-                let d148 = A::mul_add(
-                    p.MZ10l,
-                    k73,
-                    A::mul_add(
-                        -p.MX10l,
-                        k74,
-                        A::mul_add(p.m10l, d143, A::mul_add(-k69, d146, k71 * d144)),
-                    ),
-                ); // F10l.y
-                let d258 = A::mul_add(
-                    p.MZ10r,
-                    k123,
-                    A::mul_add(
-                        -p.MX10r,
-                        k120,
-                        A::mul_add(p.m10r, d253, A::mul_add(-k118, d255, k122 * d254)),
-                    ),
-                ); // F10r.y
-                let d149 = A::mul_add(
-                    -p.MX10l,
-                    k72,
-                    A::mul_add(
-                        -p.MY10l,
-                        k73,
-                        A::mul_add(-p.m10l, d139, A::mul_add(-k70, d144, k69 * d145)),
-                    ),
-                ); // F10l.z
-                let d259 = A::mul_add(
-                    -p.MX10r,
-                    k121,
-                    A::mul_add(
-                        -p.MY10r,
-                        k123,
-                        A::mul_add(-p.m10r, d250, A::mul_add(-k119, d254, k118 * d256)),
-                    ),
-                ); // F10r.z
-                let d150 = A::mul_add(
-                    p.XZ10l,
-                    k71,
-                    A::mul_add(p.XY10l, k70, p.XX10l * k69),
-                ); // J10lw10l|ud=0,g=0.x
-                let d260 = A::mul_add(
-                    p.XZ10r,
-                    k122,
-                    A::mul_add(p.XY10r, k119, p.XX10r * k118),
-                ); // J10rw10r|ud=0,g=0.x
-                let d151 = A::mul_add(
-                    p.YZ10l,
-                    k71,
-                    A::mul_add(p.YY10l, k70, p.XY10l * k69),
-                ); // J10lw10l|ud=0,g=0.y
-                let d261 = A::mul_add(
-                    p.YZ10r,
-                    k122,
-                    A::mul_add(p.YY10r, k119, p.XY10r * k118),
-                ); // J10rw10r|ud=0,g=0.y
-                let d152 = A::mul_add(
-                    p.ZZ10l,
-                    k71,
-                    A::mul_add(p.YZ10l, k70, p.XZ10l * k69),
-                ); // J10lw10l|ud=0,g=0.z
-                let d262 = A::mul_add(
-                    p.ZZ10r,
-                    k122,
-                    A::mul_add(p.YZ10r, k119, p.XZ10r * k118),
-                ); // J10rw10r|ud=0,g=0.z
-                let d153 = A::mul_add(
-                    -p.MZ10l,
-                    d143,
-                    A::mul_add(
-                        -p.MY10l,
-                        d139,
-                        A::mul_add(
-                            -p.XZ10l,
-                            k74,
-                            A::mul_add(
-                                p.XY10l,
-                                k72,
-                                A::mul_add(
-                                    -p.XX10l,
-                                    k73,
-                                    A::mul_add(-k71, d151, k70 * d152),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l.x
-                let d263 = A::mul_add(
-                    -p.MZ10r,
-                    d253,
-                    A::mul_add(
-                        -p.MY10r,
-                        d250,
-                        A::mul_add(
-                            -p.XZ10r,
-                            k120,
-                            A::mul_add(
-                                p.XY10r,
-                                k121,
-                                A::mul_add(
-                                    -p.XX10r,
-                                    k123,
-                                    A::mul_add(-k122, d261, k119 * d262),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r.x
-                let d155 = A::mul_add(
-                    -p.MY10l,
-                    d142,
-                    A::mul_add(
-                        p.MX10l,
-                        d143,
-                        A::mul_add(
-                            -p.ZZ10l,
-                            k74,
-                            A::mul_add(
-                                p.YZ10l,
-                                k72,
-                                A::mul_add(
-                                    -p.XZ10l,
-                                    k73,
-                                    A::mul_add(-k70, d150, k69 * d151),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l.z
-                out[11].0[l] = -d155;
-                let d264 = A::mul_add(
-                    -p.MY10r,
-                    d252,
-                    A::mul_add(
-                        p.MX10r,
-                        d253,
-                        A::mul_add(
-                            -p.ZZ10r,
-                            k120,
-                            A::mul_add(
-                                p.YZ10r,
-                                k121,
-                                A::mul_add(
-                                    -p.XZ10r,
-                                    k123,
-                                    A::mul_add(-k119, d260, k118 * d261),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r.z
-                out[18].0[l] = -d264;
-                let d154 = A::mul_add(
-                    p.MX10l,
-                    d139,
-                    A::mul_add(
-                        p.MZ10l,
-                        d142,
-                        A::mul_add(
-                            -p.YZ10l,
-                            k74,
-                            A::mul_add(
-                                p.YY10l,
-                                k72,
-                                A::mul_add(
-                                    -p.XY10l,
-                                    k73,
-                                    A::mul_add(-k69, d152, k71 * d150),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10l.y
-                let d265 = A::mul_add(
-                    p.MX10r,
-                    d250,
-                    A::mul_add(
-                        p.MZ10r,
-                        d252,
-                        A::mul_add(
-                            -p.YZ10r,
-                            k120,
-                            A::mul_add(
-                                p.YY10r,
-                                k121,
-                                A::mul_add(
-                                    -p.XY10r,
-                                    k123,
-                                    A::mul_add(-k118, d262, k122 * d260),
-                                ),
-                            ),
-                        ),
-                    ),
-                ); // N10r.y
-                let d322 = A::mul_add(-c_q7l, d148, s_q7l * d147); // f10l in 9l.z
-                let d266 = A::mul_add(-c_q7r, d258, s_q7r * d257); // f10r in 9r.z
-                let d323 = A::mul_add(s_q7l, d148, c_q7l * d147); // f10l in 9l.x
-                let d267 = A::mul_add(s_q7r, d258, c_q7r * d257); // f10r in 9r.x
-                let d324 = d130 - d323; // f9l.x
-                let d270 = d241 - d267; // f9r.x
-                let d325 = d131 - d149; // f9l.y
-                let d268 = d240 - d259; // f9r.y
-                let d326 = d132 + d322; // f9l.z
-                let d271 = d242 + d266; // f9r.z
-                let d327 = d137 - d155; // n9l.y
-                let d273 = d248 - d264; // n9r.y
-                let d328 = A::mul_add(
-                    -p.L9,
-                    d322,
-                    A::mul_add(-s_q7l, d154, A::mul_add(-c_q7l, d153, d136)),
-                ); // n9l.x
-                out[10].0[l] = -d328;
-                let d272 = A::mul_add(
-                    -p.L9,
-                    d266,
-                    A::mul_add(-s_q7r, d265, A::mul_add(-c_q7r, d263, d247)),
-                ); // n9r.x
-                out[17].0[l] = -d272;
-                let d329 = A::mul_add(
-                    -p.L9,
-                    d323,
-                    A::mul_add(-c_q7l, d154, A::mul_add(s_q7l, d153, d138)),
-                ); // n9l.z
-                let d269 = A::mul_add(
-                    -p.L9,
-                    d267,
-                    A::mul_add(-c_q7r, d265, A::mul_add(s_q7r, d263, d246)),
-                ); // n9r.z
-                let d330 = A::mul_add(s_q6l, d326, c_q6l * d325); // f9l in 8l.y
-                let d274 = A::mul_add(s_q6r, d271, c_q6r * d268); // f9r in 8r.y
-                let d331 = A::mul_add(-c_q6l, d326, s_q6l * d325); // f9l in 8l.z
-                let d275 = A::mul_add(-c_q6r, d271, s_q6r * d268); // f9r in 8r.z
-                let d332 = d116 - d324; // f8l.x
-                let d278 = d227 - d270; // f8r.x
-                let d333 = d122 - d328; // n8l.x
-                let d280 = d233 - d272; // n8r.x
-                let d334 = A::mul_add(c_q6l, d329, A::mul_add(-s_q6l, d327, d123)); // n8l.z
-                let d277 = A::mul_add(c_q6r, d269, A::mul_add(-s_q6r, d273, d232)); // n8r.z
-                let d335 = d117 + d330; // f8l.y
-                let d276 = d226 + d274; // f8r.y
-                let d336 = d118 + d331; // f8l.z
-                let d279 = d228 + d275; // f8r.z
-                let d337 = A::mul_add(s_q6l, d329, A::mul_add(c_q6l, d327, d124)); // n8l.y
-                out[9].0[l] = d337;
-                let d281 = A::mul_add(s_q6r, d269, A::mul_add(c_q6r, d273, d234)); // n8r.y
-                out[16].0[l] = d281;
-                let d338 = A::mul_add(-c_q5l, d336, s_q5l * d332); // f8l in 7l.z
-                let d283 = A::mul_add(-c_q5r, d279, s_q5r * d278); // f8r in 7r.z
-                let d339 = A::mul_add(s_q5l, d336, c_q5l * d332); // f8l in 7l.x
-                let d282 = A::mul_add(s_q5r, d279, c_q5r * d278); // f8r in 7r.x
-                let d340 = d99 - d339; // f7l.x
-                let d286 = d210 - d282; // f7r.x
-                let d341 = d100 + d335; // f7l.y
-                let d284 = d209 + d276; // f7r.y
-                let d342 = d101 + d338; // f7l.z
-                let d287 = d211 + d283; // f7r.z
-                let d343 = d106 + d337; // n7l.y
-                let d289 = d217 + d281; // n7r.y
-                let d344 = A::mul_add(
-                    -p.L8,
-                    d338,
-                    A::mul_add(s_q5l, d334, A::mul_add(-c_q5l, d333, d105)),
-                ); // n7l.x
-                out[8].0[l] = -d344;
-                let d288 = A::mul_add(
-                    -p.L8,
-                    d283,
-                    A::mul_add(s_q5r, d277, A::mul_add(-c_q5r, d280, d216)),
-                ); // n7r.x
-                out[15].0[l] = -d288;
-                let d345 = A::mul_add(
-                    -p.L8,
-                    d339,
-                    A::mul_add(c_q5l, d334, A::mul_add(s_q5l, d333, d107)),
-                ); // n7l.z
-                let d285 = A::mul_add(
-                    -p.L8,
-                    d282,
-                    A::mul_add(c_q5r, d277, A::mul_add(s_q5r, d280, d215)),
-                ); // n7r.z
-                let d346 = A::mul_add(s_q4l, d342, c_q4l * d341); // f7l in 6l.y
-                let d290 = A::mul_add(s_q4r, d287, c_q4r * d284); // f7r in 6r.y
-                let d347 = A::mul_add(-c_q4l, d342, s_q4l * d341); // f7l in 6l.z
-                let d291 = A::mul_add(-c_q4r, d287, s_q4r * d284); // f7r in 6r.z
-                let d348 = d85 - d340; // f6l.x
-                let d294 = d196 - d286; // f6r.x
-                let d349 = d91 - d344; // n6l.x
-                let d296 = d202 - d288; // n6r.x
-                let d350 = A::mul_add(c_q4l, d345, A::mul_add(-s_q4l, d343, d92)); // n6l.z
-                let d293 = A::mul_add(c_q4r, d285, A::mul_add(-s_q4r, d289, d201)); // n6r.z
-                let d351 = d86 + d346; // f6l.y
-                let d292 = d195 + d290; // f6r.y
-                let d352 = d87 + d347; // f6l.z
-                let d295 = d197 + d291; // f6r.z
-                let d353 = A::mul_add(s_q4l, d345, A::mul_add(c_q4l, d343, d93)); // n6l.y
-                out[7].0[l] = d353;
-                let d297 = A::mul_add(s_q4r, d285, A::mul_add(c_q4r, d289, d203)); // n6r.y
-                out[14].0[l] = d297;
-                let d354 = A::mul_add(-c_q3l, d352, s_q3l * d348); // f6l in 5l.z
-                let d299 = A::mul_add(-c_q3r, d295, s_q3r * d294); // f6r in 5r.z
-                let d355 = A::mul_add(s_q3l, d352, c_q3l * d348); // f6l in 5l.x
-                let d298 = A::mul_add(s_q3r, d295, c_q3r * d294); // f6r in 5r.x
-                let d356 = d68 - d355; // f5l.x
-                let d302 = d179 - d298; // f5r.x
-                let d357 = d69 + d351; // f5l.y
-                let d300 = d178 + d292; // f5r.y
-                let d358 = d70 + d354; // f5l.z
-                let d303 = d180 + d299; // f5r.z
-                let d359 = d75 + d353; // n5l.y
-                let d305 = d186 + d297; // n5r.y
-                let d360 = A::mul_add(
-                    -p.L7,
-                    d354,
-                    A::mul_add(s_q3l, d350, A::mul_add(-c_q3l, d349, d74)),
-                ); // n5l.x
-                out[6].0[l] = -d360;
-                let d304 = A::mul_add(
-                    -p.L7,
-                    d299,
-                    A::mul_add(s_q3r, d293, A::mul_add(-c_q3r, d296, d185)),
-                ); // n5r.x
-                out[13].0[l] = -d304;
-                let d361 = A::mul_add(
-                    -p.L7,
-                    d355,
-                    A::mul_add(c_q3l, d350, A::mul_add(s_q3l, d349, d76)),
-                ); // n5l.z
-                let d301 = A::mul_add(
-                    -p.L7,
-                    d298,
-                    A::mul_add(c_q3r, d293, A::mul_add(s_q3r, d296, d184)),
-                ); // n5r.z
-                let d362 = A::mul_add(s_q2l, d358, c_q2l * d357); // f5l in 4l.y
-                let d306 = A::mul_add(s_q2r, d303, c_q2r * d300); // f5r in 4r.y
-                let d363 = A::mul_add(-c_q2l, d358, s_q2l * d357); // f5l in 4l.z
-                let d307 = A::mul_add(-c_q2r, d303, s_q2r * d300); // f5r in 4r.z
-                let d364 = d54 - d356; // f4l.x
-                let d310 = d165 - d302; // f4r.x
-                let d365 = d60 - d360; // n4l.x
-                let d312 = d171 - d304; // n4r.x
-                let d366 = A::mul_add(c_q2l, d361, A::mul_add(-s_q2l, d359, d61)); // n4l.z
-                let d309 = A::mul_add(c_q2r, d301, A::mul_add(-s_q2r, d305, d170)); // n4r.z
-                let d367 = d55 + d362; // f4l.y
-                let d308 = d164 + d306; // f4r.y
-                let d316 = d37 + d308; // f3.x
-                let d368 = d56 + d363; // f4l.z
-                let d311 = d166 + d307; // f4r.z
-                let d369 = A::mul_add(s_q2l, d361, A::mul_add(c_q2l, d359, d62)); // n4l.y
-                out[5].0[l] = d369;
-                let d313 = A::mul_add(s_q2r, d301, A::mul_add(c_q2r, d305, d172)); // n4r.y
-                out[12].0[l] = d313;
-                let d370 = A::mul_add(s_q1l, d368, c_q1l * d364); // f4l in 3.y
-                let d314 = A::mul_add(s_q1r, d311, c_q1r * d310); // f4r in 3.y
-                let d318 = A::mul_add(
-                    -p.L5,
-                    d308,
-                    A::mul_add(
-                        -p.L6,
-                        d314,
-                        A::mul_add(c_q1r, d309, A::mul_add(s_q1r, d312, d44)),
-                    ),
-                ); // n3.z
-                let d319 = d38 - d314; // f3.y
-                let d371 = A::mul_add(-c_q1l, d368, s_q1l * d364); // f4l in 3.z
-                let d315 = A::mul_add(-c_q1r, d311, s_q1r * d310); // f4r in 3.z
-                let d317 = A::mul_add(p.L5, d315, d43 + d313); // n3.x
-                let d320 = d39 - d315; // f3.z
-                let d321 = A::mul_add(
-                    -p.L6,
-                    d315,
-                    A::mul_add(s_q1r, d309, A::mul_add(-c_q1r, d312, d45)),
-                ); // n3.y
-                let d372 = d316 - d367; // f3.x
-                let d373 = A::mul_add(-p.L5, d371, d317 - d369); // n3.x
-                let d374 = A::mul_add(
-                    p.L5,
-                    d367,
-                    A::mul_add(
-                        p.L6,
-                        d370,
-                        A::mul_add(-c_q1l, d366, A::mul_add(-s_q1l, d365, d318)),
-                    ),
-                ); // n3.z
-                let d375 = d319 - d370; // f3.y
-                let d376 = d320 + d371; // f3.z
-                let d377 = A::mul_add(
-                    -p.L6,
-                    d371,
-                    A::mul_add(s_q1l, d366, A::mul_add(-c_q1l, d365, d321)),
-                ); // n3.y
-                out[4].0[l] = d377;
-                let d378 = A::mul_add(s_q_torso, d376, c_q_torso * d372); // f3 in 2.x
-                let d379 = A::mul_add(-c_q_torso, d376, s_q_torso * d372); // f3 in 2.z
-                let d380 = d21 - d375; // f2.y
-                let d381 = A::mul_add(
-                    p.L3,
-                    d378,
-                    A::mul_add(-c_q_torso, d374, A::mul_add(-s_q_torso, d373, d27)),
-                ); // n2.z
-                let d382 = d22 + d378; // f2.x
-                let d383 = d23 + d379; // f2.z
-                let d384 = A::mul_add(
-                    -p.L4,
-                    d375,
-                    A::mul_add(
-                        p.L3,
-                        d379,
-                        A::mul_add(-s_q_torso, d374, A::mul_add(c_q_torso, d373, d28)),
-                    ),
-                ); // n2.x
-                out[3].0[l] = d384;
-                let d385 = A::mul_add(p.L4, d378, d29 + d377); // n2.y
-                let d386 = A::mul_add(-s_q_w, d383, c_q_w * d380); // f2 in 1.y
-                let d387 = A::mul_add(c_q_w, d383, s_q_w * d380); // f2 in 1.z
-                let d388 = d6 + d386; // f1.y
-                let d389 = A::mul_add(
-                    p.L1,
-                    d382,
-                    A::mul_add(c_q_w, d381, A::mul_add(s_q_w, d385, d11)),
-                ); // n1.z
-                let d390 = d7 + d387; // f1.z
-                let d391 = A::mul_add(-p.L2, d386, A::mul_add(p.L1, d387, d12 + d384)); // n1.x
-                out[2].0[l] = d391;
-                let d392 = A::mul_add(
-                    -p.L2,
-                    d382,
-                    A::mul_add(-s_q_w, d381, A::mul_add(c_q_w, d385, d13)),
-                ); // n1.y
-                let d393 = A::mul_add(c_q_imu, d390, s_q_imu * d388); // f1 in 0.x
-                out[0].0[l] = A::mul_add(pc.pc67, xdd, d393);
-                let d394 = A::mul_add(-s_q_imu, d389, c_q_imu * d392); // n0.z
-                out[1].0[l] = A::mul_add(pc.pc68, psidd, -d394);
-            }
+            let q = kanegen_runtime::lanes::inputs_soa(q);
+            let u = kanegen_runtime::lanes::inputs_soa(u);
+            let ud = kanegen_runtime::lanes::inputs_soa(ud);
+            inverse_dynamics_batch_body::<A, _, L>(p, pc, &q, &u, &ud, out);
         }
         kanegen_runtime::isa::dispatch_fused_wide_with(
             out,

@@ -2,7 +2,8 @@
 //! `$OUT_DIR`: the 7-DOF arm of `models/singlearm.urdf` (runtime parameters and baked) and Krang
 //! imported from `models/Krang.urdf` with its two-wheeled base (runtime parameters); and, for
 //! `tests/kinematics.rs`, the arm and the two-link model with every registry function; for
-//! `tests/mimic.rs`, a gripper with mimic joints; for `tests/big_tree.rs`, a 100-DOF tree.
+//! `tests/mimic.rs`, a gripper with mimic joints; for `tests/big_tree.rs`, a 100-DOF tree; for
+//! `tests/isa_batch.rs`, a cart on a rail (structurally zero c, g, C) with batched functions.
 //! The TOML Krang models come from `krang-dynamics`.
 use kanegen::model::{UrdfOptions, WheeledBaseSpec};
 
@@ -36,18 +37,50 @@ fn main() {
         .batch(true)
         .output("mimic_gripper_all.rs")
         .run();
+    // A cart on a horizontal rail: c, g and C are structurally zero, so their batched forms
+    // have no loop (`tests/isa_batch.rs` compiles them with `unused_variables` denied).
+    let slider = out_dir().join("slider.urdf");
+    std::fs::write(&slider, SLIDER_URDF).expect("OUT_DIR is writable");
+    kanegen::Builder::urdf(&slider, UrdfOptions::default())
+        .batch(true)
+        .output("slider.rs")
+        .run();
     kanegen::Builder::urdf("models/Krang.urdf", krang_urdf_options())
         .output("krang_urdf.rs")
         .run();
     // A 100-DOF tree (ten branches of ten links), for `tests/big_tree.rs`: its functions are
     // long enough to be split into blocks, and this debug build (with debug info) compiles it.
-    let out = std::path::PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
-    let tree = out.join("tree10x10.urdf");
+    let tree = out_dir().join("tree10x10.urdf");
     std::fs::write(&tree, tree_urdf(10, 10)).expect("OUT_DIR is writable");
     kanegen::Builder::urdf(&tree, UrdfOptions::default())
         .output("tree10x10.rs")
         .run();
 }
+
+/// Cargo's output directory of this build script.
+fn out_dir() -> std::path::PathBuf {
+    std::path::PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"))
+}
+
+/// One prismatic joint along x on a fixed base (gravity along −z): M = [m], c = g = C = 0.
+const SLIDER_URDF: &str = r#"<?xml version="1.0"?>
+<robot name="slider">
+  <link name="base"/>
+  <link name="cart">
+    <inertial>
+      <origin xyz="0 0 0.1"/>
+      <mass value="2.5"/>
+      <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.04"/>
+    </inertial>
+  </link>
+  <joint name="rail" type="prismatic">
+    <parent link="base"/>
+    <child link="cart"/>
+    <axis xyz="1 0 0"/>
+    <limit lower="-1" upper="1" effort="100" velocity="1"/>
+  </joint>
+</robot>
+"#;
 
 /// A tree of `branches` serial branches of `depth` revolute links each on a fixed base: joint
 /// axes cycle through z, y, x, every link has an offset origin, a distinct mass and a full

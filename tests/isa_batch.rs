@@ -22,6 +22,15 @@ use nalgebra::SVector;
 
 type V = SVector<f64, 19>;
 
+/// A cart on a horizontal rail (root `build.rs`): c, g and C are structurally zero. Unused
+/// variables and needless `mut` are denied, so a function with nothing to compute (single
+/// state or batched) must not bind a variable it never reads or writes.
+#[allow(dead_code)] // the test uses only part of the module
+#[deny(unused_variables, unused_mut)]
+mod slider {
+    include!(concat!(env!("OUT_DIR"), "/slider.rs"));
+}
+
 fn krang(model: &Model, uniform: &mut impl FnMut() -> f64) -> kd::Krang {
     let p = random_physical_params(model, uniform);
     kd::Krang::new(kd::Params::from_array(p.try_into().unwrap()))
@@ -294,4 +303,53 @@ fn selecting_an_instruction_set_the_cpu_lacks_is_an_error() {
     }
     isa::select(isa::detected()).unwrap();
     assert_eq!(isa::active(), isa::detected());
+}
+
+#[test]
+fn batched_functions_with_structurally_zero_results_compile_and_write_zeros() {
+    use kanegen_runtime::lanes::{soa, state};
+    type S = SVector<f64, 1>;
+    let k = slider::Slider::default();
+    let q: [S; 3] = [S::new(0.3), S::new(-0.7), S::new(1.0e6)];
+    let u: [S; 3] = [S::new(1.5), S::new(-2.0), S::new(0.0)];
+    let ud: [S; 3] = [S::new(-4.0), S::new(0.5), S::new(3.0)];
+    let _guard = isa_lock();
+    let nan = S::new(f64::NAN);
+    let (mut m, mut c, mut g, mut t, mut cm) = (
+        [nalgebra::SMatrix::<f64, 1, 1>::from_element(f64::NAN); 3],
+        [nan; 3],
+        [nan; 3],
+        [nan; 3],
+        [nalgebra::SMatrix::<f64, 1, 1>::from_element(f64::NAN); 3],
+    );
+    k.mass_matrix_batch_into(&q, &mut m);
+    k.coriolis_batch_into(&q, &u, &mut c);
+    k.gravity_batch_into(&q, &mut g);
+    k.inverse_dynamics_batch_into(&q, &u, &ud, &mut t);
+    k.coriolis_matrix_batch_into(&q, &u, &mut cm);
+    let (qs, us, uds) = (soa(&q), soa(&u), soa(&ud));
+    let (cs, gs, ts, cms) = (
+        k.coriolis_batch_soa(&qs, &us),
+        k.gravity_batch_soa(&qs),
+        k.inverse_dynamics_batch_soa(&qs, &us, &uds),
+        k.coriolis_matrix_batch_soa(&qs, &us),
+    );
+    for l in 0..3 {
+        // The cart's mass: M = [2.5], c = g = C = 0, τ = 2.5 u̇.
+        assert_eq!(k.mass_matrix(&q[l])[(0, 0)], 2.5);
+        assert_eq!(m[l], k.mass_matrix(&q[l]), "M lane {l}");
+        for zero in [
+            c[l][0],
+            g[l][0],
+            cm[l][(0, 0)],
+            state(&cs, l)[0],
+            state(&gs, l)[0],
+        ] {
+            assert_eq!(zero.to_bits(), 0.0f64.to_bits(), "lane {l}");
+        }
+        assert_eq!(state(&cms, l)[(0, 0)].to_bits(), 0.0f64.to_bits());
+        assert_eq!(t[l], k.inverse_dynamics(&q[l], &u[l], &ud[l]), "τ lane {l}");
+        assert_eq!(t[l][0], 2.5 * ud[l][0]);
+        assert_eq!(state(&ts, l), t[l], "SoA τ lane {l}");
+    }
 }

@@ -382,9 +382,13 @@ fn shared_body(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         .map(|(_, x)| quote!(#x: #lanes_ty,));
     let sin_cos = lane_sin_cos(cx, p, &reads);
     // One loop per part (one part unless the result has more entries than a vectorized loop
-    // can store).
+    // can store); none for a structurally zero result (its entries are all written after the
+    // body), so no loop leaves `l` unused.
     let mut loops = TokenStream::new();
     for part in loop_parts(p, &reads) {
+        if nonzero_outputs(&part).next().is_none() {
+            continue;
+        }
         let printer = cx.printer(&part.stmts);
         let part_reads = Reads::of(&part, cx.model.speeds.len());
         let lane_values = lane_values(cx, &part, &part_reads);
@@ -405,6 +409,11 @@ fn shared_body(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
             copies.extend(quote!(let pc = &{ *pc };));
         }
     }
+    let out = if loops.is_empty() {
+        quote!(_out)
+    } else {
+        quote!(out)
+    };
     quote! {
         #[doc = #doc]
         #[inline(always)]
@@ -412,7 +421,7 @@ fn shared_body(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
             A: kanegen_runtime::isa::Arith<f64>,
             S: kanegen_runtime::lanes::LaneStore<L>,
             const L: usize,
-        >(#param_args #(#inputs)* out: &mut S) {
+        >(#param_args #(#inputs)* #out: &mut S) {
             #copies
             #sin_cos
             #loops

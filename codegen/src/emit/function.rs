@@ -332,6 +332,12 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
         }
         Shape::Isometry => isometry(cx, printer, p, stores),
         Shape::Vector => {
+            // A structurally zero vector (c, g of a cart on a horizontal rail) is never written.
+            let mutable = if nonzero.clone().next().is_some() {
+                quote!(mut)
+            } else {
+                TokenStream::new()
+            };
             for (r, _, e) in nonzero {
                 let v = text(cx, printer, e);
                 // `black_box` keeps LLVM's SLP vectorizer from packing the stores of adjacent
@@ -346,7 +352,7 @@ fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) ->
             }
             Result {
                 ty: quote!(SVector<#t, #nl>),
-                init: quote!(let mut out = SVector::<#t, #nl>::zeros();),
+                init: quote!(let #mutable out = SVector::<#t, #nl>::zeros();),
                 stores,
                 value: quote!(out),
                 in_memory: false,

@@ -37,11 +37,13 @@ fn main() {
         .batch(true)
         .output("mimic_gripper_all.rs")
         .run();
-    // A cart on a horizontal rail: c, g and C are structurally zero, so their batched forms
-    // have no loop (`tests/isa_batch.rs` compiles them with `unused_variables` denied).
+    // A cart on a horizontal rail, every registry function and the batched forms: c, g and C
+    // are structurally zero (their batched forms have no loop) and the gravity regressor has no
+    // base parameter (`tests/isa_batch.rs` compiles the module with warnings denied).
     let slider = out_dir().join("slider.urdf");
     std::fs::write(&slider, SLIDER_URDF).expect("OUT_DIR is writable");
     kanegen::Builder::urdf(&slider, UrdfOptions::default())
+        .functions(kanegen::FunctionSet::all())
         .batch(true)
         .output("slider.rs")
         .run();

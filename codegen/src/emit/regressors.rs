@@ -148,12 +148,19 @@ fn base_items(
     let of_doc = format!(
         " The {what} from the full vector (in the order of [`{full_names}`]); the grouping coefficients hold for the model file's lengths."
     );
+    // No base parameter (a gravity regressor of a model gravity does not act on, such as a
+    // cart on a horizontal rail): the vector is not read.
+    let v = if b.names.is_empty() {
+        quote!(_v)
+    } else {
+        quote!(v)
+    };
     let mut out = quote! {
         #[doc = #doc]
         pub const #names_id: [&str; #nb] = [#(#names),*];
 
         #[doc = #of_doc]
-        pub fn #from_vector(v: &SVector<#t, #np>) -> SVector<#t, #nb> {
+        pub fn #from_vector(#v: &SVector<#t, #np>) -> SVector<#t, #nb> {
             SVector::<#t, #nb>::from([#(#values),*])
         }
     };
@@ -180,10 +187,15 @@ fn base_items(
             });
             quote!(#(#terms)+*)
         });
+        let body = if b.names.is_empty() {
+            quote!(let _ = p;)
+        } else {
+            quote!(let v = p.#getter();)
+        };
         out.extend(quote! {
             #[doc = #doc]
             pub fn #from_params(p: &Params) -> SVector<#t, #nb> {
-                let v = p.#getter();
+                #body
                 SVector::<#t, #nb>::from([#(#values),*])
             }
         });

@@ -3,7 +3,8 @@
 //! imported from `models/Krang.urdf` with its two-wheeled base (runtime parameters); and, for
 //! `tests/kinematics.rs`, the arm and the two-link model with every registry function; for
 //! `tests/mimic.rs`, a gripper with mimic joints; for `tests/big_tree.rs`, a 100-DOF tree; for
-//! `tests/isa_batch.rs`, a cart on a rail (structurally zero c, g, C) with batched functions.
+//! `tests/isa_batch.rs`, a cart on a rail (structurally zero c, g, C) with every registry
+//! function and the batched forms.
 //! The TOML Krang models come from `krang-dynamics`.
 use kanegen::model::{UrdfOptions, WheeledBaseSpec};
 

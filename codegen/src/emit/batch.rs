@@ -28,7 +28,9 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::Context;
-use super::function::{Reads, Stores, nonzero_outputs, store_text_after, text, unused_inputs};
+use super::function::{
+    Reads, Stores, nonzero_outputs, state_reads, store_text_after, text, unused_inputs,
+};
 use super::items::{arg_names, return_type};
 use super::print::{Printer, ident, idx};
 use crate::lower::{self, FunctionProgram, LExpr, Program};
@@ -132,45 +134,42 @@ impl Layout {
     }
 }
 
-/// The lane inputs the program reads, as `(read, name)`: `q` (also for the sines and cosines),
-/// `u`, `ud`.
-fn read_inputs(p: &Program, reads: &Reads) -> [(bool, TokenStream); 3] {
-    let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
-    [
-        (reads_q, quote!(q)),
-        (reads.speed.contains(&true), quote!(u)),
-        (reads.accel.contains(&true), quote!(ud)),
-    ]
+/// The state inputs the program reads (`q`, `u`, `ud`, as [`state_reads`] says), by name.
+fn read_inputs(p: &Program, reads: &Reads) -> Vec<TokenStream> {
+    state_reads(p, reads)
+        .into_iter()
+        .zip([quote!(q), quote!(u), quote!(ud)])
+        .filter_map(|(read, x)| read.then_some(x))
+        .collect()
 }
 
 /// The sines and cosines before the loop: all joint angles of all states in one lane-wise
 /// `sin_cos` (a dependent joint's angle from its master's).
 fn lane_sin_cos(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
-    let mut ts = TokenStream::new();
-    if !p.sincos.is_empty() {
-        // All angles of all states in one call (a dependent joint's from its master's).
-        let angles = p.sincos.iter().map(|&s| {
-            let a = super::function::joint_angle(cx, s, &quote!(q));
-            if cx.low.mimic_angles.iter().any(|(d, _)| *d == s) {
-                quote!((#a).0)
-            } else {
-                quote!(#a.0)
-            }
-        });
-        let name = |read: &[bool], n: TokenStream| {
-            if p.sincos.iter().any(|&s| read[s]) {
-                n
-            } else {
-                quote!(_)
-            }
-        };
-        let (sn, cn) = (
-            name(&reads.sin, quote!(sin_q)),
-            name(&reads.cos, quote!(cos_q)),
-        );
-        ts.extend(quote!(let (#sn, #cn) = kanegen_runtime::lanes::sin_cos_n_inline::<A, _, L>([#(#angles),*]);));
+    if p.sincos.is_empty() {
+        return TokenStream::new();
     }
-    ts
+    // All angles of all states in one call (a dependent joint's from its master's).
+    let angles = p.sincos.iter().map(|&s| {
+        let a = super::function::joint_angle(cx, s, &quote!(q));
+        if cx.low.mimic_angles.iter().any(|(d, _)| *d == s) {
+            quote!((#a).0)
+        } else {
+            quote!(#a.0)
+        }
+    });
+    let name = |read: &[bool], n: TokenStream| {
+        if p.sincos.iter().any(|&s| read[s]) {
+            n
+        } else {
+            quote!(_)
+        }
+    };
+    let (sn, cn) = (
+        name(&reads.sin, quote!(sin_q)),
+        name(&reads.cos, quote!(cos_q)),
+    );
+    quote!(let (#sn, #cn) = kanegen_runtime::lanes::sin_cos_n_inline::<A, _, L>([#(#angles),*]);)
 }
 
 /// The scalar bindings at the top of the loop body: lane `l` of every sine, cosine,
@@ -345,8 +344,13 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     if !batched(f) {
         return TokenStream::new();
     }
-    let mut items = shared_body(cx, f);
-    items.extend(Layout::ALL.iter().map(|&layout| function_in(cx, f, layout)));
+    let reads = Reads::of(&f.program, cx.model.speeds.len());
+    let mut items = shared_body(cx, f, &reads);
+    items.extend(
+        Layout::ALL
+            .iter()
+            .map(|&layout| function_in(cx, f, &reads, layout)),
+    );
     items
 }
 
@@ -362,10 +366,9 @@ fn body_name(f: &FunctionProgram) -> proc_macro2::Ident {
 /// needs run-time checks that the result stores do not overwrite parameters it reads, and gives
 /// up ("loop not vectorized: runtime pointer checks needed") — and the lane-wise sines and
 /// cosines.
-fn shared_body(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
+fn shared_body(cx: &Context<'_>, f: &FunctionProgram, reads: &Reads) -> TokenStream {
     let spec = f.id.spec();
     let p = &f.program;
-    let reads = Reads::of(p, cx.model.speeds.len());
     let name = body_name(f);
     let doc = format!(
         " The statements of [`{0}_batch_into`] and [`{0}_batch_soa_into`] for `L` states: \
@@ -373,19 +376,18 @@ fn shared_body(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
          `out.set(row, column, l, value)`.",
         spec.name
     );
-    let param_args = super::function::param_args(cx, &reads);
+    let param_args = super::function::param_args(cx, reads);
     let nl = idx(cx.low.dof);
     let lanes_ty = quote!(&[kanegen_runtime::lanes::Lanes<L>; #nl]);
-    let inputs = read_inputs(p, &reads)
+    let inputs = read_inputs(p, reads)
         .into_iter()
-        .filter(|(read, _)| *read)
-        .map(|(_, x)| quote!(#x: #lanes_ty,));
-    let sin_cos = lane_sin_cos(cx, p, &reads);
+        .map(|x| quote!(#x: #lanes_ty,));
+    let sin_cos = lane_sin_cos(cx, p, reads);
     // One loop per part (one part unless the result has more entries than a vectorized loop
     // can store); none for a structurally zero result (its entries are all written after the
     // body), so no loop leaves `l` unused.
     let mut loops = TokenStream::new();
-    for part in loop_parts(p, &reads) {
+    for part in loop_parts(p, reads) {
         if nonzero_outputs(&part).next().is_none() {
             continue;
         }
@@ -469,10 +471,14 @@ fn docs(single: &str, layout: Layout) -> (String, String) {
 
 /// [`function`] in one layout: the inputs the program reads converted to lanes, the shared
 /// body ([`shared_body`]) inlined into each dispatched copy, then [`after_stores`].
-fn function_in(cx: &Context<'_>, f: &FunctionProgram, layout: Layout) -> TokenStream {
+fn function_in(
+    cx: &Context<'_>,
+    f: &FunctionProgram,
+    reads: &Reads,
+    layout: Layout,
+) -> TokenStream {
     let spec = f.id.spec();
     let p = &f.program;
-    let reads = Reads::of(p, cx.model.speeds.len());
     let by_value = layout.name(spec);
     let name = ident(&by_value);
     let name_into = ident(&format!("{by_value}_into"));
@@ -482,12 +488,9 @@ fn function_in(cx: &Context<'_>, f: &FunctionProgram, layout: Layout) -> TokenSt
     let names = arg_names(spec.inputs);
     let ty = layout.result(cx, spec);
     let out = quote!(out: &mut #ty);
-    let read = read_inputs(p, &reads);
-    let converted = read
-        .iter()
-        .filter(|(r, _)| *r)
-        .map(|(_, x)| layout.inputs(x));
-    let passed = read.iter().filter(|(r, _)| *r).map(|(_, x)| quote!(&#x,));
+    let read = read_inputs(p, reads);
+    let converted = read.iter().map(|x| layout.inputs(x));
+    let passed = read.iter().map(|x| quote!(&#x,));
     let shared = body_name(f);
     let after = after_stores(cx, p, spec.shape, layout);
     let after_loop = match layout {
@@ -495,7 +498,7 @@ fn function_in(cx: &Context<'_>, f: &FunctionProgram, layout: Layout) -> TokenSt
         Layout::States => quote!(for m in out.iter_mut() { #after }),
         Layout::Lanes => after,
     };
-    let unused = unused_inputs(spec.inputs, p, &reads);
+    let unused = unused_inputs(spec.inputs, p, reads);
     let call = super::function::call_body_into(
         cx,
         super::function::Copies::WithV4,

@@ -748,19 +748,29 @@ pub(super) fn body_generics(cx: &Context<'_>, lanes: bool) -> (TokenStream, Toke
     }
 }
 
+/// Which state inputs `p` reads: `q` (a coordinate, or a joint angle for the sines and
+/// cosines), `u`, `ud`.
+pub(super) fn state_reads(p: &Program, reads: &Reads) -> [bool; 3] {
+    [
+        !p.sincos.is_empty() || reads.coord.contains(&true),
+        reads.speed.contains(&true),
+        reads.accel.contains(&true),
+    ]
+}
+
 /// `let _ = q;` (and `u`, `ud`) for the inputs a function's program never reads, so that the
 /// generated signature stays uniform without unused-variable warnings (single-state and batched
 /// forms alike).
 pub(super) fn unused_inputs(inputs: Inputs, p: &Program, reads: &Reads) -> TokenStream {
-    let reads_q = !p.sincos.is_empty() || reads.coord.contains(&true);
+    let [reads_q, reads_u, reads_ud] = state_reads(p, reads);
     let mut unused = TokenStream::new();
     if !reads_q {
         unused.extend(quote!(let _ = q;));
     }
-    if inputs.needs_u() && !reads.speed.contains(&true) {
+    if inputs.needs_u() && !reads_u {
         unused.extend(quote!(let _ = u;));
     }
-    if inputs.needs_ud() && !reads.accel.contains(&true) {
+    if inputs.needs_ud() && !reads_ud {
         unused.extend(quote!(let _ = ud;));
     }
     unused

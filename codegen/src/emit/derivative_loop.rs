@@ -182,7 +182,7 @@ pub(super) fn function(
         #[doc = #arg_doc]
         #[inline]
         pub fn #into(#outer_params #args, m: &mut #mat) {
-            m.fill(#zero);
+            *m = <#mat>::zeros();
             #onto(#pass_params #state, m);
         }
 

@@ -154,7 +154,7 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
     let zero_others = if others.is_empty() {
         quote!()
     } else {
-        quote!(for c in [#(#others),*] { y.column_mut(c).fill(0.0); })
+        quote!(for c in [#(#others),*] { y.column_mut(c).as_mut_slice().fill(0.0); })
     };
     let body = quote! {
         #unused

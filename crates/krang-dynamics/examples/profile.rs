@@ -14,7 +14,8 @@
 //! a suffix `_b4` or `_b8` calls the batched form (`_batch_into`, into arrays kept across
 //! calls) with 4 or 8 states, counted as one call, `_s8` the structure-of-arrays form
 //! (`_batch_soa_into`) with 8 states; with
-//! the feature `derivatives` also `inverse_dynamics_derivatives`; with the feature `kinematics`
+//! the feature `derivatives` also `inverse_dynamics_derivatives` and `…_into` (into a matrix kept
+//! across calls); with the feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
 //! `com_jacobian` and `sin_cos_17`), the
 //! number of calls, and optionally the instruction set (`baseline` or `x86-64-v3`; default: the
@@ -58,6 +59,8 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
     // The batched forms write into these (`_into`: no zeroed array, no copy of the results).
     let mut m4 = [nalgebra::SMatrix::<f64, 19, 19>::zeros(); 4];
     let mut m8 = [nalgebra::SMatrix::<f64, 19, 19>::zeros(); 8];
+    #[cfg(feature = "derivatives")]
+    let mut d_out = SMatrix::<f64, 19, 38>::zeros();
     let mut v4 = [V::zeros(); 4];
     let mut v8 = [V::zeros(); 8];
     let mut ms8 = SMatrix::<Lanes<8>, 19, 19>::from_element(Lanes::splat(0.0));
@@ -132,6 +135,17 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
             "inverse_dynamics_derivatives" => {
                 black_box(k).inverse_dynamics_derivatives(black_box(q), black_box(u), black_box(ud))
                     [(7, 20)]
+            }
+            #[cfg(feature = "derivatives")]
+            "inverse_dynamics_derivatives_into" => {
+                let d = black_box(&mut d_out);
+                black_box(k).inverse_dynamics_derivatives_into(
+                    black_box(q),
+                    black_box(u),
+                    black_box(ud),
+                    d,
+                );
+                d[(7, 20)]
             }
             other => kinematics(k, other, q, u),
         };

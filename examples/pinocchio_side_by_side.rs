@@ -15,7 +15,8 @@
 //! `cases.txt` holds [`CASES`] cases, each one parameter set (case 0: the defaults of
 //! `krang.toml`, then random physical parameters), the model exported for it by
 //! `kanegen::pinocchio` (text format in that module's documentation), one random state `q, u, u̇`
-//! and the generated code's `M, c, g, τ, C` for it (shortest round-trip decimals, exact):
+//! and the generated code's `M, c, g, τ, C, ∂τ/∂q, ∂τ/∂u` for it (shortest round-trip decimals,
+//! exact):
 //!
 //! ```text
 //! cases <n> dof <dof>
@@ -23,12 +24,15 @@
 //! <the model in the kanegen-pinocchio text format, ending with `end`>
 //! q <dof numbers>    u …    ud …
 //! M <dof² numbers, by rows>    c …    g …    tau …    C <dof², by rows>
+//! dtau_dq <dof², by rows>    dtau_du <dof², by rows>
 //! ```
 //!
 //! The C++ harness (`benches/pinocchio/harness.cpp`) builds a `pinocchio::Model` per case,
-//! compares, and times Pinocchio with case 0's parameters on the states of all cases; `time` times
-//! the generated code (`krang_dynamics::Krang`, runtime parameters, default features plus the
-//! Coriolis matrix) in the same way: per function, [`ROUNDS`] rounds of [`CALLS`] calls cycling
+//! compares, and times Pinocchio with case 0's parameters on the states of all cases (and, when
+//! `run.sh` is given `CODEGEN=1`, `benches/pinocchio/codegen.cpp` does the same for Pinocchio's
+//! CppADCodeGen code); `time` times the generated code (`krang_dynamics::Krang`, runtime
+//! parameters, the workspace's features: the Coriolis matrix and the derivatives among them) in
+//! the same way: per function, [`ROUNDS`] rounds of [`CALLS`] calls cycling
 //! through the states, the fastest round's mean ns per call. Each run appends one line per
 //! function (`name ns`) to the times files; `report` takes the smallest figure of each.
 #![forbid(unsafe_code)]
@@ -133,6 +137,9 @@ fn write(dir: &Path) -> Result<(), String> {
             k.inverse_dynamics(&q, &u, &ud).iter().copied(),
         );
         line(&mut out, "C", rows(&k.coriolis_matrix(&q, &u)));
+        let (dq, du) = k.inverse_dynamics_partials(&q, &u, &ud);
+        line(&mut out, "dtau_dq", rows(&dq));
+        line(&mut out, "dtau_du", rows(&du));
     }
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let path = dir.join("cases.txt");
@@ -171,9 +178,10 @@ fn time(dir: &Path) -> Result<(), String> {
         .collect();
     let k = &k;
     // The `_into` forms write into a matrix the caller keeps, as Pinocchio writes `data.M`, `data.C`.
-    let (mut m_out, mut c_out) = (
+    let (mut m_out, mut c_out, mut d_out) = (
         SMatrix::<f64, 19, 19>::zeros(),
         SMatrix::<f64, 19, 19>::zeros(),
+        SMatrix::<f64, 19, 38>::zeros(),
     );
     let results = [
         (
@@ -216,6 +224,18 @@ fn time(dir: &Path) -> Result<(), String> {
             "coriolis_matrix_into",
             time_one(&states, |q, u, _| {
                 black_box(k).coriolis_matrix_into(q, u, black_box(&mut c_out));
+            }),
+        ),
+        (
+            "inverse_dynamics_derivatives",
+            time_one(&states, |q, u, ud| {
+                black_box(black_box(k).inverse_dynamics_derivatives(q, u, ud));
+            }),
+        ),
+        (
+            "inverse_dynamics_derivatives_into",
+            time_one(&states, |q, u, ud| {
+                black_box(k).inverse_dynamics_derivatives_into(q, u, ud, black_box(&mut d_out));
             }),
         ),
     ];
@@ -262,63 +282,117 @@ fn best_times(path: &Path) -> Result<(BTreeMap<String, f64>, usize), String> {
     Ok((best, runs))
 }
 
-fn report(dir: &Path) -> Result<(), String> {
-    let (ours, our_runs) = best_times(&dir.join("kanegen-times.txt"))?;
-    let (pin, pin_runs) = best_times(&dir.join("pinocchio-times.txt"))?;
-    let rows = [
-        (
-            "`mass_matrix` (M)",
-            "mass_matrix",
-            "`crba` (M, upper triangle)",
-            "crba",
-        ),
-        (
-            "`coriolis` (c)",
-            "coriolis",
-            "`nonLinearEffects` (c + g)",
-            "nle",
-        ),
-        (
-            "`gravity` (g)",
-            "gravity",
-            "`computeGeneralizedGravity`",
-            "gravity",
-        ),
-        (
-            "`inverse_dynamics` (τ)",
-            "inverse_dynamics",
-            "`rnea`",
-            "rnea",
-        ),
-        (
-            "`coriolis_matrix` (C)",
-            "coriolis_matrix",
-            "`computeCoriolisMatrix`",
-            "coriolis_matrix",
-        ),
-        (
-            "`mass_matrix_into` (M, into a kept matrix)",
-            "mass_matrix_into",
-            "`crba` (M, upper triangle)",
-            "crba",
-        ),
-        (
-            "`coriolis_matrix_into` (C, into a kept matrix)",
-            "coriolis_matrix_into",
-            "`computeCoriolisMatrix`",
-            "coriolis_matrix",
-        ),
-    ];
-    println!(
-        "| kanegen (Rust) | ns | Pinocchio (C++) | ns | Pinocchio / kanegen |\n|---|--:|---|--:|--:|"
-    );
-    for (our_label, our_key, pin_label, pin_key) in rows {
-        let (Some(a), Some(b)) = (ours.get(our_key), pin.get(pin_key)) else {
+/// One row of the table: our label and times-file key, Pinocchio's label and key.
+type Row = (&'static str, &'static str, &'static str, &'static str);
+
+/// The rows of the comparison, in the order printed.
+const ROWS: [Row; 9] = [
+    (
+        "`mass_matrix` (M)",
+        "mass_matrix",
+        "`crba` (M, upper triangle)",
+        "crba",
+    ),
+    (
+        "`coriolis` (c)",
+        "coriolis",
+        "`nonLinearEffects` (c + g)",
+        "nle",
+    ),
+    (
+        "`gravity` (g)",
+        "gravity",
+        "`computeGeneralizedGravity`",
+        "gravity",
+    ),
+    (
+        "`inverse_dynamics` (τ)",
+        "inverse_dynamics",
+        "`rnea`",
+        "rnea",
+    ),
+    (
+        "`coriolis_matrix` (C)",
+        "coriolis_matrix",
+        "`computeCoriolisMatrix`",
+        "coriolis_matrix",
+    ),
+    (
+        "`mass_matrix_into` (M, into a kept matrix)",
+        "mass_matrix_into",
+        "`crba` (M, upper triangle)",
+        "crba",
+    ),
+    (
+        "`coriolis_matrix_into` (C, into a kept matrix)",
+        "coriolis_matrix_into",
+        "`computeCoriolisMatrix`",
+        "coriolis_matrix",
+    ),
+    (
+        "`inverse_dynamics_derivatives` (∂τ/∂q, ∂τ/∂u)",
+        "inverse_dynamics_derivatives",
+        "`computeRNEADerivatives` (∂τ/∂q, ∂τ/∂v, ∂τ/∂a = M)",
+        "rnea_derivatives",
+    ),
+    (
+        "`inverse_dynamics_derivatives_into` (into a kept matrix)",
+        "inverse_dynamics_derivatives_into",
+        "`computeRNEADerivatives` (∂τ/∂q, ∂τ/∂v, ∂τ/∂a = M)",
+        "rnea_derivatives",
+    ),
+];
+
+/// Prefix of the times-file keys of Pinocchio's CppADCodeGen code (`codegen.cpp`).
+const GENERATED: &str = "cg_";
+
+/// Prints one markdown table: per row our time, theirs (`prefix` + their key) and the ratio.
+/// Rows whose Pinocchio key is missing are left out when `optional`.
+fn table(
+    ours: &BTreeMap<String, f64>,
+    pin: &BTreeMap<String, f64>,
+    header: &str,
+    prefix: &str,
+    optional: bool,
+) -> Result<(), String> {
+    println!("| kanegen (Rust) | ns | {header} | ns | Pinocchio / kanegen |\n|---|--:|---|--:|--:|");
+    for (our_label, our_key, pin_label, pin_key) in ROWS {
+        let pin_key = format!("{prefix}{pin_key}");
+        let (Some(a), Some(b)) = (ours.get(our_key), pin.get(&pin_key)) else {
+            if optional && ours.contains_key(our_key) {
+                continue;
+            }
             return Err(format!("no time for `{our_key}` or `{pin_key}`"));
         };
         println!(
             "| {our_label} | {a:.0} | {pin_label} | {b:.0} | {:.1}× |",
             b / a
+        );
+    }
+    Ok(())
+}
+
+fn report(dir: &Path) -> Result<(), String> {
+    let (ours, our_runs) = best_times(&dir.join("kanegen-times.txt"))?;
+    let (pin, pin_runs) = best_times(&dir.join("pinocchio-times.txt"))?;
+    table(&ours, &pin, "Pinocchio (C++)", "", false)?;
+    if pin.keys().any(|k| k.starts_with(GENERATED)) {
+        println!();
+        table(
+            &ours,
+            &pin,
+            "Pinocchio's generated code (CppADCodeGen, C)",
+            GENERATED,
+            true,
+        )?;
+    }
+    if let (Some(d), Some(t)) = (
+        ours.get("inverse_dynamics_derivatives_into"),
+        ours.get("inverse_dynamics"),
+    ) {
+        println!(
+            "\nkanegen: both derivative matrices, into a kept matrix, take {:.1}× one `inverse_dynamics` call",
+            d / t
         );
     }
     println!(

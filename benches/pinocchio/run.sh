@@ -15,8 +15,18 @@
 #      exported by kanegen::pinocchio for 100 parameter sets, one state each, and the generated
 #      code's M, c, g, τ, C);
 #   4. RUNS times (default 3), alternately: the harness (agreement check on all cases, then
-#      Pinocchio's timings) and the Rust timings; then the table, best of the runs.
+#      Pinocchio's timings), with CODEGEN=1 the codegen harness, and the Rust timings; then the
+#      table, best of the runs.
+# With CODEGEN=1 also Pinocchio's own generated code (its CppADCodeGen path, issue 14's second
+# target): step 1 adds `cmeel-cppad` and `cmeel-cppadcodegen` (headers), step 2 compiles
+# benches/pinocchio/codegen.cpp, whose first run records crba, nonLinearEffects, gravity, rnea
+# and computeRNEADerivatives on case 0's model and compiles each to a shared library with
+# `$CC -O3 -march=native` (CC default /usr/bin/gcc) into OUT/RUN_NAME/cg (about 25 s for Krang on
+# the 2-core machine; delete that directory to regenerate); later runs load them. Compiling the
+# codegen harness itself takes about 7 minutes (CppAD's templates).
 # Environment: PIN_VERSION (default 4.1.0), EIGEN_VERSION (cmeel-eigen, 3.4.1), RUNS (3),
+# CODEGEN (0; 1 for Pinocchio's generated code), CPPAD_VERSION (cmeel-cppad, 20250000.2),
+# CPPADCG_VERSION (cmeel-cppadcodegen, 2.4.3),
 # CXX (g++), OUT (target/pinocchio),
 # CXXFLAGS_EXTRA (appended to the compiler flags), RUN_NAME (the results directory under OUT,
 # default `run`). cargo's own variables apply to the Rust side, e.g. for both sides with the
@@ -24,7 +34,7 @@
 #   RUSTFLAGS="-C target-cpu=native" CARGO_TARGET_DIR=target/native RUN_NAME=run-native \
 #       benches/pinocchio/run.sh
 # Not part of CI (it downloads). Takes about 5 minutes on a 2-core machine, most of it compiling
-# the harness (Pinocchio's templates) and the Rust example.
+# the harness (Pinocchio's templates) and the Rust example; about 8 more with CODEGEN=1.
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -32,6 +42,9 @@ out="${OUT:-$root/target/pinocchio}"
 pin_version="${PIN_VERSION:-4.1.0}"
 eigen_version="${EIGEN_VERSION:-3.4.1}"
 runs="${RUNS:-3}"
+codegen="${CODEGEN:-0}"
+cppad_version="${CPPAD_VERSION:-20250000.2}"
+cppadcg_version="${CPPADCG_VERSION:-2.4.3}"
 cxx="${CXX:-g++}"
 run_dir="$out/${RUN_NAME:-run}"
 mkdir -p "$run_dir"
@@ -40,8 +53,11 @@ echo "== 1. Pinocchio $pin_version from PyPI into $out/venv"
 if [ ! -x "$out/venv/bin/python" ]; then
     python3 -m venv "$out/venv"
 fi
-"$out/venv/bin/pip" install --quiet --disable-pip-version-check "pin==$pin_version" \
-    "cmeel-eigen==$eigen_version"
+packages=("pin==$pin_version" "cmeel-eigen==$eigen_version")
+if [ "$codegen" = 1 ]; then
+    packages+=("cmeel-cppad==$cppad_version" "cmeel-cppadcodegen==$cppadcg_version")
+fi
+"$out/venv/bin/pip" install --quiet --disable-pip-version-check "${packages[@]}"
 prefix="$("$out/venv/bin/python" -m cmeel cmake 2>/dev/null | head -n 1)"
 if [ ! -f "$prefix/include/pinocchio/config.hpp" ] || [ ! -d "$prefix/include/eigen3" ]; then
     echo "error: no Pinocchio or Eigen headers under $prefix/include (pin and cmeel-eigen wheels)" >&2
@@ -60,10 +76,26 @@ flags=(-std=c++17 -O3 -march=native -DNDEBUG
 flags+=(${CXXFLAGS_EXTRA:-})
 stamp="$out/harness.flags"
 if [ ! -x "$harness" ] || [ "$root/benches/pinocchio/harness.cpp" -nt "$harness" ] \
+    || [ "$root/benches/pinocchio/cases.hpp" -nt "$harness" ] \
     || [ "$(cat "$stamp" 2>/dev/null)" != "$cxx ${flags[*]}" ]; then
     echo "compiling (about 2-3 minutes)"
     "$cxx" "${flags[@]}" "$root/benches/pinocchio/harness.cpp" -o "$harness"
     echo "$cxx ${flags[*]}" > "$stamp"
+fi
+if [ "$codegen" = 1 ]; then
+    if [ ! -f "$prefix/include/cppad/cg.hpp" ]; then
+        echo "error: no CppADCodeGen headers under $prefix/include (cmeel-cppadcodegen wheel)" >&2
+        exit 1
+    fi
+    codegen_bin="$out/codegen"
+    codegen_stamp="$out/codegen.flags"
+    if [ ! -x "$codegen_bin" ] || [ "$root/benches/pinocchio/codegen.cpp" -nt "$codegen_bin" ] \
+        || [ "$root/benches/pinocchio/cases.hpp" -nt "$codegen_bin" ] \
+        || [ "$(cat "$codegen_stamp" 2>/dev/null)" != "$cxx ${flags[*]}" ]; then
+        echo "compiling the codegen harness (about 7 minutes)"
+        "$cxx" "${flags[@]}" "$root/benches/pinocchio/codegen.cpp" -o "$codegen_bin" -ldl
+        echo "$cxx ${flags[*]}" > "$codegen_stamp"
+    fi
 fi
 
 echo "== 3. Rust side: cargo build --release --example pinocchio_side_by_side"
@@ -79,6 +111,9 @@ status=0
 for r in $(seq 1 "$runs"); do
     echo "-- run $r"
     "$harness" "$run_dir" || status=$?
+    if [ "$codegen" = 1 ]; then
+        "$codegen_bin" "$run_dir" || status=$?
+    fi
     "$rust" time "$run_dir"
 done
 echo "== table (load $(cut -d' ' -f1-3 /proc/loadavg))"

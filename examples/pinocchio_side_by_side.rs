@@ -355,7 +355,9 @@ fn table(
     prefix: &str,
     optional: bool,
 ) -> Result<(), String> {
-    println!("| kanegen (Rust) | ns | {header} | ns | Pinocchio / kanegen |\n|---|--:|---|--:|--:|");
+    println!(
+        "| kanegen (Rust) | ns | {header} | ns | Pinocchio / kanegen |\n|---|--:|---|--:|--:|"
+    );
     for (our_label, our_key, pin_label, pin_key) in ROWS {
         let pin_key = format!("{prefix}{pin_key}");
         let (Some(a), Some(b)) = (ours.get(our_key), pin.get(&pin_key)) else {

@@ -9,8 +9,9 @@
 //! ```
 //!
 //! with the products formed by triangular solves with the block Cholesky factor of M
-//! ([`MassMatrixCholesky`]), never by a dense inverse (M⁻¹ itself is one of the results, from
-//! 19 solves of unit vectors). Everything is fixed-size on the stack.
+//! ([`MassMatrixCholesky`]), never by a dense inverse: `[∂τ/∂q | ∂τ/∂u | I]` (57 columns; M⁻¹
+//! itself is one of the results) is solved in one pass over all its columns
+//! ([`MassMatrixCholesky::solve_columns_mut`]). Everything is fixed-size on the stack.
 //!
 //! [`Krang::linearize`] turns them into the `(A, B)` of `ẋ = f(x, a)` for the state
 //! `x = [q; u]` (38) and the 18 actuator torques `a` of the actuator map (`τ = B_act a`),
@@ -21,7 +22,9 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::Krang;
 use crate::actuators::ACTUATOR_COUNT;
-use crate::forward::{MassMatrixCholesky, NotPositiveDefinite};
+#[cfg(doc)]
+use crate::forward::MassMatrixCholesky;
+use crate::forward::NotPositiveDefinite;
 
 /// The forward-dynamics derivatives of an `N`-speed model at one state:
 /// `u̇ = FD(q, u, τ)` and its partial derivatives.
@@ -45,15 +48,6 @@ fn split<const N: usize, const N2: usize>(
         d.fixed_view::<N, N>(0, 0).into_owned(),
         d.fixed_view::<N, N>(0, N).into_owned(),
     )
-}
-
-/// `x ← M⁻¹ x` column by column with Krang's block Cholesky factor.
-fn solve_columns<const C: usize>(chol: &MassMatrixCholesky, x: &mut SMatrix<f64, 19, C>) {
-    for j in 0..C {
-        let mut col: SVector<f64, 19> = x.column(j).into_owned();
-        chol.solve_mut(&mut col);
-        x.set_column(j, &col);
-    }
 }
 
 /// `(A, B)` of `ẋ = f(x, input)` for `x = [q; u]` and `q̇ = u`, from the forward-dynamics
@@ -90,8 +84,8 @@ impl Krang {
 
     /// Forward dynamics and its derivatives at `(q, u, τ)`: `u̇ = FD(q, u, τ)`, `∂u̇/∂q`,
     /// `∂u̇/∂u` and `M⁻¹ = ∂u̇/∂τ` (see the [module docs](self)). One inverse-dynamics pass,
-    /// one mass matrix and its block Cholesky factor, one derivative pass, 57 triangular
-    /// solve pairs. Allocation-free.
+    /// one mass matrix and its block Cholesky factor, one derivative pass, one block triangular
+    /// solve pair over 57 right-hand sides. Allocation-free.
     ///
     /// # Errors
     /// [`NotPositiveDefinite`] for non-physical parameters.
@@ -104,18 +98,26 @@ impl Krang {
         let chol = self.mass_matrix_cholesky(q)?;
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
         let ud = chol.solve(&(tau - bias));
-        let (mut dud_dq, mut dud_du) = self.inverse_dynamics_partials(q, u, &ud);
-        dud_dq = -dud_dq;
-        dud_du = -dud_du;
-        solve_columns(&chol, &mut dud_dq);
-        solve_columns(&chol, &mut dud_du);
-        let mut minv = SMatrix::<f64, 19, 19>::identity();
-        solve_columns(&chol, &mut minv);
+        // X = [−∂τ/∂q | −∂τ/∂u | I] (column-major: the blocks are consecutive slices), then
+        // X ← M⁻¹ X: the 57 right-hand sides in one solve.
+        let d = self.inverse_dynamics_derivatives(q, u, &ud);
+        let mut x = SMatrix::<f64, 19, 57>::zeros();
+        let (dx, ix) = x.as_mut_slice().split_at_mut(19 * 38);
+        for (x, d) in dx.iter_mut().zip(d.as_slice()) {
+            *x = -d;
+        }
+        for i in 0..19 {
+            ix[20 * i] = 1.0;
+        }
+        chol.solve_columns_mut(&mut x);
+        let block = |k: usize| {
+            SMatrix::<f64, 19, 19>::from_column_slice(&x.as_slice()[361 * k..361 * (k + 1)])
+        };
         Ok(ForwardDynamicsDerivatives {
             ud,
-            dud_dq,
-            dud_du,
-            minv,
+            dud_dq: block(0),
+            dud_du: block(1),
+            minv: block(2),
         })
     }
 
@@ -169,7 +171,7 @@ impl Krang {
         };
         let fd = self.forward_dynamics_derivatives(q, u, &self.generalized_forces(a));
         let mut dud_da = self.actuator_matrix();
-        solve_columns(&chol, &mut dud_da);
+        chol.solve_columns_mut(&mut dud_da);
         state_space(&fd, &dud_da)
     }
 }

@@ -179,6 +179,51 @@ fn backward_subst<const N: usize>(u: &SMatrix<f64, N, N>, b: &mut SVector<f64, N
     }
 }
 
+/// `rows[dst] −= a · rows[src]`, where row `k` is `rows[k*c..(k+1)*c]` and `dst ≠ src`.
+#[inline]
+fn sub_scaled(rows: &mut [f64], c: usize, dst: usize, src: usize, a: f64) {
+    let (d, s) = if dst < src {
+        let (lo, hi) = rows.split_at_mut(src * c);
+        (&mut lo[dst * c..dst * c + c], &hi[..c])
+    } else {
+        let (lo, hi) = rows.split_at_mut(dst * c);
+        (&mut hi[..c], &lo[src * c..src * c + c])
+    };
+    for (d, s) in d.iter_mut().zip(s) {
+        *d -= a * s;
+    }
+}
+
+/// `rows[k] /= d`.
+#[inline]
+fn divide_row(rows: &mut [f64], c: usize, k: usize, d: f64) {
+    for x in &mut rows[k * c..k * c + c] {
+        *x /= d;
+    }
+}
+
+/// `Y ← U⁻ᵀ Y` (= `L⁻¹ Y`) on the rows `at..at + N` of `rows`, a row at a time.
+#[inline]
+fn forward_rows<const N: usize>(u: &SMatrix<f64, N, N>, rows: &mut [f64], at: usize, c: usize) {
+    for i in 0..N {
+        for k in 0..i {
+            sub_scaled(rows, c, at + i, at + k, u[(k, i)]);
+        }
+        divide_row(rows, c, at + i, u[(i, i)]);
+    }
+}
+
+/// `Y ← U⁻¹ Y` (= `L⁻ᵀ Y`) on the rows `at..at + N` of `rows`, a row at a time.
+#[inline]
+fn backward_rows<const N: usize>(u: &SMatrix<f64, N, N>, rows: &mut [f64], at: usize, c: usize) {
+    for i in (0..N).rev() {
+        divide_row(rows, c, at + i, u[(i, i)]);
+        for k in 0..i {
+            sub_scaled(rows, c, at + k, at + i, u[(k, i)]);
+        }
+    }
+}
+
 /// Block Cholesky factorisation of Krang's 19×19 mass matrix, arms first (see the
 /// [module docs](self)). Fixed size, `Copy`, no heap.
 ///
@@ -267,6 +312,42 @@ impl MassMatrixCholesky {
         b.fixed_rows_mut::<5>(0).copy_from(&y_trunk);
         b.fixed_rows_mut::<7>(5).copy_from(&y_left);
         b.fixed_rows_mut::<7>(12).copy_from(&y_right);
+    }
+
+    /// `X ← M⁻¹ X` for the `C` columns of `x` at once (e.g. `M⁻¹ ∂τ/∂q`, `M⁻¹ B`, `M⁻¹` itself).
+    ///
+    /// The same block substitutions as [`solve_mut`](Self::solve_mut), taken a row at a time
+    /// over all columns: on the transpose of `x`, each speed's values across the right-hand
+    /// sides are contiguous, so every step is one `y_i −= l_ik y_k` over `C` independent values
+    /// (vectorized, no chain of dependent additions), where column-by-column solves spend their
+    /// time in short dependent dot products. Equal to `C` calls of `solve_mut` to rounding (the
+    /// products are summed in another order). Fixed size, on the stack.
+    pub fn solve_columns_mut<const C: usize>(&self, x: &mut SMatrix<f64, 19, C>) {
+        // Row k of X (speed k, the C right-hand sides) is column k of `t`: `rows[k*C..(k+1)*C]`.
+        let mut t: SMatrix<f64, C, 19> = x.transpose();
+        let rows = t.as_mut_slice();
+        let (left, right) = (5, 12);
+        // Forward: L y = b.
+        forward_rows(&self.u_left, rows, left, C);
+        forward_rows(&self.u_right, rows, right, C);
+        for j in 0..5 {
+            for k in 0..7 {
+                sub_scaled(rows, C, j, left + k, self.w_left[(k, j)]);
+                sub_scaled(rows, C, j, right + k, self.w_right[(k, j)]);
+            }
+        }
+        forward_rows(&self.u_trunk, rows, 0, C);
+        // Backward: Lᵀ x = y.
+        backward_rows(&self.u_trunk, rows, 0, C);
+        for k in 0..7 {
+            for j in 0..5 {
+                sub_scaled(rows, C, left + k, j, self.w_left[(k, j)]);
+                sub_scaled(rows, C, right + k, j, self.w_right[(k, j)]);
+            }
+        }
+        backward_rows(&self.u_left, rows, left, C);
+        backward_rows(&self.u_right, rows, right, C);
+        *x = t.transpose();
     }
 
     /// The factor `L` in the original speed order: `M = L Lᵀ` with `L` lower triangular

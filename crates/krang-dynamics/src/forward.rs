@@ -180,7 +180,7 @@ fn backward_subst<const N: usize>(u: &SMatrix<f64, N, N>, b: &mut SVector<f64, N
 }
 
 /// `rows[dst] −= a · rows[src]`, where row `k` is `rows[k*c..(k+1)*c]` and `dst ≠ src`.
-#[inline]
+#[inline(always)]
 fn sub_scaled(rows: &mut [f64], c: usize, dst: usize, src: usize, a: f64) {
     let (d, s) = if dst < src {
         let (lo, hi) = rows.split_at_mut(src * c);
@@ -195,7 +195,7 @@ fn sub_scaled(rows: &mut [f64], c: usize, dst: usize, src: usize, a: f64) {
 }
 
 /// `rows[k] /= d`.
-#[inline]
+#[inline(always)]
 fn divide_row(rows: &mut [f64], c: usize, k: usize, d: f64) {
     for x in &mut rows[k * c..k * c + c] {
         *x /= d;
@@ -203,7 +203,7 @@ fn divide_row(rows: &mut [f64], c: usize, k: usize, d: f64) {
 }
 
 /// `Y ← U⁻ᵀ Y` (= `L⁻¹ Y`) on the rows `at..at + N` of `rows`, a row at a time.
-#[inline]
+#[inline(always)]
 fn forward_rows<const N: usize>(u: &SMatrix<f64, N, N>, rows: &mut [f64], at: usize, c: usize) {
     for i in 0..N {
         for k in 0..i {
@@ -214,7 +214,7 @@ fn forward_rows<const N: usize>(u: &SMatrix<f64, N, N>, rows: &mut [f64], at: us
 }
 
 /// `Y ← U⁻¹ Y` (= `L⁻ᵀ Y`) on the rows `at..at + N` of `rows`, a row at a time.
-#[inline]
+#[inline(always)]
 fn backward_rows<const N: usize>(u: &SMatrix<f64, N, N>, rows: &mut [f64], at: usize, c: usize) {
     for i in (0..N).rev() {
         divide_row(rows, c, at + i, u[(i, i)]);
@@ -323,6 +323,16 @@ impl MassMatrixCholesky {
     /// time in short dependent dot products. Equal to `C` calls of `solve_mut` to rounding (the
     /// products are summed in another order). Fixed size, on the stack.
     pub fn solve_columns_mut<const C: usize>(&self, x: &mut SMatrix<f64, 19, C>) {
+        // Compiled for the baseline and, run when the CPU has it, for x86-64-v3 (4 lanes; the
+        // same operations, no fused multiply-adds: the same bits in both copies).
+        kanegen_runtime::isa::dispatch(
+            #[inline(always)]
+            || self.solve_columns_in(x),
+        );
+    }
+
+    #[inline(always)]
+    fn solve_columns_in<const C: usize>(&self, x: &mut SMatrix<f64, 19, C>) {
         // Row k of X (speed k, the C right-hand sides) is column k of `t`: `rows[k*C..(k+1)*C]`.
         let mut t: SMatrix<f64, C, 19> = x.transpose();
         let rows = t.as_mut_slice();

@@ -91,6 +91,8 @@ fn bench(c: &mut Criterion) {
         .inverse_dynamics(q, u, ud));
     cycle!("id_derivatives/generated", |q, u, ud| k
         .inverse_dynamics_derivatives(q, u, ud));
+    cycle!("id_partials/generated", |q, u, ud| k
+        .inverse_dynamics_partials(q, u, ud));
     cycle!("id_derivatives/central_differences", |q, u, ud| {
         central_differences(&k, q, u, ud)
     });

@@ -44,10 +44,15 @@ pub struct ForwardDynamicsDerivatives<const N: usize> {
 fn split<const N: usize, const N2: usize>(
     d: &SMatrix<f64, N, N2>,
 ) -> (SMatrix<f64, N, N>, SMatrix<f64, N, N>) {
-    (
-        d.fixed_view::<N, N>(0, 0).into_owned(),
-        d.fixed_view::<N, N>(0, N).into_owned(),
-    )
+    // Column-major: the two blocks are the two halves of the storage, copied as slices (one
+    // `memcpy` each). A view's `into_owned` copies through nalgebra's strided iterator, a scalar
+    // loop of ≈ 3 cycles per entry, and `from_column_slice` was not much faster (criterion:
+    // `id_partials/generated` 3.07 µs with `into_owned`, 2.89 with `from_column_slice`, 2.34 so).
+    let (dq, du) = d.as_slice().split_at(N * N);
+    let (mut a, mut b) = (SMatrix::<f64, N, N>::zeros(), SMatrix::<f64, N, N>::zeros());
+    a.as_mut_slice().copy_from_slice(dq);
+    b.as_mut_slice().copy_from_slice(du);
+    (a, b)
 }
 
 /// `(A, B)` of `ẋ = f(x, input)` for `x = [q; u]` and `q̇ = u`, from the forward-dynamics
@@ -111,7 +116,10 @@ impl Krang {
         }
         chol.solve_columns_mut(&mut x);
         let block = |k: usize| {
-            SMatrix::<f64, 19, 19>::from_column_slice(&x.as_slice()[361 * k..361 * (k + 1)])
+            let mut b = SMatrix::<f64, 19, 19>::zeros();
+            b.as_mut_slice()
+                .copy_from_slice(&x.as_slice()[361 * k..361 * (k + 1)]);
+            b
         };
         Ok(ForwardDynamicsDerivatives {
             ud,

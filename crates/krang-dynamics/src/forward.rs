@@ -179,6 +179,18 @@ fn backward_subst<const N: usize>(u: &SMatrix<f64, N, N>, b: &mut SVector<f64, N
     }
 }
 
+/// The `R×C` block of `m` at `(r0, c0)`, copied entry by entry (a view's `into_owned` copies
+/// through nalgebra's strided iterator instead: a scalar loop with a chain of conditional moves
+/// per entry, which made the factorisation and the partial-derivative split measurably slower).
+#[inline(always)]
+fn block<const R: usize, const C: usize, const M: usize, const N: usize>(
+    m: &SMatrix<f64, M, N>,
+    r0: usize,
+    c0: usize,
+) -> SMatrix<f64, R, C> {
+    SMatrix::from_fn(|i, j| m[(r0 + i, c0 + j)])
+}
+
 /// `rows[dst] −= a · rows[src]`, where row `k` is `rows[k*c..(k+1)*c]` and `dst ≠ src`.
 #[inline(always)]
 fn sub_scaled(rows: &mut [f64], c: usize, dst: usize, src: usize, a: f64) {
@@ -250,8 +262,8 @@ impl MassMatrixCholesky {
     /// # Errors
     /// [`NotPositiveDefinite`] if a pivot is not positive (or is NaN).
     pub fn new(m: &SMatrix<f64, 19, 19>) -> Result<Self, NotPositiveDefinite> {
-        let a_left: SMatrix<f64, 7, 7> = m.fixed_view::<7, 7>(5, 5).into_owned();
-        let a_right: SMatrix<f64, 7, 7> = m.fixed_view::<7, 7>(12, 12).into_owned();
+        let a_left: SMatrix<f64, 7, 7> = block(m, 5, 5);
+        let a_right: SMatrix<f64, 7, 7> = block(m, 12, 12);
         let u_left = cholesky_upper(&a_left).ok_or(NotPositiveDefinite {
             block: Block::LeftArm,
         })?;
@@ -259,12 +271,12 @@ impl MassMatrixCholesky {
             block: Block::RightArm,
         })?;
         // W = L⁻¹ M[arm, trunk] (the lower-triangle blocks).
-        let mut w_left: SMatrix<f64, 7, 5> = m.fixed_view::<7, 5>(5, 0).into_owned();
-        let mut w_right: SMatrix<f64, 7, 5> = m.fixed_view::<7, 5>(12, 0).into_owned();
+        let mut w_left: SMatrix<f64, 7, 5> = block(m, 5, 0);
+        let mut w_right: SMatrix<f64, 7, 5> = block(m, 12, 0);
         forward_subst(&u_left, &mut w_left);
         forward_subst(&u_right, &mut w_right);
         // Schur complement S = T − W_lᵀ W_l − W_rᵀ W_r (lower triangle is enough).
-        let mut s: SMatrix<f64, 5, 5> = m.fixed_view::<5, 5>(0, 0).into_owned();
+        let mut s: SMatrix<f64, 5, 5> = block(m, 0, 0);
         let (wl, wr) = (w_left.as_slice(), w_right.as_slice());
         for j in 0..5 {
             let (lj, rj) = (&wl[7 * j..7 * j + 7], &wr[7 * j..7 * j + 7]);
@@ -295,9 +307,9 @@ impl MassMatrixCholesky {
 
     /// `b ← M⁻¹ b`, in place.
     pub fn solve_mut(&self, b: &mut SVector<f64, 19>) {
-        let mut y_left: SVector<f64, 7> = b.fixed_rows::<7>(5).into_owned();
-        let mut y_right: SVector<f64, 7> = b.fixed_rows::<7>(12).into_owned();
-        let mut y_trunk: SVector<f64, 5> = b.fixed_rows::<5>(0).into_owned();
+        let mut y_left: SVector<f64, 7> = block(b, 5, 0);
+        let mut y_right: SVector<f64, 7> = block(b, 12, 0);
+        let mut y_trunk: SVector<f64, 5> = block(b, 0, 0);
         // Forward: L y = b.
         forward_subst(&self.u_left, &mut y_left);
         forward_subst(&self.u_right, &mut y_right);

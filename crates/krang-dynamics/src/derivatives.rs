@@ -47,7 +47,8 @@ fn split<const N: usize, const N2: usize>(
     // Column-major: the two blocks are the two halves of the storage, copied as slices (one
     // `memcpy` each). A view's `into_owned` copies through nalgebra's strided iterator, a scalar
     // loop of ≈ 3 cycles per entry, and `from_column_slice` was not much faster (criterion:
-    // `id_partials/generated` 3.07 µs with `into_owned`, 2.89 with `from_column_slice`, 2.34 so).
+    // `id_partials/generated` 3.07 µs with `into_owned`, 2.89 with `from_column_slice`, 2.34 with
+    // these slice copies).
     let (dq, du) = d.as_slice().split_at(N * N);
     let (mut a, mut b) = (SMatrix::<f64, N, N>::zeros(), SMatrix::<f64, N, N>::zeros());
     a.as_mut_slice().copy_from_slice(dq);

@@ -66,15 +66,20 @@ fn random_state<const N: usize>(
     )
 }
 
+/// Krang with the default parameters for the first `defaults` cases, random ones after.
+fn krang_for(case: usize, defaults: usize, rng: &mut Rng) -> Krang {
+    if case < defaults {
+        Krang::default()
+    } else {
+        Krang::new(random_params(rng))
+    }
+}
+
 #[test]
 fn generated_mass_matrix_has_exact_zeros_between_the_arms() {
     let mut rng = Rng(1);
     for case in 0..300 {
-        let k = if case == 0 {
-            Krang::default()
-        } else {
-            Krang::new(random_params(&mut rng))
-        };
+        let k = krang_for(case, 1, &mut rng);
         let (q, _, _) = random_state::<19>(&mut rng);
         let m = k.mass_matrix(&q);
         for i in LEFT_ARM {
@@ -96,11 +101,7 @@ fn forward_then_inverse_dynamics_round_trips() {
     let mut rng = Rng(2);
     let mut worst: f64 = 0.0;
     for case in 0..2000 {
-        let k = if case < 200 {
-            Krang::default()
-        } else {
-            Krang::new(random_params(&mut rng))
-        };
+        let k = krang_for(case, 200, &mut rng);
         let (q, u, tau) = random_state::<19>(&mut rng);
         let ud = k.forward_dynamics(&q, &u, &tau);
         let back = k.inverse_dynamics(&q, &u, &ud);
@@ -115,11 +116,7 @@ fn forward_then_inverse_dynamics_round_trips() {
 fn block_cholesky_agrees_with_dense_nalgebra_cholesky() {
     let mut rng = Rng(3);
     for case in 0..1000 {
-        let k = if case < 100 {
-            Krang::default()
-        } else {
-            Krang::new(random_params(&mut rng))
-        };
+        let k = krang_for(case, 100, &mut rng);
         let (q, u, tau) = random_state::<19>(&mut rng);
         let m = k.mass_matrix(&q);
         let rhs = tau - k.coriolis(&q, &u) - k.gravity(&q);
@@ -153,11 +150,7 @@ fn block_cholesky_agrees_with_dense_nalgebra_cholesky() {
 fn solving_many_columns_at_once_equals_solving_each_column() {
     let mut rng = Rng(7);
     for case in 0..300 {
-        let k = if case < 30 {
-            Krang::default()
-        } else {
-            Krang::new(random_params(&mut rng))
-        };
+        let k = krang_for(case, 30, &mut rng);
         let (q, _, _) = random_state::<19>(&mut rng);
         let m = k.mass_matrix(&q);
         let chol = MassMatrixCholesky::new(&m).unwrap();
@@ -283,11 +276,7 @@ fn solve_spd_is_generic_and_rejects_indefinite_matrices() {
 fn upright_pitch_puts_the_centre_of_mass_above_the_axle() {
     let mut rng = Rng(7);
     for case in 0..200 {
-        let k = if case == 0 {
-            Krang::default()
-        } else {
-            Krang::new(random_params(&mut rng))
-        };
+        let k = krang_for(case, 1, &mut rng);
         let (mut q, _, _) = random_state::<19>(&mut rng);
         let up = k.upright_pitch(&q);
         q[index::Q_IMU] = up;

@@ -234,6 +234,35 @@ inline std::vector<Case> read_cases(const std::string & dir) {
   return cases;
 }
 
+// A harness's command line `NAME DIR [ROUNDS CALLS]` and the cases of DIR/cases.txt.
+struct Run {
+  std::string dir;
+  int rounds = 200;  // timing rounds per algorithm (the fastest counts)
+  int calls = 2000;  // calls per round
+  std::vector<Case> cases;
+};
+
+// Parses the command line and reads the cases; prints the usage or the error and returns false
+// (the harness then exits with status 2).
+inline bool start(int argc, char ** argv, const char * name, Run & run) {
+  if (argc != 2 && argc != 4) {
+    std::cerr << "usage: " << name << " DIR [ROUNDS CALLS]\n";
+    return false;
+  }
+  run.dir = argv[1];
+  if (argc == 4) {
+    run.rounds = std::atoi(argv[2]);
+    run.calls = std::atoi(argv[3]);
+  }
+  try {
+    run.cases = read_cases(run.dir);
+  } catch (const std::exception & e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return false;
+  }
+  return true;
+}
+
 // Pinocchio's configurations, velocities and accelerations of every case's state.
 struct States {
   std::vector<VectorXd> q, v, a;

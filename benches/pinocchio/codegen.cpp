@@ -74,22 +74,13 @@ struct Generated : Base {
 }  // namespace
 
 int main(int argc, char ** argv) {
-  if (argc != 2 && argc != 4) {
-    std::cerr << "usage: codegen DIR [ROUNDS CALLS]\n";
-    return 2;
-  }
-  const std::string dir = argv[1];
-  const int rounds = argc == 4 ? std::atoi(argv[2]) : 200;
-  const int calls = argc == 4 ? std::atoi(argv[3]) : 2000;
+  Run run;
+  if (!start(argc, argv, "codegen", run)) return 2;
+  const std::string & dir = run.dir;
+  const int rounds = run.rounds, calls = run.calls;
+  const std::vector<Case> & cases = run.cases;
   const char * cc_env = std::getenv("CC");
   const std::string cc = cc_env && *cc_env ? cc_env : "/usr/bin/gcc";
-  std::vector<Case> cases;
-  try {
-    cases = read_cases(dir);
-  } catch (const std::exception & e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
-  }
   const Exported & ex = cases[0].ex;
   const pin::Model & model = ex.model;
   const Eigen::Index nq = model.nq, nv = model.nv;

@@ -27,20 +27,11 @@
 using namespace kanegen_cases;
 
 int main(int argc, char ** argv) {
-  if (argc != 2 && argc != 4) {
-    std::cerr << "usage: harness DIR [ROUNDS CALLS]\n";
-    return 2;
-  }
-  const std::string dir = argv[1];
-  const int rounds = argc == 4 ? std::atoi(argv[2]) : 200;
-  const int calls = argc == 4 ? std::atoi(argv[3]) : 2000;
-  std::vector<Case> cases;
-  try {
-    cases = read_cases(dir);
-  } catch (const std::exception & e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
-  }
+  Run run;
+  if (!start(argc, argv, "harness", run)) return 2;
+  const std::string & dir = run.dir;
+  const int rounds = run.rounds, calls = run.calls;
+  const std::vector<Case> & cases = run.cases;
 
   // Agreement on every case.
   double em = 0, ec = 0, eg = 0, et = 0, eC = 0, eCu = 0, edq = 0, edu = 0, eda = 0;

@@ -22,9 +22,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::Krang;
 use crate::actuators::ACTUATOR_COUNT;
-#[cfg(doc)]
-use crate::forward::MassMatrixCholesky;
-use crate::forward::NotPositiveDefinite;
+use crate::forward::{MassMatrixCholesky, NotPositiveDefinite};
 
 /// The forward-dynamics derivatives of an `N`-speed model at one state:
 /// `u̇ = FD(q, u, τ)` and its partial derivatives.
@@ -101,7 +99,18 @@ impl Krang {
         u: &SVector<f64, 19>,
         tau: &SVector<f64, 19>,
     ) -> Result<ForwardDynamicsDerivatives<19>, NotPositiveDefinite> {
-        let chol = self.mass_matrix_cholesky(q)?;
+        Ok(self.forward_dynamics_derivatives_with(&self.mass_matrix_cholesky(q)?, q, u, tau))
+    }
+
+    /// [`try_forward_dynamics_derivatives`](Self::try_forward_dynamics_derivatives) with the
+    /// factor of `M(q)` already computed (`linearize` reuses it for `M⁻¹ B_act`).
+    fn forward_dynamics_derivatives_with(
+        &self,
+        chol: &MassMatrixCholesky,
+        q: &SVector<f64, 19>,
+        u: &SVector<f64, 19>,
+        tau: &SVector<f64, 19>,
+    ) -> ForwardDynamicsDerivatives<19> {
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
         let ud = chol.solve(&(tau - bias));
         // X = [−∂τ/∂q | −∂τ/∂u | I] (column-major: the blocks are consecutive slices), then
@@ -122,12 +131,12 @@ impl Krang {
                 .copy_from_slice(&x.as_slice()[361 * k..361 * (k + 1)]);
             b
         };
-        Ok(ForwardDynamicsDerivatives {
+        ForwardDynamicsDerivatives {
             ud,
             dud_dq: block(0),
             dud_du: block(1),
             minv: block(2),
-        })
+        }
     }
 
     /// As [`try_forward_dynamics_derivatives`](Self::try_forward_dynamics_derivatives), but
@@ -178,7 +187,7 @@ impl Krang {
                 SMatrix::from_element(f64::NAN),
             );
         };
-        let fd = self.forward_dynamics_derivatives(q, u, &self.generalized_forces(a));
+        let fd = self.forward_dynamics_derivatives_with(&chol, q, u, &self.generalized_forces(a));
         let mut dud_da = self.actuator_matrix();
         chol.solve_columns_mut(&mut dud_da);
         state_space(&fd, &dud_da)

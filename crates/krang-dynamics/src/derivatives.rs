@@ -38,20 +38,26 @@ pub struct ForwardDynamicsDerivatives<const N: usize> {
     pub minv: SMatrix<f64, N, N>,
 }
 
+/// Square block `k` of a matrix of `N×N` blocks side by side: column-major, the block is the
+/// `k`-th run of `N²` entries of the storage, copied as a slice (one `memcpy`). A view's
+/// `into_owned` copies through nalgebra's strided iterator, a scalar loop of ≈ 3 cycles per
+/// entry, and `from_column_slice` was not much faster (criterion: `id_partials/generated` 3.07
+/// µs with `into_owned`, 2.89 with `from_column_slice`, 2.34 with slice copies).
+fn square_block<const N: usize, const C: usize>(
+    m: &SMatrix<f64, N, C>,
+    k: usize,
+) -> SMatrix<f64, N, N> {
+    let mut b = SMatrix::<f64, N, N>::zeros();
+    b.as_mut_slice()
+        .copy_from_slice(&m.as_slice()[N * N * k..N * N * (k + 1)]);
+    b
+}
+
 /// Splits the generated `[∂τ/∂q | ∂τ/∂u]` into its two square blocks.
 fn split<const N: usize, const N2: usize>(
     d: &SMatrix<f64, N, N2>,
 ) -> (SMatrix<f64, N, N>, SMatrix<f64, N, N>) {
-    // Column-major: the two blocks are the two halves of the storage, copied as slices (one
-    // `memcpy` each). A view's `into_owned` copies through nalgebra's strided iterator, a scalar
-    // loop of ≈ 3 cycles per entry, and `from_column_slice` was not much faster (criterion:
-    // `id_partials/generated` 3.07 µs with `into_owned`, 2.89 with `from_column_slice`, 2.34 with
-    // these slice copies).
-    let (dq, du) = d.as_slice().split_at(N * N);
-    let (mut a, mut b) = (SMatrix::<f64, N, N>::zeros(), SMatrix::<f64, N, N>::zeros());
-    a.as_mut_slice().copy_from_slice(dq);
-    b.as_mut_slice().copy_from_slice(du);
-    (a, b)
+    (square_block(d, 0), square_block(d, 1))
 }
 
 /// `(A, B)` of `ẋ = f(x, input)` for `x = [q; u]` and `q̇ = u`, from the forward-dynamics
@@ -125,17 +131,11 @@ impl Krang {
             ix[20 * i] = 1.0;
         }
         chol.solve_columns_mut(&mut x);
-        let block = |k: usize| {
-            let mut b = SMatrix::<f64, 19, 19>::zeros();
-            b.as_mut_slice()
-                .copy_from_slice(&x.as_slice()[361 * k..361 * (k + 1)]);
-            b
-        };
         ForwardDynamicsDerivatives {
             ud,
-            dud_dq: block(0),
-            dud_du: block(1),
-            minv: block(2),
+            dud_dq: square_block(&x, 0),
+            dud_du: square_block(&x, 1),
+            minv: square_block(&x, 2),
         }
     }
 

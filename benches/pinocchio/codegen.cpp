@@ -19,9 +19,8 @@
 
 #include "cases.hpp"
 
-#include <unistd.h>
-
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <memory>
 
@@ -76,7 +75,8 @@ struct Generated : Base {
 int main(int argc, char ** argv) {
   Run run;
   if (!start(argc, argv, "codegen", run)) return 2;
-  const std::string & dir = run.dir;
+  // Absolute: the libraries are built and loaded from DIR/cg, made the working directory below.
+  const std::string dir = std::filesystem::absolute(run.dir).string();
   const int rounds = run.rounds, calls = run.calls;
   const std::vector<Case> & cases = run.cases;
   const char * cc_env = std::getenv("CC");
@@ -124,8 +124,8 @@ int main(int argc, char ** argv) {
     });
   const std::string lib_dir = dir + "/cg";
   try {
-    std::system(("mkdir -p '" + lib_dir + "'").c_str());
-    if (chdir(lib_dir.c_str()) != 0) throw std::runtime_error(lib_dir + ": cannot enter");
+    std::filesystem::create_directories(lib_dir);
+    std::filesystem::current_path(lib_dir);  // CppADCodeGen writes and loads the libraries here
     for (Generated * g : {&crba, &nle, &gravity, &rnea, &derivatives}) g->compile_and_load(cc);
   } catch (const std::exception & e) {
     std::cerr << "error: " << lib_dir << ": " << e.what() << "\n";

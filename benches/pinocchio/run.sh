@@ -66,7 +66,6 @@ fi
 echo "headers: $prefix/include ($(grep -m1 'define PINOCCHIO_VERSION ' "$prefix/include/pinocchio/config.hpp"))"
 
 echo "== 2. C++ harness ($cxx -O3 -march=native, header-only Pinocchio)"
-harness="$out/harness"
 flags=(-std=c++17 -O3 -march=native -DNDEBUG
     # Pinocchio's CMake target pinocchio_headers sets these:
     -DBOOST_MPL_LIMIT_LIST_SIZE=30 -DBOOST_MPL_LIMIT_VECTOR_SIZE=30
@@ -74,28 +73,27 @@ flags=(-std=c++17 -O3 -march=native -DNDEBUG
     -w -I"$prefix/include" -I"$prefix/include/eigen3")
 # shellcheck disable=SC2206
 flags+=(${CXXFLAGS_EXTRA:-})
-stamp="$out/harness.flags"
-if [ ! -x "$harness" ] || [ "$root/benches/pinocchio/harness.cpp" -nt "$harness" ] \
-    || [ "$root/benches/pinocchio/cases.hpp" -nt "$harness" ] \
-    || [ "$(cat "$stamp" 2>/dev/null)" != "$cxx ${flags[*]}" ]; then
-    echo "compiling (about 2-3 minutes)"
-    "$cxx" "${flags[@]}" "$root/benches/pinocchio/harness.cpp" -o "$harness"
-    echo "$cxx ${flags[*]}" > "$stamp"
-fi
+# Compiles benches/pinocchio/NAME.cpp to OUT/NAME (extra arguments after the source) unless it
+# is up to date: built after its source and cases.hpp, with the compiler and flags recorded in
+# OUT/NAME.flags.
+compile() {
+    local name="$1" duration="$2"
+    shift 2
+    local src="$root/benches/pinocchio/$name.cpp" bin="$out/$name" stamp="$out/$name.flags"
+    if [ ! -x "$bin" ] || [ "$src" -nt "$bin" ] || [ "$root/benches/pinocchio/cases.hpp" -nt "$bin" ] \
+        || [ "$(cat "$stamp" 2>/dev/null)" != "$cxx ${flags[*]}" ]; then
+        echo "compiling $name.cpp (about $duration)"
+        "$cxx" "${flags[@]}" "$src" -o "$bin" "$@"
+        echo "$cxx ${flags[*]}" > "$stamp"
+    fi
+}
+compile harness "2-3 minutes"
 if [ "$codegen" = 1 ]; then
     if [ ! -f "$prefix/include/cppad/cg.hpp" ]; then
         echo "error: no CppADCodeGen headers under $prefix/include (cmeel-cppadcodegen wheel)" >&2
         exit 1
     fi
-    codegen_bin="$out/codegen"
-    codegen_stamp="$out/codegen.flags"
-    if [ ! -x "$codegen_bin" ] || [ "$root/benches/pinocchio/codegen.cpp" -nt "$codegen_bin" ] \
-        || [ "$root/benches/pinocchio/cases.hpp" -nt "$codegen_bin" ] \
-        || [ "$(cat "$codegen_stamp" 2>/dev/null)" != "$cxx ${flags[*]}" ]; then
-        echo "compiling the codegen harness (about 7 minutes)"
-        "$cxx" "${flags[@]}" "$root/benches/pinocchio/codegen.cpp" -o "$codegen_bin" -ldl
-        echo "$cxx ${flags[*]}" > "$codegen_stamp"
-    fi
+    compile codegen "7 minutes" -ldl
 fi
 
 echo "== 3. Rust side: cargo build --release --example pinocchio_side_by_side"
@@ -110,9 +108,9 @@ rm -f "$run_dir/pinocchio-times.txt" "$run_dir/kanegen-times.txt"
 status=0
 for r in $(seq 1 "$runs"); do
     echo "-- run $r"
-    "$harness" "$run_dir" || status=$?
+    "$out/harness" "$run_dir" || status=$?
     if [ "$codegen" = 1 ]; then
-        "$codegen_bin" "$run_dir" || status=$?
+        "$out/codegen" "$run_dir" || status=$?
     fi
     "$rust" time "$run_dir"
 done

@@ -34,7 +34,7 @@ const MIN_SPACE: usize = 60;
 const PLACEHOLDER: &str = "__kanegen_block!(";
 
 /// The default of [`EmitOptions::split_above`](super::EmitOptions::split_above): functions with
-/// more statements than this have their statements in blocks of [`SPLIT_CHUNK`] statements
+/// more statements than this have their statements in blocks of 500 statements (`SPLIT_CHUNK`)
 /// (`let (k5, d7) = { …; (k5, d7) };`). rustc's debug info nests one lexical scope per `let`,
 /// and its DWARF writer recursed through them until it overflowed its stack (SIGSEGV): measured
 /// with rustc 1.95 and the ISA-dispatch closures, 2,556 statements compiled (Krang's Coriolis

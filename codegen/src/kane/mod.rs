@@ -225,7 +225,7 @@ pub fn derive(model: &Model, options: Options) -> Derivation {
     derive_with(model, options, &[])
 }
 
-/// [`derive`], and the combined functions `combined` (resolved against `model` by
+/// [`derive()`], and the combined functions `combined` (resolved against `model` by
 /// [`crate::combined::resolve`]), each one arena phase after the module's functions.
 pub fn derive_with(model: &Model, options: Options, combined: &[ResolvedCombined]) -> Derivation {
     derive_shaped(model, options, combined, RegressorForm::Auto)

@@ -17,7 +17,7 @@
 //! Frame, joint and body names appear only in comments and documentation, which are escaped.
 //!
 //! The rule ([`Model::check_names`], run by both loaders after the URDF importer's
-//! [`sanitize_identifier`](crate::sanitize_identifier), and by the generator on any model):
+//! [`crate::sanitize_identifier`], and by the generator on any model):
 //!
 //! 1. coordinates, speeds and parameters are Rust identifiers as written (ASCII letters, digits
 //!    and `_`, not starting with a digit) and no Rust keyword; the error proposes the sanitised

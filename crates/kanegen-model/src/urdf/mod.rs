@@ -104,7 +104,7 @@ pub enum NonPhysicalInertia {
     /// Load it as written, with a note (the default; the reference libraries load such files).
     #[default]
     Note,
-    /// Fail with [`ModelErrorKind::UrdfNonPhysicalInertia`](crate::ModelErrorKind::UrdfNonPhysicalInertia).
+    /// Fail with [`ModelErrorKind::UrdfNonPhysicalInertial`](crate::ModelErrorKind::UrdfNonPhysicalInertial).
     Error,
     /// Replace it by the nearest physical inertia (principal moments projected onto
     /// `λ ≥ 0`, `λ_max ≤ λ_a + λ_b` in the least-squares sense, principal axes kept), with a note.

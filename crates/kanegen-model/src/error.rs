@@ -186,6 +186,23 @@ pub enum ModelErrorKind {
         /// Its value.
         value: f64,
     },
+    /// A number of the description is finite but absurdly large: a parameter value, a constant
+    /// of a joint's translation, or a URDF mass, inertia or origin exceeds
+    /// [`MAX_PARAMETER_MAGNITUDE`](crate::MAX_PARAMETER_MAGNITUDE) in magnitude (in SI units, no
+    /// robot has such a mass, length or inertia; the dynamics would overflow or lose every other
+    /// digit).
+    #[error(
+        "{item} = {value:e} is absurdly large: its magnitude exceeds {limit:e} (SI units: kg, m, kg·m, kg·m²); correct the value (a unit slip such as grams or millimetres, or a mistyped exponent)"
+    )]
+    AbsurdValue {
+        /// The number: `` parameter `m_b` ``, `` joint `j` translation (x) `` or
+        /// `` URDF joint `j` <origin xyz> ``.
+        item: String,
+        /// Its value.
+        value: f64,
+        /// The limit, [`MAX_PARAMETER_MAGNITUDE`](crate::MAX_PARAMETER_MAGNITUDE).
+        limit: f64,
+    },
     /// A wheel constant of the wheeled base is not physical (`R` or `L` not positive, `mw`,
     /// `YYw` or `ZZw` negative).
     #[error(

@@ -29,7 +29,7 @@ pub use error::{BadName, ModelError, ModelErrorKind};
 pub use frames::OperationalFrame;
 pub use ident::{is_keyword, sanitize_identifier};
 pub use ir::*;
-pub use limits::{MAX_DESCRIPTION_BYTES, MAX_URDF_DEPTH};
+pub use limits::{MAX_DESCRIPTION_BYTES, MAX_PARAMETER_MAGNITUDE, MAX_URDF_DEPTH};
 pub use mass_matrix::kinetic_energy_mass_matrix;
 pub use mimic::{Mimic, MimicMode};
 pub use urdf::{

@@ -1,8 +1,9 @@
-//! Size and nesting limits of the loaders, checked before any parser runs: a file larger than
+//! Limits of the loaders. Size and nesting, checked before any parser runs: a file larger than
 //! [`MAX_DESCRIPTION_BYTES`] is refused before it is read, and URDF elements nested deeper than
 //! [`MAX_URDF_DEPTH`] are found by a streaming pass of quick-xml (which keeps a depth count,
 //! not a stack frame per level), so that the recursive parsers behind urdf-rs never see them —
-//! they overflowed their stack on a few thousand levels and took minutes on 200,000.
+//! they overflowed their stack on a few thousand levels and took minutes on 200,000. And the
+//! largest number a description may give for a parameter or an offset, [`MAX_PARAMETER_MAGNITUDE`].
 
 use std::path::Path;
 
@@ -15,6 +16,28 @@ pub const MAX_DESCRIPTION_BYTES: u64 = 64 << 20;
 /// The deepest URDF element nesting accepted (`<robot>` `<link>` `<inertial>` `<mass>` is four;
 /// Gazebo and transmission extensions add a few).
 pub const MAX_URDF_DEPTH: usize = 64;
+
+/// The largest magnitude the loaders accept for a parameter value (mass, length, first moment,
+/// inertia, gravity, in SI units) and for a constant of a joint's translation: 10⁹. A
+/// thousand-tonne machine with kilometre links stays below it; a mass of 10³⁰⁰ does not, and it
+/// made the loaders' own mass-matrix check overflow and report a "speed that moves no mass".
+/// Checked by both loaders with the other parameter checks, and by the URDF importer on every
+/// mass, inertia and origin as written ([`crate::ModelErrorKind::AbsurdValue`]); the generated code's run-time `Params::validate`
+/// checks finiteness and signs, not magnitude.
+pub const MAX_PARAMETER_MAGNITUDE: f64 = 1e9;
+
+/// [`K::AbsurdValue`] for the first of `values` larger in magnitude than
+/// [`MAX_PARAMETER_MAGNITUDE`]; `item` names the number (`` parameter `m1` ``).
+pub(crate) fn check_magnitude(item: impl Fn() -> String, values: &[f64]) -> Result<(), K> {
+    match values.iter().find(|v| v.abs() > MAX_PARAMETER_MAGNITUDE) {
+        Some(&value) => Err(K::AbsurdValue {
+            item: item(),
+            value,
+            limit: MAX_PARAMETER_MAGNITUDE,
+        }),
+        None => Ok(()),
+    }
+}
 
 /// The text of description file `path`, if it is no larger than [`MAX_DESCRIPTION_BYTES`]
 /// (checked from its metadata before reading, and again while reading).

@@ -4,6 +4,7 @@ use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use crate::error::ModelErrorKind as K;
 use crate::ir::{Body, Model};
+use crate::limits::check_magnitude;
 
 /// Tolerance on orthonormality, determinant and unit norms.
 pub const TOLERANCE: f64 = 1e-9;
@@ -109,15 +110,27 @@ pub(crate) fn inertia_violation([a, b, c]: [f64; 3]) -> (f64, &'static str) {
     }
 }
 
-/// Checks the parameter values: every one finite, and the wheel constants of a wheeled base
-/// physical (radius `R` and track `L` positive; wheel mass `mw` and moments `YYw`, `ZZw` not
-/// negative).
+/// Checks the parameter values: every one finite; every one, and every constant of a joint's
+/// translation, no larger in magnitude than [`crate::MAX_PARAMETER_MAGNITUDE`]; and the wheel
+/// constants of a wheeled base physical (radius `R` and track `L` positive; wheel mass `mw` and
+/// moments `YYw`, `ZZw` not negative).
 fn check_parameters(model: &Model) -> Result<(), K> {
     if let Some(p) = model.params.iter().find(|p| !p.value.is_finite()) {
         return Err(K::NonFiniteParameter {
             name: p.name.clone(),
             value: p.value,
         });
+    }
+    for p in &model.params {
+        check_magnitude(|| format!("parameter `{}`", p.name), &[p.value])?;
+    }
+    for joint in model.links.iter().filter_map(|l| l.joint()) {
+        for (axis, length) in ["x", "y", "z"].iter().zip(&joint.translation) {
+            if length.symbol.is_none() {
+                let item = || format!("joint `{}` translation ({axis})", joint.name);
+                check_magnitude(item, &[length.coef])?;
+            }
+        }
     }
     let Some(w) = model.wheeled_base() else {
         return Ok(());

@@ -535,3 +535,41 @@ fn deeply_nested_xml_is_a_typed_error_not_a_stack_overflow() {
     assert!(matches!(kind, K::UrdfTooDeep { limit: 64, .. }), "{kind:?}");
     assert!(start.elapsed().as_secs() < 5, "{:?}", start.elapsed());
 }
+
+#[test]
+fn an_absurdly_large_mass_or_offset_names_the_number() {
+    // Finite but beyond any robot (`MAX_PARAMETER_MAGNITUDE`): named where it is written,
+    // before merging a fixed child overflowed to a NaN inertia ("`XX_L2` = NaN is not a finite
+    // number") or the mass-matrix check blamed a speed that "moves no mass".
+    let limit = kanegen_model::MAX_PARAMETER_MAGNITUDE;
+    for (from, to, item, value) in [
+        (
+            r#"<mass value="1.5"/>"#,
+            r#"<mass value="1e300"/>"#,
+            "URDF link `L2` <inertial> (mass, inertia, origin xyz)",
+            1e300,
+        ),
+        (
+            r#"<origin xyz="0.1 0 0" rpy="0 0 0.3"/>"#,
+            r#"<origin xyz="0.1 -5e10 0" rpy="0 0 0.3"/>"#,
+            "URDF link `L2` <inertial> (mass, inertia, origin xyz)",
+            -5e10,
+        ),
+        (
+            r#"<origin xyz="0.3 0 0"/>"#,
+            r#"<origin xyz="3e200 0 0"/>"#,
+            "URDF joint `tool_mount` <origin xyz>",
+            3e200,
+        ),
+    ] {
+        let kind = error_of(&mutate(&[(from, to)]), &[item, "absurdly large"]);
+        assert_kind(
+            &kind,
+            K::AbsurdValue {
+                item: item.into(),
+                value,
+                limit,
+            },
+        );
+    }
+}

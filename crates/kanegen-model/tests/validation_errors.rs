@@ -488,6 +488,34 @@ fn non_finite_translation() {
 }
 
 #[test]
+fn absurdly_large_parameter_or_translation() {
+    // Finite but beyond any robot: a mass of 10³⁰⁰ kg made the loader's positive-definiteness
+    // check overflow and blame a speed that "moves no mass"; now the number itself is named.
+    let limit = kanegen_model::MAX_PARAMETER_MAGNITUDE;
+    for (from, to, item, value) in [
+        ("m1 = 2.0", "m1 = 1e300", "parameter `m1`", 1e300),
+        ("L1 = 0.5", "L1 = -2e9", "parameter `L1`", -2e9),
+        (
+            r#"translation = [0, "L1", "-L2"]"#,
+            r#"translation = [1e12, "L1", "-L2"]"#,
+            "joint `q2` translation (x)",
+            1e12,
+        ),
+    ] {
+        let e = load_err(&mutate(&[(from, to)]), &[item, "absurdly large", "1e9"]);
+        assert!(
+            matches!(&e.kind, K::AbsurdValue { item: i, value: v, limit: l }
+                if i == item && *v == value && *l == limit),
+            "{to}: {:?}",
+            e.kind
+        );
+    }
+    // The limit itself is accepted.
+    let at_limit = mutate(&[("m1 = 2.0", "m1 = 1e9")]);
+    assert!(Model::from_toml_str(&at_limit, FILE).is_ok());
+}
+
+#[test]
 fn speed_driven_twice() {
     let e = load_err(
         &mutate(&[(r#"speed = "qd2""#, r#"speed = "qd1""#)]),

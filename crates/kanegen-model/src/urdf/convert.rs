@@ -13,6 +13,7 @@ use super::{UrdfBase, UrdfImport, UrdfOptions, bad_option};
 use crate::error::ModelErrorKind as K;
 use crate::ident::sanitize_identifier;
 use crate::ir::*;
+use crate::limits::check_magnitude;
 use crate::validate;
 
 /// Converts a parsed URDF to a validated model, with the import notes.
@@ -224,6 +225,10 @@ fn check_joints(tree: &Tree<'_>, kept: &[usize], cut: &BaseCut, wheeled: bool) -
                 expected: "finite numbers".into(),
             });
         }
+        check_magnitude(
+            || format!("URDF joint `{}` <origin xyz>", j.name),
+            &j.origin.xyz.0,
+        )?;
         if is_moving(&j.joint_type) && Vector3::from(axis).norm() == 0.0 {
             return Err(K::Invalid {
                 item: format!("URDF joint `{}`", j.name),

@@ -7,6 +7,7 @@ use super::transform::{Notes, Tf, finite3, rpy_matrix};
 use super::tree::Tree;
 use super::{AbsurdInertia, NonPhysicalInertia, UrdfOptions, ZeroMassInertia};
 use crate::error::ModelErrorKind as K;
+use crate::limits::check_magnitude;
 use crate::validate;
 
 /// A link's own inertial data in its frame: mass, centre of mass, inertia about the COM.
@@ -64,6 +65,15 @@ pub(super) fn link_inertial(
             expected: "finite numbers".into(),
         });
     }
+    check_magnitude(
+        || {
+            format!(
+                "URDF link `{}` <inertial> (mass, inertia, origin xyz)",
+                link.name
+            )
+        },
+        &[&nums[..], &inertial.origin.xyz.0[..]].concat(),
+    )?;
     let unphysical = |detail: String, fix: &str| K::UrdfNonPhysicalInertial {
         link: link.name.clone(),
         detail,

@@ -62,6 +62,24 @@ pub enum Error {
     /// The generated code did not parse (a generator bug).
     #[error(transparent)]
     Emit(#[from] emit::EmitError),
+    /// A generated function would contain a constant that is not a finite number of the
+    /// module's precision: a parameter-free part of the model divides by zero or overflows
+    /// (a model built in memory without speeds or mass, baked values beyond `f32`'s range).
+    #[error(
+        "model `{model}`: function `{function}` would contain the constant {value:e}, which is not a finite {precision} number; {fix}"
+    )]
+    NonFiniteConstant {
+        /// The model's name.
+        model: String,
+        /// The generated function (or `precompute`).
+        function: String,
+        /// The constant, as folded at generation time.
+        value: f64,
+        /// `f64` or `f32`.
+        precision: &'static str,
+        /// How to avoid it.
+        fix: &'static str,
+    },
     /// Writing the generated file failed.
     #[error("cannot write {}: {source}", path.display())]
     Write {
@@ -127,6 +145,7 @@ pub fn generate_combined(
         lower::lanes::apply(&mut lowered, &derivation);
     }
     progress.stage("lowered to straight-line programs");
+    check_constants(&model, &lowered, emit.precision)?;
     let source = emit::emit(&model, &lowered, emit)?;
     progress.stage(&format!("emitted ({} bytes of Rust)", source.len()));
     Ok(Generated {
@@ -135,6 +154,39 @@ pub fn generate_combined(
         lowered,
         source,
     })
+}
+
+/// [`Error::NonFiniteConstant`] if a program of `lowered` has a constant that the emitter could
+/// not print as a literal of `precision` (it would panic in `proc_macro2`).
+fn check_constants(
+    model: &model::Model,
+    lowered: &lower::Lowered,
+    precision: Precision,
+) -> Result<(), Error> {
+    let (name, fix): (_, &'static str) = match precision {
+        Precision::F64 => (
+            "f64",
+            "a parameter-free part of the model divides by zero or overflows: a model needs a speed and a body with mass (the loaders check that), and baked parameter values must keep its constants finite",
+        ),
+        Precision::F32 => (
+            "f32",
+            "an f32 module holds no constant beyond ±3.4e38: generate it with runtime parameters, or in f64",
+        ),
+    };
+    let fits = |v: f64| match precision {
+        Precision::F64 => v.is_finite(),
+        Precision::F32 => (v as f32).is_finite(),
+    };
+    match lowered.constant_where(fits) {
+        Some((function, value)) => Err(Error::NonFiniteConstant {
+            model: model.name.clone(),
+            function: function.to_owned(),
+            value,
+            precision: name,
+            fix,
+        }),
+        None => Ok(()),
+    }
 }
 
 /// Progress lines on stderr for long generations: a model with at least

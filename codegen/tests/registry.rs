@@ -248,3 +248,31 @@ fn generated_code_zeroes_results_with_a_memset_not_nalgebras_element_wise_fill()
         );
     }
 }
+
+#[test]
+fn a_constant_that_is_no_finite_number_is_an_error_not_a_panic() {
+    // The loaders refuse a model without speeds; one built in memory reached the emitter, whose
+    // centre of mass divides by a total mass of zero: the folded constant is infinite, and
+    // printing it as a literal panicked inside proc-macro2.
+    let mut model = kanegen::model::Model::from_toml_file(models().join("two-link.toml")).unwrap();
+    model.speeds.clear();
+    for link in &mut model.links {
+        if let Some(mount) = &mut link.mount {
+            mount.joint.kind = kanegen::model::JointKind::Fixed;
+        }
+        link.body = None;
+    }
+    let options = Options {
+        functions: FunctionSet::all(),
+        ..Options::default()
+    };
+    match kanegen::generate_model(model, options) {
+        Err(kanegen::Error::NonFiniteConstant {
+            function, value, ..
+        }) => {
+            assert_eq!(function, "center_of_mass");
+            assert!(!value.is_finite());
+        }
+        other => panic!("expected NonFiniteConstant, got {:?}", other.map(|_| ())),
+    }
+}

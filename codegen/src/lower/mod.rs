@@ -63,6 +63,24 @@ pub enum LExpr {
     Prod(Vec<(LExpr, i32)>),
 }
 
+impl LExpr {
+    /// The first constant or coefficient of this expression that `fits` refuses.
+    fn constant_where(&self, fits: &impl Fn(f64) -> bool) -> Option<f64> {
+        match self {
+            LExpr::Leaf(Leaf::Const(v)) => (!fits(*v)).then_some(*v),
+            LExpr::Leaf(_) => None,
+            LExpr::Sum { constant, terms } => {
+                (!fits(*constant)).then_some(*constant).or_else(|| {
+                    terms.iter().find_map(|(c, t)| {
+                        (!fits(*c)).then_some(*c).or_else(|| t.constant_where(fits))
+                    })
+                })
+            }
+            LExpr::Prod(factors) => factors.iter().find_map(|(b, _)| b.constant_where(fits)),
+        }
+    }
+}
+
 /// One `let` statement.
 #[derive(Clone, Debug)]
 pub struct Stmt {
@@ -465,6 +483,31 @@ pub struct CombinedProgram {
 }
 
 impl Lowered {
+    /// The first constant of any program (precompute, functions, their loop forms, combined
+    /// functions) that `fits` refuses, as `(program name, value)`: the emitter prints constants
+    /// as literals, and a literal must be a finite number of the module's precision.
+    pub fn constant_where(&self, fits: impl Fn(f64) -> bool) -> Option<(&str, f64)> {
+        let programs = std::iter::once(&self.precompute)
+            .chain(self.functions.iter().flat_map(|f| {
+                std::iter::once(&f.program).chain(f.looped.as_ref().map(|l| &l.program))
+            }))
+            .chain(self.combined.iter().map(|c| &c.program))
+            .chain(self.derivative_loop.as_ref().map(|l| &l.program));
+        for p in programs {
+            let exprs = p
+                .stmts
+                .iter()
+                .map(|s| &s.expr)
+                .chain(p.outputs.iter().map(|(_, _, e)| e));
+            for e in exprs {
+                if let Some(v) = e.constant_where(&fits) {
+                    return Some((&p.name, v));
+                }
+            }
+        }
+        None
+    }
+
     /// The program of function `id`, if the module has it (frame 0's of a per-frame function).
     pub fn function(&self, id: FunctionId) -> Option<&Program> {
         self.function_at(id, None)

@@ -377,6 +377,12 @@ pub enum ModelErrorKind {
         /// How to fix it.
         fix: String,
     },
+    /// The model has no speed: every joint is fixed and there is no wheeled base, so there are
+    /// no dynamics to generate.
+    #[error(
+        "the model has no moving joint (no speed): there are no dynamics to generate; give it a revolute, continuous or prismatic joint (URDF: type=\"fixed\" does not move), or a wheeled base"
+    )]
+    NoSpeeds,
     /// The mass matrix is singular: some speed moves no mass and no inertia.
     #[error(
         "the mass matrix is not positive definite: speed `{speed}` moves no mass or inertia that the speeds before it do not ({detail}); give the links it moves a mass or an inertia about its axis, or make its joint fixed"

@@ -163,7 +163,8 @@ fn check_parameters(model: &Model) -> Result<(), K> {
     Ok(())
 }
 
-/// Checks the parameters ([`check_parameters`]), every body, and the mass matrix.
+/// Checks that the model moves ([`K::NoSpeeds`] if it has no speed), the parameters
+/// ([`check_parameters`]), every body, and the mass matrix.
 ///
 /// A body's mass is positive, or zero with no first moment (a rotor-like body that only adds
 /// rotational inertia); its inertia about the centre of mass is positive semi-definite and
@@ -174,6 +175,9 @@ fn check_parameters(model: &Model) -> Result<(), K> {
 /// some direction, the mass matrix as a whole is checked to be positive definite
 /// ([`crate::mass_matrix::check_positive_definite`]).
 pub(crate) fn check_physics(model: &Model, inertia_tolerance: f64) -> Result<(), K> {
+    if model.dof() == 0 {
+        return Err(K::NoSpeeds);
+    }
     check_parameters(model)?;
     let p = model.param_values();
     for link in &model.links {

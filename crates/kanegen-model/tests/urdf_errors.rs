@@ -573,3 +573,21 @@ fn an_absurdly_large_mass_or_offset_names_the_number() {
         );
     }
 }
+
+#[test]
+fn a_robot_whose_joints_are_all_fixed_is_an_error() {
+    let kind = error_of(
+        &mutate(&[
+            (
+                r#"<joint name="j1" type="revolute">"#,
+                r#"<joint name="j1" type="fixed">"#,
+            ),
+            (
+                r#"<joint name="j2" type="continuous">"#,
+                r#"<joint name="j2" type="fixed">"#,
+            ),
+        ]),
+        &["no moving joint"],
+    );
+    assert_kind(&kind, K::NoSpeeds);
+}

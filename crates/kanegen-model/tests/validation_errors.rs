@@ -516,6 +516,25 @@ fn absurdly_large_parameter_or_translation() {
 }
 
 #[test]
+fn a_model_without_speeds_is_an_error() {
+    // Every joint fixed: nothing moves, and the centre-of-mass functions divided by a total
+    // mass of zero (a panic of the generator) before this was an error of its own.
+    let text = mutate(&[
+        (r#"speeds = ["qd1", "qd2"]"#, "speeds = []"),
+        (
+            "type = \"revolute\"\nparent = \"0\"\nchild = \"1\"\nspeed = \"qd1\"\naxis = [-1, 0, 0]\n",
+            "type = \"fixed\"\nparent = \"0\"\nchild = \"1\"\n",
+        ),
+        (
+            "type = \"revolute\"\nparent = \"1\"\nchild = \"2\"\nspeed = \"qd2\"\naxis = [-1, 0, 0]\n",
+            "type = \"fixed\"\nparent = \"1\"\nchild = \"2\"\n",
+        ),
+    ]);
+    let e = load_err(&text, &["no moving joint", "revolute"]);
+    assert!(matches!(e.kind, K::NoSpeeds), "{:?}", e.kind);
+}
+
+#[test]
 fn speed_driven_twice() {
     let e = load_err(
         &mutate(&[(r#"speed = "qd2""#, r#"speed = "qd1""#)]),

@@ -276,3 +276,45 @@ fn a_constant_that_is_no_finite_number_is_an_error_not_a_panic() {
         other => panic!("expected NonFiniteConstant, got {:?}", other.map(|_| ())),
     }
 }
+
+#[test]
+fn a_function_that_reads_only_sines_binds_no_unused_cosines() {
+    // Baked, this arm's mass matrix reads sin(q_b) and no cosine: the module bound
+    // `let (sin_q, cos_q) = sin_cos_n(…)` and the user's build warned "unused variable: cos_q".
+    let inertial = r#"<inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>"#;
+    let urdf = format!(
+        r#"<robot name="arm"><link name="base"/>
+        <link name="l1">{inertial}</link><link name="l2">{inertial}</link><link name="l3">{inertial}</link>
+        <joint name="a" type="continuous"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/></joint>
+        <joint name="b" type="continuous"><parent link="l1"/><child link="l2"/><axis xyz="0 1 0"/></joint>
+        <joint name="c" type="continuous"><parent link="l2"/><child link="l3"/><axis xyz="1 0 0"/></joint>
+        </robot>"#
+    );
+    let model =
+        kanegen::model::Model::from_urdf_str(&urdf, "arm.urdf", &UrdfOptions::default()).unwrap();
+    let options = Options {
+        params: kanegen::ParamMode::Baked,
+        functions: FunctionSet::all(),
+    };
+    let source = kanegen::generate_model(model, options).unwrap().source;
+    let bindings: Vec<&str> = source.split("sin_cos_n(").collect();
+    let mut sine_only = 0;
+    // Between one binding and the next, the reads of the first.
+    for pair in bindings.windows(2) {
+        let (binding, reads) = (pair[0].rsplit("let (").next().unwrap(), pair[1]);
+        for name in ["sin_q", "cos_q"] {
+            if binding.starts_with(name) || binding.contains(&format!(", {name})")) {
+                assert!(
+                    reads.contains(&format!("{name}[")),
+                    "`{name}` bound, never read"
+                );
+            }
+        }
+        sine_only +=
+            usize::from(binding.ends_with("(sin_q, _) = ") || binding.starts_with("sin_q, _)"));
+    }
+    assert!(
+        sine_only > 0,
+        "the model should have a function reading only sines"
+    );
+}

@@ -158,17 +158,7 @@ fn lane_sin_cos(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
             quote!(#a.0)
         }
     });
-    let name = |read: &[bool], n: TokenStream| {
-        if p.sincos.iter().any(|&s| read[s]) {
-            n
-        } else {
-            quote!(_)
-        }
-    };
-    let (sn, cn) = (
-        name(&reads.sin, quote!(sin_q)),
-        name(&reads.cos, quote!(cos_q)),
-    );
+    let (sn, cn) = super::function::sin_cos_names(p, reads);
     quote!(let (#sn, #cn) = kanegen_runtime::lanes::sin_cos_n_inline::<A, _, L>([#(#angles),*]);)
 }
 

@@ -106,6 +106,23 @@ pub(super) fn state_args(cx: &Context<'_>, inputs: Inputs) -> (TokenStream, &'st
     }
 }
 
+/// The names the results of `sin_cos_n` are bound to: `sin_q` and `cos_q`, or `_` for the one
+/// the program reads no entry of (a program with a sine and no cosine left `cos_q` unused: a
+/// compiler warning in the user's build).
+pub(super) fn sin_cos_names(p: &Program, reads: &Reads) -> (TokenStream, TokenStream) {
+    let name = |read: &[bool], n: TokenStream| {
+        if p.sincos.iter().any(|&s| read[s]) {
+            n
+        } else {
+            quote!(_)
+        }
+    };
+    (
+        name(&reads.sin, quote!(sin_q)),
+        name(&reads.cos, quote!(cos_q)),
+    )
+}
+
 /// The bindings of the inputs a function reads: one batched `sin_cos_n` call over the joint
 /// angles (vectorized), then per-joint names, coordinates, speeds and accelerations.
 pub(super) fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
@@ -117,7 +134,8 @@ pub(super) fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStr
         // start with `s_`/`c_`.
         // A dependent (mimic) joint's angle is formed from its master's coordinate.
         let angles = p.sincos.iter().map(|&s| joint_angle(cx, s, &quote!(q)));
-        ts.extend(quote!(let (sin_q, cos_q) = sin_cos_n([#(#angles),*]);));
+        let (sn, cn) = sin_cos_names(p, reads);
+        ts.extend(quote!(let (#sn, #cn) = sin_cos_n([#(#angles),*]);));
         for (k, &s) in p.sincos.iter().enumerate() {
             let sn = ident(&naming::sin(&speeds[s].coordinate));
             let cn = ident(&naming::cos(&speeds[s].coordinate));

@@ -279,8 +279,9 @@ fn a_constant_that_is_no_finite_number_is_an_error_not_a_panic() {
 
 #[test]
 fn a_function_that_reads_only_sines_binds_no_unused_cosines() {
-    // Baked, this arm's mass matrix reads sin(q_b) and no cosine: the module bound
-    // `let (sin_q, cos_q) = sin_cos_n(…)` and the user's build warned "unused variable: cos_q".
+    // Baked, some functions of this arm (its mass matrix among them) read sines and no cosine:
+    // the module bound `let (sin_q, cos_q) = sin_cos_n(…)`, and the user's build warned
+    // "unused variable: cos_q".
     let inertial = r#"<inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>"#;
     let urdf = format!(
         r#"<robot name="arm"><link name="base"/>

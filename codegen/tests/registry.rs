@@ -278,6 +278,35 @@ fn a_constant_that_is_no_finite_number_is_an_error_not_a_panic() {
 }
 
 #[test]
+fn a_baked_constant_beyond_f32_range_is_an_error_in_an_f32_module() {
+    // A finite f64 that an f32 literal cannot hold (the loaders bound parameters at 1e9; a
+    // model built in memory is not bound): an error naming the precision, not a panic.
+    let mut model = kanegen::model::Model::from_toml_file(models().join("two-link.toml")).unwrap();
+    let xx2 = model.params.iter().position(|p| p.name == "XX2").unwrap();
+    model.params[xx2].value = 1e40;
+    let options = Options {
+        params: kanegen::ParamMode::Baked,
+        ..Options::default()
+    };
+    let emit = kanegen::EmitOptions {
+        precision: kanegen::Precision::F32,
+        ..kanegen::EmitOptions::default()
+    };
+    match kanegen::generate_with(model.clone(), options, &emit) {
+        Err(
+            e @ kanegen::Error::NonFiniteConstant {
+                precision: "f32", ..
+            },
+        ) => {
+            assert!(e.to_string().contains("f32"), "{e}");
+        }
+        other => panic!("expected NonFiniteConstant, got {:?}", other.map(|_| ())),
+    }
+    // The same model in f64 is fine.
+    assert!(kanegen::generate_model(model, options).is_ok());
+}
+
+#[test]
 fn a_function_that_reads_only_sines_binds_no_unused_cosines() {
     // Baked, some functions of this arm (its mass matrix among them) read sines and no cosine:
     // the module bound `let (sin_q, cos_q) = sin_cos_n(…)`, and the user's build warned

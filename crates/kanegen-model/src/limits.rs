@@ -3,7 +3,8 @@
 //! [`MAX_URDF_DEPTH`] are found by a streaming pass of quick-xml (which keeps a depth count,
 //! not a stack frame per level), so that the recursive parsers behind urdf-rs never see them —
 //! they overflowed their stack on a few thousand levels and took minutes on 200,000. And the
-//! largest number a description may give for a parameter or an offset, [`MAX_PARAMETER_MAGNITUDE`].
+//! largest number a description may give for a parameter or an offset,
+//! [`MAX_PARAMETER_MAGNITUDE`].
 
 use std::path::Path;
 
@@ -22,8 +23,8 @@ pub const MAX_URDF_DEPTH: usize = 64;
 /// thousand-tonne machine with kilometre links stays below it; a mass of 10³⁰⁰ does not, and it
 /// made the loaders' own mass-matrix check overflow and report a "speed that moves no mass".
 /// Checked by both loaders with the other parameter checks, and by the URDF importer on every
-/// mass, inertia and origin as written ([`crate::ModelErrorKind::AbsurdValue`]); the generated code's run-time `Params::validate`
-/// checks finiteness and signs, not magnitude.
+/// mass, inertia and origin as written ([`crate::ModelErrorKind::AbsurdValue`]); the generated
+/// code's run-time `Params::validate` checks finiteness and signs, not magnitude.
 pub const MAX_PARAMETER_MAGNITUDE: f64 = 1e9;
 
 /// [`K::AbsurdValue`] for the first of `values` larger in magnitude than

@@ -72,8 +72,8 @@ fn spatial(w: Vector3<f64>, v: Vector3<f64>) -> Vector6<f64> {
 
 /// The mass matrix at coordinates `q` (indexed like the speeds; a wheeled base's `x`, `psi`
 /// entries are not read) for parameter values `p`, from the kinetic energy by the
-/// composite-rigid-body algorithm (this crate's `src/mass_matrix.rs` describes it). Used by validation; the generated
-/// code and `kanegen-reference` compute M independently.
+/// composite-rigid-body algorithm (this crate's `src/mass_matrix.rs` describes it). Used by
+/// validation; the generated code and `kanegen-reference` compute M independently.
 pub fn kinetic_energy_mass_matrix(model: &Model, q: &[f64], p: &[f64]) -> DMatrix<f64> {
     let n = model.dof();
     let pose = poses(model, q, p);

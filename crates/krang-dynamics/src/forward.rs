@@ -305,35 +305,20 @@ impl MassMatrixCholesky {
         x
     }
 
-    /// `b ← M⁻¹ b`, in place.
+    /// `b ← M⁻¹ b`, in place: [`solve_columns_mut`](Self::solve_columns_mut) with one column.
     pub fn solve_mut(&self, b: &mut SVector<f64, 19>) {
-        let mut y_left: SVector<f64, 7> = block(b, 5, 0);
-        let mut y_right: SVector<f64, 7> = block(b, 12, 0);
-        let mut y_trunk: SVector<f64, 5> = block(b, 0, 0);
-        // Forward: L y = b.
-        forward_subst(&self.u_left, &mut y_left);
-        forward_subst(&self.u_right, &mut y_right);
-        y_trunk -= self.w_left.tr_mul(&y_left) + self.w_right.tr_mul(&y_right);
-        forward_subst(&self.u_trunk, &mut y_trunk);
-        // Backward: Lᵀ x = y.
-        backward_subst(&self.u_trunk, &mut y_trunk);
-        y_left -= self.w_left * y_trunk;
-        y_right -= self.w_right * y_trunk;
-        backward_subst(&self.u_left, &mut y_left);
-        backward_subst(&self.u_right, &mut y_right);
-        b.fixed_rows_mut::<5>(0).copy_from(&y_trunk);
-        b.fixed_rows_mut::<7>(5).copy_from(&y_left);
-        b.fixed_rows_mut::<7>(12).copy_from(&y_right);
+        self.solve_columns_mut::<1>(b);
     }
 
     /// `X ← M⁻¹ X` for the `C` columns of `x` at once (e.g. `M⁻¹ ∂τ/∂q`, `M⁻¹ B`, `M⁻¹` itself).
     ///
-    /// The same block substitutions as [`solve_mut`](Self::solve_mut), taken a row at a time
-    /// over all columns: on the transpose of `x`, each speed's values across the right-hand
-    /// sides are contiguous, so every step is one `y_i −= l_ik y_k` over `C` independent values
-    /// (vectorized, no chain of dependent additions), where column-by-column solves spend their
-    /// time in short dependent dot products. Equal to `C` calls of `solve_mut` to rounding (the
-    /// products are summed in another order). Fixed size, on the stack.
+    /// The block substitutions (the arms' factors, their coupling to the trunk, the trunk's
+    /// factor) taken a row at a time over all columns: on the transpose of `x`, each speed's
+    /// values across the right-hand sides are contiguous, so every step is one `y_i −= l_ik y_k`
+    /// over `C` independent values (vectorized, no chain of dependent additions), where
+    /// column-by-column solves spend their time in short dependent dot products. Each column
+    /// gets the bits [`solve_mut`](Self::solve_mut) gives it alone (the same operations in the
+    /// same order). Fixed size, on the stack.
     pub fn solve_columns_mut<const C: usize>(&self, x: &mut SMatrix<f64, 19, C>) {
         // Compiled for the baseline and, run when the CPU has it, for x86-64-v3 (4 lanes; the
         // same operations, no fused multiply-adds: the same bits in both copies).

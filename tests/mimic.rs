@@ -5,7 +5,8 @@
 //! hand with the constraint map `T` (`q_all = T q + b`, `u_all = T u`): `M = Tᵀ M_all T`,
 //! `c = Tᵀ c_all`, `g = Tᵀ g_all`, `τ = Tᵀ τ_all`; the Coriolis matrix by `C u = c` and
 //! `Ṁ − 2C` skew-symmetric; frame Jacobians against `J_all T` of the model imported with
-//! `MimicMode::Independent`; and the import modes.
+//! `MimicMode::Independent`; the import modes; and a mimic with multiplier 0 against the joint
+//! imported as fixed at its offset.
 
 mod common;
 
@@ -372,6 +373,56 @@ fn inverse_dynamics_derivatives_of_the_reduced_model_match_central_differences()
                     "draw {draw}: d tau_{i} / d x_{j}: {exact} vs {fd}"
                 );
             }
+        }
+    }
+}
+
+#[test]
+fn a_mimic_with_multiplier_zero_is_the_joint_fixed_at_its_offset() {
+    // `q_k = 0 · q_j + 0.3`: the exact constraint leaves one speed and holds k at 0.3 rad, which
+    // is what importing the mimic joint as fixed at its offset gives (its child then merges into
+    // the parent link, so the two models have different parameters but the same dynamics).
+    let inertial = |m: f64| {
+        format!(
+            r#"<inertial><origin xyz="0.1 0.05 0"/><mass value="{m}"/><inertia ixx="0.02" iyy="0.03" izz="0.04" ixy="0" ixz="0" iyz="0"/></inertial>"#
+        )
+    };
+    let urdf = format!(
+        r#"<robot name="r"><link name="a"/>
+        <link name="b">{}</link><link name="c">{}</link>
+        <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+          <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+        <joint name="k" type="revolute"><parent link="b"/><child link="c"/><origin xyz="1 0 0"/>
+          <axis xyz="0 1 0"/><mimic joint="j" multiplier="0" offset="0.3"/>
+          <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+        </robot>"#,
+        inertial(1.5),
+        inertial(0.7)
+    );
+    let import = |mimic| {
+        let options = UrdfOptions {
+            mimic,
+            ..UrdfOptions::default()
+        };
+        Model::from_urdf_str(&urdf, "mimic0.urdf", &options).expect("imports")
+    };
+    let (exact, fixed) = (import(MimicMode::Exact), import(MimicMode::Fixed));
+    assert_eq!((exact.independent_dof(), fixed.independent_dof()), (1, 1));
+    let (ge, gf) = (generated(&exact), generated(&fixed));
+    let (pe, pf) = (exact.param_values(), fixed.param_values());
+    let mut r = rng(23);
+    for _ in 0..50 {
+        let (q, u, ud) = random_state(&mut r, 1);
+        for id in [
+            FunctionId::MassMatrix,
+            FunctionId::Coriolis,
+            FunctionId::Gravity,
+            FunctionId::InverseDynamics,
+        ] {
+            let e = ge.lowered.evaluate(id, &pe, &q, &u, &ud);
+            let f = gf.lowered.evaluate(id, &pf, &q, &u, &ud);
+            let err = rel_err(&e, &f, 1.0);
+            assert!(err <= TOL, "{id:?} at q = {q:?}: {err:e}");
         }
     }
 }

@@ -39,8 +39,8 @@ const USAGE: &str = "usage: kanegen <show|stats|listing|emit> <model.toml|model.
 
 options (stats, listing, emit; `show` takes only the URDF import options):
   --baked                 fold the model file's parameter values in as constants
-  --functions LIST        the generated functions, comma-separated (default: `default`;
-                          `all`, or names: mass_matrix,coriolis,gravity,inverse_dynamics,coriolis_matrix)
+  --functions LIST        the generated functions: comma-separated names and groups (listed
+                          below; default: `default`)
   --no-coriolis-matrix    leave out the Coriolis matrix C(q, u)
   --mirrored-lanes        compute mirrored subtrees (two identical arms) in two SIMD lanes
   --f32                   emit an f32 module (emit only)
@@ -101,6 +101,48 @@ fn output(text: &str) -> Result<(), Failure> {
     }
 }
 
+/// The `--functions` part of `--help`, from the registry (so that it names every function the
+/// generator has): the groups with their members, then every name.
+fn functions_help() -> String {
+    let groups = [
+        ("default", FunctionSet::default()),
+        ("kinematics", FunctionSet::kinematics()),
+        ("regressors", FunctionSet::regressors()),
+    ];
+    let mut text = String::from(
+        "functions (--functions LIST, comma-separated; each name is a generated function):\n",
+    );
+    for (name, set) in groups {
+        text += &wrapped(
+            &format!("  {name:<11}"),
+            &set.to_string().replace(',', ", "),
+        );
+    }
+    text += "  all        every function below\n";
+    text + &wrapped(
+        "  names      ",
+        &FunctionSet::all().to_string().replace(',', ", "),
+    )
+}
+
+/// `items` after `head`, broken after a comma so that no line is longer than 96 characters, the
+/// lines after the first indented as far as `head`.
+fn wrapped(head: &str, items: &str) -> String {
+    let indent = " ".repeat(head.chars().count());
+    let mut text = String::new();
+    let mut line = head.to_owned();
+    for word in items.split_inclusive(' ') {
+        if line.chars().count() + word.trim_end().chars().count() > 96 && line.trim() != head.trim()
+        {
+            text += line.trim_end();
+            text.push('\n');
+            line.clone_from(&indent);
+        }
+        line += word;
+    }
+    text + line.trim_end() + "\n"
+}
+
 /// What `stats` prints after its table: the columns, and what to run next.
 const STATS_LEGEND: &str = "
 columns (per call of each generated function; `precompute` runs once per parameter set):
@@ -120,13 +162,13 @@ columns (per call of each generated function; `precompute` runs once per paramet
 next:
   kanegen listing MODEL                 the K/D substitution listing of every function
   kanegen emit MODEL --out FILE         the generated Rust module
-  kanegen stats MODEL --functions LIST  only some functions (`default`, `all`, or names)
+  kanegen stats MODEL --functions LIST  other functions (names and groups: kanegen --help)
   kanegen stats MODEL --baked           with the parameter values folded in
 ";
 
 fn run(args: Vec<String>) -> Result<(), Failure> {
     let Some(args) = parse(args)? else {
-        return output(&format!("{USAGE}\n"));
+        return output(&format!("{USAGE}\n\n{}", functions_help()));
     };
     let (cmd, path) = (args.command, args.model.as_str());
     let urdf = kanegen::is_urdf(Path::new(path));
@@ -356,7 +398,15 @@ impl Args {
             "--mirrored-lanes" => self.mirrored_lanes = true,
             "--f32" => self.f32 = true,
             "--out" => self.out = Some(value()?),
-            "--functions" => self.functions = Some(value()?.parse().map_err(|e| format!("{e}"))?),
+            "--functions" => {
+                let set: FunctionSet = value()?.parse().map_err(|e| format!("{e}"))?;
+                if set.is_empty() {
+                    return Err("--functions names no function (give names or groups, e.g. \
+                                `--functions default,frame_pose`; `kanegen --help` lists them)"
+                        .into());
+                }
+                self.functions = Some(set);
+            }
             "--wheeled" => {
                 let v = value()?;
                 let parts: Vec<String> = v.split(',').map(|s| s.trim().to_owned()).collect();

@@ -152,6 +152,14 @@ fn unknown_commands_and_options_are_rejected_before_any_work() {
             vec!["stats", missing, "--functions", "everything"],
             "everything",
         ),
+        (
+            vec!["emit", missing, "--functions", ""],
+            "--functions names no function",
+        ),
+        (
+            vec!["stats", missing, "--functions", " , "],
+            "--functions names no function",
+        ),
         (vec![], "no command given"),
     ] {
         let o = kanegen(&args);
@@ -170,6 +178,27 @@ fn unknown_commands_and_options_are_rejected_before_any_work() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains(missing), "{}", stderr(&o));
     assert!(kanegen(&["--help"]).status.success());
+}
+
+#[test]
+fn help_lists_every_generated_function_and_group() {
+    let o = kanegen(&["--help"]);
+    assert!(o.status.success());
+    let help = stdout(&o);
+    for f in kanegen::FunctionId::all() {
+        assert!(
+            help.contains(f.name()),
+            "`{}` missing from --help:\n{help}",
+            f.name()
+        );
+    }
+    for group in ["default ", "kinematics ", "regressors ", "all "] {
+        assert!(
+            help.contains(&format!("  {group}")),
+            "group `{group}`:\n{help}"
+        );
+    }
+    assert!(help.lines().all(|l| l.chars().count() <= 100), "{help}");
 }
 
 #[test]

@@ -1,10 +1,11 @@
 //! One controller, written once against `kanegen_runtime::RobotDynamics`, runs on every
 //! generated robot: Krang (19 speeds, wheeled base), its baked module, the f32 module, the
-//! two-link model and the 7-DOF arm generated from URDF by this package's build script.
+//! two-link model and the 7-DOF arm generated from URDF by this package's build script; a
+//! simulator's forward dynamics is the trait's too.
 
 use kanegen_runtime::{CoriolisMatrix, RobotDynamics};
 use krang_dynamics as kd;
-use nalgebra::{RealField, SMatrix, SVector};
+use nalgebra::{RealField, SVector};
 
 /// The 7-DOF arm generated from `models/singlearm.urdf` by this package's `build.rs`.
 #[allow(dead_code)]
@@ -33,18 +34,6 @@ fn computed_torque<R: RobotDynamics<N>, const N: usize>(
     robot.inverse_dynamics(q, u, &ud)
 }
 
-/// The acceleration the robot takes under `tau`: `u̇ = M⁻¹ (τ − c − g)` (dense Cholesky).
-fn forward<R: RobotDynamics<N>, const N: usize>(
-    robot: &R,
-    q: &SVector<R::Scalar, N>,
-    u: &SVector<R::Scalar, N>,
-    tau: &SVector<R::Scalar, N>,
-) -> SVector<R::Scalar, N> {
-    let m: SMatrix<R::Scalar, N, N> = robot.mass_matrix(q);
-    let rhs = tau - robot.coriolis(q, u) - robot.gravity(q);
-    m.cholesky().expect("M is positive definite").solve(&rhs)
-}
-
 /// Runs the controller on `robot` at a deterministic state: the robot's acceleration under the
 /// computed torque equals the commanded one, and `C u = c` where the module has C. Returns the
 /// relative error of the acceleration.
@@ -63,7 +52,9 @@ where
     let (kp, kd) = (s(100.0), s(20.0));
     let tau = computed_torque(robot, &q, &u, &reference, (kp, kd));
     let commanded = reference.ud + (reference.u - u) * kd + (reference.q - q) * kp;
-    let ud = forward(robot, &q, &u, &tau);
+    let ud = robot
+        .forward_dynamics(&q, &u, &tau)
+        .expect("M is positive definite");
     let err: f64 = (ud - commanded).norm().into() / commanded.norm().into();
     assert!(err < tol, "acceleration error {err:e} (tolerance {tol:e})");
     let cu = robot.coriolis_matrix(&q, &u) * u;
@@ -85,6 +76,27 @@ fn one_generic_controller_runs_on_every_generated_robot() {
         check(&kd::f32::Krang::default(), 1e-2),
     ];
     eprintln!("relative acceleration errors: {errors:?}");
+    // Krang's inherent forward dynamics (block Cholesky) and the trait's dense one agree.
+    let k = kd::Krang::default();
+    let q = SVector::<f64, 19>::from_fn(|i, _| 0.4 * (i as f64 * 0.9).sin());
+    let u = SVector::<f64, 19>::from_fn(|i, _| 0.3 * (i as f64 * 1.7).cos());
+    let tau = SVector::<f64, 19>::from_fn(|i, _| 5.0 * (i as f64 * 0.4).sin());
+    let dense = RobotDynamics::forward_dynamics(&k, &q, &u, &tau).expect("M positive definite");
+    let block = k.forward_dynamics(&q, &u, &tau);
+    assert!(
+        (dense - block).norm() <= 1e-12 * block.norm(),
+        "{dense} vs {block}"
+    );
+    // A non-physical parameter set: the trait returns None instead of NaNs.
+    // m4l = -1000 kg: M[ẋ, ẋ], the total mass and more, becomes negative.
+    let bad = kd::Params {
+        m4l: -1e3,
+        ..kd::Params::default()
+    };
+    assert_eq!(
+        RobotDynamics::forward_dynamics(&kd::Krang::new(bad), &q, &u, &tau),
+        None
+    );
     assert_eq!(
         <kd::Krang as RobotDynamics<19>>::SPEED_NAMES,
         kd::SPEED_NAMES

@@ -45,6 +45,30 @@ pub trait RobotDynamics<const N: usize> {
         u: &SVector<Self::Scalar, N>,
         ud: &SVector<Self::Scalar, N>,
     ) -> SVector<Self::Scalar, N>;
+
+    /// Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))`: the accelerations the generalized
+    /// forces `tau` produce at state `(q, u)`, for simulation. `c + g` is one inverse-dynamics
+    /// pass at `u̇ = 0`, and `M` is factored by nalgebra's dense Cholesky, on the stack (no
+    /// heap, `no_std`).
+    ///
+    /// `None` when `M(q)` is not positive definite (or has a NaN entry): non-physical
+    /// parameters, such as a negative mass or an inertia violating the triangle inequalities
+    /// (`Params::validate` names the culprit). Inputs that are not finite otherwise give
+    /// non-finite accelerations.
+    ///
+    /// A provided method: every generated robot has it through this trait. `krang-dynamics`'s
+    /// `Krang::forward_dynamics` is a faster inherent method for that model (a block Cholesky
+    /// that skips the two arms' zero coupling block).
+    fn forward_dynamics(
+        &self,
+        q: &SVector<Self::Scalar, N>,
+        u: &SVector<Self::Scalar, N>,
+        tau: &SVector<Self::Scalar, N>,
+    ) -> Option<SVector<Self::Scalar, N>> {
+        let bias = self.inverse_dynamics(q, u, &SVector::zeros());
+        let factor = self.mass_matrix(q).cholesky()?;
+        Some(factor.solve(&(tau - bias)))
+    }
 }
 
 /// Implemented by generated robots whose module includes the (opt-in) Coriolis matrix.

@@ -14,7 +14,8 @@
 //!   `toml`) reads the parameter values of a model file at run time.
 //! - [`RobotDynamics`] (and [`CoriolisMatrix`], for modules generated with the Coriolis
 //!   matrix): the trait every generated robot type implements, so that a controller can be
-//!   written once for any generated robot.
+//!   written once for any generated robot; its provided `forward_dynamics` gives every
+//!   generated robot forward dynamics (dense Cholesky, [`RobotDynamics::forward_dynamics`]).
 //!
 //! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA; the
 //!   batched functions also x86-64-v4, AVX-512), the

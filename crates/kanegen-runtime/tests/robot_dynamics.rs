@@ -130,6 +130,65 @@ fn computed_torque_on_a_pendulum() {
     assert!((tau[0] - expected).abs() < 1e-12, "{tau} vs {expected}");
 }
 
+#[test]
+fn forward_dynamics_inverts_inverse_dynamics_and_refuses_a_non_physical_robot() {
+    let p = Pendulum {
+        m: 2.0,
+        l: 0.5,
+        g: 9.81,
+    };
+    let (q, u, tau) = (
+        SVector::from([0.3]),
+        SVector::from([-1.2]),
+        SVector::from([4.0]),
+    );
+    let ud = p.forward_dynamics(&q, &u, &tau).expect("positive mass");
+    let expected = (4.0 - 2.0 * 9.81 * 0.5 * 0.3_f64.sin()) / (2.0 * 0.5 * 0.5);
+    assert!((ud[0] - expected).abs() < 1e-12, "{ud} vs {expected}");
+    assert!((p.inverse_dynamics(&q, &u, &ud) - tau).norm() < 1e-12);
+    // The two-link arm: τ → u̇ → τ, in both precisions.
+    let arm = TwoLinkArm {
+        m1: 1.5,
+        m2: 0.8,
+        l1: 0.6,
+        l2: 0.4,
+        g: 9.81,
+    };
+    let (q, u, ud) = (
+        SVector::from([0.2, 0.9]),
+        SVector::from([-1.3, 0.7]),
+        SVector::from([2.5, -0.4]),
+    );
+    let tau = arm.inverse_dynamics(&q, &u, &ud);
+    let back = arm.forward_dynamics(&q, &u, &tau).unwrap();
+    assert!((back - ud).norm() < 1e-12, "{back} vs {ud}");
+    let arm32 = TwoLinkArm {
+        m1: 1.5_f32,
+        m2: 0.8,
+        l1: 0.6,
+        l2: 0.4,
+        g: 9.81,
+    };
+    let (q, u, ud) = (q.cast::<f32>(), u.cast::<f32>(), ud.cast::<f32>());
+    let back = arm32
+        .forward_dynamics(&q, &u, &arm32.inverse_dynamics(&q, &u, &ud))
+        .unwrap();
+    assert!((back - ud).norm() < 1e-4, "{back} vs {ud}");
+    // A negative mass makes M negative definite, a NaN mass makes it NaN: no acceleration.
+    let (q, u, tau) = (
+        SVector::from([0.3]),
+        SVector::from([0.0]),
+        SVector::from([1.0]),
+    );
+    for m in [-2.0, 0.0, f64::NAN] {
+        assert_eq!(
+            Pendulum { m, ..p }.forward_dynamics(&q, &u, &tau),
+            None,
+            "m = {m}"
+        );
+    }
+}
+
 /// Integrates the closed loop `M u̇ + c + g = τ(q, u)` (semi-implicit Euler) with the
 /// computed-torque law and returns the final `q`: with exact inverse dynamics the loop is the
 /// linear `ë = −kp e − kd ė`, which settles on the reference.
@@ -144,11 +203,8 @@ fn settle<R: RobotDynamics<2>>(
     let mut u = SVector::<R::Scalar, 2>::zeros();
     for _ in 0..steps {
         let tau = computed_torque(robot, &q, &u, q_ref, gains);
-        let rhs = tau - robot.coriolis(&q, &u) - robot.gravity(&q);
         let ud = robot
-            .mass_matrix(&q)
-            .lu()
-            .solve(&rhs)
+            .forward_dynamics(&q, &u, &tau)
             .expect("M is positive definite");
         u += ud * dt;
         q += u * dt;

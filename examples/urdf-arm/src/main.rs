@@ -1,5 +1,6 @@
 //! The 7-DOF Schunk LWA3 arm of `models/singlearm.urdf` (fixed base), its dynamics generated at
-//! build time by kanegen (`build.rs`): prints M(q) and g(q) at a sample configuration.
+//! build time by kanegen (`build.rs`): prints M(q), g(q), τ and the forward dynamics at a
+//! sample configuration.
 //!
 //! `cargo run -p urdf-arm-example`
 #![forbid(unsafe_code)]
@@ -13,6 +14,7 @@ mod arm {
 }
 
 use arm::{DOF, Params, SPEED_NAMES, SingleArm};
+use kanegen_runtime::RobotDynamics; // forward_dynamics, which every generated robot has
 use nalgebra::SVector;
 
 fn main() {
@@ -28,6 +30,12 @@ fn main() {
     let ud = SVector::<f64, DOF>::zeros();
     let tau = robot.inverse_dynamics(&q, &u, &ud);
     println!("tau(q, u = 0.5, ud = 0) = {:.5}", tau.transpose());
+    // Released with no torque: the accelerations of a simulator's first step.
+    let at_rest = SVector::<f64, DOF>::zeros();
+    let ud = robot
+        .forward_dynamics(&q, &at_rest, &at_rest)
+        .expect("the URDF's inertias give a positive definite M");
+    println!("ud(q, u = 0, tau = 0) = {:.5}", ud.transpose());
 }
 
 #[cfg(test)]

@@ -8,7 +8,8 @@
 //! * `∂τ/∂u = ∂c/∂u` and, c being quadratic in u, `(∂c/∂u) u = 2c`; with the Coriolis matrix,
 //!   `∂c/∂u = C + (∂C/∂u) u`, i.e. `(∂c/∂u) v = C(q, u) v + C(q, v) u`;
 //! * Krang's structural zeros: the x and ψ columns of ∂τ/∂q are exactly zero;
-//! * forward-dynamics derivatives against central differences of `forward_dynamics`;
+//! * forward-dynamics derivatives against central differences of `forward_dynamics`, Krang's
+//!   (block Cholesky) and, for every generated robot with derivatives, the runtime trait's;
 //! * `linearize`: A and B against central differences of `ẋ = f(x, a)`; the upright
 //!   equilibrium of the default Krang has exactly one unstable (pitch) mode.
 
@@ -420,6 +421,117 @@ fn fixed_wheel_forward_dynamics_derivatives_match_central_differences() {
         assert!(mat_err(a.as_slice(), fa.as_slice()) <= 1e-6);
         assert!(mat_err(b.as_slice(), fb.as_slice()) <= 1e-6);
     }
+}
+
+/// The trait's forward-dynamics derivatives (`InverseDynamicsDerivatives`, which every module
+/// generated with `inverse_dynamics_derivatives` implements) against Richardson central
+/// differences of the trait's `forward_dynamics`, on `draws` random states: worst relative
+/// errors of `[∂u̇/∂q, ∂u̇/∂u, M⁻¹]`, written once for any robot.
+fn trait_fd_derivatives_errors<R, const N: usize>(
+    robot: &R,
+    r: &mut impl FnMut() -> f64,
+    draws: usize,
+) -> [f64; 3]
+where
+    R: kanegen_runtime::InverseDynamicsDerivatives<N, Scalar = f64>,
+{
+    let fd = |q: &SVector<f64, N>, u: &SVector<f64, N>, tau: &SVector<f64, N>| {
+        kanegen_runtime::RobotDynamics::forward_dynamics(robot, q, u, tau).unwrap()
+    };
+    let mut worst = [0.0f64; 3];
+    for _ in 0..draws {
+        let (q, u, t) = random_state(r, N);
+        let (q, u, tau) = (sv::<N>(&q), sv::<N>(&u), sv::<N>(&t) * 10.0);
+        let d = robot
+            .forward_dynamics_derivatives(&q, &u, &tau)
+            .expect("physical parameters");
+        assert_eq!(d.ud, fd(&q, &u, &tau));
+        let shift = |v: &SVector<f64, N>, j: usize, h: f64| {
+            let mut w = *v;
+            w[j] += h;
+            w
+        };
+        let (mut fq, mut fu, mut ft) = (
+            SMatrix::<f64, N, N>::zeros(),
+            SMatrix::<f64, N, N>::zeros(),
+            SMatrix::<f64, N, N>::zeros(),
+        );
+        for j in 0..N {
+            fq.set_column(j, &richardson(&|h| fd(&shift(&q, j, h), &u, &tau), 1e-3));
+            fu.set_column(j, &richardson(&|h| fd(&q, &shift(&u, j, h), &tau), 1e-3));
+            ft.set_column(j, &richardson(&|h| fd(&q, &u, &shift(&tau, j, h)), 1e-3));
+        }
+        worst[0] = worst[0].max(mat_err(d.dud_dq.as_slice(), fq.as_slice()));
+        worst[1] = worst[1].max(mat_err(d.dud_du.as_slice(), fu.as_slice()));
+        worst[2] = worst[2].max(mat_err(d.minv.as_slice(), ft.as_slice()));
+    }
+    worst
+}
+
+#[test]
+fn every_generated_robot_has_forward_dynamics_derivatives_through_the_trait() {
+    let mut r = rng(1210);
+    let arm = Model::from_urdf_file(
+        root().join("models/singlearm.urdf"),
+        &UrdfOptions::default(),
+    )
+    .expect("URDF imports");
+    let fixed = model("krang-fixed-wheels.toml");
+    for draw in 0..10 {
+        let p = random_physical_params(&arm, &mut r);
+        let a =
+            singlearm_all::SingleArm::new(singlearm_all::Params::from_array(p.try_into().unwrap()));
+        let p = random_physical_params(&fixed, &mut r);
+        let f = kd::fixed_wheels::KrangFixedWheels::new(kd::fixed_wheels::Params::from_array(
+            p.try_into().unwrap(),
+        ));
+        let k = if draw == 0 {
+            kd::Krang::default()
+        } else {
+            random_krang(&mut r)
+        };
+        for (name, worst) in [
+            ("urdf arm", trait_fd_derivatives_errors(&a, &mut r, 5)),
+            ("fixed wheels", trait_fd_derivatives_errors(&f, &mut r, 2)),
+            (
+                "two-link",
+                trait_fd_derivatives_errors(&kd::two_link::TwoLink::default(), &mut r, 5),
+            ),
+            ("krang", trait_fd_derivatives_errors(&k, &mut r, 1)),
+        ] {
+            assert!(worst.iter().all(|&w| w <= 1e-6), "{name}: {worst:?}");
+        }
+        // Krang's inherent derivatives (block Cholesky) equal the trait's (dense).
+        let (q, u, t) = random_state(&mut r, 19);
+        let (q, u, tau) = (sv::<19>(&q), sv::<19>(&u), sv::<19>(&t) * 10.0);
+        let block = k.forward_dynamics_derivatives(&q, &u, &tau);
+        let dense = kanegen_runtime::InverseDynamicsDerivatives::forward_dynamics_derivatives(
+            &k, &q, &u, &tau,
+        )
+        .unwrap();
+        for (b, d) in [
+            (block.dud_dq, dense.dud_dq),
+            (block.dud_du, dense.dud_du),
+            (block.minv, dense.minv),
+        ] {
+            assert!(mat_err(d.as_slice(), b.as_slice()) <= 1e-11, "{d} vs {b}");
+        }
+    }
+    // Non-physical parameters: None, not NaNs.
+    let bad = kd::Params {
+        m4l: -1e3,
+        ..kd::Params::default()
+    };
+    let z = SVector::<f64, 19>::zeros();
+    assert!(
+        kanegen_runtime::InverseDynamicsDerivatives::forward_dynamics_derivatives(
+            &kd::Krang::new(bad),
+            &z,
+            &z,
+            &z
+        )
+        .is_none()
+    );
 }
 
 /// `ẋ = f(x, a)` of Krang for the state `x = [q; u]` and the actuator torques `a`.

@@ -231,17 +231,25 @@ pub enum RuntimeTrait {
     RobotDynamics,
     /// `kanegen_runtime::CoriolisMatrix` (C; requires `RobotDynamics`).
     CoriolisMatrix,
+    /// `kanegen_runtime::InverseDynamicsDerivatives` (∂τ/∂q, ∂τ/∂u as two square blocks;
+    /// requires `RobotDynamics`).
+    InverseDynamicsDerivatives,
 }
 
 impl RuntimeTrait {
     /// The traits in implementation order (a trait's supertraits first).
-    pub const ALL: [RuntimeTrait; 2] = [RuntimeTrait::RobotDynamics, RuntimeTrait::CoriolisMatrix];
+    pub const ALL: [RuntimeTrait; 3] = [
+        RuntimeTrait::RobotDynamics,
+        RuntimeTrait::CoriolisMatrix,
+        RuntimeTrait::InverseDynamicsDerivatives,
+    ];
 
     /// The trait's name in `kanegen_runtime`.
     pub fn name(self) -> &'static str {
         match self {
             RuntimeTrait::RobotDynamics => "RobotDynamics",
             RuntimeTrait::CoriolisMatrix => "CoriolisMatrix",
+            RuntimeTrait::InverseDynamicsDerivatives => "InverseDynamicsDerivatives",
         }
     }
 }
@@ -441,7 +449,7 @@ pub const FUNCTIONS: [FunctionSpec; 19] = [
             cols: Dim::TwoN,
         },
         default: false,
-        runtime_trait: None,
+        runtime_trait: Some(RuntimeTrait::InverseDynamicsDerivatives),
         per_frame: false,
     },
     FunctionSpec {

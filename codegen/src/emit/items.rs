@@ -458,8 +458,31 @@ pub(super) fn trait_impls(cx: &Context<'_>) -> TokenStream {
         let items = specs.iter().map(|spec| {
             let name = ident(spec.name);
             let (args, _) = state_args(cx, spec.inputs);
-            let ret = return_type(cx, spec);
             let call = forward_call(cx, spec);
+            if tr == RuntimeTrait::InverseDynamicsDerivatives {
+                // The trait cannot name an N × 2N matrix (no `2 * N` in a const generic):
+                // its method returns the two square blocks.
+                // The blocks are copied as slices (column-major, consecutive): a view's
+                // `into_owned` copies entry by entry through a strided iterator.
+                let n = idx(cx.low.dof);
+                let nn = idx(cx.low.dof * cx.low.dof);
+                return quote! {
+                    fn inverse_dynamics_partials(&self, #args)
+                        -> (SMatrix<#t, #n, #n>, SMatrix<#t, #n, #n>)
+                    {
+                        let d = #call;
+                        let (d_q, d_u) = d.as_slice().split_at(#nn);
+                        let mut blocks = (
+                            SMatrix::<#t, #n, #n>::zeros(),
+                            SMatrix::<#t, #n, #n>::zeros(),
+                        );
+                        blocks.0.as_mut_slice().copy_from_slice(d_q);
+                        blocks.1.as_mut_slice().copy_from_slice(d_u);
+                        blocks
+                    }
+                };
+            }
+            let ret = return_type(cx, spec);
             quote!(fn #name(&self, #args) -> #ret { #call })
         });
         let assoc = if tr == RuntimeTrait::RobotDynamics {

@@ -82,3 +82,126 @@ pub trait CoriolisMatrix<const N: usize>: RobotDynamics<N> {
         u: &SVector<Self::Scalar, N>,
     ) -> SMatrix<Self::Scalar, N, N>;
 }
+
+/// Implemented by generated robots whose module includes the (opt-in)
+/// `inverse_dynamics_derivatives`: the exact partial derivatives of inverse dynamics, and from
+/// them ([`forward_dynamics_derivatives`](Self::forward_dynamics_derivatives), provided) those
+/// of forward dynamics, which LQR and MPC linearize with.
+///
+/// ```
+/// use kanegen_runtime::{InverseDynamicsDerivatives, RobotDynamics};
+/// use nalgebra::{SMatrix, SVector};
+///
+/// /// `(∂u̇/∂q, ∂u̇/∂u)` at a state, for any generated robot with derivatives.
+/// fn jacobians<R: InverseDynamicsDerivatives<N, Scalar = f64>, const N: usize>(
+///     robot: &R,
+///     q: &SVector<f64, N>,
+///     u: &SVector<f64, N>,
+///     tau: &SVector<f64, N>,
+/// ) -> Option<(SMatrix<f64, N, N>, SMatrix<f64, N, N>)> {
+///     robot
+///         .forward_dynamics_derivatives(q, u, tau)
+///         .map(|d| (d.dud_dq, d.dud_du))
+/// }
+///
+/// /// A point mass `m` on a rod of length `l`, `q` from straight down: `τ = m l² u̇ + m g l sin q`.
+/// struct Pendulum { m: f64, l: f64, g: f64 }
+///
+/// impl RobotDynamics<1> for Pendulum {
+///     type Scalar = f64;
+///     const SPEED_NAMES: [&'static str; 1] = ["qd"];
+///     const COORDINATE_NAMES: [&'static str; 1] = ["q"];
+///     fn mass_matrix(&self, _: &SVector<f64, 1>) -> SMatrix<f64, 1, 1> {
+///         SMatrix::from_element(self.m * self.l * self.l)
+///     }
+///     fn coriolis(&self, _: &SVector<f64, 1>, _: &SVector<f64, 1>) -> SVector<f64, 1> {
+///         SVector::zeros()
+///     }
+///     fn gravity(&self, q: &SVector<f64, 1>) -> SVector<f64, 1> {
+///         SVector::from_element(self.m * self.g * self.l * q[0].sin())
+///     }
+///     fn inverse_dynamics(
+///         &self,
+///         q: &SVector<f64, 1>,
+///         u: &SVector<f64, 1>,
+///         ud: &SVector<f64, 1>,
+///     ) -> SVector<f64, 1> {
+///         self.mass_matrix(q) * ud + self.coriolis(q, u) + self.gravity(q)
+///     }
+/// }
+///
+/// impl InverseDynamicsDerivatives<1> for Pendulum {
+///     fn inverse_dynamics_partials(
+///         &self,
+///         q: &SVector<f64, 1>,
+///         _: &SVector<f64, 1>,
+///         _: &SVector<f64, 1>,
+///     ) -> (SMatrix<f64, 1, 1>, SMatrix<f64, 1, 1>) {
+///         let dtau_dq = self.m * self.g * self.l * q[0].cos();
+///         (SMatrix::from_element(dtau_dq), SMatrix::zeros())
+///     }
+/// }
+///
+/// let p = Pendulum { m: 2.0, l: 0.5, g: 9.81 };
+/// let (q, u) = (SVector::from([0.3]), SVector::from([0.0]));
+/// let (a, b) = jacobians(&p, &q, &u, &SVector::zeros()).unwrap();
+/// // Linearized about q: ü = −(g / l) cos q · δq.
+/// assert!((a[0] + 9.81 / 0.5 * 0.3_f64.cos()).abs() < 1e-12);
+/// assert_eq!(b[0], 0.0);
+/// ```
+pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
+    /// `(∂τ/∂q, ∂τ/∂u)` of `τ = M(q) u̇ + c(q, u) + g(q)` at `(q, u, u̇)`: column `j` of each
+    /// is the derivative with respect to `q[j]` (resp. `u[j]`); `∂τ/∂u̇` is
+    /// [`mass_matrix`](RobotDynamics::mass_matrix). Generated modules split their
+    /// `inverse_dynamics_derivatives` (`[∂τ/∂q | ∂τ/∂u]`, N × 2N) into the two blocks.
+    fn inverse_dynamics_partials(
+        &self,
+        q: &SVector<Self::Scalar, N>,
+        u: &SVector<Self::Scalar, N>,
+        ud: &SVector<Self::Scalar, N>,
+    ) -> (SMatrix<Self::Scalar, N, N>, SMatrix<Self::Scalar, N, N>);
+
+    /// Forward dynamics `u̇ = FD(q, u, τ)` and its derivatives at `(q, u, τ)`: since
+    /// `ID(q, u, FD(q, u, τ)) = τ`, `∂u̇/∂q = −M⁻¹ ∂τ/∂q`, `∂u̇/∂u = −M⁻¹ ∂τ/∂u` (the inverse
+    /// dynamics partials taken at `u̇ = FD(q, u, τ)`) and `∂u̇/∂τ = M⁻¹`. One inverse-dynamics
+    /// pass, one mass matrix and its dense Cholesky factor (nalgebra, on the stack), one
+    /// derivative pass and triangular solves; no heap.
+    ///
+    /// `None` when `M(q)` is not positive definite (non-physical parameters), as
+    /// [`forward_dynamics`](RobotDynamics::forward_dynamics). `krang-dynamics`'s
+    /// `Krang::forward_dynamics_derivatives` is a faster inherent method for that model (its
+    /// block Cholesky).
+    fn forward_dynamics_derivatives(
+        &self,
+        q: &SVector<Self::Scalar, N>,
+        u: &SVector<Self::Scalar, N>,
+        tau: &SVector<Self::Scalar, N>,
+    ) -> Option<ForwardDynamicsDerivatives<Self::Scalar, N>> {
+        let factor = self.mass_matrix(q).cholesky()?;
+        let ud = factor.solve(&(tau - self.inverse_dynamics(q, u, &SVector::zeros())));
+        let (dtau_dq, dtau_du) = self.inverse_dynamics_partials(q, u, &ud);
+        Some(ForwardDynamicsDerivatives {
+            ud,
+            dud_dq: -factor.solve(&dtau_dq),
+            dud_du: -factor.solve(&dtau_du),
+            minv: factor.inverse(),
+        })
+    }
+}
+
+/// The forward-dynamics derivatives of an `N`-speed robot at one state:
+/// `u̇ = FD(q, u, τ)` and its partial derivatives
+/// ([`InverseDynamicsDerivatives::forward_dynamics_derivatives`]). For the state `x = [q; u]`
+/// with `q̇ = u`, the linearization of `ẋ = f(x, τ)` is `A = [[0, I], [∂u̇/∂q, ∂u̇/∂u]]`,
+/// `B = [[0], [M⁻¹]]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ForwardDynamicsDerivatives<T, const N: usize> {
+    /// `u̇ = M⁻¹ (τ − c − g)`, where the derivatives are taken.
+    pub ud: SVector<T, N>,
+    /// `∂u̇/∂q` (column j: the derivative with respect to `q[j]`).
+    pub dud_dq: SMatrix<T, N, N>,
+    /// `∂u̇/∂u`.
+    pub dud_du: SMatrix<T, N, N>,
+    /// `∂u̇/∂τ = M⁻¹` (symmetric positive definite).
+    pub minv: SMatrix<T, N, N>,
+}

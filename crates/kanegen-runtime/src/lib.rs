@@ -164,7 +164,9 @@ mod set_parameter_error;
 pub mod trig;
 mod unknown_parameter;
 
-pub use dynamics::{CoriolisMatrix, RobotDynamics};
+pub use dynamics::{
+    CoriolisMatrix, ForwardDynamicsDerivatives, InverseDynamicsDerivatives, RobotDynamics,
+};
 pub use invalid_parameter::{InvalidParameter, Problem};
 pub use nalgebra;
 #[cfg(feature = "serde")]

@@ -18,25 +18,19 @@
 //! with `q̇ = u` (the wheeled base's x and ψ are integrated from ẋ and ψ̇ like every other
 //! coordinate).
 
+use kanegen_runtime::InverseDynamicsDerivatives;
 use nalgebra::{SMatrix, SVector};
 
 use crate::Krang;
 use crate::actuators::ACTUATOR_COUNT;
 use crate::forward::{MassMatrixCholesky, NotPositiveDefinite};
 
-/// The forward-dynamics derivatives of an `N`-speed model at one state:
-/// `u̇ = FD(q, u, τ)` and its partial derivatives.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ForwardDynamicsDerivatives<const N: usize> {
-    /// `u̇ = M⁻¹ (τ − c − g)`, where the derivatives are taken.
-    pub ud: SVector<f64, N>,
-    /// `∂u̇/∂q` (column j: the derivative with respect to `q[j]`).
-    pub dud_dq: SMatrix<f64, N, N>,
-    /// `∂u̇/∂u`.
-    pub dud_du: SMatrix<f64, N, N>,
-    /// `∂u̇/∂τ = M⁻¹` (symmetric positive definite).
-    pub minv: SMatrix<f64, N, N>,
-}
+/// The forward-dynamics derivatives of an `N`-speed model at one state (`u̇`, `∂u̇/∂q`,
+/// `∂u̇/∂u`, `M⁻¹`): `kanegen_runtime`'s struct in `f64`, which every generated robot with
+/// derivatives also returns from
+/// [`InverseDynamicsDerivatives::forward_dynamics_derivatives`](kanegen_runtime::InverseDynamicsDerivatives::forward_dynamics_derivatives).
+pub type ForwardDynamicsDerivatives<const N: usize> =
+    kanegen_runtime::ForwardDynamicsDerivatives<f64, N>;
 
 /// Square block `k` of a matrix of `N×N` blocks side by side: column-major, the block is the
 /// `k`-th run of `N²` entries of the storage, copied as a slice (one `memcpy`). A view's
@@ -51,13 +45,6 @@ fn square_block<const N: usize, const C: usize>(
     b.as_mut_slice()
         .copy_from_slice(&m.as_slice()[N * N * k..N * N * (k + 1)]);
     b
-}
-
-/// Splits the generated `[∂τ/∂q | ∂τ/∂u]` into its two square blocks.
-fn split<const N: usize, const N2: usize>(
-    d: &SMatrix<f64, N, N2>,
-) -> (SMatrix<f64, N, N>, SMatrix<f64, N, N>) {
-    (square_block(d, 0), square_block(d, 1))
 }
 
 /// `(A, B)` of `ẋ = f(x, input)` for `x = [q; u]` and `q̇ = u`, from the forward-dynamics
@@ -89,7 +76,7 @@ impl Krang {
         u: &SVector<f64, 19>,
         ud: &SVector<f64, 19>,
     ) -> (SMatrix<f64, 19, 19>, SMatrix<f64, 19, 19>) {
-        split(&self.inverse_dynamics_derivatives(q, u, ud))
+        InverseDynamicsDerivatives::inverse_dynamics_partials(self, q, u, ud)
     }
 
     /// Forward dynamics and its derivatives at `(q, u, τ)`: `u̇ = FD(q, u, τ)`, `∂u̇/∂q`,
@@ -212,12 +199,14 @@ impl crate::fixed_wheels::KrangFixedWheels {
         u: &SVector<f64, 17>,
         ud: &SVector<f64, 17>,
     ) -> (SMatrix<f64, 17, 17>, SMatrix<f64, 17, 17>) {
-        split(&self.inverse_dynamics_derivatives(q, u, ud))
+        InverseDynamicsDerivatives::inverse_dynamics_partials(self, q, u, ud)
     }
 
     /// Forward dynamics and its derivatives at `(q, u, τ)` (see
     /// [`Krang::try_forward_dynamics_derivatives`]), with nalgebra's dense Cholesky (17×17,
-    /// on the stack).
+    /// on the stack): the runtime trait's
+    /// [`forward_dynamics_derivatives`](kanegen_runtime::InverseDynamicsDerivatives::forward_dynamics_derivatives),
+    /// with this crate's error.
     ///
     /// # Errors
     /// [`NotPositiveDefinite`] for non-physical parameters.
@@ -227,22 +216,11 @@ impl crate::fixed_wheels::KrangFixedWheels {
         u: &SVector<f64, 17>,
         tau: &SVector<f64, 17>,
     ) -> Result<ForwardDynamicsDerivatives<17>, NotPositiveDefinite> {
-        // nalgebra's dense Cholesky: fixed-size, on the stack.
-        let chol = self.mass_matrix(q).cholesky().ok_or(NotPositiveDefinite {
-            block: crate::forward::Block::Dense,
-        })?;
-        let bias = self.inverse_dynamics(q, u, &SVector::zeros());
-        let ud = chol.solve(&(tau - bias));
-        let (dtau_dq, dtau_du) = self.inverse_dynamics_partials(q, u, &ud);
-        let dud_dq = -chol.solve(&dtau_dq);
-        let dud_du = -chol.solve(&dtau_du);
-        let minv = chol.inverse();
-        Ok(ForwardDynamicsDerivatives {
-            ud,
-            dud_dq,
-            dud_du,
-            minv,
-        })
+        InverseDynamicsDerivatives::forward_dynamics_derivatives(self, q, u, tau).ok_or(
+            NotPositiveDefinite {
+                block: crate::forward::Block::Dense,
+            },
+        )
     }
 
     /// The linearization `(A, B)` of the fixed-wheel model's `ẋ = f(x, τ)` for `x = [q; u]`

@@ -139,6 +139,11 @@ pub mod derivatives;
 pub use actuators::{ACTUATOR_COUNT, ACTUATOR_NAMES, actuator, hardware, saturate, saturate_to};
 #[cfg(feature = "derivatives")]
 pub use derivatives::ForwardDynamicsDerivatives;
+/// The trait of the generated derivatives (`inverse_dynamics_partials`, and the provided,
+/// dense `forward_dynamics_derivatives` that generic code gets; `Krang`'s inherent one uses
+/// the block Cholesky).
+#[cfg(feature = "derivatives")]
+pub use kanegen_runtime::InverseDynamicsDerivatives;
 
 /// What a controller uses besides the model: the traits every generated robot implements (so
 /// that `Krang` works with generic controller code), the errors of `Params`, and nalgebra.

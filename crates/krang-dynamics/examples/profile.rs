@@ -11,6 +11,7 @@
 //! ```
 //!
 //! Arguments: a function (`mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, or `all`;
+//! `forward_dynamics`, and `mass_matrix_cholesky` (M, its block factor and one solve);
 //! a suffix `_b4` or `_b8` calls the batched form (`_batch_into`, into arrays kept across
 //! calls) with 4 or 8 states, counted as one call, `_s8` the structure-of-arrays form
 //! (`_batch_soa_into`) with 8 states; with
@@ -65,10 +66,26 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
     let mut v8 = [V::zeros(); 8];
     let mut ms8 = SMatrix::<Lanes<8>, 19, 19>::from_element(Lanes::splat(0.0));
     let mut vs8 = SVector::<Lanes<8>, 19>::from_element(Lanes::splat(0.0));
+    let m_fixed = k.mass_matrix(&s[0].0);
+    let chol_fixed = krang_dynamics::MassMatrixCholesky::new(&m_fixed).unwrap();
     for i in 0..calls {
         let (q, u, ud) = &s[i & 63];
         acc += match f {
             "mass_matrix" => black_box(k).mass_matrix(black_box(q))[(5, 3)],
+            "forward_dynamics" => {
+                black_box(k).forward_dynamics(black_box(q), black_box(u), black_box(ud))[7]
+            }
+            "cholesky_only" => {
+                let chol = krang_dynamics::MassMatrixCholesky::new(black_box(&m_fixed)).unwrap();
+                black_box(&chol);
+                0.0
+            }
+            "solve_only" => black_box(&chol_fixed).solve(black_box(ud))[7],
+            "mass_matrix_cholesky" => {
+                let m = black_box(k).mass_matrix(black_box(q));
+                let chol = krang_dynamics::MassMatrixCholesky::new(black_box(&m)).unwrap();
+                chol.solve(black_box(ud))[7]
+            }
             "coriolis" => black_box(k).coriolis(black_box(q), black_box(u))[7],
             "gravity" => black_box(k).gravity(black_box(q))[7],
             "inverse_dynamics" => {

@@ -118,63 +118,82 @@ fn finite<const N: usize>(
     }
 }
 
-#[inline]
+// The factors are kept as upper-triangular `U = Lᵀ` in nalgebra's column-major storage, so
+// that every inner loop below runs over a contiguous column prefix, with the reciprocals of
+// their diagonals: the substitutions multiply instead of dividing.
+
+/// An upper Cholesky factor `U` (`A = Uᵀ U`; its strict lower triangle is zero) and the
+/// reciprocals of its diagonal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Upper<const N: usize> {
+    u: SMatrix<f64, N, N>,
+    inv_diag: [f64; N],
+}
+
+impl<const N: usize> Upper<N> {
+    /// The lower triangle of the N×N diagonal block of `a` at `(at, at)`, transposed into the
+    /// upper triangle (zeros below), before the first [`step`](Self::step).
+    #[inline(always)]
+    fn from_lower_at<const M: usize>(a: &SMatrix<f64, M, M>, at: usize) -> Self {
+        let mut u = SMatrix::<f64, N, N>::zeros();
+        let s = u.as_mut_slice();
+        // Column i of `s` holds row i of the block's lower triangle: U(k, i) = s[i N + k], k ≤ i.
+        for i in 0..N {
+            for k in 0..=i {
+                s[i * N + k] = a[(at + i, at + k)];
+            }
+        }
+        Upper {
+            u,
+            inv_diag: [0.0; N],
+        }
+    }
+
+    /// Pivot `k` of the right-looking factorisation, in place: the pivot's square root and
+    /// reciprocal, the rest of row `k` of `U` scaled, and that row's outer product subtracted
+    /// from the trailing block; `false` if the pivot is not positive (or is NaN).
+    ///
+    /// The updates of a step are independent of each other, so the dependency chain per pivot
+    /// is the square root (the reciprocal `√d · (1/d)` is computed beside it, not after it),
+    /// one multiply and one multiply-subtract. [`MassMatrixCholesky::new`] calls it with
+    /// literal pivot indices, so that each step indexes its block with constants.
+    #[inline(always)]
+    fn step(&mut self, k: usize) -> bool {
+        let s = self.u.as_mut_slice();
+        let d = s[k * N + k];
+        if d.is_nan() || d <= 0.0 {
+            return false;
+        }
+        let r = nalgebra::ComplexField::sqrt(d); // `f64::sqrt` needs std
+        let r_inv = r * (1.0 / d);
+        s[k * N + k] = r;
+        self.inv_diag[k] = r_inv;
+        for i in k + 1..N {
+            s[i * N + k] *= r_inv;
+        }
+        for i in k + 1..N {
+            let uki = s[i * N + k];
+            for j in k + 1..=i {
+                s[i * N + j] -= s[j * N + k] * uki;
+            }
+        }
+        true
+    }
+}
+
+#[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-// The factors are kept as upper-triangular `U = Lᵀ` in nalgebra's column-major storage, so
-// that every inner loop below runs over a contiguous column prefix.
-
-/// Upper Cholesky factor `U` (`A = Uᵀ U`) of an N×N symmetric positive definite matrix;
-/// reads the lower triangle of `A` only. The strict lower triangle of `U` is zero.
-#[inline]
-fn cholesky_upper<const N: usize>(a: &SMatrix<f64, N, N>) -> Option<SMatrix<f64, N, N>> {
-    let mut u = SMatrix::<f64, N, N>::zeros();
-    let s = u.as_mut_slice();
-    for j in 0..N {
-        let cj = j * N;
-        let d = a[(j, j)] - dot(&s[cj..cj + j], &s[cj..cj + j]);
-        if d.is_nan() || d <= 0.0 {
-            return None;
-        }
-        let ujj = nalgebra::ComplexField::sqrt(d); // `f64::sqrt` needs std
-        s[cj + j] = ujj;
-        for i in j + 1..N {
-            let ci = i * N;
-            let v = (a[(i, j)] - dot(&s[cj..cj + j], &s[ci..ci + j])) / ujj;
-            s[ci + j] = v;
-        }
-    }
-    Some(u)
-}
-
 /// `b ← U⁻ᵀ b` (= `L⁻¹ b`), column by column.
-#[inline]
-fn forward_subst<const N: usize, const C: usize>(
-    u: &SMatrix<f64, N, N>,
-    b: &mut SMatrix<f64, N, C>,
-) {
-    let us = u.as_slice();
+#[inline(always)]
+fn forward_subst<const N: usize, const C: usize>(f: &Upper<N>, b: &mut SMatrix<f64, N, C>) {
+    let us = f.u.as_slice();
     for col in b.as_mut_slice().chunks_exact_mut(N) {
         for i in 0..N {
             let ci = i * N;
-            col[i] = (col[i] - dot(&us[ci..ci + i], &col[..i])) / us[ci + i];
-        }
-    }
-}
-
-/// `b ← U⁻¹ b` (= `L⁻ᵀ b`).
-#[inline]
-fn backward_subst<const N: usize>(u: &SMatrix<f64, N, N>, b: &mut SVector<f64, N>) {
-    let us = u.as_slice();
-    let y = b.as_mut_slice();
-    for i in (0..N).rev() {
-        let ci = i * N;
-        let xi = y[i] / us[ci + i];
-        y[i] = xi;
-        for (yk, uki) in y[..i].iter_mut().zip(&us[ci..ci + i]) {
-            *yk -= uki * xi;
+            col[i] = (col[i] - dot(&us[ci..ci + i], &col[..i])) * f.inv_diag[i];
         }
     }
 }
@@ -206,32 +225,32 @@ fn sub_scaled(rows: &mut [f64], c: usize, dst: usize, src: usize, a: f64) {
     }
 }
 
-/// `rows[k] /= d`.
+/// `rows[k] *= a`.
 #[inline(always)]
-fn divide_row(rows: &mut [f64], c: usize, k: usize, d: f64) {
+fn scale_row(rows: &mut [f64], c: usize, k: usize, a: f64) {
     for x in &mut rows[k * c..k * c + c] {
-        *x /= d;
+        *x *= a;
     }
 }
 
 /// `Y ← U⁻ᵀ Y` (= `L⁻¹ Y`) on the rows `at..at + N` of `rows`, a row at a time.
 #[inline(always)]
-fn forward_rows<const N: usize>(u: &SMatrix<f64, N, N>, rows: &mut [f64], at: usize, c: usize) {
+fn forward_rows<const N: usize>(f: &Upper<N>, rows: &mut [f64], at: usize, c: usize) {
     for i in 0..N {
         for k in 0..i {
-            sub_scaled(rows, c, at + i, at + k, u[(k, i)]);
+            sub_scaled(rows, c, at + i, at + k, f.u[(k, i)]);
         }
-        divide_row(rows, c, at + i, u[(i, i)]);
+        scale_row(rows, c, at + i, f.inv_diag[i]);
     }
 }
 
 /// `Y ← U⁻¹ Y` (= `L⁻ᵀ Y`) on the rows `at..at + N` of `rows`, a row at a time.
 #[inline(always)]
-fn backward_rows<const N: usize>(u: &SMatrix<f64, N, N>, rows: &mut [f64], at: usize, c: usize) {
+fn backward_rows<const N: usize>(f: &Upper<N>, rows: &mut [f64], at: usize, c: usize) {
     for i in (0..N).rev() {
-        divide_row(rows, c, at + i, u[(i, i)]);
+        scale_row(rows, c, at + i, f.inv_diag[i]);
         for k in 0..i {
-            sub_scaled(rows, c, at + k, at + i, u[(k, i)]);
+            sub_scaled(rows, c, at + k, at + i, f.u[(k, i)]);
         }
     }
 }
@@ -244,15 +263,15 @@ fn backward_rows<const N: usize>(u: &SMatrix<f64, N, N>, rows: &mut [f64], at: u
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MassMatrixCholesky {
     /// `U_l = L_lᵀ` (upper).
-    u_left: SMatrix<f64, 7, 7>,
+    u_left: Upper<7>,
     /// `U_r = L_rᵀ` (upper).
-    u_right: SMatrix<f64, 7, 7>,
+    u_right: Upper<7>,
     /// `W_l = L_l⁻¹ M[left, trunk]`.
     w_left: SMatrix<f64, 7, 5>,
     /// `W_r = L_r⁻¹ M[right, trunk]`.
     w_right: SMatrix<f64, 7, 5>,
     /// `U_s = L_sᵀ` (upper), the factor of the Schur complement.
-    u_trunk: SMatrix<f64, 5, 5>,
+    u_trunk: Upper<5>,
 }
 
 impl MassMatrixCholesky {
@@ -262,39 +281,63 @@ impl MassMatrixCholesky {
     /// # Errors
     /// [`NotPositiveDefinite`] if a pivot is not positive (or is NaN).
     pub fn new(m: &SMatrix<f64, 19, 19>) -> Result<Self, NotPositiveDefinite> {
-        let a_left: SMatrix<f64, 7, 7> = block(m, 5, 5);
-        let a_right: SMatrix<f64, 7, 7> = block(m, 12, 12);
-        let u_left = cholesky_upper(&a_left).ok_or(NotPositiveDefinite {
-            block: Block::LeftArm,
-        })?;
-        let u_right = cholesky_upper(&a_right).ok_or(NotPositiveDefinite {
-            block: Block::RightArm,
-        })?;
-        // W = L⁻¹ M[arm, trunk] (the lower-triangle blocks).
-        let mut w_left: SMatrix<f64, 7, 5> = block(m, 5, 0);
-        let mut w_right: SMatrix<f64, 7, 5> = block(m, 12, 0);
-        forward_subst(&u_left, &mut w_left);
-        forward_subst(&u_right, &mut w_right);
-        // Schur complement S = T − W_lᵀ W_l − W_rᵀ W_r (lower triangle is enough).
-        let mut s: SMatrix<f64, 5, 5> = block(m, 0, 0);
-        let (wl, wr) = (w_left.as_slice(), w_right.as_slice());
-        for j in 0..5 {
-            let (lj, rj) = (&wl[7 * j..7 * j + 7], &wr[7 * j..7 * j + 7]);
-            for i in j..5 {
-                let (li, ri) = (&wl[7 * i..7 * i + 7], &wr[7 * i..7 * i + 7]);
-                s[(i, j)] -= dot(li, lj) + dot(ri, rj);
+        kanegen_runtime::isa::dispatch(
+            #[inline(always)]
+            || Self::new_in(m),
+        )
+    }
+
+    #[inline(always)]
+    fn new_in(m: &SMatrix<f64, 19, 19>) -> Result<Self, NotPositiveDefinite> {
+        // Built in place: the blocks are read straight from `m` into the fields, and the
+        // factorisation runs on them (no intermediate copies of the 1.5 KB structure).
+        let mut f = Self {
+            u_left: Upper::from_lower_at(m, 5),
+            u_right: Upper::from_lower_at(m, 12),
+            // W = L⁻¹ M[arm, trunk] (the lower-triangle blocks), after the substitution below.
+            w_left: block(m, 5, 0),
+            w_right: block(m, 12, 0),
+            // The Schur complement S = T − W_lᵀ W_l − W_rᵀ W_r, then its factor.
+            u_trunk: Upper::from_lower_at(m, 0),
+        };
+        // Every pivot step is written out with its index as a literal, so that it indexes its
+        // block with constants.
+        macro_rules! pivots {
+            ($f:expr, $block:expr; $($k:literal)*) => {$(
+                if !$f.step($k) {
+                    return Err(NotPositiveDefinite { block: $block });
+                }
+            )*};
+        }
+        // The two arms' pivots in turn: their dependency chains overlap.
+        pivots!(f.u_left, Block::LeftArm; 0);
+        pivots!(f.u_right, Block::RightArm; 0);
+        pivots!(f.u_left, Block::LeftArm; 1);
+        pivots!(f.u_right, Block::RightArm; 1);
+        pivots!(f.u_left, Block::LeftArm; 2);
+        pivots!(f.u_right, Block::RightArm; 2);
+        pivots!(f.u_left, Block::LeftArm; 3);
+        pivots!(f.u_right, Block::RightArm; 3);
+        pivots!(f.u_left, Block::LeftArm; 4);
+        pivots!(f.u_right, Block::RightArm; 4);
+        pivots!(f.u_left, Block::LeftArm; 5);
+        pivots!(f.u_right, Block::RightArm; 5);
+        pivots!(f.u_left, Block::LeftArm; 6);
+        pivots!(f.u_right, Block::RightArm; 6);
+        forward_subst(&f.u_left, &mut f.w_left);
+        forward_subst(&f.u_right, &mut f.w_right);
+        let (wl, wr) = (f.w_left.as_slice(), f.w_right.as_slice());
+        let s = f.u_trunk.u.as_mut_slice();
+        for i in 0..5 {
+            let (li, ri) = (&wl[7 * i..7 * i + 7], &wr[7 * i..7 * i + 7]);
+            for j in 0..=i {
+                let (lj, rj) = (&wl[7 * j..7 * j + 7], &wr[7 * j..7 * j + 7]);
+                // S(i, j), j ≤ i, is stored as U(j, i).
+                s[5 * i + j] -= dot(li, lj) + dot(ri, rj);
             }
         }
-        let u_trunk = cholesky_upper(&s).ok_or(NotPositiveDefinite {
-            block: Block::Trunk,
-        })?;
-        Ok(Self {
-            u_left,
-            u_right,
-            w_left,
-            w_right,
-            u_trunk,
-        })
+        pivots!(f.u_trunk, Block::Trunk; 0 1 2 3 4);
+        Ok(f)
     }
 
     /// `x = M⁻¹ b`.
@@ -362,15 +405,15 @@ impl MassMatrixCholesky {
     pub fn factor(&self) -> SMatrix<f64, 19, 19> {
         let mut l = SMatrix::<f64, 19, 19>::zeros();
         l.fixed_view_mut::<7, 7>(5, 5)
-            .copy_from(&self.u_left.transpose());
+            .copy_from(&self.u_left.u.transpose());
         l.fixed_view_mut::<7, 7>(12, 12)
-            .copy_from(&self.u_right.transpose());
+            .copy_from(&self.u_right.u.transpose());
         l.fixed_view_mut::<5, 7>(0, 5)
             .copy_from(&self.w_left.transpose());
         l.fixed_view_mut::<5, 7>(0, 12)
             .copy_from(&self.w_right.transpose());
         l.fixed_view_mut::<5, 5>(0, 0)
-            .copy_from(&self.u_trunk.transpose());
+            .copy_from(&self.u_trunk.u.transpose());
         l
     }
 
@@ -378,17 +421,17 @@ impl MassMatrixCholesky {
     pub fn determinant(&self) -> f64 {
         let mut d = 1.0;
         for i in 0..7 {
-            d *= self.u_left[(i, i)] * self.u_right[(i, i)];
+            d *= self.u_left.u[(i, i)] * self.u_right.u[(i, i)];
         }
         for i in 0..5 {
-            d *= self.u_trunk[(i, i)];
+            d *= self.u_trunk.u[(i, i)];
         }
         d * d
     }
 }
 
 /// Generic dense fallback: `x = A⁻¹ b` for a symmetric positive definite `A` (any fixed
-/// size) by a Cholesky factorisation of the lower triangle. Allocation-free.
+/// size) by a Cholesky factorisation of the lower triangle, on the stack.
 ///
 /// # Errors
 /// [`NotPositiveDefinite`] (`block: Block::Dense`) if a pivot is not positive (or is NaN).
@@ -396,13 +439,59 @@ pub fn solve_spd<const N: usize>(
     a: &SMatrix<f64, N, N>,
     b: &SVector<f64, N>,
 ) -> Result<SVector<f64, N>, NotPositiveDefinite> {
-    let u = cholesky_upper(a).ok_or(NotPositiveDefinite {
+    let f = cholesky_left_looking(a).ok_or(NotPositiveDefinite {
         block: Block::Dense,
     })?;
     let mut x = *b;
-    forward_subst(&u, &mut x);
-    backward_subst(&u, &mut x);
+    forward_subst(&f, &mut x);
+    backward_subst(&f, &mut x);
     Ok(x)
+}
+
+/// The upper Cholesky factor of an N×N symmetric positive definite matrix for any `N`, reading
+/// the lower triangle of `a` only; `None` if a pivot is not positive (or is NaN).
+///
+/// Left-looking (each entry a dot product of the columns before it): for the fixed-wheel
+/// tree's 17×17 matrix this is faster than the right-looking [`Upper::step`] in a loop
+/// (whose trailing updates then go through memory) and than nalgebra's `Cholesky`.
+#[inline(always)]
+fn cholesky_left_looking<const N: usize>(a: &SMatrix<f64, N, N>) -> Option<Upper<N>> {
+    let mut f = Upper {
+        u: SMatrix::<f64, N, N>::zeros(),
+        inv_diag: [0.0; N],
+    };
+    let s = f.u.as_mut_slice();
+    for j in 0..N {
+        let cj = j * N;
+        let d = a[(j, j)] - dot(&s[cj..cj + j], &s[cj..cj + j]);
+        if d.is_nan() || d <= 0.0 {
+            return None;
+        }
+        let ujj = nalgebra::ComplexField::sqrt(d); // `f64::sqrt` needs std
+        let inv = ujj * (1.0 / d);
+        s[cj + j] = ujj;
+        f.inv_diag[j] = inv;
+        for i in j + 1..N {
+            let ci = i * N;
+            s[ci + j] = (a[(i, j)] - dot(&s[cj..cj + j], &s[ci..ci + j])) * inv;
+        }
+    }
+    Some(f)
+}
+
+/// `b ← U⁻¹ b` (= `L⁻ᵀ b`).
+#[inline(always)]
+fn backward_subst<const N: usize>(f: &Upper<N>, b: &mut SVector<f64, N>) {
+    let us = f.u.as_slice();
+    let y = b.as_mut_slice();
+    for i in (0..N).rev() {
+        let ci = i * N;
+        let xi = y[i] * f.inv_diag[i];
+        y[i] = xi;
+        for (yk, uki) in y[..i].iter_mut().zip(&us[ci..ci + i]) {
+            *yk -= uki * xi;
+        }
+    }
 }
 
 impl Krang {

@@ -232,6 +232,28 @@ fn non_physical_parameters_are_reported_not_panicked() {
 }
 
 #[test]
+fn each_block_of_the_factor_reports_its_own_failure() {
+    // A body's inertial parameters times -10 make the blocks it enters indefinite: an arm body
+    // its arm's block (the arms' pivots are taken in turn), the torso the trunk's Schur
+    // complement.
+    for (body, block) in [
+        ("5l", Block::LeftArm),
+        ("9r", Block::RightArm),
+        ("3", Block::Trunk),
+    ] {
+        let mut values = Params::default().to_array();
+        for kind in INERTIAL {
+            let name = format!("{kind}{body}");
+            let i = Params::NAMES.iter().position(|n| *n == name).unwrap();
+            values[i] *= -10.0;
+        }
+        let m = Krang::new(Params::from_array(values)).mass_matrix(&SVector::zeros());
+        let err = MassMatrixCholesky::new(&m).unwrap_err();
+        assert_eq!(err.block, block, "body {body}");
+    }
+}
+
+#[test]
 fn fixed_wheel_dense_fallback_round_trips_and_agrees_with_nalgebra() {
     let mut rng = Rng(6);
     for case in 0..1000 {

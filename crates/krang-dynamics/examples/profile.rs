@@ -15,8 +15,8 @@
 //! a suffix `_b4` or `_b8` calls the batched form (`_batch_into`, into arrays kept across
 //! calls) with 4 or 8 states, counted as one call, `_s8` the structure-of-arrays form
 //! (`_batch_soa_into`) with 8 states; with
-//! the feature `derivatives` also `inverse_dynamics_derivatives` and `…_into` (into a matrix kept
-//! across calls); with the feature `kinematics`
+//! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
+//! across calls) and `forward_dynamics_derivatives`; with the feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
 //! `com_jacobian` and `sin_cos_17`), the
 //! number of calls, and optionally the instruction set (`baseline` or `x86-64-v3`; default: the
@@ -152,6 +152,12 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
             "inverse_dynamics_derivatives" => {
                 black_box(k).inverse_dynamics_derivatives(black_box(q), black_box(u), black_box(ud))
                     [(7, 20)]
+            }
+            #[cfg(feature = "derivatives")]
+            "forward_dynamics_derivatives" => {
+                black_box(k)
+                    .forward_dynamics_derivatives(black_box(q), black_box(u), black_box(ud))
+                    .dud_dq[(7, 9)]
             }
             #[cfg(feature = "derivatives")]
             "inverse_dynamics_derivatives_into" => {

@@ -71,6 +71,17 @@ impl<T: RealField + Copy> TwoLinkArm<T> {
     }
 }
 
+/// The arm every test uses: 1.5 and 0.8 kg on links of 0.6 and 0.4 m.
+fn sample_arm<T: RealField + Copy>() -> TwoLinkArm<T> {
+    TwoLinkArm {
+        m1: nalgebra::convert(1.5),
+        m2: nalgebra::convert(0.8),
+        l1: nalgebra::convert(0.6),
+        l2: nalgebra::convert(0.4),
+        g: nalgebra::convert(9.81),
+    }
+}
+
 impl<T: RealField + Copy> RobotDynamics<2> for TwoLinkArm<T> {
     type Scalar = T;
     const SPEED_NAMES: [&'static str; 2] = ["qd1", "qd2"];
@@ -147,13 +158,7 @@ fn forward_dynamics_inverts_inverse_dynamics_and_refuses_a_non_physical_robot() 
     assert!((ud[0] - expected).abs() < 1e-12, "{ud} vs {expected}");
     assert!((p.inverse_dynamics(&q, &u, &ud) - tau).norm() < 1e-12);
     // The two-link arm: τ → u̇ → τ, in both precisions.
-    let arm = TwoLinkArm {
-        m1: 1.5,
-        m2: 0.8,
-        l1: 0.6,
-        l2: 0.4,
-        g: 9.81,
-    };
+    let arm = sample_arm::<f64>();
     let (q, u, ud) = (
         SVector::from([0.2, 0.9]),
         SVector::from([-1.3, 0.7]),
@@ -162,13 +167,7 @@ fn forward_dynamics_inverts_inverse_dynamics_and_refuses_a_non_physical_robot() 
     let tau = arm.inverse_dynamics(&q, &u, &ud);
     let back = arm.forward_dynamics(&q, &u, &tau).unwrap();
     assert!((back - ud).norm() < 1e-12, "{back} vs {ud}");
-    let arm32 = TwoLinkArm {
-        m1: 1.5_f32,
-        m2: 0.8,
-        l1: 0.6,
-        l2: 0.4,
-        g: 9.81,
-    };
+    let arm32 = sample_arm::<f32>();
     let (q, u, ud) = (q.cast::<f32>(), u.cast::<f32>(), ud.cast::<f32>());
     let back = arm32
         .forward_dynamics(&q, &u, &arm32.inverse_dynamics(&q, &u, &ud))
@@ -214,23 +213,11 @@ fn settle<R: RobotDynamics<2>>(
 
 #[test]
 fn computed_torque_settles_a_two_link_arm_in_both_precisions() {
-    let arm = TwoLinkArm {
-        m1: 1.5,
-        m2: 0.8,
-        l1: 0.6,
-        l2: 0.4,
-        g: 9.81,
-    };
+    let arm = sample_arm::<f64>();
     let q_ref = SVector::from([0.7, -1.1]);
     let q = settle(&arm, &q_ref, 3000);
     assert!((q - q_ref).norm() < 1e-6, "{q}");
-    let arm32 = TwoLinkArm {
-        m1: 1.5_f32,
-        m2: 0.8,
-        l1: 0.6,
-        l2: 0.4,
-        g: 9.81,
-    };
+    let arm32 = sample_arm::<f32>();
     let q = settle(&arm32, &SVector::from([0.7_f32, -1.1]), 3000);
     assert!((q - SVector::from([0.7_f32, -1.1])).norm() < 1e-3, "{q}");
     assert_eq!(
@@ -241,13 +228,7 @@ fn computed_torque_settles_a_two_link_arm_in_both_precisions() {
 
 #[test]
 fn coriolis_matrix_conventions() {
-    let arm = TwoLinkArm {
-        m1: 1.5,
-        m2: 0.8,
-        l1: 0.6,
-        l2: 0.4,
-        g: 9.81,
-    };
+    let arm = sample_arm::<f64>();
     let (q, u) = (SVector::from([0.2, 0.9]), SVector::from([-1.3, 0.7]));
     // c = C u.
     let c = arm.coriolis(&q, &u);

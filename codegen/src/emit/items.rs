@@ -460,10 +460,10 @@ pub(super) fn trait_impls(cx: &Context<'_>) -> TokenStream {
             let (args, _) = state_args(cx, spec.inputs);
             let call = forward_call(cx, spec);
             if tr == RuntimeTrait::InverseDynamicsDerivatives {
-                // The trait cannot name an N × 2N matrix (no `2 * N` in a const generic):
-                // its method returns the two square blocks.
-                // The blocks are copied as slices (column-major, consecutive): a view's
-                // `into_owned` copies entry by entry through a strided iterator.
+                // The trait cannot name an N × 2N matrix (no `2 * N` in a const generic): its
+                // method returns the two square blocks, copied as slices (column-major, they
+                // are consecutive; a view's `into_owned` copies entry by entry through a
+                // strided iterator).
                 let n = idx(cx.low.dof);
                 let nn = idx(cx.low.dof * cx.low.dof);
                 return quote! {

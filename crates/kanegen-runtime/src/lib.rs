@@ -16,6 +16,9 @@
 //!   matrix): the trait every generated robot type implements, so that a controller can be
 //!   written once for any generated robot; its provided `forward_dynamics` gives every
 //!   generated robot forward dynamics (dense Cholesky, [`RobotDynamics::forward_dynamics`]).
+//!   [`InverseDynamicsDerivatives`], for modules generated with `inverse_dynamics_derivatives`:
+//!   the partials of inverse dynamics and, provided, those of forward dynamics
+//!   ([`ForwardDynamicsDerivatives`]), for LQR and MPC on any generated robot.
 //!
 //! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA; the
 //!   batched functions also x86-64-v4, AVX-512), the

@@ -9,8 +9,8 @@
 //! * `id_derivatives/rbd_dual`: the same by `kanegen-rbd`'s recursion in `num_dual::Dual64`
 //!   (2N = 38 forward-mode passes of the numeric RNEA);
 //! * `forward_dynamics/generated`: `Krang::forward_dynamics` (τ with u̇ = 0, M, block Cholesky);
-//! * `forward_dynamics/fixed_wheels_dense`: `KrangFixedWheels::forward_dynamics` (17 speeds, the
-//!   dense fallback `solve_spd`), at the trunk and arm coordinates of the same states;
+//! * `forward_dynamics/fixed_wheels`: `KrangFixedWheels::forward_dynamics` (17 speeds,
+//!   `BlockCholesky<3, 17>`), at the trunk and arm coordinates of the same states;
 //! * `fd_derivatives/generated`: `Krang::forward_dynamics_derivatives` (u̇, ∂u̇/∂q, ∂u̇/∂u, M⁻¹);
 //! * `linearize/generated`: `Krang::linearize` (A 38×38, B 38×18).
 //!
@@ -114,9 +114,9 @@ fn bench(c: &mut Criterion) {
     ));
     cycle!("fd_derivatives/generated", |q, u, ud| k
         .forward_dynamics_derivatives(q, u, &(ud * 10.0)));
-    // The fixed-wheel tree (17 speeds) factors M with the dense fallback `solve_spd`.
+    // The fixed-wheel tree (17 speeds): the block factor with a trunk of three speeds.
     let fixed = krang_dynamics::fixed_wheels::KrangFixedWheels::default();
-    cycle!("forward_dynamics/fixed_wheels_dense", |q, u, ud| fixed
+    cycle!("forward_dynamics/fixed_wheels", |q, u, ud| fixed
         .forward_dynamics(
             &q.fixed_rows::<17>(2).into_owned(),
             &u.fixed_rows::<17>(2).into_owned(),

@@ -28,7 +28,7 @@ use crate::forward::{MassMatrixCholesky, NotPositiveDefinite};
 /// The forward-dynamics derivatives of an `N`-speed model at one state (`u̇`, `∂u̇/∂q`,
 /// `∂u̇/∂u`, `M⁻¹`): `kanegen_runtime`'s struct in `f64`, which every generated robot with
 /// derivatives also returns from
-/// [`InverseDynamicsDerivatives::forward_dynamics_derivatives`](kanegen_runtime::InverseDynamicsDerivatives::forward_dynamics_derivatives).
+/// [`InverseDynamicsDerivatives::forward_dynamics_derivatives`].
 pub type ForwardDynamicsDerivatives<const N: usize> =
     kanegen_runtime::ForwardDynamicsDerivatives<f64, N>;
 

@@ -19,8 +19,10 @@
 //! and solve.
 //! Everything is fixed-size nalgebra on the stack; nothing allocates and nothing panics.
 //!
-//! The fixed-wheel model (17 speeds, feature `fixed-wheels`) uses the generic dense fallback
-//! [`solve_spd`].
+//! The fixed-wheel model (17 speeds, feature `fixed-wheels`) has the same structure with a
+//! trunk of three speeds: [`BlockCholesky`] is generic over the trunk size
+//! ([`MassMatrixCholesky`] = `BlockCholesky<5, 19>`, the fixed-wheel tree's
+//! `BlockCholesky<3, 17>`). [`solve_spd`] is the dense fallback for any other size.
 
 use core::fmt;
 
@@ -256,31 +258,43 @@ fn backward_rows<const N: usize>(f: &Upper<N>, rows: &mut [f64], at: usize, c: u
 }
 
 /// Block Cholesky factorisation of Krang's 19×19 mass matrix, arms first (see the
-/// [module docs](self)). Fixed size, `Copy`, no heap.
+/// [module docs](self)): [`BlockCholesky`] with a trunk of 5 speeds.
+pub type MassMatrixCholesky = BlockCholesky<5, 19>;
+
+/// Block Cholesky factorisation, arms first (see the [module docs](self)), of an `N×N` mass
+/// matrix ordered as Krang's models are: `T` trunk speeds, then two 7-speed arms that do not
+/// couple to each other (`N = T + 14`): [`MassMatrixCholesky`] (`T = 5`, Krang) and
+/// `BlockCholesky<3, 17>` (the fixed-wheel tree). Fixed size, `Copy`, no heap.
 ///
 /// Reuse one factorisation for several right-hand sides (e.g. `M⁻¹ Jᵀ` in an
 /// operational-space controller) with [`solve`](Self::solve).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MassMatrixCholesky {
+pub struct BlockCholesky<const T: usize, const N: usize> {
     /// `U_l = L_lᵀ` (upper).
     u_left: Upper<7>,
     /// `U_r = L_rᵀ` (upper).
     u_right: Upper<7>,
     /// `W_l = L_l⁻¹ M[left, trunk]`.
-    w_left: SMatrix<f64, 7, 5>,
+    w_left: SMatrix<f64, 7, T>,
     /// `W_r = L_r⁻¹ M[right, trunk]`.
-    w_right: SMatrix<f64, 7, 5>,
+    w_right: SMatrix<f64, 7, T>,
     /// `U_s = L_sᵀ` (upper), the factor of the Schur complement.
-    u_trunk: Upper<5>,
+    u_trunk: Upper<T>,
 }
 
-impl MassMatrixCholesky {
+impl<const T: usize, const N: usize> BlockCholesky<T, N> {
+    /// The first speed of the left arm (the trunk's are `0..T`).
+    const LEFT: usize = T;
+    /// The first speed of the right arm.
+    const RIGHT: usize = T + 7;
+
     /// Factorises `m`, reading its lower triangle only and assuming `M[left, right] = 0`
-    /// (exactly true of Krang's generated mass matrix; entries there are ignored).
+    /// (exactly true of Krang's generated mass matrices; entries there are ignored).
     ///
     /// # Errors
     /// [`NotPositiveDefinite`] if a pivot is not positive (or is NaN).
-    pub fn new(m: &SMatrix<f64, 19, 19>) -> Result<Self, NotPositiveDefinite> {
+    pub fn new(m: &SMatrix<f64, N, N>) -> Result<Self, NotPositiveDefinite> {
+        const { assert!(N == T + 14, "N is T trunk speeds and two arms of 7") };
         kanegen_runtime::isa::dispatch(
             #[inline(always)]
             || Self::new_in(m),
@@ -288,68 +302,75 @@ impl MassMatrixCholesky {
     }
 
     #[inline(always)]
-    fn new_in(m: &SMatrix<f64, 19, 19>) -> Result<Self, NotPositiveDefinite> {
+    fn new_in(m: &SMatrix<f64, N, N>) -> Result<Self, NotPositiveDefinite> {
         // Built in place: the blocks are read straight from `m` into the fields, and the
         // factorisation runs on them (no intermediate copies of the 1.5 KB structure).
         let mut f = Self {
-            u_left: Upper::from_lower_at(m, 5),
-            u_right: Upper::from_lower_at(m, 12),
+            u_left: Upper::from_lower_at(m, Self::LEFT),
+            u_right: Upper::from_lower_at(m, Self::RIGHT),
             // W = L⁻¹ M[arm, trunk] (the lower-triangle blocks), after the substitution below.
-            w_left: block(m, 5, 0),
-            w_right: block(m, 12, 0),
+            w_left: block(m, Self::LEFT, 0),
+            w_right: block(m, Self::RIGHT, 0),
             // The Schur complement S = T − W_lᵀ W_l − W_rᵀ W_r, then its factor.
             u_trunk: Upper::from_lower_at(m, 0),
         };
         // Every pivot step is written out with its index as a literal, so that it indexes its
         // block with constants.
         macro_rules! pivots {
-            ($f:expr, $block:expr; $($k:literal)*) => {$(
-                if !$f.step($k) {
+            ($f:expr, $block:expr, $n:expr; $($k:literal)*) => {$(
+                if $k < $n && !$f.step($k) {
                     return Err(NotPositiveDefinite { block: $block });
                 }
             )*};
         }
         // The two arms' pivots in turn: their dependency chains overlap.
-        pivots!(f.u_left, Block::LeftArm; 0);
-        pivots!(f.u_right, Block::RightArm; 0);
-        pivots!(f.u_left, Block::LeftArm; 1);
-        pivots!(f.u_right, Block::RightArm; 1);
-        pivots!(f.u_left, Block::LeftArm; 2);
-        pivots!(f.u_right, Block::RightArm; 2);
-        pivots!(f.u_left, Block::LeftArm; 3);
-        pivots!(f.u_right, Block::RightArm; 3);
-        pivots!(f.u_left, Block::LeftArm; 4);
-        pivots!(f.u_right, Block::RightArm; 4);
-        pivots!(f.u_left, Block::LeftArm; 5);
-        pivots!(f.u_right, Block::RightArm; 5);
-        pivots!(f.u_left, Block::LeftArm; 6);
-        pivots!(f.u_right, Block::RightArm; 6);
+        pivots!(f.u_left, Block::LeftArm, 7; 0);
+        pivots!(f.u_right, Block::RightArm, 7; 0);
+        pivots!(f.u_left, Block::LeftArm, 7; 1);
+        pivots!(f.u_right, Block::RightArm, 7; 1);
+        pivots!(f.u_left, Block::LeftArm, 7; 2);
+        pivots!(f.u_right, Block::RightArm, 7; 2);
+        pivots!(f.u_left, Block::LeftArm, 7; 3);
+        pivots!(f.u_right, Block::RightArm, 7; 3);
+        pivots!(f.u_left, Block::LeftArm, 7; 4);
+        pivots!(f.u_right, Block::RightArm, 7; 4);
+        pivots!(f.u_left, Block::LeftArm, 7; 5);
+        pivots!(f.u_right, Block::RightArm, 7; 5);
+        pivots!(f.u_left, Block::LeftArm, 7; 6);
+        pivots!(f.u_right, Block::RightArm, 7; 6);
         forward_subst(&f.u_left, &mut f.w_left);
         forward_subst(&f.u_right, &mut f.w_right);
         let (wl, wr) = (f.w_left.as_slice(), f.w_right.as_slice());
         let s = f.u_trunk.u.as_mut_slice();
-        for i in 0..5 {
+        for i in 0..T {
             let (li, ri) = (&wl[7 * i..7 * i + 7], &wr[7 * i..7 * i + 7]);
             for j in 0..=i {
                 let (lj, rj) = (&wl[7 * j..7 * j + 7], &wr[7 * j..7 * j + 7]);
                 // S(i, j), j ≤ i, is stored as U(j, i).
-                s[5 * i + j] -= dot(li, lj) + dot(ri, rj);
+                s[T * i + j] -= dot(li, lj) + dot(ri, rj);
             }
         }
-        pivots!(f.u_trunk, Block::Trunk; 0 1 2 3 4);
+        pivots!(f.u_trunk, Block::Trunk, T; 0 1 2 3 4 5 6 7);
+        for k in 8..T {
+            if !f.u_trunk.step(k) {
+                return Err(NotPositiveDefinite {
+                    block: Block::Trunk,
+                });
+            }
+        }
         Ok(f)
     }
 
     /// `x = M⁻¹ b`.
     #[inline]
-    pub fn solve(&self, b: &SVector<f64, 19>) -> SVector<f64, 19> {
+    pub fn solve(&self, b: &SVector<f64, N>) -> SVector<f64, N> {
         let mut x = *b;
         self.solve_mut(&mut x);
         x
     }
 
     /// `b ← M⁻¹ b`, in place: [`solve_columns_mut`](Self::solve_columns_mut) with one column.
-    pub fn solve_mut(&self, b: &mut SVector<f64, 19>) {
+    pub fn solve_mut(&self, b: &mut SVector<f64, N>) {
         self.solve_columns_mut::<1>(b);
     }
 
@@ -362,7 +383,7 @@ impl MassMatrixCholesky {
     /// column-by-column solves spend their time in short dependent dot products. Each column
     /// gets the bits [`solve_mut`](Self::solve_mut) gives it alone (the same operations in the
     /// same order). Fixed size, on the stack.
-    pub fn solve_columns_mut<const C: usize>(&self, x: &mut SMatrix<f64, 19, C>) {
+    pub fn solve_columns_mut<const C: usize>(&self, x: &mut SMatrix<f64, N, C>) {
         // Compiled for the baseline and, run when the CPU has it, for x86-64-v3 (4 lanes; the
         // same operations, no fused multiply-adds: the same bits in both copies).
         kanegen_runtime::isa::dispatch(
@@ -372,15 +393,15 @@ impl MassMatrixCholesky {
     }
 
     #[inline(always)]
-    fn solve_columns_in<const C: usize>(&self, x: &mut SMatrix<f64, 19, C>) {
+    fn solve_columns_in<const C: usize>(&self, x: &mut SMatrix<f64, N, C>) {
         // Row k of X (speed k, the C right-hand sides) is column k of `t`: `rows[k*C..(k+1)*C]`.
-        let mut t: SMatrix<f64, C, 19> = x.transpose();
+        let mut t: SMatrix<f64, C, N> = x.transpose();
         let rows = t.as_mut_slice();
-        let (left, right) = (5, 12);
+        let (left, right) = (Self::LEFT, Self::RIGHT);
         // Forward: L y = b.
         forward_rows(&self.u_left, rows, left, C);
         forward_rows(&self.u_right, rows, right, C);
-        for j in 0..5 {
+        for j in 0..T {
             for k in 0..7 {
                 sub_scaled(rows, C, j, left + k, self.w_left[(k, j)]);
                 sub_scaled(rows, C, j, right + k, self.w_right[(k, j)]);
@@ -390,7 +411,7 @@ impl MassMatrixCholesky {
         // Backward: Lᵀ x = y.
         backward_rows(&self.u_trunk, rows, 0, C);
         for k in 0..7 {
-            for j in 0..5 {
+            for j in 0..T {
                 sub_scaled(rows, C, left + k, j, self.w_left[(k, j)]);
                 sub_scaled(rows, C, right + k, j, self.w_right[(k, j)]);
             }
@@ -402,17 +423,18 @@ impl MassMatrixCholesky {
 
     /// The factor `L` in the original speed order: `M = L Lᵀ` with `L` lower triangular
     /// after the permutation `[left arm, right arm, trunk]` (for inspection and tests).
-    pub fn factor(&self) -> SMatrix<f64, 19, 19> {
-        let mut l = SMatrix::<f64, 19, 19>::zeros();
-        l.fixed_view_mut::<7, 7>(5, 5)
+    pub fn factor(&self) -> SMatrix<f64, N, N> {
+        let (left, right) = (Self::LEFT, Self::RIGHT);
+        let mut l = SMatrix::<f64, N, N>::zeros();
+        l.fixed_view_mut::<7, 7>(left, left)
             .copy_from(&self.u_left.u.transpose());
-        l.fixed_view_mut::<7, 7>(12, 12)
+        l.fixed_view_mut::<7, 7>(right, right)
             .copy_from(&self.u_right.u.transpose());
-        l.fixed_view_mut::<5, 7>(0, 5)
+        l.fixed_view_mut::<T, 7>(0, left)
             .copy_from(&self.w_left.transpose());
-        l.fixed_view_mut::<5, 7>(0, 12)
+        l.fixed_view_mut::<T, 7>(0, right)
             .copy_from(&self.w_right.transpose());
-        l.fixed_view_mut::<5, 5>(0, 0)
+        l.fixed_view_mut::<T, T>(0, 0)
             .copy_from(&self.u_trunk.u.transpose());
         l
     }
@@ -423,7 +445,7 @@ impl MassMatrixCholesky {
         for i in 0..7 {
             d *= self.u_left.u[(i, i)] * self.u_right.u[(i, i)];
         }
-        for i in 0..5 {
+        for i in 0..T {
             d *= self.u_trunk.u[(i, i)];
         }
         d * d
@@ -585,7 +607,8 @@ impl Krang {
 #[cfg(feature = "fixed-wheels")]
 impl KrangFixedWheels {
     /// Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))` of the fixed-wheel model, by the
-    /// dense fallback [`solve_spd`] (17×17 Cholesky). Allocation-free.
+    /// block Cholesky `BlockCholesky<3, 17>` (its two arms do not couple either).
+    /// Allocation-free.
     ///
     /// # Errors
     /// As [`Krang::try_forward_dynamics`].
@@ -599,7 +622,7 @@ impl KrangFixedWheels {
         finite(u, "u")?;
         finite(tau, "tau")?;
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
-        let ud = solve_spd(&self.mass_matrix(q), &(tau - bias))?;
+        let ud = BlockCholesky::<3, 17>::new(&self.mass_matrix(q))?.solve(&(tau - bias));
         finite(&ud, "u̇")?;
         Ok(ud)
     }

@@ -129,7 +129,7 @@ pub mod two_link {
 
 pub mod forward;
 pub use forward::{
-    Block, ForwardDynamicsError, MassMatrixCholesky, NotPositiveDefinite, solve_spd,
+    Block, BlockCholesky, ForwardDynamicsError, MassMatrixCholesky, NotPositiveDefinite, solve_spd,
 };
 
 pub mod actuators;

@@ -5,7 +5,7 @@
 use krang_dynamics::fixed_wheels::{self, KrangFixedWheels};
 use krang_dynamics::forward::{LEFT_ARM, RIGHT_ARM};
 use krang_dynamics::{
-    Block, ForwardDynamicsError, Krang, MassMatrixCholesky, Params, index, solve_spd,
+    Block, BlockCholesky, ForwardDynamicsError, Krang, MassMatrixCholesky, Params, index, solve_spd,
 };
 use nalgebra::{SMatrix, SVector};
 
@@ -254,7 +254,7 @@ fn each_block_of_the_factor_reports_its_own_failure() {
 }
 
 #[test]
-fn fixed_wheel_dense_fallback_round_trips_and_agrees_with_nalgebra() {
+fn fixed_wheel_block_factor_round_trips_and_agrees_with_nalgebra() {
     let mut rng = Rng(6);
     for case in 0..1000 {
         let mut p = fixed_wheels::Params::default();
@@ -276,6 +276,12 @@ fn fixed_wheel_dense_fallback_round_trips_and_agrees_with_nalgebra() {
         let rhs = tau - k.coriolis(&q, &u) - k.gravity(&q);
         let dense = m.cholesky().unwrap().solve(&rhs);
         assert!((ud - dense).norm() <= 1e-12 * dense.norm(), "case {case}");
+        // The same block factor as Krang's, with a trunk of three speeds: L Lᵀ = M.
+        let l = BlockCholesky::<3, 17>::new(&m).unwrap().factor();
+        assert!(
+            (l * l.transpose() - m).norm() <= 1e-13 * m.norm(),
+            "case {case}"
+        );
     }
 }
 

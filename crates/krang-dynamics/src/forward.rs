@@ -42,11 +42,14 @@ pub const RIGHT_ARM: core::ops::Range<usize> = 12..19;
 /// The diagonal block whose factorisation broke down.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Block {
-    /// The left-arm block `M[5..12, 5..12]`.
+    /// The left-arm block `M[5..12, 5..12]` (Krang; `M[3..10, 3..10]` of the fixed-wheel
+    /// tree).
     LeftArm,
-    /// The right-arm block `M[12..19, 12..19]`.
+    /// The right-arm block `M[12..19, 12..19]` (Krang; `M[10..17, 10..17]` of the fixed-wheel
+    /// tree).
     RightArm,
-    /// The Schur complement onto the trunk block `M[0..5, 0..5]`.
+    /// The Schur complement onto the trunk block `M[0..5, 0..5]` (Krang; `M[0..3, 0..3]` of
+    /// the fixed-wheel tree).
     Trunk,
     /// The whole matrix (dense factorisation, [`solve_spd`]).
     Dense,
@@ -304,7 +307,8 @@ impl<const T: usize, const N: usize> BlockCholesky<T, N> {
     #[inline(always)]
     fn new_in(m: &SMatrix<f64, N, N>) -> Result<Self, NotPositiveDefinite> {
         // Built in place: the blocks are read straight from `m` into the fields, and the
-        // factorisation runs on them (no intermediate copies of the 1.5 KB structure).
+        // factorisation runs on them (no intermediate copies of the structure, 1.5 KB for
+        // Krang).
         let mut f = Self {
             u_left: Upper::from_lower_at(m, Self::LEFT),
             u_right: Upper::from_lower_at(m, Self::RIGHT),

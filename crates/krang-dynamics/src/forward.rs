@@ -457,7 +457,8 @@ impl<const T: usize, const N: usize> BlockCholesky<T, N> {
 }
 
 /// Generic dense fallback: `x = A⁻¹ b` for a symmetric positive definite `A` (any fixed
-/// size) by a Cholesky factorisation of the lower triangle, on the stack.
+/// size) by nalgebra's Cholesky factorisation of the lower triangle, on the stack. Krang's
+/// models use [`BlockCholesky`] instead.
 ///
 /// # Errors
 /// [`NotPositiveDefinite`] (`block: Block::Dense`) if a pivot is not positive (or is NaN).
@@ -465,59 +466,10 @@ pub fn solve_spd<const N: usize>(
     a: &SMatrix<f64, N, N>,
     b: &SVector<f64, N>,
 ) -> Result<SVector<f64, N>, NotPositiveDefinite> {
-    let f = cholesky_left_looking(a).ok_or(NotPositiveDefinite {
+    let factor = a.cholesky().ok_or(NotPositiveDefinite {
         block: Block::Dense,
     })?;
-    let mut x = *b;
-    forward_subst(&f, &mut x);
-    backward_subst(&f, &mut x);
-    Ok(x)
-}
-
-/// The upper Cholesky factor of an N×N symmetric positive definite matrix for any `N`, reading
-/// the lower triangle of `a` only; `None` if a pivot is not positive (or is NaN).
-///
-/// Left-looking (each entry a dot product of the columns before it): for the fixed-wheel
-/// tree's 17×17 matrix this is faster than the right-looking [`Upper::step`] in a loop
-/// (whose trailing updates then go through memory) and than nalgebra's `Cholesky`.
-#[inline(always)]
-fn cholesky_left_looking<const N: usize>(a: &SMatrix<f64, N, N>) -> Option<Upper<N>> {
-    let mut f = Upper {
-        u: SMatrix::<f64, N, N>::zeros(),
-        inv_diag: [0.0; N],
-    };
-    let s = f.u.as_mut_slice();
-    for j in 0..N {
-        let cj = j * N;
-        let d = a[(j, j)] - dot(&s[cj..cj + j], &s[cj..cj + j]);
-        if d.is_nan() || d <= 0.0 {
-            return None;
-        }
-        let ujj = nalgebra::ComplexField::sqrt(d); // `f64::sqrt` needs std
-        let inv = ujj * (1.0 / d);
-        s[cj + j] = ujj;
-        f.inv_diag[j] = inv;
-        for i in j + 1..N {
-            let ci = i * N;
-            s[ci + j] = (a[(i, j)] - dot(&s[cj..cj + j], &s[ci..ci + j])) * inv;
-        }
-    }
-    Some(f)
-}
-
-/// `b ← U⁻¹ b` (= `L⁻ᵀ b`).
-#[inline(always)]
-fn backward_subst<const N: usize>(f: &Upper<N>, b: &mut SVector<f64, N>) {
-    let us = f.u.as_slice();
-    let y = b.as_mut_slice();
-    for i in (0..N).rev() {
-        let ci = i * N;
-        let xi = y[i] * f.inv_diag[i];
-        y[i] = xi;
-        for (yk, uki) in y[..i].iter_mut().zip(&us[ci..ci + i]) {
-            *yk -= uki * xi;
-        }
-    }
+    Ok(factor.solve(b))
 }
 
 impl Krang {

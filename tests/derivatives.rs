@@ -329,35 +329,14 @@ fn forward_dynamics_derivatives_match_central_differences() {
         let (q, u, _) = random_state(&mut r, 19);
         let (_, _, t) = random_state(&mut r, 19);
         let (q, u, tau) = (sv::<19>(&q), sv::<19>(&u), sv::<19>(&t) * 10.0);
-        let fd = k.forward_dynamics_derivatives(&q, &u, &tau);
-        assert_eq!(fd.ud, k.forward_dynamics(&q, &u, &tau));
-        let (mut fq, mut fu, mut ft) = (
-            SMatrix::<f64, 19, 19>::zeros(),
-            SMatrix::<f64, 19, 19>::zeros(),
-            SMatrix::<f64, 19, 19>::zeros(),
+        let e = fd_derivative_errors(
+            &k.forward_dynamics_derivatives(&q, &u, &tau),
+            |q, u, tau| k.forward_dynamics(q, u, tau),
+            (&q, &u, &tau),
         );
-        for j in 0..19 {
-            let shift = |v: &SVector<f64, 19>, h: f64| {
-                let mut w = *v;
-                w[j] += h;
-                w
-            };
-            fq.set_column(
-                j,
-                &richardson(&|h| k.forward_dynamics(&shift(&q, h), &u, &tau), 1e-3),
-            );
-            fu.set_column(
-                j,
-                &richardson(&|h| k.forward_dynamics(&q, &shift(&u, h), &tau), 1e-3),
-            );
-            ft.set_column(
-                j,
-                &richardson(&|h| k.forward_dynamics(&q, &u, &shift(&tau, h)), 1e-3),
-            );
+        for (w, e) in worst.iter_mut().zip(e) {
+            *w = w.max(e);
         }
-        worst[0] = worst[0].max(mat_err(fd.dud_dq.as_slice(), fq.as_slice()));
-        worst[1] = worst[1].max(mat_err(fd.dud_du.as_slice(), fu.as_slice()));
-        worst[2] = worst[2].max(mat_err(fd.minv.as_slice(), ft.as_slice()));
     }
     eprintln!(
         "FD derivatives: ∂u̇/∂q {:.1e}, ∂u̇/∂u {:.1e}, M⁻¹ {:.1e}",
@@ -423,10 +402,41 @@ fn fixed_wheel_forward_dynamics_derivatives_match_central_differences() {
     }
 }
 
+/// Relative errors `[∂u̇/∂q, ∂u̇/∂u, M⁻¹]` of the forward-dynamics derivatives `d` at
+/// `(q, u, τ)` against Richardson central differences of the forward dynamics `fd`, after
+/// checking that `d.ud` is `fd` at that state, bit for bit.
+fn fd_derivative_errors<const N: usize>(
+    d: &kanegen_runtime::ForwardDynamicsDerivatives<f64, N>,
+    fd: impl Fn(&SVector<f64, N>, &SVector<f64, N>, &SVector<f64, N>) -> SVector<f64, N>,
+    (q, u, tau): (&SVector<f64, N>, &SVector<f64, N>, &SVector<f64, N>),
+) -> [f64; 3] {
+    assert_eq!(d.ud, fd(q, u, tau));
+    let shift = |v: &SVector<f64, N>, j: usize, h: f64| {
+        let mut w = *v;
+        w[j] += h;
+        w
+    };
+    let (mut fq, mut fu, mut ft) = (
+        SMatrix::<f64, N, N>::zeros(),
+        SMatrix::<f64, N, N>::zeros(),
+        SMatrix::<f64, N, N>::zeros(),
+    );
+    for j in 0..N {
+        fq.set_column(j, &richardson(&|h| fd(&shift(q, j, h), u, tau), 1e-3));
+        fu.set_column(j, &richardson(&|h| fd(q, &shift(u, j, h), tau), 1e-3));
+        ft.set_column(j, &richardson(&|h| fd(q, u, &shift(tau, j, h)), 1e-3));
+    }
+    [
+        mat_err(d.dud_dq.as_slice(), fq.as_slice()),
+        mat_err(d.dud_du.as_slice(), fu.as_slice()),
+        mat_err(d.minv.as_slice(), ft.as_slice()),
+    ]
+}
+
 /// The trait's forward-dynamics derivatives (`InverseDynamicsDerivatives`, which every module
-/// generated with `inverse_dynamics_derivatives` implements) against Richardson central
-/// differences of the trait's `forward_dynamics`, on `draws` random states: worst relative
-/// errors of `[∂u̇/∂q, ∂u̇/∂u, M⁻¹]`, written once for any robot.
+/// generated with `inverse_dynamics_derivatives` implements) against central differences of
+/// the trait's `forward_dynamics` ([`fd_derivative_errors`]), on `draws` random states: the
+/// worst errors, written once for any robot.
 fn trait_fd_derivatives_errors<R, const N: usize>(
     robot: &R,
     r: &mut impl FnMut() -> f64,
@@ -435,9 +445,6 @@ fn trait_fd_derivatives_errors<R, const N: usize>(
 where
     R: kanegen_runtime::InverseDynamicsDerivatives<N, Scalar = f64>,
 {
-    let fd = |q: &SVector<f64, N>, u: &SVector<f64, N>, tau: &SVector<f64, N>| {
-        kanegen_runtime::RobotDynamics::forward_dynamics(robot, q, u, tau).unwrap()
-    };
     let mut worst = [0.0f64; 3];
     for _ in 0..draws {
         let (q, u, t) = random_state(r, N);
@@ -445,25 +452,14 @@ where
         let d = robot
             .forward_dynamics_derivatives(&q, &u, &tau)
             .expect("physical parameters");
-        assert_eq!(d.ud, fd(&q, &u, &tau));
-        let shift = |v: &SVector<f64, N>, j: usize, h: f64| {
-            let mut w = *v;
-            w[j] += h;
-            w
-        };
-        let (mut fq, mut fu, mut ft) = (
-            SMatrix::<f64, N, N>::zeros(),
-            SMatrix::<f64, N, N>::zeros(),
-            SMatrix::<f64, N, N>::zeros(),
+        let e = fd_derivative_errors(
+            &d,
+            |q, u, tau| kanegen_runtime::RobotDynamics::forward_dynamics(robot, q, u, tau).unwrap(),
+            (&q, &u, &tau),
         );
-        for j in 0..N {
-            fq.set_column(j, &richardson(&|h| fd(&shift(&q, j, h), &u, &tau), 1e-3));
-            fu.set_column(j, &richardson(&|h| fd(&q, &shift(&u, j, h), &tau), 1e-3));
-            ft.set_column(j, &richardson(&|h| fd(&q, &u, &shift(&tau, j, h)), 1e-3));
+        for (w, e) in worst.iter_mut().zip(e) {
+            *w = w.max(e);
         }
-        worst[0] = worst[0].max(mat_err(d.dud_dq.as_slice(), fq.as_slice()));
-        worst[1] = worst[1].max(mat_err(d.dud_du.as_slice(), fu.as_slice()));
-        worst[2] = worst[2].max(mat_err(d.minv.as_slice(), ft.as_slice()));
     }
     worst
 }

@@ -12,6 +12,8 @@
 //! * `forward_dynamics/fixed_wheels`: `KrangFixedWheels::forward_dynamics` (17 speeds,
 //!   `BlockCholesky<3, 17>`), at the trunk and arm coordinates of the same states;
 //! * `fd_derivatives/generated`: `Krang::forward_dynamics_derivatives` (u̇, ∂u̇/∂q, ∂u̇/∂u, M⁻¹);
+//! * `fd_derivatives/fixed_wheels`: `KrangFixedWheels::try_forward_dynamics_derivatives` (17
+//!   speeds), at the same states as `forward_dynamics/fixed_wheels`;
 //! * `linearize/generated`: `Krang::linearize` (A 38×38, B 38×18).
 //!
 //! Every variant cycles through the same 8 random states, inputs behind `black_box`.
@@ -118,6 +120,12 @@ fn bench(c: &mut Criterion) {
     let fixed = krang_dynamics::fixed_wheels::KrangFixedWheels::default();
     cycle!("forward_dynamics/fixed_wheels", |q, u, ud| fixed
         .forward_dynamics(
+            &q.fixed_rows::<17>(2).into_owned(),
+            &u.fixed_rows::<17>(2).into_owned(),
+            &(ud.fixed_rows::<17>(2) * 10.0)
+        ));
+    cycle!("fd_derivatives/fixed_wheels", |q, u, ud| fixed
+        .try_forward_dynamics_derivatives(
             &q.fixed_rows::<17>(2).into_owned(),
             &u.fixed_rows::<17>(2).into_owned(),
             &(ud.fixed_rows::<17>(2) * 10.0)

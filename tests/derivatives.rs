@@ -402,6 +402,21 @@ fn fixed_wheel_forward_dynamics_derivatives_match_central_differences() {
     }
 }
 
+/// The forward-dynamics derivatives through a block Cholesky factor (`block`) equal those
+/// through the dense one (`dense`) to 10⁻¹¹ relative.
+fn block_equals_dense<const N: usize>(
+    block: &kanegen_runtime::ForwardDynamicsDerivatives<f64, N>,
+    dense: &kanegen_runtime::ForwardDynamicsDerivatives<f64, N>,
+) {
+    for (b, d) in [
+        (block.dud_dq, dense.dud_dq),
+        (block.dud_du, dense.dud_du),
+        (block.minv, dense.minv),
+    ] {
+        assert!(mat_err(d.as_slice(), b.as_slice()) <= 1e-11, "{d} vs {b}");
+    }
+}
+
 /// Relative errors `[∂u̇/∂q, ∂u̇/∂u, M⁻¹]` of the forward-dynamics derivatives `d` at
 /// `(q, u, τ)` against Richardson central differences of the forward dynamics `fd`, after
 /// checking that `d.ud` is `fd` at that state, bit for bit.
@@ -497,21 +512,26 @@ fn every_generated_robot_has_forward_dynamics_derivatives_through_the_trait() {
         ] {
             assert!(worst.iter().all(|&w| w <= 1e-6), "{name}: {worst:?}");
         }
-        // Krang's inherent derivatives (block Cholesky) equal the trait's (dense).
+        // Krang's and the fixed-wheel tree's inherent derivatives (block Cholesky) equal the
+        // trait's (dense).
         let (q, u, t) = random_state(&mut r, 19);
         let (q, u, tau) = (sv::<19>(&q), sv::<19>(&u), sv::<19>(&t) * 10.0);
-        let block = k.forward_dynamics_derivatives(&q, &u, &tau);
-        let dense = kanegen_runtime::InverseDynamicsDerivatives::forward_dynamics_derivatives(
-            &k, &q, &u, &tau,
-        )
-        .unwrap();
-        for (b, d) in [
-            (block.dud_dq, dense.dud_dq),
-            (block.dud_du, dense.dud_du),
-            (block.minv, dense.minv),
-        ] {
-            assert!(mat_err(d.as_slice(), b.as_slice()) <= 1e-11, "{d} vs {b}");
-        }
+        block_equals_dense(
+            &k.forward_dynamics_derivatives(&q, &u, &tau),
+            &kanegen_runtime::InverseDynamicsDerivatives::forward_dynamics_derivatives(
+                &k, &q, &u, &tau,
+            )
+            .unwrap(),
+        );
+        let (q, u, t) = random_state(&mut r, 17);
+        let (q, u, tau) = (sv::<17>(&q), sv::<17>(&u), sv::<17>(&t) * 10.0);
+        block_equals_dense(
+            &f.try_forward_dynamics_derivatives(&q, &u, &tau).unwrap(),
+            &kanegen_runtime::InverseDynamicsDerivatives::forward_dynamics_derivatives(
+                &f, &q, &u, &tau,
+            )
+            .unwrap(),
+        );
     }
     // Non-physical parameters: None, not NaNs.
     let bad = kd::Params {

@@ -81,6 +81,11 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
                 0.0
             }
             "solve_only" => black_box(&chol_fixed).solve(black_box(ud))[7],
+            "solve_57" => {
+                let mut x = SMatrix::<f64, 19, 57>::from_element(ud[3]);
+                black_box(&chol_fixed).solve_columns_mut(black_box(&mut x));
+                x[(7, 40)]
+            }
             "mass_matrix_cholesky" => {
                 let m = black_box(k).mass_matrix(black_box(q));
                 let chol = krang_dynamics::MassMatrixCholesky::new(black_box(&m)).unwrap();

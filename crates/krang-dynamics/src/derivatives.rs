@@ -18,12 +18,12 @@
 //! with `q̇ = u` (the wheeled base's x and ψ are integrated from ẋ and ψ̇ like every other
 //! coordinate).
 
-use kanegen_runtime::InverseDynamicsDerivatives;
+use kanegen_runtime::{InverseDynamicsDerivatives, RobotDynamics};
 use nalgebra::{SMatrix, SVector};
 
 use crate::Krang;
 use crate::actuators::ACTUATOR_COUNT;
-use crate::forward::{MassMatrixCholesky, NotPositiveDefinite};
+use crate::forward::{BlockCholesky, MassMatrixCholesky, NotPositiveDefinite};
 
 /// The forward-dynamics derivatives of an `N`-speed model at one state (`u̇`, `∂u̇/∂q`,
 /// `∂u̇/∂u`, `M⁻¹`): `kanegen_runtime`'s struct in `f64`, which every generated robot with
@@ -65,6 +65,52 @@ fn state_space<const N: usize, const X: usize, const I: usize>(
     (a, b)
 }
 
+/// Forward dynamics and its derivatives at `(q, u, τ)` with the block Cholesky factor of
+/// `M(q)` already computed (Krang's and the fixed-wheel tree's, whose `linearize` reuses it):
+/// `derivatives` is the model's generated `inverse_dynamics_derivatives` (`N×D`, `D = 2N`),
+/// and `[−∂τ/∂q | −∂τ/∂u | I]` (`N×C`, `C = 3N`: column-major, the blocks are consecutive
+/// slices) is solved in one pass, `M⁻¹` itself being its last block.
+fn forward_dynamics_derivatives_with<
+    R,
+    const T: usize,
+    const N: usize,
+    const D: usize,
+    const C: usize,
+>(
+    robot: &R,
+    chol: &BlockCholesky<T, N>,
+    (q, u, tau): (&SVector<f64, N>, &SVector<f64, N>, &SVector<f64, N>),
+    derivatives: impl FnOnce(&SVector<f64, N>) -> SMatrix<f64, N, D>,
+) -> ForwardDynamicsDerivatives<N>
+where
+    R: RobotDynamics<N, Scalar = f64>,
+{
+    const {
+        assert!(
+            D == 2 * N && C == 3 * N,
+            "[∂τ/∂q | ∂τ/∂u] and [∂τ/∂q | ∂τ/∂u | I]"
+        )
+    };
+    let bias = robot.inverse_dynamics(q, u, &SVector::zeros());
+    let ud = chol.solve(&(tau - bias));
+    let d = derivatives(&ud);
+    let mut x = SMatrix::<f64, N, C>::zeros();
+    let (dx, ix) = x.as_mut_slice().split_at_mut(N * D);
+    for (x, d) in dx.iter_mut().zip(d.as_slice()) {
+        *x = -d;
+    }
+    for i in 0..N {
+        ix[(N + 1) * i] = 1.0;
+    }
+    chol.solve_columns_mut(&mut x);
+    ForwardDynamicsDerivatives {
+        ud,
+        dud_dq: square_block(&x, 0),
+        dud_du: square_block(&x, 1),
+        minv: square_block(&x, 2),
+    }
+}
+
 impl Krang {
     /// `(∂τ/∂q, ∂τ/∂u)` of inverse dynamics at `(q, u, u̇)`: the generated
     /// [`inverse_dynamics_derivatives`](Self::inverse_dynamics_derivatives) as two 19×19
@@ -104,26 +150,9 @@ impl Krang {
         u: &SVector<f64, 19>,
         tau: &SVector<f64, 19>,
     ) -> ForwardDynamicsDerivatives<19> {
-        let bias = self.inverse_dynamics(q, u, &SVector::zeros());
-        let ud = chol.solve(&(tau - bias));
-        // X = [−∂τ/∂q | −∂τ/∂u | I] (column-major: the blocks are consecutive slices), then
-        // X ← M⁻¹ X: the 57 right-hand sides in one solve.
-        let d = self.inverse_dynamics_derivatives(q, u, &ud);
-        let mut x = SMatrix::<f64, 19, 57>::zeros();
-        let (dx, ix) = x.as_mut_slice().split_at_mut(19 * 38);
-        for (x, d) in dx.iter_mut().zip(d.as_slice()) {
-            *x = -d;
-        }
-        for i in 0..19 {
-            ix[20 * i] = 1.0;
-        }
-        chol.solve_columns_mut(&mut x);
-        ForwardDynamicsDerivatives {
-            ud,
-            dud_dq: square_block(&x, 0),
-            dud_du: square_block(&x, 1),
-            minv: square_block(&x, 2),
-        }
+        forward_dynamics_derivatives_with::<_, 5, 19, 38, 57>(self, chol, (q, u, tau), |ud| {
+            self.inverse_dynamics_derivatives(q, u, ud)
+        })
     }
 
     /// As [`try_forward_dynamics_derivatives`](Self::try_forward_dynamics_derivatives), but
@@ -202,11 +231,12 @@ impl crate::fixed_wheels::KrangFixedWheels {
         InverseDynamicsDerivatives::inverse_dynamics_partials(self, q, u, ud)
     }
 
-    /// Forward dynamics and its derivatives at `(q, u, τ)` (see
-    /// [`Krang::try_forward_dynamics_derivatives`]), with nalgebra's dense Cholesky (17×17,
-    /// on the stack): the runtime trait's
-    /// [`forward_dynamics_derivatives`](kanegen_runtime::InverseDynamicsDerivatives::forward_dynamics_derivatives),
-    /// with this crate's error.
+    /// Forward dynamics and its derivatives at `(q, u, τ)`, as
+    /// [`Krang::try_forward_dynamics_derivatives`]: the block Cholesky factor of `M(q)`
+    /// ([`mass_matrix_cholesky`](Self::mass_matrix_cholesky)), one derivative pass, one solve
+    /// over the 51 right-hand sides `[−∂τ/∂q | −∂τ/∂u | I]`. Allocation-free. (The runtime
+    /// trait's [`forward_dynamics_derivatives`](kanegen_runtime::InverseDynamicsDerivatives::forward_dynamics_derivatives)
+    /// gives the same values through nalgebra's dense Cholesky.)
     ///
     /// # Errors
     /// [`NotPositiveDefinite`] for non-physical parameters.
@@ -216,11 +246,13 @@ impl crate::fixed_wheels::KrangFixedWheels {
         u: &SVector<f64, 17>,
         tau: &SVector<f64, 17>,
     ) -> Result<ForwardDynamicsDerivatives<17>, NotPositiveDefinite> {
-        InverseDynamicsDerivatives::forward_dynamics_derivatives(self, q, u, tau).ok_or(
-            NotPositiveDefinite {
-                block: crate::forward::Block::Dense,
-            },
-        )
+        let chol = self.mass_matrix_cholesky(q)?;
+        Ok(forward_dynamics_derivatives_with::<_, 3, 17, 34, 51>(
+            self,
+            &chol,
+            (q, u, tau),
+            |ud| self.inverse_dynamics_derivatives(q, u, ud),
+        ))
     }
 
     /// The linearization `(A, B)` of the fixed-wheel model's `ẋ = f(x, τ)` for `x = [q; u]`

@@ -14,6 +14,9 @@
 //! * `fd_derivatives/generated`: `Krang::forward_dynamics_derivatives` (u̇, ∂u̇/∂q, ∂u̇/∂u, M⁻¹);
 //! * `fd_derivatives/fixed_wheels`: `KrangFixedWheels::try_forward_dynamics_derivatives` (17
 //!   speeds), at the same states as `forward_dynamics/fixed_wheels`;
+//! * `fd_derivatives/fixed_wheels_trait`: the same through the runtime trait's provided
+//!   `InverseDynamicsDerivatives::forward_dynamics_derivatives` (a dense Cholesky), what every
+//!   generated robot without a block factor of its own gets;
 //! * `linearize/generated`: `Krang::linearize` (A 38×38, B 38×18).
 //!
 //! Every variant cycles through the same 8 random states, inputs behind `black_box`.
@@ -130,6 +133,14 @@ fn bench(c: &mut Criterion) {
             &u.fixed_rows::<17>(2).into_owned(),
             &(ud.fixed_rows::<17>(2) * 10.0)
         ));
+    cycle!("fd_derivatives/fixed_wheels_trait", |q, u, ud| {
+        krang_dynamics::InverseDynamicsDerivatives::forward_dynamics_derivatives(
+            &fixed,
+            &q.fixed_rows::<17>(2).into_owned(),
+            &u.fixed_rows::<17>(2).into_owned(),
+            &(ud.fixed_rows::<17>(2) * 10.0),
+        )
+    });
     let a = SVector::<f64, 18>::from_element(1.0);
     cycle!("linearize/generated", |q, u, _ud| k.linearize(q, u, &a));
     g.finish();

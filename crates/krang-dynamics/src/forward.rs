@@ -26,6 +26,7 @@
 
 use core::fmt;
 
+use kanegen_runtime::isa::Arith;
 use kanegen_runtime::pair::{F64x2, PairArith};
 use nalgebra::{SMatrix, SVector};
 
@@ -164,7 +165,7 @@ impl<const N: usize> Upper<N> {
     /// one multiply and one multiply-subtract. [`MassMatrixCholesky::new`] calls it with
     /// literal pivot indices, so that each step indexes its block with constants.
     #[inline(always)]
-    fn step(&mut self, k: usize) -> bool {
+    fn step<A: Arith<f64>>(&mut self, k: usize) -> bool {
         let s = self.u.as_mut_slice();
         let d = s[k * N + k];
         if d.is_nan() || d <= 0.0 {
@@ -180,26 +181,32 @@ impl<const N: usize> Upper<N> {
         for i in k + 1..N {
             let uki = s[i * N + k];
             for j in k + 1..=i {
-                s[i * N + j] -= s[j * N + k] * uki;
+                s[i * N + j] = A::mul_add(-s[j * N + k], uki, s[i * N + j]);
             }
         }
         true
     }
 }
 
+/// `acc − a · b` (the dot product subtracted term by term, each term one multiply-add of `A`).
 #[inline(always)]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+fn sub_dot<A: Arith<f64>>(acc: f64, a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(acc, |acc, (x, y)| A::mul_add(-x, *y, acc))
 }
 
 /// `b ← U⁻ᵀ b` (= `L⁻¹ b`), column by column.
 #[inline(always)]
-fn forward_subst<const N: usize, const C: usize>(f: &Upper<N>, b: &mut SMatrix<f64, N, C>) {
+fn forward_subst<A: Arith<f64>, const N: usize, const C: usize>(
+    f: &Upper<N>,
+    b: &mut SMatrix<f64, N, C>,
+) {
     let us = f.u.as_slice();
     for col in b.as_mut_slice().chunks_exact_mut(N) {
         for i in 0..N {
             let ci = i * N;
-            col[i] = (col[i] - dot(&us[ci..ci + i], &col[..i])) * f.inv_diag[i];
+            col[i] = sub_dot::<A>(col[i], &us[ci..ci + i], &col[..i]) * f.inv_diag[i];
         }
     }
 }
@@ -260,14 +267,18 @@ impl<const T: usize, const N: usize> BlockCholesky<T, N> {
                 "the pivots and substitutions are written out for T ≤ 8"
             );
         };
-        kanegen_runtime::isa::dispatch(
+        // Compiled for the baseline and, run when the CPU has it, for x86-64-v3, whose copy
+        // fuses every update into one multiply-add (results differ in the last bits).
+        kanegen_runtime::isa::dispatch_fused(
             #[inline(always)]
-            || Self::new_in(m),
+            || Self::new_in::<kanegen_runtime::isa::Plain>(m),
+            #[inline(always)]
+            || Self::new_in::<kanegen_runtime::isa::Fused>(m),
         )
     }
 
     #[inline(always)]
-    fn new_in(m: &SMatrix<f64, N, N>) -> Result<Self, NotPositiveDefinite> {
+    fn new_in<A: Arith<f64>>(m: &SMatrix<f64, N, N>) -> Result<Self, NotPositiveDefinite> {
         // Built in place: the blocks are read straight from `m` into the fields, and the
         // factorisation runs on them (no intermediate copies of the structure, 1.5 KB for
         // Krang).
@@ -284,7 +295,7 @@ impl<const T: usize, const N: usize> BlockCholesky<T, N> {
         // block with constants.
         macro_rules! pivots {
             ($f:expr, $block:expr, $n:expr; $($k:literal)*) => {$(
-                if $k < $n && !$f.step($k) {
+                if $k < $n && !$f.step::<A>($k) {
                     return Err(NotPositiveDefinite { block: $block });
                 }
             )*};
@@ -304,8 +315,8 @@ impl<const T: usize, const N: usize> BlockCholesky<T, N> {
         pivots!(f.u_right, Block::RightArm, 7; 5);
         pivots!(f.u_left, Block::LeftArm, 7; 6);
         pivots!(f.u_right, Block::RightArm, 7; 6);
-        forward_subst(&f.u_left, &mut f.w_left);
-        forward_subst(&f.u_right, &mut f.w_right);
+        forward_subst::<A, 7, T>(&f.u_left, &mut f.w_left);
+        forward_subst::<A, 7, T>(&f.u_right, &mut f.w_right);
         let (wl, wr) = (f.w_left.as_slice(), f.w_right.as_slice());
         let s = f.u_trunk.u.as_mut_slice();
         for i in 0..T {
@@ -313,7 +324,7 @@ impl<const T: usize, const N: usize> BlockCholesky<T, N> {
             for j in 0..=i {
                 let (lj, rj) = (&wl[7 * j..7 * j + 7], &wr[7 * j..7 * j + 7]);
                 // S(i, j), j ≤ i, is stored as U(j, i).
-                s[T * i + j] -= dot(li, lj) + dot(ri, rj);
+                s[T * i + j] = sub_dot::<A>(sub_dot::<A>(s[T * i + j], li, lj), ri, rj);
             }
         }
         pivots!(f.u_trunk, Block::Trunk, T; 0 1 2 3 4 5 6 7);

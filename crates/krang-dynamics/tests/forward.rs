@@ -234,19 +234,23 @@ fn non_physical_parameters_are_reported_not_panicked() {
 #[test]
 fn each_block_of_the_factor_reports_its_own_failure() {
     // A body's inertial parameters times -10 make the blocks it enters indefinite: an arm body
-    // its arm's block (the arms' pivots are taken in turn), the torso the trunk's Schur
-    // complement.
-    for (body, block) in [
-        ("5l", Block::LeftArm),
-        ("9r", Block::RightArm),
-        ("3", Block::Trunk),
+    // its arm's block (the two arms' pivots are taken together, step by step, so the arm whose
+    // pivot fails at the earlier step is named, and the left one at the same step), the torso
+    // the trunk's Schur complement.
+    for (bodies, block) in [
+        (&["5l"][..], Block::LeftArm),
+        (&["9r"], Block::RightArm),
+        (&["3"], Block::Trunk),
+        (&["9l", "5r"], Block::RightArm),
+        (&["9l", "9r"], Block::LeftArm),
     ] {
         let mut values = Params::default().to_array();
-        for kind in INERTIAL {
+        for (body, kind) in bodies.iter().flat_map(|b| INERTIAL.map(|k| (b, k))) {
             let name = format!("{kind}{body}");
             let i = Params::NAMES.iter().position(|n| *n == name).unwrap();
             values[i] *= -10.0;
         }
+        let body = bodies.join(", ");
         let m = Krang::new(Params::from_array(values)).mass_matrix(&SVector::zeros());
         let err = MassMatrixCholesky::new(&m).unwrap_err();
         assert_eq!(err.block, block, "body {body}");

@@ -125,6 +125,21 @@ fn finite<const N: usize>(
     }
 }
 
+/// `each!(i < n; { … })` runs the block for `i` = 0, 1, … while `i < n`, written out with
+/// literal indices up to 8 (every `n` here is at most 8: `BlockCholesky::new` asserts `T ≤ 8`),
+/// so that the block indexes its arrays with constants.
+macro_rules! each {
+    ($i:ident < $n:expr; $body:block) => {
+        each!(@ $i < $n; $body; 0 1 2 3 4 5 6 7)
+    };
+    (@ $i:ident < $n:expr; $body:block; $($k:literal)*) => {$(
+        if $k < $n {
+            let $i: usize = $k;
+            $body
+        }
+    )*};
+}
+
 // The factors are kept as upper-triangular `U = Lᵀ` in nalgebra's column-major storage, so
 // that every inner loop below runs over a contiguous column prefix, with the reciprocals of
 // their diagonals: the substitutions multiply instead of dividing.
@@ -203,14 +218,14 @@ pub type MassMatrixCholesky = BlockCholesky<5, 19>;
 /// operational-space controller) with [`solve`](Self::solve).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BlockCholesky<const T: usize, const N: usize> {
-    /// `U_l = L_lᵀ` (upper).
-    u_left: Upper<7>,
-    /// `U_r = L_rᵀ` (upper).
-    u_right: Upper<7>,
-    /// `W_l = L_l⁻¹ M[left, trunk]`.
-    w_left: SMatrix<f64, 7, T>,
-    /// `W_r = L_r⁻¹ M[right, trunk]`.
-    w_right: SMatrix<f64, 7, T>,
+    /// The arms' factors side by side, the left arm's in the low lane and the right arm's in
+    /// the high lane of each value: `U_l = L_lᵀ`, `U_r = L_rᵀ` (upper),
+    /// `U(k, i) = arm_u[7 i + k]` for `k ≤ i`.
+    arm_u: [F64x2; 49],
+    /// The reciprocals of their diagonals.
+    arm_inv_diag: [F64x2; 7],
+    /// `W_l = L_l⁻¹ M[left, trunk]` and `W_r = L_r⁻¹ M[right, trunk]`, `W(i, j) = arm_w[j][i]`.
+    arm_w: [[F64x2; 7]; T],
     /// `U_s = L_sᵀ` (upper), the factor of the Schur complement.
     u_trunk: Upper<T>,
 }
@@ -314,21 +329,15 @@ impl<const T: usize, const N: usize> BlockCholesky<T, N> {
             }
         }
         let mut f = Self {
-            u_left: Upper {
-                u: SMatrix::from_fn(|k, i| u[7 * i + k].lo()),
-                inv_diag: core::array::from_fn(|i| inv[i].lo()),
-            },
-            u_right: Upper {
-                u: SMatrix::from_fn(|k, i| u[7 * i + k].hi()),
-                inv_diag: core::array::from_fn(|i| inv[i].hi()),
-            },
-            w_left: SMatrix::from_fn(|i, j| w[j][i].lo()),
-            w_right: SMatrix::from_fn(|i, j| w[j][i].hi()),
+            arm_u: u,
+            arm_inv_diag: inv,
+            arm_w: w,
             u_trunk: Upper::from_lower_at(m, 0),
         };
         // The Schur complement S = T − W_lᵀ W_l − W_rᵀ W_r: both arms' products in the two
         // lanes, then the lanes' sum.
         let s = f.u_trunk.u.as_mut_slice();
+        let w = &f.arm_w;
         for i in 0..T {
             for j in 0..=i {
                 let acc = w[i]
@@ -358,9 +367,69 @@ impl<const T: usize, const N: usize> BlockCholesky<T, N> {
         x
     }
 
-    /// `b ← M⁻¹ b`, in place: [`solve_columns_mut`](Self::solve_columns_mut) with one column.
+    /// `b ← M⁻¹ b`, in place, with the two arms in the two lanes of [`F64x2`] values, as the
+    /// factor is stored (the trunk's part in `f64`). Each entry gets the bits that
+    /// [`solve_columns_mut`](Self::solve_columns_mut) gives `b` as one of its columns (the
+    /// same operations in the same order, lane by lane).
     pub fn solve_mut(&self, b: &mut SVector<f64, N>) {
-        self.solve_columns_mut::<1>(b);
+        kanegen_runtime::isa::dispatch_pair_with(
+            b,
+            #[inline(always)]
+            |b, lanes| self.solve_one::<kanegen_runtime::isa::Plain, _>(b, lanes),
+            #[inline(always)]
+            |b, lanes| self.solve_one::<kanegen_runtime::isa::Fused, _>(b, lanes),
+        );
+    }
+
+    #[inline(always)]
+    fn solve_one<A: Arith<f64>, P: PairArith>(&self, b: &mut SVector<f64, N>, lanes: P) {
+        let (left, right) = (Self::LEFT, Self::RIGHT);
+        let mut t = [0.0; T];
+        t.copy_from_slice(&b.as_slice()[..T]);
+        let mut a: [F64x2; 7] = core::array::from_fn(|i| F64x2::new(b[left + i], b[right + i]));
+        let (u, inv, w) = (&self.arm_u, &self.arm_inv_diag, &self.arm_w);
+        let (ut, inv_t) = (&self.u_trunk.u, &self.u_trunk.inv_diag);
+        // Forward: L z = b (the arms, their coupling into the trunk's rows, the trunk).
+        each!(i < 7; {
+            for k in 0..i {
+                a[i] = lanes.mul_add(a[k], -u[7 * i + k], a[i]);
+            }
+            a[i] = a[i] * inv[i];
+        });
+        each!(j < T; {
+            let mut acc = F64x2::splat(0.0);
+            each!(k < 7; { acc = lanes.mul_add(a[k], w[j][k], acc); });
+            t[j] -= acc.lo() + acc.hi();
+        });
+        each!(i < T; {
+            for k in 0..i {
+                t[i] = A::mul_add(t[k], -ut[(k, i)], t[i]);
+            }
+            t[i] *= inv_t[i];
+        });
+        // Backward: Lᵀ x = z (the trunk, its coupling into the arms' rows, the arms).
+        each!(r < T; {
+            let i = T - 1 - r;
+            t[i] *= inv_t[i];
+            for k in 0..i {
+                t[k] = A::mul_add(t[i], -ut[(k, i)], t[k]);
+            }
+        });
+        each!(k < 7; {
+            each!(j < T; { a[k] = lanes.mul_add(F64x2::splat(t[j]), -w[j][k], a[k]); });
+        });
+        each!(r < 7; {
+            let i = 6 - r;
+            a[i] = a[i] * inv[i];
+            for k in 0..i {
+                a[k] = lanes.mul_add(a[i], -u[7 * i + k], a[k]);
+            }
+        });
+        b.as_mut_slice()[..T].copy_from_slice(&t);
+        for (i, ai) in a.iter().enumerate() {
+            b[left + i] = ai.lo();
+            b[right + i] = ai.hi();
+        }
     }
 
     /// `X ← M⁻¹ X` for the `C` columns of `x` at once (e.g. `M⁻¹ ∂τ/∂q`, `M⁻¹ B`, `M⁻¹` itself).
@@ -409,74 +478,72 @@ impl<const T: usize, const N: usize> BlockCholesky<T, N> {
     /// block (left arm, right arm, trunk).
     #[inline(always)]
     fn solve_pair<A: PairArith>(&self, y: &mut [F64x2; N], lanes: A) {
-        // Every loop whose bound is not a literal is written out with literal indices (the
-        // triangles' rows, the trunk's `T`), so that after unrolling every index of `y` is a
+        // Every loop whose bound is not a literal is written out with literal indices (`each!`:
+        // the triangles' rows, the trunk's `T`), so that after unrolling every index of `y` is a
         // constant and `y` lives in registers: `F64x2` is one vector register, which the
         // compiler does not split into scalars as it does `[f64; 4]` lanes (measured: a
         // `Lanes<4>` version of this kernel ran in scalar instructions, 30 % slower than the
         // old row-at-a-time form).
-        macro_rules! each {
-            // (`T ≤ 8`: `new` asserts it.)
-            ($i:ident < $n:expr; $body:block) => {
-                each!(@ $i < $n; $body; 0 1 2 3 4 5 6 7)
-            };
-            (@ $i:ident < $n:expr; $body:block; $($k:literal)*) => {$(
-                if $k < $n {
-                    let $i: usize = $k;
-                    $body
-                }
-            )*};
-        }
         // y[d] −= y[s] · a (a multiplication and a subtraction, or one fused multiply-add).
         macro_rules! sub {
             ($d:expr, $s:expr, $a:expr) => {
                 y[$d] = lanes.mul_add(y[$s], -$a, y[$d])
             };
         }
-        // U⁻ᵀ (= L⁻¹) and U⁻¹ (= L⁻ᵀ) of an upper factor `f` of size `m` on `y[at..at + m]`.
+        // U⁻ᵀ (= L⁻¹) and U⁻¹ (= L⁻ᵀ) of an upper factor of size `m` (entry `U(k, i)` given
+        // by `u`, the reciprocals of its diagonal by `inv`) on `y[at..at + m]`.
         macro_rules! forward {
-            ($f:expr, $m:expr, $at:expr) => {
+            ($u:expr, $inv:expr, $m:expr, $at:expr) => {
                 each!(i < $m; {
                     for k in 0..i {
-                        sub!($at + i, $at + k, $f.u[(k, i)]);
+                        sub!($at + i, $at + k, $u(k, i));
                     }
-                    y[$at + i] = y[$at + i] * $f.inv_diag[i];
+                    y[$at + i] = y[$at + i] * $inv(i);
                 })
             };
         }
         macro_rules! backward {
-            ($f:expr, $m:expr, $at:expr) => {
+            ($u:expr, $inv:expr, $m:expr, $at:expr) => {
                 each!(r < $m; {
                     let i = $m - 1 - r;
-                    y[$at + i] = y[$at + i] * $f.inv_diag[i];
+                    y[$at + i] = y[$at + i] * $inv(i);
                     for k in 0..i {
-                        sub!($at + k, $at + i, $f.u[(k, i)]);
+                        sub!($at + k, $at + i, $u(k, i));
                     }
                 })
             };
         }
         let (left, right) = (Self::LEFT, Self::RIGHT);
-        // Forward: each arm, then its coupling into the trunk's rows (z_t −= Wᵀ z_arm), then the
-        // Schur complement's factor.
-        forward!(self.u_left, 7, left);
+        let (u, inv, w) = (&self.arm_u, &self.arm_inv_diag, &self.arm_w);
+        let (ut, inv_t) = (&self.u_trunk.u, &self.u_trunk.inv_diag);
+        let u_left = |k: usize, i: usize| u[7 * i + k].lo();
+        let u_right = |k: usize, i: usize| u[7 * i + k].hi();
+        let (inv_left, inv_right) = (|i: usize| inv[i].lo(), |i: usize| inv[i].hi());
+        let (u_trunk, inv_trunk) = (|k: usize, i: usize| ut[(k, i)], |i: usize| inv_t[i]);
+        // Forward: the arms, their coupling into the trunk's rows (z_t −= W_lᵀ z_l + W_rᵀ z_r,
+        // each arm's products summed before the two sums are added, as `solve_mut` does), then
+        // the Schur complement's factor.
+        forward!(u_left, inv_left, 7, left);
+        forward!(u_right, inv_right, 7, right);
         each!(j < T; {
-            each!(k < 7; { sub!(j, left + k, self.w_left[(k, j)]); });
+            let (mut l, mut r) = (F64x2::splat(0.0), F64x2::splat(0.0));
+            each!(k < 7; {
+                l = lanes.mul_add(y[left + k], w[j][k].lo(), l);
+                r = lanes.mul_add(y[right + k], w[j][k].hi(), r);
+            });
+            y[j] = y[j] - (l + r);
         });
-        forward!(self.u_right, 7, right);
-        each!(j < T; {
-            each!(k < 7; { sub!(j, right + k, self.w_right[(k, j)]); });
-        });
-        forward!(self.u_trunk, T, 0);
+        forward!(u_trunk, inv_trunk, T, 0);
         // Backward: the trunk, then each arm (y_arm −= W y_t, then its factor).
-        backward!(self.u_trunk, T, 0);
+        backward!(u_trunk, inv_trunk, T, 0);
         each!(k < 7; {
-            each!(j < T; { sub!(left + k, j, self.w_left[(k, j)]); });
+            each!(j < T; {
+                sub!(left + k, j, w[j][k].lo());
+                sub!(right + k, j, w[j][k].hi());
+            });
         });
-        backward!(self.u_left, 7, left);
-        each!(k < 7; {
-            each!(j < T; { sub!(right + k, j, self.w_right[(k, j)]); });
-        });
-        backward!(self.u_right, 7, right);
+        backward!(u_left, inv_left, 7, left);
+        backward!(u_right, inv_right, 7, right);
     }
 
     /// The factor `L` in the original speed order: `M = L Lᵀ` with `L` lower triangular
@@ -484,14 +551,18 @@ impl<const T: usize, const N: usize> BlockCholesky<T, N> {
     pub fn factor(&self) -> SMatrix<f64, N, N> {
         let (left, right) = (Self::LEFT, Self::RIGHT);
         let mut l = SMatrix::<f64, N, N>::zeros();
-        l.fixed_view_mut::<7, 7>(left, left)
-            .copy_from(&self.u_left.u.transpose());
-        l.fixed_view_mut::<7, 7>(right, right)
-            .copy_from(&self.u_right.u.transpose());
-        l.fixed_view_mut::<T, 7>(0, left)
-            .copy_from(&self.w_left.transpose());
-        l.fixed_view_mut::<T, 7>(0, right)
-            .copy_from(&self.w_right.transpose());
+        for i in 0..7 {
+            for k in 0..=i {
+                // L(i, k) = U(k, i).
+                l[(left + i, left + k)] = self.arm_u[7 * i + k].lo();
+                l[(right + i, right + k)] = self.arm_u[7 * i + k].hi();
+            }
+            for j in 0..T {
+                // The trunk's rows: L(j, arm i) = W(i, j).
+                l[(j, left + i)] = self.arm_w[j][i].lo();
+                l[(j, right + i)] = self.arm_w[j][i].hi();
+            }
+        }
         l.fixed_view_mut::<T, T>(0, 0)
             .copy_from(&self.u_trunk.u.transpose());
         l
@@ -500,8 +571,8 @@ impl<const T: usize, const N: usize> BlockCholesky<T, N> {
     /// `det M`, the product of the squared diagonal of `L`.
     pub fn determinant(&self) -> f64 {
         let mut d = 1.0;
-        for i in 0..7 {
-            d *= self.u_left.u[(i, i)] * self.u_right.u[(i, i)];
+        for u in self.arm_u.iter().step_by(8) {
+            d *= u.lo() * u.hi();
         }
         for i in 0..T {
             d *= self.u_trunk.u[(i, i)];

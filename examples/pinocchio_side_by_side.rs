@@ -25,6 +25,7 @@
 //! q <dof numbers>    u …    ud …
 //! M <dof² numbers, by rows>    c …    g …    tau …    C <dof², by rows>
 //! dtau_dq <dof², by rows>    dtau_du <dof², by rows>
+//! fd <dof numbers: the generated forward dynamics u̇ = FD(q, u, τ) of that τ>
 //! ```
 //!
 //! The C++ harness (`benches/pinocchio/harness.cpp`) builds a `pinocchio::Model` per case,
@@ -140,6 +141,12 @@ fn write(dir: &Path) -> Result<(), String> {
         let (dq, du) = k.inverse_dynamics_partials(&q, &u, &ud);
         line(&mut out, "dtau_dq", rows(&dq));
         line(&mut out, "dtau_du", rows(&du));
+        let tau = k.inverse_dynamics(&q, &u, &ud);
+        line(
+            &mut out,
+            "fd",
+            k.forward_dynamics(&q, &u, &tau).iter().copied(),
+        );
     }
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let path = dir.join("cases.txt");
@@ -175,6 +182,11 @@ fn time(dir: &Path) -> Result<(), String> {
                 V::from_column_slice(&c.ud),
             )
         })
+        .collect();
+    // Forward dynamics of each state's τ = ID(q, u, u̇) (the harness solves the same).
+    let fd_states: Vec<(V, V, V)> = states
+        .iter()
+        .map(|(q, u, ud)| (*q, *u, k.inverse_dynamics(q, u, ud)))
         .collect();
     let k = &k;
     // The `_into` forms write into a matrix the caller keeps, as Pinocchio writes `data.M`, `data.C`.
@@ -238,6 +250,12 @@ fn time(dir: &Path) -> Result<(), String> {
                 black_box(k).inverse_dynamics_derivatives_into(q, u, ud, black_box(&mut d_out));
             }),
         ),
+        (
+            "forward_dynamics",
+            time_one(&fd_states, |q, u, tau| {
+                black_box(black_box(k).forward_dynamics(q, u, tau));
+            }),
+        ),
     ];
     let mut text = String::new();
     for (name, ns) in results {
@@ -286,7 +304,7 @@ fn best_times(path: &Path) -> Result<(BTreeMap<String, f64>, usize), String> {
 type Row = (&'static str, &'static str, &'static str, &'static str);
 
 /// The rows of the comparison, in the order printed.
-const ROWS: [Row; 9] = [
+const ROWS: [Row; 11] = [
     (
         "`mass_matrix` (M)",
         "mass_matrix",
@@ -340,6 +358,18 @@ const ROWS: [Row; 9] = [
         "inverse_dynamics_derivatives_into",
         "`computeRNEADerivatives` (∂τ/∂q, ∂τ/∂v, ∂τ/∂a = M)",
         "rnea_derivatives",
+    ),
+    (
+        "`forward_dynamics` (u̇, block Cholesky)",
+        "forward_dynamics",
+        "`crba` + `nonLinearEffects` + Eigen `LLT` on the 19 speeds",
+        "fd_reduced",
+    ),
+    (
+        "`forward_dynamics` (u̇, block Cholesky)",
+        "forward_dynamics",
+        "`aba` (20 speeds: the base without its rolling constraint, other dynamics)",
+        "aba",
     ),
 ];
 

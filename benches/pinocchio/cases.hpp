@@ -196,10 +196,11 @@ inline Exported read_model(Reader & rd) {
 }
 
 // One case of cases.txt: a parameter set's model, a state and kanegen's results for them
-// (dtau_dq, dtau_du: the generated `inverse_dynamics_derivatives`).
+// (dtau_dq, dtau_du: the generated `inverse_dynamics_derivatives`; fd: `forward_dynamics` of
+// that state's tau, which returns ud up to round-off).
 struct Case {
   Exported ex;
-  VectorXd q, u, ud, c, g, tau;
+  VectorXd q, u, ud, c, g, tau, fd;
   MatrixXd M, C, dtau_dq, dtau_du;
 };
 
@@ -228,6 +229,7 @@ inline std::vector<Case> read_cases(const std::string & dir) {
     c.C = rd.mat("C", dof);
     c.dtau_dq = rd.mat("dtau_dq", dof);
     c.dtau_du = rd.mat("dtau_du", dof);
+    c.fd = rd.vec("fd", dof);
     cases.push_back(std::move(c));
   }
   if (cases.empty()) throw std::runtime_error(path + ": no cases");

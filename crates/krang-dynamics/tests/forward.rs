@@ -169,6 +169,37 @@ fn solving_many_columns_at_once_equals_solving_each_column() {
     }
 }
 
+#[test]
+fn solving_once_equals_factorising_then_solving() {
+    let mut rng = Rng(8);
+    for case in 0..300 {
+        let k = krang_for(case, 30, &mut rng);
+        let (q, _, b) = random_state::<19>(&mut rng);
+        let m = k.mass_matrix(&q);
+        let once = MassMatrixCholesky::solve_once(&m, &b).unwrap();
+        assert_eq!(
+            once,
+            MassMatrixCholesky::new(&m).unwrap().solve(&b),
+            "case {case}"
+        );
+    }
+    // The same error, naming the same block, for a matrix that is not positive definite.
+    let mut values = Params::default().to_array();
+    for kind in INERTIAL {
+        let i = Params::NAMES
+            .iter()
+            .position(|n| *n == format!("{kind}9r"))
+            .unwrap();
+        values[i] *= -10.0;
+    }
+    let m = Krang::new(Params::from_array(values)).mass_matrix(&SVector::zeros());
+    let b = SVector::<f64, 19>::from_element(1.0);
+    assert_eq!(
+        MassMatrixCholesky::solve_once(&m, &b).unwrap_err(),
+        MassMatrixCholesky::new(&m).unwrap_err()
+    );
+}
+
 fn dense_det(m: &SMatrix<f64, 19, 19>) -> f64 {
     let l = m.cholesky().unwrap();
     l.l().diagonal().iter().map(|d| d * d).product()

@@ -184,15 +184,7 @@ fn solving_once_equals_factorising_then_solving() {
         );
     }
     // The same error, naming the same block, for a matrix that is not positive definite.
-    let mut values = Params::default().to_array();
-    for kind in INERTIAL {
-        let i = Params::NAMES
-            .iter()
-            .position(|n| *n == format!("{kind}9r"))
-            .unwrap();
-        values[i] *= -10.0;
-    }
-    let m = Krang::new(Params::from_array(values)).mass_matrix(&SVector::zeros());
+    let m = Krang::new(inertia_times_minus_ten(&["9r"])).mass_matrix(&SVector::zeros());
     let b = SVector::<f64, 19>::from_element(1.0);
     assert_eq!(
         MassMatrixCholesky::solve_once(&m, &b).unwrap_err(),
@@ -262,6 +254,17 @@ fn non_physical_parameters_are_reported_not_panicked() {
     assert!(k.try_forward_dynamics(&q, &u, &u).is_err());
 }
 
+/// The default parameters with the inertial parameters of `bodies` (`"5l"`, `"3"`, …) times −10.
+fn inertia_times_minus_ten(bodies: &[&str]) -> Params {
+    let mut values = Params::default().to_array();
+    for (body, kind) in bodies.iter().flat_map(|b| INERTIAL.map(|k| (b, k))) {
+        let name = format!("{kind}{body}");
+        let i = Params::NAMES.iter().position(|n| *n == name).unwrap();
+        values[i] *= -10.0;
+    }
+    Params::from_array(values)
+}
+
 #[test]
 fn each_block_of_the_factor_reports_its_own_failure() {
     // A body's inertial parameters times -10 make the blocks it enters indefinite: an arm body
@@ -275,14 +278,8 @@ fn each_block_of_the_factor_reports_its_own_failure() {
         (&["9l", "5r"], Block::RightArm),
         (&["9l", "9r"], Block::LeftArm),
     ] {
-        let mut values = Params::default().to_array();
-        for (body, kind) in bodies.iter().flat_map(|b| INERTIAL.map(|k| (b, k))) {
-            let name = format!("{kind}{body}");
-            let i = Params::NAMES.iter().position(|n| *n == name).unwrap();
-            values[i] *= -10.0;
-        }
         let body = bodies.join(", ");
-        let m = Krang::new(Params::from_array(values)).mass_matrix(&SVector::zeros());
+        let m = Krang::new(inertia_times_minus_ten(bodies)).mass_matrix(&SVector::zeros());
         let err = MassMatrixCholesky::new(&m).unwrap_err();
         assert_eq!(err.block, block, "body {body}");
     }

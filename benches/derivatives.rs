@@ -12,6 +12,8 @@
 //! * `forward_dynamics/fixed_wheels`: `KrangFixedWheels::forward_dynamics` (17 speeds,
 //!   `BlockCholesky<3, 17>`), at the trunk and arm coordinates of the same states;
 //! * `fd_derivatives/generated`: `Krang::forward_dynamics_derivatives` (u̇, ∂u̇/∂q, ∂u̇/∂u, M⁻¹);
+//! * `forward_dynamics/fixed_wheels_trait`: the same through the runtime trait's provided
+//!   `RobotDynamics::forward_dynamics` (a dense Cholesky), what every generated robot has;
 //! * `fd_derivatives/fixed_wheels`: `KrangFixedWheels::try_forward_dynamics_derivatives` (17
 //!   speeds), at the same states as `forward_dynamics/fixed_wheels`;
 //! * `fd_derivatives/fixed_wheels_trait`: the same through the runtime trait's provided
@@ -127,6 +129,14 @@ fn bench(c: &mut Criterion) {
             &u.fixed_rows::<17>(2).into_owned(),
             &(ud.fixed_rows::<17>(2) * 10.0)
         ));
+    cycle!("forward_dynamics/fixed_wheels_trait", |q, u, ud| {
+        krang_dynamics::RobotDynamics::forward_dynamics(
+            &fixed,
+            &q.fixed_rows::<17>(2).into_owned(),
+            &u.fixed_rows::<17>(2).into_owned(),
+            &(ud.fixed_rows::<17>(2) * 10.0),
+        )
+    });
     cycle!("fd_derivatives/fixed_wheels", |q, u, ud| fixed
         .try_forward_dynamics_derivatives(
             &q.fixed_rows::<17>(2).into_owned(),

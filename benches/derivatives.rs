@@ -68,6 +68,20 @@ fn central_differences(k: &Krang, q: &V, u: &V, ud: &V) -> SMatrix<f64, 19, 38> 
     d
 }
 
+/// The fixed-wheel tree's state from one of Krang's: the trunk and arm coordinates and speeds
+/// (Krang's entries 2..19), and `τ = 10 u̇` as the Krang entries use.
+fn fixed_wheel_state(
+    q: &V,
+    u: &V,
+    ud: &V,
+) -> (SVector<f64, 17>, SVector<f64, 17>, SVector<f64, 17>) {
+    (
+        q.fixed_rows::<17>(2).into_owned(),
+        u.fixed_rows::<17>(2).into_owned(),
+        ud.fixed_rows::<17>(2) * 10.0,
+    )
+}
+
 fn bench(c: &mut Criterion) {
     let k = Krang::default();
     let s = states();
@@ -123,32 +137,22 @@ fn bench(c: &mut Criterion) {
         .forward_dynamics_derivatives(q, u, &(ud * 10.0)));
     // The fixed-wheel tree (17 speeds): the block factor with a trunk of three speeds.
     let fixed = krang_dynamics::fixed_wheels::KrangFixedWheels::default();
-    cycle!("forward_dynamics/fixed_wheels", |q, u, ud| fixed
-        .forward_dynamics(
-            &q.fixed_rows::<17>(2).into_owned(),
-            &u.fixed_rows::<17>(2).into_owned(),
-            &(ud.fixed_rows::<17>(2) * 10.0)
-        ));
-    cycle!("forward_dynamics/fixed_wheels_trait", |q, u, ud| {
-        krang_dynamics::RobotDynamics::forward_dynamics(
-            &fixed,
-            &q.fixed_rows::<17>(2).into_owned(),
-            &u.fixed_rows::<17>(2).into_owned(),
-            &(ud.fixed_rows::<17>(2) * 10.0),
-        )
+    cycle!("forward_dynamics/fixed_wheels", |q, u, ud| {
+        let (q, u, tau) = fixed_wheel_state(q, u, ud);
+        fixed.forward_dynamics(&q, &u, &tau)
     });
-    cycle!("fd_derivatives/fixed_wheels", |q, u, ud| fixed
-        .try_forward_dynamics_derivatives(
-            &q.fixed_rows::<17>(2).into_owned(),
-            &u.fixed_rows::<17>(2).into_owned(),
-            &(ud.fixed_rows::<17>(2) * 10.0)
-        ));
+    cycle!("forward_dynamics/fixed_wheels_trait", |q, u, ud| {
+        let (q, u, tau) = fixed_wheel_state(q, u, ud);
+        krang_dynamics::RobotDynamics::forward_dynamics(&fixed, &q, &u, &tau)
+    });
+    cycle!("fd_derivatives/fixed_wheels", |q, u, ud| {
+        let (q, u, tau) = fixed_wheel_state(q, u, ud);
+        fixed.try_forward_dynamics_derivatives(&q, &u, &tau)
+    });
     cycle!("fd_derivatives/fixed_wheels_trait", |q, u, ud| {
+        let (q, u, tau) = fixed_wheel_state(q, u, ud);
         krang_dynamics::InverseDynamicsDerivatives::forward_dynamics_derivatives(
-            &fixed,
-            &q.fixed_rows::<17>(2).into_owned(),
-            &u.fixed_rows::<17>(2).into_owned(),
-            &(ud.fixed_rows::<17>(2) * 10.0),
+            &fixed, &q, &u, &tau,
         )
     });
     let a = SVector::<f64, 18>::from_element(1.0);

@@ -19,7 +19,7 @@
 //! writes the entries no statement stores after the body. A result with more entries than one
 //! vectorized loop can store is computed in several loops ([`loop_parts`]). `L` is a const
 //! generic: one emitted body for every batch size and both layouts.
-//! README "Instruction sets at run time and batched evaluation" has the measurements.
+//! `docs/measurement-log.md` ("Batched evaluation: measured") has the measurements.
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;

@@ -612,6 +612,32 @@ fn krang_linearization_matches_central_differences() {
     }
 }
 
+/// `linearize` forms `B`'s lower block `M⁻¹ B_act` from the columns of `M⁻¹` (a joint's column
+/// or a wheel's sum of three) instead of solving with `B_act`: equal to the block factor's solve
+/// of `B_act` to rounding, and exactly zero where `M⁻¹ B_act` has no term.
+#[test]
+fn krang_linearization_input_matrix_equals_the_factors_solve_of_the_actuator_matrix() {
+    let mut r = rng(1211);
+    for draw in 0..100 {
+        let k = if draw == 0 {
+            kd::Krang::default()
+        } else {
+            random_krang(&mut r)
+        };
+        let (q, u, _) = random_state(&mut r, 19);
+        let a: SVector<f64, 18> = SVector::from_fn(|_, _| 20.0 * (r() - 0.5));
+        let (_, bm) = k.linearize(&sv(&q), &sv(&u), &a);
+        let mut solved = k.actuator_matrix();
+        k.mass_matrix_cholesky(&sv(&q))
+            .unwrap()
+            .solve_columns_mut(&mut solved);
+        let lower = bm.fixed_rows::<19>(19).into_owned();
+        let e = mat_err(lower.as_slice(), solved.as_slice());
+        assert!(e <= 1e-12, "draw {draw}: M⁻¹ B_act {e:e}");
+        assert!(bm.fixed_rows::<19>(0).iter().all(|&x| x == 0.0));
+    }
+}
+
 /// The upright pose with the joints held: `q` with the pitch that puts the centre of mass above
 /// the axle, and the joint torques that cancel gravity there.
 fn upright(k: &kd::Krang) -> (SVector<f64, 19>, SVector<f64, 18>) {

@@ -16,7 +16,7 @@
 //! calls) with 4 or 8 states, counted as one call, `_s8` the structure-of-arrays form
 //! (`_batch_soa_into`) with 8 states; with
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
-//! across calls) and `forward_dynamics_derivatives`; with the feature `kinematics`
+//! across calls), `forward_dynamics_derivatives` and `linearize`; with the feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
 //! `com_jacobian` and `sin_cos_17`), the
 //! number of calls, and optionally the instruction set (`baseline` or `x86-64-v3`; default: the
@@ -163,6 +163,14 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
                 black_box(k)
                     .forward_dynamics_derivatives(black_box(q), black_box(u), black_box(ud))
                     .dud_dq[(7, 9)]
+            }
+            #[cfg(feature = "derivatives")]
+            "linearize" => {
+                // Any actuator torques: the state's accelerations, as numbers.
+                let a = SVector::<f64, 18>::from_fn(|i, _| ud[i]);
+                black_box(k)
+                    .linearize(black_box(q), black_box(u), black_box(&a))
+                    .1[(25, 3)]
             }
             #[cfg(feature = "derivatives")]
             "inverse_dynamics_derivatives_into" => {

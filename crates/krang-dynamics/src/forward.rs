@@ -693,6 +693,12 @@ impl Krang {
     /// positive definite (non-physical parameters) or an input or the result is not finite, every
     /// entry of the result is NaN.
     ///
+    /// `Krang` also implements the runtime trait [`RobotDynamics`](crate::RobotDynamics), whose
+    /// provided `forward_dynamics` returns an `Option` through a dense Cholesky (what generic code
+    /// over any robot calls: `RobotDynamics::forward_dynamics(&k, &q, &u, &tau)`). In method
+    /// syntax, `k.forward_dynamics(…)` is this inherent method: Rust picks an inherent method
+    /// before a trait's.
+    ///
     /// ```
     /// use krang_dynamics::{Krang, index};
     /// use nalgebra::SVector;

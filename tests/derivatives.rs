@@ -561,21 +561,36 @@ fn krang_f(k: &kd::Krang, x: &SVector<f64, 38>, a: &SVector<f64, 18>) -> SVector
     out
 }
 
+/// A draw of the linearization tests: the default parameters first, then random physical
+/// ones, with a random state and random actuator torques.
+fn linearization_draw(
+    r: &mut impl FnMut() -> f64,
+    draw: usize,
+) -> (
+    kd::Krang,
+    SVector<f64, 19>,
+    SVector<f64, 19>,
+    SVector<f64, 18>,
+) {
+    let k = if draw == 0 {
+        kd::Krang::default()
+    } else {
+        random_krang(r)
+    };
+    let (q, u, _) = random_state(r, 19);
+    let a = SVector::from_fn(|_, _| 20.0 * (r() - 0.5));
+    (k, sv(&q), sv(&u), a)
+}
+
 #[test]
 fn krang_linearization_matches_central_differences() {
     let mut r = rng(1210);
     for draw in 0..50 {
-        let k = if draw == 0 {
-            kd::Krang::default()
-        } else {
-            random_krang(&mut r)
-        };
-        let (q, u, _) = random_state(&mut r, 19);
-        let a: SVector<f64, 18> = SVector::from_fn(|_, _| 20.0 * (r() - 0.5));
+        let (k, q, u, a) = linearization_draw(&mut r, draw);
         let mut x = SVector::<f64, 38>::zeros();
-        x.fixed_rows_mut::<19>(0).copy_from(&sv::<19>(&q));
-        x.fixed_rows_mut::<19>(19).copy_from(&sv::<19>(&u));
-        let (am, bm) = k.linearize(&sv(&q), &sv(&u), &a);
+        x.fixed_rows_mut::<19>(0).copy_from(&q);
+        x.fixed_rows_mut::<19>(19).copy_from(&u);
+        let (am, bm) = k.linearize(&q, &u, &a);
         let mut fa = SMatrix::<f64, 38, 38>::zeros();
         for j in 0..38 {
             fa.set_column(
@@ -614,21 +629,15 @@ fn krang_linearization_matches_central_differences() {
 
 /// `linearize` forms `B`'s lower block `M⁻¹ B_act` from the columns of `M⁻¹` (a joint's column
 /// or a wheel's sum of three) instead of solving with `B_act`: equal to the block factor's solve
-/// of `B_act` to rounding, and exactly zero where `M⁻¹ B_act` has no term.
+/// of `B_act` to rounding; `B`'s upper block (`∂q̇/∂a`) stays exactly zero.
 #[test]
 fn krang_linearization_input_matrix_equals_the_factors_solve_of_the_actuator_matrix() {
     let mut r = rng(1211);
     for draw in 0..100 {
-        let k = if draw == 0 {
-            kd::Krang::default()
-        } else {
-            random_krang(&mut r)
-        };
-        let (q, u, _) = random_state(&mut r, 19);
-        let a: SVector<f64, 18> = SVector::from_fn(|_, _| 20.0 * (r() - 0.5));
-        let (_, bm) = k.linearize(&sv(&q), &sv(&u), &a);
+        let (k, q, u, a) = linearization_draw(&mut r, draw);
+        let (_, bm) = k.linearize(&q, &u, &a);
         let mut solved = k.actuator_matrix();
-        k.mass_matrix_cholesky(&sv(&q))
+        k.mass_matrix_cholesky(&q)
             .unwrap()
             .solve_columns_mut(&mut solved);
         let lower = bm.fixed_rows::<19>(19).into_owned();

@@ -1,6 +1,6 @@
 //! README.md shows the controller example of `krang-dynamics`; that example is compiled and run as
-//! the crate's doc test. These tests keep the two identical, and every relative link of the README
-//! and of `docs/measurement-log.md` pointing at a file and heading that exist.
+//! the crate's doc test. These tests keep the two identical, and check that every relative link
+//! of the README and of `docs/measurement-log.md` points at a file and a heading that exist.
 
 mod common;
 

@@ -286,7 +286,8 @@ fn binding(stored: bool) -> TokenStream {
 /// (2.9 KB each for 19 speeds). A symmetric matrix's lower entry is stored right after its
 /// upper one (`m[(3, 5)] = m[(5, 3)];`, which LLVM forwards from the register), so no copy is
 /// left at the end. `docs/measurement-log.md` ("Instruction sets at run time and batched
-/// evaluation") has the measurements. Vectors stay scalar-replaced (19 values: in memory they measured slower).
+/// evaluation") has the measurements. Vectors stay scalar-replaced (19 values: in memory they
+/// measured slower).
 fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) -> Result {
     let t = scalar_type(cx.precision);
     let nl = idx(cx.low.dof);
@@ -548,7 +549,8 @@ fn zero_stores(p: &Program, n: usize, mirror: bool) -> Vec<String> {
 pub(super) enum Copies {
     /// The baseline and x86-64-v3 (`isa::dispatch_fused_with`): single-state functions. An
     /// x86-64-v4 copy was measured no faster for them (Krang's M, c, g, τ, C within 5 %) and
-    /// cost 43 % more compile time (`docs/measurement-log.md`, "x86-64-v4 copy of the batched functions").
+    /// cost 43 % more compile time (`docs/measurement-log.md`, "x86-64-v4 copy of the batched
+    /// functions").
     BaselineAndV3,
     /// Also x86-64-v4 (`isa::dispatch_fused_wide_with`): the batched functions, whose loop
     /// over the states LLVM vectorizes 8 lanes wide with AVX-512.

@@ -524,8 +524,9 @@ impl Lowered {
 }
 
 /// The functions whose statements are put in [`subtree_order`] after lowering (where that
-/// lowers the values live at once). Only the Coriolis matrix: measured on Krang (`docs/measurement-log.md`,
-/// "Instruction sets at run time and batched evaluation", "Single state toward 10× Pinocchio"), it
+/// lowers the values live at once). Only the Coriolis matrix: measured on Krang
+/// (`docs/measurement-log.md`, "Instruction sets at run time and batched evaluation", "Single
+/// state toward 10× Pinocchio"), it
 /// cut C's values live from 455 to 236, its instructions per call by 2.5 % and its time by
 /// 1–2 %; for c and τ (111 → 83 and 87 live) the instructions moved by −1.8 % and +1.6 % and
 /// the time not at all or up, so they keep the derivation's order.

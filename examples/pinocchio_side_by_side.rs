@@ -132,16 +132,12 @@ fn write(dir: &Path) -> Result<(), String> {
         line(&mut out, "M", rows(&k.mass_matrix(&q)));
         line(&mut out, "c", k.coriolis(&q, &u).iter().copied());
         line(&mut out, "g", k.gravity(&q).iter().copied());
-        line(
-            &mut out,
-            "tau",
-            k.inverse_dynamics(&q, &u, &ud).iter().copied(),
-        );
+        let tau = k.inverse_dynamics(&q, &u, &ud);
+        line(&mut out, "tau", tau.iter().copied());
         line(&mut out, "C", rows(&k.coriolis_matrix(&q, &u)));
         let (dq, du) = k.inverse_dynamics_partials(&q, &u, &ud);
         line(&mut out, "dtau_dq", rows(&dq));
         line(&mut out, "dtau_du", rows(&du));
-        let tau = k.inverse_dynamics(&q, &u, &ud);
         line(
             &mut out,
             "fd",

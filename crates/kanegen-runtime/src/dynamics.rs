@@ -183,11 +183,12 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
         let ud = factor.solve(&(tau - self.inverse_dynamics(q, u, &SVector::zeros())));
         let (dtau_dq, dtau_du) = self.inverse_dynamics_partials(q, u, &ud);
         let l = factor.l_dirty();
+        let inv_diag = core::array::from_fn(|i| nalgebra::one::<Self::Scalar>() / l[(i, i)]);
         let solve = |b: SMatrix<Self::Scalar, N, N>| {
             let mut bt = b.transpose();
             crate::isa::dispatch(
                 #[inline(always)]
-                || cholesky_solve_transposed(l, &mut bt),
+                || cholesky_solve_transposed(l, &inv_diag, &mut bt),
             );
             bt.transpose()
         };
@@ -201,7 +202,9 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
 }
 
 /// `X ← A⁻¹ X` for `A = L Lᵀ`, given the lower triangle of `l` (its strict upper triangle is
-/// ignored: nalgebra's `Cholesky::l_dirty`) and `xt = Xᵀ`, the right-hand sides as rows.
+/// ignored: nalgebra's `Cholesky::l_dirty`), the reciprocals of its diagonal `inv_diag` (computed
+/// once for the three solves of `forward_dynamics_derivatives`) and `xt = Xᵀ`, the right-hand
+/// sides as rows.
 ///
 /// On the transpose, row `i` of `X` (speed `i` of every right-hand side) is one contiguous
 /// column, so every step of the two triangular substitutions is one `x_i −= l_ik x_k` over all
@@ -212,6 +215,7 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
 #[inline(always)]
 fn cholesky_solve_transposed<T: RealField + Copy, const N: usize, const C: usize>(
     l: &SMatrix<T, N, N>,
+    inv_diag: &[T; N],
     xt: &mut SMatrix<T, C, N>,
 ) {
     // Row k of X is `s[row(k)]`; `sub` is `row dst −= a · row src` (`dst ≠ src`).
@@ -239,11 +243,11 @@ fn cholesky_solve_transposed<T: RealField + Copy, const N: usize, const C: usize
         for k in 0..i {
             sub(s, i, k, l[(i, k)]);
         }
-        scale(s, i, T::one() / l[(i, i)]);
+        scale(s, i, inv_diag[i]);
     }
     // Lᵀ x = y.
     for i in (0..N).rev() {
-        scale(s, i, T::one() / l[(i, i)]);
+        scale(s, i, inv_diag[i]);
         for k in 0..i {
             sub(s, k, i, l[(i, k)]);
         }
@@ -292,7 +296,8 @@ mod tests {
         let (a, b) = spd_and_rhs::<T, N, C>();
         let chol = a.cholesky().unwrap();
         let mut xt = b.transpose();
-        cholesky_solve_transposed(chol.l_dirty(), &mut xt);
+        let l = chol.l_dirty();
+        cholesky_solve_transposed(l, &core::array::from_fn(|i| T::one() / l[(i, i)]), &mut xt);
         let expected = chol.solve(&b);
         let err = (xt.transpose() - expected).norm() / expected.norm();
         assert!(err <= T::from_f64(bound).unwrap(), "{N}×{C}: {err}");

@@ -10,8 +10,11 @@
 //! call of `<function>_batch_into` with `L` states: divide by `L` for the time per state;
 //! `batch<L>_by_value`: `mass_matrix_batch`, which returns the results), `…/soa<L>` (the
 //! structure-of-arrays form `<function>_batch_soa_into`) and `simd/<function>_into/<isa>` (M
-//! and C written into a kept matrix). The states cycle through the profile driver's 64 random
-//! ones.
+//! and C written into a kept matrix). `simd/forward_dynamics/<isa>` and `…/soa<L>` time
+//! `Krang::forward_dynamics` and its batched form `forward_dynamics_batch_soa_into` (not
+//! generated functions: they run M, c + g and the block Cholesky; the single state's
+//! factorisation has no x86-64-v4 copy). The states cycle through the profile driver's 64
+//! random ones (their accelerations taken as the torques of forward dynamics).
 
 use std::hint::black_box;
 use std::time::Duration;
@@ -154,6 +157,21 @@ fn bench_batch_soa<const L: usize>(c: &mut Criterion, k: &Krang, s: &[(V, V, V)]
             black_box(&m);
         })
     });
+    // Forward dynamics (not generated: batched M, batched c + g and the lane block Cholesky),
+    // the accelerations of the states taken as torques.
+    c.bench_function(&format!("simd/forward_dynamics/{tag}/soa{L}"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            let (q, u, tau) = &batches[i];
+            black_box(k).forward_dynamics_batch_soa_into(
+                black_box(q),
+                black_box(u),
+                black_box(tau),
+                &mut v,
+            );
+            black_box(&v);
+        })
+    });
 }
 
 fn simd(c: &mut Criterion) {
@@ -192,6 +210,13 @@ fn simd(c: &mut Criterion) {
             b.iter(|| {
                 i = (i + 1) & 63;
                 black_box(&k).coriolis_matrix(black_box(&s[i].0), black_box(&s[i].1))
+            })
+        });
+        c.bench_function(&format!("simd/forward_dynamics/{tag}"), |b| {
+            b.iter(|| {
+                i = (i + 1) & 63;
+                let (q, u, tau) = &s[i];
+                black_box(&k).forward_dynamics(black_box(q), black_box(u), black_box(tau))
             })
         });
         let mut m = SMatrix::<f64, 19, 19>::zeros();

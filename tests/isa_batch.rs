@@ -9,7 +9,8 @@
 //! sin/cos path in one lane). The `_into` forms write every entry of the caller's
 //! results (filled with NaN before the call) and give the by-value forms' bits. The
 //! structure-of-arrays forms (`*_batch_soa`, at 3 and 8 states) give the array-of-states
-//! forms' bits in every lane.
+//! forms' bits in every lane. Batched forward dynamics (`forward_dynamics_batch_soa_into`,
+//! `forward_dynamics_batch`) gives `forward_dynamics`' bits in every lane, NaN lanes included.
 
 mod common;
 
@@ -289,6 +290,130 @@ fn dispatched_copies_agree_with_the_baseline_to_rounding() {
     );
     assert!(differing > 0, "{best} fused no multiply-add");
     isa::select(best).unwrap();
+}
+
+/// Batched forward dynamics at `L` states (both forms) against `forward_dynamics` of each
+/// state, bit for bit with the active instruction set (NaN lanes included).
+fn check_forward_batch<const L: usize>(k: &kd::Krang, q: &[V; L], u: &[V; L], tau: &[V; L]) {
+    use kd::lanes::{Lanes, soa, state};
+    let mut ud = SVector::<Lanes<L>, 19>::from_element(Lanes::splat(f64::NAN));
+    k.forward_dynamics_batch_soa_into(&soa(q), &soa(u), &soa(tau), &mut ud);
+    let by_states = k.forward_dynamics_batch(q, u, tau);
+    for l in 0..L {
+        let one = k.forward_dynamics(&q[l], &u[l], &tau[l]);
+        let lane = state(&ud, l);
+        assert!(
+            same_bits(lane.as_slice(), one.as_slice()),
+            "{}: lane {l} of {L}: {lane} against {one}",
+            isa::active()
+        );
+        assert!(same_bits(by_states[l].as_slice(), one.as_slice()));
+    }
+}
+
+#[test]
+fn batched_forward_dynamics_equals_forward_dynamics_bit_for_bit() {
+    let _one_at_a_time = isa_lock();
+    let model = model("krang.toml");
+    let mut uniform = rng(1415);
+    let mut nan_lanes = 0;
+    for isa in Isa::ALL.into_iter().filter(|&i| isa::available(i)) {
+        isa::select(isa).unwrap();
+        for draw in 0..30 {
+            let k = krang(&model, &mut uniform);
+            // The accelerations of the draw, scaled, as torques.
+            let (q1, u1, t1) = states::<1>(&mut uniform);
+            check_forward_batch(&k, &q1, &u1, &t1.map(|t| 20.0 * t));
+            let (mut q3, u3, mut t3) = states::<3>(&mut uniform);
+            t3 = t3.map(|t| 20.0 * t);
+            if draw % 3 == 0 {
+                // A lane with a NaN input and a lane with an infinite torque: NaN lanes, the
+                // other lane as alone.
+                q3[0][kd::index::Q3L] = f64::NAN;
+                t3[2][kd::index::XD] = f64::INFINITY;
+                nan_lanes += 2;
+            }
+            check_forward_batch(&k, &q3, &u3, &t3);
+            let (mut q8, u8, t8) = states::<8>(&mut uniform);
+            if draw % 5 == 0 {
+                // A huge angle: that batch's sines and cosines take the per-lane slow path.
+                q8[4][kd::index::Q2R] = 1.0e7;
+            }
+            check_forward_batch(&k, &q8, &u8, &t8.map(|t| 20.0 * t));
+        }
+    }
+    isa::select(isa::detected()).unwrap();
+    assert!(nan_lanes > 0);
+}
+
+#[test]
+fn batched_forward_dynamics_gives_nan_where_the_mass_matrix_is_not_positive_definite() {
+    let _one_at_a_time = isa_lock();
+    let mut uniform = rng(1416);
+    // A non-physical last link of the left arm: M's left-arm block is not positive definite.
+    let mut p = kd::Params::default();
+    p.set("ZZ10l", -1.0).unwrap();
+    let k = kd::Krang::new(p);
+    let (q, u, tau) = states::<4>(&mut uniform);
+    assert!(matches!(
+        k.try_forward_dynamics(&q[0], &u[0], &tau[0]),
+        Err(kd::ForwardDynamicsError::NotPositiveDefinite(_))
+    ));
+    for ud in k.forward_dynamics_batch(&q, &u, &tau) {
+        assert!(ud.iter().all(|x| x.is_nan()), "{ud}");
+    }
+    check_forward_batch(&k, &q, &u, &tau);
+}
+
+/// The lane solver alone, for both block shapes (Krang's trunk of 5 and the fixed-wheel tree's
+/// trunk of 3): every lane gets the bits of `BlockCholesky::solve_once` on its own matrix, and a
+/// lane with a matrix that is not positive definite reports it without disturbing the others.
+#[test]
+fn the_lane_block_solver_equals_the_block_cholesky_of_each_lane() {
+    use kd::forward_batch::block_solve_lanes;
+    use kd::lanes::{Lanes, soa, state};
+    use nalgebra::SMatrix;
+    fn check<const T: usize, const N: usize>(
+        m: &[SMatrix<f64, N, N>; 4],
+        b: &[SVector<f64, N>; 4],
+    ) {
+        let lanes = SMatrix::<Lanes<4>, N, N>::from_fn(|r, c| Lanes::from_fn(|l| m[l][(r, c)]));
+        let mut x = soa(b);
+        let ok = block_solve_lanes::<T, N, 4>(&lanes, &mut x);
+        for l in 0..4 {
+            match kd::BlockCholesky::<T, N>::solve_once(&m[l], &b[l]) {
+                Ok(one) => {
+                    assert!(ok[l], "lane {l}");
+                    assert!(
+                        same_bits(state(&x, l).as_slice(), one.as_slice()),
+                        "lane {l}"
+                    );
+                }
+                Err(_) => assert!(!ok[l], "lane {l}"),
+            }
+        }
+    }
+    let _one_at_a_time = isa_lock();
+    let model = model("krang.toml");
+    let mut uniform = rng(1417);
+    let fixed = kd::fixed_wheels::KrangFixedWheels::default();
+    for isa in Isa::ALL.into_iter().filter(|&i| isa::available(i)) {
+        isa::select(isa).unwrap();
+        for draw in 0..20 {
+            let k = krang(&model, &mut uniform);
+            let (q, _, b) = states::<4>(&mut uniform);
+            let mut m = q.map(|q| k.mass_matrix(&q));
+            if draw % 4 == 0 {
+                // Lane 1 not positive definite (its trunk block), the others as they are.
+                m[1][(2, 2)] = -1.0;
+            }
+            check::<5, 19>(&m, &b);
+            let qf = q.map(|q| SVector::<f64, 17>::from_fn(|i, _| q[i + 2]));
+            let bf = b.map(|b| SVector::<f64, 17>::from_fn(|i, _| b[i + 2]));
+            check::<3, 17>(&qf.map(|q| fixed.mass_matrix(&q)), &bf);
+        }
+    }
+    isa::select(isa::detected()).unwrap();
 }
 
 #[test]

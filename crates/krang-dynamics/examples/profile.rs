@@ -14,7 +14,8 @@
 //! `forward_dynamics`, and `mass_matrix_cholesky` (M, its block factor and one solve);
 //! a suffix `_b4` or `_b8` calls the batched form (`_batch_into`, into arrays kept across
 //! calls) with 4 or 8 states, counted as one call, `_s8` the structure-of-arrays form
-//! (`_batch_soa_into`) with 8 states; with
+//! (`_batch_soa_into`) with 8 states (`forward_dynamics_s8` too; `solve_s8`: the batched
+//! block solve alone, `forward_batch::block_solve_lanes`, on 8 fixed mass matrices); with
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
 //! across calls), `forward_dynamics_derivatives` and `linearize`; with the feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
@@ -68,6 +69,8 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
     let mut vs8 = SVector::<Lanes<8>, 19>::from_element(Lanes::splat(0.0));
     let m_fixed = k.mass_matrix(&s[0].0);
     let chol_fixed = krang_dynamics::MassMatrixCholesky::new(&m_fixed).unwrap();
+    let mut ms8_fixed = SMatrix::<Lanes<8>, 19, 19>::from_element(Lanes::splat(0.0));
+    k.mass_matrix_batch_soa_into(&s8[0].0, &mut ms8_fixed);
     for i in 0..calls {
         let (q, u, ud) = &s[i & 63];
         acc += match f {
@@ -151,6 +154,22 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
                 let (q, u) = &s8[i & 63];
                 let (q, u) = (black_box(q), black_box(u));
                 black_box(k).inverse_dynamics_batch_soa_into(q, u, u, &mut vs8);
+                black_box(&vs8)[7].0[1]
+            }
+            "forward_dynamics_s8" => {
+                // The speeds as the torques too: any finite τ will do.
+                let (q, u) = &s8[i & 63];
+                let (q, u) = (black_box(q), black_box(u));
+                black_box(k).forward_dynamics_batch_soa_into(q, u, u, &mut vs8);
+                black_box(&vs8)[7].0[1]
+            }
+            "solve_s8" => {
+                // The batched block solve alone, on M of the first 8 states (`ms8_fixed`).
+                vs8 = s8[i & 63].1;
+                krang_dynamics::forward_batch::block_solve_lanes::<5, 19, 8>(
+                    black_box(&ms8_fixed),
+                    &mut vs8,
+                );
                 black_box(&vs8)[7].0[1]
             }
             #[cfg(feature = "derivatives")]

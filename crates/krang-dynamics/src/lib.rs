@@ -131,6 +131,7 @@ pub mod forward;
 pub use forward::{
     Block, BlockCholesky, ForwardDynamicsError, MassMatrixCholesky, NotPositiveDefinite, solve_spd,
 };
+pub mod forward_batch;
 
 pub mod actuators;
 

@@ -1,0 +1,356 @@
+//! Batched forward dynamics: `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))` at `L` states per call, for
+//! samplers (sampling-based MPC, MPPI and RL rollouts) that step many states at once.
+//!
+//! [`Krang::forward_dynamics_batch_soa_into`] takes and gives structure-of-arrays vectors
+//! (`SVector<Lanes<L>, 19>`, lane `l` of every entry being state `l`, as the batched M, c, g and
+//! τ do; section "Instruction sets at run time and batched evaluation" of the README):
+//! - `c + g` of every state from one batched inverse-dynamics call at `u̇ = 0`
+//!   (`inverse_dynamics_batch_soa_into`), `M` of every state from `mass_matrix_batch_soa_into`;
+//! - then [`block_solve_lanes`]: the block Cholesky factorisation of [`BlockCholesky`] (arms
+//!   first, no fill-in; see [`crate::forward`]) and its two substitutions, run lane by lane in
+//!   one loop over the states that the compiler vectorizes (8 states per AVX-512 instruction
+//!   in the x86-64-v4 copy, 4 with AVX2).
+//!
+//! Every lane performs the operations of [`BlockCholesky::solve_once`] on one state, in the same
+//! order, with the same multiply-adds (fused in the x86-64-v3 and x86-64-v4 copies, not in the
+//! baseline one), so lane `l` of the result is [`Krang::forward_dynamics`] of state `l` **bit for
+//! bit** with the same instruction set (`tests/forward_batch.rs`). A state whose mass matrix is
+//! not positive definite, whose inputs are not finite or whose result is not finite gets NaN
+//! in every entry, as `forward_dynamics` gives it; the other lanes are unaffected. Nothing
+//! allocates; the hot path has no branch per state.
+//!
+//! [`Krang::forward_dynamics_batch`] is the array-of-states form (`&[SVector<f64, 19>; L]` in,
+//! `[SVector<f64, 19>; L]` out), which copies the states into lanes and back.
+
+use kanegen_runtime::isa::{self, Arith, Fused, Plain};
+use kanegen_runtime::lanes::{Lanes, soa};
+use nalgebra::{ArrayStorage, SMatrix, SVector};
+
+use crate::Krang;
+#[cfg(doc)]
+use crate::forward::BlockCholesky;
+
+/// `each!(i < n; { … })` runs the block for `i` = 0, 1, … while `i < n`, with `i` a literal
+/// (as in [`crate::forward`]): every index in the lane loop's body is then a constant, so the
+/// body is straight-line code that the compiler vectorizes across the states.
+macro_rules! each {
+    ($i:ident < $n:expr; $body:block) => {
+        each!(@ $i < $n; $body; 0 1 2 3 4 5 6 7)
+    };
+    (@ $i:ident < $n:expr; $body:block; $($k:literal)*) => {$(
+        if $k < $n {
+            let $i: usize = $k;
+            $body
+        }
+    )*};
+}
+
+/// `b ← M⁻¹ b` for the `L` states in the lanes of `m` and `b`, by the block Cholesky
+/// factorisation of [`BlockCholesky<T, N>`] (the same operations, in the same order, as
+/// [`BlockCholesky::solve_once`] on each state). Returns, per lane, whether every pivot was
+/// positive (`false` also for a NaN pivot: that lane of `b` is then garbage, never a panic).
+/// Reads the lower triangles of `m`'s blocks and assumes `M[left, right] = 0`, as
+/// [`BlockCholesky::new`] does.
+///
+/// Compiled for the baseline, x86-64-v3 and x86-64-v4 (`isa::dispatch_fused_wide_with`); the
+/// latter two fuse the multiply-adds and give the same bits as each other. Not inlined: it
+/// is vectorized across the states in a function of its own (inlined into the batched forward
+/// dynamics, it ran 5× slower).
+#[inline(never)]
+pub fn block_solve_lanes<const T: usize, const N: usize, const L: usize>(
+    m: &SMatrix<Lanes<L>, N, N>,
+    b: &mut SVector<Lanes<L>, N>,
+) -> [bool; L] {
+    const {
+        assert!(N == T + 14, "N is T trunk speeds and two arms of 7");
+        assert!(
+            T <= 8,
+            "the pivots and substitutions are written out for T ≤ 8"
+        );
+    };
+    isa::dispatch_fused_wide_with(
+        b,
+        #[inline(always)]
+        |b| solve_lanes_in::<Plain, T, N, L>(m, b),
+        #[inline(always)]
+        |b| solve_lanes_in::<Fused, T, N, L>(m, b),
+    )
+}
+
+/// The loop over the states of [`block_solve_lanes`], inlined into each instruction set's copy.
+#[inline(always)]
+fn solve_lanes_in<A: Arith<f64>, const T: usize, const N: usize, const L: usize>(
+    m: &SMatrix<Lanes<L>, N, N>,
+    b: &mut SVector<Lanes<L>, N>,
+) -> [bool; L] {
+    let mut ok = [true; L];
+    for (l, ok) in ok.iter_mut().enumerate() {
+        *ok = solve_state::<A, T, N, L>(m, b, l);
+    }
+    ok
+}
+
+/// One arm's part of [`BlockCholesky`]'s factorisation for state `l`: its pivot steps and
+/// `W = L⁻¹ M[arm, trunk]`, for the arm whose first speed is `at`. Returns `U` (`U(k, i) =
+/// u[7 i + k]`, `k ≤ i`), the reciprocals of its diagonal, `W` (`W(i, j) = w[j][i]`) and whether
+/// every pivot was positive.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn factor_arm<A: Arith<f64>, const T: usize, const N: usize, const L: usize>(
+    m: &SMatrix<Lanes<L>, N, N>,
+    l: usize,
+    at: usize,
+) -> ([f64; 49], [f64; 7], [[f64; 7]; T], bool) {
+    let mut ok = true;
+    let (mut u, mut inv, mut w) = ([0.0; 49], [0.0; 7], [[0.0; 7]; T]);
+    each!(i < 7; {
+        each!(k < 7; {
+            if k <= i {
+                u[7 * i + k] = m[(at + i, at + k)].0[l];
+            }
+        });
+    });
+    each!(j < T; {
+        each!(i < 7; { w[j][i] = m[(at + i, j)].0[l]; });
+    });
+    each!(k < 7; {
+        let d = u[8 * k];
+        ok &= d > 0.0; // false for NaN too
+        let r = nalgebra::ComplexField::sqrt(d);
+        let r_inv = r * (1.0 / d);
+        u[8 * k] = r;
+        inv[k] = r_inv;
+        each!(i < 7; {
+            if i > k {
+                u[7 * i + k] *= r_inv;
+            }
+        });
+        each!(i < 7; {
+            if i > k {
+                let uki = u[7 * i + k];
+                each!(j < 7; {
+                    if j > k && j <= i {
+                        u[7 * i + j] = A::mul_add(-u[7 * j + k], uki, u[7 * i + j]);
+                    }
+                });
+            }
+        });
+    });
+    each!(j < T; {
+        each!(i < 7; {
+            let mut acc = w[j][i];
+            each!(k < 7; {
+                if k < i {
+                    acc = A::mul_add(-u[7 * i + k], w[j][k], acc);
+                }
+            });
+            w[j][i] = acc * inv[i];
+        });
+    });
+    (u, inv, w, ok)
+}
+
+/// One state (lane `l`): [`BlockCholesky`]'s factorisation (`new_in`) and substitution
+/// (`solve_one`), with the two arms one after the other instead of in the two lanes of an
+/// `F64x2` (lane by lane the same operations), and branch-free: a pivot that is not positive
+/// clears the returned flag instead of returning.
+#[inline(always)]
+fn solve_state<A: Arith<f64>, const T: usize, const N: usize, const L: usize>(
+    m: &SMatrix<Lanes<L>, N, N>,
+    b: &mut SVector<Lanes<L>, N>,
+    l: usize,
+) -> bool {
+    let arms = [T, T + 7];
+    let (ul, invl, wl, okl) = factor_arm::<A, T, N, L>(m, l, T);
+    let (ur, invr, wr, okr) = factor_arm::<A, T, N, L>(m, l, T + 7);
+    let (u, inv, w) = ([ul, ur], [invl, invr], [wl, wr]);
+    let mut ok = okl & okr;
+    // The trunk: U_s(k, i) = s[T i + k] (k ≤ i) from M's lower triangle, minus both arms'
+    // products (each arm's sum apart, then the two sums added, as the pair's two lanes are).
+    let mut s = [0.0; 64];
+    let mut inv_t = [0.0; 8];
+    each!(i < T; {
+        each!(j < T; {
+            if j <= i {
+                let mut acc = [0.0; 2];
+                each!(a < 2; {
+                    each!(k < 7; { acc[a] = A::mul_add(w[a][i][k], w[a][j][k], acc[a]); });
+                });
+                s[T * i + j] = m[(i, j)].0[l] - (acc[0] + acc[1]);
+            }
+        });
+    });
+    // The trunk's pivot steps (`Upper::step`).
+    each!(k < T; {
+        let d = s[k * T + k];
+        ok &= d > 0.0;
+        let r = nalgebra::ComplexField::sqrt(d);
+        let r_inv = r * (1.0 / d);
+        s[k * T + k] = r;
+        inv_t[k] = r_inv;
+        each!(i < T; {
+            if i > k {
+                s[i * T + k] *= r_inv;
+            }
+        });
+        each!(i < T; {
+            if i > k {
+                let uki = s[i * T + k];
+                each!(j < T; {
+                    if j > k && j <= i {
+                        s[i * T + j] = A::mul_add(-s[j * T + k], uki, s[i * T + j]);
+                    }
+                });
+            }
+        });
+    });
+    // Forward substitution L z = b: the arms, their coupling into the trunk's rows, the trunk.
+    let mut t = [0.0; 8];
+    each!(j < T; { t[j] = b[j].0[l]; });
+    let mut y = [[0.0; 7]; 2];
+    each!(a < 2; {
+        each!(i < 7; {
+            y[a][i] = b[arms[a] + i].0[l];
+            each!(k < 7; {
+                if k < i {
+                    y[a][i] = A::mul_add(y[a][k], -u[a][7 * i + k], y[a][i]);
+                }
+            });
+            y[a][i] *= inv[a][i];
+        });
+    });
+    each!(j < T; {
+        let mut acc = [0.0; 2];
+        each!(a < 2; {
+            each!(k < 7; { acc[a] = A::mul_add(y[a][k], w[a][j][k], acc[a]); });
+        });
+        t[j] -= acc[0] + acc[1];
+    });
+    each!(i < T; {
+        each!(k < T; {
+            if k < i {
+                t[i] = A::mul_add(t[k], -s[i * T + k], t[i]);
+            }
+        });
+        t[i] *= inv_t[i];
+    });
+    // Backward substitution Lᵀ x = z: the trunk, its coupling into the arms' rows, the arms.
+    each!(r < T; {
+        let i = T - 1 - r;
+        t[i] *= inv_t[i];
+        each!(k < T; {
+            if k < i {
+                t[k] = A::mul_add(t[i], -s[i * T + k], t[k]);
+            }
+        });
+    });
+    each!(a < 2; {
+        each!(k < 7; {
+            each!(j < T; { y[a][k] = A::mul_add(t[j], -w[a][j][k], y[a][k]); });
+        });
+        each!(r < 7; {
+            let i = 6 - r;
+            y[a][i] *= inv[a][i];
+            each!(k < 7; {
+                if k < i {
+                    y[a][k] = A::mul_add(y[a][i], -u[a][7 * i + k], y[a][k]);
+                }
+            });
+        });
+    });
+    each!(j < T; { b[j].0[l] = t[j]; });
+    each!(a < 2; {
+        each!(i < 7; { b[arms[a] + i].0[l] = y[a][i]; });
+    });
+    ok
+}
+
+impl Krang {
+    /// Forward dynamics of `L` states per call in the structure-of-arrays form: lane `l` of
+    /// `ud` is [`Krang::forward_dynamics`] of lane `l` of `q`, `u`, `tau`, bit for bit with the
+    /// same instruction set (NaN in every entry of a lane whose inputs or result are not finite
+    /// or whose mass matrix is not positive definite). One batched `M`, one batched `c + g`
+    /// and the block Cholesky solve of every state vectorized across the states (see the
+    /// [module docs](self)). Allocation-free.
+    ///
+    /// ```
+    /// use krang_dynamics::lanes::{Lanes, soa, state};
+    /// use krang_dynamics::{Krang, index};
+    /// use nalgebra::SVector;
+    ///
+    /// let k = Krang::default();
+    /// // Four states that differ in the base pitch.
+    /// let q: [SVector<f64, 19>; 4] = core::array::from_fn(|l| {
+    ///     let mut q = SVector::zeros();
+    ///     q[index::Q_IMU] = 0.1 * l as f64;
+    ///     q
+    /// });
+    /// let (u, tau) = ([SVector::from_element(0.1); 4], [SVector::zeros(); 4]);
+    /// let mut ud = SVector::<Lanes<4>, 19>::from_element(Lanes::splat(0.0));
+    /// k.forward_dynamics_batch_soa_into(&soa(&q), &soa(&u), &soa(&tau), &mut ud);
+    /// assert_eq!(state(&ud, 2), k.forward_dynamics(&q[2], &u[2], &tau[2]));
+    /// ```
+    pub fn forward_dynamics_batch_soa_into<const L: usize>(
+        &self,
+        q: &SVector<Lanes<L>, 19>,
+        u: &SVector<Lanes<L>, 19>,
+        tau: &SVector<Lanes<L>, 19>,
+        ud: &mut SVector<Lanes<L>, 19>,
+    ) {
+        self.forward_dynamics_lanes(q, u, tau, ud);
+    }
+
+    /// The body of [`forward_dynamics_batch_soa_into`](Self::forward_dynamics_batch_soa_into),
+    /// inlined into each instruction set's copy.
+    #[inline(always)]
+    fn forward_dynamics_lanes<const L: usize>(
+        &self,
+        q: &SVector<Lanes<L>, 19>,
+        u: &SVector<Lanes<L>, 19>,
+        tau: &SVector<Lanes<L>, 19>,
+        ud: &mut SVector<Lanes<L>, 19>,
+    ) {
+        let zero = Lanes::splat(0.0);
+        // c + g at u̇ = 0, then the right-hand side τ − c − g, in `ud`.
+        self.inverse_dynamics_batch_soa_into(q, u, &SVector::from_element(zero), ud);
+        for (ud, tau) in ud.iter_mut().zip(tau.iter()) {
+            *ud = *tau - *ud;
+        }
+        // Zeroed in place by one `memset` (`from_element` built a zero matrix elsewhere and
+        // copied it: 23 KB at L = 8, a sixth of the call).
+        let mut m = SMatrix::from_array_storage(ArrayStorage([[Lanes([0.0; L]); 19]; 19]));
+        self.mass_matrix_batch_soa_into(q, &mut m);
+        let pivots = block_solve_lanes::<5, 19, L>(&m, ud);
+        // Per lane: every input and result entry finite (`0 · x` is ±0 for a finite `x`, NaN for
+        // ±∞ and NaN), summed across the entries lane by lane.
+        let mut sum = [0.0; L];
+        for x in q.iter().chain(u.iter()).chain(tau.iter()).chain(ud.iter()) {
+            for (s, x) in sum.iter_mut().zip(x.0) {
+                *s += 0.0 * x;
+            }
+        }
+        for (l, (ok, sum)) in pivots.into_iter().zip(sum).enumerate() {
+            if !(ok && sum == 0.0) {
+                for x in ud.iter_mut() {
+                    x.0[l] = f64::NAN;
+                }
+            }
+        }
+    }
+
+    /// Forward dynamics of `L` states per call, the array-of-states form:
+    /// `[forward_dynamics(q[l], u[l], tau[l]); L]`, bit for bit. The states are copied into
+    /// lanes and the results back; a sampler that keeps its states in lanes calls
+    /// [`forward_dynamics_batch_soa_into`](Self::forward_dynamics_batch_soa_into) and skips the
+    /// copies.
+    pub fn forward_dynamics_batch<const L: usize>(
+        &self,
+        q: &[SVector<f64, 19>; L],
+        u: &[SVector<f64, 19>; L],
+        tau: &[SVector<f64, 19>; L],
+    ) -> [SVector<f64, 19>; L] {
+        let mut ud = SVector::<Lanes<L>, 19>::from_element(Lanes::splat(0.0));
+        self.forward_dynamics_batch_soa_into(&soa(q), &soa(u), &soa(tau), &mut ud);
+        core::array::from_fn(|l| ud.map(|x| x.0[l]))
+    }
+}

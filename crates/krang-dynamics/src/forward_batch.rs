@@ -14,10 +14,11 @@
 //! Every lane performs the operations of [`BlockCholesky::solve_once`] on one state, in the same
 //! order, with the same multiply-adds (fused in the x86-64-v3 and x86-64-v4 copies, not in the
 //! baseline one), so lane `l` of the result is [`Krang::forward_dynamics`] of state `l` **bit for
-//! bit** with the same instruction set (`tests/forward_batch.rs`). A state whose mass matrix is
+//! bit** with the same instruction set (`tests/isa_batch.rs` at the workspace root). A state whose mass matrix is
 //! not positive definite, whose inputs are not finite or whose result is not finite gets NaN
 //! in every entry, as `forward_dynamics` gives it; the other lanes are unaffected. Nothing
-//! allocates; the hot path has no branch per state.
+//! allocates; the factorisation and the substitutions have no branch per state (the one test
+//! per state, after them, decides whether its lane is filled with NaN).
 //!
 //! [`Krang::forward_dynamics_batch`] is the array-of-states form (`&[SVector<f64, 19>; L]` in,
 //! `[SVector<f64, 19>; L]` out), which copies the states into lanes and back.

@@ -125,21 +125,6 @@ fn finite<const N: usize>(
     }
 }
 
-/// `each!(i < n; { … })` runs the block for `i` = 0, 1, … while `i < n`, written out with
-/// literal indices up to 8 (every `n` here is at most 8: `BlockCholesky::new` asserts `T ≤ 8`),
-/// so that the block indexes its arrays with constants.
-macro_rules! each {
-    ($i:ident < $n:expr; $body:block) => {
-        each!(@ $i < $n; $body; 0 1 2 3 4 5 6 7)
-    };
-    (@ $i:ident < $n:expr; $body:block; $($k:literal)*) => {$(
-        if $k < $n {
-            let $i: usize = $k;
-            $body
-        }
-    )*};
-}
-
 // The factors are kept as upper-triangular `U = Lᵀ` in nalgebra's column-major storage, so
 // that every inner loop below runs over a contiguous column prefix, with the reciprocals of
 // their diagonals: the substitutions multiply instead of dividing.

@@ -31,21 +31,6 @@ use crate::Krang;
 #[cfg(doc)]
 use crate::forward::BlockCholesky;
 
-/// `each!(i < n; { … })` runs the block for `i` = 0, 1, … while `i < n`, with `i` a literal
-/// (as in [`crate::forward`]): every index in the lane loop's body is then a constant, so the
-/// body is straight-line code that the compiler vectorizes across the states.
-macro_rules! each {
-    ($i:ident < $n:expr; $body:block) => {
-        each!(@ $i < $n; $body; 0 1 2 3 4 5 6 7)
-    };
-    (@ $i:ident < $n:expr; $body:block; $($k:literal)*) => {$(
-        if $k < $n {
-            let $i: usize = $k;
-            $body
-        }
-    )*};
-}
-
 /// `b ← M⁻¹ b` for the `L` states in the lanes of `m` and `b`, by the block Cholesky
 /// factorisation of [`BlockCholesky<T, N>`] (the same operations, in the same order, as
 /// [`BlockCholesky::solve_once`] on each state). Returns, per lane, whether every pivot was

@@ -127,6 +127,24 @@ pub mod two_link {
     include!(concat!(env!("OUT_DIR"), "/two_link.rs"));
 }
 
+/// `each!(i < n; { … })` runs the block for `i` = 0, 1, … while `i < n`, written out with
+/// literal indices up to 8 (every `n` of the block factor is at most 8: `BlockCholesky` asserts
+/// `T ≤ 8`), so that the block indexes its arrays with constants: the block factor's
+/// substitutions (`forward`) keep their values in registers, and the batched solver's loop body
+/// (`forward_batch`) is straight-line code that the compiler vectorizes across the states.
+/// Defined before both modules, which use it.
+macro_rules! each {
+    ($i:ident < $n:expr; $body:block) => {
+        each!(@ $i < $n; $body; 0 1 2 3 4 5 6 7)
+    };
+    (@ $i:ident < $n:expr; $body:block; $($k:literal)*) => {$(
+        if $k < $n {
+            let $i: usize = $k;
+            $body
+        }
+    )*};
+}
+
 pub mod forward;
 pub use forward::{
     Block, BlockCholesky, ForwardDynamicsError, MassMatrixCholesky, NotPositiveDefinite, solve_spd,

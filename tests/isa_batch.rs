@@ -10,7 +10,8 @@
 //! results (filled with NaN before the call) and give the by-value forms' bits. The
 //! structure-of-arrays forms (`*_batch_soa`, at 3 and 8 states) give the array-of-states
 //! forms' bits in every lane. Batched forward dynamics (`forward_dynamics_batch_soa_into`,
-//! `forward_dynamics_batch`) gives `forward_dynamics`' bits in every lane, NaN lanes included.
+//! `forward_dynamics_batch`; Krang and the fixed-wheel tree) gives `forward_dynamics`' bits in
+//! every lane, NaN lanes included.
 
 mod common;
 
@@ -293,27 +294,38 @@ fn dispatched_copies_agree_with_the_baseline_to_rounding() {
 }
 
 /// Batched forward dynamics at `L` states (both forms) against `forward_dynamics` of each
-/// state, bit for bit with the active instruction set (NaN lanes included).
+/// state, bit for bit with the active instruction set (NaN lanes included), for Krang and for
+/// the fixed-wheel tree (`$k`: either; `$n`: its speeds).
+macro_rules! check_forward_batch {
+    ($k:expr, $n:literal, $q:expr, $u:expr, $tau:expr) => {{
+        use kd::lanes::{Lanes, soa, state};
+        let (k, q, u, tau) = ($k, $q, $u, $tau);
+        let mut ud = SVector::<Lanes<_>, $n>::from_element(Lanes::splat(f64::NAN));
+        k.forward_dynamics_batch_soa_into(&soa(q), &soa(u), &soa(tau), &mut ud);
+        let by_states = k.forward_dynamics_batch(q, u, tau);
+        for l in 0..q.len() {
+            let one = k.forward_dynamics(&q[l], &u[l], &tau[l]);
+            let lane = state(&ud, l);
+            assert!(
+                same_bits(lane.as_slice(), one.as_slice()),
+                "{}: lane {l} of {}: {lane} against {one}",
+                isa::active(),
+                q.len()
+            );
+            assert!(same_bits(by_states[l].as_slice(), one.as_slice()));
+        }
+    }};
+}
+
+/// [`check_forward_batch`] for Krang.
 fn check_forward_batch<const L: usize>(k: &kd::Krang, q: &[V; L], u: &[V; L], tau: &[V; L]) {
-    use kd::lanes::{Lanes, soa, state};
-    let mut ud = SVector::<Lanes<L>, 19>::from_element(Lanes::splat(f64::NAN));
-    k.forward_dynamics_batch_soa_into(&soa(q), &soa(u), &soa(tau), &mut ud);
-    let by_states = k.forward_dynamics_batch(q, u, tau);
-    for l in 0..L {
-        let one = k.forward_dynamics(&q[l], &u[l], &tau[l]);
-        let lane = state(&ud, l);
-        assert!(
-            same_bits(lane.as_slice(), one.as_slice()),
-            "{}: lane {l} of {L}: {lane} against {one}",
-            isa::active()
-        );
-        assert!(same_bits(by_states[l].as_slice(), one.as_slice()));
-    }
+    check_forward_batch!(k, 19, q, u, tau);
 }
 
 #[test]
 fn batched_forward_dynamics_equals_forward_dynamics_bit_for_bit() {
     let _one_at_a_time = isa_lock();
+    let fixed_model = model("krang-fixed-wheels.toml");
     let model = model("krang.toml");
     let mut uniform = rng(1415);
     let mut nan_lanes = 0;
@@ -340,6 +352,19 @@ fn batched_forward_dynamics_equals_forward_dynamics_bit_for_bit() {
                 q8[4][kd::index::Q2R] = 1.0e7;
             }
             check_forward_batch(&k, &q8, &u8, &t8.map(|t| 20.0 * t));
+            // The fixed-wheel tree (trunk of 3), 4 states: Krang's speeds from the third on.
+            let p = random_physical_params(&fixed_model, &mut uniform);
+            let f = kd::fixed_wheels::KrangFixedWheels::new(kd::fixed_wheels::Params::from_array(
+                p.try_into().unwrap(),
+            ));
+            let (q, u, t) = states::<4>(&mut uniform);
+            let tail = |v: [V; 4]| v.map(|v| SVector::<f64, 17>::from_fn(|i, _| v[i + 2]));
+            let (qf, uf, mut tf) = (tail(q), tail(u), tail(t.map(|t| 20.0 * t)));
+            if draw % 3 == 1 {
+                tf[1][0] = f64::NAN;
+                nan_lanes += 1;
+            }
+            check_forward_batch!(&f, 17, &qf, &uf, &tf);
         }
     }
     isa::select(isa::detected()).unwrap();

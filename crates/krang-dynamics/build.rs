@@ -106,8 +106,10 @@ mod modules {
             if regressors {
                 functions = functions.union(FunctionSet::regressors());
             }
+            // Batched: the fixed-wheel tree's batched forward dynamics (`forward_batch`).
             builder("krang-fixed-wheels.toml")
                 .functions(functions)
+                .batch(true)
                 .run();
         }
         if enabled("TWO_LINK") {

@@ -21,13 +21,16 @@
 //! per state, after them, decides whether its lane is filled with NaN).
 //!
 //! [`Krang::forward_dynamics_batch`] is the array-of-states form (`&[SVector<f64, 19>; L]` in,
-//! `[SVector<f64, 19>; L]` out), which copies the states into lanes and back.
+//! `[SVector<f64, 19>; L]` out), which copies the states into lanes and back. The fixed-wheel
+//! tree (feature `fixed-wheels`) has both methods too, with its `BlockCholesky<3, 17>` shape.
 
 use kanegen_runtime::isa::{self, Arith, Fused, Plain};
 use kanegen_runtime::lanes::{Lanes, soa};
 use nalgebra::{ArrayStorage, SMatrix, SVector};
 
 use crate::Krang;
+#[cfg(feature = "fixed-wheels")]
+use crate::fixed_wheels::KrangFixedWheels;
 #[cfg(doc)]
 use crate::forward::BlockCholesky;
 
@@ -251,92 +254,128 @@ fn solve_state<A: Arith<f64>, const T: usize, const N: usize, const L: usize>(
     ok
 }
 
-impl Krang {
-    /// Forward dynamics of `L` states per call in the structure-of-arrays form: lane `l` of
-    /// `ud` is [`Krang::forward_dynamics`] of lane `l` of `q`, `u`, `tau`, bit for bit with the
-    /// same instruction set (NaN in every entry of a lane whose inputs or result are not finite
-    /// or whose mass matrix is not positive definite). One batched `M`, one batched `c + g`
-    /// and the block Cholesky solve of every state vectorized across the states (see the
-    /// [module docs](self)). Allocation-free.
-    ///
-    /// ```
-    /// use krang_dynamics::lanes::{Lanes, soa, state};
-    /// use krang_dynamics::{Krang, index};
-    /// use nalgebra::SVector;
-    ///
-    /// let k = Krang::default();
-    /// // Four states that differ in the base pitch.
-    /// let q: [SVector<f64, 19>; 4] = core::array::from_fn(|l| {
-    ///     let mut q = SVector::zeros();
-    ///     q[index::Q_IMU] = 0.1 * l as f64;
-    ///     q
-    /// });
-    /// let (u, tau) = ([SVector::from_element(0.1); 4], [SVector::zeros(); 4]);
-    /// let mut ud = SVector::<Lanes<4>, 19>::from_element(Lanes::splat(0.0));
-    /// k.forward_dynamics_batch_soa_into(&soa(&q), &soa(&u), &soa(&tau), &mut ud);
-    /// assert_eq!(state(&ud, 2), k.forward_dynamics(&q[2], &u[2], &tau[2]));
-    /// ```
-    pub fn forward_dynamics_batch_soa_into<const L: usize>(
-        &self,
-        q: &SVector<Lanes<L>, 19>,
-        u: &SVector<Lanes<L>, 19>,
-        tau: &SVector<Lanes<L>, 19>,
-        ud: &mut SVector<Lanes<L>, 19>,
-    ) {
-        self.forward_dynamics_lanes(q, u, tau, ud);
+/// Batched forward dynamics for a model with the block shape of [`BlockCholesky<T, N>`]: `c + g`
+/// written into `ud` by `bias_into(q, u, u̇ = 0, ud)` (batched inverse dynamics), `M` by
+/// `mass_matrix_into(q, m)`, then [`block_solve_lanes`]; a lane whose pivots, inputs or result
+/// are not all good is filled with NaN.
+fn block_forward_dynamics_lanes<const T: usize, const N: usize, const L: usize>(
+    (q, u, tau): (
+        &SVector<Lanes<L>, N>,
+        &SVector<Lanes<L>, N>,
+        &SVector<Lanes<L>, N>,
+    ),
+    ud: &mut SVector<Lanes<L>, N>,
+    bias_into: impl FnOnce(
+        &SVector<Lanes<L>, N>,
+        &SVector<Lanes<L>, N>,
+        &SVector<Lanes<L>, N>,
+        &mut SVector<Lanes<L>, N>,
+    ),
+    mass_matrix_into: impl FnOnce(&SVector<Lanes<L>, N>, &mut SMatrix<Lanes<L>, N, N>),
+) {
+    let zero = Lanes::splat(0.0);
+    // c + g at u̇ = 0, then the right-hand side τ − c − g, in `ud`.
+    bias_into(q, u, &SVector::from_element(zero), ud);
+    for (ud, tau) in ud.iter_mut().zip(tau.iter()) {
+        *ud = *tau - *ud;
     }
-
-    /// The body of [`forward_dynamics_batch_soa_into`](Self::forward_dynamics_batch_soa_into),
-    /// inlined into each instruction set's copy.
-    #[inline(always)]
-    fn forward_dynamics_lanes<const L: usize>(
-        &self,
-        q: &SVector<Lanes<L>, 19>,
-        u: &SVector<Lanes<L>, 19>,
-        tau: &SVector<Lanes<L>, 19>,
-        ud: &mut SVector<Lanes<L>, 19>,
-    ) {
-        let zero = Lanes::splat(0.0);
-        // c + g at u̇ = 0, then the right-hand side τ − c − g, in `ud`.
-        self.inverse_dynamics_batch_soa_into(q, u, &SVector::from_element(zero), ud);
-        for (ud, tau) in ud.iter_mut().zip(tau.iter()) {
-            *ud = *tau - *ud;
-        }
-        // Zeroed in place by one `memset` (`from_element` built a zero matrix elsewhere and
-        // copied it: 23 KB at L = 8, a sixth of the call).
-        let mut m = SMatrix::from_array_storage(ArrayStorage([[Lanes([0.0; L]); 19]; 19]));
-        self.mass_matrix_batch_soa_into(q, &mut m);
-        let pivots = block_solve_lanes::<5, 19, L>(&m, ud);
-        // Per lane: every input and result entry finite (`0 · x` is ±0 for a finite `x`, NaN for
-        // ±∞ and NaN), summed across the entries lane by lane.
-        let mut sum = [0.0; L];
-        for x in q.iter().chain(u.iter()).chain(tau.iter()).chain(ud.iter()) {
-            for (s, x) in sum.iter_mut().zip(x.0) {
-                *s += 0.0 * x;
-            }
-        }
-        for (l, (ok, sum)) in pivots.into_iter().zip(sum).enumerate() {
-            if !(ok && sum == 0.0) {
-                for x in ud.iter_mut() {
-                    x.0[l] = f64::NAN;
-                }
-            }
+    // Zeroed in place by one `memset` (`from_element` built a zero matrix elsewhere and copied
+    // it: 23 KB for Krang at L = 8, a sixth of the call).
+    let mut m = SMatrix::from_array_storage(ArrayStorage([[Lanes([0.0; L]); N]; N]));
+    mass_matrix_into(q, &mut m);
+    let pivots = block_solve_lanes::<T, N, L>(&m, ud);
+    // Per lane: every input and result entry finite (`0 · x` is ±0 for a finite `x`, NaN for
+    // ±∞ and NaN), summed across the entries lane by lane.
+    let mut sum = [0.0; L];
+    for x in q.iter().chain(u.iter()).chain(tau.iter()).chain(ud.iter()) {
+        for (s, x) in sum.iter_mut().zip(x.0) {
+            *s += 0.0 * x;
         }
     }
-
-    /// Forward dynamics of `L` states per call, the array-of-states form:
-    /// `[forward_dynamics(q[l], u[l], tau[l]); L]`, bit for bit. The states are copied into
-    /// lanes and the results back; a sampler that keeps its states in lanes calls
-    /// [`forward_dynamics_batch_soa_into`](Self::forward_dynamics_batch_soa_into) and skips the
-    /// copies.
-    pub fn forward_dynamics_batch<const L: usize>(
-        &self,
-        q: &[SVector<f64, 19>; L],
-        u: &[SVector<f64, 19>; L],
-        tau: &[SVector<f64, 19>; L],
-    ) -> [SVector<f64, 19>; L] {
-        let mut ud = SVector::<Lanes<L>, 19>::from_element(Lanes::splat(0.0));
-        self.forward_dynamics_batch_soa_into(&soa(q), &soa(u), &soa(tau), &mut ud);
-        core::array::from_fn(|l| ud.map(|x| x.0[l]))
+    for (l, (ok, sum)) in pivots.into_iter().zip(sum).enumerate() {
+        if !(ok && sum == 0.0) {
+            for x in ud.iter_mut() {
+                x.0[l] = f64::NAN;
+            }
+        }
     }
 }
+
+/// The batched forward-dynamics methods of a model type with `N` speeds and a trunk of `T`.
+macro_rules! batched_forward_dynamics {
+    ($robot:ty, $t:literal, $n:literal, $example:literal) => {
+        impl $robot {
+            /// Forward dynamics of `L` states per call in the structure-of-arrays form: lane
+            /// `l` of `ud` is `forward_dynamics` of lane `l` of `q`, `u`, `tau`, bit for bit
+            /// with the same instruction set (NaN in every entry of a lane whose inputs or
+            /// result are not finite or whose mass matrix is not positive definite). One
+            /// batched `M`, one batched `c + g` and the block Cholesky solve of every state
+            /// vectorized across the states (see the [module docs](crate::forward_batch)).
+            /// Allocation-free.
+            #[doc = $example]
+            pub fn forward_dynamics_batch_soa_into<const L: usize>(
+                &self,
+                q: &SVector<Lanes<L>, $n>,
+                u: &SVector<Lanes<L>, $n>,
+                tau: &SVector<Lanes<L>, $n>,
+                ud: &mut SVector<Lanes<L>, $n>,
+            ) {
+                block_forward_dynamics_lanes::<$t, $n, L>(
+                    (q, u, tau),
+                    ud,
+                    |q, u, ud0, out| self.inverse_dynamics_batch_soa_into(q, u, ud0, out),
+                    |q, m| self.mass_matrix_batch_soa_into(q, m),
+                );
+            }
+
+            /// Forward dynamics of `L` states per call, the array-of-states form:
+            /// `[forward_dynamics(q[l], u[l], tau[l]); L]`, bit for bit. The states are copied
+            /// into lanes and the results back; a sampler that keeps its states in lanes calls
+            /// [`forward_dynamics_batch_soa_into`](Self::forward_dynamics_batch_soa_into) and
+            /// skips the copies.
+            pub fn forward_dynamics_batch<const L: usize>(
+                &self,
+                q: &[SVector<f64, $n>; L],
+                u: &[SVector<f64, $n>; L],
+                tau: &[SVector<f64, $n>; L],
+            ) -> [SVector<f64, $n>; L] {
+                let mut ud = SVector::<Lanes<L>, $n>::from_element(Lanes::splat(0.0));
+                self.forward_dynamics_batch_soa_into(&soa(q), &soa(u), &soa(tau), &mut ud);
+                core::array::from_fn(|l| ud.map(|x| x.0[l]))
+            }
+        }
+    };
+}
+
+batched_forward_dynamics!(
+    Krang,
+    5,
+    19,
+    r"
+```
+use krang_dynamics::lanes::{Lanes, soa, state};
+use krang_dynamics::{Krang, index};
+use nalgebra::SVector;
+
+let k = Krang::default();
+// Four states that differ in the base pitch.
+let q: [SVector<f64, 19>; 4] = core::array::from_fn(|l| {
+    let mut q = SVector::zeros();
+    q[index::Q_IMU] = 0.1 * l as f64;
+    q
+});
+let (u, tau) = ([SVector::from_element(0.1); 4], [SVector::zeros(); 4]);
+let mut ud = SVector::<Lanes<4>, 19>::from_element(Lanes::splat(0.0));
+k.forward_dynamics_batch_soa_into(&soa(&q), &soa(&u), &soa(&tau), &mut ud);
+assert_eq!(state(&ud, 2), k.forward_dynamics(&q[2], &u[2], &tau[2]));
+```"
+);
+
+#[cfg(feature = "fixed-wheels")]
+batched_forward_dynamics!(
+    KrangFixedWheels,
+    3,
+    17,
+    r"
+The fixed-wheel tree (17 speeds; its block factor `BlockCholesky<3, 17>`)."
+);

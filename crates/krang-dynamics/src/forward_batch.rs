@@ -79,6 +79,66 @@ fn solve_lanes_in<A: Arith<f64>, const T: usize, const N: usize, const L: usize>
     ok
 }
 
+/// The pivot steps of `BlockCholesky`'s factorisation (`Upper::step` for pivots 0, 1, …, in
+/// order) on a `K×K` block in place, kept as the upper factor `U(k, i) = u[K i + k]` (`k ≤ i`),
+/// the reciprocals of its diagonal into `inv`: an arm's block (`K = 7`) and the trunk's Schur
+/// complement (`K = T`). Branch-free: `false` if a pivot is not positive (or is NaN).
+#[inline(always)]
+fn pivot_steps<A: Arith<f64>, const K: usize>(u: &mut [f64], inv: &mut [f64]) -> bool {
+    let mut ok = true;
+    each!(k < K; {
+        let d = u[K * k + k];
+        ok &= d > 0.0; // false for NaN too
+        let r = nalgebra::ComplexField::sqrt(d);
+        let r_inv = r * (1.0 / d);
+        u[K * k + k] = r;
+        inv[k] = r_inv;
+        each!(i < K; {
+            if i > k {
+                u[K * i + k] *= r_inv;
+            }
+        });
+        each!(i < K; {
+            if i > k {
+                let uki = u[K * i + k];
+                each!(j < K; {
+                    if j > k && j <= i {
+                        u[K * i + j] = A::mul_add(-u[K * j + k], uki, u[K * i + j]);
+                    }
+                });
+            }
+        });
+    });
+    ok
+}
+
+/// `y ← (Uᵀ)⁻¹ y` for a factor of [`pivot_steps`] (the forward substitution of `solve_one`).
+#[inline(always)]
+fn forward_steps<A: Arith<f64>, const K: usize>(u: &[f64], inv: &[f64], y: &mut [f64]) {
+    each!(i < K; {
+        each!(k < K; {
+            if k < i {
+                y[i] = A::mul_add(y[k], -u[K * i + k], y[i]);
+            }
+        });
+        y[i] *= inv[i];
+    });
+}
+
+/// `y ← U⁻¹ y` for a factor of [`pivot_steps`] (the backward substitution of `solve_one`).
+#[inline(always)]
+fn backward_steps<A: Arith<f64>, const K: usize>(u: &[f64], inv: &[f64], y: &mut [f64]) {
+    each!(r < K; {
+        let i = K - 1 - r;
+        y[i] *= inv[i];
+        each!(k < K; {
+            if k < i {
+                y[k] = A::mul_add(y[i], -u[K * i + k], y[k]);
+            }
+        });
+    });
+}
+
 /// One arm's part of [`BlockCholesky`]'s factorisation for state `l`: its pivot steps and
 /// `W = L⁻¹ M[arm, trunk]`, for the arm whose first speed is `at`. Returns `U` (`U(k, i) =
 /// u[7 i + k]`, `k ≤ i`), the reciprocals of its diagonal, `W` (`W(i, j) = w[j][i]`) and whether
@@ -90,7 +150,6 @@ fn factor_arm<A: Arith<f64>, const T: usize, const N: usize, const L: usize>(
     l: usize,
     at: usize,
 ) -> ([f64; 49], [f64; 7], [[f64; 7]; T], bool) {
-    let mut ok = true;
     let (mut u, mut inv, mut w) = ([0.0; 49], [0.0; 7], [[0.0; 7]; T]);
     each!(i < 7; {
         each!(k < 7; {
@@ -102,40 +161,9 @@ fn factor_arm<A: Arith<f64>, const T: usize, const N: usize, const L: usize>(
     each!(j < T; {
         each!(i < 7; { w[j][i] = m[(at + i, j)].0[l]; });
     });
-    each!(k < 7; {
-        let d = u[8 * k];
-        ok &= d > 0.0; // false for NaN too
-        let r = nalgebra::ComplexField::sqrt(d);
-        let r_inv = r * (1.0 / d);
-        u[8 * k] = r;
-        inv[k] = r_inv;
-        each!(i < 7; {
-            if i > k {
-                u[7 * i + k] *= r_inv;
-            }
-        });
-        each!(i < 7; {
-            if i > k {
-                let uki = u[7 * i + k];
-                each!(j < 7; {
-                    if j > k && j <= i {
-                        u[7 * i + j] = A::mul_add(-u[7 * j + k], uki, u[7 * i + j]);
-                    }
-                });
-            }
-        });
-    });
-    each!(j < T; {
-        each!(i < 7; {
-            let mut acc = w[j][i];
-            each!(k < 7; {
-                if k < i {
-                    acc = A::mul_add(-u[7 * i + k], w[j][k], acc);
-                }
-            });
-            w[j][i] = acc * inv[i];
-        });
-    });
+    let ok = pivot_steps::<A, 7>(&mut u, &mut inv);
+    // W = L⁻¹ M[arm, trunk], column by column.
+    each!(j < T; { forward_steps::<A, 7>(&u, &inv, &mut w[j]); });
     (u, inv, w, ok)
 }
 
@@ -169,44 +197,15 @@ fn solve_state<A: Arith<f64>, const T: usize, const N: usize, const L: usize>(
             }
         });
     });
-    // The trunk's pivot steps (`Upper::step`).
-    each!(k < T; {
-        let d = s[k * T + k];
-        ok &= d > 0.0;
-        let r = nalgebra::ComplexField::sqrt(d);
-        let r_inv = r * (1.0 / d);
-        s[k * T + k] = r;
-        inv_t[k] = r_inv;
-        each!(i < T; {
-            if i > k {
-                s[i * T + k] *= r_inv;
-            }
-        });
-        each!(i < T; {
-            if i > k {
-                let uki = s[i * T + k];
-                each!(j < T; {
-                    if j > k && j <= i {
-                        s[i * T + j] = A::mul_add(-s[j * T + k], uki, s[i * T + j]);
-                    }
-                });
-            }
-        });
-    });
+    // The trunk's pivot steps.
+    ok &= pivot_steps::<A, T>(&mut s, &mut inv_t);
     // Forward substitution L z = b: the arms, their coupling into the trunk's rows, the trunk.
     let mut t = [0.0; 8];
     each!(j < T; { t[j] = b[j].0[l]; });
     let mut y = [[0.0; 7]; 2];
     each!(a < 2; {
-        each!(i < 7; {
-            y[a][i] = b[arms[a] + i].0[l];
-            each!(k < 7; {
-                if k < i {
-                    y[a][i] = A::mul_add(y[a][k], -u[a][7 * i + k], y[a][i]);
-                }
-            });
-            y[a][i] *= inv[a][i];
-        });
+        each!(i < 7; { y[a][i] = b[arms[a] + i].0[l]; });
+        forward_steps::<A, 7>(&u[a], &inv[a], &mut y[a]);
     });
     each!(j < T; {
         let mut acc = [0.0; 2];
@@ -215,37 +214,14 @@ fn solve_state<A: Arith<f64>, const T: usize, const N: usize, const L: usize>(
         });
         t[j] -= acc[0] + acc[1];
     });
-    each!(i < T; {
-        each!(k < T; {
-            if k < i {
-                t[i] = A::mul_add(t[k], -s[i * T + k], t[i]);
-            }
-        });
-        t[i] *= inv_t[i];
-    });
+    forward_steps::<A, T>(&s, &inv_t, &mut t);
     // Backward substitution Lᵀ x = z: the trunk, its coupling into the arms' rows, the arms.
-    each!(r < T; {
-        let i = T - 1 - r;
-        t[i] *= inv_t[i];
-        each!(k < T; {
-            if k < i {
-                t[k] = A::mul_add(t[i], -s[i * T + k], t[k]);
-            }
-        });
-    });
+    backward_steps::<A, T>(&s, &inv_t, &mut t);
     each!(a < 2; {
         each!(k < 7; {
             each!(j < T; { y[a][k] = A::mul_add(t[j], -w[a][j][k], y[a][k]); });
         });
-        each!(r < 7; {
-            let i = 6 - r;
-            y[a][i] *= inv[a][i];
-            each!(k < 7; {
-                if k < i {
-                    y[a][k] = A::mul_add(y[a][i], -u[a][7 * i + k], y[a][k]);
-                }
-            });
-        });
+        backward_steps::<A, 7>(&u[a], &inv[a], &mut y[a]);
     });
     each!(j < T; { b[j].0[l] = t[j]; });
     each!(a < 2; {

@@ -11,9 +11,10 @@
 //! `batch<L>_by_value`: `mass_matrix_batch`, which returns the results), `…/soa<L>` (the
 //! structure-of-arrays form `<function>_batch_soa_into`) and `simd/<function>_into/<isa>` (M
 //! and C written into a kept matrix). `simd/forward_dynamics/<isa>` and `…/soa<L>` time
-//! `Krang::forward_dynamics` and its batched form `forward_dynamics_batch_soa_into` (not
-//! generated functions: they run M, c + g and the block Cholesky; the single state's
-//! factorisation has no x86-64-v4 copy). The states cycle through the profile driver's 64
+//! `Krang::forward_dynamics` and its batched form `forward_dynamics_batch_soa_into`, and
+//! `…/soa<L>_kept_m` `forward_dynamics_batch_soa_with_mass_matrix` (the lane mass matrix kept
+//! across calls). These are not generated functions: they run M, c + g and the block Cholesky;
+//! the single state's factorisation has no x86-64-v4 copy. The states cycle through the profile driver's 64
 //! random ones (their accelerations taken as the torques of forward dynamics).
 
 use std::hint::black_box;
@@ -167,6 +168,21 @@ fn bench_batch_soa<const L: usize>(c: &mut Criterion, k: &Krang, s: &[(V, V, V)]
                 black_box(q),
                 black_box(u),
                 black_box(tau),
+                &mut v,
+            );
+            black_box(&v);
+        })
+    });
+    // The same with the lane mass matrix kept across calls (not zeroed per call).
+    c.bench_function(&format!("simd/forward_dynamics/{tag}/soa{L}_kept_m"), |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            let (q, u, tau) = &batches[i];
+            black_box(k).forward_dynamics_batch_soa_with_mass_matrix(
+                black_box(q),
+                black_box(u),
+                black_box(tau),
+                &mut m,
                 &mut v,
             );
             black_box(&v);

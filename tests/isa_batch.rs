@@ -303,6 +303,16 @@ macro_rules! check_forward_batch {
         let mut ud = SVector::<Lanes<_>, $n>::from_element(Lanes::splat(f64::NAN));
         k.forward_dynamics_batch_soa_into(&soa(q), &soa(u), &soa(tau), &mut ud);
         let by_states = k.forward_dynamics_batch(q, u, tau);
+        // The form with a kept mass matrix, which holds NaN before: every entry is written.
+        let mut m = nalgebra::SMatrix::<Lanes<_>, $n, $n>::from_element(Lanes::splat(f64::NAN));
+        let mut ud_kept = SVector::<Lanes<_>, $n>::from_element(Lanes::splat(f64::NAN));
+        k.forward_dynamics_batch_soa_with_mass_matrix(
+            &soa(q),
+            &soa(u),
+            &soa(tau),
+            &mut m,
+            &mut ud_kept,
+        );
         for l in 0..q.len() {
             let one = k.forward_dynamics(&q[l], &u[l], &tau[l]);
             let lane = state(&ud, l);
@@ -313,6 +323,11 @@ macro_rules! check_forward_batch {
                 q.len()
             );
             assert!(same_bits(by_states[l].as_slice(), one.as_slice()));
+            assert!(same_bits(state(&ud_kept, l).as_slice(), one.as_slice()));
+            assert!(same_bits(
+                state(&m, l).as_slice(),
+                k.mass_matrix(&q[l]).as_slice()
+            ));
         }
     }};
 }

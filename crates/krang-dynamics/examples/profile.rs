@@ -14,7 +14,8 @@
 //! `forward_dynamics`, and `mass_matrix_cholesky` (M, its block factor and one solve);
 //! a suffix `_b4` or `_b8` calls the batched form (`_batch_into`, into arrays kept across
 //! calls) with 4 or 8 states, counted as one call, `_s8` the structure-of-arrays form
-//! (`_batch_soa_into`) with 8 states (`forward_dynamics_s8` too; `solve_s8`: the batched
+//! (`_batch_soa_into`) with 8 states (`forward_dynamics_s8` too, and `forward_dynamics_kept_m_s8` with the lane mass matrix
+//! kept across calls; `solve_s8`: the batched
 //! block solve alone, `forward_batch::block_solve_lanes`, on 8 fixed mass matrices); with
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
 //! across calls), `forward_dynamics_derivatives` and `linearize`; with the feature `kinematics`
@@ -161,6 +162,14 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
                 let (q, u) = &s8[i & 63];
                 let (q, u) = (black_box(q), black_box(u));
                 black_box(k).forward_dynamics_batch_soa_into(q, u, u, &mut vs8);
+                black_box(&vs8)[7].0[1]
+            }
+            "forward_dynamics_kept_m_s8" => {
+                // The same with the lane mass matrix kept across calls (`ms8`, not zeroed).
+                let (q, u) = &s8[i & 63];
+                let (q, u) = (black_box(q), black_box(u));
+                black_box(k)
+                    .forward_dynamics_batch_soa_with_mass_matrix(q, u, u, &mut ms8, &mut vs8);
                 black_box(&vs8)[7].0[1]
             }
             "solve_s8" => {

@@ -300,16 +300,17 @@ macro_rules! check_forward_batch {
     ($k:expr, $n:literal, $q:expr, $u:expr, $tau:expr) => {{
         use kd::lanes::{Lanes, soa, state};
         let (k, q, u, tau) = ($k, $q, $u, $tau);
+        let (q_lanes, u_lanes, tau_lanes) = (soa(q), soa(u), soa(tau));
         let mut ud = SVector::<Lanes<_>, $n>::from_element(Lanes::splat(f64::NAN));
-        k.forward_dynamics_batch_soa_into(&soa(q), &soa(u), &soa(tau), &mut ud);
+        k.forward_dynamics_batch_soa_into(&q_lanes, &u_lanes, &tau_lanes, &mut ud);
         let by_states = k.forward_dynamics_batch(q, u, tau);
         // The form with a kept mass matrix, which holds NaN before: every entry is written.
         let mut m = nalgebra::SMatrix::<Lanes<_>, $n, $n>::from_element(Lanes::splat(f64::NAN));
         let mut ud_kept = SVector::<Lanes<_>, $n>::from_element(Lanes::splat(f64::NAN));
         k.forward_dynamics_batch_soa_with_mass_matrix(
-            &soa(q),
-            &soa(u),
-            &soa(tau),
+            &q_lanes,
+            &u_lanes,
+            &tau_lanes,
             &mut m,
             &mut ud_kept,
         );

@@ -14,9 +14,9 @@
 //! `forward_dynamics`, and `mass_matrix_cholesky` (M, its block factor and one solve);
 //! a suffix `_b4` or `_b8` calls the batched form (`_batch_into`, into arrays kept across
 //! calls) with 4 or 8 states, counted as one call, `_s8` the structure-of-arrays form
-//! (`_batch_soa_into`) with 8 states (`forward_dynamics_s8` too, and `forward_dynamics_kept_m_s8` with the lane mass matrix
-//! kept across calls; `solve_s8`: the batched
-//! block solve alone, `forward_batch::block_solve_lanes`, on 8 fixed mass matrices); with
+//! (`_batch_soa_into`) with 8 states (`forward_dynamics_s8` too, and
+//! `forward_dynamics_kept_m_s8` with the lane mass matrix kept across calls; `solve_s8`: the
+//! batched block solve alone, `forward_batch::block_solve_lanes`, on 8 fixed mass matrices); with
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
 //! across calls), `forward_dynamics_derivatives` and `linearize`; with the feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),

@@ -250,8 +250,9 @@ fn solve_state<A: Arith<f64>, const T: usize, const N: usize, const L: usize>(
 
 /// Batched forward dynamics for a model with the block shape of [`BlockCholesky<T, N>`]: `c + g`
 /// written into `ud` by `bias_into(q, u, u̇ = 0, ud)` (batched inverse dynamics), `M` by
-/// `mass_matrix_into(q, m)`, then [`block_solve_lanes`]; a lane whose pivots, inputs or result
-/// are not all good is filled with NaN.
+/// `mass_matrix_into(q, m)` into the caller's `m` (or, for `None`, a fresh zeroed matrix), then
+/// [`block_solve_lanes`]; a lane whose pivots, inputs or result are not all good is filled
+/// with NaN.
 fn block_forward_dynamics_lanes<const T: usize, const N: usize, const L: usize>(
     (q, u, tau): (
         &SVector<Lanes<L>, N>,

@@ -12,8 +12,9 @@
 // and signs) and prints the largest relative differences. Then it times the algorithms with case
 // 0's parameters on the states of all cases: per algorithm ROUNDS rounds of CALLS calls cycling
 // through the states, the fastest round's mean ns per call, and appends `name ns` lines to
-// DIR/pinocchio-times.txt. Exit status 1 if M, c, g, τ, the derivatives or the forward dynamics differ by more than 1e-9
-// (relative to the largest entry).
+// DIR/pinocchio-times.txt. Exit status 1 if M, c, g, τ, C (and Pinocchio's C u against kanegen's
+// c), the derivatives or the forward dynamics differ by more than 1e-9 (relative to the largest
+// entry).
 //
 // Header-only use of Pinocchio (no PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION): every algorithm is
 // compiled here with the harness's flags (-O3 -march=native).
@@ -111,8 +112,8 @@ int main(int argc, char ** argv) {
   std::printf("  forward dynamics (crba + nonLinearEffects + LLT on the speeds) vs kanegen's "
               "forward_dynamics %.1e   (vs the state's ud: %.1e)\n",
               efd, efd_ud);
-  const bool ok = em < 1e-9 && ec < 1e-9 && eg < 1e-9 && et < 1e-9 && edq < 1e-9 && edu < 1e-9
-                  && efd < 1e-9;
+  const bool ok = em < 1e-9 && ec < 1e-9 && eg < 1e-9 && et < 1e-9 && eC < 1e-9 && eCu < 1e-9
+                  && edq < 1e-9 && edu < 1e-9 && efd < 1e-9;
 
   // Timings with case 0's parameters on all states.
   const Exported & ex = cases[0].ex;
@@ -160,7 +161,8 @@ int main(int argc, char ** argv) {
   });
   if (sink == 12345.678) std::printf("(sink)\n");  // keeps the results alive
   if (!ok) {
-    std::printf("FAILED: M, c, g, tau, the derivatives or the forward dynamics differ by more than 1e-9\n");
+    std::printf("FAILED: M, c, g, tau, C, the derivatives or the forward dynamics differ by more "
+                "than 1e-9\n");
     return 1;
   }
   return 0;

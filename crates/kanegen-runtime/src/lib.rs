@@ -28,12 +28,13 @@
 //!   at a time, over a generated plan; generic over [`isa::Arith`]).
 //! - [`derivative_steps`]: the loop of the looped `inverse_dynamics_derivatives` (the
 //!   (column, ancestor) steps of the analytic recursion over generated tables); its AVX2 copy
-//!   is called from the crate's second `unsafe` block.
+//!   is called only after the same feature check.
 //!
-//! `#![no_std]`, `unsafe` only to call code compiled for x86-64-v3 or v4 after the CPU was
+//! `#![no_std]`; `unsafe` only to call code compiled for x86-64-v3 or v4 after the CPU was
 //! checked ([`isa::dispatch`], [`isa::dispatch_fused_with`], [`isa::dispatch_fused_wide_with`],
-//! [`derivative_steps::run`]), no dependency but [`nalgebra`] (re-exported: its vector and
-//! matrix types are the trait's argument types) and, behind features, `serde` and `toml`.
+//! [`derivative_steps::run`]) and for the SSE2/FMA intrinsics of [`pair::F64x2`]; no dependency
+//! but [`nalgebra`] (re-exported: its vector and matrix types are the trait's argument types)
+//! and, behind features, `serde` and `toml`.
 //!
 //! # How generated code uses it
 //!
@@ -147,7 +148,8 @@
 
 #![no_std]
 // `unsafe` only to call a copy compiled for x86-64-v3 or v4 after feature detection (`isa`,
-// `derivative_steps::run`).
+// `derivative_steps::run`) and for the SSE2/FMA intrinsics of `pair::F64x2`; each use is
+// allowed where it is.
 #![deny(unsafe_code)]
 
 #[cfg(feature = "std")]

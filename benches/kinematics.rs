@@ -7,8 +7,9 @@
 //! against the eleven separate calls, with the 17-angle `sin_cos_n` every call computes.
 //!
 //! Ids `kinematics/<what>/<variant>`: `hands_jacobian`, `hands_pose_jacobian_bias`,
-//! `com_jacobian`, `coriolis` (variants `generated`, `rbd`), `whole_body` (`combined`,
-//! `separate`), `sin_cos_17/generated`. Inputs cycle through 8 random
+//! `com_jacobian`, `coriolis` (variants `generated`, `rbd`; `hands_jacobian` also `combined`,
+//! the one-program `Krang::hands_jacobians`), `whole_body` (`combined`, `separate`),
+//! `sin_cos_17/generated`. Inputs cycle through 8 random
 //! states behind `black_box`; the variants are checked against each other before timing.
 //!
 //! Also `arm_end/pose_jacobian/{generated,rbd,k}`: the end link of the URDF arm
@@ -78,6 +79,9 @@ fn kinematics(c: &mut Criterion) {
         close!(w.nonlinear_effects, k.nonlinear_effects(q, u));
         close!(w.com_jacobian, k.com_jacobian(q));
         close!(w.frame_jacobian_right_hand, k.frame_jacobian(q, hands[1]));
+        let j = k.hands_jacobians(q);
+        close!(j.frame_jacobian_left_hand, k.frame_jacobian(q, hands[0]));
+        close!(j.frame_jacobian_right_hand, k.frame_jacobian(q, hands[1]));
         close!(
             w.frame_bias_acceleration_left_hand,
             k.frame_bias_acceleration(q, u, hands[0])
@@ -116,6 +120,7 @@ fn kinematics(c: &mut Criterion) {
         k.frame_jacobian(q, hands[0]),
         k.frame_jacobian(q, hands[1])
     ));
+    bench!("hands_jacobian/combined", |q, _u| k.hands_jacobians(q));
     bench!("hands_jacobian/rbd", |q, _u| (
         rbd.frame_jacobian(q, &rbd_hands[0]),
         rbd.frame_jacobian(q, &rbd_hands[1])

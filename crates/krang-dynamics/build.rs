@@ -82,7 +82,9 @@ mod modules {
                 .mirrored_lanes(true)
                 .batch(true);
             if kinematics {
-                main = main.combined(whole_body_terms());
+                main = main
+                    .combined(whole_body_terms())
+                    .combined(hands_jacobians());
             }
             main.run();
         }
@@ -140,6 +142,18 @@ mod modules {
             .iter()
             .find(|(name, _)| *name == value)
             .map_or(auto, |&(_, form)| form)
+    }
+
+    /// Both hands' Jacobians as one generated program (`Krang::hands_jacobians`): the trunk's
+    /// sines, cosines and rotations computed once, the two arms' chains two lanes at a time
+    /// (what an operational-space controller of both hands reads every tick).
+    fn hands_jacobians() -> kanegen::combined::Combined {
+        use kanegen::FunctionId as F;
+        let mut c = kanegen::combined::Combined::new("hands_jacobians");
+        for hand in ["left_hand", "right_hand"] {
+            c = c.with_frame(F::FrameJacobian, hand);
+        }
+        c
     }
 
     /// What a whole-body controller reads every tick at one state, as one generated program

@@ -20,6 +20,7 @@
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
 //! across calls), `forward_dynamics_derivatives` and `linearize`; with the feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
+//! `hands_jacobians`, `hands_jacobians_separate` (the two `frame_jacobian` calls it combines),
 //! `com_jacobian` and `sin_cos_17`), the
 //! number of calls, and optionally the instruction set (`baseline` or `x86-64-v3`; default: the
 //! best the CPU has, see `kanegen_runtime::isa`). States cycle through 64 fixed pseudo-random
@@ -217,8 +218,8 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
     acc
 }
 
-/// The combined `whole_body_terms` and the eleven separate calls it replaces (feature
-/// `kinematics`), and the 17-angle `sin_cos_n` every call computes.
+/// The combined `whole_body_terms` and `hands_jacobians` and the separate calls they replace
+/// (feature `kinematics`), and the 17-angle `sin_cos_n` every call computes.
 #[cfg(feature = "kinematics")]
 fn kinematics(k: &Krang, f: &str, q: &V, u: &V) -> f64 {
     use krang_dynamics::Frame;
@@ -244,6 +245,16 @@ fn kinematics(k: &Krang, f: &str, q: &V, u: &V) -> f64 {
             });
             black_box((&m, &h, &g, &jg, &bg, &hs));
             m[(5, 3)] + hs[1].1[(2, 9)]
+        }
+        "hands_jacobians" => {
+            let j = black_box(k).hands_jacobians(black_box(q));
+            j.frame_jacobian_left_hand[(2, 9)] + j.frame_jacobian_right_hand[(2, 9)]
+        }
+        "hands_jacobians_separate" => {
+            let (k, q) = (black_box(k), black_box(q));
+            let j = hands.map(|f| k.frame_jacobian(q, f));
+            black_box(&j);
+            j[0][(2, 9)] + j[1][(2, 9)]
         }
         "com_jacobian" => black_box(k).com_jacobian(black_box(q))[(1, 7)],
         "sin_cos_17" => {

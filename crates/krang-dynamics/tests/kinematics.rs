@@ -8,6 +8,10 @@ use nalgebra::SVector;
 
 type V = SVector<f64, DOF>;
 
+/// Held by every test that selects an instruction set (the selection is global to the process
+/// and the tests run in parallel threads).
+static ISA_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// Deterministic, varied states: `(q, u)`.
 fn states() -> impl Iterator<Item = (V, V)> {
     (0..20).map(|k| {
@@ -118,6 +122,9 @@ fn varied_params(seed: f64) -> krang_dynamics::Params {
 #[test]
 fn whole_body_terms_equal_the_separate_functions_bit_for_bit_in_the_baseline_copy() {
     use krang_dynamics::isa::{self, Isa};
+    let _isa = ISA_LOCK
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let hands = ["left_hand", "right_hand"].map(|n| Frame::from_name(n).expect("hand frame"));
     let best = isa::detected();
     for which in Isa::ALL.into_iter().filter(|i| isa::available(*i)) {
@@ -165,6 +172,42 @@ fn whole_body_terms_equal_the_separate_functions_bit_for_bit_in_the_baseline_cop
                 k.frame_bias_acceleration(&q, &u, r),
                 false
             );
+        }
+    }
+    isa::select(best).expect("detected");
+}
+
+/// `hands_jacobians` (both hands' Jacobians as one program, the arms two lanes at a time) equals
+/// the two separate `frame_jacobian` calls: bit for bit in the baseline copy, to 10⁻¹² of the
+/// largest entry in the copies that fuse multiply-adds (as `whole_body_terms` above).
+#[test]
+fn hands_jacobians_equal_the_two_separate_frame_jacobians() {
+    use krang_dynamics::isa::{self, Isa};
+    let _isa = ISA_LOCK
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let best = isa::detected();
+    for which in Isa::ALL.into_iter().filter(|i| isa::available(*i)) {
+        isa::select(which).expect("available");
+        for (s, (q, _)) in states().enumerate() {
+            let k = Krang::new(varied_params(s as f64));
+            let j = k.hands_jacobians(&q);
+            for (a, b) in [
+                (
+                    j.frame_jacobian_left_hand,
+                    k.frame_jacobian(&q, Frame::LeftHand),
+                ),
+                (
+                    j.frame_jacobian_right_hand,
+                    k.frame_jacobian(&q, Frame::RightHand),
+                ),
+            ] {
+                if which == Isa::Baseline {
+                    assert_eq!(a, b);
+                } else {
+                    assert!((a - b).amax() <= 1e-12 * b.amax().max(1.0), "{a} {b}");
+                }
+            }
         }
     }
     isa::select(best).expect("detected");

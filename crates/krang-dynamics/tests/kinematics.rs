@@ -8,10 +8,6 @@ use nalgebra::SVector;
 
 type V = SVector<f64, DOF>;
 
-/// Held by every test that selects an instruction set (the selection is global to the process
-/// and the tests run in parallel threads).
-static ISA_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
-
 /// Deterministic, varied states: `(q, u)`.
 fn states() -> impl Iterator<Item = (V, V)> {
     (0..20).map(|k| {
@@ -111,6 +107,37 @@ fn varied_params(seed: f64) -> krang_dynamics::Params {
     krang_dynamics::Params::from_array(v)
 }
 
+/// Held while a test selects instruction sets (the selection is global to the process and the
+/// tests run in parallel threads).
+static ISA_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Runs `check(exact)` once with each instruction set this CPU has selected, `exact` for the
+/// baseline copy (whose sums are the plain ones), then selects the detected one again.
+fn for_each_isa(mut check: impl FnMut(bool)) {
+    use krang_dynamics::isa::{self, Isa};
+    let _isa = ISA_LOCK
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let best = isa::detected();
+    for which in Isa::ALL.into_iter().filter(|i| isa::available(*i)) {
+        isa::select(which).expect("available");
+        check(which == Isa::Baseline);
+    }
+    isa::select(best).expect("detected");
+}
+
+/// `a` equals `b` bit for bit if `exact`, else to 10⁻¹² of `b`'s largest entry.
+macro_rules! same {
+    ($a:expr, $b:expr, $exact:expr) => {{
+        let (a, b) = ($a, $b);
+        if $exact {
+            assert_eq!(a, b);
+        } else {
+            assert!((a - b).amax() <= 1e-12 * b.amax().max(1.0), "{a} {b}");
+        }
+    }};
+}
+
 /// Bit for bit in the baseline copy; in the x86-64-v3 copy, which fuses multiply-adds, a
 /// product that is a shared statement in one program and inline in the other is fused in only
 /// one of them, so there the parts agree to 10⁻¹² of each result's largest entry. The module
@@ -121,51 +148,37 @@ fn varied_params(seed: f64) -> krang_dynamics::Params {
 /// left hand's order: that part agrees to 10⁻¹² in both copies.
 #[test]
 fn whole_body_terms_equal_the_separate_functions_bit_for_bit_in_the_baseline_copy() {
-    use krang_dynamics::isa::{self, Isa};
-    let _isa = ISA_LOCK
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    let hands = ["left_hand", "right_hand"].map(|n| Frame::from_name(n).expect("hand frame"));
-    let best = isa::detected();
-    for which in Isa::ALL.into_iter().filter(|i| isa::available(*i)) {
-        isa::select(which).expect("available");
-        let exact = which == Isa::Baseline;
-        macro_rules! same {
-            ($a:expr, $b:expr) => {
-                same!($a, $b, exact)
-            };
-            ($a:expr, $b:expr, $exact:expr) => {{
-                let (a, b) = ($a, $b);
-                if $exact {
-                    assert_eq!(a, b);
-                } else {
-                    assert!((a - b).amax() <= 1e-12 * b.amax().max(1.0), "{a} {b}");
-                }
-            }};
-        }
+    let [l, r] = ["left_hand", "right_hand"].map(|n| Frame::from_name(n).expect("hand frame"));
+    for_each_isa(|exact| {
         for (s, (q, u)) in states().enumerate() {
             let k = Krang::new(varied_params(s as f64));
             let w = k.whole_body_terms(&q, &u);
-            same!(w.mass_matrix, k.mass_matrix(&q));
-            same!(w.nonlinear_effects, k.nonlinear_effects(&q, &u));
-            same!(w.center_of_mass, k.center_of_mass(&q));
-            same!(w.com_jacobian, k.com_jacobian(&q));
-            same!(w.com_bias_acceleration, k.com_bias_acceleration(&q, &u));
-            let [l, r] = hands;
+            same!(w.mass_matrix, k.mass_matrix(&q), exact);
+            same!(w.nonlinear_effects, k.nonlinear_effects(&q, &u), exact);
+            same!(w.center_of_mass, k.center_of_mass(&q), exact);
+            same!(w.com_jacobian, k.com_jacobian(&q), exact);
+            same!(
+                w.com_bias_acceleration,
+                k.com_bias_acceleration(&q, &u),
+                exact
+            );
             same!(
                 w.frame_pose_left_hand.to_homogeneous(),
-                k.frame_pose(&q, l).to_homogeneous()
+                k.frame_pose(&q, l).to_homogeneous(),
+                exact
             );
-            same!(w.frame_jacobian_left_hand, k.frame_jacobian(&q, l));
+            same!(w.frame_jacobian_left_hand, k.frame_jacobian(&q, l), exact);
             same!(
                 w.frame_bias_acceleration_left_hand,
-                k.frame_bias_acceleration(&q, &u, l)
+                k.frame_bias_acceleration(&q, &u, l),
+                exact
             );
             same!(
                 w.frame_pose_right_hand.to_homogeneous(),
-                k.frame_pose(&q, r).to_homogeneous()
+                k.frame_pose(&q, r).to_homogeneous(),
+                exact
             );
-            same!(w.frame_jacobian_right_hand, k.frame_jacobian(&q, r));
+            same!(w.frame_jacobian_right_hand, k.frame_jacobian(&q, r), exact);
             // Paired with the left hand's in the combined program only (see above).
             same!(
                 w.frame_bias_acceleration_right_hand,
@@ -173,8 +186,7 @@ fn whole_body_terms_equal_the_separate_functions_bit_for_bit_in_the_baseline_cop
                 false
             );
         }
-    }
-    isa::select(best).expect("detected");
+    });
 }
 
 /// `hands_jacobians` (both hands' Jacobians as one program, the arms two lanes at a time) equals
@@ -182,35 +194,22 @@ fn whole_body_terms_equal_the_separate_functions_bit_for_bit_in_the_baseline_cop
 /// largest entry in the copies that fuse multiply-adds (as `whole_body_terms` above).
 #[test]
 fn hands_jacobians_equal_the_two_separate_frame_jacobians() {
-    use krang_dynamics::isa::{self, Isa};
-    let _isa = ISA_LOCK
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    let best = isa::detected();
-    for which in Isa::ALL.into_iter().filter(|i| isa::available(*i)) {
-        isa::select(which).expect("available");
+    for_each_isa(|exact| {
         for (s, (q, _)) in states().enumerate() {
             let k = Krang::new(varied_params(s as f64));
             let j = k.hands_jacobians(&q);
-            for (a, b) in [
-                (
-                    j.frame_jacobian_left_hand,
-                    k.frame_jacobian(&q, Frame::LeftHand),
-                ),
-                (
-                    j.frame_jacobian_right_hand,
-                    k.frame_jacobian(&q, Frame::RightHand),
-                ),
-            ] {
-                if which == Isa::Baseline {
-                    assert_eq!(a, b);
-                } else {
-                    assert!((a - b).amax() <= 1e-12 * b.amax().max(1.0), "{a} {b}");
-                }
-            }
+            same!(
+                j.frame_jacobian_left_hand,
+                k.frame_jacobian(&q, Frame::LeftHand),
+                exact
+            );
+            same!(
+                j.frame_jacobian_right_hand,
+                k.frame_jacobian(&q, Frame::RightHand),
+                exact
+            );
         }
-    }
-    isa::select(best).expect("detected");
+    });
 }
 
 #[test]

@@ -33,6 +33,10 @@
 pub trait Arith<T> {
     /// `x * y + acc`.
     fn mul_add(x: T, y: T, acc: T) -> T;
+    /// Whether [`Arith::mul_add`] rounds once (a true fused multiply-add): `true` for
+    /// [`Fused`] with `std`, `false` otherwise. Code whose accuracy needs the single rounding
+    /// reads it to choose its formulas: the argument reduction of `crate::trig` does.
+    const ROUNDS_ONCE: bool = false;
 }
 
 /// `x * y + acc` with two roundings (a multiplication, then an addition): the baseline copy,
@@ -66,6 +70,7 @@ macro_rules! arith {
         }
 
         impl Arith<$t> for Fused {
+            const ROUNDS_ONCE: bool = cfg!(feature = "std");
             #[inline(always)]
             fn mul_add(x: $t, y: $t, acc: $t) -> $t {
                 #[cfg(feature = "std")]

@@ -261,6 +261,71 @@ fn inline_lanes_form_gives_the_plain_bits_and_fuses_within_two_ulp() {
 }
 
 /// Distance in units in the last place between two finite `f32` of any sign.
+/// Distance of `got` from `std`'s `exact` in units of the last place of `exact`.
+fn ulps_f64(got: f64, exact: f64) -> f64 {
+    if got == exact {
+        return 0.0;
+    }
+    let e = exact.abs();
+    let ulp = f64::from_bits(e.to_bits() + 1) - e;
+    (got - exact).abs() / ulp
+}
+
+/// The fused copies reduce the argument by three fused multiply-adds (`A::ROUNDS_ONCE`), not
+/// by fdlibm's two-part sums: both kinds of copy stay within 1 ulp of `std` up to the fast
+/// bound, also next to the multiples of π/2 (every one of them up to the bound, ±3 ulp of
+/// the argument), where the result is tiny and only a reduction accurate to about 2⁻¹⁵⁰
+/// absolute keeps it within an ulp. `Fused` is run explicitly, so this holds on any CPU.
+#[test]
+fn fused_and_plain_reductions_stay_within_an_ulp_of_std_up_to_the_fast_bound() {
+    use kanegen_runtime::isa::{Fused, Plain};
+    use kanegen_runtime::lanes::sin_cos_n_inline;
+    let mut xs = robot_angles();
+    let bound = (SIN_COS_FAST_BOUND / std::f64::consts::FRAC_PI_2) as i64;
+    for k in (1..=bound).step_by(5).chain([bound - 1, bound]) {
+        let b = k as f64 * std::f64::consts::FRAC_PI_2;
+        for d in -3..=3_i64 {
+            let x = f64::from_bits(b.to_bits().wrapping_add_signed(d));
+            if x < SIN_COS_FAST_BOUND {
+                xs.extend([x, -x]);
+            }
+        }
+    }
+    xs.resize(xs.len().next_multiple_of(8), 0.5);
+    let (mut worst_fused, mut worst_plain) = ((0.0, 0.0), (0.0, 0.0));
+    for chunk in xs.chunks_exact(8) {
+        let x: [[f64; 4]; 2] = [
+            chunk[..4].try_into().unwrap(),
+            chunk[4..].try_into().unwrap(),
+        ];
+        let (sf, cf) = sin_cos_n_inline::<Fused, 2, 4>(x);
+        let (sp, cp) = sin_cos_n_inline::<Plain, 2, 4>(x);
+        for k in 0..2 {
+            for l in 0..4 {
+                let (se, ce) = x[k][l].sin_cos();
+                let f = ulps_f64(sf[k][l], se).max(ulps_f64(cf[k][l], ce));
+                let p = ulps_f64(sp[k][l], se).max(ulps_f64(cp[k][l], ce));
+                if f > worst_fused.0 {
+                    worst_fused = (f, x[k][l]);
+                }
+                if p > worst_plain.0 {
+                    worst_plain = (p, x[k][l]);
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{} arguments: fused {:.3} ulp (x = {:e}), plain {:.3} ulp (x = {:e})",
+        xs.len(),
+        worst_fused.0,
+        worst_fused.1,
+        worst_plain.0,
+        worst_plain.1
+    );
+    assert!(worst_fused.0 <= 1.0, "fused: {worst_fused:?}");
+    assert!(worst_plain.0 <= 1.0, "plain: {worst_plain:?}");
+}
+
 fn ulps(a: f32, b: f32) -> u32 {
     fn key(x: f32) -> i64 {
         let b = i64::from(x.to_bits() as i32);

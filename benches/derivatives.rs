@@ -4,6 +4,10 @@
 //! * `inverse_dynamics/generated`: one generated τ call, the unit of the target;
 //! * `id_derivatives/generated`: the generated `inverse_dynamics_derivatives` (both 19×19
 //!   matrices ∂τ/∂q, ∂τ/∂u);
+//! * `id_derivatives/into`, `id_derivatives/with`: the same into a matrix kept across calls
+//!   (`inverse_dynamics_derivatives_into`, which zeroes it and a workspace every call) and into
+//!   a `DerivativesWorkspace` kept across calls (`inverse_dynamics_derivatives_with`, which
+//!   zeroes nothing);
 //! * `id_derivatives/central_differences`: the same two matrices by central differences of the
 //!   generated τ (2 × 2N = 76 calls; Richardson extrapolation would double that);
 //! * `id_derivatives/rbd_dual`: the same by `kanegen-rbd`'s recursion in `num_dual::Dual64`
@@ -114,6 +118,14 @@ fn bench(c: &mut Criterion) {
         .inverse_dynamics(q, u, ud));
     cycle!("id_derivatives/generated", |q, u, ud| k
         .inverse_dynamics_derivatives(q, u, ud));
+    let mut kept = SMatrix::<f64, 19, 38>::zeros();
+    cycle!("id_derivatives/into", |q, u, ud| {
+        k.inverse_dynamics_derivatives_into(q, u, ud, &mut kept);
+        kept[(7, 20)]
+    });
+    let mut ws = krang_dynamics::DerivativesWorkspace::new();
+    cycle!("id_derivatives/with", |q, u, ud| k
+        .inverse_dynamics_derivatives_with(q, u, ud, &mut ws)[(7, 20)]);
     cycle!("id_partials/generated", |q, u, ud| k
         .inverse_dynamics_partials(q, u, ud));
     cycle!("id_derivatives/central_differences", |q, u, ud| {

@@ -191,6 +191,8 @@ fn time(dir: &Path) -> Result<(), String> {
         SMatrix::<f64, 19, 19>::zeros(),
         SMatrix::<f64, 19, 38>::zeros(),
     );
+    // And the derivatives into a workspace kept across calls, as Pinocchio keeps `data`.
+    let mut d_ws = krang_dynamics::DerivativesWorkspace::new();
     let results = [
         (
             "mass_matrix",
@@ -247,9 +249,26 @@ fn time(dir: &Path) -> Result<(), String> {
             }),
         ),
         (
+            "inverse_dynamics_derivatives_with",
+            time_one(&states, |q, u, ud| {
+                black_box(black_box(k).inverse_dynamics_derivatives_with(
+                    q,
+                    u,
+                    ud,
+                    black_box(&mut d_ws),
+                ));
+            }),
+        ),
+        (
             "forward_dynamics",
             time_one(&fd_states, |q, u, tau| {
                 black_box(black_box(k).forward_dynamics(q, u, tau));
+            }),
+        ),
+        (
+            "forward_dynamics_derivatives",
+            time_one(&fd_states, |q, u, tau| {
+                black_box(black_box(k).forward_dynamics_derivatives(q, u, tau));
             }),
         ),
     ];
@@ -300,7 +319,7 @@ fn best_times(path: &Path) -> Result<(BTreeMap<String, f64>, usize), String> {
 type Row = (&'static str, &'static str, &'static str, &'static str);
 
 /// The rows of the comparison, in the order printed.
-const ROWS: [Row; 11] = [
+const ROWS: [Row; 13] = [
     (
         "`mass_matrix` (M)",
         "mass_matrix",
@@ -356,6 +375,12 @@ const ROWS: [Row; 11] = [
         "rnea_derivatives",
     ),
     (
+        "`inverse_dynamics_derivatives_with` (into a kept `DerivativesWorkspace`)",
+        "inverse_dynamics_derivatives_with",
+        "`computeRNEADerivatives` (∂τ/∂q, ∂τ/∂v, ∂τ/∂a = M)",
+        "rnea_derivatives",
+    ),
+    (
         "`forward_dynamics` (u̇, block Cholesky)",
         "forward_dynamics",
         "`crba` + `nonLinearEffects` + Eigen `LLT` on the 19 speeds",
@@ -366,6 +391,12 @@ const ROWS: [Row; 11] = [
         "forward_dynamics",
         "`aba` (20 speeds: the base without its rolling constraint, other dynamics)",
         "aba",
+    ),
+    (
+        "`forward_dynamics_derivatives` (u̇, ∂u̇/∂q, ∂u̇/∂u, M⁻¹)",
+        "forward_dynamics_derivatives",
+        "`computeABADerivatives` (∂u̇/∂q, ∂u̇/∂v, M⁻¹; 20 speeds as `aba`)",
+        "aba_derivatives",
     ),
 ];
 
@@ -414,14 +445,17 @@ fn report(dir: &Path) -> Result<(), String> {
             true,
         )?;
     }
-    if let (Some(d), Some(t)) = (
-        ours.get("inverse_dynamics_derivatives_into"),
-        ours.get("inverse_dynamics"),
-    ) {
-        println!(
-            "\nkanegen: both derivative matrices, into a kept matrix, take {:.1}× one `inverse_dynamics` call",
-            d / t
-        );
+    println!();
+    for (key, into) in [
+        ("inverse_dynamics_derivatives_into", "a kept matrix"),
+        ("inverse_dynamics_derivatives_with", "a kept workspace"),
+    ] {
+        if let (Some(d), Some(t)) = (ours.get(key), ours.get("inverse_dynamics")) {
+            println!(
+                "kanegen: both derivative matrices, into {into}, take {:.1}× one `inverse_dynamics` call",
+                d / t
+            );
+        }
     }
     println!(
         "\n(best of {our_runs} kanegen and {pin_runs} Pinocchio runs; each figure the fastest round of {ROUNDS} × {CALLS} calls)"

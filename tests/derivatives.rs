@@ -156,32 +156,62 @@ fn krang_position_and_heading_columns_are_exactly_zero() {
 }
 
 #[test]
-fn derivatives_into_a_kept_matrix_equal_the_by_value_result_bit_for_bit() {
+fn derivatives_into_a_kept_matrix_or_workspace_equal_the_by_value_result_bit_for_bit() {
     // `inverse_dynamics_derivatives_into` writes every entry (structural zeros included) of a
-    // matrix that holds anything before: Krang (looped form) and the two-link model
-    // (straight-line form), on random parameters and states.
+    // matrix that holds anything before; `inverse_dynamics_derivatives_with` reuses one
+    // `DerivativesWorkspace` across calls without zeroing it. Both must give the by-value bits,
+    // whatever the calls before left behind — other parameters, other states, a state of NaN
+    // and huge angles (the sines' and cosines' slow path) in between. Krang (looped form), the
+    // fixed-wheel tree and the two-link model (straight-line form).
     let mut r = rng(1211);
     let mut m = SMatrix::<f64, 19, 38>::from_element(f64::NAN);
-    for draw in 0..20 {
+    let mut ws = kd::DerivativesWorkspace::new();
+    assert_eq!(*ws.result(), SMatrix::<f64, 19, 38>::zeros());
+    for draw in 0..30 {
         let k = if draw == 0 {
             kd::Krang::default()
         } else {
             random_krang(&mut r)
         };
         let (q, u, ud) = random_state(&mut r, 19);
-        let (q, u, ud) = (sv::<19>(&q), sv::<19>(&u), sv::<19>(&ud));
-        k.inverse_dynamics_derivatives_into(&q, &u, &ud, &mut m);
+        let (mut q, u, ud) = (sv::<19>(&q), sv::<19>(&u), sv::<19>(&ud));
+        if draw % 10 == 5 {
+            q[7] = f64::NAN;
+            q[9] = 1e22;
+        }
         let by_value = k.inverse_dynamics_derivatives(&q, &u, &ud);
-        assert!(same_bits(m.as_slice(), by_value.as_slice()));
+        k.inverse_dynamics_derivatives_into(&q, &u, &ud, &mut m);
+        assert!(same_bits(m.as_slice(), by_value.as_slice()), "draw {draw}");
         m.fill(f64::NAN);
+        let kept = k.inverse_dynamics_derivatives_with(&q, &u, &ud, &mut ws);
+        assert!(
+            same_bits(kept.as_slice(), by_value.as_slice()),
+            "draw {draw}"
+        );
+        assert!(same_bits(ws.result().as_slice(), by_value.as_slice()));
+    }
+    let fixed = kd::fixed_wheels::KrangFixedWheels::default();
+    let mut ws = kd::fixed_wheels::DerivativesWorkspace::default();
+    for _ in 0..10 {
+        let (q, u, ud) = random_state(&mut r, 17);
+        let (q, u, ud) = (sv::<17>(&q), sv::<17>(&u), sv::<17>(&ud));
+        let by_value = fixed.inverse_dynamics_derivatives(&q, &u, &ud);
+        let kept = fixed.inverse_dynamics_derivatives_with(&q, &u, &ud, &mut ws);
+        assert!(same_bits(kept.as_slice(), by_value.as_slice()));
     }
     let two = kd::two_link::TwoLink::default();
     let mut m = SMatrix::<f64, 2, 4>::from_element(f64::NAN);
+    let mut ws = kd::two_link::DerivativesWorkspace::new();
     for _ in 0..20 {
         let (q, u, ud) = random_state(&mut r, 2);
         let (q, u, ud) = (sv::<2>(&q), sv::<2>(&u), sv::<2>(&ud));
+        let by_value = two.inverse_dynamics_derivatives(&q, &u, &ud);
         two.inverse_dynamics_derivatives_into(&q, &u, &ud, &mut m);
-        assert_eq!(m, two.inverse_dynamics_derivatives(&q, &u, &ud));
+        assert_eq!(m, by_value);
+        assert_eq!(
+            *two.inverse_dynamics_derivatives_with(&q, &u, &ud, &mut ws),
+            by_value
+        );
     }
 }
 

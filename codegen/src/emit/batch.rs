@@ -553,14 +553,9 @@ pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
             let state = layout.args(cx, spec.inputs);
             let ty = layout.result(cx, spec);
             let names = arg_names(spec.inputs);
-            let (call, call_into) = if cx.low.params.is_runtime() {
-                (
-                    quote!(#name(&self.params, &self.pre, #names)),
-                    quote!(#name_into(&self.params, &self.pre, #names, out)),
-                )
-            } else {
-                (quote!(#name(#names)), quote!(#name_into(#names, out)))
-            };
+            let pass = super::items::wrapper_params(cx);
+            let call = quote!(#name(#pass #names));
+            let call_into = quote!(#name_into(#pass #names, out));
             methods.extend(quote! {
                 #[doc = #doc]
                 #[inline]

@@ -177,11 +177,8 @@ pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
             let ty = ident(&c.spec.type_name);
             let (args, _) = state_args(cx, c.spec.inputs);
             let names = arg_names(c.spec.inputs);
-            let call = if cx.low.params.is_runtime() {
-                quote!(#name(&self.params, &self.pre, #names))
-            } else {
-                quote!(#name(#names))
-            };
+            let pass = super::items::wrapper_params(cx);
+            let call = quote!(#name(#pass #names));
             let doc = format!(" Combined function [`{}`] (free function).", c.spec.name);
             quote! {
                 #[doc = #doc]

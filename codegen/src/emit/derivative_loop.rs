@@ -18,6 +18,9 @@ use crate::lower::{FunctionProgram, LExpr, LoopedProgram};
 /// The name of the tables' `const`.
 const TABLES: &str = "INVERSE_DYNAMICS_DERIVATIVES_STEPS";
 
+/// The workspace type kept across calls of the derivatives (every module with them has one).
+const WORKSPACE: &str = "DerivativesWorkspace";
+
 /// The tables as a `kanegen_runtime::derivative_steps::Plan` constant.
 fn tables(plan: &DerivativeLoop) -> TokenStream {
     let u16_of = |x: usize| {
@@ -130,9 +133,8 @@ pub(super) fn function(
     let body = quote! {
         #unused
         #prologue
-        let mut w: [#t; #len] = [#zero; #len];
         #body
-        #run(&#tables_name, &w, m.as_mut_slice());
+        #run(&#tables_name, &w[..], m.as_mut_slice());
     };
     let mat = quote!(SMatrix<#t, #rows, #cols>);
     // The body generic over the multiply-add (fused in the x86-64-v3 copy, like every
@@ -148,7 +150,7 @@ pub(super) fn function(
         },
         quote!(),
         quote!(#pass_params #state,),
-        quote!(m),
+        quote!((w, m)),
     );
     let call = quote!(#call;);
     let tables = tables(&looped.plan);
@@ -160,8 +162,14 @@ pub(super) fn function(
         spec.name
     );
     let onto_doc = format!(
-        " The entries of [`{}`] written into `m`, whose other entries are zero (the structural zeros are not written): the by-value function passes a new zero matrix, so that the result is built where the caller keeps it rather than copied out.",
+        " The entries of [`{}`] written into `m`, whose other entries are zero (the structural zeros are not written), through the workspace `w`, whose slots the statements write before the loop reads them (those never written stay zero): the by-value function passes a new zero matrix and workspace, so that the result is built where the caller keeps it rather than copied out; [`{WORKSPACE}`] keeps both across calls.",
         spec.name
+    );
+    let workspace = workspace(
+        cx,
+        f,
+        (&mat, Some(&len), &zero),
+        quote!(#onto(#pass_params #state, &mut self.w, &mut self.m)),
     );
     quote! {
         #tables
@@ -173,7 +181,7 @@ pub(super) fn function(
         #[inline]
         pub fn #fname(#outer_params #args) -> #mat {
             let mut m = <#mat>::zeros();
-            #onto(#pass_params #state, &mut m);
+            #onto(#pass_params #state, &mut [#zero; #len], &mut m);
             m
         }
 
@@ -183,17 +191,90 @@ pub(super) fn function(
         #[inline]
         pub fn #into(#outer_params #args, m: &mut #mat) {
             *m = <#mat>::zeros();
-            #onto(#pass_params #state, m);
+            #onto(#pass_params #state, &mut [#zero; #len], m);
         }
+
+        #workspace
 
         #[doc = #onto_doc]
         #[inline(never)]
-        fn #onto(#outer_params #args, m: &mut #mat) {
+        fn #onto(#outer_params #args, w: &mut [#t; #len], m: &mut #mat) {
             #[inline(always)]
-            fn body<#generics>(#lanes_arg #param_args #args, m: &mut #mat) {
+            fn body<#generics>(#lanes_arg #param_args #args, (w, m): (&mut [#t; #len], &mut #mat)) {
                 #body
             }
             #call
+        }
+    }
+}
+
+/// `DerivativesWorkspace`: the derivatives' result matrix (and, in the looped form, the loop's
+/// workspace array) kept by the caller across calls, zeroed once when it is made. Each
+/// evaluation writes the same entries and slots (the statements are straight-line, the loop's
+/// steps fixed by the model): those it never writes are the structural zeros, which stay
+/// zero, so nothing is zeroed per call. The third argument is `(result type, workspace length,
+/// zero literal)` (a length of `None`: the straight-line form, no workspace array), `fill` the
+/// statement that fills `self.m` (and `self.w`) from the free function's arguments.
+fn workspace(
+    cx: &Context<'_>,
+    f: &FunctionProgram,
+    (mat, len, zero): (
+        &TokenStream,
+        Option<&proc_macro2::Literal>,
+        &proc_macro2::Literal,
+    ),
+    fill: TokenStream,
+) -> TokenStream {
+    let spec = f.id.spec();
+    let name = ident(WORKSPACE);
+    let (args, arg_doc) = state_args(cx, spec.inputs);
+    let (outer_params, _) = super::function::outer_params(cx);
+    let t = scalar_type(cx.precision);
+    let (field, init) = match len {
+        Some(len) => (quote!(w: [#t; #len],), quote!(w: [#zero; #len],)),
+        None => (quote!(), quote!()),
+    };
+    let doc = format!(
+        " What [`{0}`] needs kept across calls for [`{WORKSPACE}::evaluate`]: its result matrix (and its loop's workspace, the per-link values the statements compute for the loop's steps), zeroed once by [`{WORKSPACE}::new`]. Each evaluation writes the same entries, so the ones it never writes (the structural zeros) stay zero and nothing is zeroed per call: for a caller that evaluates the derivatives at many states (MPC along a horizon, iLQR/DDP backward passes), the same bits as [`{0}`] without zeroing the workspace and the matrix every call.",
+        spec.name
+    );
+    let eval_doc = format!(
+        " [`{}`] at the given state, written into the kept matrix, which it returns (`[∂τ/∂q | ∂τ/∂u]`, N × 2N).",
+        spec.name
+    );
+    quote! {
+        #[doc = #doc]
+        #[derive(Clone, Debug)]
+        pub struct #name {
+            #field
+            m: #mat,
+        }
+
+        impl #name {
+            /// A workspace with every value zero (no evaluation yet: [`Self::result`] is zero).
+            pub fn new() -> Self {
+                Self { #init m: <#mat>::zeros() }
+            }
+
+            /// The matrix of the last [`Self::evaluate`] (zero before the first).
+            pub fn result(&self) -> &#mat {
+                &self.m
+            }
+
+            #[doc = #eval_doc]
+            #[doc = ""]
+            #[doc = #arg_doc]
+            #[inline]
+            pub fn evaluate(&mut self, #outer_params #args) -> &#mat {
+                #fill;
+                &self.m
+            }
+        }
+
+        impl Default for #name {
+            fn default() -> Self {
+                Self::new()
+            }
         }
     }
 }
@@ -214,14 +295,24 @@ pub(super) fn straight_into(cx: &Context<'_>, f: &FunctionProgram, looped: bool)
     let state = super::items::arg_names(spec.inputs);
     let (outer_params, pass_params) = super::function::outer_params(cx);
     let doc = format!(" [`{}`] written into `m`.", spec.name);
+    let mat = quote!(SMatrix<#t, #rows, #cols>);
+    let zero = lit(0.0, cx.precision);
+    let workspace = workspace(
+        cx,
+        f,
+        (&mat, None, &zero),
+        quote!(self.m = #fname(#pass_params #state)),
+    );
     quote! {
         #[doc = #doc]
         #[doc = ""]
         #[doc = #arg_doc]
         #[inline]
-        pub fn #into(#outer_params #args, m: &mut SMatrix<#t, #rows, #cols>) {
+        pub fn #into(#outer_params #args, m: &mut #mat) {
             *m = #fname(#pass_params #state);
         }
+
+        #workspace
     }
 }
 
@@ -247,16 +338,26 @@ pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
     let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
     let (rows, cols) = (idx(rows), idx(cols));
     let state = super::items::arg_names(spec.inputs);
-    let call = if cx.low.params.is_runtime() {
-        quote!(#into(&self.params, &self.pre, #state, m))
-    } else {
-        quote!(#into(#state, m))
-    };
+    let pass = super::items::wrapper_params(cx);
+    let call = quote!(#into(#pass #state, m));
+    let with = ident(&format!("{}_with", spec.name));
+    let name = ident(WORKSPACE);
+    let with_doc = format!(
+        " [`Self::{}`] written into the matrix of a [`{WORKSPACE}`] the caller keeps across calls (made once by `{WORKSPACE}::new()`), which it returns: the same bits, without zeroing a workspace and a matrix every call.",
+        spec.name
+    );
+    let eval = quote!(ws.evaluate(#pass #state));
     quote! {
         #[doc = #doc]
         #[inline]
         pub fn #into(&self, #args, m: &mut SMatrix<#t, #rows, #cols>) {
             #call
+        }
+
+        #[doc = #with_doc]
+        #[inline]
+        pub fn #with<'w>(&self, #args, ws: &'w mut #name) -> &'w SMatrix<#t, #rows, #cols> {
+            #eval
         }
     }
 }

@@ -297,6 +297,17 @@ pub(super) fn return_type(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream 
     result_type(cx, spec.shape)
 }
 
+/// What a method of the wrapper passes first to a free function: the wrapper's parameters and
+/// their precomputed values (`&self.params, &self.pre,`) in a runtime-parameter module, nothing
+/// in a baked one (the free function's own first arguments: [`super::function::outer_params`]).
+pub(super) fn wrapper_params(cx: &Context<'_>) -> TokenStream {
+    if cx.low.params.is_runtime() {
+        quote!(&self.params, &self.pre,)
+    } else {
+        quote!()
+    }
+}
+
 /// A call of the free function of `spec` from a method of the wrapper.
 fn forward_call(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
     let f = ident(spec.name);
@@ -304,11 +315,8 @@ fn forward_call(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
     if spec.per_frame {
         args.extend(quote!(, frame));
     }
-    if cx.low.params.is_runtime() {
-        quote!(#f(&self.params, &self.pre, #args))
-    } else {
-        quote!(#f(#args))
-    }
+    let pass = wrapper_params(cx);
+    quote!(#f(#pass #args))
 }
 
 /// One method of the wrapper per generated function.
@@ -336,11 +344,7 @@ fn methods(cx: &Context<'_>) -> TokenStream {
                     spec.name
                 );
                 let names = arg_names(spec.inputs);
-                let pass = if cx.low.params.is_runtime() {
-                    quote!(&self.params, &self.pre,)
-                } else {
-                    quote!()
-                };
+                let pass = wrapper_params(cx);
                 quote! {
                     #[doc = #doc]
                     #[inline]

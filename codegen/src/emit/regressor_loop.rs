@@ -302,11 +302,8 @@ pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
             let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
             let (nr, nc) = (idx(rows), idx(cols));
             let state = super::items::arg_names(spec.inputs);
-            let call = if cx.low.params.is_runtime() {
-                quote!(#into(&self.params, &self.pre, #state, y))
-            } else {
-                quote!(#into(#state, y))
-            };
+            let pass = super::items::wrapper_params(cx);
+            let call = quote!(#into(#pass #state, y));
             quote! {
                 #[doc = #doc]
                 #[inline]

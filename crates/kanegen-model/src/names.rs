@@ -78,6 +78,7 @@ pub const RESERVED_ITEMS: &[&str] = &[
     "PARAM_COUNT",
     "Params",
     "Precomputed",
+    "DerivativesWorkspace",
     "UnknownParameter",
     "SetParameterError",
     "Frame",

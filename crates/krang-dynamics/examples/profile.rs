@@ -18,7 +18,8 @@
 //! `forward_dynamics_kept_m_s8` with the lane mass matrix kept across calls; `solve_s8`: the
 //! batched block solve alone, `forward_batch::block_solve_lanes`, on 8 fixed mass matrices); with
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
-//! across calls), `forward_dynamics_derivatives` and `linearize`; with the feature `kinematics`
+//! across calls), `…_with` (into a `DerivativesWorkspace` kept across calls),
+//! `forward_dynamics_derivatives` and `linearize`; with the feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
 //! `hands_jacobians`, `hands_jacobians_separate` (the two `frame_jacobian` calls it combines),
 //! `com_jacobian` and `sin_cos_17`), the
@@ -65,6 +66,8 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
     let mut m8 = [nalgebra::SMatrix::<f64, 19, 19>::zeros(); 8];
     #[cfg(feature = "derivatives")]
     let mut d_out = SMatrix::<f64, 19, 38>::zeros();
+    #[cfg(feature = "derivatives")]
+    let mut d_ws = krang_dynamics::DerivativesWorkspace::new();
     let mut v4 = [V::zeros(); 4];
     let mut v8 = [V::zeros(); 8];
     let mut ms8 = SMatrix::<Lanes<8>, 19, 19>::from_element(Lanes::splat(0.0));
@@ -211,6 +214,16 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
                     d,
                 );
                 d[(7, 20)]
+            }
+            #[cfg(feature = "derivatives")]
+            "inverse_dynamics_derivatives_with" => {
+                let ws = black_box(&mut d_ws);
+                black_box(k).inverse_dynamics_derivatives_with(
+                    black_box(q),
+                    black_box(u),
+                    black_box(ud),
+                    ws,
+                )[(7, 20)]
             }
             other => kinematics(k, other, q, u),
         };

@@ -24,6 +24,7 @@
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/algorithm/rnea-derivatives.hpp>
 #include <pinocchio/algorithm/aba.hpp>
+#include <pinocchio/algorithm/aba-derivatives.hpp>
 
 #include <Eigen/Cholesky>
 
@@ -157,6 +158,12 @@ int main(int argc, char ** argv) {
     {"rnea_derivatives", time_ns(rounds, calls / 10, [&](int i) {
        pin::computeRNEADerivatives(ex.model, data, s.q[i % n], s.v[i % n], s.a[i % n]);
        sink += data.dtau_dq(5, 6) + data.dtau_dv(5, 6);
+     })},
+    // Forward-dynamics derivatives (∂u̇/∂q, ∂u̇/∂v, M⁻¹) by ABA's analytical derivatives, on the
+    // 20-speed model like `aba` (timing only: other dynamics than kanegen's 19 speeds).
+    {"aba_derivatives", time_ns(rounds, calls / 10, [&](int i) {
+       pin::computeABADerivatives(ex.model, data, s.q[i % n], s.v[i % n], tau_v[i % n]);
+       sink += data.ddq_dq(5, 6) + data.ddq_dv(5, 6) + data.Minv(5, 6);
      })},
   });
   if (sink == 12345.678) std::printf("(sink)\n");  // keeps the results alive

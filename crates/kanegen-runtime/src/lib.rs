@@ -23,7 +23,8 @@
 //! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA; the
 //!   batched functions also x86-64-v4, AVX-512), the
 //!   crate's `unsafe` calls (see below), and [`isa::Arith`], the multiply-add the copies
-//!   differ in; [`lanes`]: the lane type of the batched functions.
+//!   differ in; [`lanes`]: the lane type of the batched functions; [`pair`]: two lanes (arms
+//!   in lanes); [`quad`]: four fused lanes of the x86-64-v3 copy (solves with many columns).
 //! - [`regressor`]: the loop of a loop-form inverse-dynamics regressor (per link and four rows
 //!   at a time, over a generated plan; generic over [`isa::Arith`]).
 //! - [`derivative_steps`]: the loop of the looped `inverse_dynamics_derivatives` (the
@@ -32,7 +33,8 @@
 //!
 //! `#![no_std]`; `unsafe` only to call code compiled for x86-64-v3 or v4 after the CPU was
 //! checked ([`isa::dispatch`], [`isa::dispatch_fused_with`], [`isa::dispatch_fused_wide_with`],
-//! [`derivative_steps::run`]) and for the SSE2/FMA intrinsics of [`pair::F64x2`]; no dependency
+//! [`derivative_steps::run`]) and for the SSE2/FMA intrinsics of [`pair::F64x2`] and the
+//! AVX/FMA intrinsics of [`quad::F64x4`] (made only where FMA is present); no dependency
 //! but [`nalgebra`] (re-exported: its vector and matrix types are the trait's argument types)
 //! and, behind features, `serde` and `toml`.
 //!
@@ -148,7 +150,8 @@
 
 #![no_std]
 // `unsafe` only to call a copy compiled for x86-64-v3 or v4 after feature detection (`isa`,
-// `derivative_steps::run`) and for the SSE2/FMA intrinsics of `pair::F64x2`; each use is
+// `derivative_steps::run`) and for the SSE2/FMA intrinsics of `pair::F64x2` and the AVX/FMA
+// ones of `quad::F64x4`; each use is
 // allowed where it is.
 #![deny(unsafe_code)]
 
@@ -162,6 +165,7 @@ mod invalid_parameter;
 pub mod isa;
 pub mod lanes;
 pub mod pair;
+pub mod quad;
 pub mod regressor;
 #[doc(hidden)]
 pub mod serde_support;

@@ -203,14 +203,20 @@ trait ColumnLanes: Copy {
     const WIDTH: usize;
     /// One value: a row of `WIDTH` columns.
     type V: Copy;
+    /// `x` in every lane.
     fn splat(self, x: f64) -> Self::V;
     /// The lanes `x(0)`, …, `x(WIDTH − 1)`.
     fn load(self, x: impl FnMut(usize) -> f64) -> Self::V;
     /// Calls `to(l, lane l)` for every lane.
     fn store(self, v: Self::V, to: impl FnMut(usize, f64));
+    /// `a + b`, lane by lane (as are the three below).
     fn add(self, a: Self::V, b: Self::V) -> Self::V;
+    /// `a − b`.
     fn sub(self, a: Self::V, b: Self::V) -> Self::V;
+    /// `a · b`.
     fn mul(self, a: Self::V, b: Self::V) -> Self::V;
+    /// `a · b + c`: rounded twice by [`Plain`](kanegen_runtime::isa::Plain), once by
+    /// [`FusedQuad`].
     fn mul_add(self, a: Self::V, b: Self::V, c: Self::V) -> Self::V;
 }
 
@@ -572,7 +578,7 @@ impl<const T: usize, const N: usize> BlockCholesky<T, N> {
         let xs = x.as_mut_slice();
         let mut padded = [[0.0; N]; 4];
         for c in (0..C).step_by(L::WIDTH) {
-            let short = (C - c) * N < L::WIDTH * N;
+            let short = C - c < L::WIDTH;
             let g = if short {
                 let rest = &xs[c * N..];
                 padded.as_flattened_mut()[..rest.len()].copy_from_slice(rest);

@@ -260,7 +260,6 @@ fn inline_lanes_form_gives_the_plain_bits_and_fuses_within_two_ulp() {
     }
 }
 
-/// Distance in units in the last place between two finite `f32` of any sign.
 /// Distance of `got` from `std`'s `exact` in units of the last place of `exact`.
 fn ulps_f64(got: f64, exact: f64) -> f64 {
     if got == exact {
@@ -326,6 +325,7 @@ fn fused_and_plain_reductions_stay_within_an_ulp_of_std_up_to_the_fast_bound() {
     assert!(worst_plain.0 <= 1.0, "plain: {worst_plain:?}");
 }
 
+/// Distance in units in the last place between two finite `f32` of any sign.
 fn ulps(a: f32, b: f32) -> u32 {
     fn key(x: f32) -> i64 {
         let b = i64::from(x.to_bits() as i32);

@@ -49,7 +49,8 @@ pub trait RobotDynamics<const N: usize> {
     /// Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))`: the accelerations the generalized
     /// forces `tau` produce at state `(q, u)`, for simulation. `c + g` is one inverse-dynamics
     /// pass at `u̇ = 0`, and `M` is factored by nalgebra's dense Cholesky, on the stack (no
-    /// heap, `no_std`).
+    /// heap, `no_std`), whose factor is then solved by the runtime's own substitutions (rows in
+    /// blocks of four: faster than nalgebra's `Cholesky::solve`).
     ///
     /// `None` when `M(q)` is not positive definite (or has a NaN entry): non-physical
     /// parameters, such as a negative mass or an inertia violating the triangle inequalities
@@ -67,7 +68,12 @@ pub trait RobotDynamics<const N: usize> {
     ) -> Option<SVector<Self::Scalar, N>> {
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
         let factor = self.mass_matrix(q).cholesky()?;
-        Some(factor.solve(&(tau - bias)))
+        let l = factor.l_dirty();
+        let inv_diag = core::array::from_fn(|i| nalgebra::one::<Self::Scalar>() / l[(i, i)]);
+        Some(crate::isa::dispatch(
+            #[inline(always)]
+            || cholesky_solve_vector(l, &inv_diag, &(tau - bias)),
+        ))
     }
 }
 
@@ -165,9 +171,9 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
     /// `ID(q, u, FD(q, u, τ)) = τ`, `∂u̇/∂q = −M⁻¹ ∂τ/∂q`, `∂u̇/∂u = −M⁻¹ ∂τ/∂u` (the inverse
     /// dynamics partials taken at `u̇ = FD(q, u, τ)`) and `∂u̇/∂τ = M⁻¹`. One inverse-dynamics
     /// pass, one mass matrix and its dense Cholesky factor (nalgebra, on the stack), one
-    /// derivative pass and the triangular solves of `−∂τ/∂q`, `−∂τ/∂u` and `I`, each over all
-    /// its columns at once (compiled for the baseline and, where the CPU has it, x86-64-v3);
-    /// no heap.
+    /// derivative pass and the triangular solves of the `3N` right-hand sides `[−∂τ/∂q | −∂τ/∂u
+    /// | I]` in place, eight at a time side by side (compiled for the baseline and, where the
+    /// CPU has it, x86-64-v3); no heap.
     ///
     /// `None` when `M(q)` is not positive definite (non-physical parameters), as
     /// [`forward_dynamics`](RobotDynamics::forward_dynamics). `krang-dynamics`'s
@@ -180,77 +186,208 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
         tau: &SVector<Self::Scalar, N>,
     ) -> Option<ForwardDynamicsDerivatives<Self::Scalar, N>> {
         let factor = self.mass_matrix(q).cholesky()?;
-        let ud = factor.solve(&(tau - self.inverse_dynamics(q, u, &SVector::zeros())));
-        let (dtau_dq, dtau_du) = self.inverse_dynamics_partials(q, u, &ud);
         let l = factor.l_dirty();
         let inv_diag = core::array::from_fn(|i| nalgebra::one::<Self::Scalar>() / l[(i, i)]);
-        let solve = |b: SMatrix<Self::Scalar, N, N>| {
-            let mut bt = b.transpose();
-            crate::isa::dispatch(
-                #[inline(always)]
-                || cholesky_solve_transposed(l, &inv_diag, &mut bt),
-            );
-            bt.transpose()
-        };
+        let bias = self.inverse_dynamics(q, u, &SVector::zeros());
+        let ud = crate::isa::dispatch(
+            #[inline(always)]
+            || cholesky_solve_vector(l, &inv_diag, &(tau - bias)),
+        );
+        let (dtau_dq, dtau_du) = self.inverse_dynamics_partials(q, u, &ud);
+        // X = M⁻¹ [−∂τ/∂q | −∂τ/∂u | I], solved in place: M⁻¹ (−B) is −(M⁻¹ B) bit for bit
+        // (every operation of the substitutions is odd in the right-hand side).
+        let (mut dud_dq, mut dud_du) = (dtau_dq, dtau_du);
+        let mut minv = SMatrix::identity();
+        let minus_one = -nalgebra::one::<Self::Scalar>();
+        crate::isa::dispatch(
+            #[inline(always)]
+            || {
+                cholesky_solve_columns(
+                    l,
+                    &inv_diag,
+                    [&mut dud_dq, &mut dud_du, &mut minv],
+                    [minus_one, minus_one, nalgebra::one()],
+                )
+            },
+        );
         Some(ForwardDynamicsDerivatives {
             ud,
-            dud_dq: solve(-dtau_dq),
-            dud_du: solve(-dtau_du),
-            minv: solve(SMatrix::identity()),
+            dud_dq,
+            dud_du,
+            minv,
         })
     }
 }
 
-/// `X ← A⁻¹ X` for `A = L Lᵀ`, given the lower triangle of `l` (its strict upper triangle is
-/// ignored: nalgebra's `Cholesky::l_dirty`), the reciprocals of its diagonal `inv_diag` (computed
-/// once for the three solves of `forward_dynamics_derivatives`) and `xt = Xᵀ`, the right-hand
-/// sides as rows.
+/// Right-hand sides per group of [`cholesky_solve_columns`]: two 256-bit vectors of `f64`.
+const SOLVE_GROUP: usize = 8;
+
+/// `X_m ← s_m A⁻¹ X_m` for each of the `M` matrices `xs` (`N × C`, every column one
+/// right-hand side) and signs or scales `s`, for `A = L Lᵀ`, given the lower triangle of `l`
+/// (its strict upper triangle is ignored: nalgebra's `Cholesky::l_dirty`) and the reciprocals
+/// of its diagonal `inv_diag`.
 ///
-/// On the transpose, row `i` of `X` (speed `i` of every right-hand side) is one contiguous
-/// column, so every step of the two triangular substitutions is one `x_i −= l_ik x_k` over all
-/// right-hand sides at once, which the compiler vectorizes. nalgebra's `Cholesky::solve` and
-/// `inverse` take the right-hand sides one at a time through strided loops: for the fixed-wheel
-/// tree's `forward_dynamics_derivatives` (17 speeds, three 17×17 solves) 17.1 µs against 4.3 µs
-/// for its block factor (criterion `fd_derivatives/fixed_wheels_trait`, tenth session).
+/// The `M·C` right-hand sides are taken [`SOLVE_GROUP`] at a time, across matrices (the
+/// fixed-wheel tree's 3 × 17 in 7 groups): a group is copied (and scaled by `s_m`) into a
+/// local `N × SOLVE_GROUP` array whose row `k` holds speed `k` of the group's right-hand sides
+/// side by side, solved there ([`solve_group`]: rows in blocks of [`SOLVE_ROWS`], each block
+/// accumulated in registers over the rows before it, then stored once), and copied back. The copy in and out is a transposition
+/// fused with the solve; a short last group is padded with zeros. The operations and their
+/// order are those of the textbook substitutions (`x_i −= l_ik x_k` for `k = 0, 1, …`, then
+/// `x_i ← x_i / l_ii` as a product with `inv_diag`; backwards `x_k −= l_ik x_i` for
+/// `i = N − 1, …, k + 1`), so each right-hand side gets the bits of solving it alone.
+///
+/// Measured on the fixed-wheel tree's `forward_dynamics_derivatives` (criterion
+/// `fd_derivatives/fixed_wheels_trait`; `docs/measurement-log.md`, "The trait's
+/// forward-dynamics derivatives"): nalgebra's `Cholesky::solve` and `inverse`, one column at a
+/// time through strided loops, took 17.1 µs (tenth session); solves on transposed copies that
+/// passed over all right-hand sides for every `x_i −= l_ik x_k`, storing and reloading `x_i`
+/// at each `k`, 7.3–7.7 µs; this form, the figure in README.md's "Derivatives".
 #[inline(always)]
-fn cholesky_solve_transposed<T: RealField + Copy, const N: usize, const C: usize>(
+fn cholesky_solve_columns<T: RealField + Copy, const N: usize, const C: usize, const M: usize>(
     l: &SMatrix<T, N, N>,
     inv_diag: &[T; N],
-    xt: &mut SMatrix<T, C, N>,
+    xs: [&mut SMatrix<T, N, C>; M],
+    s: [T; M],
 ) {
-    // Row k of X is `s[row(k)]`; `sub` is `row dst −= a · row src` (`dst ≠ src`).
-    let s = xt.as_mut_slice();
-    let row = |k: usize| k * C..(k + 1) * C;
-    let sub = |s: &mut [T], dst: usize, src: usize, a: T| {
-        let (d, x) = if dst < src {
-            let (lo, hi) = s.split_at_mut(src * C);
-            (&mut lo[row(dst)], &hi[..C])
-        } else {
-            let (lo, hi) = s.split_at_mut(dst * C);
-            (&mut hi[..C], &lo[row(src)])
-        };
-        for (d, x) in d.iter_mut().zip(x) {
-            *d -= a * *x;
+    let total = M * C;
+    let mut first = 0;
+    while first < total {
+        let width = SOLVE_GROUP.min(total - first);
+        let mut group = [[T::zero(); SOLVE_GROUP]; N];
+        for j in 0..width {
+            let (m, c) = ((first + j) / C, (first + j) % C);
+            for (row, x) in group.iter_mut().zip(xs[m].column(c).iter()) {
+                row[j] = *x * s[m];
+            }
         }
-    };
-    let scale = |s: &mut [T], k: usize, a: T| {
-        for x in &mut s[row(k)] {
-            *x *= a;
+        solve_group(l, inv_diag, &mut group);
+        for j in 0..width {
+            let (m, c) = ((first + j) / C, (first + j) % C);
+            for (row, x) in group.iter().zip(xs[m].column_mut(c).iter_mut()) {
+                *x = row[j];
+            }
         }
-    };
-    // L y = b.
-    for i in 0..N {
-        for k in 0..i {
-            sub(s, i, k, l[(i, k)]);
-        }
-        scale(s, i, inv_diag[i]);
+        first += width;
     }
-    // Lᵀ x = y.
-    for i in (0..N).rev() {
-        scale(s, i, inv_diag[i]);
-        for k in 0..i {
-            sub(s, k, i, l[(i, k)]);
+}
+
+/// Rows per block of [`solve_group`].
+const SOLVE_ROWS: usize = 4;
+
+/// `A⁻¹ b` for `A = L Lᵀ` (the lower triangle of `l`, the reciprocals of its diagonal
+/// `inv_diag`): [`solve_group`] on one right-hand side, the same bits as that right-hand side
+/// solved by [`cholesky_solve_columns`]. What the provided `forward_dynamics` methods solve
+/// with: nalgebra's `Cholesky::solve` took 0.33 µs of the fixed-wheel tree's
+/// `forward_dynamics_derivatives` (seventeenth session, `perf`).
+#[inline(always)]
+fn cholesky_solve_vector<T: RealField + Copy, const N: usize>(
+    l: &SMatrix<T, N, N>,
+    inv_diag: &[T; N],
+    b: &SVector<T, N>,
+) -> SVector<T, N> {
+    let mut x = [[T::zero(); 1]; N];
+    for (x, b) in x.iter_mut().zip(b.iter()) {
+        x[0] = *b;
+    }
+    solve_group(l, inv_diag, &mut x);
+    SVector::from_fn(|k, _| x[k][0])
+}
+
+/// The two substitutions of [`cholesky_solve_columns`] on one group: `x[k][j]` is speed `k` of
+/// right-hand side `j`. The rows are taken [`SOLVE_ROWS`] at a time ([`forward_rows`],
+/// [`backward_rows`]): the rows of a block are accumulated in registers together, so that each
+/// row already solved is loaded once per block rather than once per row, and the block's rows
+/// give the processor independent chains of subtractions. Each row's terms are still
+/// subtracted in the textbook order.
+#[inline(always)]
+fn solve_group<T: RealField + Copy, const N: usize, const W: usize>(
+    l: &SMatrix<T, N, N>,
+    inv_diag: &[T; N],
+    x: &mut [[T; W]; N],
+) {
+    let full = N - N % SOLVE_ROWS;
+    // L y = b: y_i = (b_i − Σ_{k < i} l_ik y_k) / l_ii.
+    for first in (0..full).step_by(SOLVE_ROWS) {
+        forward_rows::<T, N, W, SOLVE_ROWS>(l, inv_diag, x, first);
+    }
+    for first in full..N {
+        forward_rows::<T, N, W, 1>(l, inv_diag, x, first);
+    }
+    // Lᵀ x = y: x_k = (y_k − Σ_{i > k} l_ik x_i) / l_kk, the sum from the last row up.
+    for first in (full..N).rev() {
+        backward_rows::<T, N, W, 1>(l, inv_diag, x, first);
+    }
+    for first in (0..full).step_by(SOLVE_ROWS).rev() {
+        backward_rows::<T, N, W, SOLVE_ROWS>(l, inv_diag, x, first);
+    }
+}
+
+/// Rows `first..first + R` of the forward substitution `L y = b`, the rows before them solved.
+#[inline(always)]
+fn forward_rows<T: RealField + Copy, const N: usize, const W: usize, const R: usize>(
+    l: &SMatrix<T, N, N>,
+    inv_diag: &[T; N],
+    x: &mut [[T; W]; N],
+    first: usize,
+) {
+    let mut acc = [[T::zero(); W]; R];
+    acc.copy_from_slice(&x[first..first + R]);
+    for k in 0..first {
+        let y = x[k];
+        for (r, acc) in acc.iter_mut().enumerate() {
+            let a = l[(first + r, k)];
+            for (acc, y) in acc.iter_mut().zip(&y) {
+                *acc -= a * *y;
+            }
         }
+    }
+    for r in 0..R {
+        for k in 0..r {
+            let (a, y) = (l[(first + r, first + k)], acc[k]);
+            for (acc, y) in acc[r].iter_mut().zip(&y) {
+                *acc -= a * *y;
+            }
+        }
+        let d = inv_diag[first + r];
+        for (x, acc) in x[first + r].iter_mut().zip(&acc[r]) {
+            *x = *acc * d;
+        }
+        acc[r] = x[first + r];
+    }
+}
+
+/// Rows `first..first + R` of the back substitution `Lᵀ x = y`, the rows after them solved.
+#[inline(always)]
+fn backward_rows<T: RealField + Copy, const N: usize, const W: usize, const R: usize>(
+    l: &SMatrix<T, N, N>,
+    inv_diag: &[T; N],
+    x: &mut [[T; W]; N],
+    first: usize,
+) {
+    let mut acc = [[T::zero(); W]; R];
+    acc.copy_from_slice(&x[first..first + R]);
+    for i in (first + R..N).rev() {
+        let xi = x[i];
+        for (r, acc) in acc.iter_mut().enumerate() {
+            let a = l[(i, first + r)];
+            for (acc, xi) in acc.iter_mut().zip(&xi) {
+                *acc -= a * *xi;
+            }
+        }
+    }
+    for r in (0..R).rev() {
+        for i in (r + 1..R).rev() {
+            let (a, xi) = (l[(first + i, first + r)], acc[i]);
+            for (acc, xi) in acc[r].iter_mut().zip(&xi) {
+                *acc -= a * *xi;
+            }
+        }
+        let d = inv_diag[first + r];
+        for (x, acc) in x[first + r].iter_mut().zip(&acc[r]) {
+            *x = *acc * d;
+        }
+        acc[r] = x[first + r];
     }
 }
 
@@ -273,7 +410,7 @@ pub struct ForwardDynamicsDerivatives<T, const N: usize> {
 
 #[cfg(test)]
 mod tests {
-    use super::cholesky_solve_transposed;
+    use super::{cholesky_solve_columns, cholesky_solve_vector};
     use nalgebra::{RealField, SMatrix};
 
     /// A symmetric positive definite `A = B Bᵀ + N I` and right-hand sides from a fixed
@@ -295,13 +432,14 @@ mod tests {
     fn solves_like_nalgebra<T: RealField + Copy, const N: usize, const C: usize>(bound: f64) {
         let (a, b) = spd_and_rhs::<T, N, C>();
         let chol = a.cholesky().unwrap();
-        let mut xt = b.transpose();
+        let mut x = b;
         let l = chol.l_dirty();
-        cholesky_solve_transposed(l, &core::array::from_fn(|i| T::one() / l[(i, i)]), &mut xt);
+        let inv_diag = core::array::from_fn(|i| T::one() / l[(i, i)]);
+        cholesky_solve_columns(l, &inv_diag, [&mut x], [T::one()]);
         let expected = chol.solve(&b);
-        let err = (xt.transpose() - expected).norm() / expected.norm();
+        let err = (x - expected).norm() / expected.norm();
         assert!(err <= T::from_f64(bound).unwrap(), "{N}×{C}: {err}");
-        let residual = (a * xt.transpose() - b).norm() / b.norm();
+        let residual = (a * x - b).norm() / b.norm();
         assert!(
             residual <= T::from_f64(bound).unwrap(),
             "{N}×{C}: {residual}"
@@ -315,5 +453,46 @@ mod tests {
         solves_like_nalgebra::<f64, 17, 17>(1e-14);
         solves_like_nalgebra::<f64, 19, 57>(1e-14);
         solves_like_nalgebra::<f32, 7, 7>(1e-5);
+    }
+
+    /// The groups of right-hand sides cross the matrices' boundaries (3 × 17 columns: six
+    /// groups of 8 and one of 3); every column still gets the bits of solving it alone, scaled
+    /// (by −1 or 2: exact) before the solve, and so does the one-vector solve of
+    /// `forward_dynamics`. Sizes below, at and above the row blocks and groups.
+    fn grouped_like_alone<const N: usize, const C: usize>() {
+        let (a, b) = spd_and_rhs::<f64, N, C>();
+        let chol = a.cholesky().unwrap();
+        let l = chol.l_dirty();
+        let inv_diag = core::array::from_fn(|i| 1.0 / l[(i, i)]);
+        let rhs = [b, b.map(|v| v * v), -b];
+        let scales = [1.0, -1.0, 2.0];
+        let mut x = rhs;
+        let [x0, x1, x2] = &mut x;
+        cholesky_solve_columns(l, &inv_diag, [x0, x1, x2], scales);
+        for m in 0..3 {
+            for c in 0..C {
+                let mut alone = SMatrix::<f64, N, 1>::from_fn(|r, _| rhs[m][(r, c)] * scales[m]);
+                let vector = cholesky_solve_vector(l, &inv_diag, &alone);
+                cholesky_solve_columns(l, &inv_diag, [&mut alone], [1.0]);
+                assert_eq!(vector.map(f64::to_bits), alone.map(f64::to_bits));
+                for r in 0..N {
+                    assert_eq!(
+                        x[m][(r, c)].to_bits(),
+                        alone[r].to_bits(),
+                        "{N}×{C}, matrix {m}, entry ({r}, {c})"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn grouped_solves_give_every_right_hand_side_the_bits_of_solving_it_alone() {
+        grouped_like_alone::<1, 1>();
+        grouped_like_alone::<4, 2>();
+        grouped_like_alone::<5, 3>();
+        grouped_like_alone::<9, 8>();
+        grouped_like_alone::<17, 17>();
+        grouped_like_alone::<19, 19>();
     }
 }

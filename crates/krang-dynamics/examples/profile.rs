@@ -176,6 +176,14 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
                     .forward_dynamics_batch_soa_with_mass_matrix(q, u, u, &mut ms8, &mut vs8);
                 black_box(&vs8)[7].0[1]
             }
+            #[cfg(feature = "coriolis-matrix")]
+            "coriolis_matrix" => black_box(k).coriolis_matrix(black_box(q), black_box(u))[(7, 9)],
+            #[cfg(feature = "coriolis-matrix")]
+            "coriolis_matrix_s8" => {
+                let (q, u) = &s8[i & 63];
+                black_box(k).coriolis_matrix_batch_soa_into(black_box(q), black_box(u), &mut ms8);
+                black_box(&ms8)[(7, 9)].0[1]
+            }
             "solve_s8" => {
                 // The batched block solve alone, on M of the first 8 states (`ms8_fixed`).
                 vs8 = s8[i & 63].1;

@@ -19,7 +19,9 @@
 //! batched block solve alone, `forward_batch::block_solve_lanes`, on 8 fixed mass matrices); with
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
 //! across calls), `…_with` (into a `DerivativesWorkspace` kept across calls),
-//! `forward_dynamics_derivatives` and `linearize`; with the feature `kinematics`
+//! `forward_dynamics_derivatives` and `linearize`; with the feature `coriolis-matrix` also
+//! `coriolis_matrix` and `coriolis_matrix_s8` (its 8-state structure-of-arrays form); with the
+//! feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
 //! `hands_jacobians`, `hands_jacobians_separate` (the two `frame_jacobian` calls it combines),
 //! `com_jacobian` and `sin_cos_17`), the

@@ -336,24 +336,15 @@ fn forward_rows<T: RealField + Copy, const N: usize, const W: usize, const R: us
     for k in 0..first {
         let y = x[k];
         for (r, acc) in acc.iter_mut().enumerate() {
-            let a = l[(first + r, k)];
-            for (acc, y) in acc.iter_mut().zip(&y) {
-                *acc -= a * *y;
-            }
+            sub_scaled(acc, l[(first + r, k)], &y);
         }
     }
     for r in 0..R {
         for k in 0..r {
-            let (a, y) = (l[(first + r, first + k)], acc[k]);
-            for (acc, y) in acc[r].iter_mut().zip(&y) {
-                *acc -= a * *y;
-            }
+            let y = acc[k];
+            sub_scaled(&mut acc[r], l[(first + r, first + k)], &y);
         }
-        let d = inv_diag[first + r];
-        for (x, acc) in x[first + r].iter_mut().zip(&acc[r]) {
-            *x = *acc * d;
-        }
-        acc[r] = x[first + r];
+        store_scaled(&mut x[first + r], &mut acc[r], inv_diag[first + r]);
     }
 }
 
@@ -370,24 +361,32 @@ fn backward_rows<T: RealField + Copy, const N: usize, const W: usize, const R: u
     for i in (first + R..N).rev() {
         let xi = x[i];
         for (r, acc) in acc.iter_mut().enumerate() {
-            let a = l[(i, first + r)];
-            for (acc, xi) in acc.iter_mut().zip(&xi) {
-                *acc -= a * *xi;
-            }
+            sub_scaled(acc, l[(i, first + r)], &xi);
         }
     }
     for r in (0..R).rev() {
         for i in (r + 1..R).rev() {
-            let (a, xi) = (l[(first + i, first + r)], acc[i]);
-            for (acc, xi) in acc[r].iter_mut().zip(&xi) {
-                *acc -= a * *xi;
-            }
+            let xi = acc[i];
+            sub_scaled(&mut acc[r], l[(first + i, first + r)], &xi);
         }
-        let d = inv_diag[first + r];
-        for (x, acc) in x[first + r].iter_mut().zip(&acc[r]) {
-            *x = *acc * d;
-        }
-        acc[r] = x[first + r];
+        store_scaled(&mut x[first + r], &mut acc[r], inv_diag[first + r]);
+    }
+}
+
+/// `acc −= a · y`, lane by lane: one term of a row of the substitutions.
+#[inline(always)]
+fn sub_scaled<T: RealField + Copy, const W: usize>(acc: &mut [T; W], a: T, y: &[T; W]) {
+    for (acc, y) in acc.iter_mut().zip(y) {
+        *acc -= a * *y;
+    }
+}
+
+/// `acc ← acc · d` (a row divided by its pivot, `d` the pivot's reciprocal), stored in `x` too.
+#[inline(always)]
+fn store_scaled<T: RealField + Copy, const W: usize>(x: &mut [T; W], acc: &mut [T; W], d: T) {
+    for (x, acc) in x.iter_mut().zip(acc.iter_mut()) {
+        *acc *= d;
+        *x = *acc;
     }
 }
 

@@ -70,9 +70,12 @@ pub trait RobotDynamics<const N: usize> {
         let factor = self.mass_matrix(q).cholesky()?;
         let l = factor.l_dirty();
         let inv_diag = core::array::from_fn(|i| nalgebra::one::<Self::Scalar>() / l[(i, i)]);
-        Some(crate::isa::dispatch(
+        let b = tau - bias;
+        Some(crate::isa::dispatch_fused(
             #[inline(always)]
-            || cholesky_solve_vector(l, &inv_diag, &(tau - bias)),
+            || cholesky_solve_vector::<_, N, false>(l, &inv_diag, &b),
+            #[inline(always)]
+            || cholesky_solve_vector::<_, N, true>(l, &inv_diag, &b),
         ))
     }
 }
@@ -189,9 +192,12 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
         let l = factor.l_dirty();
         let inv_diag = core::array::from_fn(|i| nalgebra::one::<Self::Scalar>() / l[(i, i)]);
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
-        let ud = crate::isa::dispatch(
+        let b = tau - bias;
+        let ud = crate::isa::dispatch_fused(
             #[inline(always)]
-            || cholesky_solve_vector(l, &inv_diag, &(tau - bias)),
+            || cholesky_solve_vector::<_, N, false>(l, &inv_diag, &b),
+            #[inline(always)]
+            || cholesky_solve_vector::<_, N, true>(l, &inv_diag, &b),
         );
         let (dtau_dq, dtau_du) = self.inverse_dynamics_partials(q, u, &ud);
         // X = M⁻¹ [−∂τ/∂q | −∂τ/∂u | I], solved in place: M⁻¹ (−B) is −(M⁻¹ B) bit for bit
@@ -199,16 +205,13 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
         let (mut dud_dq, mut dud_du) = (dtau_dq, dtau_du);
         let mut minv = SMatrix::identity();
         let minus_one = -nalgebra::one::<Self::Scalar>();
-        crate::isa::dispatch(
+        let scales = [minus_one, minus_one, nalgebra::one()];
+        crate::isa::dispatch_fused_with(
+            [&mut dud_dq, &mut dud_du, &mut minv],
             #[inline(always)]
-            || {
-                cholesky_solve_columns(
-                    l,
-                    &inv_diag,
-                    [&mut dud_dq, &mut dud_du, &mut minv],
-                    [minus_one, minus_one, nalgebra::one()],
-                )
-            },
+            |xs| cholesky_solve_columns::<_, N, N, 3, false>(l, &inv_diag, xs, scales),
+            #[inline(always)]
+            |xs| cholesky_solve_columns::<_, N, N, 3, true>(l, &inv_diag, xs, scales),
         );
         Some(ForwardDynamicsDerivatives {
             ud,
@@ -235,7 +238,10 @@ const SOLVE_GROUP: usize = 8;
 /// fused with the solve; a short last group is padded with zeros. The operations and their
 /// order are those of the textbook substitutions (`x_i −= l_ik x_k` for `k = 0, 1, …`, then
 /// `x_i ← x_i / l_ii` as a product with `inv_diag`; backwards `x_k −= l_ik x_i` for
-/// `i = N − 1, …, k + 1`), so each right-hand side gets the bits of solving it alone.
+/// `i = N − 1, …, k + 1`), so each right-hand side gets the bits of solving it alone. With
+/// `FUSED` (the x86-64-v3 copy, chosen by `isa::dispatch_fused_with`) each term is one fused
+/// multiply-add, as in the generated functions' x86-64-v3 copies: results within rounding of
+/// the baseline copy's, not the same bits.
 ///
 /// Measured on the fixed-wheel tree's `forward_dynamics_derivatives` (criterion
 /// `fd_derivatives/fixed_wheels_trait`; `docs/measurement-log.md`, "The trait's
@@ -244,7 +250,13 @@ const SOLVE_GROUP: usize = 8;
 /// passed over all right-hand sides for every `x_i −= l_ik x_k`, storing and reloading `x_i`
 /// at each `k`, 7.3–7.7 µs; this form, the figure in README.md's "Derivatives".
 #[inline(always)]
-fn cholesky_solve_columns<T: RealField + Copy, const N: usize, const C: usize, const M: usize>(
+fn cholesky_solve_columns<
+    T: RealField + Copy,
+    const N: usize,
+    const C: usize,
+    const M: usize,
+    const FUSED: bool,
+>(
     l: &SMatrix<T, N, N>,
     inv_diag: &[T; N],
     xs: [&mut SMatrix<T, N, C>; M],
@@ -261,7 +273,7 @@ fn cholesky_solve_columns<T: RealField + Copy, const N: usize, const C: usize, c
                 row[j] = *x * s[m];
             }
         }
-        solve_group(l, inv_diag, &mut group);
+        solve_group::<T, N, SOLVE_GROUP, FUSED>(l, inv_diag, &mut group);
         for j in 0..width {
             let (m, c) = ((first + j) / C, (first + j) % C);
             for (row, x) in group.iter().zip(xs[m].column_mut(c).iter_mut()) {
@@ -281,7 +293,7 @@ const SOLVE_ROWS: usize = 4;
 /// with: nalgebra's `Cholesky::solve` took 0.33 µs of the fixed-wheel tree's
 /// `forward_dynamics_derivatives` (seventeenth session, `perf`).
 #[inline(always)]
-fn cholesky_solve_vector<T: RealField + Copy, const N: usize>(
+fn cholesky_solve_vector<T: RealField + Copy, const N: usize, const FUSED: bool>(
     l: &SMatrix<T, N, N>,
     inv_diag: &[T; N],
     b: &SVector<T, N>,
@@ -290,7 +302,7 @@ fn cholesky_solve_vector<T: RealField + Copy, const N: usize>(
     for (x, b) in x.iter_mut().zip(b.iter()) {
         x[0] = *b;
     }
-    solve_group(l, inv_diag, &mut x);
+    solve_group::<T, N, 1, FUSED>(l, inv_diag, &mut x);
     SVector::from_fn(|k, _| x[k][0])
 }
 
@@ -301,7 +313,7 @@ fn cholesky_solve_vector<T: RealField + Copy, const N: usize>(
 /// give the processor independent chains of subtractions. Each row's terms are still
 /// subtracted in the textbook order.
 #[inline(always)]
-fn solve_group<T: RealField + Copy, const N: usize, const W: usize>(
+fn solve_group<T: RealField + Copy, const N: usize, const W: usize, const FUSED: bool>(
     l: &SMatrix<T, N, N>,
     inv_diag: &[T; N],
     x: &mut [[T; W]; N],
@@ -309,23 +321,29 @@ fn solve_group<T: RealField + Copy, const N: usize, const W: usize>(
     let full = N - N % SOLVE_ROWS;
     // L y = b: y_i = (b_i − Σ_{k < i} l_ik y_k) / l_ii.
     for first in (0..full).step_by(SOLVE_ROWS) {
-        forward_rows::<T, N, W, SOLVE_ROWS>(l, inv_diag, x, first);
+        forward_rows::<T, N, W, SOLVE_ROWS, FUSED>(l, inv_diag, x, first);
     }
     for first in full..N {
-        forward_rows::<T, N, W, 1>(l, inv_diag, x, first);
+        forward_rows::<T, N, W, 1, FUSED>(l, inv_diag, x, first);
     }
     // Lᵀ x = y: x_k = (y_k − Σ_{i > k} l_ik x_i) / l_kk, the sum from the last row up.
     for first in (full..N).rev() {
-        backward_rows::<T, N, W, 1>(l, inv_diag, x, first);
+        backward_rows::<T, N, W, 1, FUSED>(l, inv_diag, x, first);
     }
     for first in (0..full).step_by(SOLVE_ROWS).rev() {
-        backward_rows::<T, N, W, SOLVE_ROWS>(l, inv_diag, x, first);
+        backward_rows::<T, N, W, SOLVE_ROWS, FUSED>(l, inv_diag, x, first);
     }
 }
 
 /// Rows `first..first + R` of the forward substitution `L y = b`, the rows before them solved.
 #[inline(always)]
-fn forward_rows<T: RealField + Copy, const N: usize, const W: usize, const R: usize>(
+fn forward_rows<
+    T: RealField + Copy,
+    const N: usize,
+    const W: usize,
+    const R: usize,
+    const FUSED: bool,
+>(
     l: &SMatrix<T, N, N>,
     inv_diag: &[T; N],
     x: &mut [[T; W]; N],
@@ -336,13 +354,13 @@ fn forward_rows<T: RealField + Copy, const N: usize, const W: usize, const R: us
     for k in 0..first {
         let y = x[k];
         for (r, acc) in acc.iter_mut().enumerate() {
-            sub_scaled(acc, l[(first + r, k)], &y);
+            sub_scaled::<T, W, FUSED>(acc, l[(first + r, k)], &y);
         }
     }
     for r in 0..R {
         for k in 0..r {
             let y = acc[k];
-            sub_scaled(&mut acc[r], l[(first + r, first + k)], &y);
+            sub_scaled::<T, W, FUSED>(&mut acc[r], l[(first + r, first + k)], &y);
         }
         store_scaled(&mut x[first + r], &mut acc[r], inv_diag[first + r]);
     }
@@ -350,7 +368,13 @@ fn forward_rows<T: RealField + Copy, const N: usize, const W: usize, const R: us
 
 /// Rows `first..first + R` of the back substitution `Lᵀ x = y`, the rows after them solved.
 #[inline(always)]
-fn backward_rows<T: RealField + Copy, const N: usize, const W: usize, const R: usize>(
+fn backward_rows<
+    T: RealField + Copy,
+    const N: usize,
+    const W: usize,
+    const R: usize,
+    const FUSED: bool,
+>(
     l: &SMatrix<T, N, N>,
     inv_diag: &[T; N],
     x: &mut [[T; W]; N],
@@ -361,23 +385,33 @@ fn backward_rows<T: RealField + Copy, const N: usize, const W: usize, const R: u
     for i in (first + R..N).rev() {
         let xi = x[i];
         for (r, acc) in acc.iter_mut().enumerate() {
-            sub_scaled(acc, l[(i, first + r)], &xi);
+            sub_scaled::<T, W, FUSED>(acc, l[(i, first + r)], &xi);
         }
     }
     for r in (0..R).rev() {
         for i in (r + 1..R).rev() {
             let xi = acc[i];
-            sub_scaled(&mut acc[r], l[(first + i, first + r)], &xi);
+            sub_scaled::<T, W, FUSED>(&mut acc[r], l[(first + i, first + r)], &xi);
         }
         store_scaled(&mut x[first + r], &mut acc[r], inv_diag[first + r]);
     }
 }
 
-/// `acc −= a · y`, lane by lane: one term of a row of the substitutions.
+/// `acc −= a · y`, lane by lane: one term of a row of the substitutions. With `FUSED` one
+/// fused multiply-add (`−a · y + acc`, one rounding: the x86-64-v3 copy, see
+/// `isa::dispatch_fused`), else a product and a difference (the baseline copy).
 #[inline(always)]
-fn sub_scaled<T: RealField + Copy, const W: usize>(acc: &mut [T; W], a: T, y: &[T; W]) {
+fn sub_scaled<T: RealField + Copy, const W: usize, const FUSED: bool>(
+    acc: &mut [T; W],
+    a: T,
+    y: &[T; W],
+) {
     for (acc, y) in acc.iter_mut().zip(y) {
-        *acc -= a * *y;
+        *acc = if FUSED {
+            (-a).mul_add(*y, *acc)
+        } else {
+            *acc - a * *y
+        };
     }
 }
 
@@ -428,13 +462,22 @@ mod tests {
         (a, SMatrix::from_fn(|_, _| next()))
     }
 
-    fn solves_like_nalgebra<T: RealField + Copy, const N: usize, const C: usize>(bound: f64) {
+    /// Both forms of the substitutions ([`cholesky_solve_columns`]'s `FUSED`: the baseline and
+    /// the x86-64-v3 copy's arithmetic).
+    fn solves_like_nalgebra<
+        T: RealField + Copy,
+        const N: usize,
+        const C: usize,
+        const FUSED: bool,
+    >(
+        bound: f64,
+    ) {
         let (a, b) = spd_and_rhs::<T, N, C>();
         let chol = a.cholesky().unwrap();
         let mut x = b;
         let l = chol.l_dirty();
         let inv_diag = core::array::from_fn(|i| T::one() / l[(i, i)]);
-        cholesky_solve_columns(l, &inv_diag, [&mut x], [T::one()]);
+        cholesky_solve_columns::<T, N, C, 1, FUSED>(l, &inv_diag, [&mut x], [T::one()]);
         let expected = chol.solve(&b);
         let err = (x - expected).norm() / expected.norm();
         assert!(err <= T::from_f64(bound).unwrap(), "{N}×{C}: {err}");
@@ -447,18 +490,22 @@ mod tests {
 
     #[test]
     fn many_column_cholesky_solve_matches_nalgebras_solve() {
-        solves_like_nalgebra::<f64, 1, 1>(1e-15);
-        solves_like_nalgebra::<f64, 5, 3>(1e-14);
-        solves_like_nalgebra::<f64, 17, 17>(1e-14);
-        solves_like_nalgebra::<f64, 19, 57>(1e-14);
-        solves_like_nalgebra::<f32, 7, 7>(1e-5);
+        solves_like_nalgebra::<f64, 1, 1, false>(1e-15);
+        solves_like_nalgebra::<f64, 5, 3, false>(1e-14);
+        solves_like_nalgebra::<f64, 17, 17, false>(1e-14);
+        solves_like_nalgebra::<f64, 19, 57, false>(1e-14);
+        solves_like_nalgebra::<f32, 7, 7, false>(1e-5);
+        solves_like_nalgebra::<f64, 1, 1, true>(1e-15);
+        solves_like_nalgebra::<f64, 17, 17, true>(1e-14);
+        solves_like_nalgebra::<f64, 19, 57, true>(1e-14);
+        solves_like_nalgebra::<f32, 7, 7, true>(1e-5);
     }
 
     /// The groups of right-hand sides cross the matrices' boundaries (3 × 17 columns: six
     /// groups of 8 and one of 3); every column still gets the bits of solving it alone, scaled
     /// (by −1 or 2: exact) before the solve, and so does the one-vector solve of
     /// `forward_dynamics`. Sizes below, at and above the row blocks and groups.
-    fn grouped_like_alone<const N: usize, const C: usize>() {
+    fn grouped_like_alone<const N: usize, const C: usize, const FUSED: bool>() {
         let (a, b) = spd_and_rhs::<f64, N, C>();
         let chol = a.cholesky().unwrap();
         let l = chol.l_dirty();
@@ -467,12 +514,12 @@ mod tests {
         let scales = [1.0, -1.0, 2.0];
         let mut x = rhs;
         let [x0, x1, x2] = &mut x;
-        cholesky_solve_columns(l, &inv_diag, [x0, x1, x2], scales);
+        cholesky_solve_columns::<f64, N, C, 3, FUSED>(l, &inv_diag, [x0, x1, x2], scales);
         for m in 0..3 {
             for c in 0..C {
                 let mut alone = SMatrix::<f64, N, 1>::from_fn(|r, _| rhs[m][(r, c)] * scales[m]);
-                let vector = cholesky_solve_vector(l, &inv_diag, &alone);
-                cholesky_solve_columns(l, &inv_diag, [&mut alone], [1.0]);
+                let vector = cholesky_solve_vector::<f64, N, FUSED>(l, &inv_diag, &alone);
+                cholesky_solve_columns::<f64, N, 1, 1, FUSED>(l, &inv_diag, [&mut alone], [1.0]);
                 assert_eq!(vector.map(f64::to_bits), alone.map(f64::to_bits));
                 for r in 0..N {
                     assert_eq!(
@@ -487,11 +534,14 @@ mod tests {
 
     #[test]
     fn grouped_solves_give_every_right_hand_side_the_bits_of_solving_it_alone() {
-        grouped_like_alone::<1, 1>();
-        grouped_like_alone::<4, 2>();
-        grouped_like_alone::<5, 3>();
-        grouped_like_alone::<9, 8>();
-        grouped_like_alone::<17, 17>();
-        grouped_like_alone::<19, 19>();
+        grouped_like_alone::<1, 1, false>();
+        grouped_like_alone::<4, 2, false>();
+        grouped_like_alone::<5, 3, false>();
+        grouped_like_alone::<9, 8, false>();
+        grouped_like_alone::<17, 17, false>();
+        grouped_like_alone::<19, 19, false>();
+        grouped_like_alone::<5, 3, true>();
+        grouped_like_alone::<17, 17, true>();
+        grouped_like_alone::<19, 19, true>();
     }
 }

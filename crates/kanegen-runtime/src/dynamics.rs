@@ -234,8 +234,9 @@ const SOLVE_GROUP: usize = 8;
 /// fixed-wheel tree's 3 × 17 in 7 groups): a group is copied (and scaled by `s_m`) into a
 /// local `N × SOLVE_GROUP` array whose row `k` holds speed `k` of the group's right-hand sides
 /// side by side, solved there ([`solve_group`]: rows in blocks of [`SOLVE_ROWS`], each block
-/// accumulated in registers over the rows before it, then stored once), and copied back. The copy in and out is a transposition
-/// fused with the solve; a short last group is padded with zeros. The operations and their
+/// accumulated in registers over the rows before it, then stored once), and copied back. The
+/// copy in and out is a transposition fused with the solve; a short last group is padded with
+/// zeros. The operations and their
 /// order are those of the textbook substitutions (`x_i −= l_ik x_k` for `k = 0, 1, …`, then
 /// `x_i ← x_i / l_ii` as a product with `inv_diag`; backwards `x_k −= l_ik x_i` for
 /// `i = N − 1, …, k + 1`), so each right-hand side gets the bits of solving it alone. With

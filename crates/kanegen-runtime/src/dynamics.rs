@@ -200,8 +200,8 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
             || cholesky_solve_vector::<_, N, true>(l, &inv_diag, &b),
         );
         let (dtau_dq, dtau_du) = self.inverse_dynamics_partials(q, u, &ud);
-        // X = M⁻¹ [−∂τ/∂q | −∂τ/∂u | I], solved in place: M⁻¹ (−B) is −(M⁻¹ B) bit for bit
-        // (every operation of the substitutions is odd in the right-hand side).
+        // X = M⁻¹ [−∂τ/∂q | −∂τ/∂u | I], solved in place: the partials are negated (exactly)
+        // as they are copied into the solve's groups.
         let (mut dud_dq, mut dud_du) = (dtau_dq, dtau_du);
         let mut minv = SMatrix::identity();
         let minus_one = -nalgebra::one::<Self::Scalar>();
@@ -236,10 +236,10 @@ const SOLVE_GROUP: usize = 8;
 /// side by side, solved there ([`solve_group`]: rows in blocks of [`SOLVE_ROWS`], each block
 /// accumulated in registers over the rows before it, then stored once), and copied back. The
 /// copy in and out is a transposition fused with the solve; a short last group is padded with
-/// zeros. The operations and their
-/// order are those of the textbook substitutions (`x_i −= l_ik x_k` for `k = 0, 1, …`, then
-/// `x_i ← x_i / l_ii` as a product with `inv_diag`; backwards `x_k −= l_ik x_i` for
-/// `i = N − 1, …, k + 1`), so each right-hand side gets the bits of solving it alone. With
+/// zeros. The operations and their order are those of the textbook substitutions
+/// (`x_i −= l_ik x_k` for `k = 0, 1, …`, then `x_i ← x_i / l_ii` as a product with
+/// `inv_diag`; backwards `x_k −= l_ik x_i` for `i = N − 1, …, k + 1`), so each right-hand side
+/// gets the bits of solving it alone. With
 /// `FUSED` (the x86-64-v3 copy, chosen by `isa::dispatch_fused_with`) each term is one fused
 /// multiply-add, as in the generated functions' x86-64-v3 copies: results within rounding of
 /// the baseline copy's, not the same bits.

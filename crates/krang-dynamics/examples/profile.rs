@@ -16,7 +16,9 @@
 //! calls) with 4 or 8 states, counted as one call, `_s8` the structure-of-arrays form
 //! (`_batch_soa_into`) with 8 states (`forward_dynamics_s8` too, and
 //! `forward_dynamics_kept_m_s8` with the lane mass matrix kept across calls; `solve_s8`: the
-//! batched block solve alone, `forward_batch::block_solve_lanes`, on 8 fixed mass matrices); with
+//! batched block solve alone, `forward_batch::block_solve_lanes`, on 8 fixed mass matrices;
+//! `gravity_s8_then_gravity` and `inverse_dynamics_s8_then_inverse_dynamics`: an 8-state batch
+//! and one single-state call in turn, what a caller mixing both pays); with
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
 //! across calls), `…_with` (into a `DerivativesWorkspace` kept across calls),
 //! `forward_dynamics_derivatives` and `linearize`; with the feature `coriolis-matrix` also
@@ -162,6 +164,19 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
                 let (q, u) = (black_box(q), black_box(u));
                 black_box(k).inverse_dynamics_batch_soa_into(q, u, u, &mut vs8);
                 black_box(&vs8)[7].0[1]
+            }
+            "gravity_s8_then_gravity" => {
+                // One 8-state batch (x86-64-v4 copy where the CPU has it), then one single-state
+                // call (x86-64-v3 copy): what a caller mixing both pays.
+                black_box(k).gravity_batch_soa_into(black_box(&s8[i & 63].0), &mut vs8);
+                black_box(&vs8)[7].0[1] + black_box(k).gravity(black_box(q))[7]
+            }
+            "inverse_dynamics_s8_then_inverse_dynamics" => {
+                let (qs, us) = &s8[i & 63];
+                let (qs, us) = (black_box(qs), black_box(us));
+                black_box(k).inverse_dynamics_batch_soa_into(qs, us, us, &mut vs8);
+                black_box(&vs8)[7].0[1]
+                    + black_box(k).inverse_dynamics(black_box(q), black_box(u), black_box(ud))[7]
             }
             "forward_dynamics_s8" => {
                 // The speeds as the torques too: any finite τ will do.

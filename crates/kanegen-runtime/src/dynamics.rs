@@ -67,16 +67,8 @@ pub trait RobotDynamics<const N: usize> {
         tau: &SVector<Self::Scalar, N>,
     ) -> Option<SVector<Self::Scalar, N>> {
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
-        let factor = self.mass_matrix(q).cholesky()?;
-        let l = factor.l_dirty();
-        let inv_diag = core::array::from_fn(|i| nalgebra::one::<Self::Scalar>() / l[(i, i)]);
-        let b = tau - bias;
-        Some(crate::isa::dispatch_fused(
-            #[inline(always)]
-            || cholesky_solve_vector::<_, N, false>(l, &inv_diag, &b),
-            #[inline(always)]
-            || cholesky_solve_vector::<_, N, true>(l, &inv_diag, &b),
-        ))
+        let factor = DenseFactor::new(self.mass_matrix(q))?;
+        Some(factor.solve(&(tau - bias)))
     }
 }
 
@@ -188,30 +180,16 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
         u: &SVector<Self::Scalar, N>,
         tau: &SVector<Self::Scalar, N>,
     ) -> Option<ForwardDynamicsDerivatives<Self::Scalar, N>> {
-        let factor = self.mass_matrix(q).cholesky()?;
-        let l = factor.l_dirty();
-        let inv_diag = core::array::from_fn(|i| nalgebra::one::<Self::Scalar>() / l[(i, i)]);
-        let bias = self.inverse_dynamics(q, u, &SVector::zeros());
-        let b = tau - bias;
-        let ud = crate::isa::dispatch_fused(
-            #[inline(always)]
-            || cholesky_solve_vector::<_, N, false>(l, &inv_diag, &b),
-            #[inline(always)]
-            || cholesky_solve_vector::<_, N, true>(l, &inv_diag, &b),
-        );
-        let (dtau_dq, dtau_du) = self.inverse_dynamics_partials(q, u, &ud);
+        let factor = DenseFactor::new(self.mass_matrix(q))?;
+        let ud = factor.solve(&(tau - self.inverse_dynamics(q, u, &SVector::zeros())));
+        let (mut dud_dq, mut dud_du) = self.inverse_dynamics_partials(q, u, &ud);
         // X = M⁻¹ [−∂τ/∂q | −∂τ/∂u | I], solved in place: the partials are negated (exactly)
         // as they are copied into the solve's groups.
-        let (mut dud_dq, mut dud_du) = (dtau_dq, dtau_du);
         let mut minv = SMatrix::identity();
         let minus_one = -nalgebra::one::<Self::Scalar>();
-        let scales = [minus_one, minus_one, nalgebra::one()];
-        crate::isa::dispatch_fused_with(
+        factor.solve_columns(
             [&mut dud_dq, &mut dud_du, &mut minv],
-            #[inline(always)]
-            |xs| cholesky_solve_columns::<_, N, N, 3, false>(l, &inv_diag, xs, scales),
-            #[inline(always)]
-            |xs| cholesky_solve_columns::<_, N, N, 3, true>(l, &inv_diag, xs, scales),
+            [minus_one, minus_one, nalgebra::one()],
         );
         Some(ForwardDynamicsDerivatives {
             ud,
@@ -219,6 +197,55 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
             dud_du,
             minv,
         })
+    }
+}
+
+/// The dense Cholesky factor `L` of a mass matrix (nalgebra's `cholesky()`, on the stack) with
+/// the reciprocals of its diagonal, solved by the runtime's substitutions
+/// ([`cholesky_solve_vector`], [`cholesky_solve_columns`]) in their dispatched copies: what the
+/// provided `forward_dynamics` and `forward_dynamics_derivatives` share.
+struct DenseFactor<T: RealField + Copy, const N: usize> {
+    factor: nalgebra::Cholesky<T, nalgebra::Const<N>>,
+    inv_diag: [T; N],
+}
+
+impl<T: RealField + Copy, const N: usize> DenseFactor<T, N> {
+    /// `None` when `m` is not positive definite (or has a NaN entry).
+    #[inline(always)]
+    fn new(m: SMatrix<T, N, N>) -> Option<Self> {
+        let factor = m.cholesky()?;
+        let l = factor.l_dirty();
+        let inv_diag = core::array::from_fn(|i| T::one() / l[(i, i)]);
+        Some(Self { factor, inv_diag })
+    }
+
+    /// `M⁻¹ b`.
+    #[inline(always)]
+    fn solve(&self, b: &SVector<T, N>) -> SVector<T, N> {
+        let (l, inv_diag) = (self.factor.l_dirty(), &self.inv_diag);
+        crate::isa::dispatch_fused(
+            #[inline(always)]
+            || cholesky_solve_vector::<_, N, false>(l, inv_diag, b),
+            #[inline(always)]
+            || cholesky_solve_vector::<_, N, true>(l, inv_diag, b),
+        )
+    }
+
+    /// `X_m ← s_m M⁻¹ X_m` for each of the matrices `xs` ([`cholesky_solve_columns`]).
+    #[inline(always)]
+    fn solve_columns<const C: usize, const K: usize>(
+        &self,
+        xs: [&mut SMatrix<T, N, C>; K],
+        s: [T; K],
+    ) {
+        let (l, inv_diag) = (self.factor.l_dirty(), &self.inv_diag);
+        crate::isa::dispatch_fused_with(
+            xs,
+            #[inline(always)]
+            |xs| cholesky_solve_columns::<_, N, C, K, false>(l, inv_diag, xs, s),
+            #[inline(always)]
+            |xs| cholesky_solve_columns::<_, N, C, K, true>(l, inv_diag, xs, s),
+        );
     }
 }
 
@@ -239,10 +266,10 @@ const SOLVE_GROUP: usize = 8;
 /// zeros. The operations and their order are those of the textbook substitutions
 /// (`x_i −= l_ik x_k` for `k = 0, 1, …`, then `x_i ← x_i / l_ii` as a product with
 /// `inv_diag`; backwards `x_k −= l_ik x_i` for `i = N − 1, …, k + 1`), so each right-hand side
-/// gets the bits of solving it alone. With
-/// `FUSED` (the x86-64-v3 copy, chosen by `isa::dispatch_fused_with`) each term is one fused
-/// multiply-add, as in the generated functions' x86-64-v3 copies: results within rounding of
-/// the baseline copy's, not the same bits.
+/// gets the bits of solving it alone. With `FUSED` (the x86-64-v3 copy, chosen by
+/// `isa::dispatch_fused_with`) each term is one fused multiply-add, as in the generated
+/// functions' x86-64-v3 copies: results within rounding of the baseline copy's, not the same
+/// bits.
 ///
 /// Measured on the fixed-wheel tree's `forward_dynamics_derivatives` (criterion
 /// `fd_derivatives/fixed_wheels_trait`; `docs/measurement-log.md`, "The trait's

@@ -226,17 +226,19 @@ fn batched_coriolis_matrix_is_split_into_two_loops_by_rows_and_the_others_are_no
 
 /// Both layouts run the one shared body (emitted once) between their own input conversion and
 /// the entries no statement stores: the array of states transposes its inputs and completes
-/// each state's result; the structure of arrays copies its inputs and copies or zeroes whole
-/// entries, all lanes at once.
+/// each state's result; the structure of arrays reads its inputs in place (c, g, τ: their
+/// bodies store into local lane buffers) or copies them (M and C: their bodies store straight
+/// into the result and read copies of the parameters), and copies or zeroes whole entries, all
+/// lanes at once.
 #[test]
 fn both_batched_layouts_share_one_body_and_differ_only_in_inputs_and_the_entries_after_it() {
     let source = batched_krang();
-    for (name, loops) in [
-        ("mass_matrix", 1),
-        ("coriolis", 1),
-        ("gravity", 1),
-        ("inverse_dynamics", 1),
-        ("coriolis_matrix", 2),
+    for (name, loops, buffered) in [
+        ("mass_matrix", 1, false),
+        ("coriolis", 1, true),
+        ("gravity", 1, true),
+        ("inverse_dynamics", 1, true),
+        ("coriolis_matrix", 2, false),
     ] {
         let shared = format!("{name}_batch_body");
         assert_eq!(
@@ -251,12 +253,23 @@ fn both_batched_layouts_share_one_body_and_differ_only_in_inputs_and_the_entries
             loops,
             "{name}"
         );
+        let body = function_body(&source, &shared);
+        assert_eq!(body.contains("let p = &{ *p };"), !buffered, "{name}");
+        assert_eq!(body.contains("out.set("), !buffered, "{name}");
+        assert_eq!(
+            body.matches("let mut entries").count(),
+            if buffered { loops } else { 0 },
+            "{name}"
+        );
+        assert_eq!(body.contains("out.set_lanes("), buffered, "{name}");
         let states = function_body(&source, &format!("{name}_batch_into"));
         let lanes = function_body(&source, &format!("{name}_batch_soa_into"));
-        for (b, inputs) in [
-            (&states, "lanes::inputs(q)"),
-            (&lanes, "lanes::inputs_soa(q)"),
-        ] {
+        let soa_inputs = if buffered {
+            "lanes::as_lanes(q)"
+        } else {
+            "lanes::inputs_soa(q)"
+        };
+        for (b, inputs) in [(&states, "lanes::inputs(q)"), (&lanes, soa_inputs)] {
             assert!(b.contains(inputs), "{name}");
             assert!(b.contains(&format!("{shared}::<A, _, L>(")), "{name}");
             assert!(!b.contains("for l in 0..L"), "{name}");

@@ -14,9 +14,10 @@
 //! (`NAME_batch_body`, [`shared_body`]) and inlined into both layouts' functions: it reads the
 //! inputs as lanes (`&[Lanes<L>; N]`), computes the sines and cosines lane by lane before the
 //! loop, and stores each entry through the layout's `kanegen_runtime::lanes::LaneStore`
-//! (`out.set(r, c, l, value)`: straight into the caller's `L` results, or into lane `l` of an
-//! entry). Each layout's function converts its inputs to lanes (transposed, or copied) and
-//! writes the entries no statement stores after the body. A result with more entries than one
+//! (straight into the caller's `L` results, or into lane `l` of an entry): from a local lane
+//! buffer after the loop, or from inside it ([`EntryStores`]). Each layout's function converts
+//! its inputs to lanes (transposed, or read in place or copied) and writes the entries no
+//! statement stores after the body. A result with more entries than one
 //! vectorized loop can store is computed in several loops ([`loop_parts`]). `L` is a const
 //! generic: one emitted body for every batch size and both layouts.
 //! `docs/measurement-log.md` ("Batched evaluation: measured") has the measurements.
@@ -123,13 +124,19 @@ impl Layout {
         }
     }
 
-    /// The body's copy of the state arguments: transposed to lane-major order
-    /// (`lanes::inputs`) or, already in lanes, copied (`lanes::inputs_soa`: like the parameters,
-    /// a local the result stores cannot overwrite). Either way an array `[Lanes<L>; N]`.
-    fn inputs(self, x: &TokenStream) -> TokenStream {
-        match self {
-            Layout::States => quote!(let #x = kanegen_runtime::lanes::inputs(#x);),
-            Layout::Lanes => quote!(let #x = kanegen_runtime::lanes::inputs_soa(#x);),
+    /// The state arguments as the body reads them, `&[Lanes<L>; N]`: transposed to lane-major
+    /// order into a local array (`lanes::inputs`), or, already in lanes, a local copy
+    /// (`lanes::inputs_soa`: for [`EntryStores::Direct`], like the parameters) or the caller's
+    /// storage itself (`lanes::as_lanes`: [`EntryStores::Buffered`]).
+    fn inputs(self, x: &TokenStream, to: EntryStores) -> TokenStream {
+        match (self, to) {
+            (Layout::States, _) => quote!(let #x = &kanegen_runtime::lanes::inputs(#x);),
+            (Layout::Lanes, EntryStores::Direct) => {
+                quote!(let #x = &kanegen_runtime::lanes::inputs_soa(#x);)
+            }
+            (Layout::Lanes, EntryStores::Buffered) => {
+                quote!(let #x = kanegen_runtime::lanes::as_lanes(#x);)
+            }
         }
     }
 }
@@ -196,6 +203,70 @@ fn lane_values(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
     ts
 }
 
+/// How many lane inputs a loop reads: sines, cosines, coordinates, speeds, accelerations.
+fn lane_inputs(reads: &Reads) -> usize {
+    [
+        &reads.sin,
+        &reads.cos,
+        &reads.coord,
+        &reads.speed,
+        &reads.accel,
+    ]
+    .iter()
+    .map(|read| read.iter().filter(|&&r| r).count())
+    .sum()
+}
+
+/// Where a batched body's loops store the result entries, and so what the loops may read in
+/// place.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum EntryStores {
+    /// Into a local lane buffer per loop (`entries0[i][l] = value`), each entry copied into
+    /// the result after its loop (`out.set_lanes(r, c, &entries0[i])`: one vector store in the
+    /// structure-of-arrays layout). The loop's stores then cannot overwrite anything it reads,
+    /// so it reads the parameters and the structure-of-arrays inputs where the caller keeps
+    /// them: no copies.
+    Buffered,
+    /// Straight into the result (`out.set(r, c, l, value)`), which the vectorizer must then
+    /// know cannot overwrite what the loop reads: the body reads local copies of the parameter
+    /// structs (`let p = &{ *p };`) and of the structure-of-arrays inputs
+    /// (`lanes::inputs_soa`). Without those, LLVM's loop vectorizer needs run-time checks that
+    /// the result stores do not overwrite them, and gives up ("loop not vectorized: runtime
+    /// pointer checks needed").
+    Direct,
+}
+
+/// Most memory locations (result entries, lane inputs, parameters read) for which a
+/// [`EntryStores::Buffered`] loop is still vectorized. Its parameter loads stay in the loop
+/// unless LLVM's LICM hoists them (it gives up after about 100 per loop,
+/// `-licm-mssa-optimization-cap`), and with the stores and lane inputs they count against the
+/// 250 locations of the alias-set tracker ([`LOOP_LOCATIONS`]). Measured on Krang, LLVM of
+/// Rust 1.95: τ (19 entries, 91 lane inputs, 182 parameters: 292) is vectorized buffered, M
+/// (141 entries, 34 lane inputs, 160 parameters: 335) is not (1.7 µs per 8 states instead of
+/// 0.6).
+const BUFFERED_LOCATIONS: usize = 300;
+
+/// [`EntryStores::Buffered`] where it is vectorized ([`BUFFERED_LOCATIONS`]) and cheaper: the
+/// buffer costs three vector moves per entry (zeroed, stored, copied out), the copies it
+/// saves two moves per parameter read and per lane of the structure-of-arrays inputs. Krang:
+/// c, g and τ are buffered (10–20 % faster per 8 states than with the copies), M and C direct
+/// (M buffered, vectorized or not, is slower: 141 entries against 160 parameters).
+fn entry_stores(cx: &Context<'_>, p: &Program, reads: &Reads) -> EntryStores {
+    let entries = nonzero_outputs(p).count();
+    let params = if cx.low.params.is_runtime() {
+        super::function::params_read(p)
+    } else {
+        0
+    };
+    let input_lanes = cx.low.dof * read_inputs(p, reads).len();
+    let locations = entries + lane_inputs(reads) + params;
+    if locations <= BUFFERED_LOCATIONS && 3 * entries < 2 * (params + input_lanes) {
+        EntryStores::Buffered
+    } else {
+        EntryStores::Direct
+    }
+}
+
 /// Most memory locations one loop over the states may touch: result entries stored plus
 /// lane inputs read (sines, cosines, coordinates, speeds, accelerations). LLVM's loop
 /// vectorizer needs to know that the loop's stores do not overwrite what it reads; its
@@ -216,16 +287,7 @@ const LOOP_LOCATIONS: usize = 240;
 /// of its two-part splits by rows (equal halves, rows 0–7 and 8–18: 10,347; one loop: 7,893).
 /// A row with more entries than the budget gets a loop of its own (which may stay scalar).
 fn loop_parts<'p>(p: &'p Program, reads: &Reads) -> Vec<Cow<'p, Program>> {
-    let inputs = [
-        &reads.sin,
-        &reads.cos,
-        &reads.coord,
-        &reads.speed,
-        &reads.accel,
-    ]
-    .iter()
-    .map(|read| read.iter().filter(|&&r| r).count())
-    .sum::<usize>();
+    let inputs = lane_inputs(reads);
     let mut per_row: BTreeMap<usize, usize> = BTreeMap::new();
     for (r, _, _) in nonzero_outputs(p) {
         *per_row.entry(*r).or_default() += 1;
@@ -255,15 +317,26 @@ fn loop_parts<'p>(p: &'p Program, reads: &Reads) -> Vec<Cow<'p, Program>> {
         .collect()
 }
 
-/// The result stores inside the loop: every nonzero entry of `p` right after the last
-/// statement it reads (with multiply-add chains), as `out.set(r, c, l, value)` through the
-/// layout's `kanegen_runtime::lanes::LaneStore` (text lines by position, see
+/// The result stores inside the loop: the `i`-th nonzero entry `(r, c)` of `p` right after
+/// the last statement it reads (with multiply-add chains), as `buffer[i][l] = value` into the
+/// loop's local lane buffer or as `out.set(r, c, l, value)` through the layout's
+/// `kanegen_runtime::lanes::LaneStore` ([`EntryStores`]; text lines by position, see
 /// [`Printer::statement_block`]).
-fn loop_stores(cx: &Context<'_>, printer: &Printer<'_>, p: &Program) -> Stores {
+fn loop_stores(
+    cx: &Context<'_>,
+    printer: &Printer<'_>,
+    p: &Program,
+    to: EntryStores,
+    buffer: &str,
+) -> Stores {
     let mut stores: Stores = vec![Vec::new(); p.stmts.len() + 1];
-    for (r, c, e) in nonzero_outputs(p) {
+    for (i, (r, c, e)) in nonzero_outputs(p).enumerate() {
         let v = text(cx, printer, e);
-        store_text_after(&mut stores, e, format!("out.set({r}, {c}, l, {v});"));
+        let store = match to {
+            EntryStores::Buffered => format!("{buffer}[{i}][l] = {v};"),
+            EntryStores::Direct => format!("out.set({r}, {c}, l, {v});"),
+        };
+        store_text_after(&mut stores, e, store);
     }
     stores
 }
@@ -352,10 +425,10 @@ fn body_name(f: &FunctionProgram) -> proc_macro2::Ident {
 /// `NAME_batch_body::<A, S, L>(params, q, u, ud, out)`, private and `#[inline(always)]`: the
 /// statements of `f` for `L` states, from the inputs it reads as lanes (`&[Lanes<L>; N]` each)
 /// into any `S: kanegen_runtime::lanes::LaneStore<L>` (both layouts' results). Before the
-/// loops: copies of the parameter structs (`let p = &{ *p };`) — without those the vectorizer
-/// needs run-time checks that the result stores do not overwrite parameters it reads, and gives
-/// up ("loop not vectorized: runtime pointer checks needed") — and the lane-wise sines and
-/// cosines.
+/// loops: the lane-wise sines and cosines, and, where the loops store straight into the result
+/// ([`EntryStores::Direct`]), copies of the parameter structs (`let p = &{ *p };`); a loop
+/// storing into a local lane buffer ([`EntryStores::Buffered`]) is followed by the copies of
+/// its entries into the result.
 fn shared_body(cx: &Context<'_>, f: &FunctionProgram, reads: &Reads) -> TokenStream {
     let spec = f.id.spec();
     let p = &f.program;
@@ -363,7 +436,7 @@ fn shared_body(cx: &Context<'_>, f: &FunctionProgram, reads: &Reads) -> TokenStr
     let doc = format!(
         " The statements of [`{0}_batch_into`] and [`{0}_batch_soa_into`] for `L` states: \
          lane `l` of every input is state `l`, and each result entry of state `l` goes to \
-         `out.set(row, column, l, value)`.",
+         lane `l` of its entry in `out`.",
         spec.name
     );
     let param_args = super::function::param_args(cx, reads);
@@ -376,24 +449,38 @@ fn shared_body(cx: &Context<'_>, f: &FunctionProgram, reads: &Reads) -> TokenStr
     // One loop per part (one part unless the result has more entries than a vectorized loop
     // can store); none for a structurally zero result (its entries are all written after the
     // body), so no loop leaves `l` unused.
+    let to = entry_stores(cx, p, reads);
     let mut loops = TokenStream::new();
-    for part in loop_parts(p, reads) {
-        if nonzero_outputs(&part).next().is_none() {
+    for (k, part) in loop_parts(p, reads).iter().enumerate() {
+        let entries: Vec<_> = nonzero_outputs(part).collect();
+        if entries.is_empty() {
             continue;
         }
         let printer = cx.printer(&part.stmts);
-        let part_reads = Reads::of(&part, cx.model.speeds.len());
-        let lane_values = lane_values(cx, &part, &part_reads);
-        let stores = loop_stores(cx, &printer, &part);
-        let stored: Vec<&LExpr> = nonzero_outputs(&part).map(|(_, _, e)| e).collect();
+        let part_reads = Reads::of(part, cx.model.speeds.len());
+        let lane_values = lane_values(cx, part, &part_reads);
+        let buffer = ident(&format!("entries{k}"));
+        let stores = loop_stores(cx, &printer, part, to, &buffer.to_string());
+        let stored: Vec<&LExpr> = entries.iter().map(|(_, _, e)| e).collect();
         let block =
             printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true);
         let statements = cx.blocks.placeholder(block);
-        loops.extend(quote!(for l in 0..L { #lane_values #statements }));
+        let the_loop = quote!(for l in 0..L { #lane_values #statements });
+        loops.extend(match to {
+            EntryStores::Buffered => {
+                let n = idx(entries.len());
+                let copies = entries.iter().enumerate().map(|(i, (r, c, _))| {
+                    let (i, r, c) = (idx(i), idx(*r), idx(*c));
+                    quote!(out.set_lanes(#r, #c, &#buffer[#i]);)
+                });
+                quote!(let mut #buffer = [[0.0f64; L]; #n]; #the_loop #(#copies)*)
+            }
+            EntryStores::Direct => the_loop,
+        });
     }
-    // Local copies of the parameters: the result stores cannot alias them (see above).
+    // Local copies of the parameters ([`EntryStores::Direct`]).
     let mut copies = TokenStream::new();
-    if cx.low.params.is_runtime() {
+    if to == EntryStores::Direct && cx.low.params.is_runtime() {
         if reads.param {
             copies.extend(quote!(let p = &{ *p };));
         }
@@ -479,8 +566,9 @@ fn function_in(
     let ty = layout.result(cx, spec);
     let out = quote!(out: &mut #ty);
     let read = read_inputs(p, reads);
-    let converted = read.iter().map(|x| layout.inputs(x));
-    let passed = read.iter().map(|x| quote!(&#x,));
+    let to = entry_stores(cx, p, reads);
+    let converted = read.iter().map(|x| layout.inputs(x, to));
+    let passed = read.iter().map(|x| quote!(#x,));
     let shared = body_name(f);
     let after = after_stores(cx, p, spec.shape, layout);
     let after_loop = match layout {

@@ -42,6 +42,27 @@ fn for_each_leaf(e: &LExpr, f: &mut dyn FnMut(&Leaf)) {
     }
 }
 
+/// How many distinct parameters (`p.…` and `pc.…`) `p` reads.
+pub(super) fn params_read(p: &Program) -> usize {
+    let mut read = std::collections::BTreeSet::new();
+    let mut visit = |l: &Leaf| match *l {
+        Leaf::Param(i) => {
+            read.insert((0, i));
+        }
+        Leaf::Pre(i) => {
+            read.insert((1, i));
+        }
+        _ => {}
+    };
+    for e in p.stmts.iter().map(|s| &s.expr) {
+        for_each_leaf(e, &mut visit);
+    }
+    for (_, _, e) in &p.outputs {
+        for_each_leaf(e, &mut visit);
+    }
+    read.len()
+}
+
 /// Which inputs a program reads, per speed, from one walk over it. (Asking [`uses`] once per
 /// speed and kind walked the program 5n times: cubic in the length of a chain, since M and C
 /// have n² entries.)

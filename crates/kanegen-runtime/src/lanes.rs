@@ -13,9 +13,9 @@
 //! copy ([`sin_cos_n_inline`]; [`sin_cos_n`] is the same as a dispatched call). [`Lanes<L>`] (`L` `f64`s with lane-wise operators, `f64`
 //! operands applied to every lane) holds the transposed inputs and forms a dependent (mimic)
 //! joint's angle from its master's. The structure-of-arrays forms (`*_batch_soa_into`) take
-//! and give every entry as a [`Lanes<L>`] ([`soa`], [`state`]; their inputs are copied by
-//! [`inputs_soa`]); both forms run one body emitted once per function, which stores each
-//! entry through [`LaneStore`].
+//! and give every entry as a [`Lanes<L>`] ([`soa`], [`state`]; their inputs are read in place,
+//! [`as_lanes`], or copied, [`inputs_soa`]); both forms run one body emitted once per
+//! function, which stores each entry through [`LaneStore`].
 //!
 //! `L` is a const generic of the batch functions: any `L ≥ 1` works; 4 (one AVX2 register) and
 //! 8 are the sizes the benchmarks measure.
@@ -184,12 +184,21 @@ pub fn inputs<const L: usize, const N: usize>(x: &[SVector<f64, N>; L]) -> [Lane
     t
 }
 
-/// The structure-of-arrays inputs of a batched function as the body reads them: a copy, so
-/// that the result stores cannot overwrite them (without it LLVM's loop vectorizer needs
-/// run-time checks and gives up). The form [`inputs`] gives for an array of states.
+/// The structure-of-arrays inputs of a batched function as the body reads them, copied: a
+/// local the result stores cannot overwrite (without it LLVM's loop vectorizer needs run-time
+/// checks and gives up). For bodies that store their results straight into the caller's
+/// result; those that store into local lane buffers read the inputs in place ([`as_lanes`]).
+/// The form [`inputs`] gives for an array of states.
 #[inline(always)]
 pub fn inputs_soa<const L: usize, const N: usize>(x: &SVector<Lanes<L>, N>) -> [Lanes<L>; N] {
     x.data.0[0]
+}
+
+/// The structure-of-arrays inputs of a batched function as the body reads them, in place: the
+/// caller's storage as an array of lanes, no copy ([`inputs_soa`] copies).
+#[inline(always)]
+pub fn as_lanes<const L: usize, const N: usize>(x: &SVector<Lanes<L>, N>) -> &[Lanes<L>; N] {
+    &x.data.0[0]
 }
 
 /// Where the body shared by a generated module's two batched forms of a function
@@ -197,7 +206,9 @@ pub fn inputs_soa<const L: usize, const N: usize>(x: &SVector<Lanes<L>, N>) -> [
 /// entry `(r, c)` of state `l` (`c = 0` for a vector): entry `(r, c)` of the `l`-th result of
 /// an array of states, or lane `l` of entry `(r, c)` of a structure-of-arrays result. With
 /// constant `r`, `c` and `l < L` from the loop over the states, the index checks fold away and
-/// the store is what each layout wrote inline before.
+/// the store is what each layout wrote inline before. A body that keeps each loop's entries
+/// in a local lane buffer copies them out after the loop with [`LaneStore::set_lanes`], all
+/// `L` states of an entry at once (one vector store in the structure-of-arrays layout).
 ///
 /// ```
 /// use kanegen_runtime::lanes::{LaneStore, Lanes};
@@ -208,10 +219,22 @@ pub fn inputs_soa<const L: usize, const N: usize>(x: &SVector<Lanes<L>, N>) -> [
 /// let mut soa = SMatrix::<Lanes<3>, 2, 1>::from_element(Lanes::splat(0.0));
 /// soa.set(1, 0, 2, 5.0);
 /// assert_eq!(soa[1].0[2], 5.0);
+/// states.set_lanes(0, 0, &[1.0, 2.0, 3.0]);
+/// soa.set_lanes(0, 0, &[1.0, 2.0, 3.0]);
+/// assert_eq!((states[1][0], soa[0].0), (2.0, [1.0, 2.0, 3.0]));
 /// ```
 pub trait LaneStore<const L: usize> {
     /// Entry `(r, c)` of state `l` becomes `v`.
     fn set(&mut self, r: usize, c: usize, l: usize, v: f64);
+
+    /// Entry `(r, c)` of every state `l` becomes `v[l]`: what the generated bodies call after
+    /// each loop over the states, from the loop's local lane buffer.
+    #[inline(always)]
+    fn set_lanes(&mut self, r: usize, c: usize, v: &[f64; L]) {
+        for (l, &x) in v.iter().enumerate() {
+            self.set(r, c, l, x);
+        }
+    }
 }
 
 impl<const R: usize, const C: usize, const L: usize> LaneStore<L> for [SMatrix<f64, R, C>; L] {
@@ -225,5 +248,11 @@ impl<const R: usize, const C: usize, const L: usize> LaneStore<L> for SMatrix<La
     #[inline(always)]
     fn set(&mut self, r: usize, c: usize, l: usize, v: f64) {
         self[(r, c)].0[l] = v;
+    }
+
+    /// One whole-entry store.
+    #[inline(always)]
+    fn set_lanes(&mut self, r: usize, c: usize, v: &[f64; L]) {
+        self[(r, c)].0 = *v;
     }
 }

@@ -10463,8 +10463,8 @@ mod generated {
             q: &[SVector<f64, 19>; L],
             out: &mut [SMatrix<f64, 19, 19>; L],
         ) {
-            let q = kanegen_runtime::lanes::inputs(q);
-            mass_matrix_batch_body::<A, _, L>(p, pc, &q, out);
+            let q = &kanegen_runtime::lanes::inputs(q);
+            mass_matrix_batch_body::<A, _, L>(p, pc, q, out);
             for m in out.iter_mut() {
                 m[(1, 0)] = m[(0, 1)];
                 m[(2, 0)] = m[(0, 2)];
@@ -10722,8 +10722,8 @@ mod generated {
             q: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
             out: &mut SMatrix<kanegen_runtime::lanes::Lanes<L>, 19, 19>,
         ) {
-            let q = kanegen_runtime::lanes::inputs_soa(q);
-            mass_matrix_batch_body::<A, _, L>(p, pc, &q, out);
+            let q = &kanegen_runtime::lanes::inputs_soa(q);
+            mass_matrix_batch_body::<A, _, L>(p, pc, q, out);
             out[(1, 0)] = out[(0, 1)];
             out[(2, 0)] = out[(0, 2)];
             out[(3, 0)] = out[(0, 3)];
@@ -10981,7 +10981,6 @@ mod generated {
         u: &[kanegen_runtime::lanes::Lanes<L>; 19],
         out: &mut S,
     ) {
-        let p = &{ *p };
         let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
             A,
             _,
@@ -11005,6 +11004,7 @@ mod generated {
             q[11].0,
             q[18].0,
         ]);
+        let mut entries0 = [[0.0f64; L]; 19];
         for l in 0..L {
             let s_q_imu = sin_q[0][l];
             let c_q_imu = cos_q[0][l];
@@ -12796,7 +12796,7 @@ mod generated {
                     ),
                 ),
             ); // N10l|ud=0,g=0.z
-            out.set(11, 0, l, d119);
+            entries0[11][l] = d119;
             let d203 = A::mul_add(
                 -p.MY10r,
                 k168,
@@ -12818,7 +12818,7 @@ mod generated {
                     ),
                 ),
             ); // N10r|ud=0,g=0.z
-            out.set(18, 0, l, d203);
+            entries0[18][l] = d203;
             let d260 = A::mul_add(s_q7l, d113, c_q7l * d112); // f10l in 9l|ud=0,g=0.x
             let d204 = A::mul_add(s_q7r, d196, c_q7r * d195); // f10r in 9r|ud=0,g=0.x
             let d261 = A::mul_add(-c_q7l, d113, s_q7l * d112); // f10l in 9l|ud=0,g=0.z
@@ -12832,13 +12832,13 @@ mod generated {
                 d261,
                 A::mul_add(s_q7l, d118, A::mul_add(c_q7l, d117, d105)),
             ); // n9l|ud=0,g=0.x
-            out.set(10, 0, l, -d264);
+            entries0[10][l] = -d264;
             let d210 = A::mul_add(
                 p.L9,
                 d205,
                 A::mul_add(s_q7r, d202, A::mul_add(c_q7r, d201, d189)),
             ); // n9r|ud=0,g=0.x
-            out.set(17, 0, l, -d210);
+            entries0[17][l] = -d210;
             let d265 = A::mul_add(
                 p.L9,
                 d260,
@@ -12866,9 +12866,9 @@ mod generated {
             let d273 = d93 + d264; // n8l|ud=0,g=0.x
             let d217 = d177 + d210; // n8r|ud=0,g=0.x
             let d274 = A::mul_add(s_q6l, d265, A::mul_add(c_q6l, d263, d94)); // n8l|ud=0,g=0.y
-            out.set(9, 0, l, d274);
+            entries0[9][l] = d274;
             let d218 = A::mul_add(s_q6r, d211, A::mul_add(c_q6r, d209, d178)); // n8r|ud=0,g=0.y
-            out.set(16, 0, l, d218);
+            entries0[16][l] = d218;
             let d275 = A::mul_add(-c_q6l, d265, A::mul_add(s_q6l, d263, d95)); // n8l|ud=0,g=0.z
             let d219 = A::mul_add(-c_q6r, d211, A::mul_add(s_q6r, d209, d179)); // n8r|ud=0,g=0.z
             let d276 = A::mul_add(s_q5l, d271, c_q5l * d272); // f8l in 7l|ud=0,g=0.x
@@ -12884,13 +12884,13 @@ mod generated {
                 d277,
                 A::mul_add(-s_q5l, d275, A::mul_add(c_q5l, d273, d81)),
             ); // n7l|ud=0,g=0.x
-            out.set(8, 0, l, -d280);
+            entries0[8][l] = -d280;
             let d226 = A::mul_add(
                 p.L8,
                 d221,
                 A::mul_add(-s_q5r, d219, A::mul_add(c_q5r, d217, d165)),
             ); // n7r|ud=0,g=0.x
-            out.set(15, 0, l, -d226);
+            entries0[15][l] = -d226;
             let d281 = A::mul_add(
                 p.L8,
                 d276,
@@ -12918,9 +12918,9 @@ mod generated {
             let d289 = d69 + d280; // n6l|ud=0,g=0.x
             let d233 = d153 + d226; // n6r|ud=0,g=0.x
             let d290 = A::mul_add(s_q4l, d281, A::mul_add(c_q4l, d279, d70)); // n6l|ud=0,g=0.y
-            out.set(7, 0, l, d290);
+            entries0[7][l] = d290;
             let d234 = A::mul_add(s_q4r, d227, A::mul_add(c_q4r, d225, d154)); // n6r|ud=0,g=0.y
-            out.set(14, 0, l, d234);
+            entries0[14][l] = d234;
             let d291 = A::mul_add(-c_q4l, d281, A::mul_add(s_q4l, d279, d71)); // n6l|ud=0,g=0.z
             let d235 = A::mul_add(-c_q4r, d227, A::mul_add(s_q4r, d225, d155)); // n6r|ud=0,g=0.z
             let d292 = A::mul_add(s_q3l, d287, c_q3l * d288); // f6l in 5l|ud=0,g=0.x
@@ -12936,13 +12936,13 @@ mod generated {
                 d293,
                 A::mul_add(-s_q3l, d291, A::mul_add(c_q3l, d289, d57)),
             ); // n5l|ud=0,g=0.x
-            out.set(6, 0, l, -d296);
+            entries0[6][l] = -d296;
             let d242 = A::mul_add(
                 p.L7,
                 d237,
                 A::mul_add(-s_q3r, d235, A::mul_add(c_q3r, d233, d141)),
             ); // n5r|ud=0,g=0.x
-            out.set(13, 0, l, -d242);
+            entries0[13][l] = -d242;
             let d297 = A::mul_add(
                 p.L7,
                 d292,
@@ -12971,9 +12971,9 @@ mod generated {
             let d305 = d45 + d296; // n4l|ud=0,g=0.x
             let d249 = d129 + d242; // n4r|ud=0,g=0.x
             let d306 = A::mul_add(s_q2l, d297, A::mul_add(c_q2l, d295, d46)); // n4l|ud=0,g=0.y
-            out.set(5, 0, l, d306);
+            entries0[5][l] = d306;
             let d250 = A::mul_add(s_q2r, d243, A::mul_add(c_q2r, d241, d130)); // n4r|ud=0,g=0.y
-            out.set(12, 0, l, d250);
+            entries0[12][l] = d250;
             let d307 = A::mul_add(-c_q2l, d297, A::mul_add(s_q2l, d295, d47)); // n4l|ud=0,g=0.z
             let d251 = A::mul_add(-c_q2r, d243, A::mul_add(s_q2r, d241, d131)); // n4r|ud=0,g=0.z
             let d308 = A::mul_add(-c_q1l, d303, s_q1l * d304); // f4l in 3|ud=0,g=0.z
@@ -13004,7 +13004,7 @@ mod generated {
                 d308,
                 A::mul_add(s_q1l, d307, A::mul_add(-c_q1l, d305, d256)),
             ); // n3|ud=0,g=0.y
-            out.set(4, 0, l, -d312);
+            entries0[4][l] = -d312;
             let d313 = A::mul_add(
                 -p.L5,
                 d302,
@@ -13030,7 +13030,7 @@ mod generated {
                     A::mul_add(-s_q_torso, d313, A::mul_add(c_q_torso, d311, d21)),
                 ),
             ); // n2|ud=0,g=0.x
-            out.set(3, 0, l, d321);
+            entries0[3][l] = d321;
             let d322 = A::mul_add(p.L4, d316, d22 - d312); // n2|ud=0,g=0.y
             let d323 = A::mul_add(
                 -p.L3,
@@ -13042,7 +13042,7 @@ mod generated {
             let d326 = d4 - d325; // f1|ud=0,g=0.y
             let d327 = d5 + d324; // f1|ud=0,g=0.z
             let d328 = A::mul_add(p.L2, d325, A::mul_add(-p.L1, d324, d9 + d321)); // n1|ud=0,g=0.x
-            out.set(2, 0, l, d328);
+            entries0[2][l] = d328;
             let d329 = A::mul_add(
                 -p.L2,
                 d318,
@@ -13054,10 +13054,29 @@ mod generated {
                 A::mul_add(c_q_w, d323, A::mul_add(-s_q_w, d322, d11)),
             ); // n1|ud=0,g=0.z
             let d331 = A::mul_add(-c_q_imu, d327, s_q_imu * d326); // f1 in 0|ud=0,g=0.x
-            out.set(0, 0, l, d331);
+            entries0[0][l] = d331;
             let d332 = A::mul_add(s_q_imu, d330, c_q_imu * d329); // n0|ud=0,g=0.z
-            out.set(1, 0, l, -d332);
+            entries0[1][l] = -d332;
         }
+        out.set_lanes(0, 0, &entries0[0]);
+        out.set_lanes(1, 0, &entries0[1]);
+        out.set_lanes(2, 0, &entries0[2]);
+        out.set_lanes(3, 0, &entries0[3]);
+        out.set_lanes(4, 0, &entries0[4]);
+        out.set_lanes(5, 0, &entries0[5]);
+        out.set_lanes(6, 0, &entries0[6]);
+        out.set_lanes(7, 0, &entries0[7]);
+        out.set_lanes(8, 0, &entries0[8]);
+        out.set_lanes(9, 0, &entries0[9]);
+        out.set_lanes(10, 0, &entries0[10]);
+        out.set_lanes(11, 0, &entries0[11]);
+        out.set_lanes(12, 0, &entries0[12]);
+        out.set_lanes(13, 0, &entries0[13]);
+        out.set_lanes(14, 0, &entries0[14]);
+        out.set_lanes(15, 0, &entries0[15]);
+        out.set_lanes(16, 0, &entries0[16]);
+        out.set_lanes(17, 0, &entries0[17]);
+        out.set_lanes(18, 0, &entries0[18]);
     }
     /// [`coriolis`] at `L` states per call, into `out`: entry `l` of `out` becomes `coriolis` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
     #[inline(never)]
@@ -13076,9 +13095,9 @@ mod generated {
             u: &[SVector<f64, 19>; L],
             out: &mut [SVector<f64, 19>; L],
         ) {
-            let q = kanegen_runtime::lanes::inputs(q);
-            let u = kanegen_runtime::lanes::inputs(u);
-            coriolis_batch_body::<A, _, L>(p, pc, &q, &u, out);
+            let q = &kanegen_runtime::lanes::inputs(q);
+            let u = &kanegen_runtime::lanes::inputs(u);
+            coriolis_batch_body::<A, _, L>(p, pc, q, u, out);
         }
         kanegen_runtime::isa::dispatch_fused_wide_with(
             out,
@@ -13117,9 +13136,9 @@ mod generated {
             u: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
             out: &mut SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
         ) {
-            let q = kanegen_runtime::lanes::inputs_soa(q);
-            let u = kanegen_runtime::lanes::inputs_soa(u);
-            coriolis_batch_body::<A, _, L>(p, pc, &q, &u, out);
+            let q = kanegen_runtime::lanes::as_lanes(q);
+            let u = kanegen_runtime::lanes::as_lanes(u);
+            coriolis_batch_body::<A, _, L>(p, pc, q, u, out);
         }
         kanegen_runtime::isa::dispatch_fused_wide_with(
             out,
@@ -13156,8 +13175,6 @@ mod generated {
         q: &[kanegen_runtime::lanes::Lanes<L>; 19],
         out: &mut S,
     ) {
-        let p = &{ *p };
-        let pc = &{ *pc };
         let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
             A,
             _,
@@ -13181,6 +13198,7 @@ mod generated {
             q[11].0,
             q[18].0,
         ]);
+        let mut entries0 = [[0.0f64; L]; 17];
         for l in 0..L {
             let s_q_imu = sin_q[0][l];
             let c_q_imu = cos_q[0][l];
@@ -13249,9 +13267,9 @@ mod generated {
             let d19 = A::mul_add(s_q7l, d18, c_q7l * d15); // gravity acceleration in 10l.x
             let d33 = A::mul_add(s_q7r, d32, c_q7r * d29); // gravity acceleration in 10r.x
             let d20 = A::mul_add(-c_q7l, d18, s_q7l * d15); // gravity acceleration in 10l.y
-            out.set(11, 0, l, A::mul_add(-p.MX10l, d20, p.MY10l * d19));
+            entries0[9][l] = A::mul_add(-p.MX10l, d20, p.MY10l * d19);
             let d34 = A::mul_add(-c_q7r, d32, s_q7r * d29); // gravity acceleration in 10r.y
-            out.set(18, 0, l, A::mul_add(-p.MY10r, d33, p.MX10r * d34));
+            entries0[16][l] = A::mul_add(-p.MY10r, d33, p.MX10r * d34);
             let d66 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
             let d35 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
             let d67 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
@@ -13259,9 +13277,9 @@ mod generated {
             let d68 = p.MX9l - d67; // MSC9l.x
             let d37 = p.MX9r - d36; // MSC9r.x
             let d69 = p.MZ9l + d66; // MSC9l.z
-            out.set(10, 0, l, A::mul_add(-pc.pc25, d18, d69 * d17));
+            entries0[8][l] = A::mul_add(-pc.pc25, d18, d69 * d17);
             let d38 = p.MZ9r + d35; // MSC9r.z
-            out.set(17, 0, l, A::mul_add(-d38, d31, pc.pc2 * d32));
+            entries0[15][l] = A::mul_add(-d38, d31, pc.pc2 * d32);
             let d70 = A::mul_add(s_q6l, d69, c_q6l * pc.pc25); // MSC9l in 8l.y
             let d39 = A::mul_add(s_q6r, d38, c_q6r * pc.pc2); // MSC9r in 8r.y
             let d71 = A::mul_add(-c_q6l, d69, s_q6l * pc.pc25); // MSC9l in 8l.z
@@ -13271,9 +13289,9 @@ mod generated {
             let d73 = p.MY8l - d70; // MSC8l.y
             let d42 = p.MY8r - d39; // MSC8r.y
             let d74 = p.MZ8l - d71; // MSC8l.z
-            out.set(9, 0, l, A::mul_add(-d72, d16, -d74 * d15));
+            entries0[7][l] = A::mul_add(-d72, d16, -d74 * d15);
             let d43 = p.MZ8r - d40; // MSC8r.z
-            out.set(16, 0, l, A::mul_add(d41, d30, d43 * d29));
+            entries0[14][l] = A::mul_add(d41, d30, d43 * d29);
             let d75 = A::mul_add(c_q5l, d74, s_q5l * d72); // MSC8l in 7l.z
             let d44 = A::mul_add(c_q5r, d43, s_q5r * d41); // MSC8r in 7r.z
             let d76 = A::mul_add(-s_q5l, d74, c_q5l * d72); // MSC8l in 7l.x
@@ -13283,9 +13301,9 @@ mod generated {
             let d78 = p.MZ7l + d75; // MSC7l.z
             let d47 = p.MZ7r + d44; // MSC7r.z
             let d79 = pc.pc36 - d73; // MSC7l.y
-            out.set(8, 0, l, A::mul_add(-d79, d14, d78 * d13));
+            entries0[6][l] = A::mul_add(-d79, d14, d78 * d13);
             let d48 = pc.pc13 - d42; // MSC7r.y
-            out.set(15, 0, l, A::mul_add(-d47, d27, d48 * d28));
+            entries0[13][l] = A::mul_add(-d47, d27, d48 * d28);
             let d80 = A::mul_add(s_q4l, d78, c_q4l * d79); // MSC7l in 6l.y
             let d49 = A::mul_add(s_q4r, d47, c_q4r * d48); // MSC7r in 6r.y
             let d81 = A::mul_add(-c_q4l, d78, s_q4l * d79); // MSC7l in 6l.z
@@ -13295,9 +13313,9 @@ mod generated {
             let d83 = p.MY6l - d80; // MSC6l.y
             let d52 = p.MY6r - d49; // MSC6r.y
             let d84 = p.MZ6l - d81; // MSC6l.z
-            out.set(7, 0, l, A::mul_add(-d82, d12, -d84 * d11));
+            entries0[5][l] = A::mul_add(-d82, d12, -d84 * d11);
             let d53 = p.MZ6r - d50; // MSC6r.z
-            out.set(14, 0, l, A::mul_add(d51, d26, d53 * d25));
+            entries0[12][l] = A::mul_add(d51, d26, d53 * d25);
             let d85 = A::mul_add(c_q3l, d84, s_q3l * d82); // MSC6l in 5l.z
             let d54 = A::mul_add(c_q3r, d53, s_q3r * d51); // MSC6r in 5r.z
             let d86 = A::mul_add(-s_q3l, d84, c_q3l * d82); // MSC6l in 5l.x
@@ -13307,9 +13325,9 @@ mod generated {
             let d88 = p.MZ5l + d85; // MSC5l.z
             let d57 = p.MZ5r + d54; // MSC5r.z
             let d89 = pc.pc42 - d83; // MSC5l.y
-            out.set(6, 0, l, A::mul_add(-d89, d10, d88 * d9));
+            entries0[4][l] = A::mul_add(-d89, d10, d88 * d9);
             let d58 = pc.pc19 - d52; // MSC5r.y
-            out.set(13, 0, l, A::mul_add(-d57, d23, d58 * d24));
+            entries0[11][l] = A::mul_add(-d57, d23, d58 * d24);
             let d90 = A::mul_add(s_q2l, d88, c_q2l * d89); // MSC5l in 4l.y
             let d59 = A::mul_add(s_q2r, d57, c_q2r * d58); // MSC5r in 4r.y
             let d91 = A::mul_add(-c_q2l, d88, s_q2l * d89); // MSC5l in 4l.z
@@ -13319,27 +13337,44 @@ mod generated {
             let d93 = p.MY4l - d90; // MSC4l.y
             let d62 = p.MY4r - d59; // MSC4r.y
             let d94 = p.MZ4l - d91; // MSC4l.z
-            out.set(5, 0, l, A::mul_add(-d92, d8, -d94 * d7));
+            entries0[3][l] = A::mul_add(-d92, d8, -d94 * d7);
             let d63 = p.MZ4r - d60; // MSC4r.z
-            out.set(12, 0, l, A::mul_add(d61, d22, d63 * d21));
+            entries0[10][l] = A::mul_add(d61, d22, d63 * d21);
             let d95 = A::mul_add(-s_q1l, d94, c_q1l * d92); // MSC4l in 3.y
             let d64 = A::mul_add(-s_q1r, d63, c_q1r * d61); // MSC4r in 3.y
             let d96 = A::mul_add(c_q1l, d94, s_q1l * d92); // MSC4l in 3.z
             let d65 = A::mul_add(c_q1r, d63, s_q1r * d61); // MSC4r in 3.z
             let d97 = p.MZ3 + d65 - d96; // MSC3.z
             let d98 = d93 - d62 + pc.pc47; // MSC3.x
-            out.set(4, 0, l, A::mul_add(-d98, d6, d97 * d5));
+            entries0[2][l] = A::mul_add(-d98, d6, d97 * d5);
             let d99 = d64 + d95 + pc.pc48; // MSC3.y
             let d100 = A::mul_add(c_q_torso, d97, s_q_torso * d98); // MSC3 in 2.z
             let d101 = d99 + pc.pc54; // MSC2.y
             let d102 = pc.pc55 - d100; // MSC2.z
-            out.set(3, 0, l, A::mul_add(-d101, d4, d102 * d3));
+            entries0[1][l] = A::mul_add(-d101, d4, d102 * d3);
             let d103 = A::mul_add(s_q_w, d102, c_q_w * d101); // MSC2 in 1.y
             let d104 = A::mul_add(-c_q_w, d102, s_q_w * d101); // MSC2 in 1.z
             let d105 = d103 + pc.pc61; // MSC1.y
             let d106 = pc.pc62 - d104; // MSC1.z
-            out.set(2, 0, l, A::mul_add(-d105, d2, d106 * d1));
+            entries0[0][l] = A::mul_add(-d105, d2, d106 * d1);
         }
+        out.set_lanes(2, 0, &entries0[0]);
+        out.set_lanes(3, 0, &entries0[1]);
+        out.set_lanes(4, 0, &entries0[2]);
+        out.set_lanes(5, 0, &entries0[3]);
+        out.set_lanes(6, 0, &entries0[4]);
+        out.set_lanes(7, 0, &entries0[5]);
+        out.set_lanes(8, 0, &entries0[6]);
+        out.set_lanes(9, 0, &entries0[7]);
+        out.set_lanes(10, 0, &entries0[8]);
+        out.set_lanes(11, 0, &entries0[9]);
+        out.set_lanes(12, 0, &entries0[10]);
+        out.set_lanes(13, 0, &entries0[11]);
+        out.set_lanes(14, 0, &entries0[12]);
+        out.set_lanes(15, 0, &entries0[13]);
+        out.set_lanes(16, 0, &entries0[14]);
+        out.set_lanes(17, 0, &entries0[15]);
+        out.set_lanes(18, 0, &entries0[16]);
     }
     /// [`gravity`] at `L` states per call, into `out`: entry `l` of `out` becomes `gravity` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
     #[inline(never)]
@@ -13356,8 +13391,8 @@ mod generated {
             q: &[SVector<f64, 19>; L],
             out: &mut [SVector<f64, 19>; L],
         ) {
-            let q = kanegen_runtime::lanes::inputs(q);
-            gravity_batch_body::<A, _, L>(p, pc, &q, out);
+            let q = &kanegen_runtime::lanes::inputs(q);
+            gravity_batch_body::<A, _, L>(p, pc, q, out);
             for m in out.iter_mut() {
                 m[0] = 0.0;
                 m[1] = 0.0;
@@ -13397,8 +13432,8 @@ mod generated {
             q: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
             out: &mut SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
         ) {
-            let q = kanegen_runtime::lanes::inputs_soa(q);
-            gravity_batch_body::<A, _, L>(p, pc, &q, out);
+            let q = kanegen_runtime::lanes::as_lanes(q);
+            gravity_batch_body::<A, _, L>(p, pc, q, out);
             out[0] = kanegen_runtime::lanes::Lanes::splat(0.0);
             out[1] = kanegen_runtime::lanes::Lanes::splat(0.0);
         }
@@ -13438,8 +13473,6 @@ mod generated {
         ud: &[kanegen_runtime::lanes::Lanes<L>; 19],
         out: &mut S,
     ) {
-        let p = &{ *p };
-        let pc = &{ *pc };
         let (sin_q, cos_q) = kanegen_runtime::lanes::sin_cos_n_inline::<
             A,
             _,
@@ -13463,6 +13496,7 @@ mod generated {
             q[11].0,
             q[18].0,
         ]);
+        let mut entries0 = [[0.0f64; L]; 19];
         for l in 0..L {
             let s_q_imu = sin_q[0][l];
             let c_q_imu = cos_q[0][l];
@@ -15165,7 +15199,7 @@ mod generated {
                     ),
                 ),
             ); // N10l.z
-            out.set(11, 0, l, -d155);
+            entries0[11][l] = -d155;
             let d264 = A::mul_add(
                 -p.MY10r,
                 d252,
@@ -15187,7 +15221,7 @@ mod generated {
                     ),
                 ),
             ); // N10r.z
-            out.set(18, 0, l, -d264);
+            entries0[18][l] = -d264;
             let d154 = A::mul_add(
                 p.MX10l,
                 d139,
@@ -15243,13 +15277,13 @@ mod generated {
                 d322,
                 A::mul_add(-s_q7l, d154, A::mul_add(-c_q7l, d153, d136)),
             ); // n9l.x
-            out.set(10, 0, l, -d328);
+            entries0[10][l] = -d328;
             let d272 = A::mul_add(
                 -p.L9,
                 d266,
                 A::mul_add(-s_q7r, d265, A::mul_add(-c_q7r, d263, d247)),
             ); // n9r.x
-            out.set(17, 0, l, -d272);
+            entries0[17][l] = -d272;
             let d329 = A::mul_add(
                 -p.L9,
                 d323,
@@ -15275,9 +15309,9 @@ mod generated {
             let d336 = d118 + d331; // f8l.z
             let d279 = d228 + d275; // f8r.z
             let d337 = A::mul_add(s_q6l, d329, A::mul_add(c_q6l, d327, d124)); // n8l.y
-            out.set(9, 0, l, d337);
+            entries0[9][l] = d337;
             let d281 = A::mul_add(s_q6r, d269, A::mul_add(c_q6r, d273, d234)); // n8r.y
-            out.set(16, 0, l, d281);
+            entries0[16][l] = d281;
             let d338 = A::mul_add(-c_q5l, d336, s_q5l * d332); // f8l in 7l.z
             let d283 = A::mul_add(-c_q5r, d279, s_q5r * d278); // f8r in 7r.z
             let d339 = A::mul_add(s_q5l, d336, c_q5l * d332); // f8l in 7l.x
@@ -15295,13 +15329,13 @@ mod generated {
                 d338,
                 A::mul_add(s_q5l, d334, A::mul_add(-c_q5l, d333, d105)),
             ); // n7l.x
-            out.set(8, 0, l, -d344);
+            entries0[8][l] = -d344;
             let d288 = A::mul_add(
                 -p.L8,
                 d283,
                 A::mul_add(s_q5r, d277, A::mul_add(-c_q5r, d280, d216)),
             ); // n7r.x
-            out.set(15, 0, l, -d288);
+            entries0[15][l] = -d288;
             let d345 = A::mul_add(
                 -p.L8,
                 d339,
@@ -15327,9 +15361,9 @@ mod generated {
             let d352 = d87 + d347; // f6l.z
             let d295 = d197 + d291; // f6r.z
             let d353 = A::mul_add(s_q4l, d345, A::mul_add(c_q4l, d343, d93)); // n6l.y
-            out.set(7, 0, l, d353);
+            entries0[7][l] = d353;
             let d297 = A::mul_add(s_q4r, d285, A::mul_add(c_q4r, d289, d203)); // n6r.y
-            out.set(14, 0, l, d297);
+            entries0[14][l] = d297;
             let d354 = A::mul_add(-c_q3l, d352, s_q3l * d348); // f6l in 5l.z
             let d299 = A::mul_add(-c_q3r, d295, s_q3r * d294); // f6r in 5r.z
             let d355 = A::mul_add(s_q3l, d352, c_q3l * d348); // f6l in 5l.x
@@ -15347,13 +15381,13 @@ mod generated {
                 d354,
                 A::mul_add(s_q3l, d350, A::mul_add(-c_q3l, d349, d74)),
             ); // n5l.x
-            out.set(6, 0, l, -d360);
+            entries0[6][l] = -d360;
             let d304 = A::mul_add(
                 -p.L7,
                 d299,
                 A::mul_add(s_q3r, d293, A::mul_add(-c_q3r, d296, d185)),
             ); // n5r.x
-            out.set(13, 0, l, -d304);
+            entries0[13][l] = -d304;
             let d361 = A::mul_add(
                 -p.L7,
                 d355,
@@ -15380,9 +15414,9 @@ mod generated {
             let d368 = d56 + d363; // f4l.z
             let d311 = d166 + d307; // f4r.z
             let d369 = A::mul_add(s_q2l, d361, A::mul_add(c_q2l, d359, d62)); // n4l.y
-            out.set(5, 0, l, d369);
+            entries0[5][l] = d369;
             let d313 = A::mul_add(s_q2r, d301, A::mul_add(c_q2r, d305, d172)); // n4r.y
-            out.set(12, 0, l, d313);
+            entries0[12][l] = d313;
             let d370 = A::mul_add(s_q1l, d368, c_q1l * d364); // f4l in 3.y
             let d314 = A::mul_add(s_q1r, d311, c_q1r * d310); // f4r in 3.y
             let d318 = A::mul_add(
@@ -15422,7 +15456,7 @@ mod generated {
                 d371,
                 A::mul_add(s_q1l, d366, A::mul_add(-c_q1l, d365, d321)),
             ); // n3.y
-            out.set(4, 0, l, d377);
+            entries0[4][l] = d377;
             let d378 = A::mul_add(s_q_torso, d376, c_q_torso * d372); // f3 in 2.x
             let d379 = A::mul_add(-c_q_torso, d376, s_q_torso * d372); // f3 in 2.z
             let d380 = d21 - d375; // f2.y
@@ -15442,7 +15476,7 @@ mod generated {
                     A::mul_add(-s_q_torso, d374, A::mul_add(c_q_torso, d373, d28)),
                 ),
             ); // n2.x
-            out.set(3, 0, l, d384);
+            entries0[3][l] = d384;
             let d385 = A::mul_add(p.L4, d378, d29 + d377); // n2.y
             let d386 = A::mul_add(-s_q_w, d383, c_q_w * d380); // f2 in 1.y
             let d387 = A::mul_add(c_q_w, d383, s_q_w * d380); // f2 in 1.z
@@ -15454,17 +15488,36 @@ mod generated {
             ); // n1.z
             let d390 = d7 + d387; // f1.z
             let d391 = A::mul_add(-p.L2, d386, A::mul_add(p.L1, d387, d12 + d384)); // n1.x
-            out.set(2, 0, l, d391);
+            entries0[2][l] = d391;
             let d392 = A::mul_add(
                 -p.L2,
                 d382,
                 A::mul_add(-s_q_w, d381, A::mul_add(c_q_w, d385, d13)),
             ); // n1.y
             let d393 = A::mul_add(c_q_imu, d390, s_q_imu * d388); // f1 in 0.x
-            out.set(0, 0, l, A::mul_add(pc.pc67, xdd, d393));
+            entries0[0][l] = A::mul_add(pc.pc67, xdd, d393);
             let d394 = A::mul_add(-s_q_imu, d389, c_q_imu * d392); // n0.z
-            out.set(1, 0, l, A::mul_add(pc.pc68, psidd, -d394));
+            entries0[1][l] = A::mul_add(pc.pc68, psidd, -d394);
         }
+        out.set_lanes(0, 0, &entries0[0]);
+        out.set_lanes(1, 0, &entries0[1]);
+        out.set_lanes(2, 0, &entries0[2]);
+        out.set_lanes(3, 0, &entries0[3]);
+        out.set_lanes(4, 0, &entries0[4]);
+        out.set_lanes(5, 0, &entries0[5]);
+        out.set_lanes(6, 0, &entries0[6]);
+        out.set_lanes(7, 0, &entries0[7]);
+        out.set_lanes(8, 0, &entries0[8]);
+        out.set_lanes(9, 0, &entries0[9]);
+        out.set_lanes(10, 0, &entries0[10]);
+        out.set_lanes(11, 0, &entries0[11]);
+        out.set_lanes(12, 0, &entries0[12]);
+        out.set_lanes(13, 0, &entries0[13]);
+        out.set_lanes(14, 0, &entries0[14]);
+        out.set_lanes(15, 0, &entries0[15]);
+        out.set_lanes(16, 0, &entries0[16]);
+        out.set_lanes(17, 0, &entries0[17]);
+        out.set_lanes(18, 0, &entries0[18]);
     }
     /// [`inverse_dynamics`] at `L` states per call, into `out`: entry `l` of `out` becomes `inverse_dynamics` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
     #[inline(never)]
@@ -15485,10 +15538,10 @@ mod generated {
             ud: &[SVector<f64, 19>; L],
             out: &mut [SVector<f64, 19>; L],
         ) {
-            let q = kanegen_runtime::lanes::inputs(q);
-            let u = kanegen_runtime::lanes::inputs(u);
-            let ud = kanegen_runtime::lanes::inputs(ud);
-            inverse_dynamics_batch_body::<A, _, L>(p, pc, &q, &u, &ud, out);
+            let q = &kanegen_runtime::lanes::inputs(q);
+            let u = &kanegen_runtime::lanes::inputs(u);
+            let ud = &kanegen_runtime::lanes::inputs(ud);
+            inverse_dynamics_batch_body::<A, _, L>(p, pc, q, u, ud, out);
         }
         kanegen_runtime::isa::dispatch_fused_wide_with(
             out,
@@ -15530,10 +15583,10 @@ mod generated {
             ud: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
             out: &mut SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
         ) {
-            let q = kanegen_runtime::lanes::inputs_soa(q);
-            let u = kanegen_runtime::lanes::inputs_soa(u);
-            let ud = kanegen_runtime::lanes::inputs_soa(ud);
-            inverse_dynamics_batch_body::<A, _, L>(p, pc, &q, &u, &ud, out);
+            let q = kanegen_runtime::lanes::as_lanes(q);
+            let u = kanegen_runtime::lanes::as_lanes(u);
+            let ud = kanegen_runtime::lanes::as_lanes(ud);
+            inverse_dynamics_batch_body::<A, _, L>(p, pc, q, u, ud, out);
         }
         kanegen_runtime::isa::dispatch_fused_wide_with(
             out,

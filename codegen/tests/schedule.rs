@@ -227,9 +227,10 @@ fn batched_coriolis_matrix_is_split_into_two_loops_by_rows_and_the_others_are_no
 /// Both layouts run the one shared body (emitted once) between their own input conversion and
 /// the entries no statement stores: the array of states transposes its inputs and completes
 /// each state's result; the structure of arrays reads its inputs in place (c, g, τ: their
-/// bodies store into local lane buffers) or copies them (M and C: their bodies store straight
-/// into the result and read copies of the parameters), and copies or zeroes whole entries, all
-/// lanes at once.
+/// bodies store into local lane buffers; M and C, whose bodies store straight into the result
+/// and read copies of the parameters, read the coordinates only through the sines and cosines
+/// before the loop) or copies them (C's speeds, which its loops read), and copies or zeroes
+/// whole entries, all lanes at once.
 #[test]
 fn both_batched_layouts_share_one_body_and_differ_only_in_inputs_and_the_entries_after_it() {
     let source = batched_krang();
@@ -264,18 +265,21 @@ fn both_batched_layouts_share_one_body_and_differ_only_in_inputs_and_the_entries
         assert_eq!(body.contains("out.set_lanes("), buffered, "{name}");
         let states = function_body(&source, &format!("{name}_batch_into"));
         let lanes = function_body(&source, &format!("{name}_batch_soa_into"));
-        let soa_inputs = if buffered {
-            "lanes::as_lanes(q)"
-        } else {
-            "lanes::inputs_soa(q)"
-        };
-        for (b, inputs) in [(&states, "lanes::inputs(q)"), (&lanes, soa_inputs)] {
+        for (b, inputs) in [
+            (&states, "lanes::inputs(q)"),
+            (&lanes, "lanes::as_lanes(q)"),
+        ] {
             assert!(b.contains(inputs), "{name}");
             assert!(b.contains(&format!("{shared}::<A, _, L>(")), "{name}");
             assert!(!b.contains("for l in 0..L"), "{name}");
         }
         assert!(!lanes.contains("out.iter_mut()"), "{name}");
     }
+    // Speeds read in the loop: in place where it stores into a buffer (c), copied where it
+    // stores straight into the result (C).
+    let soa = |name: &str| function_body(&source, &format!("{name}_batch_soa_into"));
+    assert!(soa("coriolis").contains("lanes::as_lanes(u)"));
+    assert!(soa("coriolis_matrix").contains("lanes::inputs_soa(u)"));
     // M's lower triangle: copied after the shared body, per state or as whole entries.
     let m = function_body(&source, "mass_matrix_batch_into");
     assert!(m.contains("for m in out.iter_mut()"));

@@ -124,19 +124,19 @@ impl Layout {
         }
     }
 
-    /// The state arguments as the body reads them, `&[Lanes<L>; N]`: transposed to lane-major
-    /// order into a local array (`lanes::inputs`), or, already in lanes, a local copy
-    /// (`lanes::inputs_soa`: for [`EntryStores::Direct`], like the parameters) or the caller's
-    /// storage itself (`lanes::as_lanes`: [`EntryStores::Buffered`]).
-    fn inputs(self, x: &TokenStream, to: EntryStores) -> TokenStream {
-        match (self, to) {
-            (Layout::States, _) => quote!(let #x = &kanegen_runtime::lanes::inputs(#x);),
-            (Layout::Lanes, EntryStores::Direct) => {
+    /// The state argument `x` as the body reads it, `&[Lanes<L>; N]`: transposed to
+    /// lane-major order into a local array (`lanes::inputs`), or, already in lanes, a local
+    /// copy (`lanes::inputs_soa`: where the loops read `x` and store straight into the result,
+    /// [`EntryStores::Direct`], like the parameters) or the caller's storage itself
+    /// (`lanes::as_lanes`: loops that store into local lane buffers, or read only the sines and
+    /// cosines computed from `x` before them).
+    fn inputs(self, x: &TokenStream, to: EntryStores, read_in_loop: bool) -> TokenStream {
+        match (self, to, read_in_loop) {
+            (Layout::States, _, _) => quote!(let #x = &kanegen_runtime::lanes::inputs(#x);),
+            (Layout::Lanes, EntryStores::Direct, true) => {
                 quote!(let #x = &kanegen_runtime::lanes::inputs_soa(#x);)
             }
-            (Layout::Lanes, EntryStores::Buffered) => {
-                quote!(let #x = kanegen_runtime::lanes::as_lanes(#x);)
-            }
+            (Layout::Lanes, _, _) => quote!(let #x = kanegen_runtime::lanes::as_lanes(#x);),
         }
     }
 }
@@ -567,7 +567,13 @@ fn function_in(
     let out = quote!(out: &mut #ty);
     let read = read_inputs(p, reads);
     let to = entry_stores(cx, p, reads);
-    let converted = read.iter().map(|x| layout.inputs(x, to));
+    let in_loop = [&reads.coord, &reads.speed, &reads.accel].map(|r| r.contains(&true));
+    let converted = state_reads(p, reads)
+        .into_iter()
+        .zip([quote!(q), quote!(u), quote!(ud)])
+        .zip(in_loop)
+        .filter(|((read, _), _)| *read)
+        .map(|((_, x), in_loop)| layout.inputs(&x, to, in_loop));
     let passed = read.iter().map(|x| quote!(#x,));
     let shared = body_name(f);
     let after = after_stores(cx, p, spec.shape, layout);

@@ -9297,7 +9297,7 @@ mod generated {
             |(), lanes| body::<kanegen_runtime::isa::Fused, _>(lanes, p, pc, q, u, ud),
         )
     }
-    /// The statements of [`mass_matrix_batch_into`] and [`mass_matrix_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to `out.set(row, column, l, value)`.
+    /// The statements of [`mass_matrix_batch_into`] and [`mass_matrix_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to lane `l` of its entry in `out`.
     #[inline(always)]
     fn mass_matrix_batch_body<
         A: kanegen_runtime::isa::Arith<f64>,
@@ -10722,7 +10722,7 @@ mod generated {
             q: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
             out: &mut SMatrix<kanegen_runtime::lanes::Lanes<L>, 19, 19>,
         ) {
-            let q = &kanegen_runtime::lanes::inputs_soa(q);
+            let q = kanegen_runtime::lanes::as_lanes(q);
             mass_matrix_batch_body::<A, _, L>(p, pc, q, out);
             out[(1, 0)] = out[(0, 1)];
             out[(2, 0)] = out[(0, 2)];
@@ -10968,7 +10968,7 @@ mod generated {
         mass_matrix_batch_soa_into(p, pc, q, &mut out);
         out
     }
-    /// The statements of [`coriolis_batch_into`] and [`coriolis_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to `out.set(row, column, l, value)`.
+    /// The statements of [`coriolis_batch_into`] and [`coriolis_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to lane `l` of its entry in `out`.
     #[inline(always)]
     fn coriolis_batch_body<
         A: kanegen_runtime::isa::Arith<f64>,
@@ -13163,7 +13163,7 @@ mod generated {
         coriolis_batch_soa_into(p, pc, q, u, &mut out);
         out
     }
-    /// The statements of [`gravity_batch_into`] and [`gravity_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to `out.set(row, column, l, value)`.
+    /// The statements of [`gravity_batch_into`] and [`gravity_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to lane `l` of its entry in `out`.
     #[inline(always)]
     fn gravity_batch_body<
         A: kanegen_runtime::isa::Arith<f64>,
@@ -13459,7 +13459,7 @@ mod generated {
         gravity_batch_soa_into(p, pc, q, &mut out);
         out
     }
-    /// The statements of [`inverse_dynamics_batch_into`] and [`inverse_dynamics_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to `out.set(row, column, l, value)`.
+    /// The statements of [`inverse_dynamics_batch_into`] and [`inverse_dynamics_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to lane `l` of its entry in `out`.
     #[inline(always)]
     fn inverse_dynamics_batch_body<
         A: kanegen_runtime::isa::Arith<f64>,

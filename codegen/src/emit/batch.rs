@@ -246,11 +246,17 @@ enum EntryStores {
 /// 0.6).
 const BUFFERED_LOCATIONS: usize = 300;
 
+/// Which state inputs (`q`, `u`, `ud`) the loops read themselves, not only through the sines
+/// and cosines computed before them: those a direct body must copy.
+fn read_in_loop(reads: &Reads) -> [bool; 3] {
+    [&reads.coord, &reads.speed, &reads.accel].map(|r| r.contains(&true))
+}
+
 /// [`EntryStores::Buffered`] where it is vectorized ([`BUFFERED_LOCATIONS`]) and cheaper: the
 /// buffer costs three vector moves per entry (zeroed, stored, copied out), the copies it
-/// saves two moves per parameter read and per lane of the structure-of-arrays inputs. Krang:
-/// c, g and τ are buffered (10–20 % faster per 8 states than with the copies), M and C direct
-/// (M buffered, vectorized or not, is slower: 141 entries against 160 parameters).
+/// saves two moves per parameter read and per lane of the structure-of-arrays inputs the loop
+/// reads. Krang: c, g and τ are buffered (10–20 % faster per 8 states than with the copies), M
+/// and C direct (M buffered, vectorized or not, is slower: 141 entries against 160 parameters).
 fn entry_stores(cx: &Context<'_>, p: &Program, reads: &Reads) -> EntryStores {
     let entries = nonzero_outputs(p).count();
     let params = if cx.low.params.is_runtime() {
@@ -258,7 +264,8 @@ fn entry_stores(cx: &Context<'_>, p: &Program, reads: &Reads) -> EntryStores {
     } else {
         0
     };
-    let input_lanes = cx.low.dof * read_inputs(p, reads).len();
+    let copied_inputs = read_in_loop(reads).iter().filter(|&&r| r).count();
+    let input_lanes = cx.low.dof * copied_inputs;
     let locations = entries + lane_inputs(reads) + params;
     if locations <= BUFFERED_LOCATIONS && 3 * entries < 2 * (params + input_lanes) {
         EntryStores::Buffered
@@ -408,11 +415,12 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
         return TokenStream::new();
     }
     let reads = Reads::of(&f.program, cx.model.speeds.len());
-    let mut items = shared_body(cx, f, &reads);
+    let to = entry_stores(cx, &f.program, &reads);
+    let mut items = shared_body(cx, f, &reads, to);
     items.extend(
         Layout::ALL
             .iter()
-            .map(|&layout| function_in(cx, f, &reads, layout)),
+            .map(|&layout| function_in(cx, f, &reads, to, layout)),
     );
     items
 }
@@ -429,7 +437,12 @@ fn body_name(f: &FunctionProgram) -> proc_macro2::Ident {
 /// ([`EntryStores::Direct`]), copies of the parameter structs (`let p = &{ *p };`); a loop
 /// storing into a local lane buffer ([`EntryStores::Buffered`]) is followed by the copies of
 /// its entries into the result.
-fn shared_body(cx: &Context<'_>, f: &FunctionProgram, reads: &Reads) -> TokenStream {
+fn shared_body(
+    cx: &Context<'_>,
+    f: &FunctionProgram,
+    reads: &Reads,
+    to: EntryStores,
+) -> TokenStream {
     let spec = f.id.spec();
     let p = &f.program;
     let name = body_name(f);
@@ -449,7 +462,6 @@ fn shared_body(cx: &Context<'_>, f: &FunctionProgram, reads: &Reads) -> TokenStr
     // One loop per part (one part unless the result has more entries than a vectorized loop
     // can store); none for a structurally zero result (its entries are all written after the
     // body), so no loop leaves `l` unused.
-    let to = entry_stores(cx, p, reads);
     let mut loops = TokenStream::new();
     for (k, part) in loop_parts(p, reads).iter().enumerate() {
         let entries: Vec<_> = nonzero_outputs(part).collect();
@@ -552,6 +564,7 @@ fn function_in(
     cx: &Context<'_>,
     f: &FunctionProgram,
     reads: &Reads,
+    to: EntryStores,
     layout: Layout,
 ) -> TokenStream {
     let spec = f.id.spec();
@@ -566,12 +579,10 @@ fn function_in(
     let ty = layout.result(cx, spec);
     let out = quote!(out: &mut #ty);
     let read = read_inputs(p, reads);
-    let to = entry_stores(cx, p, reads);
-    let in_loop = [&reads.coord, &reads.speed, &reads.accel].map(|r| r.contains(&true));
     let converted = state_reads(p, reads)
         .into_iter()
         .zip([quote!(q), quote!(u), quote!(ud)])
-        .zip(in_loop)
+        .zip(read_in_loop(reads))
         .filter(|((read, _), _)| *read)
         .map(|((_, x), in_loop)| layout.inputs(&x, to, in_loop));
     let passed = read.iter().map(|x| quote!(#x,));

@@ -141,12 +141,22 @@ impl Layout {
     }
 }
 
-/// The state inputs the program reads (`q`, `u`, `ud`, as [`state_reads`] says), by name.
-fn read_inputs(p: &Program, reads: &Reads) -> Vec<TokenStream> {
+/// A state input the program reads (`q`, `u`, `ud`, as [`state_reads`] says): its name, and
+/// whether the loops read it themselves rather than only through the sines and cosines
+/// computed before them (those a direct body must copy: [`EntryStores::Direct`]).
+struct ReadInput {
+    name: TokenStream,
+    in_loop: bool,
+}
+
+/// The state inputs the program reads, in argument order.
+fn read_inputs(p: &Program, reads: &Reads) -> Vec<ReadInput> {
+    let in_loop = [&reads.coord, &reads.speed, &reads.accel].map(|r| r.contains(&true));
     state_reads(p, reads)
         .into_iter()
         .zip([quote!(q), quote!(u), quote!(ud)])
-        .filter_map(|(read, x)| read.then_some(x))
+        .zip(in_loop)
+        .filter_map(|((read, name), in_loop)| read.then_some(ReadInput { name, in_loop }))
         .collect()
 }
 
@@ -229,8 +239,8 @@ enum EntryStores {
     Buffered,
     /// Straight into the result (`out.set(r, c, l, value)`), which the vectorizer must then
     /// know cannot overwrite what the loop reads: the body reads local copies of the parameter
-    /// structs (`let p = &{ *p };`) and of the structure-of-arrays inputs
-    /// (`lanes::inputs_soa`). Without those, LLVM's loop vectorizer needs run-time checks that
+    /// structs (`let p = &{ *p };`) and of the structure-of-arrays inputs the loop reads
+    /// (`lanes::inputs_soa`; [`ReadInput::in_loop`]). Without those, LLVM's loop vectorizer needs run-time checks that
     /// the result stores do not overwrite them, and gives up ("loop not vectorized: runtime
     /// pointer checks needed").
     Direct,
@@ -246,12 +256,6 @@ enum EntryStores {
 /// 0.6).
 const BUFFERED_LOCATIONS: usize = 300;
 
-/// Which state inputs (`q`, `u`, `ud`) the loops read themselves, not only through the sines
-/// and cosines computed before them: those a direct body must copy.
-fn read_in_loop(reads: &Reads) -> [bool; 3] {
-    [&reads.coord, &reads.speed, &reads.accel].map(|r| r.contains(&true))
-}
-
 /// [`EntryStores::Buffered`] where it is vectorized ([`BUFFERED_LOCATIONS`]) and cheaper: the
 /// buffer costs three vector moves per entry (zeroed, stored, copied out), the copies it
 /// saves two moves per parameter read and per lane of the structure-of-arrays inputs the loop
@@ -264,7 +268,7 @@ fn entry_stores(cx: &Context<'_>, p: &Program, reads: &Reads) -> EntryStores {
     } else {
         0
     };
-    let copied_inputs = read_in_loop(reads).iter().filter(|&&r| r).count();
+    let copied_inputs = read_inputs(p, reads).iter().filter(|x| x.in_loop).count();
     let input_lanes = cx.low.dof * copied_inputs;
     let locations = entries + lane_inputs(reads) + params;
     if locations <= BUFFERED_LOCATIONS && 3 * entries < 2 * (params + input_lanes) {
@@ -455,9 +459,10 @@ fn shared_body(
     let param_args = super::function::param_args(cx, reads);
     let nl = idx(cx.low.dof);
     let lanes_ty = quote!(&[kanegen_runtime::lanes::Lanes<L>; #nl]);
-    let inputs = read_inputs(p, reads)
-        .into_iter()
-        .map(|x| quote!(#x: #lanes_ty,));
+    let inputs = read_inputs(p, reads).into_iter().map(|x| {
+        let name = x.name;
+        quote!(#name: #lanes_ty,)
+    });
     let sin_cos = lane_sin_cos(cx, p, reads);
     // One loop per part (one part unless the result has more entries than a vectorized loop
     // can store); none for a structurally zero result (its entries are all written after the
@@ -579,13 +584,11 @@ fn function_in(
     let ty = layout.result(cx, spec);
     let out = quote!(out: &mut #ty);
     let read = read_inputs(p, reads);
-    let converted = state_reads(p, reads)
-        .into_iter()
-        .zip([quote!(q), quote!(u), quote!(ud)])
-        .zip(read_in_loop(reads))
-        .filter(|((read, _), _)| *read)
-        .map(|((_, x), in_loop)| layout.inputs(&x, to, in_loop));
-    let passed = read.iter().map(|x| quote!(#x,));
+    let converted = read.iter().map(|x| layout.inputs(&x.name, to, x.in_loop));
+    let passed = read.iter().map(|x| {
+        let name = &x.name;
+        quote!(#name,)
+    });
     let shared = body_name(f);
     let after = after_stores(cx, p, spec.shape, layout);
     let after_loop = match layout {

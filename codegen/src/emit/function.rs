@@ -42,6 +42,16 @@ fn for_each_leaf(e: &LExpr, f: &mut dyn FnMut(&Leaf)) {
     }
 }
 
+/// Calls `f` on every leaf of every statement and result entry of `p`.
+fn for_each_program_leaf(p: &Program, f: &mut dyn FnMut(&Leaf)) {
+    for e in p.stmts.iter().map(|s| &s.expr) {
+        for_each_leaf(e, f);
+    }
+    for (_, _, e) in &p.outputs {
+        for_each_leaf(e, f);
+    }
+}
+
 /// How many distinct parameters (`p.…` and `pc.…`) `p` reads.
 pub(super) fn params_read(p: &Program) -> usize {
     let mut read = std::collections::BTreeSet::new();
@@ -54,12 +64,7 @@ pub(super) fn params_read(p: &Program) -> usize {
         }
         _ => {}
     };
-    for e in p.stmts.iter().map(|s| &s.expr) {
-        for_each_leaf(e, &mut visit);
-    }
-    for (_, _, e) in &p.outputs {
-        for_each_leaf(e, &mut visit);
-    }
+    for_each_program_leaf(p, &mut visit);
     read.len()
 }
 
@@ -97,12 +102,7 @@ impl Reads {
             Leaf::Pre(_) => r.pre = true,
             Leaf::Const(_) | Leaf::Local(_) => {}
         };
-        for e in p.stmts.iter().map(|s| &s.expr) {
-            for_each_leaf(e, &mut visit);
-        }
-        for (_, _, e) in &p.outputs {
-            for_each_leaf(e, &mut visit);
-        }
+        for_each_program_leaf(p, &mut visit);
         r
     }
 }

@@ -117,10 +117,7 @@ impl Layout {
                 let one = return_type(cx, spec);
                 quote!([<#one>::zeros(); L])
             }
-            Layout::Lanes => {
-                let ty = self.result(cx, spec);
-                quote!(<#ty>::from_element(kanegen_runtime::lanes::Lanes::splat(0.0)))
-            }
+            Layout::Lanes => quote!(kanegen_runtime::lanes::zeros()),
         }
     }
 

@@ -28,8 +28,8 @@
 //! `fixed-wheels`) has the three methods too, with its `BlockCholesky<3, 17>` shape.
 
 use kanegen_runtime::isa::{self, Arith, Fused, Plain};
-use kanegen_runtime::lanes::{Lanes, soa};
-use nalgebra::{ArrayStorage, SMatrix, SVector};
+use kanegen_runtime::lanes::{self, Lanes, soa};
+use nalgebra::{SMatrix, SVector};
 
 use crate::Krang;
 #[cfg(feature = "fixed-wheels")]
@@ -269,31 +269,30 @@ fn block_forward_dynamics_lanes<const T: usize, const N: usize, const L: usize>(
     ),
     mass_matrix_into: impl FnOnce(&SVector<Lanes<L>, N>, &mut SMatrix<Lanes<L>, N, N>),
 ) {
-    let zero = Lanes::splat(0.0);
     // c + g at u̇ = 0, then the right-hand side τ − c − g, in `ud`.
-    bias_into(q, u, &SVector::from_element(zero), ud);
+    bias_into(q, u, &lanes::zeros(), ud);
     for (ud, tau) in ud.iter_mut().zip(tau.iter()) {
         *ud = *tau - *ud;
     }
-    // A fresh matrix is zeroed here, in place, by one `memset` (`from_element` built a zero
-    // matrix elsewhere and copied it, and so did a zeroed matrix made by the caller and lent
-    // here: 23 KB for Krang at L = 8, a sixth of the call).
-    let mut fresh;
-    let m = match m {
-        Some(m) => m,
-        None => {
-            fresh = SMatrix::from_array_storage(ArrayStorage([[Lanes([0.0; L]); N]; N]));
-            &mut fresh
-        }
+    // A fresh matrix is zeroed in place, as the solve's argument: built before the `match`
+    // and lent, or built by `from_element`, it was zeroed elsewhere and copied (23 KB for
+    // Krang at L = 8, a sixth of the call).
+    let factor_and_solve = |m: &mut SMatrix<Lanes<L>, N, N>| {
+        mass_matrix_into(q, m);
+        block_solve_lanes::<T, N, L>(m, ud)
     };
-    mass_matrix_into(q, m);
-    let pivots = block_solve_lanes::<T, N, L>(m, ud);
+    let pivots = match m {
+        Some(m) => factor_and_solve(m),
+        None => factor_and_solve(&mut lanes::zeros()),
+    };
     // Per lane: every input and result entry finite (`0 · x` is ±0 for a finite `x`, NaN for
     // ±∞ and NaN), summed across the entries lane by lane.
     let mut sum = [0.0; L];
-    for x in q.iter().chain(u.iter()).chain(tau.iter()).chain(ud.iter()) {
-        for (s, x) in sum.iter_mut().zip(x.0) {
-            *s += 0.0 * x;
+    for v in [q, u, tau, &*ud] {
+        for x in v.iter() {
+            for (s, x) in sum.iter_mut().zip(&x.0) {
+                *s += 0.0 * x;
+            }
         }
     }
     for (l, (ok, sum)) in pivots.into_iter().zip(sum).enumerate() {
@@ -372,7 +371,7 @@ macro_rules! batched_forward_dynamics {
                 u: &[SVector<f64, $n>; L],
                 tau: &[SVector<f64, $n>; L],
             ) -> [SVector<f64, $n>; L] {
-                let mut ud = SVector::<Lanes<L>, $n>::from_element(Lanes::splat(0.0));
+                let mut ud = lanes::zeros::<$n, 1, L>();
                 self.forward_dynamics_batch_soa_into(&soa(q), &soa(u), &soa(tau), &mut ud);
                 core::array::from_fn(|l| ud.map(|x| x.0[l]))
             }

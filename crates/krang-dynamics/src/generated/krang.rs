@@ -10960,11 +10960,7 @@ mod generated {
         pc: &Precomputed,
         q: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
     ) -> SMatrix<kanegen_runtime::lanes::Lanes<L>, 19, 19> {
-        let mut out = <SMatrix<
-            kanegen_runtime::lanes::Lanes<L>,
-            19,
-            19,
-        >>::from_element(kanegen_runtime::lanes::Lanes::splat(0.0));
+        let mut out = kanegen_runtime::lanes::zeros();
         mass_matrix_batch_soa_into(p, pc, q, &mut out);
         out
     }
@@ -13156,10 +13152,7 @@ mod generated {
         q: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
         u: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
     ) -> SVector<kanegen_runtime::lanes::Lanes<L>, 19> {
-        let mut out = <SVector<
-            kanegen_runtime::lanes::Lanes<L>,
-            19,
-        >>::from_element(kanegen_runtime::lanes::Lanes::splat(0.0));
+        let mut out = kanegen_runtime::lanes::zeros();
         coriolis_batch_soa_into(p, pc, q, u, &mut out);
         out
     }
@@ -13452,10 +13445,7 @@ mod generated {
         pc: &Precomputed,
         q: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
     ) -> SVector<kanegen_runtime::lanes::Lanes<L>, 19> {
-        let mut out = <SVector<
-            kanegen_runtime::lanes::Lanes<L>,
-            19,
-        >>::from_element(kanegen_runtime::lanes::Lanes::splat(0.0));
+        let mut out = kanegen_runtime::lanes::zeros();
         gravity_batch_soa_into(p, pc, q, &mut out);
         out
     }
@@ -15605,10 +15595,7 @@ mod generated {
         u: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
         ud: &SVector<kanegen_runtime::lanes::Lanes<L>, 19>,
     ) -> SVector<kanegen_runtime::lanes::Lanes<L>, 19> {
-        let mut out = <SVector<
-            kanegen_runtime::lanes::Lanes<L>,
-            19,
-        >>::from_element(kanegen_runtime::lanes::Lanes::splat(0.0));
+        let mut out = kanegen_runtime::lanes::zeros();
         inverse_dynamics_batch_soa_into(p, pc, q, u, ud, &mut out);
         out
     }

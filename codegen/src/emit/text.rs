@@ -3,7 +3,7 @@
 //! The module's items go through proc-macro2 → syn → prettyplease. The straight-line
 //! statements of the generated functions (almost all of a large model's bytes: 47 MB for a
 //! 200-link chain) are not built as tokens: each statement is printed directly as the line
-//! prettyplease would print for it ([`Printer::expr_text`]), and the function body holds a
+//! prettyplease would print for it ([`Printer::expr_text_with`]), and the function body holds a
 //! placeholder statement `__kanegen_block!(N);` where the block goes. After formatting,
 //! [`splice`] replaces every placeholder line by its block at the placeholder's indentation.
 //! A statement longer than prettyplease's line (at that indentation) is formatted by
@@ -157,7 +157,7 @@ impl LeafNames {
 impl Printer<'_> {
     /// The statements of the program as a block: `let NAME = EXPR; // label`, with `after[0]`
     /// before the first and `after[i + 1]` right after statement `i` (stores, printed by
-    /// [`Printer::expr_text`]). The text form of [`Printer::statements`] plus the labels.
+    /// [`Printer::expr_text_with`]). The text form of [`Printer::statements`] plus the labels.
     /// `stored` are the expressions of the stores (each stored right after the last statement
     /// it reads), `read_at_end` what the function reads after the block (a scalar result):
     /// a function of more than `split_above` statements is split into blocks (see
@@ -272,7 +272,8 @@ impl Printer<'_> {
         self.expr_text_with(names, e, atomic, false, out);
     }
 
-    /// [`Printer::expr_text`], or with `fma` the sums of products as multiply-add chains for a
+    /// Appends the text prettyplease prints for [`Printer::expr`]`(e, atomic)` on one line, or
+    /// with `fma` the sums of products as multiply-add chains for a
     /// body generic over `A: kanegen_runtime::isa::Arith` (`A::mul_add(x, y, acc)`, the terms
     /// [`fused_terms`] picks): the same IEEE operations in the same order in the baseline copy.
     pub(super) fn expr_text_with(

@@ -43,6 +43,8 @@ fn zeros_is_the_zero_matrix_of_lanes() {
         m,
         SMatrix::<Lanes<8>, 19, 19>::from_element(Lanes::splat(0.0))
     );
+    // +0.0 in every lane, bit for bit (the by-value batched forms start from it).
+    assert!(m.iter().flat_map(|x| x.0).all(|x| x.to_bits() == 0));
     let v: SVector<Lanes<3>, 5> = zeros();
-    assert!(v.iter().all(|x| x.0 == [0.0; 3]));
+    assert!(v.iter().flat_map(|x| x.0).all(|x| x.to_bits() == 0));
 }

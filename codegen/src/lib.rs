@@ -299,6 +299,7 @@ pub struct Builder {
     combined: Vec<combined::Combined>,
     isa_dispatch: bool,
     batch: bool,
+    batch_feature: Option<String>,
     mirrored_lanes: bool,
     split_above: usize,
     regressor_form: RegressorForm,
@@ -323,6 +324,7 @@ impl Builder {
             combined: Vec::new(),
             isa_dispatch: true,
             batch: false,
+            batch_feature: None,
             mirrored_lanes: false,
             split_above: emit::SPLIT_ABOVE,
             regressor_form: RegressorForm::Auto,
@@ -467,6 +469,23 @@ impl Builder {
         self
     }
 
+    /// Batched functions ([`Builder::batch`]), each behind the cargo feature `name` of the crate
+    /// that includes the module: every batched function and method gets
+    /// `#[cfg(feature = "name")]`. A crate can then ship one module (pre-generated, or
+    /// generated the same way with every feature set) whose batched half — 40 % of Krang's
+    /// source — is not even type-checked unless a user asks for it. `krang-dynamics` does this
+    /// with its `batch` feature (README, "Build time and features"). The crate must declare the
+    /// feature (`[features] batch = []`), or rustc warns of an unexpected `cfg`.
+    ///
+    /// ```no_run
+    /// kanegen::Builder::new("krang.toml").batch_feature("batch").run();
+    /// ```
+    pub fn batch_feature(mut self, name: impl Into<String>) -> Self {
+        self.batch = true;
+        self.batch_feature = Some(name.into());
+        self
+    }
+
     /// Mirrored subtrees in two SIMD lanes ("arms in lanes", default `false`; `f64` modules):
     /// where the model has two sibling subtrees of the same shape (Krang's arms: the same
     /// joints, axes and geometry below their first joint, each with its own inertial
@@ -523,6 +542,7 @@ impl Builder {
             precision: self.precision,
             isa_dispatch: self.isa_dispatch,
             batch: self.batch,
+            batch_feature: self.batch_feature.clone(),
             mirrored_lanes: self.mirrored_lanes,
             split_above: self.split_above,
             regressor_form: self.regressor_form,

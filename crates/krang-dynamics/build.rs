@@ -80,7 +80,7 @@ mod modules {
                 .regressor_form(regressor_form())
                 .derivatives_form(form)
                 .mirrored_lanes(true)
-                .batch(true);
+                .batch_feature("batch");
             if kinematics {
                 main = main
                     .combined(whole_body_terms())
@@ -89,7 +89,10 @@ mod modules {
             main.run();
         }
         if enabled("BAKED") {
-            builder("krang.toml").baked(true).batch(true).run();
+            builder("krang.toml")
+                .baked(true)
+                .batch_feature("batch")
+                .run();
         }
         if enabled("F32") {
             builder("krang.toml")
@@ -108,10 +111,11 @@ mod modules {
             if regressors {
                 functions = functions.union(FunctionSet::regressors());
             }
-            // Batched: the fixed-wheel tree's batched forward dynamics (`forward_batch`).
+            // Batched (feature `batch`): the fixed-wheel tree's batched forward dynamics
+            // (`forward_batch`).
             builder("krang-fixed-wheels.toml")
                 .functions(functions)
-                .batch(true)
+                .batch_feature("batch")
                 .run();
         }
         if enabled("TWO_LINK") {

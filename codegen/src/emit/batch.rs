@@ -507,7 +507,9 @@ fn shared_body(
     } else {
         quote!(out)
     };
+    let gate = &cx.batch_gate;
     quote! {
+        #gate
         #[doc = #doc]
         #[inline(always)]
         fn #name<
@@ -602,7 +604,9 @@ fn function_in(
         quote!(out),
     );
     let zeros = layout.zeros(cx, spec);
+    let gate = &cx.batch_gate;
     quote! {
+        #gate
         #[doc = #doc_into]
         #[inline(never)]
         pub fn #name_into<const L: usize>(#outer_params #state, #out) {
@@ -618,6 +622,7 @@ fn function_in(
             #call
         }
 
+        #gate
         #[doc = #doc]
         #[inline]
         pub fn #name<const L: usize>(#outer_params #state) -> #ty {
@@ -661,12 +666,15 @@ pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
             let pass = super::items::wrapper_params(cx);
             let call = quote!(#name(#pass #names));
             let call_into = quote!(#name_into(#pass #names, out));
+            let gate = &cx.batch_gate;
             methods.extend(quote! {
+                #gate
                 #[doc = #doc]
                 #[inline]
                 pub fn #name<const L: usize>(&self, #state) -> #ty {
                     #call
                 }
+                #gate
                 #[doc = #doc_into]
                 #[inline]
                 pub fn #name_into<const L: usize>(&self, #state, out: &mut #ty) {

@@ -66,6 +66,11 @@ pub struct EmitOptions {
     /// across them; each in two layouts: an array of states (`NAME_batch[_into]`) and a
     /// structure of arrays over `kanegen_runtime::lanes::Lanes` (`NAME_batch_soa[_into]`).
     pub batch: bool,
+    /// With [`EmitOptions::batch`]: the name of a cargo feature of the crate that compiles the
+    /// module, behind which every batched item is put (`#[cfg(feature = "NAME")]` on each
+    /// batched function and method; default `None`: always compiled). See
+    /// [`crate::Builder::batch_feature`].
+    pub batch_feature: Option<String>,
     /// Mirrored subtrees in two SIMD lanes (default `false`): see
     /// [`crate::Builder::mirrored_lanes`]. Read by [`crate::generate_combined`], which pairs
     /// the lowered programs ([`crate::lower::lanes::apply`]).
@@ -99,6 +104,7 @@ impl Default for EmitOptions {
         Self {
             isa_dispatch: true,
             batch: false,
+            batch_feature: None,
             mirrored_lanes: false,
             precision: Precision::default(),
             notes: Vec::new(),
@@ -125,6 +131,9 @@ pub(crate) struct Context<'a> {
     leaf_names: text::LeafNames,
     /// See [`EmitOptions::split_above`].
     split_above: usize,
+    /// `#[cfg(feature = "…")]` before every batched item ([`EmitOptions::batch_feature`]), or
+    /// nothing.
+    batch_gate: TokenStream,
 }
 
 impl Context<'_> {
@@ -170,6 +179,10 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         blocks: text::Blocks::default(),
         leaf_names: text::LeafNames::new(model),
         split_above: options.split_above,
+        batch_gate: options
+            .batch_feature
+            .as_deref()
+            .map_or_else(TokenStream::new, |name| quote!(#[cfg(feature = #name)])),
     };
     let runtime = low.params.is_runtime();
     let mut items = quote!(

@@ -2,7 +2,7 @@
 //! generator (the published speed figures come from the criterion benchmarks, `cargo bench`).
 //!
 //! ```sh
-//! cargo build --release -p krang-dynamics --example profile
+//! cargo build --release -p krang-dynamics --features batch --example profile
 //! # instructions per call, repeatable on a loaded machine (callgrind counts, it does not time):
 //! valgrind --tool=callgrind --callgrind-out-file=/dev/null \
 //!     target/release/examples/profile mass_matrix 1000
@@ -11,7 +11,7 @@
 //! ```
 //!
 //! Arguments: a function (`mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, or `all`;
-//! `forward_dynamics`, and `mass_matrix_cholesky` (M, its block factor and one solve);
+//! `mass_matrix_into` (into a matrix kept across calls), `forward_dynamics`, and `mass_matrix_cholesky` (M, its block factor and one solve);
 //! a suffix `_b4` or `_b8` calls the batched form (`_batch_into`, into arrays kept across
 //! calls) with 4 or 8 states, counted as one call, `_s8` the structure-of-arrays form
 //! (`_batch_soa_into`) with 8 states (`forward_dynamics_s8` too, and
@@ -22,7 +22,8 @@
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
 //! across calls), `…_with` (into a `DerivativesWorkspace` kept across calls),
 //! `forward_dynamics_derivatives` and `linearize`; with the feature `coriolis-matrix` also
-//! `coriolis_matrix` and `coriolis_matrix_s8` (its 8-state structure-of-arrays form); with the
+//! `coriolis_matrix`, `coriolis_matrix_s8` (its 8-state structure-of-arrays form) and
+//! `coriolis_matrix_b8` (array of states); with the
 //! feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
 //! `hands_jacobians`, `hands_jacobians_separate` (the two `frame_jacobian` calls it combines),
@@ -72,6 +73,7 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
     let mut d_out = SMatrix::<f64, 19, 38>::zeros();
     #[cfg(feature = "derivatives")]
     let mut d_ws = krang_dynamics::DerivativesWorkspace::new();
+    let mut m_into = nalgebra::SMatrix::<f64, 19, 19>::zeros();
     let mut v4 = [V::zeros(); 4];
     let mut v8 = [V::zeros(); 8];
     let mut ms8 = SMatrix::<Lanes<8>, 19, 19>::from_element(Lanes::splat(0.0));
@@ -84,6 +86,10 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
         let (q, u, ud) = &s[i & 63];
         acc += match f {
             "mass_matrix" => black_box(k).mass_matrix(black_box(q))[(5, 3)],
+            "mass_matrix_into" => {
+                black_box(k).mass_matrix_into(black_box(q), &mut m_into);
+                black_box(&m_into)[(5, 3)]
+            }
             "forward_dynamics" => {
                 black_box(k).forward_dynamics(black_box(q), black_box(u), black_box(ud))[7]
             }
@@ -200,6 +206,12 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
                 let (q, u) = &s8[i & 63];
                 black_box(k).coriolis_matrix_batch_soa_into(black_box(q), black_box(u), &mut ms8);
                 black_box(&ms8)[(7, 9)].0[1]
+            }
+            #[cfg(feature = "coriolis-matrix")]
+            "coriolis_matrix_b8" => {
+                let (q, u) = &b8[i & 63];
+                black_box(k).coriolis_matrix_batch_into(black_box(q), black_box(u), &mut m8);
+                black_box(&m8)[1][(7, 9)]
             }
             "solve_s8" => {
                 // The batched block solve alone, on M of the first 8 states (`ms8_fixed`).

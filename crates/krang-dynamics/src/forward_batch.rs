@@ -1,5 +1,7 @@
 //! Batched forward dynamics: `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))` at `L` states per call, for
-//! samplers (sampling-based MPC, MPPI and RL rollouts) that step many states at once.
+//! samplers (sampling-based MPC, MPPI and RL rollouts) that step many states at once. Behind
+//! the crate's feature `batch`, like the batched functions of the generated modules it builds
+//! on (README, "Build time and features").
 //!
 //! [`Krang::forward_dynamics_batch_soa_into`] takes and gives structure-of-arrays vectors
 //! (`SVector<Lanes<L>, 19>`, lane `l` of every entry being state `l`, as the batched M, c, g and

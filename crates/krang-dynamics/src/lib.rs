@@ -149,6 +149,7 @@ pub mod forward;
 pub use forward::{
     Block, BlockCholesky, ForwardDynamicsError, MassMatrixCholesky, NotPositiveDefinite, solve_spd,
 };
+#[cfg(feature = "batch")]
 pub mod forward_batch;
 
 pub mod actuators;

@@ -9297,6 +9297,7 @@ mod generated {
             |(), lanes| body::<kanegen_runtime::isa::Fused, _>(lanes, p, pc, q, u, ud),
         )
     }
+    #[cfg(feature = "batch")]
     /// The statements of [`mass_matrix_batch_into`] and [`mass_matrix_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to lane `l` of its entry in `out`.
     #[inline(always)]
     fn mass_matrix_batch_body<
@@ -10448,6 +10449,7 @@ mod generated {
             out.set(1, 1, l, d591 + pc.pc68);
         }
     }
+    #[cfg(feature = "batch")]
     /// [`mass_matrix`] at `L` states per call, into `out`: entry `l` of `out` becomes `mass_matrix` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
     #[inline(never)]
     pub fn mass_matrix_batch_into<const L: usize>(
@@ -10696,6 +10698,7 @@ mod generated {
             |out| body::<kanegen_runtime::isa::Fused, L>(p, pc, q, out),
         )
     }
+    #[cfg(feature = "batch")]
     /// [`mass_matrix`] at `L` states per call: entry `l` of the result is `mass_matrix` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Returns the results by value; [`mass_matrix_batch_into`] writes them into the caller's array instead (no zeroed array, no copy).
     #[inline]
     pub fn mass_matrix_batch<const L: usize>(
@@ -10707,6 +10710,7 @@ mod generated {
         mass_matrix_batch_into(p, pc, q, &mut out);
         out
     }
+    #[cfg(feature = "batch")]
     /// [`mass_matrix`] at `L` states per call, structure of arrays, into `out`: lane `l` of every entry of `out` becomes `mass_matrix` at lane `l` of the inputs, bit for bit with the same instruction set; every entry is written. The fastest batched form: the inputs are read as they are and every result entry is one vector store (the array-of-states form [`mass_matrix_batch_into`] transposes and scatters).
     #[inline(never)]
     pub fn mass_matrix_batch_soa_into<const L: usize>(
@@ -10953,6 +10957,7 @@ mod generated {
             |out| body::<kanegen_runtime::isa::Fused, L>(p, pc, q, out),
         )
     }
+    #[cfg(feature = "batch")]
     /// [`mass_matrix`] at `L` states per call, structure of arrays: lane `l` of every input entry is state `l` (`kanegen_runtime::lanes::soa` builds them from an array of states), and lane `l` of every result entry is `mass_matrix` at state `l`, bit for bit with the same instruction set. Returns the result by value; [`mass_matrix_batch_soa_into`] writes into the caller's instead.
     #[inline]
     pub fn mass_matrix_batch_soa<const L: usize>(
@@ -10964,6 +10969,7 @@ mod generated {
         mass_matrix_batch_soa_into(p, pc, q, &mut out);
         out
     }
+    #[cfg(feature = "batch")]
     /// The statements of [`coriolis_batch_into`] and [`coriolis_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to lane `l` of its entry in `out`.
     #[inline(always)]
     fn coriolis_batch_body<
@@ -13074,6 +13080,7 @@ mod generated {
         out.set_lanes(17, 0, &entries0[17]);
         out.set_lanes(18, 0, &entries0[18]);
     }
+    #[cfg(feature = "batch")]
     /// [`coriolis`] at `L` states per call, into `out`: entry `l` of `out` becomes `coriolis` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
     #[inline(never)]
     pub fn coriolis_batch_into<const L: usize>(
@@ -13103,6 +13110,7 @@ mod generated {
             |out| body::<kanegen_runtime::isa::Fused, L>(p, pc, q, u, out),
         )
     }
+    #[cfg(feature = "batch")]
     /// [`coriolis`] at `L` states per call: entry `l` of the result is `coriolis` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Returns the results by value; [`coriolis_batch_into`] writes them into the caller's array instead (no zeroed array, no copy).
     #[inline]
     pub fn coriolis_batch<const L: usize>(
@@ -13115,6 +13123,7 @@ mod generated {
         coriolis_batch_into(p, pc, q, u, &mut out);
         out
     }
+    #[cfg(feature = "batch")]
     /// [`coriolis`] at `L` states per call, structure of arrays, into `out`: lane `l` of every entry of `out` becomes `coriolis` at lane `l` of the inputs, bit for bit with the same instruction set; every entry is written. The fastest batched form: the inputs are read as they are and every result entry is one vector store (the array-of-states form [`coriolis_batch_into`] transposes and scatters).
     #[inline(never)]
     pub fn coriolis_batch_soa_into<const L: usize>(
@@ -13144,6 +13153,7 @@ mod generated {
             |out| body::<kanegen_runtime::isa::Fused, L>(p, pc, q, u, out),
         )
     }
+    #[cfg(feature = "batch")]
     /// [`coriolis`] at `L` states per call, structure of arrays: lane `l` of every input entry is state `l` (`kanegen_runtime::lanes::soa` builds them from an array of states), and lane `l` of every result entry is `coriolis` at state `l`, bit for bit with the same instruction set. Returns the result by value; [`coriolis_batch_soa_into`] writes into the caller's instead.
     #[inline]
     pub fn coriolis_batch_soa<const L: usize>(
@@ -13156,6 +13166,7 @@ mod generated {
         coriolis_batch_soa_into(p, pc, q, u, &mut out);
         out
     }
+    #[cfg(feature = "batch")]
     /// The statements of [`gravity_batch_into`] and [`gravity_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to lane `l` of its entry in `out`.
     #[inline(always)]
     fn gravity_batch_body<
@@ -13369,6 +13380,7 @@ mod generated {
         out.set_lanes(17, 0, &entries0[15]);
         out.set_lanes(18, 0, &entries0[16]);
     }
+    #[cfg(feature = "batch")]
     /// [`gravity`] at `L` states per call, into `out`: entry `l` of `out` becomes `gravity` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
     #[inline(never)]
     pub fn gravity_batch_into<const L: usize>(
@@ -13399,6 +13411,7 @@ mod generated {
             |out| body::<kanegen_runtime::isa::Fused, L>(p, pc, q, out),
         )
     }
+    #[cfg(feature = "batch")]
     /// [`gravity`] at `L` states per call: entry `l` of the result is `gravity` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Returns the results by value; [`gravity_batch_into`] writes them into the caller's array instead (no zeroed array, no copy).
     #[inline]
     pub fn gravity_batch<const L: usize>(
@@ -13410,6 +13423,7 @@ mod generated {
         gravity_batch_into(p, pc, q, &mut out);
         out
     }
+    #[cfg(feature = "batch")]
     /// [`gravity`] at `L` states per call, structure of arrays, into `out`: lane `l` of every entry of `out` becomes `gravity` at lane `l` of the inputs, bit for bit with the same instruction set; every entry is written. The fastest batched form: the inputs are read as they are and every result entry is one vector store (the array-of-states form [`gravity_batch_into`] transposes and scatters).
     #[inline(never)]
     pub fn gravity_batch_soa_into<const L: usize>(
@@ -13438,6 +13452,7 @@ mod generated {
             |out| body::<kanegen_runtime::isa::Fused, L>(p, pc, q, out),
         )
     }
+    #[cfg(feature = "batch")]
     /// [`gravity`] at `L` states per call, structure of arrays: lane `l` of every input entry is state `l` (`kanegen_runtime::lanes::soa` builds them from an array of states), and lane `l` of every result entry is `gravity` at state `l`, bit for bit with the same instruction set. Returns the result by value; [`gravity_batch_soa_into`] writes into the caller's instead.
     #[inline]
     pub fn gravity_batch_soa<const L: usize>(
@@ -13449,6 +13464,7 @@ mod generated {
         gravity_batch_soa_into(p, pc, q, &mut out);
         out
     }
+    #[cfg(feature = "batch")]
     /// The statements of [`inverse_dynamics_batch_into`] and [`inverse_dynamics_batch_soa_into`] for `L` states: lane `l` of every input is state `l`, and each result entry of state `l` goes to lane `l` of its entry in `out`.
     #[inline(always)]
     fn inverse_dynamics_batch_body<
@@ -15509,6 +15525,7 @@ mod generated {
         out.set_lanes(17, 0, &entries0[17]);
         out.set_lanes(18, 0, &entries0[18]);
     }
+    #[cfg(feature = "batch")]
     /// [`inverse_dynamics`] at `L` states per call, into `out`: entry `l` of `out` becomes `inverse_dynamics` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Every entry of `out` is written.
     #[inline(never)]
     pub fn inverse_dynamics_batch_into<const L: usize>(
@@ -15541,6 +15558,7 @@ mod generated {
             |out| body::<kanegen_runtime::isa::Fused, L>(p, pc, q, u, ud, out),
         )
     }
+    #[cfg(feature = "batch")]
     /// [`inverse_dynamics`] at `L` states per call: entry `l` of the result is `inverse_dynamics` at entry `l` of the inputs, bit for bit with the same instruction set (the same statements in a loop over the states, vectorized across them). Returns the results by value; [`inverse_dynamics_batch_into`] writes them into the caller's array instead (no zeroed array, no copy).
     #[inline]
     pub fn inverse_dynamics_batch<const L: usize>(
@@ -15554,6 +15572,7 @@ mod generated {
         inverse_dynamics_batch_into(p, pc, q, u, ud, &mut out);
         out
     }
+    #[cfg(feature = "batch")]
     /// [`inverse_dynamics`] at `L` states per call, structure of arrays, into `out`: lane `l` of every entry of `out` becomes `inverse_dynamics` at lane `l` of the inputs, bit for bit with the same instruction set; every entry is written. The fastest batched form: the inputs are read as they are and every result entry is one vector store (the array-of-states form [`inverse_dynamics_batch_into`] transposes and scatters).
     #[inline(never)]
     pub fn inverse_dynamics_batch_soa_into<const L: usize>(
@@ -15586,6 +15605,7 @@ mod generated {
             |out| body::<kanegen_runtime::isa::Fused, L>(p, pc, q, u, ud, out),
         )
     }
+    #[cfg(feature = "batch")]
     /// [`inverse_dynamics`] at `L` states per call, structure of arrays: lane `l` of every input entry is state `l` (`kanegen_runtime::lanes::soa` builds them from an array of states), and lane `l` of every result entry is `inverse_dynamics` at state `l`, bit for bit with the same instruction set. Returns the result by value; [`inverse_dynamics_batch_soa_into`] writes into the caller's instead.
     #[inline]
     pub fn inverse_dynamics_batch_soa<const L: usize>(
@@ -15667,6 +15687,7 @@ mod generated {
         ) -> SVector<f64, 19> {
             inverse_dynamics(&self.params, &self.pre, q, u, ud)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::mass_matrix`] at `L` states per call (entry `l` of the result at entry `l` of the inputs, bit for bit with the same instruction set; vectorized across the states). [`Self::mass_matrix_batch_into`] writes into the caller's result instead.
         #[inline]
         pub fn mass_matrix_batch<const L: usize>(
@@ -15675,6 +15696,7 @@ mod generated {
         ) -> [SMatrix<f64, 19, 19>; L] {
             mass_matrix_batch(&self.params, &self.pre, q)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::mass_matrix`] at `L` states per call, written into `out` (every entry; entry `l` of the result at entry `l` of the inputs, bit for bit with the same instruction set).
         #[inline]
         pub fn mass_matrix_batch_into<const L: usize>(
@@ -15684,6 +15706,7 @@ mod generated {
         ) {
             mass_matrix_batch_into(&self.params, &self.pre, q, out)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::mass_matrix`] at `L` states per call (structure of arrays: lane `l` of the result's entries at lane `l` of the inputs', bit for bit with the same instruction set; vectorized across the states). [`Self::mass_matrix_batch_soa_into`] writes into the caller's result instead.
         #[inline]
         pub fn mass_matrix_batch_soa<const L: usize>(
@@ -15692,6 +15715,7 @@ mod generated {
         ) -> SMatrix<kanegen_runtime::lanes::Lanes<L>, 19, 19> {
             mass_matrix_batch_soa(&self.params, &self.pre, q)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::mass_matrix`] at `L` states per call, written into `out` (every entry; structure of arrays: lane `l` of the result's entries at lane `l` of the inputs', bit for bit with the same instruction set).
         #[inline]
         pub fn mass_matrix_batch_soa_into<const L: usize>(
@@ -15701,6 +15725,7 @@ mod generated {
         ) {
             mass_matrix_batch_soa_into(&self.params, &self.pre, q, out)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::coriolis`] at `L` states per call (entry `l` of the result at entry `l` of the inputs, bit for bit with the same instruction set; vectorized across the states). [`Self::coriolis_batch_into`] writes into the caller's result instead.
         #[inline]
         pub fn coriolis_batch<const L: usize>(
@@ -15710,6 +15735,7 @@ mod generated {
         ) -> [SVector<f64, 19>; L] {
             coriolis_batch(&self.params, &self.pre, q, u)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::coriolis`] at `L` states per call, written into `out` (every entry; entry `l` of the result at entry `l` of the inputs, bit for bit with the same instruction set).
         #[inline]
         pub fn coriolis_batch_into<const L: usize>(
@@ -15720,6 +15746,7 @@ mod generated {
         ) {
             coriolis_batch_into(&self.params, &self.pre, q, u, out)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::coriolis`] at `L` states per call (structure of arrays: lane `l` of the result's entries at lane `l` of the inputs', bit for bit with the same instruction set; vectorized across the states). [`Self::coriolis_batch_soa_into`] writes into the caller's result instead.
         #[inline]
         pub fn coriolis_batch_soa<const L: usize>(
@@ -15729,6 +15756,7 @@ mod generated {
         ) -> SVector<kanegen_runtime::lanes::Lanes<L>, 19> {
             coriolis_batch_soa(&self.params, &self.pre, q, u)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::coriolis`] at `L` states per call, written into `out` (every entry; structure of arrays: lane `l` of the result's entries at lane `l` of the inputs', bit for bit with the same instruction set).
         #[inline]
         pub fn coriolis_batch_soa_into<const L: usize>(
@@ -15739,6 +15767,7 @@ mod generated {
         ) {
             coriolis_batch_soa_into(&self.params, &self.pre, q, u, out)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::gravity`] at `L` states per call (entry `l` of the result at entry `l` of the inputs, bit for bit with the same instruction set; vectorized across the states). [`Self::gravity_batch_into`] writes into the caller's result instead.
         #[inline]
         pub fn gravity_batch<const L: usize>(
@@ -15747,6 +15776,7 @@ mod generated {
         ) -> [SVector<f64, 19>; L] {
             gravity_batch(&self.params, &self.pre, q)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::gravity`] at `L` states per call, written into `out` (every entry; entry `l` of the result at entry `l` of the inputs, bit for bit with the same instruction set).
         #[inline]
         pub fn gravity_batch_into<const L: usize>(
@@ -15756,6 +15786,7 @@ mod generated {
         ) {
             gravity_batch_into(&self.params, &self.pre, q, out)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::gravity`] at `L` states per call (structure of arrays: lane `l` of the result's entries at lane `l` of the inputs', bit for bit with the same instruction set; vectorized across the states). [`Self::gravity_batch_soa_into`] writes into the caller's result instead.
         #[inline]
         pub fn gravity_batch_soa<const L: usize>(
@@ -15764,6 +15795,7 @@ mod generated {
         ) -> SVector<kanegen_runtime::lanes::Lanes<L>, 19> {
             gravity_batch_soa(&self.params, &self.pre, q)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::gravity`] at `L` states per call, written into `out` (every entry; structure of arrays: lane `l` of the result's entries at lane `l` of the inputs', bit for bit with the same instruction set).
         #[inline]
         pub fn gravity_batch_soa_into<const L: usize>(
@@ -15773,6 +15805,7 @@ mod generated {
         ) {
             gravity_batch_soa_into(&self.params, &self.pre, q, out)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::inverse_dynamics`] at `L` states per call (entry `l` of the result at entry `l` of the inputs, bit for bit with the same instruction set; vectorized across the states). [`Self::inverse_dynamics_batch_into`] writes into the caller's result instead.
         #[inline]
         pub fn inverse_dynamics_batch<const L: usize>(
@@ -15783,6 +15816,7 @@ mod generated {
         ) -> [SVector<f64, 19>; L] {
             inverse_dynamics_batch(&self.params, &self.pre, q, u, ud)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::inverse_dynamics`] at `L` states per call, written into `out` (every entry; entry `l` of the result at entry `l` of the inputs, bit for bit with the same instruction set).
         #[inline]
         pub fn inverse_dynamics_batch_into<const L: usize>(
@@ -15794,6 +15828,7 @@ mod generated {
         ) {
             inverse_dynamics_batch_into(&self.params, &self.pre, q, u, ud, out)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::inverse_dynamics`] at `L` states per call (structure of arrays: lane `l` of the result's entries at lane `l` of the inputs', bit for bit with the same instruction set; vectorized across the states). [`Self::inverse_dynamics_batch_soa_into`] writes into the caller's result instead.
         #[inline]
         pub fn inverse_dynamics_batch_soa<const L: usize>(
@@ -15804,6 +15839,7 @@ mod generated {
         ) -> SVector<kanegen_runtime::lanes::Lanes<L>, 19> {
             inverse_dynamics_batch_soa(&self.params, &self.pre, q, u, ud)
         }
+        #[cfg(feature = "batch")]
         /// [`Self::inverse_dynamics`] at `L` states per call, written into `out` (every entry; structure of arrays: lane `l` of the result's entries at lane `l` of the inputs', bit for bit with the same instruction set).
         #[inline]
         pub fn inverse_dynamics_batch_soa_into<const L: usize>(

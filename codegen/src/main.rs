@@ -44,6 +44,10 @@ options (stats, listing, emit; `show` takes only the URDF import options):
   --no-coriolis-matrix    leave out the Coriolis matrix C(q, u)
   --mirrored-lanes        compute mirrored subtrees (two identical arms) in two SIMD lanes
   --f32                   emit an f32 module (emit only)
+  --batch                 also emit the batched functions: L states per call in SIMD lanes
+                          (`mass_matrix_batch`, `…_batch_soa`, …; f64 modules; emit only)
+  --batch-feature NAME    --batch, each batched item behind `#[cfg(feature = \"NAME\")]` of the
+                          crate that includes the module (emit only)
   --out FILE              write the module to FILE (emit only)
 
 URDF import options (.urdf models; see kanegen_model::UrdfOptions):
@@ -203,6 +207,11 @@ fn run(args: Vec<String>) -> Result<(), Failure> {
         builder = builder.precision(kanegen::Precision::F32);
     }
     builder = builder.mirrored_lanes(args.mirrored_lanes);
+    if let Some(feature) = args.batch_feature {
+        builder = builder.batch_feature(feature);
+    } else if args.batch {
+        builder = builder.batch(true);
+    }
     let start = std::time::Instant::now();
     let g = builder.generate().map_err(|e| error(&e))?;
     let elapsed = start.elapsed();
@@ -273,7 +282,8 @@ impl Command {
         ];
         URDF.contains(&option)
             || (self != Command::Show && GENERATOR.contains(&option))
-            || (self == Command::Emit && ["--f32", "--out"].contains(&option))
+            || (self == Command::Emit
+                && ["--f32", "--out", "--batch", "--batch-feature"].contains(&option))
     }
 }
 
@@ -286,6 +296,8 @@ struct Args {
     no_coriolis_matrix: bool,
     mirrored_lanes: bool,
     f32: bool,
+    batch: bool,
+    batch_feature: Option<String>,
     out: Option<String>,
     wheeled: Option<[String; 3]>,
     up: Option<[f64; 3]>,
@@ -332,6 +344,8 @@ fn parse(args: Vec<String>) -> Result<Option<Args>, String> {
         no_coriolis_matrix: false,
         mirrored_lanes: false,
         f32: false,
+        batch: false,
+        batch_feature: None,
         out: None,
         wheeled: None,
         up: None,
@@ -369,11 +383,12 @@ fn parse(args: Vec<String>) -> Result<Option<Args>, String> {
 }
 
 /// The options that take no value.
-const FLAGS: [&str; 4] = [
+const FLAGS: [&str; 5] = [
     "--baked",
     "--no-coriolis-matrix",
     "--mirrored-lanes",
     "--f32",
+    "--batch",
 ];
 
 /// Whether `arg` is one of the options of the command line.
@@ -397,6 +412,16 @@ impl Args {
             "--no-coriolis-matrix" => self.no_coriolis_matrix = true,
             "--mirrored-lanes" => self.mirrored_lanes = true,
             "--f32" => self.f32 = true,
+            "--batch" => self.batch = true,
+            "--batch-feature" => {
+                let name = value()?;
+                if name.is_empty() || name.starts_with('-') {
+                    return Err(format!(
+                        "--batch-feature needs a cargo feature name, got `{name}`"
+                    ));
+                }
+                self.batch_feature = Some(name);
+            }
             "--out" => self.out = Some(value()?),
             "--functions" => {
                 let set: FunctionSet = value()?.parse().map_err(|e| format!("{e}"))?;

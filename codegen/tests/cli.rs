@@ -87,6 +87,31 @@ fn stats_counts_the_lane_pairs_of_mirrored_subtrees() {
 }
 
 #[test]
+fn emit_batch_and_batch_feature_emit_the_batched_functions_gated_or_not() {
+    let two_link = model("two-link.toml");
+    let plain = stdout(&kanegen(&["emit", &two_link]));
+    let batch = stdout(&kanegen(&["emit", &two_link, "--batch"]));
+    let gated = stdout(&kanegen(&[
+        "emit",
+        &two_link,
+        "--batch-feature",
+        "sampling",
+    ]));
+    assert!(!plain.contains("pub fn mass_matrix_batch"));
+    assert!(batch.contains("pub fn mass_matrix_batch_soa_into"));
+    assert!(!batch.contains("cfg(feature"));
+    assert!(gated.contains("pub fn mass_matrix_batch_soa_into"));
+    assert!(gated.contains("#[cfg(feature = \"sampling\")]"));
+    // The same module as the builder makes (`codegen/tests/batch_feature.rs` checks the gates).
+    let built = kanegen::Builder::new(&two_link)
+        .batch_feature("sampling")
+        .generate()
+        .unwrap()
+        .source;
+    assert_eq!(gated, built);
+}
+
+#[test]
 fn show_prints_units_and_rounded_numbers() {
     let out = stdout(&kanegen(&["show", &model("two-link.toml")]));
     // 2.942658192538247 kg·m² in the file: six significant digits and the unit.
@@ -141,6 +166,14 @@ fn unknown_commands_and_options_are_rejected_before_any_work() {
         (
             vec!["listing", missing, "--f32"],
             "`listing` does not take `--f32`",
+        ),
+        (
+            vec!["stats", missing, "--batch"],
+            "`stats` does not take `--batch`",
+        ),
+        (
+            vec!["emit", missing, "--batch-feature", "--f32"],
+            "--batch-feature needs a cargo feature name",
         ),
         (
             vec!["stats", missing, "extra.toml"],

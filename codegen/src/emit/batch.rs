@@ -285,43 +285,47 @@ fn entry_stores(cx: &Context<'_>, p: &Program, reads: &Reads) -> EntryStores {
 const LOOP_LOCATIONS: usize = 240;
 
 /// The programs of the loops over the states: `p` itself, or, when its nonzero result entries
-/// and the lane inputs it reads exceed [`LOOP_LOCATIONS`], `p` restricted to consecutive
-/// ranges of result rows ([`lower::restrict`]: each part computes the statements its entries
+/// and the lane inputs it reads exceed [`LOOP_LOCATIONS`], `p` restricted to the entries whose
+/// deeper speed (`max(row, column)`, the order of [`lower::subtree_order`]) is in one of
+/// consecutive ranges ([`lower::restrict`]: each part computes the statements its entries
 /// read, with the same expressions, so every entry keeps its bits). Each range is as long as
 /// the budget allows (the entries it stores plus the inputs the whole program reads): the
 /// fewest loops, and for a tree numbered one subtree after the other the last parts are whole
-/// subtrees, which read little of the others. Krang's Coriolis matrix: rows 0–11 (trunk and
-/// left arm, 176 entries) and 12–18 (right arm, 84): 9,531 flops per state in all, the fewest
-/// of its two-part splits by rows (equal halves, rows 0–7 and 8–18: 10,347; one loop: 7,893).
-/// A row with more entries than the budget gets a loop of its own (which may stay scalar).
+/// subtrees, which read little of the others. Krang's Coriolis matrix: deeper speeds 1–14
+/// (trunk, left arm and the right arm's first three joints, 180 entries) and 15–18 (80): 8,619
+/// flops per state in all (one loop would be 7,893); by rows, as before, rows 0–11 and 12–18
+/// took 9,531 (log, "The Coriolis matrix by the deeper speed"). A speed with more entries than
+/// the budget gets a loop of its own (which may stay scalar).
 fn loop_parts<'p>(p: &'p Program, reads: &Reads) -> Vec<Cow<'p, Program>> {
     let inputs = lane_inputs(reads);
-    let mut per_row: BTreeMap<usize, usize> = BTreeMap::new();
-    for (r, _, _) in nonzero_outputs(p) {
-        *per_row.entry(*r).or_default() += 1;
+    // Entry (r, c) belongs to the deeper of its two speeds, `max(r, c)`.
+    let key = |r: usize, c: usize| r.max(c);
+    let mut per_key: BTreeMap<usize, usize> = BTreeMap::new();
+    for (r, c, _) in nonzero_outputs(p) {
+        *per_key.entry(key(*r, *c)).or_default() += 1;
     }
     let budget = LOOP_LOCATIONS.saturating_sub(inputs);
-    if per_row.values().sum::<usize>() <= budget {
+    if per_key.values().sum::<usize>() <= budget {
         return vec![Cow::Borrowed(p)];
     }
-    // Greedy: each range of rows takes rows while its entries fit the budget.
+    // Greedy: each range of keys takes keys while its entries fit the budget.
     let mut ranges: Vec<(usize, usize)> = Vec::new();
     let mut entries = 0;
-    for (&row, &n) in &per_row {
+    for (&k, &n) in &per_key {
         match ranges.last_mut() {
             Some(range) if entries + n <= budget => {
-                range.1 = row + 1;
+                range.1 = k + 1;
                 entries += n;
             }
             _ => {
-                ranges.push((row, row + 1));
+                ranges.push((k, k + 1));
                 entries = n;
             }
         }
     }
     ranges
         .into_iter()
-        .map(|(from, to)| Cow::Owned(lower::restrict(p, |r, _| (from..to).contains(&r))))
+        .map(|(from, to)| Cow::Owned(lower::restrict(p, |r, c| (from..to).contains(&key(r, c)))))
         .collect()
 }
 

@@ -587,26 +587,26 @@ mod generated {
             let qd_w = u[1];
             let k1 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
             let k2 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+            let k3 = qd_imu + qd_w; // w2|ud=0,g=0.x
             let k4 = A::mul_add(-s_q_w, k2, c_q_w * k1); // v2.y
             let k5 = A::mul_add(c_q_w, k2, s_q_w * k1); // v2.z
+            let d1 = p.MZ2 * k3; // w2xMS2|ud=0,g=0.y
+            let d2 = p.MY2 * k3; // w2xMS2|ud=0,g=0.z
             let d3 = p.m2 * k4; // IC2(VxS(qd_w)).f.z
             let d4 = p.m2 * k5; // IC2(VxS(qd_w)).f.y
+            let d5 = d1 - d3; // h2.f.y
+            let d6 = d2 + d4; // h2.f.z
             let t1 = p.MY2 * k4; // common subexpression
             let t2 = p.MZ2 * k5; // common subexpression
             let d7 = A::mul_add(2.0, t2, 2.0 * t1); // Jd2.xx
             m[(1, 0)] = -0.5 * d7;
-            let d11 = t1 + t2; // IC2(VxS(qd_w)).n.x
-            let d12 = A::mul_add(0.5, d7, -d11); // h(C col qd_w) at 2.n.x
-            m[(1, 1)] = -d12;
-            let k3 = qd_imu + qd_w; // w2|ud=0,g=0.x
-            let d1 = p.MZ2 * k3; // w2xMS2|ud=0,g=0.y
-            let d2 = p.MY2 * k3; // w2xMS2|ud=0,g=0.z
-            let d5 = d1 - d3; // h2.f.y
-            let d6 = d2 + d4; // h2.f.z
             let d8 = A::mul_add(-s_q_w, d6, c_q_w * d5); // hC2 in 1.f.y
             let d9 = A::mul_add(c_q_w, d6, s_q_w * d5); // hC2 in 1.f.z
             let d10 = A::mul_add(-2.0, p.L2 * d9, A::mul_add(-2.0, p.L1 * d8, d7)); // JdC1.xx
             m[(0, 0)] = -0.5 * d10;
+            let d11 = t1 + t2; // IC2(VxS(qd_w)).n.x
+            let d12 = A::mul_add(0.5, d7, -d11); // h(C col qd_w) at 2.n.x
+            m[(1, 1)] = -d12;
             let d13 = d6 - d4; // h(C col qd_w) at 2.f.y
             let d14 = d5 + d3; // h(C col qd_w) at 2.f.z
             let d15 = A::mul_add(-c_q_w, d14, s_q_w * d13); // h(C col qd_w) at 1.f.z

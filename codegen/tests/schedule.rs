@@ -295,3 +295,50 @@ fn both_batched_layouts_share_one_body_and_differ_only_in_inputs_and_the_entries
     let m = function_body(&source, "mass_matrix_batch_soa_into");
     assert!(m.contains("out[(1, 0)] = out[(0, 1)];"));
 }
+
+/// The batched bodies of τ, g and the Coriolis matrix run their statements in `subtree_order`
+/// (`lower::batch_program`), which keeps fewer values live than the single-state order Krang's
+/// module uses (mirrored lanes pair and reorder the single-state programs); c keeps its own
+/// order (measured slower in subtree order). The same statements, reordered: the values are
+/// those of the single-state program bit for bit.
+#[test]
+fn batched_bodies_of_tau_g_and_c_run_in_subtree_order_with_fewer_values_live() {
+    use std::borrow::Cow;
+
+    use kanegen::lower::{BATCH_SUBTREE_ORDER, batch_program};
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let g = kanegen::Builder::new(root.join("models/krang.toml"))
+        .mirrored_lanes(true)
+        .generate()
+        .expect("generates");
+    let params: Vec<f64> = krang().params.iter().map(|p| p.value).collect();
+    let q: Vec<f64> = (0..19).map(|i| 0.11 * i as f64 - 0.8).collect();
+    let u: Vec<f64> = (0..19).map(|i| 0.35 - 0.06 * i as f64).collect();
+    let ud: Vec<f64> = (0..19).map(|i| (i as f64 * 0.41).sin()).collect();
+    for f in &g.lowered.functions {
+        let batched = batch_program(f.id, &f.program);
+        if BATCH_SUBTREE_ORDER.contains(&f.id) {
+            assert!(matches!(batched, Cow::Owned(_)), "{}", f.id);
+            let (before, after) = (f.program.max_live(), batched.max_live());
+            assert!(after < before, "{}: {before} → {after} values live", f.id);
+            let mut reordered = g.lowered.clone();
+            let r = reordered
+                .functions
+                .iter_mut()
+                .find(|r| r.id == f.id)
+                .expect("function exists");
+            r.program = batched.into_owned();
+            let (a, b) = (
+                g.lowered.evaluate(f.id, &params, &q, &u, &ud),
+                reordered.evaluate(f.id, &params, &q, &u, &ud),
+            );
+            assert!(
+                a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                "{}: values changed",
+                f.id
+            );
+        } else {
+            assert!(matches!(batched, Cow::Borrowed(_)), "{}", f.id);
+        }
+    }
+}

@@ -419,6 +419,18 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     if !batched(f) {
         return TokenStream::new();
     }
+    // The batched body's own statement order (`lower::batch_program`).
+    let reordered;
+    let f = match lower::batch_program(f.id, &f.program) {
+        Cow::Borrowed(_) => f,
+        Cow::Owned(program) => {
+            reordered = FunctionProgram {
+                program,
+                ..f.clone()
+            };
+            &reordered
+        }
+    };
     let reads = Reads::of(&f.program, cx.model.speeds.len());
     let to = entry_stores(cx, &f.program, &reads);
     let mut items = shared_body(cx, f, &reads, to);

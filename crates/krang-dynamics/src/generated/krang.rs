@@ -13244,106 +13244,106 @@ mod generated {
             let d4 = A::mul_add(c_q_w, d2, s_q_w * d1); // gravity acceleration in 2.z
             let d5 = s_q_torso * d4; // gravity acceleration in 3.x
             let d6 = c_q_torso * d4; // gravity acceleration in 3.z
-            let d7 = A::mul_add(s_q1l, d6, c_q1l * d3); // gravity acceleration in 4l.x
-            let d8 = A::mul_add(-c_q1l, d6, s_q1l * d3); // gravity acceleration in 4l.z
             let d21 = A::mul_add(-c_q1r, d3, s_q1r * d6); // gravity acceleration in 4r.x
             let d22 = A::mul_add(-c_q1r, d6, -s_q1r * d3); // gravity acceleration in 4r.z
-            let d9 = A::mul_add(s_q2l, d8, c_q2l * d5); // gravity acceleration in 5l.y
             let d23 = A::mul_add(s_q2r, d22, c_q2r * d5); // gravity acceleration in 5r.y
-            let d10 = A::mul_add(-c_q2l, d8, s_q2l * d5); // gravity acceleration in 5l.z
             let d24 = A::mul_add(-c_q2r, d22, s_q2r * d5); // gravity acceleration in 5r.z
-            let d11 = A::mul_add(s_q3l, d10, c_q3l * d7); // gravity acceleration in 6l.x
             let d25 = A::mul_add(s_q3r, d24, c_q3r * d21); // gravity acceleration in 6r.x
-            let d12 = A::mul_add(-c_q3l, d10, s_q3l * d7); // gravity acceleration in 6l.z
             let d26 = A::mul_add(-c_q3r, d24, s_q3r * d21); // gravity acceleration in 6r.z
-            let d13 = A::mul_add(s_q4l, d12, c_q4l * d9); // gravity acceleration in 7l.y
             let d27 = A::mul_add(s_q4r, d26, c_q4r * d23); // gravity acceleration in 7r.y
-            let d14 = A::mul_add(-c_q4l, d12, s_q4l * d9); // gravity acceleration in 7l.z
             let d28 = A::mul_add(-c_q4r, d26, s_q4r * d23); // gravity acceleration in 7r.z
-            let d15 = A::mul_add(s_q5l, d14, c_q5l * d11); // gravity acceleration in 8l.x
             let d29 = A::mul_add(s_q5r, d28, c_q5r * d25); // gravity acceleration in 8r.x
-            let d16 = A::mul_add(-c_q5l, d14, s_q5l * d11); // gravity acceleration in 8l.z
             let d30 = A::mul_add(-c_q5r, d28, s_q5r * d25); // gravity acceleration in 8r.z
-            let d17 = A::mul_add(s_q6l, d16, c_q6l * d13); // gravity acceleration in 9l.y
             let d31 = A::mul_add(s_q6r, d30, c_q6r * d27); // gravity acceleration in 9r.y
-            let d18 = A::mul_add(-c_q6l, d16, s_q6l * d13); // gravity acceleration in 9l.z
             let d32 = A::mul_add(-c_q6r, d30, s_q6r * d27); // gravity acceleration in 9r.z
-            let d19 = A::mul_add(s_q7l, d18, c_q7l * d15); // gravity acceleration in 10l.x
             let d33 = A::mul_add(s_q7r, d32, c_q7r * d29); // gravity acceleration in 10r.x
-            let d20 = A::mul_add(-c_q7l, d18, s_q7l * d15); // gravity acceleration in 10l.y
-            entries0[9][l] = A::mul_add(-p.MX10l, d20, p.MY10l * d19);
             let d34 = A::mul_add(-c_q7r, d32, s_q7r * d29); // gravity acceleration in 10r.y
             entries0[16][l] = A::mul_add(-p.MY10r, d33, p.MX10r * d34);
-            let d66 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
             let d35 = A::mul_add(-p.MY10r, c_q7r, p.MX10r * s_q7r); // MSC10r in 9r.z
-            let d67 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
             let d36 = A::mul_add(p.MY10r, s_q7r, p.MX10r * c_q7r); // MSC10r in 9r.x
-            let d68 = p.MX9l - d67; // MSC9l.x
             let d37 = p.MX9r - d36; // MSC9r.x
-            let d69 = p.MZ9l + d66; // MSC9l.z
-            entries0[8][l] = A::mul_add(-pc.pc25, d18, d69 * d17);
             let d38 = p.MZ9r + d35; // MSC9r.z
             entries0[15][l] = A::mul_add(-d38, d31, pc.pc2 * d32);
-            let d70 = A::mul_add(s_q6l, d69, c_q6l * pc.pc25); // MSC9l in 8l.y
             let d39 = A::mul_add(s_q6r, d38, c_q6r * pc.pc2); // MSC9r in 8r.y
-            let d71 = A::mul_add(-c_q6l, d69, s_q6l * pc.pc25); // MSC9l in 8l.z
             let d40 = A::mul_add(-c_q6r, d38, s_q6r * pc.pc2); // MSC9r in 8r.z
-            let d72 = p.MX8l - d68; // MSC8l.x
             let d41 = p.MX8r - d37; // MSC8r.x
-            let d73 = p.MY8l - d70; // MSC8l.y
             let d42 = p.MY8r - d39; // MSC8r.y
-            let d74 = p.MZ8l - d71; // MSC8l.z
-            entries0[7][l] = A::mul_add(-d72, d16, -d74 * d15);
             let d43 = p.MZ8r - d40; // MSC8r.z
             entries0[14][l] = A::mul_add(d41, d30, d43 * d29);
-            let d75 = A::mul_add(c_q5l, d74, s_q5l * d72); // MSC8l in 7l.z
             let d44 = A::mul_add(c_q5r, d43, s_q5r * d41); // MSC8r in 7r.z
-            let d76 = A::mul_add(-s_q5l, d74, c_q5l * d72); // MSC8l in 7l.x
             let d45 = A::mul_add(-s_q5r, d43, c_q5r * d41); // MSC8r in 7r.x
-            let d77 = p.MX7l - d76; // MSC7l.x
             let d46 = p.MX7r - d45; // MSC7r.x
-            let d78 = p.MZ7l + d75; // MSC7l.z
             let d47 = p.MZ7r + d44; // MSC7r.z
-            let d79 = pc.pc36 - d73; // MSC7l.y
-            entries0[6][l] = A::mul_add(-d79, d14, d78 * d13);
             let d48 = pc.pc13 - d42; // MSC7r.y
             entries0[13][l] = A::mul_add(-d47, d27, d48 * d28);
-            let d80 = A::mul_add(s_q4l, d78, c_q4l * d79); // MSC7l in 6l.y
             let d49 = A::mul_add(s_q4r, d47, c_q4r * d48); // MSC7r in 6r.y
-            let d81 = A::mul_add(-c_q4l, d78, s_q4l * d79); // MSC7l in 6l.z
             let d50 = A::mul_add(-c_q4r, d47, s_q4r * d48); // MSC7r in 6r.z
-            let d82 = p.MX6l - d77; // MSC6l.x
             let d51 = p.MX6r - d46; // MSC6r.x
-            let d83 = p.MY6l - d80; // MSC6l.y
             let d52 = p.MY6r - d49; // MSC6r.y
-            let d84 = p.MZ6l - d81; // MSC6l.z
-            entries0[5][l] = A::mul_add(-d82, d12, -d84 * d11);
             let d53 = p.MZ6r - d50; // MSC6r.z
             entries0[12][l] = A::mul_add(d51, d26, d53 * d25);
-            let d85 = A::mul_add(c_q3l, d84, s_q3l * d82); // MSC6l in 5l.z
             let d54 = A::mul_add(c_q3r, d53, s_q3r * d51); // MSC6r in 5r.z
-            let d86 = A::mul_add(-s_q3l, d84, c_q3l * d82); // MSC6l in 5l.x
             let d55 = A::mul_add(-s_q3r, d53, c_q3r * d51); // MSC6r in 5r.x
-            let d87 = p.MX5l - d86; // MSC5l.x
             let d56 = p.MX5r - d55; // MSC5r.x
-            let d88 = p.MZ5l + d85; // MSC5l.z
             let d57 = p.MZ5r + d54; // MSC5r.z
-            let d89 = pc.pc42 - d83; // MSC5l.y
-            entries0[4][l] = A::mul_add(-d89, d10, d88 * d9);
             let d58 = pc.pc19 - d52; // MSC5r.y
             entries0[11][l] = A::mul_add(-d57, d23, d58 * d24);
-            let d90 = A::mul_add(s_q2l, d88, c_q2l * d89); // MSC5l in 4l.y
-            let d59 = A::mul_add(s_q2r, d57, c_q2r * d58); // MSC5r in 4r.y
-            let d91 = A::mul_add(-c_q2l, d88, s_q2l * d89); // MSC5l in 4l.z
             let d60 = A::mul_add(-c_q2r, d57, s_q2r * d58); // MSC5r in 4r.z
-            let d92 = p.MX4l - d87; // MSC4l.x
             let d61 = p.MX4r - d56; // MSC4r.x
-            let d93 = p.MY4l - d90; // MSC4l.y
-            let d62 = p.MY4r - d59; // MSC4r.y
-            let d94 = p.MZ4l - d91; // MSC4l.z
-            entries0[3][l] = A::mul_add(-d92, d8, -d94 * d7);
             let d63 = p.MZ4r - d60; // MSC4r.z
             entries0[10][l] = A::mul_add(d61, d22, d63 * d21);
+            let d7 = A::mul_add(s_q1l, d6, c_q1l * d3); // gravity acceleration in 4l.x
+            let d8 = A::mul_add(-c_q1l, d6, s_q1l * d3); // gravity acceleration in 4l.z
+            let d9 = A::mul_add(s_q2l, d8, c_q2l * d5); // gravity acceleration in 5l.y
+            let d10 = A::mul_add(-c_q2l, d8, s_q2l * d5); // gravity acceleration in 5l.z
+            let d11 = A::mul_add(s_q3l, d10, c_q3l * d7); // gravity acceleration in 6l.x
+            let d12 = A::mul_add(-c_q3l, d10, s_q3l * d7); // gravity acceleration in 6l.z
+            let d13 = A::mul_add(s_q4l, d12, c_q4l * d9); // gravity acceleration in 7l.y
+            let d14 = A::mul_add(-c_q4l, d12, s_q4l * d9); // gravity acceleration in 7l.z
+            let d15 = A::mul_add(s_q5l, d14, c_q5l * d11); // gravity acceleration in 8l.x
+            let d16 = A::mul_add(-c_q5l, d14, s_q5l * d11); // gravity acceleration in 8l.z
+            let d17 = A::mul_add(s_q6l, d16, c_q6l * d13); // gravity acceleration in 9l.y
+            let d18 = A::mul_add(-c_q6l, d16, s_q6l * d13); // gravity acceleration in 9l.z
+            let d19 = A::mul_add(s_q7l, d18, c_q7l * d15); // gravity acceleration in 10l.x
+            let d20 = A::mul_add(-c_q7l, d18, s_q7l * d15); // gravity acceleration in 10l.y
+            entries0[9][l] = A::mul_add(-p.MX10l, d20, p.MY10l * d19);
+            let d66 = A::mul_add(-p.MY10l, c_q7l, p.MX10l * s_q7l); // MSC10l in 9l.z
+            let d67 = A::mul_add(p.MY10l, s_q7l, p.MX10l * c_q7l); // MSC10l in 9l.x
+            let d68 = p.MX9l - d67; // MSC9l.x
+            let d69 = p.MZ9l + d66; // MSC9l.z
+            entries0[8][l] = A::mul_add(-pc.pc25, d18, d69 * d17);
+            let d70 = A::mul_add(s_q6l, d69, c_q6l * pc.pc25); // MSC9l in 8l.y
+            let d71 = A::mul_add(-c_q6l, d69, s_q6l * pc.pc25); // MSC9l in 8l.z
+            let d72 = p.MX8l - d68; // MSC8l.x
+            let d73 = p.MY8l - d70; // MSC8l.y
+            let d74 = p.MZ8l - d71; // MSC8l.z
+            entries0[7][l] = A::mul_add(-d72, d16, -d74 * d15);
+            let d75 = A::mul_add(c_q5l, d74, s_q5l * d72); // MSC8l in 7l.z
+            let d76 = A::mul_add(-s_q5l, d74, c_q5l * d72); // MSC8l in 7l.x
+            let d77 = p.MX7l - d76; // MSC7l.x
+            let d78 = p.MZ7l + d75; // MSC7l.z
+            let d79 = pc.pc36 - d73; // MSC7l.y
+            entries0[6][l] = A::mul_add(-d79, d14, d78 * d13);
+            let d80 = A::mul_add(s_q4l, d78, c_q4l * d79); // MSC7l in 6l.y
+            let d81 = A::mul_add(-c_q4l, d78, s_q4l * d79); // MSC7l in 6l.z
+            let d82 = p.MX6l - d77; // MSC6l.x
+            let d83 = p.MY6l - d80; // MSC6l.y
+            let d84 = p.MZ6l - d81; // MSC6l.z
+            entries0[5][l] = A::mul_add(-d82, d12, -d84 * d11);
+            let d85 = A::mul_add(c_q3l, d84, s_q3l * d82); // MSC6l in 5l.z
+            let d86 = A::mul_add(-s_q3l, d84, c_q3l * d82); // MSC6l in 5l.x
+            let d87 = p.MX5l - d86; // MSC5l.x
+            let d88 = p.MZ5l + d85; // MSC5l.z
+            let d89 = pc.pc42 - d83; // MSC5l.y
+            entries0[4][l] = A::mul_add(-d89, d10, d88 * d9);
+            let d91 = A::mul_add(-c_q2l, d88, s_q2l * d89); // MSC5l in 4l.z
+            let d92 = p.MX4l - d87; // MSC4l.x
+            let d94 = p.MZ4l - d91; // MSC4l.z
+            entries0[3][l] = A::mul_add(-d92, d8, -d94 * d7);
+            let d90 = A::mul_add(s_q2l, d88, c_q2l * d89); // MSC5l in 4l.y
+            let d59 = A::mul_add(s_q2r, d57, c_q2r * d58); // MSC5r in 4r.y
+            let d93 = p.MY4l - d90; // MSC4l.y
+            let d62 = p.MY4r - d59; // MSC4r.y
             let d95 = A::mul_add(-s_q1l, d94, c_q1l * d92); // MSC4l in 3.y
             let d64 = A::mul_add(-s_q1r, d63, c_q1r * d61); // MSC4r in 3.y
             let d96 = A::mul_add(c_q1l, d94, s_q1l * d92); // MSC4l in 3.z
@@ -13583,6 +13583,1606 @@ mod generated {
             let k5 = A::mul_add(-c_q_imu, psidd, k3 * qd_imu); // wd1.y
             let d1 = A::mul_add(s_q_imu, xdd, c_q_imu * p.g); // a1.y
             let d2 = A::mul_add(-c_q_imu, xdd, s_q_imu * p.g); // a1.z
+            let k6 = A::mul_add(-s_q_w, k3, c_q_w * k2); // w1 in 2|ud=0,g=0.y
+            let k7 = A::mul_add(c_q_w, k3, s_q_w * k2); // w1 in 2|ud=0,g=0.z
+            let k8 = A::mul_add(c_q_w, k4, A::mul_add(-s_q_w, k5, k6 * qd_w)); // wd2.z
+            let k9 = qd_imu + qd_w; // w2|ud=0,g=0.x
+            let k10 = qdd_imu + qdd_w; // wd2.x
+            let k11 = A::mul_add(s_q_w, k4, A::mul_add(c_q_w, k5, k7 * qd_w)); // wd2.y
+            let k12 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
+            let k13 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
+            let k14 = A::mul_add(p.L1, k3, p.L2 * k2); // w1xP2|ud=0,g=0.x
+            let d14 = A::mul_add(-p.L1, qdd_imu, A::mul_add(k2, k14, qd_imu * k12) + d2); // a2 in 1.z
+            let k15 = A::mul_add(
+                p.L1,
+                k4,
+                A::mul_add(-p.L2, k5, A::mul_add(-k3, k12, A::mul_add(k2, k13, k1))),
+            ); // a2 in 1.x
+            let d15 = A::mul_add(p.L2, qdd_imu, A::mul_add(qd_imu, k13, k3 * k14) - d1); // a2 in 1.y
+            let d16 = A::mul_add(s_q_w, d14, c_q_w * d15); // a2.y
+            let d17 = A::mul_add(-c_q_w, d14, s_q_w * d15); // a2.z
+            let k16 = A::mul_add(-s_q_torso, k7, c_q_torso * k9); // w2 in 3|ud=0,g=0.x
+            let k17 = A::mul_add(c_q_torso, k7, s_q_torso * k9); // w2 in 3|ud=0,g=0.z
+            let k18 = k6 - qd_torso; // w3|ud=0,g=0.y
+            let k19 = A::mul_add(
+                s_q_torso,
+                k8,
+                A::mul_add(-c_q_torso, k10, k17 * qd_torso),
+            ); // wd3.x
+            let k20 = k11 + qdd_torso; // wd3.y
+            let k21 = A::mul_add(
+                c_q_torso,
+                k8,
+                A::mul_add(s_q_torso, k10, k16 * qd_torso),
+            ); // wd3.z
+            let k22 = A::mul_add(-p.L3, k7, p.L4 * k6); // w2xP3|ud=0,g=0.x
+            let k23 = p.L4 * k9; // w2xP3|ud=0,g=0.y
+            let k24 = p.L3 * k9; // w2xP3|ud=0,g=0.z
+            let d30 = A::mul_add(p.L4, k10, A::mul_add(-k9, k24, k7 * k22) - d16); // a3 in 2.y
+            let k25 = A::mul_add(
+                p.L3,
+                k8,
+                A::mul_add(p.L4, k11, A::mul_add(k7, k23, k6 * k24) + k15),
+            ); // a3 in 2.x
+            let d31 = A::mul_add(p.L3, k10, A::mul_add(k6, k22, k9 * k23) + d17); // a3 in 2.z
+            let d32 = A::mul_add(s_q_torso, d31, c_q_torso * k25); // a3.x
+            let d33 = A::mul_add(-c_q_torso, d31, s_q_torso * k25); // a3.z
+            let k32 = p.L5 * k17; // w3xP4l|ud=0,g=0.x
+            let k33 = p.L6 * k17; // w3xP4l|ud=0,g=0.y
+            let t1 = p.L5 * k16; // common subexpression
+            let t2 = p.L6 * k18; // common subexpression
+            let t3 = p.L5 * k21; // common subexpression
+            let t4 = p.L6 * k21; // common subexpression
+            let t5 = p.L5 * k19; // common subexpression
+            let t6 = p.L6 * k20; // common subexpression
+            let t7 = k17 * k33; // common subexpression
+            let t8 = k17 * k32; // common subexpression
+            let t9 = k16 * k33; // common subexpression
+            let t10 = k18 * k32; // common subexpression
+            let k77 = A::mul_add(-s_q1r, k17, c_q1r * k18); // w3 in 4r|ud=0,g=0.x
+            let k78 = A::mul_add(c_q1r, k17, s_q1r * k18); // w3 in 4r|ud=0,g=0.z
+            let k79 = qdd1r - k19; // wd4r.y
+            let k80 = -k16 - qd1r; // w4r|ud=0,g=0.y
+            let k81 = A::mul_add(s_q1r, k21, A::mul_add(c_q1r, k20, k78 * qd1r)); // wd4r.x
+            let k82 = A::mul_add(c_q1r, k21, A::mul_add(-s_q1r, k20, k77 * qd1r)); // wd4r.z
+            let k83 = t1 + t2; // w3xP4r|ud=0,g=0.z
+            let d156 = A::mul_add(k18, k83, t7) + d32 + t3; // a4r in 3.x
+            let d157 = t9 - t10 - d33 - t5 - t6; // a4r in 3.z
+            let d158 = A::mul_add(k16, k83, t8) - d30 - t4; // a4r in 3.y
+            let d159 = A::mul_add(c_q1r, d157, s_q1r * d158); // a4r.z
+            let d160 = A::mul_add(-s_q1r, d157, c_q1r * d158); // a4r.x
+            let d161 = A::mul_add(-p.MX4r, k80, p.MY4r * k77); // w4rxMS4r|ud=0,g=0.z
+            let d162 = A::mul_add(p.MY4r, k78, p.MZ4r * k80); // w4rxMS4r|ud=0,g=0.x
+            let d163 = A::mul_add(p.MZ4r, k77, p.MX4r * k78); // w4rxMS4r|ud=0,g=0.y
+            let d164 = A::mul_add(
+                -p.MZ4r,
+                k81,
+                A::mul_add(
+                    p.MX4r,
+                    k82,
+                    A::mul_add(p.m4r, d156, A::mul_add(k77, d161, k78 * d162)),
+                ),
+            ); // F4r.y
+            let d165 = A::mul_add(
+                p.MY4r,
+                k82,
+                A::mul_add(
+                    -p.MZ4r,
+                    k79,
+                    A::mul_add(-p.m4r, d160, A::mul_add(-k78, d163, k80 * d161)),
+                ),
+            ); // F4r.x
+            let d166 = A::mul_add(
+                -p.MX4r,
+                k79,
+                A::mul_add(
+                    p.MY4r,
+                    k81,
+                    A::mul_add(-p.m4r, d159, A::mul_add(k80, d162, k77 * d163)),
+                ),
+            ); // F4r.z
+            let d167 = A::mul_add(-p.XZ4r, k78, A::mul_add(p.XY4r, k80, p.XX4r * k77)); // J4rw4r|ud=0,g=0.x
+            let d168 = A::mul_add(-p.YZ4r, k78, A::mul_add(p.YY4r, k80, p.XY4r * k77)); // J4rw4r|ud=0,g=0.y
+            let d169 = A::mul_add(-p.ZZ4r, k78, A::mul_add(p.YZ4r, k80, p.XZ4r * k77)); // J4rw4r|ud=0,g=0.z
+            let d170 = A::mul_add(
+                p.MY4r,
+                d160,
+                A::mul_add(
+                    -p.MX4r,
+                    d156,
+                    A::mul_add(
+                        -p.ZZ4r,
+                        k82,
+                        A::mul_add(
+                            -p.YZ4r,
+                            k79,
+                            A::mul_add(-p.XZ4r, k81, A::mul_add(-k80, d167, k77 * d168)),
+                        ),
+                    ),
+                ),
+            ); // N4r.z
+            let d171 = A::mul_add(
+                p.MZ4r,
+                d156,
+                A::mul_add(
+                    p.MY4r,
+                    d159,
+                    A::mul_add(
+                        -p.XZ4r,
+                        k82,
+                        A::mul_add(
+                            -p.XY4r,
+                            k79,
+                            A::mul_add(-p.XX4r, k81, A::mul_add(k78, d168, k80 * d169)),
+                        ),
+                    ),
+                ),
+            ); // N4r.x
+            let d172 = A::mul_add(
+                p.MX4r,
+                d159,
+                A::mul_add(
+                    p.MZ4r,
+                    d160,
+                    A::mul_add(
+                        p.YZ4r,
+                        k82,
+                        A::mul_add(
+                            p.YY4r,
+                            k79,
+                            A::mul_add(p.XY4r, k81, A::mul_add(k77, d169, k78 * d167)),
+                        ),
+                    ),
+                ),
+            ); // N4r.y
+            let k84 = A::mul_add(-s_q2r, k78, c_q2r * k80); // w4r in 5r|ud=0,g=0.y
+            let k85 = A::mul_add(c_q2r, k78, s_q2r * k80); // w4r in 5r|ud=0,g=0.z
+            let k86 = k81 - qdd2r; // wd5r.x
+            let k87 = A::mul_add(c_q2r, k82, A::mul_add(-s_q2r, k79, k84 * qd2r)); // wd5r.z
+            let k88 = k77 + qd2r; // w5r|ud=0,g=0.x
+            let k89 = A::mul_add(s_q2r, k82, A::mul_add(c_q2r, k79, k85 * qd2r)); // wd5r.y
+            let d173 = A::mul_add(-c_q2r, d156, s_q2r * d159); // a5r.y
+            let d174 = A::mul_add(-c_q2r, d159, -s_q2r * d156); // a5r.z
+            let d175 = A::mul_add(-p.MY5r, k85, p.MZ5r * k84); // w5rxMS5r|ud=0,g=0.x
+            let d176 = A::mul_add(-p.MZ5r, k88, p.MX5r * k85); // w5rxMS5r|ud=0,g=0.y
+            let d177 = A::mul_add(-p.MX5r, k84, p.MY5r * k88); // w5rxMS5r|ud=0,g=0.z
+            let d178 = A::mul_add(
+                -p.MZ5r,
+                k86,
+                A::mul_add(
+                    -p.MX5r,
+                    k87,
+                    A::mul_add(-p.m5r, d173, A::mul_add(-k88, d177, k85 * d175)),
+                ),
+            ); // F5r.y
+            let d179 = A::mul_add(
+                p.MY5r,
+                k87,
+                A::mul_add(
+                    p.MZ5r,
+                    k89,
+                    A::mul_add(p.m5r, d160, A::mul_add(-k85, d176, k84 * d177)),
+                ),
+            ); // F5r.x
+            let d180 = A::mul_add(
+                -p.MX5r,
+                k89,
+                A::mul_add(
+                    p.MY5r,
+                    k86,
+                    A::mul_add(-p.m5r, d174, A::mul_add(-k84, d175, k88 * d176)),
+                ),
+            ); // F5r.z
+            let d181 = A::mul_add(p.XZ5r, k85, A::mul_add(p.XY5r, k84, p.XX5r * k88)); // J5rw5r|ud=0,g=0.x
+            let d182 = A::mul_add(p.YZ5r, k85, A::mul_add(p.YY5r, k84, p.XY5r * k88)); // J5rw5r|ud=0,g=0.y
+            let d183 = A::mul_add(p.ZZ5r, k85, A::mul_add(p.YZ5r, k84, p.XZ5r * k88)); // J5rw5r|ud=0,g=0.z
+            let d184 = A::mul_add(
+                -p.MY5r,
+                d160,
+                A::mul_add(
+                    -p.MX5r,
+                    d173,
+                    A::mul_add(
+                        -p.ZZ5r,
+                        k87,
+                        A::mul_add(
+                            p.YZ5r,
+                            k89,
+                            A::mul_add(p.XZ5r, k86, A::mul_add(-k84, d181, k88 * d182)),
+                        ),
+                    ),
+                ),
+            ); // N5r.z
+            let d185 = A::mul_add(
+                p.MZ5r,
+                d173,
+                A::mul_add(
+                    -p.MY5r,
+                    d174,
+                    A::mul_add(
+                        -p.XZ5r,
+                        k87,
+                        A::mul_add(
+                            p.XY5r,
+                            k89,
+                            A::mul_add(p.XX5r, k86, A::mul_add(-k85, d182, k84 * d183)),
+                        ),
+                    ),
+                ),
+            ); // N5r.x
+            let d186 = A::mul_add(
+                p.MX5r,
+                d174,
+                A::mul_add(
+                    p.MZ5r,
+                    d160,
+                    A::mul_add(
+                        -p.YZ5r,
+                        k87,
+                        A::mul_add(
+                            p.YY5r,
+                            k89,
+                            A::mul_add(p.XY5r, k86, A::mul_add(-k88, d183, k85 * d181)),
+                        ),
+                    ),
+                ),
+            ); // N5r.y
+            let k90 = A::mul_add(-s_q3r, k85, c_q3r * k88); // w5r in 6r|ud=0,g=0.x
+            let k91 = A::mul_add(c_q3r, k85, s_q3r * k88); // w5r in 6r|ud=0,g=0.z
+            let k92 = k89 + qdd3r; // wd6r.y
+            let k93 = k84 - qd3r; // w6r|ud=0,g=0.y
+            let k94 = A::mul_add(s_q3r, k87, A::mul_add(c_q3r, k86, k91 * qd3r)); // wd6r.x
+            let k95 = A::mul_add(c_q3r, k87, A::mul_add(-s_q3r, k86, k90 * qd3r)); // wd6r.z
+            let k96 = p.L7 * k85; // w5rxP6r|ud=0,g=0.x
+            let k97 = p.L7 * k88; // w5rxP6r|ud=0,g=0.z
+            let d187 = A::mul_add(p.L7, k87, A::mul_add(k84, k97, -d160)); // a6r in 5r.x
+            let d188 = A::mul_add(k88, k97, k85 * k96) - d173; // a6r in 5r.y
+            let d189 = A::mul_add(p.L7, k86, A::mul_add(k84, k96, d174)); // a6r in 5r.z
+            let d190 = A::mul_add(c_q3r, d189, s_q3r * d187); // a6r.z
+            let d191 = A::mul_add(-s_q3r, d189, c_q3r * d187); // a6r.x
+            let d192 = A::mul_add(-p.MX6r, k93, p.MY6r * k90); // w6rxMS6r|ud=0,g=0.z
+            let d193 = A::mul_add(p.MY6r, k91, p.MZ6r * k93); // w6rxMS6r|ud=0,g=0.x
+            let d194 = A::mul_add(p.MZ6r, k90, p.MX6r * k91); // w6rxMS6r|ud=0,g=0.y
+            let d195 = A::mul_add(
+                -p.MZ6r,
+                k94,
+                A::mul_add(
+                    p.MX6r,
+                    k95,
+                    A::mul_add(p.m6r, d188, A::mul_add(k90, d192, k91 * d193)),
+                ),
+            ); // F6r.y
+            let d196 = A::mul_add(
+                p.MY6r,
+                k95,
+                A::mul_add(
+                    -p.MZ6r,
+                    k92,
+                    A::mul_add(p.m6r, d191, A::mul_add(-k91, d194, k93 * d192)),
+                ),
+            ); // F6r.x
+            let d197 = A::mul_add(
+                -p.MX6r,
+                k92,
+                A::mul_add(
+                    p.MY6r,
+                    k94,
+                    A::mul_add(p.m6r, d190, A::mul_add(k93, d193, k90 * d194)),
+                ),
+            ); // F6r.z
+            let d198 = A::mul_add(-p.XZ6r, k91, A::mul_add(p.XY6r, k93, p.XX6r * k90)); // J6rw6r|ud=0,g=0.x
+            let d199 = A::mul_add(-p.YZ6r, k91, A::mul_add(p.YY6r, k93, p.XY6r * k90)); // J6rw6r|ud=0,g=0.y
+            let d200 = A::mul_add(-p.ZZ6r, k91, A::mul_add(p.YZ6r, k93, p.XZ6r * k90)); // J6rw6r|ud=0,g=0.z
+            let d201 = A::mul_add(
+                -p.MY6r,
+                d191,
+                A::mul_add(
+                    -p.MX6r,
+                    d188,
+                    A::mul_add(
+                        -p.ZZ6r,
+                        k95,
+                        A::mul_add(
+                            -p.YZ6r,
+                            k92,
+                            A::mul_add(-p.XZ6r, k94, A::mul_add(-k93, d198, k90 * d199)),
+                        ),
+                    ),
+                ),
+            ); // N6r.z
+            let d202 = A::mul_add(
+                p.MZ6r,
+                d188,
+                A::mul_add(
+                    -p.MY6r,
+                    d190,
+                    A::mul_add(
+                        -p.XZ6r,
+                        k95,
+                        A::mul_add(
+                            -p.XY6r,
+                            k92,
+                            A::mul_add(-p.XX6r, k94, A::mul_add(k91, d199, k93 * d200)),
+                        ),
+                    ),
+                ),
+            ); // N6r.x
+            let d203 = A::mul_add(
+                -p.MX6r,
+                d190,
+                A::mul_add(
+                    -p.MZ6r,
+                    d191,
+                    A::mul_add(
+                        p.YZ6r,
+                        k95,
+                        A::mul_add(
+                            p.YY6r,
+                            k92,
+                            A::mul_add(p.XY6r, k94, A::mul_add(k90, d200, k91 * d198)),
+                        ),
+                    ),
+                ),
+            ); // N6r.y
+            let k98 = A::mul_add(-s_q4r, k91, c_q4r * k93); // w6r in 7r|ud=0,g=0.y
+            let k99 = A::mul_add(c_q4r, k91, s_q4r * k93); // w6r in 7r|ud=0,g=0.z
+            let k100 = k94 - qdd4r; // wd7r.x
+            let k101 = A::mul_add(c_q4r, k95, A::mul_add(-s_q4r, k92, k98 * qd4r)); // wd7r.z
+            let k102 = k90 + qd4r; // w7r|ud=0,g=0.x
+            let k103 = A::mul_add(s_q4r, k95, A::mul_add(c_q4r, k92, k99 * qd4r)); // wd7r.y
+            let d204 = A::mul_add(s_q4r, d190, c_q4r * d188); // a7r.y
+            let d205 = A::mul_add(-c_q4r, d190, s_q4r * d188); // a7r.z
+            let d206 = A::mul_add(-p.MY7r, k99, p.MZ7r * k98); // w7rxMS7r|ud=0,g=0.x
+            let d207 = A::mul_add(-p.MZ7r, k102, p.MX7r * k99); // w7rxMS7r|ud=0,g=0.y
+            let d208 = A::mul_add(-p.MX7r, k98, p.MY7r * k102); // w7rxMS7r|ud=0,g=0.z
+            let d209 = A::mul_add(
+                -p.MZ7r,
+                k100,
+                A::mul_add(
+                    -p.MX7r,
+                    k101,
+                    A::mul_add(p.m7r, d204, A::mul_add(-k102, d208, k99 * d206)),
+                ),
+            ); // F7r.y
+            let d210 = A::mul_add(
+                p.MY7r,
+                k101,
+                A::mul_add(
+                    p.MZ7r,
+                    k103,
+                    A::mul_add(-p.m7r, d191, A::mul_add(-k99, d207, k98 * d208)),
+                ),
+            ); // F7r.x
+            let d211 = A::mul_add(
+                -p.MX7r,
+                k103,
+                A::mul_add(
+                    p.MY7r,
+                    k100,
+                    A::mul_add(p.m7r, d205, A::mul_add(-k98, d206, k102 * d207)),
+                ),
+            ); // F7r.z
+            let d212 = A::mul_add(p.XZ7r, k99, A::mul_add(p.XY7r, k98, p.XX7r * k102)); // J7rw7r|ud=0,g=0.x
+            let d213 = A::mul_add(p.YZ7r, k99, A::mul_add(p.YY7r, k98, p.XY7r * k102)); // J7rw7r|ud=0,g=0.y
+            let d214 = A::mul_add(p.ZZ7r, k99, A::mul_add(p.YZ7r, k98, p.XZ7r * k102)); // J7rw7r|ud=0,g=0.z
+            let d215 = A::mul_add(
+                p.MY7r,
+                d191,
+                A::mul_add(
+                    p.MX7r,
+                    d204,
+                    A::mul_add(
+                        -p.ZZ7r,
+                        k101,
+                        A::mul_add(
+                            p.YZ7r,
+                            k103,
+                            A::mul_add(p.XZ7r, k100, A::mul_add(-k98, d212, k102 * d213)),
+                        ),
+                    ),
+                ),
+            ); // N7r.z
+            let d216 = A::mul_add(
+                -p.MZ7r,
+                d204,
+                A::mul_add(
+                    p.MY7r,
+                    d205,
+                    A::mul_add(
+                        -p.XZ7r,
+                        k101,
+                        A::mul_add(
+                            p.XY7r,
+                            k103,
+                            A::mul_add(p.XX7r, k100, A::mul_add(-k99, d213, k98 * d214)),
+                        ),
+                    ),
+                ),
+            ); // N7r.x
+            let d217 = A::mul_add(
+                -p.MX7r,
+                d205,
+                A::mul_add(
+                    -p.MZ7r,
+                    d191,
+                    A::mul_add(
+                        -p.YZ7r,
+                        k101,
+                        A::mul_add(
+                            p.YY7r,
+                            k103,
+                            A::mul_add(p.XY7r, k100, A::mul_add(-k102, d214, k99 * d212)),
+                        ),
+                    ),
+                ),
+            ); // N7r.y
+            let k104 = A::mul_add(-s_q5r, k99, c_q5r * k102); // w7r in 8r|ud=0,g=0.x
+            let k105 = A::mul_add(c_q5r, k99, s_q5r * k102); // w7r in 8r|ud=0,g=0.z
+            let k106 = k103 + qdd5r; // wd8r.y
+            let k107 = k98 - qd5r; // w8r|ud=0,g=0.y
+            let k108 = A::mul_add(s_q5r, k101, A::mul_add(c_q5r, k100, k105 * qd5r)); // wd8r.x
+            let k109 = A::mul_add(c_q5r, k101, A::mul_add(-s_q5r, k100, k104 * qd5r)); // wd8r.z
+            let k110 = p.L8 * k99; // w7rxP8r|ud=0,g=0.x
+            let k111 = p.L8 * k102; // w7rxP8r|ud=0,g=0.z
+            let d218 = A::mul_add(p.L8, k101, A::mul_add(k98, k111, d191)); // a8r in 7r.x
+            let d219 = A::mul_add(k102, k111, k99 * k110) + d204; // a8r in 7r.y
+            let d220 = A::mul_add(p.L8, k100, A::mul_add(k98, k110, -d205)); // a8r in 7r.z
+            let d221 = A::mul_add(c_q5r, d220, s_q5r * d218); // a8r.z
+            let d222 = A::mul_add(-s_q5r, d220, c_q5r * d218); // a8r.x
+            let d223 = A::mul_add(-p.MX8r, k107, p.MY8r * k104); // w8rxMS8r|ud=0,g=0.z
+            let d224 = A::mul_add(p.MY8r, k105, p.MZ8r * k107); // w8rxMS8r|ud=0,g=0.x
+            let d225 = A::mul_add(p.MZ8r, k104, p.MX8r * k105); // w8rxMS8r|ud=0,g=0.y
+            let d226 = A::mul_add(
+                -p.MZ8r,
+                k108,
+                A::mul_add(
+                    p.MX8r,
+                    k109,
+                    A::mul_add(p.m8r, d219, A::mul_add(k104, d223, k105 * d224)),
+                ),
+            ); // F8r.y
+            let d227 = A::mul_add(
+                p.MY8r,
+                k109,
+                A::mul_add(
+                    -p.MZ8r,
+                    k106,
+                    A::mul_add(p.m8r, d222, A::mul_add(-k105, d225, k107 * d223)),
+                ),
+            ); // F8r.x
+            let d228 = A::mul_add(
+                -p.MX8r,
+                k106,
+                A::mul_add(
+                    p.MY8r,
+                    k108,
+                    A::mul_add(p.m8r, d221, A::mul_add(k107, d224, k104 * d225)),
+                ),
+            ); // F8r.z
+            let d229 = A::mul_add(
+                -p.XZ8r,
+                k105,
+                A::mul_add(p.XY8r, k107, p.XX8r * k104),
+            ); // J8rw8r|ud=0,g=0.x
+            let d230 = A::mul_add(
+                -p.YZ8r,
+                k105,
+                A::mul_add(p.YY8r, k107, p.XY8r * k104),
+            ); // J8rw8r|ud=0,g=0.y
+            let d231 = A::mul_add(
+                -p.ZZ8r,
+                k105,
+                A::mul_add(p.YZ8r, k107, p.XZ8r * k104),
+            ); // J8rw8r|ud=0,g=0.z
+            let d232 = A::mul_add(
+                -p.MY8r,
+                d222,
+                A::mul_add(
+                    -p.MX8r,
+                    d219,
+                    A::mul_add(
+                        -p.ZZ8r,
+                        k109,
+                        A::mul_add(
+                            -p.YZ8r,
+                            k106,
+                            A::mul_add(
+                                -p.XZ8r,
+                                k108,
+                                A::mul_add(-k107, d229, k104 * d230),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N8r.z
+            let d233 = A::mul_add(
+                p.MZ8r,
+                d219,
+                A::mul_add(
+                    -p.MY8r,
+                    d221,
+                    A::mul_add(
+                        -p.XZ8r,
+                        k109,
+                        A::mul_add(
+                            -p.XY8r,
+                            k106,
+                            A::mul_add(
+                                -p.XX8r,
+                                k108,
+                                A::mul_add(k105, d230, k107 * d231),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N8r.x
+            let d234 = A::mul_add(
+                -p.MX8r,
+                d221,
+                A::mul_add(
+                    -p.MZ8r,
+                    d222,
+                    A::mul_add(
+                        p.YZ8r,
+                        k109,
+                        A::mul_add(
+                            p.YY8r,
+                            k106,
+                            A::mul_add(p.XY8r, k108, A::mul_add(k104, d231, k105 * d229)),
+                        ),
+                    ),
+                ),
+            ); // N8r.y
+            let k112 = A::mul_add(-s_q6r, k105, c_q6r * k107); // w8r in 9r|ud=0,g=0.y
+            let k113 = A::mul_add(c_q6r, k105, s_q6r * k107); // w8r in 9r|ud=0,g=0.z
+            let k114 = k108 - qdd6r; // wd9r.x
+            let k115 = A::mul_add(c_q6r, k109, A::mul_add(-s_q6r, k106, k112 * qd6r)); // wd9r.z
+            let k116 = k104 + qd6r; // w9r|ud=0,g=0.x
+            let k117 = A::mul_add(s_q6r, k109, A::mul_add(c_q6r, k106, k113 * qd6r)); // wd9r.y
+            let d235 = A::mul_add(s_q6r, d221, c_q6r * d219); // a9r.y
+            let d236 = A::mul_add(-c_q6r, d221, s_q6r * d219); // a9r.z
+            let d237 = A::mul_add(-p.MY9r, k113, p.MZ9r * k112); // w9rxMS9r|ud=0,g=0.x
+            let d238 = A::mul_add(-p.MZ9r, k116, p.MX9r * k113); // w9rxMS9r|ud=0,g=0.y
+            let d239 = A::mul_add(-p.MX9r, k112, p.MY9r * k116); // w9rxMS9r|ud=0,g=0.z
+            let d240 = A::mul_add(
+                -p.MZ9r,
+                k114,
+                A::mul_add(
+                    -p.MX9r,
+                    k115,
+                    A::mul_add(p.m9r, d235, A::mul_add(-k116, d239, k113 * d237)),
+                ),
+            ); // F9r.y
+            let d241 = A::mul_add(
+                p.MY9r,
+                k115,
+                A::mul_add(
+                    p.MZ9r,
+                    k117,
+                    A::mul_add(-p.m9r, d222, A::mul_add(-k113, d238, k112 * d239)),
+                ),
+            ); // F9r.x
+            let d242 = A::mul_add(
+                -p.MX9r,
+                k117,
+                A::mul_add(
+                    p.MY9r,
+                    k114,
+                    A::mul_add(p.m9r, d236, A::mul_add(-k112, d237, k116 * d238)),
+                ),
+            ); // F9r.z
+            let d243 = A::mul_add(p.XZ9r, k113, A::mul_add(p.XY9r, k112, p.XX9r * k116)); // J9rw9r|ud=0,g=0.x
+            let d244 = A::mul_add(p.YZ9r, k113, A::mul_add(p.YY9r, k112, p.XY9r * k116)); // J9rw9r|ud=0,g=0.y
+            let d245 = A::mul_add(p.ZZ9r, k113, A::mul_add(p.YZ9r, k112, p.XZ9r * k116)); // J9rw9r|ud=0,g=0.z
+            let d246 = A::mul_add(
+                p.MY9r,
+                d222,
+                A::mul_add(
+                    p.MX9r,
+                    d235,
+                    A::mul_add(
+                        -p.ZZ9r,
+                        k115,
+                        A::mul_add(
+                            p.YZ9r,
+                            k117,
+                            A::mul_add(
+                                p.XZ9r,
+                                k114,
+                                A::mul_add(-k112, d243, k116 * d244),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N9r.z
+            let d247 = A::mul_add(
+                -p.MZ9r,
+                d235,
+                A::mul_add(
+                    p.MY9r,
+                    d236,
+                    A::mul_add(
+                        -p.XZ9r,
+                        k115,
+                        A::mul_add(
+                            p.XY9r,
+                            k117,
+                            A::mul_add(
+                                p.XX9r,
+                                k114,
+                                A::mul_add(-k113, d244, k112 * d245),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N9r.x
+            let d248 = A::mul_add(
+                -p.MX9r,
+                d236,
+                A::mul_add(
+                    -p.MZ9r,
+                    d222,
+                    A::mul_add(
+                        -p.YZ9r,
+                        k115,
+                        A::mul_add(
+                            p.YY9r,
+                            k117,
+                            A::mul_add(
+                                p.XY9r,
+                                k114,
+                                A::mul_add(-k116, d245, k113 * d243),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N9r.y
+            let k118 = A::mul_add(-s_q7r, k113, c_q7r * k116); // w9r in 10r|ud=0,g=0.x
+            let k119 = A::mul_add(c_q7r, k113, s_q7r * k116); // w9r in 10r|ud=0,g=0.y
+            let k120 = k117 + qdd7r; // wd10r.z
+            let k121 = A::mul_add(c_q7r, k115, A::mul_add(-s_q7r, k114, k118 * qd7r)); // wd10r.y
+            let k122 = k112 - qd7r; // w10r|ud=0,g=0.z
+            let k123 = A::mul_add(s_q7r, k115, A::mul_add(c_q7r, k114, k119 * qd7r)); // wd10r.x
+            let k124 = p.L9 * k113; // w9rxP10r|ud=0,g=0.x
+            let k125 = p.L9 * k116; // w9rxP10r|ud=0,g=0.z
+            let d249 = A::mul_add(p.L9, k115, A::mul_add(k112, k125, d222)); // a10r in 9r.x
+            let d250 = A::mul_add(k116, k125, k113 * k124) + d235; // a10r in 9r.y
+            let d251 = A::mul_add(p.L9, k114, A::mul_add(k112, k124, -d236)); // a10r in 9r.z
+            let d252 = A::mul_add(-s_q7r, d251, c_q7r * d249); // a10r.x
+            let d253 = A::mul_add(c_q7r, d251, s_q7r * d249); // a10r.y
+            let d254 = A::mul_add(-p.MY10r, k122, p.MZ10r * k119); // w10rxMS10r|ud=0,g=0.x
+            let d255 = A::mul_add(-p.MX10r, k119, p.MY10r * k118); // w10rxMS10r|ud=0,g=0.z
+            let d256 = A::mul_add(-p.MZ10r, k118, p.MX10r * k122); // w10rxMS10r|ud=0,g=0.y
+            let d257 = A::mul_add(
+                p.MY10r,
+                k120,
+                A::mul_add(
+                    p.MZ10r,
+                    k121,
+                    A::mul_add(p.m10r, d252, A::mul_add(-k122, d256, k119 * d255)),
+                ),
+            ); // F10r.x
+            let d258 = A::mul_add(
+                p.MZ10r,
+                k123,
+                A::mul_add(
+                    -p.MX10r,
+                    k120,
+                    A::mul_add(p.m10r, d253, A::mul_add(-k118, d255, k122 * d254)),
+                ),
+            ); // F10r.y
+            let d259 = A::mul_add(
+                -p.MX10r,
+                k121,
+                A::mul_add(
+                    -p.MY10r,
+                    k123,
+                    A::mul_add(-p.m10r, d250, A::mul_add(-k119, d254, k118 * d256)),
+                ),
+            ); // F10r.z
+            let d260 = A::mul_add(
+                p.XZ10r,
+                k122,
+                A::mul_add(p.XY10r, k119, p.XX10r * k118),
+            ); // J10rw10r|ud=0,g=0.x
+            let d261 = A::mul_add(
+                p.YZ10r,
+                k122,
+                A::mul_add(p.YY10r, k119, p.XY10r * k118),
+            ); // J10rw10r|ud=0,g=0.y
+            let d262 = A::mul_add(
+                p.ZZ10r,
+                k122,
+                A::mul_add(p.YZ10r, k119, p.XZ10r * k118),
+            ); // J10rw10r|ud=0,g=0.z
+            let d263 = A::mul_add(
+                -p.MZ10r,
+                d253,
+                A::mul_add(
+                    -p.MY10r,
+                    d250,
+                    A::mul_add(
+                        -p.XZ10r,
+                        k120,
+                        A::mul_add(
+                            p.XY10r,
+                            k121,
+                            A::mul_add(
+                                -p.XX10r,
+                                k123,
+                                A::mul_add(-k122, d261, k119 * d262),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N10r.x
+            let d264 = A::mul_add(
+                -p.MY10r,
+                d252,
+                A::mul_add(
+                    p.MX10r,
+                    d253,
+                    A::mul_add(
+                        -p.ZZ10r,
+                        k120,
+                        A::mul_add(
+                            p.YZ10r,
+                            k121,
+                            A::mul_add(
+                                -p.XZ10r,
+                                k123,
+                                A::mul_add(-k119, d260, k118 * d261),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N10r.z
+            entries0[18][l] = -d264;
+            let d265 = A::mul_add(
+                p.MX10r,
+                d250,
+                A::mul_add(
+                    p.MZ10r,
+                    d252,
+                    A::mul_add(
+                        -p.YZ10r,
+                        k120,
+                        A::mul_add(
+                            p.YY10r,
+                            k121,
+                            A::mul_add(
+                                -p.XY10r,
+                                k123,
+                                A::mul_add(-k118, d262, k122 * d260),
+                            ),
+                        ),
+                    ),
+                ),
+            ); // N10r.y
+            let d266 = A::mul_add(-c_q7r, d258, s_q7r * d257); // f10r in 9r.z
+            let d267 = A::mul_add(s_q7r, d258, c_q7r * d257); // f10r in 9r.x
+            let d270 = d241 - d267; // f9r.x
+            let d268 = d240 - d259; // f9r.y
+            let d271 = d242 + d266; // f9r.z
+            let d273 = d248 - d264; // n9r.y
+            let d272 = A::mul_add(
+                -p.L9,
+                d266,
+                A::mul_add(-s_q7r, d265, A::mul_add(-c_q7r, d263, d247)),
+            ); // n9r.x
+            entries0[17][l] = -d272;
+            let d269 = A::mul_add(
+                -p.L9,
+                d267,
+                A::mul_add(-c_q7r, d265, A::mul_add(s_q7r, d263, d246)),
+            ); // n9r.z
+            let d274 = A::mul_add(s_q6r, d271, c_q6r * d268); // f9r in 8r.y
+            let d275 = A::mul_add(-c_q6r, d271, s_q6r * d268); // f9r in 8r.z
+            let d278 = d227 - d270; // f8r.x
+            let d280 = d233 - d272; // n8r.x
+            let d277 = A::mul_add(c_q6r, d269, A::mul_add(-s_q6r, d273, d232)); // n8r.z
+            let d276 = d226 + d274; // f8r.y
+            let d279 = d228 + d275; // f8r.z
+            let d281 = A::mul_add(s_q6r, d269, A::mul_add(c_q6r, d273, d234)); // n8r.y
+            entries0[16][l] = d281;
+            let d283 = A::mul_add(-c_q5r, d279, s_q5r * d278); // f8r in 7r.z
+            let d282 = A::mul_add(s_q5r, d279, c_q5r * d278); // f8r in 7r.x
+            let d286 = d210 - d282; // f7r.x
+            let d284 = d209 + d276; // f7r.y
+            let d287 = d211 + d283; // f7r.z
+            let d289 = d217 + d281; // n7r.y
+            let d288 = A::mul_add(
+                -p.L8,
+                d283,
+                A::mul_add(s_q5r, d277, A::mul_add(-c_q5r, d280, d216)),
+            ); // n7r.x
+            entries0[15][l] = -d288;
+            let d285 = A::mul_add(
+                -p.L8,
+                d282,
+                A::mul_add(c_q5r, d277, A::mul_add(s_q5r, d280, d215)),
+            ); // n7r.z
+            let d290 = A::mul_add(s_q4r, d287, c_q4r * d284); // f7r in 6r.y
+            let d291 = A::mul_add(-c_q4r, d287, s_q4r * d284); // f7r in 6r.z
+            let d294 = d196 - d286; // f6r.x
+            let d296 = d202 - d288; // n6r.x
+            let d293 = A::mul_add(c_q4r, d285, A::mul_add(-s_q4r, d289, d201)); // n6r.z
+            let d292 = d195 + d290; // f6r.y
+            let d295 = d197 + d291; // f6r.z
+            let d297 = A::mul_add(s_q4r, d285, A::mul_add(c_q4r, d289, d203)); // n6r.y
+            entries0[14][l] = d297;
+            let d299 = A::mul_add(-c_q3r, d295, s_q3r * d294); // f6r in 5r.z
+            let d298 = A::mul_add(s_q3r, d295, c_q3r * d294); // f6r in 5r.x
+            let d302 = d179 - d298; // f5r.x
+            let d300 = d178 + d292; // f5r.y
+            let d303 = d180 + d299; // f5r.z
+            let d305 = d186 + d297; // n5r.y
+            let d304 = A::mul_add(
+                -p.L7,
+                d299,
+                A::mul_add(s_q3r, d293, A::mul_add(-c_q3r, d296, d185)),
+            ); // n5r.x
+            entries0[13][l] = -d304;
+            let d301 = A::mul_add(
+                -p.L7,
+                d298,
+                A::mul_add(c_q3r, d293, A::mul_add(s_q3r, d296, d184)),
+            ); // n5r.z
+            let d306 = A::mul_add(s_q2r, d303, c_q2r * d300); // f5r in 4r.y
+            let d307 = A::mul_add(-c_q2r, d303, s_q2r * d300); // f5r in 4r.z
+            let d310 = d165 - d302; // f4r.x
+            let d312 = d171 - d304; // n4r.x
+            let d309 = A::mul_add(c_q2r, d301, A::mul_add(-s_q2r, d305, d170)); // n4r.z
+            let d308 = d164 + d306; // f4r.y
+            let d311 = d166 + d307; // f4r.z
+            let d313 = A::mul_add(s_q2r, d301, A::mul_add(c_q2r, d305, d172)); // n4r.y
+            entries0[12][l] = d313;
+            let d314 = A::mul_add(s_q1r, d311, c_q1r * d310); // f4r in 3.y
+            let d315 = A::mul_add(-c_q1r, d311, s_q1r * d310); // f4r in 3.z
+            let k26 = A::mul_add(s_q1l, k17, c_q1l * k18); // w3 in 4l|ud=0,g=0.x
+            let k27 = A::mul_add(-c_q1l, k17, s_q1l * k18); // w3 in 4l|ud=0,g=0.z
+            let k28 = k16 - qd1l; // w4l|ud=0,g=0.y
+            let k29 = A::mul_add(-s_q1l, k21, A::mul_add(c_q1l, k20, k27 * qd1l)); // wd4l.x
+            let k30 = k19 + qdd1l; // wd4l.y
+            let k31 = A::mul_add(-c_q1l, k21, A::mul_add(-s_q1l, k20, k26 * qd1l)); // wd4l.z
+            let k34 = t1 - t2; // w3xP4l|ud=0,g=0.z
+            let d46 = A::mul_add(k18, k34, -t7) + d32 + t3; // a4l in 3.x
+            let d47 = A::mul_add(k16, k34, t8) - d30 + t4; // a4l in 3.y
+            let d48 = t9 + t10 + d33 + t5 - t6; // a4l in 3.z
+            let d49 = A::mul_add(c_q1l, d48, s_q1l * d47); // a4l.z
+            let d50 = A::mul_add(-s_q1l, d48, c_q1l * d47); // a4l.x
+            let d63 = A::mul_add(s_q2l, d49, c_q2l * d46); // a5l.y
+            let d64 = A::mul_add(-c_q2l, d49, s_q2l * d46); // a5l.z
+            let d52 = A::mul_add(-p.MX4l, k28, p.MY4l * k26); // w4lxMS4l|ud=0,g=0.z
+            let d51 = A::mul_add(p.MY4l, k27, p.MZ4l * k28); // w4lxMS4l|ud=0,g=0.x
+            let d55 = A::mul_add(
+                -p.MZ4l,
+                k29,
+                A::mul_add(
+                    p.MX4l,
+                    k31,
+                    A::mul_add(-p.m4l, d46, A::mul_add(k26, d52, k27 * d51)),
+                ),
+            ); // F4l.y
+            let d53 = A::mul_add(p.MZ4l, k26, p.MX4l * k27); // w4lxMS4l|ud=0,g=0.y
+            let d54 = A::mul_add(
+                p.MY4l,
+                k31,
+                A::mul_add(
+                    -p.MZ4l,
+                    k30,
+                    A::mul_add(-p.m4l, d50, A::mul_add(-k27, d53, k28 * d52)),
+                ),
+            ); // F4l.x
+            let d56 = A::mul_add(
+                -p.MX4l,
+                k30,
+                A::mul_add(
+                    p.MY4l,
+                    k29,
+                    A::mul_add(-p.m4l, d49, A::mul_add(k28, d51, k26 * d53)),
+                ),
+            ); // F4l.z
+            let d57 = A::mul_add(-p.XZ4l, k27, A::mul_add(p.XY4l, k28, p.XX4l * k26)); // J4lw4l|ud=0,g=0.x
+            let d58 = A::mul_add(-p.YZ4l, k27, A::mul_add(p.YY4l, k28, p.XY4l * k26)); // J4lw4l|ud=0,g=0.y
+            let d61 = A::mul_add(
+                p.MY4l,
+                d50,
+                A::mul_add(
+                    p.MX4l,
+                    d46,
+                    A::mul_add(
+                        -p.ZZ4l,
+                        k31,
+                        A::mul_add(
+                            -p.YZ4l,
+                            k30,
+                            A::mul_add(-p.XZ4l, k29, A::mul_add(-k28, d57, k26 * d58)),
+                        ),
+                    ),
+                ),
+            ); // N4l.z
+            let d59 = A::mul_add(-p.ZZ4l, k27, A::mul_add(p.YZ4l, k28, p.XZ4l * k26)); // J4lw4l|ud=0,g=0.z
+            let d60 = A::mul_add(
+                -p.MZ4l,
+                d46,
+                A::mul_add(
+                    p.MY4l,
+                    d49,
+                    A::mul_add(
+                        -p.XZ4l,
+                        k31,
+                        A::mul_add(
+                            -p.XY4l,
+                            k30,
+                            A::mul_add(-p.XX4l, k29, A::mul_add(k27, d58, k28 * d59)),
+                        ),
+                    ),
+                ),
+            ); // N4l.x
+            let d62 = A::mul_add(
+                p.MX4l,
+                d49,
+                A::mul_add(
+                    p.MZ4l,
+                    d50,
+                    A::mul_add(
+                        p.YZ4l,
+                        k31,
+                        A::mul_add(
+                            p.YY4l,
+                            k30,
+                            A::mul_add(p.XY4l, k29, A::mul_add(k26, d59, k27 * d57)),
+                        ),
+                    ),
+                ),
+            ); // N4l.y
+            let k35 = A::mul_add(-s_q2l, k27, c_q2l * k28); // w4l in 5l|ud=0,g=0.y
+            let k36 = A::mul_add(c_q2l, k27, s_q2l * k28); // w4l in 5l|ud=0,g=0.z
+            let k37 = k29 - qdd2l; // wd5l.x
+            let k40 = A::mul_add(c_q2l, k31, A::mul_add(-s_q2l, k30, k35 * qd2l)); // wd5l.z
+            let k39 = k26 + qd2l; // w5l|ud=0,g=0.x
+            let k38 = A::mul_add(s_q2l, k31, A::mul_add(c_q2l, k30, k36 * qd2l)); // wd5l.y
+            let d65 = A::mul_add(-p.MY5l, k36, p.MZ5l * k35); // w5lxMS5l|ud=0,g=0.x
+            let d66 = A::mul_add(-p.MZ5l, k39, p.MX5l * k36); // w5lxMS5l|ud=0,g=0.y
+            let d67 = A::mul_add(-p.MX5l, k35, p.MY5l * k39); // w5lxMS5l|ud=0,g=0.z
+            let d69 = A::mul_add(
+                -p.MZ5l,
+                k37,
+                A::mul_add(
+                    -p.MX5l,
+                    k40,
+                    A::mul_add(-p.m5l, d63, A::mul_add(-k39, d67, k36 * d65)),
+                ),
+            ); // F5l.y
+            let d68 = A::mul_add(
+                p.MY5l,
+                k40,
+                A::mul_add(
+                    p.MZ5l,
+                    k38,
+                    A::mul_add(p.m5l, d50, A::mul_add(-k36, d66, k35 * d67)),
+                ),
+            ); // F5l.x
+            let d70 = A::mul_add(
+                -p.MX5l,
+                k38,
+                A::mul_add(
+                    p.MY5l,
+                    k37,
+                    A::mul_add(-p.m5l, d64, A::mul_add(-k35, d65, k39 * d66)),
+                ),
+            ); // F5l.z
+            let d71 = A::mul_add(p.XZ5l, k36, A::mul_add(p.XY5l, k35, p.XX5l * k39)); // J5lw5l|ud=0,g=0.x
+            let d72 = A::mul_add(p.YZ5l, k36, A::mul_add(p.YY5l, k35, p.XY5l * k39)); // J5lw5l|ud=0,g=0.y
+            let d73 = A::mul_add(p.ZZ5l, k36, A::mul_add(p.YZ5l, k35, p.XZ5l * k39)); // J5lw5l|ud=0,g=0.z
+            let d76 = A::mul_add(
+                -p.MY5l,
+                d50,
+                A::mul_add(
+                    -p.MX5l,
+                    d63,
+                    A::mul_add(
+                        -p.ZZ5l,
+                        k40,
+                        A::mul_add(
+                            p.YZ5l,
+                            k38,
+                            A::mul_add(p.XZ5l, k37, A::mul_add(-k35, d71, k39 * d72)),
+                        ),
+                    ),
+                ),
+            ); // N5l.z
+            let d74 = A::mul_add(
+                p.MZ5l,
+                d63,
+                A::mul_add(
+                    -p.MY5l,
+                    d64,
+                    A::mul_add(
+                        -p.XZ5l,
+                        k40,
+                        A::mul_add(
+                            p.XY5l,
+                            k38,
+                            A::mul_add(p.XX5l, k37, A::mul_add(-k36, d72, k35 * d73)),
+                        ),
+                    ),
+                ),
+            ); // N5l.x
+            let d75 = A::mul_add(
+                p.MX5l,
+                d64,
+                A::mul_add(
+                    p.MZ5l,
+                    d50,
+                    A::mul_add(
+                        -p.YZ5l,
+                        k40,
+                        A::mul_add(
+                            p.YY5l,
+                            k38,
+                            A::mul_add(p.XY5l, k37, A::mul_add(-k39, d73, k36 * d71)),
+                        ),
+                    ),
+                ),
+            ); // N5l.y
+            let k41 = A::mul_add(-s_q3l, k36, c_q3l * k39); // w5l in 6l|ud=0,g=0.x
+            let k42 = A::mul_add(c_q3l, k36, s_q3l * k39); // w5l in 6l|ud=0,g=0.z
+            let k45 = k38 + qdd3l; // wd6l.y
+            let k43 = k35 - qd3l; // w6l|ud=0,g=0.y
+            let k44 = A::mul_add(s_q3l, k40, A::mul_add(c_q3l, k37, k42 * qd3l)); // wd6l.x
+            let k46 = A::mul_add(c_q3l, k40, A::mul_add(-s_q3l, k37, k41 * qd3l)); // wd6l.z
+            let k47 = p.L7 * k36; // w5lxP6l|ud=0,g=0.x
+            let k48 = p.L7 * k39; // w5lxP6l|ud=0,g=0.z
+            let d78 = A::mul_add(p.L7, k40, A::mul_add(k35, k48, -d50)); // a6l in 5l.x
+            let d77 = A::mul_add(k39, k48, k36 * k47) - d63; // a6l in 5l.y
+            let d79 = A::mul_add(p.L7, k37, A::mul_add(k35, k47, d64)); // a6l in 5l.z
+            let d81 = A::mul_add(c_q3l, d79, s_q3l * d78); // a6l.z
+            let d80 = A::mul_add(-s_q3l, d79, c_q3l * d78); // a6l.x
+            let d83 = A::mul_add(-p.MX6l, k43, p.MY6l * k41); // w6lxMS6l|ud=0,g=0.z
+            let d82 = A::mul_add(p.MY6l, k42, p.MZ6l * k43); // w6lxMS6l|ud=0,g=0.x
+            let d84 = A::mul_add(p.MZ6l, k41, p.MX6l * k42); // w6lxMS6l|ud=0,g=0.y
+            let d86 = A::mul_add(
+                -p.MZ6l,
+                k44,
+                A::mul_add(
+                    p.MX6l,
+                    k46,
+                    A::mul_add(p.m6l, d77, A::mul_add(k41, d83, k42 * d82)),
+                ),
+            ); // F6l.y
+            let d85 = A::mul_add(
+                p.MY6l,
+                k46,
+                A::mul_add(
+                    -p.MZ6l,
+                    k45,
+                    A::mul_add(p.m6l, d80, A::mul_add(-k42, d84, k43 * d83)),
+                ),
+            ); // F6l.x
+            let d87 = A::mul_add(
+                -p.MX6l,
+                k45,
+                A::mul_add(
+                    p.MY6l,
+                    k44,
+                    A::mul_add(p.m6l, d81, A::mul_add(k43, d82, k41 * d84)),
+                ),
+            ); // F6l.z
+            let d88 = A::mul_add(-p.XZ6l, k42, A::mul_add(p.XY6l, k43, p.XX6l * k41)); // J6lw6l|ud=0,g=0.x
+            let d89 = A::mul_add(-p.YZ6l, k42, A::mul_add(p.YY6l, k43, p.XY6l * k41)); // J6lw6l|ud=0,g=0.y
+            let d90 = A::mul_add(-p.ZZ6l, k42, A::mul_add(p.YZ6l, k43, p.XZ6l * k41)); // J6lw6l|ud=0,g=0.z
+            let d92 = A::mul_add(
+                -p.MY6l,
+                d80,
+                A::mul_add(
+                    -p.MX6l,
+                    d77,
+                    A::mul_add(
+                        -p.ZZ6l,
+                        k46,
+                        A::mul_add(
+                            -p.YZ6l,
+                            k45,
+                            A::mul_add(-p.XZ6l, k44, A::mul_add(-k43, d88, k41 * d89)),
+                        ),
+                    ),
+                ),
+            ); // N6l.z
+            let d91 = A::mul_add(
+                p.MZ6l,
+                d77,
+                A::mul_add(
+                    -p.MY6l,
+                    d81,
+                    A::mul_add(
+                        -p.XZ6l,
+                        k46,
+                        A::mul_add(
+                            -p.XY6l,
+                            k45,
+                            A::mul_add(-p.XX6l, k44, A::mul_add(k42, d89, k43 * d90)),
+                        ),
+                    ),
+                ),
+            ); // N6l.x
+            let d93 = A::mul_add(
+                -p.MX6l,
+                d81,
+                A::mul_add(
+                    -p.MZ6l,
+                    d80,
+                    A::mul_add(
+                        p.YZ6l,
+                        k46,
+                        A::mul_add(
+                            p.YY6l,
+                            k45,
+                            A::mul_add(p.XY6l, k44, A::mul_add(k41, d90, k42 * d88)),
+                        ),
+                    ),
+                ),
+            ); // N6l.y
+            let k49 = A::mul_add(-s_q4l, k42, c_q4l * k43); // w6l in 7l|ud=0,g=0.y
+            let k50 = A::mul_add(c_q4l, k42, s_q4l * k43); // w6l in 7l|ud=0,g=0.z
+            let k51 = k44 - qdd4l; // wd7l.x
+            let k54 = A::mul_add(c_q4l, k46, A::mul_add(-s_q4l, k45, k49 * qd4l)); // wd7l.z
+            let k53 = k41 + qd4l; // w7l|ud=0,g=0.x
+            let k52 = A::mul_add(s_q4l, k46, A::mul_add(c_q4l, k45, k50 * qd4l)); // wd7l.y
+            let d94 = A::mul_add(s_q4l, d81, c_q4l * d77); // a7l.y
+            let d95 = A::mul_add(-c_q4l, d81, s_q4l * d77); // a7l.z
+            let d96 = A::mul_add(-p.MY7l, k50, p.MZ7l * k49); // w7lxMS7l|ud=0,g=0.x
+            let d97 = A::mul_add(-p.MZ7l, k53, p.MX7l * k50); // w7lxMS7l|ud=0,g=0.y
+            let d98 = A::mul_add(-p.MX7l, k49, p.MY7l * k53); // w7lxMS7l|ud=0,g=0.z
+            let d100 = A::mul_add(
+                -p.MZ7l,
+                k51,
+                A::mul_add(
+                    -p.MX7l,
+                    k54,
+                    A::mul_add(p.m7l, d94, A::mul_add(-k53, d98, k50 * d96)),
+                ),
+            ); // F7l.y
+            let d99 = A::mul_add(
+                p.MY7l,
+                k54,
+                A::mul_add(
+                    p.MZ7l,
+                    k52,
+                    A::mul_add(-p.m7l, d80, A::mul_add(-k50, d97, k49 * d98)),
+                ),
+            ); // F7l.x
+            let d101 = A::mul_add(
+                -p.MX7l,
+                k52,
+                A::mul_add(
+                    p.MY7l,
+                    k51,
+                    A::mul_add(p.m7l, d95, A::mul_add(-k49, d96, k53 * d97)),
+                ),
+            ); // F7l.z
+            let d102 = A::mul_add(p.XZ7l, k50, A::mul_add(p.XY7l, k49, p.XX7l * k53)); // J7lw7l|ud=0,g=0.x
+            let d103 = A::mul_add(p.YZ7l, k50, A::mul_add(p.YY7l, k49, p.XY7l * k53)); // J7lw7l|ud=0,g=0.y
+            let d104 = A::mul_add(p.ZZ7l, k50, A::mul_add(p.YZ7l, k49, p.XZ7l * k53)); // J7lw7l|ud=0,g=0.z
+            let d107 = A::mul_add(
+                p.MY7l,
+                d80,
+                A::mul_add(
+                    p.MX7l,
+                    d94,
+                    A::mul_add(
+                        -p.ZZ7l,
+                        k54,
+                        A::mul_add(
+                            p.YZ7l,
+                            k52,
+                            A::mul_add(p.XZ7l, k51, A::mul_add(-k49, d102, k53 * d103)),
+                        ),
+                    ),
+                ),
+            ); // N7l.z
+            let d105 = A::mul_add(
+                -p.MZ7l,
+                d94,
+                A::mul_add(
+                    p.MY7l,
+                    d95,
+                    A::mul_add(
+                        -p.XZ7l,
+                        k54,
+                        A::mul_add(
+                            p.XY7l,
+                            k52,
+                            A::mul_add(p.XX7l, k51, A::mul_add(-k50, d103, k49 * d104)),
+                        ),
+                    ),
+                ),
+            ); // N7l.x
+            let d106 = A::mul_add(
+                -p.MX7l,
+                d95,
+                A::mul_add(
+                    -p.MZ7l,
+                    d80,
+                    A::mul_add(
+                        -p.YZ7l,
+                        k54,
+                        A::mul_add(
+                            p.YY7l,
+                            k52,
+                            A::mul_add(p.XY7l, k51, A::mul_add(-k53, d104, k50 * d102)),
+                        ),
+                    ),
+                ),
+            ); // N7l.y
+            let k55 = A::mul_add(-s_q5l, k50, c_q5l * k53); // w7l in 8l|ud=0,g=0.x
+            let k56 = A::mul_add(c_q5l, k50, s_q5l * k53); // w7l in 8l|ud=0,g=0.z
+            let k59 = k52 + qdd5l; // wd8l.y
+            let k57 = k49 - qd5l; // w8l|ud=0,g=0.y
+            let k58 = A::mul_add(s_q5l, k54, A::mul_add(c_q5l, k51, k56 * qd5l)); // wd8l.x
+            let k60 = A::mul_add(c_q5l, k54, A::mul_add(-s_q5l, k51, k55 * qd5l)); // wd8l.z
+            let k61 = p.L8 * k50; // w7lxP8l|ud=0,g=0.x
+            let k62 = p.L8 * k53; // w7lxP8l|ud=0,g=0.z
+            let d109 = A::mul_add(p.L8, k54, A::mul_add(k49, k62, d80)); // a8l in 7l.x
+            let d108 = A::mul_add(k53, k62, k50 * k61) + d94; // a8l in 7l.y
+            let d110 = A::mul_add(p.L8, k51, A::mul_add(k49, k61, -d95)); // a8l in 7l.z
+            let d112 = A::mul_add(c_q5l, d110, s_q5l * d109); // a8l.z
+            let d111 = A::mul_add(-s_q5l, d110, c_q5l * d109); // a8l.x
+            let d114 = A::mul_add(-p.MX8l, k57, p.MY8l * k55); // w8lxMS8l|ud=0,g=0.z
+            let d113 = A::mul_add(p.MY8l, k56, p.MZ8l * k57); // w8lxMS8l|ud=0,g=0.x
+            let d115 = A::mul_add(p.MZ8l, k55, p.MX8l * k56); // w8lxMS8l|ud=0,g=0.y
+            let d117 = A::mul_add(
+                -p.MZ8l,
+                k58,
+                A::mul_add(
+                    p.MX8l,
+                    k60,
+                    A::mul_add(p.m8l, d108, A::mul_add(k55, d114, k56 * d113)),
+                ),
+            ); // F8l.y
+            let d116 = A::mul_add(
+                p.MY8l,
+                k60,
+                A::mul_add(
+                    -p.MZ8l,
+                    k59,
+                    A::mul_add(p.m8l, d111, A::mul_add(-k56, d115, k57 * d114)),
+                ),
+            ); // F8l.x
+            let d118 = A::mul_add(
+                -p.MX8l,
+                k59,
+                A::mul_add(
+                    p.MY8l,
+                    k58,
+                    A::mul_add(p.m8l, d112, A::mul_add(k57, d113, k55 * d115)),
+                ),
+            ); // F8l.z
+            let d119 = A::mul_add(-p.XZ8l, k56, A::mul_add(p.XY8l, k57, p.XX8l * k55)); // J8lw8l|ud=0,g=0.x
+            let d120 = A::mul_add(-p.YZ8l, k56, A::mul_add(p.YY8l, k57, p.XY8l * k55)); // J8lw8l|ud=0,g=0.y
+            let d121 = A::mul_add(-p.ZZ8l, k56, A::mul_add(p.YZ8l, k57, p.XZ8l * k55)); // J8lw8l|ud=0,g=0.z
+            let d123 = A::mul_add(
+                -p.MY8l,
+                d111,
+                A::mul_add(
+                    -p.MX8l,
+                    d108,
+                    A::mul_add(
+                        -p.ZZ8l,
+                        k60,
+                        A::mul_add(
+                            -p.YZ8l,
+                            k59,
+                            A::mul_add(-p.XZ8l, k58, A::mul_add(-k57, d119, k55 * d120)),
+                        ),
+                    ),
+                ),
+            ); // N8l.z
+            let d122 = A::mul_add(
+                p.MZ8l,
+                d108,
+                A::mul_add(
+                    -p.MY8l,
+                    d112,
+                    A::mul_add(
+                        -p.XZ8l,
+                        k60,
+                        A::mul_add(
+                            -p.XY8l,
+                            k59,
+                            A::mul_add(-p.XX8l, k58, A::mul_add(k56, d120, k57 * d121)),
+                        ),
+                    ),
+                ),
+            ); // N8l.x
+            let d124 = A::mul_add(
+                -p.MX8l,
+                d112,
+                A::mul_add(
+                    -p.MZ8l,
+                    d111,
+                    A::mul_add(
+                        p.YZ8l,
+                        k60,
+                        A::mul_add(
+                            p.YY8l,
+                            k59,
+                            A::mul_add(p.XY8l, k58, A::mul_add(k55, d121, k56 * d119)),
+                        ),
+                    ),
+                ),
+            ); // N8l.y
+            let k63 = A::mul_add(-s_q6l, k56, c_q6l * k57); // w8l in 9l|ud=0,g=0.y
+            let k64 = A::mul_add(c_q6l, k56, s_q6l * k57); // w8l in 9l|ud=0,g=0.z
+            let k65 = k58 - qdd6l; // wd9l.x
+            let k68 = A::mul_add(c_q6l, k60, A::mul_add(-s_q6l, k59, k63 * qd6l)); // wd9l.z
+            let k67 = k55 + qd6l; // w9l|ud=0,g=0.x
+            let k66 = A::mul_add(s_q6l, k60, A::mul_add(c_q6l, k59, k64 * qd6l)); // wd9l.y
+            let d125 = A::mul_add(s_q6l, d112, c_q6l * d108); // a9l.y
+            let d126 = A::mul_add(-c_q6l, d112, s_q6l * d108); // a9l.z
+            let d127 = A::mul_add(-p.MY9l, k64, p.MZ9l * k63); // w9lxMS9l|ud=0,g=0.x
+            let d128 = A::mul_add(-p.MZ9l, k67, p.MX9l * k64); // w9lxMS9l|ud=0,g=0.y
+            let d129 = A::mul_add(-p.MX9l, k63, p.MY9l * k67); // w9lxMS9l|ud=0,g=0.z
+            let d131 = A::mul_add(
+                -p.MZ9l,
+                k65,
+                A::mul_add(
+                    -p.MX9l,
+                    k68,
+                    A::mul_add(p.m9l, d125, A::mul_add(-k67, d129, k64 * d127)),
+                ),
+            ); // F9l.y
+            let d130 = A::mul_add(
+                p.MY9l,
+                k68,
+                A::mul_add(
+                    p.MZ9l,
+                    k66,
+                    A::mul_add(-p.m9l, d111, A::mul_add(-k64, d128, k63 * d129)),
+                ),
+            ); // F9l.x
+            let d132 = A::mul_add(
+                -p.MX9l,
+                k66,
+                A::mul_add(
+                    p.MY9l,
+                    k65,
+                    A::mul_add(p.m9l, d126, A::mul_add(-k63, d127, k67 * d128)),
+                ),
+            ); // F9l.z
+            let d133 = A::mul_add(p.XZ9l, k64, A::mul_add(p.XY9l, k63, p.XX9l * k67)); // J9lw9l|ud=0,g=0.x
+            let d134 = A::mul_add(p.YZ9l, k64, A::mul_add(p.YY9l, k63, p.XY9l * k67)); // J9lw9l|ud=0,g=0.y
+            let d135 = A::mul_add(p.ZZ9l, k64, A::mul_add(p.YZ9l, k63, p.XZ9l * k67)); // J9lw9l|ud=0,g=0.z
+            let d138 = A::mul_add(
+                p.MY9l,
+                d111,
+                A::mul_add(
+                    p.MX9l,
+                    d125,
+                    A::mul_add(
+                        -p.ZZ9l,
+                        k68,
+                        A::mul_add(
+                            p.YZ9l,
+                            k66,
+                            A::mul_add(p.XZ9l, k65, A::mul_add(-k63, d133, k67 * d134)),
+                        ),
+                    ),
+                ),
+            ); // N9l.z
+            let d136 = A::mul_add(
+                -p.MZ9l,
+                d125,
+                A::mul_add(
+                    p.MY9l,
+                    d126,
+                    A::mul_add(
+                        -p.XZ9l,
+                        k68,
+                        A::mul_add(
+                            p.XY9l,
+                            k66,
+                            A::mul_add(p.XX9l, k65, A::mul_add(-k64, d134, k63 * d135)),
+                        ),
+                    ),
+                ),
+            ); // N9l.x
+            let d137 = A::mul_add(
+                -p.MX9l,
+                d126,
+                A::mul_add(
+                    -p.MZ9l,
+                    d111,
+                    A::mul_add(
+                        -p.YZ9l,
+                        k68,
+                        A::mul_add(
+                            p.YY9l,
+                            k66,
+                            A::mul_add(p.XY9l, k65, A::mul_add(-k67, d135, k64 * d133)),
+                        ),
+                    ),
+                ),
+            ); // N9l.y
+            let k69 = A::mul_add(-s_q7l, k64, c_q7l * k67); // w9l in 10l|ud=0,g=0.x
+            let k70 = A::mul_add(c_q7l, k64, s_q7l * k67); // w9l in 10l|ud=0,g=0.y
+            let k74 = k66 + qdd7l; // wd10l.z
+            let k72 = A::mul_add(c_q7l, k68, A::mul_add(-s_q7l, k65, k69 * qd7l)); // wd10l.y
+            let k71 = k63 - qd7l; // w10l|ud=0,g=0.z
+            let k73 = A::mul_add(s_q7l, k68, A::mul_add(c_q7l, k65, k70 * qd7l)); // wd10l.x
+            let k75 = p.L9 * k64; // w9lxP10l|ud=0,g=0.x
+            let k76 = p.L9 * k67; // w9lxP10l|ud=0,g=0.z
+            let d140 = A::mul_add(p.L9, k68, A::mul_add(k63, k76, d111)); // a10l in 9l.x
+            let d139 = A::mul_add(k67, k76, k64 * k75) + d125; // a10l in 9l.y
+            let d141 = A::mul_add(p.L9, k65, A::mul_add(k63, k75, -d126)); // a10l in 9l.z
+            let d142 = A::mul_add(-s_q7l, d141, c_q7l * d140); // a10l.x
+            let d143 = A::mul_add(c_q7l, d141, s_q7l * d140); // a10l.y
+            let d144 = A::mul_add(-p.MY10l, k71, p.MZ10l * k70); // w10lxMS10l|ud=0,g=0.x
+            let d146 = A::mul_add(-p.MX10l, k70, p.MY10l * k69); // w10lxMS10l|ud=0,g=0.z
+            let d145 = A::mul_add(-p.MZ10l, k69, p.MX10l * k71); // w10lxMS10l|ud=0,g=0.y
+            let d147 = A::mul_add(
+                p.MY10l,
+                k74,
+                A::mul_add(
+                    p.MZ10l,
+                    k72,
+                    A::mul_add(p.m10l, d142, A::mul_add(-k71, d145, k70 * d146)),
+                ),
+            ); // F10l.x
+            let d148 = A::mul_add(
+                p.MZ10l,
+                k73,
+                A::mul_add(
+                    -p.MX10l,
+                    k74,
+                    A::mul_add(p.m10l, d143, A::mul_add(-k69, d146, k71 * d144)),
+                ),
+            ); // F10l.y
+            let d149 = A::mul_add(
+                -p.MX10l,
+                k72,
+                A::mul_add(
+                    -p.MY10l,
+                    k73,
+                    A::mul_add(-p.m10l, d139, A::mul_add(-k70, d144, k69 * d145)),
+                ),
+            ); // F10l.z
+            let d150 = A::mul_add(p.XZ10l, k71, A::mul_add(p.XY10l, k70, p.XX10l * k69)); // J10lw10l|ud=0,g=0.x
+            let d151 = A::mul_add(p.YZ10l, k71, A::mul_add(p.YY10l, k70, p.XY10l * k69)); // J10lw10l|ud=0,g=0.y
+            let d152 = A::mul_add(p.ZZ10l, k71, A::mul_add(p.YZ10l, k70, p.XZ10l * k69)); // J10lw10l|ud=0,g=0.z
+            let d153 = A::mul_add(
+                -p.MZ10l,
+                d143,
+                A::mul_add(
+                    -p.MY10l,
+                    d139,
+                    A::mul_add(
+                        -p.XZ10l,
+                        k74,
+                        A::mul_add(
+                            p.XY10l,
+                            k72,
+                            A::mul_add(-p.XX10l, k73, A::mul_add(-k71, d151, k70 * d152)),
+                        ),
+                    ),
+                ),
+            ); // N10l.x
+            let d155 = A::mul_add(
+                -p.MY10l,
+                d142,
+                A::mul_add(
+                    p.MX10l,
+                    d143,
+                    A::mul_add(
+                        -p.ZZ10l,
+                        k74,
+                        A::mul_add(
+                            p.YZ10l,
+                            k72,
+                            A::mul_add(-p.XZ10l, k73, A::mul_add(-k70, d150, k69 * d151)),
+                        ),
+                    ),
+                ),
+            ); // N10l.z
+            entries0[11][l] = -d155;
+            let d154 = A::mul_add(
+                p.MX10l,
+                d139,
+                A::mul_add(
+                    p.MZ10l,
+                    d142,
+                    A::mul_add(
+                        -p.YZ10l,
+                        k74,
+                        A::mul_add(
+                            p.YY10l,
+                            k72,
+                            A::mul_add(-p.XY10l, k73, A::mul_add(-k69, d152, k71 * d150)),
+                        ),
+                    ),
+                ),
+            ); // N10l.y
+            let d322 = A::mul_add(-c_q7l, d148, s_q7l * d147); // f10l in 9l.z
+            let d323 = A::mul_add(s_q7l, d148, c_q7l * d147); // f10l in 9l.x
+            let d324 = d130 - d323; // f9l.x
+            let d325 = d131 - d149; // f9l.y
+            let d326 = d132 + d322; // f9l.z
+            let d327 = d137 - d155; // n9l.y
+            let d328 = A::mul_add(
+                -p.L9,
+                d322,
+                A::mul_add(-s_q7l, d154, A::mul_add(-c_q7l, d153, d136)),
+            ); // n9l.x
+            entries0[10][l] = -d328;
+            let d329 = A::mul_add(
+                -p.L9,
+                d323,
+                A::mul_add(-c_q7l, d154, A::mul_add(s_q7l, d153, d138)),
+            ); // n9l.z
+            let d330 = A::mul_add(s_q6l, d326, c_q6l * d325); // f9l in 8l.y
+            let d331 = A::mul_add(-c_q6l, d326, s_q6l * d325); // f9l in 8l.z
+            let d332 = d116 - d324; // f8l.x
+            let d333 = d122 - d328; // n8l.x
+            let d334 = A::mul_add(c_q6l, d329, A::mul_add(-s_q6l, d327, d123)); // n8l.z
+            let d335 = d117 + d330; // f8l.y
+            let d336 = d118 + d331; // f8l.z
+            let d337 = A::mul_add(s_q6l, d329, A::mul_add(c_q6l, d327, d124)); // n8l.y
+            entries0[9][l] = d337;
+            let d338 = A::mul_add(-c_q5l, d336, s_q5l * d332); // f8l in 7l.z
+            let d339 = A::mul_add(s_q5l, d336, c_q5l * d332); // f8l in 7l.x
+            let d340 = d99 - d339; // f7l.x
+            let d341 = d100 + d335; // f7l.y
+            let d342 = d101 + d338; // f7l.z
+            let d343 = d106 + d337; // n7l.y
+            let d344 = A::mul_add(
+                -p.L8,
+                d338,
+                A::mul_add(s_q5l, d334, A::mul_add(-c_q5l, d333, d105)),
+            ); // n7l.x
+            entries0[8][l] = -d344;
+            let d345 = A::mul_add(
+                -p.L8,
+                d339,
+                A::mul_add(c_q5l, d334, A::mul_add(s_q5l, d333, d107)),
+            ); // n7l.z
+            let d346 = A::mul_add(s_q4l, d342, c_q4l * d341); // f7l in 6l.y
+            let d347 = A::mul_add(-c_q4l, d342, s_q4l * d341); // f7l in 6l.z
+            let d348 = d85 - d340; // f6l.x
+            let d349 = d91 - d344; // n6l.x
+            let d350 = A::mul_add(c_q4l, d345, A::mul_add(-s_q4l, d343, d92)); // n6l.z
+            let d351 = d86 + d346; // f6l.y
+            let d352 = d87 + d347; // f6l.z
+            let d353 = A::mul_add(s_q4l, d345, A::mul_add(c_q4l, d343, d93)); // n6l.y
+            entries0[7][l] = d353;
+            let d354 = A::mul_add(-c_q3l, d352, s_q3l * d348); // f6l in 5l.z
+            let d355 = A::mul_add(s_q3l, d352, c_q3l * d348); // f6l in 5l.x
+            let d356 = d68 - d355; // f5l.x
+            let d357 = d69 + d351; // f5l.y
+            let d358 = d70 + d354; // f5l.z
+            let d359 = d75 + d353; // n5l.y
+            let d360 = A::mul_add(
+                -p.L7,
+                d354,
+                A::mul_add(s_q3l, d350, A::mul_add(-c_q3l, d349, d74)),
+            ); // n5l.x
+            entries0[6][l] = -d360;
+            let d361 = A::mul_add(
+                -p.L7,
+                d355,
+                A::mul_add(c_q3l, d350, A::mul_add(s_q3l, d349, d76)),
+            ); // n5l.z
+            let d362 = A::mul_add(s_q2l, d358, c_q2l * d357); // f5l in 4l.y
+            let d363 = A::mul_add(-c_q2l, d358, s_q2l * d357); // f5l in 4l.z
+            let d364 = d54 - d356; // f4l.x
+            let d365 = d60 - d360; // n4l.x
+            let d366 = A::mul_add(c_q2l, d361, A::mul_add(-s_q2l, d359, d61)); // n4l.z
+            let d367 = d55 + d362; // f4l.y
+            let d368 = d56 + d363; // f4l.z
+            let d369 = A::mul_add(s_q2l, d361, A::mul_add(c_q2l, d359, d62)); // n4l.y
+            entries0[5][l] = d369;
+            let d370 = A::mul_add(s_q1l, d368, c_q1l * d364); // f4l in 3.y
+            let d371 = A::mul_add(-c_q1l, d368, s_q1l * d364); // f4l in 3.z
             let d3 = A::mul_add(-p.MY1, k3, p.MZ1 * k2); // w1xMS1|ud=0,g=0.x
             let d4 = A::mul_add(p.MZ1, qd_imu, p.MX1 * k3); // w1xMS1|ud=0,g=0.y
             let d5 = A::mul_add(p.MX1, k2, p.MY1 * qd_imu); // w1xMS1|ud=0,g=0.z
@@ -13658,24 +15258,6 @@ mod generated {
                     ),
                 ),
             ); // N1.y
-            let k6 = A::mul_add(-s_q_w, k3, c_q_w * k2); // w1 in 2|ud=0,g=0.y
-            let k7 = A::mul_add(c_q_w, k3, s_q_w * k2); // w1 in 2|ud=0,g=0.z
-            let k8 = A::mul_add(c_q_w, k4, A::mul_add(-s_q_w, k5, k6 * qd_w)); // wd2.z
-            let k9 = qd_imu + qd_w; // w2|ud=0,g=0.x
-            let k10 = qdd_imu + qdd_w; // wd2.x
-            let k11 = A::mul_add(s_q_w, k4, A::mul_add(c_q_w, k5, k7 * qd_w)); // wd2.y
-            let k12 = p.L2 * qd_imu; // w1xP2|ud=0,g=0.y
-            let k13 = p.L1 * qd_imu; // w1xP2|ud=0,g=0.z
-            let k14 = A::mul_add(p.L1, k3, p.L2 * k2); // w1xP2|ud=0,g=0.x
-            let d14 = A::mul_add(-p.L1, qdd_imu, A::mul_add(k2, k14, qd_imu * k12) + d2); // a2 in 1.z
-            let k15 = A::mul_add(
-                p.L1,
-                k4,
-                A::mul_add(-p.L2, k5, A::mul_add(-k3, k12, A::mul_add(k2, k13, k1))),
-            ); // a2 in 1.x
-            let d15 = A::mul_add(p.L2, qdd_imu, A::mul_add(qd_imu, k13, k3 * k14) - d1); // a2 in 1.y
-            let d16 = A::mul_add(s_q_w, d14, c_q_w * d15); // a2.y
-            let d17 = A::mul_add(-c_q_w, d14, s_q_w * d15); // a2.z
             let d18 = A::mul_add(-p.MY2, k7, p.MZ2 * k6); // w2xMS2|ud=0,g=0.x
             let d19 = A::mul_add(p.MZ2, k9, p.MX2 * k7); // w2xMS2|ud=0,g=0.y
             let d20 = A::mul_add(p.MX2, k6, p.MY2 * k9); // w2xMS2|ud=0,g=0.z
@@ -13760,32 +15342,6 @@ mod generated {
                     ),
                 ),
             ); // N2.y
-            let k16 = A::mul_add(-s_q_torso, k7, c_q_torso * k9); // w2 in 3|ud=0,g=0.x
-            let k17 = A::mul_add(c_q_torso, k7, s_q_torso * k9); // w2 in 3|ud=0,g=0.z
-            let k18 = k6 - qd_torso; // w3|ud=0,g=0.y
-            let k19 = A::mul_add(
-                s_q_torso,
-                k8,
-                A::mul_add(-c_q_torso, k10, k17 * qd_torso),
-            ); // wd3.x
-            let k20 = k11 + qdd_torso; // wd3.y
-            let k21 = A::mul_add(
-                c_q_torso,
-                k8,
-                A::mul_add(s_q_torso, k10, k16 * qd_torso),
-            ); // wd3.z
-            let k22 = A::mul_add(-p.L3, k7, p.L4 * k6); // w2xP3|ud=0,g=0.x
-            let k23 = p.L4 * k9; // w2xP3|ud=0,g=0.y
-            let k24 = p.L3 * k9; // w2xP3|ud=0,g=0.z
-            let d30 = A::mul_add(p.L4, k10, A::mul_add(-k9, k24, k7 * k22) - d16); // a3 in 2.y
-            let k25 = A::mul_add(
-                p.L3,
-                k8,
-                A::mul_add(p.L4, k11, A::mul_add(k7, k23, k6 * k24) + k15),
-            ); // a3 in 2.x
-            let d31 = A::mul_add(p.L3, k10, A::mul_add(k6, k22, k9 * k23) + d17); // a3 in 2.z
-            let d32 = A::mul_add(s_q_torso, d31, c_q_torso * k25); // a3.x
-            let d33 = A::mul_add(-c_q_torso, d31, s_q_torso * k25); // a3.z
             let d34 = A::mul_add(p.MY3, k17, p.MZ3 * k18); // w3xMS3|ud=0,g=0.x
             let d35 = A::mul_add(-p.MX3, k18, p.MY3 * k16); // w3xMS3|ud=0,g=0.z
             let d36 = A::mul_add(p.MZ3, k16, p.MX3 * k17); // w3xMS3|ud=0,g=0.y
@@ -13870,1561 +15426,7 @@ mod generated {
                     ),
                 ),
             ); // N3.y
-            let k26 = A::mul_add(s_q1l, k17, c_q1l * k18); // w3 in 4l|ud=0,g=0.x
-            let k27 = A::mul_add(-c_q1l, k17, s_q1l * k18); // w3 in 4l|ud=0,g=0.z
-            let k28 = k16 - qd1l; // w4l|ud=0,g=0.y
-            let k29 = A::mul_add(-s_q1l, k21, A::mul_add(c_q1l, k20, k27 * qd1l)); // wd4l.x
-            let k30 = k19 + qdd1l; // wd4l.y
-            let k31 = A::mul_add(-c_q1l, k21, A::mul_add(-s_q1l, k20, k26 * qd1l)); // wd4l.z
-            let k32 = p.L5 * k17; // w3xP4l|ud=0,g=0.x
-            let k33 = p.L6 * k17; // w3xP4l|ud=0,g=0.y
-            let t1 = p.L5 * k16; // common subexpression
-            let t2 = p.L6 * k18; // common subexpression
-            let k34 = t1 - t2; // w3xP4l|ud=0,g=0.z
-            let t3 = p.L5 * k21; // common subexpression
-            let t4 = p.L6 * k21; // common subexpression
-            let t5 = p.L5 * k19; // common subexpression
-            let t6 = p.L6 * k20; // common subexpression
-            let t7 = k17 * k33; // common subexpression
-            let t8 = k17 * k32; // common subexpression
-            let t9 = k16 * k33; // common subexpression
-            let t10 = k18 * k32; // common subexpression
-            let d46 = A::mul_add(k18, k34, -t7) + d32 + t3; // a4l in 3.x
-            let d47 = A::mul_add(k16, k34, t8) - d30 + t4; // a4l in 3.y
-            let d48 = t9 + t10 + d33 + t5 - t6; // a4l in 3.z
-            let d49 = A::mul_add(c_q1l, d48, s_q1l * d47); // a4l.z
-            let d50 = A::mul_add(-s_q1l, d48, c_q1l * d47); // a4l.x
-            let d63 = A::mul_add(s_q2l, d49, c_q2l * d46); // a5l.y
-            let d64 = A::mul_add(-c_q2l, d49, s_q2l * d46); // a5l.z
-            let k77 = A::mul_add(-s_q1r, k17, c_q1r * k18); // w3 in 4r|ud=0,g=0.x
-            let k78 = A::mul_add(c_q1r, k17, s_q1r * k18); // w3 in 4r|ud=0,g=0.z
-            let k79 = qdd1r - k19; // wd4r.y
-            let k80 = -k16 - qd1r; // w4r|ud=0,g=0.y
-            let k81 = A::mul_add(s_q1r, k21, A::mul_add(c_q1r, k20, k78 * qd1r)); // wd4r.x
-            let k82 = A::mul_add(c_q1r, k21, A::mul_add(-s_q1r, k20, k77 * qd1r)); // wd4r.z
-            let k83 = t1 + t2; // w3xP4r|ud=0,g=0.z
-            let d156 = A::mul_add(k18, k83, t7) + d32 + t3; // a4r in 3.x
-            let d157 = t9 - t10 - d33 - t5 - t6; // a4r in 3.z
-            let d158 = A::mul_add(k16, k83, t8) - d30 - t4; // a4r in 3.y
-            let d159 = A::mul_add(c_q1r, d157, s_q1r * d158); // a4r.z
-            let d160 = A::mul_add(-s_q1r, d157, c_q1r * d158); // a4r.x
-            let d52 = A::mul_add(-p.MX4l, k28, p.MY4l * k26); // w4lxMS4l|ud=0,g=0.z
-            let d161 = A::mul_add(-p.MX4r, k80, p.MY4r * k77); // w4rxMS4r|ud=0,g=0.z
-            let d51 = A::mul_add(p.MY4l, k27, p.MZ4l * k28); // w4lxMS4l|ud=0,g=0.x
-            let d162 = A::mul_add(p.MY4r, k78, p.MZ4r * k80); // w4rxMS4r|ud=0,g=0.x
-            let d55 = A::mul_add(
-                -p.MZ4l,
-                k29,
-                A::mul_add(
-                    p.MX4l,
-                    k31,
-                    A::mul_add(-p.m4l, d46, A::mul_add(k26, d52, k27 * d51)),
-                ),
-            ); // F4l.y
-            let d53 = A::mul_add(p.MZ4l, k26, p.MX4l * k27); // w4lxMS4l|ud=0,g=0.y
-            let d163 = A::mul_add(p.MZ4r, k77, p.MX4r * k78); // w4rxMS4r|ud=0,g=0.y
-            let d164 = A::mul_add(
-                -p.MZ4r,
-                k81,
-                A::mul_add(
-                    p.MX4r,
-                    k82,
-                    A::mul_add(p.m4r, d156, A::mul_add(k77, d161, k78 * d162)),
-                ),
-            ); // F4r.y
-            let d54 = A::mul_add(
-                p.MY4l,
-                k31,
-                A::mul_add(
-                    -p.MZ4l,
-                    k30,
-                    A::mul_add(-p.m4l, d50, A::mul_add(-k27, d53, k28 * d52)),
-                ),
-            ); // F4l.x
-            let d165 = A::mul_add(
-                p.MY4r,
-                k82,
-                A::mul_add(
-                    -p.MZ4r,
-                    k79,
-                    A::mul_add(-p.m4r, d160, A::mul_add(-k78, d163, k80 * d161)),
-                ),
-            ); // F4r.x
-            let d56 = A::mul_add(
-                -p.MX4l,
-                k30,
-                A::mul_add(
-                    p.MY4l,
-                    k29,
-                    A::mul_add(-p.m4l, d49, A::mul_add(k28, d51, k26 * d53)),
-                ),
-            ); // F4l.z
-            let d166 = A::mul_add(
-                -p.MX4r,
-                k79,
-                A::mul_add(
-                    p.MY4r,
-                    k81,
-                    A::mul_add(-p.m4r, d159, A::mul_add(k80, d162, k77 * d163)),
-                ),
-            ); // F4r.z
-            let d57 = A::mul_add(-p.XZ4l, k27, A::mul_add(p.XY4l, k28, p.XX4l * k26)); // J4lw4l|ud=0,g=0.x
-            let d167 = A::mul_add(-p.XZ4r, k78, A::mul_add(p.XY4r, k80, p.XX4r * k77)); // J4rw4r|ud=0,g=0.x
-            let d58 = A::mul_add(-p.YZ4l, k27, A::mul_add(p.YY4l, k28, p.XY4l * k26)); // J4lw4l|ud=0,g=0.y
-            let d168 = A::mul_add(-p.YZ4r, k78, A::mul_add(p.YY4r, k80, p.XY4r * k77)); // J4rw4r|ud=0,g=0.y
-            let d61 = A::mul_add(
-                p.MY4l,
-                d50,
-                A::mul_add(
-                    p.MX4l,
-                    d46,
-                    A::mul_add(
-                        -p.ZZ4l,
-                        k31,
-                        A::mul_add(
-                            -p.YZ4l,
-                            k30,
-                            A::mul_add(-p.XZ4l, k29, A::mul_add(-k28, d57, k26 * d58)),
-                        ),
-                    ),
-                ),
-            ); // N4l.z
-            let d59 = A::mul_add(-p.ZZ4l, k27, A::mul_add(p.YZ4l, k28, p.XZ4l * k26)); // J4lw4l|ud=0,g=0.z
-            let d169 = A::mul_add(-p.ZZ4r, k78, A::mul_add(p.YZ4r, k80, p.XZ4r * k77)); // J4rw4r|ud=0,g=0.z
-            let d60 = A::mul_add(
-                -p.MZ4l,
-                d46,
-                A::mul_add(
-                    p.MY4l,
-                    d49,
-                    A::mul_add(
-                        -p.XZ4l,
-                        k31,
-                        A::mul_add(
-                            -p.XY4l,
-                            k30,
-                            A::mul_add(-p.XX4l, k29, A::mul_add(k27, d58, k28 * d59)),
-                        ),
-                    ),
-                ),
-            ); // N4l.x
-            let d170 = A::mul_add(
-                p.MY4r,
-                d160,
-                A::mul_add(
-                    -p.MX4r,
-                    d156,
-                    A::mul_add(
-                        -p.ZZ4r,
-                        k82,
-                        A::mul_add(
-                            -p.YZ4r,
-                            k79,
-                            A::mul_add(-p.XZ4r, k81, A::mul_add(-k80, d167, k77 * d168)),
-                        ),
-                    ),
-                ),
-            ); // N4r.z
-            let d171 = A::mul_add(
-                p.MZ4r,
-                d156,
-                A::mul_add(
-                    p.MY4r,
-                    d159,
-                    A::mul_add(
-                        -p.XZ4r,
-                        k82,
-                        A::mul_add(
-                            -p.XY4r,
-                            k79,
-                            A::mul_add(-p.XX4r, k81, A::mul_add(k78, d168, k80 * d169)),
-                        ),
-                    ),
-                ),
-            ); // N4r.x
-            let d62 = A::mul_add(
-                p.MX4l,
-                d49,
-                A::mul_add(
-                    p.MZ4l,
-                    d50,
-                    A::mul_add(
-                        p.YZ4l,
-                        k31,
-                        A::mul_add(
-                            p.YY4l,
-                            k30,
-                            A::mul_add(p.XY4l, k29, A::mul_add(k26, d59, k27 * d57)),
-                        ),
-                    ),
-                ),
-            ); // N4l.y
-            let d172 = A::mul_add(
-                p.MX4r,
-                d159,
-                A::mul_add(
-                    p.MZ4r,
-                    d160,
-                    A::mul_add(
-                        p.YZ4r,
-                        k82,
-                        A::mul_add(
-                            p.YY4r,
-                            k79,
-                            A::mul_add(p.XY4r, k81, A::mul_add(k77, d169, k78 * d167)),
-                        ),
-                    ),
-                ),
-            ); // N4r.y
-            let k35 = A::mul_add(-s_q2l, k27, c_q2l * k28); // w4l in 5l|ud=0,g=0.y
-            let k84 = A::mul_add(-s_q2r, k78, c_q2r * k80); // w4r in 5r|ud=0,g=0.y
-            let k36 = A::mul_add(c_q2l, k27, s_q2l * k28); // w4l in 5l|ud=0,g=0.z
-            let k85 = A::mul_add(c_q2r, k78, s_q2r * k80); // w4r in 5r|ud=0,g=0.z
-            let k37 = k29 - qdd2l; // wd5l.x
-            let k86 = k81 - qdd2r; // wd5r.x
-            let k40 = A::mul_add(c_q2l, k31, A::mul_add(-s_q2l, k30, k35 * qd2l)); // wd5l.z
-            let k87 = A::mul_add(c_q2r, k82, A::mul_add(-s_q2r, k79, k84 * qd2r)); // wd5r.z
-            let k39 = k26 + qd2l; // w5l|ud=0,g=0.x
-            let k88 = k77 + qd2r; // w5r|ud=0,g=0.x
-            let k38 = A::mul_add(s_q2l, k31, A::mul_add(c_q2l, k30, k36 * qd2l)); // wd5l.y
-            let k89 = A::mul_add(s_q2r, k82, A::mul_add(c_q2r, k79, k85 * qd2r)); // wd5r.y
-            let d173 = A::mul_add(-c_q2r, d156, s_q2r * d159); // a5r.y
-            let d174 = A::mul_add(-c_q2r, d159, -s_q2r * d156); // a5r.z
-            let d65 = A::mul_add(-p.MY5l, k36, p.MZ5l * k35); // w5lxMS5l|ud=0,g=0.x
-            let d175 = A::mul_add(-p.MY5r, k85, p.MZ5r * k84); // w5rxMS5r|ud=0,g=0.x
-            let d66 = A::mul_add(-p.MZ5l, k39, p.MX5l * k36); // w5lxMS5l|ud=0,g=0.y
-            let d176 = A::mul_add(-p.MZ5r, k88, p.MX5r * k85); // w5rxMS5r|ud=0,g=0.y
-            let d67 = A::mul_add(-p.MX5l, k35, p.MY5l * k39); // w5lxMS5l|ud=0,g=0.z
-            let d177 = A::mul_add(-p.MX5r, k84, p.MY5r * k88); // w5rxMS5r|ud=0,g=0.z
-            let d69 = A::mul_add(
-                -p.MZ5l,
-                k37,
-                A::mul_add(
-                    -p.MX5l,
-                    k40,
-                    A::mul_add(-p.m5l, d63, A::mul_add(-k39, d67, k36 * d65)),
-                ),
-            ); // F5l.y
-            let d178 = A::mul_add(
-                -p.MZ5r,
-                k86,
-                A::mul_add(
-                    -p.MX5r,
-                    k87,
-                    A::mul_add(-p.m5r, d173, A::mul_add(-k88, d177, k85 * d175)),
-                ),
-            ); // F5r.y
-            let d68 = A::mul_add(
-                p.MY5l,
-                k40,
-                A::mul_add(
-                    p.MZ5l,
-                    k38,
-                    A::mul_add(p.m5l, d50, A::mul_add(-k36, d66, k35 * d67)),
-                ),
-            ); // F5l.x
-            let d179 = A::mul_add(
-                p.MY5r,
-                k87,
-                A::mul_add(
-                    p.MZ5r,
-                    k89,
-                    A::mul_add(p.m5r, d160, A::mul_add(-k85, d176, k84 * d177)),
-                ),
-            ); // F5r.x
-            let d70 = A::mul_add(
-                -p.MX5l,
-                k38,
-                A::mul_add(
-                    p.MY5l,
-                    k37,
-                    A::mul_add(-p.m5l, d64, A::mul_add(-k35, d65, k39 * d66)),
-                ),
-            ); // F5l.z
-            let d180 = A::mul_add(
-                -p.MX5r,
-                k89,
-                A::mul_add(
-                    p.MY5r,
-                    k86,
-                    A::mul_add(-p.m5r, d174, A::mul_add(-k84, d175, k88 * d176)),
-                ),
-            ); // F5r.z
-            let d71 = A::mul_add(p.XZ5l, k36, A::mul_add(p.XY5l, k35, p.XX5l * k39)); // J5lw5l|ud=0,g=0.x
-            let d181 = A::mul_add(p.XZ5r, k85, A::mul_add(p.XY5r, k84, p.XX5r * k88)); // J5rw5r|ud=0,g=0.x
-            let d72 = A::mul_add(p.YZ5l, k36, A::mul_add(p.YY5l, k35, p.XY5l * k39)); // J5lw5l|ud=0,g=0.y
-            let d182 = A::mul_add(p.YZ5r, k85, A::mul_add(p.YY5r, k84, p.XY5r * k88)); // J5rw5r|ud=0,g=0.y
-            let d73 = A::mul_add(p.ZZ5l, k36, A::mul_add(p.YZ5l, k35, p.XZ5l * k39)); // J5lw5l|ud=0,g=0.z
-            let d183 = A::mul_add(p.ZZ5r, k85, A::mul_add(p.YZ5r, k84, p.XZ5r * k88)); // J5rw5r|ud=0,g=0.z
-            let d76 = A::mul_add(
-                -p.MY5l,
-                d50,
-                A::mul_add(
-                    -p.MX5l,
-                    d63,
-                    A::mul_add(
-                        -p.ZZ5l,
-                        k40,
-                        A::mul_add(
-                            p.YZ5l,
-                            k38,
-                            A::mul_add(p.XZ5l, k37, A::mul_add(-k35, d71, k39 * d72)),
-                        ),
-                    ),
-                ),
-            ); // N5l.z
-            let d184 = A::mul_add(
-                -p.MY5r,
-                d160,
-                A::mul_add(
-                    -p.MX5r,
-                    d173,
-                    A::mul_add(
-                        -p.ZZ5r,
-                        k87,
-                        A::mul_add(
-                            p.YZ5r,
-                            k89,
-                            A::mul_add(p.XZ5r, k86, A::mul_add(-k84, d181, k88 * d182)),
-                        ),
-                    ),
-                ),
-            ); // N5r.z
-            let d74 = A::mul_add(
-                p.MZ5l,
-                d63,
-                A::mul_add(
-                    -p.MY5l,
-                    d64,
-                    A::mul_add(
-                        -p.XZ5l,
-                        k40,
-                        A::mul_add(
-                            p.XY5l,
-                            k38,
-                            A::mul_add(p.XX5l, k37, A::mul_add(-k36, d72, k35 * d73)),
-                        ),
-                    ),
-                ),
-            ); // N5l.x
-            let d185 = A::mul_add(
-                p.MZ5r,
-                d173,
-                A::mul_add(
-                    -p.MY5r,
-                    d174,
-                    A::mul_add(
-                        -p.XZ5r,
-                        k87,
-                        A::mul_add(
-                            p.XY5r,
-                            k89,
-                            A::mul_add(p.XX5r, k86, A::mul_add(-k85, d182, k84 * d183)),
-                        ),
-                    ),
-                ),
-            ); // N5r.x
-            let d75 = A::mul_add(
-                p.MX5l,
-                d64,
-                A::mul_add(
-                    p.MZ5l,
-                    d50,
-                    A::mul_add(
-                        -p.YZ5l,
-                        k40,
-                        A::mul_add(
-                            p.YY5l,
-                            k38,
-                            A::mul_add(p.XY5l, k37, A::mul_add(-k39, d73, k36 * d71)),
-                        ),
-                    ),
-                ),
-            ); // N5l.y
-            let d186 = A::mul_add(
-                p.MX5r,
-                d174,
-                A::mul_add(
-                    p.MZ5r,
-                    d160,
-                    A::mul_add(
-                        -p.YZ5r,
-                        k87,
-                        A::mul_add(
-                            p.YY5r,
-                            k89,
-                            A::mul_add(p.XY5r, k86, A::mul_add(-k88, d183, k85 * d181)),
-                        ),
-                    ),
-                ),
-            ); // N5r.y
-            let k41 = A::mul_add(-s_q3l, k36, c_q3l * k39); // w5l in 6l|ud=0,g=0.x
-            let k90 = A::mul_add(-s_q3r, k85, c_q3r * k88); // w5r in 6r|ud=0,g=0.x
-            let k42 = A::mul_add(c_q3l, k36, s_q3l * k39); // w5l in 6l|ud=0,g=0.z
-            let k91 = A::mul_add(c_q3r, k85, s_q3r * k88); // w5r in 6r|ud=0,g=0.z
-            let k45 = k38 + qdd3l; // wd6l.y
-            let k92 = k89 + qdd3r; // wd6r.y
-            let k43 = k35 - qd3l; // w6l|ud=0,g=0.y
-            let k93 = k84 - qd3r; // w6r|ud=0,g=0.y
-            let k44 = A::mul_add(s_q3l, k40, A::mul_add(c_q3l, k37, k42 * qd3l)); // wd6l.x
-            let k94 = A::mul_add(s_q3r, k87, A::mul_add(c_q3r, k86, k91 * qd3r)); // wd6r.x
-            let k46 = A::mul_add(c_q3l, k40, A::mul_add(-s_q3l, k37, k41 * qd3l)); // wd6l.z
-            let k95 = A::mul_add(c_q3r, k87, A::mul_add(-s_q3r, k86, k90 * qd3r)); // wd6r.z
-            let k47 = p.L7 * k36; // w5lxP6l|ud=0,g=0.x
-            let k96 = p.L7 * k85; // w5rxP6r|ud=0,g=0.x
-            let k48 = p.L7 * k39; // w5lxP6l|ud=0,g=0.z
-            let k97 = p.L7 * k88; // w5rxP6r|ud=0,g=0.z
-            let d78 = A::mul_add(p.L7, k40, A::mul_add(k35, k48, -d50)); // a6l in 5l.x
-            let d187 = A::mul_add(p.L7, k87, A::mul_add(k84, k97, -d160)); // a6r in 5r.x
-            let d77 = A::mul_add(k39, k48, k36 * k47) - d63; // a6l in 5l.y
-            let d188 = A::mul_add(k88, k97, k85 * k96) - d173; // a6r in 5r.y
-            let d79 = A::mul_add(p.L7, k37, A::mul_add(k35, k47, d64)); // a6l in 5l.z
-            let d189 = A::mul_add(p.L7, k86, A::mul_add(k84, k96, d174)); // a6r in 5r.z
-            let d81 = A::mul_add(c_q3l, d79, s_q3l * d78); // a6l.z
-            let d190 = A::mul_add(c_q3r, d189, s_q3r * d187); // a6r.z
-            let d80 = A::mul_add(-s_q3l, d79, c_q3l * d78); // a6l.x
-            let d191 = A::mul_add(-s_q3r, d189, c_q3r * d187); // a6r.x
-            let d83 = A::mul_add(-p.MX6l, k43, p.MY6l * k41); // w6lxMS6l|ud=0,g=0.z
-            let d192 = A::mul_add(-p.MX6r, k93, p.MY6r * k90); // w6rxMS6r|ud=0,g=0.z
-            let d82 = A::mul_add(p.MY6l, k42, p.MZ6l * k43); // w6lxMS6l|ud=0,g=0.x
-            let d193 = A::mul_add(p.MY6r, k91, p.MZ6r * k93); // w6rxMS6r|ud=0,g=0.x
-            let d84 = A::mul_add(p.MZ6l, k41, p.MX6l * k42); // w6lxMS6l|ud=0,g=0.y
-            let d194 = A::mul_add(p.MZ6r, k90, p.MX6r * k91); // w6rxMS6r|ud=0,g=0.y
-            let d86 = A::mul_add(
-                -p.MZ6l,
-                k44,
-                A::mul_add(
-                    p.MX6l,
-                    k46,
-                    A::mul_add(p.m6l, d77, A::mul_add(k41, d83, k42 * d82)),
-                ),
-            ); // F6l.y
-            let d195 = A::mul_add(
-                -p.MZ6r,
-                k94,
-                A::mul_add(
-                    p.MX6r,
-                    k95,
-                    A::mul_add(p.m6r, d188, A::mul_add(k90, d192, k91 * d193)),
-                ),
-            ); // F6r.y
-            let d85 = A::mul_add(
-                p.MY6l,
-                k46,
-                A::mul_add(
-                    -p.MZ6l,
-                    k45,
-                    A::mul_add(p.m6l, d80, A::mul_add(-k42, d84, k43 * d83)),
-                ),
-            ); // F6l.x
-            let d196 = A::mul_add(
-                p.MY6r,
-                k95,
-                A::mul_add(
-                    -p.MZ6r,
-                    k92,
-                    A::mul_add(p.m6r, d191, A::mul_add(-k91, d194, k93 * d192)),
-                ),
-            ); // F6r.x
-            let d87 = A::mul_add(
-                -p.MX6l,
-                k45,
-                A::mul_add(
-                    p.MY6l,
-                    k44,
-                    A::mul_add(p.m6l, d81, A::mul_add(k43, d82, k41 * d84)),
-                ),
-            ); // F6l.z
-            let d197 = A::mul_add(
-                -p.MX6r,
-                k92,
-                A::mul_add(
-                    p.MY6r,
-                    k94,
-                    A::mul_add(p.m6r, d190, A::mul_add(k93, d193, k90 * d194)),
-                ),
-            ); // F6r.z
-            let d88 = A::mul_add(-p.XZ6l, k42, A::mul_add(p.XY6l, k43, p.XX6l * k41)); // J6lw6l|ud=0,g=0.x
-            let d198 = A::mul_add(-p.XZ6r, k91, A::mul_add(p.XY6r, k93, p.XX6r * k90)); // J6rw6r|ud=0,g=0.x
-            let d89 = A::mul_add(-p.YZ6l, k42, A::mul_add(p.YY6l, k43, p.XY6l * k41)); // J6lw6l|ud=0,g=0.y
-            let d199 = A::mul_add(-p.YZ6r, k91, A::mul_add(p.YY6r, k93, p.XY6r * k90)); // J6rw6r|ud=0,g=0.y
-            let d90 = A::mul_add(-p.ZZ6l, k42, A::mul_add(p.YZ6l, k43, p.XZ6l * k41)); // J6lw6l|ud=0,g=0.z
-            let d200 = A::mul_add(-p.ZZ6r, k91, A::mul_add(p.YZ6r, k93, p.XZ6r * k90)); // J6rw6r|ud=0,g=0.z
-            let d92 = A::mul_add(
-                -p.MY6l,
-                d80,
-                A::mul_add(
-                    -p.MX6l,
-                    d77,
-                    A::mul_add(
-                        -p.ZZ6l,
-                        k46,
-                        A::mul_add(
-                            -p.YZ6l,
-                            k45,
-                            A::mul_add(-p.XZ6l, k44, A::mul_add(-k43, d88, k41 * d89)),
-                        ),
-                    ),
-                ),
-            ); // N6l.z
-            let d201 = A::mul_add(
-                -p.MY6r,
-                d191,
-                A::mul_add(
-                    -p.MX6r,
-                    d188,
-                    A::mul_add(
-                        -p.ZZ6r,
-                        k95,
-                        A::mul_add(
-                            -p.YZ6r,
-                            k92,
-                            A::mul_add(-p.XZ6r, k94, A::mul_add(-k93, d198, k90 * d199)),
-                        ),
-                    ),
-                ),
-            ); // N6r.z
-            let d91 = A::mul_add(
-                p.MZ6l,
-                d77,
-                A::mul_add(
-                    -p.MY6l,
-                    d81,
-                    A::mul_add(
-                        -p.XZ6l,
-                        k46,
-                        A::mul_add(
-                            -p.XY6l,
-                            k45,
-                            A::mul_add(-p.XX6l, k44, A::mul_add(k42, d89, k43 * d90)),
-                        ),
-                    ),
-                ),
-            ); // N6l.x
-            let d202 = A::mul_add(
-                p.MZ6r,
-                d188,
-                A::mul_add(
-                    -p.MY6r,
-                    d190,
-                    A::mul_add(
-                        -p.XZ6r,
-                        k95,
-                        A::mul_add(
-                            -p.XY6r,
-                            k92,
-                            A::mul_add(-p.XX6r, k94, A::mul_add(k91, d199, k93 * d200)),
-                        ),
-                    ),
-                ),
-            ); // N6r.x
-            let d93 = A::mul_add(
-                -p.MX6l,
-                d81,
-                A::mul_add(
-                    -p.MZ6l,
-                    d80,
-                    A::mul_add(
-                        p.YZ6l,
-                        k46,
-                        A::mul_add(
-                            p.YY6l,
-                            k45,
-                            A::mul_add(p.XY6l, k44, A::mul_add(k41, d90, k42 * d88)),
-                        ),
-                    ),
-                ),
-            ); // N6l.y
-            let d203 = A::mul_add(
-                -p.MX6r,
-                d190,
-                A::mul_add(
-                    -p.MZ6r,
-                    d191,
-                    A::mul_add(
-                        p.YZ6r,
-                        k95,
-                        A::mul_add(
-                            p.YY6r,
-                            k92,
-                            A::mul_add(p.XY6r, k94, A::mul_add(k90, d200, k91 * d198)),
-                        ),
-                    ),
-                ),
-            ); // N6r.y
-            let k49 = A::mul_add(-s_q4l, k42, c_q4l * k43); // w6l in 7l|ud=0,g=0.y
-            let k98 = A::mul_add(-s_q4r, k91, c_q4r * k93); // w6r in 7r|ud=0,g=0.y
-            let k50 = A::mul_add(c_q4l, k42, s_q4l * k43); // w6l in 7l|ud=0,g=0.z
-            let k99 = A::mul_add(c_q4r, k91, s_q4r * k93); // w6r in 7r|ud=0,g=0.z
-            let k51 = k44 - qdd4l; // wd7l.x
-            let k100 = k94 - qdd4r; // wd7r.x
-            let k54 = A::mul_add(c_q4l, k46, A::mul_add(-s_q4l, k45, k49 * qd4l)); // wd7l.z
-            let k101 = A::mul_add(c_q4r, k95, A::mul_add(-s_q4r, k92, k98 * qd4r)); // wd7r.z
-            let k53 = k41 + qd4l; // w7l|ud=0,g=0.x
-            let k102 = k90 + qd4r; // w7r|ud=0,g=0.x
-            let k52 = A::mul_add(s_q4l, k46, A::mul_add(c_q4l, k45, k50 * qd4l)); // wd7l.y
-            let k103 = A::mul_add(s_q4r, k95, A::mul_add(c_q4r, k92, k99 * qd4r)); // wd7r.y
-            let d94 = A::mul_add(s_q4l, d81, c_q4l * d77); // a7l.y
-            let d204 = A::mul_add(s_q4r, d190, c_q4r * d188); // a7r.y
-            let d95 = A::mul_add(-c_q4l, d81, s_q4l * d77); // a7l.z
-            let d205 = A::mul_add(-c_q4r, d190, s_q4r * d188); // a7r.z
-            let d96 = A::mul_add(-p.MY7l, k50, p.MZ7l * k49); // w7lxMS7l|ud=0,g=0.x
-            let d206 = A::mul_add(-p.MY7r, k99, p.MZ7r * k98); // w7rxMS7r|ud=0,g=0.x
-            let d97 = A::mul_add(-p.MZ7l, k53, p.MX7l * k50); // w7lxMS7l|ud=0,g=0.y
-            let d207 = A::mul_add(-p.MZ7r, k102, p.MX7r * k99); // w7rxMS7r|ud=0,g=0.y
-            let d98 = A::mul_add(-p.MX7l, k49, p.MY7l * k53); // w7lxMS7l|ud=0,g=0.z
-            let d208 = A::mul_add(-p.MX7r, k98, p.MY7r * k102); // w7rxMS7r|ud=0,g=0.z
-            let d100 = A::mul_add(
-                -p.MZ7l,
-                k51,
-                A::mul_add(
-                    -p.MX7l,
-                    k54,
-                    A::mul_add(p.m7l, d94, A::mul_add(-k53, d98, k50 * d96)),
-                ),
-            ); // F7l.y
-            let d209 = A::mul_add(
-                -p.MZ7r,
-                k100,
-                A::mul_add(
-                    -p.MX7r,
-                    k101,
-                    A::mul_add(p.m7r, d204, A::mul_add(-k102, d208, k99 * d206)),
-                ),
-            ); // F7r.y
-            let d99 = A::mul_add(
-                p.MY7l,
-                k54,
-                A::mul_add(
-                    p.MZ7l,
-                    k52,
-                    A::mul_add(-p.m7l, d80, A::mul_add(-k50, d97, k49 * d98)),
-                ),
-            ); // F7l.x
-            let d210 = A::mul_add(
-                p.MY7r,
-                k101,
-                A::mul_add(
-                    p.MZ7r,
-                    k103,
-                    A::mul_add(-p.m7r, d191, A::mul_add(-k99, d207, k98 * d208)),
-                ),
-            ); // F7r.x
-            let d101 = A::mul_add(
-                -p.MX7l,
-                k52,
-                A::mul_add(
-                    p.MY7l,
-                    k51,
-                    A::mul_add(p.m7l, d95, A::mul_add(-k49, d96, k53 * d97)),
-                ),
-            ); // F7l.z
-            let d211 = A::mul_add(
-                -p.MX7r,
-                k103,
-                A::mul_add(
-                    p.MY7r,
-                    k100,
-                    A::mul_add(p.m7r, d205, A::mul_add(-k98, d206, k102 * d207)),
-                ),
-            ); // F7r.z
-            let d102 = A::mul_add(p.XZ7l, k50, A::mul_add(p.XY7l, k49, p.XX7l * k53)); // J7lw7l|ud=0,g=0.x
-            let d212 = A::mul_add(p.XZ7r, k99, A::mul_add(p.XY7r, k98, p.XX7r * k102)); // J7rw7r|ud=0,g=0.x
-            let d103 = A::mul_add(p.YZ7l, k50, A::mul_add(p.YY7l, k49, p.XY7l * k53)); // J7lw7l|ud=0,g=0.y
-            let d213 = A::mul_add(p.YZ7r, k99, A::mul_add(p.YY7r, k98, p.XY7r * k102)); // J7rw7r|ud=0,g=0.y
-            let d104 = A::mul_add(p.ZZ7l, k50, A::mul_add(p.YZ7l, k49, p.XZ7l * k53)); // J7lw7l|ud=0,g=0.z
-            let d214 = A::mul_add(p.ZZ7r, k99, A::mul_add(p.YZ7r, k98, p.XZ7r * k102)); // J7rw7r|ud=0,g=0.z
-            let d107 = A::mul_add(
-                p.MY7l,
-                d80,
-                A::mul_add(
-                    p.MX7l,
-                    d94,
-                    A::mul_add(
-                        -p.ZZ7l,
-                        k54,
-                        A::mul_add(
-                            p.YZ7l,
-                            k52,
-                            A::mul_add(p.XZ7l, k51, A::mul_add(-k49, d102, k53 * d103)),
-                        ),
-                    ),
-                ),
-            ); // N7l.z
-            let d215 = A::mul_add(
-                p.MY7r,
-                d191,
-                A::mul_add(
-                    p.MX7r,
-                    d204,
-                    A::mul_add(
-                        -p.ZZ7r,
-                        k101,
-                        A::mul_add(
-                            p.YZ7r,
-                            k103,
-                            A::mul_add(p.XZ7r, k100, A::mul_add(-k98, d212, k102 * d213)),
-                        ),
-                    ),
-                ),
-            ); // N7r.z
-            let d105 = A::mul_add(
-                -p.MZ7l,
-                d94,
-                A::mul_add(
-                    p.MY7l,
-                    d95,
-                    A::mul_add(
-                        -p.XZ7l,
-                        k54,
-                        A::mul_add(
-                            p.XY7l,
-                            k52,
-                            A::mul_add(p.XX7l, k51, A::mul_add(-k50, d103, k49 * d104)),
-                        ),
-                    ),
-                ),
-            ); // N7l.x
-            let d216 = A::mul_add(
-                -p.MZ7r,
-                d204,
-                A::mul_add(
-                    p.MY7r,
-                    d205,
-                    A::mul_add(
-                        -p.XZ7r,
-                        k101,
-                        A::mul_add(
-                            p.XY7r,
-                            k103,
-                            A::mul_add(p.XX7r, k100, A::mul_add(-k99, d213, k98 * d214)),
-                        ),
-                    ),
-                ),
-            ); // N7r.x
-            let d106 = A::mul_add(
-                -p.MX7l,
-                d95,
-                A::mul_add(
-                    -p.MZ7l,
-                    d80,
-                    A::mul_add(
-                        -p.YZ7l,
-                        k54,
-                        A::mul_add(
-                            p.YY7l,
-                            k52,
-                            A::mul_add(p.XY7l, k51, A::mul_add(-k53, d104, k50 * d102)),
-                        ),
-                    ),
-                ),
-            ); // N7l.y
-            let d217 = A::mul_add(
-                -p.MX7r,
-                d205,
-                A::mul_add(
-                    -p.MZ7r,
-                    d191,
-                    A::mul_add(
-                        -p.YZ7r,
-                        k101,
-                        A::mul_add(
-                            p.YY7r,
-                            k103,
-                            A::mul_add(p.XY7r, k100, A::mul_add(-k102, d214, k99 * d212)),
-                        ),
-                    ),
-                ),
-            ); // N7r.y
-            let k55 = A::mul_add(-s_q5l, k50, c_q5l * k53); // w7l in 8l|ud=0,g=0.x
-            let k104 = A::mul_add(-s_q5r, k99, c_q5r * k102); // w7r in 8r|ud=0,g=0.x
-            let k56 = A::mul_add(c_q5l, k50, s_q5l * k53); // w7l in 8l|ud=0,g=0.z
-            let k105 = A::mul_add(c_q5r, k99, s_q5r * k102); // w7r in 8r|ud=0,g=0.z
-            let k59 = k52 + qdd5l; // wd8l.y
-            let k106 = k103 + qdd5r; // wd8r.y
-            let k57 = k49 - qd5l; // w8l|ud=0,g=0.y
-            let k107 = k98 - qd5r; // w8r|ud=0,g=0.y
-            let k58 = A::mul_add(s_q5l, k54, A::mul_add(c_q5l, k51, k56 * qd5l)); // wd8l.x
-            let k108 = A::mul_add(s_q5r, k101, A::mul_add(c_q5r, k100, k105 * qd5r)); // wd8r.x
-            let k60 = A::mul_add(c_q5l, k54, A::mul_add(-s_q5l, k51, k55 * qd5l)); // wd8l.z
-            let k109 = A::mul_add(c_q5r, k101, A::mul_add(-s_q5r, k100, k104 * qd5r)); // wd8r.z
-            let k61 = p.L8 * k50; // w7lxP8l|ud=0,g=0.x
-            let k110 = p.L8 * k99; // w7rxP8r|ud=0,g=0.x
-            let k62 = p.L8 * k53; // w7lxP8l|ud=0,g=0.z
-            let k111 = p.L8 * k102; // w7rxP8r|ud=0,g=0.z
-            let d109 = A::mul_add(p.L8, k54, A::mul_add(k49, k62, d80)); // a8l in 7l.x
-            let d218 = A::mul_add(p.L8, k101, A::mul_add(k98, k111, d191)); // a8r in 7r.x
-            let d108 = A::mul_add(k53, k62, k50 * k61) + d94; // a8l in 7l.y
-            let d219 = A::mul_add(k102, k111, k99 * k110) + d204; // a8r in 7r.y
-            let d110 = A::mul_add(p.L8, k51, A::mul_add(k49, k61, -d95)); // a8l in 7l.z
-            let d220 = A::mul_add(p.L8, k100, A::mul_add(k98, k110, -d205)); // a8r in 7r.z
-            let d112 = A::mul_add(c_q5l, d110, s_q5l * d109); // a8l.z
-            let d221 = A::mul_add(c_q5r, d220, s_q5r * d218); // a8r.z
-            let d111 = A::mul_add(-s_q5l, d110, c_q5l * d109); // a8l.x
-            let d222 = A::mul_add(-s_q5r, d220, c_q5r * d218); // a8r.x
-            let d114 = A::mul_add(-p.MX8l, k57, p.MY8l * k55); // w8lxMS8l|ud=0,g=0.z
-            let d223 = A::mul_add(-p.MX8r, k107, p.MY8r * k104); // w8rxMS8r|ud=0,g=0.z
-            let d113 = A::mul_add(p.MY8l, k56, p.MZ8l * k57); // w8lxMS8l|ud=0,g=0.x
-            let d224 = A::mul_add(p.MY8r, k105, p.MZ8r * k107); // w8rxMS8r|ud=0,g=0.x
-            let d115 = A::mul_add(p.MZ8l, k55, p.MX8l * k56); // w8lxMS8l|ud=0,g=0.y
-            let d225 = A::mul_add(p.MZ8r, k104, p.MX8r * k105); // w8rxMS8r|ud=0,g=0.y
-            let d117 = A::mul_add(
-                -p.MZ8l,
-                k58,
-                A::mul_add(
-                    p.MX8l,
-                    k60,
-                    A::mul_add(p.m8l, d108, A::mul_add(k55, d114, k56 * d113)),
-                ),
-            ); // F8l.y
-            let d226 = A::mul_add(
-                -p.MZ8r,
-                k108,
-                A::mul_add(
-                    p.MX8r,
-                    k109,
-                    A::mul_add(p.m8r, d219, A::mul_add(k104, d223, k105 * d224)),
-                ),
-            ); // F8r.y
-            let d116 = A::mul_add(
-                p.MY8l,
-                k60,
-                A::mul_add(
-                    -p.MZ8l,
-                    k59,
-                    A::mul_add(p.m8l, d111, A::mul_add(-k56, d115, k57 * d114)),
-                ),
-            ); // F8l.x
-            let d227 = A::mul_add(
-                p.MY8r,
-                k109,
-                A::mul_add(
-                    -p.MZ8r,
-                    k106,
-                    A::mul_add(p.m8r, d222, A::mul_add(-k105, d225, k107 * d223)),
-                ),
-            ); // F8r.x
-            let d118 = A::mul_add(
-                -p.MX8l,
-                k59,
-                A::mul_add(
-                    p.MY8l,
-                    k58,
-                    A::mul_add(p.m8l, d112, A::mul_add(k57, d113, k55 * d115)),
-                ),
-            ); // F8l.z
-            let d228 = A::mul_add(
-                -p.MX8r,
-                k106,
-                A::mul_add(
-                    p.MY8r,
-                    k108,
-                    A::mul_add(p.m8r, d221, A::mul_add(k107, d224, k104 * d225)),
-                ),
-            ); // F8r.z
-            let d119 = A::mul_add(-p.XZ8l, k56, A::mul_add(p.XY8l, k57, p.XX8l * k55)); // J8lw8l|ud=0,g=0.x
-            let d229 = A::mul_add(
-                -p.XZ8r,
-                k105,
-                A::mul_add(p.XY8r, k107, p.XX8r * k104),
-            ); // J8rw8r|ud=0,g=0.x
-            let d120 = A::mul_add(-p.YZ8l, k56, A::mul_add(p.YY8l, k57, p.XY8l * k55)); // J8lw8l|ud=0,g=0.y
-            let d230 = A::mul_add(
-                -p.YZ8r,
-                k105,
-                A::mul_add(p.YY8r, k107, p.XY8r * k104),
-            ); // J8rw8r|ud=0,g=0.y
-            let d121 = A::mul_add(-p.ZZ8l, k56, A::mul_add(p.YZ8l, k57, p.XZ8l * k55)); // J8lw8l|ud=0,g=0.z
-            let d231 = A::mul_add(
-                -p.ZZ8r,
-                k105,
-                A::mul_add(p.YZ8r, k107, p.XZ8r * k104),
-            ); // J8rw8r|ud=0,g=0.z
-            let d123 = A::mul_add(
-                -p.MY8l,
-                d111,
-                A::mul_add(
-                    -p.MX8l,
-                    d108,
-                    A::mul_add(
-                        -p.ZZ8l,
-                        k60,
-                        A::mul_add(
-                            -p.YZ8l,
-                            k59,
-                            A::mul_add(-p.XZ8l, k58, A::mul_add(-k57, d119, k55 * d120)),
-                        ),
-                    ),
-                ),
-            ); // N8l.z
-            let d232 = A::mul_add(
-                -p.MY8r,
-                d222,
-                A::mul_add(
-                    -p.MX8r,
-                    d219,
-                    A::mul_add(
-                        -p.ZZ8r,
-                        k109,
-                        A::mul_add(
-                            -p.YZ8r,
-                            k106,
-                            A::mul_add(
-                                -p.XZ8r,
-                                k108,
-                                A::mul_add(-k107, d229, k104 * d230),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N8r.z
-            let d122 = A::mul_add(
-                p.MZ8l,
-                d108,
-                A::mul_add(
-                    -p.MY8l,
-                    d112,
-                    A::mul_add(
-                        -p.XZ8l,
-                        k60,
-                        A::mul_add(
-                            -p.XY8l,
-                            k59,
-                            A::mul_add(-p.XX8l, k58, A::mul_add(k56, d120, k57 * d121)),
-                        ),
-                    ),
-                ),
-            ); // N8l.x
-            let d233 = A::mul_add(
-                p.MZ8r,
-                d219,
-                A::mul_add(
-                    -p.MY8r,
-                    d221,
-                    A::mul_add(
-                        -p.XZ8r,
-                        k109,
-                        A::mul_add(
-                            -p.XY8r,
-                            k106,
-                            A::mul_add(
-                                -p.XX8r,
-                                k108,
-                                A::mul_add(k105, d230, k107 * d231),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N8r.x
-            let d124 = A::mul_add(
-                -p.MX8l,
-                d112,
-                A::mul_add(
-                    -p.MZ8l,
-                    d111,
-                    A::mul_add(
-                        p.YZ8l,
-                        k60,
-                        A::mul_add(
-                            p.YY8l,
-                            k59,
-                            A::mul_add(p.XY8l, k58, A::mul_add(k55, d121, k56 * d119)),
-                        ),
-                    ),
-                ),
-            ); // N8l.y
-            let d234 = A::mul_add(
-                -p.MX8r,
-                d221,
-                A::mul_add(
-                    -p.MZ8r,
-                    d222,
-                    A::mul_add(
-                        p.YZ8r,
-                        k109,
-                        A::mul_add(
-                            p.YY8r,
-                            k106,
-                            A::mul_add(p.XY8r, k108, A::mul_add(k104, d231, k105 * d229)),
-                        ),
-                    ),
-                ),
-            ); // N8r.y
-            let k63 = A::mul_add(-s_q6l, k56, c_q6l * k57); // w8l in 9l|ud=0,g=0.y
-            let k112 = A::mul_add(-s_q6r, k105, c_q6r * k107); // w8r in 9r|ud=0,g=0.y
-            let k64 = A::mul_add(c_q6l, k56, s_q6l * k57); // w8l in 9l|ud=0,g=0.z
-            let k113 = A::mul_add(c_q6r, k105, s_q6r * k107); // w8r in 9r|ud=0,g=0.z
-            let k65 = k58 - qdd6l; // wd9l.x
-            let k114 = k108 - qdd6r; // wd9r.x
-            let k68 = A::mul_add(c_q6l, k60, A::mul_add(-s_q6l, k59, k63 * qd6l)); // wd9l.z
-            let k115 = A::mul_add(c_q6r, k109, A::mul_add(-s_q6r, k106, k112 * qd6r)); // wd9r.z
-            let k67 = k55 + qd6l; // w9l|ud=0,g=0.x
-            let k116 = k104 + qd6r; // w9r|ud=0,g=0.x
-            let k66 = A::mul_add(s_q6l, k60, A::mul_add(c_q6l, k59, k64 * qd6l)); // wd9l.y
-            let k117 = A::mul_add(s_q6r, k109, A::mul_add(c_q6r, k106, k113 * qd6r)); // wd9r.y
-            let d125 = A::mul_add(s_q6l, d112, c_q6l * d108); // a9l.y
-            let d235 = A::mul_add(s_q6r, d221, c_q6r * d219); // a9r.y
-            let d126 = A::mul_add(-c_q6l, d112, s_q6l * d108); // a9l.z
-            let d236 = A::mul_add(-c_q6r, d221, s_q6r * d219); // a9r.z
-            let d127 = A::mul_add(-p.MY9l, k64, p.MZ9l * k63); // w9lxMS9l|ud=0,g=0.x
-            let d237 = A::mul_add(-p.MY9r, k113, p.MZ9r * k112); // w9rxMS9r|ud=0,g=0.x
-            let d128 = A::mul_add(-p.MZ9l, k67, p.MX9l * k64); // w9lxMS9l|ud=0,g=0.y
-            let d238 = A::mul_add(-p.MZ9r, k116, p.MX9r * k113); // w9rxMS9r|ud=0,g=0.y
-            let d129 = A::mul_add(-p.MX9l, k63, p.MY9l * k67); // w9lxMS9l|ud=0,g=0.z
-            let d239 = A::mul_add(-p.MX9r, k112, p.MY9r * k116); // w9rxMS9r|ud=0,g=0.z
-            let d131 = A::mul_add(
-                -p.MZ9l,
-                k65,
-                A::mul_add(
-                    -p.MX9l,
-                    k68,
-                    A::mul_add(p.m9l, d125, A::mul_add(-k67, d129, k64 * d127)),
-                ),
-            ); // F9l.y
-            let d240 = A::mul_add(
-                -p.MZ9r,
-                k114,
-                A::mul_add(
-                    -p.MX9r,
-                    k115,
-                    A::mul_add(p.m9r, d235, A::mul_add(-k116, d239, k113 * d237)),
-                ),
-            ); // F9r.y
-            let d130 = A::mul_add(
-                p.MY9l,
-                k68,
-                A::mul_add(
-                    p.MZ9l,
-                    k66,
-                    A::mul_add(-p.m9l, d111, A::mul_add(-k64, d128, k63 * d129)),
-                ),
-            ); // F9l.x
-            let d241 = A::mul_add(
-                p.MY9r,
-                k115,
-                A::mul_add(
-                    p.MZ9r,
-                    k117,
-                    A::mul_add(-p.m9r, d222, A::mul_add(-k113, d238, k112 * d239)),
-                ),
-            ); // F9r.x
-            let d132 = A::mul_add(
-                -p.MX9l,
-                k66,
-                A::mul_add(
-                    p.MY9l,
-                    k65,
-                    A::mul_add(p.m9l, d126, A::mul_add(-k63, d127, k67 * d128)),
-                ),
-            ); // F9l.z
-            let d242 = A::mul_add(
-                -p.MX9r,
-                k117,
-                A::mul_add(
-                    p.MY9r,
-                    k114,
-                    A::mul_add(p.m9r, d236, A::mul_add(-k112, d237, k116 * d238)),
-                ),
-            ); // F9r.z
-            let d133 = A::mul_add(p.XZ9l, k64, A::mul_add(p.XY9l, k63, p.XX9l * k67)); // J9lw9l|ud=0,g=0.x
-            let d243 = A::mul_add(p.XZ9r, k113, A::mul_add(p.XY9r, k112, p.XX9r * k116)); // J9rw9r|ud=0,g=0.x
-            let d134 = A::mul_add(p.YZ9l, k64, A::mul_add(p.YY9l, k63, p.XY9l * k67)); // J9lw9l|ud=0,g=0.y
-            let d244 = A::mul_add(p.YZ9r, k113, A::mul_add(p.YY9r, k112, p.XY9r * k116)); // J9rw9r|ud=0,g=0.y
-            let d135 = A::mul_add(p.ZZ9l, k64, A::mul_add(p.YZ9l, k63, p.XZ9l * k67)); // J9lw9l|ud=0,g=0.z
-            let d245 = A::mul_add(p.ZZ9r, k113, A::mul_add(p.YZ9r, k112, p.XZ9r * k116)); // J9rw9r|ud=0,g=0.z
-            let d138 = A::mul_add(
-                p.MY9l,
-                d111,
-                A::mul_add(
-                    p.MX9l,
-                    d125,
-                    A::mul_add(
-                        -p.ZZ9l,
-                        k68,
-                        A::mul_add(
-                            p.YZ9l,
-                            k66,
-                            A::mul_add(p.XZ9l, k65, A::mul_add(-k63, d133, k67 * d134)),
-                        ),
-                    ),
-                ),
-            ); // N9l.z
-            let d246 = A::mul_add(
-                p.MY9r,
-                d222,
-                A::mul_add(
-                    p.MX9r,
-                    d235,
-                    A::mul_add(
-                        -p.ZZ9r,
-                        k115,
-                        A::mul_add(
-                            p.YZ9r,
-                            k117,
-                            A::mul_add(
-                                p.XZ9r,
-                                k114,
-                                A::mul_add(-k112, d243, k116 * d244),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N9r.z
-            let d136 = A::mul_add(
-                -p.MZ9l,
-                d125,
-                A::mul_add(
-                    p.MY9l,
-                    d126,
-                    A::mul_add(
-                        -p.XZ9l,
-                        k68,
-                        A::mul_add(
-                            p.XY9l,
-                            k66,
-                            A::mul_add(p.XX9l, k65, A::mul_add(-k64, d134, k63 * d135)),
-                        ),
-                    ),
-                ),
-            ); // N9l.x
-            let d247 = A::mul_add(
-                -p.MZ9r,
-                d235,
-                A::mul_add(
-                    p.MY9r,
-                    d236,
-                    A::mul_add(
-                        -p.XZ9r,
-                        k115,
-                        A::mul_add(
-                            p.XY9r,
-                            k117,
-                            A::mul_add(
-                                p.XX9r,
-                                k114,
-                                A::mul_add(-k113, d244, k112 * d245),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N9r.x
-            let d137 = A::mul_add(
-                -p.MX9l,
-                d126,
-                A::mul_add(
-                    -p.MZ9l,
-                    d111,
-                    A::mul_add(
-                        -p.YZ9l,
-                        k68,
-                        A::mul_add(
-                            p.YY9l,
-                            k66,
-                            A::mul_add(p.XY9l, k65, A::mul_add(-k67, d135, k64 * d133)),
-                        ),
-                    ),
-                ),
-            ); // N9l.y
-            let d248 = A::mul_add(
-                -p.MX9r,
-                d236,
-                A::mul_add(
-                    -p.MZ9r,
-                    d222,
-                    A::mul_add(
-                        -p.YZ9r,
-                        k115,
-                        A::mul_add(
-                            p.YY9r,
-                            k117,
-                            A::mul_add(
-                                p.XY9r,
-                                k114,
-                                A::mul_add(-k116, d245, k113 * d243),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N9r.y
-            let k69 = A::mul_add(-s_q7l, k64, c_q7l * k67); // w9l in 10l|ud=0,g=0.x
-            let k118 = A::mul_add(-s_q7r, k113, c_q7r * k116); // w9r in 10r|ud=0,g=0.x
-            let k70 = A::mul_add(c_q7l, k64, s_q7l * k67); // w9l in 10l|ud=0,g=0.y
-            let k119 = A::mul_add(c_q7r, k113, s_q7r * k116); // w9r in 10r|ud=0,g=0.y
-            let k74 = k66 + qdd7l; // wd10l.z
-            let k120 = k117 + qdd7r; // wd10r.z
-            let k72 = A::mul_add(c_q7l, k68, A::mul_add(-s_q7l, k65, k69 * qd7l)); // wd10l.y
-            let k121 = A::mul_add(c_q7r, k115, A::mul_add(-s_q7r, k114, k118 * qd7r)); // wd10r.y
-            let k71 = k63 - qd7l; // w10l|ud=0,g=0.z
-            let k122 = k112 - qd7r; // w10r|ud=0,g=0.z
-            let k73 = A::mul_add(s_q7l, k68, A::mul_add(c_q7l, k65, k70 * qd7l)); // wd10l.x
-            let k123 = A::mul_add(s_q7r, k115, A::mul_add(c_q7r, k114, k119 * qd7r)); // wd10r.x
-            let k75 = p.L9 * k64; // w9lxP10l|ud=0,g=0.x
-            let k124 = p.L9 * k113; // w9rxP10r|ud=0,g=0.x
-            let k76 = p.L9 * k67; // w9lxP10l|ud=0,g=0.z
-            let k125 = p.L9 * k116; // w9rxP10r|ud=0,g=0.z
-            let d140 = A::mul_add(p.L9, k68, A::mul_add(k63, k76, d111)); // a10l in 9l.x
-            let d249 = A::mul_add(p.L9, k115, A::mul_add(k112, k125, d222)); // a10r in 9r.x
-            let d139 = A::mul_add(k67, k76, k64 * k75) + d125; // a10l in 9l.y
-            let d250 = A::mul_add(k116, k125, k113 * k124) + d235; // a10r in 9r.y
-            let d141 = A::mul_add(p.L9, k65, A::mul_add(k63, k75, -d126)); // a10l in 9l.z
-            let d251 = A::mul_add(p.L9, k114, A::mul_add(k112, k124, -d236)); // a10r in 9r.z
-            let d142 = A::mul_add(-s_q7l, d141, c_q7l * d140); // a10l.x
-            let d252 = A::mul_add(-s_q7r, d251, c_q7r * d249); // a10r.x
-            let d143 = A::mul_add(c_q7l, d141, s_q7l * d140); // a10l.y
-            let d253 = A::mul_add(c_q7r, d251, s_q7r * d249); // a10r.y
-            let d144 = A::mul_add(-p.MY10l, k71, p.MZ10l * k70); // w10lxMS10l|ud=0,g=0.x
-            let d254 = A::mul_add(-p.MY10r, k122, p.MZ10r * k119); // w10rxMS10r|ud=0,g=0.x
-            let d146 = A::mul_add(-p.MX10l, k70, p.MY10l * k69); // w10lxMS10l|ud=0,g=0.z
-            let d255 = A::mul_add(-p.MX10r, k119, p.MY10r * k118); // w10rxMS10r|ud=0,g=0.z
-            let d145 = A::mul_add(-p.MZ10l, k69, p.MX10l * k71); // w10lxMS10l|ud=0,g=0.y
-            let d256 = A::mul_add(-p.MZ10r, k118, p.MX10r * k122); // w10rxMS10r|ud=0,g=0.y
-            let d147 = A::mul_add(
-                p.MY10l,
-                k74,
-                A::mul_add(
-                    p.MZ10l,
-                    k72,
-                    A::mul_add(p.m10l, d142, A::mul_add(-k71, d145, k70 * d146)),
-                ),
-            ); // F10l.x
-            let d257 = A::mul_add(
-                p.MY10r,
-                k120,
-                A::mul_add(
-                    p.MZ10r,
-                    k121,
-                    A::mul_add(p.m10r, d252, A::mul_add(-k122, d256, k119 * d255)),
-                ),
-            ); // F10r.x
-            let d148 = A::mul_add(
-                p.MZ10l,
-                k73,
-                A::mul_add(
-                    -p.MX10l,
-                    k74,
-                    A::mul_add(p.m10l, d143, A::mul_add(-k69, d146, k71 * d144)),
-                ),
-            ); // F10l.y
-            let d258 = A::mul_add(
-                p.MZ10r,
-                k123,
-                A::mul_add(
-                    -p.MX10r,
-                    k120,
-                    A::mul_add(p.m10r, d253, A::mul_add(-k118, d255, k122 * d254)),
-                ),
-            ); // F10r.y
-            let d149 = A::mul_add(
-                -p.MX10l,
-                k72,
-                A::mul_add(
-                    -p.MY10l,
-                    k73,
-                    A::mul_add(-p.m10l, d139, A::mul_add(-k70, d144, k69 * d145)),
-                ),
-            ); // F10l.z
-            let d259 = A::mul_add(
-                -p.MX10r,
-                k121,
-                A::mul_add(
-                    -p.MY10r,
-                    k123,
-                    A::mul_add(-p.m10r, d250, A::mul_add(-k119, d254, k118 * d256)),
-                ),
-            ); // F10r.z
-            let d150 = A::mul_add(p.XZ10l, k71, A::mul_add(p.XY10l, k70, p.XX10l * k69)); // J10lw10l|ud=0,g=0.x
-            let d260 = A::mul_add(
-                p.XZ10r,
-                k122,
-                A::mul_add(p.XY10r, k119, p.XX10r * k118),
-            ); // J10rw10r|ud=0,g=0.x
-            let d151 = A::mul_add(p.YZ10l, k71, A::mul_add(p.YY10l, k70, p.XY10l * k69)); // J10lw10l|ud=0,g=0.y
-            let d261 = A::mul_add(
-                p.YZ10r,
-                k122,
-                A::mul_add(p.YY10r, k119, p.XY10r * k118),
-            ); // J10rw10r|ud=0,g=0.y
-            let d152 = A::mul_add(p.ZZ10l, k71, A::mul_add(p.YZ10l, k70, p.XZ10l * k69)); // J10lw10l|ud=0,g=0.z
-            let d262 = A::mul_add(
-                p.ZZ10r,
-                k122,
-                A::mul_add(p.YZ10r, k119, p.XZ10r * k118),
-            ); // J10rw10r|ud=0,g=0.z
-            let d153 = A::mul_add(
-                -p.MZ10l,
-                d143,
-                A::mul_add(
-                    -p.MY10l,
-                    d139,
-                    A::mul_add(
-                        -p.XZ10l,
-                        k74,
-                        A::mul_add(
-                            p.XY10l,
-                            k72,
-                            A::mul_add(-p.XX10l, k73, A::mul_add(-k71, d151, k70 * d152)),
-                        ),
-                    ),
-                ),
-            ); // N10l.x
-            let d263 = A::mul_add(
-                -p.MZ10r,
-                d253,
-                A::mul_add(
-                    -p.MY10r,
-                    d250,
-                    A::mul_add(
-                        -p.XZ10r,
-                        k120,
-                        A::mul_add(
-                            p.XY10r,
-                            k121,
-                            A::mul_add(
-                                -p.XX10r,
-                                k123,
-                                A::mul_add(-k122, d261, k119 * d262),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N10r.x
-            let d155 = A::mul_add(
-                -p.MY10l,
-                d142,
-                A::mul_add(
-                    p.MX10l,
-                    d143,
-                    A::mul_add(
-                        -p.ZZ10l,
-                        k74,
-                        A::mul_add(
-                            p.YZ10l,
-                            k72,
-                            A::mul_add(-p.XZ10l, k73, A::mul_add(-k70, d150, k69 * d151)),
-                        ),
-                    ),
-                ),
-            ); // N10l.z
-            entries0[11][l] = -d155;
-            let d264 = A::mul_add(
-                -p.MY10r,
-                d252,
-                A::mul_add(
-                    p.MX10r,
-                    d253,
-                    A::mul_add(
-                        -p.ZZ10r,
-                        k120,
-                        A::mul_add(
-                            p.YZ10r,
-                            k121,
-                            A::mul_add(
-                                -p.XZ10r,
-                                k123,
-                                A::mul_add(-k119, d260, k118 * d261),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N10r.z
-            entries0[18][l] = -d264;
-            let d154 = A::mul_add(
-                p.MX10l,
-                d139,
-                A::mul_add(
-                    p.MZ10l,
-                    d142,
-                    A::mul_add(
-                        -p.YZ10l,
-                        k74,
-                        A::mul_add(
-                            p.YY10l,
-                            k72,
-                            A::mul_add(-p.XY10l, k73, A::mul_add(-k69, d152, k71 * d150)),
-                        ),
-                    ),
-                ),
-            ); // N10l.y
-            let d265 = A::mul_add(
-                p.MX10r,
-                d250,
-                A::mul_add(
-                    p.MZ10r,
-                    d252,
-                    A::mul_add(
-                        -p.YZ10r,
-                        k120,
-                        A::mul_add(
-                            p.YY10r,
-                            k121,
-                            A::mul_add(
-                                -p.XY10r,
-                                k123,
-                                A::mul_add(-k118, d262, k122 * d260),
-                            ),
-                        ),
-                    ),
-                ),
-            ); // N10r.y
-            let d322 = A::mul_add(-c_q7l, d148, s_q7l * d147); // f10l in 9l.z
-            let d266 = A::mul_add(-c_q7r, d258, s_q7r * d257); // f10r in 9r.z
-            let d323 = A::mul_add(s_q7l, d148, c_q7l * d147); // f10l in 9l.x
-            let d267 = A::mul_add(s_q7r, d258, c_q7r * d257); // f10r in 9r.x
-            let d324 = d130 - d323; // f9l.x
-            let d270 = d241 - d267; // f9r.x
-            let d325 = d131 - d149; // f9l.y
-            let d268 = d240 - d259; // f9r.y
-            let d326 = d132 + d322; // f9l.z
-            let d271 = d242 + d266; // f9r.z
-            let d327 = d137 - d155; // n9l.y
-            let d273 = d248 - d264; // n9r.y
-            let d328 = A::mul_add(
-                -p.L9,
-                d322,
-                A::mul_add(-s_q7l, d154, A::mul_add(-c_q7l, d153, d136)),
-            ); // n9l.x
-            entries0[10][l] = -d328;
-            let d272 = A::mul_add(
-                -p.L9,
-                d266,
-                A::mul_add(-s_q7r, d265, A::mul_add(-c_q7r, d263, d247)),
-            ); // n9r.x
-            entries0[17][l] = -d272;
-            let d329 = A::mul_add(
-                -p.L9,
-                d323,
-                A::mul_add(-c_q7l, d154, A::mul_add(s_q7l, d153, d138)),
-            ); // n9l.z
-            let d269 = A::mul_add(
-                -p.L9,
-                d267,
-                A::mul_add(-c_q7r, d265, A::mul_add(s_q7r, d263, d246)),
-            ); // n9r.z
-            let d330 = A::mul_add(s_q6l, d326, c_q6l * d325); // f9l in 8l.y
-            let d274 = A::mul_add(s_q6r, d271, c_q6r * d268); // f9r in 8r.y
-            let d331 = A::mul_add(-c_q6l, d326, s_q6l * d325); // f9l in 8l.z
-            let d275 = A::mul_add(-c_q6r, d271, s_q6r * d268); // f9r in 8r.z
-            let d332 = d116 - d324; // f8l.x
-            let d278 = d227 - d270; // f8r.x
-            let d333 = d122 - d328; // n8l.x
-            let d280 = d233 - d272; // n8r.x
-            let d334 = A::mul_add(c_q6l, d329, A::mul_add(-s_q6l, d327, d123)); // n8l.z
-            let d277 = A::mul_add(c_q6r, d269, A::mul_add(-s_q6r, d273, d232)); // n8r.z
-            let d335 = d117 + d330; // f8l.y
-            let d276 = d226 + d274; // f8r.y
-            let d336 = d118 + d331; // f8l.z
-            let d279 = d228 + d275; // f8r.z
-            let d337 = A::mul_add(s_q6l, d329, A::mul_add(c_q6l, d327, d124)); // n8l.y
-            entries0[9][l] = d337;
-            let d281 = A::mul_add(s_q6r, d269, A::mul_add(c_q6r, d273, d234)); // n8r.y
-            entries0[16][l] = d281;
-            let d338 = A::mul_add(-c_q5l, d336, s_q5l * d332); // f8l in 7l.z
-            let d283 = A::mul_add(-c_q5r, d279, s_q5r * d278); // f8r in 7r.z
-            let d339 = A::mul_add(s_q5l, d336, c_q5l * d332); // f8l in 7l.x
-            let d282 = A::mul_add(s_q5r, d279, c_q5r * d278); // f8r in 7r.x
-            let d340 = d99 - d339; // f7l.x
-            let d286 = d210 - d282; // f7r.x
-            let d341 = d100 + d335; // f7l.y
-            let d284 = d209 + d276; // f7r.y
-            let d342 = d101 + d338; // f7l.z
-            let d287 = d211 + d283; // f7r.z
-            let d343 = d106 + d337; // n7l.y
-            let d289 = d217 + d281; // n7r.y
-            let d344 = A::mul_add(
-                -p.L8,
-                d338,
-                A::mul_add(s_q5l, d334, A::mul_add(-c_q5l, d333, d105)),
-            ); // n7l.x
-            entries0[8][l] = -d344;
-            let d288 = A::mul_add(
-                -p.L8,
-                d283,
-                A::mul_add(s_q5r, d277, A::mul_add(-c_q5r, d280, d216)),
-            ); // n7r.x
-            entries0[15][l] = -d288;
-            let d345 = A::mul_add(
-                -p.L8,
-                d339,
-                A::mul_add(c_q5l, d334, A::mul_add(s_q5l, d333, d107)),
-            ); // n7l.z
-            let d285 = A::mul_add(
-                -p.L8,
-                d282,
-                A::mul_add(c_q5r, d277, A::mul_add(s_q5r, d280, d215)),
-            ); // n7r.z
-            let d346 = A::mul_add(s_q4l, d342, c_q4l * d341); // f7l in 6l.y
-            let d290 = A::mul_add(s_q4r, d287, c_q4r * d284); // f7r in 6r.y
-            let d347 = A::mul_add(-c_q4l, d342, s_q4l * d341); // f7l in 6l.z
-            let d291 = A::mul_add(-c_q4r, d287, s_q4r * d284); // f7r in 6r.z
-            let d348 = d85 - d340; // f6l.x
-            let d294 = d196 - d286; // f6r.x
-            let d349 = d91 - d344; // n6l.x
-            let d296 = d202 - d288; // n6r.x
-            let d350 = A::mul_add(c_q4l, d345, A::mul_add(-s_q4l, d343, d92)); // n6l.z
-            let d293 = A::mul_add(c_q4r, d285, A::mul_add(-s_q4r, d289, d201)); // n6r.z
-            let d351 = d86 + d346; // f6l.y
-            let d292 = d195 + d290; // f6r.y
-            let d352 = d87 + d347; // f6l.z
-            let d295 = d197 + d291; // f6r.z
-            let d353 = A::mul_add(s_q4l, d345, A::mul_add(c_q4l, d343, d93)); // n6l.y
-            entries0[7][l] = d353;
-            let d297 = A::mul_add(s_q4r, d285, A::mul_add(c_q4r, d289, d203)); // n6r.y
-            entries0[14][l] = d297;
-            let d354 = A::mul_add(-c_q3l, d352, s_q3l * d348); // f6l in 5l.z
-            let d299 = A::mul_add(-c_q3r, d295, s_q3r * d294); // f6r in 5r.z
-            let d355 = A::mul_add(s_q3l, d352, c_q3l * d348); // f6l in 5l.x
-            let d298 = A::mul_add(s_q3r, d295, c_q3r * d294); // f6r in 5r.x
-            let d356 = d68 - d355; // f5l.x
-            let d302 = d179 - d298; // f5r.x
-            let d357 = d69 + d351; // f5l.y
-            let d300 = d178 + d292; // f5r.y
-            let d358 = d70 + d354; // f5l.z
-            let d303 = d180 + d299; // f5r.z
-            let d359 = d75 + d353; // n5l.y
-            let d305 = d186 + d297; // n5r.y
-            let d360 = A::mul_add(
-                -p.L7,
-                d354,
-                A::mul_add(s_q3l, d350, A::mul_add(-c_q3l, d349, d74)),
-            ); // n5l.x
-            entries0[6][l] = -d360;
-            let d304 = A::mul_add(
-                -p.L7,
-                d299,
-                A::mul_add(s_q3r, d293, A::mul_add(-c_q3r, d296, d185)),
-            ); // n5r.x
-            entries0[13][l] = -d304;
-            let d361 = A::mul_add(
-                -p.L7,
-                d355,
-                A::mul_add(c_q3l, d350, A::mul_add(s_q3l, d349, d76)),
-            ); // n5l.z
-            let d301 = A::mul_add(
-                -p.L7,
-                d298,
-                A::mul_add(c_q3r, d293, A::mul_add(s_q3r, d296, d184)),
-            ); // n5r.z
-            let d362 = A::mul_add(s_q2l, d358, c_q2l * d357); // f5l in 4l.y
-            let d306 = A::mul_add(s_q2r, d303, c_q2r * d300); // f5r in 4r.y
-            let d363 = A::mul_add(-c_q2l, d358, s_q2l * d357); // f5l in 4l.z
-            let d307 = A::mul_add(-c_q2r, d303, s_q2r * d300); // f5r in 4r.z
-            let d364 = d54 - d356; // f4l.x
-            let d310 = d165 - d302; // f4r.x
-            let d365 = d60 - d360; // n4l.x
-            let d312 = d171 - d304; // n4r.x
-            let d366 = A::mul_add(c_q2l, d361, A::mul_add(-s_q2l, d359, d61)); // n4l.z
-            let d309 = A::mul_add(c_q2r, d301, A::mul_add(-s_q2r, d305, d170)); // n4r.z
-            let d367 = d55 + d362; // f4l.y
-            let d308 = d164 + d306; // f4r.y
             let d316 = d37 + d308; // f3.x
-            let d368 = d56 + d363; // f4l.z
-            let d311 = d166 + d307; // f4r.z
-            let d369 = A::mul_add(s_q2l, d361, A::mul_add(c_q2l, d359, d62)); // n4l.y
-            entries0[5][l] = d369;
-            let d313 = A::mul_add(s_q2r, d301, A::mul_add(c_q2r, d305, d172)); // n4r.y
-            entries0[12][l] = d313;
-            let d370 = A::mul_add(s_q1l, d368, c_q1l * d364); // f4l in 3.y
-            let d314 = A::mul_add(s_q1r, d311, c_q1r * d310); // f4r in 3.y
             let d318 = A::mul_add(
                 -p.L5,
                 d308,
@@ -15435,8 +15437,6 @@ mod generated {
                 ),
             ); // n3.z
             let d319 = d38 - d314; // f3.y
-            let d371 = A::mul_add(-c_q1l, d368, s_q1l * d364); // f4l in 3.z
-            let d315 = A::mul_add(-c_q1r, d311, s_q1r * d310); // f4r in 3.z
             let d317 = A::mul_add(p.L5, d315, d43 + d313); // n3.x
             let d320 = d39 - d315; // f3.z
             let d321 = A::mul_add(

@@ -273,10 +273,9 @@ pub fn restrict(p: &Program, keep: impl Fn(usize, usize) -> bool) -> Program {
 /// the arm, so the arm's column forces carried up to the trunk are read as soon as they are
 /// made instead of staying live until the trunk's rows (Krang's C: 144 values live instead of
 /// 236 by rows; log, "The Coriolis matrix by the deeper speed"); consecutive entries form one
-/// *group* (a chain of joints) while each shares at
-/// least half of the statements it reads, directly or not, with the previous one (joint j's
-/// torque reads most of what its child's does; the first joint of the other arm, or the trunk
-/// joint where both arms meet, does not). Each group in turn places the statements its entries
+/// *group* (a chain of joints) while each shares at least half of the statements it reads,
+/// directly or not, with the previous one (joint j's torque reads most of what its child's
+/// does; the first joint of the other arm, or the trunk joint where both arms meet, does not). Each group in turn places the statements its entries
 /// read that no earlier group placed, in their derivation order, and then every statement that
 /// is ready (all it reads placed) and reads a value of this group that no later group's entries
 /// read, except the last group (the root's): e.g. an arm's first link force, which only the
@@ -533,8 +532,9 @@ impl Lowered {
 /// (`docs/measurement-log.md`, "Instruction sets at run time and batched evaluation", "Single
 /// state toward 10× Pinocchio"), it
 /// cut C's values live from 455 to 236 (144 since entries go by their deeper speed), its
-/// instructions per call by 2.5 % and its time by 1–2 %; for c and τ (111 → 83 and 87 live) the instructions moved by −1.8 % and +1.6 % and
-/// the time not at all or up, so they keep the derivation's order.
+/// instructions per call by 2.5 % and its time by 1–2 %; for c and τ (111 → 83 and 87 live)
+/// the instructions moved by −1.8 % and +1.6 % and the time not at all or up, so they keep the
+/// derivation's order.
 pub const SUBTREE_ORDER: [FunctionId; 1] = [FunctionId::CoriolisMatrix];
 
 /// The functions whose batched bodies (`emit::batch`: the statements in a loop over the states,

@@ -237,9 +237,9 @@ enum EntryStores {
     /// Straight into the result (`out.set(r, c, l, value)`), which the vectorizer must then
     /// know cannot overwrite what the loop reads: the body reads local copies of the parameter
     /// structs (`let p = &{ *p };`) and of the structure-of-arrays inputs the loop reads
-    /// (`lanes::inputs_soa`; [`ReadInput::in_loop`]). Without those, LLVM's loop vectorizer needs run-time checks that
-    /// the result stores do not overwrite them, and gives up ("loop not vectorized: runtime
-    /// pointer checks needed").
+    /// (`lanes::inputs_soa`; [`ReadInput::in_loop`]). Without those, LLVM's loop vectorizer
+    /// needs run-time checks that the result stores do not overwrite them, and gives up ("loop
+    /// not vectorized: runtime pointer checks needed").
     Direct,
 }
 

@@ -273,9 +273,9 @@ impl Printer<'_> {
     }
 
     /// Appends the text prettyplease prints for [`Printer::expr`]`(e, atomic)` on one line, or
-    /// with `fma` the sums of products as multiply-add chains for a
-    /// body generic over `A: kanegen_runtime::isa::Arith` (`A::mul_add(x, y, acc)`, the terms
-    /// [`fused_terms`] picks): the same IEEE operations in the same order in the baseline copy.
+    /// with `fma` the sums of products as multiply-add chains for a body generic over
+    /// `A: kanegen_runtime::isa::Arith` (`A::mul_add(x, y, acc)`, the terms [`fused_terms`]
+    /// picks): the same IEEE operations in the same order in the baseline copy.
     pub(super) fn expr_text_with(
         &self,
         names: &LeafNames,

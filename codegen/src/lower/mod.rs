@@ -554,14 +554,21 @@ pub const BATCH_SUBTREE_ORDER: [FunctionId; 3] = [
 /// [`BATCH_SUBTREE_ORDER`] and that order keeps fewer values live, else `p` itself. The same
 /// statements in another order: every entry keeps its bits.
 pub fn batch_program(id: FunctionId, p: &Program) -> std::borrow::Cow<'_, Program> {
-    if BATCH_SUBTREE_ORDER.contains(&id) {
-        let mut reordered = p.clone();
-        subtree_order(&mut reordered);
-        if reordered.max_live() < p.max_live() {
-            return std::borrow::Cow::Owned(reordered);
-        }
+    if BATCH_SUBTREE_ORDER.contains(&id)
+        && let Some(reordered) = in_subtree_order_if_fewer_live(p)
+    {
+        return std::borrow::Cow::Owned(reordered);
     }
     std::borrow::Cow::Borrowed(p)
+}
+
+/// `p` in [`subtree_order`] if that keeps fewer values live at once ([`Program::max_live`]),
+/// else `None` (the derivation's order can keep fewer). What [`SUBTREE_ORDER`] and
+/// [`BATCH_SUBTREE_ORDER`] apply.
+fn in_subtree_order_if_fewer_live(p: &Program) -> Option<Program> {
+    let mut reordered = p.clone();
+    subtree_order(&mut reordered);
+    (reordered.max_live() < p.max_live()).then_some(reordered)
 }
 
 /// Lower every function of a derivation (`inverse_dynamics_derivatives` in the form
@@ -581,14 +588,10 @@ pub fn lower_with(d: &Derivation, form: DerivativesForm) -> Lowered {
         .iter()
         .map(|f| {
             let mut program = lower_function(&d.arena, f, hoist, &mut pre);
-            if SUBTREE_ORDER.contains(&f.id) {
-                // Kept where it lowers the values live at once (not always: the order of the
-                // derivation can keep fewer).
-                let mut reordered = program.clone();
-                subtree_order(&mut reordered);
-                if reordered.max_live() < program.max_live() {
-                    program = reordered;
-                }
+            if SUBTREE_ORDER.contains(&f.id)
+                && let Some(reordered) = in_subtree_order_if_fewer_live(&program)
+            {
+                program = reordered;
             }
             if let Some(l) = f.frame {
                 program.name = format!("{}[{}]", f.id.name(), d.frame_names[l]);

@@ -22,8 +22,9 @@
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
 //! across calls), `…_with` (into a `DerivativesWorkspace` kept across calls),
 //! `forward_dynamics_derivatives` and `linearize`; with the feature `coriolis-matrix` also
-//! `coriolis_matrix`, `coriolis_matrix_s8` (its 8-state structure-of-arrays form) and
-//! `coriolis_matrix_b8` (array of states); with the
+//! `coriolis_matrix`, `coriolis_matrix_s8` and `coriolis_matrix_s16` (its 8- and 16-state
+//! structure-of-arrays forms), `coriolis_matrix_b4` and `coriolis_matrix_b8` (arrays of 4 and
+//! 8 states); with the
 //! feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
 //! `hands_jacobians`, `hands_jacobians_separate` (the two `frame_jacobian` calls it combines),
@@ -48,6 +49,9 @@ struct Batches {
     b4: Vec<([V; 4], [V; 4])>,
     b8: Vec<([V; 8], [V; 8])>,
     s8: Vec<(SVector<Lanes<8>, 19>, SVector<Lanes<8>, 19>)>,
+    /// 16 states in structure-of-arrays form (`coriolis_matrix_s16`).
+    #[cfg(feature = "coriolis-matrix")]
+    s16: Vec<(SVector<Lanes<16>, 19>, SVector<Lanes<16>, 19>)>,
 }
 
 impl Batches {
@@ -59,13 +63,21 @@ impl Batches {
             .map(|i| (batch::<8>(s, i), batch_u::<8>(s, i)))
             .collect();
         let s8 = b8.iter().map(|(q, u)| (soa(q), soa(u))).collect();
-        Batches { b4, b8, s8 }
+        Batches {
+            b4,
+            b8,
+            s8,
+            #[cfg(feature = "coriolis-matrix")]
+            s16: (0..64)
+                .map(|i| (soa(&batch::<16>(s, i)), soa(&batch_u::<16>(s, i))))
+                .collect(),
+        }
     }
 }
 
 fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> f64 {
     let mut acc = 0.0;
-    let Batches { b4, b8, s8 } = batches;
+    let Batches { b4, b8, s8, .. } = batches;
     // The batched forms write into these (`_into`: no zeroed array, no copy of the results).
     let mut m4 = [nalgebra::SMatrix::<f64, 19, 19>::zeros(); 4];
     let mut m8 = [nalgebra::SMatrix::<f64, 19, 19>::zeros(); 8];
@@ -77,6 +89,8 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
     let mut v4 = [V::zeros(); 4];
     let mut v8 = [V::zeros(); 8];
     let mut ms8 = SMatrix::<Lanes<8>, 19, 19>::from_element(Lanes::splat(0.0));
+    #[cfg(feature = "coriolis-matrix")]
+    let mut ms16 = SMatrix::<Lanes<16>, 19, 19>::from_element(Lanes::splat(0.0));
     let mut vs8 = SVector::<Lanes<8>, 19>::from_element(Lanes::splat(0.0));
     let m_fixed = k.mass_matrix(&s[0].0);
     let chol_fixed = krang_dynamics::MassMatrixCholesky::new(&m_fixed).unwrap();
@@ -206,6 +220,18 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
                 let (q, u) = &s8[i & 63];
                 black_box(k).coriolis_matrix_batch_soa_into(black_box(q), black_box(u), &mut ms8);
                 black_box(&ms8)[(7, 9)].0[1]
+            }
+            #[cfg(feature = "coriolis-matrix")]
+            "coriolis_matrix_s16" => {
+                let (q, u) = &batches.s16[i & 63];
+                black_box(k).coriolis_matrix_batch_soa_into(black_box(q), black_box(u), &mut ms16);
+                black_box(&ms16)[(7, 9)].0[1]
+            }
+            #[cfg(feature = "coriolis-matrix")]
+            "coriolis_matrix_b4" => {
+                let (q, u) = &b4[i & 63];
+                black_box(k).coriolis_matrix_batch_into(black_box(q), black_box(u), &mut m4);
+                black_box(&m4)[1][(7, 9)]
             }
             #[cfg(feature = "coriolis-matrix")]
             "coriolis_matrix_b8" => {

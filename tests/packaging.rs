@@ -116,3 +116,104 @@ fn krang_dynamics_model_files_are_real_copies_of_models() {
         );
     }
 }
+
+/// `"1.89"` or `"1.89.0"` as `(1, 89, 0)`.
+fn version(v: &str) -> (u64, u64, u64) {
+    let mut parts = v.split('.').map(|p| p.parse::<u64>().unwrap_or(0));
+    let mut next = || parts.next().unwrap_or(0);
+    (next(), next(), next())
+}
+
+/// The oldest Rust the published crates declare (`rust-version` in the root `Cargo.toml`, which
+/// every publishable crate inherits) is no older than what any crate they depend on needs, so
+/// that an older compiler is refused by cargo up front instead of failing deep in a dependency
+/// (nalgebra 0.35 needs 1.89; `kanegen-runtime`'s x86-64-v4 copies need AVX-512 target
+/// features, stable since 1.89). `cargo metadata` over the locked graph, all features.
+#[test]
+fn declared_rust_version_covers_every_dependency_of_the_published_crates() {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = std::process::Command::new(cargo)
+        .args([
+            "metadata",
+            "--format-version",
+            "1",
+            "--all-features",
+            "--locked",
+        ])
+        .current_dir(common::root())
+        .output()
+        .expect("cargo metadata runs");
+    assert!(
+        out.status.success(),
+        "cargo metadata: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let meta: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let packages = meta["packages"].as_array().unwrap();
+    let by_id = |id: &str| packages.iter().find(|p| p["id"] == id).unwrap();
+    let published: Vec<&serde_json::Value> = packages
+        .iter()
+        .filter(|p| {
+            meta["workspace_members"]
+                .as_array()
+                .unwrap()
+                .contains(&p["id"])
+                && p["publish"] != serde_json::json!([])
+        })
+        .collect();
+    assert_eq!(published.len(), 6, "the six publishable crates");
+    let root = std::fs::read_to_string(common::root().join("Cargo.toml")).unwrap();
+    let declared = strings(&root, "rust-version")
+        .pop()
+        .expect("[workspace.package] rust-version");
+    let declared = declared.as_str();
+    for p in &published {
+        assert_eq!(
+            p["rust_version"].as_str(),
+            Some(declared),
+            "{}: add `rust-version.workspace = true` to its [package]",
+            p["name"].as_str().unwrap()
+        );
+    }
+    // The normal and build dependencies of the published crates, transitively.
+    let nodes = meta["resolve"]["nodes"].as_array().unwrap();
+    let node = |id: &str| nodes.iter().find(|n| n["id"] == id).unwrap();
+    let mut stack: Vec<String> = published
+        .iter()
+        .map(|p| p["id"].as_str().unwrap().to_owned())
+        .collect();
+    let mut seen = std::collections::BTreeSet::new();
+    while let Some(id) = stack.pop() {
+        if !seen.insert(id.clone()) {
+            continue;
+        }
+        for dep in node(&id)["deps"].as_array().unwrap() {
+            let used = dep["dep_kinds"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|k| k["kind"] != "dev");
+            if used {
+                stack.push(dep["pkg"].as_str().unwrap().to_owned());
+            }
+        }
+    }
+    let mut too_new = Vec::new();
+    for id in &seen {
+        let p = by_id(id);
+        if let Some(needs) = p["rust_version"].as_str()
+            && version(needs) > version(declared)
+        {
+            too_new.push(format!(
+                "{} {} needs {needs}",
+                p["name"].as_str().unwrap(),
+                p["version"].as_str().unwrap()
+            ));
+        }
+    }
+    assert!(
+        too_new.is_empty(),
+        "the workspace declares rust-version {declared} (root Cargo.toml), but {}: raise it",
+        too_new.join(", ")
+    );
+}

@@ -6,7 +6,7 @@ use kanegen_runtime::lanes::{Lanes, zeros};
 use nalgebra::{SMatrix, SVector};
 
 fn starts_on_a_cache_line<T>(x: &T) -> bool {
-    (x as *const T as usize) % 64 == 0
+    (x as *const T as usize).is_multiple_of(64)
 }
 
 #[test]

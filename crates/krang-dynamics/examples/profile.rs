@@ -22,9 +22,9 @@
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
 //! across calls), `…_with` (into a `DerivativesWorkspace` kept across calls),
 //! `forward_dynamics_derivatives` and `linearize`; with the feature `coriolis-matrix` also
-//! `coriolis_matrix`, `coriolis_matrix_s8` and `coriolis_matrix_s16` (its 8- and 16-state
-//! structure-of-arrays forms), `coriolis_matrix_b4` and `coriolis_matrix_b8` (arrays of 4 and
-//! 8 states); with the
+//! `coriolis_matrix`, `coriolis_matrix_s4`, `coriolis_matrix_s8` and `coriolis_matrix_s16`
+//! (its 4-, 8- and 16-state structure-of-arrays forms), `coriolis_matrix_b4` and
+//! `coriolis_matrix_b8` (arrays of 4 and 8 states); with the
 //! feature `kinematics`
 //! also `whole_body_terms`, `whole_body_separate` (the eleven calls it combines),
 //! `hands_jacobians`, `hands_jacobians_separate` (the two `frame_jacobian` calls it combines),
@@ -49,6 +49,9 @@ struct Batches {
     b4: Vec<([V; 4], [V; 4])>,
     b8: Vec<([V; 8], [V; 8])>,
     s8: Vec<(SVector<Lanes<8>, 19>, SVector<Lanes<8>, 19>)>,
+    /// 4 states in structure-of-arrays form (`coriolis_matrix_s4`).
+    #[cfg(feature = "coriolis-matrix")]
+    s4: Vec<(SVector<Lanes<4>, 19>, SVector<Lanes<4>, 19>)>,
     /// 16 states in structure-of-arrays form (`coriolis_matrix_s16`).
     #[cfg(feature = "coriolis-matrix")]
     s16: Vec<(SVector<Lanes<16>, 19>, SVector<Lanes<16>, 19>)>,
@@ -63,7 +66,11 @@ impl Batches {
             .map(|i| (batch::<8>(s, i), batch_u::<8>(s, i)))
             .collect();
         let s8 = b8.iter().map(|(q, u)| (soa(q), soa(u))).collect();
+        #[cfg(feature = "coriolis-matrix")]
+        let s4 = b4.iter().map(|(q, u)| (soa(q), soa(u))).collect();
         Batches {
+            #[cfg(feature = "coriolis-matrix")]
+            s4,
             b4,
             b8,
             s8,
@@ -89,6 +96,8 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
     let mut v4 = [V::zeros(); 4];
     let mut v8 = [V::zeros(); 8];
     let mut ms8 = SMatrix::<Lanes<8>, 19, 19>::from_element(Lanes::splat(0.0));
+    #[cfg(feature = "coriolis-matrix")]
+    let mut ms4 = SMatrix::<Lanes<4>, 19, 19>::from_element(Lanes::splat(0.0));
     #[cfg(feature = "coriolis-matrix")]
     let mut ms16 = SMatrix::<Lanes<16>, 19, 19>::from_element(Lanes::splat(0.0));
     let mut vs8 = SVector::<Lanes<8>, 19>::from_element(Lanes::splat(0.0));
@@ -226,6 +235,12 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
                 let (q, u) = &batches.s16[i & 63];
                 black_box(k).coriolis_matrix_batch_soa_into(black_box(q), black_box(u), &mut ms16);
                 black_box(&ms16)[(7, 9)].0[1]
+            }
+            #[cfg(feature = "coriolis-matrix")]
+            "coriolis_matrix_s4" => {
+                let (q, u) = &batches.s4[i & 63];
+                black_box(k).coriolis_matrix_batch_soa_into(black_box(q), black_box(u), &mut ms4);
+                black_box(&ms4)[(7, 9)].0[1]
             }
             #[cfg(feature = "coriolis-matrix")]
             "coriolis_matrix_b4" => {

@@ -419,14 +419,18 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram) -> TokenStream {
     if !batched(f) {
         return TokenStream::new();
     }
-    // The batched body's own statement order (`lower::batch_program`).
+    // The batched body's own statement order (`lower::batch_program`); the rest of `f` as it
+    // is (field by field: `..f.clone()` would copy the whole program only to drop it).
     let reordered;
     let f = match lower::batch_program(f.id, &f.program) {
         Cow::Borrowed(_) => f,
         Cow::Owned(program) => {
             reordered = FunctionProgram {
+                id: f.id,
+                frame: f.frame,
                 program,
-                ..f.clone()
+                looped: f.looped.clone(),
+                lanes: f.lanes.clone(),
             };
             &reordered
         }

@@ -275,11 +275,12 @@ pub fn restrict(p: &Program, keep: impl Fn(usize, usize) -> bool) -> Program {
 /// 236 by rows; log, "The Coriolis matrix by the deeper speed"); consecutive entries form one
 /// *group* (a chain of joints) while each shares at least half of the statements it reads,
 /// directly or not, with the previous one (joint j's torque reads most of what its child's
-/// does; the first joint of the other arm, or the trunk joint where both arms meet, does not). Each group in turn places the statements its entries
-/// read that no earlier group placed, in their derivation order, and then every statement that
-/// is ready (all it reads placed) and reads a value of this group that no later group's entries
-/// read, except the last group (the root's): e.g. an arm's first link force, which only the
-/// trunk's torques read but which frees that link's velocities and accelerations. For a tree
+/// does; the first joint of the other arm, or the trunk joint where both arms meet, does not).
+/// Each group in turn places the statements its entries read that no earlier group placed, in
+/// their derivation order, and then every statement that is ready (all it reads placed) and
+/// reads a value of this group that no later group's entries read, except the last group (the
+/// root's): e.g. an arm's first link force, which only the trunk's torques read but which frees
+/// that link's velocities and accelerations. For a tree
 /// whose speeds are numbered parent before child, one subtree after the other (Krang: trunk,
 /// left arm, right arm), that is the right arm, the left arm, then the trunk. Values are
 /// unchanged: every statement still follows the statements it reads; only the order, and so

@@ -27,44 +27,54 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
         let v = u16::try_from(x).expect("`lower_with` checked that the tables fit u16");
         proc_macro2::Literal::u16_unsuffixed(v)
     };
-    let links = plan.links.iter().map(|l| {
-        let parent = match l.parent {
-            Some(p) => {
-                let p = u16_of(p);
-                quote!(#p)
-            }
-            None => quote!(kanegen_runtime::derivative_steps::NO_PARENT),
-        };
-        let (t, a, b) = (
-            u16_of(l.transform),
-            u16_of(l.speeds.start),
-            u16_of(l.speeds.end),
+    let or_marker = |x: Option<usize>, marker: TokenStream| match x {
+        Some(v) => {
+            let v = u16_of(v);
+            quote!(#v)
+        }
+        None => marker,
+    };
+    let (flat_columns, flat_steps) = plan.flatten();
+    let steps = flat_steps.iter().map(|s| {
+        let speed = plan.speeds[s.speed];
+        let transform = or_marker(
+            s.transform,
+            quote!(kanegen_runtime::derivative_steps::NO_TRANSFORM),
         );
-        quote!(kanegen_runtime::derivative_steps::Link { parent: #parent, transform: #t, first: #a, end: #b })
-    });
-    let speeds = plan.speeds.iter().map(|s| {
-        let (i, m, j) = (u16_of(s.index), u16_of(s.motion), s.joint);
-        let axis = match s.axis {
+        let m = u16_of(speed.motion);
+        let j = speed.joint;
+        let axis = match speed.axis {
             Some(k) => {
                 let k = proc_macro2::Literal::u8_unsuffixed(k);
                 quote!(#k)
             }
             None => quote!(kanegen_runtime::derivative_steps::DENSE),
         };
-        quote!(kanegen_runtime::derivative_steps::Speed { index: #i, motion: #m, joint: #j, axis: #axis })
+        let entries = s
+            .entries
+            .map(|e| or_marker(e, quote!(kanegen_runtime::derivative_steps::NO_ENTRY)));
+        quote!(kanegen_runtime::derivative_steps::Step {
+            transform: #transform, motion: #m, axis: #axis, joint: #j, entries: [#(#entries),*]
+        })
     });
-    let columns = plan.columns.iter().map(|c| {
-        let (l, s, f) = (u16_of(c.link), u16_of(c.speed), u16_of(c.forces));
-        quote!(kanegen_runtime::derivative_steps::Column { link: #l, speed: #s, forces: #f })
+    let columns = flat_columns.iter().map(|c| {
+        let (f, a, o, e) = (
+            u16_of(c.forces),
+            u16_of(c.first),
+            u16_of(c.own),
+            u16_of(c.end),
+        );
+        quote!(kanegen_runtime::derivative_steps::Column { forces: #f, first: #a, own: #o, end: #e })
     });
     let name = ident(TABLES);
     let dof = idx(plan.dof);
     let doc = format!(
-        " The tables of `inverse_dynamics_derivatives`'s loop: {} links, {} speeds, {} columns, {} steps up; a workspace of {} values.",
+        " The tables of `inverse_dynamics_derivatives`'s loop: {} links, {} speeds, {} columns, {} steps up, {} reads; a workspace of {} values.",
         plan.links.len(),
         plan.speeds.len(),
         plan.columns.len(),
         plan.steps(),
+        flat_steps.len(),
         plan.workspace
     );
     quote! {
@@ -72,9 +82,8 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
         const #name: kanegen_runtime::derivative_steps::Plan<'static> =
             kanegen_runtime::derivative_steps::Plan {
                 dof: #dof,
-                links: &[#(#links),*],
-                speeds: &[#(#speeds),*],
                 columns: &[#(#columns),*],
+                steps: &[#(#steps),*],
             };
     }
 }

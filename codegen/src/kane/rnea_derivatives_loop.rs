@@ -73,6 +73,35 @@ pub struct LoopColumn {
     pub forces: usize,
 }
 
+/// One step of a column's walk in the flat tables (`kanegen_runtime::derivative_steps::Step`):
+/// the forces moved up one link (unless `transform` is `None`), then one speed's reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FlatStep {
+    /// Workspace offset of the transform from the link below; `None` for the rows of the
+    /// column's own link and for a second speed of the same link.
+    pub transform: Option<usize>,
+    /// The speed read, index in [`DerivativeLoop::speeds`].
+    pub speed: usize,
+    /// The four result offsets (column-major `N × 2N`) the step writes, `None` where it writes
+    /// nothing: `∂τ_a/∂q_i`, `∂τ_a/∂u_i`, `∂τ_i/∂q_a`, `∂τ_i/∂u_a` for the step's speed `a`
+    /// and the column's speed `i`.
+    pub entries: [Option<usize>; 4],
+}
+
+/// One column of the flat tables: its forces and its range of steps, the own link's rows
+/// first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FlatColumn {
+    /// Workspace offset of the column's four forces.
+    pub forces: usize,
+    /// First step.
+    pub first: usize,
+    /// End of the own link's rows.
+    pub own: usize,
+    /// End of the column's steps.
+    pub end: usize,
+}
+
 impl DerivativeLoop {
     /// Number of steps up (one force transform of the four forces each).
     pub fn steps(&self) -> usize {
@@ -113,10 +142,65 @@ impl DerivativeLoop {
         total
     }
 
-    /// Whether every offset and index fits the runtime tables' `u16`.
+    /// Every column's walk to the root as one run of steps (the runtime's flat tables): the
+    /// rows of its own link, then one step per speed of each ancestor link, from the parent up.
+    pub fn flatten(&self) -> (Vec<FlatColumn>, Vec<FlatStep>) {
+        let n = self.dof;
+        let mut columns = Vec::with_capacity(self.columns.len());
+        let mut steps = Vec::new();
+        for c in &self.columns {
+            let this = self.speeds[c.speed];
+            let ci = this.index;
+            let first = steps.len();
+            for a in self.links[c.link].speeds.clone() {
+                let ai = self.speeds[a].index;
+                steps.push(FlatStep {
+                    transform: None,
+                    speed: a,
+                    entries: [
+                        this.joint.then_some(ai + n * ci),
+                        Some(ai + n * (n + ci)),
+                        None,
+                        None,
+                    ],
+                });
+            }
+            let own = steps.len();
+            let mut l = c.link;
+            while let Some(p) = self.links[l].parent {
+                let mut transform = Some(self.links[l].transform);
+                for a in self.links[p].speeds.clone() {
+                    let s = self.speeds[a];
+                    let ai = s.index;
+                    steps.push(FlatStep {
+                        transform: transform.take(),
+                        speed: a,
+                        entries: [
+                            this.joint.then_some(ai + n * ci),
+                            Some(ai + n * (n + ci)),
+                            s.joint.then_some(ci + n * ai),
+                            Some(ci + n * (n + ai)),
+                        ],
+                    });
+                }
+                l = p;
+            }
+            columns.push(FlatColumn {
+                forces: c.forces,
+                first,
+                own,
+                end: steps.len(),
+            });
+        }
+        (columns, steps)
+    }
+
+    /// Whether every offset and index fits the runtime tables' `u16` (`u16::MAX` marks a step
+    /// without a transform or an entry not written).
     pub fn fits_u16(&self) -> bool {
         let max = usize::from(u16::MAX - 1);
-        self.workspace <= max && self.links.len() <= max && self.speeds.len() <= max
+        let flat_steps = self.flatten().1.len();
+        self.workspace <= max && 2 * self.dof * self.dof <= max && flat_steps <= max
     }
 }
 
@@ -242,7 +326,7 @@ mod tests {
 
     use kanegen_model::{Model, UrdfOptions, WheeledBaseSpec};
     use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
-    use kanegen_runtime::derivative_steps::{Column, Link, NO_PARENT, Plan, Speed};
+    use kanegen_runtime::derivative_steps::{Column, NO_ENTRY, NO_TRANSFORM, Plan, Step};
 
     use crate::expr::Values;
     use crate::options::{Options, ParamMode};
@@ -265,40 +349,35 @@ mod tests {
             .expect("no mimic joints: looped form derived");
         let plan = &looped.plan;
         let u16_of = |x: usize| u16::try_from(x).expect("fits");
-        let links: Vec<Link> = plan
-            .links
+        let (flat_columns, flat_steps) = plan.flatten();
+        let steps: Vec<Step> = flat_steps
             .iter()
-            .map(|l| Link {
-                parent: l.parent.map_or(NO_PARENT, u16_of),
-                transform: u16_of(l.transform),
-                first: u16_of(l.speeds.start),
-                end: u16_of(l.speeds.end),
+            .map(|s| {
+                let speed = plan.speeds[s.speed];
+                Step {
+                    transform: s.transform.map_or(NO_TRANSFORM, u16_of),
+                    motion: u16_of(speed.motion),
+                    axis: speed
+                        .axis
+                        .unwrap_or(kanegen_runtime::derivative_steps::DENSE),
+                    joint: speed.joint,
+                    entries: s.entries.map(|e| e.map_or(NO_ENTRY, u16_of)),
+                }
             })
             .collect();
-        let speeds: Vec<Speed> = plan
-            .speeds
-            .iter()
-            .map(|s| Speed {
-                index: u16_of(s.index),
-                motion: u16_of(s.motion),
-                joint: s.joint,
-                axis: s.axis.unwrap_or(kanegen_runtime::derivative_steps::DENSE),
-            })
-            .collect();
-        let columns: Vec<Column> = plan
-            .columns
+        let columns: Vec<Column> = flat_columns
             .iter()
             .map(|c| Column {
-                link: u16_of(c.link),
-                speed: u16_of(c.speed),
                 forces: u16_of(c.forces),
+                first: u16_of(c.first),
+                own: u16_of(c.own),
+                end: u16_of(c.end),
             })
             .collect();
         let tables = Plan {
             dof: plan.dof,
-            links: &links,
-            speeds: &speeds,
             columns: &columns,
+            steps: &steps,
         };
         let n = model.independent_dof();
         let mut rng = SplitMix64::new(seed);

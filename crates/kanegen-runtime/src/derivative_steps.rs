@@ -89,6 +89,20 @@ pub struct Column {
     pub end: u16,
 }
 
+impl Column {
+    /// The rows of the column's own link and its steps up to the root, as ranges of
+    /// [`Plan::steps`].
+    #[inline(always)]
+    pub fn ranges(&self) -> (core::ops::Range<usize>, core::ops::Range<usize>) {
+        let (first, own, end) = (
+            usize::from(self.first),
+            usize::from(self.own),
+            usize::from(self.end),
+        );
+        (first..own, own..end)
+    }
+}
+
 /// The generated tables of one model: every column's walk to the root, flattened, with the
 /// result offsets it writes, so that the loop reads one record per step and computes no
 /// index.
@@ -236,6 +250,27 @@ fn put<T>(out: &mut [T], entry: u16, v: T) {
     }
 }
 
+/// Writes the entries of an ancestor step `s` from its dot products with the four forces `Φ`,
+/// `Ξ`, `H`, `G` (one lane each): `ds = S · F`, `dpd = Ψ̇ · F` and, when `s` is a joint,
+/// `dpdd = Ψ̈ · F` (not read otherwise).
+#[inline(always)]
+fn write_reads<T: Copy + Add<Output = T>>(
+    out: &mut [T],
+    s: &Step,
+    ds: [T; 4],
+    dpd: [T; 4],
+    dpdd: [T; 4],
+) {
+    put(out, s.entries[0], ds[3]);
+    put(out, s.entries[1], ds[2]);
+    if s.joint {
+        put(out, s.entries[2], dpdd[0] + dpd[1]);
+        put(out, s.entries[3], (dpd[0] + dpd[0]) + ds[1]);
+    } else {
+        put(out, s.entries[3], dpd[0] + ds[1]);
+    }
+}
+
 /// The loop of [`run`].
 #[inline(always)]
 fn steps<T>(plan: &Plan<'_>, w: &[T], out: &mut [T])
@@ -246,20 +281,16 @@ where
         let o = usize::from(col.forces);
         let x = &w[o..o + 24];
         let mut f: Forces<T> = [0, 1, 2, 3, 4, 5].map(|k| L4::load(&x[4 * k..4 * k + 4]));
-        let (first, own, end) = (
-            usize::from(col.first),
-            usize::from(col.own),
-            usize::from(col.end),
-        );
+        let (own_rows, up_steps) = col.ranges();
         // Rows of the column's own link: S_a · G, S_a · H.
-        for s in &plan.steps[first..own] {
+        for s in &plan.steps[own_rows] {
             let m = usize::from(s.motion);
             let ds = dots(&w[m..m + 6], &f);
             put(out, s.entries[0], ds.0[3]);
             put(out, s.entries[1], ds.0[2]);
         }
         // Up to the root: every ancestor speed reads the four forces in its frame.
-        for s in &plan.steps[own..end] {
+        for s in &plan.steps[up_steps] {
             if s.transform != NO_TRANSFORM {
                 let t = usize::from(s.transform);
                 f = up(&w[t..t + 12], &f);
@@ -267,15 +298,13 @@ where
             let m = usize::from(s.motion);
             let ds = dots(&w[m..m + 6], &f);
             let dpd = dots(&w[m + 6..m + 12], &f);
-            put(out, s.entries[0], ds.0[3]);
-            put(out, s.entries[1], ds.0[2]);
-            if s.joint {
-                let dpdd = dots(&w[m + 12..m + 18], &f);
-                put(out, s.entries[2], dpdd.0[0] + dpd.0[1]);
-                put(out, s.entries[3], (dpd.0[0] + dpd.0[0]) + ds.0[1]);
+            // Ψ̈ only for a joint (`write_reads` reads no `dpdd` otherwise: `ds` fills it).
+            let dpdd = if s.joint {
+                dots(&w[m + 12..m + 18], &f)
             } else {
-                put(out, s.entries[3], dpd.0[0] + ds.0[1]);
-            }
+                ds
+            };
+            write_reads(out, s, ds.0, dpd.0, dpdd.0);
         }
     }
 }
@@ -297,7 +326,7 @@ mod avx2 {
         _mm256_set1_pd,
     };
 
-    use super::{NO_TRANSFORM, Plan, Step, put};
+    use super::{NO_TRANSFORM, Plan, Step, put, write_reads};
 
     #[target_feature(enable = "avx,avx2,fma")]
     #[inline]
@@ -431,18 +460,14 @@ mod avx2 {
                 load(&x[16..20]),
                 load(&x[20..24]),
             ];
-            let (first, own, end) = (
-                usize::from(col.first),
-                usize::from(col.own),
-                usize::from(col.end),
-            );
-            for s in &plan.steps[first..own] {
+            let (own_rows, up_steps) = col.ranges();
+            for s in &plan.steps[own_rows] {
                 let m = usize::from(s.motion);
                 let ds = dots(&w[m..m + 6], &f);
                 put(out, s.entries[0], ds[3]);
                 put(out, s.entries[1], ds[2]);
             }
-            for s in &plan.steps[own..end] {
+            for s in &plan.steps[up_steps] {
                 if s.transform != NO_TRANSFORM {
                     let t = usize::from(s.transform);
                     f = up(&w[t..t + 12], &f);
@@ -454,14 +479,7 @@ mod avx2 {
                     2 => reads::<2>(w, m, s, &f),
                     _ => reads_dense(w, m, s, &f),
                 };
-                put(out, s.entries[0], ds[3]);
-                put(out, s.entries[1], ds[2]);
-                if s.joint {
-                    put(out, s.entries[2], dpdd[0] + dpd[1]);
-                    put(out, s.entries[3], (dpd[0] + dpd[0]) + ds[1]);
-                } else {
-                    put(out, s.entries[3], dpd[0] + ds[1]);
-                }
+                write_reads(out, s, ds, dpd, dpdd);
             }
         }
     }

@@ -27,20 +27,20 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
         let v = u16::try_from(x).expect("`lower_with` checked that the tables fit u16");
         proc_macro2::Literal::u16_unsuffixed(v)
     };
-    let or_marker = |x: Option<usize>, marker: TokenStream| match x {
-        Some(v) => {
-            let v = u16_of(v);
-            quote!(#v)
-        }
-        None => marker,
+    let u32_of = |x: usize| {
+        let v = u32::try_from(x).expect("`lower_with` checked that the tables fit u32");
+        proc_macro2::Literal::u32_unsuffixed(v)
     };
     let (flat_columns, flat_steps) = plan.flatten();
     let steps = flat_steps.iter().map(|s| {
         let speed = plan.speeds[s.speed];
-        let transform = or_marker(
-            s.transform,
-            quote!(kanegen_runtime::derivative_steps::NO_TRANSFORM),
-        );
+        let transform = match s.transform {
+            Some(t) => {
+                let t = u16_of(t);
+                quote!(#t)
+            }
+            None => quote!(kanegen_runtime::derivative_steps::NO_TRANSFORM),
+        };
         let m = u16_of(speed.motion);
         let j = speed.joint;
         let axis = match speed.axis {
@@ -50,9 +50,13 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
             }
             None => quote!(kanegen_runtime::derivative_steps::DENSE),
         };
-        let entries = s
-            .entries
-            .map(|e| or_marker(e, quote!(kanegen_runtime::derivative_steps::NO_ENTRY)));
+        let entries = s.entries.map(|e| match e {
+            Some(e) => {
+                let e = u32_of(e);
+                quote!(#e)
+            }
+            None => quote!(kanegen_runtime::derivative_steps::NO_ENTRY),
+        });
         quote!(kanegen_runtime::derivative_steps::Step {
             transform: #transform, motion: #m, axis: #axis, joint: #j, entries: [#(#entries),*]
         })
@@ -60,9 +64,9 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
     let columns = flat_columns.iter().map(|c| {
         let (f, a, o, e) = (
             u16_of(c.forces),
-            u16_of(c.first),
-            u16_of(c.own),
-            u16_of(c.end),
+            u32_of(c.first),
+            u32_of(c.own),
+            u32_of(c.end),
         );
         quote!(kanegen_runtime::derivative_steps::Column { forces: #f, first: #a, own: #o, end: #e })
     });

@@ -195,12 +195,16 @@ impl DerivativeLoop {
         (columns, steps)
     }
 
-    /// Whether every offset and index fits the runtime tables' `u16` (`u16::MAX` marks a step
+    /// Whether every offset and index fits the runtime tables: workspace offsets in `u16`,
+    /// result offsets and step indices in `u32` (the largest value of each marks a step
     /// without a transform or an entry not written).
-    pub fn fits_u16(&self) -> bool {
-        let max = usize::from(u16::MAX - 1);
+    pub fn fits_tables(&self) -> bool {
+        let max16 = usize::from(u16::MAX - 1);
+        let max32 = usize::try_from(u32::MAX - 1).unwrap_or(usize::MAX);
         let flat_steps = self.flatten().1.len();
-        self.workspace <= max && 2 * self.dof * self.dof <= max && flat_steps <= max
+        self.workspace <= max16
+            && self.dof.saturating_mul(2 * self.dof) <= max32
+            && flat_steps <= max32
     }
 }
 
@@ -349,6 +353,7 @@ mod tests {
             .expect("no mimic joints: looped form derived");
         let plan = &looped.plan;
         let u16_of = |x: usize| u16::try_from(x).expect("fits");
+        let u32_of = |x: usize| u32::try_from(x).expect("fits");
         let (flat_columns, flat_steps) = plan.flatten();
         let steps: Vec<Step> = flat_steps
             .iter()
@@ -361,7 +366,7 @@ mod tests {
                         .axis
                         .unwrap_or(kanegen_runtime::derivative_steps::DENSE),
                     joint: speed.joint,
-                    entries: s.entries.map(|e| e.map_or(NO_ENTRY, u16_of)),
+                    entries: s.entries.map(|e| e.map_or(NO_ENTRY, u32_of)),
                 }
             })
             .collect();
@@ -369,9 +374,9 @@ mod tests {
             .iter()
             .map(|c| Column {
                 forces: u16_of(c.forces),
-                first: u16_of(c.first),
-                own: u16_of(c.own),
-                end: u16_of(c.end),
+                first: u32_of(c.first),
+                own: u32_of(c.own),
+                end: u32_of(c.end),
             })
             .collect();
         let tables = Plan {
@@ -468,6 +473,45 @@ mod tests {
         )
         .expect("imports");
         compare("lift on a wheeled base", &lift, ParamMode::Runtime, 50, 16);
+    }
+
+    #[test]
+    fn flat_tables_write_every_entry_once_and_move_once_per_ancestor_link() {
+        let krang = Model::from_toml_file(models_dir().join("krang.toml")).expect("loads");
+        let options = Options {
+            params: ParamMode::Runtime,
+            functions: FunctionSet::default().with(FunctionId::InverseDynamicsDerivatives),
+        };
+        let d = super::super::derive(&krang, options);
+        let plan = &d
+            .derivative_loop
+            .as_ref()
+            .expect("looped form derived")
+            .plan;
+        let (columns, steps) = plan.flatten();
+        assert!(plan.fits_tables());
+        // Each result entry has one writer, so the loop may run the columns in any order.
+        let n = plan.dof;
+        let mut writers = vec![0usize; 2 * n * n];
+        for s in &steps {
+            for e in s.entries.into_iter().flatten() {
+                writers[e] += 1;
+            }
+        }
+        assert!(writers.iter().all(|&w| w <= 1), "an entry written twice");
+        // The columns' runs tile the steps; a run moves the forces once per ancestor link.
+        assert_eq!(columns.last().map(|c| c.end), Some(steps.len()));
+        let mut moves = 0;
+        for (k, c) in columns.iter().enumerate() {
+            assert_eq!(c.first, k.checked_sub(1).map_or(0, |j| columns[j].end));
+            assert!(c.first <= c.own && c.own <= c.end);
+            assert!(steps[c.first..c.own].iter().all(|s| s.transform.is_none()));
+            moves += steps[c.own..c.end]
+                .iter()
+                .filter(|s| s.transform.is_some())
+                .count();
+        }
+        assert_eq!(moves, plan.steps(), "one transform per step up");
     }
 
     #[test]

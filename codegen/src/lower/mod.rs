@@ -647,11 +647,12 @@ pub fn lower_with(d: &Derivation, form: DerivativesForm) -> Lowered {
         DerivativesForm::Looped => true,
         DerivativesForm::Auto => straight_flops > LOOPED_ABOVE_FLOPS,
     };
-    // The runtime's tables hold u16 offsets: larger models keep the straight-line form.
+    // The runtime's tables hold u16 workspace and u32 result offsets: larger models keep the
+    // straight-line form.
     let derivative_loop = d
         .derivative_loop
         .as_ref()
-        .filter(|l| looped && l.plan.fits_u16())
+        .filter(|l| looped && l.plan.fits_tables())
         .map(|l| LoopedProgram {
             program: lower_entries(
                 &d.arena,

@@ -120,26 +120,29 @@ impl DerivativeLoop {
     }
 
     /// Floating-point operations of the loop per call, as `derivative_steps::run` performs
-    /// them (dense: the loop does not skip the zeros of axis-aligned joints).
+    /// them on the [`flatten`](Self::flatten)ed tables (dense: the loop does not skip the zeros
+    /// of axis-aligned joints).
     pub fn flops(&self) -> usize {
         // A step: 4 forces × (R f, R n: 2 × 15; P × f: 9; the sum: 3).
         let step = 4 * 42;
         // A dot product of a motion with the four forces: 4 × 11.
         let dots = 44;
-        let mut total = 0;
-        for c in &self.columns {
-            total += self.links[c.link].speeds.len() * dots;
-            let mut l = c.link;
-            while let Some(p) = self.links[l].parent {
-                total += step;
-                for s in &self.speeds[self.links[p].speeds.clone()] {
-                    // S, Ψ̇ (and Ψ̈) dots, then the sums of the two column entries.
-                    total += if s.joint { 3 * dots + 3 } else { 2 * dots + 1 };
-                }
-                l = p;
-            }
-        }
-        total
+        let (columns, steps) = self.flatten();
+        let ancestor = |s: &FlatStep| {
+            // S, Ψ̇ (and Ψ̈) dots, then the sums of the two column entries.
+            let reads = if self.speeds[s.speed].joint {
+                3 * dots + 3
+            } else {
+                2 * dots + 1
+            };
+            s.transform.map_or(0, |_| step) + reads
+        };
+        columns
+            .iter()
+            .map(|c| {
+                (c.own - c.first) * dots + steps[c.own..c.end].iter().map(ancestor).sum::<usize>()
+            })
+            .sum()
     }
 
     /// Every column's walk to the root as one run of steps (the runtime's flat tables): the

@@ -16,6 +16,8 @@
 //! * `forward_dynamics/fixed_wheels`: `KrangFixedWheels::forward_dynamics` (17 speeds,
 //!   `BlockCholesky<3, 17>`), at the trunk and arm coordinates of the same states;
 //! * `fd_derivatives/generated`: `Krang::forward_dynamics_derivatives` (u̇, ∂u̇/∂q, ∂u̇/∂u, M⁻¹);
+//! * `fd_derivatives/with`: `Krang::forward_dynamics_derivatives_with`, the same into a
+//!   `ForwardDynamicsDerivativesWorkspace` kept across calls;
 //! * `forward_dynamics/fixed_wheels_trait`: the same through the runtime trait's provided
 //!   `RobotDynamics::forward_dynamics` (a dense Cholesky), what every generated robot has;
 //! * `fd_derivatives/fixed_wheels`: `KrangFixedWheels::try_forward_dynamics_derivatives` (17
@@ -147,6 +149,10 @@ fn bench(c: &mut Criterion) {
     ));
     cycle!("fd_derivatives/generated", |q, u, ud| k
         .forward_dynamics_derivatives(q, u, &(ud * 10.0)));
+    let mut fd_ws = krang_dynamics::ForwardDynamicsDerivativesWorkspace::new();
+    cycle!("fd_derivatives/with", |q, u, ud| k
+        .forward_dynamics_derivatives_with(q, u, &(ud * 10.0), &mut fd_ws)
+        .dud_dq[(7, 9)]);
     // The fixed-wheel tree (17 speeds): the block factor with a trunk of three speeds.
     let fixed = krang_dynamics::fixed_wheels::KrangFixedWheels::default();
     cycle!("forward_dynamics/fixed_wheels", |q, u, ud| {

@@ -10,6 +10,7 @@
 //! * Krang's structural zeros: the x and ψ columns of ∂τ/∂q are exactly zero;
 //! * forward-dynamics derivatives against central differences of `forward_dynamics`, Krang's
 //!   (block Cholesky) and, for every generated robot with derivatives, the runtime trait's;
+//!   Krang's into a kept workspace bit for bit equal to its by-value result;
 //! * `linearize`: A and B against central differences of `ẋ = f(x, a)`; the upright
 //!   equilibrium of the default Krang has exactly one unstable (pitch) mode.
 
@@ -373,6 +374,52 @@ fn forward_dynamics_derivatives_match_central_differences() {
         worst[0], worst[1], worst[2]
     );
     assert!(worst.iter().all(|&w| w <= 1e-6), "{worst:?}");
+}
+
+#[test]
+fn forward_dynamics_derivatives_into_a_kept_workspace_equal_the_by_value_result_bit_for_bit() {
+    // One `ForwardDynamicsDerivativesWorkspace` across draws of other parameters and states
+    // (and of non-physical parameters, which NaN-fill it as they do the by-value result): each
+    // call overwrites every entry it returns, and solves each block's columns alone, with the
+    // bits the by-value form's one solve of all 57 columns gives them.
+    let mut r = rng(1212);
+    let mut ws = kd::ForwardDynamicsDerivativesWorkspace::new();
+    assert!(ws.result().minv.iter().all(|x| x.is_nan()));
+    let bits = |fd: &kd::ForwardDynamicsDerivatives<19>| {
+        [
+            fd.ud.as_slice(),
+            fd.dud_dq.as_slice(),
+            fd.dud_du.as_slice(),
+            fd.minv.as_slice(),
+        ]
+        .concat()
+    };
+    for draw in 0..30 {
+        let k = match draw {
+            0 => kd::Krang::default(),
+            13 => {
+                // The right hand's body with a negative mass: M is not positive definite.
+                let mut p = kd::Params::default();
+                for kind in ["m", "MX", "MY", "MZ", "XX", "XY", "XZ", "YY", "YZ", "ZZ"] {
+                    let name = format!("{kind}7r");
+                    let i = kd::Params::NAMES.iter().position(|n| *n == name).unwrap();
+                    let mut values = p.to_array();
+                    values[i] *= -10.0;
+                    p = kd::Params::from_array(values);
+                }
+                kd::Krang::new(p)
+            }
+            _ => random_krang(&mut r),
+        };
+        let (q, u, _) = random_state(&mut r, 19);
+        let (_, _, t) = random_state(&mut r, 19);
+        let (q, u, tau) = (sv::<19>(&q), sv::<19>(&u), sv::<19>(&t) * 10.0);
+        let by_value = k.forward_dynamics_derivatives(&q, &u, &tau);
+        let kept = k.forward_dynamics_derivatives_with(&q, &u, &tau, &mut ws);
+        assert!(same_bits(&bits(kept), &bits(&by_value)), "draw {draw}");
+        assert_eq!(draw == 13, by_value.minv.iter().all(|x| x.is_nan()));
+        assert!(same_bits(&bits(ws.result()), &bits(&by_value)));
+    }
 }
 
 #[test]

@@ -21,7 +21,8 @@
 //! and one single-state call in turn, what a caller mixing both pays); with
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
 //! across calls), `…_with` (into a `DerivativesWorkspace` kept across calls),
-//! `forward_dynamics_derivatives` and `linearize`; with the feature `coriolis-matrix` also
+//! `forward_dynamics_derivatives`, `forward_dynamics_derivatives_with` (into a
+//! `ForwardDynamicsDerivativesWorkspace` kept across calls) and `linearize`; with the feature `coriolis-matrix` also
 //! `coriolis_matrix`, `coriolis_matrix_s4`, `coriolis_matrix_s8` and `coriolis_matrix_s16`
 //! (its 4-, 8- and 16-state structure-of-arrays forms), `coriolis_matrix_b4` and
 //! `coriolis_matrix_b8` (arrays of 4 and 8 states); with the
@@ -92,6 +93,8 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
     let mut d_out = SMatrix::<f64, 19, 38>::zeros();
     #[cfg(feature = "derivatives")]
     let mut d_ws = krang_dynamics::DerivativesWorkspace::new();
+    #[cfg(feature = "derivatives")]
+    let mut fd_ws = krang_dynamics::ForwardDynamicsDerivativesWorkspace::new();
     let mut m_into = nalgebra::SMatrix::<f64, 19, 19>::zeros();
     let mut v4 = [V::zeros(); 4];
     let mut v8 = [V::zeros(); 8];
@@ -267,6 +270,17 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
             "inverse_dynamics_derivatives" => {
                 black_box(k).inverse_dynamics_derivatives(black_box(q), black_box(u), black_box(ud))
                     [(7, 20)]
+            }
+            #[cfg(feature = "derivatives")]
+            "forward_dynamics_derivatives_with" => {
+                let ws = black_box(&mut fd_ws);
+                black_box(k).forward_dynamics_derivatives_with(
+                    black_box(q),
+                    black_box(u),
+                    black_box(ud),
+                    ws,
+                );
+                black_box(&fd_ws).result().dud_dq[(7, 9)]
             }
             #[cfg(feature = "derivatives")]
             "forward_dynamics_derivatives" => {

@@ -11,7 +11,8 @@
 //! structure-of-arrays forms (`*_batch_soa`, at 3 and 8 states) give the array-of-states
 //! forms' bits in every lane. Batched forward dynamics (`forward_dynamics_batch_soa_into`,
 //! `forward_dynamics_batch`; Krang and the fixed-wheel tree) gives `forward_dynamics`' bits in
-//! every lane, NaN lanes included.
+//! every lane, NaN lanes included. The derivative loop's x86-64-v4 copy gives its x86-64-v3
+//! copy's bits.
 
 mod common;
 
@@ -291,6 +292,32 @@ fn dispatched_copies_agree_with_the_baseline_to_rounding() {
     );
     assert!(differing > 0, "{best} fused no multiply-add");
     isa::select(best).unwrap();
+}
+
+#[test]
+fn the_derivative_loops_x86_64_v4_copy_gives_the_x86_64_v3_copys_bits() {
+    // `derivative_steps::run` has a copy compiled for AVX-512 (VL: 32 registers, broadcasts
+    // folded into the multiply-adds, still 256-bit), run when x86-64-v4 is active: the same
+    // operations in the same order as the AVX2 copy, so the same bits.
+    let _one_at_a_time = isa_lock();
+    if !isa::available(Isa::X86_64V4) {
+        eprintln!("note: this CPU or build has no x86-64-v4 copy; nothing to compare");
+        return;
+    }
+    let model = model("krang.toml");
+    let mut uniform = rng(1415);
+    for _ in 0..50 {
+        let k = krang(&model, &mut uniform);
+        let (q, u, ud) = random_state(&mut uniform, 19);
+        let (q, u, ud): (V, V, V) = (sv(&q), sv(&u), sv(&ud));
+        let eval = |isa: Isa| {
+            isa::select(isa).unwrap();
+            k.inverse_dynamics_derivatives(&q, &u, &ud)
+        };
+        let (v3, v4) = (eval(Isa::X86_64V3), eval(Isa::X86_64V4));
+        assert!(same_bits(v3.as_slice(), v4.as_slice()));
+    }
+    isa::select(isa::detected()).unwrap();
 }
 
 /// Batched forward dynamics at `L` states (both forms) against `forward_dynamics` of each

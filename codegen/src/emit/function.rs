@@ -580,6 +580,11 @@ pub(super) enum Copies {
     /// (`isa::dispatch_pair_with`): the body's first argument is the copy's two-lane
     /// multiply-add (`lanes`).
     Lanes,
+    /// [`Copies::Lanes`] and an x86-64-v4 copy (`isa::dispatch_pair_wide_with`): the looped
+    /// derivatives' straight-line part, whose 54 KB of statements (Krang) run 4 % faster with
+    /// AVX-512's 32 registers (`docs/measurement-log.md`, "The looped derivatives in an
+    /// x86-64-v4 copy").
+    LanesWithV4,
 }
 
 /// The call of a generated function's inner `body::<A, …>(…, out)`, generic over the
@@ -596,12 +601,13 @@ pub(super) fn call_body_into(
     args: TokenStream,
     out: TokenStream,
 ) -> TokenStream {
-    let lanes = matches!(copies, Copies::Lanes);
+    let lanes = matches!(copies, Copies::Lanes | Copies::LanesWithV4);
     if cx.isa_dispatch {
         let dispatch = match copies {
             Copies::BaselineAndV3 => quote!(dispatch_fused_with),
             Copies::WithV4 => quote!(dispatch_fused_wide_with),
             Copies::Lanes => quote!(dispatch_pair_with),
+            Copies::LanesWithV4 => quote!(dispatch_pair_wide_with),
         };
         if lanes {
             return quote!(kanegen_runtime::isa::#dispatch(

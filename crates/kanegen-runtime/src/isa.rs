@@ -369,6 +369,26 @@ pub fn dispatch_pair_with<T, R>(
     )
 }
 
+/// [`dispatch_pair_with`] with a third copy of `fused`, compiled for x86-64-v4 and run when
+/// [`active`] is [`Isa::X86_64V4`] (as [`dispatch_fused_wide_with`] does): for a body with
+/// paired statements that gains from AVX-512's 32 registers and folded broadcasts while it
+/// computes with the same two-lane and scalar operations (the same bits as its x86-64-v3
+/// copy). The generated looped derivatives use it.
+#[inline(always)]
+pub fn dispatch_pair_wide_with<T, R>(
+    arg: T,
+    plain: impl FnOnce(T, Plain) -> R,
+    fused: impl FnOnce(T, FusedPair) -> R,
+) -> R {
+    dispatch_fused_wide_with(
+        arg,
+        #[inline(always)]
+        |arg| plain(arg, Plain),
+        #[inline(always)]
+        |arg| fused(arg, FusedPair::new_unchecked()),
+    )
+}
+
 /// The two-lane multiply-add that goes with [`Native`] (for a module generated without
 /// dispatch, `kanegen::Builder::isa_dispatch(false)`): a [`FusedPair`] when the build enables
 /// FMA (and `std` is on; aarch64), [`Plain`] otherwise.

@@ -193,6 +193,7 @@ fn time(dir: &Path) -> Result<(), String> {
     );
     // And the derivatives into a workspace kept across calls, as Pinocchio keeps `data`.
     let mut d_ws = krang_dynamics::DerivativesWorkspace::new();
+    let mut fd_ws = krang_dynamics::ForwardDynamicsDerivativesWorkspace::new();
     let results = [
         (
             "mass_matrix",
@@ -269,6 +270,17 @@ fn time(dir: &Path) -> Result<(), String> {
             "forward_dynamics_derivatives",
             time_one(&fd_states, |q, u, tau| {
                 black_box(black_box(k).forward_dynamics_derivatives(q, u, tau));
+            }),
+        ),
+        (
+            "forward_dynamics_derivatives_with",
+            time_one(&fd_states, |q, u, tau| {
+                black_box(black_box(k).forward_dynamics_derivatives_with(
+                    q,
+                    u,
+                    tau,
+                    black_box(&mut fd_ws),
+                ));
             }),
         ),
     ];
@@ -395,6 +407,12 @@ const ROWS: [Row; 13] = [
     (
         "`forward_dynamics_derivatives` (u̇, ∂u̇/∂q, ∂u̇/∂u, M⁻¹)",
         "forward_dynamics_derivatives",
+        "`computeABADerivatives` (∂u̇/∂q, ∂u̇/∂v, M⁻¹; 20 speeds as `aba`)",
+        "aba_derivatives",
+    ),
+    (
+        "`forward_dynamics_derivatives_with` (into a kept workspace)",
+        "forward_dynamics_derivatives_with",
         "`computeABADerivatives` (∂u̇/∂q, ∂u̇/∂v, M⁻¹; 20 speeds as `aba`)",
         "aba_derivatives",
     ),

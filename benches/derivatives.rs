@@ -25,7 +25,9 @@
 //! * `fd_derivatives/fixed_wheels_trait`: the same through the runtime trait's provided
 //!   `InverseDynamicsDerivatives::forward_dynamics_derivatives` (a dense Cholesky), what every
 //!   generated robot without a block factor of its own gets;
-//! * `linearize/generated`: `Krang::linearize` (A 38×38, B 38×18).
+//! * `linearize/generated`: `Krang::linearize` (A 38×38, B 38×18);
+//! * `linearize/with`: `Krang::linearize_with`, the same into a `LinearizationWorkspace` kept
+//!   across calls.
 //!
 //! Every variant cycles through the same 8 random states, inputs behind `black_box`.
 //!
@@ -175,6 +177,10 @@ fn bench(c: &mut Criterion) {
     });
     let a = SVector::<f64, 18>::from_element(1.0);
     cycle!("linearize/generated", |q, u, _ud| k.linearize(q, u, &a));
+    let mut lin_ws = krang_dynamics::LinearizationWorkspace::new();
+    cycle!("linearize/with", |q, u, _ud| k
+        .linearize_with(q, u, &a, &mut lin_ws)
+        .1[(25, 3)]);
     g.finish();
 }
 

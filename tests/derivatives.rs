@@ -11,6 +11,7 @@
 //! * forward-dynamics derivatives against central differences of `forward_dynamics`, Krang's
 //!   (block Cholesky) and, for every generated robot with derivatives, the runtime trait's;
 //!   Krang's into a kept workspace bit for bit equal to its by-value result;
+//! * `linearize_with` (a kept workspace) bit for bit equal to `linearize`;
 //! * `linearize`: A and B against central differences of `ẋ = f(x, a)`; the upright
 //!   equilibrium of the default Krang has exactly one unstable (pitch) mode.
 
@@ -707,6 +708,41 @@ fn krang_linearization_matches_central_differences() {
 /// `linearize` forms `B`'s lower block `M⁻¹ B_act` from the columns of `M⁻¹` (a joint's column
 /// or a wheel's sum of three) instead of solving with `B_act`: equal to the block factor's solve
 /// of `B_act` to rounding; `B`'s upper block (`∂q̇/∂a`) stays exactly zero.
+#[test]
+fn linearization_into_a_kept_workspace_equals_the_by_value_result_bit_for_bit() {
+    // One `LinearizationWorkspace` across draws of other parameters, states and inputs, and
+    // of non-physical parameters (all NaN, as by value; the constant blocks come back after).
+    let mut r = rng(1213);
+    let mut ws = kd::LinearizationWorkspace::new();
+    for draw in 0..24 {
+        let k = if draw % 8 == 3 {
+            let mut values = kd::Params::default().to_array();
+            for kind in ["m", "MX", "MY", "MZ", "XX", "XY", "XZ", "YY", "YZ", "ZZ"] {
+                let name = format!("{kind}7r");
+                let i = kd::Params::NAMES.iter().position(|n| *n == name).unwrap();
+                values[i] *= -10.0;
+            }
+            kd::Krang::new(kd::Params::from_array(values))
+        } else {
+            random_krang(&mut r)
+        };
+        let (q, u, _) = random_state(&mut r, 19);
+        let (q, u) = (sv::<19>(&q), sv::<19>(&u));
+        let a = SVector::<f64, 18>::from_fn(|_, _| 20.0 * r() - 10.0);
+        let (a_mat, b_mat) = k.linearize(&q, &u, &a);
+        let (a_kept, b_kept) = k.linearize_with(&q, &u, &a, &mut ws);
+        assert!(
+            same_bits(a_kept.as_slice(), a_mat.as_slice()),
+            "A, draw {draw}"
+        );
+        assert!(
+            same_bits(b_kept.as_slice(), b_mat.as_slice()),
+            "B, draw {draw}"
+        );
+        assert_eq!(draw % 8 == 3, a_mat.iter().all(|x| x.is_nan()));
+    }
+}
+
 #[test]
 fn krang_linearization_input_matrix_equals_the_factors_solve_of_the_actuator_matrix() {
     let mut r = rng(1211);

@@ -22,7 +22,8 @@
 //! the feature `derivatives` also `inverse_dynamics_derivatives`, `…_into` (into a matrix kept
 //! across calls), `…_with` (into a `DerivativesWorkspace` kept across calls),
 //! `forward_dynamics_derivatives`, `forward_dynamics_derivatives_with` (into a
-//! `ForwardDynamicsDerivativesWorkspace` kept across calls) and `linearize`; with the feature `coriolis-matrix` also
+//! `ForwardDynamicsDerivativesWorkspace` kept across calls), `linearize` and `linearize_with`
+//! (into a `LinearizationWorkspace` kept across calls); with the feature `coriolis-matrix` also
 //! `coriolis_matrix`, `coriolis_matrix_s4`, `coriolis_matrix_s8` and `coriolis_matrix_s16`
 //! (its 4-, 8- and 16-state structure-of-arrays forms), `coriolis_matrix_b4` and
 //! `coriolis_matrix_b8` (arrays of 4 and 8 states); with the
@@ -95,6 +96,8 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
     let mut d_ws = krang_dynamics::DerivativesWorkspace::new();
     #[cfg(feature = "derivatives")]
     let mut fd_ws = krang_dynamics::ForwardDynamicsDerivativesWorkspace::new();
+    #[cfg(feature = "derivatives")]
+    let mut lin_ws = krang_dynamics::LinearizationWorkspace::new();
     let mut m_into = nalgebra::SMatrix::<f64, 19, 19>::zeros();
     let mut v4 = [V::zeros(); 4];
     let mut v8 = [V::zeros(); 8];
@@ -294,6 +297,14 @@ fn run(k: &Krang, f: &str, s: &[(V, V, V)], batches: &Batches, calls: usize) -> 
                 let a = SVector::<f64, 18>::from_fn(|i, _| ud[i]);
                 black_box(k)
                     .linearize(black_box(q), black_box(u), black_box(&a))
+                    .1[(25, 3)]
+            }
+            #[cfg(feature = "derivatives")]
+            "linearize_with" => {
+                let a = SVector::<f64, 18>::from_fn(|i, _| ud[i]);
+                let ws = black_box(&mut lin_ws);
+                black_box(k)
+                    .linearize_with(black_box(q), black_box(u), black_box(&a), ws)
                     .1[(25, 3)]
             }
             #[cfg(feature = "derivatives")]

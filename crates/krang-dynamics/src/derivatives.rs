@@ -268,18 +268,32 @@ impl Krang {
         tau: &SVector<f64, 19>,
         ws: &'w mut ForwardDynamicsDerivativesWorkspace,
     ) -> &'w ForwardDynamicsDerivatives<19> {
-        self.mass_matrix_into(q, &mut ws.mass_matrix);
-        match MassMatrixCholesky::new(&ws.mass_matrix) {
-            Ok(chol) => forward_dynamics_derivatives_onto(
-                self,
-                &chol,
-                (q, u, tau),
-                |ud| self.inverse_dynamics_derivatives_with(q, u, ud, &mut ws.derivatives),
-                &mut ws.result,
-            ),
-            Err(_) => ws.result = nan_derivatives(),
-        }
+        self.forward_dynamics_derivatives_kept(q, u, tau, ws);
         &ws.result
+    }
+
+    /// [`forward_dynamics_derivatives_with`](Self::forward_dynamics_derivatives_with) into
+    /// `ws`; `false` (and NaN) where `M(q)` is not positive definite.
+    fn forward_dynamics_derivatives_kept(
+        &self,
+        q: &SVector<f64, 19>,
+        u: &SVector<f64, 19>,
+        tau: &SVector<f64, 19>,
+        ws: &mut ForwardDynamicsDerivativesWorkspace,
+    ) -> bool {
+        self.mass_matrix_into(q, &mut ws.mass_matrix);
+        let Ok(chol) = MassMatrixCholesky::new(&ws.mass_matrix) else {
+            ws.result = nan_derivatives();
+            return false;
+        };
+        forward_dynamics_derivatives_onto(
+            self,
+            &chol,
+            (q, u, tau),
+            |ud| self.inverse_dynamics_derivatives_with(q, u, ud, &mut ws.derivatives),
+            &mut ws.result,
+        );
+        true
     }
 
     /// The linearization `(A, B)` of `ẋ = f(x, a)` at `(q, u, a)`, with the state
@@ -320,25 +334,137 @@ impl Krang {
         };
         let fd =
             self.forward_dynamics_derivatives_factored(&chol, q, u, &self.generalized_forces(a));
-        // `M⁻¹ B_act` from the `M⁻¹` just computed: a column of `B_act` has one non-zero (a
-        // joint's actuator) or three (a wheel's: ẋ, ψ̇, q_imu), so each column of the product
-        // is one column of `M⁻¹` or a sum of three, instead of 18 more triangular solves.
-        // (Column slices: nalgebra's strided column iterators compile to scalar loops.)
-        let b_act = self.actuator_matrix();
-        let minv = fd.minv.as_slice();
         let mut dud_da = SMatrix::<f64, 19, ACTUATOR_COUNT>::zeros();
-        for (out, b) in dud_da
-            .as_mut_slice()
-            .chunks_exact_mut(19)
-            .zip(b_act.as_slice().chunks_exact(19))
-        {
+        self.minv_times_actuators(&fd.minv, dud_da.as_mut_slice().chunks_exact_mut(19));
+        state_space(&fd, &dud_da)
+    }
+}
+
+impl Krang {
+    /// `M⁻¹ B_act` from the `M⁻¹` just computed, into `columns` (19 entries each, zero on
+    /// entry): a column of `B_act` has one non-zero (a joint's actuator) or three (a wheel's: ẋ,
+    /// ψ̇, q_imu), so each column of the product is one column of `M⁻¹` or a sum of three,
+    /// instead of 18 more triangular solves. (Column slices: nalgebra's strided column
+    /// iterators compile to scalar loops.)
+    fn minv_times_actuators<'c>(
+        &self,
+        minv: &SMatrix<f64, 19, 19>,
+        columns: impl Iterator<Item = &'c mut [f64]>,
+    ) {
+        let b_act = self.actuator_matrix();
+        let minv = minv.as_slice();
+        for (out, b) in columns.zip(b_act.as_slice().chunks_exact(19)) {
             for (r, &x) in b.iter().enumerate().filter(|(_, x)| **x != 0.0) {
                 for (o, m) in out.iter_mut().zip(&minv[19 * r..19 * (r + 1)]) {
                     *o += x * m;
                 }
             }
         }
-        state_space(&fd, &dud_da)
+    }
+
+    /// [`linearize`](Self::linearize) written into a workspace the caller keeps across calls,
+    /// whose `(A, B)` it returns: the same bits, through
+    /// [`forward_dynamics_derivatives_with`](Self::forward_dynamics_derivatives_with), with
+    /// the constant blocks of `A` and `B` (`0`, `I`) written once instead of every call. For
+    /// an iLQR/DDP or MPC horizon, which linearizes at every knot. NaN-filled for non-physical
+    /// parameters, like `linearize`. Allocation-free.
+    ///
+    /// ```
+    /// use krang_dynamics::{Krang, LinearizationWorkspace};
+    /// use nalgebra::SVector;
+    ///
+    /// let k = Krang::default();
+    /// let mut ws = LinearizationWorkspace::new();
+    /// let (q, u) = (SVector::zeros(), SVector::zeros());
+    /// let (a_mat, b_mat) = k.linearize_with(&q, &u, &SVector::zeros(), &mut ws);
+    /// assert_eq!(a_mat[(0, 19)], 1.0);
+    /// assert_eq!(b_mat[(0, 0)], 0.0);
+    /// ```
+    pub fn linearize_with<'w>(
+        &self,
+        q: &SVector<f64, 19>,
+        u: &SVector<f64, 19>,
+        a: &SVector<f64, ACTUATOR_COUNT>,
+        ws: &'w mut LinearizationWorkspace,
+    ) -> (
+        &'w SMatrix<f64, 38, 38>,
+        &'w SMatrix<f64, 38, ACTUATOR_COUNT>,
+    ) {
+        if !self.forward_dynamics_derivatives_kept(q, u, &self.generalized_forces(a), &mut ws.fd) {
+            // Non-physical parameters (M is not positive definite): all NaN, as `linearize`.
+            ws.a.fill(f64::NAN);
+            ws.b.fill(f64::NAN);
+            ws.constant_blocks = false;
+            return (&ws.a, &ws.b);
+        }
+        if !ws.constant_blocks {
+            LinearizationWorkspace::write_constant_blocks(&mut ws.a, &mut ws.b);
+            ws.constant_blocks = true;
+        }
+        // The lower halves of the columns: [∂u̇/∂q, ∂u̇/∂u] in A, M⁻¹ B_act in B.
+        let fd = &ws.fd.result;
+        let blocks = fd
+            .dud_dq
+            .as_slice()
+            .chunks_exact(19)
+            .chain(fd.dud_du.as_slice().chunks_exact(19));
+        for (column, block) in ws.a.as_mut_slice().chunks_exact_mut(38).zip(blocks) {
+            column[19..].copy_from_slice(block);
+        }
+        let lower = ws.b.as_mut_slice().chunks_exact_mut(38).map(|c| {
+            let lower = &mut c[19..];
+            lower.fill(0.0);
+            lower
+        });
+        self.minv_times_actuators(&fd.minv, lower);
+        (&ws.a, &ws.b)
+    }
+}
+
+/// What [`Krang::linearize_with`] keeps across calls: a [`ForwardDynamicsDerivativesWorkspace`]
+/// and `A` (38 × 38) and `B` (38 × 18), whose constant blocks are written once (about 50 KB),
+/// made once by [`new`](Self::new). `A` and `B` are NaN before the first linearization.
+#[derive(Clone, Debug)]
+pub struct LinearizationWorkspace {
+    fd: ForwardDynamicsDerivativesWorkspace,
+    a: SMatrix<f64, 38, 38>,
+    b: SMatrix<f64, 38, ACTUATOR_COUNT>,
+    /// Whether the upper halves of `A` (`[0, I]`) and `B` (`0`) hold their constants (not
+    /// after a linearization with non-physical parameters, which NaN-fills both).
+    constant_blocks: bool,
+}
+
+impl LinearizationWorkspace {
+    /// A workspace whose `A` and `B` are NaN until the first linearization.
+    pub fn new() -> Self {
+        Self {
+            fd: ForwardDynamicsDerivativesWorkspace::new(),
+            a: SMatrix::from_element(f64::NAN),
+            b: SMatrix::from_element(f64::NAN),
+            constant_blocks: false,
+        }
+    }
+
+    /// The upper halves: `A = [[0, I], …]`, `B = [[0], …]` (`q̇ = u`).
+    fn write_constant_blocks(
+        a: &mut SMatrix<f64, 38, 38>,
+        b: &mut SMatrix<f64, 38, ACTUATOR_COUNT>,
+    ) {
+        for (j, column) in a.as_mut_slice().chunks_exact_mut(38).enumerate() {
+            column[..19].fill(0.0);
+            if j >= 19 {
+                column[j - 19] = 1.0;
+            }
+        }
+        for column in b.as_mut_slice().chunks_exact_mut(38) {
+            column[..19].fill(0.0);
+        }
+    }
+}
+
+impl Default for LinearizationWorkspace {
+    fn default() -> Self {
+        Self::new()
     }
 }
 

@@ -158,7 +158,9 @@ pub mod actuators;
 pub mod derivatives;
 pub use actuators::{ACTUATOR_COUNT, ACTUATOR_NAMES, actuator, hardware, saturate, saturate_to};
 #[cfg(feature = "derivatives")]
-pub use derivatives::{ForwardDynamicsDerivatives, ForwardDynamicsDerivativesWorkspace};
+pub use derivatives::{
+    ForwardDynamicsDerivatives, ForwardDynamicsDerivativesWorkspace, LinearizationWorkspace,
+};
 /// The trait of the generated derivatives (`inverse_dynamics_partials`, and the provided,
 /// dense `forward_dynamics_derivatives` that generic code gets; `Krang`'s inherent one uses
 /// the block Cholesky).

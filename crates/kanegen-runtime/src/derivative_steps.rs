@@ -426,27 +426,26 @@ macro_rules! avx_steps {
         fn reads<const K: usize>(mo: &[f64; 18], a: &Step, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
             let ds = lanes(_mm256_mul_pd(f[K], _mm256_set1_pd(mo[K])));
             let dpd = dots4::<K>(&mo[6..12], f);
-            // Ψ̈ = A_λ × S + V_λ × Ψ̇ has all six components in general.
-            let dpdd = if a.joint {
+            [ds, dpd, psidd_dots(mo, a, f)]
+        }
+
+        /// `Ψ̈ · F` for a joint (`Ψ̈ = A_λ × S + V_λ × Ψ̇` has all six components in general),
+        /// zeros for a quasi-velocity (not read).
+        #[target_feature(enable = $features)]
+        #[inline]
+        fn psidd_dots(mo: &[f64; 18], a: &Step, f: &[__m256d; 6]) -> [f64; 4] {
+            if a.joint {
                 dots(&mo[12..18], f)
             } else {
                 [0.0; 4]
-            };
-            [ds, dpd, dpdd]
+            }
         }
 
         /// [`reads`] for any `S`.
         #[target_feature(enable = $features)]
         #[inline]
         fn reads_dense(mo: &[f64; 18], a: &Step, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
-            let ds = dots(&mo[0..6], f);
-            let dpd = dots(&mo[6..12], f);
-            let dpdd = if a.joint {
-                dots(&mo[12..18], f)
-            } else {
-                [0.0; 4]
-            };
-            [ds, dpd, dpdd]
+            [dots(&mo[0..6], f), dots(&mo[6..12], f), psidd_dots(mo, a, f)]
         }
 
         /// See [`super::steps`].

@@ -117,8 +117,8 @@ where
 }
 
 /// What [`Krang::forward_dynamics_derivatives_with`] keeps across calls: the inverse-dynamics
-/// derivatives' workspace, `M(q)` and the result (about 33 KB), made once by
-/// [`new`](Self::new). Each call overwrites every entry it reads, so nothing is zeroed per
+/// derivatives' workspace, `M(q)` and the result (about 26 KB), made once by
+/// [`new`](Self::new). Each call overwrites every entry it returns, so nothing is zeroed per
 /// call; the result stays readable through [`result`](Self::result) until the next call.
 #[derive(Clone, Debug)]
 pub struct ForwardDynamicsDerivativesWorkspace {
@@ -392,8 +392,8 @@ impl Krang {
     ) {
         if !self.forward_dynamics_derivatives_kept(q, u, &self.generalized_forces(a), &mut ws.fd) {
             // Non-physical parameters (M is not positive definite): all NaN, as `linearize`.
-            ws.a.fill(f64::NAN);
-            ws.b.fill(f64::NAN);
+            ws.a.as_mut_slice().fill(f64::NAN);
+            ws.b.as_mut_slice().fill(f64::NAN);
             ws.constant_blocks = false;
             return (&ws.a, &ws.b);
         }
@@ -422,7 +422,7 @@ impl Krang {
 }
 
 /// What [`Krang::linearize_with`] keeps across calls: a [`ForwardDynamicsDerivativesWorkspace`]
-/// and `A` (38 × 38) and `B` (38 × 18), whose constant blocks are written once (about 50 KB),
+/// and `A` (38 × 38) and `B` (38 × 18), whose constant blocks are written once (about 43 KB),
 /// made once by [`new`](Self::new). `A` and `B` are NaN before the first linearization.
 #[derive(Clone, Debug)]
 pub struct LinearizationWorkspace {

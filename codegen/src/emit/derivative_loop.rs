@@ -150,10 +150,10 @@ pub(super) fn function(
         #run(&#tables_name, &w[..], m.as_mut_slice());
     };
     let mat = quote!(SMatrix<#t, #rows, #cols>);
-    // The body generic over the multiply-add (fused in the x86-64-v3 and x86-64-v4 copies),
-    // writing into `m`. An x86-64-v4 copy too, unlike the other single-state functions: its
-    // long straight-line part gains from the 32 registers (measurement log, "The looped
-    // derivatives in an x86-64-v4 copy").
+    // The body generic over the multiply-add (fused in the x86-64-v3 copy), writing into `m`.
+    // With the arms in lanes (Krang) an x86-64-v4 copy too, unlike the other single-state
+    // functions: its long straight-line part gains from the 32 registers (measurement log,
+    // "The looped derivatives in an x86-64-v4 copy"); models without lanes were not measured.
     let (outer_params, pass_params) = super::function::outer_params(cx);
     let state = super::items::arg_names(spec.inputs);
     let call = super::function::call_body_into(
@@ -161,7 +161,7 @@ pub(super) fn function(
         if lanes {
             super::function::Copies::LanesWithV4
         } else {
-            super::function::Copies::WithV4
+            super::function::Copies::BaselineAndV3
         },
         quote!(),
         quote!(#pass_params #state,),

@@ -348,6 +348,18 @@ fn random_krang(r: &mut impl FnMut() -> f64) -> kd::Krang {
     kd::Krang::new(kd::Params::from_array(p.try_into().unwrap()))
 }
 
+/// Krang with the right hand's body scaled by −10 (a negative mass): M is not positive
+/// definite.
+fn non_physical_krang() -> kd::Krang {
+    let mut values = kd::Params::default().to_array();
+    for kind in ["m", "MX", "MY", "MZ", "XX", "XY", "XZ", "YY", "YZ", "ZZ"] {
+        let name = format!("{kind}7r");
+        let i = kd::Params::NAMES.iter().position(|n| *n == name).unwrap();
+        values[i] *= -10.0;
+    }
+    kd::Krang::new(kd::Params::from_array(values))
+}
+
 #[test]
 fn forward_dynamics_derivatives_match_central_differences() {
     let mut r = rng(1208);
@@ -398,18 +410,7 @@ fn forward_dynamics_derivatives_into_a_kept_workspace_equal_the_by_value_result_
     for draw in 0..30 {
         let k = match draw {
             0 => kd::Krang::default(),
-            13 => {
-                // The right hand's body with a negative mass: M is not positive definite.
-                let mut p = kd::Params::default();
-                for kind in ["m", "MX", "MY", "MZ", "XX", "XY", "XZ", "YY", "YZ", "ZZ"] {
-                    let name = format!("{kind}7r");
-                    let i = kd::Params::NAMES.iter().position(|n| *n == name).unwrap();
-                    let mut values = p.to_array();
-                    values[i] *= -10.0;
-                    p = kd::Params::from_array(values);
-                }
-                kd::Krang::new(p)
-            }
+            13 => non_physical_krang(),
             _ => random_krang(&mut r),
         };
         let (q, u, _) = random_state(&mut r, 19);
@@ -716,13 +717,7 @@ fn linearization_into_a_kept_workspace_equals_the_by_value_result_bit_for_bit() 
     let mut ws = kd::LinearizationWorkspace::new();
     for draw in 0..24 {
         let k = if draw % 8 == 3 {
-            let mut values = kd::Params::default().to_array();
-            for kind in ["m", "MX", "MY", "MZ", "XX", "XY", "XZ", "YY", "YZ", "ZZ"] {
-                let name = format!("{kind}7r");
-                let i = kd::Params::NAMES.iter().position(|n| *n == name).unwrap();
-                values[i] *= -10.0;
-            }
-            kd::Krang::new(kd::Params::from_array(values))
+            non_physical_krang()
         } else {
             random_krang(&mut r)
         };

@@ -11,8 +11,8 @@
 //! structure-of-arrays forms (`*_batch_soa`, at 3 and 8 states) give the array-of-states
 //! forms' bits in every lane. Batched forward dynamics (`forward_dynamics_batch_soa_into`,
 //! `forward_dynamics_batch`; Krang and the fixed-wheel tree) gives `forward_dynamics`' bits in
-//! every lane, NaN lanes included. The derivative loop's x86-64-v4 copy gives its x86-64-v3
-//! copy's bits.
+//! every lane, NaN lanes included. The looped derivatives' x86-64-v4 copies (straight-line
+//! part and loop) give their x86-64-v3 copies' bits.
 
 mod common;
 
@@ -295,10 +295,11 @@ fn dispatched_copies_agree_with_the_baseline_to_rounding() {
 }
 
 #[test]
-fn the_derivative_loops_x86_64_v4_copy_gives_the_x86_64_v3_copys_bits() {
-    // `derivative_steps::run` has a copy compiled for AVX-512 (VL: 32 registers, broadcasts
-    // folded into the multiply-adds, still 256-bit), run when x86-64-v4 is active: the same
-    // operations in the same order as the AVX2 copy, so the same bits.
+fn the_derivatives_x86_64_v4_copies_give_the_x86_64_v3_copies_bits() {
+    // With x86-64-v4 active, the looped derivatives run their straight-line part's x86-64-v4
+    // copy (`isa::dispatch_pair_wide_with`) and `derivative_steps::run`'s AVX-512VL copy (32
+    // registers, broadcasts folded into the multiply-adds, still 256-bit): the same operations
+    // in the same order as the x86-64-v3 copies, so the same bits.
     let _one_at_a_time = isa_lock();
     if !isa::available(Isa::X86_64V4) {
         eprintln!("note: this CPU or build has no x86-64-v4 copy; nothing to compare");

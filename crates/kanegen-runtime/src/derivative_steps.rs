@@ -17,7 +17,8 @@
 //!
 //! The four forces are kept component-major (component `k` of `Φ`, `Ξ`, `H`, `G` side by side),
 //! so that one step is one 4-wide transform: one AVX2 register per component in the x86-64-v3
-//! copy ([`run`]; on an AVX-512 CPU the same code compiled for AVX-512VL, still 256-bit). The loop's code is about 2 KB and stays in the instruction cache, where the
+//! copy ([`run`]; on an AVX-512 CPU the same code compiled for AVX-512VL, still 256-bit). The
+//! loop's code is about 2 KB and stays in the instruction cache, where the
 //! straight-line form of the same steps was streamed from L2 on every call (Krang: 233 KB of
 //! code in all). The transforms and dot products are dense (the loop does not know which
 //! entries of an axis-aligned joint's `R`, `P`, `S` vanish): more arithmetic than the
@@ -196,7 +197,8 @@ where
 /// is long). On x86-64 it runs a copy written with AVX2 and FMA intrinsics when
 /// [`crate::isa::active`] is x86-64-v3 or x86-64-v4 (or the crate is compiled for AVX2 and
 /// FMA): the four lanes in one register; when x86-64-v4 is active, that copy compiled for
-/// AVX-512 F and VL (the same bits). LLVM does not vectorize the portable form (it splits the lanes into
+/// AVX-512 F and VL (the same bits). LLVM does not vectorize the portable form (it splits the
+/// lanes into
 /// scalars): Krang's 104 steps take 46,000 instructions in it even in the x86-64-v3 copy,
 /// 21,200 with AVX2 intrinsics and 18,600 with AVX2 and FMA (callgrind). Elsewhere the
 /// portable form runs. The two copies differ in the last bits (the fused multiply-adds round
@@ -323,166 +325,172 @@ macro_rules! avx_steps {
     ($(#[$attr:meta])* $name:ident, $features:literal) => {
         $(#[$attr])*
         mod $name {
-        use core::arch::x86_64::{
-            __m256d, _mm_cvtsd_f64, _mm_unpackhi_pd, _mm256_add_pd, _mm256_castpd256_pd128,
-            _mm256_extractf128_pd, _mm256_fmadd_pd, _mm256_fnmadd_pd, _mm256_mul_pd, _mm256_set_pd,
-            _mm256_set1_pd,
-        };
+            use core::arch::x86_64::{
+                __m256d, _mm_cvtsd_f64, _mm_unpackhi_pd, _mm256_add_pd,
+                _mm256_castpd256_pd128, _mm256_extractf128_pd, _mm256_fmadd_pd,
+                _mm256_fnmadd_pd, _mm256_mul_pd, _mm256_set_pd, _mm256_set1_pd,
+            };
 
-        use super::{NO_TRANSFORM, Plan, Step, put, write_reads};
+            use super::{NO_TRANSFORM, Plan, Step, put, write_reads};
 
-        #[target_feature(enable = $features)]
-        #[inline]
-        fn load(x: &[f64]) -> __m256d {
-            _mm256_set_pd(x[3], x[2], x[1], x[0])
-        }
-
-        #[target_feature(enable = $features)]
-        #[inline]
-        fn lanes(v: __m256d) -> [f64; 4] {
-            let lo = _mm256_castpd256_pd128(v);
-            let hi = _mm256_extractf128_pd::<1>(v);
-            [
-                _mm_cvtsd_f64(lo),
-                _mm_cvtsd_f64(_mm_unpackhi_pd(lo, lo)),
-                _mm_cvtsd_f64(hi),
-                _mm_cvtsd_f64(_mm_unpackhi_pd(hi, hi)),
-            ]
-        }
-
-        #[target_feature(enable = $features)]
-        #[inline]
-        fn dots(x: &[f64], f: &[__m256d; 6]) -> [f64; 4] {
-            let a = _mm256_fmadd_pd(
-                f[1],
-                _mm256_set1_pd(x[1]),
-                _mm256_mul_pd(f[0], _mm256_set1_pd(x[0])),
-            );
-            let b = _mm256_fmadd_pd(
-                f[3],
-                _mm256_set1_pd(x[3]),
-                _mm256_mul_pd(f[2], _mm256_set1_pd(x[2])),
-            );
-            let c = _mm256_fmadd_pd(
-                f[5],
-                _mm256_set1_pd(x[5]),
-                _mm256_mul_pd(f[4], _mm256_set1_pd(x[4])),
-            );
-            lanes(_mm256_add_pd(_mm256_add_pd(a, b), c))
-        }
-
-        #[target_feature(enable = $features)]
-        #[inline]
-        fn up(t: &[f64], f: &[__m256d; 6]) -> [__m256d; 6] {
-            let t = &t[..12];
-            // Row i of R times (x0, x1, x2).
-            macro_rules! rot {
-                ($i:expr, $x0:expr, $x1:expr, $x2:expr) => {{
-                    let a = _mm256_fmadd_pd(
-                        $x1,
-                        _mm256_set1_pd(t[3 * $i + 1]),
-                        _mm256_mul_pd($x0, _mm256_set1_pd(t[3 * $i])),
-                    );
-                    _mm256_fmadd_pd($x2, _mm256_set1_pd(t[3 * $i + 2]), a)
-                }};
+            #[target_feature(enable = $features)]
+            #[inline]
+            fn load(x: &[f64]) -> __m256d {
+                _mm256_set_pd(x[3], x[2], x[1], x[0])
             }
-            let (p0, p1, p2) = (
-                _mm256_set1_pd(t[9]),
-                _mm256_set1_pd(t[10]),
-                _mm256_set1_pd(t[11]),
-            );
-            let f0 = rot!(0, f[3], f[4], f[5]);
-            let f1 = rot!(1, f[3], f[4], f[5]);
-            let f2 = rot!(2, f[3], f[4], f[5]);
-            // R n + P × R f: two fused operations per component.
-            let n0 = _mm256_fmadd_pd(f2, p1, _mm256_fnmadd_pd(f1, p2, rot!(0, f[0], f[1], f[2])));
-            let n1 = _mm256_fmadd_pd(f0, p2, _mm256_fnmadd_pd(f2, p0, rot!(1, f[0], f[1], f[2])));
-            let n2 = _mm256_fmadd_pd(f1, p0, _mm256_fnmadd_pd(f0, p1, rot!(2, f[0], f[1], f[2])));
-            [n0, n1, n2, f0, f1, f2]
-        }
 
-        /// `Σ_j x[j] f[j]` over the four components `j` other than `k` and `3 + k`.
-        #[target_feature(enable = $features)]
-        #[inline]
-        fn dots4<const K: usize>(x: &[f64], f: &[__m256d; 6]) -> [f64; 4] {
-            let (a, b) = ((K + 1) % 3, (K + 2) % 3);
-            let p = _mm256_fmadd_pd(
-                f[b],
-                _mm256_set1_pd(x[b]),
-                _mm256_mul_pd(f[a], _mm256_set1_pd(x[a])),
-            );
-            let q = _mm256_fmadd_pd(
-                f[3 + b],
-                _mm256_set1_pd(x[3 + b]),
-                _mm256_mul_pd(f[3 + a], _mm256_set1_pd(x[3 + a])),
-            );
-            lanes(_mm256_add_pd(p, q))
-        }
-
-        /// The dot products the step `a` reads: `S·F`, `Ψ̇·F` and (joints) `Ψ̈·F`, from the motions
-        /// at `m` (`S = ±e_k` read as one component and `Ψ̇` as four when `a.axis` is `k`).
-        #[target_feature(enable = $features)]
-        #[inline]
-        fn reads<const K: usize>(mo: &[f64; 18], a: &Step, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
-            let ds = lanes(_mm256_mul_pd(f[K], _mm256_set1_pd(mo[K])));
-            let dpd = dots4::<K>(&mo[6..12], f);
-            [ds, dpd, psidd_dots(mo, a, f)]
-        }
-
-        /// `Ψ̈ · F` for a joint (`Ψ̈ = A_λ × S + V_λ × Ψ̇` has all six components in general),
-        /// zeros for a quasi-velocity (not read).
-        #[target_feature(enable = $features)]
-        #[inline]
-        fn psidd_dots(mo: &[f64; 18], a: &Step, f: &[__m256d; 6]) -> [f64; 4] {
-            if a.joint {
-                dots(&mo[12..18], f)
-            } else {
-                [0.0; 4]
+            #[target_feature(enable = $features)]
+            #[inline]
+            fn lanes(v: __m256d) -> [f64; 4] {
+                let lo = _mm256_castpd256_pd128(v);
+                let hi = _mm256_extractf128_pd::<1>(v);
+                [
+                    _mm_cvtsd_f64(lo),
+                    _mm_cvtsd_f64(_mm_unpackhi_pd(lo, lo)),
+                    _mm_cvtsd_f64(hi),
+                    _mm_cvtsd_f64(_mm_unpackhi_pd(hi, hi)),
+                ]
             }
-        }
 
-        /// [`reads`] for any `S`.
-        #[target_feature(enable = $features)]
-        #[inline]
-        fn reads_dense(mo: &[f64; 18], a: &Step, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
-            [dots(&mo[0..6], f), dots(&mo[6..12], f), psidd_dots(mo, a, f)]
-        }
+            #[target_feature(enable = $features)]
+            #[inline]
+            fn dots(x: &[f64], f: &[__m256d; 6]) -> [f64; 4] {
+                let a = _mm256_fmadd_pd(
+                    f[1],
+                    _mm256_set1_pd(x[1]),
+                    _mm256_mul_pd(f[0], _mm256_set1_pd(x[0])),
+                );
+                let b = _mm256_fmadd_pd(
+                    f[3],
+                    _mm256_set1_pd(x[3]),
+                    _mm256_mul_pd(f[2], _mm256_set1_pd(x[2])),
+                );
+                let c = _mm256_fmadd_pd(
+                    f[5],
+                    _mm256_set1_pd(x[5]),
+                    _mm256_mul_pd(f[4], _mm256_set1_pd(x[4])),
+                );
+                lanes(_mm256_add_pd(_mm256_add_pd(a, b), c))
+            }
 
-        /// See [`super::steps`].
-        #[target_feature(enable = $features)]
-        pub(super) fn steps(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
-            for col in plan.columns {
-                let x: &[f64; 24] = super::chunk(w, usize::from(col.forces));
-                                let mut f = [
-                    load(&x[0..4]),
-                    load(&x[4..8]),
-                    load(&x[8..12]),
-                    load(&x[12..16]),
-                    load(&x[16..20]),
-                    load(&x[20..24]),
-                ];
-                let (own_rows, up_steps) = col.ranges();
-                for s in &plan.steps[own_rows] {
-                    let mo: &[f64; 18] = super::chunk(w, usize::from(s.motion));
-                    let ds = dots(&mo[0..6], &f);
-                    put(out, s.entries[0], ds[3]);
-                    put(out, s.entries[1], ds[2]);
+            #[target_feature(enable = $features)]
+            #[inline]
+            fn up(t: &[f64], f: &[__m256d; 6]) -> [__m256d; 6] {
+                let t = &t[..12];
+                // Row i of R times (x0, x1, x2).
+                macro_rules! rot {
+                    ($i:expr, $x0:expr, $x1:expr, $x2:expr) => {{
+                        let a = _mm256_fmadd_pd(
+                            $x1,
+                            _mm256_set1_pd(t[3 * $i + 1]),
+                            _mm256_mul_pd($x0, _mm256_set1_pd(t[3 * $i])),
+                        );
+                        _mm256_fmadd_pd($x2, _mm256_set1_pd(t[3 * $i + 2]), a)
+                    }};
                 }
-                for s in &plan.steps[up_steps] {
-                    if s.transform != NO_TRANSFORM {
-                        f = up(super::chunk::<f64, 12>(w, usize::from(s.transform)), &f);
+                let (p0, p1, p2) = (
+                    _mm256_set1_pd(t[9]),
+                    _mm256_set1_pd(t[10]),
+                    _mm256_set1_pd(t[11]),
+                );
+                let f0 = rot!(0, f[3], f[4], f[5]);
+                let f1 = rot!(1, f[3], f[4], f[5]);
+                let f2 = rot!(2, f[3], f[4], f[5]);
+                // R n + P × R f: two fused operations per component.
+                let (m0, m1, m2) = (
+                    rot!(0, f[0], f[1], f[2]),
+                    rot!(1, f[0], f[1], f[2]),
+                    rot!(2, f[0], f[1], f[2]),
+                );
+                let n0 = _mm256_fmadd_pd(f2, p1, _mm256_fnmadd_pd(f1, p2, m0));
+                let n1 = _mm256_fmadd_pd(f0, p2, _mm256_fnmadd_pd(f2, p0, m1));
+                let n2 = _mm256_fmadd_pd(f1, p0, _mm256_fnmadd_pd(f0, p1, m2));
+                [n0, n1, n2, f0, f1, f2]
+            }
+
+            /// `Σ_j x[j] f[j]` over the four components `j` other than `k` and `3 + k`.
+            #[target_feature(enable = $features)]
+            #[inline]
+            fn dots4<const K: usize>(x: &[f64], f: &[__m256d; 6]) -> [f64; 4] {
+                let (a, b) = ((K + 1) % 3, (K + 2) % 3);
+                let p = _mm256_fmadd_pd(
+                    f[b],
+                    _mm256_set1_pd(x[b]),
+                    _mm256_mul_pd(f[a], _mm256_set1_pd(x[a])),
+                );
+                let q = _mm256_fmadd_pd(
+                    f[3 + b],
+                    _mm256_set1_pd(x[3 + b]),
+                    _mm256_mul_pd(f[3 + a], _mm256_set1_pd(x[3 + a])),
+                );
+                lanes(_mm256_add_pd(p, q))
+            }
+
+            /// The dot products the step `a` reads: `S·F`, `Ψ̇·F` and (joints) `Ψ̈·F`, from its
+            /// motions `mo` (`S = ±e_k` read as one component and `Ψ̇` as four when `a.axis` is
+            /// `k`).
+            #[target_feature(enable = $features)]
+            #[inline]
+            fn reads<const K: usize>(mo: &[f64; 18], a: &Step, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
+                let ds = lanes(_mm256_mul_pd(f[K], _mm256_set1_pd(mo[K])));
+                let dpd = dots4::<K>(&mo[6..12], f);
+                [ds, dpd, psidd_dots(mo, a, f)]
+            }
+
+            /// `Ψ̈ · F` for a joint (`Ψ̈ = A_λ × S + V_λ × Ψ̇` has all six components in general),
+            /// zeros for a quasi-velocity (not read).
+            #[target_feature(enable = $features)]
+            #[inline]
+            fn psidd_dots(mo: &[f64; 18], a: &Step, f: &[__m256d; 6]) -> [f64; 4] {
+                if a.joint {
+                    dots(&mo[12..18], f)
+                } else {
+                    [0.0; 4]
+                }
+            }
+
+            /// [`reads`] for any `S`.
+            #[target_feature(enable = $features)]
+            #[inline]
+            fn reads_dense(mo: &[f64; 18], a: &Step, f: &[__m256d; 6]) -> [[f64; 4]; 3] {
+                [dots(&mo[0..6], f), dots(&mo[6..12], f), psidd_dots(mo, a, f)]
+            }
+
+            /// See [`super::steps`].
+            #[target_feature(enable = $features)]
+            pub(super) fn steps(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
+                for col in plan.columns {
+                    let x: &[f64; 24] = super::chunk(w, usize::from(col.forces));
+                                    let mut f = [
+                        load(&x[0..4]),
+                        load(&x[4..8]),
+                        load(&x[8..12]),
+                        load(&x[12..16]),
+                        load(&x[16..20]),
+                        load(&x[20..24]),
+                    ];
+                    let (own_rows, up_steps) = col.ranges();
+                    for s in &plan.steps[own_rows] {
+                        let mo: &[f64; 18] = super::chunk(w, usize::from(s.motion));
+                        let ds = dots(&mo[0..6], &f);
+                        put(out, s.entries[0], ds[3]);
+                        put(out, s.entries[1], ds[2]);
                     }
-                    let mo: &[f64; 18] = super::chunk(w, usize::from(s.motion));
-                    let [ds, dpd, dpdd] = match s.axis {
-                        0 => reads::<0>(mo, s, &f),
-                        1 => reads::<1>(mo, s, &f),
-                        2 => reads::<2>(mo, s, &f),
-                        _ => reads_dense(mo, s, &f),
-                    };
-                    write_reads(out, s, ds, dpd, dpdd);
+                    for s in &plan.steps[up_steps] {
+                        if s.transform != NO_TRANSFORM {
+                            f = up(super::chunk::<f64, 12>(w, usize::from(s.transform)), &f);
+                        }
+                        let mo: &[f64; 18] = super::chunk(w, usize::from(s.motion));
+                        let [ds, dpd, dpdd] = match s.axis {
+                            0 => reads::<0>(mo, s, &f),
+                            1 => reads::<1>(mo, s, &f),
+                            2 => reads::<2>(mo, s, &f),
+                            _ => reads_dense(mo, s, &f),
+                        };
+                        write_reads(out, s, ds, dpd, dpdd);
+                    }
                 }
             }
-        }
         }
     };
 }

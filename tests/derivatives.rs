@@ -10,8 +10,9 @@
 //! * Krang's structural zeros: the x and ψ columns of ∂τ/∂q are exactly zero;
 //! * forward-dynamics derivatives against central differences of `forward_dynamics`, Krang's
 //!   (block Cholesky) and, for every generated robot with derivatives, the runtime trait's;
-//!   Krang's into a kept workspace bit for bit equal to its by-value result;
-//! * `linearize_with` (a kept workspace) bit for bit equal to `linearize`;
+//!   Krang's and the fixed-wheel tree's into a kept workspace bit for bit equal to their
+//!   by-value results;
+//! * `linearize_with` (a kept workspace) bit for bit equal to `linearize`, both models;
 //! * `linearize`: A and B against central differences of `ẋ = f(x, a)`; the upright
 //!   equilibrium of the default Krang has exactly one unstable (pitch) mode.
 
@@ -352,12 +353,24 @@ fn random_krang(r: &mut impl FnMut() -> f64) -> kd::Krang {
 /// definite.
 fn non_physical_krang() -> kd::Krang {
     let mut values = kd::Params::default().to_array();
+    scale_right_hand(&mut values, &kd::Params::NAMES, -10.0);
+    kd::Krang::new(kd::Params::from_array(values))
+}
+
+/// The fixed-wheel tree with the right hand's body scaled by −10, as [`non_physical_krang`].
+fn non_physical_fixed_wheels() -> kd::fixed_wheels::KrangFixedWheels {
+    let mut values = kd::fixed_wheels::Params::default().to_array();
+    scale_right_hand(&mut values, &kd::fixed_wheels::Params::NAMES, -10.0);
+    kd::fixed_wheels::KrangFixedWheels::new(kd::fixed_wheels::Params::from_array(values))
+}
+
+/// Scales the inertial parameters of the right hand's body (link `7r`) by `k`.
+fn scale_right_hand(values: &mut [f64], names: &[&str], k: f64) {
     for kind in ["m", "MX", "MY", "MZ", "XX", "XY", "XZ", "YY", "YZ", "ZZ"] {
         let name = format!("{kind}7r");
-        let i = kd::Params::NAMES.iter().position(|n| *n == name).unwrap();
-        values[i] *= -10.0;
+        let i = names.iter().position(|n| *n == name).unwrap();
+        values[i] *= k;
     }
-    kd::Krang::new(kd::Params::from_array(values))
 }
 
 #[test]
@@ -421,6 +434,65 @@ fn forward_dynamics_derivatives_into_a_kept_workspace_equal_the_by_value_result_
         assert!(same_bits(&bits(kept), &bits(&by_value)), "draw {draw}");
         assert_eq!(draw == 13, by_value.minv.iter().all(|x| x.is_nan()));
         assert!(same_bits(&bits(ws.result()), &bits(&by_value)));
+    }
+}
+
+#[test]
+fn fixed_wheel_derivatives_and_linearization_into_kept_workspaces_equal_the_by_value_results() {
+    // The fixed-wheel tree's `forward_dynamics_derivatives_with` and `linearize_with`, one
+    // workspace each across draws of other parameters and states, and of non-physical
+    // parameters (NaN, as the by-value `linearize`; `try_forward_dynamics_derivatives` errs).
+    let model = model("krang-fixed-wheels.toml");
+    let mut r = rng(1214);
+    let mut fd_ws = kd::fixed_wheels::ForwardDynamicsDerivativesWorkspace::new();
+    let mut lin_ws = kd::fixed_wheels::LinearizationWorkspace::new();
+    assert!(fd_ws.result().minv.iter().all(|x| x.is_nan()));
+    for draw in 0..24 {
+        let k = if draw % 8 == 5 {
+            non_physical_fixed_wheels()
+        } else {
+            let p = random_physical_params(&model, &mut r);
+            kd::fixed_wheels::KrangFixedWheels::new(kd::fixed_wheels::Params::from_array(
+                p.try_into().unwrap(),
+            ))
+        };
+        let (q, u, t) = random_state(&mut r, 17);
+        let (q, u, tau) = (sv::<17>(&q), sv::<17>(&u), sv::<17>(&t) * 10.0);
+        let kept = k.forward_dynamics_derivatives_with(&q, &u, &tau, &mut fd_ws);
+        let kept = [
+            kept.ud.as_slice(),
+            kept.dud_dq.as_slice(),
+            kept.dud_du.as_slice(),
+            kept.minv.as_slice(),
+        ]
+        .concat();
+        match k.try_forward_dynamics_derivatives(&q, &u, &tau) {
+            Ok(fd) => {
+                let by_value = [
+                    fd.ud.as_slice(),
+                    fd.dud_dq.as_slice(),
+                    fd.dud_du.as_slice(),
+                    fd.minv.as_slice(),
+                ]
+                .concat();
+                assert!(same_bits(&kept, &by_value), "draw {draw}");
+            }
+            Err(_) => {
+                assert_eq!(draw % 8, 5);
+                assert!(kept.iter().all(|x| x.is_nan()), "draw {draw}");
+            }
+        }
+        let (a_mat, b_mat) = k.linearize(&q, &u, &tau);
+        let (a_kept, b_kept) = k.linearize_with(&q, &u, &tau, &mut lin_ws);
+        assert!(
+            same_bits(a_kept.as_slice(), a_mat.as_slice()),
+            "A, draw {draw}"
+        );
+        assert!(
+            same_bits(b_kept.as_slice(), b_mat.as_slice()),
+            "B, draw {draw}"
+        );
+        assert_eq!(draw % 8 == 5, a_mat.iter().all(|x| x.is_nan()));
     }
 }
 

@@ -118,20 +118,28 @@ where
 
 /// What [`Krang::forward_dynamics_derivatives_with`] keeps across calls: the inverse-dynamics
 /// derivatives' workspace, `M(q)` and the result (about 26 KB), made once by
-/// [`new`](Self::new). Each call overwrites every entry it returns, so nothing is zeroed per
-/// call; the result stays readable through [`result`](Self::result) until the next call.
+/// [`new`](ForwardDynamicsDerivativesWorkspaceOf::new). Each call overwrites every entry it
+/// returns, so nothing is zeroed per call; the result stays readable through
+/// [`result`](ForwardDynamicsDerivativesWorkspaceOf::result) until the next call.
+pub type ForwardDynamicsDerivativesWorkspace =
+    ForwardDynamicsDerivativesWorkspaceOf<crate::DerivativesWorkspace, 19>;
+
+/// The kept workspace of `forward_dynamics_derivatives_with` for a model of `N` speeds whose
+/// generated module's derivatives workspace is `W`: Krang's
+/// [`ForwardDynamicsDerivativesWorkspace`] and the fixed-wheel tree's
+/// `fixed_wheels::ForwardDynamicsDerivativesWorkspace` (feature `fixed-wheels`).
 #[derive(Clone, Debug)]
-pub struct ForwardDynamicsDerivativesWorkspace {
-    derivatives: crate::DerivativesWorkspace,
-    mass_matrix: SMatrix<f64, 19, 19>,
-    result: ForwardDynamicsDerivatives<19>,
+pub struct ForwardDynamicsDerivativesWorkspaceOf<W, const N: usize> {
+    derivatives: W,
+    mass_matrix: SMatrix<f64, N, N>,
+    result: ForwardDynamicsDerivatives<N>,
 }
 
-impl ForwardDynamicsDerivativesWorkspace {
+impl<W: Default, const N: usize> ForwardDynamicsDerivativesWorkspaceOf<W, N> {
     /// A workspace whose result is NaN until the first evaluation.
     pub fn new() -> Self {
         Self {
-            derivatives: crate::DerivativesWorkspace::new(),
+            derivatives: W::default(),
             mass_matrix: SMatrix::zeros(),
             result: nan_derivatives(),
         }
@@ -139,15 +147,47 @@ impl ForwardDynamicsDerivativesWorkspace {
 
     /// The derivatives of the last [`Krang::forward_dynamics_derivatives_with`] (NaN before
     /// the first, and after one with non-physical parameters).
-    pub fn result(&self) -> &ForwardDynamicsDerivatives<19> {
+    pub fn result(&self) -> &ForwardDynamicsDerivatives<N> {
         &self.result
     }
 }
 
-impl Default for ForwardDynamicsDerivativesWorkspace {
+impl<W: Default, const N: usize> Default for ForwardDynamicsDerivativesWorkspaceOf<W, N> {
     fn default() -> Self {
         Self::new()
     }
+}
+
+/// Fills `ws` with forward dynamics and its derivatives at `(q, u, τ)` (Krang's and the
+/// fixed-wheel tree's `forward_dynamics_derivatives_with`): `M(q)` into the kept matrix by
+/// `mass_matrix_into`, its block Cholesky factor (`T` trunk speeds), then
+/// [`forward_dynamics_derivatives_onto`] through the kept derivatives workspace
+/// (`derivatives_with`: the model's generated `inverse_dynamics_derivatives_with`). `false`,
+/// and the result NaN, where `M(q)` is not positive definite.
+fn forward_dynamics_derivatives_kept<R, W, const T: usize, const N: usize, const D: usize>(
+    robot: &R,
+    (q, u, tau): (&SVector<f64, N>, &SVector<f64, N>, &SVector<f64, N>),
+    ws: &mut ForwardDynamicsDerivativesWorkspaceOf<W, N>,
+    mass_matrix_into: impl FnOnce(&mut SMatrix<f64, N, N>),
+    derivatives_with: impl for<'w> FnOnce(&SVector<f64, N>, &'w mut W) -> &'w SMatrix<f64, N, D>,
+) -> bool
+where
+    R: RobotDynamics<N, Scalar = f64>,
+{
+    mass_matrix_into(&mut ws.mass_matrix);
+    let Ok(chol) = BlockCholesky::<T, N>::new(&ws.mass_matrix) else {
+        ws.result = nan_derivatives();
+        return false;
+    };
+    let (derivatives, result) = (&mut ws.derivatives, &mut ws.result);
+    forward_dynamics_derivatives_onto(
+        robot,
+        &chol,
+        (q, u, tau),
+        |ud| derivatives_with(ud, derivatives),
+        result,
+    );
+    true
 }
 
 /// [`forward_dynamics_derivatives_by_value`] into a result the caller keeps: `−∂τ/∂q` and
@@ -281,19 +321,13 @@ impl Krang {
         tau: &SVector<f64, 19>,
         ws: &mut ForwardDynamicsDerivativesWorkspace,
     ) -> bool {
-        self.mass_matrix_into(q, &mut ws.mass_matrix);
-        let Ok(chol) = MassMatrixCholesky::new(&ws.mass_matrix) else {
-            ws.result = nan_derivatives();
-            return false;
-        };
-        forward_dynamics_derivatives_onto(
+        forward_dynamics_derivatives_kept::<_, _, 5, 19, 38>(
             self,
-            &chol,
             (q, u, tau),
-            |ud| self.inverse_dynamics_derivatives_with(q, u, ud, &mut ws.derivatives),
-            &mut ws.result,
-        );
-        true
+            ws,
+            |m| self.mass_matrix_into(q, m),
+            |ud, w| self.inverse_dynamics_derivatives_with(q, u, ud, w),
+        )
     }
 
     /// The linearization `(A, B)` of `ẋ = f(x, a)` at `(q, u, a)`, with the state
@@ -390,79 +424,101 @@ impl Krang {
         &'w SMatrix<f64, 38, 38>,
         &'w SMatrix<f64, 38, ACTUATOR_COUNT>,
     ) {
-        if !self.forward_dynamics_derivatives_kept(q, u, &self.generalized_forces(a), &mut ws.fd) {
-            // Non-physical parameters (M is not positive definite): all NaN, as `linearize`.
-            ws.a.as_mut_slice().fill(f64::NAN);
-            ws.b.as_mut_slice().fill(f64::NAN);
-            ws.constant_blocks = false;
-            return (&ws.a, &ws.b);
-        }
-        if !ws.constant_blocks {
-            LinearizationWorkspace::write_constant_blocks(&mut ws.a, &mut ws.b);
-            ws.constant_blocks = true;
-        }
-        // The lower halves of the columns: [∂u̇/∂q, ∂u̇/∂u] in A, M⁻¹ B_act in B.
-        let fd = &ws.fd.result;
-        let blocks = fd
-            .dud_dq
-            .as_slice()
-            .chunks_exact(19)
-            .chain(fd.dud_du.as_slice().chunks_exact(19));
-        for (column, block) in ws.a.as_mut_slice().chunks_exact_mut(38).zip(blocks) {
-            column[19..].copy_from_slice(block);
-        }
-        let lower = ws.b.as_mut_slice().chunks_exact_mut(38).map(|c| {
-            let lower = &mut c[19..];
-            lower.fill(0.0);
-            lower
-        });
-        self.minv_times_actuators(&fd.minv, lower);
-        (&ws.a, &ws.b)
+        let ok =
+            self.forward_dynamics_derivatives_kept(q, u, &self.generalized_forces(a), &mut ws.fd);
+        // B's lower half: M⁻¹ B_act.
+        ws.fill(ok, |minv, b| {
+            let lower = b.as_mut_slice().chunks_exact_mut(38).map(|c| {
+                let lower = &mut c[19..];
+                lower.fill(0.0);
+                lower
+            });
+            self.minv_times_actuators(minv, lower);
+        })
     }
 }
 
 /// What [`Krang::linearize_with`] keeps across calls: a [`ForwardDynamicsDerivativesWorkspace`]
 /// and `A` (38 × 38) and `B` (38 × 18), whose constant blocks are written once (about 43 KB),
-/// made once by [`new`](Self::new). `A` and `B` are NaN before the first linearization.
+/// made once by [`new`](LinearizationWorkspaceOf::new). `A` and `B` are NaN before the first
+/// linearization.
+pub type LinearizationWorkspace =
+    LinearizationWorkspaceOf<crate::DerivativesWorkspace, 19, 38, ACTUATOR_COUNT>;
+
+/// The kept workspace of `linearize_with` for a model of `N` speeds (the state `X = 2N`, `I`
+/// inputs) whose generated module's derivatives workspace is `W`: Krang's
+/// [`LinearizationWorkspace`] and the fixed-wheel tree's `fixed_wheels::LinearizationWorkspace`
+/// (feature `fixed-wheels`: 17 speeds, 17 inputs).
 #[derive(Clone, Debug)]
-pub struct LinearizationWorkspace {
-    fd: ForwardDynamicsDerivativesWorkspace,
-    a: SMatrix<f64, 38, 38>,
-    b: SMatrix<f64, 38, ACTUATOR_COUNT>,
+pub struct LinearizationWorkspaceOf<W, const N: usize, const X: usize, const I: usize> {
+    fd: ForwardDynamicsDerivativesWorkspaceOf<W, N>,
+    a: SMatrix<f64, X, X>,
+    b: SMatrix<f64, X, I>,
     /// Whether the upper halves of `A` (`[0, I]`) and `B` (`0`) hold their constants (not
     /// after a linearization with non-physical parameters, which NaN-fills both).
     constant_blocks: bool,
 }
 
-impl LinearizationWorkspace {
+impl<W: Default, const N: usize, const X: usize, const I: usize>
+    LinearizationWorkspaceOf<W, N, X, I>
+{
     /// A workspace whose `A` and `B` are NaN until the first linearization.
     pub fn new() -> Self {
+        const { assert!(X == 2 * N, "the state is [q; u]") };
         Self {
-            fd: ForwardDynamicsDerivativesWorkspace::new(),
+            fd: ForwardDynamicsDerivativesWorkspaceOf::new(),
             a: SMatrix::from_element(f64::NAN),
             b: SMatrix::from_element(f64::NAN),
             constant_blocks: false,
         }
     }
+}
 
-    /// The upper halves: `A = [[0, I], …]`, `B = [[0], …]` (`q̇ = u`).
-    fn write_constant_blocks(
-        a: &mut SMatrix<f64, 38, 38>,
-        b: &mut SMatrix<f64, 38, ACTUATOR_COUNT>,
-    ) {
-        for (j, column) in a.as_mut_slice().chunks_exact_mut(38).enumerate() {
-            column[..19].fill(0.0);
-            if j >= 19 {
-                column[j - 19] = 1.0;
+impl<W, const N: usize, const X: usize, const I: usize> LinearizationWorkspaceOf<W, N, X, I> {
+    /// `A` and `B` from the forward-dynamics derivatives just written into `self.fd` (`ok`:
+    /// `M(q)` was positive definite, else both NaN, as by value): the constant upper halves
+    /// once, `[∂u̇/∂q, ∂u̇/∂u]` into `A`'s lower half, and `B`'s lower half (`∂u̇/∂input`, its
+    /// `N` rows of each column) by `input` from `M⁻¹` (the upper rows it must leave).
+    fn fill(
+        &mut self,
+        ok: bool,
+        input: impl FnOnce(&SMatrix<f64, N, N>, &mut SMatrix<f64, X, I>),
+    ) -> (&SMatrix<f64, X, X>, &SMatrix<f64, X, I>) {
+        if !ok {
+            self.a.as_mut_slice().fill(f64::NAN);
+            self.b.as_mut_slice().fill(f64::NAN);
+            self.constant_blocks = false;
+            return (&self.a, &self.b);
+        }
+        if !self.constant_blocks {
+            for (j, column) in self.a.as_mut_slice().chunks_exact_mut(X).enumerate() {
+                column[..N].fill(0.0);
+                if j >= N {
+                    column[j - N] = 1.0;
+                }
             }
+            for column in self.b.as_mut_slice().chunks_exact_mut(X) {
+                column[..N].fill(0.0);
+            }
+            self.constant_blocks = true;
         }
-        for column in b.as_mut_slice().chunks_exact_mut(38) {
-            column[..19].fill(0.0);
+        let fd = &self.fd.result;
+        let blocks = fd
+            .dud_dq
+            .as_slice()
+            .chunks_exact(N)
+            .chain(fd.dud_du.as_slice().chunks_exact(N));
+        for (column, block) in self.a.as_mut_slice().chunks_exact_mut(X).zip(blocks) {
+            column[N..].copy_from_slice(block);
         }
+        input(&fd.minv, &mut self.b);
+        (&self.a, &self.b)
     }
 }
 
-impl Default for LinearizationWorkspace {
+impl<W: Default, const N: usize, const X: usize, const I: usize> Default
+    for LinearizationWorkspaceOf<W, N, X, I>
+{
     fn default() -> Self {
         Self::new()
     }
@@ -522,9 +578,89 @@ impl crate::fixed_wheels::KrangFixedWheels {
         u: &SVector<f64, 17>,
         tau: &SVector<f64, 17>,
     ) -> (SMatrix<f64, 34, 34>, SMatrix<f64, 34, 17>) {
-        let fd = self
-            .try_forward_dynamics_derivatives(q, u, tau)
-            .unwrap_or_else(|_| nan_derivatives());
-        state_space(&fd, &fd.minv)
+        match self.try_forward_dynamics_derivatives(q, u, tau) {
+            Ok(fd) => state_space(&fd, &fd.minv),
+            // All NaN, as Krang's (not only the blocks that depend on the parameters).
+            Err(_) => (
+                SMatrix::from_element(f64::NAN),
+                SMatrix::from_element(f64::NAN),
+            ),
+        }
+    }
+
+    /// [`try_forward_dynamics_derivatives`](Self::try_forward_dynamics_derivatives) written into
+    /// a workspace the caller keeps across calls, whose result it returns, as
+    /// [`Krang::forward_dynamics_derivatives_with`]: the same bits, without zeroing and copying
+    /// the matrices of every call; NaN-filled for non-physical parameters. Allocation-free.
+    ///
+    /// ```
+    /// use krang_dynamics::fixed_wheels::{ForwardDynamicsDerivativesWorkspace, KrangFixedWheels};
+    /// use nalgebra::SVector;
+    ///
+    /// let k = KrangFixedWheels::default();
+    /// let mut ws = ForwardDynamicsDerivativesWorkspace::new();
+    /// let (q, u, tau) = (SVector::zeros(), SVector::zeros(), SVector::zeros());
+    /// let fd = k.forward_dynamics_derivatives_with(&q, &u, &tau, &mut ws);
+    /// assert!(fd.minv[(5, 5)] > 0.0);
+    /// ```
+    pub fn forward_dynamics_derivatives_with<'w>(
+        &self,
+        q: &SVector<f64, 17>,
+        u: &SVector<f64, 17>,
+        tau: &SVector<f64, 17>,
+        ws: &'w mut crate::fixed_wheels::ForwardDynamicsDerivativesWorkspace,
+    ) -> &'w ForwardDynamicsDerivatives<17> {
+        self.forward_dynamics_derivatives_kept(q, u, tau, ws);
+        &ws.result
+    }
+
+    /// [`forward_dynamics_derivatives_with`](Self::forward_dynamics_derivatives_with) into
+    /// `ws`; `false` (and NaN) where `M(q)` is not positive definite.
+    fn forward_dynamics_derivatives_kept(
+        &self,
+        q: &SVector<f64, 17>,
+        u: &SVector<f64, 17>,
+        tau: &SVector<f64, 17>,
+        ws: &mut crate::fixed_wheels::ForwardDynamicsDerivativesWorkspace,
+    ) -> bool {
+        forward_dynamics_derivatives_kept::<_, _, 3, 17, 34>(
+            self,
+            (q, u, tau),
+            ws,
+            |m| self.mass_matrix_into(q, m),
+            |ud, w| self.inverse_dynamics_derivatives_with(q, u, ud, w),
+        )
+    }
+
+    /// [`linearize`](Self::linearize) written into a workspace the caller keeps across calls,
+    /// whose `(A, B)` it returns, as [`Krang::linearize_with`]: the same bits, the constant
+    /// blocks written once; NaN-filled for non-physical parameters. Allocation-free.
+    ///
+    /// ```
+    /// use krang_dynamics::fixed_wheels::{KrangFixedWheels, LinearizationWorkspace};
+    /// use nalgebra::SVector;
+    ///
+    /// let k = KrangFixedWheels::default();
+    /// let mut ws = LinearizationWorkspace::new();
+    /// let (q, u) = (SVector::zeros(), SVector::zeros());
+    /// let (a_mat, b_mat) = k.linearize_with(&q, &u, &SVector::zeros(), &mut ws);
+    /// assert_eq!(a_mat[(0, 17)], 1.0);
+    /// assert!(b_mat[(17, 0)] > 0.0);
+    /// ```
+    pub fn linearize_with<'w>(
+        &self,
+        q: &SVector<f64, 17>,
+        u: &SVector<f64, 17>,
+        tau: &SVector<f64, 17>,
+        ws: &'w mut crate::fixed_wheels::LinearizationWorkspace,
+    ) -> (&'w SMatrix<f64, 34, 34>, &'w SMatrix<f64, 34, 17>) {
+        let ok = self.forward_dynamics_derivatives_kept(q, u, tau, &mut ws.fd);
+        // B's lower half: M⁻¹ (every speed is actuated).
+        ws.fill(ok, |minv, b| {
+            let lower = b.as_mut_slice().chunks_exact_mut(34).map(|c| &mut c[17..]);
+            for (lower, column) in lower.zip(minv.as_slice().chunks_exact(17)) {
+                lower.copy_from_slice(column);
+            }
+        })
     }
 }

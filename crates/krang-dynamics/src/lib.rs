@@ -119,6 +119,18 @@ pub mod f32 {
 #[cfg(feature = "fixed-wheels")]
 pub mod fixed_wheels {
     include!(concat!(env!("OUT_DIR"), "/krang_fixed_wheels.rs"));
+
+    /// What [`KrangFixedWheels::forward_dynamics_derivatives_with`] keeps across calls (17
+    /// speeds; see [`crate::ForwardDynamicsDerivativesWorkspace`], Krang's).
+    #[cfg(feature = "derivatives")]
+    pub type ForwardDynamicsDerivativesWorkspace =
+        crate::derivatives::ForwardDynamicsDerivativesWorkspaceOf<DerivativesWorkspace, 17>;
+
+    /// What [`KrangFixedWheels::linearize_with`] keeps across calls (`A` 34 × 34, `B` 34 × 17;
+    /// see [`crate::LinearizationWorkspace`], Krang's).
+    #[cfg(feature = "derivatives")]
+    pub type LinearizationWorkspace =
+        crate::derivatives::LinearizationWorkspaceOf<DerivativesWorkspace, 17, 34, 17>;
 }
 
 /// Seed 002 Appendix B: the two-link model (bodies 1 and 2, frame 0 fixed).

@@ -22,6 +22,10 @@
 //!   `RobotDynamics::forward_dynamics` (a dense Cholesky), what every generated robot has;
 //! * `fd_derivatives/fixed_wheels`: `KrangFixedWheels::try_forward_dynamics_derivatives` (17
 //!   speeds), at the same states as `forward_dynamics/fixed_wheels`;
+//! * `fd_derivatives/fixed_wheels_with`: `KrangFixedWheels::forward_dynamics_derivatives_with`,
+//!   the same into a `fixed_wheels::ForwardDynamicsDerivativesWorkspace` kept across calls;
+//! * `linearize/fixed_wheels`, `linearize/fixed_wheels_with`: `KrangFixedWheels::linearize`
+//!   (A 34×34, B 34×17) and `linearize_with` (into a `fixed_wheels::LinearizationWorkspace`);
 //! * `fd_derivatives/fixed_wheels_trait`: the same through the runtime trait's provided
 //!   `InverseDynamicsDerivatives::forward_dynamics_derivatives` (a dense Cholesky), what every
 //!   generated robot without a block factor of its own gets;
@@ -168,6 +172,22 @@ fn bench(c: &mut Criterion) {
     cycle!("fd_derivatives/fixed_wheels", |q, u, ud| {
         let (q, u, tau) = fixed_wheel_state(q, u, ud);
         fixed.try_forward_dynamics_derivatives(&q, &u, &tau)
+    });
+    let mut fixed_fd_ws = krang_dynamics::fixed_wheels::ForwardDynamicsDerivativesWorkspace::new();
+    cycle!("fd_derivatives/fixed_wheels_with", |q, u, ud| {
+        let (q, u, tau) = fixed_wheel_state(q, u, ud);
+        fixed
+            .forward_dynamics_derivatives_with(&q, &u, &tau, &mut fixed_fd_ws)
+            .dud_dq[(7, 9)]
+    });
+    cycle!("linearize/fixed_wheels", |q, u, ud| {
+        let (q, u, tau) = fixed_wheel_state(q, u, ud);
+        fixed.linearize(&q, &u, &tau)
+    });
+    let mut fixed_lin_ws = krang_dynamics::fixed_wheels::LinearizationWorkspace::new();
+    cycle!("linearize/fixed_wheels_with", |q, u, ud| {
+        let (q, u, tau) = fixed_wheel_state(q, u, ud);
+        fixed.linearize_with(&q, &u, &tau, &mut fixed_lin_ws).1[(25, 3)]
     });
     cycle!("fd_derivatives/fixed_wheels_trait", |q, u, ud| {
         let (q, u, tau) = fixed_wheel_state(q, u, ud);

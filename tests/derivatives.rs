@@ -411,15 +411,6 @@ fn forward_dynamics_derivatives_into_a_kept_workspace_equal_the_by_value_result_
     let mut r = rng(1212);
     let mut ws = kd::ForwardDynamicsDerivativesWorkspace::new();
     assert!(ws.result().minv.iter().all(|x| x.is_nan()));
-    let bits = |fd: &kd::ForwardDynamicsDerivatives<19>| {
-        [
-            fd.ud.as_slice(),
-            fd.dud_dq.as_slice(),
-            fd.dud_du.as_slice(),
-            fd.minv.as_slice(),
-        ]
-        .concat()
-    };
     for draw in 0..30 {
         let k = match draw {
             0 => kd::Krang::default(),
@@ -431,10 +422,30 @@ fn forward_dynamics_derivatives_into_a_kept_workspace_equal_the_by_value_result_
         let (q, u, tau) = (sv::<19>(&q), sv::<19>(&u), sv::<19>(&t) * 10.0);
         let by_value = k.forward_dynamics_derivatives(&q, &u, &tau);
         let kept = k.forward_dynamics_derivatives_with(&q, &u, &tau, &mut ws);
-        assert!(same_bits(&bits(kept), &bits(&by_value)), "draw {draw}");
+        assert!(
+            same_bits(&fd_bits(kept), &fd_bits(&by_value)),
+            "draw {draw}"
+        );
         assert_eq!(draw == 13, by_value.minv.iter().all(|x| x.is_nan()));
-        assert!(same_bits(&bits(ws.result()), &bits(&by_value)));
+        assert!(same_bits(&fd_bits(ws.result()), &fd_bits(&by_value)));
     }
+}
+
+/// `u̇`, `∂u̇/∂q`, `∂u̇/∂u` and `M⁻¹` as one run of values, to compare their bits.
+fn fd_bits<const N: usize>(fd: &kd::ForwardDynamicsDerivatives<N>) -> Vec<f64> {
+    [
+        fd.ud.as_slice(),
+        fd.dud_dq.as_slice(),
+        fd.dud_du.as_slice(),
+        fd.minv.as_slice(),
+    ]
+    .concat()
+}
+
+/// A kept workspace's `(A, B)` has the bits of the by-value linearization's.
+fn assert_same_linearization(kept: (&[f64], &[f64]), by_value: (&[f64], &[f64]), draw: usize) {
+    assert!(same_bits(kept.0, by_value.0), "A, draw {draw}");
+    assert!(same_bits(kept.1, by_value.1), "B, draw {draw}");
 }
 
 #[test]
@@ -458,25 +469,9 @@ fn fixed_wheel_derivatives_and_linearization_into_kept_workspaces_equal_the_by_v
         };
         let (q, u, t) = random_state(&mut r, 17);
         let (q, u, tau) = (sv::<17>(&q), sv::<17>(&u), sv::<17>(&t) * 10.0);
-        let kept = k.forward_dynamics_derivatives_with(&q, &u, &tau, &mut fd_ws);
-        let kept = [
-            kept.ud.as_slice(),
-            kept.dud_dq.as_slice(),
-            kept.dud_du.as_slice(),
-            kept.minv.as_slice(),
-        ]
-        .concat();
+        let kept = fd_bits(k.forward_dynamics_derivatives_with(&q, &u, &tau, &mut fd_ws));
         match k.try_forward_dynamics_derivatives(&q, &u, &tau) {
-            Ok(fd) => {
-                let by_value = [
-                    fd.ud.as_slice(),
-                    fd.dud_dq.as_slice(),
-                    fd.dud_du.as_slice(),
-                    fd.minv.as_slice(),
-                ]
-                .concat();
-                assert!(same_bits(&kept, &by_value), "draw {draw}");
-            }
+            Ok(fd) => assert!(same_bits(&kept, &fd_bits(&fd)), "draw {draw}"),
             Err(_) => {
                 assert_eq!(draw % 8, 5);
                 assert!(kept.iter().all(|x| x.is_nan()), "draw {draw}");
@@ -484,13 +479,10 @@ fn fixed_wheel_derivatives_and_linearization_into_kept_workspaces_equal_the_by_v
         }
         let (a_mat, b_mat) = k.linearize(&q, &u, &tau);
         let (a_kept, b_kept) = k.linearize_with(&q, &u, &tau, &mut lin_ws);
-        assert!(
-            same_bits(a_kept.as_slice(), a_mat.as_slice()),
-            "A, draw {draw}"
-        );
-        assert!(
-            same_bits(b_kept.as_slice(), b_mat.as_slice()),
-            "B, draw {draw}"
+        assert_same_linearization(
+            (a_kept.as_slice(), b_kept.as_slice()),
+            (a_mat.as_slice(), b_mat.as_slice()),
+            draw,
         );
         assert_eq!(draw % 8 == 5, a_mat.iter().all(|x| x.is_nan()));
     }
@@ -798,13 +790,10 @@ fn linearization_into_a_kept_workspace_equals_the_by_value_result_bit_for_bit() 
         let a = SVector::<f64, 18>::from_fn(|_, _| 20.0 * r() - 10.0);
         let (a_mat, b_mat) = k.linearize(&q, &u, &a);
         let (a_kept, b_kept) = k.linearize_with(&q, &u, &a, &mut ws);
-        assert!(
-            same_bits(a_kept.as_slice(), a_mat.as_slice()),
-            "A, draw {draw}"
-        );
-        assert!(
-            same_bits(b_kept.as_slice(), b_mat.as_slice()),
-            "B, draw {draw}"
+        assert_same_linearization(
+            (a_kept.as_slice(), b_kept.as_slice()),
+            (a_mat.as_slice(), b_mat.as_slice()),
+            draw,
         );
         assert_eq!(draw % 8 == 3, a_mat.iter().all(|x| x.is_nan()));
     }

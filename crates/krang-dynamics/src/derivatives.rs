@@ -145,8 +145,9 @@ impl<W: Default, const N: usize> ForwardDynamicsDerivativesWorkspaceOf<W, N> {
         }
     }
 
-    /// The derivatives of the last [`Krang::forward_dynamics_derivatives_with`] (NaN before
-    /// the first, and after one with non-physical parameters).
+    /// The derivatives of the last `forward_dynamics_derivatives_with` (Krang's
+    /// [`Krang::forward_dynamics_derivatives_with`] or the fixed-wheel tree's) into this
+    /// workspace: NaN before the first, and after one with non-physical parameters.
     pub fn result(&self) -> &ForwardDynamicsDerivatives<N> {
         &self.result
     }

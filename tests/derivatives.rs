@@ -349,6 +349,17 @@ fn random_krang(r: &mut impl FnMut() -> f64) -> kd::Krang {
     kd::Krang::new(kd::Params::from_array(p.try_into().unwrap()))
 }
 
+/// Fixed-wheel tree parameters drawn as [`random_krang`]'s, from its model `fixed`.
+fn random_fixed_wheels(
+    fixed: &Model,
+    r: &mut impl FnMut() -> f64,
+) -> kd::fixed_wheels::KrangFixedWheels {
+    let p = random_physical_params(fixed, r);
+    kd::fixed_wheels::KrangFixedWheels::new(kd::fixed_wheels::Params::from_array(
+        p.try_into().unwrap(),
+    ))
+}
+
 /// Krang with the right hand's body scaled by −10 (a negative mass): M is not positive
 /// definite.
 fn non_physical_krang() -> kd::Krang {
@@ -462,10 +473,7 @@ fn fixed_wheel_derivatives_and_linearization_into_kept_workspaces_equal_the_by_v
         let k = if draw % 8 == 5 {
             non_physical_fixed_wheels()
         } else {
-            let p = random_physical_params(&model, &mut r);
-            kd::fixed_wheels::KrangFixedWheels::new(kd::fixed_wheels::Params::from_array(
-                p.try_into().unwrap(),
-            ))
+            random_fixed_wheels(&model, &mut r)
         };
         let (q, u, t) = random_state(&mut r, 17);
         let (q, u, tau) = (sv::<17>(&q), sv::<17>(&u), sv::<17>(&t) * 10.0);
@@ -493,10 +501,7 @@ fn fixed_wheel_forward_dynamics_derivatives_match_central_differences() {
     let model = model("krang-fixed-wheels.toml");
     let mut r = rng(1209);
     for _ in 0..50 {
-        let p = random_physical_params(&model, &mut r);
-        let k = kd::fixed_wheels::KrangFixedWheels::new(kd::fixed_wheels::Params::from_array(
-            p.try_into().unwrap(),
-        ));
+        let k = random_fixed_wheels(&model, &mut r);
         let (q, u, t) = random_state(&mut r, 17);
         let (q, u, tau) = (sv::<17>(&q), sv::<17>(&u), sv::<17>(&t));
         let (a, b) = k.linearize(&q, &u, &tau);
@@ -635,10 +640,7 @@ fn every_generated_robot_has_forward_dynamics_derivatives_through_the_trait() {
         let p = random_physical_params(&arm, &mut r);
         let a =
             singlearm_all::SingleArm::new(singlearm_all::Params::from_array(p.try_into().unwrap()));
-        let p = random_physical_params(&fixed, &mut r);
-        let f = kd::fixed_wheels::KrangFixedWheels::new(kd::fixed_wheels::Params::from_array(
-            p.try_into().unwrap(),
-        ));
+        let f = random_fixed_wheels(&fixed, &mut r);
         let k = if draw == 0 {
             kd::Krang::default()
         } else {

@@ -168,13 +168,10 @@ where
 /// The four forces moved from a link to its parent: `(R n + P × R f; R f)`, `t` = `R` by rows
 /// then `P`.
 #[inline(always)]
-fn up<T>(t: &[T], f: &Forces<T>) -> Forces<T>
+fn up<T>(t: &[T; 12], f: &Forces<T>) -> Forces<T>
 where
     T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
 {
-    let t: [T; 12] = [
-        t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8], t[9], t[10], t[11],
-    ];
     let rot = |x: &[L4<T>], i: usize| {
         x[0].scale(t[3 * i])
             .add(x[1].scale(t[3 * i + 1]))
@@ -198,9 +195,8 @@ where
 /// [`crate::isa::active`] is x86-64-v3 or x86-64-v4 (or the crate is compiled for AVX2 and
 /// FMA): the four lanes in one register; when x86-64-v4 is active, that copy compiled for
 /// AVX-512 F and VL (the same bits). LLVM does not vectorize the portable form (it splits the
-/// lanes into
-/// scalars): Krang's 104 steps take 46,000 instructions in it even in the x86-64-v3 copy,
-/// 21,200 with AVX2 intrinsics and 18,600 with AVX2 and FMA (callgrind). Elsewhere the
+/// lanes into scalars): Krang's 104 steps take 46,000 instructions in it even in the x86-64-v3
+/// copy, 21,200 with AVX2 intrinsics and 18,600 with AVX2 and FMA (callgrind). Elsewhere the
 /// portable form runs. The two copies differ in the last bits (the fused multiply-adds round
 /// once); the straight-line part of the generated function is the same in both.
 #[inline(never)]
@@ -375,8 +371,7 @@ macro_rules! avx_steps {
 
             #[target_feature(enable = $features)]
             #[inline]
-            fn up(t: &[f64], f: &[__m256d; 6]) -> [__m256d; 6] {
-                let t = &t[..12];
+            fn up(t: &[f64; 12], f: &[__m256d; 6]) -> [__m256d; 6] {
                 // Row i of R times (x0, x1, x2).
                 macro_rules! rot {
                     ($i:expr, $x0:expr, $x1:expr, $x2:expr) => {{
@@ -461,7 +456,7 @@ macro_rules! avx_steps {
             pub(super) fn steps(plan: &Plan<'_>, w: &[f64], out: &mut [f64]) {
                 for col in plan.columns {
                     let x: &[f64; 24] = super::chunk(w, usize::from(col.forces));
-                                    let mut f = [
+                    let mut f = [
                         load(&x[0..4]),
                         load(&x[4..8]),
                         load(&x[8..12]),

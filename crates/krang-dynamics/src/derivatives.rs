@@ -63,11 +63,26 @@ fn state_space<const N: usize, const X: usize, const I: usize>(
     for i in 0..N {
         a[(i, N + i)] = 1.0;
     }
-    a.fixed_view_mut::<N, N>(N, 0).copy_from(&fd.dud_dq);
-    a.fixed_view_mut::<N, N>(N, N).copy_from(&fd.dud_du);
+    write_a_lower(&mut a, fd);
     let mut b = SMatrix::<f64, X, I>::zeros();
     b.fixed_view_mut::<N, I>(N, 0).copy_from(dud_dinput);
     (a, b)
+}
+
+/// `[∂u̇/∂q, ∂u̇/∂u]` into the lower half of `A`'s columns (column slices: nalgebra's strided
+/// views copy with scalar loops).
+fn write_a_lower<const N: usize, const X: usize>(
+    a: &mut SMatrix<f64, X, X>,
+    fd: &ForwardDynamicsDerivatives<N>,
+) {
+    let blocks = fd
+        .dud_dq
+        .as_slice()
+        .chunks_exact(N)
+        .chain(fd.dud_du.as_slice().chunks_exact(N));
+    for (column, block) in a.as_mut_slice().chunks_exact_mut(X).zip(blocks) {
+        column[N..].copy_from_slice(block);
+    }
 }
 
 /// Forward dynamics and its derivatives at `(q, u, τ)` with the block Cholesky factor of
@@ -503,16 +518,8 @@ impl<W, const N: usize, const X: usize, const I: usize> LinearizationWorkspaceOf
             }
             self.constant_blocks = true;
         }
-        let fd = &self.fd.result;
-        let blocks = fd
-            .dud_dq
-            .as_slice()
-            .chunks_exact(N)
-            .chain(fd.dud_du.as_slice().chunks_exact(N));
-        for (column, block) in self.a.as_mut_slice().chunks_exact_mut(X).zip(blocks) {
-            column[N..].copy_from_slice(block);
-        }
-        input(&fd.minv, &mut self.b);
+        write_a_lower(&mut self.a, &self.fd.result);
+        input(&self.fd.result.minv, &mut self.b);
         (&self.a, &self.b)
     }
 }

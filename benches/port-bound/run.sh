@@ -18,6 +18,13 @@
 # Needs: valgrind, objdump (binutils), python3, cc; x86-64 Linux.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
+for tool in valgrind objdump python3 cc; do
+    command -v "$tool" >/dev/null || {
+        echo "benches/port-bound/run.sh needs \`$tool\` on the PATH (e.g. apt install valgrind binutils python3 gcc)" >&2
+        exit 1
+    }
+done
+[ "$(uname -m)" = x86_64 ] || { echo "benches/port-bound/run.sh: x86-64 only (the port model is Intel Golden Cove's)" >&2; exit 1; }
 entries=("$@")
 [ ${#entries[@]} -gt 0 ] || entries=(mass_matrix_into coriolis gravity inverse_dynamics
     coriolis_matrix inverse_dynamics_derivatives_with)

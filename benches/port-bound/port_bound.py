@@ -125,6 +125,9 @@ def classify(mnemonic, ops):
     if base.startswith("nop") or base in ("endbr64", "vzeroupper", "data16", "cs"):
         c["other"] += 1
         return c
+    if base.startswith("lea"):
+        c["int"] += 1  # an address computed, no memory read
+        return c
     if base in ("push",):
         c["store"] += 1
         return c

@@ -8,6 +8,8 @@
 //!     target/release/examples/profile mass_matrix 1000
 //! # rough ns per call (the fastest of many batches of 1000 calls):
 //! target/release/examples/profile all 200000
+//! # instructions per call by execution port, and the floors in cycles they imply:
+//! benches/port-bound/run.sh mass_matrix_into inverse_dynamics
 //! ```
 //!
 //! Arguments: a function (`mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, or `all`;

@@ -88,6 +88,10 @@ SHUFFLE = re.compile(
 LOGIC = re.compile(r"^v?p?(xor|and|andn|or|blend\w*)(p[sd])?$|^vp(xor|and|or|andn)[dq]?$")
 MOVES = re.compile(r"^v?mov(apd|aps|upd|ups|dqa|dqu|dqa64|dqu64|sd|ss|q|d|hpd|lpd|hps|lps)$")
 BRANCH = re.compile(r"^(j\w+|call\w*|ret\w*)$")
+# `rep`-prefixed string instructions (`rep stosb`/`rep movsb`: a `memset`/`memcpy`), which
+# callgrind counts once per byte; the fast string microcode moves about 32 bytes per store.
+REP_STRING = ("rep", "repz", "repnz", "repe", "repne")
+STRING_BYTES_PER_STORE = 32
 
 
 def operands(ops):
@@ -116,11 +120,9 @@ def classify(mnemonic, ops):
     dest_mem = bool(parts) and is_mem[-1]
     src_mem = any(is_mem[:-1]) if parts else False
     base = mnemonic.split("{")[0]
-    if base in ("rep", "repz", "repnz", "repe", "repne"):
-        # `rep stosb`/`rep movsb` (a `memset`/`memcpy`): callgrind counts one instruction per
-        # byte; the fast string microcode moves about 32 bytes per store.
+    if base in REP_STRING:
         c["string"] += 1
-        c["store"] += 1 / 32
+        c["store"] += 1 / STRING_BYTES_PER_STORE
         return c
     if base.startswith("nop") or base in ("endbr64", "vzeroupper", "data16", "cs"):
         c["other"] += 1
@@ -177,7 +179,7 @@ def classify(mnemonic, ops):
         c["logic"] += 1
     elif base.startswith("v"):
         c["vector-other"] += 1
-    elif base in ("mov", "movl", "movq") or base.startswith("mov"):
+    elif base.startswith("mov"):
         if not (src_mem or dest_mem):
             c["int"] += 1
     else:
@@ -210,13 +212,14 @@ def main():
                 totals["unknown"] += n
                 continue
             mnemonic, ops = table[addr]
-            executed = n / 32 if mnemonic in ("rep", "repz", "repe") else n
+            executed = n / STRING_BYTES_PER_STORE if mnemonic in REP_STRING else n
+            function = by_function[names.get((obj, addr), "?")]
             instructions += executed
             by_mnemonic[mnemonic] += executed
-            by_function[names.get((obj, addr), "?")]["instructions"] += executed
+            function["instructions"] += executed
             for k, v in classify(mnemonic, ops).items():
                 totals[k] += v * n
-                by_function[names.get((obj, addr), "?")][k] += v * n
+                function[k] += v * n
     vec = sum(totals[k] for k in ("fma", "fadd", "shuffle", "logic", "vector-other"))
     bounds = {
         "rename (instructions / 6)": instructions / 6,

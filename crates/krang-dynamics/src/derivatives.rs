@@ -60,13 +60,21 @@ fn state_space<const N: usize, const X: usize, const I: usize>(
 ) -> (SMatrix<f64, X, X>, SMatrix<f64, X, I>) {
     assert_eq!(X, 2 * N, "the state is [q; u]");
     let mut a = SMatrix::<f64, X, X>::zeros();
-    for i in 0..N {
-        a[(i, N + i)] = 1.0;
-    }
+    write_a_upper::<N, X>(&mut a);
     write_a_lower(&mut a, fd);
     let mut b = SMatrix::<f64, X, I>::zeros();
     b.fixed_view_mut::<N, I>(N, 0).copy_from(dud_dinput);
     (a, b)
+}
+
+/// `[0, I]` (`q̇ = u`) into the upper half of `A`'s columns.
+fn write_a_upper<const N: usize, const X: usize>(a: &mut SMatrix<f64, X, X>) {
+    for (j, column) in a.as_mut_slice().chunks_exact_mut(X).enumerate() {
+        column[..N].fill(0.0);
+        if j >= N {
+            column[j - N] = 1.0;
+        }
+    }
 }
 
 /// `[∂u̇/∂q, ∂u̇/∂u]` into the lower half of `A`'s columns (column slices: nalgebra's strided
@@ -507,12 +515,7 @@ impl<W, const N: usize, const X: usize, const I: usize> LinearizationWorkspaceOf
             return (&self.a, &self.b);
         }
         if !self.constant_blocks {
-            for (j, column) in self.a.as_mut_slice().chunks_exact_mut(X).enumerate() {
-                column[..N].fill(0.0);
-                if j >= N {
-                    column[j - N] = 1.0;
-                }
-            }
+            write_a_upper::<N, X>(&mut self.a);
             for column in self.b.as_mut_slice().chunks_exact_mut(X) {
                 column[..N].fill(0.0);
             }

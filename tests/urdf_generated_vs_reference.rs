@@ -8,8 +8,8 @@
 mod common;
 
 use common::*;
+use kanegen::Builder;
 use kanegen::FunctionId;
-use kanegen::{Builder, Options};
 use kanegen_model::{AngleSnap, Model, UrdfOptions, WheeledBaseSpec};
 use kanegen_reference::Reference;
 use kanegen_reference::random::random_physical_params;

@@ -16,7 +16,7 @@ enum Source {
     /// A TOML description file.
     Toml(PathBuf),
     /// A URDF file and its import options.
-    Urdf(PathBuf, model::UrdfOptions),
+    Urdf(PathBuf, Box<model::UrdfOptions>),
     /// A model in memory, with the notes of its import (empty if it was not imported).
     Model(Box<model::Model>, Vec<String>),
 }
@@ -60,7 +60,7 @@ impl Builder {
     pub fn new(description: impl Into<PathBuf>) -> Self {
         let path = description.into();
         Self::with_source(if is_urdf(&path) {
-            Source::Urdf(path, model::UrdfOptions::default())
+            Source::Urdf(path, Box::default())
         } else {
             Source::Toml(path)
         })
@@ -129,7 +129,7 @@ impl Builder {
     /// kanegen::Builder::urdf("Krang.urdf", UrdfOptions::wheeled(base).drop_links(["lgPlate1"])).run();
     /// ```
     pub fn urdf(path: impl Into<PathBuf>, import_options: model::UrdfOptions) -> Self {
-        Self::with_source(Source::Urdf(path.into(), import_options))
+        Self::with_source(Source::Urdf(path.into(), Box::new(import_options)))
     }
 
     /// How parameters enter and which functions the module gets, both at once (default
@@ -347,7 +347,6 @@ impl Builder {
             mirrored_lanes: self.mirrored_lanes,
             split_above: self.split_above,
             regressor_form: self.regressor_form,
-            ..EmitOptions::default()
         }
     }
 
@@ -479,7 +478,9 @@ impl Builder {
     /// warning: arm@0.1.0: kanegen: arm.urdf: 6 angles snapped to a multiple of π/2 (joint1, joint2, joint4 and 2 more); UrdfOptions::snap_angles = AngleSnap::Off keeps angles as written
     /// ```
     ///
-    /// Every note, one per angle or link, is in the generated file's header.
+    /// A line already printed by an earlier build of the same process (a build script that
+    /// generates several modules from one URDF) is not repeated. Every note, one per angle or
+    /// link, is in the generated file's header.
     pub fn build(&self) -> Result<PathBuf, Error> {
         let dir = match &self.out_dir {
             Some(d) => d.clone(),
@@ -489,7 +490,7 @@ impl Builder {
             println!("cargo:rerun-if-changed={}", path.display());
         }
         let g = self.generate()?;
-        for line in g.warnings() {
+        for line in warnings::not_printed_yet(g.warnings()) {
             println!("cargo:warning={line}");
         }
         let path = dir.join(self.output.clone().unwrap_or_else(|| self.file_name()));

@@ -63,8 +63,9 @@
 //! | `coriolis_matrix(&q, &u)` | `C(q, u)` with `c = C u` ([`Builder::coriolis_matrix`]) |
 //! | `forward_dynamics(&q, &u, &tau)` | `ud`, from the `kanegen_runtime::RobotDynamics` trait |
 //!
-//! and an `…_into` form of each that writes into the caller's matrix. [`Builder::functions`]
-//! adds kinematics (`frame_pose`, `frame_jacobian`, `com`, …), derivatives and regressors.
+//! and `…_into` forms of the matrix-valued ones (`mass_matrix_into(&q, &mut m)`) that write into
+//! the caller's matrix. [`Builder::functions`] adds kinematics (`frame_pose`, `frame_jacobian`,
+//! `center_of_mass`, …), derivatives and regressors.
 //!
 //! ```ignore
 //! use kanegen_runtime::RobotDynamics as _; // forward_dynamics
@@ -92,18 +93,25 @@
 //! to π/2, links merged, inertias repaired or dropped; [`Generated::warnings`]), and
 //! [`Builder::run`] fails the build with the typed [`Error`], reported once.
 #![forbid(unsafe_code)]
+// The build-script examples above show their `fn main`.
+#![allow(clippy::needless_doctest_main)]
 
 mod builder;
-// Internal stages, public only for the workspace's own tests and tools; not part of the API.
+// Internal stages, public only for the workspace's own tests and tools; not part of the API
+// (their documentation may link to the crate's private items).
 #[doc(hidden)]
 pub mod combined;
 #[doc(hidden)]
+#[allow(rustdoc::private_intra_doc_links)]
 pub mod emit;
 #[doc(hidden)]
+#[allow(rustdoc::private_intra_doc_links)]
 pub mod expr;
 #[doc(hidden)]
+#[allow(rustdoc::private_intra_doc_links)]
 pub mod kane;
 #[doc(hidden)]
+#[allow(rustdoc::private_intra_doc_links)]
 pub mod lower;
 #[doc(hidden)]
 pub mod naming;

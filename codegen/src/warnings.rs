@@ -180,6 +180,25 @@ pub(crate) fn summary(source: &str, notes: &[String]) -> Vec<String> {
     lines
 }
 
+/// The lines of `lines` that this process has not returned before (each summary line is
+/// printed once per build script, however many modules it generates from one model).
+pub(crate) fn not_printed_yet(lines: Vec<String>) -> Vec<String> {
+    static PRINTED: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+    let mut printed = PRINTED
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    lines
+        .into_iter()
+        .filter(|line| {
+            let new = !printed.contains(line);
+            if new {
+                printed.push(line.clone());
+            }
+            new
+        })
+        .collect()
+}
+
 /// `text` as one line that cannot end or extend a cargo instruction: control characters
 /// (newlines included) and bidirectional-text controls are escaped (`\n`, `\u{202e}`).
 pub(crate) fn one_line(text: &str) -> String {
@@ -220,6 +239,13 @@ mod tests {
             ]
         );
         assert!(summary("arm.urdf", &[]).is_empty());
+    }
+
+    #[test]
+    fn a_line_is_printed_once_per_process() {
+        let line = || vec!["kanegen: once.urdf: a line printed once".to_owned()];
+        assert_eq!(not_printed_yet(line()), line());
+        assert!(not_printed_yet(line()).is_empty());
     }
 
     #[test]

@@ -116,7 +116,12 @@ fn child() {
         return;
     };
     match what.to_str().unwrap() {
-        "build" => Builder::from_import(import(&UrdfOptions::default())).run(),
+        "build" => {
+            // Two modules of one model (runtime and baked parameters): the lines print once.
+            let builder = Builder::from_import(import(&UrdfOptions::default()));
+            builder.clone().run();
+            builder.baked(true).run();
+        }
         "fail" => Builder::new("no-such-model.toml").run(),
         other => panic!("unknown child task {other}"),
     }
@@ -137,6 +142,7 @@ fn a_build_prints_each_warning_line_once() {
     // In-memory models have no file to watch; the module is named after the model.
     assert!(!stdout.contains("cargo:rerun-if-changed"), "{stdout}");
     assert!(dir.join("snap_arm.rs").is_file());
+    assert!(dir.join("snap_arm_baked.rs").is_file());
     let _ = std::fs::remove_dir_all(dir);
 }
 

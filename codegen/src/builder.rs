@@ -21,7 +21,10 @@ enum Source {
     Model(Box<model::Model>, Vec<String>),
 }
 
-/// Generates a dynamics module from a build script.
+/// Generates a dynamics module: from a build script ([`Builder::run`], [`Builder::build`]) or
+/// in memory ([`Builder::generate`]). It starts from a description file ([`Builder::new`],
+/// [`Builder::urdf`]) or a model in memory ([`Builder::from_model`], [`Builder::from_import`]);
+/// every other setting has a default.
 ///
 /// ```no_run
 /// use kanegen::{FunctionId, FunctionSet};
@@ -498,7 +501,8 @@ impl Builder {
         Ok(path)
     }
 
-    /// [`Builder::build`], and on error fail the build with the typed error, printed once.
+    /// [`Builder::build`] (with its `cargo:warning=` summary of the URDF import), and on error
+    /// fail the build with the typed error, printed once.
     ///
     /// In a cargo build script (`CARGO` and `OUT_DIR` set) the error is one
     /// `cargo::error=kanegen: …` line and the script exits with status 0: cargo reports the

@@ -38,10 +38,13 @@
 //!
 //! ```ignore
 //! // src/lib.rs
-//! mod two_link {
+//! pub mod two_link {
 //!     include!(concat!(env!("OUT_DIR"), "/two_link.rs"));
 //! }
 //! ```
+//!
+//! (In a private module, or a binary, rustc warns of every generated item the crate does not
+//! use: add `#[allow(dead_code)]` to the module there.)
 //!
 //! The module holds `DOF`, `SPEED_NAMES` and `COORDINATE_NAMES`, a `Params` struct of the
 //! model's parameters (`Params::default()`: the description's values), a free function per

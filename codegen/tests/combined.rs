@@ -1,4 +1,4 @@
-//! Combined functions (`kanegen::combined`, `Builder::combined`): one straight-line program for
+//! Combined functions (`kanegen::Combined`, `Builder::combined`): one straight-line program for
 //! several registry functions and frames.
 //!
 //! * every part equals its separate function **bit for bit** (the lowering's interpreter, random

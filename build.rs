@@ -119,9 +119,9 @@ fn tree_urdf(branches: usize, depth: usize) -> String {
 
 /// A combined function of every part shape (symmetric matrix, vectors, Jacobians, isometry,
 /// scalars) on the arm's end link and a link merged by a fixed joint.
-fn arm_terms() -> kanegen::combined::Combined {
+fn arm_terms() -> kanegen::Combined {
     use kanegen::FunctionId as F;
-    let mut c = kanegen::combined::Combined::new("arm_terms")
+    let mut c = kanegen::Combined::new("arm_terms")
         .with(F::MassMatrix)
         .with(F::NonlinearEffects)
         .with(F::CenterOfMass)

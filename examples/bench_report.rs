@@ -219,8 +219,12 @@ fn generate(b: &Bench, params: ParamMode) -> Result<Generated, String> {
     };
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     match &b.source {
-        Source::Toml(p) => kanegen::generate(root.join(p), options),
-        Source::Urdf(p, urdf) => kanegen::generate_urdf(root.join(p), &urdf(), options),
+        Source::Toml(p) => kanegen::Builder::new(root.join(p))
+            .options(options)
+            .generate(),
+        Source::Urdf(p, urdf) => kanegen::Builder::urdf(root.join(p), urdf())
+            .options(options)
+            .generate(),
     }
     .map_err(|e| format!("{}: {e}", b.key))
 }

@@ -15,7 +15,7 @@ mod common;
 mod raw_urdf;
 
 use common::*;
-use kanegen::{FunctionId, Options, generate_model};
+use kanegen::{Builder, FunctionId, Options};
 use kanegen_model::{MimicMode, Model, ModelErrorKind, UrdfImport, UrdfOptions};
 use kanegen_reference::Reference;
 use kanegen_reference::random::random_physical_params;
@@ -225,7 +225,9 @@ fn check(entry: &Entry, draws: usize) -> [f64; 4] {
         functions: functions.into_iter().collect(),
         ..Options::default()
     };
-    let g = generate_model(model.clone(), options)
+    let g = Builder::from_model(model.clone())
+        .options(options)
+        .generate()
         .unwrap_or_else(|e| panic!("{}: generation: {e}", entry.file));
     assert!(g.source.contains("pub fn mass_matrix"), "{}", entry.file);
     let n = model.independent_dof();
@@ -294,12 +296,11 @@ fn every_corpus_robot_emits_batched_and_lane_paired_code() {
             functions: functions.into_iter().collect(),
             ..Options::default()
         };
-        let emit = kanegen::EmitOptions {
-            batch: true,
-            mirrored_lanes: true,
-            ..kanegen::EmitOptions::default()
-        };
-        let g = kanegen::generate_with(model, options, &emit)
+        let g = kanegen::Builder::from_model(model)
+            .options(options)
+            .batch(true)
+            .mirrored_lanes(true)
+            .generate()
             .unwrap_or_else(|e| panic!("{}: generation: {e}", entry.file));
         for f in ["mass_matrix_batch_into<", "coriolis_batch_soa_into<"] {
             assert!(g.source.contains(f), "{}: {f}", entry.file);

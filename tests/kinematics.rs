@@ -8,7 +8,7 @@ mod common;
 
 use common::*;
 use kanegen::model::{Model, UrdfOptions};
-use kanegen::{FunctionId, FunctionSet, Generated, Options, generate_model};
+use kanegen::{Builder, FunctionId, FunctionSet, Generated, Options};
 use kanegen_reference::random::random_physical_params;
 
 #[allow(dead_code)] // a module uses only the functions under test
@@ -31,7 +31,10 @@ fn generated(model: &Model) -> Generated {
         functions: FunctionSet::all(),
         ..Options::default()
     };
-    generate_model(model.clone(), options).expect("generates")
+    Builder::from_model(model.clone())
+        .options(options)
+        .generate()
+        .expect("generates")
 }
 
 /// Row-major data of a fixed-size matrix.

@@ -12,7 +12,7 @@ mod common;
 
 use common::*;
 use kanegen::model::{MimicMode, Model, ModelErrorKind, UrdfImport, UrdfOptions};
-use kanegen::{FunctionId, FunctionSet, Generated, Options, generate_model};
+use kanegen::{Builder, FunctionId, FunctionSet, Generated, Options};
 use kanegen_reference::Reference;
 use kanegen_reference::random::random_physical_params;
 use nalgebra::{DMatrix, DVector};
@@ -37,7 +37,10 @@ fn generated(model: &Model) -> Generated {
         functions: FunctionSet::all(),
         ..Options::default()
     };
-    generate_model(model.clone(), options).expect("generates")
+    Builder::from_model(model.clone())
+        .options(options)
+        .generate()
+        .expect("generates")
 }
 
 /// The constraint map written out from the URDF's `<mimic>` elements (not from the library's

@@ -17,7 +17,7 @@ mod raw_urdf;
 use std::fmt::Write as _;
 
 use common::*;
-use kanegen::{FunctionId, Options, generate_model};
+use kanegen::{Builder, FunctionId, Options};
 use kanegen_model::{AngleSnap, Model, ModelErrorKind as K, UrdfOptions, WheeledBaseSpec};
 use kanegen_reference::Reference;
 use proptest::prelude::*;
@@ -320,7 +320,10 @@ fn worst_error(model: &Model, states: usize, seed: u64) -> f64 {
         functions: functions.into_iter().collect(),
         ..Options::default()
     };
-    let g = generate_model(model.clone(), options).expect("a valid model generates");
+    let g = Builder::from_model(model.clone())
+        .options(options)
+        .generate()
+        .expect("a valid model generates");
     let p = model.param_values();
     let reference = Reference::<f64>::with_params(model, &p);
     let mut r = rng(seed);
@@ -653,7 +656,7 @@ proptest! {
         if let Ok(model) = Model::from_toml_str(&text, name)
             && which == 0
         {
-            prop_assert!(generate_model(model, Options::default()).is_ok());
+            prop_assert!(Builder::from_model(model).generate().is_ok());
         }
     }
 }

@@ -8,7 +8,7 @@ mod common;
 
 use common::*;
 use kanegen::model::{Model, UrdfOptions};
-use kanegen::{FunctionId, FunctionSet, Options, generate_model};
+use kanegen::{Builder, FunctionId, FunctionSet, Options};
 use kanegen_reference::random::random_physical_params;
 
 #[allow(dead_code)] // a module uses only the functions under test
@@ -36,7 +36,10 @@ macro_rules! compiled_regressors {
             functions: FunctionSet::all(),
             ..Options::default()
         };
-        let g = generate_model(model.clone(), options).expect("generates");
+        let g = Builder::from_model(model.clone())
+            .options(options)
+            .generate()
+            .expect("generates");
         let reg = &g.derivation.regressors;
         let names = |ids: &[usize]| -> Vec<String> {
             ids.iter().map(|&p| model.params[p].name.clone()).collect()

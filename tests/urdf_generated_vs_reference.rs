@@ -8,8 +8,8 @@
 mod common;
 
 use common::*;
+use kanegen::Builder;
 use kanegen::FunctionId;
-use kanegen::{Options, generate_model};
 use kanegen_model::{AngleSnap, Model, UrdfOptions, WheeledBaseSpec};
 use kanegen_reference::Reference;
 use kanegen_reference::random::random_physical_params;
@@ -41,7 +41,9 @@ fn krang_options() -> UrdfOptions {
 /// Worst relative error of the derivation and of the lowered programs against the reference,
 /// per function, over `draws` random parameter sets and states.
 fn check(label: &str, model: &Model, draws: usize, seed: u64) {
-    let g = generate_model(model.clone(), Options::default()).expect("generates");
+    let g = Builder::from_model(model.clone())
+        .generate()
+        .expect("generates");
     let n = model.dof();
     let mut r = rng(seed);
     let mut worst = [0.0f64; 6];

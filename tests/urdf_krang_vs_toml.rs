@@ -11,8 +11,8 @@
 mod common;
 
 use common::*;
+use kanegen::Builder;
 use kanegen::FunctionId;
-use kanegen::{Options, generate_model};
 use kanegen_model::{Model, UrdfOptions, WheeledBaseSpec};
 use kanegen_reference::Reference;
 use kanegen_reference::random::random_physical_params;
@@ -100,7 +100,7 @@ fn symmetric_krang_urdf_equals_krang_toml() {
     let urdf = urdf_model(&symmetric_krang_urdf());
     assert_eq!(urdf.dof(), toml.dof());
     let n = toml.dof();
-    let g = generate_model(urdf.clone(), Options::default()).unwrap();
+    let g = Builder::from_model(urdf.clone()).generate().unwrap();
     let (lj7, rj7) = (
         urdf.speed_index("qd_LJFT").unwrap(),
         urdf.speed_index("qd_RJFT").unwrap(),

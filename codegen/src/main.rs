@@ -215,6 +215,11 @@ fn run(args: Vec<String>) -> Result<(), Failure> {
     let start = std::time::Instant::now();
     let g = builder.generate().map_err(|e| error(&e))?;
     let elapsed = start.elapsed();
+    // The URDF import decisions that change the numbers, one line per kind (as a build prints
+    // them after `cargo:warning=`); every note is in the generated file's header.
+    for line in g.warnings() {
+        eprintln!("warning: {line}");
+    }
     match cmd {
         Command::Stats => output(&format!(
             "{}generation time: {:.0} ms\n{STATS_LEGEND}",

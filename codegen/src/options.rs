@@ -34,13 +34,12 @@ pub enum Precision {
 }
 
 /// The code shape of `inverse_dynamics_regressor` and `base_regressor` (see README,
-/// "Regressors: the loop form"); chosen with [`Builder::regressor_form`](crate::Builder::regressor_form)
-/// or [`EmitOptions::regressor_form`](crate::EmitOptions::regressor_form).
+/// "Regressors: the loop form"); chosen with
+/// [`Builder::regressor_form`](crate::Builder::regressor_form).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum RegressorForm {
-    /// The loop form for models without mimic joints with at least
-    /// [`LOOP_MIN_PAIRS`](crate::kane::LOOP_MIN_PAIRS) (speed, body) pairs (where the straight
-    /// line outgrows the instruction cache), the straight line otherwise.
+    /// The loop form for models without mimic joints with at least 40 (speed, body) pairs
+    /// (where the straight line outgrows the instruction cache), the straight line otherwise.
     #[default]
     Auto,
     /// One straight-line program per function (every entry its own derivative chain).
@@ -50,7 +49,8 @@ pub enum RegressorForm {
     Loop,
 }
 
-/// How `inverse_dynamics_derivatives` is emitted (`Builder::derivatives_form`).
+/// How `inverse_dynamics_derivatives` is emitted
+/// ([`Builder::derivatives_form`](crate::Builder::derivatives_form)).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum DerivativesForm {
     /// [`DerivativesForm::Looped`] when the model allows it and the straight-line form has more
@@ -88,5 +88,14 @@ impl Options {
     /// Whether the module gets function `f`.
     pub fn has(&self, f: FunctionId) -> bool {
         self.functions.contains(f)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// [`super::RegressorForm::Auto`]'s documentation states the threshold.
+    #[test]
+    fn the_documented_loop_threshold_is_the_derivation_s() {
+        assert_eq!(crate::kane::LOOP_MIN_PAIRS, 40);
     }
 }

@@ -1,4 +1,4 @@
-//! Combined functions (`kanegen::combined`, `Builder::combined`): one straight-line program for
+//! Combined functions (`kanegen::Combined`, `Builder::combined`): one straight-line program for
 //! several registry functions and frames.
 //!
 //! * every part equals its separate function **bit for bit** (the lowering's interpreter, random
@@ -12,12 +12,9 @@
 //!   function, a taken or malformed name, a part twice, no part, a regressor) is a typed error
 //!   naming the model file, the combined function and the fix.
 
-use kanegen::combined::{Combined, CombinedError};
 use kanegen::model::{Model, UrdfOptions};
-use kanegen::{
-    EmitOptions, Error, FunctionId as F, FunctionSet, Generated, Options, ParamMode,
-    generate_combined,
-};
+use kanegen::{Builder, Error, FunctionId as F, FunctionSet, Generated, Options, ParamMode};
+use kanegen::{Combined, CombinedError};
 use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
 
 fn models_dir() -> std::path::PathBuf {
@@ -64,7 +61,11 @@ fn generate(model: &Model, params: ParamMode, combined: &[Combined]) -> Generate
         params,
         functions: functions(),
     };
-    generate_combined(model.clone(), options, combined, &EmitOptions::default()).expect("generates")
+    let mut builder = Builder::from_model(model.clone()).options(options);
+    for c in combined {
+        builder = builder.combined(c.clone());
+    }
+    builder.generate().expect("generates")
 }
 
 /// Every part of combined function 0 equals its separate function, bit for bit, on `states`
@@ -225,7 +226,7 @@ fn emitted_module_has_the_struct_function_and_method() {
 
 fn error(c: Combined) -> CombinedError {
     let model = load("two-link.toml");
-    match generate_combined(model, Options::default(), &[c], &EmitOptions::default()) {
+    match Builder::from_model(model).combined(c).generate() {
         Err(Error::Combined(e)) => e,
         other => panic!(
             "expected a combined-function error, got {:?}",
@@ -276,6 +277,9 @@ fn bad_combined_functions_are_typed_errors_naming_the_fix() {
         Combined::new("terms").with(F::Gravity),
         Combined::new("terms").with(F::MassMatrix),
     ];
-    let e = generate_combined(model, Options::default(), &twice, &EmitOptions::default());
+    let e = twice
+        .into_iter()
+        .fold(Builder::from_model(model), Builder::combined)
+        .generate();
     assert!(matches!(e, Err(Error::Combined(e)) if e.problem.contains("two combined functions")));
 }

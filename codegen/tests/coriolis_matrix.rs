@@ -6,7 +6,7 @@
 
 use kanegen::FunctionId;
 use kanegen::model::{Model, UrdfOptions, WheeledBaseSpec};
-use kanegen::{Generated, Options, ParamMode, generate_model};
+use kanegen::{Builder, Generated, Options, ParamMode};
 use kanegen_reference::Reference;
 use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
 
@@ -107,14 +107,13 @@ fn check(label: &str, g: &Generated, draws: usize, seed: u64) -> [f64; 4] {
 }
 
 fn generated(m: Model, params: ParamMode) -> Generated {
-    generate_model(
-        m,
-        Options {
+    Builder::from_model(m)
+        .options(Options {
             params,
             ..Options::default()
-        },
-    )
-    .expect("generates")
+        })
+        .generate()
+        .expect("generates")
 }
 
 #[test]

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use kanegen::model::{Model, ModelErrorKind as K, UrdfImport, UrdfOptions};
-use kanegen::{EmitOptions, Error, Options, generate_model, generate_with};
+use kanegen::{Builder, Error};
 
 fn two_link() -> Model {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models/two-link.toml");
@@ -14,7 +14,7 @@ fn two_link() -> Model {
 
 /// The `BadName` of generating `model`; the name it reports.
 fn rejected_name(model: Model) -> String {
-    match generate_model(model, Options::default()) {
+    match Builder::from_model(model).generate() {
         Err(Error::Model(e)) => match e.kind {
             K::BadName(b) => b.name,
             other => panic!("expected BadName, got {other:?}"),
@@ -108,12 +108,7 @@ fn link_names_cannot_inject_code_through_comments() {
         "the merge note names the hostile link: {:?}",
         import.notes
     );
-    let emit = EmitOptions {
-        notes: import.notes.clone(),
-        notes_title: "URDF import notes".into(),
-        ..EmitOptions::default()
-    };
-    let g = generate_with(import.model, Options::default(), &emit).expect("generates");
+    let g = Builder::from_import(import).generate().expect("generates");
     let src = &g.source;
     // The link names reach the statement labels and the notes, escaped.
     assert!(

@@ -16,7 +16,7 @@
 //!   derivative.
 
 use kanegen::model::{Model, UrdfOptions};
-use kanegen::{FunctionId, FunctionSet, Generated, Options, generate_model};
+use kanegen::{Builder, FunctionId, FunctionSet, Generated, Options};
 use kanegen_reference::Reference;
 use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
 use nalgebra::{Matrix3, Vector3};
@@ -81,7 +81,10 @@ fn case(name: &'static str, seed: u64) -> Case {
             .collect(),
         ..Options::default()
     };
-    let generated = generate_model(model.clone(), options).expect("generates");
+    let generated = Builder::from_model(model.clone())
+        .options(options)
+        .generate()
+        .expect("generates");
     let mut r = SplitMix64::new(seed);
     let mut uniform: Box<dyn FnMut() -> f64> = Box::new(move || r.next_f64());
     let params = random_physical_params(&model, &mut uniform);

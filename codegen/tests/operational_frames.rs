@@ -14,7 +14,7 @@
 //! central differences are in `kinematics.rs` (Krang's hands, the slider's merged `bracket`).
 
 use kanegen::model::{Model, ModelErrorKind, OperationalFrame, UrdfOptions};
-use kanegen::{Builder, FunctionId, FunctionSet, Generated, Options, generate_model};
+use kanegen::{Builder, FunctionId, FunctionSet, Generated, Options};
 use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
@@ -106,7 +106,10 @@ fn merged_fixed_links_keep_their_frames_at_the_parent_pose_composed_with_the_fix
             "link `{link}` addressable: {names:?}"
         );
     }
-    let g = generate_model(model.clone(), all_functions()).expect("generates");
+    let g = Builder::from_model(model.clone())
+        .options(all_functions())
+        .generate()
+        .expect("generates");
     let mut rng = SplitMix64::new(11);
     let mut uniform = move || rng.next_f64();
     let params = model.param_values();
@@ -142,8 +145,8 @@ fn link_frames_do_not_change_the_dynamics() {
     let without = Model::from_urdf_str(MERGED, "merged.urdf", &options).unwrap();
     assert_eq!(with.links.len(), without.links.len() + 4);
     assert_eq!(with.params, without.params);
-    let a = generate_model(with, Options::default()).unwrap();
-    let b = generate_model(without, Options::default()).unwrap();
+    let a = Builder::from_model(with).generate().unwrap();
+    let b = Builder::from_model(without).generate().unwrap();
     let mut rng = SplitMix64::new(12);
     let mut uniform = move || rng.next_f64();
     let params = random_physical_params(&a.model, &mut uniform);
@@ -172,7 +175,10 @@ fn toml_frames_sit_at_their_offset_from_the_parent_for_any_parameters() {
     );
     let model = Model::from_toml_str(&text, "two-link+tool.toml").expect("loads");
     assert_eq!(model.links.len(), 5);
-    let g = generate_model(model.clone(), all_functions()).expect("generates");
+    let g = Builder::from_model(model.clone())
+        .options(all_functions())
+        .generate()
+        .expect("generates");
     assert!(g.source.contains("ToolTip"), "Frame::ToolTip generated");
     let mut rng = SplitMix64::new(13);
     let mut uniform = move || rng.next_f64();

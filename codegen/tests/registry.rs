@@ -6,7 +6,7 @@ use std::process::Command;
 
 use kanegen::model::{UrdfOptions, WheeledBaseSpec};
 use kanegen::registry::FUNCTIONS;
-use kanegen::{Builder, FunctionId, FunctionSet, Options, generate};
+use kanegen::{Builder, FunctionId, FunctionSet, Options};
 
 fn models() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models")
@@ -34,7 +34,10 @@ fn a_module_gets_only_the_functions_asked_for() {
         functions: set,
         ..Options::default()
     };
-    let g = generate(models().join("two-link.toml"), options).unwrap();
+    let g = Builder::new(models().join("two-link.toml"))
+        .options(options)
+        .generate()
+        .unwrap();
     let ids: Vec<FunctionId> = g.derivation.functions.iter().map(|f| f.id).collect();
     assert_eq!(ids, [FunctionId::MassMatrix, FunctionId::Gravity]);
     let ids: Vec<FunctionId> = g.lowered.functions.iter().map(|f| f.id).collect();
@@ -59,7 +62,9 @@ fn a_module_gets_only_the_functions_asked_for() {
     }
     // M, c, g and τ together make `RobotDynamics`: without c and τ the wrapper does not claim it.
     assert!(!g.source.contains("RobotDynamics"));
-    let full = generate(models().join("two-link.toml"), Options::default()).unwrap();
+    let full = Builder::new(models().join("two-link.toml"))
+        .generate()
+        .unwrap();
     assert!(
         full.source
             .contains("impl kanegen_runtime::RobotDynamics<DOF> for TwoLink")
@@ -75,15 +80,16 @@ fn functions_derived_without_the_mass_matrix_compute_the_same_values() {
     let set: FunctionSet = [FunctionId::Gravity, FunctionId::CoriolisMatrix]
         .into_iter()
         .collect();
-    let part = generate(
-        models().join("krang.toml"),
-        Options {
+    let part = Builder::new(models().join("krang.toml"))
+        .options(Options {
             functions: set,
             ..Options::default()
-        },
-    )
-    .unwrap();
-    let full = generate(models().join("krang.toml"), Options::default()).unwrap();
+        })
+        .generate()
+        .unwrap();
+    let full = Builder::new(models().join("krang.toml"))
+        .generate()
+        .unwrap();
     let params = full.model.param_values();
     let q: Vec<f64> = (0..19).map(|i| 0.13 * i as f64 - 0.9).collect();
     let u: Vec<f64> = (0..19).map(|i| 0.4 - 0.03 * i as f64).collect();
@@ -205,7 +211,10 @@ fn kinematics_are_opt_in_listed_by_stats_and_the_same_without_the_dynamics() {
             functions,
             ..Options::default()
         };
-        generate(models().join("krang.toml"), options).unwrap()
+        Builder::new(models().join("krang.toml"))
+            .options(options)
+            .generate()
+            .unwrap()
     };
     let (part, full) = (with(kinematics), with(FunctionSet::all()));
     let params = full.model.param_values();
@@ -234,7 +243,10 @@ fn generated_code_zeroes_results_with_a_memset_not_nalgebras_element_wise_fill()
         functions: FunctionSet::all(),
         ..Options::default()
     };
-    let g = generate(models().join("krang.toml"), options).unwrap();
+    let g = Builder::new(models().join("krang.toml"))
+        .options(options)
+        .generate()
+        .unwrap();
     let s = &g.source;
     // Both looped forms, whose `_into` functions zero before storing the non-zero entries.
     assert!(s.contains("kanegen_runtime::derivative_steps::run"));
@@ -267,7 +279,10 @@ fn a_constant_that_is_no_finite_number_is_an_error_not_a_panic() {
         functions: FunctionSet::all(),
         ..Options::default()
     };
-    match kanegen::generate_model(model, options) {
+    match kanegen::Builder::from_model(model)
+        .options(options)
+        .generate()
+    {
         Err(kanegen::Error::NonFiniteConstant {
             function, value, ..
         }) => {
@@ -289,11 +304,11 @@ fn a_baked_constant_beyond_f32_range_is_an_error_in_an_f32_module() {
         params: kanegen::ParamMode::Baked,
         ..Options::default()
     };
-    let emit = kanegen::EmitOptions {
-        precision: kanegen::Precision::F32,
-        ..kanegen::EmitOptions::default()
-    };
-    match kanegen::generate_with(model.clone(), options, &emit) {
+    match kanegen::Builder::from_model(model.clone())
+        .options(options)
+        .precision(kanegen::Precision::F32)
+        .generate()
+    {
         Err(
             e @ kanegen::Error::NonFiniteConstant {
                 precision: "f32", ..
@@ -304,7 +319,12 @@ fn a_baked_constant_beyond_f32_range_is_an_error_in_an_f32_module() {
         other => panic!("expected NonFiniteConstant, got {:?}", other.map(|_| ())),
     }
     // The same model in f64 is fine.
-    assert!(kanegen::generate_model(model, options).is_ok());
+    assert!(
+        kanegen::Builder::from_model(model)
+            .options(options)
+            .generate()
+            .is_ok()
+    );
 }
 
 #[test]
@@ -327,7 +347,11 @@ fn a_function_that_reads_only_sines_binds_no_unused_cosines() {
         params: kanegen::ParamMode::Baked,
         functions: FunctionSet::all(),
     };
-    let source = kanegen::generate_model(model, options).unwrap().source;
+    let source = kanegen::Builder::from_model(model)
+        .options(options)
+        .generate()
+        .unwrap()
+        .source;
     let bindings: Vec<&str> = source.split("sin_cos_n(").collect();
     let mut sine_only = 0;
     // Between one binding and the next, the reads of the first.

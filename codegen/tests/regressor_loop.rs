@@ -11,9 +11,7 @@
 
 use kanegen::kane::{CarryFrom, KIN, RegressorLoop};
 use kanegen::model::{Model, UrdfOptions};
-use kanegen::{
-    EmitOptions, FunctionId, FunctionSet, Generated, Options, RegressorForm, generate_with,
-};
+use kanegen::{Builder, FunctionId, FunctionSet, Generated, Options, RegressorForm};
 use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
 use kanegen_runtime::isa::{Arith, Fused, Plain};
 use kanegen_runtime::regressor::{
@@ -45,11 +43,11 @@ fn generated(model: &Model, form: RegressorForm) -> Generated {
         functions: FunctionSet::regressors().with(FunctionId::InverseDynamics),
         ..Options::default()
     };
-    let emit = EmitOptions {
-        regressor_form: form,
-        ..EmitOptions::default()
-    };
-    generate_with(model.clone(), options, &emit).expect("generates")
+    Builder::from_model(model.clone())
+        .options(options)
+        .regressor_form(form)
+        .generate()
+        .expect("generates")
 }
 
 /// What both kernels start from: function `id`'s loop tables, its `kin` table evaluated from the

@@ -12,7 +12,7 @@
 //! * with baked parameters the regressors equal the runtime ones at the model's values.
 
 use kanegen::model::{Model, UrdfOptions};
-use kanegen::{FunctionId, FunctionSet, Generated, Options, ParamMode, generate_model};
+use kanegen::{Builder, FunctionId, FunctionSet, Generated, Options, ParamMode};
 use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
 use nalgebra::DMatrix;
 use std::sync::OnceLock;
@@ -39,7 +39,10 @@ fn generated(model: &Model, params: ParamMode) -> Generated {
             .with(FunctionId::Gravity),
         params,
     };
-    generate_model(model.clone(), options).expect("generates")
+    Builder::from_model(model.clone())
+        .options(options)
+        .generate()
+        .expect("generates")
 }
 
 /// The model `MODELS[i]` and its runtime-parameter generation, made once per test binary.
@@ -827,6 +830,6 @@ fn stats_and_listing_print_the_base_parameters() {
     assert!(listing.contains("% MYR1 = MY1 + L1*m2"), "{listing}");
     // Without base regressors nothing is printed.
     let model = load("two-link.toml");
-    let plain = generate_model(model, Options::default()).unwrap();
+    let plain = Builder::from_model(model).generate().unwrap();
     assert!(!kanegen::stats(&plain).contains("base parameters"));
 }

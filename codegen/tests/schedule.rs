@@ -171,11 +171,10 @@ fn restricted_programs_give_their_entries_bits_and_hold_only_what_they_read() {
 
 /// Krang's module with the batched functions.
 fn batched_krang() -> String {
-    let emit = kanegen::EmitOptions {
-        batch: true,
-        ..kanegen::EmitOptions::default()
-    };
-    let g = kanegen::generate_with(krang(), kanegen::Options::default(), &emit).expect("generates");
+    let g = kanegen::Builder::from_model(krang())
+        .batch(true)
+        .generate()
+        .expect("generates");
     g.source
 }
 

@@ -21,7 +21,8 @@ fuzz_target!(|data: &[u8]| {
         if let Ok(model) = Model::from_urdf_str(text, "fuzz.urdf", &options)
             && model.dof() <= 8
         {
-            kanegen::generate_model(model, kanegen::Options::default())
+            kanegen::Builder::from_model(model)
+                .generate()
                 .expect("a model the loader accepts generates");
         }
     }

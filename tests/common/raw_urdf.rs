@@ -3,7 +3,7 @@
 //! generated module's g and M with them.
 #![allow(dead_code)]
 
-use kanegen::{FunctionId, Options, generate_model};
+use kanegen::{Builder, FunctionId, Options};
 use kanegen_model::Model;
 
 use super::common::{random_state, rel_err, rng};
@@ -136,16 +136,15 @@ impl RawUrdf {
     /// gradient of [`potential`](Self::potential) and of ½ uᵀ M u against
     /// [`kinetic`](Self::kinetic) (the model's own parameters; fixed base).
     pub fn energy_errors(&self, model: &Model, draws: usize, seed: u64) -> (f64, f64) {
-        let g = generate_model(
-            model.clone(),
-            Options {
+        let g = Builder::from_model(model.clone())
+            .options(Options {
                 functions: [FunctionId::MassMatrix, FunctionId::Gravity]
                     .into_iter()
                     .collect(),
                 ..Options::default()
-            },
-        )
-        .expect("generates");
+            })
+            .generate()
+            .expect("generates");
         let p = model.param_values();
         // Mimic joints: the generated functions take the independent coordinates; the raw
         // file's energies are taken at the whole tree's expanded state.

@@ -45,7 +45,7 @@ use nalgebra::{DMatrix, DVector, SVector};
 
 // The charts: the `simulate` example's drawing code.
 #[allow(dead_code)]
-#[path = "simulate.rs"]
+#[path = "simulate/main.rs"]
 mod simulate;
 use simulate::{BLUE_, GREEN_, GREY, ORANGE, PALETTE, Panel, RED_, Series, figure_over};
 

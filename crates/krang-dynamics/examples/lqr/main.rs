@@ -35,7 +35,7 @@ use nalgebra::{DMatrix, SVector};
 
 // The charts: the `simulate` example's drawing code (also used by `whole_body`).
 #[allow(dead_code)]
-#[path = "../simulate.rs"]
+#[path = "../simulate/main.rs"]
 mod simulate;
 use simulate::{BLUE_, GREEN_, ORANGE, Panel, RED_, Series, figure};
 

@@ -121,8 +121,9 @@ impl<const N: usize> Upper<N> {
 /// a multiplication and an addition), four per [`F64x4`] in the x86-64-v3 copy ([`FusedQuad`]:
 /// fused). A substitution is a chain of dependent multiply-adds, so four columns per chain run
 /// half as many chains (Krang's 57 columns of `forward_dynamics_derivatives`, Intel Xeon, Nov
-/// 2026: 1,710 → 1,140 ns in the x86-64-v3 copy; the baseline copy's 2,590 ns unchanged). Each lane
-/// runs the operations of [`BlockCholesky::solve_mut`] on its column in the same order.
+/// 2026: 1,710 → 1,140 ns in the x86-64-v3 copy; the baseline copy's 2,590 ns unchanged).
+/// Each lane runs the operations of [`BlockCholesky::solve_mut`] on its column in the same
+/// order.
 trait ColumnLanes: Copy {
     /// Columns per value.
     const WIDTH: usize;

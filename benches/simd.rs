@@ -1,4 +1,4 @@
-//! Issue 14: the generated Krang functions with each instruction set of the run-time dispatch
+//! The generated Krang functions with each instruction set of the run-time dispatch
 //! (`baseline`, `x86-64-v3`: AVX2 + FMA, `x86-64-v4`: AVX-512, which only the batched functions
 //! have a copy for) and batched at 4 and 8 states per call.
 //!
@@ -26,9 +26,9 @@ use krang_dynamics::isa::{self, Isa};
 use krang_dynamics::lanes::{Lanes, soa};
 use nalgebra::{SMatrix, SVector};
 
-/// The 64 states the profile driver (`crates/krang-dynamics/examples/profile.rs`) cycles
-/// through, so that its figures and this bench's measure the same inputs.
-#[path = "../crates/krang-dynamics/examples/profile_states/mod.rs"]
+/// The 64 states the profile driver (`crates/krang-dynamics/benches/profile/functions.rs`)
+/// cycles through, so that its figures and this bench's measure the same inputs.
+#[path = "../crates/krang-dynamics/benches/profile/states.rs"]
 mod profile_states;
 use profile_states::{V, states};
 

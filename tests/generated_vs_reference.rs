@@ -89,10 +89,7 @@ fn krang_generated_matches_reference_with_wheels_zeroed() {
 #[test]
 fn krang_generated_matches_reference_with_hardware_fitted_masses() {
     let model = model("krang.toml");
-    let Some(p) = hardware_fitted_params(&model) else {
-        eprintln!("note: shared/krang/params not found beside the repository; skipped");
-        return;
-    };
+    let p = hardware_fitted_params(&model);
     let mut r = rng(3);
     let mut w = [0.0; 4];
     for _ in 0..300 {

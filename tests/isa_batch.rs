@@ -1,4 +1,4 @@
-//! Run-time instruction-set dispatch and batched evaluation (issue 14): the x86-64-v3 copy of
+//! Run-time instruction-set dispatch and batched evaluation: the x86-64-v3 copy of
 //! every generated function (which fuses multiply-adds) agrees with the baseline copy to
 //! rounding, and every batched function gives, in every lane, the bits of the single-state
 //! function *with the same instruction set* (the same statements, multiply-add chains included,

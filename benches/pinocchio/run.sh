@@ -3,7 +3,8 @@
 # Pinocchio's C++ and in kanegen's generated Rust, checked against each other on random
 # parameters and states, then timed alternately in one run.
 #
-#   benches/pinocchio/run.sh            # from anywhere; everything goes to target/pinocchio
+#   benches/pinocchio/run.sh            # from anywhere; everything goes to target/pinocchio,
+#                                       # this run's results to target/pinocchio/YYYY-MM-DD
 #
 # Needs python3 (with venv), a C++17 compiler (g++ or clang++; CXX to choose), cargo, and network
 # access to PyPI. Steps:
@@ -17,21 +18,21 @@
 #   4. RUNS times (default 3), alternately: the harness (agreement check on all cases, then
 #      Pinocchio's timings), with CODEGEN=1 the codegen harness, and the Rust timings; then the
 #      table, best of the runs.
-# With CODEGEN=1 also Pinocchio's own generated code (its CppADCodeGen path, issue 14's second
-# target): step 1 adds `cmeel-cppad` and `cmeel-cppadcodegen` (headers), step 2 compiles
+# With CODEGEN=1 also Pinocchio's own generated code (its CppADCodeGen path, the other code
+# generator to compare with): step 1 adds `cmeel-cppad` and `cmeel-cppadcodegen` (headers), step 2 compiles
 # benches/pinocchio/codegen.cpp, whose first run records crba, nonLinearEffects, gravity, rnea
 # and computeRNEADerivatives on case 0's model and compiles each to a shared library with
 # `$CC -O3 -march=native` (CC default /usr/bin/gcc) into OUT/RUN_NAME/cg (about 25 s for Krang on
-# the 2-core machine; delete that directory to regenerate); later runs load them. Compiling the
+# a 2-core Intel Xeon; delete that directory to regenerate); later runs load them. Compiling the
 # codegen harness itself takes about 7 minutes (CppAD's templates).
 # Environment: PIN_VERSION (default 4.1.0), EIGEN_VERSION (cmeel-eigen, 3.4.1), RUNS (3),
 # CODEGEN (0; 1 for Pinocchio's generated code), CPPAD_VERSION (cmeel-cppad, 20250000.2),
 # CPPADCG_VERSION (cmeel-cppadcodegen, 2.4.3),
 # CXX (g++), OUT (target/pinocchio),
 # CXXFLAGS_EXTRA (appended to the compiler flags), RUN_NAME (the results directory under OUT,
-# default `run`). cargo's own variables apply to the Rust side, e.g. for both sides with the
+# default today's date, YYYY-MM-DD: name it to keep runs apart, e.g. RUN_NAME=native). cargo's own variables apply to the Rust side, e.g. for both sides with the
 # machine's instruction set (a separate target directory keeps the default build):
-#   RUSTFLAGS="-C target-cpu=native" CARGO_TARGET_DIR=target/native RUN_NAME=run-native \
+#   RUSTFLAGS="-C target-cpu=native" CARGO_TARGET_DIR=target/native RUN_NAME=native \
 #       benches/pinocchio/run.sh
 # Not part of CI (it downloads). Takes about 5 minutes on a 2-core machine, most of it compiling
 # the harness (Pinocchio's templates) and the Rust example; about 8 more with CODEGEN=1.
@@ -46,7 +47,7 @@ codegen="${CODEGEN:-0}"
 cppad_version="${CPPAD_VERSION:-20250000.2}"
 cppadcg_version="${CPPADCG_VERSION:-2.4.3}"
 cxx="${CXX:-g++}"
-run_dir="$out/${RUN_NAME:-run}"
+run_dir="$out/${RUN_NAME:-$(date +%Y-%m-%d)}"
 mkdir -p "$run_dir"
 
 echo "== 1. Pinocchio $pin_version from PyPI into $out/venv"

@@ -1,5 +1,5 @@
 //! The symbolic derivation, evaluated numerically, against the three Pinocchio cases of
-//! `shared/krang/reference-values.json` (an independent library).
+//! `models/krang/reference-values.json` (an independent library).
 
 use kanegen::kane::derive;
 use kanegen::model::Model;
@@ -27,11 +27,9 @@ fn rel_err(a: &[f64], b: &[f64]) -> f64 {
 
 #[test]
 fn symbolic_krang_matches_pinocchio_reference_values() {
-    let path = root().join("../shared/krang/reference-values.json");
-    let Ok(text) = std::fs::read_to_string(&path) else {
-        eprintln!("note: {} not found; skipping", path.display());
-        return;
-    };
+    let path = root().join("models/krang/reference-values.json");
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: {e} (the Pinocchio reference values)", path.display()));
     let json: serde_json::Value = serde_json::from_str(&text).unwrap();
     let model = Model::from_toml_file(root().join("models/krang.toml")).unwrap();
     let d = derive(

@@ -22,7 +22,7 @@ the centre of mass in the inertial frame,
 
 Left out (see the header of models/krang.toml): the gripper plates lgPlate1/2, rgPlate1/2 (fixed
 children, 0.1 g, placeholder inertias ~0.09 kg m^2) and the Kinect (commented out in Krang.urdf).
-The default paths are those of the shared tree (/work/shared/krang); pass --urdf/--reference elsewhere.
+The default paths are the repository's copies (models/Krang.urdf, models/krang/reference-values.json).
 """
 
 import argparse
@@ -34,8 +34,8 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-DEFAULT_URDF = Path("/work/shared/krang/urdf/Krang.urdf")
-DEFAULT_REFERENCE = Path("/work/shared/krang/reference-values.json")
+DEFAULT_URDF = HERE.parent / "Krang.urdf"
+DEFAULT_REFERENCE = HERE.parent / "krang" / "reference-values.json"
 DEFAULT_MODEL = HERE.parent / "krang.toml"
 
 # Report body <- URDF link.

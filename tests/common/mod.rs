@@ -22,10 +22,12 @@ pub fn model(name: &str) -> Model {
     Model::from_toml_file(root().join("models").join(name)).expect("model loads")
 }
 
-/// `shared/` beside the repository (absent on a machine without it).
-pub fn shared(rel: &str) -> Option<PathBuf> {
-    let p = root().join("../shared").join(rel);
-    p.exists().then_some(p)
+/// The text of `models/krang/<rel>` (the Krang data, `models/krang/README.md`); a missing file
+/// fails the test with its path.
+pub fn krang_data(rel: &str) -> String {
+    let path = root().join("models/krang").join(rel);
+    std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: {e} (the Krang data files)", path.display()))
 }
 
 /// `max |a − b| / max(max |b|, floor)`: relative to the largest entry, absolute below `floor`
@@ -78,16 +80,15 @@ pub fn dvec(v: &DVector<f64>) -> Vec<f64> {
     v.iter().copied().collect()
 }
 
-/// The hardware-fitted masses and first moments of Krang (`shared/krang/params`), applied to the
+/// The hardware-fitted masses and first moments of Krang (`models/krang/params`), applied to the
 /// model's bodies (inertias keep their defaults). The 23 entries of the hardware-trained beta
 /// vector are, in order: Base, LWheel, RWheel, Spine, Bracket, L1..L6, lGripper, lgPlate1,
 /// lgPlate2, R1..R6, rGripper, rgPlate1, rgPlate2 (the ideal vector has a 24th, the Kinect, after
 /// Bracket), each `[m, m·cx, m·cy, m·cz]` in the link frame (which coincides with the report's
 /// frame, see MODEL-NOTES). The fitted plates have negative masses; they are not bodies of the
 /// 19-speed model and are left out.
-pub fn hardware_fitted_params(model: &Model) -> Option<Vec<f64>> {
-    let path = shared("krang/params/convergedBetaVector104PosesHardwareTrained.txt")?;
-    let text = std::fs::read_to_string(path).ok()?;
+pub fn hardware_fitted_params(model: &Model) -> Vec<f64> {
+    let text = krang_data("params/convergedBetaVector104PosesHardwareTrained.txt");
     let beta: Vec<f64> = text
         .split_whitespace()
         .map(|t| t.parse().unwrap())
@@ -127,7 +128,7 @@ pub fn hardware_fitted_params(model: &Model) -> Option<Vec<f64>> {
             }
         }
     }
-    Some(p)
+    p
 }
 
 /// `Ṁ = dM(q(t))/dt` along `q̇` by central differences with one Richardson step (error O(h⁴)):

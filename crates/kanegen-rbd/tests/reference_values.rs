@@ -1,7 +1,6 @@
-//! The three Pinocchio cases of `shared/krang/reference-values.json` (next to the repository):
-//! parameters by symbol name (matched to `ParamId`s with `model.param_index`), `q`, `u`, `u̇` →
-//! `M`, `c`, `g`, `τ`, compared to 1e-9 relative to the largest entry of each quantity. Skipped
-//! with a note if the file is absent.
+//! The three Pinocchio cases of `models/krang/reference-values.json`: parameters by symbol name
+//! (matched to `ParamId`s with `model.param_index`), `q`, `u`, `u̇` → `M`, `c`, `g`, `τ`,
+//! compared to 1e-9 relative to the largest entry of each quantity.
 
 mod common;
 
@@ -24,15 +23,10 @@ fn numbers(v: &Value, what: &str) -> Vec<f64> {
 
 #[test]
 fn pinocchio_reference_values_match() {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/krang/reference-values.json");
-    let Ok(text) = std::fs::read_to_string(&path) else {
-        println!(
-            "note: {} not found; skipping the Pinocchio reference values",
-            path.display()
-        );
-        return;
-    };
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models/krang/reference-values.json");
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: {e} (the Pinocchio reference values)", path.display()));
     let json: Value = serde_json::from_str(&text).expect("reference-values.json is valid JSON");
     let model = common::load_model("krang");
     let cases = json["cases"].as_array().expect("`cases` array");

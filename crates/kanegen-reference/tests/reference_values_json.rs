@@ -1,5 +1,4 @@
-//! The three Pinocchio cases of `shared/krang/reference-values.json` (next to the repository):
-//! parameters by symbol name, `q`, `u`, `u̇` → `M`, `c`, `g`, `τ`, compared to 1e-9 relative to
+//! The three Pinocchio cases of `models/krang/reference-values.json`: parameters by symbol name, `q`, `u`, `u̇` → `M`, `c`, `g`, `τ`, compared to 1e-9 relative to
 //! the largest entry of each quantity.
 
 mod common;
@@ -23,15 +22,10 @@ fn numbers(v: &Value, what: &str) -> Vec<f64> {
 
 #[test]
 fn pinocchio_reference_values_match() {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/krang/reference-values.json");
-    let Ok(text) = std::fs::read_to_string(&path) else {
-        eprintln!(
-            "note: {} not found (shared/ is not next to the repository); skipping",
-            path.display()
-        );
-        return;
-    };
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models/krang/reference-values.json");
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: {e} (the Pinocchio reference values)", path.display()));
     let json: Value = serde_json::from_str(&text).expect("reference-values.json is valid JSON");
     let model = common::load_model("krang");
     let n = model.dof();

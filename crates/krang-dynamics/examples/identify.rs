@@ -1,7 +1,7 @@
 //! Identification of Krang's inertial parameters from simulated measurements, with plots.
 //!
 //! * **(a) The beta vector from static poses**, as the lab learned it on hardware
-//!   (`../shared/krang/controllers/README.md`, "Centre-of-mass (beta) learning": 104 poses). At
+//!   (the Krang project's CoM-learning programs, munzir/18c-ParameterConvergence: 104 poses). At
 //!   each of `poses` random poses of the waist, torso and arms the robot balances: its pitch
 //!   `q_imu` is the one that puts the centre of mass above the wheel axle (the pitch row of
 //!   g(q) vanishes; found in closed form, g_imu = a cos q_imu + b sin q_imu). Measured: the
@@ -17,8 +17,8 @@
 //!   regressor (`fixed_wheels::base_regressor`, 111 of 170 parameters) gives π_b; the report
 //!   lists the arm's (bodies 4l–10l).
 //!
-//! **The lab's vectors** (`../shared/krang/params/`): `idealBetaVector.txt` (24 bodies: Base,
-//! the two wheels, Spine, Bracket, Kinect, L1–L6, lGripper and its two motor plates, the same on
+//! **The lab's vectors** (`models/krang/params/`, provenance in `models/krang/README.md`):
+//! `idealBetaVector.txt` (24 bodies: Base, the two wheels, Spine, Bracket, Kinect, L1–L6, lGripper and its two motor plates, the same on
 //! the right) and `convergedBetaVector104PosesHardwareTrained.txt` (23 bodies: no Kinect). Each
 //! body's `[m, m·cx, m·cy, m·cz]` is in its URDF link frame, which is the model's body frame
 //! (`models/krang.toml`: "The URDF link frames are the report frames"; the gripper's inertia
@@ -45,7 +45,7 @@ use nalgebra::{DMatrix, DVector, SVector};
 
 // The charts: the `simulate` example's drawing code.
 #[allow(dead_code)]
-#[path = "simulate.rs"]
+#[path = "simulate/main.rs"]
 mod simulate;
 use simulate::{BLUE_, GREEN_, GREY, ORANGE, PALETTE, Panel, RED_, Series, figure_over};
 
@@ -605,7 +605,7 @@ fn main() -> Res<()> {
         .nth(1)
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from("target/plots"));
-    let lab = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/krang/params");
+    let lab = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/krang/params");
     let cfg = Config::default();
     let s = run(&dir, &lab, &cfg)?;
     let e = &s.beta.estimate;

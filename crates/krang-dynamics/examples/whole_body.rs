@@ -46,7 +46,7 @@ use krang_dynamics::{ACTUATOR_COUNT, Frame, Krang, actuator, hardware, index, sa
 use nalgebra::{DMatrix, DVector, Matrix3, SMatrix, SVector, Vector3};
 
 #[allow(dead_code)]
-#[path = "simulate.rs"]
+#[path = "simulate/main.rs"]
 mod simulate;
 use simulate::{BLUE_, GREEN_, ORANGE, PALETTE, Panel, RED_, Series, figure, rk4};
 

@@ -219,8 +219,7 @@ where
 /// solved in place (three solves of `N` columns take as many groups of lanes as one of `3N`,
 /// Krang: 15 of four, and each column gets the bits it gets alone). No matrix is zeroed or
 /// copied: besides their own time, a few KB stored just before the generated code slow that
-/// code (about 40 ns per 3 KB on the Intel Xeon of the measurement log, "Stores before a
-/// call").
+/// code (about 40 ns per 3 KB stored; Intel Xeon, Nov 2026).
 fn forward_dynamics_derivatives_onto<'d, R, const T: usize, const N: usize, const D: usize>(
     robot: &R,
     chol: &BlockCholesky<T, N>,

@@ -1,4 +1,5 @@
-//! Golem Krang's dynamics, generated at build time by [kanegen] from `krang.toml`.
+//! Golem Krang's dynamics, generated at build time by kanegen (the generator crate, `codegen/` in
+//! this crate's repository) from `krang.toml`.
 //!
 //! `τ = M(q) u̇ + c(q, u) + g(q)` for the 19 generalized speeds
 //! `u = [ẋ, ψ̇, q̇_imu, q̇_w, q̇_torso, q̇_1l … q̇_7l, q̇_1r … q̇_7r]` (coordinates
@@ -30,26 +31,31 @@
 //! range of indices into the vector at hand: [`forward::LEFT_ARM`] (`5..12` in `u`),
 //! [`actuator::LEFT_ARM`] (`4..11` in the actuator vector).
 //!
-//! [kanegen]: https://docs.rs/kanegen
-//!
 //! # Features: optional modules and compile time
 //!
 //! Each generated module is one generator call in `build.rs` and about 100–300 KB of Rust to
 //! compile, so the optional ones are features (the README's "Build time and features" has the
-//! measured build times). Default: `std` and the f64 Krang model above (M, c, g, inverse
-//! dynamics), with forward dynamics and the actuator map.
+//! measured build times). Default: `std`, `isa-dispatch` and the f64 Krang model above (M, c, g,
+//! inverse dynamics, pre-generated), with forward dynamics and the actuator map. Every feature
+//! but `std`, `isa-dispatch`, `batch`, `serde` and `toml` makes the generator a build
+//! dependency.
 //!
 //! | feature | adds |
 //! |---|---|
-//! | `std` (default) | `std` for nalgebra; without it the crate is `#![no_std]` |
+//! | `std` (default) | `std` for nalgebra and the runtime; without it the crate is `#![no_std]` (nalgebra's math through `libm`) |
+//! | `isa-dispatch` (default) | run-time instruction-set dispatch: every generated function compiled for the baseline and for x86-64-v3 (AVX2 + FMA; fused multiply-adds, so results differ from the baseline copy's in the last bits), the CPU's best copy runs (`isa::active()`); turn it off when compiling with `-C target-cpu=native`, or to halve the generated code's size |
 //! | `coriolis-matrix` | `coriolis_matrix(&q, &u)`, the Coriolis matrix `C(q, u)` with `c = C u` and `Ṁ − 2C` skew-symmetric (Slotine–Li `τ = M a_r + C v_r + g − K s`), and the `CoriolisMatrix` trait, in every module built; about doubles each module's compile time |
+//! | `kinematics` | on `Krang`: centre of mass, its Jacobian and bias acceleration, frame poses, Jacobians and bias accelerations (`Frame`), kinetic and potential energy, `nonlinear_effects` (c + g), and the combined functions `whole_body_terms` (M, c + g, the centre-of-mass terms and both hands' pose, Jacobian and bias in one program) and `hands_jacobians` |
+//! | `derivatives` | `inverse_dynamics_derivatives` (∂τ/∂q, ∂τ/∂u) in the Krang, fixed-wheel and two-link modules built, `forward_dynamics_derivatives` and `linearize` (with workspaces kept across calls) on `Krang` and `KrangFixedWheels` |
+//! | `regressors` | on `Krang` and (with `fixed-wheels`) `KrangFixedWheels`: `τ = Y π`, `g = Y_g β`, the base regressors and base parameters (`inertial_vector`, `base_parameters`), for identification and adaptive control |
+//! | `batch` | the batched functions (`Krang::mass_matrix_batch`, `_batch_into`, `_batch_soa`, … for every function with a vector or matrix result) and the batched forward dynamics (`forward_batch`): L states per call in SIMD lanes; without it they are not compiled (about 40 % of the crate's compile time) |
 //! | `baked` | `baked`: the parameter values of `krang.toml` folded in as constants |
 //! | `f32` | `f32::{Krang, Params}`: single precision, sin/cos computed in `f32` too |
 //! | `fixed-wheels` | `fixed_wheels::KrangFixedWheels` (17 speeds) and its forward dynamics |
-//! | `two-link` | `two_link::TwoLink`, seed 002 Appendix B |
-//! | `full` | all of the above but `std`, `serde`, `toml` |
+//! | `two-link` | `two_link::TwoLink`, the two-link model of the reports (a check against printed matrices) |
+//! | `full` | every optional module and function: `batch`, `coriolis-matrix`, `kinematics`, `derivatives`, `regressors`, `baked`, `f32`, `fixed-wheels`, `two-link` (not `serde`, `toml`) |
 //! | `serde` | `Serialize`/`Deserialize` for every `Params` (`no_std`-compatible) |
-//! | `toml` | `params_from_model_toml`: `Params` from a model file's `[parameters]` at run time |
+//! | `toml` | `params_from_model_toml`: `Params` from a model file's `[parameters]` at run time (needs `std`) |
 //!
 //! # Parameters as data
 //!
@@ -157,6 +163,7 @@ macro_rules! each {
     )*};
 }
 
+mod cholesky;
 pub mod forward;
 pub use forward::{
     Block, BlockCholesky, ForwardDynamicsError, MassMatrixCholesky, NotPositiveDefinite, solve_spd,

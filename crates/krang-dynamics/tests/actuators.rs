@@ -1,5 +1,5 @@
 //! The actuator map (DynamicModeling.tex, Kane's right-hand side) and the hardware constants
-//! (krang/hardware/*.cfg).
+//! (`models/krang/hardware/*.cfg`).
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -224,10 +224,16 @@ fn joint_fields(j: &JointDrive) -> Vec<(&'static str, Vec<f64>)> {
     f
 }
 
+/// The text of a cfg file; a missing file fails the test with its path.
+fn read(path: &std::path::Path) -> String {
+    std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("{}: {e} (the hardware cfg files)", path.display()))
+}
+
 /// Every key of the cfg file is a constant, with the same value(s), and vice versa.
 fn check_drive(dir: &std::path::Path, model: &str, fields: Vec<(&'static str, Vec<f64>)>) {
     let path = dir.join(format!("{model}.cfg"));
-    let cfg = parse_cfg(&std::fs::read_to_string(&path).unwrap());
+    let cfg = parse_cfg(&read(&path));
     let ours: BTreeMap<&str, Vec<f64>> = fields.into_iter().collect();
     assert_eq!(
         cfg.keys().map(String::as_str).collect::<Vec<_>>(),
@@ -246,15 +252,7 @@ fn check_drive(dir: &std::path::Path, model: &str, fields: Vec<(&'static str, Ve
 
 #[test]
 fn hardware_constants_match_the_cfg_files() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/krang/hardware");
-    if !dir.join("krang_motors.cfg").exists() {
-        eprintln!(
-            "note: {} not found (shared/ is not next to this checkout); \
-             skipping the comparison of the hardware constants with the cfg files",
-            dir.display()
-        );
-        return;
-    }
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models/krang/hardware");
     check_drive(&dir, "bly343d", wheel_fields(&hardware::BLY343D));
     for j in [
         hardware::WAIST,
@@ -266,7 +264,7 @@ fn hardware_constants_match_the_cfg_files() {
         check_drive(&dir, j.model, joint_fields(&j));
     }
     // krang_motors.cfg: make and model of every actuator, and nothing else in the file.
-    let motors = parse_cfg(&std::fs::read_to_string(dir.join("krang_motors.cfg")).unwrap());
+    let motors = parse_cfg(&read(&dir.join("krang_motors.cfg")));
     assert_eq!(motors.len(), 2 * ACTUATOR_COUNT);
     for a in hardware::ACTUATORS {
         assert_eq!(motors[&format!("{}_make", a.joint)], a.make, "{}", a.joint);

@@ -14,8 +14,9 @@ use std::path::{Path, PathBuf};
 use krang_dynamics::{Krang, Params, index};
 use nalgebra::SVector;
 
+/// The lab's beta vectors (`models/krang/params`).
 fn lab() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/krang/params")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/krang/params")
 }
 
 /// Sized for CI: 104 poses as on hardware, a shorter trajectory.

@@ -5,7 +5,7 @@
 //! The full run is `cargo run --release -p krang-dynamics --features fixed-wheels,kinematics --example simulate -- DIR`.
 
 #[allow(dead_code)]
-#[path = "../examples/simulate.rs"]
+#[path = "../examples/simulate/main.rs"]
 mod simulate;
 
 use std::path::Path;

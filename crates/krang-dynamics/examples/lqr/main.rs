@@ -10,7 +10,7 @@
 //!   (38 states `[q; u]`, 18 actuators), discretised exactly for the zero-order hold, gain
 //!   from the discrete Riccati equation (solved by the structure-preserving doubling
 //!   algorithm below), `a = a₀ − K (x − x₀)`: every wheel and joint torque from one law;
-//! * **WIP LQR** (the lab's balancing controller, `../shared/krang/controllers/README.md`):
+//! * **WIP LQR** (the lab's balancing controller, munzir/18h-krang-utils `linearize_wip.cpp`):
 //!   states `[θ_COM, θ̇_COM, θ_wheel, θ̇_wheel]`, `Q = diag(300, 96000, 30000, 90000)`,
 //!   `R = 500` on the total wheel torque, split equally between the wheels. Its model is the
 //!   robot with every joint locked, built from the full model at the upright pose (as the lab
@@ -35,7 +35,7 @@ use nalgebra::{DMatrix, SVector};
 
 // The charts: the `simulate` example's drawing code (also used by `whole_body`).
 #[allow(dead_code)]
-#[path = "../simulate.rs"]
+#[path = "../simulate/main.rs"]
 mod simulate;
 use simulate::{BLUE_, GREEN_, ORANGE, Panel, RED_, Series, figure};
 

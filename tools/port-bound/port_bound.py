@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Per-call instruction mix of one profile-driver entry and the throughput bounds it implies.
 
-Reads two callgrind outputs of `examples/profile.rs` (the same entry run for N1 and N2 calls,
+Reads two callgrind outputs of the profile driver (example `profile`,
+`crates/krang-dynamics/benches/profile/functions.rs`; the same entry run for N1 and N2 calls,
 `--dump-instr=yes --compress-pos=no --compress-strings=no`), takes the difference of the
 execution counts of every instruction (so the driver's start-up cancels), divides by N2 - N1,
 disassembles each executed instruction with objdump and sorts it into the execution resources

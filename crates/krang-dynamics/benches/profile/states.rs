@@ -1,5 +1,5 @@
-//! The 64 fixed pseudo-random Krang states the profiling examples (`profile`,
-//! `profile_regressors`) and the workspace's `benches/simd.rs` cycle through: a small LCG,
+//! The 64 fixed pseudo-random Krang states the profiling drivers (`profile`,
+//! `profile_regressors`, in this folder) and the workspace's `benches/simd.rs` cycle through: a small LCG,
 //! deterministic and dependency-free.
 
 use nalgebra::SVector;

@@ -1,5 +1,8 @@
-//! A driver for instruction counts of Krang's generated regressors (next to `profile.rs`, which
-//! covers the default functions), for work on the generator.
+//! Profiling driver (example `profile_regressors`): instruction counts and rough timings of
+//! Krang's generated regressors, one function called N times, for work on the generator (next
+//! to `functions.rs`, the example `profile`, which covers the other functions). Measures the
+//! cost of one call of `inverse_dynamics_regressor`, `base_regressor`, the gravity regressors
+//! and their in-place forms, against τ and g.
 //!
 //! ```sh
 //! cargo build --release -p krang-dynamics --features regressors --example profile_regressors
@@ -21,8 +24,8 @@ use std::time::Instant;
 
 use krang_dynamics::Krang;
 
-mod profile_states;
-use profile_states::{V, states};
+mod states;
+use states::{V, states};
 
 fn run(k: &Krang, f: &str, s: &[(V, V, V)], calls: usize) -> Result<f64, String> {
     let mut acc = 0.0;

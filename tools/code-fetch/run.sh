@@ -1,16 +1,16 @@
 #!/usr/bin/env bash
-# How fast this CPU runs straight-line code that does not fit its level-1 instruction cache.
+# How fast the CPU runs straight-line code that does not fit its level-1 instruction cache.
 #
 # Builds, with the system C compiler, functions that are one long run of 8-byte NOPs
 # (`nopl 0x0(%rax,%rax,1)` with a 4-byte displacement: nothing to execute but the fetch and
 # decode) of 16 to 128 KB (or the sizes given), and prints for each the best time per call over
-# 200 rounds and the bytes fetched per ns. On the 2-core Xeon of README's "Status at a glance"
-# (64 KB level-1 instruction cache) runs of up to 64 KB went at 120-180 B/ns, longer ones at
-# about 46 B/ns: the rate of code streamed from the level-2 cache, whatever the instructions.
-# Long generated functions above the cache run at that rate (README, "Status at a glance": the
-# Coriolis matrix's 8-state batch).
+# 200 rounds and the bytes fetched per ns. On an Intel Xeon (Nov 2026, 2 cores, 64 KB level-1
+# instruction cache) runs of up to 64 KB went at 120-180 B/ns, longer ones at about 46 B/ns:
+# the rate of code streamed from the level-2 cache, whatever the instructions. Long generated
+# functions above the cache run at that rate (e.g. the Coriolis matrix's 8-state batch), which
+# is why the generator emits loop forms for the largest functions.
 #
-# Usage: benches/code-fetch/run.sh [sizes in KB ...]   (x86-64 Linux, cc on the PATH)
+# Usage: tools/code-fetch/run.sh [sizes in KB ...]   (x86-64 Linux, cc on the PATH)
 set -euo pipefail
 sizes=("$@")
 [ ${#sizes[@]} -gt 0 ] || sizes=(16 32 48 56 64 72 96 128)

@@ -1,5 +1,7 @@
-//! A driver for instruction counts and quick timings of the generated functions, for work on the
-//! generator (the published speed figures come from the criterion benchmarks, `cargo bench`).
+//! Profiling driver (example `profile`): instruction counts and quick timings of one generated
+//! function of Krang (or a batched form, or the block-Cholesky forward dynamics) called N times,
+//! for work on the generator (the published speed figures come from the criterion benchmarks,
+//! `cargo bench`).
 //!
 //! ```sh
 //! cargo build --release -p krang-dynamics --features batch --example profile
@@ -9,7 +11,7 @@
 //! # rough ns per call (the fastest of many batches of 1000 calls):
 //! target/release/examples/profile all 200000
 //! # instructions per call by execution port, and the floors in cycles they imply:
-//! benches/port-bound/run.sh mass_matrix_into inverse_dynamics
+//! tools/port-bound/run.sh mass_matrix_into inverse_dynamics
 //! ```
 //!
 //! Arguments: a function (`mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics`, or `all`;
@@ -44,8 +46,8 @@ use krang_dynamics::Krang;
 use krang_dynamics::lanes::{Lanes, soa};
 use nalgebra::{SMatrix, SVector};
 
-mod profile_states;
-use profile_states::{V, states};
+mod states;
+use states::{V, states};
 
 /// The batched inputs: coordinates and speeds of 4 or 8 consecutive states from each state,
 /// and the 8-state ones in structure-of-arrays form (`_s8`). Made once, before any timing.

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # What the execution ports allow: the least time a generated function's instructions can take.
 #
-# For each entry of `crates/krang-dynamics/examples/profile.rs` given (default: M into a kept
-# matrix, c, g, τ, the Coriolis matrix and the derivatives into a kept workspace), this
+# For each entry of the profile driver given (example `profile`,
+# `crates/krang-dynamics/benches/profile/functions.rs`; default: M into a kept matrix, c, g, τ,
+# the Coriolis matrix and the derivatives into a kept workspace), this
 #   1. times it with the x86-64-v3 copies forced (the profile driver's fastest batch of 1000
 #      calls, the best of three runs),
 #   2. counts the instructions one call executes, each by its address (callgrind, 1000 calls
@@ -11,26 +12,25 @@
 #   3. measures the core clock (a chain of dependent integer multiplies, 3 cycles each),
 # and prints `port_bound.py`'s per-call instruction mix, its lower bounds in cycles (rename
 # width, the two multiply-add ports, the three vector ports, loads, stores) and the measured
-# cycles beside them. The README's "Targets not met" and the measurement log's "What the ports
-# allow" come from it.
+# cycles beside them. The README's "What the ports allow" figures come from it.
 #
-# Usage: benches/port-bound/run.sh [entry ...]
+# Usage: tools/port-bound/run.sh [entry ...]
 # Needs: valgrind, objdump (binutils), python3, cc; x86-64 Linux.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 for tool in valgrind objdump python3 cc; do
     command -v "$tool" >/dev/null || {
-        echo "benches/port-bound/run.sh needs \`$tool\` on the PATH (e.g. apt install valgrind binutils python3 gcc)" >&2
+        echo "tools/port-bound/run.sh needs \`$tool\` on the PATH (e.g. apt install valgrind binutils python3 gcc)" >&2
         exit 1
     }
 done
-[ "$(uname -m)" = x86_64 ] || { echo "benches/port-bound/run.sh: x86-64 only (the port model is Intel Golden Cove's)" >&2; exit 1; }
+[ "$(uname -m)" = x86_64 ] || { echo "tools/port-bound/run.sh: x86-64 only (the port model is Intel Golden Cove's)" >&2; exit 1; }
 entries=("$@")
 [ ${#entries[@]} -gt 0 ] || entries=(mass_matrix_into coriolis gravity inverse_dynamics
     coriolis_matrix inverse_dynamics_derivatives_with)
 cargo build --release -q -p krang-dynamics \
     --features batch,kinematics,derivatives,coriolis-matrix --example profile
-profile=target/release/examples/profile
+profile=${CARGO_TARGET_DIR:-target}/release/examples/profile
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 
@@ -70,5 +70,5 @@ for entry in "${entries[@]}"; do
     done
     echo
     echo "== $entry: $best ns per call (x86-64-v3 copies, fastest batch of 1000)"
-    python3 benches/port-bound/port_bound.py "$dir/cg.500" 500 "$dir/cg.1000" 1000 "$ghz" "$best"
+    python3 tools/port-bound/port_bound.py "$dir/cg.500" 500 "$dir/cg.1000" 1000 "$ghz" "$best"
 done

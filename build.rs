@@ -138,7 +138,7 @@ fn arm_terms() -> kanegen::Combined {
     c
 }
 
-/// The declaration of Krang's wheeled base (as in README "Any robot from URDF" and
+/// The declaration of Krang's wheeled base (as in docs/urdf.md and
 /// `tests/urdf_generated_vs_reference.rs`); the 0.1 g gripper plates are dropped.
 fn krang_urdf_options() -> UrdfOptions {
     let mut base = WheeledBaseSpec::new("JLWheel", "JRWheel", "Base", [0.0, 1.0, 0.0], 0.25);

@@ -58,7 +58,7 @@ fn bench(c: &mut Criterion) {
         black_box(&x.1),
         black_box(&x.2)
     ));
-    // The loop form's in-place variants (README, "Regressors: the loop form"): the result
+    // The loop form's in-place variants (docs/regressors.md): the result
     // matrix kept by the caller, nothing zeroed or copied per call.
     let mut y = nalgebra::SMatrix::<f64, 19, 173>::zeros();
     run!("inverse_dynamics_regressor_into", |x| {

@@ -1,5 +1,4 @@
-//! The Rust side of the Pinocchio comparison (`benches/pinocchio/run.sh`, README "Pinocchio side
-//! by side"): writes Krang (`models/krang.toml`) as a Pinocchio tree with test cases, times the
+//! The Rust side of the Pinocchio comparison (`benches/pinocchio/run.sh`, docs/performance.md): writes Krang (`models/krang.toml`) as a Pinocchio tree with test cases, times the
 //! generated functions, and prints the combined table.
 //!
 //! ```sh

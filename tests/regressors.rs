@@ -175,7 +175,7 @@ fn krang_compiled_regressors_reproduce_tau_and_g() {
     assert!(worst <= 1e-12, "{worst:e}");
 }
 
-/// Krang's regressors are in loop form (README, "Regressors: the loop form"): the in-place
+/// Krang's regressors are in loop form (docs/regressors.md): the in-place
 /// variants write every entry of a matrix of any content (here NaN and a previous state's
 /// result) and equal the by-value functions bit for bit; the fixed-wheel tree's too.
 #[test]

@@ -1,4 +1,4 @@
-// Shared by the Pinocchio harnesses (harness.cpp, codegen.cpp; README "Pinocchio side by side"):
+// Shared by the Pinocchio harnesses (harness.cpp, codegen.cpp; docs/performance.md):
 // reading DIR/cases.txt (written by `cargo run --release --example pinocchio_side_by_side --
 // write DIR`; format in that example's documentation), building each case's pinocchio::Model,
 // the maps between kanegen's and Pinocchio's coordinates, and the timing loop.

@@ -1,5 +1,5 @@
-// Pinocchio's own generated code (CppADCodeGen) in the kanegen comparison (README "Pinocchio
-// side by side"; run by run.sh when CODEGEN=1).
+// Pinocchio's own generated code (CppADCodeGen) in the kanegen comparison (docs/performance.md;
+// run by run.sh when CODEGEN=1).
 //
 //   codegen DIR [ROUNDS CALLS]
 //

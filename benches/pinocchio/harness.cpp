@@ -1,4 +1,4 @@
-// Pinocchio side of the kanegen comparison (README "Pinocchio side by side"; run by run.sh).
+// Pinocchio side of the kanegen comparison (docs/performance.md; run by run.sh).
 //
 //   harness DIR [ROUNDS CALLS]
 //

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Pinocchio side by side (README "Pinocchio side by side"): Krang (models/krang.toml) in
+# Pinocchio side by side (docs/performance.md): Krang (models/krang.toml) in
 # Pinocchio's C++ and in kanegen's generated Rust, checked against each other on random
 # parameters and states, then timed alternately in one run.
 #

@@ -206,8 +206,7 @@ impl Builder {
 
     /// The code shape of `inverse_dynamics_regressor` and `base_regressor` (default
     /// [`RegressorForm::Auto`]: a loop over (speed, body) pairs for models where the straight
-    /// line outgrows the instruction cache, e.g. Krang; see README, "Regressors: the loop
-    /// form").
+    /// line outgrows the instruction cache, e.g. Krang; see docs/regressors.md.
     ///
     /// ```no_run
     /// kanegen::Builder::new("krang.toml").regressor_form(kanegen::RegressorForm::StraightLine).run();
@@ -271,7 +270,7 @@ impl Builder {
     /// `#[cfg(feature = "name")]`. A crate can then ship one module (pre-generated, or
     /// generated the same way with every feature set) whose batched half — 40 % of Krang's
     /// source — is not even type-checked unless a user asks for it. `krang-dynamics` does this
-    /// with its `batch` feature (README, "Build time and features"). The crate must declare the
+    /// with its `batch` feature (docs/runtime.md, "Build time and features"). The crate must declare the
     /// feature (`[features] batch = []`), or rustc warns of an unexpected `cfg`.
     ///
     /// ```no_run
@@ -292,7 +291,7 @@ impl Builder {
     /// `kanegen_runtime::pair::F64x2` and the second in the high lane. Every result entry is
     /// computed with the same operations as the scalar statements, in the same order (tested
     /// bit for bit); the right subtree's sums are printed in the left's order. Models without
-    /// mirrored subtrees are unaffected. See README, "Arms in lanes".
+    /// mirrored subtrees are unaffected. See docs/batched-and-dispatch.md, "Arms in lanes".
     ///
     /// ```no_run
     /// kanegen::Builder::new("krang.toml").mirrored_lanes(true).run();

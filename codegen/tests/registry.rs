@@ -235,7 +235,7 @@ fn kinematics_are_opt_in_listed_by_stats_and_the_same_without_the_dynamics() {
 /// Results are zeroed by assigning `zeros()` or filling a slice (one `memset`), never by
 /// nalgebra's element-wise `Matrix::fill`: its strided iterator compiles to a dependent scalar
 /// loop, which made `inverse_dynamics_derivatives_into` a third slower than the by-value form
-/// (≈ 600 ns to zero the 19×38 matrix; `docs/measurement-log.md`, "Pinocchio side by side";
+/// (≈ 600 ns to zero the 19×38 matrix; `docs/performance.md`;
 /// regression test).
 #[test]
 fn generated_code_zeroes_results_with_a_memset_not_nalgebras_element_wise_fill() {

@@ -1,5 +1,4 @@
-//! The loop form of the inverse-dynamics regressor and its base regressor (README, "Regressors:
-//! the loop form"): the straight-line part through the lowering's interpreter, the loop through
+//! The loop form of the inverse-dynamics regressor and its base regressor (docs/regressors.md): the straight-line part through the lowering's interpreter, the loop through
 //! `kanegen_runtime::regressor` itself, against the straight-line function on random physical
 //! parameters and states (Krang with its wheeled base, the two-link model, the URDF arm), and
 //! the rule that chooses the form. Two kernels: the plain one the plan was derived from

@@ -154,7 +154,7 @@ impl<const N: usize, T: Scalar> Rbd<N, T> {
     ///
     /// One function of ~125 lines on purpose: the forward and backward passes share per-link
     /// temporaries that the optimiser keeps in registers, and this is the benchmark baseline
-    /// whose speed the README's tables report (helpers would need `#[inline(always)]` and
+    /// whose speed docs/performance.md reports (helpers would need `#[inline(always)]` and
     /// re-measurement to be an equal baseline).
     #[inline(always)]
     fn rnea<const UD: bool, const GRAV: bool>(

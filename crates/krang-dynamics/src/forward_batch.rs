@@ -1,11 +1,11 @@
 //! Batched forward dynamics: `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))` at `L` states per call, for
 //! samplers (sampling-based MPC, MPPI and RL rollouts) that step many states at once. Behind
 //! the crate's feature `batch`, like the batched functions of the generated modules it builds
-//! on (README, "Build time and features").
+//! on (docs/runtime.md, "Build time and features").
 //!
 //! [`Krang::forward_dynamics_batch_soa_into`] takes and gives structure-of-arrays vectors
 //! (`SVector<Lanes<L>, 19>`, lane `l` of every entry being state `l`, as the batched M, c, g and
-//! τ do; section "Instruction sets at run time and batched evaluation" of the README):
+//! τ do; docs/batched-and-dispatch.md):
 //! - `c + g` of every state from one batched inverse-dynamics call at `u̇ = 0`
 //!   (`inverse_dynamics_batch_soa_into`), `M` of every state from `mass_matrix_batch_soa_into`;
 //! - then [`block_solve_lanes`]: the block Cholesky factorisation of [`BlockCholesky`] (arms

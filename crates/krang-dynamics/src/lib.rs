@@ -34,7 +34,7 @@
 //! # Features: optional modules and compile time
 //!
 //! Each generated module is one generator call in `build.rs` and about 100–300 KB of Rust to
-//! compile, so the optional ones are features (the README's "Build time and features" has the
+//! compile, so the optional ones are features (the guide's docs/runtime.md, "Build time and features", has the
 //! measured build times). Default: `std`, `isa-dispatch` and the f64 Krang model above (M, c, g,
 //! inverse dynamics, pre-generated), with forward dynamics and the actuator map. Every feature
 //! but `std`, `isa-dispatch`, `batch`, `serde` and `toml` makes the generator a build

@@ -141,7 +141,7 @@ macro_rules! same {
 /// Bit for bit in the baseline copy; in the x86-64-v3 copy, which fuses multiply-adds, a
 /// product that is a shared statement in one program and inline in the other is fused in only
 /// one of them, so there the parts agree to 10⁻¹² of each result's largest entry. The module
-/// is generated with mirrored lanes (README "Arms in lanes"): the combined program and the
+/// is generated with mirrored lanes (docs/batched-and-dispatch.md, "Arms in lanes"): the combined program and the
 /// separate M, `c + g` and centre-of-mass functions are paired alike and agree bit for bit,
 /// but the right hand's bias acceleration, a per-frame function with no mirror inside it,
 /// keeps the derivation's order separately while the combined program adds its sums in the

@@ -25,7 +25,7 @@
 //! cargo run --release -p krang-dynamics --features derivatives,fixed-wheels,kinematics --example lqr -- [DIR]
 //! ```
 //! writes `lqr_pitch.png`, `lqr_position.png`, `lqr_heading.png` and `lqr_torques.png` to DIR
-//! (default `target/plots`; the README's images: `DIR = docs/plots`).
+//! (default `target/plots`; the guide's images: `DIR = docs/plots`).
 
 use std::error::Error;
 use std::path::{Path, PathBuf};

@@ -10,8 +10,8 @@ use super::function::state_args;
 use super::items::arg_names;
 use super::print::{ident, idx};
 use crate::lower::FunctionProgram;
-use crate::model::Model;
 use crate::registry::FunctionId;
+use kanegen_model::Model;
 
 /// The `Frame` variant of every link: its name in CamelCase (`base` → `Base`, `link_1` →
 /// `Link1`), `F` before a leading digit (`10l` → `F10l`), the link index appended where two

@@ -524,7 +524,7 @@ pub(super) fn lanes_in<'a>(
 ) -> Option<(&'a LaneLeaves, &'a LanePlan)> {
     let leaves = cx.low.lane_leaves.as_ref()?;
     let plan = plan?;
-    (cx.precision == crate::Precision::F64 && p.stmts.len() <= cx.split_above)
+    (cx.precision == crate::options::Precision::F64 && p.stmts.len() <= cx.split_above)
         .then_some((leaves, plan))
 }
 

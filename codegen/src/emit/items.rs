@@ -9,9 +9,9 @@ use super::function::{result_type, state_args, uses};
 use super::print::{ident, idx, signed_lit};
 use super::{Context, file_name, scalar_type};
 use crate::lower::{Leaf, Program};
-use crate::model::{Model, ParamKind};
 use crate::naming;
 use crate::registry::{FunctionSpec, Inputs, RuntimeTrait};
+use kanegen_model::{Model, ParamKind};
 
 /// `DOF`, `SPEED_NAMES`, `COORDINATE_NAMES` and the `index` constants: one per coordinate
 /// (`Q_IMU`) and one per speed (`QD_IMU`), the same index, unless the speed's constant would
@@ -59,7 +59,7 @@ pub(super) fn names(cx: &Context<'_>) -> TokenStream {
     }
 }
 
-fn param_doc(p: &crate::model::Param) -> String {
+fn param_doc(p: &kanegen_model::Param) -> String {
     let what = match p.kind {
         ParamKind::Length => "length (m)",
         ParamKind::Gravity => "gravity acceleration (m/s²)",
@@ -202,8 +202,8 @@ fn validate(cx: &Context<'_>) -> TokenStream {
         quote!(f64::from(self.#f))
     };
     let rel_tol = match cx.precision {
-        crate::Precision::F64 => 1e-9,
-        crate::Precision::F32 => 1e-5,
+        crate::options::Precision::F64 => 1e-9,
+        crate::options::Precision::F32 => 1e-5,
     };
     let bodies = model.links.iter().filter_map(|l| l.body.as_ref()).map(|b| {
         let name = b.name.as_str();

@@ -161,8 +161,8 @@ pub(super) fn lane_block(
 #[cfg(test)]
 mod tests {
     use crate::emit::EmitOptions;
-    use crate::model::Model;
     use crate::options::Options;
+    use kanegen_model::Model;
 
     fn krang_source(isa_dispatch: bool) -> String {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");

@@ -33,9 +33,9 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use crate::lower::Lowered;
-use crate::model::Model;
 use crate::options::{DerivativesForm, ParamMode, Precision, RegressorForm};
 use crate::registry::FunctionId;
+use kanegen_model::Model;
 
 /// The generator's version, written into every header.
 pub const GENERATOR_VERSION: &str = env!("CARGO_PKG_VERSION");

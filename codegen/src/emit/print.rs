@@ -4,9 +4,9 @@ use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::quote;
 
 use crate::lower::{LExpr, Leaf, Stmt};
-use crate::model::Model;
 use crate::naming;
 use crate::options::Precision;
+use kanegen_model::Model;
 
 /// A model-derived name as an identifier, by [`naming::identifier`] (never a keyword, so never
 /// a raw identifier; the names of a validated model are unchanged).

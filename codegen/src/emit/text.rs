@@ -21,8 +21,8 @@ use quote::quote;
 use super::comment_text;
 use super::print::{Printer, lit};
 use crate::lower::{LExpr, Leaf, fused_terms, sum_order};
-use crate::model::Model;
 use crate::naming;
+use kanegen_model::Model;
 
 /// prettyplease's line width ([`MARGIN`] columns including the indentation, at least
 /// [`MIN_SPACE`] after it): a statement that fits stays on one line.
@@ -132,7 +132,7 @@ pub(super) struct LeafNames {
 impl LeafNames {
     /// The names of `model`'s parameters and of its speeds' leaves.
     pub(super) fn new(model: &Model) -> Self {
-        let speeds = |f: &dyn Fn(&crate::model::Speed) -> String| -> Vec<String> {
+        let speeds = |f: &dyn Fn(&kanegen_model::Speed) -> String| -> Vec<String> {
             model
                 .speeds
                 .iter()
@@ -672,7 +672,7 @@ mod tests {
         indents: &[usize],
     ) {
         let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
-        let model = crate::model::Model::from_toml_file(format!("{root}/{path}")).unwrap();
+        let model = kanegen_model::Model::from_toml_file(format!("{root}/{path}")).unwrap();
         let names = LeafNames::new(&model);
         for &(params, functions, precision) in variants {
             let options = Options { params, functions };
@@ -792,11 +792,11 @@ mod tests {
         // the blocks' lines and indentation.
         let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
         let model =
-            crate::model::Model::from_toml_file(format!("{root}/models/krang.toml")).unwrap();
+            kanegen_model::Model::from_toml_file(format!("{root}/models/krang.toml")).unwrap();
         let emit = |split_above| {
-            let options = crate::EmitOptions {
+            let options = crate::emit::EmitOptions {
                 split_above,
-                ..crate::EmitOptions::default()
+                ..crate::emit::EmitOptions::default()
             };
             crate::generate_with(model.clone(), Options::default(), &options)
                 .unwrap()
@@ -901,7 +901,7 @@ mod tests {
         let mut rng = rand::rngs::StdRng::seed_from_u64(14);
         let (mut fused_total, mut differing) = (0usize, 0usize);
         for path in ["models/krang.toml", "models/two-link.toml"] {
-            let model = crate::model::Model::from_toml_file(format!("{root}/{path}")).unwrap();
+            let model = kanegen_model::Model::from_toml_file(format!("{root}/{path}")).unwrap();
             let names = LeafNames::new(&model);
             let options = Options {
                 params: ParamMode::Runtime,

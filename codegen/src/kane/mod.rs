@@ -453,7 +453,7 @@ impl Ctx<'_> {
             return entries;
         }
         let params = if gravity { &reg.beta } else { &reg.inertial };
-        let baked = !matches!(self.options.params, crate::ParamMode::Runtime);
+        let baked = !matches!(self.options.params, crate::options::ParamMode::Runtime);
         let base = regressor::base_parameters(self.ar, self.model, &entries, params, baked);
         let column: std::collections::HashMap<usize, usize> = base
             .groups

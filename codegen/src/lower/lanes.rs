@@ -812,8 +812,8 @@ fn lane_order(stmts: &[super::Stmt], found: &[Found]) -> Option<Vec<usize>> {
 mod tests {
     use super::*;
     use crate::kane::derive;
-    use crate::model::Model;
     use crate::options::Options;
+    use kanegen_model::Model;
 
     fn lowered(file: &str) -> (Derivation, Lowered, Lowered) {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");

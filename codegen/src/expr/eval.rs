@@ -38,7 +38,16 @@ impl Arena {
 
 #[cfg(test)]
 mod tests {
-    use crate::expr::arena::{Arena, Atom, Names, Values};
+    use crate::expr::arena::{Arena, Atom, Names, Values, VarKind};
+
+    fn arena() -> Arena {
+        Arena::new(Names {
+            params: vec!["a".into(), "b".into()],
+            speeds: vec!["qd1".into()],
+            coords: vec!["q1".into()],
+            lengths: Vec::new(),
+        })
+    }
 
     #[test]
     fn evaluator_matches_direct_computation() {

@@ -54,6 +54,7 @@
 mod algebra;
 mod composite;
 mod coriolis_matrix;
+mod ctx;
 mod derivatives;
 mod frames;
 mod gravity;
@@ -64,9 +65,14 @@ mod mimic;
 mod mirror;
 mod regressor;
 mod regressor_loop;
+mod regressor_sample;
 mod rnea;
 mod rnea_derivatives;
 mod rnea_derivatives_loop;
+#[cfg(test)]
+mod rnea_derivatives_loop_tests;
+#[cfg(test)]
+mod rnea_derivatives_tests;
 
 use kanegen_model::{Model, ParamKind};
 
@@ -75,8 +81,8 @@ use crate::expr::{Arena, ExprId, Names};
 use crate::options::{Options, RegressorForm};
 use crate::registry::{FunctionId, Sizes};
 
-use algebra::{M3, V3};
 use composite::Composite;
+use ctx::Ctx;
 pub use grouping::{Coefficient, Exactness, SymbolicGroup, symbolic_group_text};
 pub use mirror::Mirror;
 pub use regressor::{BaseParameters, Regressors, group_text};
@@ -527,23 +533,6 @@ impl Ctx<'_> {
             _ => unreachable!("`{id}` is not a per-frame function"),
         }
     }
-}
-
-/// The derivation's state: the arena, the model, and the per-link caches of `iAj(q)` and
-/// `iPj(q)`. Its methods are spread over this module's files, one concern each.
-struct Ctx<'a> {
-    ar: &'a mut Arena,
-    model: &'a Model,
-    options: Options,
-    rot: Vec<Option<M3>>,
-    pos: Vec<Option<V3>>,
-    /// `⁰A_l(q)`: the rotation of frame l relative to frame 0, cached.
-    root_rot: Vec<Option<M3>>,
-    /// `⁰p_l(q)`: the origin of frame l in frame 0, cached.
-    root_pos: Vec<Option<V3>>,
-    /// Keep the regressor parameters (inertial, wheel mass and inertias) as symbols even with
-    /// baked parameters: set while a regressor's dynamics are derived.
-    keep_inertial: bool,
 }
 
 impl Derivation {

@@ -15,7 +15,7 @@
 
 use kanegen_model::{JointKind, Model};
 
-use super::Ctx;
+use super::ctx::Ctx;
 use crate::expr::ExprId;
 use crate::options::RegressorForm;
 

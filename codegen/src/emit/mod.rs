@@ -16,7 +16,9 @@
 
 mod annotate;
 mod batch;
+mod body;
 mod combined;
+mod context;
 mod derivative_loop;
 mod frames;
 mod function;
@@ -25,9 +27,8 @@ mod lanes;
 mod print;
 mod regressor_loop;
 mod regressors;
+mod signature;
 mod text;
-
-use std::path::Path;
 
 use proc_macro2::TokenStream;
 use quote::quote;
@@ -35,7 +36,9 @@ use quote::quote;
 use crate::lower::Lowered;
 use crate::options::{DerivativesForm, ParamMode, Precision, RegressorForm};
 use crate::registry::FunctionId;
+use context::{Context, file_name};
 use kanegen_model::Model;
+pub(crate) use print::comment_text;
 
 /// The generator's version, written into every header.
 pub const GENERATOR_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -114,53 +117,6 @@ impl Default for EmitOptions {
             derivatives_form: DerivativesForm::default(),
         }
     }
-}
-
-/// What every part of the emitter reads.
-pub(crate) struct Context<'a> {
-    model: &'a Model,
-    low: &'a Lowered,
-    precision: Precision,
-    /// See [`EmitOptions::isa_dispatch`].
-    isa_dispatch: bool,
-    /// Field names of the precomputed values, by slot.
-    pre: Vec<String>,
-    /// The statement blocks of the functions, spliced in after formatting (`text.rs`).
-    blocks: text::Blocks,
-    /// The model's leaves as printed in statement blocks.
-    leaf_names: text::LeafNames,
-    /// See [`EmitOptions::split_above`].
-    split_above: usize,
-    /// `#[cfg(feature = "…")]` before every batched item ([`EmitOptions::batch_feature`]), or
-    /// nothing.
-    batch_gate: TokenStream,
-}
-
-impl Context<'_> {
-    /// The expression printer for a program's statements `stmts`.
-    fn printer<'p>(&'p self, stmts: &'p [crate::lower::Stmt]) -> print::Printer<'p> {
-        print::Printer {
-            model: self.model,
-            stmts,
-            pre: &self.pre,
-            precision: self.precision,
-            lane: None,
-        }
-    }
-}
-
-fn scalar_type(precision: Precision) -> TokenStream {
-    match precision {
-        Precision::F64 => quote!(f64),
-        Precision::F32 => quote!(f32),
-    }
-}
-
-fn file_name(path: &str) -> String {
-    Path::new(path)
-        .file_name()
-        .map(|f| f.to_string_lossy().into_owned())
-        .unwrap_or_else(|| path.to_owned())
 }
 
 /// Generate the Rust module for a lowered model. Deterministic: same input, same bytes. The
@@ -280,28 +236,6 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
     })?;
     out.push_str(&body);
     Ok(out)
-}
-
-/// `s` made safe for a `//` comment: control characters (a newline would end the comment and
-/// let the rest of the line be compiled) and the bidirectional-override characters that rustc
-/// rejects in comments (`text_direction_codepoint_in_comment`) are written as escapes (`\n`,
-/// `\u{202e}`). Every comment text that comes from input (header, notes, statement labels)
-/// goes through this function.
-pub(crate) fn comment_text(s: &str) -> String {
-    let escaped =
-        |c: char| c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}');
-    if !s.chars().any(escaped) {
-        return s.to_owned();
-    }
-    s.chars()
-        .flat_map(|c| {
-            if c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}') {
-                c.escape_default().collect::<Vec<_>>()
-            } else {
-                vec![c]
-            }
-        })
-        .collect()
 }
 
 fn header(model: &Model, low: &Lowered) -> String {

@@ -18,7 +18,7 @@ use std::fmt::Write as _;
 use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::comment_text;
+use super::print::comment_text;
 use super::print::{Printer, lit};
 use crate::lower::{LExpr, Leaf, fused_terms, sum_order};
 use crate::naming;

@@ -5,7 +5,6 @@ use std::collections::HashMap;
 
 use nalgebra::Vector3;
 
-use super::UrdfImport;
 use super::cut::BaseCut;
 use super::inertia::{Clusters, Inertial, link_inertial, merge};
 use super::options::{UrdfBase, UrdfOptions, bad_option};
@@ -19,12 +18,12 @@ use crate::ir::*;
 use crate::limits::check_magnitude;
 use crate::validate;
 
-/// Converts a parsed URDF to a validated model, with the import notes.
+/// Converts a parsed URDF to a validated model and the import notes.
 pub(super) fn convert(
     robot: &urdf_rs::Robot,
     file: &str,
     opts: &UrdfOptions,
-) -> Result<UrdfImport, K> {
+) -> Result<(Model, Vec<String>), K> {
     opts.check()?;
     let mut notes = Notes::default();
     let (robot, mimics) = super::mimic::prepare(robot, opts.mimic, &mut notes);
@@ -73,10 +72,7 @@ pub(super) fn convert(
         let t = f.translation.map(Length::number);
         crate::frames::add_fixed_frame(&mut model, &f.name, &f.parent, f.rotation, t, &f.name)?;
     }
-    Ok(UrdfImport {
-        model,
-        notes: notes.finish(),
-    })
+    Ok((model, notes.finish()))
 }
 
 /// Applies the options to the URDF's tree: dropped links, the base cut, the checks of the kept

@@ -111,7 +111,9 @@ impl UrdfImport {
                 detail: e.to_string(),
             })
         })?;
-        convert::convert(&robot, label, options).map_err(err)
+        convert::convert(&robot, label, options)
+            .map(|(model, notes)| UrdfImport { model, notes })
+            .map_err(err)
     }
 }
 

@@ -8,7 +8,7 @@ use quote::quote;
 use super::context::{Context, scalar_type};
 use super::print::{Printer, ident, idx, lit, signed_lit};
 use super::signature::result_type;
-use crate::lower::lanes::{LaneLeaves, LanePlan};
+use crate::lower::mirrored_lanes::{LaneLeaves, LanePlan};
 use crate::lower::{FunctionProgram, LExpr, Leaf, Program};
 use crate::naming;
 use crate::registry::{Inputs, Shape};
@@ -441,7 +441,7 @@ pub(super) fn body_block(
 ) -> super::text::Block {
     match lanes {
         Some((leaves, plan)) => {
-            super::lanes::lane_block(printer, &cx.leaf_names, leaves, p, plan, stores)
+            super::mirrored_lanes::lane_block(printer, &cx.leaf_names, leaves, p, plan, stores)
         }
         None => printer.statement_block(&cx.leaf_names, stores, outputs, cx.split_above, true),
     }

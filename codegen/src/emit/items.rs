@@ -349,7 +349,7 @@ pub(super) fn wrapper(cx: &Context<'_>, batched: bool) -> TokenStream {
     let mut methods = methods(cx);
     methods.extend(super::combined::methods(cx));
     methods.extend(super::regressor_loop::methods(cx));
-    methods.extend(super::derivative_loop::methods(cx));
+    methods.extend(super::derivatives_loop::methods(cx));
     if batched {
         methods.extend(super::batch::methods(cx));
     }

@@ -10,23 +10,30 @@
 //! Statements carry the reports' style comments (`let k12 = …; // w2.x`). Output is
 //! deterministic byte for byte.
 //!
-//! Files: `print.rs` (expressions, identifiers, literals), `function.rs` (one generated
-//! function), `items.rs` (names, `Params`, `Precomputed`, wrapper, trait impls), `annotate.rs`
-//! (statement comments), this file (the module and its header).
+//! Files, each depending only on files listed before it (this file collects them):
+//! `print.rs` (expressions, identifiers, literals, comment text), `text.rs` (statement blocks
+//! printed as text and spliced into the formatted module), `context.rs` (what every part
+//! reads), `mirrored_lanes.rs` (paired statements over two lanes), `signature.rs` (argument
+//! names, result types), `body.rs` (the building blocks of a function body), the forms
+//! `regressor_loop.rs`, `frames.rs` (the `Frame` type and per-frame dispatchers),
+//! `function.rs` (straight-line), `derivatives_loop.rs`, `combined.rs`, `batch.rs`,
+//! `regressor.rs` (the regressors' items), then `items.rs` (names, `Params`, `Precomputed`, the
+//! wrapper collecting every form's methods, trait impls), `annotate.rs` (statement comments)
+//! and this file (the module and its header).
 
 mod annotate;
 mod batch;
 mod body;
 mod combined;
 mod context;
-mod derivative_loop;
+mod derivatives_loop;
 mod frames;
 mod function;
 mod items;
-mod lanes;
+mod mirrored_lanes;
 mod print;
+mod regressor;
 mod regressor_loop;
-mod regressors;
 mod signature;
 mod text;
 
@@ -76,7 +83,7 @@ pub struct EmitOptions {
     pub batch_feature: Option<String>,
     /// Mirrored subtrees in two SIMD lanes (default `false`): see
     /// [`crate::Builder::mirrored_lanes`]. Read by [`crate::generate_combined`], which pairs
-    /// the lowered programs ([`crate::lower::lanes::apply`]).
+    /// the lowered programs ([`crate::lower::mirrored_lanes::apply`]).
     pub mirrored_lanes: bool,
     /// The floating-point type of the module.
     pub precision: Precision,
@@ -168,7 +175,7 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         items.extend(items::precomputed(&cx));
         labels.add("new", &low.precompute);
     }
-    items.extend(regressors::items(&cx));
+    items.extend(regressor::items(&cx));
     if low.functions.iter().any(|f| f.frame.is_some()) {
         items.extend(frames::frame_type(&cx));
     }
@@ -176,12 +183,12 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         // Its statements carry their labels in their block (`text.rs`).
         match &low.derivative_loop {
             Some(looped) if f.id == FunctionId::InverseDynamicsDerivatives => {
-                items.extend(derivative_loop::function(&cx, f, looped));
+                items.extend(derivatives_loop::function(&cx, f, looped));
             }
             _ => items.extend(function::function(&cx, f)),
         }
         items.extend(regressor_loop::straight_into(&cx, f));
-        items.extend(derivative_loop::straight_into(
+        items.extend(derivatives_loop::straight_into(
             &cx,
             f,
             low.derivative_loop.is_some(),

@@ -14,6 +14,10 @@
 //! constants). Substitution variables ([`Atom::Var`]) name compound subexpressions: the reports'
 //! K (kinematic) and D (inertial/gravity) variables. [`Arena::diff`] (`diff.rs`) differentiates
 //! exactly, variable by variable.
+//!
+//! Files: `arena.rs` (the arena, its node types and canonicalising constructors), `subst.rs`
+//! (substitution variables, hoisting), `diff.rs` (differentiation), `partial.rs`, `eval.rs`
+//! (numeric evaluation), `display.rs` (printing), `modular.rs` (exact modular arithmetic).
 
 mod arena;
 mod diff;

@@ -11,12 +11,20 @@
 //! ([`kanegen_model::names::is_generated_local`], checked by
 //! [`Model::check_names`](kanegen_model::Model::check_names)), so a local never shadows a speed,
 //! coordinate or parameter.
+//!
+//! Files: `program.rs` (the lowered form and its operation counts), `order.rs` (statement
+//! order), `build.rs` (lowering a derivation), `eval.rs` (an interpreter of the programs, for
+//! tests), `mirrored_lanes.rs` (the statements of mirrored subtrees paired into two lanes;
+//! also reachable as `lower::lanes`).
 
 mod build;
 mod eval;
-pub mod lanes;
+pub mod mirrored_lanes;
 mod order;
 mod program;
+
+/// The former name of [`mirrored_lanes`].
+pub use mirrored_lanes as lanes;
 
 pub use build::{lower, lower_with};
 pub use order::{BATCH_SUBTREE_ORDER, SUBTREE_ORDER, batch_program, restrict, subtree_order};

@@ -207,7 +207,7 @@ pub struct FunctionProgram {
     /// runs instead of `program` (which stays the reference for evaluation and counts).
     pub looped: Option<LoopProgram>,
     /// The two-lane form of `program` (arms in lanes, see [`lanes`](super::lanes)), when
-    /// [`lanes::apply`](super::lanes::apply) paired its statements: `program` is then the rewritten program.
+    /// [`lanes::apply`](super::mirrored_lanes::apply) paired its statements: `program` is then the rewritten program.
     pub lanes: Option<LanePlan>,
 }
 
@@ -259,7 +259,7 @@ pub struct Lowered {
     /// straight-line program of [`Lowered::functions`] (which the batched form, `listing` and
     /// the interpreter keep using).
     pub derivative_loop: Option<LoopedProgram>,
-    /// The mirrors of the leaves, when [`lanes::apply`](super::lanes::apply) paired a function's statements (what
+    /// The mirrors of the leaves, when [`lanes::apply`](super::mirrored_lanes::apply) paired a function's statements (what
     /// the emitter prints for a leaf in two lanes).
     pub lane_leaves: Option<LaneLeaves>,
 }
@@ -272,7 +272,7 @@ pub struct LoopedProgram {
     pub program: Program,
     /// The tables of the loop.
     pub plan: crate::kane::DerivativeLoop,
-    /// The two-lane form of `program` (see [`lanes`](super::lanes)), when [`lanes::apply`](super::lanes::apply) paired it.
+    /// The two-lane form of `program` (see [`lanes`](super::lanes)), when [`lanes::apply`](super::mirrored_lanes::apply) paired it.
     pub lanes: Option<LanePlan>,
 }
 
@@ -286,7 +286,7 @@ pub struct CombinedProgram {
     pub program: Program,
     /// Per part, its range in `program.outputs`.
     pub parts: Vec<std::ops::Range<usize>>,
-    /// The two-lane form of `program` (see [`lanes`](super::lanes)), when [`lanes::apply`](super::lanes::apply) paired it.
+    /// The two-lane form of `program` (see [`lanes`](super::lanes)), when [`lanes::apply`](super::mirrored_lanes::apply) paired it.
     pub lanes: Option<LanePlan>,
 }
 

@@ -15,7 +15,7 @@
 
 use super::print::Printer;
 use super::text::{Block, LeafNames, locals_of as reads};
-use crate::lower::lanes::{LaneLeaves, LanePlan, Role};
+use crate::lower::mirrored_lanes::{LaneLeaves, LanePlan, Role};
 use crate::lower::{Leaf, Program};
 
 /// The name of the lane value of the pair `(left, right)`: `d5_d90`.

@@ -1,4 +1,4 @@
-//! The looped form of `inverse_dynamics_derivatives` (`kane/rnea_derivatives_loop.rs`): the
+//! The looped form of `inverse_dynamics_derivatives` (`kane/derivatives_loop.rs`): the
 //! straight-line statements fill a workspace array, then
 //! `kanegen_runtime::derivative_steps::run` walks the generated tables (a `const` next to the
 //! function) and writes the result.
@@ -123,7 +123,7 @@ pub(super) fn function(
     let lanes = super::body::lanes_in(cx, p, looped.lanes.as_ref());
     let block = match lanes {
         Some((leaves, plan)) => {
-            super::lanes::lane_block(&printer, &cx.leaf_names, leaves, p, plan, stores)
+            super::mirrored_lanes::lane_block(&printer, &cx.leaf_names, leaves, p, plan, stores)
         }
         None => {
             printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true)

@@ -16,7 +16,7 @@
 //! exactly, variable by variable.
 //!
 //! Files: `arena.rs` (the arena, its node types and canonicalising constructors), `subst.rs`
-//! (substitution variables, hoisting), `diff.rs` (differentiation), `partial.rs`, `eval.rs`
+//! (substitution variables, hoisting), `diff.rs` (differentiation), `partial.rs` (evaluating only what some roots need), `eval.rs`
 //! (numeric evaluation), `display.rs` (printing), `modular.rs` (exact modular arithmetic).
 
 mod arena;

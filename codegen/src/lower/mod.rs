@@ -23,7 +23,7 @@ pub mod mirrored_lanes;
 mod order;
 mod program;
 
-/// The former name of [`mirrored_lanes`].
+/// [`mirrored_lanes`] under the shorter name the crate root and the reports use.
 pub use mirrored_lanes as lanes;
 
 pub use build::{lower, lower_with};

@@ -249,20 +249,21 @@ fn read_crate(root: &Path) -> Crate {
                     use_tree(&toks[i + 1..end], &[], &mut paths);
                     i = end;
                 }
-                s if i == 0 || toks[i - 1] != "::" => {
-                    if toks.get(i + 1).map(String::as_str) == Some("::") && is_ident(s) {
-                        let mut k = i;
-                        let mut p = Vec::new();
-                        while k < toks.len() && is_ident(&toks[k]) {
-                            p.push(toks[k].clone());
-                            if toks.get(k + 1).map(String::as_str) != Some("::") {
-                                break;
-                            }
-                            k += 2;
+                s if (i == 0 || toks[i - 1] != "::")
+                    && toks.get(i + 1).map(String::as_str) == Some("::")
+                    && is_ident(s) =>
+                {
+                    let mut k = i;
+                    let mut p = Vec::new();
+                    while k < toks.len() && is_ident(&toks[k]) {
+                        p.push(toks[k].clone());
+                        if toks.get(k + 1).map(String::as_str) != Some("::") {
+                            break;
                         }
-                        paths.push(p);
-                        i = k;
+                        k += 2;
                     }
+                    paths.push(p);
+                    i = k;
                 }
                 _ => {}
             }

@@ -304,7 +304,6 @@ mod imp {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::arith::Arith;
 
     fn values() -> impl Iterator<Item = f64> {
         [0.1, -2.5, 3.0e-17, 7.25, -1.0 / 3.0, 1.0e300, -0.0].into_iter()

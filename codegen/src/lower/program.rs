@@ -249,13 +249,13 @@ pub struct Lowered {
     pub mimic_angles: Vec<(usize, MimicLeaf)>,
     /// Result sizes (speeds, regressor columns).
     pub sizes: crate::registry::Sizes,
-    /// The regressors' parameters and base parameters (see [`Derivation::regressors`]).
+    /// The regressors' parameters and base parameters (see [`Derivation::regressors`](crate::kane::Derivation::regressors)).
     pub regressors: crate::kane::Regressors,
     /// The combined functions (see [`crate::combined`]).
     pub combined: Vec<CombinedProgram>,
     /// The looped form of `inverse_dynamics_derivatives` (see
-    /// [`Derivation::derivative_loop`]): the program filling its workspace and the tables;
-    /// `Some` when that form is chosen (see [`lower_with`]) and emitted instead of the
+    /// [`Derivation::derivative_loop`](crate::kane::Derivation::derivative_loop)): the program filling its workspace and the tables;
+    /// `Some` when that form is chosen (see [`lower_with`](super::lower_with)) and emitted instead of the
     /// straight-line program of [`Lowered::functions`] (which the batched form, `listing` and
     /// the interpreter keep using).
     pub derivative_loop: Option<LoopedProgram>,

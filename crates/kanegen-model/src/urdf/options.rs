@@ -77,7 +77,7 @@ pub enum UrdfBase {
     /// The root link's frame is the inertial base frame (links fixed to it carry no dynamics).
     #[default]
     Fixed,
-    /// The two-wheeled inverted-pendulum base ([`WheeledBase`]).
+    /// The two-wheeled inverted-pendulum base ([`WheeledBase`](crate::WheeledBase)).
     Wheeled(WheeledBaseSpec),
 }
 

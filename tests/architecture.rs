@@ -34,73 +34,57 @@ const STAGES: [&str; 4] = ["expr", "kane", "lower", "emit"];
 /// Source text with comments, string and character literals blanked (newlines kept).
 fn strip(src: &str) -> Vec<char> {
     let c: Vec<char> = src.chars().collect();
-    let mut out = c.clone();
-    let blank = |out: &mut Vec<char>, a: usize, b: usize| {
-        for ch in &mut out[a..b.min(c.len())] {
+    let at = |k: usize| c.get(k).copied().unwrap_or('\0');
+    // The end of the literal that opens at `k` with the quote `q` (escapes skipped).
+    let quoted = |mut k: usize, q: char| {
+        k += 1;
+        while k < c.len() && c[k] != q {
+            k += if c[k] == '\\' { 2 } else { 1 };
+        }
+        k + 1
+    };
+    let (mut out, mut i) = (c.clone(), 0);
+    while i < c.len() {
+        let after_ident = i > 0 && (at(i - 1).is_alphanumeric() || at(i - 1) == '_');
+        let r = if at(i) == 'b' { i + 1 } else { i };
+        let hashes = (r + 1..c.len()).take_while(|&k| c[k] == '#').count();
+        let end = if at(i) == '/' && at(i + 1) == '/' {
+            (i..c.len()).find(|&k| c[k] == '\n').unwrap_or(c.len())
+        } else if at(i) == '/' && at(i + 1) == '*' {
+            let (mut depth, mut k) = (1, i + 2);
+            while depth > 0 && k < c.len() {
+                let two = (at(k), at(k + 1));
+                depth += (two == ('/', '*')) as i32 - (two == ('*', '/')) as i32;
+                k += if two == ('/', '*') || two == ('*', '/') {
+                    2
+                } else {
+                    1
+                };
+            }
+            k
+        } else if !after_ident && at(r) == 'r' && at(r + 1 + hashes) == '"' {
+            let close: Vec<char> = std::iter::once('"')
+                .chain(std::iter::repeat_n('#', hashes))
+                .collect();
+            let mut k = r + hashes + 2;
+            while k < c.len() && !c[k..].starts_with(&close) {
+                k += 1;
+            }
+            k + close.len()
+        } else if at(i) == '"' {
+            quoted(i, '"')
+        } else if at(i) == '\'' && (at(i + 1) == '\\' || at(i + 2) == '\'') {
+            quoted(i, '\'')
+        } else {
+            i += 1;
+            continue;
+        };
+        for ch in &mut out[i..end.min(c.len())] {
             if *ch != '\n' {
                 *ch = ' ';
             }
         }
-    };
-    let mut i = 0;
-    while i < c.len() {
-        let at = |k: usize| c.get(k).copied().unwrap_or('\0');
-        let ident_before = i > 0 && (at(i - 1).is_alphanumeric() || at(i - 1) == '_');
-        if at(i) == '/' && at(i + 1) == '/' {
-            let end = (i..c.len()).find(|&k| c[k] == '\n').unwrap_or(c.len());
-            blank(&mut out, i, end);
-            i = end;
-        } else if at(i) == '/' && at(i + 1) == '*' {
-            let (mut depth, mut k) = (0, i);
-            while k < c.len() {
-                if at(k) == '/' && at(k + 1) == '*' {
-                    depth += 1;
-                    k += 2;
-                } else if at(k) == '*' && at(k + 1) == '/' {
-                    depth -= 1;
-                    k += 2;
-                    if depth == 0 {
-                        break;
-                    }
-                } else {
-                    k += 1;
-                }
-            }
-            blank(&mut out, i, k);
-            i = k;
-        } else if !ident_before && (at(i) == 'r' || (at(i) == 'b' && at(i + 1) == 'r')) && {
-            let s = if at(i) == 'b' { i + 2 } else { i + 1 };
-            let h = (s..c.len()).take_while(|&k| c[k] == '#').count();
-            at(s + h) == '"'
-        } {
-            let s = if at(i) == 'b' { i + 2 } else { i + 1 };
-            let h = (s..c.len()).take_while(|&k| c[k] == '#').count();
-            let close: Vec<char> = std::iter::once('"')
-                .chain(std::iter::repeat_n('#', h))
-                .collect();
-            let mut k = s + h + 1;
-            while k < c.len() && !c[k..].starts_with(&close) {
-                k += 1;
-            }
-            blank(&mut out, i, k + close.len());
-            i = k + close.len();
-        } else if at(i) == '"' {
-            let mut k = i + 1;
-            while k < c.len() && c[k] != '"' {
-                k += if c[k] == '\\' { 2 } else { 1 };
-            }
-            blank(&mut out, i, k + 1);
-            i = k + 1;
-        } else if at(i) == '\'' && (at(i + 1) == '\\' || at(i + 2) == '\'') {
-            let mut k = i + 1;
-            while k < c.len() && c[k] != '\'' {
-                k += if c[k] == '\\' { 2 } else { 1 };
-            }
-            blank(&mut out, i, k + 1);
-            i = k + 1;
-        } else {
-            i += 1;
-        }
+        i = end;
     }
     out
 }
@@ -164,8 +148,11 @@ fn use_tree(t: &[String], prefix: &[String], out: &mut Vec<Vec<String>>) -> usiz
 /// One crate's files: module path → file, and each file's dependencies on other files.
 struct Crate {
     files: BTreeMap<Vec<String>, PathBuf>,
-    deps: BTreeMap<PathBuf, BTreeMap<PathBuf, bool>>,
+    deps: Deps,
 }
+
+/// Per file: the files it depends on, each with whether only test code (`mod tests`) does.
+type Deps = BTreeMap<PathBuf, BTreeMap<PathBuf, bool>>;
 
 fn is_ident(s: &str) -> bool {
     s.chars().all(|c| c.is_alphanumeric() || c == '_')
@@ -320,58 +307,32 @@ fn rel(p: &Path) -> String {
         .to_string()
 }
 
-/// Strongly connected components with more than one file (Tarjan).
-fn cycles(deps: &BTreeMap<PathBuf, BTreeMap<PathBuf, bool>>) -> Vec<Vec<PathBuf>> {
-    struct T<'a> {
-        deps: &'a BTreeMap<PathBuf, BTreeMap<PathBuf, bool>>,
-        index: BTreeMap<&'a PathBuf, (usize, usize)>,
-        stack: Vec<&'a PathBuf>,
-        on: BTreeSet<&'a PathBuf>,
-        out: Vec<Vec<PathBuf>>,
-    }
-    fn visit<'a>(t: &mut T<'a>, v: &'a PathBuf) {
-        let n = t.index.len();
-        t.index.insert(v, (n, n));
-        t.stack.push(v);
-        t.on.insert(v);
-        for w in t.deps[v].keys() {
-            if !t.index.contains_key(w) {
-                visit(t, w);
-                let low = t.index[w].1.min(t.index[v].1);
-                t.index.get_mut(v).unwrap().1 = low;
-            } else if t.on.contains(w) {
-                let low = t.index[w].0.min(t.index[v].1);
-                t.index.get_mut(v).unwrap().1 = low;
-            }
-        }
-        if t.index[v].0 == t.index[v].1 {
-            let mut scc = Vec::new();
-            while let Some(w) = t.stack.pop() {
-                t.on.remove(w);
-                scc.push(w.clone());
-                if w == v {
-                    break;
+/// The groups of files that depend on each other, directly or not: each an import cycle.
+fn cycles(deps: &Deps) -> Vec<Vec<PathBuf>> {
+    let reach = |from: &PathBuf| {
+        let (mut seen, mut stack) = (BTreeSet::new(), vec![from]);
+        while let Some(f) = stack.pop() {
+            for g in deps[f].keys() {
+                if seen.insert(g) {
+                    stack.push(g);
                 }
             }
-            if scc.len() > 1 {
-                scc.sort();
-                t.out.push(scc);
-            }
         }
-    }
-    let mut t = T {
-        deps,
-        index: BTreeMap::new(),
-        stack: Vec::new(),
-        on: BTreeSet::new(),
-        out: Vec::new(),
+        seen
     };
-    for v in deps.keys() {
-        if !t.index.contains_key(v) {
-            visit(&mut t, v);
+    let reached: BTreeMap<_, _> = deps.keys().map(|f| (f, reach(f))).collect();
+    let mut out: Vec<Vec<PathBuf>> = Vec::new();
+    for (f, r) in &reached {
+        let group: Vec<PathBuf> = r
+            .iter()
+            .filter(|g| reached[*g].contains(f))
+            .map(|g| (*g).clone())
+            .collect();
+        if group.len() > 1 && !out.contains(&group) {
+            out.push(group);
         }
     }
-    t.out
+    out
 }
 
 #[test]

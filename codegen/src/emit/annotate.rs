@@ -6,7 +6,7 @@
 
 use std::collections::HashMap;
 
-use super::comment_text;
+use super::print::comment_text;
 use crate::lower::Program;
 
 /// Statement labels, by function name and local name.

@@ -28,12 +28,12 @@ use std::collections::BTreeMap;
 use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::Context;
-use super::function::{
+use super::body::{
     Reads, Stores, nonzero_outputs, state_reads, store_text_after, text, unused_inputs,
 };
-use super::items::{arg_names, return_type};
+use super::context::Context;
 use super::print::{Printer, ident, idx};
+use super::signature::{arg_names, return_type};
 use crate::lower::{self, FunctionProgram, LExpr, Program};
 use crate::naming;
 use crate::registry::{FunctionSpec, Inputs, Shape};
@@ -165,14 +165,14 @@ fn lane_sin_cos(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
     }
     // All angles of all states in one call (a dependent joint's from its master's).
     let angles = p.sincos.iter().map(|&s| {
-        let a = super::function::joint_angle(cx, s, &quote!(q));
+        let a = super::body::joint_angle(cx, s, &quote!(q));
         if cx.low.mimic_angles.iter().any(|(d, _)| *d == s) {
             quote!((#a).0)
         } else {
             quote!(#a.0)
         }
     });
-    let (sn, cn) = super::function::sin_cos_names(p, reads);
+    let (sn, cn) = super::body::sin_cos_names(p, reads);
     quote!(let (#sn, #cn) = kanegen_runtime::lanes::sin_cos_n_inline::<A, _, L>([#(#angles),*]);)
 }
 
@@ -261,7 +261,7 @@ const BUFFERED_LOCATIONS: usize = 300;
 fn entry_stores(cx: &Context<'_>, p: &Program, reads: &Reads) -> EntryStores {
     let entries = nonzero_outputs(p).count();
     let params = if cx.low.params.is_runtime() {
-        super::function::params_read(p)
+        super::body::params_read(p)
     } else {
         0
     };
@@ -473,7 +473,7 @@ fn shared_body(
          lane `l` of its entry in `out`.",
         spec.name
     );
-    let param_args = super::function::param_args(cx, reads);
+    let param_args = super::body::param_args(cx, reads);
     let nl = idx(cx.low.dof);
     let lanes_ty = quote!(&[kanegen_runtime::lanes::Lanes<L>; #nl]);
     let inputs = read_inputs(p, reads).into_iter().map(|x| {
@@ -597,7 +597,7 @@ fn function_in(
     let name = ident(&by_value);
     let name_into = ident(&format!("{by_value}_into"));
     let (doc, doc_into) = docs(spec.name, layout);
-    let (outer_params, pass_params) = super::function::outer_params(cx);
+    let (outer_params, pass_params) = super::body::outer_params(cx);
     let state = layout.args(cx, spec.inputs);
     let names = arg_names(spec.inputs);
     let ty = layout.result(cx, spec);
@@ -616,9 +616,9 @@ fn function_in(
         Layout::Lanes => after,
     };
     let unused = unused_inputs(spec.inputs, p, reads);
-    let call = super::function::call_body_into(
+    let call = super::body::call_body_into(
         cx,
-        super::function::Copies::WithV4,
+        super::body::Copies::WithV4,
         quote!(, L),
         quote!(#pass_params #names,),
         quote!(out),
@@ -683,7 +683,7 @@ pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
             let state = layout.args(cx, spec.inputs);
             let ty = layout.result(cx, spec);
             let names = arg_names(spec.inputs);
-            let pass = super::items::wrapper_params(cx);
+            let pass = super::signature::wrapper_params(cx);
             let call = quote!(#name(#pass #names));
             let call_into = quote!(#name_into(#pass #names, out));
             let gate = &cx.batch_gate;

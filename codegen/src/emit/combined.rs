@@ -6,14 +6,14 @@
 use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::Context;
-use super::function::{
-    Reads, Stores, generic_body, prologue, result_type, state_args, store_text_after, text,
-    unused_inputs,
+use super::body::{
+    Reads, Stores, generic_body, prologue, state_args, store_text_after, text, unused_inputs,
 };
-use super::items::arg_names;
+use super::context::Context;
+use super::context::scalar_type;
 use super::print::{ident, idx};
-use super::scalar_type;
+use super::signature::arg_names;
+use super::signature::result_type;
 use crate::lower::{CombinedProgram, LExpr, Leaf};
 use crate::registry::Shape;
 
@@ -62,7 +62,7 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
 
     // The body: `out` is a tuple with one element per part (an isometry's is `(rotation,
     // translation)`), filled by stores after the statements they read.
-    let lanes = super::function::lanes_in(cx, p, c.lanes.as_ref());
+    let lanes = super::body::lanes_in(cx, p, c.lanes.as_ref());
     // Text lines by position (see `Printer::statement_block`), for either block form.
     let mut stores: Stores = vec![Vec::new(); p.stmts.len() + 1];
     let mut stored_exprs: Vec<&LExpr> = Vec::new();
@@ -117,7 +117,7 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
         }
     }
     let stored = !stored_exprs.is_empty();
-    let block = super::function::body_block(cx, &printer, p, lanes, stores, (&stored_exprs, &[]));
+    let block = super::body::body_block(cx, &printer, p, lanes, stores, (&stored_exprs, &[]));
     let body = cx.blocks.placeholder(block);
     let prologue = prologue(cx, p, &reads);
     let unused = unused_inputs(c.spec.inputs, p, &reads);
@@ -129,7 +129,7 @@ pub(super) fn items(cx: &Context<'_>, c: &CombinedProgram) -> TokenStream {
         #body
         #ty { #(#finals,)* }
     };
-    let param_args = super::function::param_args(cx, &reads);
+    let param_args = super::body::param_args(cx, &reads);
     // Generic over the multiply-add, as the separate functions (whose bits it gives).
     let (param_args, body) = generic_body(
         cx,
@@ -177,7 +177,7 @@ pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
             let ty = ident(&c.spec.type_name);
             let (args, _) = state_args(cx, c.spec.inputs);
             let names = arg_names(c.spec.inputs);
-            let pass = super::items::wrapper_params(cx);
+            let pass = super::signature::wrapper_params(cx);
             let call = quote!(#name(#pass #names));
             let doc = format!(" Combined function [`{}`] (free function).", c.spec.name);
             quote! {

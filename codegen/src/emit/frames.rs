@@ -5,13 +5,13 @@
 use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::Context;
-use super::function::state_args;
-use super::items::arg_names;
+use super::body::state_args;
+use super::context::Context;
 use super::print::{ident, idx};
+use super::signature::arg_names;
 use crate::lower::FunctionProgram;
-use crate::model::Model;
 use crate::registry::FunctionId;
+use kanegen_model::Model;
 
 /// The `Frame` variant of every link: its name in CamelCase (`base` → `Base`, `link_1` →
 /// `Link1`), `F` before a leading digit (`10l` → `F10l`), the link index appended where two
@@ -111,7 +111,7 @@ pub(super) fn dispatcher(cx: &Context<'_>, id: FunctionId) -> TokenStream {
     let doc = format!(" {}", spec.doc);
     let (args, arg_doc) = state_args(cx, spec.inputs);
     let names = arg_names(spec.inputs);
-    let (params, forward) = super::function::outer_params(cx);
+    let (params, forward) = super::body::outer_params(cx);
     let variants = variants(cx.model);
     let arms = cx.low.functions.iter().filter(|f| f.id == id).map(|f| {
         let l = f.frame.expect("a per-frame program has a frame");
@@ -119,7 +119,7 @@ pub(super) fn dispatcher(cx: &Context<'_>, id: FunctionId) -> TokenStream {
         let callee = ident(&rust_name(cx, f));
         quote!(Frame::#v => #callee(#forward #names),)
     });
-    let ty = super::function::result_type(cx, spec.shape);
+    let ty = super::signature::result_type(cx, spec.shape);
     quote! {
         #[doc = #doc]
         #[doc = ""]

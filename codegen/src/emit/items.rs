@@ -5,13 +5,14 @@
 use proc_macro2::{Ident, TokenStream};
 use quote::quote;
 
-use super::function::{result_type, state_args, uses};
+use super::body::{state_args, uses};
+use super::context::{Context, file_name, scalar_type};
 use super::print::{ident, idx, signed_lit};
-use super::{Context, file_name, scalar_type};
+use super::signature::{arg_names, return_type, wrapper_params};
 use crate::lower::{Leaf, Program};
-use crate::model::{Model, ParamKind};
 use crate::naming;
-use crate::registry::{FunctionSpec, Inputs, RuntimeTrait};
+use crate::registry::{FunctionSpec, RuntimeTrait};
+use kanegen_model::{Model, ParamKind};
 
 /// `DOF`, `SPEED_NAMES`, `COORDINATE_NAMES` and the `index` constants: one per coordinate
 /// (`Q_IMU`) and one per speed (`QD_IMU`), the same index, unless the speed's constant would
@@ -59,7 +60,7 @@ pub(super) fn names(cx: &Context<'_>) -> TokenStream {
     }
 }
 
-fn param_doc(p: &crate::model::Param) -> String {
+fn param_doc(p: &kanegen_model::Param) -> String {
     let what = match p.kind {
         ParamKind::Length => "length (m)",
         ParamKind::Gravity => "gravity acceleration (m/s²)",
@@ -202,8 +203,8 @@ fn validate(cx: &Context<'_>) -> TokenStream {
         quote!(f64::from(self.#f))
     };
     let rel_tol = match cx.precision {
-        crate::Precision::F64 => 1e-9,
-        crate::Precision::F32 => 1e-5,
+        crate::options::Precision::F64 => 1e-9,
+        crate::options::Precision::F32 => 1e-5,
     };
     let bodies = model.links.iter().filter_map(|l| l.body.as_ref()).map(|b| {
         let name = b.name.as_str();
@@ -283,31 +284,6 @@ pub(super) fn precomputed(cx: &Context<'_>) -> TokenStream {
     }
 }
 
-/// The argument names of a function with `inputs`, as passed on by a wrapper.
-pub(super) fn arg_names(inputs: Inputs) -> TokenStream {
-    match inputs {
-        Inputs::Q => quote!(q),
-        Inputs::QU => quote!(q, u),
-        Inputs::QUUd => quote!(q, u, ud),
-    }
-}
-
-/// The return type of a registry function.
-pub(super) fn return_type(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
-    result_type(cx, spec.shape)
-}
-
-/// What a method of the wrapper passes first to a free function: the wrapper's parameters and
-/// their precomputed values (`&self.params, &self.pre,`) in a runtime-parameter module, nothing
-/// in a baked one (the free function's own first arguments: [`super::function::outer_params`]).
-pub(super) fn wrapper_params(cx: &Context<'_>) -> TokenStream {
-    if cx.low.params.is_runtime() {
-        quote!(&self.params, &self.pre,)
-    } else {
-        quote!()
-    }
-}
-
 /// A call of the free function of `spec` from a method of the wrapper.
 fn forward_call(cx: &Context<'_>, spec: &FunctionSpec) -> TokenStream {
     let f = ident(spec.name);
@@ -336,7 +312,7 @@ fn methods(cx: &Context<'_>) -> TokenStream {
             }
             let ret = return_type(cx, spec);
             let call = forward_call(cx, spec);
-            let into = super::function::has_into(f).then(|| {
+            let into = super::body::has_into(f).then(|| {
                 let into = ident(&format!("{}_into", spec.name));
                 let doc = format!(
                     " [`{0}`](Self::{0}) written into `out` (every entry), without returning the \
@@ -373,7 +349,7 @@ pub(super) fn wrapper(cx: &Context<'_>, batched: bool) -> TokenStream {
     let mut methods = methods(cx);
     methods.extend(super::combined::methods(cx));
     methods.extend(super::regressor_loop::methods(cx));
-    methods.extend(super::derivative_loop::methods(cx));
+    methods.extend(super::derivatives_loop::methods(cx));
     if batched {
         methods.extend(super::batch::methods(cx));
     }

@@ -10,32 +10,42 @@
 //! Statements carry the reports' style comments (`let k12 = …; // w2.x`). Output is
 //! deterministic byte for byte.
 //!
-//! Files: `print.rs` (expressions, identifiers, literals), `function.rs` (one generated
-//! function), `items.rs` (names, `Params`, `Precomputed`, wrapper, trait impls), `annotate.rs`
-//! (statement comments), this file (the module and its header).
+//! Files, each depending only on files listed before it (this file collects them):
+//! `print.rs` (expressions, identifiers, literals, comment text), `text.rs` (statement blocks
+//! printed as text and spliced into the formatted module), `context.rs` (what every part
+//! reads), `mirrored_lanes.rs` (paired statements over two lanes), `signature.rs` (argument
+//! names, result types), `body.rs` (the building blocks of a function body), the forms
+//! `regressor_loop.rs`, `frames.rs` (the `Frame` type and per-frame dispatchers),
+//! `function.rs` (straight-line), `derivatives_loop.rs`, `combined.rs`, `batch.rs`,
+//! `regressor.rs` (the regressors' items), then `items.rs` (names, `Params`, `Precomputed`, the
+//! wrapper collecting every form's methods, trait impls), `annotate.rs` (statement comments)
+//! and this file (the module and its header).
 
 mod annotate;
 mod batch;
+mod body;
 mod combined;
-mod derivative_loop;
+mod context;
+mod derivatives_loop;
 mod frames;
 mod function;
 mod items;
-mod lanes;
+mod mirrored_lanes;
 mod print;
+mod regressor;
 mod regressor_loop;
-mod regressors;
+mod signature;
 mod text;
-
-use std::path::Path;
 
 use proc_macro2::TokenStream;
 use quote::quote;
 
 use crate::lower::Lowered;
-use crate::model::Model;
 use crate::options::{DerivativesForm, ParamMode, Precision, RegressorForm};
 use crate::registry::FunctionId;
+use context::{Context, file_name};
+use kanegen_model::Model;
+pub(crate) use print::comment_text;
 
 /// The generator's version, written into every header.
 pub const GENERATOR_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -73,7 +83,7 @@ pub struct EmitOptions {
     pub batch_feature: Option<String>,
     /// Mirrored subtrees in two SIMD lanes (default `false`): see
     /// [`crate::Builder::mirrored_lanes`]. Read by [`crate::generate_combined`], which pairs
-    /// the lowered programs ([`crate::lower::lanes::apply`]).
+    /// the lowered programs ([`crate::lower::mirrored_lanes::apply`]).
     pub mirrored_lanes: bool,
     /// The floating-point type of the module.
     pub precision: Precision,
@@ -114,53 +124,6 @@ impl Default for EmitOptions {
             derivatives_form: DerivativesForm::default(),
         }
     }
-}
-
-/// What every part of the emitter reads.
-pub(crate) struct Context<'a> {
-    model: &'a Model,
-    low: &'a Lowered,
-    precision: Precision,
-    /// See [`EmitOptions::isa_dispatch`].
-    isa_dispatch: bool,
-    /// Field names of the precomputed values, by slot.
-    pre: Vec<String>,
-    /// The statement blocks of the functions, spliced in after formatting (`text.rs`).
-    blocks: text::Blocks,
-    /// The model's leaves as printed in statement blocks.
-    leaf_names: text::LeafNames,
-    /// See [`EmitOptions::split_above`].
-    split_above: usize,
-    /// `#[cfg(feature = "…")]` before every batched item ([`EmitOptions::batch_feature`]), or
-    /// nothing.
-    batch_gate: TokenStream,
-}
-
-impl Context<'_> {
-    /// The expression printer for a program's statements `stmts`.
-    fn printer<'p>(&'p self, stmts: &'p [crate::lower::Stmt]) -> print::Printer<'p> {
-        print::Printer {
-            model: self.model,
-            stmts,
-            pre: &self.pre,
-            precision: self.precision,
-            lane: None,
-        }
-    }
-}
-
-fn scalar_type(precision: Precision) -> TokenStream {
-    match precision {
-        Precision::F64 => quote!(f64),
-        Precision::F32 => quote!(f32),
-    }
-}
-
-fn file_name(path: &str) -> String {
-    Path::new(path)
-        .file_name()
-        .map(|f| f.to_string_lossy().into_owned())
-        .unwrap_or_else(|| path.to_owned())
 }
 
 /// Generate the Rust module for a lowered model. Deterministic: same input, same bytes. The
@@ -212,7 +175,7 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         items.extend(items::precomputed(&cx));
         labels.add("new", &low.precompute);
     }
-    items.extend(regressors::items(&cx));
+    items.extend(regressor::items(&cx));
     if low.functions.iter().any(|f| f.frame.is_some()) {
         items.extend(frames::frame_type(&cx));
     }
@@ -220,12 +183,12 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         // Its statements carry their labels in their block (`text.rs`).
         match &low.derivative_loop {
             Some(looped) if f.id == FunctionId::InverseDynamicsDerivatives => {
-                items.extend(derivative_loop::function(&cx, f, looped));
+                items.extend(derivatives_loop::function(&cx, f, looped));
             }
             _ => items.extend(function::function(&cx, f)),
         }
         items.extend(regressor_loop::straight_into(&cx, f));
-        items.extend(derivative_loop::straight_into(
+        items.extend(derivatives_loop::straight_into(
             &cx,
             f,
             low.derivative_loop.is_some(),
@@ -280,28 +243,6 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
     })?;
     out.push_str(&body);
     Ok(out)
-}
-
-/// `s` made safe for a `//` comment: control characters (a newline would end the comment and
-/// let the rest of the line be compiled) and the bidirectional-override characters that rustc
-/// rejects in comments (`text_direction_codepoint_in_comment`) are written as escapes (`\n`,
-/// `\u{202e}`). Every comment text that comes from input (header, notes, statement labels)
-/// goes through this function.
-pub(crate) fn comment_text(s: &str) -> String {
-    let escaped =
-        |c: char| c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}');
-    if !s.chars().any(escaped) {
-        return s.to_owned();
-    }
-    s.chars()
-        .flat_map(|c| {
-            if c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}') {
-                c.escape_default().collect::<Vec<_>>()
-            } else {
-                vec![c]
-            }
-        })
-        .collect()
 }
 
 fn header(model: &Model, low: &Lowered) -> String {

@@ -4,9 +4,9 @@ use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::quote;
 
 use crate::lower::{LExpr, Leaf, Stmt};
-use crate::model::Model;
 use crate::naming;
 use crate::options::Precision;
+use kanegen_model::Model;
 
 /// A model-derived name as an identifier, by [`naming::identifier`] (never a keyword, so never
 /// a raw identifier; the names of a validated model are unchanged).
@@ -177,4 +177,26 @@ impl Printer<'_> {
         }
         ts
     }
+}
+
+/// `s` made safe for a `//` comment: control characters (a newline would end the comment and
+/// let the rest of the line be compiled) and the bidirectional-override characters that rustc
+/// rejects in comments (`text_direction_codepoint_in_comment`) are written as escapes (`\n`,
+/// `\u{202e}`). Every comment text that comes from input (header, notes, statement labels)
+/// goes through this function.
+pub(crate) fn comment_text(s: &str) -> String {
+    let escaped =
+        |c: char| c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}');
+    if !s.chars().any(escaped) {
+        return s.to_owned();
+    }
+    s.chars()
+        .flat_map(|c| {
+            if c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}') {
+                c.escape_default().collect::<Vec<_>>()
+            } else {
+                vec![c]
+            }
+        })
+        .collect()
 }

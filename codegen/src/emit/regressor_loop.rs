@@ -8,11 +8,10 @@
 use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::function::{
-    Reads, last_local, param_args, prologue, result_type, state_args, unused_inputs,
-};
+use super::body::{Reads, last_local, param_args, prologue, state_args, unused_inputs};
+use super::context::{Context, scalar_type};
 use super::print::{idx, signed_lit};
-use super::{Context, scalar_type};
+use super::signature::result_type;
 use crate::kane::{CarryFrom, KIN};
 use crate::lower::{FunctionProgram, LExpr, Leaf, LoopProgram};
 use crate::registry::FunctionId;
@@ -165,13 +164,13 @@ pub(super) fn function(cx: &Context<'_>, f: &FunctionProgram, lp: &LoopProgram) 
         let plan = kanegen_runtime::regressor::Plan { columns: &COLUMNS, steps: &STEPS, seeds: &SEEDS, zeros: &ZEROS };
         kanegen_runtime::regressor::inverse_dynamics_regressor::<A, _, #nl, #slots>(&kin, &plan, #nr, y.as_mut_slice());
     };
-    let (outer_params, pass_params) = super::function::outer_params(cx);
-    let state = super::items::arg_names(spec.inputs);
+    let (outer_params, pass_params) = super::body::outer_params(cx);
+    let state = super::signature::arg_names(spec.inputs);
     // The body generic over the multiply-add, compiled twice with dispatch (`Plain` for the
     // baseline, `Fused` for x86-64-v3), writing into `y`.
-    let call = super::function::call_body_into(
+    let call = super::body::call_body_into(
         cx,
-        super::function::Copies::BaselineAndV3,
+        super::body::Copies::BaselineAndV3,
         quote!(),
         quote!(#pass_params #state,),
         quote!(y),
@@ -258,7 +257,7 @@ pub(super) fn straight_into(cx: &Context<'_>, f: &FunctionProgram) -> TokenStrea
     let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
     let (nr, nc) = (idx(rows), idx(cols));
     let (args, arg_doc) = state_args(cx, spec.inputs);
-    let state = super::items::arg_names(spec.inputs);
+    let state = super::signature::arg_names(spec.inputs);
     let (params, forward) = if cx.low.params.is_runtime() {
         (quote!(p: &Params, pc: &Precomputed,), quote!(p, pc,))
     } else {
@@ -301,8 +300,8 @@ pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
             let t = scalar_type(cx.precision);
             let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
             let (nr, nc) = (idx(rows), idx(cols));
-            let state = super::items::arg_names(spec.inputs);
-            let pass = super::items::wrapper_params(cx);
+            let state = super::signature::arg_names(spec.inputs);
+            let pass = super::signature::wrapper_params(cx);
             let call = quote!(#into(#pass #state, y));
             quote! {
                 #[doc = #doc]

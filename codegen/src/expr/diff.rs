@@ -10,25 +10,7 @@
 //! `(node, variable)`; the traversal is iterative, so deep chains of variables do not overflow
 //! the stack.
 
-use std::collections::HashMap;
-
-use super::{Arena, Atom, ExprId, Node};
-
-/// The independent variable of a derivative.
-#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
-pub enum Wrt {
-    /// The coordinate `q[i]` (speed index `i`): `sin q[i]`, `cos q[i]` and `q[i]` depend on it.
-    Coord(u32),
-    /// The speed `u[i]`.
-    Speed(u32),
-    /// The acceleration `u̇[i]`.
-    Accel(u32),
-    /// The model parameter `p` (index into `Model::params`).
-    Param(u32),
-}
-
-/// Memo of [`Arena::diff`]: `(node, variable) → derivative`.
-pub(super) type DiffMemo = HashMap<(ExprId, Wrt), ExprId>;
+use super::arena::{Arena, Atom, ExprId, Node, Wrt};
 
 impl Arena {
     /// `∂e/∂wrt`, exact, as an expression of the same arena.
@@ -150,7 +132,7 @@ impl Arena {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::expr::{Names, Values, VarKind};
+    use crate::expr::arena::{Names, Values, VarKind};
 
     fn arena() -> Arena {
         Arena::new(Names {

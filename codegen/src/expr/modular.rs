@@ -12,7 +12,7 @@
 //! and no rounding is involved: a zero at several independent points is an exact identity with
 //! overwhelming probability.
 
-use super::{Arena, Atom, Node};
+use super::arena::{Arena, Atom, Node};
 
 /// The prime `2⁶¹ − 1`.
 pub const P: u64 = (1 << 61) - 1;

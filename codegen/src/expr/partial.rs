@@ -5,7 +5,7 @@
 //! derivatives or the Coriolis matrix in the module, most of it unrelated) would dominate
 //! generation time.
 
-use super::{Arena, Atom, ExprId, Node, Values};
+use super::arena::{Arena, Atom, ExprId, Node, Values};
 
 impl Arena {
     /// Per node: whether `roots` read it (through substitution variables too).

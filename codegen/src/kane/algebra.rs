@@ -2,24 +2,8 @@
 
 use kanegen_model::Joint;
 
-use super::Ctx;
+pub(super) use super::ctx::{AXES, Ctx, M3, V3, V6, join3, split3};
 use crate::expr::{ExprId, VarKind};
-
-pub(super) type V3 = [ExprId; 3];
-pub(super) type M3 = [[ExprId; 3]; 3];
-/// A spatial vector: motion `(ω; v)` or force `(n; f)`.
-pub(super) type V6 = [ExprId; 6];
-
-pub(super) fn split3(x: &V6) -> (V3, V3) {
-    ([x[0], x[1], x[2]], [x[3], x[4], x[5]])
-}
-
-pub(super) fn join3(a: &V3, b: &V3) -> V6 {
-    [a[0], a[1], a[2], b[0], b[1], b[2]]
-}
-
-/// Component suffixes of substitution labels.
-pub(super) const AXES: [&str; 3] = ["x", "y", "z"];
 
 impl Ctx<'_> {
     pub(super) fn matmul(&mut self, a: &M3, b: &M3) -> M3 {

@@ -2,8 +2,8 @@
 
 use kanegen_model::{Joint, JointKind};
 
-use super::Ctx;
 use super::algebra::{AXES, M3, V3};
+use super::ctx::Ctx;
 use crate::expr::{Atom, ExprId, VarKind};
 
 /// Composite (subtree) inertial quantities of a frame, in that frame.

@@ -4,9 +4,9 @@ use std::collections::BTreeMap;
 
 use kanegen_model::JointKind;
 
-use super::Ctx;
 use super::algebra::{V3, V6, join3, split3};
 use super::composite::Composite;
+use super::ctx::Ctx;
 use crate::expr::{Atom, ExprId, VarKind};
 
 impl Ctx<'_> {

@@ -7,7 +7,7 @@
 //! variables (one pass per input over everything that depends on it; Krang: 35,959 flops
 //! against the analytic recursion's 14,728). Both are exact, so they agree to rounding.
 
-use super::Ctx;
+use super::ctx::Ctx;
 use crate::expr::ExprId;
 #[cfg(test)]
 use crate::expr::Wrt;

@@ -2,9 +2,9 @@
 
 use kanegen_model::JointKind;
 
-use super::Ctx;
 use super::algebra::V3;
 use super::composite::Composite;
+use super::ctx::Ctx;
 use crate::expr::{ExprId, VarKind};
 
 impl Ctx<'_> {

@@ -29,7 +29,7 @@
 
 use kanegen_model::{Model, ParamKind};
 
-use super::regressor::{Rng, regressor_at};
+use super::regressor_sample::{Rng, regressor_at};
 use crate::expr::modular::{self, ModValues};
 use crate::expr::{Arena, ExprId};
 

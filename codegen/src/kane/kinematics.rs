@@ -14,9 +14,9 @@
 //! height), `2 mw · [1, 0, 0]` to the momentum per `ẋ` and `2 mw · [0, ẋψ̇, 0]` to the bias.
 //! Their rotational inertia enters only the kinetic energy (through `M`).
 
-use super::Ctx;
 use super::algebra::{M3, V3};
 use super::composite::Composite;
+use super::ctx::Ctx;
 use crate::expr::{Atom, ExprId, VarKind};
 use kanegen_model::JointKind;
 

@@ -2,8 +2,8 @@
 
 use kanegen_model::{Joint, JointKind};
 
-use super::Ctx;
 use super::composite::Composite;
+use super::ctx::Ctx;
 use crate::expr::{ExprId, VarKind};
 
 impl Ctx<'_> {

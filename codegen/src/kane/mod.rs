@@ -31,19 +31,25 @@
 //! | file | what |
 //! |---|---|
 //! | `mod.rs` | public types, [`derive()`] (one arena phase per function), [`Derivation::evaluate`] |
+//! | `ctx.rs` | the derivation's state `Ctx` and its vector and matrix types |
 //! | `algebra.rs` | 3-vector and 3×3 algebra, spatial motion/force algebra |
-//! | `frames.rs` | leaves, model data: parameters, `iAj(q)`, `iPj(q)`, bodies, axes, wheels |
+//! | `leaves.rs` | leaves, model data: parameters, `iAj(q)`, `iPj(q)`, bodies, axes, wheels |
 //! | `composite.rs` | composite (subtree) mass, first moment and inertia; rotation of inertias |
 //! | `mass_matrix.rs` | M, one column per joint, formed inside the composite pass |
 //! | `gravity.rs` | g |
 //! | `rnea.rs` | c and τ: forward motion pass, body inertia forces, backward accumulation |
 //! | `coriolis_matrix.rs` | C: frame velocities, subtree momenta and inertia rates, columns |
 //! | `rnea_derivatives.rs` | ∂τ/∂q, ∂τ/∂u: the analytic recursion (four forces per column carried up; `derivatives.rs` keeps forward mode as its test oracle) |
-//! | `rnea_derivatives_loop.rs` | the looped form of the same: per-link and per-column quantities into a workspace, tables for `kanegen_runtime::derivative_steps` |
+//! | `derivatives_loop.rs` | the looped form of the same: per-link and per-column quantities into a workspace, tables for `kanegen_runtime::derivative_steps` |
 //! | `kinematics.rs` | frames in frame 0 (`⁰A`, `⁰p`), centre of mass, its Jacobian and bias acceleration, energies |
 //! | `regressor.rs` | regressors `∂τ/∂π`, `∂g/∂β` (by [`Arena::diff`]) and their base parameters |
+//! | `regressor_sample.rs` | the regressor evaluated at random states, what the base parameters are found from |
 //! | `regressor_loop.rs` | the loop form of Y and the base regressor: per-link motion and joint transforms, the (speed, body) tables of `kanegen_runtime::regressor` |
 //! | `grouping.rs` | the base parameters' groupings as exact expressions of the geometry (fitted, then verified in exact modular arithmetic) |
+//! | `mimic.rs`, `mirror.rs` | mimic joints' projection; the mirrored subtrees that `lower::mirrored_lanes` pairs |
+//!
+//! The files depend on `ctx.rs` and on each other one way; `mod.rs` drives them and re-exports
+//! what later stages use.
 //!
 //! The arena records the order in which each phase first asks for a node and the lowering
 //! schedules statements in that order: moving arena calls around changes the generated code.
@@ -54,19 +60,25 @@
 mod algebra;
 mod composite;
 mod coriolis_matrix;
+mod ctx;
 mod derivatives;
-mod frames;
+mod derivatives_loop;
+#[cfg(test)]
+mod derivatives_loop_tests;
 mod gravity;
 mod grouping;
 mod kinematics;
+mod leaves;
 mod mass_matrix;
 mod mimic;
 mod mirror;
 mod regressor;
 mod regressor_loop;
+mod regressor_sample;
 mod rnea;
 mod rnea_derivatives;
-mod rnea_derivatives_loop;
+#[cfg(test)]
+mod rnea_derivatives_tests;
 
 use kanegen_model::{Model, ParamKind};
 
@@ -75,8 +87,9 @@ use crate::expr::{Arena, ExprId, Names};
 use crate::options::{Options, RegressorForm};
 use crate::registry::{FunctionId, Sizes};
 
-use algebra::{M3, V3};
 use composite::Composite;
+use ctx::Ctx;
+pub use derivatives_loop::{DerivativeLink, DerivativeLoop, LoopColumn, LoopSpeed};
 pub use grouping::{Coefficient, Exactness, SymbolicGroup, symbolic_group_text};
 pub use mirror::Mirror;
 pub use regressor::{BaseParameters, Regressors, group_text};
@@ -84,7 +97,6 @@ pub use regressor_loop::{
     CarryFrom, JointShape, KIN, LANES, LOOP_MIN_PAIRS, LoopLink, LoopPlan, LoopStep, PlanStep,
     RegressorLoop, first_row,
 };
-pub use rnea_derivatives_loop::{DerivativeLink, DerivativeLoop, LoopColumn, LoopSpeed};
 
 /// One derived registry function: its output entries as expressions in the arena (its name,
 /// inputs and result shape are in the registry).
@@ -138,7 +150,7 @@ pub struct Derivation {
     pub mirror: Option<Mirror>,
 }
 
-/// The looped form of `inverse_dynamics_derivatives` (`kane/rnea_derivatives_loop.rs`): the
+/// The looped form of `inverse_dynamics_derivatives` (`kane/derivatives_loop.rs`): the
 /// workspace the generated statements fill and the tables the runtime loop runs over.
 #[derive(Clone, Debug)]
 pub struct LoopedDerivatives {
@@ -453,7 +465,7 @@ impl Ctx<'_> {
             return entries;
         }
         let params = if gravity { &reg.beta } else { &reg.inertial };
-        let baked = !matches!(self.options.params, crate::ParamMode::Runtime);
+        let baked = !matches!(self.options.params, crate::options::ParamMode::Runtime);
         let base = regressor::base_parameters(self.ar, self.model, &entries, params, baked);
         let column: std::collections::HashMap<usize, usize> = base
             .groups
@@ -527,23 +539,6 @@ impl Ctx<'_> {
             _ => unreachable!("`{id}` is not a per-frame function"),
         }
     }
-}
-
-/// The derivation's state: the arena, the model, and the per-link caches of `iAj(q)` and
-/// `iPj(q)`. Its methods are spread over this module's files, one concern each.
-struct Ctx<'a> {
-    ar: &'a mut Arena,
-    model: &'a Model,
-    options: Options,
-    rot: Vec<Option<M3>>,
-    pos: Vec<Option<V3>>,
-    /// `⁰A_l(q)`: the rotation of frame l relative to frame 0, cached.
-    root_rot: Vec<Option<M3>>,
-    /// `⁰p_l(q)`: the origin of frame l in frame 0, cached.
-    root_pos: Vec<Option<V3>>,
-    /// Keep the regressor parameters (inertial, wheel mass and inertias) as symbols even with
-    /// baked parameters: set while a regressor's dynamics are derived.
-    keep_inertial: bool,
 }
 
 impl Derivation {

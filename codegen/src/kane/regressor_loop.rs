@@ -1,4 +1,4 @@
-//! The loop form of the inverse-dynamics regressor and its base regressor (issue 13, speed).
+//! The loop form of the inverse-dynamics regressor and its base regressor.
 //!
 //! The straight-line Y is one derivative chain per parameter column (`regressor.rs`): for
 //! Krang 9,950 flops in 135 KB of machine code, which runs from L2 (the L1 instruction cache
@@ -15,7 +15,7 @@
 
 use kanegen_model::{JointKind, Model};
 
-use super::Ctx;
+use super::ctx::Ctx;
 use crate::expr::ExprId;
 use crate::options::RegressorForm;
 

@@ -3,8 +3,8 @@
 
 use kanegen_model::{Joint, JointKind, Mount};
 
-use super::Ctx;
 use super::algebra::V3;
+use super::ctx::Ctx;
 use crate::expr::{Arena, Atom, ExprId, VarKind};
 
 impl Ctx<'_> {

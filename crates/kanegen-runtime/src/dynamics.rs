@@ -274,7 +274,7 @@ const SOLVE_GROUP: usize = 8;
 /// Measured on the fixed-wheel tree's `forward_dynamics_derivatives` (criterion
 /// `fd_derivatives/fixed_wheels_trait`; `docs/measurement-log.md`, "The trait's
 /// forward-dynamics derivatives"): nalgebra's `Cholesky::solve` and `inverse`, one column at a
-/// time through strided loops, took 17.1 µs (tenth session); solves on transposed copies that
+/// time through strided loops, took 17.1 µs; solves on transposed copies that
 /// passed over all right-hand sides for every `x_i −= l_ik x_k`, storing and reloading `x_i`
 /// at each `k`, 7.3–7.7 µs; this form, the figure in README.md's "Derivatives".
 #[inline(always)]
@@ -319,7 +319,7 @@ const SOLVE_ROWS: usize = 4;
 /// `inv_diag`): [`solve_group`] on one right-hand side, the same bits as that right-hand side
 /// solved by [`cholesky_solve_columns`]. What the provided `forward_dynamics` methods solve
 /// with: nalgebra's `Cholesky::solve` took 0.33 µs of the fixed-wheel tree's
-/// `forward_dynamics_derivatives` (seventeenth session, `perf`).
+/// `forward_dynamics_derivatives` (measured with `perf`).
 #[inline(always)]
 fn cholesky_solve_vector<T: RealField + Copy, const N: usize, const FUSED: bool>(
     l: &SMatrix<T, N, N>,

@@ -5,23 +5,25 @@ use std::collections::HashMap;
 
 use nalgebra::Vector3;
 
+use super::cut::BaseCut;
 use super::inertia::{Clusters, Inertial, link_inertial, merge};
+use super::options::{UrdfBase, UrdfOptions, bad_option};
+use super::resolved::{Ir, Resolved};
 use super::transform::{Notes, Tf, clean, finite3, numbers, pose_tf, rows};
 use super::tree::{Tree, is_moving, type_name};
-use super::wheeled::{self, BaseCut};
-use super::{UrdfBase, UrdfImport, UrdfOptions, bad_option};
+use super::wheeled;
 use crate::error::ModelErrorKind as K;
 use crate::ident::sanitize_identifier;
 use crate::ir::*;
 use crate::limits::check_magnitude;
 use crate::validate;
 
-/// Converts a parsed URDF to a validated model, with the import notes.
+/// Converts a parsed URDF to a validated model and the import notes.
 pub(super) fn convert(
     robot: &urdf_rs::Robot,
     file: &str,
     opts: &UrdfOptions,
-) -> Result<UrdfImport, K> {
+) -> Result<(Model, Vec<String>), K> {
     opts.check()?;
     let mut notes = Notes::default();
     let (robot, mimics) = super::mimic::prepare(robot, opts.mimic, &mut notes);
@@ -70,29 +72,7 @@ pub(super) fn convert(
         let t = f.translation.map(Length::number);
         crate::frames::add_fixed_frame(&mut model, &f.name, &f.parent, f.rotation, t, &f.name)?;
     }
-    Ok(UrdfImport {
-        model,
-        notes: notes.finish(),
-    })
-}
-
-/// The URDF with the options applied: what is kept, where the base is, the joint origins, the
-/// link inertials and the rigid clusters.
-pub(super) struct Resolved<'a> {
-    /// The URDF's link/joint graph.
-    pub(super) tree: Tree<'a>,
-    /// Per link: removed by [`UrdfOptions::drop_links`].
-    pub(super) dropped: Vec<bool>,
-    /// The top of the kept tree, the body link and the wheels.
-    pub(super) cut: BaseCut,
-    /// The kept links, depth first from the top (wheel subtrees included, dropped links not).
-    kept: Vec<usize>,
-    /// Per joint: its origin, for the joints above the kept links other than the top.
-    pub(super) origin: Vec<Option<Tf>>,
-    /// Per kept link: its inertial data (`None` without mass or when dropped as absurd).
-    pub(super) inertial: Vec<Option<Inertial>>,
-    /// The rigid clusters (links joined by fixed joints).
-    pub(super) clusters: Clusters,
+    Ok((model, notes.finish()))
 }
 
 /// Applies the options to the URDF's tree: dropped links, the base cut, the checks of the kept
@@ -237,45 +217,6 @@ fn check_joints(tree: &Tree<'_>, kept: &[usize], cut: &BaseCut, wheeled: bool) -
         }
     }
     Ok(())
-}
-
-/// The IR under construction.
-pub(super) struct Ir {
-    /// Parameters; the first is the gravity magnitude `g`.
-    params: Vec<Param>,
-    /// Generalized speeds in the order of `u`.
-    pub(super) speeds: Vec<Speed>,
-    /// Frames, parents first.
-    pub(super) links: Vec<Link>,
-    /// The IR frame of each URDF link that is one (the representatives of the rigid clusters).
-    pub(super) ir_index: HashMap<usize, usize>,
-    /// The gravity magnitude `g`.
-    gravity: ParamId,
-}
-
-impl Ir {
-    /// No frames or speeds yet; the parameter `g` with the default value `gravity`.
-    fn new(gravity: f64) -> Self {
-        let mut ir = Self {
-            params: Vec::new(),
-            speeds: Vec::new(),
-            links: Vec::new(),
-            ir_index: HashMap::new(),
-            gravity: 0,
-        };
-        ir.gravity = ir.param("g".into(), gravity, ParamKind::Gravity);
-        ir
-    }
-
-    /// Adds a parameter (`-0.0` stored as `0.0`) and returns its index.
-    pub(super) fn param(&mut self, name: String, value: f64, kind: ParamKind) -> ParamId {
-        self.params.push(Param {
-            name,
-            value: if value == 0.0 { 0.0 } else { value },
-            kind,
-        });
-        self.params.len() - 1
-    }
 }
 
 /// Adds a frame, a joint and a speed per moving URDF joint, depth first; each joint hangs from

@@ -3,9 +3,9 @@
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
+use super::options::{AbsurdInertia, NonPhysicalInertia, UrdfOptions, ZeroMassInertia};
 use super::transform::{Notes, Tf, finite3, rpy_matrix};
 use super::tree::Tree;
-use super::{AbsurdInertia, NonPhysicalInertia, UrdfOptions, ZeroMassInertia};
 use crate::error::ModelErrorKind as K;
 use crate::limits::check_magnitude;
 use crate::validate;

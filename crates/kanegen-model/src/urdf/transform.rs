@@ -5,7 +5,7 @@ use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::AngleSnap;
+use super::options::AngleSnap;
 use crate::ir::Length;
 
 /// A rigid transform: the pose of a frame in another (rotation `r`, origin `p`).

@@ -5,8 +5,8 @@
 use proc_macro2::{Ident, TokenStream};
 use quote::quote;
 
+use super::context::{Context, scalar_type};
 use super::print::{ident, idx, signed_lit};
-use super::{Context, scalar_type};
 use crate::kane::{BaseParameters, Coefficient};
 use crate::registry::FunctionId;
 

@@ -31,7 +31,10 @@
 
 use rustc_hash::FxHashMap;
 
-use super::{LExpr, Leaf, Lowered, Program, locals};
+use super::eval::output_values;
+use super::order::apply_order;
+use super::program::{LExpr, Leaf, Lowered, Program, Stmt, locals};
+pub use super::program::{LaneLeaves, LanePlan, Role};
 use crate::kane::{Derivation, Mirror};
 use crate::registry::FunctionId;
 
@@ -49,66 +52,6 @@ pub const LANE_FUNCTIONS: [FunctionId; 9] = [
     FunctionId::ComJacobian,
     FunctionId::ComBiasAcceleration,
 ];
-
-/// A statement's part in the two-lane form.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Role {
-    /// Computed alone.
-    Scalar,
-    /// The left (low-lane) statement of a lane pair; the next statement is its right one.
-    Left,
-    /// The right (high-lane) statement of a lane pair: computed with the statement before it.
-    Right,
-}
-
-/// How a rewritten program is emitted in two lanes.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct LanePlan {
-    /// Per statement.
-    pub roles: Vec<Role>,
-    /// The packed pairs `(left, right)`: two scalar statements put in lanes (after the later
-    /// of the two) for the lane statements that read them.
-    pub packed: Vec<(usize, usize)>,
-    /// Per statement, its partner in a lane or packed pair (`None` for the others); shared
-    /// statements (their own mirror) are `None`.
-    pub partner: Vec<Option<usize>>,
-}
-
-impl LanePlan {
-    /// The number of lane pairs.
-    pub fn lane_pairs(&self) -> usize {
-        self.roles.iter().filter(|r| **r == Role::Left).count()
-    }
-}
-
-/// The mirror of every leaf a paired statement reads: the model's [`Mirror`] and the
-/// precomputed slots' mirrors.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct LaneLeaves {
-    /// Parameters and speeds.
-    pub mirror: Mirror,
-    /// `pre[slot]`: the mirror slot (`None`: none; a paired statement does not read it).
-    pub pre: Vec<Option<usize>>,
-}
-
-impl LaneLeaves {
-    /// The leaf of the other subtree in `l`'s place (`l` itself when shared; `None` for a
-    /// statement or a slot without a mirror).
-    pub fn leaf(&self, l: Leaf) -> Option<Leaf> {
-        let s = |i: usize| self.mirror.speeds[i];
-        Some(match l {
-            Leaf::Const(c) => Leaf::Const(c),
-            Leaf::Param(p) => Leaf::Param(self.mirror.params[p]),
-            Leaf::Pre(k) => Leaf::Pre(self.pre.get(k).copied().flatten()?),
-            Leaf::Speed(i) => Leaf::Speed(s(i)),
-            Leaf::Accel(i) => Leaf::Accel(s(i)),
-            Leaf::Sin(i) => Leaf::Sin(s(i)),
-            Leaf::Cos(i) => Leaf::Cos(s(i)),
-            Leaf::Coord(i) => Leaf::Coord(s(i)),
-            Leaf::Local(_) => return None,
-        })
-    }
-}
 
 /// Pairs the programs of [`LANE_FUNCTIONS`] of `low` (and the straight-line part of the looped
 /// `inverse_dynamics_derivatives`) where `d`'s model has mirrored subtrees: rewrites each
@@ -180,8 +123,8 @@ fn same_values(a: &Program, b: &Program, n: usize, params: &[f64], pre: &[f64]) 
             .iter()
             .map(|v| v * 0.7 + shift)
             .collect();
-        let oa = super::output_values(a, params, pre, &q, &u, &ud);
-        let ob = super::output_values(b, params, pre, &q, &u, &ud);
+        let oa = output_values(a, params, pre, &q, &u, &ud);
+        let ob = output_values(b, params, pre, &q, &u, &ud);
         let scale = oa.iter().fold(1.0f64, |m, v| m.max(v.abs()));
         oa.iter()
             .zip(&ob)
@@ -616,7 +559,7 @@ pub fn pair(p: &Program, map: &LaneLeaves) -> Option<(Program, LanePlan)> {
         sincos: interleaved(&p.sincos, mirror),
         ..p.clone()
     };
-    super::apply_order(&mut out, &order);
+    apply_order(&mut out, &order);
     let mut new_index = vec![0; n];
     for (new, &old) in order.iter().enumerate() {
         new_index[old] = new;
@@ -761,7 +704,7 @@ fn negated(e: LExpr) -> LExpr {
 /// A statement order in which each lane pair is adjacent (left, right), every statement
 /// follows what it reads, and statements otherwise keep their order (a lane pair at the later
 /// of its two places).
-fn lane_order(stmts: &[super::Stmt], found: &[Found]) -> Option<Vec<usize>> {
+fn lane_order(stmts: &[Stmt], found: &[Found]) -> Option<Vec<usize>> {
     let n = stmts.len();
     // Nodes: a statement, or a lane pair (under its left statement).
     let node = |k: usize| match found[k] {
@@ -809,188 +752,4 @@ fn lane_order(stmts: &[super::Stmt], found: &[Found]) -> Option<Vec<usize>> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::kane::derive;
-    use crate::model::Model;
-    use crate::options::Options;
-
-    fn lowered(file: &str) -> (Derivation, Lowered, Lowered) {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let model = Model::from_toml_file(root.join(file)).expect("model loads");
-        let d = derive(&model, Options::default());
-        let plain = super::super::lower(&d);
-        let mut paired = plain.clone();
-        apply(&mut paired, &d);
-        (d, plain, paired)
-    }
-
-    /// A deterministic pseudo-random value in ±`scale` (the `k`-th of a sequence).
-    fn draw(k: usize, scale: f64) -> f64 {
-        scale * ((k as f64 * 12.9898 + 78.233).sin() * 43_758.547).fract()
-    }
-
-    #[test]
-    fn krang_pairs_most_arm_statements_and_computes_the_same_values() {
-        let (d, plain, paired) = lowered("models/krang.toml");
-        // (function, at least this many lane pairs): Krang's figures are M 301, c 181, g 43,
-        // τ 192, C 967.
-        for (id, at_least) in [
-            (FunctionId::MassMatrix, 250),
-            (FunctionId::Coriolis, 150),
-            (FunctionId::Gravity, 35),
-            (FunctionId::InverseDynamics, 150),
-            (FunctionId::CoriolisMatrix, 800),
-        ] {
-            let f = paired
-                .functions
-                .iter()
-                .find(|f| f.id == id)
-                .expect("function");
-            let plan = f.lanes.as_ref().expect("Krang's arms pair");
-            assert!(
-                plan.lane_pairs() >= at_least,
-                "{id:?}: {}",
-                plan.lane_pairs()
-            );
-            // The same operations: the rewrite moves statements and signs, never adds work.
-            let before = plain.function(id).expect("function").ops;
-            assert_eq!(f.program.ops.muls, before.muls, "{id:?}");
-            assert_eq!(f.program.ops.fmas, before.fmas, "{id:?}");
-            for draw_at in 0..20 {
-                let n = d.dof;
-                let params: Vec<f64> = (0..paired
-                    .lane_leaves
-                    .as_ref()
-                    .expect("paired")
-                    .mirror
-                    .params
-                    .len())
-                    .map(|k| 1.0 + draw(draw_at * 1000 + k, 0.5))
-                    .collect();
-                let q: Vec<f64> = (0..n).map(|k| draw(draw_at * 77 + k, 3.1)).collect();
-                let u: Vec<f64> = (0..n).map(|k| draw(draw_at * 91 + k + 500, 2.0)).collect();
-                let ud: Vec<f64> = (0..n).map(|k| draw(draw_at * 13 + k + 900, 5.0)).collect();
-                let a = plain.evaluate(id, &params, &q, &u, &ud);
-                let b = paired.evaluate(id, &params, &q, &u, &ud);
-                let scale = a.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-                for (x, y) in a.iter().zip(&b) {
-                    assert!((x - y).abs() <= 1e-12 * scale, "{id:?}: {x} against {y}");
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn every_lane_pair_is_its_left_statement_mirrored_term_for_term() {
-        // What makes the two-lane statement compute both scalar statements' bits: the right
-        // statement is the left one with mirrored leaves and partners, same terms, same order.
-        let (_, _, paired) = lowered("models/krang.toml");
-        let leaves = paired.lane_leaves.as_ref().expect("paired");
-        for f in &paired.functions {
-            let Some(plan) = &f.lanes else { continue };
-            let p = &f.program;
-            for (t, role) in plan.roles.iter().enumerate() {
-                if *role != Role::Left {
-                    continue;
-                }
-                assert_eq!(plan.roles[t + 1], Role::Right);
-                let image = |k: usize| Some(plan.partner[k].unwrap_or(k));
-                let mirrored = map_expr(&p.stmts[t].expr, &|l| leaves.leaf(l), &image)
-                    .expect("a lane statement's leaves have mirrors");
-                assert_eq!(
-                    mirrored,
-                    p.stmts[t + 1].expr,
-                    "{}: {}",
-                    p.name,
-                    p.stmts[t].name
-                );
-                // Every statement it reads comes before it.
-                let mut reads = Vec::new();
-                locals(&p.stmts[t + 1].expr, &mut reads);
-                assert!(reads.iter().all(|&r| r < t), "{}", p.stmts[t].name);
-            }
-        }
-    }
-
-    #[test]
-    fn the_looped_derivatives_straight_line_part_pairs_and_fills_the_same_workspace() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let model = Model::from_toml_file(root.join("models/krang.toml")).expect("loads");
-        let options = Options {
-            functions: crate::registry::FunctionSet::default()
-                .with(FunctionId::InverseDynamicsDerivatives),
-            ..Options::default()
-        };
-        let d = derive(&model, options);
-        let plain = super::super::lower(&d);
-        let mut paired = plain.clone();
-        apply(&mut paired, &d);
-        let (a, b) = (
-            plain
-                .derivative_loop
-                .as_ref()
-                .expect("Krang's derivatives are looped"),
-            paired.derivative_loop.as_ref().expect("looped"),
-        );
-        let plan = b.lanes.as_ref().expect("the straight-line part pairs");
-        // Krang: 2,200 statements, 793 lane pairs, 54 packed pairs.
-        assert!(plan.lane_pairs() >= 600, "{}", plan.lane_pairs());
-        // Other parameter values than `apply`'s check used.
-        let params: Vec<f64> = (0..model.params.len())
-            .map(|k| 1.0 + draw(k, 0.5))
-            .collect();
-        let pre = plain.precompute_values(&params);
-        assert!(same_values(&a.program, &b.program, d.dof, &params, &pre));
-    }
-
-    #[test]
-    fn combined_programs_pair_and_give_the_same_parts() {
-        use crate::combined::{Combined, resolve};
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let model = Model::from_toml_file(root.join("models/krang.toml")).expect("loads");
-        let mut c = Combined::new("whole_body_terms")
-            .with(FunctionId::MassMatrix)
-            .with(FunctionId::NonlinearEffects)
-            .with(FunctionId::ComJacobian);
-        for hand in ["left_hand", "right_hand"] {
-            c = c.with_frame(FunctionId::FrameBiasAcceleration, hand);
-        }
-        let combined = resolve(&model, &[c]).expect("resolves");
-        let d = crate::kane::derive_with(&model, Options::default(), &combined);
-        let plain = super::super::lower(&d);
-        let mut paired = plain.clone();
-        apply(&mut paired, &d);
-        let plan = paired.combined[0]
-            .lanes
-            .as_ref()
-            .expect("the combined program pairs");
-        assert!(plan.lane_pairs() > 300, "{}", plan.lane_pairs());
-        let n = d.dof;
-        for k in 0..10 {
-            let params: Vec<f64> = (0..model.params.len())
-                .map(|i| 1.0 + draw(k * 1000 + i, 0.5))
-                .collect();
-            let q: Vec<f64> = (0..n).map(|i| draw(k * 77 + i, 3.1)).collect();
-            let u: Vec<f64> = (0..n).map(|i| draw(k * 91 + i + 500, 2.0)).collect();
-            let a = plain.evaluate_combined(0, &params, &q, &u, &[]);
-            let b = paired.evaluate_combined(0, &params, &q, &u, &[]);
-            for (x, y) in a.iter().flatten().zip(b.iter().flatten()) {
-                assert!((x - y).abs() <= 1e-12 * (1.0 + x.abs()), "{x} against {y}");
-            }
-        }
-    }
-
-    #[test]
-    fn a_model_without_mirrored_subtrees_is_left_as_it_is() {
-        let (_, plain, paired) = lowered("models/two-link.toml");
-        assert!(paired.lane_leaves.is_none());
-        for (a, b) in plain.functions.iter().zip(&paired.functions) {
-            assert!(b.lanes.is_none());
-            assert_eq!(
-                format!("{:?}", a.program.stmts),
-                format!("{:?}", b.program.stmts)
-            );
-        }
-    }
-}
+mod tests;

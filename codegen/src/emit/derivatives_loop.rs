@@ -1,4 +1,4 @@
-//! The looped form of `inverse_dynamics_derivatives` (`kane/rnea_derivatives_loop.rs`): the
+//! The looped form of `inverse_dynamics_derivatives` (`kane/derivatives_loop.rs`): the
 //! straight-line statements fill a workspace array, then
 //! `kanegen_runtime::derivative_steps::run` walks the generated tables (a `const` next to the
 //! function) and writes the result.
@@ -6,12 +6,12 @@
 use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::function::{
+use super::body::{
     Reads, Stores, nonzero_outputs, param_args, prologue, state_args, store_text_after, text,
     unused_inputs,
 };
+use super::context::{Context, scalar_type};
 use super::print::{ident, idx, lit};
-use super::{Context, scalar_type};
 use crate::kane::DerivativeLoop;
 use crate::lower::{FunctionProgram, LExpr, LoopedProgram};
 
@@ -120,10 +120,10 @@ pub(super) fn function(
         store_text_after(&mut stores, e, format!("w[{k}] = {v};"));
     }
     let stored: Vec<&LExpr> = nonzero_outputs(p).map(|(_, _, e)| e).collect();
-    let lanes = super::function::lanes_in(cx, p, looped.lanes.as_ref());
+    let lanes = super::body::lanes_in(cx, p, looped.lanes.as_ref());
     let block = match lanes {
         Some((leaves, plan)) => {
-            super::lanes::lane_block(&printer, &cx.leaf_names, leaves, p, plan, stores)
+            super::mirrored_lanes::lane_block(&printer, &cx.leaf_names, leaves, p, plan, stores)
         }
         None => {
             printer.statement_block(&cx.leaf_names, stores, (&stored, &[]), cx.split_above, true)
@@ -154,14 +154,14 @@ pub(super) fn function(
     // With the arms in lanes (Krang) an x86-64-v4 copy too, unlike the other single-state
     // functions: its long straight-line part gains from the 32 registers (measurement log,
     // "The looped derivatives in an x86-64-v4 copy"); models without lanes were not measured.
-    let (outer_params, pass_params) = super::function::outer_params(cx);
-    let state = super::items::arg_names(spec.inputs);
-    let call = super::function::call_body_into(
+    let (outer_params, pass_params) = super::body::outer_params(cx);
+    let state = super::signature::arg_names(spec.inputs);
+    let call = super::body::call_body_into(
         cx,
         if lanes {
-            super::function::Copies::LanesWithV4
+            super::body::Copies::LanesWithV4
         } else {
-            super::function::Copies::BaselineAndV3
+            super::body::Copies::BaselineAndV3
         },
         quote!(),
         quote!(#pass_params #state,),
@@ -169,7 +169,7 @@ pub(super) fn function(
     );
     let call = quote!(#call;);
     let tables = tables(&looped.plan);
-    let (generics, lanes_arg) = super::function::body_generics(cx, lanes);
+    let (generics, lanes_arg) = super::body::body_generics(cx, lanes);
     let into = ident(&format!("{}_into", spec.name));
     let onto = ident(&format!("{}_onto", spec.name));
     let into_doc = format!(
@@ -243,7 +243,7 @@ fn workspace(
     let spec = f.id.spec();
     let name = ident(WORKSPACE);
     let (args, arg_doc) = state_args(cx, spec.inputs);
-    let (outer_params, _) = super::function::outer_params(cx);
+    let (outer_params, _) = super::body::outer_params(cx);
     let t = scalar_type(cx.precision);
     let (field, init) = match len {
         Some(len) => (quote!(w: [#t; #len],), quote!(w: [#zero; #len],)),
@@ -307,8 +307,8 @@ pub(super) fn straight_into(cx: &Context<'_>, f: &FunctionProgram, looped: bool)
     let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
     let (rows, cols) = (idx(rows), idx(cols));
     let (args, arg_doc) = state_args(cx, spec.inputs);
-    let state = super::items::arg_names(spec.inputs);
-    let (outer_params, pass_params) = super::function::outer_params(cx);
+    let state = super::signature::arg_names(spec.inputs);
+    let (outer_params, pass_params) = super::body::outer_params(cx);
     let doc = format!(" [`{}`] written into `m`.", spec.name);
     let mat = quote!(SMatrix<#t, #rows, #cols>);
     let zero = lit(0.0, cx.precision);
@@ -352,8 +352,8 @@ pub(super) fn methods(cx: &Context<'_>) -> TokenStream {
     let t = scalar_type(cx.precision);
     let (rows, cols) = spec.shape.size_in(&cx.low.sizes);
     let (rows, cols) = (idx(rows), idx(cols));
-    let state = super::items::arg_names(spec.inputs);
-    let pass = super::items::wrapper_params(cx);
+    let state = super::signature::arg_names(spec.inputs);
+    let pass = super::signature::wrapper_params(cx);
     let call = quote!(#into(#pass #state, m));
     let with = ident(&format!("{}_with", spec.name));
     let name = ident(WORKSPACE);

@@ -3,8 +3,8 @@
 
 use kanegen_model::{Base, Joint, JointKind, Length};
 
-use super::Ctx;
 use super::algebra::{M3, V3};
+use super::ctx::Ctx;
 use crate::expr::{Atom, ExprId, VarKind};
 use crate::options::ParamMode;
 

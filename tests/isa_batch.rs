@@ -297,7 +297,7 @@ fn dispatched_copies_agree_with_the_baseline_to_rounding() {
 #[test]
 fn the_derivatives_x86_64_v4_copies_give_the_x86_64_v3_copies_bits() {
     // With x86-64-v4 active, the looped derivatives run their straight-line part's x86-64-v4
-    // copy (`isa::dispatch_pair_wide_with`) and `derivative_steps::run`'s AVX-512VL copy (32
+    // copy (`isa::dispatch_pair_wide_with`) and `derivatives_loop::run`'s AVX-512VL copy (32
     // registers, broadcasts folded into the multiply-adds, still 256-bit): the same operations
     // in the same order as the x86-64-v3 copies, so the same bits.
     let _one_at_a_time = isa_lock();

@@ -62,7 +62,7 @@ pub enum DerivativesForm {
     StraightLine,
     /// Per-link and per-column quantities straight-line into a workspace, then the
     /// O(columns × ancestors) steps as a loop over generated tables
-    /// (`kanegen_runtime::derivative_steps`). Models with mimic joints keep the straight-line
+    /// (`kanegen_runtime::derivatives_loop`). Models with mimic joints keep the straight-line
     /// form (the tables do not express the constraint's sums).
     Looped,
 }

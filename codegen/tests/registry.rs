@@ -249,7 +249,7 @@ fn generated_code_zeroes_results_with_a_memset_not_nalgebras_element_wise_fill()
         .unwrap();
     let s = &g.source;
     // Both looped forms, whose `_into` functions zero before storing the non-zero entries.
-    assert!(s.contains("kanegen_runtime::derivative_steps::run"));
+    assert!(s.contains("kanegen_runtime::derivatives_loop::run"));
     assert!(s.contains("kanegen_runtime::regressor::inverse_dynamics_regressor::<"));
     assert!(s.contains("*m = <SMatrix<f64, 19, 38>>::zeros();"));
     for (at, _) in s.match_indices(".fill(") {

@@ -20,7 +20,7 @@
 //! statement stores after the body. A result with more entries than one
 //! vectorized loop can store is computed in several loops ([`loop_parts`]). `L` is a const
 //! generic: one emitted body for every batch size and both layouts.
-//! `docs/measurement-log.md` ("Batched evaluation: measured") has the measurements.
+//! `docs/batched-and-dispatch.md` has the measured figures.
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;

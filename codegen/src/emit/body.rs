@@ -313,8 +313,7 @@ pub(super) fn binding(stored: bool) -> TokenStream {
 /// stack). The cost is a `memset` of the zeroed matrix and a `memcpy` into the return slot
 /// (2.9 KB each for 19 speeds). A symmetric matrix's lower entry is stored right after its
 /// upper one (`m[(3, 5)] = m[(5, 3)];`, which LLVM forwards from the register), so no copy is
-/// left at the end. `docs/measurement-log.md` ("Instruction sets at run time and batched
-/// evaluation") has the measurements. Vectors stay scalar-replaced (19 values: in memory they
+/// left at the end (measured on Krang, Nov 2026, Intel Xeon with AVX-512). Vectors stay scalar-replaced (19 values: in memory they
 /// measured slower).
 pub(super) fn result(cx: &Context<'_>, printer: &Printer<'_>, p: &Program, shape: Shape) -> Result {
     let t = scalar_type(cx.precision);
@@ -470,8 +469,7 @@ pub(super) fn zero_stores(p: &Program, n: usize, mirror: bool) -> Vec<String> {
 pub(super) enum Copies {
     /// The baseline and x86-64-v3 (`isa::dispatch_fused_with`): single-state functions. An
     /// x86-64-v4 copy was measured no faster for them (Krang's M, c, g, τ, C within 5 %) and
-    /// cost 43 % more compile time (`docs/measurement-log.md`, "x86-64-v4 copy of the batched
-    /// functions").
+    /// cost 43 % more compile time (Nov 2026, Intel Xeon with AVX-512).
     BaselineAndV3,
     /// Also x86-64-v4 (`isa::dispatch_fused_wide_with`): the batched functions, whose loop
     /// over the states LLVM vectorizes 8 lanes wide with AVX-512.
@@ -482,8 +480,7 @@ pub(super) enum Copies {
     Lanes,
     /// [`Copies::Lanes`] and an x86-64-v4 copy (`isa::dispatch_pair_wide_with`): the looped
     /// derivatives' straight-line part, whose 54 KB of statements (Krang) run 4 % faster with
-    /// AVX-512's 32 registers (`docs/measurement-log.md`, "The looped derivatives in an
-    /// x86-64-v4 copy").
+    /// AVX-512's 32 registers (Nov 2026, Intel Xeon with AVX-512).
     LanesWithV4,
 }
 

@@ -1,6 +1,6 @@
 //! The looped form of `inverse_dynamics_derivatives` (`kane/derivatives_loop.rs`): the
 //! straight-line statements fill a workspace array, then
-//! `kanegen_runtime::derivative_steps::run` walks the generated tables (a `const` next to the
+//! `kanegen_runtime::derivatives_loop::run` walks the generated tables (a `const` next to the
 //! function) and writes the result.
 
 use proc_macro2::TokenStream;
@@ -21,7 +21,7 @@ const TABLES: &str = "INVERSE_DYNAMICS_DERIVATIVES_STEPS";
 /// The workspace type kept across calls of the derivatives (every module with them has one).
 const WORKSPACE: &str = "DerivativesWorkspace";
 
-/// The tables as a `kanegen_runtime::derivative_steps::Plan` constant.
+/// The tables as a `kanegen_runtime::derivatives_loop::Plan` constant.
 fn tables(plan: &DerivativeLoop) -> TokenStream {
     let u16_of = |x: usize| {
         let v = u16::try_from(x).expect("`lower_with` checked that the tables fit u16");
@@ -39,7 +39,7 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
                 let t = u16_of(t);
                 quote!(#t)
             }
-            None => quote!(kanegen_runtime::derivative_steps::NO_TRANSFORM),
+            None => quote!(kanegen_runtime::derivatives_loop::NO_TRANSFORM),
         };
         let m = u16_of(speed.motion);
         let j = speed.joint;
@@ -48,16 +48,16 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
                 let k = proc_macro2::Literal::u8_unsuffixed(k);
                 quote!(#k)
             }
-            None => quote!(kanegen_runtime::derivative_steps::DENSE),
+            None => quote!(kanegen_runtime::derivatives_loop::DENSE),
         };
         let entries = s.entries.map(|e| match e {
             Some(e) => {
                 let e = u32_of(e);
                 quote!(#e)
             }
-            None => quote!(kanegen_runtime::derivative_steps::NO_ENTRY),
+            None => quote!(kanegen_runtime::derivatives_loop::NO_ENTRY),
         });
-        quote!(kanegen_runtime::derivative_steps::Step {
+        quote!(kanegen_runtime::derivatives_loop::Step {
             transform: #transform, motion: #m, axis: #axis, joint: #j, entries: [#(#entries),*]
         })
     });
@@ -68,7 +68,7 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
             u32_of(c.own),
             u32_of(c.end),
         );
-        quote!(kanegen_runtime::derivative_steps::Column { forces: #f, first: #a, own: #o, end: #e })
+        quote!(kanegen_runtime::derivatives_loop::Column { forces: #f, first: #a, own: #o, end: #e })
     });
     let name = ident(TABLES);
     let dof = idx(plan.dof);
@@ -83,8 +83,8 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
     );
     quote! {
         #[doc = #doc]
-        const #name: kanegen_runtime::derivative_steps::Plan<'static> =
-            kanegen_runtime::derivative_steps::Plan {
+        const #name: kanegen_runtime::derivatives_loop::Plan<'static> =
+            kanegen_runtime::derivatives_loop::Plan {
                 dof: #dof,
                 columns: &[#(#columns),*],
                 steps: &[#(#steps),*],
@@ -105,7 +105,7 @@ pub(super) fn function(
     let fname = ident(spec.name);
     let doc = format!(" {}", spec.doc);
     let ops = format!(
-        " Generated code: {} straight-line (per link and per column, into a workspace of {} values), then a loop of {} steps over `{TABLES}` (`kanegen_runtime::derivative_steps::run`, {} flops).",
+        " Generated code: {} straight-line (per link and per column, into a workspace of {} values), then a loop of {} steps over `{TABLES}` (`kanegen_runtime::derivatives_loop::run`, {} flops).",
         p.ops,
         looped.plan.workspace,
         looped.plan.steps(),
@@ -140,8 +140,8 @@ pub(super) fn function(
     let tables_name = ident(TABLES);
     // f64: the dispatched kernel (AVX2 copy); other precisions: the portable one.
     let run = match cx.precision {
-        crate::options::Precision::F64 => quote!(kanegen_runtime::derivative_steps::run),
-        crate::options::Precision::F32 => quote!(kanegen_runtime::derivative_steps::run_generic),
+        crate::options::Precision::F64 => quote!(kanegen_runtime::derivatives_loop::run),
+        crate::options::Precision::F32 => quote!(kanegen_runtime::derivatives_loop::run_generic),
     };
     let body = quote! {
         #unused
@@ -152,8 +152,8 @@ pub(super) fn function(
     let mat = quote!(SMatrix<#t, #rows, #cols>);
     // The body generic over the multiply-add (fused in the x86-64-v3 copy), writing into `m`.
     // With the arms in lanes (Krang) an x86-64-v4 copy too, unlike the other single-state
-    // functions: its long straight-line part gains from the 32 registers (measurement log,
-    // "The looped derivatives in an x86-64-v4 copy"); models without lanes were not measured.
+    // functions: its long straight-line part gains from the 32 registers (4 % on Krang,
+    // Nov 2026, Intel Xeon with AVX-512); models without lanes were not measured.
     let (outer_params, pass_params) = super::body::outer_params(cx);
     let state = super::signature::arg_names(spec.inputs);
     let call = super::body::call_body_into(

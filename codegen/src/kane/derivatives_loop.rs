@@ -7,7 +7,7 @@
 //! (τ's pass, composite inertias, subtree momenta and inertia rates come first, as in the
 //! straight-line form). The O(columns × ancestors) part, carrying the four forces of each column
 //! up to the root and reading them with every ancestor speed, is
-//! `kanegen_runtime::derivative_steps::run` over the generated [`DerivativeLoop`] tables: one
+//! `kanegen_runtime::derivatives_loop::run` over the generated [`DerivativeLoop`] tables: one
 //! small loop instead of Krang's ~100 unrolled steps (233 KB of code, beyond the instruction
 //! cache).
 //!
@@ -18,7 +18,7 @@ use super::ctx::Ctx;
 use super::rnea_derivatives::Setup;
 use crate::expr::ExprId;
 
-/// The tables of the looped derivatives (mirrors of `kanegen_runtime::derivative_steps`'s
+/// The tables of the looped derivatives (mirrors of `kanegen_runtime::derivatives_loop`'s
 /// `Link`, `Speed`, `Column`, emitted as a `const`), and the size of the workspace the
 /// generated statements fill.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -73,7 +73,7 @@ pub struct LoopColumn {
     pub forces: usize,
 }
 
-/// One step of a column's walk in the flat tables (`kanegen_runtime::derivative_steps::Step`):
+/// One step of a column's walk in the flat tables (`kanegen_runtime::derivatives_loop::Step`):
 /// the forces moved up one link (unless `transform` is `None`), then one speed's reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct FlatStep {
@@ -119,7 +119,7 @@ impl DerivativeLoop {
             .sum()
     }
 
-    /// Floating-point operations of the loop per call, as `derivative_steps::run` performs
+    /// Floating-point operations of the loop per call, as `derivatives_loop::run` performs
     /// them on the [`flatten`](Self::flatten)ed tables (dense: the loop does not skip the zeros
     /// of axis-aligned joints).
     pub fn flops(&self) -> usize {

@@ -4,7 +4,7 @@
 
 use kanegen_model::{Model, UrdfOptions, WheeledBaseSpec};
 use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
-use kanegen_runtime::derivative_steps::{Column, NO_ENTRY, NO_TRANSFORM, Plan, Step};
+use kanegen_runtime::derivatives_loop::{Column, NO_ENTRY, NO_TRANSFORM, Plan, Step};
 
 use crate::expr::Values;
 use crate::options::{Options, ParamMode};
@@ -38,7 +38,7 @@ fn compare(label: &str, model: &Model, params: ParamMode, draws: usize, seed: u6
                 motion: u16_of(speed.motion),
                 axis: speed
                     .axis
-                    .unwrap_or(kanegen_runtime::derivative_steps::DENSE),
+                    .unwrap_or(kanegen_runtime::derivatives_loop::DENSE),
                 joint: speed.joint,
                 entries: s.entries.map(|e| e.map_or(NO_ENTRY, u32_of)),
             }
@@ -88,9 +88,9 @@ fn compare(label: &str, model: &Model, params: ParamMode, draws: usize, seed: u6
         // Column-major N × 2N: the dispatched kernel (the AVX2 copy on x86-64-v3 CPUs)
         // and the portable one.
         let mut out = vec![0.0; n * 2 * n];
-        kanegen_runtime::derivative_steps::run(&tables, &w, &mut out);
+        kanegen_runtime::derivatives_loop::run(&tables, &w, &mut out);
         let mut portable = vec![0.0; n * 2 * n];
-        kanegen_runtime::derivative_steps::run_generic(&tables, &w, &mut portable);
+        kanegen_runtime::derivatives_loop::run_generic(&tables, &w, &mut portable);
         let scale = straight.iter().fold(1.0f64, |m, v| m.max(v.abs()));
         for r in 0..n {
             for c in 0..2 * n {

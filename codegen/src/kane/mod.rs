@@ -40,7 +40,7 @@
 //! | `rnea.rs` | c and τ: forward motion pass, body inertia forces, backward accumulation |
 //! | `coriolis_matrix.rs` | C: frame velocities, subtree momenta and inertia rates, columns |
 //! | `rnea_derivatives.rs` | ∂τ/∂q, ∂τ/∂u: the analytic recursion (four forces per column carried up; `derivatives.rs` keeps forward mode as its test oracle) |
-//! | `derivatives_loop.rs` | the looped form of the same: per-link and per-column quantities into a workspace, tables for `kanegen_runtime::derivative_steps` |
+//! | `derivatives_loop.rs` | the looped form of the same: per-link and per-column quantities into a workspace, tables for `kanegen_runtime::derivatives_loop` |
 //! | `kinematics.rs` | frames in frame 0 (`⁰A`, `⁰p`), centre of mass, its Jacobian and bias acceleration, energies |
 //! | `regressor.rs` | regressors `∂τ/∂π`, `∂g/∂β` (by [`Arena::diff`]) and their base parameters |
 //! | `regressor_sample.rs` | the regressor evaluated at random states, what the base parameters are found from |

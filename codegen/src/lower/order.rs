@@ -190,8 +190,7 @@ pub(super) fn renumber(e: &mut LExpr, new_index: &[usize]) {
 
 /// The functions whose statements are put in [`subtree_order`] after lowering (where that
 /// lowers the values live at once). Only the Coriolis matrix: measured on Krang
-/// (`docs/measurement-log.md`, "Instruction sets at run time and batched evaluation", "Single
-/// state toward 10× Pinocchio"), it
+/// (Nov 2026, Intel Xeon with AVX-512), it
 /// cut C's values live from 455 to 236 (144 since entries go by their deeper speed), its
 /// instructions per call by 2.5 % and its time by 1–2 %; for c and τ (111 → 83 and 87 live)
 /// the instructions moved by −1.8 % and +1.6 % and the time not at all or up, so they keep the
@@ -202,8 +201,7 @@ pub const SUBTREE_ORDER: [FunctionId; 1] = [FunctionId::CoriolisMatrix];
 /// vectorized across them, 32 vector registers in the x86-64-v4 copy) run their statements in
 /// [`subtree_order`] where that lowers the values live at once ([`batch_program`]), although
 /// their single-state form keeps its own order. Measured on Krang with mirrored lanes (whose
-/// pairing reorders the single-state program; `docs/measurement-log.md`, "Batched bodies in
-/// subtree order"): 8 states of τ 403 → 352 ns (121 → 87 values live), g 152 → 148 ns (34 →
+/// pairing reorders the single-state program; Nov 2026, Intel Xeon with AVX-512): 8 states of τ 403 → 352 ns (121 → 87 values live), g 152 → 148 ns (34 →
 /// 24), C 1,970 → 1,905 ns (193 → 144); c (121 → 83) got slower, 351 → 373 ns, and stays out.
 pub const BATCH_SUBTREE_ORDER: [FunctionId; 3] = [
     FunctionId::InverseDynamics,

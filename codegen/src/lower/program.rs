@@ -265,7 +265,7 @@ pub struct Lowered {
 }
 
 /// The program of the looped `inverse_dynamics_derivatives`: its outputs `(offset, 0, value)`
-/// are the workspace entries that `kanegen_runtime::derivative_steps::run` reads with `plan`.
+/// are the workspace entries that `kanegen_runtime::derivatives_loop::run` reads with `plan`.
 #[derive(Clone, Debug)]
 pub struct LoopedProgram {
     /// The straight-line part.

@@ -272,8 +272,7 @@ const SOLVE_GROUP: usize = 8;
 /// bits.
 ///
 /// Measured on the fixed-wheel tree's `forward_dynamics_derivatives` (criterion
-/// `fd_derivatives/fixed_wheels_trait`; `docs/measurement-log.md`, "The trait's
-/// forward-dynamics derivatives"): nalgebra's `Cholesky::solve` and `inverse`, one column at a
+/// `fd_derivatives/fixed_wheels_trait`, Nov 2026, Intel Xeon with AVX-512): nalgebra's `Cholesky::solve` and `inverse`, one column at a
 /// time through strided loops, took 17.1 µs; solves on transposed copies that
 /// passed over all right-hand sides for every `x_i −= l_ik x_k`, storing and reloading `x_i`
 /// at each `k`, 7.3–7.7 µs; this form, the figure in README.md's "Derivatives".

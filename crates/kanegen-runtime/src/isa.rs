@@ -22,7 +22,7 @@
 //! [`dispatch_fused`] and [`dispatch_pair_with`] run, and [`dispatch_fused_wide_with`], which
 //! also calls the x86-64-v4 copy), right after the check that
 //! the features are present; the crate's other `unsafe` blocks are the same kind of call in
-//! [`crate::derivative_steps::run`] (its AVX2 kernel, after [`active`] reported x86-64-v3 or
+//! [`crate::derivatives_loop::run`] (its AVX2 kernel, after [`active`] reported x86-64-v3 or
 //! x86-64-v4) and the SSE2 and FMA intrinsics of [`crate::pair`] (two lanes; its FMA only
 //! behind a [`FusedPair`], which [`dispatch_pair_with`] makes after the same check).
 //!

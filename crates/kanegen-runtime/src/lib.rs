@@ -27,13 +27,13 @@
 //!   in lanes); [`quad`]: four fused lanes of the x86-64-v3 copy (solves with many columns).
 //! - [`regressor`]: the loop of a loop-form inverse-dynamics regressor (per link and four rows
 //!   at a time, over a generated plan; generic over [`isa::Arith`]).
-//! - [`derivative_steps`]: the loop of the looped `inverse_dynamics_derivatives` (the
+//! - [`derivatives_loop`]: the loop of the looped `inverse_dynamics_derivatives` (the
 //!   (column, ancestor) steps of the analytic recursion over generated tables); its AVX2 copy
 //!   is called only after the same feature check.
 //!
 //! `#![no_std]`; `unsafe` only to call code compiled for x86-64-v3 or v4 after the CPU was
 //! checked ([`isa::dispatch`], [`isa::dispatch_fused_with`], [`isa::dispatch_fused_wide_with`],
-//! [`derivative_steps::run`]) and for the SSE2/FMA intrinsics of [`pair::F64x2`] and the
+//! [`derivatives_loop::run`]) and for the SSE2/FMA intrinsics of [`pair::F64x2`] and the
 //! AVX/FMA intrinsics of [`quad::F64x4`] (made only where FMA is present); no dependency
 //! but [`nalgebra`] (re-exported: its vector and matrix types are the trait's argument types)
 //! and, behind features, `serde` and `toml`.
@@ -150,7 +150,7 @@
 
 #![no_std]
 // `unsafe` only to call a copy compiled for x86-64-v3 or v4 after feature detection (`isa`,
-// `derivative_steps::run`) and for the SSE2/FMA intrinsics of `pair::F64x2` and the AVX/FMA
+// `derivatives_loop::run`) and for the SSE2/FMA intrinsics of `pair::F64x2` and the AVX/FMA
 // ones of `quad::F64x4`; each use is
 // allowed where it is.
 #![deny(unsafe_code)]
@@ -159,7 +159,7 @@
 extern crate std;
 
 mod arith;
-pub mod derivative_steps;
+pub mod derivatives_loop;
 mod dynamics;
 mod invalid_parameter;
 pub mod isa;

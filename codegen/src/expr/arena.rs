@@ -572,18 +572,21 @@ fn collect_factors(mut v: Vec<(ExprId, i32)>) -> Vec<(ExprId, i32)> {
     out
 }
 
+/// A two-parameter, one-speed arena for the stage's unit tests.
+#[cfg(test)]
+pub(crate) fn test_arena() -> Arena {
+    Arena::new(Names {
+        params: vec!["a".into(), "b".into()],
+        speeds: vec!["qd1".into()],
+        coords: vec!["q1".into()],
+        lengths: Vec::new(),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn arena() -> Arena {
-        Arena::new(Names {
-            params: vec!["a".into(), "b".into()],
-            speeds: vec!["qd1".into()],
-            coords: vec!["q1".into()],
-            lengths: Vec::new(),
-        })
-    }
+    use test_arena as arena;
 
     #[test]
     fn identical_subexpressions_are_shared() {

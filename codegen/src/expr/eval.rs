@@ -38,16 +38,9 @@ impl Arena {
 
 #[cfg(test)]
 mod tests {
-    use crate::expr::arena::{Arena, Atom, Names, Values, VarKind};
+    use crate::expr::arena::{Atom, Values, VarKind};
 
-    fn arena() -> Arena {
-        Arena::new(Names {
-            params: vec!["a".into(), "b".into()],
-            speeds: vec!["qd1".into()],
-            coords: vec!["q1".into()],
-            lengths: Vec::new(),
-        })
-    }
+    use crate::expr::arena::test_arena as arena;
 
     #[test]
     fn evaluator_matches_direct_computation() {

@@ -142,14 +142,7 @@ mod tests {
     use super::*;
     use crate::expr::arena::Names;
 
-    fn arena() -> Arena {
-        Arena::new(Names {
-            params: vec!["a".into(), "b".into()],
-            speeds: vec!["qd1".into()],
-            coords: vec!["q1".into()],
-            lengths: Vec::new(),
-        })
-    }
+    use crate::expr::arena::test_arena as arena;
 
     #[test]
     fn kinematic_variables_with_lengths_stay_k_and_inertial_ones_are_d() {

@@ -43,7 +43,7 @@ struct Entry {
     non_physical: Option<f64>,
 }
 
-/// The corpus, as listed in README's table.
+/// The corpus, as listed in `tests/corpus/SOURCES.md` and docs/urdf.md.
 const CORPUS: &[Entry] = &[
     Entry {
         file: "panda",

@@ -318,8 +318,7 @@ impl Builder {
     /// How `inverse_dynamics_derivatives` is emitted (default [`DerivativesForm::Auto`]: looped
     /// for models whose straight-line derivatives exceed
     /// [`LOOPED_ABOVE_FLOPS`](crate::LOOPED_ABOVE_FLOPS), such as Krang; straight-line for small models and
-    /// models with mimic joints). Both forms give the same matrices to rounding (README,
-    /// "Derivatives: the looped form").
+    /// models with mimic joints). Both forms give the same matrices to rounding (docs/derivatives.md).
     ///
     /// ```no_run
     /// kanegen::Builder::new("krang.toml")

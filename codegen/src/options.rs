@@ -33,8 +33,8 @@ pub enum Precision {
     F32,
 }
 
-/// The code shape of `inverse_dynamics_regressor` and `base_regressor` (see README,
-/// "Regressors: the loop form"); chosen with
+/// The code shape of `inverse_dynamics_regressor` and `base_regressor` (see docs/regressors.md); chosen
+/// with
 /// [`Builder::regressor_form`](crate::Builder::regressor_form).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum RegressorForm {
@@ -88,14 +88,5 @@ impl Options {
     /// Whether the module gets function `f`.
     pub fn has(&self, f: FunctionId) -> bool {
         self.functions.contains(f)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    /// [`super::RegressorForm::Auto`]'s documentation states the threshold.
-    #[test]
-    fn the_documented_loop_threshold_is_the_derivation_s() {
-        assert_eq!(crate::kane::LOOP_MIN_PAIRS, 40);
     }
 }

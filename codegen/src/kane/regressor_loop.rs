@@ -526,3 +526,17 @@ impl Ctx<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    /// `RegressorForm::Auto`'s documentation (`codegen/src/options.rs`) states this threshold.
+    #[test]
+    fn the_loop_threshold_is_the_documented_40_pairs() {
+        assert_eq!(super::LOOP_MIN_PAIRS, 40);
+        let doc = include_str!("../options.rs");
+        assert!(
+            doc.contains("40 (speed, body) pairs"),
+            "RegressorForm::Auto's doc names 40 pairs"
+        );
+    }
+}

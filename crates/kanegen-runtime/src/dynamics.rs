@@ -275,7 +275,7 @@ const SOLVE_GROUP: usize = 8;
 /// `fd_derivatives/fixed_wheels_trait`, Nov 2026, Intel Xeon with AVX-512): nalgebra's `Cholesky::solve` and `inverse`, one column at a
 /// time through strided loops, took 17.1 µs; solves on transposed copies that
 /// passed over all right-hand sides for every `x_i −= l_ik x_k`, storing and reloading `x_i`
-/// at each `k`, 7.3–7.7 µs; this form, the figure in README.md's "Derivatives".
+/// at each `k`, 7.3–7.7 µs; this form, the figure in docs/derivatives.md.
 #[inline(always)]
 fn cholesky_solve_columns<
     T: RealField + Copy,

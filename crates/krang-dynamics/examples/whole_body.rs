@@ -7,8 +7,7 @@
 //! combined function, see `build.rs`): the sines and cosines, rotations, positions and motion
 //! pass are computed once for all of them (the values are those of the separate functions: bit
 //! for bit in the baseline copy, to 10⁻¹² in the dispatched x86-64-v3 copy, where a product
-//! shared in one program and written inline in the other is fused in only one; README,
-//! "Combined functions").
+//! shared in one program and written inline in the other is fused in only one; docs/kinematics.md).
 //!
 //! The 19-speed robot (wheeled base, no ground contact other than rolling) starts at rest,
 //! balanced (centre of mass above the axle), arms in the pose of the `simulate` example. The

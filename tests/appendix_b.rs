@@ -1,4 +1,4 @@
-//! The generated two-link code (seed 002, Appendix B) reproduces the printed closed forms
+//! The generated two-link code (the fixed-wheels report (Zafar 2014), Appendix B) reproduces the printed closed forms
 //! A (B.1, Lagrange), C and Q exactly: τ = A q̈ + C q̇ + Q.
 //!
 //! B.2 (Kane) prints A with XXᵢ + (MYᵢ² + MZᵢ²)/mᵢ in place of XXᵢ, which double-counts the

@@ -8,7 +8,7 @@
 //! * every column of Y is `∂τ/∂π_p` by central differences of τ in the parameter;
 //! * `Y_b π_b = τ` and `Y_gb β_b = g`; the base regressor of 50 random states has full column
 //!   rank B, and B is the rank of the stacked full regressors (SVD); the grouping residual;
-//! * the two-link model of seed 002 Appendix B: its base parameters by hand;
+//! * the two-link model of the fixed-wheels report (Zafar 2014), Appendix B: its base parameters by hand;
 //! * with baked parameters the regressors equal the runtime ones at the model's values.
 
 use kanegen::model::{Model, UrdfOptions};
@@ -311,7 +311,7 @@ fn base_regressors_have_full_column_rank_and_reproduce_tau_and_g() {
 
 #[test]
 fn two_link_base_parameters_are_the_hand_derived_groupings() {
-    // Seed 002 Appendix B: both axes along −x, 1P2 = [0, L1, −L2]. The motion is planar about
+    // Appendix B of the fixed-wheels report (Zafar 2014): both axes along −x, 1P2 = [0, L1, −L2]. The motion is planar about
     // x: only XX, MY, MZ act; body 2's mass is a point mass at 1P2 for body 1 (grouped into
     // MY1, MZ1 and XX1 with the parallel-axis term L1² + L2²); body 1's mass has no effect.
     let (model, g) = cached(2);

@@ -9,7 +9,7 @@
 //! subtree of j. These subtree sums are accumulated backward, so the generated code grows with
 //! the number of bodies plus the sum of depths instead of their product.
 //!
-//! * ω, α and the origin acceleration a of every frame follow seed 002 eqs. 3–6 (K variables);
+//! * ω, α and the origin acceleration a of every frame follow the fixed-wheels report (Zafar 2014) eqs. 3–6 (K variables);
 //!   for the wheeled base `ω0 = [0,0,ψ̇]`, `α0 = [0,0,ψ̈]`, `a0 = [ẍ, ẋψ̇, 0]` (the report's
 //!   `[ẍ, ψ̇, 0]` is a known error). Gravity enters as the base acceleration `a0 − g0`.
 //! * inverse dynamics and c: body inertia forces and moments (D variables), accumulated backward;

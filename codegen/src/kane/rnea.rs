@@ -138,7 +138,7 @@ impl Ctx<'_> {
         if let Some((fl, nl)) = self.body_force(0, &motion.w[0], &motion.wd[0], &motion.a[0], tag) {
             (f[0], n[0]) = (fl, nl);
         }
-        // Forward: seed 002 eqs. 3, 4, 6. (A depth-first interleaving of the forward and
+        // Forward: the fixed-wheels report (Zafar 2014) eqs. 3, 4, 6. (A depth-first interleaving of the forward and
         // backward passes keeps fewer values live, but measured for Krang it made the compiled
         // functions larger and slower: their speed is bound by code size.)
         for (l, _, mount) in model.mounted_links() {
@@ -186,7 +186,7 @@ impl Ctx<'_> {
         Motion { w, wd, a }
     }
 
-    /// The forward step to link `l` from its parent (seed 002 eqs. 3, 4, 6): its `ω`, `α` and
+    /// The forward step to link `l` from its parent (the fixed-wheels report (Zafar 2014) eqs. 3, 4, 6): its `ω`, `α` and
     /// origin acceleration.
     fn forward_motion(&mut self, l: usize, mount: &Mount, motion: &mut Motion, inputs: Inputs) {
         let tag = inputs.tag;

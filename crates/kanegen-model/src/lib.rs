@@ -3,7 +3,7 @@
 //! A [`Model`] is a tree of frames rooted at the base frame (`"0"` in the Krang reports). Every
 //! non-root frame is attached to its parent by a [`Joint`] whose transform is
 //! `iTj(q) = iTj(0) · Rot(e_j, q_j)` (revolute), `iTj(0) · Trans(e_j q_j)` (prismatic) or the
-//! constant `iTj(0)` (fixed), with the axis `e_j` expressed in the child frame, as in seed 002 §2.1.
+//! constant `iTj(0)` (fixed), with the axis `e_j` expressed in the child frame, as in the fixed-wheels report (Zafar 2014) §2.1.
 //! Bodies carry Khalil's standard inertial parameters (mass, first moments `MS = m·S`, inertia about
 //! the frame origin) as named, symbolic [`Param`]s with default values, so that the generator can
 //! keep them as runtime inputs and the reference recursion can evaluate them.

@@ -3,7 +3,7 @@
 //! ```toml
 //! [model]
 //! name = "two-link"
-//! description = "Seed 002 Appendix B"
+//! description = "the fixed-wheels report (Zafar 2014), Appendix B"
 //! speeds = ["qd_imu", "qd_w"]          # the order of u
 //!
 //! [base]

@@ -1,5 +1,5 @@
 //! URDF import: rpy convention, axes, snapping, fixed-joint merging (Huygens–Steiner and
-//! rotation), names, the wheeled base (Krang: 0A1(0) and e1 of seed 002) and the shipped URDFs.
+//! rotation), names, the wheeled base (Krang: 0A1(0) and e1 of the fixed-wheels report (Zafar 2014)) and the shipped URDFs.
 #![allow(clippy::approx_constant)] // the rounded angles of real URDF files are the point here
 
 use std::path::PathBuf;

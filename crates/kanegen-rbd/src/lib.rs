@@ -16,7 +16,7 @@
 //!
 //! # Formulation
 //!
-//! Classical 3-vectors expressed in each link frame, as in seed 002 (eqs. 3–6): angular velocity
+//! Classical 3-vectors expressed in each link frame, as in the fixed-wheels report (Zafar 2014) (eqs. 3–6): angular velocity
 //! `ω`, angular acceleration `α`, linear acceleration `a` of the frame origin; bodies carry
 //! Khalil's standard parameters (mass `m`, first moment `h = m·S`, inertia `J` about the frame
 //! origin). Joint `j` moves by `iAj(q) = iAj(0)·Rot(e_j, q_j)` (revolute) or adds `iAj(0) e_j q_j`

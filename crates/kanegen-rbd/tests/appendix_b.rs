@@ -1,4 +1,4 @@
-//! The two-link model of seed 002 Appendix B (bodies 1 and 2 on a fixed frame 0) against the
+//! The two-link model of the fixed-wheels report (Zafar 2014), Appendix B (bodies 1 and 2 on a fixed frame 0) against the
 //! printed closed forms B.1 (with Khalil's origin-referred `XX_i`): `τ = A q̈ + C q̇ + Q`, at 250
 //! random states with random physical parameters.
 

@@ -1,7 +1,7 @@
 //! Numeric reference of the rigid-body dynamics of a [`kanegen_model::Model`]: the test oracle
 //! of the generated code and the "naive recursion" benchmark baseline.
 //!
-//! It is written from seed 002 (frames, eqs. 3–6) and Kane's equations, independently of any
+//! It is written from the fixed-wheels report (Zafar 2014) (frames, eqs. 3–6) and Kane's equations, independently of any
 //! symbolic code, and deliberately *naively*: for every generalized speed `r` the partial
 //! velocities `(v_k)_r`, `(ω_k)_r` of every frame are computed by their own forward recursion,
 //! and the generalized inertia and gravity forces are summed body by body,
@@ -23,7 +23,7 @@
 //!
 //! For the two-wheeled base (DynamicModeling.tex) the base frame moves with
 //! `ω0 = [0, 0, ψ̇]`, `v0 = [ẋ, 0, 0]`, `α0 = [0, 0, ψ̈]`, `a0 = [ẍ, ẋψ̇, 0]` (the centripetal
-//! term `ẋψ̇`; seed 000's MATLAB wrongly used `ψ̇`), and the axisymmetric wheels add
+//! term `ẋψ̇`; the MATLAB behind the efficient-computation report (Zafar 2015) wrongly used `ψ̇`), and the axisymmetric wheels add
 //! `(2 mw + 2 YYw/R²) ẍ` to the `ẋ` row and `(mw L²/2 + YYw L²/(2R²) + 2 ZZw) ψ̈` to the `ψ̇` row.
 //!
 //! The scalar type is generic (`f64`, `f32`, or any [`RealField`] + [`Copy`]).
@@ -86,7 +86,7 @@ struct WheelData<T> {
 ///
 /// `rotation` and `position` are relative to the base frame (frame 0) and expressed in it; the
 /// velocities and accelerations are absolute (relative to the ground) and expressed in the frame
-/// itself, as in seed 002 eqs. 3–6.
+/// itself, as in the fixed-wheels report (Zafar 2014) eqs. 3–6.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FrameState<T: RealField + Copy> {
     /// `0A_k`: the frame's unit vectors (columns) in frame 0.
@@ -286,7 +286,7 @@ impl<T: RealField + Copy> Reference<T> {
                     Vector3::new(z, z, psid),
                     Vector3::new(z, z, psidd),
                     Vector3::new(xd, z, z),
-                    // The centripetal term ẋψ̇ along y0 (not ψ̇ as in seed 000).
+                    // The centripetal term ẋψ̇ along y0 (not ψ̇ as in the efficient-computation report (Zafar 2015)).
                     Vector3::new(xdd, xd * psid, z),
                 ]
             }
@@ -294,7 +294,7 @@ impl<T: RealField + Copy> Reference<T> {
     }
 
     /// Positions, velocities and accelerations of every frame (indexed like
-    /// [`Model::links`]), by seed 002 eqs. 3–6.
+    /// [`Model::links`]), by the fixed-wheels report (Zafar 2014) eqs. 3–6.
     ///
     /// # Panics
     /// If a slice does not have [`Reference::dof`] entries.

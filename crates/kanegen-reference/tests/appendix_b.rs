@@ -1,4 +1,4 @@
-//! The two-link model of seed 002 Appendix B (bodies 1 and 2, frame 0 fixed) against the
+//! The two-link model of the fixed-wheels report (Zafar 2014), Appendix B (bodies 1 and 2, frame 0 fixed) against the
 //! printed closed forms.
 //!
 //! Appendix B prints two versions of `A`: B.1 (Lagrange) with `XX1`, `XX2`, and B.2 (Kane) with

@@ -121,7 +121,7 @@ pub mod f32 {
     include!(concat!(env!("OUT_DIR"), "/krang_f32.rs"));
 }
 
-/// Krang on fixed wheels: the 17-DOF tree of seed 002 (frame 0 fixed).
+/// Krang on fixed wheels: the 17-DOF tree of the fixed-wheels report (Zafar 2014) (frame 0 fixed).
 #[cfg(feature = "fixed-wheels")]
 pub mod fixed_wheels {
     include!(concat!(env!("OUT_DIR"), "/krang_fixed_wheels.rs"));
@@ -139,7 +139,7 @@ pub mod fixed_wheels {
         crate::derivatives::LinearizationWorkspaceOf<DerivativesWorkspace, 17, 34, 17>;
 }
 
-/// Seed 002 Appendix B: the two-link model (bodies 1 and 2, frame 0 fixed).
+/// Appendix B of the fixed-wheels report (Zafar 2014): the two-link model (bodies 1 and 2, frame 0 fixed).
 #[cfg(feature = "two-link")]
 pub mod two_link {
     include!(concat!(env!("OUT_DIR"), "/two_link.rs"));

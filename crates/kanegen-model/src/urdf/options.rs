@@ -97,7 +97,7 @@ pub enum UrdfBase {
 /// replaced by the base: links above it are discarded.
 ///
 /// For Krang.urdf: wheels `JLWheel`/`JRWheel`, body `Base`, up `[0, 1, 0]`, which gives
-/// `0A1(0) = [[0, 0, −1], [−1, 0, 0], [0, 1, 0]]` and the pitch axis `e1 = [−1, 0, 0]` of seed 002.
+/// `0A1(0) = [[0, 0, −1], [−1, 0, 0], [0, 1, 0]]` and the pitch axis `e1 = [−1, 0, 0]` of the fixed-wheels report (Zafar 2014).
 #[derive(Debug, Clone, PartialEq)]
 pub struct WheeledBaseSpec {
     /// The left wheel's joint (revolute or continuous; its child link is the wheel).

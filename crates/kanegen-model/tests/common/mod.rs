@@ -1,6 +1,6 @@
 //! What the model-error tests share: a small valid description and its mutations.
 
-/// Two revolute links on a fixed base frame (the shape of seed 002 Appendix B). Both bodies have
+/// Two revolute links on a fixed base frame (the shape of the fixed-wheels report (Zafar 2014), Appendix B). Both bodies have
 /// m = 2, S = [0, 0.1, 0] and I_G = diag(0.03, 0.01, 0.03), so J = diag(0.05, 0.01, 0.05).
 pub const VALID: &str = include_str!("../data/two_link.toml");
 

@@ -13,7 +13,7 @@
 //!
 //! ```no_run
 //! use kanegen::FunctionId as F;
-//! use kanegen::combined::Combined;
+//! use kanegen::Combined;
 //! kanegen::Builder::new("krang.toml")
 //!     .combined(
 //!         Combined::new("whole_body_terms")

@@ -33,8 +33,7 @@ fn main() {
     feature = "two-link"
 ))]
 mod modules {
-    use kanegen::combined::Combined;
-    use kanegen::{Builder, FunctionId as F, FunctionSet, Precision};
+    use kanegen::{Builder, Combined, FunctionId as F, FunctionSet, Precision};
 
     const CORIOLIS_MATRIX: bool = cfg!(feature = "coriolis-matrix");
     const KINEMATICS: bool = cfg!(feature = "kinematics");

@@ -36,10 +36,9 @@ struct Entry {
     /// Whether the mimic joints and their masters are made fixed (see [`mimic_as_independent`]).
     fix_mimic: bool,
     /// The largest violation of inertia physics among its links (semi-definiteness or the
-    /// triangle inequality, relative to the largest principal moment) if it exceeds the default
-    /// `UrdfOptions::inertia_tolerance` (5 %): the file is then a typed error with the defaults
-    /// and is imported with the tolerance raised to this value, keeping the inertias as written
-    /// (as Pinocchio loads them).
+    /// triangle inequality, relative to the largest principal moment) if it exceeds 5 %: the
+    /// defaults load such inertias as written (as Pinocchio loads them), with a note per link,
+    /// and a `UrdfOptions::inertia_tolerance` below this value refuses the file.
     non_physical: Option<f64>,
 }
 
@@ -196,14 +195,9 @@ fn import(entry: &Entry) -> UrdfImport {
         .unwrap_or_else(|e| panic!("{}: {e}", entry.file))
 }
 
-/// The import options of a corpus file: the defaults, with the inertia tolerance raised for the
-/// files with links that break inertia physics by more than 5 %.
-fn options(entry: &Entry) -> UrdfOptions {
-    let mut options = UrdfOptions::default();
-    if let Some(violation) = entry.non_physical {
-        options.inertia_tolerance = violation + 1e-6;
-    }
-    options
+/// The import options of a corpus file: the defaults.
+fn options(_entry: &Entry) -> UrdfOptions {
+    UrdfOptions::default()
 }
 
 /// Worst relative errors of the lowered M, c, g, τ against the reference over `draws` draws
@@ -378,38 +372,51 @@ fn corpus_files_with_mimic_joints_import_with_exact_constraints() {
     }
 }
 
-/// The files whose inertias break physics by more than the default tolerance are typed errors
-/// in URDF terms with the default options (naming a link, `<inertial>` and the fix), and load
-/// with the tolerance at their worst violation (the test above): the recorded violation is the
-/// file's worst.
+/// The files whose inertias break physics by more than 5 % load with the default options, with
+/// a note for each such link, and are typed errors in URDF terms (naming a link, `<inertial>`
+/// and the option) with the tolerance just below their worst violation: the recorded violation
+/// is the file's worst.
 #[test]
-fn corpus_files_with_non_physical_inertias_need_the_tolerance_raised() {
+fn corpus_files_with_non_physical_inertias_load_with_notes_and_a_tolerance_refuses_them() {
     for entry in CORPUS {
         let mut text = text(entry);
         if entry.mimic > 0 {
             text = mimic_as_independent(&text, entry.fix_mimic);
         }
-        let defaults = UrdfImport::parse(&text, entry.file, &UrdfOptions::default());
+        let defaults = UrdfImport::parse(&text, entry.file, &UrdfOptions::default())
+            .unwrap_or_else(|e| panic!("{}: {e}", entry.file));
         let Some(violation) = entry.non_physical else {
-            assert!(defaults.is_ok(), "{}: {:?}", entry.file, defaults.err());
             continue;
         };
-        let err = defaults
+        assert!(
+            defaults
+                .notes
+                .iter()
+                .any(|n| n.ends_with("; kept as written") && n.contains("principal moments")),
+            "{}: {:?}",
+            entry.file,
+            defaults.notes
+        );
+        let below = UrdfOptions {
+            inertia_tolerance: violation - 1e-3,
+            ..UrdfOptions::default()
+        };
+        let err = UrdfImport::parse(&text, entry.file, &below)
             .err()
-            .unwrap_or_else(|| panic!("{}: loads", entry.file));
+            .unwrap_or_else(|| panic!("{}: the worst violation is below {violation}", entry.file));
         assert!(
             matches!(err.kind, ModelErrorKind::UrdfNonPhysicalInertial { .. }),
             "{}: {err}",
             entry.file
         );
         assert!(err.to_string().contains("inertia_tolerance"), "{err}");
-        let below = UrdfOptions {
-            inertia_tolerance: violation - 1e-3,
+        let at = UrdfOptions {
+            inertia_tolerance: violation + 1e-6,
             ..UrdfOptions::default()
         };
         assert!(
-            UrdfImport::parse(&text, entry.file, &below).is_err(),
-            "{}: the worst violation is below {violation}",
+            UrdfImport::parse(&text, entry.file, &at).is_ok(),
+            "{}: a violation above {violation}",
             entry.file
         );
     }

@@ -18,7 +18,9 @@ use std::fmt::Write as _;
 
 use common::*;
 use kanegen::{Builder, FunctionId, Options};
-use kanegen_model::{AngleSnap, Model, ModelErrorKind as K, UrdfOptions, WheeledBaseSpec};
+use kanegen_model::{
+    AngleSnap, Model, ModelErrorKind as K, NonPhysicalInertia, UrdfOptions, WheeledBaseSpec,
+};
 use kanegen_reference::Reference;
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
@@ -628,7 +630,9 @@ proptest! {
         (tree, m) in tree().prop_flat_map(|t| { let links = t.joints.len() + 1; (Just(t), mutation(links)) })
     ) {
         let Some(text) = apply(&tree, &m) else { return Ok(()) };
-        match Model::from_urdf_str(&text, "mutated.urdf", &tree.options()) {
+        // A broken triangle inequality loads as written by default; refused on request.
+        let options = UrdfOptions { non_physical_inertia: NonPhysicalInertia::Error, ..tree.options() };
+        match Model::from_urdf_str(&text, "mutated.urdf", &options) {
             Ok(_) => prop_assert!(false, "{:?} accepted:\n{}", m, text),
             Err(e) => {
                 prop_assert_eq!(&e.file, "mutated.urdf");

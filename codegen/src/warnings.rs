@@ -5,7 +5,8 @@
 //! The import records every decision as a note in prose (`joint `j1` <origin> rpy roll: 1.5708
 //! snapped to π/2 (…)`); the emitter writes them all into the generated file's header. A build
 //! prints only the kinds below, each once, with its count, the first few names and the
-//! [`UrdfOptions`](crate::model::UrdfOptions) field that decides it. Notes of what the caller
+//! [`UrdfOptions`](crate::model::UrdfOptions) field that decides it; a non-physical link
+//! inertia (loaded as written or repaired) gets a line of its own, with its numbers. Notes of what the caller
 //! asked for by name (`drop_links`, a `mimic` mode, the wheeled base's constants) and of links
 //! fixed to the base (no effect on the dynamics) are left to the header.
 
@@ -20,6 +21,9 @@ struct Kind {
     names: fn(&str) -> Vec<String>,
     /// Whether the count is of notes (angles) rather than of distinct names (links).
     count_notes: bool,
+    /// Whether each note is a line of its own (the note, then the remedy) instead of a count:
+    /// for what questions the model's numbers link by link (non-physical inertias).
+    each: bool,
     /// Singular and plural noun.
     noun: (&'static str, &'static str),
     /// What happened to them.
@@ -49,6 +53,7 @@ const KINDS: &[Kind] = &[
         matches: |n| n.contains(" snapped to "),
         names: first_quoted,
         count_notes: true,
+        each: false,
         noun: ("angle", "angles"),
         what: "snapped to a multiple of π/2",
         remedy: "UrdfOptions::snap_angles = AngleSnap::Off keeps angles as written",
@@ -57,6 +62,7 @@ const KINDS: &[Kind] = &[
         matches: |n| n.starts_with("merged into `") && n.contains(" through fixed joints: "),
         names: |n| listed_after(n, " through fixed joints: "),
         count_notes: false,
+        each: false,
         noun: ("link", "links"),
         what: "merged through fixed joints (mass and inertia added to the parent's parameters)",
         remedy: "UrdfOptions::link_frames keeps a frame for each",
@@ -65,17 +71,19 @@ const KINDS: &[Kind] = &[
         matches: |n| n.contains("principal moments") && n.ends_with("; kept as written"),
         names: first_quoted,
         count_notes: false,
+        each: true,
         noun: ("non-physical inertia", "non-physical inertias"),
         what: "loaded as written",
-        remedy: "UrdfOptions::non_physical_inertia = NonPhysicalInertia::Repair repairs, Error rejects them",
+        remedy: "UrdfOptions::non_physical_inertia = NonPhysicalInertia::Repair repairs it, Error refuses it",
     },
     Kind {
         matches: |n| n.contains("; repaired to the principal moments "),
         names: first_quoted,
         count_notes: false,
+        each: true,
         noun: ("non-physical inertia", "non-physical inertias"),
         what: "repaired to the nearest physical one",
-        remedy: "UrdfOptions::non_physical_inertia = NonPhysicalInertia::Note keeps them as written",
+        remedy: "UrdfOptions::non_physical_inertia = NonPhysicalInertia::Note keeps it as written, Error refuses it",
     },
     Kind {
         matches: |n| {
@@ -84,6 +92,7 @@ const KINDS: &[Kind] = &[
         },
         names: first_quoted,
         count_notes: false,
+        each: false,
         noun: ("zero-mass link", "zero-mass links"),
         what: "kept as a body with its rotational inertia",
         remedy: "UrdfOptions::zero_mass_inertia = ZeroMassInertia::Drop drops their inertia",
@@ -95,6 +104,7 @@ const KINDS: &[Kind] = &[
         },
         names: first_quoted,
         count_notes: false,
+        each: false,
         noun: ("zero-mass link", "zero-mass links"),
         what: "without its rotational inertia",
         remedy: "UrdfOptions::zero_mass_inertia = ZeroMassInertia::Keep keeps it",
@@ -103,6 +113,7 @@ const KINDS: &[Kind] = &[
         matches: |n| n.contains(": radius of gyration ") && n.ends_with(": inertia dropped"),
         names: first_quoted,
         count_notes: false,
+        each: false,
         noun: ("implausible inertia", "implausible inertias"),
         what: "dropped",
         remedy: "UrdfOptions::absurd_inertia and max_radius_of_gyration decide",
@@ -111,6 +122,7 @@ const KINDS: &[Kind] = &[
         matches: |n| n.contains(": radius of gyration ") && n.ends_with(": kept as written"),
         names: first_quoted,
         count_notes: false,
+        each: false,
         noun: ("implausible inertia", "implausible inertias"),
         what: "kept as written",
         remedy: "UrdfOptions::absurd_inertia and max_radius_of_gyration decide",
@@ -130,6 +142,7 @@ const KINDS: &[Kind] = &[
             }
         },
         count_notes: true,
+        each: false,
         noun: ("wheel constant", "wheel constants"),
         what: "averaged or simplified",
         remedy: "WheeledBaseSpec::wheel_mass, wheel_axle_inertia and wheel_diametral_inertia set them",
@@ -137,7 +150,8 @@ const KINDS: &[Kind] = &[
 ];
 
 /// The summary lines of the import `notes` of the model loaded from `source`, one per kind
-/// present, in a fixed order:
+/// present (one per note for non-physical inertias, which question a link's numbers), in a
+/// fixed order:
 ///
 /// ```text
 /// kanegen: arm.urdf: 2 angles snapped to a multiple of π/2 (j1, j2); UrdfOptions::snap_angles = AngleSnap::Off keeps angles as written
@@ -147,6 +161,15 @@ const KINDS: &[Kind] = &[
 pub(crate) fn summary(source: &str, notes: &[String]) -> Vec<String> {
     let mut lines = Vec::new();
     for kind in KINDS {
+        if kind.each {
+            for note in notes.iter().filter(|n| (kind.matches)(n)) {
+                lines.push(one_line(&format!(
+                    "kanegen: {source}: {note}; {}",
+                    kind.remedy
+                )));
+            }
+            continue;
+        }
         let mut count = 0;
         let mut names: Vec<String> = Vec::new();
         for note in notes.iter().filter(|n| (kind.matches)(n)) {

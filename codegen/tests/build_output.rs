@@ -83,6 +83,79 @@ fn toml_models_print_no_warnings() {
     assert!(g.warnings().is_empty());
 }
 
+/// A file of the workspace's `tests/data/` (URDF files with vendors' non-physical inertias).
+fn data(file: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data")
+        .join(file)
+}
+
+/// The warning line of a link inertia loaded as written.
+fn kept_line(source: &str, link: &str, detail: &str) -> String {
+    format!(
+        "kanegen: {source}: link `{link}`: {detail}; kept as written; \
+         UrdfOptions::non_physical_inertia = NonPhysicalInertia::Repair repairs it, Error refuses it"
+    )
+}
+
+#[test]
+fn each_non_physical_inertia_is_a_warning_line_of_its_own() {
+    let two = ARM
+        .replace(
+            r#"<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+  </link>
+  <link name="lower">"#,
+            r#"<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.03"/></inertial>
+  </link>
+  <link name="lower">"#,
+        )
+        .replace(
+            r#"<mass value="0.1"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/>"#,
+            r#"<mass value="0.1"/><inertia ixx="-0.0001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/>"#,
+        );
+    let import = UrdfImport::parse(&two, "arm.urdf", &UrdfOptions::default()).unwrap();
+    let g = Builder::from_import(import).generate().expect("generates");
+    let upper = "the inertia (ixx 0.01, ixy 0, ixz 0, iyy 0.01, iyz 0, izz 0.03) has the principal \
+                 moments 1.000000e-2, 1.000000e-2, 3.000000e-2 about the centre of mass: triangle \
+                 inequality: the largest exceeds the sum of the other two, by 33.33 % of the largest";
+    let flange = "the inertia (ixx -0.0001, ixy 0, ixz 0, iyy 0.001, iyz 0, izz 0.001) has the \
+                  principal moments -1.000000e-4, 1.000000e-3, 1.000000e-3 about the centre of \
+                  mass: not positive semi-definite, by 10.00 % of the largest";
+    assert_eq!(
+        g.warnings(),
+        [
+            WARNINGS[0].to_owned(),
+            WARNINGS[1].to_owned(),
+            kept_line("arm.urdf", "upper", upper),
+            kept_line("arm.urdf", "flange", flange),
+        ]
+    );
+}
+
+#[test]
+fn a_build_prints_each_non_physical_inertia_once() {
+    let dir = scratch("inertias");
+    let o = run_child("inertias", &dir, true);
+    assert!(o.status.success(), "{o:?}");
+    let stdout = String::from_utf8(o.stdout).unwrap();
+    let printed: Vec<&str> = stdout
+        .lines()
+        .filter_map(|l| l.split_once("cargo:warning=").map(|(_, w)| w))
+        .filter(|w| w.contains("non_physical_inertia"))
+        .collect();
+    let source = data("pr2_sensor_mount.urdf").display().to_string();
+    let detail = "the inertia (ixx 0.001, ixy 0, ixz 0, iyy 0.001, iyz 0, izz 0.01) has the \
+                  principal moments 1.000000e-3, 1.000000e-3, 1.000000e-2 about the centre of \
+                  mass: triangle inequality: the largest exceeds the sum of the other two, by \
+                  80.00 % of the largest";
+    assert_eq!(
+        printed,
+        [kept_line(&source, "sensor_mount_link", detail)],
+        "{stdout}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 /// A scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!(
@@ -119,6 +192,12 @@ fn child() {
         "build" => {
             // Two modules of one model (runtime and baked parameters): the lines print once.
             let builder = Builder::from_import(import(&UrdfOptions::default()));
+            builder.clone().run();
+            builder.baked(true).run();
+        }
+        "inertias" => {
+            // Two modules of a model with non-physical inertias: one line per link, once.
+            let builder = Builder::urdf(data("pr2_sensor_mount.urdf"), UrdfOptions::default());
             builder.clone().run();
             builder.baked(true).run();
         }

@@ -366,8 +366,8 @@ pub enum ModelErrorKind {
     },
     /// A URDF link's `<inertial>` is not physical: a negative mass, or an inertia about the
     /// centre of mass (`ixx` … `izz`) that is not positive semi-definite or breaks the triangle
-    /// inequality by more than `UrdfOptions::inertia_tolerance` (or at all, with
-    /// `NonPhysicalInertia::Error`).
+    /// inequality by more than `UrdfOptions::inertia_tolerance` (no limit by default), or at
+    /// all with `NonPhysicalInertia::Error`.
     #[error("URDF link `{link}` <inertial>: {detail}; {fix}")]
     UrdfNonPhysicalInertial {
         /// The link.

@@ -82,6 +82,21 @@ fn error_of(text: &str, fragments: &[&str]) -> K {
     e.kind
 }
 
+/// The error of `text` imported with non-physical inertias refused
+/// (`NonPhysicalInertia::Error`), with message fragments checked.
+fn strict_error_of(text: &str, fragments: &[&str]) -> K {
+    let options = UrdfOptions {
+        non_physical_inertia: kanegen_model::NonPhysicalInertia::Error,
+        ..UrdfOptions::default()
+    };
+    let e = Model::from_urdf_str(text, FILE, &options).expect_err("the inertia is refused");
+    let msg = e.to_string();
+    for f in fragments {
+        assert!(msg.contains(f), "message `{msg}` lacks `{f}`");
+    }
+    e.kind
+}
+
 /// `actual` is `expected`, field by field (error kinds are not `PartialEq`: the I/O error that
 /// one of them holds is not).
 fn assert_kind(actual: &K, expected: K) {
@@ -367,23 +382,34 @@ fn negative_mass_is_an_error_in_urdf_terms() {
     );
 }
 
+/// A non-physical link inertia loads as written by default (with a note); beyond
+/// `inertia_tolerance` it is an error in URDF terms that names the options.
 #[test]
-fn a_non_physical_link_inertia_is_an_error_in_urdf_terms() {
+fn a_non_physical_link_inertia_beyond_the_tolerance_is_an_error_in_urdf_terms() {
     // Triangle inequality broken by 40 %: 0.01 + 0.02 < 0.05.
-    let kind = error_of(
-        &mutate(&[("izz=\"0.02\"", "izz=\"0.05\"")]),
-        &[
-            "URDF link `L2` <inertial>",
-            "ixx 0.01",
-            "izz 0.05",
-            "triangle inequality",
-            "40.00 %",
-            "inertia_tolerance",
-        ],
-    );
+    let text = mutate(&[("izz=\"0.02\"", "izz=\"0.05\"")]);
+    assert!(import(&text).is_ok());
+    let options = UrdfOptions {
+        inertia_tolerance: 0.05,
+        ..UrdfOptions::default()
+    };
+    let e = Model::from_urdf_str(&text, FILE, &options).unwrap_err();
+    let msg = e.to_string();
+    for f in [
+        "URDF link `L2` <inertial>",
+        "ixx 0.01",
+        "izz 0.05",
+        "triangle inequality",
+        "40.00 %",
+        "UrdfOptions::inertia_tolerance (0.05)",
+        "inertia_tolerance at least 0.4000",
+    ] {
+        assert!(msg.contains(f), "message `{msg}` lacks `{f}`");
+    }
     assert!(
-        matches!(&kind, K::UrdfNonPhysicalInertial { link, .. } if link == "L2"),
-        "{kind:?}"
+        matches!(&e.kind, K::UrdfNonPhysicalInertial { link, .. } if link == "L2"),
+        "{:?}",
+        e.kind
     );
 }
 
@@ -392,7 +418,7 @@ fn a_non_physical_link_inertia_is_an_error_in_urdf_terms() {
 /// inequality by 100 %: the error names the triangle inequality, not semi-definiteness.
 #[test]
 fn a_rounding_negative_principal_moment_is_not_called_indefinite() {
-    let kind = error_of(
+    let kind = strict_error_of(
         &mutate(&[(
             r#"<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/>"#,
             r#"<inertia ixx="0.000001" ixy="0.000001" ixz="0.000001" iyy="0.000001" iyz="0.000001" izz="0.000001"/>"#,

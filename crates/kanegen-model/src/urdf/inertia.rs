@@ -39,8 +39,8 @@ pub(super) fn merge(items: &[(Tf, Inertial)]) -> (f64, Vector3<f64>, Matrix3<f64
 
 /// A link's inertial data (`None` for none: no mass and no inertia, or dropped by the options),
 /// after the checks of the options: finite numbers, a mass ≥ 0, a physical inertia about the
-/// centre of mass (up to [`UrdfOptions::inertia_tolerance`], as
-/// [`UrdfOptions::non_physical_inertia`] says), a plausible radius of gyration, and the
+/// centre of mass (zero to rounding below [`UrdfOptions::inertia_floor`]; otherwise up to
+/// [`UrdfOptions::inertia_tolerance`], as [`UrdfOptions::non_physical_inertia`] says), a plausible radius of gyration, and the
 /// inertia of a zero-mass link ([`UrdfOptions::zero_mass_inertia`]).
 pub(super) fn link_inertial(
     link: &urdf_rs::Link,
@@ -98,6 +98,9 @@ pub(super) fn link_inertial(
         notes,
     );
     let ig = physical_inertia(link, rot * ic * rot.transpose(), opts, notes)?;
+    if m == 0.0 && ig == Matrix3::zeros() {
+        return Ok(None);
+    }
     if m == 0.0 {
         let what = format!(
             "link `{}`: zero mass with a nonzero rotational inertia (ixx {}, iyy {}, izz {})",
@@ -118,9 +121,11 @@ pub(super) fn link_inertial(
     }))
 }
 
-/// The inertia `ig` about the centre of mass of `link` if it is physical (positive
-/// semi-definite, triangle inequality; point masses and rods are), or slightly non-physical as
-/// [`UrdfOptions::non_physical_inertia`] allows; otherwise the error, in URDF terms.
+/// The inertia `ig` about the centre of mass of `link`: zero if it is zero to rounding (every
+/// principal moment within [`UrdfOptions::inertia_floor`] of 0), as written if it is physical
+/// (positive semi-definite, triangle inequality; point masses and rods are), otherwise as
+/// [`UrdfOptions::non_physical_inertia`] says up to [`UrdfOptions::inertia_tolerance`] (kept with
+/// a note, repaired with a note, or refused); beyond the tolerance the error, in URDF terms.
 fn physical_inertia(
     link: &urdf_rs::Link,
     ig: Matrix3<f64>,
@@ -128,6 +133,9 @@ fn physical_inertia(
     notes: &mut Notes,
 ) -> Result<Matrix3<f64>, K> {
     let moments = validate::principal_moments(&ig);
+    if moments.iter().all(|l| l.abs() <= opts.inertia_floor) {
+        return Ok(Matrix3::zeros());
+    }
     let (violation, what) = validate::inertia_violation(moments);
     if violation <= validate::TOLERANCE {
         return Ok(ig);
@@ -147,14 +155,22 @@ fn physical_inertia(
     );
     if violation > opts.inertia_tolerance || opts.non_physical_inertia == NonPhysicalInertia::Error
     {
+        let limit = if opts.non_physical_inertia == NonPhysicalInertia::Error {
+            "non_physical_inertia is Error".to_owned()
+        } else {
+            format!(
+                "the violation exceeds UrdfOptions::inertia_tolerance ({})",
+                opts.inertia_tolerance
+            )
+        };
         return Err(K::UrdfNonPhysicalInertial {
             link: link.name.clone(),
             detail,
             fix: format!(
-                "correct ixx … izz (each principal moment ≥ 0 and at most the sum of the other \
-                 two); violations up to UrdfOptions::inertia_tolerance ({}) load with a note or \
-                 are repaired unless non_physical_inertia is Error",
-                opts.inertia_tolerance
+                "refused because {limit}; correct ixx … izz (each principal moment ≥ 0 and at \
+                 most the sum of the other two), or load it as written (NonPhysicalInertia::Note) \
+                 or repaired (NonPhysicalInertia::Repair) with inertia_tolerance at least {:.4}",
+                (violation * 1e4 - 1e-6).ceil() / 1e4
             ),
         });
     }

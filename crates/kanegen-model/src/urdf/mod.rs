@@ -41,9 +41,10 @@
 //!   multiple of π/2 (`3.1416`, `1.5708`, `3.14`) are snapped to it ([`AngleSnap::Rounded`], the
 //!   default; everything else is kept exactly), so that the rotations are exactly sparse
 //!   (smaller generated code). A link's inertia about its centre of mass may be positive
-//!   semi-definite (point masses, rods); a slightly non-physical one (within
-//!   [`UrdfOptions::inertia_tolerance`]) loads with a note, or is an error or repaired
-//!   ([`NonPhysicalInertia`]); a zero-mass link keeps its rotational inertia (a body with
+//!   semi-definite (point masses, rods); a non-physical one (by any amount, as the reference
+//!   libraries load it; [`UrdfOptions::inertia_tolerance`] can bound it) loads as written with
+//!   a note, or is an error or repaired ([`NonPhysicalInertia`]); one zero to rounding
+//!   ([`UrdfOptions::inertia_floor`]) is zero; a zero-mass link keeps its rotational inertia (a body with
 //!   `m = 0`) unless [`ZeroMassInertia::Drop`]. Links whose inertia has a radius of gyration
 //!   above [`UrdfOptions::max_radius_of_gyration`] (default 5 m; Krang's gripper plates: 0.1 g
 //!   with 0.09 kg·m², ~30 m) are an error by default, or dropped/kept ([`AbsurdInertia`]);
@@ -69,8 +70,9 @@ mod wheeled;
 use std::path::Path;
 
 pub use options::{
-    AbsurdInertia, AngleSnap, DEFAULT_INERTIA_TOLERANCE, DEFAULT_MAX_RADIUS_OF_GYRATION,
-    NonPhysicalInertia, UrdfBase, UrdfOptions, WheeledBaseSpec, ZeroMassInertia,
+    AbsurdInertia, AngleSnap, DEFAULT_INERTIA_FLOOR, DEFAULT_INERTIA_TOLERANCE,
+    DEFAULT_MAX_RADIUS_OF_GYRATION, NonPhysicalInertia, UrdfBase, UrdfOptions, WheeledBaseSpec,
+    ZeroMassInertia,
 };
 
 use crate::error::{ModelError, ModelErrorKind as K};

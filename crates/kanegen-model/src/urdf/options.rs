@@ -8,10 +8,16 @@ use crate::validate;
 
 /// Default of [`UrdfOptions::max_radius_of_gyration`], in metres.
 pub const DEFAULT_MAX_RADIUS_OF_GYRATION: f64 = 5.0;
-/// Default of [`UrdfOptions::inertia_tolerance`]: a link's inertia about its centre of mass may
-/// break positive semi-definiteness or the triangle inequality by 5 % of its largest principal
-/// moment (rounding of CAD exports) and still load, as [`UrdfOptions::non_physical_inertia`] says.
-pub const DEFAULT_INERTIA_TOLERANCE: f64 = 0.05;
+/// Default of [`UrdfOptions::inertia_tolerance`]: no limit. A link's inertia about its centre of
+/// mass may break positive semi-definiteness or the triangle inequality by any amount and still
+/// load as [`UrdfOptions::non_physical_inertia`] says (by default as written, with a warning), as
+/// the reference libraries load such files; the model must still have a positive definite mass
+/// matrix.
+pub const DEFAULT_INERTIA_TOLERANCE: f64 = f64::INFINITY;
+/// Default of [`UrdfOptions::inertia_floor`], in kg·m²: a link inertia whose principal moments
+/// are all at most this in magnitude is zero to rounding (a millimetre-sized gram part has
+/// about 10⁻⁹ kg·m²; exports write 10⁻²⁰ for "none").
+pub const DEFAULT_INERTIA_FLOOR: f64 = 1e-12;
 
 /// How rotation angles (joint and inertial `rpy`) are snapped to multiples of π/2.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -30,16 +36,20 @@ pub enum AngleSnap {
     Within(f64),
 }
 
-/// What to do with a link inertia (about its centre of mass) that is slightly non-physical:
-/// not positive semi-definite, or breaking the triangle inequality, by at most
-/// [`UrdfOptions::inertia_tolerance`] of its largest principal moment. Larger violations are
-/// always errors.
+/// What to do with a link inertia (about its centre of mass) that is non-physical: not positive
+/// semi-definite, or breaking the triangle inequality, by at most
+/// [`UrdfOptions::inertia_tolerance`] of its largest principal moment (by default by any
+/// amount). Larger violations are always errors. Inertias zero to rounding
+/// ([`UrdfOptions::inertia_floor`]) are zero, whatever the policy.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum NonPhysicalInertia {
-    /// Load it as written, with a note (the default; the reference libraries load such files).
+    /// Load it as written, with a note (a build prints one warning line per link; the default:
+    /// the reference libraries load such files). The model is still refused if its mass matrix
+    /// is not positive definite.
     #[default]
     Note,
-    /// Fail with [`ModelErrorKind::UrdfNonPhysicalInertial`](crate::ModelErrorKind::UrdfNonPhysicalInertial).
+    /// Fail with [`ModelErrorKind::UrdfNonPhysicalInertial`](crate::ModelErrorKind::UrdfNonPhysicalInertial),
+    /// whatever the amount.
     Error,
     /// Replace it by the nearest physical inertia (principal moments projected onto
     /// `λ ≥ 0`, `λ_max ≤ λ_a + λ_b` in the least-squares sense, principal axes kept), with a note.
@@ -150,8 +160,9 @@ impl WheeledBaseSpec {
 
 /// Options of the URDF import. `UrdfOptions::default()` is a fixed base, angles snapped only
 /// when written as rounded multiples of π/2 ([`AngleSnap::Rounded`]), nothing dropped, absurd
-/// inertias an error, slightly non-physical ones noted, zero-mass inertias kept, g = 9.81 along
-/// −z of the root frame.
+/// inertias an error, non-physical ones loaded as written with a note (by any amount),
+/// inertias below 10⁻¹² kg·m² zero, zero-mass inertias kept, g = 9.81 along −z of the root
+/// frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct UrdfOptions {
     /// Fixed or two-wheeled base.
@@ -168,11 +179,15 @@ pub struct UrdfOptions {
     pub max_radius_of_gyration: f64,
     /// What to do with a link above [`UrdfOptions::max_radius_of_gyration`].
     pub absurd_inertia: AbsurdInertia,
-    /// What to do with a slightly non-physical link inertia (default: load it, with a note).
+    /// What to do with a non-physical link inertia (default: load it as written, with a note).
     pub non_physical_inertia: NonPhysicalInertia,
     /// How far (relative to the largest principal moment) a link inertia may be non-physical
-    /// and count as slightly so ([`DEFAULT_INERTIA_TOLERANCE`]).
+    /// and still load as [`UrdfOptions::non_physical_inertia`] says; beyond it the inertia is an
+    /// error ([`DEFAULT_INERTIA_TOLERANCE`]: no limit; `0.05` refuses violations above 5 %).
     pub inertia_tolerance: f64,
+    /// Largest magnitude (kg·m²) of the principal moments of a link inertia that is zero to
+    /// rounding: such an inertia is imported as zero, silently ([`DEFAULT_INERTIA_FLOOR`]).
+    pub inertia_floor: f64,
     /// What to do with the rotational inertia of a zero-mass link (default: keep it).
     pub zero_mass_inertia: ZeroMassInertia,
     /// Default value of the gravity parameter `g` (m/s²).
@@ -203,6 +218,7 @@ impl Default for UrdfOptions {
             absurd_inertia: AbsurdInertia::Error,
             non_physical_inertia: NonPhysicalInertia::Note,
             inertia_tolerance: DEFAULT_INERTIA_TOLERANCE,
+            inertia_floor: DEFAULT_INERTIA_FLOOR,
             zero_mass_inertia: ZeroMassInertia::Keep,
             gravity: 9.81,
             gravity_direction: [0.0, 0.0, -1.0],
@@ -255,10 +271,22 @@ impl UrdfOptions {
                 format!("tolerance {t} must be a finite angle ≥ 0 (radians)"),
             ));
         }
-        if !(opts.inertia_tolerance.is_finite() && opts.inertia_tolerance >= 0.0) {
+        if opts.inertia_tolerance.is_nan() || opts.inertia_tolerance < 0.0 {
             return Err(bad_option(
                 "inertia_tolerance",
-                format!("{} must be a finite fraction ≥ 0", opts.inertia_tolerance),
+                format!(
+                    "{} must be a fraction ≥ 0 (f64::INFINITY: no limit)",
+                    opts.inertia_tolerance
+                ),
+            ));
+        }
+        if !(opts.inertia_floor.is_finite() && opts.inertia_floor >= 0.0) {
+            return Err(bad_option(
+                "inertia_floor",
+                format!(
+                    "{} must be a finite inertia ≥ 0 (kg·m²)",
+                    opts.inertia_floor
+                ),
             ));
         }
         if opts.max_radius_of_gyration.is_nan() || opts.max_radius_of_gyration <= 0.0 {

@@ -54,6 +54,10 @@ pub struct Builder {
     split_above: usize,
     regressor_form: RegressorForm,
     derivatives_form: DerivativesForm,
+    /// [`Builder::memory_limit`] (`None`: what the process may use).
+    memory_limit: Option<u64>,
+    /// [`Builder::unoptimised_limit`].
+    unoptimised_limit: u64,
 }
 
 impl Builder {
@@ -116,7 +120,30 @@ impl Builder {
             split_above: emit::SPLIT_ABOVE,
             regressor_form: RegressorForm::Auto,
             derivatives_form: DerivativesForm::Auto,
+            memory_limit: None,
+            unoptimised_limit: crate::DEFAULT_UNOPTIMISED_LIMIT,
         }
+    }
+
+    /// The memory (bytes) the generator may use for this model (default: the process's
+    /// address-space limit or the machine's memory, whichever is smaller; [`crate::available_memory`]).
+    /// A model whose estimated peak ([`crate::estimate`]) is larger is the typed
+    /// [`Error::TooLarge`] before anything is derived, instead of an aborted allocation.
+    /// `u64::MAX` turns the check off.
+    pub fn memory_limit(mut self, bytes: u64) -> Self {
+        self.memory_limit = Some(bytes);
+        self
+    }
+
+    /// The largest module (estimated bytes of Rust, [`crate::estimate`]) that
+    /// [`Builder::build`] generates for an unoptimised build (a build script whose crate has
+    /// `OPT_LEVEL=0`, cargo's default `dev` profile); a larger one is the typed
+    /// [`Error::TooLarge`] naming the settings that help, before rustc spends minutes and
+    /// gigabytes on it (default [`crate::DEFAULT_UNOPTIMISED_LIMIT`]; `u64::MAX` turns the
+    /// check off).
+    pub fn unoptimised_limit(mut self, bytes: u64) -> Self {
+        self.unoptimised_limit = bytes;
+        self
     }
 
     /// Generate from the URDF file `path` (relative to the crate's manifest directory when run
@@ -428,12 +455,24 @@ impl Builder {
         for f in &self.frames {
             robot.add_frame(f)?;
         }
+        let limit = self.memory_limit.or_else(crate::available_memory);
+        crate::size::check_generator_memory(&robot, &self.options, limit)?;
+        if self.for_unoptimised_build() {
+            crate::size::check_unoptimised_build(&robot, &self.options, self.unoptimised_limit)?;
+        }
         generate_combined(
             robot,
             self.options,
             &self.combined,
             &self.emit_options(notes),
         )
+    }
+
+    /// Whether this runs in a cargo build script of a crate built without optimisation
+    /// (`OPT_LEVEL=0`, with `OUT_DIR` set).
+    fn for_unoptimised_build(&self) -> bool {
+        std::env::var_os("OUT_DIR").is_some()
+            && std::env::var("OPT_LEVEL").is_ok_and(|level| level == "0")
     }
 
     /// The default output file name (see [`Builder::output`]).

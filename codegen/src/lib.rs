@@ -124,6 +124,7 @@ pub mod pinocchio;
 #[doc(hidden)]
 pub mod registry;
 mod report;
+mod size;
 mod warnings;
 /// The robot description IR and its loaders (re-exported from `kanegen-model`).
 pub mod model {
@@ -141,6 +142,7 @@ pub use options::{
 };
 pub use registry::{FunctionId, FunctionSet};
 pub use report::{listing, stats};
+pub use size::{DEFAULT_UNOPTIMISED_LIMIT, SizeEstimate, available_memory, estimate};
 
 /// Anything that can go wrong while generating.
 #[derive(Debug, thiserror::Error)]
@@ -179,6 +181,18 @@ pub enum Error {
         path: PathBuf,
         /// The OS error.
         source: std::io::Error,
+    },
+    /// The model is too large for this generation: its estimated memory exceeds what the
+    /// process may use, or its module is too large for an unoptimised build
+    /// ([`estimate`], docs/big-models.md). Found before anything is derived.
+    #[error("model `{model}` is too large: {what}; {fix}")]
+    TooLarge {
+        /// The model's name.
+        model: String,
+        /// The estimate and the limit it exceeds.
+        what: String,
+        /// What to do.
+        fix: String,
     },
     /// The build script environment lacks `OUT_DIR`.
     #[error(

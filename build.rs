@@ -4,7 +4,8 @@
 //! `tests/kinematics.rs`, the arm and the two-link model with every registry function; for
 //! `tests/mimic.rs`, a gripper with mimic joints; for `tests/big_tree.rs`, a 100-DOF tree; for
 //! `tests/isa_batch.rs`, a cart on a rail (structurally zero c, g, C) with every registry
-//! function and the batched forms.
+//! function and the batched forms; for `tests/unicode_names.rs`, two models with names in
+//! Greek and Japanese.
 //! The TOML Krang models come from `krang-dynamics`.
 use kanegen::model::{UrdfOptions, WheeledBaseSpec};
 
@@ -47,6 +48,13 @@ fn main() {
         .functions(kanegen::FunctionSet::all())
         .batch(true)
         .output("slider.rs")
+        .run();
+    // Names in Greek and Japanese (links, joints, a speed `qd_ψ`), for `tests/unicode_names.rs`.
+    kanegen::Builder::urdf("tests/data/unicode_arm.urdf", UrdfOptions::default())
+        .output("unicode_arm.rs")
+        .run();
+    kanegen::Builder::new("tests/data/unicode_two_link.toml")
+        .output("unicode_two_link.rs")
         .run();
     kanegen::Builder::urdf("models/Krang.urdf", krang_urdf_options())
         .output("krang_urdf.rs")

@@ -10,8 +10,9 @@
 pub use kanegen_model::names::{accel, cos, index_constant, sin, type_name};
 
 /// A model name as a Rust identifier, by the one sanitiser
-/// [`sanitize_identifier`](kanegen_model::sanitize_identifier): ASCII letters, digits and `_`
-/// are kept, every other character becomes `_`, a name that is empty or starts with a digit gets
+/// [`sanitize_identifier`](kanegen_model::sanitize_identifier): NFC; letters of every script,
+/// digits and `_` are kept, ASCII punctuation becomes `_` and other characters their code point
+/// (`_u2192_`), a name that is empty or starts with a digit gets
 /// a leading `_`, and a keyword gets a trailing `_`. Names of a validated model are returned
 /// unchanged.
 pub fn identifier(name: &str) -> String {

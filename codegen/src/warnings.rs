@@ -6,12 +6,16 @@
 //! snapped to π/2 (…)`); the emitter writes them all into the generated file's header. A build
 //! prints only the kinds below, each once, with its count, the first few names and the
 //! [`UrdfOptions`](crate::model::UrdfOptions) field that decides it; a non-physical link
-//! inertia (loaded as written or repaired) gets a line of its own, with its numbers. Notes of what the caller
+//! inertia (loaded as written or repaired) gets a line of its own, with its numbers (the first
+//! five; the rest are summarised in one line). Notes of what the caller
 //! asked for by name (`drop_links`, a `mimic` mode, the wheeled base's constants) and of links
 //! fixed to the base (no effect on the dynamics) are left to the header.
 
 /// How many names a summary line shows before `and N more`.
 const NAMES_SHOWN: usize = 3;
+/// How many notes of a kind printed one line each ([`Kind::each`]) are printed before the rest
+/// are summarised in one line (a generated tree with the same inertia on every link).
+const EACH_SHOWN: usize = 5;
 
 /// One kind of note: how to recognise it, what its line says, where its names are.
 struct Kind {
@@ -150,8 +154,8 @@ const KINDS: &[Kind] = &[
 ];
 
 /// The summary lines of the import `notes` of the model loaded from `source`, one per kind
-/// present (one per note for non-physical inertias, which question a link's numbers), in a
-/// fixed order:
+/// present (one per note for non-physical inertias, which question a link's numbers: the
+/// first five, then a summary line of the rest), in a fixed order:
 ///
 /// ```text
 /// kanegen: arm.urdf: 2 angles snapped to a multiple of π/2 (j1, j2); UrdfOptions::snap_angles = AngleSnap::Off keeps angles as written
@@ -161,18 +165,23 @@ const KINDS: &[Kind] = &[
 pub(crate) fn summary(source: &str, notes: &[String]) -> Vec<String> {
     let mut lines = Vec::new();
     for kind in KINDS {
+        let matching: Vec<&String> = notes.iter().filter(|n| (kind.matches)(n)).collect();
+        let mut rest = &matching[..];
+        let mut more = "";
         if kind.each {
-            for note in notes.iter().filter(|n| (kind.matches)(n)) {
+            let shown = matching.len().min(EACH_SHOWN);
+            for note in &matching[..shown] {
                 lines.push(one_line(&format!(
                     "kanegen: {source}: {note}; {}",
                     kind.remedy
                 )));
             }
-            continue;
+            rest = &matching[shown..];
+            more = "more ";
         }
         let mut count = 0;
         let mut names: Vec<String> = Vec::new();
-        for note in notes.iter().filter(|n| (kind.matches)(n)) {
+        for note in rest {
             let found = (kind.names)(note);
             count += if kind.count_notes { 1 } else { found.len() };
             for name in found {
@@ -195,7 +204,7 @@ pub(crate) fn summary(source: &str, notes: &[String]) -> Vec<String> {
             shown.push_str(&format!(" and {} more", names.len() - NAMES_SHOWN));
         }
         let line = format!(
-            "kanegen: {source}: {count} {noun} {} ({shown}); {}",
+            "kanegen: {source}: {count} {more}{noun} {} ({shown}); {}",
             kind.what, kind.remedy
         );
         lines.push(one_line(&line));
@@ -223,18 +232,10 @@ pub(crate) fn not_printed_yet(lines: Vec<String>) -> Vec<String> {
 }
 
 /// `text` as one line that cannot end or extend a cargo instruction: control characters
-/// (newlines included) and bidirectional-text controls are escaped (`\n`, `\u{202e}`).
+/// (newlines included) and bidirectional-text controls are escaped (`\n`, `\u{202e}`), by the
+/// one escaping rule of [`kanegen_model::escape_unprintable`].
 pub(crate) fn one_line(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        let bidi = matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
-        if c.is_control() || bidi {
-            out.extend(c.escape_default());
-        } else {
-            out.push(c);
-        }
-    }
-    out
+    kanegen_model::escape_unprintable(text)
 }
 
 #[cfg(test)]
@@ -262,6 +263,35 @@ mod tests {
             ]
         );
         assert!(summary("arm.urdf", &[]).is_empty());
+    }
+
+    #[test]
+    fn non_physical_inertias_get_a_line_each_then_a_summary() {
+        let notes: Vec<String> = (0..7)
+            .map(|i| {
+                format!(
+                    "link `l{i}`: the inertia (…) has the principal moments 1, 1, 3 about the \
+                     centre of mass: triangle inequality, by 33.33 % of the largest; kept as written"
+                )
+            })
+            .collect();
+        let lines = summary("tree.urdf", &notes);
+        assert_eq!(lines.len(), 6, "{lines:?}");
+        for (i, line) in lines[..5].iter().enumerate() {
+            assert!(
+                line.starts_with(&format!("kanegen: tree.urdf: link `l{i}`: ")),
+                "{line}"
+            );
+            assert!(
+                line.ends_with("Repair repairs it, Error refuses it"),
+                "{line}"
+            );
+        }
+        assert_eq!(
+            lines[5],
+            "kanegen: tree.urdf: 2 more non-physical inertias loaded as written (l5, l6); \
+             UrdfOptions::non_physical_inertia = NonPhysicalInertia::Repair repairs it, Error refuses it"
+        );
     }
 
     #[test]

@@ -99,24 +99,51 @@ const HOSTILE: &str = r#"<robot name="arm">
   </joint>
 </robot>"#;
 
+/// Link names with control characters (a newline would end a generated comment) are typed
+/// errors naming the frame, escaped.
 #[test]
-fn link_names_cannot_inject_code_through_comments() {
-    let import = UrdfImport::parse(HOSTILE, "hostile.urdf", &UrdfOptions::default())
-        .expect("the arm imports");
-    assert!(
-        import.notes.iter().any(|n| n.contains("injected3")),
-        "the merge note names the hostile link: {:?}",
-        import.notes
-    );
+fn link_names_with_control_characters_are_typed_errors() {
+    let e = UrdfImport::parse(HOSTILE, "hostile.urdf", &UrdfOptions::default()).unwrap_err();
+    let K::BadName(b) = &e.kind else {
+        panic!("expected BadName, got {:?}", e.kind)
+    };
+    assert_eq!(b.item, r"frame `a\npub fn injected() -> u32 { 42 }`");
+    assert!(b.problem.contains("'\\n'"), "{}", b.problem);
+}
+
+/// A frame name with a newline in a model built in memory is refused by the generator too.
+#[test]
+fn a_frame_name_with_a_newline_is_a_typed_error() {
+    let mut m = two_link();
+    let last = m.links.len() - 1;
+    m.links[last].name = "2\nlet d1 = 0.0;\n".into();
+    match Builder::from_model(m).generate() {
+        Err(Error::Model(e)) => match e.kind {
+            K::BadName(b) => {
+                assert_eq!(b.item, r"frame `2\nlet d1 = 0.0;\n`");
+                assert_eq!(b.name, r"2\nlet d1 = 0.0;\n");
+            }
+            other => panic!("expected BadName, got {other:?}"),
+        },
+        other => panic!("expected a model error, got {other:?}"),
+    }
+}
+
+/// Every comment that carries input is escaped: notes with a newline or a bidirectional
+/// override cannot inject code.
+#[test]
+fn notes_cannot_inject_code_through_comments() {
+    let import = UrdfImport {
+        model: two_link(),
+        notes: vec![
+            "c\npub fn injected3() -> u32 { 42 }".into(),
+            "b\r\u{202E}pub fn injected2() -> u32 { 42 }".into(),
+        ],
+    };
     let g = Builder::from_import(import).generate().expect("generates");
     let src = &g.source;
-    // The link names reach the statement labels and the notes, escaped.
-    assert!(
-        src.contains(r"a\npub fn injected() -> u32 { 42 }.z"),
-        "labels"
-    );
-    assert!(src.contains(r"b\r\u{202e}pub fn injected2()"), "labels");
     assert!(src.contains(r"c\npub fn injected3()"), "notes");
+    assert!(src.contains(r"b\r\u{202e}pub fn injected2()"), "notes");
     assert!(!src.contains('\u{202E}') && !src.contains('\r'));
     for line in src.lines().filter(|l| l.contains("pub fn injected")) {
         let comment = line

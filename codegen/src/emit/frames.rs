@@ -22,7 +22,11 @@ pub(super) fn variants(model: &Model) -> Vec<String> {
         let mut v = String::new();
         let mut up = true;
         for ch in link.name.chars() {
-            if ch.is_ascii_alphanumeric() {
+            // Letters of every script are kept (`肘` → `肘`, `ψ` → `Ψ`), other characters
+            // separate words.
+            let letter =
+                !ch.is_ascii() && kanegen_model::is_identifier(ch.encode_utf8(&mut [0; 4]));
+            if ch.is_ascii_alphanumeric() || letter {
                 if up {
                     v.extend(ch.to_uppercase());
                 } else {
@@ -36,7 +40,7 @@ pub(super) fn variants(model: &Model) -> Vec<String> {
         if v.is_empty() || v.starts_with(|c: char| c.is_ascii_digit()) {
             v.insert(0, 'F');
         }
-        if out.iter().any(|o| o.eq_ignore_ascii_case(&v)) {
+        if out.iter().any(|o| o.to_lowercase() == v.to_lowercase()) {
             v.push_str(&i.to_string());
         }
         out.push(v);

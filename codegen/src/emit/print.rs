@@ -185,18 +185,5 @@ impl Printer<'_> {
 /// `\u{202e}`). Every comment text that comes from input (header, notes, statement labels)
 /// goes through this function.
 pub(crate) fn comment_text(s: &str) -> String {
-    let escaped =
-        |c: char| c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}');
-    if !s.chars().any(escaped) {
-        return s.to_owned();
-    }
-    s.chars()
-        .flat_map(|c| {
-            if c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}') {
-                c.escape_default().collect::<Vec<_>>()
-            } else {
-                vec![c]
-            }
-        })
-        .collect()
+    kanegen_model::escape_unprintable(s)
 }

@@ -27,7 +27,9 @@ mod validate;
 
 pub use error::{BadName, ModelError, ModelErrorKind};
 pub use frames::OperationalFrame;
-pub use ident::{is_keyword, sanitize_identifier};
+pub use ident::{
+    escape_unprintable, is_identifier, is_keyword, is_unprintable, nfc, sanitize_identifier,
+};
 pub use ir::*;
 pub use limits::{MAX_DESCRIPTION_BYTES, MAX_PARAMETER_MAGNITUDE, MAX_URDF_DEPTH};
 pub use mass_matrix::kinetic_energy_mass_matrix;

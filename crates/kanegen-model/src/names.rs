@@ -14,23 +14,26 @@
 //! * the wrapper type is [`type_name`] of the model name (`krang-fixed-wheels` →
 //!   `KrangFixedWheels`), next to the module's items ([`RESERVED_ITEMS`]).
 //!
-//! Frame, joint and body names appear only in comments and documentation, which are escaped.
+//! Frame, joint and body names appear only in comments, documentation and string literals.
 //!
 //! The rule ([`Model::check_names`], run by both loaders after the URDF importer's
 //! [`crate::sanitize_identifier`], and by the generator on any model):
 //!
-//! 1. coordinates, speeds and parameters are Rust identifiers as written (ASCII letters, digits
-//!    and `_`, not starting with a digit) and no Rust keyword; the error proposes the sanitised
-//!    spelling;
+//! 1. coordinates, speeds and parameters are Rust identifiers as written (rustc's rule: an
+//!    `XID_Start` character or `_`, then `XID_Continue` characters — letters of every script,
+//!    digits, `_` — in Unicode normalisation form C) and no Rust keyword; the error proposes
+//!    the sanitised spelling;
 //! 2. none of them is a name that generated code binds itself ([`is_reserved`]): `k<digits>`,
 //!    `d<digits>`, `t<digits>`, `pc<digits>`, [`RESERVED_LOCALS`], [`RESERVED_ITEMS`], or the
 //!    model's wrapper type;
 //! 3. the local names of a function body (coordinates, speeds, accelerations, sines, cosines)
-//!    are distinct ignoring ASCII case (so a speed `s_q_w` cannot shadow the sine of `q_w`, and
-//!    `qa`/`QA` cannot both give the index constant `QA`); parameters are distinct;
+//!    are distinct ignoring case (so a speed `s_q_w` cannot shadow the sine of `q_w`, and
+//!    `qa`/`QA`, or `q_ψ`/`q_Ψ`, cannot both give one index constant); parameters are distinct;
 //! 4. the model's wrapper type is not a keyword or a name of [`RESERVED_ITEMS`], and the model
 //!    name has no control or bidirectional-override characters (it is written into comments and
-//!    documentation).
+//!    documentation);
+//! 5. frame, joint and body names have no control or bidirectional-override characters
+//!    ([`crate::is_unprintable`]): a newline in a frame name is an error naming the frame.
 //!
 //! The generated locals keep their short shapes (`k12`, `d3`): generated code stays as readable
 //! as the reports, and the rule rejects model names of those shapes instead.
@@ -38,7 +41,7 @@
 use std::collections::HashMap;
 
 use crate::error::{BadName, ModelError, ModelErrorKind as K};
-use crate::ident::{is_keyword, sanitize_identifier};
+use crate::ident::{escape_unprintable, is_keyword, is_unprintable, sanitize_identifier};
 use crate::ir::{JointKind, Model};
 
 /// Names that generated function bodies bind or call besides the model's names and the
@@ -119,9 +122,10 @@ pub fn cos(coordinate: &str) -> String {
     format!("c_{coordinate}")
 }
 
-/// Name of the index constant of a coordinate: `q_imu` → `Q_IMU`.
+/// Name of the index constant of a coordinate: `q_imu` → `Q_IMU`, `q_ψ` → `Q_Ψ` (Unicode upper
+/// case; letters without case, such as `肘`, stay).
 pub fn index_constant(coordinate: &str) -> String {
-    coordinate.to_ascii_uppercase()
+    coordinate.to_uppercase()
 }
 
 /// The wrapper type of a model: `krang-fixed-wheels` → `KrangFixedWheels` (`Model…` if the
@@ -169,12 +173,6 @@ pub fn is_reserved(name: &str) -> bool {
     is_generated_local(name) || RESERVED_LOCALS.contains(&name) || RESERVED_ITEMS.contains(&name)
 }
 
-/// Characters that rustc rejects in comments and literals (`text_direction_codepoint_*` lints),
-/// and control characters.
-fn is_unprintable(c: char) -> bool {
-    c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}')
-}
-
 /// The typed error for name `name` of `item`.
 fn bad(item: String, name: &str, problem: String, fix: String) -> K {
     K::BadName(Box::new(BadName {
@@ -200,8 +198,11 @@ fn check_identifier(item: &str, name: &str, taken: &dyn Fn(&str) -> bool) -> Res
     }
     let problem = if is_keyword(name) {
         "is a Rust keyword"
+    } else if crate::ident::is_identifier(&crate::ident::nfc(name)) {
+        "is not in Unicode normalisation form C (rustc normalises identifiers to NFC)"
     } else {
-        "is not a Rust identifier (ASCII letters, digits and `_`, not starting with a digit)"
+        "is not a Rust identifier (letters of any script, digits and `_`, not starting with a \
+         digit)"
     };
     Err(bad(
         item.to_owned(),
@@ -284,7 +285,7 @@ fn check_model_name(model: &Model) -> Result<String, K> {
     if let Some(c) = model.name.chars().find(|&c| is_unprintable(c)) {
         return Err(bad(
             item,
-            &model.name.escape_default().to_string(),
+            &escape_unprintable(&model.name),
             format!(
                 "contains the character {:?}, which generated comments and documentation cannot carry",
                 c
@@ -340,23 +341,24 @@ fn check_params(model: &Model, ty: &str) -> Result<(), K> {
     Ok(())
 }
 
-/// The local names of function bodies: identifiers, not reserved, distinct ignoring ASCII case.
+/// The local names of function bodies: identifiers, not reserved, distinct ignoring case (as
+/// upper-cased by [`index_constant`]).
 fn check_locals(model: &Model, ty: &str) -> Result<(), K> {
     let locals = locals(model);
     let folded: HashMap<String, usize> = locals
         .iter()
         .enumerate()
         .rev()
-        .map(|(k, l)| (l.name.to_ascii_lowercase(), k))
+        .map(|(k, l)| (index_constant(&l.name), k))
         .collect();
     for (k, l) in locals.iter().enumerate() {
         if l.written {
             check_identifier(&l.item, &l.name, &|n| {
-                folded.contains_key(&n.to_ascii_lowercase())
+                folded.contains_key(&index_constant(n))
             })?;
         }
         check_not_reserved(&l.item, &l.name, ty)?;
-        let first = folded[&l.name.to_ascii_lowercase()];
+        let first = folded[&index_constant(&l.name)];
         if first != k {
             // Report the name the model writes (a derived name follows from it).
             let other = &locals[first];
@@ -365,7 +367,7 @@ fn check_locals(model: &Model, ty: &str) -> Result<(), K> {
                 format!("is also the name of the {} in generated code", clash.item)
             } else {
                 format!(
-                    "equals `{}`, the name of the {}, ignoring ASCII case (generated index \
+                    "equals `{}`, the name of the {}, ignoring case (generated index \
                      constants are upper-cased)",
                     clash.name, clash.item
                 )
@@ -381,9 +383,38 @@ fn check_locals(model: &Model, ty: &str) -> Result<(), K> {
     Ok(())
 }
 
+/// The names that generated comments, documentation and string literals carry as written
+/// (frames, joints, bodies): printable, so that no name can end a comment and start code.
+fn check_printable(model: &Model) -> Result<(), K> {
+    for link in &model.links {
+        let mut names = vec![("frame", &link.name)];
+        if let Some(j) = link.joint() {
+            names.push(("joint", &j.name));
+        }
+        if let Some(b) = &link.body {
+            names.push(("body", &b.name));
+        }
+        for (what, name) in names {
+            if let Some(c) = name.chars().find(|&c| is_unprintable(c)) {
+                return Err(bad(
+                    format!("{what} `{}`", escape_unprintable(name)),
+                    &escape_unprintable(name),
+                    format!(
+                        "contains the character {c:?}, which generated comments, documentation \
+                         and name strings cannot carry as written"
+                    ),
+                    "rename it without control or bidirectional-override characters".into(),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The one validation of every name that reaches generated code (see the [module](self)).
 pub(crate) fn check(model: &Model) -> Result<(), K> {
     let ty = check_model_name(model)?;
+    check_printable(model)?;
     check_params(model, &ty)?;
     check_locals(model, &ty)
 }

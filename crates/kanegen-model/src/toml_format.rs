@@ -304,11 +304,7 @@ fn parse_length(entry: &LengthEntry, joint: &str, syms: &mut Symbols) -> Result<
                 Some(rest) => (-1.0, rest.trim()),
                 None => (1.0, t.strip_prefix('+').unwrap_or(t).trim()),
             };
-            let valid = name
-                .chars()
-                .next()
-                .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
-                && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+            let valid = crate::ident::is_identifier(name);
             if !valid {
                 return Err(K::BadLength {
                     joint: joint.to_owned(),

@@ -27,8 +27,9 @@
 //!   `XY_L1`, `XZ_L1`, `YY_L1`, `YZ_L1`, `ZZ_L1` (also the field names of the generated `Params`);
 //!   the gravity magnitude is `g`; a moving joint `LJ1` has the coordinate `q_LJ1` and the speed
 //!   `qd_LJ1` (generated index constant `Q_LJ1`). Each of these names, and the body name, is made
-//!   an identifier by [`sanitize_identifier`](crate::sanitize_identifier) (every character other
-//!   than ASCII letters, digits and `_` becomes `_`: link `base-link` gives `m_base_link`), then
+//!   an identifier by [`sanitize_identifier`](crate::sanitize_identifier) (letters of every
+//!   script are kept, ASCII punctuation becomes `_`, other symbols their escaped code point: link
+//!   `base-link` gives `m_base_link`, `肘` gives `m_肘`, `a→b` gives `m_a_u2192_b`), then
 //!   checked by [`Model::check_names`] like the names of a TOML model (names that are equal once
 //!   sanitised or ignoring case, or a `<robot name>` that cannot name the wrapper type, are
 //!   typed errors).

@@ -156,7 +156,11 @@ pub(crate) fn model(m: &Model) -> String {
                 "base: floating frame `{}`, coordinates {} (position in the world, quaternion base → world), speeds {} (linear and angular velocity in the base frame)",
                 m.links[0].name,
                 m.coordinate_names()[..7].join(", "),
-                m.speeds[..6].iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
+                m.speeds[..6]
+                    .iter()
+                    .map(|s| s.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
             );
         }
     }

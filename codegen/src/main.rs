@@ -483,7 +483,9 @@ impl Args {
                     base.pitch_name = p.clone();
                 }
                 if self.floating {
-                    return Err("--floating and --wheeled exclude each other: a model has one base".into());
+                    return Err(
+                        "--floating and --wheeled exclude each other: a model has one base".into(),
+                    );
                 }
                 UrdfOptions::wheeled(base)
             }

@@ -130,6 +130,10 @@ pub struct Derivation {
     pub functions: Vec<Function>,
     /// Number of speeds.
     pub dof: usize,
+    /// Number of coordinates (the length of `q`): `dof`, or `dof + 1` for a floating base.
+    pub nq: usize,
+    /// Whether the base is floating ([`kanegen_model::Base::Floating`]).
+    pub floating: bool,
     /// Options used.
     pub options: Options,
     /// The body frames' names (the model's links, in order): the frames of the per-frame
@@ -253,6 +257,9 @@ pub fn derive_shaped(
 ) -> Derivation {
     let mut arena = Arena::new(names_of(model));
     arena.hoist_params = options.params.is_runtime();
+    if model.is_floating() {
+        arena.set_floating();
+    }
     mimic::declare(&mut arena, model);
     let mut cx = Ctx {
         ar: &mut arena,
@@ -357,13 +364,17 @@ pub fn derive_shaped(
         arena,
         functions,
         dof: n,
+        nq: model.nq(),
+        floating: model.is_floating(),
         options,
         frame_names: model.links.iter().map(|l| l.name.clone()).collect(),
         regressors,
         sizes,
         combined: combined_out,
         derivative_loop,
-        mirror: Mirror::of(model),
+        // A floating base's coordinates are not indexed like its speeds, which the pairing of
+        // mirrored subtrees assumes.
+        mirror: Mirror::of(model).filter(|_| !model.is_floating()),
     }
 }
 

@@ -316,7 +316,11 @@ impl Model {
     /// Index in `q` of the coordinate of speed `s`: `s`, or `s + 1` for a joint speed of a
     /// floating base (after the base's seven coordinates).
     pub fn coordinate_index(&self, s: usize) -> usize {
-        if self.is_floating() && s >= 6 { s + 1 } else { s }
+        if self.is_floating() && s >= 6 {
+            s + 1
+        } else {
+            s
+        }
     }
 
     /// The coordinate names of generated code, in the order of `q` ([`Model::nq`] of them): the

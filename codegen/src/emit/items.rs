@@ -18,6 +18,9 @@ use kanegen_model::{Model, ParamKind};
 /// (`Q_IMU`) and one per speed (`QD_IMU`), the same index, unless the speed's constant would
 /// repeat a name already taken.
 pub(super) fn names(cx: &Context<'_>) -> TokenStream {
+    if cx.low.floating {
+        return floating_names(cx);
+    }
     let model = cx.model;
     let nl = idx(cx.low.dof);
     // The independent speeds (a mimic joint's dependent speed is not an input).
@@ -54,6 +57,65 @@ pub(super) fn names(cx: &Context<'_>) -> TokenStream {
 
         /// Index constants: of each coordinate in `q` (`Q_IMU`) and of its speed in `u`, `u̇`
         /// and `τ` (`QD_IMU`); a coordinate and its speed have the same index.
+        pub mod index {
+            #(#index_consts)*
+        }
+    }
+}
+
+/// [`names`] of a floating base: `NQ = DOF + 1` coordinates (the base's seven first), and the
+/// index constants of each coordinate in `q` and of each speed in `u`.
+fn floating_names(cx: &Context<'_>) -> TokenStream {
+    let model = cx.model;
+    let (nl, nq) = (idx(cx.low.dof), idx(cx.low.nq));
+    let speeds = &model.speeds[..cx.low.dof];
+    let speed_names: Vec<&str> = speeds.iter().map(|s| s.name.as_str()).collect();
+    let coord_names = model.coordinate_names();
+    let mut taken: Vec<String> = coord_names
+        .iter()
+        .map(|c| ident(&c.to_uppercase()).to_string())
+        .collect();
+    let mut index_consts = Vec::new();
+    for (k, c) in coord_names.iter().enumerate() {
+        let id = ident(&c.to_uppercase());
+        let doc = format!(" Index of the coordinate `{c}` in q.");
+        let k = idx(k);
+        index_consts.push(quote!(#[doc = #doc] pub const #id: usize = #k;));
+    }
+    for (i, s) in speeds.iter().enumerate() {
+        let speed_id = ident(&s.name.to_uppercase());
+        if !taken.contains(&speed_id.to_string()) {
+            taken.push(speed_id.to_string());
+            let doc = if i < 6 {
+                format!(
+                    " Index of the floating base's speed `{}` in u, u̇ and τ.",
+                    s.name
+                )
+            } else {
+                format!(
+                    " Index of the speed `{}` in u, u̇ and τ (the rate of `{}`).",
+                    s.name, s.coordinate
+                )
+            };
+            let i = idx(i);
+            index_consts.push(quote!(#[doc = #doc] pub const #speed_id: usize = #i;));
+        }
+    }
+    quote! {
+        /// Number of generalized speeds: the floating base's six (`v`, `ω` in the base frame),
+        /// then the joints'.
+        pub const DOF: usize = #nl;
+        /// Number of coordinates: the floating base's seven (position in the world, unit
+        /// quaternion `(qx, qy, qz, qw)` base → world), then the joints'.
+        pub const NQ: usize = #nq;
+        /// Generalized speed names, in the order of `u`.
+        pub const SPEED_NAMES: [&str; #nl] = [#(#speed_names),*];
+        /// Coordinate names, in the order of `q`.
+        pub const COORDINATE_NAMES: [&str; #nq] = [#(#coord_names),*];
+
+        /// Index constants: of each coordinate in `q` (`Q_HIP`, `BASE_QW`) and of each speed in
+        /// `u`, `u̇` and `τ` (`QD_HIP`, `BASE_WX`). A joint's coordinate is one place after its
+        /// speed (the base's quaternion has four entries for three speeds).
         pub mod index {
             #(#index_consts)*
         }
@@ -415,6 +477,9 @@ pub(super) fn wrapper(cx: &Context<'_>, batched: bool) -> TokenStream {
 
 /// The `kanegen-runtime` traits whose functions the module has all of.
 pub(super) fn trait_impls(cx: &Context<'_>) -> TokenStream {
+    if cx.low.floating {
+        return TokenStream::new();
+    }
     let ty = ident(&naming::type_name(&cx.model.name));
     let t = scalar_type(cx.precision);
     let mut out = TokenStream::new();

@@ -4,7 +4,8 @@
 //! `tests/kinematics.rs`, the arm and the two-link model with every registry function; for
 //! `tests/mimic.rs`, a gripper with mimic joints; for `tests/big_tree.rs`, a 100-DOF tree; for
 //! `tests/isa_batch.rs`, a cart on a rail (structurally zero c, g, C) with every registry
-//! function and the batched forms.
+//! function and the batched forms; for `tests/floating_base.rs`, the small floating-base model
+//! `models/floating-hopper.toml` and Solo 12 (`tests/corpus/solo12.urdf`) on a floating base.
 //! The TOML Krang models come from `krang-dynamics`.
 use kanegen::model::{UrdfOptions, WheeledBaseSpec};
 
@@ -47,6 +48,20 @@ fn main() {
         .functions(kanegen::FunctionSet::all())
         .batch(true)
         .output("slider.rs")
+        .run();
+    // Floating bases (M, c, g, τ, nonlinear effects), for `tests/floating_base.rs`.
+    let floating = kanegen::FunctionSet::default()
+        .iter()
+        .filter(|f| *f != kanegen::FunctionId::CoriolisMatrix)
+        .chain([kanegen::FunctionId::NonlinearEffects])
+        .collect::<kanegen::FunctionSet>();
+    kanegen::Builder::new("models/floating-hopper.toml")
+        .functions(floating)
+        .output("floating_hopper.rs")
+        .run();
+    kanegen::Builder::urdf("tests/corpus/solo12.urdf", UrdfOptions::floating())
+        .functions(floating)
+        .output("solo12_floating.rs")
         .run();
     kanegen::Builder::urdf("models/Krang.urdf", krang_urdf_options())
         .output("krang_urdf.rs")

@@ -412,6 +412,9 @@ pub(super) fn wrapper(cx: &Context<'_>, batched: bool) -> TokenStream {
     methods.extend(super::combined::methods(cx));
     methods.extend(super::regressor_loop::methods(cx));
     methods.extend(super::derivatives_loop::methods(cx));
+    if cx.low.floating {
+        methods.extend(configuration_methods(cx));
+    }
     if batched {
         methods.extend(super::batch::methods(cx));
     }
@@ -478,7 +481,7 @@ pub(super) fn wrapper(cx: &Context<'_>, batched: bool) -> TokenStream {
 /// The `kanegen-runtime` traits whose functions the module has all of.
 pub(super) fn trait_impls(cx: &Context<'_>) -> TokenStream {
     if cx.low.floating {
-        return TokenStream::new();
+        return floating_trait_impl(cx);
     }
     let ty = ident(&naming::type_name(&cx.model.name));
     let t = scalar_type(cx.precision);
@@ -547,4 +550,87 @@ pub(super) fn trait_impls(cx: &Context<'_>) -> TokenStream {
         });
     }
     out
+}
+
+/// A floating base's configuration-space methods of the wrapper (`kanegen_runtime::free_flyer`).
+fn configuration_methods(cx: &Context<'_>) -> TokenStream {
+    let t = scalar_type(cx.precision);
+    quote! {
+        /// The neutral configuration: the base at the world origin with the identity quaternion,
+        /// the joints at zero (`pinocchio::neutral`).
+        #[inline]
+        pub fn neutral(&self) -> SVector<#t, NQ> {
+            kanegen_runtime::free_flyer::neutral()
+        }
+        /// `q ⊕ u dt`: the base moves by the SE(3) exponential of its twist `(v, ω) dt` in the
+        /// base frame, the joints by `u dt` (`pinocchio::integrate`); the quaternion stays unit.
+        #[inline]
+        pub fn integrate(&self, q: &SVector<#t, NQ>, u: &SVector<#t, DOF>, dt: #t) -> SVector<#t, NQ> {
+            kanegen_runtime::free_flyer::integrate(q, u, dt)
+        }
+        /// The speeds `δ` with `integrate(q0, δ, 1) = q1`: the SE(3) logarithm of the relative
+        /// base pose and the joints' differences (`pinocchio::difference`).
+        #[inline]
+        pub fn difference(&self, q0: &SVector<#t, NQ>, q1: &SVector<#t, NQ>) -> SVector<#t, DOF> {
+            kanegen_runtime::free_flyer::difference(q0, q1)
+        }
+        /// `q` with the base's quaternion scaled to unit norm (`pinocchio::normalize`).
+        #[inline]
+        pub fn normalize(&self, q: &SVector<#t, NQ>) -> SVector<#t, NQ> {
+            kanegen_runtime::free_flyer::normalize(q)
+        }
+    }
+}
+
+/// A floating base's `kanegen_runtime::Multibody` implementation, when the module has M, c, g
+/// and τ (it cannot implement `RobotDynamics`, whose `q` has `DOF` entries).
+fn floating_trait_impl(cx: &Context<'_>) -> TokenStream {
+    let complete = crate::registry::FUNCTIONS
+        .iter()
+        .filter(|s| s.runtime_trait == Some(RuntimeTrait::RobotDynamics))
+        .all(|s| cx.low.functions.iter().any(|f| f.id == s.id));
+    if !complete {
+        return TokenStream::new();
+    }
+    let ty = ident(&naming::type_name(&cx.model.name));
+    let t = scalar_type(cx.precision);
+    let forward = |name: &str, inputs| {
+        let spec = crate::registry::FUNCTIONS
+            .iter()
+            .find(|s| s.name == name)
+            .expect("registry function");
+        let f = ident(name);
+        let (args, _) = state_args(cx, inputs);
+        let ret = return_type(cx, spec);
+        let call = forward_call(cx, spec);
+        quote!(fn #f(&self, #args) -> #ret { #call })
+    };
+    use crate::registry::Inputs;
+    let methods = [
+        forward("mass_matrix", Inputs::Q),
+        forward("coriolis", Inputs::QU),
+        forward("gravity", Inputs::Q),
+        forward("inverse_dynamics", Inputs::QUUd),
+    ];
+    quote! {
+        impl kanegen_runtime::Multibody<DOF> for #ty {
+            type Scalar = #t;
+            type Configuration = SVector<#t, NQ>;
+            const SPEED_NAMES: [&'static str; DOF] = SPEED_NAMES;
+            const COORDINATE_NAMES: &'static [&'static str] = &COORDINATE_NAMES;
+            fn neutral(&self) -> SVector<#t, NQ> {
+                kanegen_runtime::free_flyer::neutral()
+            }
+            fn integrate(&self, q: &SVector<#t, NQ>, u: &SVector<#t, DOF>, dt: #t) -> SVector<#t, NQ> {
+                kanegen_runtime::free_flyer::integrate(q, u, dt)
+            }
+            fn difference(&self, q0: &SVector<#t, NQ>, q1: &SVector<#t, NQ>) -> SVector<#t, DOF> {
+                kanegen_runtime::free_flyer::difference(q0, q1)
+            }
+            fn normalize(&self, q: &SVector<#t, NQ>) -> SVector<#t, NQ> {
+                kanegen_runtime::free_flyer::normalize(q)
+            }
+            #(#methods)*
+        }
+    }
 }

@@ -267,3 +267,16 @@ pub fn integrate(model: &Model, q: &[f64], delta: &[f64]) -> Vec<f64> {
     }
     out
 }
+
+/// The centre of mass in the world frame.
+pub fn center_of_mass(model: &Model, p: &[f64], q: &[f64]) -> Vector3<f64> {
+    let r0 = base_rotation(q);
+    let p0 = Vector3::new(q[0], q[1], q[2]);
+    let (mut m, mut mp) = (0.0, Vector3::zeros());
+    for (l, (r, o)) in link_poses(model, q, p).iter().enumerate() {
+        let (mass, h, _) = body(model, l, p);
+        m += mass;
+        mp += mass * (p0 + r0 * o) + r0 * r * h;
+    }
+    mp / m
+}

@@ -49,16 +49,17 @@ fn main() {
         .batch(true)
         .output("slider.rs")
         .run();
-    // Floating bases (M, c, g, τ, nonlinear effects), for `tests/floating_base.rs`.
+    // Floating bases, for `tests/floating_base.rs`: the hopper with every function a floating
+    // base has, Solo 12 with M, c, g, τ and the nonlinear effects.
+    kanegen::Builder::new("models/floating-hopper.toml")
+        .functions(kanegen::floating::SUPPORTED.into_iter().collect())
+        .output("floating_hopper.rs")
+        .run();
     let floating = kanegen::FunctionSet::default()
         .iter()
         .filter(|f| *f != kanegen::FunctionId::CoriolisMatrix)
         .chain([kanegen::FunctionId::NonlinearEffects])
         .collect::<kanegen::FunctionSet>();
-    kanegen::Builder::new("models/floating-hopper.toml")
-        .functions(floating)
-        .output("floating_hopper.rs")
-        .run();
     kanegen::Builder::urdf("tests/corpus/solo12.urdf", UrdfOptions::floating())
         .functions(floating)
         .output("solo12_floating.rs")

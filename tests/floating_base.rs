@@ -41,8 +41,11 @@ fn hopper_model() -> Model {
 }
 
 fn solo_model() -> Model {
-    Model::from_urdf_file(root().join("tests/corpus/solo12.urdf"), &UrdfOptions::floating())
-        .expect("imports")
+    Model::from_urdf_file(
+        root().join("tests/corpus/solo12.urdf"),
+        &UrdfOptions::floating(),
+    )
+    .expect("imports")
 }
 
 /// A deterministic pseudo-random stream in [0, 1).
@@ -61,7 +64,11 @@ fn rel(a: &DVector<f64>, b: &DVector<f64>) -> f64 {
 
 /// The generated functions against the recursion, the configuration helpers and free fall, for
 /// one floating robot `R` with `N` speeds and `NQ` coordinates.
-fn check<R: Multibody<N, Scalar = f64, Configuration = SVector<f64, NQ>>, const N: usize, const NQ: usize>(
+fn check<
+    R: Multibody<N, Scalar = f64, Configuration = SVector<f64, NQ>>,
+    const N: usize,
+    const NQ: usize,
+>(
     robot: &R,
     model: &Model,
     nle: &dyn Fn(&SVector<f64, NQ>, &SVector<f64, N>) -> SVector<f64, N>,
@@ -72,34 +79,61 @@ fn check<R: Multibody<N, Scalar = f64, Configuration = SVector<f64, NQ>>, const 
     let params = model.param_values();
     let mut uniform = stream(seed);
     for _ in 0..3 {
-        let q = SVector::<f64, NQ>::from_column_slice(&free_flyer::random_configuration(model, &mut uniform));
+        let q = SVector::<f64, NQ>::from_column_slice(&free_flyer::random_configuration(
+            model,
+            &mut uniform,
+        ));
         let u: SVector<f64, N> = random_speeds(&mut uniform, 2.0);
         let ud: SVector<f64, N> = random_speeds(&mut uniform, 5.0);
         let dv = |v: SVector<f64, N>| DVector::from_column_slice(v.as_slice());
         let zero = [0.0; N];
-        let tau_ref = free_flyer::rnea(model, &params, q.as_slice(), u.as_slice(), ud.as_slice(), true);
+        let tau_ref = free_flyer::rnea(
+            model,
+            &params,
+            q.as_slice(),
+            u.as_slice(),
+            ud.as_slice(),
+            true,
+        );
         let c_ref = free_flyer::rnea(model, &params, q.as_slice(), u.as_slice(), &zero, false);
         let g_ref = free_flyer::rnea(model, &params, q.as_slice(), &zero, &zero, true);
         let m_ref = free_flyer::mass_matrix(model, &params, q.as_slice());
-        assert!(rel(&dv(robot.inverse_dynamics(&q, &u, &ud)), &tau_ref) < 1e-10, "τ");
+        assert!(
+            rel(&dv(robot.inverse_dynamics(&q, &u, &ud)), &tau_ref) < 1e-10,
+            "τ"
+        );
         assert!(rel(&dv(robot.coriolis(&q, &u)), &c_ref) < 1e-10, "c");
         assert!(rel(&dv(robot.gravity(&q)), &g_ref) < 1e-10, "g");
-        assert!(rel(&dv(nle(&q, &u)), &(&c_ref + &g_ref)) < 1e-10, "nonlinear effects");
+        assert!(
+            rel(&dv(nle(&q, &u)), &(&c_ref + &g_ref)) < 1e-10,
+            "nonlinear effects"
+        );
         let m = robot.mass_matrix(&q);
         let m_d = nalgebra::DMatrix::from_column_slice(N, N, m.as_slice());
         assert!((m_d - &m_ref).amax() < 1e-10 * m_ref.amax(), "M");
 
         // The configuration helpers.
         let q1 = robot.integrate(&q, &u, 0.7);
-        assert!((q1.fixed_rows::<4>(3).norm() - 1.0).abs() < 1e-14, "unit quaternion");
+        assert!(
+            (q1.fixed_rows::<4>(3).norm() - 1.0).abs() < 1e-14,
+            "unit quaternion"
+        );
         let back = robot.integrate(&q, &robot.difference(&q, &q1), 1.0);
-        assert!((back - q1).amax() < 1e-13, "integrate(q0, difference(q0, q1), 1) = q1");
+        assert!(
+            (back - q1).amax() < 1e-13,
+            "integrate(q0, difference(q0, q1), 1) = q1"
+        );
         let ours = free_flyer::integrate(model, q.as_slice(), (u * 0.7).as_slice());
-        assert!((q1 - SVector::<f64, NQ>::from_column_slice(&ours)).amax() < 1e-13, "q ⊕ δ");
+        assert!(
+            (q1 - SVector::<f64, NQ>::from_column_slice(&ours)).amax() < 1e-13,
+            "q ⊕ δ"
+        );
 
         // Free fall: τ = 0, the centre of mass accelerates at g. Its second difference along the
         // motion (u(t) = u + u̇ t, integrated in small midpoint steps on SE(3)).
-        let fall = robot.forward_dynamics(&q, &u, &SVector::zeros()).expect("M positive definite");
+        let fall = robot
+            .forward_dynamics(&q, &u, &SVector::zeros())
+            .expect("M positive definite");
         let at = |t: f64| {
             let steps = 20;
             let dt = t / steps as f64;
@@ -113,20 +147,33 @@ fn check<R: Multibody<N, Scalar = f64, Configuration = SVector<f64, NQ>>, const 
         let h = 1e-3;
         let acc = (at(h) - 2.0 * at(0.0) + at(-h)) / (h * h);
         let g = params[model.gravity.symbol] * nalgebra::Vector3::from(model.gravity.direction);
-        assert!((acc - g).norm() < 1e-4 * g.norm(), "free fall: {acc} vs {g}");
+        assert!(
+            (acc - g).norm() < 1e-4 * g.norm(),
+            "free fall: {acc} vs {g}"
+        );
     }
 }
 
 #[test]
 fn floating_hopper_generated_dynamics_helpers_and_free_fall() {
     let robot = hopper::FloatingHopper::default();
-    check(&robot, &hopper_model(), &|q, u| robot.nonlinear_effects(q, u), 21);
+    check(
+        &robot,
+        &hopper_model(),
+        &|q, u| robot.nonlinear_effects(q, u),
+        21,
+    );
 }
 
 #[test]
 fn floating_solo12_generated_dynamics_helpers_and_free_fall() {
     let robot = solo::Solo::default();
-    check(&robot, &solo_model(), &|q, u| robot.nonlinear_effects(q, u), 22);
+    check(
+        &robot,
+        &solo_model(),
+        &|q, u| robot.nonlinear_effects(q, u),
+        22,
+    );
 }
 
 /// A PD law in the tangent space, written once: the torque that gives
@@ -145,11 +192,14 @@ fn pd<R: Multibody<N, Scalar = f64>, const N: usize>(
 /// dynamics of its torque give back the commanded acceleration.
 fn run_generic<R: Multibody<N, Scalar = f64>, const N: usize>(robot: &R, seed: u64) {
     let mut uniform = stream(seed);
-    let q = robot.normalize(&robot.integrate(&robot.neutral(), &random_speeds(&mut uniform, 0.5), 1.0));
+    let q =
+        robot.normalize(&robot.integrate(&robot.neutral(), &random_speeds(&mut uniform, 0.5), 1.0));
     let q_ref = robot.integrate(&q, &random_speeds(&mut uniform, 0.3), 1.0);
     let u: SVector<f64, N> = random_speeds(&mut uniform, 1.0);
     let (tau, ud) = pd(robot, &q, &u, &q_ref);
-    let back = robot.forward_dynamics(&q, &u, &tau).expect("M positive definite");
+    let back = robot
+        .forward_dynamics(&q, &u, &tau)
+        .expect("M positive definite");
     assert!((back - ud).amax() < 1e-8 * ud.amax().max(1.0));
 }
 

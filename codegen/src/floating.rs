@@ -15,16 +15,24 @@ use crate::registry::FunctionId;
 use crate::{Error, model};
 
 /// The registry functions generated for a floating base.
-pub const SUPPORTED: [FunctionId; 5] = [
+pub const SUPPORTED: [FunctionId; 13] = [
     FunctionId::MassMatrix,
     FunctionId::Coriolis,
     FunctionId::Gravity,
     FunctionId::InverseDynamics,
     FunctionId::NonlinearEffects,
+    FunctionId::CenterOfMass,
+    FunctionId::ComJacobian,
+    FunctionId::ComBiasAcceleration,
+    FunctionId::KineticEnergy,
+    FunctionId::PotentialEnergy,
+    FunctionId::FramePose,
+    FunctionId::FrameJacobian,
+    FunctionId::FrameBiasAcceleration,
 ];
 
 /// The fix the errors suggest.
-const FIX: &str = "generate M, c, g, τ and nonlinear_effects only (`.functions(FunctionSet::default())`, `--functions default`) for a floating base";
+const FIX: &str = "leave it out for a floating base (M, c, g, τ, nonlinear_effects, the kinematics and the energies are generated; `Builder::coriolis_matrix(false)` or `--no-coriolis-matrix` leaves out the default Coriolis matrix)";
 
 /// [`Error::FloatingBase`] if `robot` has a floating base and the options ask for something
 /// outside [`SUPPORTED`].

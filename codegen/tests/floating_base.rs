@@ -8,7 +8,11 @@
 //!   and `½ uᵀ M u` is the bodies' kinetic energy;
 //! * g is the gradient of the potential energy in the tangent space (`q ⊕ δ`, central
 //!   differences);
-//! * the base position never enters τ.
+//! * the base position never enters τ;
+//! * kinematics and energies: every frame's world pose and the centre of mass equal the
+//!   recursion's; along trajectories integrated on SE(3) (`q ⊕ δ`), `J u` is the derivative of
+//!   the frame's world pose and of the centre of mass and `J u̇ + bias` the second derivative
+//!   (in the base frame's axes); `T = ½ uᵀ M u` and `V` equal the recursion's.
 
 #[path = "support/free_flyer.rs"]
 mod free_flyer;
@@ -17,7 +21,7 @@ use kanegen::kane::derive;
 use kanegen::model::{Model, UrdfOptions, kinetic_energy_mass_matrix};
 use kanegen::{FunctionId, FunctionSet, Options};
 use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 fn model(name: &str) -> Model {
     let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -148,6 +152,205 @@ fn check_model(name: &str, seed: u64) {
             DVector::from_vec(d.evaluate(FunctionId::InverseDynamics, &params, &moved, &u, &ud));
         assert_eq!(tau_moved, tau, "{name}: τ independent of the base position");
     }
+}
+
+const KINEMATICS: [FunctionId; 8] = [
+    FunctionId::CenterOfMass,
+    FunctionId::ComJacobian,
+    FunctionId::ComBiasAcceleration,
+    FunctionId::KineticEnergy,
+    FunctionId::PotentialEnergy,
+    FunctionId::FramePose,
+    FunctionId::FrameJacobian,
+    FunctionId::FrameBiasAcceleration,
+];
+
+/// The world pose of link `l` from the recursion: `(R, p)`.
+fn world_pose(model: &Model, params: &[f64], q: &[f64], l: usize) -> (Matrix3<f64>, Vector3<f64>) {
+    let (r, o) = free_flyer::link_poses(model, q, params)[l];
+    let r0 = free_flyer::base_rotation(q);
+    (r0 * r, Vector3::new(q[0], q[1], q[2]) + r0 * o)
+}
+
+fn check_kinematics(name: &str, seed: u64) {
+    let model = model(name);
+    let n = model.dof();
+    let options = Options {
+        functions: DYNAMICS
+            .into_iter()
+            .chain(KINEMATICS)
+            .collect::<FunctionSet>(),
+        ..Options::default()
+    };
+    let d = derive(&model, options);
+    let mut r = SplitMix64::new(seed);
+    let mut uniform = move || r.next_f64();
+    let params = random_physical_params(&model, &mut uniform);
+    let q = free_flyer::random_configuration(&model, &mut uniform);
+    let u = uniform_vec(&mut uniform, n, -1.5, 1.5);
+    let ud = uniform_vec(&mut uniform, n, -3.0, 3.0);
+    let zero = vec![0.0; n];
+    // The motion q(t) with u(t) = u + u̇ t, integrated on SE(3) in midpoint steps.
+    let state = |t: f64| {
+        let steps = 40;
+        let dt = t / steps as f64;
+        let mut x = q.clone();
+        for k in 0..steps {
+            let mid: Vec<f64> = (0..n)
+                .map(|i| (u[i] + ud[i] * dt * (k as f64 + 0.5)) * dt)
+                .collect();
+            x = free_flyer::integrate(&model, &x, &mid);
+        }
+        let ut: Vec<f64> = (0..n).map(|i| u[i] + ud[i] * t).collect();
+        (x, ut)
+    };
+    let h = 2e-4;
+    let samples = [-h, 0.0, h].map(state);
+    let r0 = free_flyer::base_rotation(&q);
+    let eval_at =
+        |id, frame, q: &[f64], u: &[f64], ud: &[f64]| d.evaluate_at(id, frame, &params, q, u, ud);
+    let close = |a: Vector3<f64>, b: Vector3<f64>, tol: f64, what: &str| {
+        assert!(
+            (a - b).norm() <= tol * b.norm().max(1.0),
+            "{name}: {what}: {a} vs {b}"
+        );
+    };
+    for l in 0..model.links.len() {
+        let pose = eval_at(FunctionId::FramePose, Some(l), &q, &zero, &zero);
+        let (rw, pw) = world_pose(&model, &params, &q, l);
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!(
+                    (pose[i * 4 + j] - rw[(i, j)]).abs() < 1e-12,
+                    "{name}: frame {l} rotation"
+                );
+            }
+            assert!(
+                (pose[i * 4 + 3] - pw[i]).abs() < 1e-12,
+                "{name}: frame {l} origin"
+            );
+        }
+        // J u against the derivative of the world pose (base axes), J u̇ + bias against the
+        // second derivative.
+        let jac = DMatrix::from_row_slice(
+            6,
+            n,
+            &eval_at(FunctionId::FrameJacobian, Some(l), &q, &zero, &zero),
+        );
+        let bias = eval_at(FunctionId::FrameBiasAcceleration, Some(l), &q, &u, &zero);
+        let poses = samples
+            .clone()
+            .map(|(x, _)| world_pose(&model, &params, &x, l));
+        let vel = &jac * DVector::from_vec(u.clone());
+        let acc = &jac * DVector::from_vec(ud.clone()) + DVector::from_vec(bias);
+        let v_fd = (poses[2].1 - poses[0].1) / (2.0 * h);
+        let a_fd = (poses[2].1 - 2.0 * poses[1].1 + poses[0].1) / (h * h);
+        close(
+            Vector3::new(vel[0], vel[1], vel[2]),
+            r0.transpose() * v_fd,
+            1e-6,
+            "frame velocity",
+        );
+        close(
+            Vector3::new(acc[0], acc[1], acc[2]),
+            r0.transpose() * a_fd,
+            1e-5,
+            "frame acceleration",
+        );
+        let w_of = |(rm, _): &(Matrix3<f64>, Vector3<f64>),
+                    (rp, _): &(Matrix3<f64>, Vector3<f64>),
+                    dt: f64| {
+            let s = (rp - rm) / dt * rp.transpose();
+            Vector3::new(
+                s[(2, 1)] - s[(1, 2)],
+                s[(0, 2)] - s[(2, 0)],
+                s[(1, 0)] - s[(0, 1)],
+            ) / 2.0
+        };
+        let w_fd = w_of(&poses[0], &poses[2], 2.0 * h);
+        close(
+            Vector3::new(vel[3], vel[4], vel[5]),
+            r0.transpose() * w_fd,
+            1e-5,
+            "frame angular velocity",
+        );
+        // Angular acceleration: the derivative of the world angular velocity (J u at q(t), u(t)).
+        let w_world = |(x, ut): &(Vec<f64>, Vec<f64>)| {
+            let j = DMatrix::from_row_slice(
+                6,
+                n,
+                &eval_at(FunctionId::FrameJacobian, Some(l), x, &zero, &zero),
+            );
+            let w = &j * DVector::from_vec(ut.clone());
+            free_flyer::base_rotation(x) * Vector3::new(w[3], w[4], w[5])
+        };
+        let alpha_fd = (w_world(&samples[2]) - w_world(&samples[0])) / (2.0 * h);
+        close(
+            Vector3::new(acc[3], acc[4], acc[5]),
+            r0.transpose() * alpha_fd,
+            1e-5,
+            "frame angular acceleration",
+        );
+    }
+    // Centre of mass: position, J u, J u̇ + bias.
+    let com = |x: &[f64]| free_flyer::center_of_mass(&model, &params, x);
+    let c = eval_at(FunctionId::CenterOfMass, None, &q, &zero, &zero);
+    close(
+        Vector3::new(c[0], c[1], c[2]),
+        com(&q),
+        1e-12,
+        "centre of mass",
+    );
+    let jg = DMatrix::from_row_slice(
+        3,
+        n,
+        &eval_at(FunctionId::ComJacobian, None, &q, &zero, &zero),
+    );
+    let bg = eval_at(FunctionId::ComBiasAcceleration, None, &q, &u, &zero);
+    let cs = samples.clone().map(|(x, _)| com(&x));
+    let vg = &jg * DVector::from_vec(u.clone());
+    let ag = &jg * DVector::from_vec(ud.clone()) + DVector::from_vec(bg);
+    close(
+        Vector3::new(vg[0], vg[1], vg[2]),
+        r0.transpose() * (cs[2] - cs[0]) / (2.0 * h),
+        1e-6,
+        "CoM velocity",
+    );
+    close(
+        Vector3::new(ag[0], ag[1], ag[2]),
+        r0.transpose() * (cs[2] - 2.0 * cs[1] + cs[0]) / (h * h),
+        1e-5,
+        "CoM acceleration",
+    );
+    // Energies.
+    let m = DMatrix::from_row_slice(
+        n,
+        n,
+        &d.evaluate(FunctionId::MassMatrix, &params, &q, &zero, &zero),
+    );
+    let t = d.evaluate(FunctionId::KineticEnergy, &params, &q, &u, &zero)[0];
+    let uv = DVector::from_vec(u.clone());
+    assert!(
+        (t - 0.5 * uv.dot(&(&m * &uv))).abs() < 1e-10 * t.abs().max(1.0),
+        "{name}: T = ½ uᵀMu"
+    );
+    let t_ref = free_flyer::kinetic_energy(&model, &params, &q, &u);
+    assert!(
+        (t - t_ref).abs() < 1e-10 * t_ref.abs().max(1.0),
+        "{name}: T"
+    );
+    let v = d.evaluate(FunctionId::PotentialEnergy, &params, &q, &zero, &zero)[0];
+    let v_ref = free_flyer::potential_energy(&model, &params, &q);
+    assert!(
+        (v - v_ref).abs() < 1e-10 * v_ref.abs().max(1.0),
+        "{name}: V {v} vs {v_ref}"
+    );
+}
+
+#[test]
+fn floating_kinematics_and_energies_match_the_recursion_and_finite_differences() {
+    check_kinematics("floating-hopper.toml", 13);
+    check_kinematics("solo12.urdf", 14);
 }
 
 #[test]

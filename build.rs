@@ -50,14 +50,13 @@ fn main() {
         .output("slider.rs")
         .run();
     // Floating bases, for `tests/floating_base.rs`: the hopper with every function a floating
-    // base has, Solo 12 with M, c, g, τ and the nonlinear effects.
+    // base has, Solo 12 with the default functions and the nonlinear effects.
     kanegen::Builder::new("models/floating-hopper.toml")
         .functions(kanegen::floating::SUPPORTED.into_iter().collect())
         .output("floating_hopper.rs")
         .run();
     let floating = kanegen::FunctionSet::default()
         .iter()
-        .filter(|f| *f != kanegen::FunctionId::CoriolisMatrix)
         .chain([kanegen::FunctionId::NonlinearEffects])
         .collect::<kanegen::FunctionSet>();
     kanegen::Builder::urdf("tests/corpus/solo12.urdf", UrdfOptions::floating())

@@ -15,9 +15,10 @@ use crate::registry::FunctionId;
 use crate::{Error, model};
 
 /// The registry functions generated for a floating base.
-pub const SUPPORTED: [FunctionId; 13] = [
+pub const SUPPORTED: [FunctionId; 14] = [
     FunctionId::MassMatrix,
     FunctionId::Coriolis,
+    FunctionId::CoriolisMatrix,
     FunctionId::Gravity,
     FunctionId::InverseDynamics,
     FunctionId::NonlinearEffects,
@@ -32,7 +33,7 @@ pub const SUPPORTED: [FunctionId; 13] = [
 ];
 
 /// The fix the errors suggest.
-const FIX: &str = "leave it out for a floating base (M, c, g, τ, nonlinear_effects, the kinematics and the energies are generated; `Builder::coriolis_matrix(false)` or `--no-coriolis-matrix` leaves out the default Coriolis matrix)";
+const FIX: &str = "leave it out for a floating base (M, c, g, τ, the Coriolis matrix, nonlinear_effects, the kinematics and the energies are generated)";
 
 /// [`Error::FloatingBase`] if `robot` has a floating base and the options ask for something
 /// outside [`SUPPORTED`].

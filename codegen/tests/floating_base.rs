@@ -33,8 +33,9 @@ fn model(name: &str) -> Model {
     }
 }
 
-const DYNAMICS: [FunctionId; 5] = [
+const DYNAMICS: [FunctionId; 6] = [
     FunctionId::MassMatrix,
+    FunctionId::CoriolisMatrix,
     FunctionId::Coriolis,
     FunctionId::Gravity,
     FunctionId::InverseDynamics,
@@ -143,6 +144,31 @@ fn check_model(name: &str, seed: u64) {
                 g[k]
             );
         }
+
+        // The Coriolis matrix: C u = c, and Ṁ − 2C skew-symmetric (Ṁ by central differences
+        // along q ⊕ u t).
+        let cm = DMatrix::from_row_slice(
+            n,
+            n,
+            &d.evaluate(FunctionId::CoriolisMatrix, &params, &q, &u, &zero),
+        );
+        assert!(rel_err(&(&cm * &u_v), &c) < 1e-10, "{name}: C u = c");
+        let m_at = |t: f64| {
+            let step: Vec<f64> = u.iter().map(|x| x * t).collect();
+            let x = free_flyer::integrate(&model, &q, &step);
+            DMatrix::from_row_slice(
+                n,
+                n,
+                &d.evaluate(FunctionId::MassMatrix, &params, &x, &zero, &zero),
+            )
+        };
+        let hs = 1e-5;
+        let mdot = (m_at(hs) - m_at(-hs)) / (2.0 * hs);
+        let skew = &mdot - &cm * 2.0;
+        assert!(
+            (&skew + skew.transpose()).amax() < 1e-6 * mdot.amax().max(1.0),
+            "{name}: Ṁ − 2C skew"
+        );
 
         // The base position does not enter τ.
         let mut moved = q.clone();

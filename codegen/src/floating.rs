@@ -15,7 +15,8 @@ use crate::registry::FunctionId;
 use crate::{Error, model};
 
 /// The registry functions generated for a floating base.
-pub const SUPPORTED: [FunctionId; 14] = [
+pub const SUPPORTED: [FunctionId; 15] = [
+    FunctionId::InverseDynamicsDerivatives,
     FunctionId::MassMatrix,
     FunctionId::Coriolis,
     FunctionId::CoriolisMatrix,
@@ -33,7 +34,7 @@ pub const SUPPORTED: [FunctionId; 14] = [
 ];
 
 /// The fix the errors suggest.
-const FIX: &str = "leave it out for a floating base (M, c, g, τ, the Coriolis matrix, nonlinear_effects, the kinematics and the energies are generated)";
+const FIX: &str = "leave it out for a floating base (M, c, g, τ, the Coriolis matrix, nonlinear_effects, the derivatives, the kinematics and the energies are generated)";
 
 /// [`Error::FloatingBase`] if `robot` has a floating base and the options ask for something
 /// outside [`SUPPORTED`].

@@ -33,7 +33,8 @@ fn model(name: &str) -> Model {
     }
 }
 
-const DYNAMICS: [FunctionId; 6] = [
+const DYNAMICS: [FunctionId; 7] = [
+    FunctionId::InverseDynamicsDerivatives,
     FunctionId::MassMatrix,
     FunctionId::CoriolisMatrix,
     FunctionId::Coriolis,
@@ -169,6 +170,38 @@ fn check_model(name: &str, seed: u64) {
             (&skew + skew.transpose()).amax() < 1e-6 * mdot.amax().max(1.0),
             "{name}: Ṁ − 2C skew"
         );
+
+        // ∂τ/∂q in the tangent space and ∂τ/∂u against central differences of τ along
+        // q ⊕ ε eₖ and u + ε eₖ.
+        let dd = DMatrix::from_row_slice(
+            n,
+            2 * n,
+            &d.evaluate(FunctionId::InverseDynamicsDerivatives, &params, &q, &u, &ud),
+        );
+        let eps = 1e-6;
+        for k in 0..n {
+            let mut dp = vec![0.0; n];
+            dp[k] = eps;
+            let dm: Vec<f64> = dp.iter().map(|x| -x).collect();
+            let at = |x: &[f64], v: &[f64]| {
+                DVector::from_vec(d.evaluate(FunctionId::InverseDynamics, &params, x, v, &ud))
+            };
+            let fq = (at(&free_flyer::integrate(&model, &q, &dp), &u)
+                - at(&free_flyer::integrate(&model, &q, &dm), &u))
+                / (2.0 * eps);
+            let up: Vec<f64> = u.iter().zip(&dp).map(|(a, b)| a + b).collect();
+            let um: Vec<f64> = u.iter().zip(&dm).map(|(a, b)| a + b).collect();
+            let fu = (at(&q, &up) - at(&q, &um)) / (2.0 * eps);
+            let scale = tau.amax().max(1.0);
+            assert!(
+                (dd.column(k) - &fq).amax() < 1e-6 * scale,
+                "{name}: ∂τ/∂q[{k}]"
+            );
+            assert!(
+                (dd.column(n + k) - &fu).amax() < 1e-6 * scale,
+                "{name}: ∂τ/∂u[{k}]"
+            );
+        }
 
         // The base position does not enter τ.
         let mut moved = q.clone();

@@ -15,7 +15,10 @@ use crate::registry::FunctionId;
 use crate::{Error, model};
 
 /// The registry functions generated for a floating base.
-pub const SUPPORTED: [FunctionId; 15] = [
+pub const SUPPORTED: [FunctionId; 18] = [
+    FunctionId::CentroidalMomentumMatrix,
+    FunctionId::CentroidalMomentumBias,
+    FunctionId::CentroidalInertia,
     FunctionId::InverseDynamicsDerivatives,
     FunctionId::MassMatrix,
     FunctionId::Coriolis,
@@ -34,7 +37,7 @@ pub const SUPPORTED: [FunctionId; 15] = [
 ];
 
 /// The fix the errors suggest.
-const FIX: &str = "leave it out for a floating base (M, c, g, τ, the Coriolis matrix, nonlinear_effects, the derivatives, the kinematics and the energies are generated)";
+const FIX: &str = "leave it out for a floating base (M, c, g, τ, the Coriolis matrix, nonlinear_effects, the derivatives, the kinematics, the energies and the centroidal functions are generated)";
 
 /// [`Error::FloatingBase`] if `robot` has a floating base and the options ask for something
 /// outside [`SUPPORTED`].

@@ -12,13 +12,19 @@
 //! * kinematics and energies: every frame's world pose and the centre of mass equal the
 //!   recursion's; along trajectories integrated on SE(3) (`q ⊕ δ`), `J u` is the derivative of
 //!   the frame's world pose and of the centre of mass and `J u̇ + bias` the second derivative
-//!   (in the base frame's axes); `T = ½ uᵀ M u` and `V` equal the recursion's.
+//!   (in the base frame's axes); `T = ½ uᵀ M u` and `V` equal the recursion's;
+//! * centroidal functions: `A_G u` is the momentum summed over the bodies (linear, angular about
+//!   the centre of mass, world axes), `A_G u̇ + Ȧ_G u` its derivative along the motion, and
+//!   `I_G` gives the angular momentum of the robot turning rigidly; on fixed bases `A_G` and
+//!   `Ȧ_G u` equal the joint columns of the same tree on a floating base at rest.
 
 #[path = "support/free_flyer.rs"]
 mod free_flyer;
 
 use kanegen::kane::derive;
-use kanegen::model::{Model, UrdfOptions, kinetic_energy_mass_matrix};
+use kanegen::model::{
+    Base, JointKind, Model, UrdfOptions, floating_base_speeds, kinetic_energy_mass_matrix,
+};
 use kanegen::{FunctionId, FunctionSet, Options};
 use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
@@ -213,7 +219,10 @@ fn check_model(name: &str, seed: u64) {
     }
 }
 
-const KINEMATICS: [FunctionId; 8] = [
+const KINEMATICS: [FunctionId; 11] = [
+    FunctionId::CentroidalMomentumMatrix,
+    FunctionId::CentroidalMomentumBias,
+    FunctionId::CentroidalInertia,
     FunctionId::CenterOfMass,
     FunctionId::ComJacobian,
     FunctionId::ComBiasAcceleration,
@@ -381,6 +390,68 @@ fn check_kinematics(name: &str, seed: u64) {
         1e-5,
         "CoM acceleration",
     );
+    // Centroidal momentum: A_G u against the bodies' momentum, A_G u̇ + Ȧ_G u against the
+    // derivative of A_G u along the motion, I_G against a rigid rotation.
+    let ag_at = |x: &[f64]| {
+        DMatrix::from_row_slice(
+            6,
+            n,
+            &eval_at(FunctionId::CentroidalMomentumMatrix, None, x, &zero, &zero),
+        )
+    };
+    let ag = ag_at(&q);
+    let hg = &ag * DVector::from_vec(u.clone());
+    let (lin, ang) = free_flyer::centroidal_momentum(&model, &params, &q, &u);
+    close(
+        Vector3::new(hg[0], hg[1], hg[2]),
+        lin,
+        1e-12,
+        "linear momentum",
+    );
+    close(
+        Vector3::new(hg[3], hg[4], hg[5]),
+        ang,
+        1e-12,
+        "angular momentum about the CoM",
+    );
+    let bias = DVector::from_vec(eval_at(
+        FunctionId::CentroidalMomentumBias,
+        None,
+        &q,
+        &u,
+        &zero,
+    ));
+    let rate = &ag * DVector::from_vec(ud.clone()) + bias;
+    let hs = samples
+        .clone()
+        .map(|(x, ut)| ag_at(&x) * DVector::from_vec(ut));
+    let fd = (&hs[2] - &hs[0]) / (2.0 * h);
+    assert!(
+        (&rate - &fd).amax() < 1e-6 * fd.amax().max(1.0),
+        "{name}: Ȧ_G u\n{rate}\n{fd}"
+    );
+    let ig = DMatrix::from_row_slice(
+        6,
+        6,
+        &eval_at(FunctionId::CentroidalInertia, None, &q, &zero, &zero),
+    );
+    let mut rigid = vec![0.0; n];
+    rigid[3..6].copy_from_slice(&u[3..6]);
+    let (_, ang) = free_flyer::centroidal_momentum(&model, &params, &q, &rigid);
+    let w_world = r0 * Vector3::new(u[3], u[4], u[5]);
+    let jg = ig.fixed_view::<3, 3>(3, 3).into_owned();
+    close(jg * w_world, ang, 1e-12, "I_G ω = L_G");
+    let total: f64 = model
+        .links
+        .iter()
+        .filter_map(|l| l.body.as_ref())
+        .map(|b| params[b.mass])
+        .sum();
+    assert!(
+        (ig[(0, 0)] - total).abs() < 1e-12 * total,
+        "{name}: I_G mass"
+    );
+
     // Energies.
     let m = DMatrix::from_row_slice(
         n,
@@ -420,4 +491,118 @@ fn floating_toml_model_dynamics_match_the_free_flyer_recursion() {
 #[test]
 fn floating_solo12_dynamics_match_the_free_flyer_recursion() {
     check_model("solo12.urdf", 12);
+}
+
+/// The tree of `fixed` on a floating base (its speeds after the base's six).
+fn on_floating_base(fixed: &Model) -> Model {
+    let mut m = fixed.clone();
+    m.base = Base::Floating;
+    let mut speeds = floating_base_speeds();
+    speeds.extend(m.speeds.drain(..));
+    m.speeds = speeds;
+    for link in &mut m.links {
+        if let Some(mount) = &mut link.mount {
+            mount.joint.kind = match mount.joint.kind {
+                JointKind::Revolute { speed } => JointKind::Revolute { speed: speed + 6 },
+                JointKind::Prismatic { speed } => JointKind::Prismatic { speed: speed + 6 },
+                JointKind::Fixed => JointKind::Fixed,
+            };
+        }
+    }
+    m
+}
+
+#[test]
+fn fixed_base_centroidal_functions_equal_the_floating_tree_at_rest() {
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let arm = Model::from_urdf_file(dir.join("models/singlearm.urdf"), &UrdfOptions::default())
+        .expect("imports");
+    let two_link = Model::from_toml_file(dir.join("models/two-link.toml")).expect("loads");
+    let functions: FunctionSet = FunctionSet::centroidal()
+        .iter()
+        .chain([
+            FunctionId::CenterOfMass,
+            FunctionId::ComJacobian,
+            FunctionId::ComBiasAcceleration,
+        ])
+        .collect();
+    for (k, fixed) in [arm, two_link].into_iter().enumerate() {
+        let floating = on_floating_base(&fixed);
+        let options = Options {
+            functions,
+            ..Options::default()
+        };
+        let (df, dl) = (derive(&fixed, options), derive(&floating, options));
+        let n = fixed.dof();
+        let mut r = SplitMix64::new(40 + k as u64);
+        let mut uniform = move || r.next_f64();
+        let params = random_physical_params(&fixed, &mut uniform);
+        let q = uniform_vec(&mut uniform, n, -3.0, 3.0);
+        let u = uniform_vec(&mut uniform, n, -2.0, 2.0);
+        let mut qf = vec![0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+        qf.extend(&q);
+        let mut uf = vec![0.0; 6];
+        uf.extend(&u);
+        let zero = vec![0.0; n];
+        let zf = vec![0.0; n + 6];
+        let ag = df.evaluate(
+            FunctionId::CentroidalMomentumMatrix,
+            &params,
+            &q,
+            &zero,
+            &zero,
+        );
+        let agf = dl.evaluate(FunctionId::CentroidalMomentumMatrix, &params, &qf, &zf, &zf);
+        for row in 0..6 {
+            for col in 0..n {
+                let (a, b) = (ag[row * n + col], agf[row * (n + 6) + 6 + col]);
+                assert!(
+                    (a - b).abs() < 1e-12 * b.abs().max(1.0),
+                    "{}: A_G[{row},{col}] {a} vs {b}",
+                    fixed.name
+                );
+            }
+        }
+        let bias = DVector::from_vec(df.evaluate(
+            FunctionId::CentroidalMomentumBias,
+            &params,
+            &q,
+            &u,
+            &zero,
+        ));
+        let biasf = DVector::from_vec(dl.evaluate(
+            FunctionId::CentroidalMomentumBias,
+            &params,
+            &qf,
+            &uf,
+            &zf,
+        ));
+        assert!(rel_err(&bias, &biasf) < 1e-12, "{}: Ȧ_G u", fixed.name);
+        let ig = DVector::from_vec(df.evaluate(
+            FunctionId::CentroidalInertia,
+            &params,
+            &q,
+            &zero,
+            &zero,
+        ));
+        let igf =
+            DVector::from_vec(dl.evaluate(FunctionId::CentroidalInertia, &params, &qf, &zf, &zf));
+        assert!(rel_err(&ig, &igf) < 1e-12, "{}: I_G", fixed.name);
+        // Linear rows: m J_G and m times the CoM bias.
+        let jg = df.evaluate(FunctionId::ComJacobian, &params, &q, &zero, &zero);
+        let m = ig[0];
+        for row in 0..3 {
+            for col in 0..n {
+                assert!((ag[row * n + col] - m * jg[row * n + col]).abs() < 1e-12 * m.max(1.0));
+            }
+        }
+        let ab = df.evaluate(FunctionId::ComBiasAcceleration, &params, &q, &u, &zero);
+        for row in 0..3 {
+            assert!(
+                (bias[row] - m * ab[row]).abs() < 1e-10 * m.max(1.0),
+                "{}: linear bias",
+                fixed.name
+            );
+        }
+    }
 }

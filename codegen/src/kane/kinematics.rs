@@ -81,7 +81,7 @@ impl Ctx<'_> {
     }
 
     /// The wheels' total mass `2 mw` (none without a wheeled base).
-    fn wheel_mass(&mut self) -> Option<ExprId> {
+    pub(super) fn wheel_mass(&mut self) -> Option<ExprId> {
         let mw = self.model.wheeled_base()?.wheel_mass;
         let mw = self.param(mw);
         Some(self.ar.scale(mw, 2.0))
@@ -89,7 +89,7 @@ impl Ctx<'_> {
 
     /// `1 / m` for the total mass `m` (wheels included), a D variable (parameter-only: computed
     /// once per parameter set with runtime parameters).
-    fn inverse_total_mass(&mut self, comp: &[Composite]) -> ExprId {
+    pub(super) fn inverse_total_mass(&mut self, comp: &[Composite]) -> ExprId {
         let mut m = comp[0].mass;
         if let Some(mw) = self.wheel_mass() {
             m = self.ar.add(m, mw);
@@ -300,7 +300,7 @@ impl Ctx<'_> {
     }
 
     /// A point given in frame 0 (`x`), in the world: `p0 + R0 x` (floating base).
-    fn to_world(&mut self, x: &V3) -> V3 {
+    pub(super) fn to_world(&mut self, x: &V3) -> V3 {
         let r0 = self.base_rotation();
         let p0 = self.base_position();
         let rx = self.rot_up(&r0, x);

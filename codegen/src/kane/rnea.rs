@@ -86,6 +86,13 @@ impl Ctx<'_> {
         self.inertia_forces(Inputs::new(false, false)).0[0]
     }
 
+    /// [`Ctx::bias_inertia_force`] with the moment about frame 0's origin: the whole robot's
+    /// inertia wrench `(f, n)` at `u̇ = 0` without gravity, in frame 0's axes.
+    pub(super) fn bias_inertia_wrench(&mut self) -> (V3, V3) {
+        let (f, n) = self.inertia_forces(Inputs::new(false, false));
+        (f[0], n[0])
+    }
+
     /// Every frame's motion at `u̇ = 0` without gravity (the variables `c` uses): `(ω, α, a)`
     /// of each frame in its own axes; `a` is the classical acceleration of its origin.
     pub(super) fn bias_motion(&mut self) -> Motion {

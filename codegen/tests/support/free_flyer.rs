@@ -280,3 +280,48 @@ pub fn center_of_mass(model: &Model, p: &[f64], q: &[f64]) -> Vector3<f64> {
     }
     mp / m
 }
+
+/// The whole robot's momentum at `(q, u)` in world axes: linear `P` and angular about the
+/// centre of mass `L_G`, summed over the bodies.
+pub fn centroidal_momentum(
+    model: &Model,
+    p: &[f64],
+    q: &[f64],
+    u: &[f64],
+) -> (Vector3<f64>, Vector3<f64>) {
+    let n = model.links.len();
+    let r0 = base_rotation(q);
+    let p0 = Vector3::new(q[0], q[1], q[2]);
+    let poses = link_poses(model, q, p);
+    let mut w = vec![Vector3::zeros(); n];
+    let mut v = vec![Vector3::zeros(); n];
+    w[0] = Vector3::new(u[3], u[4], u[5]);
+    v[0] = Vector3::new(u[0], u[1], u[2]);
+    let g = center_of_mass(model, p, q);
+    let (mut lin, mut ang) = (Vector3::zeros(), Vector3::zeros());
+    for i in 0..n {
+        if let Some(m) = &model.links[i].mount {
+            let (r, c) = joint_transform(model, i, q, p);
+            let rt = r.transpose();
+            let pi = m.parent;
+            w[i] = rt * w[pi];
+            v[i] = rt * (v[pi] + w[pi].cross(&c));
+            let e = Vector3::from(m.joint.axis);
+            if let Some(s) = m.joint.speed() {
+                match m.joint.kind {
+                    JointKind::Prismatic { .. } => v[i] += e * u[s],
+                    _ => w[i] += e * u[s],
+                }
+            }
+        }
+        let (mass, h, j) = body(model, i, p);
+        // Body momentum about its origin, in its frame: (J ω + h × v, m v − h × ω).
+        let (nb, fb) = (j * w[i] + h.cross(&v[i]), mass * v[i] - h.cross(&w[i]));
+        let rw = r0 * poses[i].0;
+        let origin = p0 + r0 * poses[i].1;
+        let (nw, fw) = (rw * nb, rw * fb);
+        lin += fw;
+        ang += nw + (origin - g).cross(&fw);
+    }
+    (lin, ang)
+}

@@ -15,7 +15,9 @@ use crate::registry::FunctionId;
 use crate::{Error, model};
 
 /// The registry functions generated for a floating base.
-pub const SUPPORTED: [FunctionId; 18] = [
+pub const SUPPORTED: [FunctionId; 20] = [
+    FunctionId::InverseDynamicsRegressor,
+    FunctionId::GravityRegressor,
     FunctionId::CentroidalMomentumMatrix,
     FunctionId::CentroidalMomentumBias,
     FunctionId::CentroidalInertia,
@@ -37,7 +39,7 @@ pub const SUPPORTED: [FunctionId; 18] = [
 ];
 
 /// The fix the errors suggest.
-const FIX: &str = "leave it out for a floating base (M, c, g, τ, the Coriolis matrix, nonlinear_effects, the derivatives, the kinematics, the energies and the centroidal functions are generated)";
+const FIX: &str = "leave it out for a floating base (M, c, g, τ, the Coriolis matrix, nonlinear_effects, the derivatives, the kinematics, the energies, the centroidal functions and the full regressors are generated; the base regressors are not)";
 
 /// [`Error::FloatingBase`] if `robot` has a floating base and the options ask for something
 /// outside [`SUPPORTED`].

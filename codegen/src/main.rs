@@ -52,7 +52,7 @@ options (stats, listing, emit; `show` takes only the URDF import options):
 
 URDF import options (.urdf models; see kanegen_model::UrdfOptions):
   --floating              a floating (free-flyer) base at the URDF root (the default when the
-                          root is a link without inertia whose one joint is `floating`)
+                          root is a bare `world` link whose one joint is `floating`)
   --wheeled LEFT_JOINT,RIGHT_JOINT,BODY_LINK   a two-wheeled inverted-pendulum base
   --up X,Y,Z              the body axis that points up at zero pitch (with --wheeled; default 0,0,1)
   --radius R              wheel radius in m (required with --wheeled)
@@ -114,6 +114,7 @@ fn functions_help() -> String {
         ("default", FunctionSet::default()),
         ("kinematics", FunctionSet::kinematics()),
         ("regressors", FunctionSet::regressors()),
+        ("centroidal", FunctionSet::centroidal()),
     ];
     let mut text = String::from(
         "functions (--functions LIST, comma-separated; each name is a generated function):\n",

@@ -39,7 +39,9 @@ fn model(name: &str) -> Model {
     }
 }
 
-const DYNAMICS: [FunctionId; 7] = [
+const DYNAMICS: [FunctionId; 9] = [
+    FunctionId::InverseDynamicsRegressor,
+    FunctionId::GravityRegressor,
     FunctionId::InverseDynamicsDerivatives,
     FunctionId::MassMatrix,
     FunctionId::CoriolisMatrix,
@@ -208,6 +210,28 @@ fn check_model(name: &str, seed: u64) {
                 "{name}: ∂τ/∂u[{k}]"
             );
         }
+
+        // The regressors: τ = Y π, g = Y_g β.
+        let pi: Vec<f64> = d.regressors.inertial.iter().map(|&k| params[k]).collect();
+        let beta: Vec<f64> = d.regressors.beta.iter().map(|&k| params[k]).collect();
+        let y = DMatrix::from_row_slice(
+            n,
+            pi.len(),
+            &d.evaluate(FunctionId::InverseDynamicsRegressor, &params, &q, &u, &ud),
+        );
+        let yg = DMatrix::from_row_slice(
+            n,
+            beta.len(),
+            &d.evaluate(FunctionId::GravityRegressor, &params, &q, &zero, &zero),
+        );
+        assert!(
+            rel_err(&(&y * DVector::from_vec(pi)), &tau) < 1e-10,
+            "{name}: Y π = τ"
+        );
+        assert!(
+            rel_err(&(&yg * DVector::from_vec(beta)), &g) < 1e-10,
+            "{name}: Y_g β = g"
+        );
 
         // The base position does not enter τ.
         let mut moved = q.clone();
@@ -605,4 +629,110 @@ fn fixed_base_centroidal_functions_equal_the_floating_tree_at_rest() {
             );
         }
     }
+}
+
+/// A small URDF whose root is a bare `world` link with one `floating` joint.
+const WORLD_FLOATING: &str = r#"<robot name="hopper">
+  <link name="world"/>
+  <link name="torso"><inertial><origin xyz="0.01 0 0.05"/><mass value="3"/>
+    <inertia ixx="0.05" ixy="0" ixz="0" iyy="0.06" iyz="0" izz="0.04"/></inertial></link>
+  <link name="leg"><inertial><origin xyz="0 0 -0.2"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.002"/></inertial></link>
+  <joint name="root" type="floating"><parent link="world"/><child link="torso"/></joint>
+  <joint name="hip" type="revolute"><parent link="torso"/><child link="leg"/>
+    <origin xyz="0 0 -0.1"/><axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+</robot>"#;
+
+#[test]
+fn a_urdf_hanging_from_a_world_floating_joint_gets_a_floating_base_by_default() {
+    let import =
+        kanegen::model::UrdfImport::parse(WORLD_FLOATING, "hopper.urdf", &UrdfOptions::default())
+            .expect("imports");
+    let m = &import.model;
+    assert!(m.is_floating());
+    assert_eq!(m.links[0].name, "torso");
+    assert!(m.links[0].body.is_some(), "the base frame's inertia counts");
+    assert_eq!(m.dof(), 7);
+    assert_eq!(m.nq(), 8);
+    assert_eq!(
+        m.coordinate_names(),
+        [
+            "base_x", "base_y", "base_z", "base_qx", "base_qy", "base_qz", "base_qw", "q_hip"
+        ]
+    );
+    assert!(
+        import
+            .notes
+            .iter()
+            .any(|n| n.contains("floating joint `root`")),
+        "{:?}",
+        import.notes
+    );
+    // The same file with the root declared floating explicitly.
+    let declared = Model::from_urdf_str(WORLD_FLOATING, "hopper.urdf", &UrdfOptions::floating())
+        .expect("imports");
+    assert_eq!(&declared, m);
+}
+
+#[test]
+fn what_a_floating_base_does_not_generate_is_a_typed_error() {
+    let model = model("floating-hopper.toml");
+    for (what, builder) in [
+        (
+            "base_regressor",
+            kanegen::Builder::from_model(model.clone()).functions(FunctionSet::regressors()),
+        ),
+        (
+            "batched",
+            kanegen::Builder::from_model(model.clone()).batch(true),
+        ),
+    ] {
+        let err = builder
+            .generate()
+            .expect_err("not generated for a floating base");
+        let text = err.to_string();
+        assert!(
+            matches!(err, kanegen::Error::FloatingBase { .. }),
+            "{what}: {text}"
+        );
+        assert!(
+            text.contains("floating-hopper") && text.contains("floating base"),
+            "{what}: {text}"
+        );
+    }
+}
+
+#[test]
+fn floating_modules_have_nq_coordinates_and_combined_functions() {
+    let model = model("floating-hopper.toml");
+    let combined = kanegen::Combined::new("whole_body")
+        .with(FunctionId::MassMatrix)
+        .with(FunctionId::NonlinearEffects)
+        .with_frame(FunctionId::FrameJacobian, "foot");
+    let g = kanegen::Builder::from_model(model.clone())
+        .functions(FunctionSet::default().with(FunctionId::CentroidalMomentumMatrix))
+        .combined(combined)
+        .generate()
+        .expect("generates");
+    assert!(g.source.contains("pub const NQ: usize = 10;"));
+    assert!(g.source.contains("pub const COORDINATE_NAMES: [&str; 10]"));
+    assert!(
+        g.source
+            .contains("impl kanegen_runtime::Multibody<DOF> for FloatingHopper")
+    );
+    assert!(g.source.contains("q: &SVector<f64, 10>"));
+    let mut r = SplitMix64::new(50);
+    let mut uniform = move || r.next_f64();
+    let params = random_physical_params(&model, &mut uniform);
+    let q = free_flyer::random_configuration(&model, &mut uniform);
+    let u = uniform_vec(&mut uniform, 9, -1.0, 1.0);
+    let zero = vec![0.0; 9];
+    let parts = g.lowered.evaluate_combined(0, &params, &q, &u, &zero);
+    assert_eq!(
+        parts[0],
+        g.lowered
+            .evaluate(FunctionId::MassMatrix, &params, &q, &zero, &zero)
+    );
+    let h = free_flyer::rnea(&model, &params, &q, &u, &zero, true);
+    assert!(rel_err(&DVector::from_vec(parts[1].clone()), &h) < 1e-10);
 }

@@ -191,7 +191,7 @@ fn check_joints(tree: &Tree<'_>, kept: &[usize], cut: &BaseCut, wheeled: bool) -
             J::Floating | J::Planar | J::Spherical => {
                 let fix = match (&j.joint_type, wheeled) {
                     (J::Spherical, _) => "model it as three revolute joints with massless links between them, or make it fixed".to_owned(),
-                    (_, false) => "the generator has fixed, floating and two-wheeled bases: make it fixed; a floating base is the one `floating` joint of a root link without inertia (a `world` link), or the root itself with UrdfBase::Floating; or declare a wheeled base (UrdfBase::Wheeled) whose body link hangs from it".to_owned(),
+                    (_, false) => "the generator has fixed, floating and two-wheeled bases: make it fixed; a floating base is the one `floating` joint of a bare root link named `world`, or the root itself with UrdfBase::Floating; or declare a wheeled base (UrdfBase::Wheeled) whose body link hangs from it".to_owned(),
                     (_, true) => "only the joint directly above the wheeled base's body link (through fixed joints) is replaced by the base; make this one fixed".to_owned(),
                 };
                 return Err(K::UrdfUnsupportedJoint {

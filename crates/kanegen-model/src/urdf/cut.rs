@@ -34,7 +34,7 @@ impl BaseCut {
     }
 
     /// The kept tree of a fixed base (`declared_floating` false) or a floating one: a root link
-    /// without inertia whose only joint is `floating` (a `world` link) is cut off and its child
+    /// named `world`, without inertia, whose only joint is `floating` is cut off and its child
     /// becomes the floating base frame, declared or not (noted); otherwise the URDF root is the
     /// base frame, floating if declared.
     pub(super) fn fixed_or_floating(
@@ -47,6 +47,7 @@ impl BaseCut {
         let mut cut = Self::fixed(root, links);
         cut.floating = declared_floating;
         if let [k] = tree.child_joints[root][..]
+            && tree.link(root).name == "world"
             && tree.joint(k).joint_type == urdf_rs::JointType::Floating
             && tree.link(root).inertial.mass.value == 0.0
         {

@@ -80,9 +80,9 @@ pub enum UrdfBase {
     /// The two-wheeled inverted-pendulum base ([`WheeledBase`](crate::WheeledBase)).
     Wheeled(WheeledBaseSpec),
     /// A free-flying base ([`Base::Floating`](crate::Base::Floating)): the URDF root link is the
-    /// base frame and its inertia counts (a root link without inertia whose one joint is
-    /// `floating`, such as `world`, is cut off, and its child is the base frame; that happens
-    /// with [`UrdfBase::Fixed`] too). Gravity's direction is in the world frame.
+    /// base frame and its inertia counts (a root link named `world`, without inertia, whose one
+    /// joint is `floating` is cut off, and its child is the base frame; that happens with
+    /// [`UrdfBase::Fixed`] too). Gravity's direction is in the world frame.
     Floating,
 }
 

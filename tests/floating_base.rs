@@ -62,6 +62,10 @@ fn rel(a: &DVector<f64>, b: &DVector<f64>) -> f64 {
     (a - b).amax() / b.amax().max(1.0)
 }
 
+/// A robot's nonlinear effects `h(q, u)` (an inherent method of the generated wrapper).
+type Nle<'a, const N: usize, const NQ: usize> =
+    &'a dyn Fn(&SVector<f64, NQ>, &SVector<f64, N>) -> SVector<f64, N>;
+
 /// The generated functions against the recursion, the configuration helpers and free fall, for
 /// one floating robot `R` with `N` speeds and `NQ` coordinates.
 fn check<
@@ -71,7 +75,7 @@ fn check<
 >(
     robot: &R,
     model: &Model,
-    nle: &dyn Fn(&SVector<f64, NQ>, &SVector<f64, N>) -> SVector<f64, N>,
+    nle: Nle<'_, N, NQ>,
     seed: u64,
 ) {
     assert_eq!(R::COORDINATE_NAMES.len(), NQ);

@@ -522,7 +522,7 @@ fn on_floating_base(fixed: &Model) -> Model {
     let mut m = fixed.clone();
     m.base = Base::Floating;
     let mut speeds = floating_base_speeds();
-    speeds.extend(m.speeds.drain(..));
+    speeds.append(&mut m.speeds);
     m.speeds = speeds;
     for link in &mut m.links {
         if let Some(mount) = &mut link.mount {

@@ -105,7 +105,7 @@ impl Ctx<'_> {
         let inv = self.inverse_total_mass(comp);
         let mut c = self.scale3(inv, &comp[0].first_moment);
         if self.model.is_floating() {
-            c = self.to_world(&c);
+            c = self.in_world(&c);
         }
         self.finish(c.to_vec(), "rG")
             .try_into()
@@ -235,7 +235,7 @@ impl Ctx<'_> {
             // In the world: `R0 ⁰A_l`, `p0 + R0 ⁰p_l`.
             let r0 = self.base_rotation();
             a = self.matmul(&r0, &a);
-            p = self.to_world(&p);
+            p = self.in_world(&p);
         }
         (0..3)
             .flat_map(|r| (0..3).map(move |c| (r, c, a[r][c])).chain([(r, 3, p[r])]))
@@ -300,7 +300,7 @@ impl Ctx<'_> {
     }
 
     /// A point given in frame 0 (`x`), in the world: `p0 + R0 x` (floating base).
-    pub(super) fn to_world(&mut self, x: &V3) -> V3 {
+    pub(super) fn in_world(&mut self, x: &V3) -> V3 {
         let r0 = self.base_rotation();
         let p0 = self.base_position();
         let rx = self.rot_up(&r0, x);

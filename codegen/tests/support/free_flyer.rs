@@ -5,7 +5,7 @@
 //! `q = [x, y, z, qx, qy, qz, qw, joints]`, `u = [v, ω, joint speeds]` (base frame), gravity
 //! along the model's direction in the world frame.
 
-#![allow(dead_code)]
+#![allow(dead_code, clippy::needless_range_loop)]
 
 use kanegen::model::{JointKind, Model};
 use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};

@@ -50,9 +50,11 @@ fn main() {
         .output("slider.rs")
         .run();
     // Floating bases, for `tests/floating_base.rs`: the hopper with every function a floating
-    // base has, Solo 12 with the default functions and the nonlinear effects.
+    // base has and the batched forms, Solo 12 with the default functions and the nonlinear
+    // effects.
     kanegen::Builder::new("models/floating-hopper.toml")
         .functions(kanegen::floating::SUPPORTED.into_iter().collect())
+        .batch(true)
         .output("floating_hopper.rs")
         .run();
     let floating = kanegen::FunctionSet::default()

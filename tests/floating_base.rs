@@ -8,7 +8,8 @@
 //! * free fall: with τ = 0 the forward dynamics (the `Multibody` trait's) accelerate the centre of
 //!   mass at g, measured by second differences along the motion integrated with `integrate`;
 //! * one generic controller, written against `kanegen_runtime::Multibody`, runs on a fixed-base
-//!   arm and on both floating robots.
+//!   arm and on both floating robots;
+//! * the hopper's batched functions equal its single-state ones.
 
 #[path = "../codegen/tests/support/free_flyer.rs"]
 mod free_flyer;
@@ -212,4 +213,37 @@ fn one_generic_controller_runs_on_fixed_and_floating_robots() {
     run_generic(&arm::SingleArm::default(), 31);
     run_generic(&hopper::FloatingHopper::default(), 32);
     run_generic(&solo::Solo::default(), 33);
+}
+
+#[test]
+fn floating_batched_functions_equal_the_single_state_ones() {
+    let robot = hopper::FloatingHopper::default();
+    let model = hopper_model();
+    let mut uniform = stream(41);
+    let qs: [SVector<f64, 10>; 4] = core::array::from_fn(|_| {
+        SVector::from_column_slice(&free_flyer::random_configuration(&model, &mut uniform))
+    });
+    let us: [SVector<f64, 9>; 4] = core::array::from_fn(|_| random_speeds(&mut uniform, 2.0));
+    let uds: [SVector<f64, 9>; 4] = core::array::from_fn(|_| random_speeds(&mut uniform, 5.0));
+    let m = robot.mass_matrix_batch(&qs);
+    let tau = robot.inverse_dynamics_batch(&qs, &us, &uds);
+    let dd = robot.inverse_dynamics_derivatives_batch(&qs, &us, &uds);
+    for l in 0..4 {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
+        let m1 = robot.mass_matrix(&qs[l]);
+        assert!(
+            m[l].iter().zip(m1.iter()).all(|(a, b)| close(*a, *b)),
+            "M, state {l}"
+        );
+        let t1 = robot.inverse_dynamics(&qs[l], &us[l], &uds[l]);
+        assert!(
+            tau[l].iter().zip(t1.iter()).all(|(a, b)| close(*a, *b)),
+            "τ, state {l}"
+        );
+        let d1 = robot.inverse_dynamics_derivatives(&qs[l], &us[l], &uds[l]);
+        assert!(
+            dd[l].iter().zip(d1.iter()).all(|(a, b)| close(*a, *b)),
+            "∂τ, state {l}"
+        );
+    }
 }

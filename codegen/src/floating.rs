@@ -4,12 +4,11 @@
 //! A floating base's module has `NQ = DOF + 1` coordinates (the base's position and unit
 //! quaternion first) and `DOF` speeds (the base's twist `v`, `ω` in the base frame first), laid
 //! out as Pinocchio's free-flyer joint; `docs/floating-base.md` describes it. The functions of
-//! [`SUPPORTED`] are derived with the base's structure; asking for another one, for the batched
-//! forms or for a model with mimic joints is [`Error::FloatingBase`] (never code with wrong
-//! numbers).
+//! [`SUPPORTED`] are derived with the base's structure (single-state and batched); asking for
+//! another one or for a model with mimic joints is [`Error::FloatingBase`] (never code with
+//! wrong numbers).
 
 use crate::combined::Combined;
-use crate::emit::EmitOptions;
 use crate::options::Options;
 use crate::registry::FunctionId;
 use crate::{Error, model};
@@ -42,12 +41,11 @@ pub const SUPPORTED: [FunctionId; 20] = [
 const FIX: &str = "leave it out for a floating base (M, c, g, τ, the Coriolis matrix, nonlinear_effects, the derivatives, the kinematics, the energies, the centroidal functions and the full regressors are generated; the base regressors are not)";
 
 /// [`Error::FloatingBase`] if `robot` has a floating base and the options ask for something
-/// outside [`SUPPORTED`].
+/// outside [`SUPPORTED`] or has mimic constraints.
 pub(crate) fn check(
     robot: &model::Model,
     opts: &Options,
     combined: &[Combined],
-    emit: &EmitOptions,
 ) -> Result<(), Error> {
     if !robot.is_floating() {
         return Ok(());
@@ -72,12 +70,6 @@ pub(crate) fn check(
                 FIX,
             ));
         }
-    }
-    if emit.batch {
-        return Err(err(
-            "the batched form (`Builder::batch`, `--batch`)".into(),
-            "generate the single-state functions (leave the batched form off)",
-        ));
     }
     if !robot.mimics.is_empty() {
         return Err(err(

@@ -674,6 +674,22 @@ fn a_urdf_hanging_from_a_world_floating_joint_gets_a_floating_base_by_default() 
     assert_eq!(&declared, m);
 }
 
+/// `model` with its arm joint an exact mimic of its hip.
+fn with_mimic(model: &Model) -> Model {
+    let mut m = model.clone();
+    let (arm, hip) = (
+        m.speed_index("qd_arm").unwrap(),
+        m.speed_index("qd_hip").unwrap(),
+    );
+    m.mimics.push(kanegen::model::Mimic {
+        speed: arm,
+        master: hip,
+        multiplier: 1.0,
+        offset: 0.0,
+    });
+    m
+}
+
 #[test]
 fn what_a_floating_base_does_not_generate_is_a_typed_error() {
     let model = model("floating-hopper.toml");
@@ -682,10 +698,7 @@ fn what_a_floating_base_does_not_generate_is_a_typed_error() {
             "base_regressor",
             kanegen::Builder::from_model(model.clone()).functions(FunctionSet::regressors()),
         ),
-        (
-            "batched",
-            kanegen::Builder::from_model(model.clone()).batch(true),
-        ),
+        ("mimic", kanegen::Builder::from_model(with_mimic(&model))),
     ] {
         let err = builder
             .generate()

@@ -14,9 +14,11 @@ use crate::registry::FunctionId;
 use crate::{Error, model};
 
 /// The registry functions generated for a floating base.
-pub const SUPPORTED: [FunctionId; 20] = [
+pub const SUPPORTED: [FunctionId; 22] = [
     FunctionId::InverseDynamicsRegressor,
     FunctionId::GravityRegressor,
+    FunctionId::BaseRegressor,
+    FunctionId::BaseGravityRegressor,
     FunctionId::CentroidalMomentumMatrix,
     FunctionId::CentroidalMomentumBias,
     FunctionId::CentroidalInertia,
@@ -38,7 +40,7 @@ pub const SUPPORTED: [FunctionId; 20] = [
 ];
 
 /// The fix the errors suggest.
-const FIX: &str = "leave it out for a floating base (M, c, g, τ, the Coriolis matrix, nonlinear_effects, the derivatives, the kinematics, the energies, the centroidal functions and the full regressors are generated; the base regressors are not)";
+const FIX: &str = "leave it out for a floating base (M, c, g, τ, the Coriolis matrix, nonlinear_effects, the derivatives, the kinematics, the energies, the centroidal functions and the regressors are generated)";
 
 /// [`Error::FloatingBase`] if `robot` has a floating base and the options ask for something
 /// outside [`SUPPORTED`] or has mimic constraints.

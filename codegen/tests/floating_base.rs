@@ -16,7 +16,9 @@
 //! * centroidal functions: `A_G u` is the momentum summed over the bodies (linear, angular about
 //!   the centre of mass, world axes), `A_G u̇ + Ȧ_G u` its derivative along the motion, and
 //!   `I_G` gives the angular momentum of the robot turning rigidly; on fixed bases `A_G` and
-//!   `Ȧ_G u` equal the joint columns of the same tree on a floating base at rest.
+//!   `Ȧ_G u` equal the joint columns of the same tree on a floating base at rest; on Krang's
+//!   wheeled base the linear rows are `m J_G` and `m` times the CoM bias, and `A_G u̇ + Ȧ_G u` the
+//!   rate of `A_G u` in the turning heading frame.
 
 #[path = "support/free_flyer.rs"]
 mod free_flyer;
@@ -750,4 +752,89 @@ fn floating_modules_have_nq_coordinates_and_combined_functions() {
     );
     let h = free_flyer::rnea(&model, &params, &q, &u, &zero, true);
     assert!(rel_err(&DVector::from_vec(parts[1].clone()), &h) < 1e-10);
+}
+
+#[test]
+fn wheeled_centroidal_momentum_is_consistent_with_the_centre_of_mass_and_its_rate() {
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let krang = Model::from_toml_file(dir.join("models/krang.toml")).expect("loads");
+    let functions: FunctionSet = [
+        FunctionId::CentroidalMomentumMatrix,
+        FunctionId::CentroidalMomentumBias,
+        FunctionId::CentroidalInertia,
+        FunctionId::ComJacobian,
+        FunctionId::ComBiasAcceleration,
+    ]
+    .into_iter()
+    .collect();
+    let d = derive(
+        &krang,
+        Options {
+            functions,
+            ..Options::default()
+        },
+    );
+    let n = krang.dof();
+    let mut r = SplitMix64::new(60);
+    let mut uniform = move || r.next_f64();
+    let params = random_physical_params(&krang, &mut uniform);
+    let q = uniform_vec(&mut uniform, n, -3.0, 3.0);
+    let u = uniform_vec(&mut uniform, n, -1.5, 1.5);
+    let ud = uniform_vec(&mut uniform, n, -3.0, 3.0);
+    let zero = vec![0.0; n];
+    let ag_at = |x: &[f64]| {
+        DMatrix::from_row_slice(
+            6,
+            n,
+            &d.evaluate(
+                FunctionId::CentroidalMomentumMatrix,
+                &params,
+                x,
+                &zero,
+                &zero,
+            ),
+        )
+    };
+    let ag = ag_at(&q);
+    let ig = d.evaluate(FunctionId::CentroidalInertia, &params, &q, &zero, &zero);
+    let m = ig[0];
+    // Linear rows: m J_G (wheels included) and m times the CoM bias.
+    let jg = DMatrix::from_row_slice(
+        3,
+        n,
+        &d.evaluate(FunctionId::ComJacobian, &params, &q, &zero, &zero),
+    );
+    assert!(
+        (ag.rows(0, 3) - &jg * m).amax() < 1e-12 * m,
+        "A_G linear rows"
+    );
+    let bias = d.evaluate(FunctionId::CentroidalMomentumBias, &params, &q, &u, &zero);
+    let ab = d.evaluate(FunctionId::ComBiasAcceleration, &params, &q, &u, &zero);
+    for k in 0..3 {
+        assert!((bias[k] - m * ab[k]).abs() < 1e-10 * m, "linear bias");
+    }
+    // A_G u̇ + Ȧ_G u is the rate of A_G u in frame 0's axes, which turn at ψ̇ about z:
+    // d/dt (R_ψ h) = R_ψ (ḣ + ψ̇ ẑ × h), with h(t) = A_G(q(t)) u(t), q(t) = q + u t + ½ u̇ t².
+    let psi = krang.speed_index("psid").expect("ψ̇");
+    let at = |t: f64| {
+        let x: Vec<f64> = (0..n)
+            .map(|i| q[i] + u[i] * t + 0.5 * ud[i] * t * t)
+            .collect();
+        let v: Vec<f64> = (0..n).map(|i| u[i] + ud[i] * t).collect();
+        ag_at(&x) * DVector::from_vec(v)
+    };
+    let h = 1e-5;
+    let hdot = (at(h) - at(-h)) / (2.0 * h);
+    let h0 = &ag * DVector::from_vec(u.clone());
+    let rate = &ag * DVector::from_vec(ud.clone()) + DVector::from_vec(bias);
+    let w = Vector3::new(0.0, 0.0, u[psi]);
+    for part in [0, 3] {
+        let hv = Vector3::new(h0[part], h0[part + 1], h0[part + 2]);
+        let expected = Vector3::new(hdot[part], hdot[part + 1], hdot[part + 2]) + w.cross(&hv);
+        let got = Vector3::new(rate[part], rate[part + 1], rate[part + 2]);
+        assert!(
+            (got - expected).norm() < 1e-6 * expected.norm().max(1.0),
+            "rows {part}..: {got} vs {expected}"
+        );
+    }
 }

@@ -5,7 +5,8 @@
 //! `tests/mimic.rs`, a gripper with mimic joints; for `tests/big_tree.rs`, a 100-DOF tree; for
 //! `tests/isa_batch.rs`, a cart on a rail (structurally zero c, g, C) with every registry
 //! function and the batched forms; for `tests/unicode_names.rs`, two models with names in
-//! Greek and Japanese.
+//! Greek and Japanese; for `tests/floating_base.rs`, the small floating-base model
+//! `models/floating-hopper.toml` and Solo 12 (`tests/corpus/solo12.urdf`) on a floating base.
 //! The TOML Krang models come from `krang-dynamics`.
 use kanegen::model::{UrdfOptions, WheeledBaseSpec};
 
@@ -55,6 +56,22 @@ fn main() {
         .run();
     kanegen::Builder::new("tests/data/unicode_two_link.toml")
         .output("unicode_two_link.rs")
+        .run();
+    // Floating bases, for `tests/floating_base.rs`: the hopper with every function a floating
+    // base has and the batched forms, Solo 12 with the default functions and the nonlinear
+    // effects.
+    kanegen::Builder::new("models/floating-hopper.toml")
+        .functions(kanegen::floating::SUPPORTED.into_iter().collect())
+        .batch(true)
+        .output("floating_hopper.rs")
+        .run();
+    let floating = kanegen::FunctionSet::default()
+        .iter()
+        .chain([kanegen::FunctionId::NonlinearEffects])
+        .collect::<kanegen::FunctionSet>();
+    kanegen::Builder::urdf("tests/corpus/solo12.urdf", UrdfOptions::floating())
+        .functions(floating)
+        .output("solo12_floating.rs")
         .run();
     kanegen::Builder::urdf("models/Krang.urdf", krang_urdf_options())
         .output("krang_urdf.rs")

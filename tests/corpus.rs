@@ -6,9 +6,10 @@
 //! compared with the numeric reference recursion on random states, at the file's own
 //! parameters and at random physical parameters.
 //!
-//! The robots' floating bases (legged robots, humanoids) are not modelled: the generator has no
-//! free-flyer joint, so each file is a fixed-base tree rooted at its root link (as the files are
-//! written: the free-flyer is what Pinocchio adds on load, not part of the URDF).
+//! Each file is imported with the defaults, as a fixed-base tree rooted at its root link (as the
+//! files are written: the free-flyer is what Pinocchio adds on load, not part of the URDF);
+//! `tests/floating_base.rs` and `codegen/tests/floating_base.rs` check legged robots on a
+//! floating base (`UrdfOptions::floating()`).
 
 mod common;
 #[path = "common/raw_urdf.rs"]

@@ -150,14 +150,28 @@ pub(crate) fn model(m: &Model) -> String {
                 m.links[0].name, m.speeds[w.x_speed].name, m.speeds[w.psi_speed].name
             );
         }
+        Base::Floating => {
+            let _ = writeln!(
+                s,
+                "base: floating frame `{}`, coordinates {} (position in the world, quaternion base → world), speeds {} (linear and angular velocity in the base frame)",
+                m.links[0].name,
+                m.coordinate_names()[..7].join(", "),
+                m.speeds[..6]
+                    .iter()
+                    .map(|s| s.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
     }
     let g = &m.gravity;
     let _ = writeln!(
         s,
-        "gravity: {} = {} m/s² along {} in the base frame",
+        "gravity: {} = {} m/s² along {} in the {} frame",
         m.params[g.symbol].name,
         number(m.params[g.symbol].value),
-        axis(g.direction)
+        axis(g.direction),
+        if m.is_floating() { "world" } else { "base" }
     );
     frames(m, &mut s);
     let _ = writeln!(s, "speeds ({}):", m.independent_dof());
@@ -171,6 +185,19 @@ pub(crate) fn model(m: &Model) -> String {
                 m.speeds[mm.master].coordinate,
                 if mm.offset < 0.0 { '-' } else { '+' },
                 number(mm.offset.abs())
+            );
+            continue;
+        }
+        if m.is_floating() && i < 6 {
+            let (what, u) = if i < 3 {
+                ("linear velocity", "m/s")
+            } else {
+                ("angular velocity", "rad/s")
+            };
+            let _ = writeln!(
+                s,
+                "  u[{i:2}] = {} in {u} (base {what}, base frame)",
+                sp.name
             );
             continue;
         }

@@ -110,6 +110,7 @@ pub mod emit;
 #[doc(hidden)]
 #[allow(rustdoc::private_intra_doc_links)]
 pub mod expr;
+pub mod floating;
 #[doc(hidden)]
 #[allow(rustdoc::private_intra_doc_links)]
 pub mod kane;
@@ -199,6 +200,19 @@ pub enum Error {
         "OUT_DIR is not set: Builder::build must run inside a cargo build script (or call Builder::out_dir)"
     )]
     NoOutDir,
+    /// A floating-base model asked for something the generator does not emit for a floating
+    /// base yet (see [`floating::SUPPORTED`]).
+    #[error("model `{model}` ({file}): {what} is not generated for a floating base yet; {fix}")]
+    FloatingBase {
+        /// The model's name.
+        model: String,
+        /// The description file.
+        file: String,
+        /// The function or option.
+        what: String,
+        /// How to avoid it.
+        fix: &'static str,
+    },
 }
 
 /// Everything the generator produced for one model.
@@ -254,6 +268,7 @@ pub(crate) fn generate_combined(
 ) -> Result<Generated, Error> {
     // The loaders check names; a model built in memory is checked here.
     robot.check_names()?;
+    floating::check(&robot, &opts, combined_functions)?;
     let resolved = combined::resolve(&robot, combined_functions)?;
     let mut progress = Progress::new(&robot);
     let derivation = kane::derive_shaped(&robot, opts, &resolved, emit_options.regressor_form);

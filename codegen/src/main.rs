@@ -51,6 +51,8 @@ options (stats, listing, emit; `show` takes only the URDF import options):
   --out FILE              write the module to FILE (emit only)
 
 URDF import options (.urdf models; see kanegen_model::UrdfOptions):
+  --floating              a floating (free-flyer) base at the URDF root (the default when the
+                          root is a bare `world` link whose one joint is `floating`)
   --wheeled LEFT_JOINT,RIGHT_JOINT,BODY_LINK   a two-wheeled inverted-pendulum base
   --up X,Y,Z              the body axis that points up at zero pitch (with --wheeled; default 0,0,1)
   --radius R              wheel radius in m (required with --wheeled)
@@ -112,6 +114,7 @@ fn functions_help() -> String {
         ("default", FunctionSet::default()),
         ("kinematics", FunctionSet::kinematics()),
         ("regressors", FunctionSet::regressors()),
+        ("centroidal", FunctionSet::centroidal()),
     ];
     let mut text = String::from(
         "functions (--functions LIST, comma-separated; each name is a generated function):\n",
@@ -270,7 +273,8 @@ impl Command {
 
     /// Whether the command takes `option` (one of the options of [`parse`]).
     fn takes(self, option: &str) -> bool {
-        const URDF: [&str; 7] = [
+        const URDF: [&str; 8] = [
+            "--floating",
             "--wheeled",
             "--up",
             "--radius",
@@ -304,6 +308,7 @@ struct Args {
     batch: bool,
     batch_feature: Option<String>,
     out: Option<String>,
+    floating: bool,
     wheeled: Option<[String; 3]>,
     up: Option<[f64; 3]>,
     radius: Option<f64>,
@@ -352,6 +357,7 @@ fn parse(args: Vec<String>) -> Result<Option<Args>, String> {
         batch: false,
         batch_feature: None,
         out: None,
+        floating: false,
         wheeled: None,
         up: None,
         radius: None,
@@ -388,7 +394,8 @@ fn parse(args: Vec<String>) -> Result<Option<Args>, String> {
 }
 
 /// The options that take no value.
-const FLAGS: [&str; 5] = [
+const FLAGS: [&str; 6] = [
+    "--floating",
     "--baked",
     "--no-coriolis-matrix",
     "--mirrored-lanes",
@@ -413,6 +420,7 @@ impl Args {
     fn set(&mut self, arg: &str, value: Option<String>) -> Result<(), String> {
         let value = || value.clone().ok_or(format!("{arg} needs a value"));
         match arg {
+            "--floating" => self.floating = true,
             "--baked" => self.baked = true,
             "--no-coriolis-matrix" => self.no_coriolis_matrix = true,
             "--mirrored-lanes" => self.mirrored_lanes = true,
@@ -475,6 +483,11 @@ impl Args {
                 if let Some(p) = &self.pitch_name {
                     base.pitch_name = p.clone();
                 }
+                if self.floating {
+                    return Err(
+                        "--floating and --wheeled exclude each other: a model has one base".into(),
+                    );
+                }
                 UrdfOptions::wheeled(base)
             }
             None => {
@@ -485,7 +498,11 @@ impl Args {
                 {
                     return Err("--up, --radius, --track and --pitch-name need --wheeled".into());
                 }
-                UrdfOptions::default()
+                if self.floating {
+                    UrdfOptions::floating()
+                } else {
+                    UrdfOptions::default()
+                }
             }
         };
         o = o.drop_links(self.drop_links.iter().cloned());
@@ -494,7 +511,8 @@ impl Args {
     }
 
     fn has_urdf_options(&self) -> bool {
-        self.wheeled.is_some()
+        self.floating
+            || self.wheeled.is_some()
             || self.up.is_some()
             || self.radius.is_some()
             || self.track.is_some()

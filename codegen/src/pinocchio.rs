@@ -111,6 +111,16 @@ pub enum ExportError {
         /// Its first moment `[MX, MY, MZ]`.
         first_moment: [f64; 3],
     },
+    /// A floating base: the export's text format has no free-flyer joint.
+    #[error(
+        "model `{model}` ({file}): the Pinocchio export has no free-flyer joint; export the model with a fixed base (import the URDF with `UrdfBase::Fixed` after dropping its `floating` joint, or `[base] type = \"fixed\"`)"
+    )]
+    FloatingBase {
+        /// The model name.
+        model: String,
+        /// The description file.
+        file: String,
+    },
 }
 
 /// The Pinocchio joint model of a [`PinJoint`].
@@ -304,6 +314,12 @@ pub fn export(model: &Model, params: &[f64]) -> Result<PinocchioModel, ExportErr
 
     match &model.base {
         Base::Fixed => attach.push((0, IDENTITY, [0.0; 3])),
+        Base::Floating => {
+            return Err(ExportError::FloatingBase {
+                model: model.name.clone(),
+                file: model.source.clone(),
+            });
+        }
         Base::Wheeled(w) => {
             let dir = model.gravity.direction;
             if dir[0] != 0.0 || dir[1] != 0.0 {

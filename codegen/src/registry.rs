@@ -54,6 +54,13 @@ pub enum FunctionId {
     BaseGravityRegressor,
     /// Nonlinear effects `h(q, u) = c(q, u) + g(q)` in one pass (inverse dynamics at `u̇ = 0`).
     NonlinearEffects,
+    /// Centroidal momentum matrix `A_G(q)`: linear momentum, then angular momentum about the
+    /// centre of mass, in world axes, as `A_G u`.
+    CentroidalMomentumMatrix,
+    /// Centroidal momentum bias `Ȧ_G u`: the momentum's rate at `u̇ = 0` without gravity.
+    CentroidalMomentumBias,
+    /// Centroidal composite inertia `I_G = [[m 1, 0], [0, J_G]]` (world axes).
+    CentroidalInertia,
 }
 
 /// One dimension of a [`Shape::Dense`] result: the number of speeds N, or a constant.
@@ -279,7 +286,7 @@ pub struct FunctionSpec {
 }
 
 /// The registry, in the order generated modules define the functions.
-pub const FUNCTIONS: [FunctionSpec; 19] = [
+pub const FUNCTIONS: [FunctionSpec; 22] = [
     FunctionSpec {
         id: FunctionId::MassMatrix,
         name: "mass_matrix",
@@ -519,6 +526,48 @@ pub const FUNCTIONS: [FunctionSpec; 19] = [
         runtime_trait: None,
         per_frame: false,
     },
+    FunctionSpec {
+        id: FunctionId::CentroidalMomentumMatrix,
+        name: "centroidal_momentum_matrix",
+        symbol: "AG",
+        doc: "Centroidal momentum matrix A_G(q) (Pinocchio's `ccrba` Ag): `A_G u` is the whole robot's linear momentum (rows 0–2) and its angular momentum about the centre of mass (rows 3–5), in world axes (frame 0's for a fixed or wheeled base).",
+        inputs: Inputs::Q,
+        shape: Shape::Dense {
+            rows: Dim::Fixed(6),
+            cols: Dim::N,
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::CentroidalMomentumBias,
+        name: "centroidal_momentum_bias",
+        symbol: "dAGu",
+        doc: "Centroidal momentum bias `Ȧ_G u`: the rate of the centroidal momentum at `u̇ = 0` without gravity (world axes), so that its rate is `A_G u̇ + Ȧ_G u`.",
+        inputs: Inputs::QU,
+        shape: Shape::Dense {
+            rows: Dim::Fixed(6),
+            cols: Dim::Fixed(1),
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
+    FunctionSpec {
+        id: FunctionId::CentroidalInertia,
+        name: "centroidal_inertia",
+        symbol: "IG",
+        doc: "Centroidal composite inertia `I_G = [[m 1, 0], [0, J_G]]` (Pinocchio's `ccrba` Ig): the total mass and the whole robot's inertia about its centre of mass, in world axes.",
+        inputs: Inputs::Q,
+        shape: Shape::Dense {
+            rows: Dim::Fixed(6),
+            cols: Dim::Fixed(6),
+        },
+        default: false,
+        runtime_trait: None,
+        per_frame: false,
+    },
 ];
 
 impl FunctionId {
@@ -662,6 +711,7 @@ impl std::str::FromStr for FunctionSet {
                 "default" => set.union(FunctionSet::default()),
                 "kinematics" => set.union(FunctionSet::kinematics()),
                 "regressors" => set.union(FunctionSet::regressors()),
+                "centroidal" => set.union(FunctionSet::centroidal()),
                 _ => set.with(FunctionId::from_name(name).ok_or_else(|| UnknownFunction {
                     name: name.to_owned(),
                 })?),
@@ -690,6 +740,18 @@ impl FunctionSet {
             FunctionId::FramePose,
             FunctionId::FrameJacobian,
             FunctionId::FrameBiasAcceleration,
+        ]
+        .into_iter()
+        .collect()
+    }
+
+    /// The centroidal functions: the centroidal momentum matrix, its bias and the centroidal
+    /// composite inertia.
+    pub fn centroidal() -> Self {
+        [
+            FunctionId::CentroidalMomentumMatrix,
+            FunctionId::CentroidalMomentumBias,
+            FunctionId::CentroidalInertia,
         ]
         .into_iter()
         .collect()

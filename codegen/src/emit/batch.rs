@@ -79,15 +79,19 @@ impl Layout {
 
     /// The state arguments: `&[SVector<f64, N>; L]` or `&SVector<Lanes<L>, N>` per input.
     fn args(self, cx: &Context<'_>, inputs: Inputs) -> TokenStream {
-        let nl = idx(cx.low.dof);
-        let v = match self {
-            Layout::States => quote!(&[SVector<f64, #nl>; L]),
-            Layout::Lanes => quote!(&SVector<kanegen_runtime::lanes::Lanes<L>, #nl>),
+        let ty = |n: usize| {
+            let n = idx(n);
+            match self {
+                Layout::States => quote!(&[SVector<f64, #n>; L]),
+                Layout::Lanes => quote!(&SVector<kanegen_runtime::lanes::Lanes<L>, #n>),
+            }
         };
+        // `q` has `NQ` entries (one more than the speeds for a floating base).
+        let (v, c) = (ty(cx.low.dof), ty(cx.low.nq));
         match inputs {
-            Inputs::Q => quote!(q: #v),
-            Inputs::QU => quote!(q: #v, u: #v),
-            Inputs::QUUd => quote!(q: #v, u: #v, ud: #v),
+            Inputs::Q => quote!(q: #c),
+            Inputs::QU => quote!(q: #c, u: #v),
+            Inputs::QUUd => quote!(q: #c, u: #v, ud: #v),
         }
     }
 
@@ -192,12 +196,14 @@ fn lane_values(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStream {
             ts.extend(quote!(let #id = cos_q[#kl][l];));
         }
     }
+    for (k, name) in cx.model.coordinate_names().into_iter().enumerate() {
+        if reads.coord.get(k).copied().unwrap_or(false) {
+            let (id, kl) = (ident(name), idx(k));
+            ts.extend(quote!(let #id = q[#kl].0[l];));
+        }
+    }
     for (s, speed) in cx.model.speeds.iter().enumerate() {
         let sl = idx(s);
-        if reads.coord[s] {
-            let id = ident(&speed.coordinate);
-            ts.extend(quote!(let #id = q[#sl].0[l];));
-        }
         if reads.speed[s] {
             let id = ident(&speed.name);
             ts.extend(quote!(let #id = u[#sl].0[l];));
@@ -474,11 +480,12 @@ fn shared_body(
         spec.name
     );
     let param_args = super::body::param_args(cx, reads);
-    let nl = idx(cx.low.dof);
-    let lanes_ty = quote!(&[kanegen_runtime::lanes::Lanes<L>; #nl]);
+    let (nl, nq) = (idx(cx.low.dof), idx(cx.low.nq));
     let inputs = read_inputs(p, reads).into_iter().map(|x| {
         let name = x.name;
-        quote!(#name: #lanes_ty,)
+        // `q` has `NQ` entries (one more than the speeds for a floating base).
+        let n = if name.to_string() == "q" { &nq } else { &nl };
+        quote!(#name: &[kanegen_runtime::lanes::Lanes<L>; #n],)
     });
     let sin_cos = lane_sin_cos(cx, p, reads);
     // One loop per part (one part unless the result has more entries than a vectorized loop

@@ -84,9 +84,11 @@ pub(super) struct Reads {
 }
 
 impl Reads {
+    /// `dof`: the length of the speed vectors (the coordinates of `q` are one more for a
+    /// floating base, allowed for).
     pub(super) fn of(p: &Program, dof: usize) -> Self {
         let mut r = Reads {
-            coord: vec![false; dof],
+            coord: vec![false; dof + 1],
             speed: vec![false; dof],
             accel: vec![false; dof],
             sin: vec![false; dof],
@@ -113,17 +115,18 @@ impl Reads {
 pub(super) fn state_args(cx: &Context<'_>, inputs: Inputs) -> (TokenStream, &'static str) {
     let t = scalar_type(cx.precision);
     let nl = idx(cx.low.dof);
+    let nq = idx(cx.low.nq);
     match inputs {
         Inputs::Q => (
-            quote!(q: &SVector<#t, #nl>),
+            quote!(q: &SVector<#t, #nq>),
             " `q`: coordinates in the order of [`COORDINATE_NAMES`].",
         ),
         Inputs::QU => (
-            quote!(q: &SVector<#t, #nl>, u: &SVector<#t, #nl>),
+            quote!(q: &SVector<#t, #nq>, u: &SVector<#t, #nl>),
             " `q`, `u`: coordinates and speeds in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].",
         ),
         Inputs::QUUd => (
-            quote!(q: &SVector<#t, #nl>, u: &SVector<#t, #nl>, ud: &SVector<#t, #nl>),
+            quote!(q: &SVector<#t, #nq>, u: &SVector<#t, #nl>, ud: &SVector<#t, #nl>),
             " `q`, `u`, `ud`: coordinates, speeds and accelerations in the order of [`COORDINATE_NAMES`], [`SPEED_NAMES`].",
         ),
     }
@@ -171,12 +174,14 @@ pub(super) fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStr
             }
         }
     }
+    for (k, name) in cx.model.coordinate_names().into_iter().enumerate() {
+        if reads.coord.get(k).copied().unwrap_or(false) {
+            let (id, kl) = (ident(name), idx(k));
+            ts.extend(quote!(let #id = q[#kl];));
+        }
+    }
     for (s, speed) in speeds.iter().enumerate() {
         let sl = idx(s);
-        if reads.coord[s] {
-            let id = ident(&speed.coordinate);
-            ts.extend(quote!(let #id = q[#sl];));
-        }
         if reads.speed[s] {
             let id = ident(&speed.name);
             ts.extend(quote!(let #id = u[#sl];));
@@ -194,9 +199,10 @@ pub(super) fn prologue(cx: &Context<'_>, p: &Program, reads: &Reads) -> TokenStr
 /// (`-q[3]`, `2.0 * q[3] + 0.1`). The single-state prologue indexes `f64`s, the batched one
 /// `kanegen_runtime::lanes::Lanes` (whose operators take `f64` on either side).
 pub(super) fn joint_angle(cx: &Context<'_>, s: usize, q: &TokenStream) -> TokenStream {
+    let coord = |s: usize| if cx.low.floating && s >= 6 { s + 1 } else { s };
     match cx.low.mimic_angles.iter().find(|(d, _)| *d == s) {
         Some((_, m)) => {
-            let ml = idx(m.master as usize);
+            let ml = idx(coord(m.master as usize));
             let aq = match m.multiplier {
                 1.0 => quote!(#q[#ml]),
                 -1.0 => quote!(-#q[#ml]),
@@ -213,7 +219,7 @@ pub(super) fn joint_angle(cx: &Context<'_>, s: usize, q: &TokenStream) -> TokenS
             }
         }
         None => {
-            let sl = idx(s);
+            let sl = idx(coord(s));
             quote!(#q[#sl])
         }
     }

@@ -18,6 +18,9 @@ use kanegen_model::{Model, ParamKind};
 /// (`Q_IMU`) and one per speed (`QD_IMU`), the same index, unless the speed's constant would
 /// repeat a name already taken.
 pub(super) fn names(cx: &Context<'_>) -> TokenStream {
+    if cx.low.floating {
+        return floating_names(cx);
+    }
     let model = cx.model;
     let nl = idx(cx.low.dof);
     // The independent speeds (a mimic joint's dependent speed is not an input).
@@ -54,6 +57,65 @@ pub(super) fn names(cx: &Context<'_>) -> TokenStream {
 
         /// Index constants: of each coordinate in `q` (`Q_IMU`) and of its speed in `u`, `u̇`
         /// and `τ` (`QD_IMU`); a coordinate and its speed have the same index.
+        pub mod index {
+            #(#index_consts)*
+        }
+    }
+}
+
+/// [`names`] of a floating base: `NQ = DOF + 1` coordinates (the base's seven first), and the
+/// index constants of each coordinate in `q` and of each speed in `u`.
+fn floating_names(cx: &Context<'_>) -> TokenStream {
+    let model = cx.model;
+    let (nl, nq) = (idx(cx.low.dof), idx(cx.low.nq));
+    let speeds = &model.speeds[..cx.low.dof];
+    let speed_names: Vec<&str> = speeds.iter().map(|s| s.name.as_str()).collect();
+    let coord_names = model.coordinate_names();
+    let mut taken: Vec<String> = coord_names
+        .iter()
+        .map(|c| ident(&c.to_uppercase()).to_string())
+        .collect();
+    let mut index_consts = Vec::new();
+    for (k, c) in coord_names.iter().enumerate() {
+        let id = ident(&c.to_uppercase());
+        let doc = format!(" Index of the coordinate `{c}` in q.");
+        let k = idx(k);
+        index_consts.push(quote!(#[doc = #doc] pub const #id: usize = #k;));
+    }
+    for (i, s) in speeds.iter().enumerate() {
+        let speed_id = ident(&s.name.to_uppercase());
+        if !taken.contains(&speed_id.to_string()) {
+            taken.push(speed_id.to_string());
+            let doc = if i < 6 {
+                format!(
+                    " Index of the floating base's speed `{}` in u, u̇ and τ.",
+                    s.name
+                )
+            } else {
+                format!(
+                    " Index of the speed `{}` in u, u̇ and τ (the rate of `{}`).",
+                    s.name, s.coordinate
+                )
+            };
+            let i = idx(i);
+            index_consts.push(quote!(#[doc = #doc] pub const #speed_id: usize = #i;));
+        }
+    }
+    quote! {
+        /// Number of generalized speeds: the floating base's six (`v`, `ω` in the base frame),
+        /// then the joints'.
+        pub const DOF: usize = #nl;
+        /// Number of coordinates: the floating base's seven (position in the world, unit
+        /// quaternion `(qx, qy, qz, qw)` base → world), then the joints'.
+        pub const NQ: usize = #nq;
+        /// Generalized speed names, in the order of `u`.
+        pub const SPEED_NAMES: [&str; #nl] = [#(#speed_names),*];
+        /// Coordinate names, in the order of `q`.
+        pub const COORDINATE_NAMES: [&str; #nq] = [#(#coord_names),*];
+
+        /// Index constants: of each coordinate in `q` (`Q_HIP`, `BASE_QW`) and of each speed in
+        /// `u`, `u̇` and `τ` (`QD_HIP`, `BASE_WX`). A joint's coordinate is one place after its
+        /// speed (the base's quaternion has four entries for three speeds).
         pub mod index {
             #(#index_consts)*
         }
@@ -350,6 +412,9 @@ pub(super) fn wrapper(cx: &Context<'_>, batched: bool) -> TokenStream {
     methods.extend(super::combined::methods(cx));
     methods.extend(super::regressor_loop::methods(cx));
     methods.extend(super::derivatives_loop::methods(cx));
+    if cx.low.floating {
+        methods.extend(configuration_methods(cx));
+    }
     if batched {
         methods.extend(super::batch::methods(cx));
     }
@@ -415,6 +480,9 @@ pub(super) fn wrapper(cx: &Context<'_>, batched: bool) -> TokenStream {
 
 /// The `kanegen-runtime` traits whose functions the module has all of.
 pub(super) fn trait_impls(cx: &Context<'_>) -> TokenStream {
+    if cx.low.floating {
+        return floating_trait_impl(cx);
+    }
     let ty = ident(&naming::type_name(&cx.model.name));
     let t = scalar_type(cx.precision);
     let mut out = TokenStream::new();
@@ -482,4 +550,87 @@ pub(super) fn trait_impls(cx: &Context<'_>) -> TokenStream {
         });
     }
     out
+}
+
+/// A floating base's configuration-space methods of the wrapper (`kanegen_runtime::free_flyer`).
+fn configuration_methods(cx: &Context<'_>) -> TokenStream {
+    let t = scalar_type(cx.precision);
+    quote! {
+        /// The neutral configuration: the base at the world origin with the identity quaternion,
+        /// the joints at zero (`pinocchio::neutral`).
+        #[inline]
+        pub fn neutral(&self) -> SVector<#t, NQ> {
+            kanegen_runtime::free_flyer::neutral()
+        }
+        /// `q ⊕ u dt`: the base moves by the SE(3) exponential of its twist `(v, ω) dt` in the
+        /// base frame, the joints by `u dt` (`pinocchio::integrate`); the quaternion stays unit.
+        #[inline]
+        pub fn integrate(&self, q: &SVector<#t, NQ>, u: &SVector<#t, DOF>, dt: #t) -> SVector<#t, NQ> {
+            kanegen_runtime::free_flyer::integrate(q, u, dt)
+        }
+        /// The speeds `δ` with `integrate(q0, δ, 1) = q1`: the SE(3) logarithm of the relative
+        /// base pose and the joints' differences (`pinocchio::difference`).
+        #[inline]
+        pub fn difference(&self, q0: &SVector<#t, NQ>, q1: &SVector<#t, NQ>) -> SVector<#t, DOF> {
+            kanegen_runtime::free_flyer::difference(q0, q1)
+        }
+        /// `q` with the base's quaternion scaled to unit norm (`pinocchio::normalize`).
+        #[inline]
+        pub fn normalize(&self, q: &SVector<#t, NQ>) -> SVector<#t, NQ> {
+            kanegen_runtime::free_flyer::normalize(q)
+        }
+    }
+}
+
+/// A floating base's `kanegen_runtime::Multibody` implementation, when the module has M, c, g
+/// and τ (it cannot implement `RobotDynamics`, whose `q` has `DOF` entries).
+fn floating_trait_impl(cx: &Context<'_>) -> TokenStream {
+    let complete = crate::registry::FUNCTIONS
+        .iter()
+        .filter(|s| s.runtime_trait == Some(RuntimeTrait::RobotDynamics))
+        .all(|s| cx.low.functions.iter().any(|f| f.id == s.id));
+    if !complete {
+        return TokenStream::new();
+    }
+    let ty = ident(&naming::type_name(&cx.model.name));
+    let t = scalar_type(cx.precision);
+    let forward = |name: &str, inputs| {
+        let spec = crate::registry::FUNCTIONS
+            .iter()
+            .find(|s| s.name == name)
+            .expect("registry function");
+        let f = ident(name);
+        let (args, _) = state_args(cx, inputs);
+        let ret = return_type(cx, spec);
+        let call = forward_call(cx, spec);
+        quote!(fn #f(&self, #args) -> #ret { #call })
+    };
+    use crate::registry::Inputs;
+    let methods = [
+        forward("mass_matrix", Inputs::Q),
+        forward("coriolis", Inputs::QU),
+        forward("gravity", Inputs::Q),
+        forward("inverse_dynamics", Inputs::QUUd),
+    ];
+    quote! {
+        impl kanegen_runtime::Multibody<DOF> for #ty {
+            type Scalar = #t;
+            type Configuration = SVector<#t, NQ>;
+            const SPEED_NAMES: [&'static str; DOF] = SPEED_NAMES;
+            const COORDINATE_NAMES: &'static [&'static str] = &COORDINATE_NAMES;
+            fn neutral(&self) -> SVector<#t, NQ> {
+                kanegen_runtime::free_flyer::neutral()
+            }
+            fn integrate(&self, q: &SVector<#t, NQ>, u: &SVector<#t, DOF>, dt: #t) -> SVector<#t, NQ> {
+                kanegen_runtime::free_flyer::integrate(q, u, dt)
+            }
+            fn difference(&self, q0: &SVector<#t, NQ>, q1: &SVector<#t, NQ>) -> SVector<#t, DOF> {
+                kanegen_runtime::free_flyer::difference(q0, q1)
+            }
+            fn normalize(&self, q: &SVector<#t, NQ>) -> SVector<#t, NQ> {
+                kanegen_runtime::free_flyer::normalize(q)
+            }
+            #(#methods)*
+        }
+    }
 }

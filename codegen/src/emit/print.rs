@@ -71,7 +71,7 @@ impl Printer<'_> {
             Leaf::Accel(s) => ident(&naming::accel(&m.speeds[s].name)),
             Leaf::Sin(s) => ident(&naming::sin(&m.speeds[s].coordinate)),
             Leaf::Cos(s) => ident(&naming::cos(&m.speeds[s].coordinate)),
-            Leaf::Coord(s) => ident(&m.speeds[s].coordinate),
+            Leaf::Coord(s) => ident(m.coordinate_names()[s]),
             Leaf::Local(i) => ident(&self.stmts[i].name),
         };
         quote!(#id)

@@ -149,7 +149,12 @@ impl LeafNames {
             accels: speeds(&|s| naming::accel(&s.name)),
             sins: speeds(&|s| naming::sin(&s.coordinate)),
             coss: speeds(&|s| naming::cos(&s.coordinate)),
-            coords: speeds(&|s| s.coordinate.clone()),
+            // Indexed like `q` (a floating base's `base_qw` has no speed).
+            coords: model
+                .coordinate_names()
+                .into_iter()
+                .map(naming::identifier)
+                .collect(),
         }
     }
 }

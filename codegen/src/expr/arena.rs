@@ -45,7 +45,9 @@ pub enum Atom {
     Sin(u32),
     /// `cos(q[i])`.
     Cos(u32),
-    /// The coordinate `q[i]` itself (prismatic joints).
+    /// The coordinate `q[i]` itself, by its index in `q` (prismatic joints; a floating base's
+    /// position and quaternion). The index of speed `s`'s coordinate is `s`, or `s + 1` for a
+    /// joint speed of a floating base ([`Arena::coordinate_index`]).
     Coord(u32),
     /// Substitution variable (index into [`Arena::vars`]).
     Var(u32),
@@ -136,6 +138,9 @@ pub struct Arena {
     /// Per speed index: the mimic constraint `q = a·q_master + b` of a dependent speed (see
     /// [`Arena::set_mimic`]), `None` for an independent one.
     pub(super) mimics: Vec<Option<MimicLeaf>>,
+    /// Whether the coordinates are a floating base's (`q` has the base's seven coordinates, then
+    /// the joints': speed `s ≥ 6` is the rate of `q[s + 1]`), see [`Arena::set_floating`].
+    pub(super) floating: bool,
 }
 
 /// A dependent coordinate `q = multiplier · q[master] + offset` (a mimic joint).
@@ -178,6 +183,7 @@ impl Arena {
             touched: Vec::new(),
             diff_memo: Default::default(),
             mimics: Vec::new(),
+            floating: false,
         };
         a.constant(0.0);
         a.constant(1.0);
@@ -321,6 +327,17 @@ impl Arena {
         self.mimics[s] = Some(m);
     }
 
+    /// Declare the coordinates a floating base's: the coordinate of joint speed `s ≥ 6` is
+    /// `q[s + 1]` (the base's quaternion has four entries for three speeds).
+    pub fn set_floating(&mut self) {
+        self.floating = true;
+    }
+
+    /// Index in `q` of speed `s`'s coordinate (`s`, or `s + 1` for a floating base's joints).
+    pub fn coordinate_index(&self, s: u32) -> u32 {
+        if self.floating && s >= 6 { s + 1 } else { s }
+    }
+
     /// The mimic constraint of speed `s`, if it is dependent.
     pub fn mimic(&self, s: u32) -> Option<MimicLeaf> {
         self.mimics.get(s as usize).copied().flatten()
@@ -330,8 +347,8 @@ impl Arena {
     /// dependent speed).
     pub fn angle(&self, q: &[f64], s: u32) -> f64 {
         match self.mimic(s) {
-            Some(m) => m.multiplier * q[m.master as usize] + m.offset,
-            None => q[s as usize],
+            Some(m) => m.multiplier * q[self.coordinate_index(m.master) as usize] + m.offset,
+            None => q[self.coordinate_index(s) as usize],
         }
     }
 
@@ -340,7 +357,9 @@ impl Arena {
         let (s, ctor): (u32, fn(u32) -> Atom) = match a {
             Atom::Speed(s) => (s, Atom::Speed),
             Atom::Accel(s) => (s, Atom::Accel),
-            Atom::Coord(s) => (s, Atom::Coord),
+            // A floating base's own coordinates (q[0..7]) are never dependent.
+            Atom::Coord(k) if self.floating && k < 7 => return None,
+            Atom::Coord(k) => (k - u32::from(self.floating), Atom::Coord),
             Atom::Sin(s) => (s, Atom::Sin),
             Atom::Cos(s) => (s, Atom::Cos),
             Atom::Param(_) | Atom::Var(_) => return None,
@@ -348,7 +367,11 @@ impl Arena {
         let m = self.mimic(s)?;
         let (k, b) = (m.multiplier, m.offset);
         let pure_sign = b == 0.0 && (k == 1.0 || k == -1.0);
-        let master = self.intern(Node::Atom(ctor(m.master)));
+        let master = match a {
+            Atom::Coord(_) => self.coordinate_index(m.master),
+            _ => m.master,
+        };
+        let master = self.intern(Node::Atom(ctor(master)));
         Some(match a {
             Atom::Speed(_) | Atom::Accel(_) => self.scale(master, k),
             Atom::Coord(_) => {

@@ -49,7 +49,7 @@ impl Arena {
     /// Name of the independent variable for labels.
     fn wrt_name(&self, wrt: Wrt) -> String {
         match wrt {
-            Wrt::Coord(i) => self.atom_name(Atom::Coord(i)),
+            Wrt::Coord(i) => self.atom_name(Atom::Coord(self.coordinate_index(i))),
             Wrt::Speed(i) => self.atom_name(Atom::Speed(i)),
             Wrt::Accel(i) => self.atom_name(Atom::Accel(i)),
             Wrt::Param(p) => self.atom_name(Atom::Param(p)),
@@ -65,11 +65,12 @@ impl Arena {
                 (Atom::Param(p), Wrt::Param(x))
                 | (Atom::Speed(p), Wrt::Speed(x))
                 | (Atom::Accel(p), Wrt::Accel(x))
-                | (Atom::Coord(p), Wrt::Coord(x))
                     if p == x =>
                 {
                     self.one()
                 }
+                // `Wrt::Coord` names the coordinate by its speed, `Atom::Coord` by its index in q.
+                (Atom::Coord(p), Wrt::Coord(x)) if p == self.coordinate_index(x) => self.one(),
                 (Atom::Sin(i), Wrt::Coord(x)) if i == x => self.atom(Atom::Cos(i)),
                 (Atom::Cos(i), Wrt::Coord(x)) if i == x => {
                     let s = self.atom(Atom::Sin(i));

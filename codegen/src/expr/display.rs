@@ -15,7 +15,10 @@ impl Arena {
             Atom::Accel(s) => naming::accel(&n.speeds[s as usize]),
             Atom::Sin(s) => naming::sin(&n.coords[s as usize]),
             Atom::Cos(s) => naming::cos(&n.coords[s as usize]),
-            Atom::Coord(s) => n.coords[s as usize].clone(),
+            Atom::Coord(k) if self.floating && k < 7 => {
+                kanegen_model::FLOATING_BASE_COORDINATES[k as usize].to_owned()
+            }
+            Atom::Coord(k) => n.coords[(k - u32::from(self.floating)) as usize].clone(),
             Atom::Var(v) => {
                 let info = &self.vars[v as usize];
                 match info.kind {

@@ -193,7 +193,7 @@ impl Ctx<'_> {
     }
 
     /// The columns (speeds) of every link and their motion subspaces `S` in its frame: a
-    /// joint's, or the base's ẋ and ψ̇ at the root.
+    /// joint's, or the base's ẋ and ψ̇ (a floating base's v and ω) at the root.
     pub(super) fn speed_columns(&mut self) -> Vec<Vec<(usize, V6)>> {
         let model = self.model;
         let links = model.links.len();
@@ -203,6 +203,15 @@ impl Ctx<'_> {
             let one = self.ar.one();
             cols[0].push((w.x_speed, [zero, zero, zero, one, zero, zero]));
             cols[0].push((w.psi_speed, [zero, zero, one, zero, zero, zero]));
+        }
+        if model.is_floating() {
+            // The base's v (linear) and ω (angular) speeds: unit vectors of frame 0.
+            let one = self.ar.one();
+            for i in 0..6 {
+                let mut s = [zero; 6];
+                s[(i + 3) % 6] = one;
+                cols[0].push((i, s));
+            }
         }
         for (l, _, mount) in model.mounted_links() {
             let Some(s) = mount.joint.speed() else {
@@ -313,6 +322,10 @@ impl Ctx<'_> {
         if let Some(wb) = model.wheeled_base() {
             w[0] = [zero, zero, self.ar.atom(Atom::Speed(wb.psi_speed as u32))];
             v[0] = [self.ar.atom(Atom::Speed(wb.x_speed as u32)), zero, zero];
+        }
+        if model.is_floating() {
+            v[0] = [0u32, 1, 2].map(|s| self.ar.atom(Atom::Speed(s)));
+            w[0] = [3u32, 4, 5].map(|s| self.ar.atom(Atom::Speed(s)));
         }
         let tag = "|ud=0,g=0";
         for (l, _, mount) in model.mounted_links() {

@@ -39,6 +39,14 @@ impl Ctx<'_> {
                 }
             };
         }
+        if self.model.is_floating() {
+            let c = &comp[0];
+            let x = self.cross(&c.first_moment, &acc[0]);
+            for i in 0..3 {
+                out[i] = self.ar.mul(c.mass, acc[0][i]);
+                out[3 + i] = x[i];
+            }
+        }
         if let Some(w) = self.model.wheeled_base().cloned() {
             let c = &comp[0];
             out[w.x_speed] = self.ar.mul(c.mass, acc[0][0]);

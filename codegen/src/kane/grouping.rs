@@ -452,6 +452,9 @@ impl Problem<'_> {
         if !self.model.mimics.is_empty() {
             return Err("mimic joints: dependent angles are not independent circle points".into());
         }
+        if self.model.is_floating() {
+            return Err("floating base: the quaternion's entries are not free points".into());
+        }
         let n = self.model.dof();
         let cols = self.params.len();
         let mut ok = vec![true; self.dependent.len() + self.unidentifiable.len()];

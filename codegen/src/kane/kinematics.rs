@@ -13,6 +13,12 @@
 //! frame 0's origin (so nothing to the potential energy, which is zero at that origin's
 //! height), `2 mw · [1, 0, 0]` to the momentum per `ẋ` and `2 mw · [0, ẋψ̇, 0]` to the bias.
 //! Their rotational inertia enters only the kinetic energy (through `M`).
+//!
+//! A floating base: frame poses, the centre of mass and the potential energy are in the world
+//! frame (the base pose `p0`, `R0` of the coordinates composed in); Jacobians and bias
+//! accelerations keep the convention above (velocities and classical accelerations relative to
+//! the world, in frame 0's axes), the base's `v` columns being the unit vectors `(eᵢ; 0)` and its
+//! `ω` columns `(eᵢ × ⁰p; eᵢ)`.
 
 use super::algebra::{M3, V3};
 use super::composite::Composite;
@@ -75,7 +81,7 @@ impl Ctx<'_> {
     }
 
     /// The wheels' total mass `2 mw` (none without a wheeled base).
-    fn wheel_mass(&mut self) -> Option<ExprId> {
+    pub(super) fn wheel_mass(&mut self) -> Option<ExprId> {
         let mw = self.model.wheeled_base()?.wheel_mass;
         let mw = self.param(mw);
         Some(self.ar.scale(mw, 2.0))
@@ -83,7 +89,7 @@ impl Ctx<'_> {
 
     /// `1 / m` for the total mass `m` (wheels included), a D variable (parameter-only: computed
     /// once per parameter set with runtime parameters).
-    fn inverse_total_mass(&mut self, comp: &[Composite]) -> ExprId {
+    pub(super) fn inverse_total_mass(&mut self, comp: &[Composite]) -> ExprId {
         let mut m = comp[0].mass;
         if let Some(mw) = self.wheel_mass() {
             m = self.ar.add(m, mw);
@@ -97,7 +103,10 @@ impl Ctx<'_> {
     /// over the total mass).
     pub(super) fn center_of_mass(&mut self, comp: &[Composite]) -> V3 {
         let inv = self.inverse_total_mass(comp);
-        let c = self.scale3(inv, &comp[0].first_moment);
+        let mut c = self.scale3(inv, &comp[0].first_moment);
+        if self.model.is_floating() {
+            c = self.in_world(&c);
+        }
         self.finish(c.to_vec(), "rG")
             .try_into()
             .expect("three entries")
@@ -138,6 +147,20 @@ impl Ctx<'_> {
             let gy = self.ar.neg(gy);
             let v = self.finish(vec![gy, gx], &format!("JG[:,{ps}]"));
             entries.extend([(0, ps, v[0]), (1, ps, v[1])]);
+        }
+        if model.is_floating() {
+            // v columns: the unit vectors; ω columns: eᵢ × r_G (r_G about the base origin).
+            let one = self.ar.one();
+            let rg = self.scale3(inv, &comp[0].first_moment);
+            let rg = self.subst3(rg, VarKind::D, "rG in 0");
+            for i in 0..3 {
+                entries.push((i, i, one));
+            }
+            let nz = self.ar.neg(rg[2]);
+            let ny = self.ar.neg(rg[1]);
+            let nx = self.ar.neg(rg[0]);
+            entries.extend([(1, 3, nz), (2, 3, rg[1]), (0, 4, rg[2]), (2, 4, nx)]);
+            entries.extend([(0, 5, ny), (1, 5, rg[0])]);
         }
         entries
     }
@@ -189,7 +212,16 @@ impl Ctx<'_> {
     /// whole robot about frame 0's origin (the wheels' is zero).
     pub(super) fn potential_energy(&mut self, comp: &[Composite]) -> ExprId {
         let g0 = self.gravity_vector();
-        let v = self.dot(&g0, &comp[0].first_moment);
+        let mut v = self.dot(&g0, &comp[0].first_moment);
+        if self.model.is_floating() {
+            // The base origin's height: `m g · p0` (world frame) on top of `g_b · MSC0`.
+            let g = self.param(self.model.gravity.symbol);
+            let d = self.consts(self.model.gravity.direction);
+            let p0 = self.base_position();
+            let dp = self.dot(&d, &p0);
+            let mgp = self.ar.product([comp[0].mass, g, dp]);
+            v = self.ar.add(v, mgp);
+        }
         let v = self.ar.neg(v);
         self.finish(vec![v], "V")[0]
     }
@@ -197,8 +229,14 @@ impl Ctx<'_> {
     /// The pose of frame `l` relative to frame 0 ([`Shape::Isometry`](crate::registry::Shape)
     /// entries): `(r, c)` of `⁰A_l` and `(r, 3)` of `⁰p_l`.
     pub(super) fn frame_pose(&mut self, l: usize) -> Vec<(usize, usize, ExprId)> {
-        let a = self.root_rotation(l);
-        let p = self.root_position(l);
+        let mut a = self.root_rotation(l);
+        let mut p = self.root_position(l);
+        if self.model.is_floating() {
+            // In the world: `R0 ⁰A_l`, `p0 + R0 ⁰p_l`.
+            let r0 = self.base_rotation();
+            a = self.matmul(&r0, &a);
+            p = self.in_world(&p);
+        }
         (0..3)
             .flat_map(|r| (0..3).map(move |c| (r, c, a[r][c])).chain([(r, 3, p[r])]))
             .collect()
@@ -244,7 +282,29 @@ impl Ctx<'_> {
             let py = self.ar.neg(p[1]);
             column(w.psi_speed, [py, p[0], zero], [zero, zero, one]);
         }
+        if model.is_floating() {
+            let (nx, ny, nz) = (self.ar.neg(p[0]), self.ar.neg(p[1]), self.ar.neg(p[2]));
+            column(0, [one, zero, zero], [zero; 3]);
+            column(1, [zero, one, zero], [zero; 3]);
+            column(2, [zero, zero, one], [zero; 3]);
+            column(3, [zero, nz, p[1]], [one, zero, zero]);
+            column(4, [p[2], zero, nx], [zero, one, zero]);
+            column(5, [ny, p[0], zero], [zero, zero, one]);
+        }
         entries
+    }
+
+    /// The floating base's origin in the world, `q[0..3]`.
+    pub(super) fn base_position(&mut self) -> V3 {
+        [0u32, 1, 2].map(|k| self.ar.atom(Atom::Coord(k)))
+    }
+
+    /// A point given in frame 0 (`x`), in the world: `p0 + R0 x` (floating base).
+    pub(super) fn in_world(&mut self, x: &V3) -> V3 {
+        let r0 = self.base_rotation();
+        let p0 = self.base_position();
+        let rx = self.rot_up(&r0, x);
+        self.add3(&p0, &rx)
     }
 
     /// The acceleration of frame `l` at `u̇ = 0` (the motion pass of `c`: classical origin

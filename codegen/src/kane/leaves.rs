@@ -90,7 +90,9 @@ impl Ctx<'_> {
         }
         let mut p = j.translation.map(|s| self.length(&s));
         if let JointKind::Prismatic { speed: s } = j.kind {
-            let q = self.ar.atom(Atom::Coord(s as u32));
+            let q = self
+                .ar
+                .atom(Atom::Coord(self.ar.coordinate_index(s as u32)));
             let dir = [0, 1, 2].map(|r| (0..3).map(|c| j.rotation[r][c] * j.axis[c]).sum::<f64>());
             for (r, pr) in p.iter_mut().enumerate() {
                 let k = self.ar.constant(dir[r]);
@@ -112,10 +114,61 @@ impl Ctx<'_> {
         Some((m, ms, j))
     }
 
+    /// Gravity `g · direction` in the base frame: constant for a fixed or wheeled base; for a
+    /// floating base `g_b = Rᵀ(quat) · g · direction`, polynomial in the quaternion (formed once,
+    /// as the variables `g_b`).
     pub(super) fn gravity_vector(&mut self) -> V3 {
         let g = self.param(self.model.gravity.symbol);
         let d = self.consts(self.model.gravity.direction);
-        self.scale3(g, &d)
+        if !self.model.is_floating() {
+            return self.scale3(g, &d);
+        }
+        let r = self.base_rotation();
+        let dir = self.model.gravity.direction;
+        let mut gb = [self.ar.zero(); 3];
+        for (i, gi) in gb.iter_mut().enumerate() {
+            // (Rᵀ d)_i = Σ_j R[j][i] d_j, only over the non-zero d_j.
+            let terms: Vec<ExprId> = (0..3)
+                .filter(|&j| dir[j] != 0.0)
+                .map(|j| self.ar.mul(r[j][i], d[j]))
+                .collect();
+            let s = self.ar.sum(terms);
+            *gi = self.ar.mul(g, s);
+        }
+        self.subst3(gb, VarKind::D, "g_b")
+    }
+
+    /// The floating base's rotation base → world from its unit quaternion `(qx, qy, qz, qw)` =
+    /// `q[3..7]`: `R = (2w² − 1)·1 + 2 w [v]× + 2 v vᵀ` written as Eigen and Pinocchio do,
+    /// `R[0][0] = 1 − 2(y² + z²)`, `R[0][1] = 2(xy − zw)`, … (polynomial: no trigonometry).
+    pub(super) fn base_rotation(&mut self) -> M3 {
+        let [x, y, z, w] = [3u32, 4, 5, 6].map(|k| self.ar.atom(Atom::Coord(k)));
+        let sq = |s: &mut Self, a: ExprId, b: ExprId| {
+            let p = s.ar.mul(a, b);
+            s.ar.scale(p, 2.0)
+        };
+        let one = self.ar.one();
+        let (xx, yy, zz) = (sq(self, x, x), sq(self, y, y), sq(self, z, z));
+        let (xy, xz, yz) = (sq(self, x, y), sq(self, x, z), sq(self, y, z));
+        let (xw, yw, zw) = (sq(self, x, w), sq(self, y, w), sq(self, z, w));
+        let diag = |s: &mut Self, a: ExprId, b: ExprId| {
+            let t = s.ar.add(a, b);
+            s.ar.sub(one, t)
+        };
+        let r = [
+            [diag(self, yy, zz), self.ar.sub(xy, zw), self.ar.add(xz, yw)],
+            [self.ar.add(xy, zw), diag(self, xx, zz), self.ar.sub(yz, xw)],
+            [self.ar.sub(xz, yw), self.ar.add(yz, xw), diag(self, xx, yy)],
+        ];
+        let mut out = r;
+        for (ri, row) in out.iter_mut().enumerate() {
+            for (ci, e) in row.iter_mut().enumerate() {
+                *e = self
+                    .ar
+                    .subst(*e, VarKind::K, &format!("R0({},{})", ri + 1, ci + 1));
+            }
+        }
+        out
     }
 
     pub(super) fn axis(&mut self, l: usize) -> V3 {

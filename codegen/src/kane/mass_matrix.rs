@@ -73,6 +73,12 @@ impl Ctx<'_> {
                         put(entries, w.x_speed, col, f[0]);
                         put(entries, w.psi_speed, col, n[2]);
                     }
+                    if model.is_floating() {
+                        for i in 0..3 {
+                            put(entries, i, col, f[i]);
+                            put(entries, 3 + i, col, n[i]);
+                        }
+                    }
                 }
             }
         }
@@ -97,6 +103,31 @@ impl Ctx<'_> {
             put(&mut entries, xs, xs, mxx);
             put(&mut entries, xs, ps, mxp);
             put(&mut entries, ps, ps, mpp);
+        }
+        if self.model.is_floating() {
+            // The base block: `[[m 1, −[MS]×], [[MS]×, J]]` of the whole robot's composite.
+            let c = &comp[0];
+            let jc = c.inertia.expect("inertia computed");
+            let ms = c.first_moment;
+            for i in 0..3 {
+                put(&mut entries, i, i, c.mass);
+            }
+            let neg = |s: &mut Self, e: ExprId| s.ar.neg(e);
+            let v_w = [
+                (0, 4, ms[2]),
+                (0, 5, neg(self, ms[1])),
+                (1, 3, neg(self, ms[2])),
+                (1, 5, ms[0]),
+                (2, 3, ms[1]),
+                (2, 4, neg(self, ms[0])),
+            ];
+            for (a, b, e) in v_w {
+                put(&mut entries, a, b, e);
+            }
+            let idx = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+            for (k, (a, b)) in idx.into_iter().enumerate() {
+                put(&mut entries, 3 + a, 3 + b, jc[k]);
+            }
         }
         let mut entries: Vec<(usize, usize, ExprId)> = entries
             .into_iter()

@@ -42,6 +42,7 @@
 //! | `rnea_derivatives.rs` | ∂τ/∂q, ∂τ/∂u: the analytic recursion (four forces per column carried up; `derivatives.rs` keeps forward mode as its test oracle) |
 //! | `derivatives_loop.rs` | the looped form of the same: per-link and per-column quantities into a workspace, tables for `kanegen_runtime::derivatives_loop` |
 //! | `kinematics.rs` | frames in frame 0 (`⁰A`, `⁰p`), centre of mass, its Jacobian and bias acceleration, energies |
+//! | `centroidal.rs` | the centroidal momentum matrix `A_G`, its bias `Ȧ_G u`, the centroidal inertia |
 //! | `regressor.rs` | regressors `∂τ/∂π`, `∂g/∂β` (by [`Arena::diff`]) and their base parameters |
 //! | `regressor_sample.rs` | the regressor evaluated at random states, what the base parameters are found from |
 //! | `regressor_loop.rs` | the loop form of Y and the base regressor: per-link motion and joint transforms, the (speed, body) tables of `kanegen_runtime::regressor` |
@@ -58,6 +59,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod algebra;
+mod centroidal;
 mod composite;
 mod coriolis_matrix;
 mod ctx;
@@ -130,6 +132,10 @@ pub struct Derivation {
     pub functions: Vec<Function>,
     /// Number of speeds.
     pub dof: usize,
+    /// Number of coordinates (the length of `q`): `dof`, or `dof + 1` for a floating base.
+    pub nq: usize,
+    /// Whether the base is floating ([`kanegen_model::Base::Floating`]).
+    pub floating: bool,
     /// Options used.
     pub options: Options,
     /// The body frames' names (the model's links, in order): the frames of the per-frame
@@ -210,7 +216,7 @@ pub fn names_of(model: &Model) -> Names {
 /// spills); g and C reuse those composites. The order fixes the arena's numbering and with it the
 /// generated code, so it is part of the output's definition. The opt-in kinematics come last, so
 /// that they do not change the dynamics' code.
-const DERIVATION_ORDER: [FunctionId; 19] = [
+const DERIVATION_ORDER: [FunctionId; 22] = [
     FunctionId::MassMatrix,
     FunctionId::Gravity,
     FunctionId::Coriolis,
@@ -230,6 +236,9 @@ const DERIVATION_ORDER: [FunctionId; 19] = [
     FunctionId::BaseRegressor,
     FunctionId::BaseGravityRegressor,
     FunctionId::NonlinearEffects,
+    FunctionId::CentroidalMomentumMatrix,
+    FunctionId::CentroidalMomentumBias,
+    FunctionId::CentroidalInertia,
 ];
 
 /// Derive the functions of `options.functions` for `model` (M as its upper triangle).
@@ -253,6 +262,9 @@ pub fn derive_shaped(
 ) -> Derivation {
     let mut arena = Arena::new(names_of(model));
     arena.hoist_params = options.params.is_runtime();
+    if model.is_floating() {
+        arena.set_floating();
+    }
     mimic::declare(&mut arena, model);
     let mut cx = Ctx {
         ar: &mut arena,
@@ -331,7 +343,8 @@ pub fn derive_shaped(
     // The looped derivatives: one more phase, after every other (the other functions' code is
     // unchanged).
     let derivative_loop = (options.has(FunctionId::InverseDynamicsDerivatives)
-        && model.mimics.is_empty())
+        && model.mimics.is_empty()
+        && !model.is_floating())
     .then(|| {
         cx.ar.begin_phase();
         let (entries, plan) = cx.inverse_dynamics_derivatives_looped();
@@ -357,13 +370,17 @@ pub fn derive_shaped(
         arena,
         functions,
         dof: n,
+        nq: model.nq(),
+        floating: model.is_floating(),
         options,
         frame_names: model.links.iter().map(|l| l.name.clone()).collect(),
         regressors,
         sizes,
         combined: combined_out,
         derivative_loop,
-        mirror: Mirror::of(model),
+        // A floating base's coordinates are not indexed like its speeds, which the pairing of
+        // mirrored subtrees assumes.
+        mirror: Mirror::of(model).filter(|_| !model.is_floating()),
     }
 }
 
@@ -413,6 +430,19 @@ impl Ctx<'_> {
                 vec![(0, 0, self.potential_energy(comp))]
             }
             FunctionId::InverseDynamicsDerivatives => self.inverse_dynamics_derivatives(),
+            FunctionId::CentroidalMomentumMatrix => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                self.centroidal_momentum_matrix(comp)
+            }
+            FunctionId::CentroidalMomentumBias => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                let [f, n] = self.centroidal_momentum_bias(comp);
+                vector(f.into_iter().chain(n).collect())
+            }
+            FunctionId::CentroidalInertia => {
+                let comp = composites.get_or_insert_with(|| self.composites(true, None));
+                self.centroidal_inertia(comp)
+            }
             FunctionId::FramePose
             | FunctionId::FrameJacobian
             | FunctionId::FrameBiasAcceleration => {

@@ -362,7 +362,9 @@ pub fn first_row(c: usize, rows: usize) -> usize {
 /// Whether `form` asks for the loop form of `model`'s regressor with `pairs` (speed, body)
 /// pairs.
 pub(super) fn use_loop(form: RegressorForm, model: &Model, pairs: usize) -> bool {
+    // A floating base's root rows are not in the loop's (speed, body) tables.
     model.mimics.is_empty()
+        && !model.is_floating()
         && match form {
             RegressorForm::Auto => pairs >= LOOP_MIN_PAIRS,
             RegressorForm::Loop => true,

@@ -40,7 +40,13 @@ pub(super) fn regressor_at(
     rng: &mut Rng,
 ) -> Vec<f64> {
     let n = model.dof();
-    let q: Vec<f64> = (0..n).map(|_| rng.sym(std::f64::consts::PI)).collect();
+    // A floating base's q has one entry more: its quaternion, scaled to unit norm.
+    let nq = n + usize::from(model.is_floating());
+    let mut q: Vec<f64> = (0..nq).map(|_| rng.sym(std::f64::consts::PI)).collect();
+    if model.is_floating() {
+        let norm = q[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
+        q[3..7].iter_mut().for_each(|x| *x /= norm);
+    }
     let u: Vec<f64> = (0..n).map(|_| rng.sym(2.0)).collect();
     let ud: Vec<f64> = (0..n).map(|_| rng.sym(2.0)).collect();
     let vals = ar.eval_needed(

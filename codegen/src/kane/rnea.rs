@@ -86,6 +86,13 @@ impl Ctx<'_> {
         self.inertia_forces(Inputs::new(false, false)).0[0]
     }
 
+    /// [`Ctx::bias_inertia_force`] with the moment about frame 0's origin: the whole robot's
+    /// inertia wrench `(f, n)` at `u̇ = 0` without gravity, in frame 0's axes.
+    pub(super) fn bias_inertia_wrench(&mut self) -> (V3, V3) {
+        let (f, n) = self.inertia_forces(Inputs::new(false, false));
+        (f[0], n[0])
+    }
+
     /// Every frame's motion at `u̇ = 0` without gravity (the variables `c` uses): `(ω, α, a)`
     /// of each frame in its own axes; `a` is the classical acceleration of its origin.
     pub(super) fn bias_motion(&mut self) -> Motion {
@@ -156,7 +163,8 @@ impl Ctx<'_> {
     }
 
     /// The motion of the root frame (the wheeled base's `ω0 = [0,0,ψ̇]`, `α0 = [0,0,ψ̈]`,
-    /// `a0 = [ẍ, ẋψ̇, 0]`, minus gravity if asked); the other frames' are zero until the forward
+    /// `a0 = [ẍ, ẋψ̇, 0]`; the floating base's `ω0 = ω`, `α0 = ω̇`, `a0 = v̇ + ω × v`; minus
+    /// gravity if asked); the other frames' are zero until the forward
     /// pass forms them.
     fn base_motion(&mut self, inputs: Inputs) -> Motion {
         let model = self.model;
@@ -176,6 +184,18 @@ impl Ctx<'_> {
             // a0 = [ẍ, ẋψ̇, 0]: the centripetal term ẋψ̇ along y0.
             let xp = self.ar.mul(xd, psid);
             a[0] = [xdd, xp, zero];
+        }
+        if model.is_floating() {
+            // The base twist (v, ω) in the base frame: α0 = ω̇, a0 = v̇ + ω × v (the classical
+            // acceleration of the base origin, in the base frame).
+            let v = [0, 1, 2].map(|s| inputs.speed(self.ar, s));
+            w[0] = [3, 4, 5].map(|s| inputs.speed(self.ar, s));
+            wd[0] = [3, 4, 5].map(|s| inputs.accel(self.ar, s));
+            let vd = [0, 1, 2].map(|s| inputs.accel(self.ar, s));
+            let wxv = self.cross(&w[0], &v);
+            let root = self.link_name(0).to_owned();
+            let wxv = self.subst3(wxv, VarKind::K, &format!("w{root}xv{root}"));
+            a[0] = self.add3(&vd, &wxv);
         }
         if inputs.gravity {
             let g0 = self.gravity_vector();
@@ -267,7 +287,8 @@ impl Ctx<'_> {
 
     /// The generalized forces from the accumulated subtree forces `f` and moments `n`: `e · f`
     /// (prismatic) or `e · n` (revolute) per joint, and the root's `f_x`, `n_z` plus the wheel
-    /// terms (times ẍ, ψ̈ with `with_accel`) on the base's ẋ and ψ̇ rows.
+    /// terms (times ẍ, ψ̈ with `with_accel`) on the base's ẋ and ψ̇ rows; a floating base's rows
+    /// are the root's `f` and `n`.
     fn generalized_forces(&mut self, f: &[V3], n: &[V3], with_accel: bool) -> Vec<ExprId> {
         let model = self.model;
         let zero = self.ar.zero();
@@ -281,6 +302,12 @@ impl Ctx<'_> {
                 JointKind::Prismatic { .. } => self.dot(&e, &f[l]),
                 _ => self.dot(&e, &n[l]),
             };
+        }
+        if model.is_floating() {
+            // The base speeds' partial velocities are the base frame's unit vectors: the whole
+            // robot's inertia force (v rows) and moment about the base origin (ω rows).
+            out[..3].copy_from_slice(&f[0]);
+            out[3..6].copy_from_slice(&n[0]);
         }
         if let Some((xs, kx, ps, kp)) = self.wheel_terms() {
             out[xs] = f[0][0];

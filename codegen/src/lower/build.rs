@@ -112,6 +112,8 @@ pub fn lower_with(d: &Derivation, form: DerivativesForm) -> Lowered {
         pre_slots,
         functions,
         dof: d.dof,
+        nq: d.nq,
+        floating: d.floating,
         params: d.options.params,
         mimic_angles: (0..d.arena.names.speeds.len())
             .filter_map(|s| d.arena.mimic(s as u32).map(|m| (s, m)))

@@ -8,7 +8,7 @@ use crate::registry::FunctionId;
 impl Lowered {
     /// Values of the precompute slots for parameter values `params`.
     pub fn precompute_values(&self, params: &[f64]) -> Vec<f64> {
-        let locals = run(&self.precompute, params, &[], &[], &[], &[]);
+        let locals = run(&self.precompute, params, &[], &[], &[], &[], &[]);
         self.pre_slots.iter().map(|&i| locals[i]).collect()
     }
 
@@ -40,7 +40,7 @@ impl Lowered {
         let p = self
             .function_at(id, frame)
             .unwrap_or_else(|| panic!("the lowered model has no function `{id}`"));
-        let values = output_values(p, params, &pre, &self.expand_angles(q), u, ud);
+        let values = output_values(p, params, &pre, q, &self.expand_angles(q), u, ud);
         let entries = p
             .outputs
             .iter()
@@ -71,7 +71,7 @@ impl Lowered {
             .as_ref()?;
         let pre = self.precompute_values(params);
         let p = &lp.program;
-        let values = output_values(p, params, &pre, &self.expand_angles(q), u, ud);
+        let values = output_values(p, params, &pre, q, &self.expand_angles(q), u, ud);
         let kin = values[..lp.kin_len].to_vec();
         let extra = p.outputs[lp.kin_len..]
             .iter()
@@ -97,7 +97,7 @@ impl Lowered {
         let pre = self.precompute_values(params);
         let c = &self.combined[index];
         let p = &c.program;
-        let values = output_values(p, params, &pre, &self.expand_angles(q), u, ud);
+        let values = output_values(p, params, &pre, q, &self.expand_angles(q), u, ud);
         c.spec
             .parts
             .iter()
@@ -112,8 +112,9 @@ impl Lowered {
             .collect()
     }
 
-    /// `q` extended by the angles of the dependent (mimic) speeds at their indices, which the
-    /// programs' `sin`/`cos` leaves of those speeds read.
+    /// The angle of every speed's `sin`/`cos` leaves, by speed index, from the coordinates `q`:
+    /// `q` itself (a floating base's joint angles moved down by one, to their speeds' indices)
+    /// extended by the angles of the dependent (mimic) speeds at their indices.
     pub fn expand_angles(&self, q: &[f64]) -> Vec<f64> {
         let len = self
             .mimic_angles
@@ -121,12 +122,15 @@ impl Lowered {
             .map(|(s, _)| s + 1)
             .max()
             .unwrap_or(0);
-        let mut out = q.to_vec();
+        let coord = |s: usize| if self.floating && s >= 6 { s + 1 } else { s };
+        let mut out: Vec<f64> = (0..q.len() - usize::from(self.floating))
+            .map(|s| q[coord(s)])
+            .collect();
         if out.len() < len {
             out.resize(len, 0.0);
         }
         for (s, m) in &self.mimic_angles {
-            out[*s] = m.multiplier * q[m.master as usize] + m.offset;
+            out[*s] = m.multiplier * q[coord(m.master as usize)] + m.offset;
         }
         out
     }
@@ -136,6 +140,7 @@ struct EvalCtx<'a> {
     params: &'a [f64],
     pre: &'a [f64],
     q: &'a [f64],
+    angles: &'a [f64],
     u: &'a [f64],
     ud: &'a [f64],
     locals: &'a [f64],
@@ -150,8 +155,8 @@ impl EvalCtx<'_> {
                 Leaf::Pre(s) => self.pre[s],
                 Leaf::Speed(s) => self.u[s],
                 Leaf::Accel(s) => self.ud[s],
-                Leaf::Sin(s) => self.q[s].sin(),
-                Leaf::Cos(s) => self.q[s].cos(),
+                Leaf::Sin(s) => self.angles[s].sin(),
+                Leaf::Cos(s) => self.angles[s].cos(),
                 Leaf::Coord(s) => self.q[s],
                 Leaf::Local(i) => self.locals[i],
             },
@@ -165,21 +170,24 @@ impl EvalCtx<'_> {
     }
 }
 
-/// The values of `p`'s outputs, in order, at one input point (`q` with the mimic angles
-/// expanded, see [`Lowered::expand_angles`]).
+/// The values of `p`'s outputs, in order, at one input point (the coordinates `q` and the
+/// angles of the `sin`/`cos` leaves, see [`Lowered::expand_angles`]).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn output_values(
     p: &Program,
     params: &[f64],
     pre: &[f64],
     q: &[f64],
+    angles: &[f64],
     u: &[f64],
     ud: &[f64],
 ) -> Vec<f64> {
-    let locals = run(p, params, pre, q, u, ud);
+    let locals = run(p, params, pre, q, angles, u, ud);
     let ctx = EvalCtx {
         params,
         pre,
         q,
+        angles,
         u,
         ud,
         locals: &locals,
@@ -187,11 +195,13 @@ pub(super) fn output_values(
     p.outputs.iter().map(|(_, _, e)| ctx.eval(e)).collect()
 }
 
+#[allow(clippy::too_many_arguments)]
 pub(super) fn run(
     p: &Program,
     params: &[f64],
     pre: &[f64],
     q: &[f64],
+    angles: &[f64],
     u: &[f64],
     ud: &[f64],
 ) -> Vec<f64> {
@@ -201,6 +211,7 @@ pub(super) fn run(
             params,
             pre,
             q,
+            angles,
             u,
             ud,
             locals: &locals,

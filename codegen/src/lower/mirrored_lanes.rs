@@ -123,8 +123,8 @@ fn same_values(a: &Program, b: &Program, n: usize, params: &[f64], pre: &[f64]) 
             .iter()
             .map(|v| v * 0.7 + shift)
             .collect();
-        let oa = output_values(a, params, pre, &q, &u, &ud);
-        let ob = output_values(b, params, pre, &q, &u, &ud);
+        let oa = output_values(a, params, pre, &q, &q, &u, &ud);
+        let ob = output_values(b, params, pre, &q, &q, &u, &ud);
         let scale = oa.iter().fold(1.0f64, |m, v| m.max(v.abs()));
         oa.iter()
             .zip(&ob)

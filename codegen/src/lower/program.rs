@@ -242,6 +242,12 @@ pub struct Lowered {
     pub functions: Vec<FunctionProgram>,
     /// Number of speeds.
     pub dof: usize,
+    /// Number of coordinates (the length of `q`): `dof`, or `dof + 1` for a floating base.
+    pub nq: usize,
+    /// Whether the base is floating: `q` starts with the base's seven coordinates and the
+    /// coordinate of joint speed `s ≥ 6` is `q[s + 1]` (`Leaf::Coord` indexes `q`, `Leaf::Sin` and
+    /// `Leaf::Cos` index speeds).
+    pub floating: bool,
     /// Parameter mode.
     pub params: ParamMode,
     /// The dependent (mimic) speeds whose `sin`/`cos` leaves the programs may read: speed index

@@ -206,14 +206,49 @@ pub enum Base {
     Fixed,
     /// Two-wheeled inverted-pendulum base with quasi-velocities ẋ, ψ̇.
     Wheeled(WheeledBase),
+    /// A free-flying base frame (legged robots, humanoids), laid out as Pinocchio's free-flyer
+    /// joint. The first six speeds of [`Model::speeds`] are the base's: the base origin's
+    /// velocity `v` and the base's angular velocity `ω`, both in the base frame
+    /// ([`FLOATING_BASE_SPEEDS`]). Its seven coordinates come first in `q`: the base origin in
+    /// the world, then the unit quaternion `(qx, qy, qz, qw)` that rotates base vectors into the
+    /// world ([`FLOATING_BASE_COORDINATES`]); the first six are the coordinates of the six base
+    /// speeds and `base_qw` has no speed, so a model has [`Model::nq`] = [`Model::dof`] + 1
+    /// coordinates. Gravity's direction is in the world frame.
+    Floating,
 }
 
-/// Uniform gravity `g · direction` in the base frame.
+/// The coordinates of a floating base, first in `q`: position of the base origin in the world,
+/// then the quaternion (vector part first, as Pinocchio and Eigen store it).
+pub const FLOATING_BASE_COORDINATES: [&str; 7] = [
+    "base_x", "base_y", "base_z", "base_qx", "base_qy", "base_qz", "base_qw",
+];
+
+/// The speeds of a floating base, first in `u`: the base origin's linear velocity and the base's
+/// angular velocity, both in the base frame.
+pub const FLOATING_BASE_SPEEDS: [&str; 6] = [
+    "base_vx", "base_vy", "base_vz", "base_wx", "base_wy", "base_wz",
+];
+
+/// The floating base's six speeds (named [`FLOATING_BASE_SPEEDS`], the rates of the first six
+/// [`FLOATING_BASE_COORDINATES`]), to put first in [`Model::speeds`].
+pub fn floating_base_speeds() -> Vec<Speed> {
+    FLOATING_BASE_SPEEDS
+        .iter()
+        .zip(FLOATING_BASE_COORDINATES)
+        .map(|(s, c)| Speed {
+            name: (*s).to_owned(),
+            coordinate: c.to_owned(),
+        })
+        .collect()
+}
+
+/// Uniform gravity `g · direction` in the base frame (in the world frame for a floating base).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Gravity {
     /// The magnitude parameter (`g`).
     pub symbol: ParamId,
-    /// Unit direction in the base frame (`[0, 0, -1]` for z up).
+    /// Unit direction in the base frame (`[0, 0, -1]` for z up); in the world frame for a
+    /// floating base.
     pub direction: [f64; 3],
 }
 
@@ -265,6 +300,40 @@ impl Model {
     /// Default parameter values, indexed by [`ParamId`].
     pub fn param_values(&self) -> Vec<f64> {
         self.params.iter().map(|p| p.value).collect()
+    }
+
+    /// Whether the base is floating ([`Base::Floating`]).
+    pub fn is_floating(&self) -> bool {
+        matches!(self.base, Base::Floating)
+    }
+
+    /// Number of coordinates of generated code (the length of `q`): [`Model::independent_dof`],
+    /// plus one for a floating base (its quaternion has four entries for three speeds).
+    pub fn nq(&self) -> usize {
+        self.independent_dof() + usize::from(self.is_floating())
+    }
+
+    /// Index in `q` of the coordinate of speed `s`: `s`, or `s + 1` for a joint speed of a
+    /// floating base (after the base's seven coordinates).
+    pub fn coordinate_index(&self, s: usize) -> usize {
+        if self.is_floating() && s >= 6 {
+            s + 1
+        } else {
+            s
+        }
+    }
+
+    /// The coordinate names of generated code, in the order of `q` ([`Model::nq`] of them): the
+    /// coordinates of the independent speeds, with `base_qw` after the floating base's first six.
+    pub fn coordinate_names(&self) -> Vec<&str> {
+        let mut names: Vec<&str> = self.speeds[..self.independent_dof()]
+            .iter()
+            .map(|s| s.coordinate.as_str())
+            .collect();
+        if self.is_floating() {
+            names.insert(6, FLOATING_BASE_COORDINATES[6]);
+        }
+        names
     }
 
     /// Index of the speed called `name`.
@@ -321,7 +390,7 @@ impl Model {
     pub fn wheeled_base(&self) -> Option<&WheeledBase> {
         match &self.base {
             Base::Wheeled(w) => Some(w),
-            Base::Fixed => None,
+            Base::Fixed | Base::Floating => None,
         }
     }
 
@@ -349,6 +418,13 @@ impl fmt::Display for Model {
         }
         match &self.base {
             Base::Fixed => writeln!(f, "base: fixed frame `{}`", self.links[0].name)?,
+            Base::Floating => writeln!(
+                f,
+                "base: floating frame `{}`; coordinates {}; speeds {}",
+                self.links[0].name,
+                FLOATING_BASE_COORDINATES.join(", "),
+                FLOATING_BASE_SPEEDS.join(", ")
+            )?,
             Base::Wheeled(w) => writeln!(
                 f,
                 "base: two-wheeled heading frame `{}`; speeds {} and {}; R = {}, L = {}, mw = {}, YYw = {}, ZZw = {}",
@@ -363,9 +439,10 @@ impl fmt::Display for Model {
             )?,
         }
         let g = &self.gravity;
+        let frame = if self.is_floating() { "world" } else { "base" };
         writeln!(
             f,
-            "gravity: {} * {:?} in the base frame",
+            "gravity: {} * {:?} in the {frame} frame",
             self.params[g.symbol].name, g.direction
         )?;
         writeln!(f, "frames ({}):", self.links.len())?;

@@ -9,7 +9,9 @@
 //! `I_b = [[J_O, [h]×], [−[h]×, m·1]]` with `h = m·o + MS` and
 //! `J_O = J − [o]×[MS]× − [MS]×[o]× − m [o]×[o]×`. A joint's motion is the spatial vector
 //! `S = (e, o_j × e)` (revolute about the world axis `e` through `o_j`) or `(0, e)` (prismatic);
-//! a wheeled base's `ẋ`, `ψ̇` move everything by `(0, x̂)` and `(ẑ, 0)` and add the wheel terms.
+//! a wheeled base's `ẋ`, `ψ̇` move everything by `(0, x̂)` and `(ẑ, 0)` and add the wheel terms;
+//! a floating base's `v`, `ω` (in the base frame) move everything by `(0, eᵢ)` and `(eᵢ, 0)`,
+//! and its base frame's body counts.
 //! Then `M[a, b] = S_aᵀ I_c(b) S_b` for `a` on the path from `b` to the base, with `I_c(b)` the
 //! composite inertia of everything `b` moves (the composite-rigid-body algorithm: O(n·depth)).
 //! This is independent of the generator and of `kanegen-reference` (which builds M from inverse
@@ -71,7 +73,7 @@ fn spatial(w: Vector3<f64>, v: Vector3<f64>) -> Vector6<f64> {
 }
 
 /// The mass matrix at coordinates `q` (indexed like the speeds; a wheeled base's `x`, `psi`
-/// entries are not read) for parameter values `p`, from the kinetic energy by the
+/// entries and a floating base's first six are not read) for parameter values `p`, from the kinetic energy by the
 /// composite-rigid-body algorithm (this crate's `src/mass_matrix.rs` describes it). Used by
 /// validation; the generated code and `kanegen-reference` compute M independently.
 pub fn kinetic_energy_mass_matrix(model: &Model, q: &[f64], p: &[f64]) -> DMatrix<f64> {
@@ -105,12 +107,17 @@ pub fn kinetic_energy_mass_matrix(model: &Model, q: &[f64], p: &[f64]) -> DMatri
             JointKind::Fixed => None,
         };
     }
-    let base: Vec<(usize, Vector6<f64>)> = model.wheeled_base().map_or(Vec::new(), |w| {
+    let mut base: Vec<(usize, Vector6<f64>)> = model.wheeled_base().map_or(Vec::new(), |w| {
         vec![
             (w.x_speed, spatial(Vector3::zeros(), Vector3::x())),
             (w.psi_speed, spatial(Vector3::z(), Vector3::zeros())),
         ]
     });
+    if model.is_floating() {
+        let e = [Vector3::x(), Vector3::y(), Vector3::z()];
+        base.extend((0..3).map(|i| (i, spatial(Vector3::zeros(), e[i]))));
+        base.extend((0..3).map(|i| (3 + i, spatial(e[i], Vector3::zeros()))));
+    }
     let mut mm = DMatrix::zeros(n, n);
     let mut set = |a: usize, b: usize, v: f64| {
         mm[(a, b)] = v;

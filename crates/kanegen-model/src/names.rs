@@ -256,6 +256,7 @@ fn locals(model: &Model) -> Vec<Local> {
     for (s, sp) in model.speeds.iter().zip(&driver) {
         let of = match sp {
             Some(j) => format!(" of joint `{j}`"),
+            None if model.is_floating() => " of the floating base".to_owned(),
             None => " of the wheeled base".to_owned(),
         };
         let c = &s.coordinate;
@@ -275,6 +276,13 @@ fn locals(model: &Model) -> Vec<Local> {
         );
         push(format!("sine of coordinate `{c}`"), sin(c), false);
         push(format!("cosine of coordinate `{c}`"), cos(c), false);
+    }
+    if model.is_floating() {
+        out.push(Local {
+            item: "coordinate of the floating base".to_owned(),
+            name: crate::ir::FLOATING_BASE_COORDINATES[6].to_owned(),
+            written: true,
+        });
     }
     out
 }

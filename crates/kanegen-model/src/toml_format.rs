@@ -7,12 +7,12 @@
 //! speeds = ["qd_imu", "qd_w"]          # the order of u
 //!
 //! [base]
-//! type = "fixed"                        # or "wheeled" (see WheeledBase)
+//! type = "fixed"                        # or "wheeled" (see WheeledBase) or "floating"
 //! frame = "0"
 //!
 //! [gravity]
 //! symbol = "g"
-//! direction = [0, 0, -1]                # unit vector in the base frame
+//! direction = [0, 0, -1]                # unit vector in the base frame (world frame if floating)
 //!
 //! [parameters]                          # every symbol with its default value (SI)
 //! g = 9.81
@@ -37,6 +37,10 @@
 //! rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]   # parentAframe by rows (default: identity)
 //! translation = [0, 0, "L1"]            # the origin in the parent frame: numbers or [-]SYMBOL
 //! ```
+//!
+//! A floating base (`type = "floating"`, with its `frame`) puts its six speeds
+//! ([`FLOATING_BASE_SPEEDS`](crate::FLOATING_BASE_SPEEDS)) before those of `[model] speeds`, which
+//! lists the joints' speeds only; see [`Base::Floating`](crate::Base::Floating).
 //!
 //! Operational frames are appended after the joints' frames, in file order (see
 //! [`OperationalFrame`](crate::OperationalFrame)).
@@ -92,6 +96,9 @@ struct ModelSection {
 #[serde(deny_unknown_fields, rename_all = "lowercase", tag = "type")]
 enum BaseSection {
     Fixed {
+        frame: String,
+    },
+    Floating {
         frame: String,
     },
     Wheeled {
@@ -324,7 +331,14 @@ fn parse_length(entry: &LengthEntry, joint: &str, syms: &mut Symbols) -> Result<
 /// bodies, each checked.
 fn build(f: File, file: &str) -> Result<Model, K> {
     let mut syms = Symbols::from_table(&f.parameters)?;
-    let mut speeds = Speeds::new(&f.model.speeds)?;
+    let mut speeds = match f.base {
+        BaseSection::Floating { .. } => {
+            let mut names: Vec<String> = FLOATING_BASE_SPEEDS.map(str::to_owned).to_vec();
+            names.extend(f.model.speeds.iter().cloned());
+            Speeds::new(&names)?
+        }
+        _ => Speeds::new(&f.model.speeds)?,
+    };
     let (base_frame, base) = build_base(&f.base, &mut syms, &mut speeds)?;
 
     let gsym = syms.lookup("gravity", &f.gravity.symbol, ParamKind::Gravity)?;
@@ -386,6 +400,12 @@ fn build_base(
 ) -> Result<(String, Base), K> {
     match section {
         BaseSection::Fixed { frame } => Ok((frame.clone(), Base::Fixed)),
+        BaseSection::Floating { frame } => {
+            for (s, c) in FLOATING_BASE_SPEEDS.iter().zip(FLOATING_BASE_COORDINATES) {
+                speeds.drive(s, "the floating base".into(), c)?;
+            }
+            Ok((frame.clone(), Base::Floating))
+        }
         BaseSection::Wheeled {
             frame,
             x_speed,

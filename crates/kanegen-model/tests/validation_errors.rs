@@ -695,6 +695,7 @@ fn shipped_models_load() {
     assert_eq!(
         found,
         vec![
+            ("floating-hopper".to_owned(), 9, 4),
             ("krang".to_owned(), 19, 17),
             ("krang-fixed-wheels".to_owned(), 17, 17),
             ("two-link".to_owned(), 2, 2),

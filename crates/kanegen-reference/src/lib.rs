@@ -189,7 +189,9 @@ impl<T: RealField + Copy> Reference<T> {
             })
             .collect();
         let wheels = match &model.base {
-            Base::Fixed => None,
+            // A floating base's six speeds drive no joint of this recursion: it holds the base
+            // frame still (the free-flyer recursion is a separate entry point).
+            Base::Fixed | Base::Floating => None,
             Base::Wheeled(w) => {
                 let (r, l) = (p(w.radius), p(w.track));
                 let (mw, yy, zz) = (

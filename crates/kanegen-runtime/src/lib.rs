@@ -19,6 +19,10 @@
 //!   [`InverseDynamicsDerivatives`], for modules generated with `inverse_dynamics_derivatives`:
 //!   the partials of inverse dynamics and, provided, those of forward dynamics
 //!   ([`ForwardDynamicsDerivatives`]), for LQR and MPC on any generated robot.
+//! - [`Multibody`]: the same dynamics with the configuration as an associated type and the
+//!   configuration space's `integrate`, `difference`, `neutral` and `normalize`, implemented by
+//!   every generated robot, floating bases included (whose `q` has one entry more than `u`);
+//!   [`free_flyer`]: a floating base's configuration space (Pinocchio's free-flyer layout).
 //!
 //! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA; the
 //!   batched functions also x86-64-v4, AVX-512), the
@@ -161,9 +165,11 @@ extern crate std;
 mod arith;
 pub mod derivatives_loop;
 mod dynamics;
+pub mod free_flyer;
 mod invalid_parameter;
 pub mod isa;
 pub mod lanes;
+mod multibody;
 pub mod pair;
 pub mod quad;
 pub mod regressor;
@@ -177,6 +183,7 @@ pub use dynamics::{
     CoriolisMatrix, ForwardDynamicsDerivatives, InverseDynamicsDerivatives, RobotDynamics,
 };
 pub use invalid_parameter::{InvalidParameter, Problem};
+pub use multibody::Multibody;
 pub use nalgebra;
 #[cfg(feature = "serde")]
 pub use serde;

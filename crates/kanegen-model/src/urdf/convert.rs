@@ -31,7 +31,7 @@ pub(super) fn convert(
     let r = resolve(robot, opts, &mut notes)?;
     let wheel = match &opts.base {
         UrdfBase::Wheeled(w) => Some((w, wheeled::wheel_geometry(w, &r, &mut notes)?)),
-        UrdfBase::Fixed => None,
+        UrdfBase::Fixed | UrdfBase::Floating => None,
     };
     let mut ir = Ir::new(opts.gravity);
     let base = match &wheel {
@@ -43,7 +43,12 @@ pub(super) fn convert(
                 body: None,
             });
             ir.ir_index.insert(r.cut.top, 0);
-            Base::Fixed
+            if r.cut.floating {
+                ir.speeds.extend(crate::ir::floating_base_speeds());
+                Base::Floating
+            } else {
+                Base::Fixed
+            }
         }
     };
     add_moving_joints(&mut ir, &r);
@@ -88,7 +93,8 @@ fn resolve<'a>(
     let dropped = dropped_links(&tree, root, opts, notes)?;
     let cut = match &opts.base {
         UrdfBase::Wheeled(w) => BaseCut::wheeled(w, &tree, &dropped, notes)?,
-        UrdfBase::Fixed => BaseCut::fixed(root, n),
+        UrdfBase::Fixed => BaseCut::fixed_or_floating(&tree, root, false, notes),
+        UrdfBase::Floating => BaseCut::fixed_or_floating(&tree, root, true, notes),
     };
     let kept = tree.preorder(cut.top, &|k| !dropped[tree.child_of(k)]);
     check_joints(
@@ -185,7 +191,7 @@ fn check_joints(tree: &Tree<'_>, kept: &[usize], cut: &BaseCut, wheeled: bool) -
             J::Floating | J::Planar | J::Spherical => {
                 let fix = match (&j.joint_type, wheeled) {
                     (J::Spherical, _) => "model it as three revolute joints with massless links between them, or make it fixed".to_owned(),
-                    (_, false) => "the generator has fixed and two-wheeled bases: make it fixed, or declare a wheeled base (UrdfBase::Wheeled) whose body link hangs from it".to_owned(),
+                    (_, false) => "the generator has fixed, floating and two-wheeled bases: make it fixed; a floating base is the one `floating` joint of a bare root link named `world`, or the root itself with UrdfBase::Floating; or declare a wheeled base (UrdfBase::Wheeled) whose body link hangs from it".to_owned(),
                     (_, true) => "only the joint directly above the wheeled base's body link (through fixed joints) is replaced by the base; make this one fixed".to_owned(),
                 };
                 return Err(K::UrdfUnsupportedJoint {
@@ -393,6 +399,7 @@ fn assemble(
         match base {
             Base::Fixed => "fixed",
             Base::Wheeled(_) => "two-wheeled",
+            Base::Floating => "floating",
         }
     );
     let model = Model {

@@ -17,6 +17,8 @@ pub(super) struct BaseCut {
     pub(super) wheel_joints: Vec<usize>,
     /// Per link: is it a wheel link or fixed to one?
     pub(super) wheel_part: Vec<bool>,
+    /// Whether the base is floating (declared, or a `floating` joint below a bare root).
+    pub(super) floating: bool,
 }
 
 impl BaseCut {
@@ -27,7 +29,40 @@ impl BaseCut {
             body: root,
             wheel_joints: Vec::new(),
             wheel_part: vec![false; links],
+            floating: false,
         }
+    }
+
+    /// The kept tree of a fixed base (`declared_floating` false) or a floating one: a root link
+    /// named `world`, without inertia, whose only joint is `floating` is cut off and its child
+    /// becomes the floating base frame, declared or not (noted); otherwise the URDF root is the
+    /// base frame, floating if declared.
+    pub(super) fn fixed_or_floating(
+        tree: &Tree<'_>,
+        root: usize,
+        declared_floating: bool,
+        notes: &mut Notes,
+    ) -> Self {
+        let links = tree.parent_joint.len();
+        let mut cut = Self::fixed(root, links);
+        cut.floating = declared_floating;
+        if let [k] = tree.child_joints[root][..]
+            && tree.link(root).name == "world"
+            && tree.joint(k).joint_type == urdf_rs::JointType::Floating
+            && tree.link(root).inertial.mass.value == 0.0
+        {
+            let child = tree.child_of(k);
+            notes.push(format!(
+                "floating joint `{}` from `{}` gives the floating base: `{}` is the base frame",
+                tree.joint(k).name,
+                tree.link(root).name,
+                tree.link(child).name
+            ));
+            cut.top = child;
+            cut.body = child;
+            cut.floating = true;
+        }
+        cut
     }
 
     /// Resolves the wheeled base declaration against the tree: the body link, the cut above it,
@@ -44,6 +79,7 @@ impl BaseCut {
             body,
             wheel_joints: Vec::new(),
             wheel_part: vec![false; tree.parent_joint.len()],
+            floating: false,
         };
         for (option, name) in [
             ("base.left_wheel_joint", &w.left_wheel_joint),

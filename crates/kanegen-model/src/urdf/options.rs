@@ -89,6 +89,11 @@ pub enum UrdfBase {
     Fixed,
     /// The two-wheeled inverted-pendulum base ([`WheeledBase`](crate::WheeledBase)).
     Wheeled(WheeledBaseSpec),
+    /// A free-flying base ([`Base::Floating`](crate::Base::Floating)): the URDF root link is the
+    /// base frame and its inertia counts (a root link named `world`, without inertia, whose one
+    /// joint is `floating` is cut off, and its child is the base frame; that happens with
+    /// [`UrdfBase::Fixed`] too). Gravity's direction is in the world frame.
+    Floating,
 }
 
 /// Declaration of a two-wheeled inverted-pendulum base (Krang's base, DynamicModeling.tex).
@@ -165,7 +170,7 @@ impl WheeledBaseSpec {
 /// frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct UrdfOptions {
-    /// Fixed or two-wheeled base.
+    /// Fixed, floating or two-wheeled base.
     pub base: UrdfBase,
     /// Model name (default: the `<robot name>`); the generated wrapper type is named after it.
     pub name: Option<String>,
@@ -230,6 +235,14 @@ impl Default for UrdfOptions {
 }
 
 impl UrdfOptions {
+    /// Default options with a floating base.
+    pub fn floating() -> Self {
+        Self {
+            base: UrdfBase::Floating,
+            ..Self::default()
+        }
+    }
+
     /// Default options with a two-wheeled base.
     pub fn wheeled(spec: WheeledBaseSpec) -> Self {
         Self {

@@ -139,6 +139,11 @@ pub fn direct_kinetic_energy(model: &Model, params: &[f64], q: &[f64], u: &[f64]
             Vector3::new(u[w.x_speed], 0.0, 0.0),
         ),
         Base::Fixed => (Vector3::zeros(), Vector3::zeros()),
+        // The base twist (v, ω) in frame 0 (speeds 0..6).
+        Base::Floating => (
+            Vector3::new(u[3], u[4], u[5]),
+            Vector3::new(u[0], u[1], u[2]),
+        ),
     };
     // Pose of each link in frame 0, and the list of joints on its path (axis, origin, speed, kind).
     let mut rot = vec![Matrix3::identity(); n];

@@ -86,18 +86,19 @@ impl<'py> Rows<'py> {
                 )));
             }
         };
-        let array = borrow(array, name)?;
-        if array.as_slice().is_err() {
+        // `as_slice` also accepts Fortran order, whose rows are not consecutive.
+        if !array.is_c_contiguous() {
             return Err(ShapeError::new_err(format!(
                 "`{name}` must be C-contiguous (np.ascontiguousarray(x))"
             )));
         }
+        let array = borrow(array, name)?;
         Ok(Self { array, n: rows })
     }
 
     /// The values, row after row (`n × cols`).
     pub fn values(&self) -> &[f64] {
-        // Checked contiguous in `new`.
+        // Checked C-contiguous in `new`.
         self.array.as_slice().unwrap_or(&[])
     }
 }

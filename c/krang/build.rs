@@ -16,6 +16,7 @@ fn main() {
         .with_config(config)
         .with_src(std::path::Path::new(&dir).join("src/lib.rs"))
         .generate();
+    let _ = std::fs::create_dir_all(std::path::Path::new(&dir).join("include"));
     match header {
         Ok(h) => {
             h.write_to_file(std::path::Path::new(&dir).join("include/krang.h"));

@@ -4,8 +4,8 @@
 // number with 17 significant digits.
 //
 //   cargo build --release --manifest-path c/krang/Cargo.toml   # libkrang.a, include/krang.h
-//   g++ -std=c++17 -O2 examples/cpp/krang_example.cpp -Ic/krang/include \
-//       c/krang/target/release/libkrang.a -lpthread -ldl -lm -o krang_example
+//   g++ -std=c++17 -O2 examples/cpp/krang_example.cpp -Ic/krang/include
+//       c/krang/target/release/libkrang.a -lpthread -ldl -lm -o krang_example   (one line)
 //
 // or with CMake: examples/cpp/CMakeLists.txt.
 #include <cstdio>

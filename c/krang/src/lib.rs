@@ -23,7 +23,8 @@ pub const KRANG_INVALID_PARAMETER: i32 = -2;
 /// The frame index is not below `KRANG_FRAME_COUNT`.
 pub const KRANG_BAD_FRAME: i32 = -3;
 /// The number of generalized speeds: the length of `q`, `u`, `ud` and `tau`.
-pub const KRANG_DOF: usize = model::DOF;
+pub const KRANG_DOF: usize = 19;
+const _: () = assert!(KRANG_DOF == model::DOF);
 /// The number of parameters (the fields of `KrangParams`).
 pub const KRANG_PARAM_COUNT: usize = 185;
 /// The number of body frames (frame indices are below it).
@@ -1012,7 +1013,8 @@ const FRAME_NAMES: [&core::ffi::CStr; 20] = [
     c"right_hand",
 ];
 const SPEED_NAMES: [&str; model::DOF] = model::SPEED_NAMES;
-/// Raw-pointer access, the checks first.
+/// Raw-pointer access, the checks first; the row-major writers.
+#[allow(dead_code)]
 mod ffi {
     use nalgebra::{Isometry3, SMatrix, SVector};
     /// The `N` values at `p`, or `None` if `p` is null.

@@ -24,6 +24,8 @@ pub(crate) struct CModule<'a> {
     pub frames: &'a [String],
     /// The parameter names, in `Params::NAMES` order.
     pub params: Vec<&'a str>,
+    /// The number of (independent) speeds.
+    pub dof: usize,
     /// The functions.
     pub functions: &'a [Wrapped],
 }
@@ -110,7 +112,8 @@ pub const {up}_INVALID_PARAMETER: i32 = -2;
 pub const {up}_BAD_FRAME: i32 = -3;
 
 /// The number of generalized speeds: the length of `q`, `u`, `ud` and `tau`.
-pub const {up}_DOF: usize = model::DOF;
+pub const {up}_DOF: usize = {dof};
+const _: () = assert!({up}_DOF == model::DOF);
 /// The number of parameters (the fields of `{class}Params`).
 pub const {up}_PARAM_COUNT: usize = {nparams};
 /// The number of body frames (frame indices are below it).
@@ -143,7 +146,8 @@ impl {class}Params {{
 const FRAME_NAMES: [&core::ffi::CStr; {nframes}] = [{frame_names}];
 const SPEED_NAMES: [&str; model::DOF] = model::SPEED_NAMES;
 
-/// Raw-pointer access, the checks first.
+/// Raw-pointer access, the checks first; the row-major writers.
+#[allow(dead_code)]
 mod ffi {{
     use nalgebra::{{Isometry3, SMatrix, SVector}};
 
@@ -323,6 +327,7 @@ pub unsafe extern "C" fn {name}_speed_name(index: usize, buffer: *mut core::ffi:
         rust_file = m.rust_file,
         nparams = m.params.len(),
         nframes = m.frames.len(),
+        dof = m.dof,
     );
     for f in m.functions {
         s += &function(m, f);

@@ -194,6 +194,7 @@ fn c_files(
         rust_file: &rust_file,
         frames: &frames,
         params: g.model.params.iter().map(|p| p.name.as_str()).collect(),
+        dof: g.lowered.dof,
         functions: &functions,
     };
     Ok(vec![

@@ -37,8 +37,9 @@ fn dependency(source: &KanegenSource, dir: &Path, name: &str, extra: &str) -> St
     }
 }
 
-/// `to` relative to the directory `from`, when both resolve (after `..` and symbolic links)
-/// to absolute paths.
+/// `to` relative to the directory `from`, both resolved as cargo resolves a manifest's
+/// directory: symbolic links followed (through the longest existing prefix: the crate's
+/// directory may not exist yet).
 fn relative(from: &Path, to: &Path) -> Option<PathBuf> {
     let from = absolute(from)?;
     let to = absolute(to)?;
@@ -60,8 +61,8 @@ fn relative(from: &Path, to: &Path) -> Option<PathBuf> {
     Some(out)
 }
 
-/// `p` as an absolute path with `.` and `..` resolved (the longest existing prefix through
-/// the file system, the rest lexically).
+/// `p` as an absolute path: `.` and `..` resolved, and its longest existing prefix
+/// canonicalized (symbolic links followed).
 fn absolute(p: &Path) -> Option<PathBuf> {
     let p = std::path::absolute(p).ok()?;
     let mut out = PathBuf::new();
@@ -74,7 +75,15 @@ fn absolute(p: &Path) -> Option<PathBuf> {
             c => out.push(c),
         }
     }
-    Some(std::fs::canonicalize(&out).unwrap_or(out))
+    let mut existing = out.clone();
+    let mut rest = Vec::new();
+    while !existing.exists() {
+        rest.push(existing.file_name()?.to_owned());
+        existing.pop();
+    }
+    let mut resolved = std::fs::canonicalize(&existing).ok()?;
+    resolved.extend(rest.iter().rev());
+    Some(resolved)
 }
 
 /// The `Cargo.toml` of a Python extension crate named `module` in `dir`.

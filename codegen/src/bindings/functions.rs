@@ -69,3 +69,17 @@ pub(crate) fn wrapped(low: &Lowered) -> Vec<Wrapped> {
     }
     out
 }
+
+/// A shape as Python prints it: `(19,)`, `(19, 19)`, `()`.
+pub(crate) fn shape_text(dims: &[usize]) -> String {
+    match dims {
+        [n] => format!("({n},)"),
+        _ => format!(
+            "({})",
+            dims.iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}

@@ -224,17 +224,3 @@ fn format_rust(model: &str, source: &str) -> Result<String, Error> {
         prettyplease::unparse(&file)
     ))
 }
-
-/// A shape as Python prints it: `(19,)`, `(19, 19)`, `()`.
-fn shape_text(dims: &[usize]) -> String {
-    match dims {
-        [n] => format!("({n},)"),
-        _ => format!(
-            "({})",
-            dims.iter()
-                .map(usize::to_string)
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-    }
-}

@@ -212,7 +212,7 @@ fn doc(f: &Wrapped, batched: bool) -> String {
     if f.spec.per_frame {
         args.push("frame".into());
     }
-    let shape = |dims: &[usize]| super::shape_text(dims);
+    let shape = |dims: &[usize]| super::functions::shape_text(dims);
     let mut d = format!("/// {}\n///\n", f.spec.doc);
     if batched {
         let mut dims = vec![0];
@@ -358,9 +358,14 @@ fn batch(f: &Wrapped) -> String {
     let mut dims = vec!["n".to_owned()];
     dims.extend(f.dims.iter().map(usize::to_string));
     format!(
-        "{doc}#[pyo3(signature = ({sig}))]\nfn {name}_batch<'py>(&self, py: Python<'py>, {list}) -> PyResult<Bound<'py, PyAny>> {{\n{reads}{frame}let robot = &self.inner;\noutput::batch(py, out, &[{dims}], |values| {{\nfor i in 0..n {{\n{states}let r = {call};\nlet o = &mut values[i * {len}..(i + 1) * {len}];\n{w}\n}}\n}})\n}}\n\n",
+        "{doc}#[pyo3(signature = ({sig}))]\nfn {name}_batch<'py>(&self, py: Python<'py>, {list}) -> PyResult<Bound<'py, PyAny>> {{\n{reads}{frame}let robot = &self.inner;\noutput::batch(py, out, &[{dims}], |values| {{\nfor i in 0..n {{\n{states}let r = {call};\nlet o = &mut values[{range}];\n{w}\n}}\n}})\n}}\n\n",
         doc = doc(f, true),
         dims = dims.join(", "),
+        range = if len == 1 {
+            "i..i + 1".to_owned()
+        } else {
+            format!("i * {len}..(i + 1) * {len}")
+        },
         w = write_result(f)
     )
 }

@@ -12,7 +12,7 @@
 //! - [`output`]: results: a new array, or the caller's `out=` array checked for shape, dtype,
 //!   layout and writability and filled in place ([`output::single`], [`output::batch`], which
 //!   releases the GIL while it fills).
-//! - [`write`]: nalgebra results into row-major (C-order) slices.
+//! - [`write`](mod@write): nalgebra results into row-major (C-order) slices.
 //! - [`params`]: parameters by name and from a dict, with errors as `ParameterError`.
 //!
 //! Everything is safe Rust: NumPy buffers are reached only through the `numpy` crate's borrow

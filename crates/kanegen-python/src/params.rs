@@ -41,10 +41,10 @@ pub fn frame(frame: &Bound<'_, PyAny>, names: &[&str]) -> PyResult<usize> {
         if i < names.len() {
             return Ok(i);
         }
-    } else if let Ok(name) = frame.extract::<String>() {
-        if let Some(i) = names.iter().position(|n| *n == name) {
-            return Ok(i);
-        }
+    } else if let Ok(name) = frame.extract::<String>()
+        && let Some(i) = names.iter().position(|n| *n == name)
+    {
+        return Ok(i);
     }
     Err(crate::exceptions::FrameError::new_err(format!(
         "no frame {frame} (the frames: FRAME_NAMES, or an index below {})",

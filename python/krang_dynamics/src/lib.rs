@@ -662,7 +662,7 @@ impl Krang {
                         DOF,
                     >::from_column_slice(&u_rows[i * DOF..(i + 1) * DOF]);
                     let r = robot.kinetic_energy(&q, &u);
-                    let o = &mut values[i * 1..(i + 1) * 1];
+                    let o = &mut values[i..i + 1];
                     o[0] = r;
                 }
             },
@@ -701,7 +701,7 @@ impl Krang {
                         DOF,
                     >::from_column_slice(&q_rows[i * DOF..(i + 1) * DOF]);
                     let r = robot.potential_energy(&q);
-                    let o = &mut values[i * 1..(i + 1) * 1];
+                    let o = &mut values[i..i + 1];
                     o[0] = r;
                 }
             },

@@ -16,7 +16,7 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def reference():
     path = pathlib.Path(
         os.environ.get("KANEGEN_REFERENCE", ROOT / "target" / "python" / "reference.json")

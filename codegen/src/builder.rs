@@ -475,9 +475,11 @@ impl Builder {
             && std::env::var("OPT_LEVEL").is_ok_and(|level| level == "0")
     }
 
-    /// The default output file name (see [`Builder::output`]).
-    fn file_name(&self) -> String {
-        let stem = match &self.source {
+    /// The model file's stem (`-` → `_`), or for a model in memory its name in lower case with
+    /// every character other than an ASCII letter or digit `_`: the default file name's stem
+    /// and the default name of a bindings crate.
+    pub(crate) fn stem(&self) -> String {
+        match &self.source {
             Source::Toml(path) | Source::Urdf(path, _) => path
                 .file_stem()
                 .map(|s| s.to_string_lossy().replace('-', "_"))
@@ -493,7 +495,17 @@ impl Builder {
                     }
                 })
                 .collect(),
-        };
+        }
+    }
+
+    /// The floating-point type of the module.
+    pub(crate) fn precision_of(&self) -> Precision {
+        self.precision
+    }
+
+    /// The default output file name (see [`Builder::output`]).
+    fn file_name(&self) -> String {
+        let stem = self.stem();
         let baked = match self.options.params {
             ParamMode::Runtime => "",
             ParamMode::Baked => "_baked",

@@ -99,6 +99,7 @@
 // The build-script examples above show their `fn main`.
 #![allow(clippy::needless_doctest_main)]
 
+pub mod bindings;
 mod builder;
 // Internal stages, public only for the workspace's own tests and tools; not part of the API
 // (their documentation may link to the crate's private items).
@@ -175,6 +176,10 @@ pub enum Error {
         /// How to avoid it.
         fix: &'static str,
     },
+    /// A bindings crate cannot be written for this module ([`Builder::python_crate`],
+    /// [`Builder::c_crate`]).
+    #[error(transparent)]
+    Bindings(#[from] bindings::BindingsError),
     /// Writing the generated file failed.
     #[error("cannot write {}: {source}", path.display())]
     Write {

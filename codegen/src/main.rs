@@ -5,6 +5,8 @@
 //! kanegen stats   <model> [options]        K/D counts and op counts per generated function
 //! kanegen listing <model> [options]        the substitution listing in the reports' style
 //! kanegen emit    <model> [options] [--out FILE]   the generated Rust (stdout or FILE)
+//! kanegen python  <model> [options] --out DIR      a Python extension crate (PyO3, maturin)
+//! kanegen c       <model> [options] --out DIR      a C library crate (static library, header)
 //! ```
 //!
 //! `<model>` is a TOML description or a URDF file (`.urdf`, imported with the default
@@ -27,17 +29,20 @@ use kanegen::{Builder, FunctionSet};
 
 /// The reminder after a command-line error.
 const SHORT_USAGE: &str =
-    "usage: kanegen <show|stats|listing|emit> <model.toml|model.urdf> [options]
+    "usage: kanegen <show|stats|listing|emit|python|c> <model.toml|model.urdf> [options]
 (`kanegen --help` lists the commands and the options each one takes)";
 
-const USAGE: &str = "usage: kanegen <show|stats|listing|emit> <model.toml|model.urdf> [options]
+const USAGE: &str =
+    "usage: kanegen <show|stats|listing|emit|python|c> <model.toml|model.urdf> [options]
 
   show     print the validated model: frame tree, speeds, parameters
   stats    print K/D variable counts and operation counts per generated function
   listing  print the substitution listing (K/D variables) in the reports' style
   emit     print the generated Rust module, or write it to --out FILE (only if changed)
+  python   write a Python extension crate (PyO3, built with maturin) into --out DIR
+  c        write a C library crate (static library, header by cbindgen) into --out DIR
 
-options (stats, listing, emit; `show` takes only the URDF import options):
+options (stats, listing, emit, python, c; `show` takes only the URDF import options):
   --baked                 fold the model file's parameter values in as constants
   --functions LIST        the generated functions: comma-separated names and groups (listed
                           below; default: `default`)
@@ -48,7 +53,12 @@ options (stats, listing, emit; `show` takes only the URDF import options):
                           (`mass_matrix_batch`, `…_batch_soa`, …; f64 modules; emit only)
   --batch-feature NAME    --batch, each batched item behind `#[cfg(feature = \"NAME\")]` of the
                           crate that includes the module (emit only)
-  --out FILE              write the module to FILE (emit only)
+  --out FILE              write the module to FILE (emit), the crate into the directory FILE
+                          (python, c: required)
+  --module NAME           the Python module or C library name (python, c; default: the model
+                          file's stem)
+  --kanegen-path DIR      take the kanegen crates from the checkout DIR instead of the git
+                          repository (python, c)
 
 URDF import options (.urdf models; see kanegen_model::UrdfOptions):
   --floating              a floating (free-flyer) base at the URDF root (the default when the
@@ -210,10 +220,13 @@ fn run(args: Vec<String>) -> Result<(), Failure> {
         builder = builder.precision(kanegen::Precision::F32);
     }
     builder = builder.mirrored_lanes(args.mirrored_lanes);
-    if let Some(feature) = args.batch_feature {
+    if let Some(feature) = args.batch_feature.clone() {
         builder = builder.batch_feature(feature);
     } else if args.batch {
         builder = builder.batch(true);
+    }
+    if matches!(cmd, Command::Python | Command::C) {
+        return bindings(cmd, &args, &builder);
     }
     let start = std::time::Instant::now();
     let g = builder.generate().map_err(|e| error(&e))?;
@@ -242,6 +255,30 @@ fn run(args: Vec<String>) -> Result<(), Failure> {
     }
 }
 
+/// `kanegen python` and `kanegen c`: the bindings crate written into `--out DIR`.
+fn bindings(cmd: Command, args: &Args, builder: &Builder) -> Result<(), Failure> {
+    let Some(dir) = &args.out else {
+        return Err(format!("`{}` needs --out DIR (the crate's directory)", cmd.name()).into());
+    };
+    let options = kanegen::bindings::BindingsOptions {
+        name: args.module.clone(),
+        kanegen: match &args.kanegen_path {
+            Some(p) => kanegen::bindings::KanegenSource::Path(p.into()),
+            None => kanegen::bindings::KanegenSource::default(),
+        },
+    };
+    let written = if cmd == Command::Python {
+        builder.python_crate(dir, &options)
+    } else {
+        builder.c_crate(dir, &options)
+    }
+    .map_err(|e| Failure::Error(format!("error: {e}")))?;
+    for path in written {
+        eprintln!("{}", path.display());
+    }
+    Ok(())
+}
+
 /// The command.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Command {
@@ -249,6 +286,8 @@ enum Command {
     Stats,
     Listing,
     Emit,
+    Python,
+    C,
 }
 
 impl Command {
@@ -258,6 +297,8 @@ impl Command {
             "stats" => Command::Stats,
             "listing" => Command::Listing,
             "emit" => Command::Emit,
+            "python" => Command::Python,
+            "c" => Command::C,
             _ => return None,
         })
     }
@@ -268,6 +309,8 @@ impl Command {
             Command::Stats => "stats",
             Command::Listing => "listing",
             Command::Emit => "emit",
+            Command::Python => "python",
+            Command::C => "c",
         }
     }
 
@@ -293,6 +336,8 @@ impl Command {
             || (self != Command::Show && GENERATOR.contains(&option))
             || (self == Command::Emit
                 && ["--f32", "--out", "--batch", "--batch-feature"].contains(&option))
+            || (matches!(self, Command::Python | Command::C)
+                && ["--out", "--module", "--kanegen-path"].contains(&option))
     }
 }
 
@@ -309,6 +354,8 @@ struct Args {
     batch_feature: Option<String>,
     out: Option<String>,
     floating: bool,
+    module: Option<String>,
+    kanegen_path: Option<String>,
     wheeled: Option<[String; 3]>,
     up: Option<[f64; 3]>,
     radius: Option<f64>,
@@ -358,6 +405,8 @@ fn parse(args: Vec<String>) -> Result<Option<Args>, String> {
         batch_feature: None,
         out: None,
         floating: false,
+        module: None,
+        kanegen_path: None,
         wheeled: None,
         up: None,
         radius: None,
@@ -410,6 +459,8 @@ fn is_option(arg: &str) -> bool {
         Command::Stats,
         Command::Listing,
         Command::Emit,
+        Command::Python,
+        Command::C,
     ]
     .iter()
     .any(|c| c.takes(arg))
@@ -436,6 +487,8 @@ impl Args {
                 self.batch_feature = Some(name);
             }
             "--out" => self.out = Some(value()?),
+            "--module" => self.module = Some(value()?),
+            "--kanegen-path" => self.kanegen_path = Some(value()?),
             "--functions" => {
                 let set: FunctionSet = value()?.parse().map_err(|e| format!("{e}"))?;
                 if set.is_empty() {

@@ -204,7 +204,7 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
 /// the reciprocals of its diagonal, solved by the runtime's substitutions
 /// ([`cholesky_solve_vector`], [`cholesky_solve_columns`]) in their dispatched copies: what the
 /// provided `forward_dynamics` and `forward_dynamics_derivatives` share.
-struct DenseFactor<T: RealField + Copy, const N: usize> {
+pub(crate) struct DenseFactor<T: RealField + Copy, const N: usize> {
     factor: nalgebra::Cholesky<T, nalgebra::Const<N>>,
     inv_diag: [T; N],
 }
@@ -212,7 +212,7 @@ struct DenseFactor<T: RealField + Copy, const N: usize> {
 impl<T: RealField + Copy, const N: usize> DenseFactor<T, N> {
     /// `None` when `m` is not positive definite (or has a NaN entry).
     #[inline(always)]
-    fn new(m: SMatrix<T, N, N>) -> Option<Self> {
+    pub(crate) fn new(m: SMatrix<T, N, N>) -> Option<Self> {
         let factor = m.cholesky()?;
         let l = factor.l_dirty();
         let inv_diag = core::array::from_fn(|i| T::one() / l[(i, i)]);
@@ -221,7 +221,7 @@ impl<T: RealField + Copy, const N: usize> DenseFactor<T, N> {
 
     /// `M⁻¹ b`.
     #[inline(always)]
-    fn solve(&self, b: &SVector<T, N>) -> SVector<T, N> {
+    pub(crate) fn solve(&self, b: &SVector<T, N>) -> SVector<T, N> {
         let (l, inv_diag) = (self.factor.l_dirty(), &self.inv_diag);
         crate::isa::dispatch_fused(
             #[inline(always)]
@@ -233,7 +233,7 @@ impl<T: RealField + Copy, const N: usize> DenseFactor<T, N> {
 
     /// `X_m ← s_m M⁻¹ X_m` for each of the matrices `xs` ([`cholesky_solve_columns`]).
     #[inline(always)]
-    fn solve_columns<const C: usize, const K: usize>(
+    pub(crate) fn solve_columns<const C: usize, const K: usize>(
         &self,
         xs: [&mut SMatrix<T, N, C>; K],
         s: [T; K],

@@ -20,6 +20,9 @@
 //!   the partials of inverse dynamics and, provided, those of forward dynamics
 //!   ([`ForwardDynamicsDerivatives`]), for LQR and MPC on any generated robot.
 //!
+//! - [`contact`]: contact-constrained forward dynamics and contact impulses (point and frame
+//!   contacts, the Schur complement of the mass matrix's Cholesky factor), allocation-free.
+//!
 //! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA; the
 //!   batched functions also x86-64-v4, AVX-512), the
 //!   crate's `unsafe` calls (see below), and [`isa::Arith`], the multiply-add the copies
@@ -159,6 +162,7 @@
 extern crate std;
 
 mod arith;
+pub mod contact;
 pub mod derivatives_loop;
 mod dynamics;
 mod invalid_parameter;

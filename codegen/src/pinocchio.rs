@@ -212,6 +212,20 @@ pub struct PinBody {
     pub inertia_com: [[f64; 3]; 3],
 }
 
+/// Where a frame of the model (a link, a merged link or an operational frame) sits in the
+/// exported tree: Pinocchio's `Frame(name, joint, placement)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PinFrame {
+    /// The model's link name.
+    pub name: String,
+    /// The joint id it moves with (0: the universe).
+    pub joint: usize,
+    /// Rotation of the frame in the joint frame, by rows.
+    pub rotation: [[f64; 3]; 3],
+    /// Origin of the frame in the joint frame.
+    pub translation: [f64; 3],
+}
+
 /// Where one of the model's speeds is in Pinocchio's velocity `v`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpeedMap {
@@ -269,6 +283,9 @@ pub struct PinocchioModel {
     pub coordinates: Vec<CoordinateMap>,
     /// The model's coordinate names, in the order of `q`.
     pub coordinate_names: Vec<String>,
+    /// Every frame of the model (indexed like `Model::links`) in the tree; not part of the
+    /// text format.
+    pub frames: Vec<PinFrame>,
 }
 
 type M3 = [[f64; 3]; 3];
@@ -531,7 +548,19 @@ fn export_tree(
         });
     }
 
+    let frames = model
+        .links
+        .iter()
+        .zip(&attach)
+        .map(|(link, &(joint, rotation, translation))| PinFrame {
+            name: link.name.clone(),
+            joint,
+            rotation,
+            translation,
+        })
+        .collect();
     Ok(PinocchioModel {
+        frames,
         name: model.name.clone(),
         joints,
         bodies,

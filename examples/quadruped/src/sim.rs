@@ -55,7 +55,7 @@ impl Scenario {
     }
 
     /// Position, velocity and acceleration of the reference at `t` (derivatives by central
-    /// differences of [`Scenario::offset`], exact to ~1e-8).
+    /// differences of the offset from the start point, exact to ~1e-8).
     pub fn target(&self, start: &Vector3<f64>, t: f64) -> ComTarget {
         let h = 1e-4;
         let (m, z, p) = (self.offset(t - h), self.offset(t), self.offset(t + h));

@@ -41,8 +41,8 @@
 # machine's instruction set (a separate target directory keeps the default build):
 #   RUSTFLAGS="-C target-cpu=native" CARGO_TARGET_DIR=target/native RUN_NAME=native \
 #       benches/pinocchio/run.sh
-# Not part of CI (it downloads). Takes about 5 minutes on a 2-core machine, most of it compiling
-# the harness (Pinocchio's templates) and the Rust example; about 8 more with CODEGEN=1.
+# Not part of CI (it downloads). Takes about 8 minutes on a 2-core machine, most of it compiling
+# the harnesses (Pinocchio's templates) and the Rust examples; about 8 more with CODEGEN=1.
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"

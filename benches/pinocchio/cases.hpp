@@ -78,13 +78,14 @@ struct Exported {
   int dof = 0;
   std::vector<int> v_index;   // per kanegen speed: index in Pinocchio's v
   std::vector<double> sign;   // per kanegen speed: v[v_index] = sign * u
-  std::vector<Coord> coord;   // per kanegen coordinate
+  std::vector<Coord> coord;   // per kanegen coordinate (dof, or dof + 1 with a free flyer)
   std::vector<int> q_index;
+  std::vector<double> q_sign;  // per kanegen coordinate: q_pin[q_index] = q_sign * q
 
   VectorXd configuration(const VectorXd & q) const {
     VectorXd out = pin::neutral(model);
-    for (int i = 0; i < dof; ++i) switch (coord[i]) {
-        case Coord::Joint: out[q_index[i]] = sign[i] * q[i]; break;
+    for (int i = 0; i < int(coord.size()); ++i) switch (coord[i]) {
+        case Coord::Joint: out[q_index[i]] = q_sign[i] * q[i]; break;
         case Coord::PlanarX: out[q_index[i]] = q[i]; out[q_index[i] + 1] = 0.0; break;
         case Coord::PlanarPsi:
           out[q_index[i]] = std::cos(q[i]);
@@ -145,6 +146,7 @@ inline Exported read_model(Reader & rd) {
     else if (type == "RU") jm = pin::JointModelRevoluteUnaligned(axis);
     else if (type == "PU") jm = pin::JointModelPrismaticUnaligned(axis);
     else if (type == "PLANAR") jm = pin::JointModelPlanar();
+    else if (type == "FREEFLYER") jm = pin::JointModelFreeFlyer();
     else throw std::runtime_error(rd.where + ": unknown joint type `" + type + "`");
     ex.model.addJoint(parent, jm, placement, name);
   }
@@ -178,8 +180,9 @@ inline Exported read_model(Reader & rd) {
     ex.sign.push_back(rd.num());
   }
   rd.expect("coordinates");
-  rd.get<int>("the coordinate count");
-  for (int i = 0; i < ex.dof; ++i) {
+  // dof, or dof + 1 with a free-flyer root (its quaternion).
+  const int ncoord = rd.get<int>("the coordinate count");
+  for (int i = 0; i < ncoord; ++i) {
     rd.expect("coordinate");
     rd.get<std::string>("a coordinate name");
     const auto kind = rd.get<std::string>("a coordinate kind");
@@ -189,7 +192,7 @@ inline Exported read_model(Reader & rd) {
                          ? Coord::PlanarPsi
                          : throw std::runtime_error(rd.where + ": coordinate kind `" + kind + "`"));
     ex.q_index.push_back(rd.get<int>("a q index"));
-    rd.num();  // the sign, equal to the speed's
+    ex.q_sign.push_back(rd.num());
   }
   rd.expect("end");
   return ex;

@@ -17,7 +17,14 @@
 #      code's M, c, g, τ, C);
 #   4. RUNS times (default 3), alternately: the harness (agreement check on all cases, then
 #      Pinocchio's timings), with CODEGEN=1 the codegen harness, and the Rust timings; then the
-#      table, best of the runs.
+#      table, best of the runs;
+#   5. free-flyer models: examples/pinocchio_free_flyer.rs writes ff-cases.txt (Solo 12 and a
+#      humanoid of tests/corpus exported with a JointModelFreeFlyer root, random states, the
+#      free-flyer reference recursion's M, nle, g, rnea, ccrba, Ȧ_G v, RNEA derivatives and the
+#      contact-constrained dynamics of kanegen_runtime::contact), and
+#      benches/pinocchio/harness_ff.cpp compares them with Pinocchio's crba, nonLinearEffects,
+#      computeGeneralizedGravity, rnea, ccrba, computeCentroidalMomentumTimeVariation,
+#      computeRNEADerivatives and constraintDynamics (agreement only, no timings).
 # With CODEGEN=1 also Pinocchio's own generated code (its CppADCodeGen path, the other code
 # generator to compare with): step 1 adds `cmeel-cppad` and `cmeel-cppadcodegen` (headers), step 2 compiles
 # benches/pinocchio/codegen.cpp, whose first run records crba, nonLinearEffects, gravity, rnea
@@ -34,8 +41,8 @@
 # machine's instruction set (a separate target directory keeps the default build):
 #   RUSTFLAGS="-C target-cpu=native" CARGO_TARGET_DIR=target/native RUN_NAME=native \
 #       benches/pinocchio/run.sh
-# Not part of CI (it downloads). Takes about 5 minutes on a 2-core machine, most of it compiling
-# the harness (Pinocchio's templates) and the Rust example; about 8 more with CODEGEN=1.
+# Not part of CI (it downloads). Takes about 8 minutes on a 2-core machine, most of it compiling
+# the harnesses (Pinocchio's templates) and the Rust examples; about 8 more with CODEGEN=1.
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -89,6 +96,7 @@ compile() {
     fi
 }
 compile harness "2-3 minutes"
+compile harness_ff "2 minutes"
 if [ "$codegen" = 1 ]; then
     if [ ! -f "$prefix/include/cppad/cg.hpp" ]; then
         echo "error: no CppADCodeGen headers under $prefix/include (cmeel-cppadcodegen wheel)" >&2
@@ -101,6 +109,8 @@ echo "== 3. Rust side: cargo build --release --example pinocchio_side_by_side"
 (cd "$root" && cargo build --release --quiet --example pinocchio_side_by_side)
 rust="${CARGO_TARGET_DIR:-$root/target}/release/examples/pinocchio_side_by_side"
 "$rust" write "$run_dir"
+(cd "$root" && cargo build --release --quiet --example pinocchio_free_flyer)
+"${CARGO_TARGET_DIR:-$root/target}/release/examples/pinocchio_free_flyer" "$run_dir"
 
 echo "== 4. agreement and timings, $runs runs alternating Pinocchio and kanegen"
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | xargs), $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
@@ -117,6 +127,8 @@ for r in $(seq 1 "$runs"); do
 done
 echo "== table (load $(cut -d' ' -f1-3 /proc/loadavg))"
 "$rust" report "$run_dir"
+echo "== 5. free-flyer models: agreement with the reference recursion and the contact solver"
+"$out/harness_ff" "$run_dir" || status=$?
 if [ "$status" -ne 0 ]; then
     echo "error: Pinocchio and kanegen disagree (see above)" >&2
     exit "$status"

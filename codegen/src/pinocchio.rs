@@ -40,6 +40,10 @@
 //!   slider has the acceleration `[ẍ, 2ẋψ̇, 0]` (polar coordinates), not `a0`.
 //!   The coordinate `x` (distance travelled) is not a position in the plane; it enters neither
 //!   model, and [`CoordinateMap::PlanarX`] puts it in Pinocchio's `x` with `y = 0`.
+//! * **A free-flyer root** ([`export_free_flyer`]): the root link on a `JointModelFreeFlyer`,
+//!   whose configuration `(x, y, z, qx, qy, qz, qw)` and velocity `(v, ω)` (base frame) are
+//!   those of `kanegen_reference::FreeFlyer` and of generated floating-base modules, mapped one
+//!   to one; gravity `(0, 0, −g)` in the world.
 //!
 //! # Text format (version 1)
 //!
@@ -52,13 +56,13 @@
 //! model <name> nq <nq> nv <nv> dof <dof>
 //! gravity <gx> <gy> <gz>
 //! joints <n>
-//! joint <name> <parent: 0 = universe> <RX|RY|RZ|PX|PY|PZ|RU|PU|PLANAR> <ax> <ay> <az> <R: 9> <p: 3>
+//! joint <name> <parent: 0 = universe> <RX|RY|RZ|PX|PY|PZ|RU|PU|PLANAR|FREEFLYER> <ax> <ay> <az> <R: 9> <p: 3>
 //! bodies <n>
 //! body <name> <joint> <R: 9> <p: 3> <m> <c: 3> <I_c by rows: 9>
 //! armature <nv values>
 //! speeds <dof>
 //! speed <name> <v index> <sign>
-//! coordinates <dof>
+//! coordinates <dof, or dof + 1 with a free flyer>
 //! coordinate <name> <joint|planar_x|planar_psi> <q index> <sign>
 //! end
 //! ```
@@ -96,6 +100,16 @@ pub enum ExportError {
         file: String,
         /// The direction in the model.
         direction: [f64; 3],
+    },
+    /// [`export_free_flyer`] of a wheeled base: its root is not free.
+    #[error(
+        "model `{model}` ({file}): a two-wheeled base cannot be exported with a free-flyer root; load the robot with a fixed base (UrdfOptions::base) to export it as a free flyer"
+    )]
+    WheeledFreeFlyer {
+        /// The model name.
+        model: String,
+        /// The description file.
+        file: String,
     },
     /// A body with zero mass and a non-zero first moment has no centre of mass.
     #[error(
@@ -136,6 +150,9 @@ pub enum PinJointType {
     PrismaticUnaligned([f64; 3]),
     /// `JointModelPlanar` (the two-wheeled base: x, y, rotation about z).
     Planar,
+    /// `JointModelFreeFlyer` (a free-flyer root, [`export_free_flyer`]): position and unit
+    /// quaternion `(x, y, z, qx, qy, qz, qw)`, velocity `(v, ω)` in the joint's frame.
+    FreeFlyer,
 }
 
 impl PinJointType {
@@ -152,6 +169,7 @@ impl PinJointType {
             PinJointType::RevoluteUnaligned(a) => ("RU", a),
             PinJointType::PrismaticUnaligned(a) => ("PU", a),
             PinJointType::Planar => ("PLANAR", [0.0, 0.0, 1.0]),
+            PinJointType::FreeFlyer => ("FREEFLYER", [0.0, 0.0, 0.0]),
         }
     }
 
@@ -159,6 +177,7 @@ impl PinJointType {
     pub fn sizes(self) -> (usize, usize) {
         match self {
             PinJointType::Planar => (4, 3),
+            PinJointType::FreeFlyer => (7, 6),
             _ => (1, 1),
         }
     }
@@ -201,6 +220,20 @@ pub struct PinBody {
     pub com: [f64; 3],
     /// Inertia about the centre of mass, body axes, by rows.
     pub inertia_com: [[f64; 3]; 3],
+}
+
+/// Where a frame of the model (a link, a merged link or an operational frame) sits in the
+/// exported tree: Pinocchio's `Frame(name, joint, placement)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PinFrame {
+    /// The model's link name.
+    pub name: String,
+    /// The joint id it moves with (0: the universe).
+    pub joint: usize,
+    /// Rotation of the frame in the joint frame, by rows.
+    pub rotation: [[f64; 3]; 3],
+    /// Origin of the frame in the joint frame.
+    pub translation: [f64; 3],
 }
 
 /// Where one of the model's speeds is in Pinocchio's velocity `v`.
@@ -260,6 +293,9 @@ pub struct PinocchioModel {
     pub coordinates: Vec<CoordinateMap>,
     /// The model's coordinate names, in the order of `q`.
     pub coordinate_names: Vec<String>,
+    /// Every frame of the model (indexed like `Model::links`) in the tree; not part of the
+    /// text format.
+    pub frames: Vec<PinFrame>,
 }
 
 type M3 = [[f64; 3]; 3];
@@ -292,6 +328,24 @@ fn cartesian(axis: [f64; 3]) -> Option<(usize, f64)> {
 /// Exports `model` with parameter values `params` (indexed like [`Model::params`]) as a
 /// Pinocchio tree; see the module documentation for the mapping.
 pub fn export(model: &Model, params: &[f64]) -> Result<PinocchioModel, ExportError> {
+    export_tree(model, params, false)
+}
+
+/// Exports `model` with its root link on a `JointModelFreeFlyer` (joint 1), in the layout of
+/// `kanegen_reference::FreeFlyer` and of generated floating-base modules: the first seven
+/// coordinates are the free flyer's `(x, y, z, qx, qy, qz, qw)` (names `base_x` … `base_qw`),
+/// the first six speeds its `(v, ω)` in the base frame (`base_vx` … `base_wz`), both mapped one
+/// to one; the joints follow as in [`export`]. Gravity is `(0, 0, −g)` in the world. A wheeled
+/// base is an error ([`ExportError::WheeledFreeFlyer`]); a fixed base's root becomes free.
+pub fn export_free_flyer(model: &Model, params: &[f64]) -> Result<PinocchioModel, ExportError> {
+    export_tree(model, params, true)
+}
+
+fn export_tree(
+    model: &Model,
+    params: &[f64],
+    free_flyer: bool,
+) -> Result<PinocchioModel, ExportError> {
     if params.len() != model.params.len() {
         return Err(ExportError::ParamCount {
             model: model.name.clone(),
@@ -312,7 +366,46 @@ pub fn export(model: &Model, params: &[f64]) -> Result<PinocchioModel, ExportErr
     // Per link: the Pinocchio joint id it moves with and its placement in that joint's frame.
     let mut attach: Vec<(usize, M3, [f64; 3])> = Vec::with_capacity(model.links.len());
 
+    let mut base_speeds: Vec<SpeedMap> = Vec::new();
+    let mut base_coordinates: Vec<(CoordinateMap, String)> = Vec::new();
+    let gravity = if free_flyer {
+        if matches!(model.base, Base::Wheeled(_)) {
+            return Err(ExportError::WheeledFreeFlyer {
+                model: model.name.clone(),
+                file: model.source.clone(),
+            });
+        }
+        joints.push(PinJoint {
+            name: "root_joint".into(),
+            parent: 0,
+            kind: PinJointType::FreeFlyer,
+            rotation: IDENTITY,
+            translation: [0.0; 3],
+            idx_q: 0,
+            idx_v: 0,
+        });
+        for (v, name) in ["vx", "vy", "vz", "wx", "wy", "wz"].iter().enumerate() {
+            base_speeds.push(SpeedMap {
+                name: format!("base_{name}"),
+                v,
+                sign: 1.0,
+            });
+        }
+        for (q, name) in ["x", "y", "z", "qx", "qy", "qz", "qw"].iter().enumerate() {
+            base_coordinates.push((
+                CoordinateMap::Joint { q, sign: 1.0 },
+                format!("base_{name}"),
+            ));
+        }
+        armature.extend([0.0; 6]);
+        (nq, nv) = (7, 6);
+        attach.push((1, IDENTITY, [0.0; 3]));
+        [0.0, 0.0, -g]
+    } else {
+        gravity
+    };
     match &model.base {
+        _ if free_flyer => {}
         Base::Fixed => attach.push((0, IDENTITY, [0.0; 3])),
         Base::Floating => {
             return Err(ExportError::FloatingBase {
@@ -471,7 +564,19 @@ pub fn export(model: &Model, params: &[f64]) -> Result<PinocchioModel, ExportErr
         });
     }
 
+    let frames = model
+        .links
+        .iter()
+        .zip(&attach)
+        .map(|(link, &(joint, rotation, translation))| PinFrame {
+            name: link.name.clone(),
+            joint,
+            rotation,
+            translation,
+        })
+        .collect();
     Ok(PinocchioModel {
+        frames,
         name: model.name.clone(),
         joints,
         bodies,
@@ -480,9 +585,20 @@ pub fn export(model: &Model, params: &[f64]) -> Result<PinocchioModel, ExportErr
         nq,
         nv,
         // Every speed is driven by exactly one joint or the base (validated IR).
-        speeds: speeds.into_iter().flatten().collect(),
-        coordinates: coordinates.into_iter().flatten().collect(),
-        coordinate_names: model.speeds.iter().map(|s| s.coordinate.clone()).collect(),
+        speeds: base_speeds
+            .into_iter()
+            .chain(speeds.into_iter().flatten())
+            .collect(),
+        coordinates: base_coordinates
+            .iter()
+            .map(|(c, _)| c.clone())
+            .chain(coordinates.into_iter().flatten())
+            .collect(),
+        coordinate_names: base_coordinates
+            .into_iter()
+            .map(|(_, n)| n)
+            .chain(model.speeds.iter().map(|s| s.coordinate.clone()))
+            .collect(),
     })
 }
 

@@ -51,7 +51,7 @@ fn energies(pm: &PinocchioModel, q: &[f64], v: &[f64]) -> (f64, f64) {
             PinJointType::RevoluteUnaligned(a) => (Some(Vector3::from(a)), None),
             PinJointType::Prismatic(k) => (None, Some(axis(k))),
             PinJointType::PrismaticUnaligned(a) => (None, Some(Vector3::from(a))),
-            PinJointType::Planar => (None, None),
+            PinJointType::Planar | PinJointType::FreeFlyer => (None, None),
         };
         if let Some(e) = rev {
             rot = r_pre * Rotation3::from_axis_angle(&Unit::new_normalize(e), q[iq]).matrix();
@@ -67,6 +67,19 @@ fn energies(pm: &PinocchioModel, q: &[f64], v: &[f64]) -> (f64, f64) {
             pos += r_pre * Vector3::new(q[iq], q[iq + 1], 0.0);
             vel = v0 + w0.cross(&(pos - p0)) + rot * Vector3::new(v[iv], v[iv + 1], 0.0);
             w += rot * Vector3::new(0.0, 0.0, v[iv + 2]);
+        }
+        if j.kind == PinJointType::FreeFlyer {
+            // Position and quaternion (x, y, z, w) base → parent; (v, ω) in the joint's frame.
+            let quat = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+                q[iq + 6],
+                q[iq + 3],
+                q[iq + 4],
+                q[iq + 5],
+            ));
+            rot = r_pre * quat.to_rotation_matrix().matrix();
+            pos += r_pre * Vector3::new(q[iq], q[iq + 1], q[iq + 2]);
+            vel = v0 + w0.cross(&(pos - p0)) + rot * Vector3::new(v[iv], v[iv + 1], v[iv + 2]);
+            w += rot * Vector3::new(v[iv + 3], v[iv + 4], v[iv + 5]);
         }
         frames.push((rot, pos, w, vel));
     }
@@ -358,4 +371,45 @@ fn names_with_whitespace_stay_one_token_of_the_text_format() {
         text.contains("\nmodel two_link_robot nq 2 nv 2 dof 2\n"),
         "{text}"
     );
+}
+
+/// The free-flyer export of Solo 12 and a humanoid has the kinetic and potential energy of the
+/// free-flyer reference recursion (`kanegen_reference::FreeFlyer`): the same configuration and
+/// speeds, one to one.
+#[test]
+fn free_flyer_export_has_the_energies_of_the_free_flyer_recursion() {
+    use kanegen::pinocchio::export_free_flyer;
+    use kanegen_reference::FreeFlyer;
+    let mut rng = SplitMix64::new(15);
+    let mut uniform = move || rng.next_f64();
+    for file in ["solo12", "simple_humanoid"] {
+        let path = root().join("tests/corpus").join(format!("{file}.urdf"));
+        let m = Model::from_urdf_file(&path, &UrdfOptions::default()).unwrap();
+        let pm = export_free_flyer(&m, &m.param_values()).unwrap();
+        assert_eq!((pm.nq, pm.nv), (m.dof() + 7, m.dof() + 6));
+        assert_eq!(pm.speeds.len(), m.dof() + 6);
+        assert_eq!(pm.coordinates.len(), m.dof() + 7);
+        assert_eq!(pm.joints[0].kind, PinJointType::FreeFlyer);
+        let ff = FreeFlyer::<f64>::new(&m).unwrap();
+        for _ in 0..5 {
+            let mut q = uniform_vec(&mut uniform, ff.nq(), -1.5, 1.5);
+            let norm = q[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
+            q[3..7].iter_mut().for_each(|x| *x /= norm);
+            let u = uniform_vec(&mut uniform, ff.dof(), -2.0, 2.0);
+            let (t, v) = energies(&pm, &pm.configuration(&q), &pm.velocity(&u));
+            let (t_ref, v_ref) = (ff.kinetic_energy(&q, &u), ff.potential_energy(&q));
+            let scale = t_ref.abs().max(v_ref.abs()).max(1e-3);
+            assert!(
+                (t - t_ref).abs() < 1e-12 * scale,
+                "{file}: T {t} vs {t_ref}"
+            );
+            assert!(
+                (v - v_ref).abs() < 1e-12 * scale,
+                "{file}: V {v} vs {v_ref}"
+            );
+        }
+    }
+    let krang = model("krang.toml");
+    let err = export_free_flyer(&krang, &krang.param_values()).unwrap_err();
+    assert!(matches!(err, ExportError::WheeledFreeFlyer { .. }));
 }

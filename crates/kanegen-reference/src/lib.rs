@@ -26,6 +26,10 @@
 //! term `ẋψ̇`; the MATLAB behind the efficient-computation report (Zafar 2015) wrongly used `ψ̇`), and the axisymmetric wheels add
 //! `(2 mw + 2 YYw/R²) ẍ` to the `ẋ` row and `(mw L²/2 + YYw L²/(2R²) + 2 ZZw) ψ̈` to the `ψ̇` row.
 //!
+//! [`FreeFlyer`] evaluates the same recursion with the root link floating in the world (a
+//! free-flyer base in Pinocchio's layout; [`se3`] its configuration space), with centroidal
+//! momentum and tangent-space derivatives.
+//!
 //! The scalar type is generic (`f64`, `f32`, or any [`RealField`] + [`Copy`]).
 //!
 //! ```
@@ -41,7 +45,13 @@
 use kanegen_model::{Base, JointKind, Model};
 use nalgebra::{DMatrix, DVector, Matrix3, RealField, Vector3};
 
+mod free_flyer;
+mod free_flyer_centroidal;
+mod free_flyer_derivatives;
 pub mod random;
+pub mod se3;
+
+pub use free_flyer::{FreeFlyer, FreeFlyerError};
 
 /// Converts an `f64` constant of the model to the scalar type.
 fn cst<T: RealField + Copy>(x: f64) -> T {

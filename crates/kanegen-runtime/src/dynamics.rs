@@ -233,7 +233,7 @@ impl<T: RealField + Copy, const N: usize> DenseFactor<T, N> {
 
     /// `X_m ← s_m M⁻¹ X_m` for each of the matrices `xs` ([`cholesky_solve_columns`]).
     #[inline(always)]
-    fn solve_columns<const C: usize, const K: usize>(
+    pub(crate) fn solve_columns<const C: usize, const K: usize>(
         &self,
         xs: [&mut SMatrix<T, N, C>; K],
         s: [T; K],

@@ -24,6 +24,9 @@
 //!   every generated robot, floating bases included (whose `q` has one entry more than `u`);
 //!   [`free_flyer`]: a floating base's configuration space (Pinocchio's free-flyer layout).
 //!
+//! - [`contact`]: contact-constrained forward dynamics and contact impulses (point and frame
+//!   contacts, the Schur complement of the mass matrix's Cholesky factor), allocation-free.
+//!
 //! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA; the
 //!   batched functions also x86-64-v4, AVX-512), the
 //!   crate's `unsafe` calls (see below), and [`isa::Arith`], the multiply-add the copies
@@ -163,6 +166,7 @@
 extern crate std;
 
 mod arith;
+pub mod contact;
 pub mod derivatives_loop;
 mod dynamics;
 pub mod free_flyer;

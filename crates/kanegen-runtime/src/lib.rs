@@ -161,6 +161,7 @@ extern crate std;
 mod arith;
 pub mod derivatives_loop;
 mod dynamics;
+pub mod gpu;
 mod invalid_parameter;
 pub mod isa;
 pub mod lanes;

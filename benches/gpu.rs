@@ -183,7 +183,16 @@ fn main() {
         .measurement_time(Duration::from_secs(2));
     match Gpu::new() {
         Ok(gpu) => {
-            eprintln!("adapter: {} ({})", gpu.adapter_name(), gpu.backend());
+            eprintln!(
+                "adapter: {} ({}), kernel times from {}",
+                gpu.adapter_name(),
+                gpu.backend(),
+                if gpu.has_timestamps() {
+                    "timestamps"
+                } else {
+                    "the wall clock"
+                }
+            );
             let krang = krang_dynamics::Params::default().to_array();
             bench_gpu(&mut c, &gpu, "krang", &krang_dynamics::gpu::MODULE, &krang);
             let p = arm::Params::default().to_array();

@@ -93,6 +93,6 @@ impl Gpu {
     /// The largest storage binding the device allows, in bytes (what [`Dynamics`](crate::Dynamics) chunks
     /// batches by; 128 MiB on lavapipe).
     pub fn max_binding_bytes(&self) -> u64 {
-        u64::from(self.limits.max_storage_buffer_binding_size)
+        self.limits.max_storage_buffer_binding_size
     }
 }

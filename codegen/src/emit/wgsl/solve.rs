@@ -10,6 +10,8 @@ use crate::lower::Program;
 
 /// Appends `fn solve(m: array<T, E>, b: array<T, n>) -> array<T, n>` for the mass matrix
 /// program `mass` (outputs: its upper triangle `(row ≤ col)`, in program order).
+// Index loops over the triangle of L read as the formulas are written.
+#[allow(clippy::needless_range_loop)]
 pub(super) fn cholesky(mass: &Program, n: usize, float: Float, out: &mut String) {
     let ty = float.ty();
     let entries = mass.outputs.len().max(1);

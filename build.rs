@@ -2,6 +2,7 @@
 //! `$OUT_DIR`: the 7-DOF arm of `models/singlearm.urdf` (runtime parameters and baked) and Krang
 //! imported from `models/Krang.urdf` with its two-wheeled base (runtime parameters); and, for
 //! `tests/kinematics.rs`, the arm and the two-link model with every registry function; for
+//! `tests/gpu.rs` and `benches/gpu.rs`, the arm with GPU kernels and batched forms, and in f32; for
 //! `tests/mimic.rs`, a gripper with mimic joints; for `tests/big_tree.rs`, a 100-DOF tree; for
 //! `tests/isa_batch.rs`, a cart on a rail (structurally zero c, g, C) with every registry
 //! function and the batched forms; for `tests/unicode_names.rs`, two models with names in
@@ -22,6 +23,28 @@ fn main() {
         .functions(kanegen::FunctionSet::all())
         .combined(arm_terms())
         .output("singlearm_all.rs")
+        .run();
+    // The arm's GPU kernels and, for the comparison in `tests/gpu.rs`, the same functions on
+    // the CPU in f32 (the f64 ones are in the module with the kernels).
+    let gpu_set = {
+        use kanegen::FunctionId as F;
+        kanegen::FunctionSet::default()
+            .with(F::NonlinearEffects)
+            .with(F::CenterOfMass)
+            .with(F::ComJacobian)
+            .with(F::KineticEnergy)
+            .with(F::PotentialEnergy)
+    };
+    arm()
+        .functions(gpu_set)
+        .gpu(true)
+        .batch(true)
+        .output("singlearm_gpu.rs")
+        .run();
+    arm()
+        .functions(gpu_set)
+        .precision(kanegen::Precision::F32)
+        .output("singlearm_gpu_f32.rs")
         .run();
     kanegen::Builder::new("models/two-link.toml")
         .functions(kanegen::FunctionSet::all())

@@ -40,11 +40,13 @@ fn publishable() -> Vec<(PathBuf, String)> {
         names,
         [
             "kanegen",
+            "kanegen-gpu",
             "kanegen-model",
             "kanegen-runtime",
             "krang-dynamics"
         ],
-        "the publishable crates: the generator, the model, the runtime and Krang's dynamics \
+        "the publishable crates: the generator, the GPU runtime, the model, the runtime and \
+         Krang's dynamics \
          (the baselines kanegen-reference and kanegen-rbd, the examples and the suite are \
          `publish = false`)"
     );
@@ -173,7 +175,7 @@ fn declared_rust_version_covers_every_dependency_of_the_published_crates() {
                 && p["publish"] != serde_json::json!([])
         })
         .collect();
-    assert_eq!(published.len(), 4, "the four publishable crates");
+    assert_eq!(published.len(), 5, "the five publishable crates");
     let root = std::fs::read_to_string(common::root().join("Cargo.toml")).unwrap();
     let declared = strings(&root, "rust-version")
         .pop()

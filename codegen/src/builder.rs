@@ -58,6 +58,7 @@ pub struct Builder {
     memory_limit: Option<u64>,
     /// [`Builder::unoptimised_limit`].
     unoptimised_limit: u64,
+    gpu: Option<FunctionSet>,
 }
 
 impl Builder {
@@ -122,6 +123,7 @@ impl Builder {
             derivatives_form: DerivativesForm::Auto,
             memory_limit: None,
             unoptimised_limit: crate::DEFAULT_UNOPTIMISED_LIMIT,
+            gpu: None,
         }
     }
 
@@ -358,6 +360,41 @@ impl Builder {
         self
     }
 
+    /// GPU kernels (default `false`): the module also gets `pub mod gpu`, every lowered
+    /// function of the module ([`Builder::functions`], one kernel per frame of a per-frame
+    /// function) as a WGSL compute kernel in `f32` and in `f64` (`gpu::WGSL_F32`,
+    /// `gpu::WGSL_F64`), from the same straight-line programs as the Rust functions, and their
+    /// layout (`gpu::MODULE`, a `kanegen_runtime::gpu::GpuModule`) for the `kanegen-gpu`
+    /// crate. With the mass matrix and `nonlinear_effects`, `coriolis` and `gravity`, or
+    /// `inverse_dynamics` in the set, also `forward_dynamics` and `rollout` kernels. The Rust
+    /// part of the module is unchanged. See docs/gpu.md.
+    ///
+    /// ```no_run
+    /// kanegen::Builder::new("krang.toml").gpu(true).run();
+    /// ```
+    pub fn gpu(mut self, on: bool) -> Self {
+        self.gpu = on.then(FunctionSet::all);
+        self
+    }
+
+    /// GPU kernels ([`Builder::gpu`]) for the functions of `set` only: a function gets a
+    /// kernel when it is both in the module ([`Builder::functions`]) and in `set`. The Rust
+    /// functions are as [`Builder::functions`] says; `forward_dynamics` and `rollout` need the
+    /// mass matrix and the velocity and gravity terms among the kernels.
+    ///
+    /// ```no_run
+    /// use kanegen::{FunctionId as F, FunctionSet};
+    /// let kernels: FunctionSet = [F::MassMatrix, F::NonlinearEffects].into_iter().collect();
+    /// kanegen::Builder::new("krang.toml")
+    ///     .functions(FunctionSet::default().with(F::NonlinearEffects))
+    ///     .gpu_functions(kernels)
+    ///     .run();
+    /// ```
+    pub fn gpu_functions(mut self, set: FunctionSet) -> Self {
+        self.gpu = Some(set);
+        self
+    }
+
     fn emit_options(&self, notes: Vec<String>) -> EmitOptions {
         let notes_title = if notes.is_empty() {
             String::new()
@@ -375,6 +412,7 @@ impl Builder {
             mirrored_lanes: self.mirrored_lanes,
             split_above: self.split_above,
             regressor_form: self.regressor_form,
+            gpu: self.gpu,
         }
     }
 

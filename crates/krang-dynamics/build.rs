@@ -4,8 +4,8 @@
 //! this script does nothing and `kanegen` is not even a build dependency: the default module
 //! (f64 Krang with M, c, g and inverse dynamics) is pre-generated in `src/generated/krang.rs`
 //! (`tests/pregenerated.rs` checks it against the generator). With `coriolis-matrix`,
-//! `kinematics`, `derivatives` or `regressors` the Krang module is generated here instead, with
-//! those functions.
+//! `kinematics`, `derivatives`, `regressors` or `gpu` the Krang module is generated here
+//! instead, with those functions (and with `gpu`, its GPU kernels).
 fn main() {
     #[cfg(any(
         feature = "coriolis-matrix",
@@ -15,7 +15,8 @@ fn main() {
         feature = "baked",
         feature = "f32",
         feature = "fixed-wheels",
-        feature = "two-link"
+        feature = "two-link",
+        feature = "gpu"
     ))]
     modules::generate();
 }
@@ -30,7 +31,8 @@ fn main() {
     feature = "baked",
     feature = "f32",
     feature = "fixed-wheels",
-    feature = "two-link"
+    feature = "two-link",
+    feature = "gpu"
 ))]
 mod modules {
     use kanegen::{Builder, Combined, FunctionId as F, FunctionSet, Precision};
@@ -39,6 +41,7 @@ mod modules {
     const KINEMATICS: bool = cfg!(feature = "kinematics");
     const DERIVATIVES: bool = cfg!(feature = "derivatives");
     const REGRESSORS: bool = cfg!(feature = "regressors");
+    const GPU: bool = cfg!(feature = "gpu");
 
     /// `set` if `on`, else no function.
     fn when(on: bool, set: FunctionSet) -> FunctionSet {
@@ -46,7 +49,7 @@ mod modules {
     }
 
     pub fn generate() {
-        if CORIOLIS_MATRIX || KINEMATICS || DERIVATIVES || REGRESSORS {
+        if CORIOLIS_MATRIX || KINEMATICS || DERIVATIVES || REGRESSORS || GPU {
             // The main module: M, c, g, τ and the functions of the features (the Coriolis
             // matrix, the kinematics and energies with c + g and two combined programs, the
             // derivatives, the regressors).
@@ -57,12 +60,21 @@ mod modules {
                             KINEMATICS,
                             FunctionSet::kinematics().with(F::NonlinearEffects),
                         ))
-                        .union(when(REGRESSORS, FunctionSet::regressors())),
+                        .union(when(REGRESSORS, FunctionSet::regressors()))
+                        .union(when(GPU, FunctionSet::EMPTY.with(F::NonlinearEffects))),
                 )
                 .coriolis_matrix(CORIOLIS_MATRIX)
                 .derivatives(DERIVATIVES)
                 .mirrored_lanes(true)
                 .batch_feature("batch");
+            // With `gpu`: the kernels of M, c, g, τ, c + g (and C), which give forward
+            // dynamics and rollouts on the device; not the kinematics, derivatives or
+            // regressors (their kernels are as large as their Rust functions).
+            let krang = if GPU {
+                krang.gpu_functions(FunctionSet::default().with(F::NonlinearEffects))
+            } else {
+                krang
+            };
             if KINEMATICS {
                 krang
                     .combined(whole_body_terms())

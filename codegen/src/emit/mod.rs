@@ -19,7 +19,8 @@
 //! `function.rs` (straight-line), `derivatives_loop.rs`, `combined.rs`, `batch.rs`,
 //! `regressor.rs` (the regressors' items), then `items.rs` (names, `Params`, `Precomputed`, the
 //! wrapper collecting every form's methods, trait impls), `annotate.rs` (statement comments)
-//! and this file (the module and its header).
+//! and this file (the module and its header). `wgsl/` prints the same programs as WGSL
+//! compute kernels (the module's `gpu` part, on request).
 
 mod annotate;
 mod batch;
@@ -36,6 +37,7 @@ mod regressor;
 mod regressor_loop;
 mod signature;
 mod text;
+pub mod wgsl;
 
 use proc_macro2::TokenStream;
 use quote::quote;
@@ -105,6 +107,10 @@ pub struct EmitOptions {
     /// by the lowering ([`crate::lower::lower_with`]): the emitter emits the looped form when
     /// [`Lowered::derivative_loop`] is `Some`.
     pub derivatives_form: DerivativesForm,
+    /// GPU kernels (default `None`: none): a `pub mod gpu` after the module, with the WGSL
+    /// compute kernel of every function of the module that is in the set, and their layout
+    /// ([`wgsl`], [`crate::Builder::gpu`]).
+    pub gpu: Option<crate::registry::FunctionSet>,
 }
 
 pub use text::SPLIT_ABOVE;
@@ -122,6 +128,7 @@ impl Default for EmitOptions {
             split_above: SPLIT_ABOVE,
             regressor_form: RegressorForm::default(),
             derivatives_form: DerivativesForm::default(),
+            gpu: None,
         }
     }
 }
@@ -242,6 +249,13 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
         message,
     })?;
     out.push_str(&body);
+    if let Some(set) = options.gpu {
+        let kernels = wgsl::kernels(model, low, set).map_err(|e| EmitError {
+            model: model.name.clone(),
+            message: e.to_string(),
+        })?;
+        out.push_str(&wgsl::rust_module(model, &kernels));
+    }
     Ok(out)
 }
 

@@ -34,6 +34,8 @@
 //!   in lanes); [`quad`]: four fused lanes of the x86-64-v3 copy (solves with many columns).
 //! - [`regressor`]: the loop of a loop-form inverse-dynamics regressor (per link and four rows
 //!   at a time, over a generated plan; generic over [`isa::Arith`]).
+//! - [`gpu`]: the layout of a generated module's GPU kernels (`gpu::MODULE`, generated with
+//!   `Builder::gpu`), which the `kanegen-gpu` crate runs.
 //! - [`derivatives_loop`]: the loop of the looped `inverse_dynamics_derivatives` (the
 //!   (column, ancestor) steps of the analytic recursion over generated tables); its AVX2 copy
 //!   is called only after the same feature check.
@@ -170,6 +172,7 @@ pub mod contact;
 pub mod derivatives_loop;
 mod dynamics;
 pub mod free_flyer;
+pub mod gpu;
 mod invalid_parameter;
 pub mod isa;
 pub mod lanes;

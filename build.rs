@@ -153,7 +153,7 @@ fn tree_urdf(branches: usize, depth: usize) -> String {
             s += &format!(
                 "<link name=\"{link}\"><inertial><origin xyz=\"0.01 0.02 0.1\" rpy=\"0 0 0\"/>\
                  <mass value=\"{mass}\"/><inertia ixx=\"0.02\" ixy=\"0.001\" ixz=\"0\" \
-                 iyy=\"0.03\" iyz=\"0.002\" izz=\"0.01\"/></inertial></link>\n\
+                 iyy=\"0.03\" iyz=\"0.002\" izz=\"0.015\"/></inertial></link>\n\
                  <joint name=\"j{b}_{d}\" type=\"revolute\"><parent link=\"{parent}\"/>\
                  <child link=\"{link}\"/><origin xyz=\"0.01 0.02 0.2\" rpy=\"0 0 {yaw}\"/>\
                  <axis xyz=\"{axis}\"/><limit lower=\"-3\" upper=\"3\" effort=\"10\" \

@@ -195,7 +195,9 @@ fn arm(rng: &mut Rng) -> Value {
                 com_jacobian,
                 potential_energy,
                 gravity_regressor,
-                base_gravity_regressor
+                base_gravity_regressor,
+                centroidal_momentum_matrix,
+                centroidal_inertia
             ]
         );
         record!(
@@ -207,7 +209,8 @@ fn arm(rng: &mut Rng) -> Value {
                 coriolis_matrix,
                 com_bias_acceleration,
                 kinetic_energy,
-                nonlinear_effects
+                nonlinear_effects,
+                centroidal_momentum_bias
             ]
         );
         record!(

@@ -704,6 +704,15 @@ fn what_a_floating_base_does_not_generate_is_a_typed_error() {
             kanegen::Builder::from_model(with_mimic(&model)).coriolis_matrix(false),
         ),
         ("mimic", kanegen::Builder::from_model(with_mimic(&model))),
+        (
+            "GPU kernels",
+            kanegen::Builder::from_model(model.clone()).gpu(true),
+        ),
+        (
+            "GPU kernels of one function",
+            kanegen::Builder::from_model(model.clone())
+                .gpu_functions([FunctionId::MassMatrix].into_iter().collect()),
+        ),
     ] {
         let err = builder
             .generate()

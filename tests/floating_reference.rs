@@ -93,7 +93,7 @@ fn rotate_rows(r: &Matrix3<f64>, m: &DMatrix<f64>) -> DMatrix<f64> {
 /// `$sets` random parameter sets and `$states` random states per set.
 macro_rules! compare_with_reference {
     ($m:ident, $robot:ident, $model:expr, $seed:expr, $sets:expr, $states:expr) => {{
-        use $m::{Frame, Params, $robot, DOF, NQ, PARAM_COUNT};
+        use $m::{DOF, Frame, NQ, PARAM_COUNT, Params, $robot};
         let model: Model = $model;
         let names: Vec<&str> = model.params.iter().map(|p| p.name.as_str()).collect();
         assert_eq!(names, Params::NAMES, "parameter order");
@@ -116,11 +116,7 @@ macro_rules! compare_with_reference {
                     let e = rel(&got, &want);
                     assert!(e < tol, "{}: {what}: relative error {e:e}", model.name);
                 };
-                check(
-                    "M",
-                    dm(&robot.mass_matrix(&q)),
-                    reference.mass_matrix(&qv),
-                );
+                check("M", dm(&robot.mass_matrix(&q)), reference.mass_matrix(&qv));
                 check(
                     "c",
                     dm(&robot.coriolis(&q, &u)),
@@ -156,16 +152,8 @@ macro_rules! compare_with_reference {
                 );
                 let (dq, du) = reference.inverse_dynamics_derivatives(&qv, &uv, &udv);
                 let d = robot.inverse_dynamics_derivatives(&q, &u, &ud);
-                check(
-                    "∂τ/∂q",
-                    dm(&d.fixed_columns::<DOF>(0).into_owned()),
-                    dq,
-                );
-                check(
-                    "∂τ/∂u",
-                    dm(&d.fixed_columns::<DOF>(DOF).into_owned()),
-                    du,
-                );
+                check("∂τ/∂q", dm(&d.fixed_columns::<DOF>(0).into_owned()), dq);
+                check("∂τ/∂u", dm(&d.fixed_columns::<DOF>(DOF).into_owned()), du);
                 let (r0, _) = reference.base_pose(&qv);
                 for frame in Frame::ALL {
                     let index = model
@@ -181,7 +169,10 @@ macro_rules! compare_with_reference {
                         DMatrix::from_iterator(
                             12,
                             1,
-                            got_rot.iter().chain(pose.translation.vector.iter()).copied(),
+                            got_rot
+                                .iter()
+                                .chain(pose.translation.vector.iter())
+                                .copied(),
                         ),
                         DMatrix::from_iterator(12, 1, rot.iter().chain(pos.iter()).copied()),
                     );

@@ -114,7 +114,8 @@ fn baked_and_f32_modules_and_bad_names_are_refused() {
 /// written.
 #[test]
 fn floating_base_models_are_refused_with_a_typed_error() {
-    let dir = std::env::temp_dir().join(format!("kanegen-bindings-floating-{}", std::process::id()));
+    let dir =
+        std::env::temp_dir().join(format!("kanegen-bindings-floating-{}", std::process::id()));
     let model = root().join("models/floating-hopper.toml");
     let o = BindingsOptions::default();
     for r in [
@@ -127,7 +128,10 @@ fn floating_base_models_are_refused_with_a_typed_error() {
             matches!(err, Error::Bindings(BindingsError::FloatingBase { .. })),
             "{text}"
         );
-        assert!(text.contains("floating-hopper") && text.contains("NQ"), "{text}");
+        assert!(
+            text.contains("floating-hopper") && text.contains("NQ"),
+            "{text}"
+        );
     }
     assert!(!dir.exists(), "nothing is written for a refused crate");
 }

@@ -448,8 +448,16 @@ fn floating_models_export_through_the_free_flyer() {
             let (t, v) = energies(&pm, &pm.configuration(&q), &pm.velocity(&u));
             let (t_ref, v_ref) = (ff.kinetic_energy(&q, &u), ff.potential_energy(&q));
             let scale = t_ref.abs().max(v_ref.abs()).max(1e-3);
-            assert!((t - t_ref).abs() < 1e-12 * scale, "{}: T {t} vs {t_ref}", m.name);
-            assert!((v - v_ref).abs() < 1e-12 * scale, "{}: V {v} vs {v_ref}", m.name);
+            assert!(
+                (t - t_ref).abs() < 1e-12 * scale,
+                "{}: T {t} vs {t_ref}",
+                m.name
+            );
+            assert!(
+                (v - v_ref).abs() < 1e-12 * scale,
+                "{}: V {v} vs {v_ref}",
+                m.name
+            );
         }
     }
 }

@@ -27,7 +27,12 @@ pub fn link_poses(model: &Model, q: &[f64], p: &[f64]) -> Vec<(Matrix3<f64>, Vec
     let (r0, p0) = ff.base_pose(q);
     ff.frame_states(q, &zero, &zero)
         .iter()
-        .map(|s| (r0.transpose() * s.rotation, r0.transpose() * (s.position - p0)))
+        .map(|s| {
+            (
+                r0.transpose() * s.rotation,
+                r0.transpose() * (s.position - p0),
+            )
+        })
         .collect()
 }
 

@@ -80,9 +80,9 @@ fn main() {
     kanegen::Builder::new("tests/data/unicode_two_link.toml")
         .output("unicode_two_link.rs")
         .run();
-    // Floating bases, for `tests/floating_base.rs`: the hopper with every function a floating
-    // base has and the batched forms, Solo 12 with the default functions and the nonlinear
-    // effects.
+    // Floating bases, for `tests/floating_base.rs` and `tests/floating_reference.rs`: the hopper
+    // with every function a floating base has and the batched forms, Solo 12 with the default
+    // functions, the nonlinear effects, the kinematics, the centroidal terms and the derivatives.
     kanegen::Builder::new("models/floating-hopper.toml")
         .functions(kanegen::floating::SUPPORTED.into_iter().collect())
         .batch(true)
@@ -90,7 +90,16 @@ fn main() {
         .run();
     let floating = kanegen::FunctionSet::default()
         .iter()
-        .chain([kanegen::FunctionId::NonlinearEffects])
+        .chain([
+            kanegen::FunctionId::NonlinearEffects,
+            kanegen::FunctionId::CenterOfMass,
+            kanegen::FunctionId::FramePose,
+            kanegen::FunctionId::FrameJacobian,
+            kanegen::FunctionId::FrameBiasAcceleration,
+            kanegen::FunctionId::CentroidalMomentumMatrix,
+            kanegen::FunctionId::CentroidalMomentumBias,
+            kanegen::FunctionId::InverseDynamicsDerivatives,
+        ])
         .collect::<kanegen::FunctionSet>();
     kanegen::Builder::urdf("tests/corpus/solo12.urdf", UrdfOptions::floating())
         .functions(floating)

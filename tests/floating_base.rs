@@ -1,8 +1,9 @@
 //! Generated floating-base modules (`models/floating-hopper.toml` and Solo 12, from this
 //! package's build script), compiled:
 //!
-//! * M, c, g, τ and the nonlinear effects equal the spatial-vector recursion with a free-flyer
-//!   root of `codegen/tests/support/free_flyer.rs`, at random states;
+//! * M, c, g, τ and the nonlinear effects equal the free-flyer reference recursion
+//!   (`kanegen_reference::FreeFlyer`, through the adapters of
+//!   `codegen/tests/support/free_flyer.rs`), at random states;
 //! * the wrapper's `integrate` keeps the quaternion unit, `integrate(q0, difference(q0, q1), 1)
 //!   = q1`, and `integrate` is the recursion's `q ⊕ δ`;
 //! * free fall: with τ = 0 the forward dynamics (the `Multibody` trait's) accelerate the centre of

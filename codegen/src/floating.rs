@@ -43,11 +43,13 @@ pub const SUPPORTED: [FunctionId; 22] = [
 const FIX: &str = "leave it out for a floating base (M, c, g, τ, the Coriolis matrix, nonlinear_effects, the derivatives, the kinematics, the energies, the centroidal functions and the regressors are generated)";
 
 /// [`Error::FloatingBase`] if `robot` has a floating base and the options ask for something
-/// outside [`SUPPORTED`] or has mimic constraints.
+/// outside [`SUPPORTED`] or GPU kernels (`gpu`: their buffers hold DOF coordinates per state, not
+/// NQ), or has mimic constraints.
 pub(crate) fn check(
     robot: &model::Model,
     opts: &Options,
     combined: &[Combined],
+    gpu: bool,
 ) -> Result<(), Error> {
     if !robot.is_floating() {
         return Ok(());
@@ -72,6 +74,12 @@ pub(crate) fn check(
                 FIX,
             ));
         }
+    }
+    if gpu {
+        return Err(err(
+            "GPU kernels".into(),
+            "leave out `Builder::gpu` and `Builder::gpu_functions` for a floating base (the CPU functions, single-state and batched, take `q` of NQ entries)",
+        ));
     }
     if !robot.mimics.is_empty() {
         return Err(err(

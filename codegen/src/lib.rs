@@ -273,7 +273,12 @@ pub(crate) fn generate_combined(
 ) -> Result<Generated, Error> {
     // The loaders check names; a model built in memory is checked here.
     robot.check_names()?;
-    floating::check(&robot, &opts, combined_functions)?;
+    floating::check(
+        &robot,
+        &opts,
+        combined_functions,
+        emit_options.gpu.is_some(),
+    )?;
     let resolved = combined::resolve(&robot, combined_functions)?;
     let mut progress = Progress::new(&robot);
     let derivation = kane::derive_shaped(&robot, opts, &resolved, emit_options.regressor_form);

@@ -125,16 +125,6 @@ pub enum ExportError {
         /// Its first moment `[MX, MY, MZ]`.
         first_moment: [f64; 3],
     },
-    /// A floating base: the export's text format has no free-flyer joint.
-    #[error(
-        "model `{model}` ({file}): the Pinocchio export has no free-flyer joint; export the model with a fixed base (import the URDF with `UrdfBase::Fixed` after dropping its `floating` joint, or `[base] type = \"fixed\"`)"
-    )]
-    FloatingBase {
-        /// The model name.
-        model: String,
-        /// The description file.
-        file: String,
-    },
 }
 
 /// The Pinocchio joint model of a [`PinJoint`].
@@ -326,16 +316,19 @@ fn cartesian(axis: [f64; 3]) -> Option<(usize, f64)> {
 }
 
 /// Exports `model` with parameter values `params` (indexed like [`Model::params`]) as a
-/// Pinocchio tree; see the module documentation for the mapping.
+/// Pinocchio tree; see the module documentation for the mapping. A model with a floating base
+/// ([`Base::Floating`]) is exported through [`export_free_flyer`]: its base is the free flyer, its
+/// `q`, `u` and gravity those of its generated module, one to one.
 pub fn export(model: &Model, params: &[f64]) -> Result<PinocchioModel, ExportError> {
-    export_tree(model, params, false)
+    export_tree(model, params, model.is_floating())
 }
 
 /// Exports `model` with its root link on a `JointModelFreeFlyer` (joint 1), in the layout of
 /// `kanegen_reference::FreeFlyer` and of generated floating-base modules: the first seven
 /// coordinates are the free flyer's `(x, y, z, qx, qy, qz, qw)` (names `base_x` … `base_qw`),
 /// the first six speeds its `(v, ω)` in the base frame (`base_vx` … `base_wz`), both mapped one
-/// to one; the joints follow as in [`export`]. Gravity is `(0, 0, −g)` in the world. A wheeled
+/// to one; the joints follow as in [`export`]. Gravity is `(0, 0, −g)` in the world for a
+/// fixed model made free, the model's own gravity direction for a floating one. A wheeled
 /// base is an error ([`ExportError::WheeledFreeFlyer`]); a fixed base's root becomes free.
 pub fn export_free_flyer(model: &Model, params: &[f64]) -> Result<PinocchioModel, ExportError> {
     export_tree(model, params, true)
@@ -400,19 +393,21 @@ fn export_tree(
         armature.extend([0.0; 6]);
         (nq, nv) = (7, 6);
         attach.push((1, IDENTITY, [0.0; 3]));
-        [0.0, 0.0, -g]
+        // A floating model keeps its own gravity direction (in the world), as its generated
+        // code does; a fixed model made free falls along −z, as `kanegen_reference::FreeFlyer`.
+        if model.is_floating() {
+            gravity
+        } else {
+            [0.0, 0.0, -g]
+        }
     } else {
         gravity
     };
     match &model.base {
         _ if free_flyer => {}
         Base::Fixed => attach.push((0, IDENTITY, [0.0; 3])),
-        Base::Floating => {
-            return Err(ExportError::FloatingBase {
-                model: model.name.clone(),
-                file: model.source.clone(),
-            });
-        }
+        // `export` sends a floating model through the free-flyer path.
+        Base::Floating => unreachable!("a floating base is exported with its free flyer"),
         Base::Wheeled(w) => {
             let dir = model.gravity.direction;
             if dir[0] != 0.0 || dir[1] != 0.0 {
@@ -597,7 +592,14 @@ fn export_tree(
         coordinate_names: base_coordinates
             .into_iter()
             .map(|(_, n)| n)
-            .chain(model.speeds.iter().map(|s| s.coordinate.clone()))
+            .chain(
+                // A floating model's own base speeds are the free flyer's, named above.
+                model
+                    .speeds
+                    .iter()
+                    .skip(if model.is_floating() { 6 } else { 0 })
+                    .map(|s| s.coordinate.clone()),
+            )
             .collect(),
     })
 }

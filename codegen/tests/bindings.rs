@@ -108,3 +108,30 @@ fn baked_and_f32_modules_and_bad_names_are_refused() {
     }
     assert!(!dir.exists(), "nothing is written for a refused crate");
 }
+
+/// A floating model's `q` has NQ = DOF + 1 entries, which the bindings' arrays do not hold: both
+/// kinds of crate are refused with a typed error naming the model and the fix, and nothing is
+/// written.
+#[test]
+fn floating_base_models_are_refused_with_a_typed_error() {
+    let dir =
+        std::env::temp_dir().join(format!("kanegen-bindings-floating-{}", std::process::id()));
+    let model = root().join("models/floating-hopper.toml");
+    let o = BindingsOptions::default();
+    for r in [
+        Builder::new(&model).python_crate(&dir, &o),
+        Builder::new(&model).c_crate(&dir, &o),
+    ] {
+        let err = r.expect_err("a floating base is refused");
+        let text = err.to_string();
+        assert!(
+            matches!(err, Error::Bindings(BindingsError::FloatingBase { .. })),
+            "{text}"
+        );
+        assert!(
+            text.contains("floating-hopper") && text.contains("NQ"),
+            "{text}"
+        );
+    }
+    assert!(!dir.exists(), "nothing is written for a refused crate");
+}

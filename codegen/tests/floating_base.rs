@@ -2,8 +2,9 @@
 //! generation), on a small TOML model with a prismatic joint and on Solo 12, with random
 //! parameters and states:
 //!
-//! * M, c, g, τ and the nonlinear effects equal a spatial-vector recursion with a free-flyer root
-//!   (`support/free_flyer.rs`, independent of the Kane derivation);
+//! * M, c, g, τ and the nonlinear effects equal the free-flyer reference recursion
+//!   `kanegen_reference::FreeFlyer` (independent of the Kane derivation; `support/free_flyer.rs`
+//!   adapts its calls);
 //! * M equals the kinetic-energy mass matrix of `kanegen-model`, is symmetric positive definite,
 //!   and `½ uᵀ M u` is the bodies' kinetic energy;
 //! * g is the gradient of the potential energy in the tangent space (`q ⊕ δ`, central
@@ -703,6 +704,15 @@ fn what_a_floating_base_does_not_generate_is_a_typed_error() {
             kanegen::Builder::from_model(with_mimic(&model)).coriolis_matrix(false),
         ),
         ("mimic", kanegen::Builder::from_model(with_mimic(&model))),
+        (
+            "GPU kernels",
+            kanegen::Builder::from_model(model.clone()).gpu(true),
+        ),
+        (
+            "GPU kernels of one function",
+            kanegen::Builder::from_model(model.clone())
+                .gpu_functions([FunctionId::MassMatrix].into_iter().collect()),
+        ),
     ] {
         let err = builder
             .generate()

@@ -413,3 +413,51 @@ fn free_flyer_export_has_the_energies_of_the_free_flyer_recursion() {
     let err = export_free_flyer(&krang, &krang.param_values()).unwrap_err();
     assert!(matches!(err, ExportError::WheeledFreeFlyer { .. }));
 }
+
+/// A model with a floating base goes through `export` directly: the free flyer is its base, the
+/// coordinates and speeds are its generated module's one to one (names included), and the energies
+/// are those of the free-flyer reference recursion at random physical parameters.
+#[test]
+fn floating_models_export_through_the_free_flyer() {
+    use kanegen::model::Base;
+    use kanegen_reference::FreeFlyer;
+    let mut rng = SplitMix64::new(48);
+    let mut uniform = move || rng.next_f64();
+    let solo = Model::from_urdf_file(
+        root().join("tests/corpus/solo12.urdf"),
+        &UrdfOptions::floating(),
+    )
+    .unwrap();
+    let hopper = Model::from_toml_file(root().join("models/floating-hopper.toml")).unwrap();
+    for m in [solo, hopper] {
+        assert!(matches!(m.base, Base::Floating));
+        let params = random_physical_params(&m, &mut uniform);
+        let pm = export(&m, &params).unwrap();
+        assert_eq!(pm.joints[0].kind, PinJointType::FreeFlyer);
+        assert_eq!((pm.nq, pm.nv), (m.nq(), m.dof()));
+        assert_eq!(pm.coordinate_names, m.coordinate_names(), "{}", m.name);
+        let speed_names: Vec<&str> = pm.speeds.iter().map(|s| s.name.as_str()).collect();
+        let model_speeds: Vec<&str> = m.speeds.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(speed_names, model_speeds, "{}", m.name);
+        let ff = FreeFlyer::<f64>::with_params(&m, &params).unwrap();
+        for _ in 0..5 {
+            let mut q = uniform_vec(&mut uniform, ff.nq(), -1.5, 1.5);
+            let norm = q[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
+            q[3..7].iter_mut().for_each(|x| *x /= norm);
+            let u = uniform_vec(&mut uniform, ff.dof(), -2.0, 2.0);
+            let (t, v) = energies(&pm, &pm.configuration(&q), &pm.velocity(&u));
+            let (t_ref, v_ref) = (ff.kinetic_energy(&q, &u), ff.potential_energy(&q));
+            let scale = t_ref.abs().max(v_ref.abs()).max(1e-3);
+            assert!(
+                (t - t_ref).abs() < 1e-12 * scale,
+                "{}: T {t} vs {t_ref}",
+                m.name
+            );
+            assert!(
+                (v - v_ref).abs() < 1e-12 * scale,
+                "{}: V {v} vs {v_ref}",
+                m.name
+            );
+        }
+    }
+}

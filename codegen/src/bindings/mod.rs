@@ -45,6 +45,15 @@ pub enum BindingsError {
         /// The model's name.
         model: String,
     },
+    /// The model has a floating base: the bindings' arrays hold DOF coordinates per state, not
+    /// NQ.
+    #[error(
+        "model `{model}`: bindings wrap fixed and wheeled bases only (their `q` arrays have DOF entries; a floating base has NQ = DOF + 1); generate the floating model as a Rust module (`Builder::output`) or import it with a fixed base (`UrdfBase::Fixed`, `[base] type = \"fixed\"`)"
+    )]
+    FloatingBase {
+        /// The model's name.
+        model: String,
+    },
     /// The name is not a valid Python module or C identifier.
     #[error(
         "`{name}` cannot name a bindings crate: use ASCII letters, digits and `_`, not starting with a digit (e.g. `--name my_robot`)"
@@ -117,6 +126,12 @@ impl Builder {
         let g = self.generate()?;
         if g.lowered.params != ParamMode::Runtime || self.precision_of() != Precision::F64 {
             return Err(BindingsError::Unsupported {
+                model: g.model.name.clone(),
+            }
+            .into());
+        }
+        if g.model.is_floating() {
+            return Err(BindingsError::FloatingBase {
                 model: g.model.name.clone(),
             }
             .into());

@@ -4,10 +4,12 @@
 //! `kanegen_runtime::contact` simulates the robot under them ([`sim`]). The dynamics come
 //! through a small trait, [`robot::WholeBodyModel`] (M, h, contact Jacobians and their bias,
 //! centroidal momentum matrix and bias, centre of mass, integration on the configuration space),
-//! implemented here by the free-flyer reference recursion ([`robot::ReferenceSolo`]) and, through
-//! [`impl_whole_body_model!`], by any generated floating-base module. The guide's chapter is
+//! implemented by the generated module of Solo 12 on a floating base ([`generated::Solo`], through
+//! [`impl_whole_body_model!`]; the example runs on it) and by the free-flyer reference recursion
+//! ([`robot::ReferenceSolo`], which the tests compare the generated run with). The guide's chapter is
 //! `docs/contacts.md`.
 
+pub mod generated;
 pub mod robot;
 pub mod sim;
 pub mod wbc;

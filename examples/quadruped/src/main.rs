@@ -10,7 +10,7 @@ use std::error::Error;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use quadruped_example::robot::ReferenceSolo;
+use quadruped_example::generated::Solo;
 use quadruped_example::sim::{self, Sample, Scenario};
 use quadruped_example::wbc::Settings;
 
@@ -33,8 +33,8 @@ const LEGS: [&str; 4] = ["FL", "FR", "HL", "HR"];
 fn main() -> Res<()> {
     let out = PathBuf::from(std::env::args().nth(1).unwrap_or("target/quadruped".into()));
     std::fs::create_dir_all(&out)?;
-    // The dynamics: the free-flyer reference recursion.
-    let robot = ReferenceSolo::load()?;
+    // The dynamics: the generated module (Solo 12 on a floating base).
+    let robot = Solo::default();
     let scenario = Scenario::default();
     let settings = Settings::default();
     let start = Instant::now();

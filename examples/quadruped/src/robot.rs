@@ -1,4 +1,6 @@
-//! The dynamics the controller and the simulator use, as one trait, and its implementations.
+//! The dynamics the controller and the simulator use, as one trait, and its implementations:
+//! the generated module (`generated`, the example's dynamics) and the free-flyer reference
+//! recursion ([`ReferenceSolo`], the independent check of the generated run in tests/circle.rs).
 
 use kanegen_model::{Model, UrdfImport, UrdfOptions};
 use kanegen_reference::FreeFlyer;
@@ -42,7 +44,7 @@ pub trait WholeBodyModel {
     fn integrate(&self, q: &Q, u: &U, dt: f64) -> Q;
 }
 
-/// Solo 12 (`tests/corpus/solo12.urdf`, default import options) on the free-flyer reference
+/// Solo 12 (`tests/corpus/solo12.urdf`, imported on a floating base) on the free-flyer reference
 /// recursion of `kanegen-reference`; frames are indices into the model's links.
 #[derive(Debug, Clone)]
 pub struct ReferenceSolo {
@@ -57,7 +59,8 @@ impl ReferenceSolo {
             env!("CARGO_MANIFEST_DIR"),
             "/../../tests/corpus/solo12.urdf"
         );
-        let model = UrdfImport::read(path, &UrdfOptions::default())?.model;
+        // A floating import: the trunk (`base_link`) keeps its body, which a fixed import drops.
+        let model = UrdfImport::read(path, &UrdfOptions::floating())?.model;
         let ff = FreeFlyer::new(&model)?;
         Ok(Self { model, ff })
     }
@@ -121,12 +124,30 @@ impl WholeBodyModel for ReferenceSolo {
     }
 }
 
+/// `blockdiag(R, R) m`: a 6-row matrix with rows 0–2 and 3–5 rotated by `R`.
+pub fn rotate_rows<const C: usize>(
+    r: &nalgebra::Matrix3<f64>,
+    m: &SMatrix<f64, 6, C>,
+) -> SMatrix<f64, 6, C> {
+    let mut out = *m;
+    for c in 0..C {
+        for b in 0..2 {
+            let v = r * m.fixed_view::<3, 1>(3 * b, c);
+            out.fixed_view_mut::<3, 1>(3 * b, c).copy_from(&v);
+        }
+    }
+    out
+}
+
 /// Implements [`WholeBodyModel`] for a generated floating-base robot type `$robot` with frame
 /// enum `$frame` by forwarding to its generated methods of the same names (`mass_matrix`,
 /// `nonlinear_effects`, `frame_pose`, `frame_jacobian`, `frame_bias_acceleration`,
 /// `centroidal_momentum_matrix`, `centroidal_momentum_bias`, `center_of_mass`, `integrate`) and
-/// `Frame::from_name`. The module must be generated with a floating base and the functions
-/// `nonlinear_effects`, the group `kinematics` and the centroidal functions.
+/// `Frame::from_name`. The generated Jacobians and bias accelerations are in the base frame's
+/// axes (docs/floating-base.md): they are rotated to the world's by the base rotation of `q`.
+/// The module must be generated with a floating base and the functions `mass_matrix`,
+/// `nonlinear_effects`, `center_of_mass`, `frame_pose`, `frame_jacobian`,
+/// `frame_bias_acceleration`, `centroidal_momentum_matrix` and `centroidal_momentum_bias`.
 #[macro_export]
 macro_rules! impl_whole_body_model {
     ($robot:ty, $frame:ty) => {
@@ -157,7 +178,10 @@ macro_rules! impl_whole_body_model {
                 q: &$crate::robot::Q,
                 frame: $frame,
             ) -> nalgebra::SMatrix<f64, 6, 18> {
-                <$robot>::frame_jacobian(self, q, frame)
+                $crate::robot::rotate_rows(
+                    &$crate::robot::base_rotation(q),
+                    &<$robot>::frame_jacobian(self, q, frame),
+                )
             }
             fn frame_bias_acceleration(
                 &self,
@@ -165,7 +189,10 @@ macro_rules! impl_whole_body_model {
                 u: &$crate::robot::U,
                 frame: $frame,
             ) -> nalgebra::SVector<f64, 6> {
-                <$robot>::frame_bias_acceleration(self, q, u, frame)
+                $crate::robot::rotate_rows(
+                    &$crate::robot::base_rotation(q),
+                    &<$robot>::frame_bias_acceleration(self, q, u, frame),
+                )
             }
             fn centroidal_momentum_matrix(
                 &self,
@@ -193,4 +220,11 @@ macro_rules! impl_whole_body_model {
             }
         }
     };
+}
+
+/// The base rotation (base → world) of `q`: its unit quaternion `q[3..7]`, `(x, y, z, w)`.
+pub fn base_rotation(q: &Q) -> nalgebra::Matrix3<f64> {
+    nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(q[6], q[3], q[4], q[5]))
+        .to_rotation_matrix()
+        .into_inner()
 }

@@ -1,21 +1,27 @@
-//! A short run of the example on the reference recursion: the centre of mass follows the
-//! circle, the contact forces stay in their friction cones, the torques within their limits and
-//! the feet where they touched down.
+//! A short run of the example on the generated module: the centre of mass follows the circle,
+//! the contact forces stay in their friction cones, the torques within their limits and the
+//! feet where they touched down; and the same run on the independent free-flyer reference
+//! recursion gives the same motion, forces and torques.
 
+use quadruped_example::generated::Solo;
 use quadruped_example::robot::ReferenceSolo;
 use quadruped_example::sim::{self, Scenario};
 use quadruped_example::wbc::Settings;
 
-#[test]
-fn solo12_moves_its_centre_of_mass_along_a_circle_within_its_friction_cones() {
-    let robot = ReferenceSolo::load().unwrap();
-    let scenario = Scenario {
+fn short() -> Scenario {
+    Scenario {
         radius: 0.03,
         period: 0.6,
         ramp: 0.3,
         duration: 0.6,
         dt: 2e-3,
-    };
+    }
+}
+
+#[test]
+fn solo12_moves_its_centre_of_mass_along_a_circle_within_its_friction_cones() {
+    let robot = Solo::default();
+    let scenario = short();
     let settings = Settings::default();
     let log = sim::run(&robot, &scenario, &settings).unwrap();
     let s = sim::summarize(&log, scenario.ramp);
@@ -37,4 +43,34 @@ fn solo12_moves_its_centre_of_mass_along_a_circle_within_its_friction_cones() {
         "{s:?}"
     );
     assert!(s.max_foot_drift < 1e-4, "{s:?}");
+}
+
+#[test]
+fn generated_and_reference_runs_agree() {
+    let scenario = Scenario {
+        duration: 0.2,
+        ..short()
+    };
+    let settings = Settings::default();
+    let generated = sim::run(&Solo::default(), &scenario, &settings).unwrap();
+    let reference = sim::run(&ReferenceSolo::load().unwrap(), &scenario, &settings).unwrap();
+    assert_eq!(generated.len(), reference.len());
+    for (g, r) in generated.iter().zip(&reference) {
+        assert!(
+            (g.com - r.com).amax() < 1e-9,
+            "t = {}: centre of mass off by {:e}",
+            g.t,
+            (g.com - r.com).amax()
+        );
+        assert!(
+            (g.lambda - r.lambda).amax() < 1e-6 * r.lambda.amax().max(1.0),
+            "t = {}: contact forces",
+            g.t
+        );
+        assert!(
+            (g.tau - r.tau).amax() < 1e-6 * r.tau.amax().max(1.0),
+            "t = {}: torques",
+            g.t
+        );
+    }
 }

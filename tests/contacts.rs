@@ -14,10 +14,11 @@ const N: usize = 18;
 const K: usize = 12;
 const FEET: [&str; 4] = ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"];
 
+/// Solo 12 imported on a floating base (the trunk's body kept) and its free-flyer recursion.
 fn solo12() -> (Model, FreeFlyer<f64>) {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/corpus/solo12.urdf");
     let text = std::fs::read_to_string(path).unwrap();
-    let model = UrdfImport::parse(&text, "solo12", &UrdfOptions::default())
+    let model = UrdfImport::parse(&text, "solo12", &UrdfOptions::floating())
         .unwrap()
         .model;
     let ff = FreeFlyer::new(&model).unwrap();

@@ -180,20 +180,7 @@ impl<T: RealField + Copy> FreeFlyer<T> {
                 })
             })
             .collect();
-        let bodies = model
-            .links
-            .iter()
-            .map(|link| {
-                link.body.as_ref().map(|b| {
-                    let [xx, xy, xz, yy, yz, zz] = b.inertia.map(p);
-                    BodyData {
-                        mass: p(b.mass),
-                        first_moment: Vector3::from_fn(|r, _| p(b.first_moment[r])),
-                        inertia: Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
-                    }
-                })
-            })
-            .collect();
+        let bodies = BodyData::per_link(model, params);
         let g = p(model.gravity.symbol);
         Ok(Self {
             model: model.clone(),

@@ -81,6 +81,28 @@ struct BodyData<T> {
     inertia: Matrix3<T>,
 }
 
+impl<T: RealField + Copy> BodyData<T> {
+    /// Every link's body (`None` for a link without one) with the parameter values `params`,
+    /// indexed by [`kanegen_model::ParamId`].
+    fn per_link(model: &Model, params: &[T]) -> Vec<Option<Self>> {
+        let p = |i: usize| params[i];
+        model
+            .links
+            .iter()
+            .map(|link| {
+                link.body.as_ref().map(|b| {
+                    let [xx, xy, xz, yy, yz, zz] = b.inertia.map(p);
+                    BodyData {
+                        mass: p(b.mass),
+                        first_moment: Vector3::from_fn(|r, _| p(b.first_moment[r])),
+                        inertia: Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
+                    }
+                })
+            })
+            .collect()
+    }
+}
+
 /// The wheeled base's speed indices and the wheels' inertia on those rows.
 #[derive(Debug, Clone)]
 struct WheelData<T> {
@@ -184,20 +206,7 @@ impl<T: RealField + Copy> Reference<T> {
                 })
             })
             .collect();
-        let bodies = model
-            .links
-            .iter()
-            .map(|link| {
-                link.body.as_ref().map(|b| {
-                    let [xx, xy, xz, yy, yz, zz] = b.inertia.map(p);
-                    BodyData {
-                        mass: p(b.mass),
-                        first_moment: Vector3::from_fn(|r, _| p(b.first_moment[r])),
-                        inertia: Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
-                    }
-                })
-            })
-            .collect();
+        let bodies = BodyData::per_link(model, params);
         let wheels = match &model.base {
             // A floating base's six speeds drive no joint of this recursion: it holds the base
             // frame still (the free-flyer recursion is a separate entry point).

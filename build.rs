@@ -6,8 +6,10 @@
 //! `tests/mimic.rs`, a gripper with mimic joints; for `tests/big_tree.rs`, a 100-DOF tree; for
 //! `tests/isa_batch.rs`, a cart on a rail (structurally zero c, g, C) with every registry
 //! function and the batched forms; for `tests/unicode_names.rs`, two models with names in
-//! Greek and Japanese; for `tests/floating_base.rs`, the small floating-base model
-//! `models/floating-hopper.toml` and Solo 12 (`tests/corpus/solo12.urdf`) on a floating base.
+//! Greek and Japanese; for `tests/floating_base.rs`, `tests/floating_reference.rs` and
+//! `examples/pinocchio_free_flyer.rs`, the small floating-base model
+//! `models/floating-hopper.toml`, Solo 12 (`tests/corpus/solo12.urdf`) and the humanoid
+//! `tests/corpus/simple_humanoid.urdf` on a floating base.
 //! The TOML Krang models come from `krang-dynamics`.
 use kanegen::model::{UrdfOptions, WheeledBaseSpec};
 
@@ -104,6 +106,12 @@ fn main() {
     kanegen::Builder::urdf("tests/corpus/solo12.urdf", UrdfOptions::floating())
         .functions(floating)
         .output("solo12_floating.rs")
+        .run();
+    // The 35-speed humanoid with the same functions, for `tests/floating_reference.rs` and the
+    // Pinocchio comparison (`examples/pinocchio_free_flyer.rs`).
+    kanegen::Builder::urdf("tests/corpus/simple_humanoid.urdf", UrdfOptions::floating())
+        .functions(floating)
+        .output("simple_humanoid_floating.rs")
         .run();
     kanegen::Builder::urdf("models/Krang.urdf", krang_urdf_options())
         .output("krang_urdf.rs")

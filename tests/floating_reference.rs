@@ -1,7 +1,9 @@
 //! Generated floating-base modules against the independent free-flyer recursion
 //! [`kanegen_reference::FreeFlyer`], on random physical parameter sets and random states: the
-//! hopper (`models/floating-hopper.toml`, every function a floating base has) and Solo 12
-//! (`tests/corpus/solo12.urdf` on a floating base), both from this package's build script.
+//! hopper (`models/floating-hopper.toml`, every function a floating base has), Solo 12
+//! (`tests/corpus/solo12.urdf` on a floating base, 18 speeds) and the humanoid
+//! `tests/corpus/simple_humanoid.urdf` (floating, 35 speeds), all from this package's build
+//! script.
 //!
 //! Compared: M, c, g, τ, the nonlinear effects, the centre of mass, every frame's world pose,
 //! every frame's Jacobian and bias acceleration, the centroidal momentum matrix A_G and bias
@@ -21,6 +23,11 @@ mod hopper {
 #[allow(dead_code)]
 mod solo {
     include!(concat!(env!("OUT_DIR"), "/solo12_floating.rs"));
+}
+
+#[allow(dead_code)]
+mod humanoid {
+    include!(concat!(env!("OUT_DIR"), "/simple_humanoid_floating.rs"));
 }
 
 fn root() -> std::path::PathBuf {
@@ -207,4 +214,21 @@ fn floating_solo12_every_generated_function_equals_the_free_flyer_reference() {
     )
     .expect("imports");
     compare_with_reference!(solo, Solo, model, 0x48_02, 4, 3);
+}
+
+#[test]
+fn floating_humanoid_every_generated_function_equals_the_free_flyer_reference() {
+    let model = Model::from_urdf_file(
+        root().join("tests/corpus/simple_humanoid.urdf"),
+        &UrdfOptions::floating(),
+    )
+    .expect("imports");
+    // Unoptimised, each statement of the 35-speed functions keeps its own stack slot: more than
+    // the 2 MB of a test thread (docs/big-models.md). Optimised builds need a few KB.
+    std::thread::Builder::new()
+        .stack_size(64 << 20)
+        .spawn(move || compare_with_reference!(humanoid, SimpleHumanoid, model, 0x48_03, 3, 3))
+        .expect("a thread can be spawned")
+        .join()
+        .expect("the comparison passes");
 }

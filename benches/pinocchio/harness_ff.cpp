@@ -11,12 +11,19 @@
 // ccrba (Ag), computeCentroidalMomentumTimeVariation at a = 0 (Ȧ_G v), computeRNEADerivatives
 // and constraintDynamics with one CONTACT_3D per contact frame (LOCAL_WORLD_ALIGNED, mu = 0),
 // maps the results back and prints the largest differences relative to the largest entry, per
-// model. Exit status 1 if any exceeds 1e-9.
+// model. Exit status 1 if any exceeds 1e-9. Then it times, per model on its states (the fastest
+// of ROUNDS rounds of CALLS calls, a tenth of them for the derivatives), crba,
+// nonLinearEffects, computeGeneralizedGravity, rnea, ccrba, computeRNEADerivatives, aba (with
+// the case's actuation) and constraintDynamics, and appends `model/algorithm ns` lines to
+// DIR/pinocchio-ff-times.txt (`examples/pinocchio_free_flyer.rs report` makes the tables).
+//
+//   harness_ff DIR [ROUNDS CALLS]      (default 100 2000)
 
 #include <pinocchio/multibody.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/algorithm/rnea-derivatives.hpp>
+#include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/centroidal.hpp>
 #include <pinocchio/algorithm/constrained-dynamics.hpp>
 
@@ -34,6 +41,13 @@ struct Errors {
   }
 };
 
+// One model's timing material: the model, its contacts and its states in Pinocchio's layout.
+struct Timing {
+  Exported ex;
+  PINOCCHIO_STD_VECTOR_WITH_EIGEN_ALLOCATOR(pin::RigidConstraintModel) contacts;
+  std::vector<VectorXd> q, v, a, f;
+};
+
 // Columns of a 6 × nv Pinocchio matrix in the kanegen speeds (A S).
 static MatrixXd columns(const Exported & ex, const MatrixXd & a) {
   MatrixXd out(a.rows(), ex.dof);
@@ -42,10 +56,12 @@ static MatrixXd columns(const Exported & ex, const MatrixXd & a) {
 }
 
 int main(int argc, char ** argv) {
-  if (argc != 2) {
-    std::cerr << "usage: harness_ff DIR\n";
+  if (argc != 2 && argc != 4) {
+    std::cerr << "usage: harness_ff DIR [ROUNDS CALLS]\n";
     return 2;
   }
+  const int rounds = argc == 4 ? std::atoi(argv[2]) : 100;
+  const int calls = argc == 4 ? std::atoi(argv[3]) : 2000;
   const std::string path = std::string(argv[1]) + "/ff-cases.txt";
   std::ifstream file(path);
   if (!file) {
@@ -53,6 +69,7 @@ int main(int argc, char ** argv) {
     return 2;
   }
   std::map<std::string, Errors> errors;
+  std::map<std::string, Timing> timing;
   try {
     Reader rd{file, path};
     rd.expect("ff-cases");
@@ -117,6 +134,12 @@ int main(int argc, char ** argv) {
                                                    contacts, datas, prox);
       e.cud = std::max(e.cud, rel(ex.speeds(ddq), kcud));
       e.lambda = std::max(e.lambda, rel(data.lambda_c, klambda));
+      Timing & t = timing.try_emplace(ex.model.name, Timing{ex, contacts, {}, {}, {}, {}})
+                     .first->second;
+      t.q.push_back(q);
+      t.v.push_back(v);
+      t.a.push_back(a);
+      t.f.push_back(ex.velocity(kf));
     }
   } catch (const std::exception & ex) {
     std::cerr << "error: " << ex.what() << "\n";
@@ -138,5 +161,52 @@ int main(int argc, char ** argv) {
     std::printf("FAILED: a free-flyer result differs by more than 1e-9\n");
     return 1;
   }
+
+  std::ofstream out(std::string(argv[1]) + "/pinocchio-ff-times.txt", std::ios::app);
+  double sink = 0;
+  for (auto & [name, t] : timing) {
+    const pin::Model & model = t.ex.model;
+    pin::Data data(model);
+    PINOCCHIO_STD_VECTOR_WITH_EIGEN_ALLOCATOR(pin::RigidConstraintData) datas;
+    for (const auto & c : t.contacts) datas.push_back(pin::RigidConstraintData(c));
+    pin::initConstraintDynamics(model, data, t.contacts, datas);
+    pin::ProximalSettings prox(1e-12, 0.0, 1);
+    const size_t n = t.q.size();
+    const std::vector<Row> rows = {
+      {"crba", time_ns(rounds, calls, [&](int i) {
+         pin::crba(model, data, t.q[i % n]);
+         sink += data.M(0, 1);
+       })},
+      {"nle", time_ns(rounds, calls, [&](int i) {
+         sink += pin::nonLinearEffects(model, data, t.q[i % n], t.v[i % n])[1];
+       })},
+      {"gravity", time_ns(rounds, calls, [&](int i) {
+         sink += pin::computeGeneralizedGravity(model, data, t.q[i % n])[1];
+       })},
+      {"rnea", time_ns(rounds, calls, [&](int i) {
+         sink += pin::rnea(model, data, t.q[i % n], t.v[i % n], t.a[i % n])[1];
+       })},
+      {"ccrba", time_ns(rounds, calls, [&](int i) {
+         sink += pin::ccrba(model, data, t.q[i % n], t.v[i % n])(0, 1);
+       })},
+      {"rnea_derivatives", time_ns(rounds, calls / 10, [&](int i) {
+         pin::computeRNEADerivatives(model, data, t.q[i % n], t.v[i % n], t.a[i % n]);
+         sink += data.dtau_dq(5, 6) + data.dtau_dv(5, 6);
+       })},
+      {"aba", time_ns(rounds, calls, [&](int i) {
+         sink += pin::aba(model, data, t.q[i % n], t.v[i % n], t.f[i % n])[1];
+       })},
+      {"constraint_dynamics", time_ns(rounds, calls, [&](int i) {
+         sink += pin::constraintDynamics(model, data, t.q[i % n], t.v[i % n], t.f[i % n],
+                                         t.contacts, datas, prox)[1];
+         sink += data.lambda_c[0];
+       })},
+    };
+    for (const auto & r : rows) {
+      std::printf("pinocchio %s/%-20s %9.1f ns\n", name.c_str(), r.name, r.ns);
+      out << name << "/" << r.name << " " << r.ns << "\n";
+    }
+  }
+  if (sink == 12345.678) std::printf("(sink)\n");  // keeps the results alive
   return 0;
 }

@@ -18,13 +18,15 @@
 #   4. RUNS times (default 3), alternately: the harness (agreement check on all cases, then
 #      Pinocchio's timings), with CODEGEN=1 the codegen harness, and the Rust timings; then the
 #      table, best of the runs;
-#   5. free-flyer models: examples/pinocchio_free_flyer.rs writes ff-cases.txt (Solo 12 and a
-#      humanoid of tests/corpus exported with a JointModelFreeFlyer root, random states, the
-#      free-flyer reference recursion's M, nle, g, rnea, ccrba, Ȧ_G v, RNEA derivatives and the
-#      contact-constrained dynamics of kanegen_runtime::contact), and
-#      benches/pinocchio/harness_ff.cpp compares them with Pinocchio's crba, nonLinearEffects,
-#      computeGeneralizedGravity, rnea, ccrba, computeCentroidalMomentumTimeVariation,
-#      computeRNEADerivatives and constraintDynamics (agreement only, no timings).
+#   5. free-flyer models: `examples/pinocchio_free_flyer.rs write` writes ff-cases.txt (Solo 12
+#      and a 35-speed humanoid of tests/corpus on a floating base, exported with a
+#      JointModelFreeFlyer root, random states, the free-flyer reference recursion's M, nle, g,
+#      rnea, ccrba, Ȧ_G v, RNEA derivatives and the contact-constrained dynamics of
+#      kanegen_runtime::contact); in each of the RUNS, benches/pinocchio/harness_ff.cpp compares
+#      them with Pinocchio's crba, nonLinearEffects, computeGeneralizedGravity, rnea, ccrba,
+#      computeCentroidalMomentumTimeVariation, computeRNEADerivatives and constraintDynamics,
+#      then times those and aba; `pinocchio_free_flyer time` checks the generated modules of
+#      both robots against the reference and times them; `report` prints a table per robot.
 # With CODEGEN=1 also Pinocchio's own generated code (its CppADCodeGen path, the other code
 # generator to compare with): step 1 adds `cmeel-cppad` and `cmeel-cppadcodegen` (headers), step 2 compiles
 # benches/pinocchio/codegen.cpp, whose first run records crba, nonLinearEffects, gravity, rnea
@@ -110,12 +112,14 @@ echo "== 3. Rust side: cargo build --release --example pinocchio_side_by_side"
 rust="${CARGO_TARGET_DIR:-$root/target}/release/examples/pinocchio_side_by_side"
 "$rust" write "$run_dir"
 (cd "$root" && cargo build --release --quiet --example pinocchio_free_flyer)
-"${CARGO_TARGET_DIR:-$root/target}/release/examples/pinocchio_free_flyer" "$run_dir"
+ff="${CARGO_TARGET_DIR:-$root/target}/release/examples/pinocchio_free_flyer"
+"$ff" write "$run_dir"
 
 echo "== 4. agreement and timings, $runs runs alternating Pinocchio and kanegen"
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | xargs), $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "compilers: $("$cxx" --version | head -n 1); $(rustc --version)"
-rm -f "$run_dir/pinocchio-times.txt" "$run_dir/kanegen-times.txt"
+rm -f "$run_dir/pinocchio-times.txt" "$run_dir/kanegen-times.txt" \
+    "$run_dir/pinocchio-ff-times.txt" "$run_dir/kanegen-ff-times.txt"
 status=0
 for r in $(seq 1 "$runs"); do
     echo "-- run $r"
@@ -124,11 +128,13 @@ for r in $(seq 1 "$runs"); do
         "$out/codegen" "$run_dir" || status=$?
     fi
     "$rust" time "$run_dir"
+    "$out/harness_ff" "$run_dir" || status=$?
+    "$ff" time "$run_dir" || status=$?
 done
 echo "== table (load $(cut -d' ' -f1-3 /proc/loadavg))"
 "$rust" report "$run_dir"
-echo "== 5. free-flyer models: agreement with the reference recursion and the contact solver"
-"$out/harness_ff" "$run_dir" || status=$?
+echo "== 5. free-flyer models (floating base), load $(cut -d' ' -f1-3 /proc/loadavg)"
+"$ff" report "$run_dir"
 if [ "$status" -ne 0 ]; then
     echo "error: Pinocchio and kanegen disagree (see above)" >&2
     exit "$status"

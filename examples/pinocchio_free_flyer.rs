@@ -496,6 +496,9 @@ const ROWS: [(&str, &str, &str, &str); 10] = [
     ),
 ];
 
+/// Prefix of the keys of Pinocchio's CppADCodeGen code (`benches/pinocchio/codegen.cpp`).
+const GENERATED: &str = "cg_";
+
 fn report(dir: &str) -> Result<(), String> {
     let dir = Path::new(dir);
     let (ours, our_runs) = best_times(&dir.join("kanegen-ff-times.txt"))?;
@@ -514,6 +517,23 @@ fn report(dir: &str) -> Result<(), String> {
                 "| {our_label} | {a:.0} | {pin_label} | {b:.0} | {:.1}× |",
                 b / a
             );
+        }
+        // Pinocchio's CppADCodeGen code (`CODEGEN=1`), where it was timed.
+        if pin.contains_key(&format!("{name}/{GENERATED}crba")) {
+            println!(
+                "\n| kanegen (Rust) | ns | Pinocchio's generated code (CppADCodeGen, C) | ns | Pinocchio / kanegen |"
+            );
+            println!("|---|--:|---|--:|--:|");
+            for (our_label, our_key, pin_label, pin_key) in ROWS {
+                let ok = format!("{name}/{our_key}");
+                let pk = format!("{name}/{GENERATED}{pin_key}");
+                if let (Some(a), Some(b)) = (ours.get(&ok), pin.get(&pk)) {
+                    println!(
+                        "| {our_label} | {a:.0} | {pin_label} | {b:.0} | {:.1}× |",
+                        b / a
+                    );
+                }
+            }
         }
     }
     println!(

@@ -1,7 +1,9 @@
-// Shared by the Pinocchio harnesses (harness.cpp, codegen.cpp; docs/performance.md):
-// reading DIR/cases.txt (written by `cargo run --release --example pinocchio_side_by_side --
-// write DIR`; format in that example's documentation), building each case's pinocchio::Model,
-// the maps between kanegen's and Pinocchio's coordinates, and the timing loop.
+// Shared by the Pinocchio harnesses (harness.cpp, harness_ff.cpp, codegen.cpp;
+// docs/performance.md): reading DIR/cases.txt (written by `cargo run --release --example
+// pinocchio_side_by_side -- write DIR`; format in that example's documentation) and
+// DIR/ff-cases.txt (the free-flyer models, `--example pinocchio_free_flyer -- write DIR`),
+// building each case's pinocchio::Model, the maps between kanegen's and Pinocchio's
+// coordinates, and the timing loop.
 //
 // Include it after Pinocchio's own headers (codegen.cpp includes CppADCodeGen's first).
 
@@ -239,6 +241,65 @@ inline std::vector<Case> read_cases(const std::string & dir) {
   return cases;
 }
 
+// One case of ff-cases.txt: a free-flyer model, its contact frames (parent joint, placement), a
+// state in kanegen's coordinates and the free-flyer reference recursion's results for it.
+struct FfCase {
+  Exported ex;
+  std::vector<std::pair<pin::JointIndex, pin::SE3>> contacts;
+  VectorXd q, u, ud, nle, g, tau, dhg, f, cud, lambda;
+  MatrixXd M, Ag, dtau_dq, dtau_du;
+};
+
+// Reads DIR/ff-cases.txt; throws std::runtime_error naming the file, the case and what was
+// expected.
+inline std::vector<FfCase> read_ff_cases(const std::string & dir) {
+  std::vector<FfCase> cases;
+  const std::string path = dir + "/ff-cases.txt";
+  std::ifstream file(path);
+  if (!file)
+    throw std::runtime_error(path + ": cannot open (run the pinocchio_free_flyer `write` step first)");
+  Reader rd{file, path};
+  rd.expect("ff-cases");
+  const int n = rd.get<int>("the case count");
+  for (int k = 0; k < n; ++k) {
+    rd.expect("ff-case");
+    rd.where = path + ", case " + std::to_string(rd.get<int>("a case number"));
+    rd.expect("nq");
+    const int nq = rd.get<int>("nq");
+    rd.expect("nv");
+    const int nv = rd.get<int>("nv");
+    rd.expect("contacts");
+    const int nc = rd.get<int>("the contact count");
+    FfCase c{read_model(rd)};
+    for (int i = 0; i < nc; ++i) {
+      rd.expect("contact");
+      rd.get<std::string>("a frame name");
+      const auto joint = rd.get<pin::JointIndex>("a joint index");
+      c.contacts.emplace_back(joint, rd.se3());
+    }
+    c.q = rd.vec("q", nq);
+    c.u = rd.vec("u", nv);
+    c.ud = rd.vec("ud", nv);
+    c.M = rd.mat("M", nv);
+    c.nle = rd.vec("nle", nv);
+    c.g = rd.vec("g", nv);
+    c.tau = rd.vec("tau", nv);
+    rd.expect("Ag");
+    c.Ag = MatrixXd(6, nv);
+    for (int r = 0; r < 6; ++r)
+      for (int col = 0; col < nv; ++col) c.Ag(r, col) = rd.num();
+    c.dhg = rd.vec("dhg", 6);
+    c.dtau_dq = rd.mat("dtau_dq", nv);
+    c.dtau_du = rd.mat("dtau_du", nv);
+    c.f = rd.vec("f", nv);
+    c.cud = rd.vec("cud", nv);
+    c.lambda = rd.vec("lambda", 3 * nc);
+    cases.push_back(std::move(c));
+  }
+  if (cases.empty()) throw std::runtime_error(path + ": no cases");
+  return cases;
+}
+
 // A harness's command line `NAME DIR [ROUNDS CALLS]` and the cases of DIR/cases.txt.
 struct Run {
   std::string dir;
@@ -268,15 +329,20 @@ inline bool start(int argc, char ** argv, const char * name, Run & run) {
   return true;
 }
 
-// Pinocchio's configurations, velocities and accelerations of every case's state.
+// Pinocchio's configurations, velocities and accelerations of every case's state (cases of
+// cases.txt or ff-cases.txt: anything with q, u and ud).
 struct States {
   std::vector<VectorXd> q, v, a;
-  explicit States(const Exported & ex, const std::vector<Case> & cases) {
-    for (const auto & k : cases) {
-      q.push_back(ex.configuration(k.q));
-      v.push_back(ex.velocity(k.u));
-      a.push_back(ex.velocity(k.ud));
-    }
+  States() = default;
+  template<typename C>
+  explicit States(const Exported & ex, const std::vector<C> & cases) {
+    for (const auto & k : cases) add(ex, k);
+  }
+  template<typename C>
+  void add(const Exported & ex, const C & k) {
+    q.push_back(ex.configuration(k.q));
+    v.push_back(ex.velocity(k.u));
+    a.push_back(ex.velocity(k.ud));
   }
 };
 
@@ -305,12 +371,15 @@ struct Row {
   double ns;
 };
 
-// Prints the rows and appends `name ns` lines to DIR/pinocchio-times.txt.
-inline void append_times(const std::string & dir, const std::vector<Row> & rows) {
-  std::ofstream out(dir + "/pinocchio-times.txt", std::ios::app);
+// Prints the rows and appends `PREFIXname ns` lines to DIR/FILE (default
+// DIR/pinocchio-times.txt, no prefix).
+inline void append_times(const std::string & dir, const std::vector<Row> & rows,
+                         const std::string & file = "pinocchio-times.txt",
+                         const std::string & prefix = "") {
+  std::ofstream out(dir + "/" + file, std::ios::app);
   for (const auto & r : rows) {
-    std::printf("pinocchio %-22s %9.1f ns\n", r.name, r.ns);
-    out << r.name << " " << r.ns << "\n";
+    std::printf("pinocchio %s%-22s %9.1f ns\n", prefix.c_str(), r.name, r.ns);
+    out << prefix << r.name << " " << r.ns << "\n";
   }
 }
 

@@ -30,7 +30,8 @@
 # With CODEGEN=1 also Pinocchio's own generated code (its CppADCodeGen path, the other code
 # generator to compare with): step 1 adds `cmeel-cppad` and `cmeel-cppadcodegen` (headers), step 2 compiles
 # benches/pinocchio/codegen.cpp, whose first run records crba, nonLinearEffects, gravity, rnea
-# and computeRNEADerivatives on case 0's model and compiles each to a shared library with
+# and computeRNEADerivatives on case 0's model and on each free-flyer model (Solo 12, the
+# humanoid) and compiles each to a shared library with
 # `$CC -O3 -march=native` (CC default /usr/bin/gcc) into OUT/RUN_NAME/cg (about 25 s for Krang on
 # a 2-core Intel Xeon; delete that directory to regenerate); later runs load them. Compiling the
 # codegen harness itself takes about 7 minutes (CppAD's templates).

@@ -55,8 +55,12 @@ pub struct LoopSpeed {
     pub index: usize,
     /// Workspace offset of `S`, `Ψ̇`, `Ψ̈` (6 each).
     pub motion: usize,
-    /// A joint's speed (`true`) or one of the wheeled base's.
+    /// A joint's speed (`true`) or one of the wheeled or floating base's.
     pub joint: bool,
+    /// A floating base's rotation speed: its `Ψ̈` slot holds `(0; e_k × g_b)` and its column of
+    /// `∂τ/∂q` is `Φ · Ψ̈` (see `rnea_derivatives.rs`), read by every column, the base's own
+    /// included.
+    pub rotation: bool,
     /// `Some(k)` when `S = ±(e_k; 0)` (a rotation about a coordinate axis of the link's frame,
     /// `k < 3`): `Ψ̇ = V_λ × S` vanishes in components `k` and `3 + k`.
     pub axis: Option<u8>,
@@ -130,17 +134,29 @@ impl DerivativeLoop {
         let (columns, steps) = self.flatten();
         let ancestor = |s: &FlatStep| {
             // S, Ψ̇ (and Ψ̈) dots, then the sums of the two column entries.
-            let reads = if self.speeds[s.speed].joint {
+            let speed = self.speeds[s.speed];
+            let reads = if speed.joint {
                 3 * dots + 3
+            } else if speed.rotation {
+                3 * dots + 1
             } else {
                 2 * dots + 1
             };
             s.transform.map_or(0, |_| step) + reads
         };
+        // A row of the own link: the S dots (and a floating base's rotation's Ψ̈ dots).
+        let own = |s: &FlatStep| {
+            if s.entries[2].is_some() {
+                2 * dots
+            } else {
+                dots
+            }
+        };
         columns
             .iter()
             .map(|c| {
-                (c.own - c.first) * dots + steps[c.own..c.end].iter().map(ancestor).sum::<usize>()
+                steps[c.first..c.own].iter().map(own).sum::<usize>()
+                    + steps[c.own..c.end].iter().map(ancestor).sum::<usize>()
             })
             .sum()
     }
@@ -156,14 +172,15 @@ impl DerivativeLoop {
             let ci = this.index;
             let first = steps.len();
             for a in self.links[c.link].speeds.clone() {
-                let ai = self.speeds[a].index;
+                let s = self.speeds[a];
+                let ai = s.index;
                 steps.push(FlatStep {
                     transform: None,
                     speed: a,
                     entries: [
                         this.joint.then_some(ai + n * ci),
                         Some(ai + n * (n + ci)),
-                        None,
+                        s.rotation.then_some(ci + n * ai),
                         None,
                     ],
                 });
@@ -181,7 +198,7 @@ impl DerivativeLoop {
                         entries: [
                             this.joint.then_some(ai + n * ci),
                             Some(ai + n * (n + ci)),
-                            s.joint.then_some(ci + n * ai),
+                            (s.joint || s.rotation).then_some(ci + n * ai),
                             Some(ci + n * (n + ai)),
                         ],
                     });
@@ -282,12 +299,13 @@ impl Ctx<'_> {
             for col in &columns[l] {
                 let mut m = col.s.to_vec();
                 m.extend_from_slice(&col.psid);
-                m.extend_from_slice(&col.psidd.unwrap_or([zero; 6]));
+                m.extend_from_slice(&col.psidd.or(col.rotation).unwrap_or([zero; 6]));
                 let motion = push(&mut ws, &m);
                 plan.speeds.push(LoopSpeed {
                     index: col.speed,
                     motion,
                     joint: col.psidd.is_some(),
+                    rotation: col.rotation.is_some(),
                     axis: self.rotation_axis(&col.s),
                 });
             }

@@ -61,7 +61,6 @@ fn compare(label: &str, model: &Model, params: ParamMode, draws: usize, seed: u6
     let n = model.independent_dof();
     let mut rng = SplitMix64::new(seed);
     let mut uni = move || rng.next_f64();
-    let pi = std::f64::consts::PI;
     let mut worst = 0.0f64;
     for draw in 0..draws {
         let p = if draw == 0 || params == ParamMode::Baked {
@@ -69,7 +68,7 @@ fn compare(label: &str, model: &Model, params: ParamMode, draws: usize, seed: u6
         } else {
             random_physical_params(model, &mut uni)
         };
-        let q = uniform_vec(&mut uni, model.dof(), -pi, pi);
+        let q = super::rnea_derivatives_tests::random_coordinates(model, &mut uni);
         let u = uniform_vec(&mut uni, model.dof(), -2.0, 2.0);
         let ud = uniform_vec(&mut uni, model.dof(), -2.0, 2.0);
         // Row-major N × 2N.
@@ -148,13 +147,33 @@ fn looped_derivatives_equal_the_straight_line_form_on_trees_and_wheeled_bases() 
 }
 
 #[test]
+fn looped_derivatives_equal_the_straight_line_form_on_floating_bases() {
+    let hopper = Model::from_toml_file(models_dir().join("floating-hopper.toml")).expect("loads");
+    compare("floating hopper", &hopper, ParamMode::Runtime, 20, 17);
+    compare("floating hopper, baked", &hopper, ParamMode::Baked, 2, 18);
+    let solo = Model::from_urdf_file(
+        models_dir().join("../tests/corpus/solo12.urdf"),
+        &UrdfOptions::floating(),
+    )
+    .expect("imports");
+    compare("solo 12, floating", &solo, ParamMode::Runtime, 10, 19);
+}
+
+#[test]
 fn flat_tables_write_every_entry_once_and_move_once_per_ancestor_link() {
     let krang = Model::from_toml_file(models_dir().join("krang.toml")).expect("loads");
+    let hopper = Model::from_toml_file(models_dir().join("floating-hopper.toml")).expect("loads");
+    for model in [krang, hopper] {
+        check_tables(&model);
+    }
+}
+
+fn check_tables(model: &Model) {
     let options = Options {
         params: ParamMode::Runtime,
         functions: FunctionSet::default().with(FunctionId::InverseDynamicsDerivatives),
     };
-    let d = super::derive(&krang, options);
+    let d = super::derive(model, options);
     let plan = &d
         .derivative_loop
         .as_ref()

@@ -12,8 +12,12 @@
 //! * row `a` (an ancestor speed or a speed of the column's own link), column `i`:
 //!   `∂τ_a/∂q_i = S_a · G_i` and `∂τ_a/∂u_i = S_a · H_i`;
 //! * row `i`, column `a` (ancestors only): `∂τ_i/∂q_a = Φ_i · Ψ̈_a + Ξ_i · Ψ̇_a` and
-//!   `∂τ_i/∂u_a = k Φ_i · Ψ̇_a + Ξ_i · S_a` (`k = 2` for a joint, 1 for the wheeled base's
-//!   quasi-velocities, whose `Ψ̇` is `V_0 × S`).
+//!   `∂τ_i/∂u_a = k Φ_i · Ψ̇_a + Ξ_i · S_a` (`k = 2` for a joint, 1 for the wheeled or
+//!   floating base's quasi-velocities, whose `Ψ̇` is `V_0 × S`);
+//! * a floating base's rotation speeds `a` (a quasi-velocity whose step has a q-entry): row
+//!   `i`, column `a`: `∂τ_i/∂q_a = Φ_i · Ψ̈_a`, for every column, those of the base's own speeds
+//!   included (their `Ψ̈` slot holds the derivative of the base acceleration along the
+//!   rotation, `(0; e_a × g_b)`).
 //!
 //! The four forces are kept component-major (component `k` of `Φ`, `Ξ`, `H`, `G` side by side),
 //! so that one step is one 4-wide transform: one AVX2 register per component in the x86-64-v3
@@ -64,13 +68,15 @@ pub struct Step {
     /// `3 + k` and the x86-64-v3 copy reads `S` as one component and `Ψ̇` as four); [`DENSE`]
     /// otherwise.
     pub axis: u8,
-    /// A joint speed (`true`) or one of the wheeled base's quasi-velocities (`false`: no
-    /// coordinate of its own enters τ, so it has no `Ψ̈` and no q-column).
+    /// A joint speed (`true`) or one of the wheeled or floating base's quasi-velocities
+    /// (`false`: no coordinate of its own enters the recursion; its q-column, if
+    /// `entries[2]` is written, is `Φ · Ψ̈`, a floating base's rotation).
     pub joint: bool,
     /// Where the step writes, as offsets in the column-major `N × 2N` result ([`NO_ENTRY`]:
     /// not written), for the speed `a` of the step and the column's speed `i`:
     /// `∂τ_a/∂q_i = S_a · G` (none when `i` is a quasi-velocity), `∂τ_a/∂u_i = S_a · H`,
-    /// `∂τ_i/∂q_a = Φ · Ψ̈_a + Ξ · Ψ̇_a` (joints `a` that are ancestors only) and
+    /// `∂τ_i/∂q_a = Φ · Ψ̈_a + Ξ · Ψ̇_a` (joints `a` that are ancestors only; `Φ · Ψ̈_a` for a
+    /// floating base's rotation `a`, on the own link's rows too) and
     /// `∂τ_i/∂u_a = k Φ · Ψ̇_a + Ξ · S_a` (ancestors only; `k = 2` for a joint, 1 for a
     /// quasi-velocity, whose `Ψ̇` is `V_0 × S`).
     pub entries: [u32; 4],
@@ -262,8 +268,8 @@ fn chunk<T, const K: usize>(w: &[T], at: usize) -> &[T; K] {
 }
 
 /// Writes the entries of an ancestor step `s` from its dot products with the four forces `Φ`,
-/// `Ξ`, `H`, `G` (one lane each): `ds = S · F`, `dpd = Ψ̇ · F` and, when `s` is a joint,
-/// `dpdd = Ψ̈ · F` (not read otherwise).
+/// `Ξ`, `H`, `G` (one lane each): `ds = S · F`, `dpd = Ψ̇ · F` and, when `s` is a joint or
+/// writes a q-entry (a floating base's rotation), `dpdd = Ψ̈ · F` (not read otherwise).
 #[inline(always)]
 fn write_reads<T: Copy + Add<Output = T>>(
     out: &mut [T],
@@ -278,8 +284,16 @@ fn write_reads<T: Copy + Add<Output = T>>(
         put(out, s.entries[2], dpdd[0] + dpd[1]);
         put(out, s.entries[3], (dpd[0] + dpd[0]) + ds[1]);
     } else {
+        put(out, s.entries[2], dpdd[0]);
         put(out, s.entries[3], dpd[0] + ds[1]);
     }
+}
+
+/// Whether step `s` reads `Ψ̈`: a joint, or a quasi-velocity with a q-entry (a floating
+/// base's rotation).
+#[inline(always)]
+fn reads_psidd(s: &Step) -> bool {
+    s.joint || s.entries[2] != NO_ENTRY
 }
 
 /// The loop of [`run`].
@@ -292,12 +306,16 @@ where
         let x: &[T; 24] = chunk(w, usize::from(col.forces));
         let mut f: Forces<T> = [0, 1, 2, 3, 4, 5].map(|k| L4::load(&x[4 * k..4 * k + 4]));
         let (own_rows, up_steps) = col.ranges();
-        // Rows of the column's own link: S_a · G, S_a · H.
+        // Rows of the column's own link: S_a · G, S_a · H (and Φ · Ψ̈_a for a floating
+        // base's rotation a).
         for s in &plan.steps[own_rows] {
             let mo: &[T; 18] = chunk(w, usize::from(s.motion));
             let ds = dots(&mo[0..6], &f);
             put(out, s.entries[0], ds.0[3]);
             put(out, s.entries[1], ds.0[2]);
+            if s.entries[2] != NO_ENTRY {
+                put(out, s.entries[2], dots(&mo[12..18], &f).0[0]);
+            }
         }
         // Up to the root: every ancestor speed reads the four forces in its frame.
         for s in &plan.steps[up_steps] {
@@ -307,8 +325,12 @@ where
             let mo: &[T; 18] = chunk(w, usize::from(s.motion));
             let ds = dots(&mo[0..6], &f);
             let dpd = dots(&mo[6..12], &f);
-            // Ψ̈ only for a joint (`write_reads` reads no `dpdd` otherwise: `ds` fills it).
-            let dpdd = if s.joint { dots(&mo[12..18], &f) } else { ds };
+            // Ψ̈ only where it is read (`write_reads` reads no `dpdd` otherwise: `ds` fills it).
+            let dpdd = if reads_psidd(s) {
+                dots(&mo[12..18], &f)
+            } else {
+                ds
+            };
             write_reads(out, s, ds.0, dpd.0, dpdd.0);
         }
     }
@@ -327,7 +349,7 @@ macro_rules! avx_steps {
                 _mm256_fnmadd_pd, _mm256_mul_pd, _mm256_set_pd, _mm256_set1_pd,
             };
 
-            use super::{NO_TRANSFORM, Plan, Step, put, write_reads};
+            use super::{NO_ENTRY, NO_TRANSFORM, Plan, Step, put, reads_psidd, write_reads};
 
             #[target_feature(enable = $features)]
             #[inline]
@@ -432,12 +454,12 @@ macro_rules! avx_steps {
                 [ds, dpd, psidd_dots(mo, a, f)]
             }
 
-            /// `Ψ̈ · F` for a joint (`Ψ̈ = A_λ × S + V_λ × Ψ̇` has all six components in general),
-            /// zeros for a quasi-velocity (not read).
+            /// `Ψ̈ · F` for a joint (`Ψ̈ = A_λ × S + V_λ × Ψ̇` has all six components in general)
+            /// or a floating base's rotation, zeros for another quasi-velocity (not read).
             #[target_feature(enable = $features)]
             #[inline]
             fn psidd_dots(mo: &[f64; 18], a: &Step, f: &[__m256d; 6]) -> [f64; 4] {
-                if a.joint {
+                if reads_psidd(a) {
                     dots(&mo[12..18], f)
                 } else {
                     [0.0; 4]
@@ -470,6 +492,9 @@ macro_rules! avx_steps {
                         let ds = dots(&mo[0..6], &f);
                         put(out, s.entries[0], ds[3]);
                         put(out, s.entries[1], ds[2]);
+                        if s.entries[2] != NO_ENTRY {
+                            put(out, s.entries[2], dots(&mo[12..18], &f)[0]);
+                        }
                     }
                     for s in &plan.steps[up_steps] {
                         if s.transform != NO_TRANSFORM {

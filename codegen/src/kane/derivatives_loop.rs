@@ -35,6 +35,10 @@ pub struct DerivativeLoop {
     pub speeds: Vec<LoopSpeed>,
     /// The columns in run order: link, index in `speeds`, workspace offset of the forces.
     pub columns: Vec<LoopColumn>,
+    /// A floating base: workspace offset of its twist `V_0 = (ω; v)` and gravity `g_b` (9
+    /// values), which its root step reads instead of one step per base speed (see
+    /// [`FlatStep::root`]); `None` for other bases.
+    pub floating_root: Option<usize>,
 }
 
 /// One link of a [`DerivativeLoop`].
@@ -88,8 +92,32 @@ pub struct FlatStep {
     pub speed: usize,
     /// The four result offsets (column-major `N × 2N`) the step writes, `None` where it writes
     /// nothing: `∂τ_a/∂q_i`, `∂τ_a/∂u_i`, `∂τ_i/∂q_a`, `∂τ_i/∂u_a` for the step's speed `a`
-    /// and the column's speed `i`.
+    /// and the column's speed `i`. For a [`root`](Self::root) step, the first offset of each
+    /// of the four runs it writes instead: `∂τ_a/∂q_i` and `∂τ_a/∂u_i` for the six base
+    /// speeds `a` (consecutive), `∂τ_i/∂q_a` for the three rotations and `∂τ_i/∂u_a` for the
+    /// six speeds (every `N` entries).
     pub entries: [Option<usize>; 4],
+    /// A floating base's root step (`kanegen_runtime::derivatives_loop::FLOATING_ROOT`): the
+    /// six base speeds read at once from `V_0` and `g_b`, their `S` being unit vectors: `S_a ·
+    /// G`, `S_a · H` and `Ξ · S_a` are components, `Φ · (V_0 × S_a)` the components of
+    /// `−V_0 ×* Φ`, and `Φ · (0; e_k × g_b)` those of `g_b × f_Φ`.
+    pub root: bool,
+}
+
+impl FlatStep {
+    /// The result offsets the step writes (for a table of `n` speeds).
+    pub fn writes(&self, n: usize) -> Vec<usize> {
+        if !self.root {
+            return self.entries.into_iter().flatten().collect();
+        }
+        let runs = [(6, 1), (6, 1), (3, n), (6, n)];
+        self.entries
+            .iter()
+            .zip(runs)
+            .filter_map(|(e, run)| e.map(|e| (e, run)))
+            .flat_map(|(e, (len, stride))| (0..len).map(move |k| e + k * stride))
+            .collect()
+    }
 }
 
 /// One column of the flat tables: its forces and its range of steps, the own link's rows
@@ -142,6 +170,8 @@ impl DerivativeLoop {
             } else {
                 2 * dots + 1
             };
+            // The root step: −V_0 ×* Φ on one lane (30), g_b × f_Φ (9), Ξ · S_a − (…)_a (6).
+            let reads = if s.root { 45 } else { reads };
             s.transform.map_or(0, |_| step) + reads
         };
         // A row of the own link: the S dots (and a floating base's rotation's Ψ̈ dots).
@@ -183,12 +213,30 @@ impl DerivativeLoop {
                         s.rotation.then_some(ci + n * ai),
                         None,
                     ],
+                    root: false,
                 });
             }
             let own = steps.len();
             let mut l = c.link;
             while let Some(p) = self.links[l].parent {
                 let mut transform = Some(self.links[l].transform);
+                if p == 0 && self.floating_root.is_some() {
+                    // The base speeds are the first six, on the root.
+                    debug_assert!((0..6).all(|a| self.speeds[a].index == a));
+                    steps.push(FlatStep {
+                        transform,
+                        speed: self.links[0].speeds.start,
+                        entries: [
+                            this.joint.then_some(n * ci),
+                            Some(n * (n + ci)),
+                            Some(ci + 3 * n),
+                            Some(ci + n * n),
+                        ],
+                        root: true,
+                    });
+                    l = p;
+                    continue;
+                }
                 for a in self.links[p].speeds.clone() {
                     let s = self.speeds[a];
                     let ai = s.index;
@@ -201,6 +249,7 @@ impl DerivativeLoop {
                             (s.joint || s.rotation).then_some(ci + n * ai),
                             Some(ci + n * (n + ai)),
                         ],
+                        root: false,
                     });
                 }
                 l = p;
@@ -281,6 +330,7 @@ impl Ctx<'_> {
             links: Vec::with_capacity(links),
             speeds: Vec::new(),
             columns: Vec::new(),
+            floating_root: None,
         };
         // Transforms and motions.
         for l in 0..links {
@@ -314,6 +364,14 @@ impl Ctx<'_> {
                 transform,
                 speeds: first..plan.speeds.len(),
             });
+        }
+        // A floating base's twist (ω; v) and gravity, for its root step.
+        if model.is_floating() {
+            let mut x: Vec<ExprId> = [3u32, 4, 5, 0, 1, 2]
+                .map(|s| self.ar.atom(crate::expr::Atom::Speed(s)))
+                .to_vec();
+            x.extend_from_slice(&self.gravity_vector());
+            plan.floating_root = Some(push(&mut ws, &x));
         }
         // The columns' forces, leaves first (the straight-line form's order).
         for l in (0..links).rev() {

@@ -33,13 +33,17 @@ fn compare(label: &str, model: &Model, params: ParamMode, draws: usize, seed: u6
         .iter()
         .map(|s| {
             let speed = plan.speeds[s.speed];
+            let root = plan.floating_root.filter(|_| s.root);
             Step {
                 transform: s.transform.map_or(NO_TRANSFORM, u16_of),
-                motion: u16_of(speed.motion),
-                axis: speed
-                    .axis
-                    .unwrap_or(kanegen_runtime::derivatives_loop::DENSE),
-                joint: speed.joint,
+                motion: u16_of(root.unwrap_or(speed.motion)),
+                axis: match root {
+                    Some(_) => kanegen_runtime::derivatives_loop::FLOATING_ROOT,
+                    None => speed
+                        .axis
+                        .unwrap_or(kanegen_runtime::derivatives_loop::DENSE),
+                },
+                joint: speed.joint && root.is_none(),
                 entries: s.entries.map(|e| e.map_or(NO_ENTRY, u32_of)),
             }
         })
@@ -185,11 +189,14 @@ fn check_tables(model: &Model) {
     let n = plan.dof;
     let mut writers = vec![0usize; 2 * n * n];
     for s in &steps {
-        for e in s.entries.into_iter().flatten() {
+        for e in s.writes(n) {
             writers[e] += 1;
         }
     }
     assert!(writers.iter().all(|&w| w <= 1), "an entry written twice");
+    if model.is_floating() {
+        assert!(steps.iter().any(|s| s.root), "a floating base's root step");
+    }
     // The columns' runs tile the steps; a run moves the forces once per ancestor link.
     assert_eq!(columns.last().map(|c| c.end), Some(steps.len()));
     let mut moves = 0;

@@ -51,6 +51,17 @@ pub const NO_ENTRY: u32 = u32::MAX;
 /// [`Step::axis`] of a speed whose `S` is not a rotation about a coordinate axis.
 pub const DENSE: u8 = u8::MAX;
 
+/// [`Step::axis`] of a floating base's root step, which reads the six base speeds at once.
+/// Their `S` are the unit vectors of the base frame (`v` then `ω`), so `S_a · G`, `S_a · H`
+/// and `Ξ · S_a` are components of the forces, `Φ · (V_0 × S_a)` is component `a` of
+/// `−V_0 ×* Φ` and the rotations' q-entries `Φ · (0; e_k × g_b)` are the components of
+/// `g_b × f_Φ`. [`Step::motion`] is then the offset of `V_0 = (ω; v)` and `g_b` (9 values),
+/// and [`Step::entries`] are the first offsets of four runs: `∂τ_a/∂q_i` and `∂τ_a/∂u_i` for
+/// the six base rows `a` (consecutive; the first [`NO_ENTRY`] when the column's speed `i` is
+/// not a joint's), `∂τ_i/∂q_a` for the three rotations and `∂τ_i/∂u_a` for the six speeds
+/// (every `N` entries, [`Plan::dof`]).
+pub const FLOATING_ROOT: u8 = u8::MAX - 1;
+
 /// One step of a column: move its four forces up one link (unless [`NO_TRANSFORM`]), then
 /// write the entries that one speed of that link reads from them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -296,6 +307,41 @@ fn reads_psidd(s: &Step) -> bool {
     s.joint || s.entries[2] != NO_ENTRY
 }
 
+/// The reads of a [`FLOATING_ROOT`] step `s` from the forces' components `f` (`f[k][j]`:
+/// component `k` of `Φ`, `Ξ`, `H`, `G`), the base's `V_0` and `g_b` in `m`, for `n` speeds.
+#[inline(always)]
+fn root_reads<T>(out: &mut [T], n: usize, s: &Step, m: &[T; 9], f: &[[T; 4]; 6])
+where
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
+{
+    let cross = |a: [T; 3], b: [T; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let (w, v, g) = ([m[0], m[1], m[2]], [m[3], m[4], m[5]], [m[6], m[7], m[8]]);
+    let (pn, pf) = ([f[0][0], f[1][0], f[2][0]], [f[3][0], f[4][0], f[5][0]]);
+    // V_0 ×* Φ = (ω × n + v × f; ω × f), component-major like the forces.
+    let (a, b, c) = (cross(w, pn), cross(v, pf), cross(w, pf));
+    let x = [a[0] + b[0], a[1] + b[1], a[2] + b[2], c[0], c[1], c[2]];
+    let [gq, hq, rq, uq] = s.entries.map(|e| e as usize);
+    for a in 0..6 {
+        // S_a picks component 3 + a (v) or a − 3 (ω) of a force.
+        let k = if a < 3 { 3 + a } else { a - 3 };
+        if s.entries[0] != NO_ENTRY {
+            put(out, (gq + a) as u32, f[k][3]);
+        }
+        put(out, (hq + a) as u32, f[k][2]);
+        put(out, (uq + n * a) as u32, f[k][1] - x[k]);
+    }
+    let r = cross(g, pf);
+    for (k, rk) in r.into_iter().enumerate() {
+        put(out, (rq + n * k) as u32, rk);
+    }
+}
+
 /// The loop of [`run`].
 #[inline(always)]
 fn steps<T>(plan: &Plan<'_>, w: &[T], out: &mut [T])
@@ -321,6 +367,11 @@ where
         for s in &plan.steps[up_steps] {
             if s.transform != NO_TRANSFORM {
                 f = up(chunk::<T, 12>(w, usize::from(s.transform)), &f);
+            }
+            if s.axis == FLOATING_ROOT {
+                let comps = f.map(|c| c.0);
+                root_reads(out, plan.dof, s, chunk(w, usize::from(s.motion)), &comps);
+                continue;
             }
             let mo: &[T; 18] = chunk(w, usize::from(s.motion));
             let ds = dots(&mo[0..6], &f);
@@ -349,7 +400,10 @@ macro_rules! avx_steps {
                 _mm256_fnmadd_pd, _mm256_mul_pd, _mm256_set_pd, _mm256_set1_pd,
             };
 
-            use super::{NO_ENTRY, NO_TRANSFORM, Plan, Step, put, reads_psidd, write_reads};
+            use super::{
+                FLOATING_ROOT, NO_ENTRY, NO_TRANSFORM, Plan, Step, put, reads_psidd, root_reads,
+                write_reads,
+            };
 
             #[target_feature(enable = $features)]
             #[inline]
@@ -499,6 +553,19 @@ macro_rules! avx_steps {
                     for s in &plan.steps[up_steps] {
                         if s.transform != NO_TRANSFORM {
                             f = up(super::chunk::<f64, 12>(w, usize::from(s.transform)), &f);
+                        }
+                        if s.axis == FLOATING_ROOT {
+                            let comps = [
+                                lanes(f[0]),
+                                lanes(f[1]),
+                                lanes(f[2]),
+                                lanes(f[3]),
+                                lanes(f[4]),
+                                lanes(f[5]),
+                            ];
+                            let m = super::chunk(w, usize::from(s.motion));
+                            root_reads(out, plan.dof, s, m, &comps);
+                            continue;
                         }
                         let mo: &[f64; 18] = super::chunk(w, usize::from(s.motion));
                         let [ds, dpd, dpdd] = match s.axis {

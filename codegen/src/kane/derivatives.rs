@@ -6,8 +6,8 @@
 //! derivation: τ is derived by the recursion of `rnea.rs`, then every entry is differentiated
 //! with [`Arena::diff`](crate::expr::Arena::diff), forward mode over the K/D substitution
 //! variables (one pass per input over everything that depends on it; Krang: 35,959 flops
-//! against the analytic recursion's 14,728; Solo 12 on a floating base: 13,474, with its base's
-//! orientation columns from M, against 4,779). Both are exact, so they agree to rounding.
+//! against the analytic recursion's 14,728; Solo 12 on a floating base, with its base's
+//! orientation columns from M: 13,474 against 7,768). Both are exact, so they agree to rounding.
 
 #[cfg(test)]
 use std::collections::HashMap;

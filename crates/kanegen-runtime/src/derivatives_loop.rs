@@ -72,7 +72,7 @@ pub struct Step {
     /// step before it, and for the rows of the column's own link.
     pub transform: u16,
     /// Offset in the workspace of the speed's `S`, `Ψ̇`, `Ψ̈` (6 entries each, in its link's
-    /// frame).
+    /// frame); of `V_0` and `g_b` for a [`FLOATING_ROOT`] step.
     pub motion: u16,
     /// `k` when the speed's `S` is the unit rotation about axis `k` of its link's frame, times
     /// ±1 (`S = ±(e_k; 0)`, `k` in 0..3: then `Ψ̇ = V_λ × S` vanishes in components `k` and

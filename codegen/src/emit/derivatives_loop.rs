@@ -41,9 +41,12 @@ fn tables(plan: &DerivativeLoop) -> TokenStream {
             }
             None => quote!(kanegen_runtime::derivatives_loop::NO_TRANSFORM),
         };
-        let m = u16_of(speed.motion);
-        let j = speed.joint;
+        let (m, j) = match (s.root, plan.floating_root) {
+            (true, Some(root)) => (u16_of(root), false),
+            _ => (u16_of(speed.motion), speed.joint),
+        };
         let axis = match speed.axis {
+            _ if s.root => quote!(kanegen_runtime::derivatives_loop::FLOATING_ROOT),
             Some(k) => {
                 let k = proc_macro2::Literal::u8_unsuffixed(k);
                 quote!(#k)

@@ -33,13 +33,17 @@ fn compare(label: &str, model: &Model, params: ParamMode, draws: usize, seed: u6
         .iter()
         .map(|s| {
             let speed = plan.speeds[s.speed];
+            let root = plan.floating_root.filter(|_| s.root);
             Step {
                 transform: s.transform.map_or(NO_TRANSFORM, u16_of),
-                motion: u16_of(speed.motion),
-                axis: speed
-                    .axis
-                    .unwrap_or(kanegen_runtime::derivatives_loop::DENSE),
-                joint: speed.joint,
+                motion: u16_of(root.unwrap_or(speed.motion)),
+                axis: match root {
+                    Some(_) => kanegen_runtime::derivatives_loop::FLOATING_ROOT,
+                    None => speed
+                        .axis
+                        .unwrap_or(kanegen_runtime::derivatives_loop::DENSE),
+                },
+                joint: speed.joint && root.is_none(),
                 entries: s.entries.map(|e| e.map_or(NO_ENTRY, u32_of)),
             }
         })
@@ -61,7 +65,6 @@ fn compare(label: &str, model: &Model, params: ParamMode, draws: usize, seed: u6
     let n = model.independent_dof();
     let mut rng = SplitMix64::new(seed);
     let mut uni = move || rng.next_f64();
-    let pi = std::f64::consts::PI;
     let mut worst = 0.0f64;
     for draw in 0..draws {
         let p = if draw == 0 || params == ParamMode::Baked {
@@ -69,7 +72,7 @@ fn compare(label: &str, model: &Model, params: ParamMode, draws: usize, seed: u6
         } else {
             random_physical_params(model, &mut uni)
         };
-        let q = uniform_vec(&mut uni, model.dof(), -pi, pi);
+        let q = super::rnea_derivatives_tests::random_coordinates(model, &mut uni);
         let u = uniform_vec(&mut uni, model.dof(), -2.0, 2.0);
         let ud = uniform_vec(&mut uni, model.dof(), -2.0, 2.0);
         // Row-major N × 2N.
@@ -148,13 +151,33 @@ fn looped_derivatives_equal_the_straight_line_form_on_trees_and_wheeled_bases() 
 }
 
 #[test]
+fn looped_derivatives_equal_the_straight_line_form_on_floating_bases() {
+    let hopper = Model::from_toml_file(models_dir().join("floating-hopper.toml")).expect("loads");
+    compare("floating hopper", &hopper, ParamMode::Runtime, 20, 17);
+    compare("floating hopper, baked", &hopper, ParamMode::Baked, 2, 18);
+    let solo = Model::from_urdf_file(
+        models_dir().join("../tests/corpus/solo12.urdf"),
+        &UrdfOptions::floating(),
+    )
+    .expect("imports");
+    compare("solo 12, floating", &solo, ParamMode::Runtime, 10, 19);
+}
+
+#[test]
 fn flat_tables_write_every_entry_once_and_move_once_per_ancestor_link() {
     let krang = Model::from_toml_file(models_dir().join("krang.toml")).expect("loads");
+    let hopper = Model::from_toml_file(models_dir().join("floating-hopper.toml")).expect("loads");
+    for model in [krang, hopper] {
+        check_tables(&model);
+    }
+}
+
+fn check_tables(model: &Model) {
     let options = Options {
         params: ParamMode::Runtime,
         functions: FunctionSet::default().with(FunctionId::InverseDynamicsDerivatives),
     };
-    let d = super::derive(&krang, options);
+    let d = super::derive(model, options);
     let plan = &d
         .derivative_loop
         .as_ref()
@@ -166,11 +189,14 @@ fn flat_tables_write_every_entry_once_and_move_once_per_ancestor_link() {
     let n = plan.dof;
     let mut writers = vec![0usize; 2 * n * n];
     for s in &steps {
-        for e in s.entries.into_iter().flatten() {
+        for e in s.writes(n) {
             writers[e] += 1;
         }
     }
     assert!(writers.iter().all(|&w| w <= 1), "an entry written twice");
+    if model.is_floating() {
+        assert!(steps.iter().any(|s| s.root), "a floating base's root step");
+    }
     // The columns' runs tile the steps; a run moves the forces once per ancestor link.
     assert_eq!(columns.last().map(|c| c.end), Some(steps.len()));
     let mut moves = 0;

@@ -343,8 +343,7 @@ pub fn derive_shaped(
     // The looped derivatives: one more phase, after every other (the other functions' code is
     // unchanged).
     let derivative_loop = (options.has(FunctionId::InverseDynamicsDerivatives)
-        && model.mimics.is_empty()
-        && !model.is_floating())
+        && model.mimics.is_empty())
     .then(|| {
         cx.ar.begin_phase();
         let (entries, plan) = cx.inverse_dynamics_derivatives_looped();

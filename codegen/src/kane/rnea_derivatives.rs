@@ -29,6 +29,12 @@
 //! frame 0 (quasi-velocities): nothing depends on x or ψ, and their u-columns take `V_0 × S`
 //! where a joint has `2 Ψ̇` (`∂A_k/∂u = S × V_k + V_0 × S`: there is no parent motion, and the
 //! bias `V_0 × V_0` of the base vanishes identically).
+//! A floating base's six speeds `(v, ω)` are such quasi-velocities too (`S` the unit vectors of
+//! frame 0, spatial acceleration `(ω̇; v̇)` of frame 0 with no velocity term). Its position does
+//! not enter τ; its orientation enters only through gravity `g_b = Rᵀ g`, folded into frame 0's
+//! acceleration, and `q ⊕ δ e_k` along `ω_k` turns `g_b` by `g_b × e_k`: a motion
+//! `Ψ̈ = (0; e_k × g_b)` applied to the whole tree without turning any frame, so column `ω_k`
+//! of ∂τ/∂q reads `Φ_i · Ψ̈` from every column's `Φ_i` at the root ([`Column::rotation`]).
 //!
 //! Four forces are carried per (speed, ancestor speed) pair, like the three of C, instead of
 //! forward mode's derivative of the whole subtree's motion and forces per input.
@@ -66,8 +72,14 @@ pub(super) struct Column {
     pub(super) s: V6,
     /// `Ψ̇ = V_λ × S` (joints) or `V_0 × S` (the base's speeds).
     pub(super) psid: V6,
-    /// `Ψ̈ = A_λ × S + V_λ × Ψ̇`; `None` for the base's speeds (no coordinate of theirs enters τ).
+    /// `Ψ̈ = A_λ × S + V_λ × Ψ̇`; `None` for the base's speeds (no coordinate of theirs enters τ
+    /// through the recursion).
     pub(super) psidd: Option<V6>,
+    /// A floating base's rotation speed `ω_k`: `(0; e_k × g_b)`, the derivative of the base
+    /// acceleration `a_0 − g_b` along the tangent rotation `q ⊕ δ e_k` (`∂g_b/∂δ = g_b × e_k`),
+    /// whose column reads `∂τ_i/∂q_k = Φ_i · (0; e_k × g_b)` (`−M[i, v] · (g_b × e_k)`); `None`
+    /// for every other speed.
+    pub(super) rotation: Option<V6>,
 }
 
 /// The four forces of a column on its way up to the root.
@@ -107,7 +119,8 @@ impl Ctx<'_> {
                 let col = columns[l][k];
                 let sname = self.model.speeds[col.speed].name.clone();
                 let mut carried = self.derivative_forces(l, &col, &comp, &hc, &dc, &f, &n);
-                // Rows of the same frame.
+                // Rows of the same frame (and a floating base's rotation columns of the base's
+                // rows).
                 for a in &columns[l] {
                     if let Some(g) = carried.g {
                         let e = self.dot6(&a.s, &g);
@@ -115,6 +128,10 @@ impl Ctx<'_> {
                     }
                     let e = self.dot6(&a.s, &carried.h);
                     raw.push((group, a.speed, col.speed, true, e));
+                    if let Some(r) = a.rotation {
+                        let e = self.dot6(&carried.phi, &r);
+                        raw.push((group, col.speed, a.speed, false, e));
+                    }
                 }
                 for (child, mount) in model.path_to_base(l) {
                     let (at, joint) = (mount.parent, &mount.joint);
@@ -139,6 +156,10 @@ impl Ctx<'_> {
                             let t1 = self.dot6(&carried.phi, &psidd);
                             let t2 = self.dot6(&carried.xi, &a.psid);
                             let e = self.ar.add(t1, t2);
+                            raw.push((group, col.speed, a.speed, false, e));
+                        }
+                        if let Some(r) = a.rotation {
+                            let e = self.dot6(&carried.phi, &r);
                             raw.push((group, col.speed, a.speed, false, e));
                         }
                         // 2 Φ·Ψ̇ for a joint, Φ·(V_0 × S) for the base.
@@ -204,6 +225,7 @@ impl Ctx<'_> {
         self.subtree_momenta(&mut hc, &mut dc);
         let cols = self.speed_columns();
         let vxs = self.bias_columns(&vel, &cols);
+        let rotations = self.base_rotation_columns();
         // Ψ̇ and Ψ̈ of every speed.
         let mut columns: Vec<Vec<Column>> = vec![Vec::new(); links];
         for l in 0..links {
@@ -212,11 +234,16 @@ impl Ctx<'_> {
                     .mount
                     .as_ref()
                     .map(|mount| self.psidd(l, mount, speed, &s, &vxs[l][k], &motion, &vel));
+                let rotation = match (l, &rotations) {
+                    (0, Some(r)) if (3..6).contains(&speed) => Some(r[speed - 3]),
+                    _ => None,
+                };
                 columns[l].push(Column {
                     speed,
                     s,
                     psid: vxs[l][k],
                     psidd,
+                    rotation,
                 });
             }
         }
@@ -228,6 +255,22 @@ impl Ctx<'_> {
             f,
             n,
         }
+    }
+
+    /// A floating base's `(0; e_k × g_b)` for its rotation speeds `ω_x, ω_y, ω_z` (see
+    /// [`Column::rotation`]); `None` for a fixed or wheeled base (nothing asked of the arena).
+    fn base_rotation_columns(&mut self) -> Option<[V6; 3]> {
+        if !self.model.is_floating() {
+            return None;
+        }
+        let g = self.gravity_vector();
+        let zero = self.ar.zero();
+        Some([0, 1, 2].map(|k| {
+            let mut e = [zero; 3];
+            e[k] = self.ar.one();
+            let x = self.cross(&e, &g);
+            join3(&[zero; 3], &x)
+        }))
     }
 
     /// `Ψ̈ = A_λ × S + V_λ × Ψ̇` of the speed of link `l` (its joint's), in its frame: `A_λ`, `V_λ`

@@ -23,6 +23,9 @@ fn derive(
 ) -> (Arena, Vec<(usize, usize, ExprId)>) {
     let mut arena = Arena::new(names_of(model));
     arena.hoist_params = params.is_runtime();
+    if model.is_floating() {
+        arena.set_floating();
+    }
     mimic::declare(&mut arena, model);
     let links = model.links.len();
     let mut cx = Ctx {
@@ -51,6 +54,17 @@ fn derive(
     (arena, entries)
 }
 
+/// Random coordinates: angles in ±π, a floating base's position in ±π and its quaternion unit.
+pub(super) fn random_coordinates(model: &Model, uni: &mut impl FnMut() -> f64) -> Vec<f64> {
+    let pi = std::f64::consts::PI;
+    let mut q = uniform_vec(uni, model.nq(), -pi, pi);
+    if model.is_floating() {
+        let norm = q[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
+        q[3..7].iter_mut().for_each(|x| *x /= norm);
+    }
+    q
+}
+
 fn dense(ar: &Arena, entries: &[(usize, usize, ExprId)], n: usize, x: &Values<'_>) -> Vec<f64> {
     let v = ar.eval(x);
     let mut out = vec![0.0; n * 2 * n];
@@ -67,7 +81,6 @@ fn compare(label: &str, model: &Model, params: ParamMode, draws: usize, seed: u6
     let n = model.independent_dof();
     let mut rng = SplitMix64::new(seed);
     let mut uni = move || rng.next_f64();
-    let pi = std::f64::consts::PI;
     let mut worst = 0.0f64;
     for draw in 0..draws {
         let p = if draw == 0 || params == ParamMode::Baked {
@@ -75,7 +88,7 @@ fn compare(label: &str, model: &Model, params: ParamMode, draws: usize, seed: u6
         } else {
             random_physical_params(model, &mut uni)
         };
-        let q = uniform_vec(&mut uni, model.dof(), -pi, pi);
+        let q = random_coordinates(model, &mut uni);
         let u = uniform_vec(&mut uni, model.dof(), -2.0, 2.0);
         let ud = uniform_vec(&mut uni, model.dof(), -2.0, 2.0);
         let x = Values {
@@ -144,8 +157,24 @@ fn analytic_derivatives_equal_forward_mode_with_prismatic_and_mimic_joints() {
     compare("lift on a wheeled base", &lift, ParamMode::Runtime, 50, 7);
 }
 
-/// ∂τ/∂u = 2C on a tree; on Krang's wheeled base, on every joint's column (the base's ẋ
-/// and ψ̇ columns take `V_0 × S` where a joint has `2 Ψ̇`, so they differ).
+/// A floating base: the orientation columns `Φ_i · (0; e_k × g_b)` of the recursion against
+/// `−M[:, v] [g_b]×`, the joints' columns and ∂τ/∂u against forward mode.
+#[test]
+fn analytic_derivatives_equal_forward_mode_on_floating_bases() {
+    let hopper = Model::from_toml_file(models_dir().join("floating-hopper.toml")).expect("loads");
+    assert!(hopper.is_floating());
+    compare("floating hopper", &hopper, ParamMode::Runtime, 20, 9);
+    compare("floating hopper, baked", &hopper, ParamMode::Baked, 2, 10);
+    let solo = Model::from_urdf_file(
+        models_dir().join("../tests/corpus/solo12.urdf"),
+        &UrdfOptions::floating(),
+    )
+    .expect("imports");
+    compare("solo 12, floating", &solo, ParamMode::Runtime, 5, 11);
+}
+
+/// ∂τ/∂u = 2C on a tree; on Krang's wheeled base and on a floating base, on every joint's
+/// column (the base's columns take `V_0 × S` where a joint has `2 Ψ̇`, so they differ).
 #[test]
 fn on_a_tree_and_on_every_joint_column_the_speed_derivative_is_twice_the_coriolis_matrix() {
     use crate::registry::{FunctionId, FunctionSet};
@@ -154,6 +183,7 @@ fn on_a_tree_and_on_every_joint_column_the_speed_derivative_is_twice_the_corioli
         ("fixed wheels", toml("krang-fixed-wheels.toml"), 0),
         ("two-link", toml("two-link.toml"), 0),
         ("krang", toml("krang.toml"), 2),
+        ("floating hopper", toml("floating-hopper.toml"), 6),
     ] {
         let options = Options {
             params: ParamMode::Runtime,
@@ -167,7 +197,7 @@ fn on_a_tree_and_on_every_joint_column_the_speed_derivative_is_twice_the_corioli
         let mut uni = move || rng.next_f64();
         for _ in 0..10 {
             let p = random_physical_params(&model, &mut uni);
-            let q = uniform_vec(&mut uni, n, -3.0, 3.0);
+            let q = random_coordinates(&model, &mut uni);
             let u = uniform_vec(&mut uni, n, -2.0, 2.0);
             let ud = uniform_vec(&mut uni, n, -2.0, 2.0);
             let c = d.evaluate(FunctionId::CoriolisMatrix, &p, &q, &u, &ud);

@@ -12,8 +12,12 @@
 //! * row `a` (an ancestor speed or a speed of the column's own link), column `i`:
 //!   `∂τ_a/∂q_i = S_a · G_i` and `∂τ_a/∂u_i = S_a · H_i`;
 //! * row `i`, column `a` (ancestors only): `∂τ_i/∂q_a = Φ_i · Ψ̈_a + Ξ_i · Ψ̇_a` and
-//!   `∂τ_i/∂u_a = k Φ_i · Ψ̇_a + Ξ_i · S_a` (`k = 2` for a joint, 1 for the wheeled base's
-//!   quasi-velocities, whose `Ψ̇` is `V_0 × S`).
+//!   `∂τ_i/∂u_a = k Φ_i · Ψ̇_a + Ξ_i · S_a` (`k = 2` for a joint, 1 for the wheeled or
+//!   floating base's quasi-velocities, whose `Ψ̇` is `V_0 × S`);
+//! * a floating base's rotation speeds `a` (a quasi-velocity whose step has a q-entry): row
+//!   `i`, column `a`: `∂τ_i/∂q_a = Φ_i · Ψ̈_a`, for every column, those of the base's own speeds
+//!   included (their `Ψ̈` slot holds the derivative of the base acceleration along the
+//!   rotation, `(0; e_a × g_b)`).
 //!
 //! The four forces are kept component-major (component `k` of `Φ`, `Ξ`, `H`, `G` side by side),
 //! so that one step is one 4-wide transform: one AVX2 register per component in the x86-64-v3
@@ -47,6 +51,17 @@ pub const NO_ENTRY: u32 = u32::MAX;
 /// [`Step::axis`] of a speed whose `S` is not a rotation about a coordinate axis.
 pub const DENSE: u8 = u8::MAX;
 
+/// [`Step::axis`] of a floating base's root step, which reads the six base speeds at once.
+/// Their `S` are the unit vectors of the base frame (`v` then `ω`), so `S_a · G`, `S_a · H`
+/// and `Ξ · S_a` are components of the forces, `Φ · (V_0 × S_a)` is component `a` of
+/// `−V_0 ×* Φ` and the rotations' q-entries `Φ · (0; e_k × g_b)` are the components of
+/// `g_b × f_Φ`. [`Step::motion`] is then the offset of `V_0 = (ω; v)` and `g_b` (9 values),
+/// and [`Step::entries`] are the first offsets of four runs: `∂τ_a/∂q_i` and `∂τ_a/∂u_i` for
+/// the six base rows `a` (consecutive; the first [`NO_ENTRY`] when the column's speed `i` is
+/// not a joint's), `∂τ_i/∂q_a` for the three rotations and `∂τ_i/∂u_a` for the six speeds
+/// (every `N` entries, [`Plan::dof`]).
+pub const FLOATING_ROOT: u8 = u8::MAX - 1;
+
 /// One step of a column: move its four forces up one link (unless [`NO_TRANSFORM`]), then
 /// write the entries that one speed of that link reads from them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,20 +72,22 @@ pub struct Step {
     /// step before it, and for the rows of the column's own link.
     pub transform: u16,
     /// Offset in the workspace of the speed's `S`, `Ψ̇`, `Ψ̈` (6 entries each, in its link's
-    /// frame).
+    /// frame); of `V_0` and `g_b` for a [`FLOATING_ROOT`] step.
     pub motion: u16,
     /// `k` when the speed's `S` is the unit rotation about axis `k` of its link's frame, times
     /// ±1 (`S = ±(e_k; 0)`, `k` in 0..3: then `Ψ̇ = V_λ × S` vanishes in components `k` and
     /// `3 + k` and the x86-64-v3 copy reads `S` as one component and `Ψ̇` as four); [`DENSE`]
     /// otherwise.
     pub axis: u8,
-    /// A joint speed (`true`) or one of the wheeled base's quasi-velocities (`false`: no
-    /// coordinate of its own enters τ, so it has no `Ψ̈` and no q-column).
+    /// A joint speed (`true`) or one of the wheeled or floating base's quasi-velocities
+    /// (`false`: no coordinate of its own enters the recursion; its q-column, if
+    /// `entries[2]` is written, is `Φ · Ψ̈`, a floating base's rotation).
     pub joint: bool,
     /// Where the step writes, as offsets in the column-major `N × 2N` result ([`NO_ENTRY`]:
     /// not written), for the speed `a` of the step and the column's speed `i`:
     /// `∂τ_a/∂q_i = S_a · G` (none when `i` is a quasi-velocity), `∂τ_a/∂u_i = S_a · H`,
-    /// `∂τ_i/∂q_a = Φ · Ψ̈_a + Ξ · Ψ̇_a` (joints `a` that are ancestors only) and
+    /// `∂τ_i/∂q_a = Φ · Ψ̈_a + Ξ · Ψ̇_a` (joints `a` that are ancestors only; `Φ · Ψ̈_a` for a
+    /// floating base's rotation `a`, on the own link's rows too) and
     /// `∂τ_i/∂u_a = k Φ · Ψ̇_a + Ξ · S_a` (ancestors only; `k = 2` for a joint, 1 for a
     /// quasi-velocity, whose `Ψ̇` is `V_0 × S`).
     pub entries: [u32; 4],
@@ -262,8 +279,8 @@ fn chunk<T, const K: usize>(w: &[T], at: usize) -> &[T; K] {
 }
 
 /// Writes the entries of an ancestor step `s` from its dot products with the four forces `Φ`,
-/// `Ξ`, `H`, `G` (one lane each): `ds = S · F`, `dpd = Ψ̇ · F` and, when `s` is a joint,
-/// `dpdd = Ψ̈ · F` (not read otherwise).
+/// `Ξ`, `H`, `G` (one lane each): `ds = S · F`, `dpd = Ψ̇ · F` and, when `s` is a joint or
+/// writes a q-entry (a floating base's rotation), `dpdd = Ψ̈ · F` (not read otherwise).
 #[inline(always)]
 fn write_reads<T: Copy + Add<Output = T>>(
     out: &mut [T],
@@ -278,7 +295,50 @@ fn write_reads<T: Copy + Add<Output = T>>(
         put(out, s.entries[2], dpdd[0] + dpd[1]);
         put(out, s.entries[3], (dpd[0] + dpd[0]) + ds[1]);
     } else {
+        put(out, s.entries[2], dpdd[0]);
         put(out, s.entries[3], dpd[0] + ds[1]);
+    }
+}
+
+/// Whether step `s` reads `Ψ̈`: a joint, or a quasi-velocity with a q-entry (a floating
+/// base's rotation).
+#[inline(always)]
+fn reads_psidd(s: &Step) -> bool {
+    s.joint || s.entries[2] != NO_ENTRY
+}
+
+/// The reads of a [`FLOATING_ROOT`] step `s` from the forces' components `f` (`f[k][j]`:
+/// component `k` of `Φ`, `Ξ`, `H`, `G`), the base's `V_0` and `g_b` in `m`, for `n` speeds.
+#[inline(always)]
+fn root_reads<T>(out: &mut [T], n: usize, s: &Step, m: &[T; 9], f: &[[T; 4]; 6])
+where
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
+{
+    let cross = |a: [T; 3], b: [T; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let (w, v, g) = ([m[0], m[1], m[2]], [m[3], m[4], m[5]], [m[6], m[7], m[8]]);
+    let (pn, pf) = ([f[0][0], f[1][0], f[2][0]], [f[3][0], f[4][0], f[5][0]]);
+    // V_0 ×* Φ = (ω × n + v × f; ω × f), component-major like the forces.
+    let (a, b, c) = (cross(w, pn), cross(v, pf), cross(w, pf));
+    let x = [a[0] + b[0], a[1] + b[1], a[2] + b[2], c[0], c[1], c[2]];
+    let [gq, hq, rq, uq] = s.entries.map(|e| e as usize);
+    for a in 0..6 {
+        // S_a picks component 3 + a (v) or a − 3 (ω) of a force.
+        let k = if a < 3 { 3 + a } else { a - 3 };
+        if s.entries[0] != NO_ENTRY {
+            put(out, (gq + a) as u32, f[k][3]);
+        }
+        put(out, (hq + a) as u32, f[k][2]);
+        put(out, (uq + n * a) as u32, f[k][1] - x[k]);
+    }
+    let r = cross(g, pf);
+    for (k, rk) in r.into_iter().enumerate() {
+        put(out, (rq + n * k) as u32, rk);
     }
 }
 
@@ -292,23 +352,36 @@ where
         let x: &[T; 24] = chunk(w, usize::from(col.forces));
         let mut f: Forces<T> = [0, 1, 2, 3, 4, 5].map(|k| L4::load(&x[4 * k..4 * k + 4]));
         let (own_rows, up_steps) = col.ranges();
-        // Rows of the column's own link: S_a · G, S_a · H.
+        // Rows of the column's own link: S_a · G, S_a · H (and Φ · Ψ̈_a for a floating
+        // base's rotation a).
         for s in &plan.steps[own_rows] {
             let mo: &[T; 18] = chunk(w, usize::from(s.motion));
             let ds = dots(&mo[0..6], &f);
             put(out, s.entries[0], ds.0[3]);
             put(out, s.entries[1], ds.0[2]);
+            if s.entries[2] != NO_ENTRY {
+                put(out, s.entries[2], dots(&mo[12..18], &f).0[0]);
+            }
         }
         // Up to the root: every ancestor speed reads the four forces in its frame.
         for s in &plan.steps[up_steps] {
             if s.transform != NO_TRANSFORM {
                 f = up(chunk::<T, 12>(w, usize::from(s.transform)), &f);
             }
+            if s.axis == FLOATING_ROOT {
+                let comps = f.map(|c| c.0);
+                root_reads(out, plan.dof, s, chunk(w, usize::from(s.motion)), &comps);
+                continue;
+            }
             let mo: &[T; 18] = chunk(w, usize::from(s.motion));
             let ds = dots(&mo[0..6], &f);
             let dpd = dots(&mo[6..12], &f);
-            // Ψ̈ only for a joint (`write_reads` reads no `dpdd` otherwise: `ds` fills it).
-            let dpdd = if s.joint { dots(&mo[12..18], &f) } else { ds };
+            // Ψ̈ only where it is read (`write_reads` reads no `dpdd` otherwise: `ds` fills it).
+            let dpdd = if reads_psidd(s) {
+                dots(&mo[12..18], &f)
+            } else {
+                ds
+            };
             write_reads(out, s, ds.0, dpd.0, dpdd.0);
         }
     }
@@ -327,7 +400,10 @@ macro_rules! avx_steps {
                 _mm256_fnmadd_pd, _mm256_mul_pd, _mm256_set_pd, _mm256_set1_pd,
             };
 
-            use super::{NO_TRANSFORM, Plan, Step, put, write_reads};
+            use super::{
+                FLOATING_ROOT, NO_ENTRY, NO_TRANSFORM, Plan, Step, put, reads_psidd, root_reads,
+                write_reads,
+            };
 
             #[target_feature(enable = $features)]
             #[inline]
@@ -432,12 +508,12 @@ macro_rules! avx_steps {
                 [ds, dpd, psidd_dots(mo, a, f)]
             }
 
-            /// `Ψ̈ · F` for a joint (`Ψ̈ = A_λ × S + V_λ × Ψ̇` has all six components in general),
-            /// zeros for a quasi-velocity (not read).
+            /// `Ψ̈ · F` for a joint (`Ψ̈ = A_λ × S + V_λ × Ψ̇` has all six components in general)
+            /// or a floating base's rotation, zeros for another quasi-velocity (not read).
             #[target_feature(enable = $features)]
             #[inline]
             fn psidd_dots(mo: &[f64; 18], a: &Step, f: &[__m256d; 6]) -> [f64; 4] {
-                if a.joint {
+                if reads_psidd(a) {
                     dots(&mo[12..18], f)
                 } else {
                     [0.0; 4]
@@ -470,10 +546,26 @@ macro_rules! avx_steps {
                         let ds = dots(&mo[0..6], &f);
                         put(out, s.entries[0], ds[3]);
                         put(out, s.entries[1], ds[2]);
+                        if s.entries[2] != NO_ENTRY {
+                            put(out, s.entries[2], dots(&mo[12..18], &f)[0]);
+                        }
                     }
                     for s in &plan.steps[up_steps] {
                         if s.transform != NO_TRANSFORM {
                             f = up(super::chunk::<f64, 12>(w, usize::from(s.transform)), &f);
+                        }
+                        if s.axis == FLOATING_ROOT {
+                            let comps = [
+                                lanes(f[0]),
+                                lanes(f[1]),
+                                lanes(f[2]),
+                                lanes(f[3]),
+                                lanes(f[4]),
+                                lanes(f[5]),
+                            ];
+                            let m = super::chunk(w, usize::from(s.motion));
+                            root_reads(out, plan.dof, s, m, &comps);
+                            continue;
                         }
                         let mo: &[f64; 18] = super::chunk(w, usize::from(s.motion));
                         let [ds, dpd, dpdd] = match s.axis {

@@ -9,7 +9,8 @@
 //! Greek and Japanese; for `tests/floating_base.rs`, `tests/floating_reference.rs` and
 //! `examples/pinocchio_free_flyer.rs`, the small floating-base model
 //! `models/floating-hopper.toml`, Solo 12 (`tests/corpus/solo12.urdf`) and the humanoid
-//! `tests/corpus/simple_humanoid.urdf` on a floating base.
+//! `tests/corpus/simple_humanoid.urdf` on a floating base (and, for the example, the last two
+//! baked).
 //! The TOML Krang models come from `krang-dynamics`.
 use kanegen::model::{UrdfOptions, WheeledBaseSpec};
 
@@ -113,6 +114,25 @@ fn main() {
         .functions(floating)
         .output("simple_humanoid_floating.rs")
         .run();
+    // Both with the URDF's parameter values folded in (baked), M, c, g, τ, h and the derivatives:
+    // the form to set beside Pinocchio's generated code, which folds them in too.
+    let baked = kanegen::FunctionSet::default()
+        .without(kanegen::FunctionId::CoriolisMatrix)
+        .with(kanegen::FunctionId::NonlinearEffects)
+        .with(kanegen::FunctionId::InverseDynamicsDerivatives);
+    for (urdf, output) in [
+        ("tests/corpus/solo12.urdf", "solo12_floating_baked.rs"),
+        (
+            "tests/corpus/simple_humanoid.urdf",
+            "simple_humanoid_floating_baked.rs",
+        ),
+    ] {
+        kanegen::Builder::urdf(urdf, UrdfOptions::floating())
+            .functions(baked)
+            .baked(true)
+            .output(output)
+            .run();
+    }
     kanegen::Builder::urdf("models/Krang.urdf", krang_urdf_options())
         .output("krang_urdf.rs")
         .run();

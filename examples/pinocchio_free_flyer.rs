@@ -27,8 +27,9 @@
 //! ```
 //!
 //! `time` checks the generated modules of both robots (this package's build script generates
-//! them, `solo12_floating.rs` and `simple_humanoid_floating.rs`) against the same reference on
-//! the same states, then times them and appends `robot/function ns` lines to
+//! them, `solo12_floating.rs` and `simple_humanoid_floating.rs`, and their baked forms, with the
+//! parameter values folded in as Pinocchio's generated code folds them) against the same
+//! reference on the same states, then times them and appends `robot/function ns` lines to
 //! `DIR/kanegen-ff-times.txt`, keyed by the model's name (the harness appends Pinocchio's to
 //! `DIR/pinocchio-ff-times.txt`).
 //! `report` prints one Markdown table per robot, the best of the runs of each side.
@@ -56,6 +57,19 @@ mod solo {
 #[allow(dead_code)]
 mod humanoid {
     include!(concat!(env!("OUT_DIR"), "/simple_humanoid_floating.rs"));
+}
+
+#[allow(dead_code)]
+mod solo_baked {
+    include!(concat!(env!("OUT_DIR"), "/solo12_floating_baked.rs"));
+}
+
+#[allow(dead_code)]
+mod humanoid_baked {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/simple_humanoid_floating_baked.rs"
+    ));
 }
 
 /// Random states per model.
@@ -271,7 +285,7 @@ fn rel_err(got: &[f64], want: &[f64]) -> f64 {
 /// Checks and times the generated module `$m` (wrapper `$robot`, `$k` contact rows) of the
 /// corpus robot `$name` with contact frames `$feet`; appends to `$text`.
 macro_rules! time_robot {
-    ($m:ident, $robot:ident, $k:literal, $name:expr, $feet:expr, $text:expr) => {{
+    ($m:ident, $baked:ident, $robot:ident, $k:literal, $name:expr, $feet:expr, $text:expr) => {{
         use $m::{DOF, Frame, NQ, $robot};
         type Q = SVector<f64, NQ>;
         type U = SVector<f64, DOF>;
@@ -400,6 +414,45 @@ macro_rules! time_robot {
                 black_box(constrained(black_box(q), u, f).ok());
             })),
         ];
+        // The baked module (parameter values folded in), checked on the same states.
+        let baked = $baked::$robot::default();
+        let mut worst = 0.0_f64;
+        for (q, u, ud, _) in &states {
+            let d = robot.inverse_dynamics_derivatives(q, u, ud);
+            let db = baked.inverse_dynamics_derivatives(q, u, ud);
+            worst = worst.max(rel_err(db.as_slice(), d.as_slice()));
+            let h = robot.nonlinear_effects(q, u);
+            worst = worst.max(rel_err(baked.nonlinear_effects(q, u).as_slice(), h.as_slice()));
+            let m = robot.mass_matrix(q);
+            worst = worst.max(rel_err(baked.mass_matrix(q).as_slice(), m.as_slice()));
+        }
+        if worst > 1e-9 {
+            return Err(format!("{name}: the baked module differs by {worst:e}"));
+        }
+        let baked = &baked;
+        let mut rows = rows;
+        rows.extend([
+            ("baked_mass_matrix_into", time_ns(CALLS, |i| {
+                black_box(baked).mass_matrix_into(&st(i).0, black_box(&mut m_out));
+            })),
+            ("baked_coriolis", time_ns(CALLS, |i| {
+                black_box(black_box(baked).coriolis(&st(i).0, &st(i).1));
+            })),
+            ("baked_nonlinear_effects", time_ns(CALLS, |i| {
+                black_box(black_box(baked).nonlinear_effects(&st(i).0, &st(i).1));
+            })),
+            ("baked_gravity", time_ns(CALLS, |i| {
+                black_box(black_box(baked).gravity(&st(i).0));
+            })),
+            ("baked_inverse_dynamics", time_ns(CALLS, |i| {
+                let (q, u, ud, _) = st(i);
+                black_box(black_box(baked).inverse_dynamics(q, u, ud));
+            })),
+            ("baked_inverse_dynamics_derivatives_into", time_ns(CALLS / 10, |i| {
+                let (q, u, ud, _) = st(i);
+                black_box(baked).inverse_dynamics_derivatives_into(q, u, ud, black_box(&mut d_out));
+            })),
+        ]);
         // Keyed by the model's name, as the harness keys Pinocchio's times.
         for (function, ns) in rows {
             println!("kanegen {}/{function:<34} {ns:9.1} ns", model.name);
@@ -410,8 +463,16 @@ macro_rules! time_robot {
 
 fn time(dir: &str) -> Result<(), String> {
     let mut text = String::new();
-    time_robot!(solo, Solo, 12, ROBOTS[0].0, ROBOTS[0].1, text);
-    time_robot!(humanoid, SimpleHumanoid, 6, ROBOTS[1].0, ROBOTS[1].1, text);
+    time_robot!(solo, solo_baked, Solo, 12, ROBOTS[0].0, ROBOTS[0].1, text);
+    time_robot!(
+        humanoid,
+        humanoid_baked,
+        SimpleHumanoid,
+        6,
+        ROBOTS[1].0,
+        ROBOTS[1].1,
+        text
+    );
     let path = Path::new(dir).join("kanegen-ff-times.txt");
     use std::io::Write as _;
     std::fs::OpenOptions::new()
@@ -499,6 +560,9 @@ const ROWS: [(&str, &str, &str, &str); 10] = [
 /// Prefix of the keys of Pinocchio's CppADCodeGen code (`benches/pinocchio/codegen.cpp`).
 const GENERATED: &str = "cg_";
 
+/// Prefix of the keys of kanegen's baked modules.
+const BAKED: &str = "baked_";
+
 fn report(dir: &str) -> Result<(), String> {
     let dir = Path::new(dir);
     let (ours, our_runs) = best_times(&dir.join("kanegen-ff-times.txt"))?;
@@ -518,19 +582,22 @@ fn report(dir: &str) -> Result<(), String> {
                 b / a
             );
         }
-        // Pinocchio's CppADCodeGen code (`CODEGEN=1`), where it was timed.
+        // Pinocchio's CppADCodeGen code (`CODEGEN=1`), where it was timed. It folds the
+        // parameter values in, as kanegen's baked modules do.
         if pin.contains_key(&format!("{name}/{GENERATED}crba")) {
             println!(
-                "\n| kanegen (Rust) | ns | Pinocchio's generated code (CppADCodeGen, C) | ns | Pinocchio / kanegen |"
+                "\n| kanegen (Rust) | run-time parameters, ns | baked, ns | Pinocchio's generated code (CppADCodeGen, C) | ns | Pinocchio / kanegen (run-time) | Pinocchio / kanegen (baked) |"
             );
-            println!("|---|--:|---|--:|--:|");
+            println!("|---|--:|--:|---|--:|--:|--:|");
             for (our_label, our_key, pin_label, pin_key) in ROWS {
                 let ok = format!("{name}/{our_key}");
+                let bk = format!("{name}/{BAKED}{our_key}");
                 let pk = format!("{name}/{GENERATED}{pin_key}");
-                if let (Some(a), Some(b)) = (ours.get(&ok), pin.get(&pk)) {
+                if let (Some(a), Some(c), Some(b)) = (ours.get(&ok), ours.get(&bk), pin.get(&pk)) {
                     println!(
-                        "| {our_label} | {a:.0} | {pin_label} | {b:.0} | {:.1}× |",
-                        b / a
+                        "| {our_label} | {a:.0} | {c:.0} | {pin_label} | {b:.0} | {:.1}× | {:.1}× |",
+                        b / a,
+                        b / c
                     );
                 }
             }

@@ -2,6 +2,8 @@
 
 use nalgebra::{RealField, SMatrix, SVector};
 
+use crate::tree_factor::TreeFactor;
+
 /// The dynamics of a robot with `N` generalized coordinates `q` and `N` generalized speeds
 /// `u`, in the form `τ = M(q) u̇ + c(q, u) + g(q)`. Implemented by the robot type of every
 /// generated module (for its model's parameter set), so that a controller, estimator or
@@ -19,6 +21,13 @@ pub trait RobotDynamics<const N: usize> {
 
     /// Coordinate names, in the order of `q`.
     const COORDINATE_NAMES: [&'static str; N];
+
+    /// The speeds' parent array `λ` (`λ(i) < i`, `None` for a speed at the root) when the mass
+    /// matrix is structurally zero off the tree's ancestor pairs ([`crate::tree_factor`]):
+    /// generated modules set it to their `SPEED_PARENTS` where the generator verified the
+    /// pattern, and [`forward_dynamics`](Self::forward_dynamics) then factors `M` without
+    /// fill-in. `None` (the default): `M` is taken as dense.
+    const SPEED_PARENTS: Option<[Option<usize>; N]> = None;
 
     /// The mass matrix `M(q)`, symmetric positive definite: the kinetic energy is `½ uᵀ M u`,
     /// and `M u̇` is the part of `τ` that depends on `u̇`.
@@ -48,9 +57,11 @@ pub trait RobotDynamics<const N: usize> {
 
     /// Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))`: the accelerations the generalized
     /// forces `tau` produce at state `(q, u)`, for simulation. `c + g` is one inverse-dynamics
-    /// pass at `u̇ = 0`, and `M` is factored by nalgebra's dense Cholesky, on the stack (no
-    /// heap, `no_std`), whose factor is then solved by the runtime's own substitutions (rows in
-    /// blocks of four: faster than nalgebra's `Cholesky::solve`).
+    /// pass at `u̇ = 0`. With [`SPEED_PARENTS`](Self::SPEED_PARENTS) `M` is factored along the
+    /// tree ([`TreeFactor`](crate::tree_factor::TreeFactor): no fill-in, two legs never
+    /// coupled); without, by nalgebra's dense Cholesky, whose factor is then solved by the
+    /// runtime's own substitutions (rows in blocks of four: faster than nalgebra's
+    /// `Cholesky::solve`). Either on the stack (no heap, `no_std`).
     ///
     /// `None` when `M(q)` is not positive definite (or has a NaN entry): non-physical
     /// parameters, such as a negative mass or an inertia violating the triangle inequalities
@@ -67,6 +78,10 @@ pub trait RobotDynamics<const N: usize> {
         tau: &SVector<Self::Scalar, N>,
     ) -> Option<SVector<Self::Scalar, N>> {
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
+        if let Some(parents) = Self::SPEED_PARENTS {
+            let factor = TreeFactor::new(&self.mass_matrix(q), &parents)?;
+            return Some(factor.solve(&(tau - bias)));
+        }
         let factor = DenseFactor::new(self.mass_matrix(q))?;
         Some(factor.solve(&(tau - bias)))
     }

@@ -183,6 +183,7 @@ pub mod regressor;
 #[doc(hidden)]
 pub mod serde_support;
 mod set_parameter_error;
+pub mod tree_factor;
 pub mod trig;
 mod unknown_parameter;
 

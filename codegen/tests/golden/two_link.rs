@@ -19,6 +19,13 @@ mod generated {
     pub const SPEED_NAMES: [&str; 2] = ["qd_imu", "qd_w"];
     /// Coordinate names, in the order of `q`.
     pub const COORDINATE_NAMES: [&str; 2] = ["q_imu", "q_w"];
+    /// The speeds' parent array `λ`: entry `i` is the speed nearest to speed `i` on the path
+    /// from its joint towards the root (`None` at the root; a floating base's six speeds form
+    /// a chain there), always before `i`. The mass matrix is structurally zero between two
+    /// speeds neither of which is an ancestor of the other (verified on the generated
+    /// matrix), so `kanegen_runtime::tree_factor::TreeFactor` factors it without fill-in:
+    /// the traits' `forward_dynamics` and `mass_matrix_factor` do.
+    pub const SPEED_PARENTS: [Option<usize>; 2] = [None, Some(0)];
     /// Index constants: of each coordinate in `q` (`Q_IMU`) and of its speed in `u`, `u̇`
     /// and `τ` (`QD_IMU`); a coordinate and its speed have the same index.
     pub mod index {
@@ -714,6 +721,7 @@ mod generated {
         type Scalar = f64;
         const SPEED_NAMES: [&'static str; DOF] = SPEED_NAMES;
         const COORDINATE_NAMES: [&'static str; DOF] = COORDINATE_NAMES;
+        const SPEED_PARENTS: Option<[Option<usize>; DOF]> = Some(SPEED_PARENTS);
         fn mass_matrix(&self, q: &SVector<f64, 2>) -> SMatrix<f64, 2, 2> {
             mass_matrix(&self.params, &self.pre, q)
         }

@@ -126,6 +126,33 @@ mod generated {
         "q6r",
         "q7r",
     ];
+    /// The speeds' parent array `λ`: entry `i` is the speed nearest to speed `i` on the path
+    /// from its joint towards the root (`None` at the root; a floating base's six speeds form
+    /// a chain there), always before `i`. The mass matrix is structurally zero between two
+    /// speeds neither of which is an ancestor of the other (verified on the generated
+    /// matrix), so `kanegen_runtime::tree_factor::TreeFactor` factors it without fill-in:
+    /// the traits' `forward_dynamics` and `mass_matrix_factor` do.
+    pub const SPEED_PARENTS: [Option<usize>; 19] = [
+        None,
+        Some(0),
+        Some(1),
+        Some(2),
+        Some(3),
+        Some(4),
+        Some(5),
+        Some(6),
+        Some(7),
+        Some(8),
+        Some(9),
+        Some(10),
+        Some(4),
+        Some(12),
+        Some(13),
+        Some(14),
+        Some(15),
+        Some(16),
+        Some(17),
+    ];
     /// Index constants: of each coordinate in `q` (`Q_IMU`) and of its speed in `u`, `u̇`
     /// and `τ` (`QD_IMU`); a coordinate and its speed have the same index.
     pub mod index {
@@ -30109,6 +30136,7 @@ mod generated {
         type Scalar = f64;
         const SPEED_NAMES: [&'static str; DOF] = SPEED_NAMES;
         const COORDINATE_NAMES: [&'static str; DOF] = COORDINATE_NAMES;
+        const SPEED_PARENTS: Option<[Option<usize>; DOF]> = Some(SPEED_PARENTS);
         fn mass_matrix(&self, q: &SVector<f64, 19>) -> SMatrix<f64, 19, 19> {
             mass_matrix(&self.params, &self.pre, q)
         }

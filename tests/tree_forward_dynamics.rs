@@ -27,6 +27,11 @@ mod arm {
 }
 
 #[allow(dead_code)]
+mod two_link_f32 {
+    include!(concat!(env!("OUT_DIR"), "/two_link_all_baked_f32.rs"));
+}
+
+#[allow(dead_code)]
 mod gripper {
     include!(concat!(env!("OUT_DIR"), "/mimic_gripper_all.rs"));
 }
@@ -128,6 +133,46 @@ fn floating_solo12_forward_dynamics_along_the_tree_matches_the_dense_one_and_the
         let tau_ref = DVector::from_column_slice(tau.as_slice());
         assert!((back - &tau_ref).amax() <= 1e-9 * tau_ref.amax().max(1.0));
     }
+}
+
+#[test]
+fn generated_straight_line_kernels_give_the_runtime_loops_factor() {
+    let model = solo_model();
+    let robot = solo::Solo::default();
+    let mut uniform = stream(17);
+    for _ in 0..10 {
+        let q = SVector::<f64, 19>::from_column_slice(&free_flyer::random_configuration(
+            &model,
+            &mut uniform,
+        ));
+        let m = robot.mass_matrix(&q);
+        let kernels = robot.mass_matrix_factor(&q).unwrap();
+        let loops = TreeFactor::new(&m, &solo::SPEED_PARENTS).unwrap();
+        let direct =
+            TreeFactor::with_kernels(&m, &solo::SPEED_PARENTS, solo::TREE_KERNELS).unwrap();
+        let (dk, dl) = (kernels.pivots(), loops.pivots());
+        assert!(close(&dk, &dl, 1e-12));
+        assert_eq!(dk, direct.pivots());
+        let b: SVector<f64, 18> = random(&mut uniform, 3.0);
+        assert!(close(&kernels.solve(&b), &loops.solve(&b), 1e-11));
+        let mut cols = SMatrix::<f64, 18, 3>::from_fn(|_, _| uniform());
+        let expected = m.cholesky().unwrap().solve(&cols);
+        kernels.solve_columns(&mut cols);
+        assert!((cols - expected).amax() <= 1e-10 * expected.amax());
+        // Not positive definite: the kernels refuse it as the loops do.
+        assert!(
+            TreeFactor::with_kernels(&(-m), &solo::SPEED_PARENTS, solo::TREE_KERNELS).is_none()
+        );
+    }
+    // An f32 module with its parameters baked in has the kernels in f32.
+    let two = two_link_f32::TwoLink::default();
+    let q = SVector::<f32, 2>::from([0.3, -0.7]);
+    let m = kanegen_runtime::RobotDynamics::mass_matrix(&two, &q);
+    let b = SVector::<f32, 2>::from([1.0, 2.0]);
+    let x = kanegen_runtime::RobotDynamics::mass_matrix_factor(&two, &q)
+        .unwrap()
+        .solve(&b);
+    assert!((m * x - b).amax() < 1e-5);
 }
 
 #[test]

@@ -538,7 +538,8 @@ pub(super) fn trait_impls(cx: &Context<'_>) -> TokenStream {
             quote!(fn #name(&self, #args) -> #ret { #call })
         });
         let assoc = if tr == RuntimeTrait::RobotDynamics {
-            let parents = super::speed_parents::trait_const(cx);
+            let q_ty = quote!(SVector<#t, DOF>);
+            let parents = super::speed_parents::trait_items(cx, &q_ty);
             quote! {
                 type Scalar = #t;
                 const SPEED_NAMES: [&'static str; DOF] = SPEED_NAMES;
@@ -612,7 +613,7 @@ fn floating_trait_impl(cx: &Context<'_>) -> TokenStream {
         quote!(fn #f(&self, #args) -> #ret { #call })
     };
     use crate::registry::Inputs;
-    let parents = super::speed_parents::trait_const(cx);
+    let parents = super::speed_parents::trait_items(cx, &quote!(SVector<#t, NQ>));
     let methods = [
         forward("mass_matrix", Inputs::Q),
         forward("coriolis", Inputs::QU),

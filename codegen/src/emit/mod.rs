@@ -220,6 +220,7 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
     }
     items.extend(items::wrapper(&cx, batched));
     items.extend(items::trait_impls(&cx));
+    items.extend(speed_parents::kernels(&cx));
     // Model names (`MX4l`, `q_1L`) are not snake case, and straight-line code trips clippy's
     // style lints (long functions, many arguments, literal precision): one allowance for the
     // whole generated module instead of one per item.

@@ -16,7 +16,7 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::body::nonzero_outputs;
-use super::context::Context;
+use super::context::{Context, scalar_type};
 use super::print::idx;
 use crate::registry::FunctionId;
 use kanegen_model::{Base, Model};
@@ -126,13 +126,198 @@ pub(super) fn constant(cx: &Context<'_>) -> TokenStream {
     }
 }
 
-/// The trait item `const SPEED_PARENTS: Option<[Option<usize>; DOF]> = Some(SPEED_PARENTS);`,
-/// or nothing.
-pub(super) fn trait_const(cx: &Context<'_>) -> TokenStream {
+/// The straight-line kernels are emitted up to this many multiply-adds of the factorisation
+/// (`Σ_k d_k (d_k + 1) / 2`, `d_k` the ancestors of speed `k`): a humanoid on a floating base
+/// has about 1,700, a 100-speed tree of ten branches 1,650, while a 60-speed chain would have
+/// 36,000 lines; above it the runtime's loops factor along `SPEED_PARENTS`.
+pub const KERNEL_LIMIT: usize = 6_000;
+
+/// The ancestors of `i`, nearest first.
+fn ancestors(lambda: &[Option<usize>], i: usize) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut at = lambda[i];
+    while let Some(p) = at {
+        out.push(p);
+        at = lambda[p];
+    }
+    out
+}
+
+/// The module's parent array when it has `TREE_KERNELS` too (within [`KERNEL_LIMIT`]).
+fn kernel_parents(cx: &Context<'_>) -> Option<Vec<Option<usize>>> {
+    let lambda = module_parents(cx)?;
+    let work: usize = (0..lambda.len())
+        .map(|k| {
+            let d = ancestors(&lambda, k).len();
+            d * (d + 1) / 2
+        })
+        .sum();
+    (work <= KERNEL_LIMIT).then_some(lambda)
+}
+
+/// The trait items: `const SPEED_PARENTS: Option<[Option<usize>; DOF]> = Some(SPEED_PARENTS);`
+/// and, with kernels, `mass_matrix_factor` through them; or nothing. `q_ty` is the type of `q`.
+pub(super) fn trait_items(cx: &Context<'_>, q_ty: &TokenStream) -> TokenStream {
     if module_parents(cx).is_none() {
         return TokenStream::new();
     }
-    quote!(
+    let mut out = quote!(
         const SPEED_PARENTS: Option<[Option<usize>; DOF]> = Some(SPEED_PARENTS);
-    )
+    );
+    if kernel_parents(cx).is_some() {
+        let t = scalar_type(cx.precision);
+        out.extend(quote! {
+            fn mass_matrix_factor(&self, q: &#q_ty)
+                -> Option<kanegen_runtime::tree_factor::TreeFactor<#t, DOF>>
+            {
+                kanegen_runtime::tree_factor::TreeFactor::with_kernels(
+                    &self.mass_matrix(q), &SPEED_PARENTS, TREE_KERNELS,
+                )
+            }
+        });
+    }
+    out
+}
+
+/// `TREE_KERNELS` and its three functions (`kanegen_runtime::tree_factor::TreeKernels`): the
+/// runtime's factorisation and substitutions along `SPEED_PARENTS` unrolled, each multiply-add
+/// an `Arith::mul_add` (fused in the x86-64-v3 copy); or nothing.
+pub(super) fn kernels(cx: &Context<'_>) -> TokenStream {
+    let Some(lambda) = kernel_parents(cx) else {
+        return TokenStream::new();
+    };
+    let n = lambda.len();
+    let t = scalar_type(cx.precision);
+    let nn = idx(n);
+    let anc: Vec<Vec<usize>> = (0..n).map(|i| ancestors(&lambda, i)).collect();
+    // Featherstone's LTDL, k = N − 1, …, 0; column k of `h` holds row k of L.
+    let mut factorise = Vec::new();
+    for k in (0..n).rev() {
+        let kk = idx(k);
+        factorise.push(quote! {
+            ok &= h[#kk][#kk] > 0.0;
+            let inv = 1.0 / h[#kk][#kk];
+            h[#kk][#kk] = inv;
+        });
+        for &i in &anc[k] {
+            let ii = idx(i);
+            // `j` ascending: runs of consecutive updates, which LLVM's SLP vectoriser packs.
+            let mut js: Vec<usize> = std::iter::once(i).chain(anc[i].iter().copied()).collect();
+            js.sort_unstable();
+            let updates = js.into_iter().map(|j| {
+                let jj = idx(j);
+                quote!(h[#ii][#jj] = A::mul_add(-a, h[#kk][#jj], h[#ii][#jj]);)
+            });
+            factorise.push(quote! {{
+                let a = h[#kk][#ii] * inv;
+                #(#updates)*
+                h[#kk][#ii] = a;
+            }});
+        }
+    }
+    // Lᵀ y = b, from the last speed up; a zero entry moves nothing.
+    let backward = (0..n).rev().filter(|&i| !anc[i].is_empty()).map(|i| {
+        let ii = idx(i);
+        let updates = anc[i].iter().rev().map(|&j| {
+            let jj = idx(j);
+            quote!(y[#jj] = A::mul_add(-h[#ii][#jj], yi, y[#jj]);)
+        });
+        quote! {{
+            let yi = y[#ii];
+            if yi != 0.0 {
+                #(#updates)*
+            }
+        }}
+    });
+    // L x = D⁻¹ y, from the root down: `x_i = x_i / D_i − Σ_j L_ij x_j`, the sum in four
+    // partial sums (`j` mod 4, ascending) so that its chain of dependent multiply-adds is a
+    // quarter as long.
+    let forward = (0..n).map(|i| {
+        let ii = idx(i);
+        let mut js = anc[i].clone();
+        js.sort_unstable();
+        if js.is_empty() {
+            return quote!(x[#ii] *= h[#ii][#ii];);
+        }
+        let lanes = js.len().min(4);
+        let init = (0..lanes).map(|l| {
+            let s = quote::format_ident!("s{}", l);
+            quote!(let mut #s = 0.0;)
+        });
+        let terms = js.iter().enumerate().map(|(n, &j)| {
+            let jj = idx(j);
+            let s = quote::format_ident!("s{}", n % 4);
+            quote!(#s = A::mul_add(h[#ii][#jj], x[#jj], #s);)
+        });
+        let sum = match lanes {
+            1 => quote!(s0),
+            2 => quote!(s0 + s1),
+            3 => quote!((s0 + s1) + s2),
+            _ => quote!((s0 + s1) + (s2 + s3)),
+        };
+        quote! {{
+            #(#init)*
+            #(#terms)*
+            x[#ii] = x[#ii] * h[#ii][#ii] - (#sum);
+        }}
+    });
+    let call = |args: TokenStream| {
+        if cx.isa_dispatch {
+            quote! {
+                kanegen_runtime::isa::dispatch_fused_with(
+                    #args,
+                    #[inline(always)]
+                    |#args| body::<kanegen_runtime::isa::Plain>(#args),
+                    #[inline(always)]
+                    |#args| body::<kanegen_runtime::isa::Fused>(#args),
+                )
+            }
+        } else {
+            quote!(body::<kanegen_runtime::isa::Native>(#args))
+        }
+    };
+    let call_factorise = call(quote!(h));
+    let call_backward = call(quote!((h, y)));
+    let call_forward = call(quote!((h, x)));
+    quote! {
+        /// Straight-line kernels of `M = Lᵀ D L` along [`SPEED_PARENTS`]
+        /// (`kanegen_runtime::tree_factor`): what the traits' `mass_matrix_factor` and
+        /// `forward_dynamics` of this robot run.
+        pub const TREE_KERNELS: kanegen_runtime::tree_factor::TreeKernels<#t, #nn> =
+            kanegen_runtime::tree_factor::TreeKernels {
+                factorise: tree_factorise,
+                solve_transposed_unit: tree_solve_transposed_unit,
+                finish_solve: tree_finish_solve,
+            };
+
+        /// The factorisation of [`TREE_KERNELS`], in place; `false` when a pivot is not
+        /// positive.
+        pub fn tree_factorise(h: &mut [[#t; #nn]; #nn]) -> bool {
+            #[inline(always)]
+            fn body<A: kanegen_runtime::isa::Arith<#t>>(h: &mut [[#t; #nn]; #nn]) -> bool {
+                let mut ok = true;
+                #(#factorise)*
+                ok
+            }
+            #call_factorise
+        }
+
+        /// `y ← L⁻ᵀ y` of [`TREE_KERNELS`].
+        pub fn tree_solve_transposed_unit(h: &[[#t; #nn]; #nn], y: &mut [#t; #nn]) {
+            #[inline(always)]
+            fn body<A: kanegen_runtime::isa::Arith<#t>>((h, y): (&[[#t; #nn]; #nn], &mut [#t; #nn])) {
+                #(#backward)*
+            }
+            #call_backward
+        }
+
+        /// `x ← L⁻¹ D⁻¹ x` of [`TREE_KERNELS`].
+        pub fn tree_finish_solve(h: &[[#t; #nn]; #nn], x: &mut [#t; #nn]) {
+            #[inline(always)]
+            fn body<A: kanegen_runtime::isa::Arith<#t>>((h, x): (&[[#t; #nn]; #nn], &mut [#t; #nn])) {
+                #(#forward)*
+            }
+            #call_forward
+        }
+    }
 }

@@ -78,12 +78,26 @@ pub trait RobotDynamics<const N: usize> {
         tau: &SVector<Self::Scalar, N>,
     ) -> Option<SVector<Self::Scalar, N>> {
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
-        if let Some(parents) = Self::SPEED_PARENTS {
-            let factor = TreeFactor::new(&self.mass_matrix(q), &parents)?;
-            return Some(factor.solve(&(tau - bias)));
+        if Self::SPEED_PARENTS.is_some() {
+            return Some(self.mass_matrix_factor(q)?.solve(&(tau - bias)));
         }
         let factor = DenseFactor::new(self.mass_matrix(q))?;
         Some(factor.solve(&(tau - bias)))
+    }
+
+    /// `M(q) = Lᵀ D L` along [`SPEED_PARENTS`](Self::SPEED_PARENTS) (without fill-in), or, when
+    /// that is `None`, along [`chain_parents`](crate::tree_factor::chain_parents) (a dense
+    /// factorisation): what [`forward_dynamics`](Self::forward_dynamics),
+    /// [`crate::contact::constrained_forward_dynamics_factored`] and
+    /// [`crate::contact::contact_impulse_factored`] solve with. Generated robots override it
+    /// with their straight-line kernels (`TREE_KERNELS`). `None` when `M(q)` is not positive
+    /// definite.
+    fn mass_matrix_factor(
+        &self,
+        q: &SVector<Self::Scalar, N>,
+    ) -> Option<TreeFactor<Self::Scalar, N>> {
+        let parents = Self::SPEED_PARENTS.unwrap_or(crate::tree_factor::chain_parents());
+        TreeFactor::new(&self.mass_matrix(q), &parents)
     }
 }
 

@@ -100,9 +100,8 @@ pub trait Multibody<const N: usize> {
         tau: &SVector<Self::Scalar, N>,
     ) -> Option<SVector<Self::Scalar, N>> {
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
-        if let Some(parents) = Self::SPEED_PARENTS {
-            let factor = TreeFactor::new(&self.mass_matrix(q), &parents)?;
-            return Some(factor.solve(&(tau - bias)));
+        if Self::SPEED_PARENTS.is_some() {
+            return Some(self.mass_matrix_factor(q)?.solve(&(tau - bias)));
         }
         let factor = DenseFactor::new(self.mass_matrix(q))?;
         Some(factor.solve(&(tau - bias)))
@@ -110,8 +109,10 @@ pub trait Multibody<const N: usize> {
 
     /// `M(q) = Lᵀ D L` along [`SPEED_PARENTS`](Self::SPEED_PARENTS) (without fill-in), or, when
     /// that is `None`, along [`chain_parents`](crate::tree_factor::chain_parents) (a dense
-    /// factorisation): what [`crate::contact::constrained_forward_dynamics_factored`] and
-    /// [`crate::contact::contact_impulse_factored`] take. `None` when `M(q)` is not positive
+    /// factorisation): what [`forward_dynamics`](Self::forward_dynamics),
+    /// [`crate::contact::constrained_forward_dynamics_factored`] and
+    /// [`crate::contact::contact_impulse_factored`] solve with. Generated robots override it
+    /// with their straight-line kernels (`TREE_KERNELS`). `None` when `M(q)` is not positive
     /// definite.
     fn mass_matrix_factor(&self, q: &Self::Configuration) -> Option<TreeFactor<Self::Scalar, N>> {
         let parents = Self::SPEED_PARENTS.unwrap_or(crate::tree_factor::chain_parents());
@@ -183,5 +184,9 @@ impl<R: RobotDynamics<N>, const N: usize> Multibody<N> for R {
         tau: &SVector<R::Scalar, N>,
     ) -> Option<SVector<R::Scalar, N>> {
         RobotDynamics::forward_dynamics(self, q, u, tau)
+    }
+
+    fn mass_matrix_factor(&self, q: &Self::Configuration) -> Option<TreeFactor<R::Scalar, N>> {
+        RobotDynamics::mass_matrix_factor(self, q)
     }
 }

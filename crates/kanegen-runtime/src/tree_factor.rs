@@ -69,13 +69,29 @@ pub const fn is_parent_array<const N: usize>(parents: &[Option<usize>; N]) -> bo
     true
 }
 
+/// Straight-line kernels of the factorisation and the two substitutions for one parent array,
+/// generated with a module (its `TREE_KERNELS`, the loops of [`TreeFactor`] unrolled at
+/// generation time: no loop or index arithmetic left, which on a quadruped or a humanoid is most
+/// of the loops' time). The arrays are [`TreeFactor`]'s storage: column `k` holds `L(k, i)` in
+/// row `i` and `1 / D(k)` in row `k`.
+#[derive(Clone, Copy, Debug)]
+pub struct TreeKernels<T, const N: usize> {
+    /// The factorisation in place (the matrix in, the factor out); `false` when a pivot is not
+    /// positive.
+    pub factorise: fn(&mut [[T; N]; N]) -> bool,
+    /// `y ← L⁻ᵀ y` ([`TreeFactor::solve_transposed_unit`]).
+    pub solve_transposed_unit: fn(&[[T; N]; N], &mut [T; N]),
+    /// `x ← L⁻¹ D⁻¹ x` ([`TreeFactor::finish_solve`]).
+    pub finish_solve: fn(&[[T; N]; N], &mut [T; N]),
+}
+
 /// `M = Lᵀ D L` for a symmetric positive definite `M` whose pattern fits a parent array (see the
 /// [module docs](self)), on the stack: [`new`](Self::new), then [`solve`](Self::solve) or
 /// [`solve_columns`](Self::solve_columns) (`M⁻¹ b`), or the two halves
 /// ([`solve_transposed_unit`](Self::solve_transposed_unit), then
 /// [`finish_solve`](Self::finish_solve)) where `M⁻¹ = L⁻¹ D⁻¹ L⁻ᵀ` is needed as a product
 /// (the contact Schur complement, [`crate::contact`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug)]
 pub struct TreeFactor<T, const N: usize> {
     /// Column `k`: `L(k, i)` in row `i` for the ancestors `i` of `k`, `1 / D(k)` in row `k`.
     cols: [[T; N]; N],
@@ -84,6 +100,8 @@ pub struct TreeFactor<T, const N: usize> {
     /// The first speed of the run of consecutive ancestors that ends at `k`: every `j` in
     /// `run_start[k] + 1 ..= k` has parent `j − 1`.
     run_start: [usize; N],
+    /// Straight-line kernels for `parents`, if generated.
+    kernels: Option<TreeKernels<T, N>>,
 }
 
 impl<T: RealField + Copy, const N: usize> TreeFactor<T, N> {
@@ -93,6 +111,27 @@ impl<T: RealField + Copy, const N: usize> TreeFactor<T, N> {
     /// definite, or has a NaN entry) or `parents` is not a parent array (`λ(i) ≥ i`).
     #[inline]
     pub fn new(m: &SMatrix<T, N, N>, parents: &[Option<usize>; N]) -> Option<Self> {
+        Self::build(m, parents, None)
+    }
+
+    /// [`new`](Self::new) through the straight-line `kernels` generated for `parents` (a
+    /// generated module's `TREE_KERNELS` with its `SPEED_PARENTS`), which then also run the
+    /// substitutions. Kernels generated for another parent array give a wrong factor.
+    #[inline]
+    pub fn with_kernels(
+        m: &SMatrix<T, N, N>,
+        parents: &[Option<usize>; N],
+        kernels: TreeKernels<T, N>,
+    ) -> Option<Self> {
+        Self::build(m, parents, Some(kernels))
+    }
+
+    #[inline(always)]
+    fn build(
+        m: &SMatrix<T, N, N>,
+        parents: &[Option<usize>; N],
+        kernels: Option<TreeKernels<T, N>>,
+    ) -> Option<Self> {
         if !is_parent_array(parents) {
             return None;
         }
@@ -107,7 +146,11 @@ impl<T: RealField + Copy, const N: usize> TreeFactor<T, N> {
             cols: m.data.0,
             parents: *parents,
             run_start,
+            kernels,
         };
+        if let Some(k) = kernels {
+            return (k.factorise)(&mut factor.cols).then_some(factor);
+        }
         let ok = crate::isa::dispatch_fused_with(
             &mut factor,
             #[inline(always)]
@@ -188,6 +231,9 @@ impl<T: RealField + Copy, const N: usize> TreeFactor<T, N> {
     /// that is zero outside the ancestors of some speed stays so (a contact Jacobian's row).
     #[inline]
     pub fn solve_transposed_unit(&self, y: &mut SVector<T, N>) {
+        if let Some(k) = &self.kernels {
+            return (k.solve_transposed_unit)(&self.cols, &mut y.data.0[0]);
+        }
         crate::isa::dispatch_fused_with(
             y,
             #[inline(always)]
@@ -201,6 +247,9 @@ impl<T: RealField + Copy, const N: usize> TreeFactor<T, N> {
     /// [`solve_transposed_unit`](Self::solve_transposed_unit).
     #[inline]
     pub fn finish_solve(&self, x: &mut SVector<T, N>) {
+        if let Some(k) = &self.kernels {
+            return (k.finish_solve)(&self.cols, &mut x.data.0[0]);
+        }
         crate::isa::dispatch_fused_with(
             x,
             #[inline(always)]
@@ -214,6 +263,11 @@ impl<T: RealField + Copy, const N: usize> TreeFactor<T, N> {
     #[inline]
     pub fn solve(&self, b: &SVector<T, N>) -> SVector<T, N> {
         let mut x = *b;
+        if let Some(k) = &self.kernels {
+            (k.solve_transposed_unit)(&self.cols, &mut x.data.0[0]);
+            (k.finish_solve)(&self.cols, &mut x.data.0[0]);
+            return x;
+        }
         crate::isa::dispatch_fused_with(
             &mut x,
             #[inline(always)]
@@ -233,6 +287,13 @@ impl<T: RealField + Copy, const N: usize> TreeFactor<T, N> {
     /// `X ← M⁻¹ X`, column by column.
     #[inline]
     pub fn solve_columns<const C: usize>(&self, x: &mut SMatrix<T, N, C>) {
+        if let Some(k) = &self.kernels {
+            for c in x.data.0.iter_mut() {
+                (k.solve_transposed_unit)(&self.cols, c);
+                (k.finish_solve)(&self.cols, c);
+            }
+            return;
+        }
         crate::isa::dispatch_fused_with(
             x,
             #[inline(always)]

@@ -215,7 +215,12 @@ pub(super) fn kernels(cx: &Context<'_>) -> TokenStream {
             }});
         }
     }
-    // Lᵀ y = b, from the last speed up; a zero entry moves nothing.
+    // Lᵀ y = b, from the last speed up; a zero entry moves nothing. Speeds at the root only
+    // (no ancestors anywhere): nothing to do.
+    let unused = anc
+        .iter()
+        .all(Vec::is_empty)
+        .then(|| quote!(let _ = (h, y);));
     let backward = (0..n).rev().filter(|&i| !anc[i].is_empty()).map(|i| {
         let ii = idx(i);
         let updates = anc[i].iter().rev().map(|&j| {
@@ -306,6 +311,7 @@ pub(super) fn kernels(cx: &Context<'_>) -> TokenStream {
         pub fn tree_solve_transposed_unit(h: &[[#t; #nn]; #nn], y: &mut [#t; #nn]) {
             #[inline(always)]
             fn body<A: kanegen_runtime::isa::Arith<#t>>((h, y): (&[[#t; #nn]; #nn], &mut [#t; #nn])) {
+                #unused
                 #(#backward)*
             }
             #call_backward

@@ -297,9 +297,9 @@ pub fn contact_impulse<T: RealField + Copy, const N: usize, const K: usize>(
 }
 
 /// `W = L⁻ᵀ J_cᵀ` (`M = Lᵀ D L`, `factor`), the pivots' reciprocals `D⁻¹`, and the Cholesky
-/// factor of `J_c M⁻¹ J_cᵀ + ρ 1 = Wᵀ D⁻¹ W + ρ 1` (symmetric by construction). A contact's
-/// rows of `J_c` are zero off the speeds that move its frame, and so are their columns of `W`
-/// (the substitution skips them).
+/// factor of `J_c M⁻¹ J_cᵀ + ρ 1 = Wᵀ D⁻¹ W + ρ 1`. A contact's rows of `J_c` are zero off the
+/// speeds that move its frame, and so are their columns of `W` (the substitution skips them, and
+/// so does the product, [`gram`]).
 #[allow(clippy::type_complexity)]
 fn tree_schur<T: RealField + Copy, const N: usize, const K: usize>(
     factor: &TreeFactor<T, N>,
@@ -314,24 +314,51 @@ fn tree_schur<T: RealField + Copy, const N: usize, const K: usize>(
     ContactError,
 > {
     let mut w = jc.transpose();
-    for mut c in w.column_iter_mut() {
-        let mut col: SVector<T, N> = c.clone_owned();
-        factor.solve_transposed_unit(&mut col);
-        c.copy_from(&col);
+    for c in w.data.0.iter_mut() {
+        factor.solve_transposed_unit_array(c);
     }
     let d_inv = factor.pivots().map(|d| T::one() / d);
+    let wt = w.transpose();
     let mut s = SMatrix::<T, K, K>::zeros();
-    for a in 0..K {
-        let wa = w.column(a).component_mul(&d_inv);
-        for b in 0..=a {
-            let v = wa.dot(&w.column(b));
-            s[(a, b)] = v;
-            s[(b, a)] = v;
-        }
-        s[(a, a)] += damping;
+    crate::isa::dispatch_fused_with(
+        &mut s.data.0,
+        #[inline(always)]
+        |s| gram::<T, N, K, false>(&wt.data.0, &w.data.0, &d_inv.data.0[0], s),
+        #[inline(always)]
+        |s| gram::<T, N, K, true>(&wt.data.0, &w.data.0, &d_inv.data.0[0], s),
+    );
+    for i in 0..K {
+        s[(i, i)] += damping;
     }
     let chol = s.cholesky().ok_or(ContactError::DependentContacts)?;
     Ok((w, d_inv, chol))
+}
+
+/// `S = Wᵀ D⁻¹ W`, column `b` at a time: `S(:, b) = Σ_i W(i, :)ᵀ D⁻¹_i W(i, b)` over the rows
+/// `i` where `W(i, b) ≠ 0`, each term a `K`-long multiply-add over a column of `Wᵀ` (`wt`), which
+/// the compiler vectorises.
+#[inline(always)]
+fn gram<T: RealField + Copy, const N: usize, const K: usize, const FUSED: bool>(
+    wt: &[[T; K]; N],
+    w: &[[T; N]; K],
+    d_inv: &[T; N],
+    s: &mut [[T; K]; K],
+) {
+    for (sb, wb) in s.iter_mut().zip(w) {
+        for i in 0..N {
+            if wb[i] == T::zero() {
+                continue;
+            }
+            let x = wb[i] * d_inv[i];
+            for (sab, wia) in sb.iter_mut().zip(&wt[i]) {
+                *sab = if FUSED {
+                    wia.mul_add(x, *sab)
+                } else {
+                    *sab + *wia * x
+                };
+            }
+        }
+    }
 }
 
 /// [`constrained_forward_dynamics`] through a factor of `M` along the tree

@@ -197,7 +197,10 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
     /// pass, one mass matrix and its dense Cholesky factor (nalgebra, on the stack), one
     /// derivative pass and the triangular solves of the `3N` right-hand sides `[−∂τ/∂q | −∂τ/∂u
     /// | I]` in place, eight at a time side by side (compiled for the baseline and, where the
-    /// CPU has it, x86-64-v3); no heap.
+    /// CPU has it, x86-64-v3); no heap. With [`SPEED_PARENTS`](RobotDynamics::SPEED_PARENTS)
+    /// `u̇` itself comes from [`mass_matrix_factor`](RobotDynamics::mass_matrix_factor) (a
+    /// second mass matrix), so that it is [`forward_dynamics`](RobotDynamics::forward_dynamics)'s
+    /// bit for bit.
     ///
     /// `None` when `M(q)` is not positive definite (non-physical parameters), as
     /// [`forward_dynamics`](RobotDynamics::forward_dynamics). `krang-dynamics`'s
@@ -210,7 +213,14 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
         tau: &SVector<Self::Scalar, N>,
     ) -> Option<ForwardDynamicsDerivatives<Self::Scalar, N>> {
         let factor = DenseFactor::new(self.mass_matrix(q))?;
-        let ud = factor.solve(&(tau - self.inverse_dynamics(q, u, &SVector::zeros())));
+        let bias = self.inverse_dynamics(q, u, &SVector::zeros());
+        // `ud` as `forward_dynamics` computes it, bit for bit (along the tree where there is one;
+        // the many-column solves below stay with the dense factor's grouped substitutions).
+        let ud = if Self::SPEED_PARENTS.is_some() {
+            self.mass_matrix_factor(q)?.solve(&(tau - bias))
+        } else {
+            factor.solve(&(tau - bias))
+        };
         let (mut dud_dq, mut dud_du) = self.inverse_dynamics_partials(q, u, &ud);
         // X = M⁻¹ [−∂τ/∂q | −∂τ/∂u | I], solved in place: the partials are negated (exactly)
         // as they are copied into the solve's groups.

@@ -231,15 +231,22 @@ impl<T: RealField + Copy, const N: usize> TreeFactor<T, N> {
     /// that is zero outside the ancestors of some speed stays so (a contact Jacobian's row).
     #[inline]
     pub fn solve_transposed_unit(&self, y: &mut SVector<T, N>) {
+        self.solve_transposed_unit_array(&mut y.data.0[0]);
+    }
+
+    /// [`solve_transposed_unit`](Self::solve_transposed_unit) of an array (a column of a
+    /// matrix's storage).
+    #[inline]
+    pub(crate) fn solve_transposed_unit_array(&self, y: &mut [T; N]) {
         if let Some(k) = &self.kernels {
-            return (k.solve_transposed_unit)(&self.cols, &mut y.data.0[0]);
+            return (k.solve_transposed_unit)(&self.cols, y);
         }
         crate::isa::dispatch_fused_with(
             y,
             #[inline(always)]
-            |y| self.backward::<false>(y.as_mut_slice()),
+            |y| self.backward::<false>(y),
             #[inline(always)]
-            |y| self.backward::<true>(y.as_mut_slice()),
+            |y| self.backward::<true>(y),
         );
     }
 

@@ -165,7 +165,7 @@ fn generated_straight_line_kernels_give_the_runtime_loops_factor() {
         );
     }
     // An f32 module with its parameters baked in has the kernels in f32.
-    let two = two_link_f32::TwoLink::default();
+    let two = two_link_f32::TwoLink;
     let q = SVector::<f32, 2>::from([0.3, -0.7]);
     let m = kanegen_runtime::RobotDynamics::mass_matrix(&two, &q);
     let b = SVector::<f32, 2>::from([1.0, 2.0]);

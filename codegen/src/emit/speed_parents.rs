@@ -167,6 +167,7 @@ pub(super) fn trait_items(cx: &Context<'_>, q_ty: &TokenStream) -> TokenStream {
     if kernel_parents(cx).is_some() {
         let t = scalar_type(cx.precision);
         out.extend(quote! {
+            #[inline]
             fn mass_matrix_factor(&self, q: &#q_ty)
                 -> Option<kanegen_runtime::tree_factor::TreeFactor<#t, DOF>>
             {

@@ -117,7 +117,7 @@ impl<T: RealField + Copy, const N: usize> TreeFactor<T, N> {
     /// [`new`](Self::new) through the straight-line `kernels` generated for `parents` (a
     /// generated module's `TREE_KERNELS` with its `SPEED_PARENTS`), which then also run the
     /// substitutions. Kernels generated for another parent array give a wrong factor.
-    #[inline]
+    #[inline(always)]
     pub fn with_kernels(
         m: &SMatrix<T, N, N>,
         parents: &[Option<usize>; N],
@@ -149,7 +149,11 @@ impl<T: RealField + Copy, const N: usize> TreeFactor<T, N> {
             kernels,
         };
         if let Some(k) = kernels {
-            return (k.factorise)(&mut factor.cols).then_some(factor);
+            return if (k.factorise)(&mut factor.cols) {
+                Some(factor)
+            } else {
+                None
+            };
         }
         let ok = crate::isa::dispatch_fused_with(
             &mut factor,
@@ -195,7 +199,8 @@ impl<T: RealField + Copy, const N: usize> TreeFactor<T, N> {
     fn factorise<const FUSED: bool>(&mut self) -> bool {
         for k in (0..N).rev() {
             let d = self.cols[k][k];
-            if !(d > T::zero()) {
+            // Not positive, or NaN.
+            if d.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
                 return false;
             }
             let inv = T::one() / d;

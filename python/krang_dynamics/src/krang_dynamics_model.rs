@@ -30137,6 +30137,7 @@ mod generated {
         const SPEED_NAMES: [&'static str; DOF] = SPEED_NAMES;
         const COORDINATE_NAMES: [&'static str; DOF] = COORDINATE_NAMES;
         const SPEED_PARENTS: Option<[Option<usize>; DOF]> = Some(SPEED_PARENTS);
+        #[inline]
         fn mass_matrix_factor(
             &self,
             q: &SVector<f64, DOF>,

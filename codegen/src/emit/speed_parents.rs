@@ -328,3 +328,70 @@ pub(super) fn kernels(cx: &Context<'_>) -> TokenStream {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{fits, parents};
+    use crate::options::{Options, ParamMode};
+    use crate::registry::{FunctionId, FunctionSet};
+    use kanegen_model::{Model, UrdfOptions};
+
+    fn root() -> String {
+        concat!(env!("CARGO_MANIFEST_DIR"), "/..").to_owned()
+    }
+
+    /// The lowered mass matrix of `model`.
+    fn mass_matrix(model: &Model) -> crate::lower::Program {
+        let options = Options {
+            params: ParamMode::Runtime,
+            functions: FunctionSet::default(),
+        };
+        let low = crate::lower::lower(&crate::kane::derive(model, options));
+        low.functions
+            .into_iter()
+            .find(|f| f.id == FunctionId::MassMatrix)
+            .unwrap()
+            .program
+    }
+
+    #[test]
+    fn parents_follow_the_tree_and_fit_the_generated_mass_matrix() {
+        let solo = Model::from_urdf_file(
+            format!("{}/tests/corpus/solo12.urdf", root()),
+            &UrdfOptions::floating(),
+        )
+        .unwrap();
+        let lambda = parents(&solo).unwrap();
+        let mut expected: Vec<Option<usize>> = (0..18).map(|i: usize| i.checked_sub(1)).collect();
+        for leg in 0..4 {
+            expected[6 + 3 * leg] = Some(5);
+        }
+        assert_eq!(lambda, expected);
+        assert!(fits(&lambda, &mass_matrix(&solo)));
+        // Krang: the wheeled base's two speeds at the root.
+        let krang = Model::from_toml_file(format!("{}/models/krang.toml", root())).unwrap();
+        let lambda = parents(&krang).unwrap();
+        assert_eq!(&lambda[..2], &[None, Some(0)]);
+        assert!(fits(&lambda, &mass_matrix(&krang)));
+    }
+
+    #[test]
+    fn a_parent_array_that_misses_a_coupling_does_not_fit() {
+        let two = Model::from_toml_file(format!("{}/models/two-link.toml", root())).unwrap();
+        let m = mass_matrix(&two);
+        assert!(fits(&[None, Some(0)], &m));
+        // Two independent roots would claim M(0, 1) = 0; the generated matrix says otherwise.
+        assert!(!fits(&[None, None], &m));
+    }
+
+    #[test]
+    fn mimic_joints_have_no_parent_array() {
+        let gripper = Model::from_urdf_file(
+            format!("{}/models/mimic_gripper.urdf", root()),
+            &UrdfOptions::default(),
+        )
+        .unwrap();
+        assert!(!gripper.mimics.is_empty());
+        assert_eq!(parents(&gripper), None);
+    }
+}

@@ -101,7 +101,11 @@ pub trait Multibody<const N: usize> {
     ) -> Option<SVector<Self::Scalar, N>> {
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
         if Self::SPEED_PARENTS.is_some() {
-            return Some(self.mass_matrix_factor(q)?.solve(&(tau - bias)));
+            // Solved where it lies: the factor (N² entries) is not moved out of the `Option`.
+            return self
+                .mass_matrix_factor(q)
+                .as_ref()
+                .map(|factor| factor.solve(&(tau - bias)));
         }
         let factor = DenseFactor::new(self.mass_matrix(q))?;
         Some(factor.solve(&(tau - bias)))

@@ -60,6 +60,33 @@ mod generated {
         "q6r",
         "q7r",
     ];
+    /// The speeds' parent array `λ`: entry `i` is the speed nearest to speed `i` on the path
+    /// from its joint towards the root (`None` at the root; a floating base's six speeds form
+    /// a chain there), always before `i`. The mass matrix is structurally zero between two
+    /// speeds neither of which is an ancestor of the other (verified on the generated
+    /// matrix), so `kanegen_runtime::tree_factor::TreeFactor` factors it without fill-in:
+    /// the traits' `forward_dynamics` and `mass_matrix_factor` do.
+    pub const SPEED_PARENTS: [Option<usize>; 19] = [
+        None,
+        Some(0),
+        Some(1),
+        Some(2),
+        Some(3),
+        Some(4),
+        Some(5),
+        Some(6),
+        Some(7),
+        Some(8),
+        Some(9),
+        Some(10),
+        Some(4),
+        Some(12),
+        Some(13),
+        Some(14),
+        Some(15),
+        Some(16),
+        Some(17),
+    ];
     /// Index constants: of each coordinate in `q` (`Q_IMU`) and of its speed in `u`, `u̇`
     /// and `τ` (`QD_IMU`); a coordinate and its speed have the same index.
     pub mod index {
@@ -16152,6 +16179,18 @@ mod generated {
         type Scalar = f64;
         const SPEED_NAMES: [&'static str; DOF] = SPEED_NAMES;
         const COORDINATE_NAMES: [&'static str; DOF] = COORDINATE_NAMES;
+        const SPEED_PARENTS: Option<[Option<usize>; DOF]> = Some(SPEED_PARENTS);
+        #[inline]
+        fn mass_matrix_factor(
+            &self,
+            q: &SVector<f64, DOF>,
+        ) -> Option<kanegen_runtime::tree_factor::TreeFactor<f64, DOF>> {
+            kanegen_runtime::tree_factor::TreeFactor::with_kernels(
+                &self.mass_matrix(q),
+                &SPEED_PARENTS,
+                TREE_KERNELS,
+            )
+        }
         fn mass_matrix(&self, q: &SVector<f64, 19>) -> SMatrix<f64, 19, 19> {
             mass_matrix(&self.params, &self.pre, q)
         }
@@ -16182,5 +16221,1611 @@ mod generated {
         ) -> SMatrix<f64, 19, 19> {
             coriolis_matrix(&self.params, &self.pre, q, u)
         }
+    }
+    /// Straight-line kernels of `M = Lᵀ D L` along [`SPEED_PARENTS`]
+    /// (`kanegen_runtime::tree_factor`): what the traits' `mass_matrix_factor` and
+    /// `forward_dynamics` of this robot run.
+    pub const TREE_KERNELS: kanegen_runtime::tree_factor::TreeKernels<f64, 19> = kanegen_runtime::tree_factor::TreeKernels {
+        factorise: tree_factorise,
+        solve_transposed_unit: tree_solve_transposed_unit,
+        finish_solve: tree_finish_solve,
+    };
+    /// The factorisation of [`TREE_KERNELS`], in place; `false` when a pivot is not
+    /// positive.
+    pub fn tree_factorise(h: &mut [[f64; 19]; 19]) -> bool {
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>>(h: &mut [[f64; 19]; 19]) -> bool {
+            let mut ok = true;
+            ok &= h[18][18] > 0.0;
+            let inv = 1.0 / h[18][18];
+            h[18][18] = inv;
+            {
+                let a = h[18][17] * inv;
+                h[17][0] = A::mul_add(-a, h[18][0], h[17][0]);
+                h[17][1] = A::mul_add(-a, h[18][1], h[17][1]);
+                h[17][2] = A::mul_add(-a, h[18][2], h[17][2]);
+                h[17][3] = A::mul_add(-a, h[18][3], h[17][3]);
+                h[17][4] = A::mul_add(-a, h[18][4], h[17][4]);
+                h[17][12] = A::mul_add(-a, h[18][12], h[17][12]);
+                h[17][13] = A::mul_add(-a, h[18][13], h[17][13]);
+                h[17][14] = A::mul_add(-a, h[18][14], h[17][14]);
+                h[17][15] = A::mul_add(-a, h[18][15], h[17][15]);
+                h[17][16] = A::mul_add(-a, h[18][16], h[17][16]);
+                h[17][17] = A::mul_add(-a, h[18][17], h[17][17]);
+                h[18][17] = a;
+            }
+            {
+                let a = h[18][16] * inv;
+                h[16][0] = A::mul_add(-a, h[18][0], h[16][0]);
+                h[16][1] = A::mul_add(-a, h[18][1], h[16][1]);
+                h[16][2] = A::mul_add(-a, h[18][2], h[16][2]);
+                h[16][3] = A::mul_add(-a, h[18][3], h[16][3]);
+                h[16][4] = A::mul_add(-a, h[18][4], h[16][4]);
+                h[16][12] = A::mul_add(-a, h[18][12], h[16][12]);
+                h[16][13] = A::mul_add(-a, h[18][13], h[16][13]);
+                h[16][14] = A::mul_add(-a, h[18][14], h[16][14]);
+                h[16][15] = A::mul_add(-a, h[18][15], h[16][15]);
+                h[16][16] = A::mul_add(-a, h[18][16], h[16][16]);
+                h[18][16] = a;
+            }
+            {
+                let a = h[18][15] * inv;
+                h[15][0] = A::mul_add(-a, h[18][0], h[15][0]);
+                h[15][1] = A::mul_add(-a, h[18][1], h[15][1]);
+                h[15][2] = A::mul_add(-a, h[18][2], h[15][2]);
+                h[15][3] = A::mul_add(-a, h[18][3], h[15][3]);
+                h[15][4] = A::mul_add(-a, h[18][4], h[15][4]);
+                h[15][12] = A::mul_add(-a, h[18][12], h[15][12]);
+                h[15][13] = A::mul_add(-a, h[18][13], h[15][13]);
+                h[15][14] = A::mul_add(-a, h[18][14], h[15][14]);
+                h[15][15] = A::mul_add(-a, h[18][15], h[15][15]);
+                h[18][15] = a;
+            }
+            {
+                let a = h[18][14] * inv;
+                h[14][0] = A::mul_add(-a, h[18][0], h[14][0]);
+                h[14][1] = A::mul_add(-a, h[18][1], h[14][1]);
+                h[14][2] = A::mul_add(-a, h[18][2], h[14][2]);
+                h[14][3] = A::mul_add(-a, h[18][3], h[14][3]);
+                h[14][4] = A::mul_add(-a, h[18][4], h[14][4]);
+                h[14][12] = A::mul_add(-a, h[18][12], h[14][12]);
+                h[14][13] = A::mul_add(-a, h[18][13], h[14][13]);
+                h[14][14] = A::mul_add(-a, h[18][14], h[14][14]);
+                h[18][14] = a;
+            }
+            {
+                let a = h[18][13] * inv;
+                h[13][0] = A::mul_add(-a, h[18][0], h[13][0]);
+                h[13][1] = A::mul_add(-a, h[18][1], h[13][1]);
+                h[13][2] = A::mul_add(-a, h[18][2], h[13][2]);
+                h[13][3] = A::mul_add(-a, h[18][3], h[13][3]);
+                h[13][4] = A::mul_add(-a, h[18][4], h[13][4]);
+                h[13][12] = A::mul_add(-a, h[18][12], h[13][12]);
+                h[13][13] = A::mul_add(-a, h[18][13], h[13][13]);
+                h[18][13] = a;
+            }
+            {
+                let a = h[18][12] * inv;
+                h[12][0] = A::mul_add(-a, h[18][0], h[12][0]);
+                h[12][1] = A::mul_add(-a, h[18][1], h[12][1]);
+                h[12][2] = A::mul_add(-a, h[18][2], h[12][2]);
+                h[12][3] = A::mul_add(-a, h[18][3], h[12][3]);
+                h[12][4] = A::mul_add(-a, h[18][4], h[12][4]);
+                h[12][12] = A::mul_add(-a, h[18][12], h[12][12]);
+                h[18][12] = a;
+            }
+            {
+                let a = h[18][4] * inv;
+                h[4][0] = A::mul_add(-a, h[18][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[18][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[18][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[18][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[18][4], h[4][4]);
+                h[18][4] = a;
+            }
+            {
+                let a = h[18][3] * inv;
+                h[3][0] = A::mul_add(-a, h[18][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[18][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[18][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[18][3], h[3][3]);
+                h[18][3] = a;
+            }
+            {
+                let a = h[18][2] * inv;
+                h[2][0] = A::mul_add(-a, h[18][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[18][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[18][2], h[2][2]);
+                h[18][2] = a;
+            }
+            {
+                let a = h[18][1] * inv;
+                h[1][0] = A::mul_add(-a, h[18][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[18][1], h[1][1]);
+                h[18][1] = a;
+            }
+            {
+                let a = h[18][0] * inv;
+                h[0][0] = A::mul_add(-a, h[18][0], h[0][0]);
+                h[18][0] = a;
+            }
+            ok &= h[17][17] > 0.0;
+            let inv = 1.0 / h[17][17];
+            h[17][17] = inv;
+            {
+                let a = h[17][16] * inv;
+                h[16][0] = A::mul_add(-a, h[17][0], h[16][0]);
+                h[16][1] = A::mul_add(-a, h[17][1], h[16][1]);
+                h[16][2] = A::mul_add(-a, h[17][2], h[16][2]);
+                h[16][3] = A::mul_add(-a, h[17][3], h[16][3]);
+                h[16][4] = A::mul_add(-a, h[17][4], h[16][4]);
+                h[16][12] = A::mul_add(-a, h[17][12], h[16][12]);
+                h[16][13] = A::mul_add(-a, h[17][13], h[16][13]);
+                h[16][14] = A::mul_add(-a, h[17][14], h[16][14]);
+                h[16][15] = A::mul_add(-a, h[17][15], h[16][15]);
+                h[16][16] = A::mul_add(-a, h[17][16], h[16][16]);
+                h[17][16] = a;
+            }
+            {
+                let a = h[17][15] * inv;
+                h[15][0] = A::mul_add(-a, h[17][0], h[15][0]);
+                h[15][1] = A::mul_add(-a, h[17][1], h[15][1]);
+                h[15][2] = A::mul_add(-a, h[17][2], h[15][2]);
+                h[15][3] = A::mul_add(-a, h[17][3], h[15][3]);
+                h[15][4] = A::mul_add(-a, h[17][4], h[15][4]);
+                h[15][12] = A::mul_add(-a, h[17][12], h[15][12]);
+                h[15][13] = A::mul_add(-a, h[17][13], h[15][13]);
+                h[15][14] = A::mul_add(-a, h[17][14], h[15][14]);
+                h[15][15] = A::mul_add(-a, h[17][15], h[15][15]);
+                h[17][15] = a;
+            }
+            {
+                let a = h[17][14] * inv;
+                h[14][0] = A::mul_add(-a, h[17][0], h[14][0]);
+                h[14][1] = A::mul_add(-a, h[17][1], h[14][1]);
+                h[14][2] = A::mul_add(-a, h[17][2], h[14][2]);
+                h[14][3] = A::mul_add(-a, h[17][3], h[14][3]);
+                h[14][4] = A::mul_add(-a, h[17][4], h[14][4]);
+                h[14][12] = A::mul_add(-a, h[17][12], h[14][12]);
+                h[14][13] = A::mul_add(-a, h[17][13], h[14][13]);
+                h[14][14] = A::mul_add(-a, h[17][14], h[14][14]);
+                h[17][14] = a;
+            }
+            {
+                let a = h[17][13] * inv;
+                h[13][0] = A::mul_add(-a, h[17][0], h[13][0]);
+                h[13][1] = A::mul_add(-a, h[17][1], h[13][1]);
+                h[13][2] = A::mul_add(-a, h[17][2], h[13][2]);
+                h[13][3] = A::mul_add(-a, h[17][3], h[13][3]);
+                h[13][4] = A::mul_add(-a, h[17][4], h[13][4]);
+                h[13][12] = A::mul_add(-a, h[17][12], h[13][12]);
+                h[13][13] = A::mul_add(-a, h[17][13], h[13][13]);
+                h[17][13] = a;
+            }
+            {
+                let a = h[17][12] * inv;
+                h[12][0] = A::mul_add(-a, h[17][0], h[12][0]);
+                h[12][1] = A::mul_add(-a, h[17][1], h[12][1]);
+                h[12][2] = A::mul_add(-a, h[17][2], h[12][2]);
+                h[12][3] = A::mul_add(-a, h[17][3], h[12][3]);
+                h[12][4] = A::mul_add(-a, h[17][4], h[12][4]);
+                h[12][12] = A::mul_add(-a, h[17][12], h[12][12]);
+                h[17][12] = a;
+            }
+            {
+                let a = h[17][4] * inv;
+                h[4][0] = A::mul_add(-a, h[17][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[17][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[17][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[17][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[17][4], h[4][4]);
+                h[17][4] = a;
+            }
+            {
+                let a = h[17][3] * inv;
+                h[3][0] = A::mul_add(-a, h[17][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[17][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[17][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[17][3], h[3][3]);
+                h[17][3] = a;
+            }
+            {
+                let a = h[17][2] * inv;
+                h[2][0] = A::mul_add(-a, h[17][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[17][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[17][2], h[2][2]);
+                h[17][2] = a;
+            }
+            {
+                let a = h[17][1] * inv;
+                h[1][0] = A::mul_add(-a, h[17][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[17][1], h[1][1]);
+                h[17][1] = a;
+            }
+            {
+                let a = h[17][0] * inv;
+                h[0][0] = A::mul_add(-a, h[17][0], h[0][0]);
+                h[17][0] = a;
+            }
+            ok &= h[16][16] > 0.0;
+            let inv = 1.0 / h[16][16];
+            h[16][16] = inv;
+            {
+                let a = h[16][15] * inv;
+                h[15][0] = A::mul_add(-a, h[16][0], h[15][0]);
+                h[15][1] = A::mul_add(-a, h[16][1], h[15][1]);
+                h[15][2] = A::mul_add(-a, h[16][2], h[15][2]);
+                h[15][3] = A::mul_add(-a, h[16][3], h[15][3]);
+                h[15][4] = A::mul_add(-a, h[16][4], h[15][4]);
+                h[15][12] = A::mul_add(-a, h[16][12], h[15][12]);
+                h[15][13] = A::mul_add(-a, h[16][13], h[15][13]);
+                h[15][14] = A::mul_add(-a, h[16][14], h[15][14]);
+                h[15][15] = A::mul_add(-a, h[16][15], h[15][15]);
+                h[16][15] = a;
+            }
+            {
+                let a = h[16][14] * inv;
+                h[14][0] = A::mul_add(-a, h[16][0], h[14][0]);
+                h[14][1] = A::mul_add(-a, h[16][1], h[14][1]);
+                h[14][2] = A::mul_add(-a, h[16][2], h[14][2]);
+                h[14][3] = A::mul_add(-a, h[16][3], h[14][3]);
+                h[14][4] = A::mul_add(-a, h[16][4], h[14][4]);
+                h[14][12] = A::mul_add(-a, h[16][12], h[14][12]);
+                h[14][13] = A::mul_add(-a, h[16][13], h[14][13]);
+                h[14][14] = A::mul_add(-a, h[16][14], h[14][14]);
+                h[16][14] = a;
+            }
+            {
+                let a = h[16][13] * inv;
+                h[13][0] = A::mul_add(-a, h[16][0], h[13][0]);
+                h[13][1] = A::mul_add(-a, h[16][1], h[13][1]);
+                h[13][2] = A::mul_add(-a, h[16][2], h[13][2]);
+                h[13][3] = A::mul_add(-a, h[16][3], h[13][3]);
+                h[13][4] = A::mul_add(-a, h[16][4], h[13][4]);
+                h[13][12] = A::mul_add(-a, h[16][12], h[13][12]);
+                h[13][13] = A::mul_add(-a, h[16][13], h[13][13]);
+                h[16][13] = a;
+            }
+            {
+                let a = h[16][12] * inv;
+                h[12][0] = A::mul_add(-a, h[16][0], h[12][0]);
+                h[12][1] = A::mul_add(-a, h[16][1], h[12][1]);
+                h[12][2] = A::mul_add(-a, h[16][2], h[12][2]);
+                h[12][3] = A::mul_add(-a, h[16][3], h[12][3]);
+                h[12][4] = A::mul_add(-a, h[16][4], h[12][4]);
+                h[12][12] = A::mul_add(-a, h[16][12], h[12][12]);
+                h[16][12] = a;
+            }
+            {
+                let a = h[16][4] * inv;
+                h[4][0] = A::mul_add(-a, h[16][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[16][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[16][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[16][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[16][4], h[4][4]);
+                h[16][4] = a;
+            }
+            {
+                let a = h[16][3] * inv;
+                h[3][0] = A::mul_add(-a, h[16][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[16][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[16][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[16][3], h[3][3]);
+                h[16][3] = a;
+            }
+            {
+                let a = h[16][2] * inv;
+                h[2][0] = A::mul_add(-a, h[16][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[16][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[16][2], h[2][2]);
+                h[16][2] = a;
+            }
+            {
+                let a = h[16][1] * inv;
+                h[1][0] = A::mul_add(-a, h[16][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[16][1], h[1][1]);
+                h[16][1] = a;
+            }
+            {
+                let a = h[16][0] * inv;
+                h[0][0] = A::mul_add(-a, h[16][0], h[0][0]);
+                h[16][0] = a;
+            }
+            ok &= h[15][15] > 0.0;
+            let inv = 1.0 / h[15][15];
+            h[15][15] = inv;
+            {
+                let a = h[15][14] * inv;
+                h[14][0] = A::mul_add(-a, h[15][0], h[14][0]);
+                h[14][1] = A::mul_add(-a, h[15][1], h[14][1]);
+                h[14][2] = A::mul_add(-a, h[15][2], h[14][2]);
+                h[14][3] = A::mul_add(-a, h[15][3], h[14][3]);
+                h[14][4] = A::mul_add(-a, h[15][4], h[14][4]);
+                h[14][12] = A::mul_add(-a, h[15][12], h[14][12]);
+                h[14][13] = A::mul_add(-a, h[15][13], h[14][13]);
+                h[14][14] = A::mul_add(-a, h[15][14], h[14][14]);
+                h[15][14] = a;
+            }
+            {
+                let a = h[15][13] * inv;
+                h[13][0] = A::mul_add(-a, h[15][0], h[13][0]);
+                h[13][1] = A::mul_add(-a, h[15][1], h[13][1]);
+                h[13][2] = A::mul_add(-a, h[15][2], h[13][2]);
+                h[13][3] = A::mul_add(-a, h[15][3], h[13][3]);
+                h[13][4] = A::mul_add(-a, h[15][4], h[13][4]);
+                h[13][12] = A::mul_add(-a, h[15][12], h[13][12]);
+                h[13][13] = A::mul_add(-a, h[15][13], h[13][13]);
+                h[15][13] = a;
+            }
+            {
+                let a = h[15][12] * inv;
+                h[12][0] = A::mul_add(-a, h[15][0], h[12][0]);
+                h[12][1] = A::mul_add(-a, h[15][1], h[12][1]);
+                h[12][2] = A::mul_add(-a, h[15][2], h[12][2]);
+                h[12][3] = A::mul_add(-a, h[15][3], h[12][3]);
+                h[12][4] = A::mul_add(-a, h[15][4], h[12][4]);
+                h[12][12] = A::mul_add(-a, h[15][12], h[12][12]);
+                h[15][12] = a;
+            }
+            {
+                let a = h[15][4] * inv;
+                h[4][0] = A::mul_add(-a, h[15][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[15][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[15][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[15][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[15][4], h[4][4]);
+                h[15][4] = a;
+            }
+            {
+                let a = h[15][3] * inv;
+                h[3][0] = A::mul_add(-a, h[15][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[15][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[15][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[15][3], h[3][3]);
+                h[15][3] = a;
+            }
+            {
+                let a = h[15][2] * inv;
+                h[2][0] = A::mul_add(-a, h[15][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[15][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[15][2], h[2][2]);
+                h[15][2] = a;
+            }
+            {
+                let a = h[15][1] * inv;
+                h[1][0] = A::mul_add(-a, h[15][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[15][1], h[1][1]);
+                h[15][1] = a;
+            }
+            {
+                let a = h[15][0] * inv;
+                h[0][0] = A::mul_add(-a, h[15][0], h[0][0]);
+                h[15][0] = a;
+            }
+            ok &= h[14][14] > 0.0;
+            let inv = 1.0 / h[14][14];
+            h[14][14] = inv;
+            {
+                let a = h[14][13] * inv;
+                h[13][0] = A::mul_add(-a, h[14][0], h[13][0]);
+                h[13][1] = A::mul_add(-a, h[14][1], h[13][1]);
+                h[13][2] = A::mul_add(-a, h[14][2], h[13][2]);
+                h[13][3] = A::mul_add(-a, h[14][3], h[13][3]);
+                h[13][4] = A::mul_add(-a, h[14][4], h[13][4]);
+                h[13][12] = A::mul_add(-a, h[14][12], h[13][12]);
+                h[13][13] = A::mul_add(-a, h[14][13], h[13][13]);
+                h[14][13] = a;
+            }
+            {
+                let a = h[14][12] * inv;
+                h[12][0] = A::mul_add(-a, h[14][0], h[12][0]);
+                h[12][1] = A::mul_add(-a, h[14][1], h[12][1]);
+                h[12][2] = A::mul_add(-a, h[14][2], h[12][2]);
+                h[12][3] = A::mul_add(-a, h[14][3], h[12][3]);
+                h[12][4] = A::mul_add(-a, h[14][4], h[12][4]);
+                h[12][12] = A::mul_add(-a, h[14][12], h[12][12]);
+                h[14][12] = a;
+            }
+            {
+                let a = h[14][4] * inv;
+                h[4][0] = A::mul_add(-a, h[14][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[14][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[14][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[14][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[14][4], h[4][4]);
+                h[14][4] = a;
+            }
+            {
+                let a = h[14][3] * inv;
+                h[3][0] = A::mul_add(-a, h[14][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[14][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[14][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[14][3], h[3][3]);
+                h[14][3] = a;
+            }
+            {
+                let a = h[14][2] * inv;
+                h[2][0] = A::mul_add(-a, h[14][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[14][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[14][2], h[2][2]);
+                h[14][2] = a;
+            }
+            {
+                let a = h[14][1] * inv;
+                h[1][0] = A::mul_add(-a, h[14][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[14][1], h[1][1]);
+                h[14][1] = a;
+            }
+            {
+                let a = h[14][0] * inv;
+                h[0][0] = A::mul_add(-a, h[14][0], h[0][0]);
+                h[14][0] = a;
+            }
+            ok &= h[13][13] > 0.0;
+            let inv = 1.0 / h[13][13];
+            h[13][13] = inv;
+            {
+                let a = h[13][12] * inv;
+                h[12][0] = A::mul_add(-a, h[13][0], h[12][0]);
+                h[12][1] = A::mul_add(-a, h[13][1], h[12][1]);
+                h[12][2] = A::mul_add(-a, h[13][2], h[12][2]);
+                h[12][3] = A::mul_add(-a, h[13][3], h[12][3]);
+                h[12][4] = A::mul_add(-a, h[13][4], h[12][4]);
+                h[12][12] = A::mul_add(-a, h[13][12], h[12][12]);
+                h[13][12] = a;
+            }
+            {
+                let a = h[13][4] * inv;
+                h[4][0] = A::mul_add(-a, h[13][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[13][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[13][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[13][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[13][4], h[4][4]);
+                h[13][4] = a;
+            }
+            {
+                let a = h[13][3] * inv;
+                h[3][0] = A::mul_add(-a, h[13][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[13][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[13][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[13][3], h[3][3]);
+                h[13][3] = a;
+            }
+            {
+                let a = h[13][2] * inv;
+                h[2][0] = A::mul_add(-a, h[13][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[13][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[13][2], h[2][2]);
+                h[13][2] = a;
+            }
+            {
+                let a = h[13][1] * inv;
+                h[1][0] = A::mul_add(-a, h[13][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[13][1], h[1][1]);
+                h[13][1] = a;
+            }
+            {
+                let a = h[13][0] * inv;
+                h[0][0] = A::mul_add(-a, h[13][0], h[0][0]);
+                h[13][0] = a;
+            }
+            ok &= h[12][12] > 0.0;
+            let inv = 1.0 / h[12][12];
+            h[12][12] = inv;
+            {
+                let a = h[12][4] * inv;
+                h[4][0] = A::mul_add(-a, h[12][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[12][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[12][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[12][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[12][4], h[4][4]);
+                h[12][4] = a;
+            }
+            {
+                let a = h[12][3] * inv;
+                h[3][0] = A::mul_add(-a, h[12][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[12][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[12][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[12][3], h[3][3]);
+                h[12][3] = a;
+            }
+            {
+                let a = h[12][2] * inv;
+                h[2][0] = A::mul_add(-a, h[12][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[12][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[12][2], h[2][2]);
+                h[12][2] = a;
+            }
+            {
+                let a = h[12][1] * inv;
+                h[1][0] = A::mul_add(-a, h[12][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[12][1], h[1][1]);
+                h[12][1] = a;
+            }
+            {
+                let a = h[12][0] * inv;
+                h[0][0] = A::mul_add(-a, h[12][0], h[0][0]);
+                h[12][0] = a;
+            }
+            ok &= h[11][11] > 0.0;
+            let inv = 1.0 / h[11][11];
+            h[11][11] = inv;
+            {
+                let a = h[11][10] * inv;
+                h[10][0] = A::mul_add(-a, h[11][0], h[10][0]);
+                h[10][1] = A::mul_add(-a, h[11][1], h[10][1]);
+                h[10][2] = A::mul_add(-a, h[11][2], h[10][2]);
+                h[10][3] = A::mul_add(-a, h[11][3], h[10][3]);
+                h[10][4] = A::mul_add(-a, h[11][4], h[10][4]);
+                h[10][5] = A::mul_add(-a, h[11][5], h[10][5]);
+                h[10][6] = A::mul_add(-a, h[11][6], h[10][6]);
+                h[10][7] = A::mul_add(-a, h[11][7], h[10][7]);
+                h[10][8] = A::mul_add(-a, h[11][8], h[10][8]);
+                h[10][9] = A::mul_add(-a, h[11][9], h[10][9]);
+                h[10][10] = A::mul_add(-a, h[11][10], h[10][10]);
+                h[11][10] = a;
+            }
+            {
+                let a = h[11][9] * inv;
+                h[9][0] = A::mul_add(-a, h[11][0], h[9][0]);
+                h[9][1] = A::mul_add(-a, h[11][1], h[9][1]);
+                h[9][2] = A::mul_add(-a, h[11][2], h[9][2]);
+                h[9][3] = A::mul_add(-a, h[11][3], h[9][3]);
+                h[9][4] = A::mul_add(-a, h[11][4], h[9][4]);
+                h[9][5] = A::mul_add(-a, h[11][5], h[9][5]);
+                h[9][6] = A::mul_add(-a, h[11][6], h[9][6]);
+                h[9][7] = A::mul_add(-a, h[11][7], h[9][7]);
+                h[9][8] = A::mul_add(-a, h[11][8], h[9][8]);
+                h[9][9] = A::mul_add(-a, h[11][9], h[9][9]);
+                h[11][9] = a;
+            }
+            {
+                let a = h[11][8] * inv;
+                h[8][0] = A::mul_add(-a, h[11][0], h[8][0]);
+                h[8][1] = A::mul_add(-a, h[11][1], h[8][1]);
+                h[8][2] = A::mul_add(-a, h[11][2], h[8][2]);
+                h[8][3] = A::mul_add(-a, h[11][3], h[8][3]);
+                h[8][4] = A::mul_add(-a, h[11][4], h[8][4]);
+                h[8][5] = A::mul_add(-a, h[11][5], h[8][5]);
+                h[8][6] = A::mul_add(-a, h[11][6], h[8][6]);
+                h[8][7] = A::mul_add(-a, h[11][7], h[8][7]);
+                h[8][8] = A::mul_add(-a, h[11][8], h[8][8]);
+                h[11][8] = a;
+            }
+            {
+                let a = h[11][7] * inv;
+                h[7][0] = A::mul_add(-a, h[11][0], h[7][0]);
+                h[7][1] = A::mul_add(-a, h[11][1], h[7][1]);
+                h[7][2] = A::mul_add(-a, h[11][2], h[7][2]);
+                h[7][3] = A::mul_add(-a, h[11][3], h[7][3]);
+                h[7][4] = A::mul_add(-a, h[11][4], h[7][4]);
+                h[7][5] = A::mul_add(-a, h[11][5], h[7][5]);
+                h[7][6] = A::mul_add(-a, h[11][6], h[7][6]);
+                h[7][7] = A::mul_add(-a, h[11][7], h[7][7]);
+                h[11][7] = a;
+            }
+            {
+                let a = h[11][6] * inv;
+                h[6][0] = A::mul_add(-a, h[11][0], h[6][0]);
+                h[6][1] = A::mul_add(-a, h[11][1], h[6][1]);
+                h[6][2] = A::mul_add(-a, h[11][2], h[6][2]);
+                h[6][3] = A::mul_add(-a, h[11][3], h[6][3]);
+                h[6][4] = A::mul_add(-a, h[11][4], h[6][4]);
+                h[6][5] = A::mul_add(-a, h[11][5], h[6][5]);
+                h[6][6] = A::mul_add(-a, h[11][6], h[6][6]);
+                h[11][6] = a;
+            }
+            {
+                let a = h[11][5] * inv;
+                h[5][0] = A::mul_add(-a, h[11][0], h[5][0]);
+                h[5][1] = A::mul_add(-a, h[11][1], h[5][1]);
+                h[5][2] = A::mul_add(-a, h[11][2], h[5][2]);
+                h[5][3] = A::mul_add(-a, h[11][3], h[5][3]);
+                h[5][4] = A::mul_add(-a, h[11][4], h[5][4]);
+                h[5][5] = A::mul_add(-a, h[11][5], h[5][5]);
+                h[11][5] = a;
+            }
+            {
+                let a = h[11][4] * inv;
+                h[4][0] = A::mul_add(-a, h[11][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[11][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[11][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[11][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[11][4], h[4][4]);
+                h[11][4] = a;
+            }
+            {
+                let a = h[11][3] * inv;
+                h[3][0] = A::mul_add(-a, h[11][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[11][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[11][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[11][3], h[3][3]);
+                h[11][3] = a;
+            }
+            {
+                let a = h[11][2] * inv;
+                h[2][0] = A::mul_add(-a, h[11][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[11][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[11][2], h[2][2]);
+                h[11][2] = a;
+            }
+            {
+                let a = h[11][1] * inv;
+                h[1][0] = A::mul_add(-a, h[11][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[11][1], h[1][1]);
+                h[11][1] = a;
+            }
+            {
+                let a = h[11][0] * inv;
+                h[0][0] = A::mul_add(-a, h[11][0], h[0][0]);
+                h[11][0] = a;
+            }
+            ok &= h[10][10] > 0.0;
+            let inv = 1.0 / h[10][10];
+            h[10][10] = inv;
+            {
+                let a = h[10][9] * inv;
+                h[9][0] = A::mul_add(-a, h[10][0], h[9][0]);
+                h[9][1] = A::mul_add(-a, h[10][1], h[9][1]);
+                h[9][2] = A::mul_add(-a, h[10][2], h[9][2]);
+                h[9][3] = A::mul_add(-a, h[10][3], h[9][3]);
+                h[9][4] = A::mul_add(-a, h[10][4], h[9][4]);
+                h[9][5] = A::mul_add(-a, h[10][5], h[9][5]);
+                h[9][6] = A::mul_add(-a, h[10][6], h[9][6]);
+                h[9][7] = A::mul_add(-a, h[10][7], h[9][7]);
+                h[9][8] = A::mul_add(-a, h[10][8], h[9][8]);
+                h[9][9] = A::mul_add(-a, h[10][9], h[9][9]);
+                h[10][9] = a;
+            }
+            {
+                let a = h[10][8] * inv;
+                h[8][0] = A::mul_add(-a, h[10][0], h[8][0]);
+                h[8][1] = A::mul_add(-a, h[10][1], h[8][1]);
+                h[8][2] = A::mul_add(-a, h[10][2], h[8][2]);
+                h[8][3] = A::mul_add(-a, h[10][3], h[8][3]);
+                h[8][4] = A::mul_add(-a, h[10][4], h[8][4]);
+                h[8][5] = A::mul_add(-a, h[10][5], h[8][5]);
+                h[8][6] = A::mul_add(-a, h[10][6], h[8][6]);
+                h[8][7] = A::mul_add(-a, h[10][7], h[8][7]);
+                h[8][8] = A::mul_add(-a, h[10][8], h[8][8]);
+                h[10][8] = a;
+            }
+            {
+                let a = h[10][7] * inv;
+                h[7][0] = A::mul_add(-a, h[10][0], h[7][0]);
+                h[7][1] = A::mul_add(-a, h[10][1], h[7][1]);
+                h[7][2] = A::mul_add(-a, h[10][2], h[7][2]);
+                h[7][3] = A::mul_add(-a, h[10][3], h[7][3]);
+                h[7][4] = A::mul_add(-a, h[10][4], h[7][4]);
+                h[7][5] = A::mul_add(-a, h[10][5], h[7][5]);
+                h[7][6] = A::mul_add(-a, h[10][6], h[7][6]);
+                h[7][7] = A::mul_add(-a, h[10][7], h[7][7]);
+                h[10][7] = a;
+            }
+            {
+                let a = h[10][6] * inv;
+                h[6][0] = A::mul_add(-a, h[10][0], h[6][0]);
+                h[6][1] = A::mul_add(-a, h[10][1], h[6][1]);
+                h[6][2] = A::mul_add(-a, h[10][2], h[6][2]);
+                h[6][3] = A::mul_add(-a, h[10][3], h[6][3]);
+                h[6][4] = A::mul_add(-a, h[10][4], h[6][4]);
+                h[6][5] = A::mul_add(-a, h[10][5], h[6][5]);
+                h[6][6] = A::mul_add(-a, h[10][6], h[6][6]);
+                h[10][6] = a;
+            }
+            {
+                let a = h[10][5] * inv;
+                h[5][0] = A::mul_add(-a, h[10][0], h[5][0]);
+                h[5][1] = A::mul_add(-a, h[10][1], h[5][1]);
+                h[5][2] = A::mul_add(-a, h[10][2], h[5][2]);
+                h[5][3] = A::mul_add(-a, h[10][3], h[5][3]);
+                h[5][4] = A::mul_add(-a, h[10][4], h[5][4]);
+                h[5][5] = A::mul_add(-a, h[10][5], h[5][5]);
+                h[10][5] = a;
+            }
+            {
+                let a = h[10][4] * inv;
+                h[4][0] = A::mul_add(-a, h[10][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[10][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[10][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[10][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[10][4], h[4][4]);
+                h[10][4] = a;
+            }
+            {
+                let a = h[10][3] * inv;
+                h[3][0] = A::mul_add(-a, h[10][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[10][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[10][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[10][3], h[3][3]);
+                h[10][3] = a;
+            }
+            {
+                let a = h[10][2] * inv;
+                h[2][0] = A::mul_add(-a, h[10][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[10][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[10][2], h[2][2]);
+                h[10][2] = a;
+            }
+            {
+                let a = h[10][1] * inv;
+                h[1][0] = A::mul_add(-a, h[10][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[10][1], h[1][1]);
+                h[10][1] = a;
+            }
+            {
+                let a = h[10][0] * inv;
+                h[0][0] = A::mul_add(-a, h[10][0], h[0][0]);
+                h[10][0] = a;
+            }
+            ok &= h[9][9] > 0.0;
+            let inv = 1.0 / h[9][9];
+            h[9][9] = inv;
+            {
+                let a = h[9][8] * inv;
+                h[8][0] = A::mul_add(-a, h[9][0], h[8][0]);
+                h[8][1] = A::mul_add(-a, h[9][1], h[8][1]);
+                h[8][2] = A::mul_add(-a, h[9][2], h[8][2]);
+                h[8][3] = A::mul_add(-a, h[9][3], h[8][3]);
+                h[8][4] = A::mul_add(-a, h[9][4], h[8][4]);
+                h[8][5] = A::mul_add(-a, h[9][5], h[8][5]);
+                h[8][6] = A::mul_add(-a, h[9][6], h[8][6]);
+                h[8][7] = A::mul_add(-a, h[9][7], h[8][7]);
+                h[8][8] = A::mul_add(-a, h[9][8], h[8][8]);
+                h[9][8] = a;
+            }
+            {
+                let a = h[9][7] * inv;
+                h[7][0] = A::mul_add(-a, h[9][0], h[7][0]);
+                h[7][1] = A::mul_add(-a, h[9][1], h[7][1]);
+                h[7][2] = A::mul_add(-a, h[9][2], h[7][2]);
+                h[7][3] = A::mul_add(-a, h[9][3], h[7][3]);
+                h[7][4] = A::mul_add(-a, h[9][4], h[7][4]);
+                h[7][5] = A::mul_add(-a, h[9][5], h[7][5]);
+                h[7][6] = A::mul_add(-a, h[9][6], h[7][6]);
+                h[7][7] = A::mul_add(-a, h[9][7], h[7][7]);
+                h[9][7] = a;
+            }
+            {
+                let a = h[9][6] * inv;
+                h[6][0] = A::mul_add(-a, h[9][0], h[6][0]);
+                h[6][1] = A::mul_add(-a, h[9][1], h[6][1]);
+                h[6][2] = A::mul_add(-a, h[9][2], h[6][2]);
+                h[6][3] = A::mul_add(-a, h[9][3], h[6][3]);
+                h[6][4] = A::mul_add(-a, h[9][4], h[6][4]);
+                h[6][5] = A::mul_add(-a, h[9][5], h[6][5]);
+                h[6][6] = A::mul_add(-a, h[9][6], h[6][6]);
+                h[9][6] = a;
+            }
+            {
+                let a = h[9][5] * inv;
+                h[5][0] = A::mul_add(-a, h[9][0], h[5][0]);
+                h[5][1] = A::mul_add(-a, h[9][1], h[5][1]);
+                h[5][2] = A::mul_add(-a, h[9][2], h[5][2]);
+                h[5][3] = A::mul_add(-a, h[9][3], h[5][3]);
+                h[5][4] = A::mul_add(-a, h[9][4], h[5][4]);
+                h[5][5] = A::mul_add(-a, h[9][5], h[5][5]);
+                h[9][5] = a;
+            }
+            {
+                let a = h[9][4] * inv;
+                h[4][0] = A::mul_add(-a, h[9][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[9][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[9][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[9][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[9][4], h[4][4]);
+                h[9][4] = a;
+            }
+            {
+                let a = h[9][3] * inv;
+                h[3][0] = A::mul_add(-a, h[9][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[9][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[9][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[9][3], h[3][3]);
+                h[9][3] = a;
+            }
+            {
+                let a = h[9][2] * inv;
+                h[2][0] = A::mul_add(-a, h[9][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[9][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[9][2], h[2][2]);
+                h[9][2] = a;
+            }
+            {
+                let a = h[9][1] * inv;
+                h[1][0] = A::mul_add(-a, h[9][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[9][1], h[1][1]);
+                h[9][1] = a;
+            }
+            {
+                let a = h[9][0] * inv;
+                h[0][0] = A::mul_add(-a, h[9][0], h[0][0]);
+                h[9][0] = a;
+            }
+            ok &= h[8][8] > 0.0;
+            let inv = 1.0 / h[8][8];
+            h[8][8] = inv;
+            {
+                let a = h[8][7] * inv;
+                h[7][0] = A::mul_add(-a, h[8][0], h[7][0]);
+                h[7][1] = A::mul_add(-a, h[8][1], h[7][1]);
+                h[7][2] = A::mul_add(-a, h[8][2], h[7][2]);
+                h[7][3] = A::mul_add(-a, h[8][3], h[7][3]);
+                h[7][4] = A::mul_add(-a, h[8][4], h[7][4]);
+                h[7][5] = A::mul_add(-a, h[8][5], h[7][5]);
+                h[7][6] = A::mul_add(-a, h[8][6], h[7][6]);
+                h[7][7] = A::mul_add(-a, h[8][7], h[7][7]);
+                h[8][7] = a;
+            }
+            {
+                let a = h[8][6] * inv;
+                h[6][0] = A::mul_add(-a, h[8][0], h[6][0]);
+                h[6][1] = A::mul_add(-a, h[8][1], h[6][1]);
+                h[6][2] = A::mul_add(-a, h[8][2], h[6][2]);
+                h[6][3] = A::mul_add(-a, h[8][3], h[6][3]);
+                h[6][4] = A::mul_add(-a, h[8][4], h[6][4]);
+                h[6][5] = A::mul_add(-a, h[8][5], h[6][5]);
+                h[6][6] = A::mul_add(-a, h[8][6], h[6][6]);
+                h[8][6] = a;
+            }
+            {
+                let a = h[8][5] * inv;
+                h[5][0] = A::mul_add(-a, h[8][0], h[5][0]);
+                h[5][1] = A::mul_add(-a, h[8][1], h[5][1]);
+                h[5][2] = A::mul_add(-a, h[8][2], h[5][2]);
+                h[5][3] = A::mul_add(-a, h[8][3], h[5][3]);
+                h[5][4] = A::mul_add(-a, h[8][4], h[5][4]);
+                h[5][5] = A::mul_add(-a, h[8][5], h[5][5]);
+                h[8][5] = a;
+            }
+            {
+                let a = h[8][4] * inv;
+                h[4][0] = A::mul_add(-a, h[8][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[8][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[8][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[8][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[8][4], h[4][4]);
+                h[8][4] = a;
+            }
+            {
+                let a = h[8][3] * inv;
+                h[3][0] = A::mul_add(-a, h[8][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[8][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[8][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[8][3], h[3][3]);
+                h[8][3] = a;
+            }
+            {
+                let a = h[8][2] * inv;
+                h[2][0] = A::mul_add(-a, h[8][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[8][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[8][2], h[2][2]);
+                h[8][2] = a;
+            }
+            {
+                let a = h[8][1] * inv;
+                h[1][0] = A::mul_add(-a, h[8][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[8][1], h[1][1]);
+                h[8][1] = a;
+            }
+            {
+                let a = h[8][0] * inv;
+                h[0][0] = A::mul_add(-a, h[8][0], h[0][0]);
+                h[8][0] = a;
+            }
+            ok &= h[7][7] > 0.0;
+            let inv = 1.0 / h[7][7];
+            h[7][7] = inv;
+            {
+                let a = h[7][6] * inv;
+                h[6][0] = A::mul_add(-a, h[7][0], h[6][0]);
+                h[6][1] = A::mul_add(-a, h[7][1], h[6][1]);
+                h[6][2] = A::mul_add(-a, h[7][2], h[6][2]);
+                h[6][3] = A::mul_add(-a, h[7][3], h[6][3]);
+                h[6][4] = A::mul_add(-a, h[7][4], h[6][4]);
+                h[6][5] = A::mul_add(-a, h[7][5], h[6][5]);
+                h[6][6] = A::mul_add(-a, h[7][6], h[6][6]);
+                h[7][6] = a;
+            }
+            {
+                let a = h[7][5] * inv;
+                h[5][0] = A::mul_add(-a, h[7][0], h[5][0]);
+                h[5][1] = A::mul_add(-a, h[7][1], h[5][1]);
+                h[5][2] = A::mul_add(-a, h[7][2], h[5][2]);
+                h[5][3] = A::mul_add(-a, h[7][3], h[5][3]);
+                h[5][4] = A::mul_add(-a, h[7][4], h[5][4]);
+                h[5][5] = A::mul_add(-a, h[7][5], h[5][5]);
+                h[7][5] = a;
+            }
+            {
+                let a = h[7][4] * inv;
+                h[4][0] = A::mul_add(-a, h[7][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[7][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[7][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[7][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[7][4], h[4][4]);
+                h[7][4] = a;
+            }
+            {
+                let a = h[7][3] * inv;
+                h[3][0] = A::mul_add(-a, h[7][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[7][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[7][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[7][3], h[3][3]);
+                h[7][3] = a;
+            }
+            {
+                let a = h[7][2] * inv;
+                h[2][0] = A::mul_add(-a, h[7][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[7][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[7][2], h[2][2]);
+                h[7][2] = a;
+            }
+            {
+                let a = h[7][1] * inv;
+                h[1][0] = A::mul_add(-a, h[7][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[7][1], h[1][1]);
+                h[7][1] = a;
+            }
+            {
+                let a = h[7][0] * inv;
+                h[0][0] = A::mul_add(-a, h[7][0], h[0][0]);
+                h[7][0] = a;
+            }
+            ok &= h[6][6] > 0.0;
+            let inv = 1.0 / h[6][6];
+            h[6][6] = inv;
+            {
+                let a = h[6][5] * inv;
+                h[5][0] = A::mul_add(-a, h[6][0], h[5][0]);
+                h[5][1] = A::mul_add(-a, h[6][1], h[5][1]);
+                h[5][2] = A::mul_add(-a, h[6][2], h[5][2]);
+                h[5][3] = A::mul_add(-a, h[6][3], h[5][3]);
+                h[5][4] = A::mul_add(-a, h[6][4], h[5][4]);
+                h[5][5] = A::mul_add(-a, h[6][5], h[5][5]);
+                h[6][5] = a;
+            }
+            {
+                let a = h[6][4] * inv;
+                h[4][0] = A::mul_add(-a, h[6][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[6][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[6][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[6][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[6][4], h[4][4]);
+                h[6][4] = a;
+            }
+            {
+                let a = h[6][3] * inv;
+                h[3][0] = A::mul_add(-a, h[6][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[6][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[6][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[6][3], h[3][3]);
+                h[6][3] = a;
+            }
+            {
+                let a = h[6][2] * inv;
+                h[2][0] = A::mul_add(-a, h[6][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[6][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[6][2], h[2][2]);
+                h[6][2] = a;
+            }
+            {
+                let a = h[6][1] * inv;
+                h[1][0] = A::mul_add(-a, h[6][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[6][1], h[1][1]);
+                h[6][1] = a;
+            }
+            {
+                let a = h[6][0] * inv;
+                h[0][0] = A::mul_add(-a, h[6][0], h[0][0]);
+                h[6][0] = a;
+            }
+            ok &= h[5][5] > 0.0;
+            let inv = 1.0 / h[5][5];
+            h[5][5] = inv;
+            {
+                let a = h[5][4] * inv;
+                h[4][0] = A::mul_add(-a, h[5][0], h[4][0]);
+                h[4][1] = A::mul_add(-a, h[5][1], h[4][1]);
+                h[4][2] = A::mul_add(-a, h[5][2], h[4][2]);
+                h[4][3] = A::mul_add(-a, h[5][3], h[4][3]);
+                h[4][4] = A::mul_add(-a, h[5][4], h[4][4]);
+                h[5][4] = a;
+            }
+            {
+                let a = h[5][3] * inv;
+                h[3][0] = A::mul_add(-a, h[5][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[5][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[5][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[5][3], h[3][3]);
+                h[5][3] = a;
+            }
+            {
+                let a = h[5][2] * inv;
+                h[2][0] = A::mul_add(-a, h[5][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[5][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[5][2], h[2][2]);
+                h[5][2] = a;
+            }
+            {
+                let a = h[5][1] * inv;
+                h[1][0] = A::mul_add(-a, h[5][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[5][1], h[1][1]);
+                h[5][1] = a;
+            }
+            {
+                let a = h[5][0] * inv;
+                h[0][0] = A::mul_add(-a, h[5][0], h[0][0]);
+                h[5][0] = a;
+            }
+            ok &= h[4][4] > 0.0;
+            let inv = 1.0 / h[4][4];
+            h[4][4] = inv;
+            {
+                let a = h[4][3] * inv;
+                h[3][0] = A::mul_add(-a, h[4][0], h[3][0]);
+                h[3][1] = A::mul_add(-a, h[4][1], h[3][1]);
+                h[3][2] = A::mul_add(-a, h[4][2], h[3][2]);
+                h[3][3] = A::mul_add(-a, h[4][3], h[3][3]);
+                h[4][3] = a;
+            }
+            {
+                let a = h[4][2] * inv;
+                h[2][0] = A::mul_add(-a, h[4][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[4][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[4][2], h[2][2]);
+                h[4][2] = a;
+            }
+            {
+                let a = h[4][1] * inv;
+                h[1][0] = A::mul_add(-a, h[4][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[4][1], h[1][1]);
+                h[4][1] = a;
+            }
+            {
+                let a = h[4][0] * inv;
+                h[0][0] = A::mul_add(-a, h[4][0], h[0][0]);
+                h[4][0] = a;
+            }
+            ok &= h[3][3] > 0.0;
+            let inv = 1.0 / h[3][3];
+            h[3][3] = inv;
+            {
+                let a = h[3][2] * inv;
+                h[2][0] = A::mul_add(-a, h[3][0], h[2][0]);
+                h[2][1] = A::mul_add(-a, h[3][1], h[2][1]);
+                h[2][2] = A::mul_add(-a, h[3][2], h[2][2]);
+                h[3][2] = a;
+            }
+            {
+                let a = h[3][1] * inv;
+                h[1][0] = A::mul_add(-a, h[3][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[3][1], h[1][1]);
+                h[3][1] = a;
+            }
+            {
+                let a = h[3][0] * inv;
+                h[0][0] = A::mul_add(-a, h[3][0], h[0][0]);
+                h[3][0] = a;
+            }
+            ok &= h[2][2] > 0.0;
+            let inv = 1.0 / h[2][2];
+            h[2][2] = inv;
+            {
+                let a = h[2][1] * inv;
+                h[1][0] = A::mul_add(-a, h[2][0], h[1][0]);
+                h[1][1] = A::mul_add(-a, h[2][1], h[1][1]);
+                h[2][1] = a;
+            }
+            {
+                let a = h[2][0] * inv;
+                h[0][0] = A::mul_add(-a, h[2][0], h[0][0]);
+                h[2][0] = a;
+            }
+            ok &= h[1][1] > 0.0;
+            let inv = 1.0 / h[1][1];
+            h[1][1] = inv;
+            {
+                let a = h[1][0] * inv;
+                h[0][0] = A::mul_add(-a, h[1][0], h[0][0]);
+                h[1][0] = a;
+            }
+            ok &= h[0][0] > 0.0;
+            let inv = 1.0 / h[0][0];
+            h[0][0] = inv;
+            ok
+        }
+        kanegen_runtime::isa::dispatch_fused_with(
+            h,
+            #[inline(always)]
+            |h| body::<kanegen_runtime::isa::Plain>(h),
+            #[inline(always)]
+            |h| body::<kanegen_runtime::isa::Fused>(h),
+        )
+    }
+    /// `y ← L⁻ᵀ y` of [`TREE_KERNELS`].
+    pub fn tree_solve_transposed_unit(h: &[[f64; 19]; 19], y: &mut [f64; 19]) {
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+            (h, y): (&[[f64; 19]; 19], &mut [f64; 19]),
+        ) {
+            {
+                let yi = y[18];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[18][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[18][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[18][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[18][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[18][4], yi, y[4]);
+                    y[12] = A::mul_add(-h[18][12], yi, y[12]);
+                    y[13] = A::mul_add(-h[18][13], yi, y[13]);
+                    y[14] = A::mul_add(-h[18][14], yi, y[14]);
+                    y[15] = A::mul_add(-h[18][15], yi, y[15]);
+                    y[16] = A::mul_add(-h[18][16], yi, y[16]);
+                    y[17] = A::mul_add(-h[18][17], yi, y[17]);
+                }
+            }
+            {
+                let yi = y[17];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[17][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[17][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[17][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[17][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[17][4], yi, y[4]);
+                    y[12] = A::mul_add(-h[17][12], yi, y[12]);
+                    y[13] = A::mul_add(-h[17][13], yi, y[13]);
+                    y[14] = A::mul_add(-h[17][14], yi, y[14]);
+                    y[15] = A::mul_add(-h[17][15], yi, y[15]);
+                    y[16] = A::mul_add(-h[17][16], yi, y[16]);
+                }
+            }
+            {
+                let yi = y[16];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[16][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[16][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[16][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[16][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[16][4], yi, y[4]);
+                    y[12] = A::mul_add(-h[16][12], yi, y[12]);
+                    y[13] = A::mul_add(-h[16][13], yi, y[13]);
+                    y[14] = A::mul_add(-h[16][14], yi, y[14]);
+                    y[15] = A::mul_add(-h[16][15], yi, y[15]);
+                }
+            }
+            {
+                let yi = y[15];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[15][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[15][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[15][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[15][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[15][4], yi, y[4]);
+                    y[12] = A::mul_add(-h[15][12], yi, y[12]);
+                    y[13] = A::mul_add(-h[15][13], yi, y[13]);
+                    y[14] = A::mul_add(-h[15][14], yi, y[14]);
+                }
+            }
+            {
+                let yi = y[14];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[14][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[14][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[14][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[14][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[14][4], yi, y[4]);
+                    y[12] = A::mul_add(-h[14][12], yi, y[12]);
+                    y[13] = A::mul_add(-h[14][13], yi, y[13]);
+                }
+            }
+            {
+                let yi = y[13];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[13][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[13][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[13][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[13][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[13][4], yi, y[4]);
+                    y[12] = A::mul_add(-h[13][12], yi, y[12]);
+                }
+            }
+            {
+                let yi = y[12];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[12][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[12][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[12][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[12][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[12][4], yi, y[4]);
+                }
+            }
+            {
+                let yi = y[11];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[11][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[11][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[11][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[11][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[11][4], yi, y[4]);
+                    y[5] = A::mul_add(-h[11][5], yi, y[5]);
+                    y[6] = A::mul_add(-h[11][6], yi, y[6]);
+                    y[7] = A::mul_add(-h[11][7], yi, y[7]);
+                    y[8] = A::mul_add(-h[11][8], yi, y[8]);
+                    y[9] = A::mul_add(-h[11][9], yi, y[9]);
+                    y[10] = A::mul_add(-h[11][10], yi, y[10]);
+                }
+            }
+            {
+                let yi = y[10];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[10][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[10][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[10][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[10][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[10][4], yi, y[4]);
+                    y[5] = A::mul_add(-h[10][5], yi, y[5]);
+                    y[6] = A::mul_add(-h[10][6], yi, y[6]);
+                    y[7] = A::mul_add(-h[10][7], yi, y[7]);
+                    y[8] = A::mul_add(-h[10][8], yi, y[8]);
+                    y[9] = A::mul_add(-h[10][9], yi, y[9]);
+                }
+            }
+            {
+                let yi = y[9];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[9][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[9][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[9][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[9][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[9][4], yi, y[4]);
+                    y[5] = A::mul_add(-h[9][5], yi, y[5]);
+                    y[6] = A::mul_add(-h[9][6], yi, y[6]);
+                    y[7] = A::mul_add(-h[9][7], yi, y[7]);
+                    y[8] = A::mul_add(-h[9][8], yi, y[8]);
+                }
+            }
+            {
+                let yi = y[8];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[8][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[8][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[8][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[8][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[8][4], yi, y[4]);
+                    y[5] = A::mul_add(-h[8][5], yi, y[5]);
+                    y[6] = A::mul_add(-h[8][6], yi, y[6]);
+                    y[7] = A::mul_add(-h[8][7], yi, y[7]);
+                }
+            }
+            {
+                let yi = y[7];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[7][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[7][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[7][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[7][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[7][4], yi, y[4]);
+                    y[5] = A::mul_add(-h[7][5], yi, y[5]);
+                    y[6] = A::mul_add(-h[7][6], yi, y[6]);
+                }
+            }
+            {
+                let yi = y[6];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[6][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[6][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[6][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[6][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[6][4], yi, y[4]);
+                    y[5] = A::mul_add(-h[6][5], yi, y[5]);
+                }
+            }
+            {
+                let yi = y[5];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[5][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[5][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[5][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[5][3], yi, y[3]);
+                    y[4] = A::mul_add(-h[5][4], yi, y[4]);
+                }
+            }
+            {
+                let yi = y[4];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[4][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[4][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[4][2], yi, y[2]);
+                    y[3] = A::mul_add(-h[4][3], yi, y[3]);
+                }
+            }
+            {
+                let yi = y[3];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[3][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[3][1], yi, y[1]);
+                    y[2] = A::mul_add(-h[3][2], yi, y[2]);
+                }
+            }
+            {
+                let yi = y[2];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[2][0], yi, y[0]);
+                    y[1] = A::mul_add(-h[2][1], yi, y[1]);
+                }
+            }
+            {
+                let yi = y[1];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[1][0], yi, y[0]);
+                }
+            }
+        }
+        kanegen_runtime::isa::dispatch_fused_with(
+            (h, y),
+            #[inline(always)]
+            |(h, y)| body::<kanegen_runtime::isa::Plain>((h, y)),
+            #[inline(always)]
+            |(h, y)| body::<kanegen_runtime::isa::Fused>((h, y)),
+        )
+    }
+    /// `x ← L⁻¹ D⁻¹ x` of [`TREE_KERNELS`].
+    pub fn tree_finish_solve(h: &[[f64; 19]; 19], x: &mut [f64; 19]) {
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+            (h, x): (&[[f64; 19]; 19], &mut [f64; 19]),
+        ) {
+            x[0] *= h[0][0];
+            {
+                let mut s0 = 0.0;
+                s0 = A::mul_add(h[1][0], x[0], s0);
+                x[1] = x[1] * h[1][1] - (s0);
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                s0 = A::mul_add(h[2][0], x[0], s0);
+                s1 = A::mul_add(h[2][1], x[1], s1);
+                x[2] = x[2] * h[2][2] - (s0 + s1);
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                s0 = A::mul_add(h[3][0], x[0], s0);
+                s1 = A::mul_add(h[3][1], x[1], s1);
+                s2 = A::mul_add(h[3][2], x[2], s2);
+                x[3] = x[3] * h[3][3] - ((s0 + s1) + s2);
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[4][0], x[0], s0);
+                s1 = A::mul_add(h[4][1], x[1], s1);
+                s2 = A::mul_add(h[4][2], x[2], s2);
+                s3 = A::mul_add(h[4][3], x[3], s3);
+                x[4] = x[4] * h[4][4] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[5][0], x[0], s0);
+                s1 = A::mul_add(h[5][1], x[1], s1);
+                s2 = A::mul_add(h[5][2], x[2], s2);
+                s3 = A::mul_add(h[5][3], x[3], s3);
+                s0 = A::mul_add(h[5][4], x[4], s0);
+                x[5] = x[5] * h[5][5] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[6][0], x[0], s0);
+                s1 = A::mul_add(h[6][1], x[1], s1);
+                s2 = A::mul_add(h[6][2], x[2], s2);
+                s3 = A::mul_add(h[6][3], x[3], s3);
+                s0 = A::mul_add(h[6][4], x[4], s0);
+                s1 = A::mul_add(h[6][5], x[5], s1);
+                x[6] = x[6] * h[6][6] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[7][0], x[0], s0);
+                s1 = A::mul_add(h[7][1], x[1], s1);
+                s2 = A::mul_add(h[7][2], x[2], s2);
+                s3 = A::mul_add(h[7][3], x[3], s3);
+                s0 = A::mul_add(h[7][4], x[4], s0);
+                s1 = A::mul_add(h[7][5], x[5], s1);
+                s2 = A::mul_add(h[7][6], x[6], s2);
+                x[7] = x[7] * h[7][7] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[8][0], x[0], s0);
+                s1 = A::mul_add(h[8][1], x[1], s1);
+                s2 = A::mul_add(h[8][2], x[2], s2);
+                s3 = A::mul_add(h[8][3], x[3], s3);
+                s0 = A::mul_add(h[8][4], x[4], s0);
+                s1 = A::mul_add(h[8][5], x[5], s1);
+                s2 = A::mul_add(h[8][6], x[6], s2);
+                s3 = A::mul_add(h[8][7], x[7], s3);
+                x[8] = x[8] * h[8][8] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[9][0], x[0], s0);
+                s1 = A::mul_add(h[9][1], x[1], s1);
+                s2 = A::mul_add(h[9][2], x[2], s2);
+                s3 = A::mul_add(h[9][3], x[3], s3);
+                s0 = A::mul_add(h[9][4], x[4], s0);
+                s1 = A::mul_add(h[9][5], x[5], s1);
+                s2 = A::mul_add(h[9][6], x[6], s2);
+                s3 = A::mul_add(h[9][7], x[7], s3);
+                s0 = A::mul_add(h[9][8], x[8], s0);
+                x[9] = x[9] * h[9][9] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[10][0], x[0], s0);
+                s1 = A::mul_add(h[10][1], x[1], s1);
+                s2 = A::mul_add(h[10][2], x[2], s2);
+                s3 = A::mul_add(h[10][3], x[3], s3);
+                s0 = A::mul_add(h[10][4], x[4], s0);
+                s1 = A::mul_add(h[10][5], x[5], s1);
+                s2 = A::mul_add(h[10][6], x[6], s2);
+                s3 = A::mul_add(h[10][7], x[7], s3);
+                s0 = A::mul_add(h[10][8], x[8], s0);
+                s1 = A::mul_add(h[10][9], x[9], s1);
+                x[10] = x[10] * h[10][10] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[11][0], x[0], s0);
+                s1 = A::mul_add(h[11][1], x[1], s1);
+                s2 = A::mul_add(h[11][2], x[2], s2);
+                s3 = A::mul_add(h[11][3], x[3], s3);
+                s0 = A::mul_add(h[11][4], x[4], s0);
+                s1 = A::mul_add(h[11][5], x[5], s1);
+                s2 = A::mul_add(h[11][6], x[6], s2);
+                s3 = A::mul_add(h[11][7], x[7], s3);
+                s0 = A::mul_add(h[11][8], x[8], s0);
+                s1 = A::mul_add(h[11][9], x[9], s1);
+                s2 = A::mul_add(h[11][10], x[10], s2);
+                x[11] = x[11] * h[11][11] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[12][0], x[0], s0);
+                s1 = A::mul_add(h[12][1], x[1], s1);
+                s2 = A::mul_add(h[12][2], x[2], s2);
+                s3 = A::mul_add(h[12][3], x[3], s3);
+                s0 = A::mul_add(h[12][4], x[4], s0);
+                x[12] = x[12] * h[12][12] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[13][0], x[0], s0);
+                s1 = A::mul_add(h[13][1], x[1], s1);
+                s2 = A::mul_add(h[13][2], x[2], s2);
+                s3 = A::mul_add(h[13][3], x[3], s3);
+                s0 = A::mul_add(h[13][4], x[4], s0);
+                s1 = A::mul_add(h[13][12], x[12], s1);
+                x[13] = x[13] * h[13][13] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[14][0], x[0], s0);
+                s1 = A::mul_add(h[14][1], x[1], s1);
+                s2 = A::mul_add(h[14][2], x[2], s2);
+                s3 = A::mul_add(h[14][3], x[3], s3);
+                s0 = A::mul_add(h[14][4], x[4], s0);
+                s1 = A::mul_add(h[14][12], x[12], s1);
+                s2 = A::mul_add(h[14][13], x[13], s2);
+                x[14] = x[14] * h[14][14] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[15][0], x[0], s0);
+                s1 = A::mul_add(h[15][1], x[1], s1);
+                s2 = A::mul_add(h[15][2], x[2], s2);
+                s3 = A::mul_add(h[15][3], x[3], s3);
+                s0 = A::mul_add(h[15][4], x[4], s0);
+                s1 = A::mul_add(h[15][12], x[12], s1);
+                s2 = A::mul_add(h[15][13], x[13], s2);
+                s3 = A::mul_add(h[15][14], x[14], s3);
+                x[15] = x[15] * h[15][15] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[16][0], x[0], s0);
+                s1 = A::mul_add(h[16][1], x[1], s1);
+                s2 = A::mul_add(h[16][2], x[2], s2);
+                s3 = A::mul_add(h[16][3], x[3], s3);
+                s0 = A::mul_add(h[16][4], x[4], s0);
+                s1 = A::mul_add(h[16][12], x[12], s1);
+                s2 = A::mul_add(h[16][13], x[13], s2);
+                s3 = A::mul_add(h[16][14], x[14], s3);
+                s0 = A::mul_add(h[16][15], x[15], s0);
+                x[16] = x[16] * h[16][16] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[17][0], x[0], s0);
+                s1 = A::mul_add(h[17][1], x[1], s1);
+                s2 = A::mul_add(h[17][2], x[2], s2);
+                s3 = A::mul_add(h[17][3], x[3], s3);
+                s0 = A::mul_add(h[17][4], x[4], s0);
+                s1 = A::mul_add(h[17][12], x[12], s1);
+                s2 = A::mul_add(h[17][13], x[13], s2);
+                s3 = A::mul_add(h[17][14], x[14], s3);
+                s0 = A::mul_add(h[17][15], x[15], s0);
+                s1 = A::mul_add(h[17][16], x[16], s1);
+                x[17] = x[17] * h[17][17] - ((s0 + s1) + (s2 + s3));
+            }
+            {
+                let mut s0 = 0.0;
+                let mut s1 = 0.0;
+                let mut s2 = 0.0;
+                let mut s3 = 0.0;
+                s0 = A::mul_add(h[18][0], x[0], s0);
+                s1 = A::mul_add(h[18][1], x[1], s1);
+                s2 = A::mul_add(h[18][2], x[2], s2);
+                s3 = A::mul_add(h[18][3], x[3], s3);
+                s0 = A::mul_add(h[18][4], x[4], s0);
+                s1 = A::mul_add(h[18][12], x[12], s1);
+                s2 = A::mul_add(h[18][13], x[13], s2);
+                s3 = A::mul_add(h[18][14], x[14], s3);
+                s0 = A::mul_add(h[18][15], x[15], s0);
+                s1 = A::mul_add(h[18][16], x[16], s1);
+                s2 = A::mul_add(h[18][17], x[17], s2);
+                x[18] = x[18] * h[18][18] - ((s0 + s1) + (s2 + s3));
+            }
+        }
+        kanegen_runtime::isa::dispatch_fused_with(
+            (h, x),
+            #[inline(always)]
+            |(h, x)| body::<kanegen_runtime::isa::Plain>((h, x)),
+            #[inline(always)]
+            |(h, x)| body::<kanegen_runtime::isa::Fused>((h, x)),
+        )
     }
 }

@@ -47,6 +47,7 @@ pub(super) fn names(cx: &Context<'_>) -> TokenStream {
             index_consts.push(quote!(#[doc = #doc] pub const #speed_id: usize = #i;));
         }
     }
+    let parents = super::speed_parents::constant(cx);
     quote! {
         /// Number of generalized speeds (and coordinates).
         pub const DOF: usize = #nl;
@@ -54,6 +55,7 @@ pub(super) fn names(cx: &Context<'_>) -> TokenStream {
         pub const SPEED_NAMES: [&str; #nl] = [#(#speed_names),*];
         /// Coordinate names, in the order of `q`.
         pub const COORDINATE_NAMES: [&str; #nl] = [#(#coord_names),*];
+        #parents
 
         /// Index constants: of each coordinate in `q` (`Q_IMU`) and of its speed in `u`, `u̇`
         /// and `τ` (`QD_IMU`); a coordinate and its speed have the same index.
@@ -101,6 +103,7 @@ fn floating_names(cx: &Context<'_>) -> TokenStream {
             index_consts.push(quote!(#[doc = #doc] pub const #speed_id: usize = #i;));
         }
     }
+    let parents = super::speed_parents::constant(cx);
     quote! {
         /// Number of generalized speeds: the floating base's six (`v`, `ω` in the base frame),
         /// then the joints'.
@@ -112,6 +115,7 @@ fn floating_names(cx: &Context<'_>) -> TokenStream {
         pub const SPEED_NAMES: [&str; #nl] = [#(#speed_names),*];
         /// Coordinate names, in the order of `q`.
         pub const COORDINATE_NAMES: [&str; #nq] = [#(#coord_names),*];
+        #parents
 
         /// Index constants: of each coordinate in `q` (`Q_HIP`, `BASE_QW`) and of each speed in
         /// `u`, `u̇` and `τ` (`QD_HIP`, `BASE_WX`). A joint's coordinate is one place after its
@@ -534,10 +538,13 @@ pub(super) fn trait_impls(cx: &Context<'_>) -> TokenStream {
             quote!(fn #name(&self, #args) -> #ret { #call })
         });
         let assoc = if tr == RuntimeTrait::RobotDynamics {
+            let q_ty = quote!(SVector<#t, DOF>);
+            let parents = super::speed_parents::trait_items(cx, &q_ty);
             quote! {
                 type Scalar = #t;
                 const SPEED_NAMES: [&'static str; DOF] = SPEED_NAMES;
                 const COORDINATE_NAMES: [&'static str; DOF] = COORDINATE_NAMES;
+                #parents
             }
         } else {
             quote!()
@@ -606,6 +613,7 @@ fn floating_trait_impl(cx: &Context<'_>) -> TokenStream {
         quote!(fn #f(&self, #args) -> #ret { #call })
     };
     use crate::registry::Inputs;
+    let parents = super::speed_parents::trait_items(cx, &quote!(SVector<#t, NQ>));
     let methods = [
         forward("mass_matrix", Inputs::Q),
         forward("coriolis", Inputs::QU),
@@ -618,6 +626,7 @@ fn floating_trait_impl(cx: &Context<'_>) -> TokenStream {
             type Configuration = SVector<#t, NQ>;
             const SPEED_NAMES: [&'static str; DOF] = SPEED_NAMES;
             const COORDINATE_NAMES: &'static [&'static str] = &COORDINATE_NAMES;
+            #parents
             fn neutral(&self) -> SVector<#t, NQ> {
                 kanegen_runtime::free_flyer::neutral()
             }

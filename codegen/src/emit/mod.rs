@@ -14,7 +14,8 @@
 //! `print.rs` (expressions, identifiers, literals, comment text), `text.rs` (statement blocks
 //! printed as text and spliced into the formatted module), `context.rs` (what every part
 //! reads), `mirrored_lanes.rs` (paired statements over two lanes), `signature.rs` (argument
-//! names, result types), `body.rs` (the building blocks of a function body), the forms
+//! names, result types), `body.rs` (the building blocks of a function body),
+//! `speed_parents.rs` (the `SPEED_PARENTS` parent array, verified on the mass matrix), the forms
 //! `regressor_loop.rs`, `frames.rs` (the `Frame` type and per-frame dispatchers),
 //! `function.rs` (straight-line), `derivatives_loop.rs`, `combined.rs`, `batch.rs`,
 //! `regressor.rs` (the regressors' items), then `items.rs` (names, `Params`, `Precomputed`, the
@@ -36,6 +37,7 @@ mod print;
 mod regressor;
 mod regressor_loop;
 mod signature;
+mod speed_parents;
 mod text;
 pub mod wgsl;
 
@@ -218,6 +220,7 @@ pub fn emit(model: &Model, low: &Lowered, options: &EmitOptions) -> Result<Strin
     }
     items.extend(items::wrapper(&cx, batched));
     items.extend(items::trait_impls(&cx));
+    items.extend(speed_parents::kernels(&cx));
     // Model names (`MX4l`, `q_1L`) are not snake case, and straight-line code trips clippy's
     // style lints (long functions, many arguments, literal precision): one allowance for the
     // whole generated module instead of one per item.

@@ -19,6 +19,13 @@ mod generated {
     pub const SPEED_NAMES: [&str; 2] = ["qd_imu", "qd_w"];
     /// Coordinate names, in the order of `q`.
     pub const COORDINATE_NAMES: [&str; 2] = ["q_imu", "q_w"];
+    /// The speeds' parent array `λ`: entry `i` is the speed nearest to speed `i` on the path
+    /// from its joint towards the root (`None` at the root; a floating base's six speeds form
+    /// a chain there), always before `i`. The mass matrix is structurally zero between two
+    /// speeds neither of which is an ancestor of the other (verified on the generated
+    /// matrix), so `kanegen_runtime::tree_factor::TreeFactor` factors it without fill-in:
+    /// the traits' `forward_dynamics` and `mass_matrix_factor` do.
+    pub const SPEED_PARENTS: [Option<usize>; 2] = [None, Some(0)];
     /// Index constants: of each coordinate in `q` (`Q_IMU`) and of its speed in `u`, `u̇`
     /// and `τ` (`QD_IMU`); a coordinate and its speed have the same index.
     pub mod index {
@@ -714,6 +721,18 @@ mod generated {
         type Scalar = f64;
         const SPEED_NAMES: [&'static str; DOF] = SPEED_NAMES;
         const COORDINATE_NAMES: [&'static str; DOF] = COORDINATE_NAMES;
+        const SPEED_PARENTS: Option<[Option<usize>; DOF]> = Some(SPEED_PARENTS);
+        #[inline]
+        fn mass_matrix_factor(
+            &self,
+            q: &SVector<f64, DOF>,
+        ) -> Option<kanegen_runtime::tree_factor::TreeFactor<f64, DOF>> {
+            kanegen_runtime::tree_factor::TreeFactor::with_kernels(
+                &self.mass_matrix(q),
+                &SPEED_PARENTS,
+                TREE_KERNELS,
+            )
+        }
         fn mass_matrix(&self, q: &SVector<f64, 2>) -> SMatrix<f64, 2, 2> {
             mass_matrix(&self.params, &self.pre, q)
         }
@@ -740,5 +759,82 @@ mod generated {
         ) -> SMatrix<f64, 2, 2> {
             coriolis_matrix(&self.params, &self.pre, q, u)
         }
+    }
+    /// Straight-line kernels of `M = Lᵀ D L` along [`SPEED_PARENTS`]
+    /// (`kanegen_runtime::tree_factor`): what the traits' `mass_matrix_factor` and
+    /// `forward_dynamics` of this robot run.
+    pub const TREE_KERNELS: kanegen_runtime::tree_factor::TreeKernels<f64, 2> = kanegen_runtime::tree_factor::TreeKernels {
+        factorise: tree_factorise,
+        solve_transposed_unit: tree_solve_transposed_unit,
+        finish_solve: tree_finish_solve,
+    };
+    /// The factorisation of [`TREE_KERNELS`], in place; `false` when a pivot is not
+    /// positive.
+    pub fn tree_factorise(h: &mut [[f64; 2]; 2]) -> bool {
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>>(h: &mut [[f64; 2]; 2]) -> bool {
+            let mut ok = true;
+            ok &= h[1][1] > 0.0;
+            let inv = 1.0 / h[1][1];
+            h[1][1] = inv;
+            {
+                let a = h[1][0] * inv;
+                h[0][0] = A::mul_add(-a, h[1][0], h[0][0]);
+                h[1][0] = a;
+            }
+            ok &= h[0][0] > 0.0;
+            let inv = 1.0 / h[0][0];
+            h[0][0] = inv;
+            ok
+        }
+        kanegen_runtime::isa::dispatch_fused_with(
+            h,
+            #[inline(always)]
+            |h| body::<kanegen_runtime::isa::Plain>(h),
+            #[inline(always)]
+            |h| body::<kanegen_runtime::isa::Fused>(h),
+        )
+    }
+    /// `y ← L⁻ᵀ y` of [`TREE_KERNELS`].
+    pub fn tree_solve_transposed_unit(h: &[[f64; 2]; 2], y: &mut [f64; 2]) {
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+            (h, y): (&[[f64; 2]; 2], &mut [f64; 2]),
+        ) {
+            {
+                let yi = y[1];
+                if yi != 0.0 {
+                    y[0] = A::mul_add(-h[1][0], yi, y[0]);
+                }
+            }
+        }
+        kanegen_runtime::isa::dispatch_fused_with(
+            (h, y),
+            #[inline(always)]
+            |(h, y)| body::<kanegen_runtime::isa::Plain>((h, y)),
+            #[inline(always)]
+            |(h, y)| body::<kanegen_runtime::isa::Fused>((h, y)),
+        )
+    }
+    /// `x ← L⁻¹ D⁻¹ x` of [`TREE_KERNELS`].
+    pub fn tree_finish_solve(h: &[[f64; 2]; 2], x: &mut [f64; 2]) {
+        #[inline(always)]
+        fn body<A: kanegen_runtime::isa::Arith<f64>>(
+            (h, x): (&[[f64; 2]; 2], &mut [f64; 2]),
+        ) {
+            x[0] *= h[0][0];
+            {
+                let mut s0 = 0.0;
+                s0 = A::mul_add(h[1][0], x[0], s0);
+                x[1] = x[1] * h[1][1] - (s0);
+            }
+        }
+        kanegen_runtime::isa::dispatch_fused_with(
+            (h, x),
+            #[inline(always)]
+            |(h, x)| body::<kanegen_runtime::isa::Plain>((h, x)),
+            #[inline(always)]
+            |(h, x)| body::<kanegen_runtime::isa::Fused>((h, x)),
+        )
     }
 }

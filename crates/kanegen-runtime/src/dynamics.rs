@@ -2,6 +2,8 @@
 
 use nalgebra::{RealField, SMatrix, SVector};
 
+use crate::tree_factor::TreeFactor;
+
 /// The dynamics of a robot with `N` generalized coordinates `q` and `N` generalized speeds
 /// `u`, in the form `τ = M(q) u̇ + c(q, u) + g(q)`. Implemented by the robot type of every
 /// generated module (for its model's parameter set), so that a controller, estimator or
@@ -19,6 +21,13 @@ pub trait RobotDynamics<const N: usize> {
 
     /// Coordinate names, in the order of `q`.
     const COORDINATE_NAMES: [&'static str; N];
+
+    /// The speeds' parent array `λ` (`λ(i) < i`, `None` for a speed at the root) when the mass
+    /// matrix is structurally zero off the tree's ancestor pairs ([`crate::tree_factor`]):
+    /// generated modules set it to their `SPEED_PARENTS` where the generator verified the
+    /// pattern, and [`forward_dynamics`](Self::forward_dynamics) then factors `M` without
+    /// fill-in. `None` (the default): `M` is taken as dense.
+    const SPEED_PARENTS: Option<[Option<usize>; N]> = None;
 
     /// The mass matrix `M(q)`, symmetric positive definite: the kinetic energy is `½ uᵀ M u`,
     /// and `M u̇` is the part of `τ` that depends on `u̇`.
@@ -48,9 +57,11 @@ pub trait RobotDynamics<const N: usize> {
 
     /// Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))`: the accelerations the generalized
     /// forces `tau` produce at state `(q, u)`, for simulation. `c + g` is one inverse-dynamics
-    /// pass at `u̇ = 0`, and `M` is factored by nalgebra's dense Cholesky, on the stack (no
-    /// heap, `no_std`), whose factor is then solved by the runtime's own substitutions (rows in
-    /// blocks of four: faster than nalgebra's `Cholesky::solve`).
+    /// pass at `u̇ = 0`. With [`SPEED_PARENTS`](Self::SPEED_PARENTS) `M` is factored along the
+    /// tree ([`TreeFactor`](crate::tree_factor::TreeFactor): no fill-in, two legs never
+    /// coupled); without, by nalgebra's dense Cholesky, whose factor is then solved by the
+    /// runtime's own substitutions (rows in blocks of four: faster than nalgebra's
+    /// `Cholesky::solve`). Either on the stack (no heap, `no_std`).
     ///
     /// `None` when `M(q)` is not positive definite (or has a NaN entry): non-physical
     /// parameters, such as a negative mass or an inertia violating the triangle inequalities
@@ -67,8 +78,30 @@ pub trait RobotDynamics<const N: usize> {
         tau: &SVector<Self::Scalar, N>,
     ) -> Option<SVector<Self::Scalar, N>> {
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
+        if Self::SPEED_PARENTS.is_some() {
+            // Solved where it lies: the factor (N² entries) is not moved out of the `Option`.
+            return self
+                .mass_matrix_factor(q)
+                .as_ref()
+                .map(|factor| factor.solve(&(tau - bias)));
+        }
         let factor = DenseFactor::new(self.mass_matrix(q))?;
         Some(factor.solve(&(tau - bias)))
+    }
+
+    /// `M(q) = Lᵀ D L` along [`SPEED_PARENTS`](Self::SPEED_PARENTS) (without fill-in), or, when
+    /// that is `None`, along [`chain_parents`](crate::tree_factor::chain_parents) (a dense
+    /// factorisation): what [`forward_dynamics`](Self::forward_dynamics),
+    /// [`crate::contact::constrained_forward_dynamics_factored`] and
+    /// [`crate::contact::contact_impulse_factored`] solve with. Generated robots override it
+    /// with their straight-line kernels (`TREE_KERNELS`). `None` when `M(q)` is not positive
+    /// definite.
+    fn mass_matrix_factor(
+        &self,
+        q: &SVector<Self::Scalar, N>,
+    ) -> Option<TreeFactor<Self::Scalar, N>> {
+        let parents = Self::SPEED_PARENTS.unwrap_or(crate::tree_factor::chain_parents());
+        TreeFactor::new(&self.mass_matrix(q), &parents)
     }
 }
 
@@ -168,7 +201,10 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
     /// pass, one mass matrix and its dense Cholesky factor (nalgebra, on the stack), one
     /// derivative pass and the triangular solves of the `3N` right-hand sides `[−∂τ/∂q | −∂τ/∂u
     /// | I]` in place, eight at a time side by side (compiled for the baseline and, where the
-    /// CPU has it, x86-64-v3); no heap.
+    /// CPU has it, x86-64-v3); no heap. With [`SPEED_PARENTS`](RobotDynamics::SPEED_PARENTS)
+    /// `u̇` itself comes from [`mass_matrix_factor`](RobotDynamics::mass_matrix_factor) (a
+    /// second mass matrix), so that it is [`forward_dynamics`](RobotDynamics::forward_dynamics)'s
+    /// bit for bit.
     ///
     /// `None` when `M(q)` is not positive definite (non-physical parameters), as
     /// [`forward_dynamics`](RobotDynamics::forward_dynamics). `krang-dynamics`'s
@@ -181,7 +217,14 @@ pub trait InverseDynamicsDerivatives<const N: usize>: RobotDynamics<N> {
         tau: &SVector<Self::Scalar, N>,
     ) -> Option<ForwardDynamicsDerivatives<Self::Scalar, N>> {
         let factor = DenseFactor::new(self.mass_matrix(q))?;
-        let ud = factor.solve(&(tau - self.inverse_dynamics(q, u, &SVector::zeros())));
+        let bias = self.inverse_dynamics(q, u, &SVector::zeros());
+        // `ud` as `forward_dynamics` computes it, bit for bit (along the tree where there is one;
+        // the many-column solves below stay with the dense factor's grouped substitutions).
+        let ud = if Self::SPEED_PARENTS.is_some() {
+            self.mass_matrix_factor(q)?.solve(&(tau - bias))
+        } else {
+            factor.solve(&(tau - bias))
+        };
         let (mut dud_dq, mut dud_du) = self.inverse_dynamics_partials(q, u, &ud);
         // X = M⁻¹ [−∂τ/∂q | −∂τ/∂u | I], solved in place: the partials are negated (exactly)
         // as they are copied into the solve's groups.

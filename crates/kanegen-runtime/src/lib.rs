@@ -26,6 +26,9 @@
 //!
 //! - [`contact`]: contact-constrained forward dynamics and contact impulses (point and frame
 //!   contacts, the Schur complement of the mass matrix's Cholesky factor), allocation-free.
+//! - [`tree_factor`]: the mass matrix factored along the kinematic tree without fill-in
+//!   (`M = Lᵀ D L` over the speeds' parent array, a generated module's `SPEED_PARENTS`), what the
+//!   traits' `forward_dynamics` and `mass_matrix_factor` of generated robots use.
 //!
 //! - [`isa`]: run-time instruction-set dispatch (baseline or x86-64-v3, AVX2 + FMA; the
 //!   batched functions also x86-64-v4, AVX-512), the
@@ -183,6 +186,7 @@ pub mod regressor;
 #[doc(hidden)]
 pub mod serde_support;
 mod set_parameter_error;
+pub mod tree_factor;
 pub mod trig;
 mod unknown_parameter;
 

@@ -7,6 +7,7 @@ use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::RobotDynamics;
 use crate::dynamics::DenseFactor;
+use crate::tree_factor::TreeFactor;
 
 /// The dynamics `τ = M(q) u̇ + c(q, u) + g(q)` of a robot with `N` speeds `u` and a
 /// configuration `q` of type [`Configuration`](Self::Configuration), with the operations of its
@@ -36,6 +37,11 @@ pub trait Multibody<const N: usize> {
 
     /// Coordinate names, in the order of `q` (`N` of them, `N + 1` for a floating base).
     const COORDINATE_NAMES: &'static [&'static str];
+
+    /// The speeds' parent array `λ` when `M` has the tree's pattern (generated modules:
+    /// `Some(SPEED_PARENTS)`, see [`RobotDynamics::SPEED_PARENTS`]); `None` (the default): `M`
+    /// is taken as dense.
+    const SPEED_PARENTS: Option<[Option<usize>; N]> = None;
 
     /// The neutral configuration: zero coordinates (a floating base at the origin with the
     /// identity quaternion).
@@ -82,8 +88,9 @@ pub trait Multibody<const N: usize> {
         ud: &SVector<Self::Scalar, N>,
     ) -> SVector<Self::Scalar, N>;
 
-    /// Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))` by a dense Cholesky factorisation
-    /// (as [`RobotDynamics::forward_dynamics`]); `None` when `M(q)` is not positive definite.
+    /// Forward dynamics `u̇ = M(q)⁻¹ (τ − c(q, u) − g(q))`, `M` factored along the tree with
+    /// [`SPEED_PARENTS`](Self::SPEED_PARENTS), else by a dense Cholesky factorisation (as
+    /// [`RobotDynamics::forward_dynamics`]); `None` when `M(q)` is not positive definite.
     /// For a floating base the first six entries of `tau` are the generalized forces on the
     /// base (zero for a robot in free flight).
     fn forward_dynamics(
@@ -93,8 +100,27 @@ pub trait Multibody<const N: usize> {
         tau: &SVector<Self::Scalar, N>,
     ) -> Option<SVector<Self::Scalar, N>> {
         let bias = self.inverse_dynamics(q, u, &SVector::zeros());
+        if Self::SPEED_PARENTS.is_some() {
+            // Solved where it lies: the factor (N² entries) is not moved out of the `Option`.
+            return self
+                .mass_matrix_factor(q)
+                .as_ref()
+                .map(|factor| factor.solve(&(tau - bias)));
+        }
         let factor = DenseFactor::new(self.mass_matrix(q))?;
         Some(factor.solve(&(tau - bias)))
+    }
+
+    /// `M(q) = Lᵀ D L` along [`SPEED_PARENTS`](Self::SPEED_PARENTS) (without fill-in), or, when
+    /// that is `None`, along [`chain_parents`](crate::tree_factor::chain_parents) (a dense
+    /// factorisation): what [`forward_dynamics`](Self::forward_dynamics),
+    /// [`crate::contact::constrained_forward_dynamics_factored`] and
+    /// [`crate::contact::contact_impulse_factored`] solve with. Generated robots override it
+    /// with their straight-line kernels (`TREE_KERNELS`). `None` when `M(q)` is not positive
+    /// definite.
+    fn mass_matrix_factor(&self, q: &Self::Configuration) -> Option<TreeFactor<Self::Scalar, N>> {
+        let parents = Self::SPEED_PARENTS.unwrap_or(crate::tree_factor::chain_parents());
+        TreeFactor::new(&self.mass_matrix(q), &parents)
     }
 }
 
@@ -103,6 +129,7 @@ impl<R: RobotDynamics<N>, const N: usize> Multibody<N> for R {
     type Configuration = SVector<R::Scalar, N>;
     const SPEED_NAMES: [&'static str; N] = R::SPEED_NAMES;
     const COORDINATE_NAMES: &'static [&'static str] = &R::COORDINATE_NAMES;
+    const SPEED_PARENTS: Option<[Option<usize>; N]> = R::SPEED_PARENTS;
 
     fn neutral(&self) -> Self::Configuration {
         SVector::zeros()
@@ -161,5 +188,9 @@ impl<R: RobotDynamics<N>, const N: usize> Multibody<N> for R {
         tau: &SVector<R::Scalar, N>,
     ) -> Option<SVector<R::Scalar, N>> {
         RobotDynamics::forward_dynamics(self, q, u, tau)
+    }
+
+    fn mass_matrix_factor(&self, q: &Self::Configuration) -> Option<TreeFactor<R::Scalar, N>> {
+        RobotDynamics::mass_matrix_factor(self, q)
     }
 }

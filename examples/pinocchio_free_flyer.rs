@@ -45,7 +45,7 @@ use kanegen_reference::FreeFlyer;
 use kanegen_reference::random::SplitMix64;
 use kanegen_runtime::contact::{
     ConstrainedAcceleration, Contact, ContactJacobian, ContactSettings,
-    constrained_forward_dynamics,
+    constrained_forward_dynamics, constrained_forward_dynamics_factored,
 };
 use nalgebra::{DMatrix, Matrix3, SMatrix, SVector};
 
@@ -299,8 +299,8 @@ macro_rules! time_robot {
             .collect::<Result<_, _>>()?;
         let links = contact_links(&model, feet)?;
         let contacts: Vec<Contact<Frame>> = frames.iter().map(|&f| Contact::point(f)).collect();
-        // The whole constrained forward dynamics from the generated functions: M, h, and the
-        // feet's Jacobians and bias accelerations, which are in the base frame's axes. The
+        // The whole constrained forward dynamics from the generated functions: M factored along
+        // the tree (`mass_matrix_factor`), h, and the feet's Jacobians and bias accelerations, which are in the base frame's axes. The
         // constraint rows are solved in those axes (the same equations, rotated per contact);
         // λ is rotated to the world's at the end.
         let constrained = |q: &Q,
@@ -314,10 +314,17 @@ macro_rules! time_robot {
                 )
             })
             .map_err(|e| e.to_string())?;
-            let m = robot.mass_matrix(q);
+            let factor = kanegen_runtime::Multibody::mass_matrix_factor(robot, q)
+                .ok_or(format!("{name}: M not positive definite"))?;
             let h = robot.nonlinear_effects(q, u);
-            let mut s = constrained_forward_dynamics(m, &h, f, &c, &ContactSettings::default())
-                .map_err(|e| e.to_string())?;
+            let mut s = constrained_forward_dynamics_factored(
+                &factor,
+                &h,
+                f,
+                &c,
+                &ContactSettings::default(),
+            )
+            .map_err(|e| e.to_string())?;
             let r0 = base_rotation(q.as_slice());
             for k in 0..$k / 3 {
                 let l = r0 * s.lambda.fixed_rows::<3>(3 * k);
@@ -548,9 +555,14 @@ const ROWS: [(&str, &str, &str, &str); 10] = [
         "`computeRNEADerivatives`",
         "rnea_derivatives",
     ),
-    ("u̇ `forward_dynamics`", "forward_dynamics", "`aba`", "aba"),
     (
-        "u̇, λ under the contacts (M, h, the feet's J and J̇u, `contact::constrained_forward_dynamics`)",
+        "u̇ `forward_dynamics` (M factored along the tree)",
+        "forward_dynamics",
+        "`aba`",
+        "aba",
+    ),
+    (
+        "u̇, λ under the contacts (M factored, h, the feet's J and J̇u, `contact::constrained_forward_dynamics_factored`)",
         "constrained_forward_dynamics",
         "`constraintDynamics` (3-D contacts)",
         "constraint_dynamics",

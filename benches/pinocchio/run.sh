@@ -68,7 +68,7 @@ packages=("pin==$pin_version" "cmeel-eigen==$eigen_version")
 if [ "$codegen" = 1 ]; then
     packages+=("cmeel-cppad==$cppad_version" "cmeel-cppadcodegen==$cppadcg_version")
 fi
-"$out/venv/bin/pip" install --quiet --disable-pip-version-check "${packages[@]}"
+"$out/venv/bin/python" -m pip install --quiet --disable-pip-version-check "${packages[@]}"
 prefix="$("$out/venv/bin/python" -m cmeel cmake 2>/dev/null | head -n 1)"
 if [ ! -f "$prefix/include/pinocchio/config.hpp" ] || [ ! -d "$prefix/include/eigen3" ]; then
     echo "error: no Pinocchio or Eigen headers under $prefix/include (pin and cmeel-eigen wheels)" >&2

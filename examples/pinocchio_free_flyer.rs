@@ -314,7 +314,7 @@ macro_rules! time_robot {
                 )
             })
             .map_err(|e| e.to_string())?;
-            let factor = kanegen_runtime::Multibody::mass_matrix_factor(robot, q)
+            let factor = kanegen_runtime::Multibody::mass_matrix_factor(&robot, q)
                 .ok_or(format!("{name}: M not positive definite"))?;
             let h = robot.nonlinear_effects(q, u);
             let mut s = constrained_forward_dynamics_factored(

@@ -34,11 +34,13 @@
 //! `DIR/pinocchio-ff-times.txt`).
 //! `report` prints one Markdown table per robot, the best of the runs of each side.
 
-use std::collections::BTreeMap;
 use std::hint::black_box;
 use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
+
+#[path = "support/times.rs"]
+mod times;
 
 use kanegen_model::{Model, UrdfImport, UrdfOptions};
 use kanegen_reference::FreeFlyer;
@@ -48,6 +50,7 @@ use kanegen_runtime::contact::{
     constrained_forward_dynamics, constrained_forward_dynamics_factored,
 };
 use nalgebra::{DMatrix, Matrix3, SMatrix, SVector};
+use times::{append, best_times};
 
 #[allow(dead_code)]
 mod solo {
@@ -282,6 +285,59 @@ fn rel_err(got: &[f64], want: &[f64]) -> f64 {
         / scale
 }
 
+/// The timings of the functions both forms of a module have (M into a kept matrix, c, h, g, τ
+/// and the derivatives) on the states `$st(i)`, keys prefixed by `$prefix`.
+macro_rules! shared_rows {
+    ($r:expr, $prefix:expr, $st:expr, $m_out:expr, $d_out:expr) => {{
+        let (r, st, m_out, d_out) = ($r, $st, $m_out, $d_out);
+        vec![
+            (
+                format!("{}mass_matrix_into", $prefix),
+                time_ns(CALLS, |i| {
+                    black_box(r).mass_matrix_into(&st(i).0, black_box(&mut *m_out));
+                }),
+            ),
+            (
+                format!("{}coriolis", $prefix),
+                time_ns(CALLS, |i| {
+                    black_box(black_box(r).coriolis(&st(i).0, &st(i).1));
+                }),
+            ),
+            (
+                format!("{}nonlinear_effects", $prefix),
+                time_ns(CALLS, |i| {
+                    black_box(black_box(r).nonlinear_effects(&st(i).0, &st(i).1));
+                }),
+            ),
+            (
+                format!("{}gravity", $prefix),
+                time_ns(CALLS, |i| {
+                    black_box(black_box(r).gravity(&st(i).0));
+                }),
+            ),
+            (
+                format!("{}inverse_dynamics", $prefix),
+                time_ns(CALLS, |i| {
+                    let (q, u, ud, _) = st(i);
+                    black_box(black_box(r).inverse_dynamics(q, u, ud));
+                }),
+            ),
+            (
+                format!("{}inverse_dynamics_derivatives_into", $prefix),
+                time_ns(CALLS / 10, |i| {
+                    let (q, u, ud, _) = st(i);
+                    black_box(r).inverse_dynamics_derivatives_into(
+                        q,
+                        u,
+                        ud,
+                        black_box(&mut *d_out),
+                    );
+                }),
+            ),
+        ]
+    }};
+}
+
 /// Checks and times the generated module `$m` (wrapper `$robot`, `$k` contact rows) of the
 /// corpus robot `$name` with contact frames `$feet`; appends to `$text`.
 macro_rules! time_robot {
@@ -380,34 +436,14 @@ macro_rules! time_robot {
             .collect();
         let mut m_out = SMatrix::<f64, DOF, DOF>::zeros();
         let mut d_out = SMatrix::<f64, DOF, { 2 * DOF }>::zeros();
-        let rows: Vec<(&str, f64)> = vec![
-            ("mass_matrix", time_ns(CALLS, |i| {
+        let mut rows: Vec<(String, f64)> = vec![
+            ("mass_matrix".into(), time_ns(CALLS, |i| {
                 black_box(black_box(robot).mass_matrix(&st(i).0));
             })),
-            ("mass_matrix_into", time_ns(CALLS, |i| {
-                black_box(robot).mass_matrix_into(&st(i).0, black_box(&mut m_out));
-            })),
-            ("coriolis", time_ns(CALLS, |i| {
-                black_box(black_box(robot).coriolis(&st(i).0, &st(i).1));
-            })),
-            ("nonlinear_effects", time_ns(CALLS, |i| {
-                black_box(black_box(robot).nonlinear_effects(&st(i).0, &st(i).1));
-            })),
-            ("gravity", time_ns(CALLS, |i| {
-                black_box(black_box(robot).gravity(&st(i).0));
-            })),
-            ("inverse_dynamics", time_ns(CALLS, |i| {
-                let (q, u, ud, _) = st(i);
-                black_box(black_box(robot).inverse_dynamics(q, u, ud));
-            })),
-            ("centroidal_momentum_matrix", time_ns(CALLS, |i| {
+            ("centroidal_momentum_matrix".into(), time_ns(CALLS, |i| {
                 black_box(black_box(robot).centroidal_momentum_matrix(&st(i).0));
             })),
-            ("inverse_dynamics_derivatives_into", time_ns(CALLS / 10, |i| {
-                let (q, u, ud, _) = st(i);
-                black_box(robot).inverse_dynamics_derivatives_into(q, u, ud, black_box(&mut d_out));
-            })),
-            ("forward_dynamics", time_ns(CALLS, |i| {
+            ("forward_dynamics".into(), time_ns(CALLS, |i| {
                 let (q, u, _, _) = st(i);
                 black_box(kanegen_runtime::Multibody::forward_dynamics(
                     black_box(robot),
@@ -416,11 +452,12 @@ macro_rules! time_robot {
                     &taus[i % n],
                 ));
             })),
-            ("constrained_forward_dynamics", time_ns(CALLS, |i| {
+            ("constrained_forward_dynamics".into(), time_ns(CALLS, |i| {
                 let (q, u, _, f) = st(i);
                 black_box(constrained(black_box(q), u, f).ok());
             })),
         ];
+        rows.extend(shared_rows!(robot, "", st, &mut m_out, &mut d_out));
         // The baked module (parameter values folded in), checked on the same states.
         let baked = $baked::$robot::default();
         let mut worst = 0.0_f64;
@@ -436,30 +473,7 @@ macro_rules! time_robot {
         if worst > 1e-9 {
             return Err(format!("{name}: the baked module differs by {worst:e}"));
         }
-        let baked = &baked;
-        let mut rows = rows;
-        rows.extend([
-            ("baked_mass_matrix_into", time_ns(CALLS, |i| {
-                black_box(baked).mass_matrix_into(&st(i).0, black_box(&mut m_out));
-            })),
-            ("baked_coriolis", time_ns(CALLS, |i| {
-                black_box(black_box(baked).coriolis(&st(i).0, &st(i).1));
-            })),
-            ("baked_nonlinear_effects", time_ns(CALLS, |i| {
-                black_box(black_box(baked).nonlinear_effects(&st(i).0, &st(i).1));
-            })),
-            ("baked_gravity", time_ns(CALLS, |i| {
-                black_box(black_box(baked).gravity(&st(i).0));
-            })),
-            ("baked_inverse_dynamics", time_ns(CALLS, |i| {
-                let (q, u, ud, _) = st(i);
-                black_box(black_box(baked).inverse_dynamics(q, u, ud));
-            })),
-            ("baked_inverse_dynamics_derivatives_into", time_ns(CALLS / 10, |i| {
-                let (q, u, ud, _) = st(i);
-                black_box(baked).inverse_dynamics_derivatives_into(q, u, ud, black_box(&mut d_out));
-            })),
-        ]);
+        rows.extend(shared_rows!(&baked, BAKED, st, &mut m_out, &mut d_out));
         // Keyed by the model's name, as the harness keys Pinocchio's times.
         for (function, ns) in rows {
             println!("kanegen {}/{function:<34} {ns:9.1} ns", model.name);
@@ -480,39 +494,7 @@ fn time(dir: &str) -> Result<(), String> {
         ROBOTS[1].1,
         text
     );
-    let path = Path::new(dir).join("kanegen-ff-times.txt");
-    use std::io::Write as _;
-    std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(&path)
-        .and_then(|mut f| f.write_all(text.as_bytes()))
-        .map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// The smallest figure per key in a times file (`key ns` per line) and the number of runs.
-fn best_times(path: &Path) -> Result<(BTreeMap<String, f64>, usize), String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut best: BTreeMap<String, f64> = BTreeMap::new();
-    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-    for (n, l) in text.lines().enumerate() {
-        let bad = || {
-            format!(
-                "{}:{}: expected `key ns`, found `{l}`",
-                path.display(),
-                n + 1
-            )
-        };
-        let mut it = l.split_whitespace();
-        let (Some(key), Some(ns), None) = (it.next(), it.next(), it.next()) else {
-            return Err(bad());
-        };
-        let ns: f64 = ns.parse().map_err(|_| bad())?;
-        let b = best.entry(key.to_owned()).or_insert(f64::INFINITY);
-        *b = b.min(ns);
-        *counts.entry(key.to_owned()).or_default() += 1;
-    }
-    Ok((best, counts.values().copied().min().unwrap_or(0)))
+    append(&Path::new(dir).join("kanegen-ff-times.txt"), &text)
 }
 
 /// One row of the tables: our label and key, Pinocchio's label and key (`harness_ff.cpp`).

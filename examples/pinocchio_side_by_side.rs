@@ -44,10 +44,14 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+#[path = "support/times.rs"]
+mod times;
+
 use kanegen_model::Model;
 use kanegen_reference::random::{SplitMix64, random_physical_params, uniform_vec};
 use krang_dynamics::{Krang, Params};
 use nalgebra::{SMatrix, SVector};
+use times::{append, best_times};
 
 /// Number of cases (parameter sets with one state each).
 const CASES: usize = 100;
@@ -289,41 +293,6 @@ fn time(dir: &Path) -> Result<(), String> {
         let _ = writeln!(text, "{name} {ns}");
     }
     append(&dir.join("kanegen-times.txt"), &text)
-}
-
-fn append(path: &Path, text: &str) -> Result<(), String> {
-    use std::io::Write as _;
-    std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(path)
-        .and_then(|mut f| f.write_all(text.as_bytes()))
-        .map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// The smallest figure per name in a times file (`name ns` per line) and the number of runs.
-fn best_times(path: &Path) -> Result<(BTreeMap<String, f64>, usize), String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut best: BTreeMap<String, f64> = BTreeMap::new();
-    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-    for (n, l) in text.lines().enumerate() {
-        let mut it = l.split_whitespace();
-        let (Some(name), Some(ns), None) = (it.next(), it.next(), it.next()) else {
-            return Err(format!(
-                "{}:{}: expected `name ns`, found `{l}`",
-                path.display(),
-                n + 1
-            ));
-        };
-        let ns: f64 = ns
-            .parse()
-            .map_err(|e| format!("{}:{}: `{ns}`: {e}", path.display(), n + 1))?;
-        let b = best.entry(name.to_owned()).or_insert(f64::INFINITY);
-        *b = b.min(ns);
-        *counts.entry(name.to_owned()).or_default() += 1;
-    }
-    let runs = counts.values().copied().min().unwrap_or(0);
-    Ok((best, runs))
 }
 
 /// One row of the table: our label and times-file key, Pinocchio's label and key.

@@ -468,19 +468,7 @@ pub fn contact_impulse_factored<T: RealField + Copy, const N: usize, const K: us
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A deterministic uniform source in [−1, 1).
-    fn source(seed: u64) -> impl FnMut() -> f64 {
-        let mut s = seed;
-        move || {
-            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = s;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^= z >> 31;
-            2.0 * ((z >> 11) as f64 / (1u64 << 53) as f64) - 1.0
-        }
-    }
+    use crate::tree_factor::tests::source;
 
     const N: usize = 18;
     const K: usize = 12;

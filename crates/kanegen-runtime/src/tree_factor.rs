@@ -381,13 +381,13 @@ fn dot_sub<T: RealField + Copy, const FUSED: bool>(mut acc: T, l: &[T], x: &[T])
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::{TreeFactor, chain_parents, is_parent_array};
     use nalgebra::{SMatrix, SVector};
     use std::vec::Vec;
 
-    /// A deterministic uniform source in [−1, 1).
-    fn source(seed: u64) -> impl FnMut() -> f64 {
+    /// A deterministic uniform source in [−1, 1) (the contact tests' too).
+    pub(crate) fn source(seed: u64) -> impl FnMut() -> f64 {
         let mut s = seed;
         move || {
             s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);

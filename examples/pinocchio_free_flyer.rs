@@ -49,6 +49,7 @@ use kanegen_runtime::contact::{
     ConstrainedAcceleration, Contact, ContactJacobian, ContactSettings,
     constrained_forward_dynamics, constrained_forward_dynamics_factored,
 };
+use kanegen_runtime::tree_factor::{TreeFactor, chain_parents};
 use nalgebra::{DMatrix, Matrix3, SMatrix, SVector};
 use times::{append, best_times};
 
@@ -452,6 +453,15 @@ macro_rules! time_robot {
                     &taus[i % n],
                 ));
             })),
+            // The same through a dense factorisation (the factor of a type without
+            // SPEED_PARENTS: every speed the previous one's child), for scale.
+            ("forward_dynamics_dense".into(), time_ns(CALLS, |i| {
+                let (q, u, _, _) = st(i);
+                let bias = black_box(robot).inverse_dynamics(q, u, &U::zeros());
+                let m = robot.mass_matrix(q);
+                let factor = TreeFactor::new(&m, &chain_parents()).expect("M positive definite");
+                black_box(factor.solve(&(taus[i % n] - bias)));
+            })),
             ("constrained_forward_dynamics".into(), time_ns(CALLS, |i| {
                 let (q, u, _, f) = st(i);
                 black_box(constrained(black_box(q), u, f).ok());
@@ -574,6 +584,15 @@ fn report(dir: &str) -> Result<(), String> {
             println!(
                 "| {our_label} | {a:.0} | {pin_label} | {b:.0} | {:.1}× |",
                 b / a
+            );
+        }
+        if let (Some(tree), Some(dense)) = (
+            ours.get(&format!("{name}/forward_dynamics")),
+            ours.get(&format!("{name}/forward_dynamics_dense")),
+        ) {
+            println!(
+                "\n`forward_dynamics` through a dense factorisation instead of the tree's: {dense:.0} ns ({:.1}× the tree's)",
+                dense / tree
             );
         }
         // Pinocchio's CppADCodeGen code (`CODEGEN=1`), where it was timed. It folds the

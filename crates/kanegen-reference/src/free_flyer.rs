@@ -31,7 +31,7 @@ use kanegen_model::{Base, JointKind, Model};
 use nalgebra::{DMatrix, DVector, Matrix3, RealField, Vector3, Vector6};
 
 use crate::se3::quaternion_to_rotation;
-use crate::{BodyData, FrameState, axis_rotation, cst};
+use crate::{BodyData, FrameState, axis_rotation, cst, joint_placement};
 
 /// Why a [`FreeFlyer`] could not be built.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -159,23 +159,16 @@ impl<T: RealField + Copy> FreeFlyer<T> {
             .iter()
             .map(|link| {
                 let mount = link.mount.as_ref()?;
-                let j = &mount.joint;
-                let translation = Vector3::from_fn(|r, _| {
-                    let s = j.translation[r];
-                    match s.symbol {
-                        Some(id) => cst::<T>(s.coef) * p(id),
-                        None => cst(s.coef),
-                    }
-                });
+                let (axis, rotation0, translation) = joint_placement(&mount.joint, params);
                 Some(Joint {
                     parent: mount.parent,
-                    motion: match j.kind {
+                    motion: match mount.joint.kind {
                         JointKind::Revolute { speed } => Motion::Revolute(slot(speed)),
                         JointKind::Prismatic { speed } => Motion::Prismatic(slot(speed)),
                         JointKind::Fixed => Motion::Fixed,
                     },
-                    axis: Vector3::from_fn(|r, _| cst(j.axis[r])),
-                    rotation0: Matrix3::from_fn(|r, c| cst(j.rotation[r][c])),
+                    axis,
+                    rotation0,
                     translation,
                 })
             })

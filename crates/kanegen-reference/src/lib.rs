@@ -71,6 +71,27 @@ struct JointData<T> {
     translation: Vector3<T>,
 }
 
+/// A joint's constant placement with the parameter values `params`: its axis `e_j` (child
+/// frame), `iAj(0)` and the constant part of `iPj` (the fixed/wheeled and the free-flyer
+/// recursions' joints share it).
+fn joint_placement<T: RealField + Copy>(
+    j: &kanegen_model::Joint,
+    params: &[T],
+) -> (Vector3<T>, Matrix3<T>, Vector3<T>) {
+    let translation = Vector3::from_fn(|r, _| {
+        let s = j.translation[r];
+        match s.symbol {
+            Some(id) => cst::<T>(s.coef) * params[id],
+            None => cst(s.coef),
+        }
+    });
+    (
+        Vector3::from_fn(|r, _| cst(j.axis[r])),
+        Matrix3::from_fn(|r, c| cst(j.rotation[r][c])),
+        translation,
+    )
+}
+
 /// Khalil's standard inertial parameters of one body, converted to `T`.
 #[derive(Debug, Clone)]
 struct BodyData<T> {
@@ -189,19 +210,12 @@ impl<T: RealField + Copy> Reference<T> {
             .iter()
             .map(|link| {
                 let mount = link.mount.as_ref()?;
-                let j = &mount.joint;
-                let translation = Vector3::from_fn(|r, _| {
-                    let s = j.translation[r];
-                    match s.symbol {
-                        Some(id) => cst::<T>(s.coef) * p(id),
-                        None => cst(s.coef),
-                    }
-                });
+                let (axis, rotation0, translation) = joint_placement(&mount.joint, params);
                 Some(JointData {
                     parent: mount.parent,
-                    kind: j.kind,
-                    axis: Vector3::from_fn(|r, _| cst(j.axis[r])),
-                    rotation0: Matrix3::from_fn(|r, c| cst(j.rotation[r][c])),
+                    kind: mount.joint.kind,
+                    axis,
+                    rotation0,
                     translation,
                 })
             })

@@ -14,12 +14,10 @@
 
 use nalgebra::{Matrix3, RealField, Vector3};
 
+use crate::cst;
+
 /// Below this squared angle the series of the exponential and logarithm are used.
 const SMALL_ANGLE2: f64 = 1e-8;
-
-fn cst<T: RealField + Copy>(x: f64) -> T {
-    nalgebra::convert(x)
-}
 
 /// The rotation matrix of the quaternion `(x, y, z, w)`, normalized first.
 pub fn quaternion_to_rotation<T: RealField + Copy>(quat: [T; 4]) -> Matrix3<T> {

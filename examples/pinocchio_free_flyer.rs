@@ -50,7 +50,7 @@ use kanegen_runtime::contact::{
     constrained_forward_dynamics, constrained_forward_dynamics_factored,
 };
 use kanegen_runtime::tree_factor::{TreeFactor, chain_parents};
-use nalgebra::{DMatrix, Matrix3, SMatrix, SVector};
+use nalgebra::{DMatrix, SMatrix, SVector};
 use times::{append, best_times};
 
 #[allow(dead_code)]
@@ -269,14 +269,6 @@ fn time_ns(calls: usize, mut f: impl FnMut(usize)) -> f64 {
     best
 }
 
-/// The base rotation (base → world) of a free-flyer configuration `[x, y, z, qx, qy, qz, qw, …]`.
-fn base_rotation(q: &[f64]) -> Matrix3<f64> {
-    let quat = nalgebra::Quaternion::new(q[6], q[3], q[4], q[5]);
-    nalgebra::UnitQuaternion::new_unchecked(quat)
-        .to_rotation_matrix()
-        .into_inner()
-}
-
 /// Largest difference relative to the largest entry of `want`.
 fn rel_err(got: &[f64], want: &[f64]) -> f64 {
     let scale = want.iter().fold(1e-300_f64, |m, x| m.max(x.abs()));
@@ -382,7 +374,7 @@ macro_rules! time_robot {
                 &ContactSettings::default(),
             )
             .map_err(|e| e.to_string())?;
-            let r0 = base_rotation(q.as_slice());
+            let r0 = kanegen_reference::se3::quaternion_to_rotation([q[3], q[4], q[5], q[6]]);
             for k in 0..$k / 3 {
                 let l = r0 * s.lambda.fixed_rows::<3>(3 * k);
                 s.lambda.fixed_rows_mut::<3>(3 * k).copy_from(&l);

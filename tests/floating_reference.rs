@@ -11,9 +11,12 @@
 //! in the base frame's axes and the reference's in the world's: the test rotates the generated
 //! ones by the base rotation `R0` (`J_world = blockdiag(R0, R0) J_base`).
 
+#[path = "../codegen/tests/support/free_flyer.rs"]
+mod free_flyer;
+
 use kanegen::model::{Model, UrdfOptions};
 use kanegen_reference::FreeFlyer;
-use nalgebra::{DMatrix, DVector, Matrix3, SMatrix, SVector, UnitQuaternion};
+use nalgebra::{DMatrix, DVector, Matrix3, SMatrix, SVector};
 
 #[allow(dead_code)]
 mod hopper {
@@ -38,33 +41,6 @@ fn root() -> std::path::PathBuf {
 fn stream(seed: u64) -> impl FnMut() -> f64 {
     let mut r = kanegen_reference::random::SplitMix64::new(seed);
     move || r.next_f64()
-}
-
-/// A random configuration: base position in [−1, 1)³, a random unit quaternion, joint angles
-/// in [−π, π) (prismatic joints in [−0.3, 0.3)).
-fn random_configuration(model: &Model, uniform: &mut impl FnMut() -> f64) -> Vec<f64> {
-    use kanegen::model::JointKind;
-    let mut q = vec![0.0; model.nq()];
-    for x in q.iter_mut().take(3) {
-        *x = 2.0 * uniform() - 1.0;
-    }
-    let quat = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
-        uniform() - 0.5,
-        uniform() - 0.5,
-        uniform() - 0.5,
-        uniform() - 0.5,
-    ));
-    q[3..7].copy_from_slice(&[quat.i, quat.j, quat.k, quat.w]);
-    for s in 6..model.independent_dof() {
-        let prismatic = model
-            .links
-            .iter()
-            .filter_map(|l| l.joint())
-            .any(|j| matches!(j.kind, JointKind::Prismatic { speed } if speed == s));
-        let range = if prismatic { 0.3 } else { std::f64::consts::PI };
-        q[model.coordinate_index(s)] = range * (2.0 * uniform() - 1.0);
-    }
-    q
 }
 
 fn random_vec(uniform: &mut impl FnMut() -> f64, n: usize, a: f64) -> Vec<f64> {
@@ -113,7 +89,7 @@ macro_rules! compare_with_reference {
             array.copy_from_slice(&values);
             let robot = $robot::new(Params::from_array(array));
             for _ in 0..$states {
-                let qv = random_configuration(&model, &mut uniform);
+                let qv = free_flyer::random_configuration(&model, &mut uniform);
                 let uv = random_vec(&mut uniform, DOF, 2.0);
                 let udv = random_vec(&mut uniform, DOF, 5.0);
                 let q = SVector::<f64, NQ>::from_column_slice(&qv);

@@ -126,52 +126,65 @@ fn v32<const N: usize>(x: &[f64]) -> SVector<f32, N> {
     SVector::from_iterator(x.iter().map(|&a| a as f32))
 }
 
+/// The entries M, c, g, τ and C of a `*_functions` list: the robot `$k`'s CPU functions in f64
+/// and `$k32`'s in f32, `$n` speeds.
+macro_rules! dynamics_functions {
+    ($k:ident, $k32:ident, $n:ident) => {{
+        let functions: [(&'static str, Cpu<'static>, Option<Cpu<'static>>); 5] = [
+            (
+                "mass_matrix",
+                Box::new(move |q, _, _| dense($k.mass_matrix(&v::<$n>(q)))),
+                Some(Box::new(move |q, _, _| {
+                    dense32($k32.mass_matrix(&v32::<$n>(q)))
+                })),
+            ),
+            (
+                "coriolis",
+                Box::new(move |q, u, _| dense($k.coriolis(&v::<$n>(q), &v(u)))),
+                Some(Box::new(move |q, u, _| {
+                    dense32($k32.coriolis(&v32::<$n>(q), &v32(u)))
+                })),
+            ),
+            (
+                "gravity",
+                Box::new(move |q, _, _| dense($k.gravity(&v::<$n>(q)))),
+                Some(Box::new(move |q, _, _| {
+                    dense32($k32.gravity(&v32::<$n>(q)))
+                })),
+            ),
+            (
+                "inverse_dynamics",
+                Box::new(move |q, u, a| dense($k.inverse_dynamics(&v::<$n>(q), &v(u), &v(a)))),
+                Some(Box::new(move |q, u, a| {
+                    dense32($k32.inverse_dynamics(&v32::<$n>(q), &v32(u), &v32(a)))
+                })),
+            ),
+            (
+                "coriolis_matrix",
+                Box::new(move |q, u, _| dense($k.coriolis_matrix(&v::<$n>(q), &v(u)))),
+                Some(Box::new(move |q, u, _| {
+                    dense32($k32.coriolis_matrix(&v32::<$n>(q), &v32(u)))
+                })),
+            ),
+        ];
+        functions
+    }};
+}
+
 /// Krang's kernels and its CPU functions in f64 and f32.
 fn krang_functions() -> Vec<(&'static str, Cpu<'static>, Option<Cpu<'static>>)> {
     let k: &'static Krang = Box::leak(Box::new(Krang::default()));
     let k32: &'static krang_dynamics::f32::Krang =
         Box::leak(Box::new(krang_dynamics::f32::Krang::default()));
     const N: usize = 19;
-    vec![
-        (
-            "mass_matrix",
-            Box::new(move |q, _, _| dense(k.mass_matrix(&v::<N>(q)))),
-            Some(Box::new(move |q, _, _| {
-                dense32(k32.mass_matrix(&v32::<N>(q)))
-            })),
-        ),
-        (
-            "coriolis",
-            Box::new(move |q, u, _| dense(k.coriolis(&v::<N>(q), &v(u)))),
-            Some(Box::new(move |q, u, _| {
-                dense32(k32.coriolis(&v32::<N>(q), &v32(u)))
-            })),
-        ),
-        (
-            "gravity",
-            Box::new(move |q, _, _| dense(k.gravity(&v::<N>(q)))),
-            Some(Box::new(move |q, _, _| dense32(k32.gravity(&v32::<N>(q))))),
-        ),
-        (
-            "inverse_dynamics",
-            Box::new(move |q, u, a| dense(k.inverse_dynamics(&v::<N>(q), &v(u), &v(a)))),
-            Some(Box::new(move |q, u, a| {
-                dense32(k32.inverse_dynamics(&v32::<N>(q), &v32(u), &v32(a)))
-            })),
-        ),
-        (
-            "coriolis_matrix",
-            Box::new(move |q, u, _| dense(k.coriolis_matrix(&v::<N>(q), &v(u)))),
-            Some(Box::new(move |q, u, _| {
-                dense32(k32.coriolis_matrix(&v32::<N>(q), &v32(u)))
-            })),
-        ),
-        (
-            "nonlinear_effects",
-            Box::new(move |q, u, _| dense(k.nonlinear_effects(&v::<N>(q), &v(u)))),
-            None,
-        ),
-    ]
+    let mut functions = Vec::from(dynamics_functions!(k, k32, N));
+    let rest: Vec<(&'static str, Cpu<'static>, Option<Cpu<'static>>)> = vec![(
+        "nonlinear_effects",
+        Box::new(move |q, u, _| dense(k.nonlinear_effects(&v::<N>(q), &v(u)))),
+        None,
+    )];
+    functions.extend(rest);
+    functions
 }
 
 /// The arm's kernels and its CPU functions in f64 and f32.
@@ -182,40 +195,8 @@ fn arm_functions() -> Vec<(&'static str, Cpu<'static>, Option<Cpu<'static>>)> {
     let k32: &'static SingleArm32 = Box::leak(Box::new(SingleArm32::default()));
     const N: usize = arm::DOF;
     let scalar = |x: f64| vec![x];
-    vec![
-        (
-            "mass_matrix",
-            Box::new(move |q, _, _| dense(k.mass_matrix(&v::<N>(q)))),
-            Some(Box::new(move |q, _, _| {
-                dense32(k32.mass_matrix(&v32::<N>(q)))
-            })),
-        ),
-        (
-            "coriolis",
-            Box::new(move |q, u, _| dense(k.coriolis(&v::<N>(q), &v(u)))),
-            Some(Box::new(move |q, u, _| {
-                dense32(k32.coriolis(&v32::<N>(q), &v32(u)))
-            })),
-        ),
-        (
-            "gravity",
-            Box::new(move |q, _, _| dense(k.gravity(&v::<N>(q)))),
-            Some(Box::new(move |q, _, _| dense32(k32.gravity(&v32::<N>(q))))),
-        ),
-        (
-            "inverse_dynamics",
-            Box::new(move |q, u, a| dense(k.inverse_dynamics(&v::<N>(q), &v(u), &v(a)))),
-            Some(Box::new(move |q, u, a| {
-                dense32(k32.inverse_dynamics(&v32::<N>(q), &v32(u), &v32(a)))
-            })),
-        ),
-        (
-            "coriolis_matrix",
-            Box::new(move |q, u, _| dense(k.coriolis_matrix(&v::<N>(q), &v(u)))),
-            Some(Box::new(move |q, u, _| {
-                dense32(k32.coriolis_matrix(&v32::<N>(q), &v32(u)))
-            })),
-        ),
+    let mut functions = Vec::from(dynamics_functions!(k, k32, N));
+    let rest: Vec<(&'static str, Cpu<'static>, Option<Cpu<'static>>)> = vec![
         (
             "nonlinear_effects",
             Box::new(move |q, u, _| dense(k.nonlinear_effects(&v::<N>(q), &v(u)))),
@@ -251,7 +232,9 @@ fn arm_functions() -> Vec<(&'static str, Cpu<'static>, Option<Cpu<'static>>)> {
                 vec![f64::from(k32.potential_energy(&v32::<N>(q)))]
             })),
         ),
-    ]
+    ];
+    functions.extend(rest);
+    functions
 }
 
 /// Every kernel of a module is in `functions`; each within the tolerances in f32 (and in f64
